@@ -1,0 +1,296 @@
+//! Forward kinematics of the parallel module: leg commands to the UP limb's
+//! joint values, the platform point and orientation.
+//!
+//! The unknowns are the UP joints `x = (phi, theta, q4)`; the equations are
+//! the three leg closures `f_i(x) = |A_i(x) - B_i| - (q_i + dq_i) = 0`. Their
+//! Jacobian is the paper's `J1` (see [`crate::LegGeometry::j1`]), so Newton's
+//! method costs one 3x3 solve per iteration. The iteration is safeguarded by
+//! a backtracking line search on `|f|^2`; it starts from a closed-form seed
+//! (two rounds of three-sphere trilateration) unless the caller passes one.
+//!
+//! Every solution carries the condition number of `J1` made unit-free by
+//! scaling its angle columns by `1/q4`, and the solver refuses (with an
+//! error, never a wrong number) configurations where that number exceeds
+//! [`crate::SINGULARITY_CONDITION_LIMIT`].
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::error::KinematicsError;
+use crate::machine::{LegGeometry, Machine, SINGULARITY_CONDITION_LIMIT};
+use crate::up_limb::UpJoints;
+
+/// Result of the forward kinematics.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FkSolution {
+    /// UP limb joint values.
+    pub up: UpJoints,
+    /// Platform point O' in the base frame, mm.
+    pub position_mm: Vector3<f64>,
+    /// Platform orientation `R`.
+    pub rotation: Matrix3<f64>,
+    /// Condition number of `J1 diag(1/q4, 1/q4, 1)` in the Frobenius norm
+    /// (an upper bound on the 2-norm condition within a factor 3). It
+    /// measures how much the leg-length errors are amplified into the UP
+    /// joints; around 3-20 in the Table 1 workspace.
+    pub condition: f64,
+    /// Newton iterations used.
+    pub iterations: u32,
+    /// Euclidean norm of the leg-closure residual at the solution, mm.
+    pub residual_mm: f64,
+}
+
+const MAX_ITERATIONS: u32 = 60;
+/// Converged when the scaled Newton step is below this, mm.
+const STEP_TOLERANCE_MM: f64 = 1e-10;
+/// A converged solution must close the legs to this, mm.
+const RESIDUAL_TOLERANCE_MM: f64 = 1e-8;
+
+impl Machine {
+    /// Forward kinematics from leg commands (mm), starting from a closed-form seed.
+    pub fn forward(&self, legs_mm: &[f64; 3]) -> Result<FkSolution, KinematicsError> {
+        self.check_leg_stroke(legs_mm)?;
+        let lengths = self.actual_lengths(legs_mm);
+        let seed = self.trilateration_seed(&lengths);
+        self.newton(legs_mm, &lengths, seed)
+    }
+
+    /// Forward kinematics from leg commands (mm), starting at `seed` (useful
+    /// when a nearby solution is known, e.g. the nominal configuration when
+    /// solving for an actual machine).
+    pub fn forward_from(
+        &self,
+        legs_mm: &[f64; 3],
+        seed: &UpJoints,
+    ) -> Result<FkSolution, KinematicsError> {
+        self.check_leg_stroke(legs_mm)?;
+        for (what, v) in [
+            ("seed phi", seed.phi_rad),
+            ("seed theta", seed.theta_rad),
+            ("seed q4", seed.q4_mm),
+        ] {
+            if !v.is_finite() {
+                return Err(KinematicsError::NotFinite { what, value: v });
+            }
+        }
+        let lengths = self.actual_lengths(legs_mm);
+        self.newton(legs_mm, &lengths, *seed)
+    }
+
+    fn actual_lengths(&self, legs_mm: &[f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|i| legs_mm[i] + self.leg_offsets_mm[i])
+    }
+
+    /// Seed: place O' by trilateration with the platform joints rotated by
+    /// the orientation of the previous round (identity first), twice.
+    fn trilateration_seed(&self, lengths: &[f64; 3]) -> UpJoints {
+        let z_mid = 0.5 * (self.workspace.z_min_mm + self.workspace.z_max_mm);
+        let mut rotation = Matrix3::identity();
+        let mut r = Vector3::new(0.0, 0.0, z_mid);
+        for _ in 0..2 {
+            let centres: [Vector3<f64>; 3] = std::array::from_fn(|i| {
+                self.base_joints_mm[i] - rotation * self.platform_joints_mm[i]
+            });
+            match trilaterate(&centres, lengths) {
+                Some(p) => r = p,
+                None => break,
+            }
+            match self.up_limb.inverse(&r) {
+                Ok(up) => rotation = self.up_limb.pose(&up).rotation,
+                Err(_) => break,
+            }
+        }
+        self.up_limb.inverse(&r).unwrap_or(UpJoints {
+            phi_rad: 0.0,
+            theta_rad: 0.0,
+            q4_mm: z_mid,
+        })
+    }
+
+    fn closure(&self, x: &UpJoints, lengths: &[f64; 3]) -> (LegGeometry, Vector3<f64>) {
+        let g = self.legs_at(x);
+        let f = Vector3::from_fn(|i, _| g.lengths_mm[i] - lengths[i]);
+        (g, f)
+    }
+
+    fn newton(
+        &self,
+        legs_mm: &[f64; 3],
+        lengths: &[f64; 3],
+        seed: UpJoints,
+    ) -> Result<FkSolution, KinematicsError> {
+        let mut x = seed;
+        let (mut geometry, mut f) = self.closure(&x, lengths);
+        let mut merit = f.norm_squared();
+        for iteration in 1..=MAX_ITERATIONS {
+            let j1 = geometry.j1();
+            let Some(j1_inv) = j1.try_inverse() else {
+                return Err(KinematicsError::Singular {
+                    condition: f64::INFINITY,
+                    limit: SINGULARITY_CONDITION_LIMIT,
+                });
+            };
+            let step = -(j1_inv * f);
+            let step_mm = step.z.abs() + x.q4_mm.abs() * (step.x.abs() + step.y.abs());
+            // Backtracking line search on |f|^2 (Armijo with c = 1e-4).
+            let mut t = 1.0;
+            loop {
+                let trial = UpJoints {
+                    phi_rad: x.phi_rad + t * step.x,
+                    theta_rad: x.theta_rad + t * step.y,
+                    q4_mm: x.q4_mm + t * step.z,
+                };
+                let (g, ft) = self.closure(&trial, lengths);
+                let m = ft.norm_squared();
+                if m <= (1.0 - 1e-4 * t) * merit || m == 0.0 || step_mm * t < STEP_TOLERANCE_MM {
+                    x = trial;
+                    geometry = g;
+                    f = ft;
+                    merit = m;
+                    break;
+                }
+                t *= 0.5;
+                if t < 1e-8 {
+                    return Err(KinematicsError::NoAssembly {
+                        residual_mm: merit.sqrt(),
+                    });
+                }
+            }
+            if step_mm * t < STEP_TOLERANCE_MM || merit == 0.0 {
+                let residual_mm = merit.sqrt();
+                if residual_mm > RESIDUAL_TOLERANCE_MM {
+                    return Err(KinematicsError::NoAssembly { residual_mm });
+                }
+                return self.finish(legs_mm, x, &geometry, iteration, residual_mm);
+            }
+        }
+        Err(KinematicsError::NotConverged {
+            solver: "forward kinematics",
+            iterations: MAX_ITERATIONS,
+            residual: merit.sqrt(),
+        })
+    }
+
+    fn finish(
+        &self,
+        legs_mm: &[f64; 3],
+        x: UpJoints,
+        geometry: &LegGeometry,
+        iterations: u32,
+        residual_mm: f64,
+    ) -> Result<FkSolution, KinematicsError> {
+        let condition = unit_free_condition(&geometry.j1(), x.q4_mm);
+        if condition > SINGULARITY_CONDITION_LIMIT {
+            return Err(KinematicsError::Singular {
+                condition,
+                limit: SINGULARITY_CONDITION_LIMIT,
+            });
+        }
+        self.check_limits(legs_mm, &x, &geometry.limb)?;
+        Ok(FkSolution {
+            up: x,
+            position_mm: geometry.limb.position_mm,
+            rotation: geometry.limb.rotation,
+            condition,
+            iterations,
+            residual_mm,
+        })
+    }
+}
+
+/// Frobenius condition number of `J1 diag(1/q4, 1/q4, 1)`.
+pub(crate) fn unit_free_condition(j1: &Matrix3<f64>, q4_mm: f64) -> f64 {
+    let mut scaled = *j1;
+    for i in 0..3 {
+        scaled[(i, 0)] /= q4_mm;
+        scaled[(i, 1)] /= q4_mm;
+    }
+    match scaled.try_inverse() {
+        Some(inv) => scaled.norm() * inv.norm(),
+        None => f64::INFINITY,
+    }
+}
+
+/// The intersection of three spheres on the side of larger z, if any.
+fn trilaterate(c: &[Vector3<f64>; 3], r: &[f64; 3]) -> Option<Vector3<f64>> {
+    let d_vec = c[1] - c[0];
+    let d = d_vec.norm();
+    let ex = d_vec / d;
+    let c3 = c[2] - c[0];
+    let i = ex.dot(&c3);
+    let ey_raw = c3 - i * ex;
+    let j = ey_raw.norm();
+    if d < 1e-9 || j < 1e-9 {
+        return None;
+    }
+    let ey = ey_raw / j;
+    let mut ez = ex.cross(&ey);
+    if ez.z < 0.0 {
+        ez = -ez;
+    }
+    let x = (r[0] * r[0] - r[1] * r[1] + d * d) / (2.0 * d);
+    let y = (r[0] * r[0] - r[2] * r[2] + i * i + j * j) / (2.0 * j) - i / j * x;
+    let z2 = r[0] * r[0] - x * x - y * y;
+    if !(z2 >= 0.0) {
+        return None;
+    }
+    Some(c[0] + x * ex + y * ey + z2.sqrt() * ez)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trilateration_finds_a_known_point() {
+        let c = [
+            Vector3::new(-100.0, 170.0, 0.0),
+            Vector3::new(-100.0, -170.0, 0.0),
+            Vector3::new(190.0, 0.0, 0.0),
+        ];
+        let p = Vector3::new(30.0, -40.0, 700.0);
+        let r = c.map(|ci| (p - ci).norm());
+        let found = trilaterate(&c, &r).unwrap();
+        assert!((found - p).norm() < 1e-9);
+    }
+
+    #[test]
+    fn fk_inverts_ik_at_the_workspace_corners() {
+        let m = Machine::paper();
+        for r in [
+            Vector3::new(400.0, 0.0, 650.0),
+            Vector3::new(-400.0, 0.0, 850.0),
+            Vector3::new(0.0, 400.0, 650.0),
+            Vector3::new(0.0, -400.0, 850.0),
+            Vector3::new(0.0, 0.0, 750.0),
+        ] {
+            let ik = m.inverse(&r).unwrap();
+            let fk = m.forward(&ik.legs_mm).unwrap();
+            assert!(
+                (fk.position_mm - r).norm() < 1e-9,
+                "{r}: {}",
+                fk.position_mm
+            );
+            assert!(fk.condition < 50.0, "{r}: condition {}", fk.condition);
+        }
+    }
+
+    #[test]
+    fn inconsistent_commands_are_an_error_not_a_number() {
+        let m = Machine::paper();
+        // Leg 1 far shorter than the other two: no assembly exists.
+        let e = m.forward(&[460.0, 1200.0, 1200.0]).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                KinematicsError::NoAssembly { .. }
+                    | KinematicsError::OutOfReach { .. }
+                    | KinematicsError::Singular { .. }
+            ),
+            "{e:?}"
+        );
+        assert!(matches!(
+            m.forward(&[100.0, 800.0, 800.0]),
+            Err(KinematicsError::OutOfStroke { leg: 1, .. })
+        ));
+    }
+}

@@ -1,0 +1,377 @@
+//! The computational machine model and its inverse kinematics.
+//!
+//! A [`Machine`] is a validated [`MachineDescription`] in the form the
+//! solvers use: joint centres as vectors, the UP limb chain, limits. The same
+//! type represents the nominal machine and an "actual" one with geometric
+//! errors (see `tricept-model`), so simulated readings always come from this
+//! exact model.
+//!
+//! Inverse kinematics of the parallel module (eq. 1 of the paper):
+//! `q_i = |r + R a_0i - b_i| - dq_i`, with `R` and the UP joints from the UP
+//! limb (`r = q4 R e_z` on an ideal joint).
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::description::{
+    LoadsDescription, MachineDescription, Placement, SensorDescription, UpLimbDescription,
+    WorkspaceDescription,
+};
+use crate::error::KinematicsError;
+use crate::head::Head;
+use crate::up_limb::{UpJoints, UpLimb, UpLimbPose};
+use crate::workspace::Workspace;
+
+/// Joint limits in solver form.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Limits {
+    /// Stroke of the actuated legs `[min, max]`, mm.
+    pub leg_stroke_mm: [f64; 2],
+    /// Stroke of the UP limb's prismatic joint `[min, max]`, mm.
+    pub up_stroke_mm: [f64; 2],
+    /// Largest tilt of the UP limb from the base z axis, rad.
+    pub max_tilt_rad: f64,
+}
+
+/// Standard deviations of one *logged* sensor value (the mean of
+/// `readings_per_pose` readings).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorNoise {
+    /// Encoder noise of one reading, rad.
+    pub angle_rad: f64,
+    /// Linear-scale noise of one reading, mm.
+    pub length_mm: f64,
+    /// Readings averaged into one logged value.
+    pub readings_per_pose: u32,
+}
+
+impl SensorNoise {
+    /// One arcsecond in radians.
+    pub const ARCSEC: f64 = std::f64::consts::PI / (180.0 * 3600.0);
+
+    /// Builds from the description's units (arcsec, um).
+    pub fn from_description(s: &SensorDescription) -> SensorNoise {
+        SensorNoise {
+            angle_rad: s.angle_noise_arcsec * Self::ARCSEC,
+            length_mm: s.length_noise_um * 1e-3,
+            readings_per_pose: s.readings_per_pose,
+        }
+    }
+
+    /// Standard deviations `[phi, theta, s]` of one logged value
+    /// (rad, rad, mm): single-reading noise divided by `sqrt(readings)`.
+    pub fn logged_sigma(&self) -> [f64; 3] {
+        let k = f64::from(self.readings_per_pose.max(1)).sqrt();
+        [self.angle_rad / k, self.angle_rad / k, self.length_mm / k]
+    }
+}
+
+/// Result of the inverse kinematics of the parallel module.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IkSolution {
+    /// Commands of the three actuated legs, mm.
+    pub legs_mm: [f64; 3],
+    /// The UP limb's joint values.
+    pub up: UpJoints,
+}
+
+/// Per-leg geometry at one configuration of the module.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LegGeometry {
+    /// The UP limb at this configuration.
+    pub limb: UpLimbPose,
+    /// Platform joint centres `A_i` in the base frame, mm.
+    pub platform_joints_mm: [Vector3<f64>; 3],
+    /// Geometric leg lengths `|A_i - B_i|` (actual, not commanded), mm.
+    pub lengths_mm: [f64; 3],
+    /// Unit leg vectors `w_i` from `B_i` to `A_i`.
+    pub directions: [Vector3<f64>; 3],
+}
+
+impl LegGeometry {
+    /// The paper's `J1` generalised to any UP chain: row `i` is
+    /// `w_i^T dA_i/d(phi, theta, q4)`. On an ideal joint this is
+    /// `[(b_i x w_i)^T J_theta, w_i^T w_4]` (eq. 9). It is also the Jacobian
+    /// of the leg lengths with respect to the UP joints, used by FK.
+    pub fn j1(&self) -> Matrix3<f64> {
+        let mut j1 = Matrix3::zeros();
+        for i in 0..3 {
+            let row = self.directions[i].transpose()
+                * self.limb.point_jacobian(&self.platform_joints_mm[i]);
+            j1.set_row(i, &row);
+        }
+        j1
+    }
+}
+
+/// The Tricept module (3-UPS + UP) with its head: nominal or actual.
+///
+/// # Example
+/// ```
+/// use nalgebra::Vector3;
+/// use tricept_kinematics::Machine;
+/// let m = Machine::paper();
+/// let r = Vector3::new(120.0, -80.0, 760.0);
+/// let ik = m.inverse(&r).unwrap();
+/// let fk = m.forward(&ik.legs_mm).unwrap();
+/// assert!((fk.position_mm - r).norm() < 1e-9);
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct Machine {
+    /// Name from the description.
+    pub name: String,
+    /// Base joint centres `B_1..B_3` in Oxyz, mm (`B_4` is the origin).
+    pub base_joints_mm: [Vector3<f64>; 3],
+    /// Platform joint centres `A_1..A_3` in O'x'y'z', mm.
+    pub platform_joints_mm: [Vector3<f64>; 3],
+    /// Actual leg length = command + offset, mm (the `dq_i` errors).
+    pub leg_offsets_mm: [f64; 3],
+    /// The UP limb chain.
+    pub up_limb: UpLimb,
+    /// The workspace cylinder of O'.
+    pub workspace: Workspace,
+    /// Joint limits.
+    pub limits: Limits,
+    /// The 2-DOF head.
+    pub head: Head,
+    /// Sensor noise (one reading).
+    pub sensors: SensorNoise,
+    /// Masses and stiffness (for the plant simulator's compliance effect).
+    pub loads: LoadsDescription,
+}
+
+/// Largest condition number (of the unit-free `J1`, see
+/// [`crate::FkSolution::condition`]) accepted before a configuration is
+/// declared singular. In the Table 1 workspace it stays below 20.
+pub const SINGULARITY_CONDITION_LIMIT: f64 = 1e6;
+
+/// Limits are checked with this slack (mm or rad) so that a configuration
+/// exactly on a limit survives the rounding of an IK/FK round trip.
+const LIMIT_SLACK: f64 = 1e-9;
+
+impl Machine {
+    /// The paper's Table 1 machine (embedded default).
+    pub fn paper() -> Machine {
+        Machine::from_validated(&MachineDescription::paper())
+    }
+
+    /// Builds from a description that [`MachineDescription::validate`] accepted.
+    pub(crate) fn from_validated(d: &MachineDescription) -> Machine {
+        let (base, platform) = d.joints_mm();
+        Machine {
+            name: d.name.clone(),
+            base_joints_mm: base.map(Vector3::from),
+            platform_joints_mm: platform.map(Vector3::from),
+            leg_offsets_mm: d.leg_offsets_mm,
+            up_limb: UpLimb::from_description(&d.up_limb),
+            workspace: Workspace::from_description(&d.workspace),
+            limits: Limits {
+                leg_stroke_mm: d.limits.leg_stroke_mm,
+                up_stroke_mm: d.limits.up_stroke_mm,
+                max_tilt_rad: d.limits.max_tilt_deg.to_radians(),
+            },
+            head: Head::from_description(&d.head),
+            sensors: SensorNoise::from_description(&d.sensors),
+            loads: d.loads.clone(),
+        }
+    }
+
+    /// The description of this machine, with explicit joint coordinates
+    /// (so that an identified machine can be written out and loaded again).
+    pub fn to_description(&self) -> MachineDescription {
+        let v3 = |v: &Vector3<f64>| [v.x, v.y, v.z];
+        let w = &self.workspace;
+        MachineDescription {
+            name: self.name.clone(),
+            notes: None,
+            placement: Placement::Explicit(crate::description::ExplicitPlacement {
+                base_joints_mm: self.base_joints_mm.each_ref().map(v3),
+                platform_joints_mm: self.platform_joints_mm.each_ref().map(v3),
+            }),
+            up_limb: UpLimbDescription {
+                axis_order: self.up_limb.axis_order,
+                axis_skew_rad: self.up_limb.axis_skew_rad,
+                axis_offset_mm: self.up_limb.axis_offset_mm,
+                twist_rad_per_mm: self.up_limb.twist_rad_per_mm,
+                twist_reference_mm: self.up_limb.twist_reference_mm,
+            },
+            leg_offsets_mm: self.leg_offsets_mm,
+            workspace: WorkspaceDescription {
+                radius_mm: w.radius_mm,
+                height_mm: w.z_max_mm - w.z_min_mm,
+                distance_mm: w.z_min_mm,
+            },
+            limits: crate::description::LimitsDescription {
+                leg_stroke_mm: self.limits.leg_stroke_mm,
+                up_stroke_mm: self.limits.up_stroke_mm,
+                max_tilt_deg: self.limits.max_tilt_rad.to_degrees(),
+            },
+            head: self.head.to_description(),
+            sensors: SensorDescription {
+                angle_noise_arcsec: self.sensors.angle_rad / SensorNoise::ARCSEC,
+                length_noise_um: self.sensors.length_mm * 1e3,
+                readings_per_pose: self.sensors.readings_per_pose,
+            },
+            loads: self.loads.clone(),
+        }
+    }
+
+    /// The same machine with a different ideal U-joint axis order.
+    pub fn with_axis_order(mut self, order: crate::AxisOrder) -> Machine {
+        self.up_limb.axis_order = order;
+        self
+    }
+
+    /// Leg geometry with the UP limb at `up`.
+    pub fn legs_at(&self, up: &UpJoints) -> LegGeometry {
+        let limb = self.up_limb.pose(up);
+        let mut platform_joints_mm = [Vector3::zeros(); 3];
+        let mut lengths_mm = [0.0; 3];
+        let mut directions = [Vector3::zeros(); 3];
+        for i in 0..3 {
+            let a = limb.position_mm + limb.rotation * self.platform_joints_mm[i];
+            let d = a - self.base_joints_mm[i];
+            let n = d.norm();
+            platform_joints_mm[i] = a;
+            lengths_mm[i] = n;
+            directions[i] = d / n;
+        }
+        LegGeometry {
+            limb,
+            platform_joints_mm,
+            lengths_mm,
+            directions,
+        }
+    }
+
+    /// Leg commands that put the legs at the geometric lengths of `geometry`.
+    pub fn commands_for(&self, geometry: &LegGeometry) -> [f64; 3] {
+        std::array::from_fn(|i| geometry.lengths_mm[i] - self.leg_offsets_mm[i])
+    }
+
+    /// Inverse kinematics: platform point `r` (mm) to leg commands and UP
+    /// joint values. Fails when `r` is not finite or outside the joint limits.
+    pub fn inverse(&self, r: &Vector3<f64>) -> Result<IkSolution, KinematicsError> {
+        for (what, v) in [("x", r.x), ("y", r.y), ("z", r.z)] {
+            if !v.is_finite() {
+                return Err(KinematicsError::NotFinite { what, value: v });
+            }
+        }
+        let up = self.up_limb.inverse(r)?;
+        let geometry = self.legs_at(&up);
+        let legs_mm = self.commands_for(&geometry);
+        self.check_limits(&legs_mm, &up, &geometry.limb)?;
+        Ok(IkSolution { legs_mm, up })
+    }
+
+    /// Checks leg commands, UP stroke and tilt against the limits.
+    pub(crate) fn check_limits(
+        &self,
+        legs_mm: &[f64; 3],
+        up: &UpJoints,
+        limb: &UpLimbPose,
+    ) -> Result<(), KinematicsError> {
+        self.check_leg_stroke(legs_mm)?;
+        let [lo, hi] = self.limits.up_stroke_mm;
+        if !(lo - LIMIT_SLACK..=hi + LIMIT_SLACK).contains(&up.q4_mm) {
+            return Err(KinematicsError::OutOfReach {
+                reason: format!(
+                    "UP limb extension {:.3} mm is outside its stroke [{lo}, {hi}] mm",
+                    up.q4_mm
+                ),
+            });
+        }
+        let tilt = limb.limb_axis.z.clamp(-1.0, 1.0).acos();
+        if tilt > self.limits.max_tilt_rad + LIMIT_SLACK {
+            return Err(KinematicsError::OutOfReach {
+                reason: format!(
+                    "UP limb tilt {:.3} deg exceeds the limit {:.3} deg",
+                    tilt.to_degrees(),
+                    self.limits.max_tilt_rad.to_degrees()
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Checks leg commands against the stroke.
+    pub(crate) fn check_leg_stroke(&self, legs_mm: &[f64; 3]) -> Result<(), KinematicsError> {
+        let [lo, hi] = self.limits.leg_stroke_mm;
+        for (i, &q) in legs_mm.iter().enumerate() {
+            if !q.is_finite() {
+                return Err(KinematicsError::NotFinite {
+                    what: "leg command",
+                    value: q,
+                });
+            }
+            if !(lo - LIMIT_SLACK..=hi + LIMIT_SLACK).contains(&q) {
+                return Err(KinematicsError::OutOfStroke {
+                    leg: i + 1,
+                    length_mm: q,
+                    min_mm: lo,
+                    max_mm: hi,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paper_joints_are_on_their_circles() {
+        let m = Machine::paper();
+        let b = 288.7;
+        let s3 = 3f64.sqrt() / 2.0;
+        let expect = [
+            Vector3::new(-b / 2.0, b * s3, 0.0),
+            Vector3::new(-b / 2.0, -b * s3, 0.0),
+            Vector3::new(b, 0.0, 0.0),
+        ];
+        for i in 0..3 {
+            assert!((m.base_joints_mm[i] - expect[i]).norm() < 1e-12);
+            assert!((m.platform_joints_mm[i] * b / 100.0 - expect[i]).norm() < 1e-12);
+        }
+        // The paper's frame convention: B1B2 parallel to y.
+        let b1b2 = m.base_joints_mm[1] - m.base_joints_mm[0];
+        assert!(b1b2.x.abs() < 1e-12 && b1b2.z.abs() < 1e-12);
+    }
+
+    #[test]
+    fn ik_at_the_centre_is_symmetric() {
+        let m = Machine::paper();
+        let ik = m.inverse(&Vector3::new(0.0, 0.0, 750.0)).unwrap();
+        // Every leg runs from radius 288.7 at z = 0 to radius 100 at z = 750.
+        let expected = ((288.7f64 - 100.0).powi(2) + 750.0f64.powi(2)).sqrt();
+        for q in ik.legs_mm {
+            assert!((q - expected).abs() < 1e-9);
+        }
+        assert_eq!(ik.up.phi_rad, 0.0);
+        assert_eq!(ik.up.theta_rad, 0.0);
+    }
+
+    #[test]
+    fn ik_refuses_points_beyond_the_limits() {
+        let m = Machine::paper();
+        assert!(matches!(
+            m.inverse(&Vector3::new(0.0, 0.0, 2000.0)),
+            Err(KinematicsError::OutOfStroke { .. })
+        ));
+        // 45 degrees of tilt with every leg inside its stroke.
+        let e = m.inverse(&Vector3::new(600.0, 0.0, 600.0)).unwrap_err();
+        assert!(e.to_string().contains("tilt"), "{e}");
+        assert!(matches!(
+            m.inverse(&Vector3::new(f64::NAN, 0.0, 700.0)),
+            Err(KinematicsError::NotFinite { .. })
+        ));
+    }
+
+    #[test]
+    fn logged_sigma_divides_by_root_readings() {
+        let s = Machine::paper().sensors.logged_sigma();
+        assert!((s[0] - 0.8 * SensorNoise::ARCSEC / 3f64.sqrt()).abs() < 1e-18);
+        assert!((s[2] - 0.5e-3 / 3f64.sqrt()).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,329 @@
+//! The UP limb: the passive universal-prismatic chain that alone fixes the
+//! platform's orientation, and whose three joints carry the sensors.
+//!
+//! For the x-first convention (the paper's eq. 8) the chain is
+//!
+//! ```text
+//! R_limb = Rx(phi) S Ry(theta) S^T,     S = Rz(skew)
+//! O2     = Rx(phi) (offset e_z)         (a point on the second axis)
+//! r      = O2 + q4 R_limb e_z           (the platform point O')
+//! R      = R_limb Rz(twist (q4 - q_ref)) (the platform orientation)
+//! ```
+//!
+//! and for y-first the roles of x and y swap (`R_limb = Ry(theta) S Rx(phi) S^T`).
+//! `skew`, `offset` and `twist` are the "class 2" errors of the paper (zero
+//! on an ideal joint, where `R = Rx(phi) Ry(theta)` and `r = q4 R e_z`).
+//! Angles in rad, lengths in mm.
+
+use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
+
+use crate::description::{AxisOrder, UpLimbDescription};
+use crate::error::KinematicsError;
+
+/// Values of the UP limb's three passive joints: what its encoders and
+/// linear scale read (before their zero offsets).
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct UpJoints {
+    /// Rotation about the U joint's x-type axis, rad.
+    pub phi_rad: f64,
+    /// Rotation about the U joint's y-type axis, rad.
+    pub theta_rad: f64,
+    /// Extension of the prismatic joint: distance from the U joint to O', mm.
+    pub q4_mm: f64,
+}
+
+impl UpJoints {
+    /// The three values as `[phi, theta, q4]` (rad, rad, mm).
+    pub fn to_array(self) -> [f64; 3] {
+        [self.phi_rad, self.theta_rad, self.q4_mm]
+    }
+
+    /// Builds from `[phi, theta, q4]` (rad, rad, mm).
+    pub fn from_array(v: [f64; 3]) -> UpJoints {
+        UpJoints {
+            phi_rad: v[0],
+            theta_rad: v[1],
+            q4_mm: v[2],
+        }
+    }
+}
+
+/// The UP limb's kinematic chain (see the module docs for the formulas).
+#[derive(Debug, Clone, PartialEq)]
+pub struct UpLimb {
+    /// Which U-joint axis is fixed to the base.
+    pub axis_order: AxisOrder,
+    /// Non-orthogonality of the two U-joint axes, rad.
+    pub axis_skew_rad: f64,
+    /// Distance between the two U-joint axes along their common normal, mm.
+    pub axis_offset_mm: f64,
+    /// Platform twist about the limb axis per mm of extension, rad/mm.
+    pub twist_rad_per_mm: f64,
+    /// Extension at which the twist is zero, mm.
+    pub twist_reference_mm: f64,
+}
+
+/// Everything about the limb at one joint configuration, in the base frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UpLimbPose {
+    /// Platform orientation `R` (O'x'y'z' relative to Oxyz).
+    pub rotation: Matrix3<f64>,
+    /// Platform point O', mm.
+    pub position_mm: Vector3<f64>,
+    /// Unit direction of the limb (prismatic) axis, `w4`.
+    pub limb_axis: Vector3<f64>,
+    /// Unit direction of the U joint's first (base-fixed) axis, through the origin.
+    pub first_axis: Vector3<f64>,
+    /// Unit direction of the U joint's second axis.
+    pub second_axis: Vector3<f64>,
+    /// A point on the second axis, mm.
+    pub second_axis_point_mm: Vector3<f64>,
+    /// `d/dphi` and `d/dtheta` of the orientation as angular-velocity
+    /// vectors: columns are the rotation axes of `phi` and `theta`.
+    pub angle_axes: [Vector3<f64>; 2],
+    /// A point on each of those two axes, mm (the origin for the base-fixed
+    /// axis, [`UpLimbPose::second_axis_point_mm`] for the other).
+    pub angle_pivots_mm: [Vector3<f64>; 2],
+    /// Twist rate copied from the limb, rad/mm.
+    twist_rad_per_mm: f64,
+}
+
+impl UpLimbPose {
+    /// Derivatives of a point rigidly attached to the platform, at world
+    /// position `p` (mm), with respect to `(phi, theta, q4)`: columns in mm/rad,
+    /// mm/rad and mm/mm.
+    pub fn point_jacobian(&self, p: &Vector3<f64>) -> Matrix3<f64> {
+        let [phi_axis, theta_axis] = self.angle_axes;
+        let [phi_point, theta_point] = self.angle_pivots_mm;
+        let d_phi = phi_axis.cross(&(p - phi_point));
+        let d_theta = theta_axis.cross(&(p - theta_point));
+        let d_q4 =
+            self.limb_axis + self.twist_rad_per_mm * self.limb_axis.cross(&(p - self.position_mm));
+        Matrix3::from_columns(&[d_phi, d_theta, d_q4])
+    }
+
+    /// Derivatives of a platform-fixed direction `v` (unit) with respect to
+    /// `(phi, theta, q4)`.
+    pub fn direction_jacobian(&self, v: &Vector3<f64>) -> Matrix3<f64> {
+        let [phi_axis, theta_axis] = self.angle_axes;
+        Matrix3::from_columns(&[
+            phi_axis.cross(v),
+            theta_axis.cross(v),
+            self.twist_rad_per_mm * self.limb_axis.cross(v),
+        ])
+    }
+}
+
+fn rot(axis: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
+    Rotation3::from_axis_angle(&Unit::new_unchecked(*axis), angle).into_inner()
+}
+
+impl UpLimb {
+    /// Builds the chain from its description.
+    pub fn from_description(d: &UpLimbDescription) -> UpLimb {
+        UpLimb {
+            axis_order: d.axis_order,
+            axis_skew_rad: d.axis_skew_rad,
+            axis_offset_mm: d.axis_offset_mm,
+            twist_rad_per_mm: d.twist_rad_per_mm,
+            twist_reference_mm: d.twist_reference_mm,
+        }
+    }
+
+    /// An ideal U joint (no class-2 errors) with the given axis order.
+    pub fn ideal(axis_order: AxisOrder) -> UpLimb {
+        UpLimb {
+            axis_order,
+            axis_skew_rad: 0.0,
+            axis_offset_mm: 0.0,
+            twist_rad_per_mm: 0.0,
+            twist_reference_mm: 0.0,
+        }
+    }
+
+    /// True when the limb has no class-2 errors (closed-form inverse applies).
+    pub fn is_ideal(&self) -> bool {
+        self.axis_skew_rad == 0.0 && self.axis_offset_mm == 0.0
+    }
+
+    /// The limb's geometry at joint values `j`.
+    pub fn pose(&self, j: &UpJoints) -> UpLimbPose {
+        let ex = Vector3::x();
+        let ey = Vector3::y();
+        let ez = Vector3::z();
+        let (first_axis, second_local, first_angle, second_angle) = match self.axis_order {
+            AxisOrder::XFirst => (ex, ey, j.phi_rad, j.theta_rad),
+            AxisOrder::YFirst => (ey, ex, j.theta_rad, j.phi_rad),
+        };
+        let r1 = rot(&first_axis, first_angle);
+        let (s, c) = self.axis_skew_rad.sin_cos();
+        let skew = Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+        let second_in_first = skew * second_local;
+        let r2 = rot(&second_in_first, second_angle);
+        let limb_rotation = r1 * r2;
+        let second_axis = r1 * second_in_first;
+        let second_axis_point_mm = r1 * (self.axis_offset_mm * ez);
+        let limb_axis = limb_rotation * ez;
+        let position_mm = second_axis_point_mm + j.q4_mm * limb_axis;
+        let twist = self.twist_rad_per_mm * (j.q4_mm - self.twist_reference_mm);
+        let rotation = if twist == 0.0 {
+            limb_rotation
+        } else {
+            limb_rotation * rot(&ez, twist)
+        };
+        let origin = Vector3::zeros();
+        let (angle_axes, angle_pivots_mm) = match self.axis_order {
+            AxisOrder::XFirst => ([first_axis, second_axis], [origin, second_axis_point_mm]),
+            AxisOrder::YFirst => ([second_axis, first_axis], [second_axis_point_mm, origin]),
+        };
+        UpLimbPose {
+            rotation,
+            position_mm,
+            limb_axis,
+            first_axis,
+            second_axis,
+            second_axis_point_mm,
+            angle_axes,
+            angle_pivots_mm,
+            twist_rad_per_mm: self.twist_rad_per_mm,
+        }
+    }
+
+    /// Joint values that put O' at `r` (mm). Closed form for an ideal joint;
+    /// Newton's method seeded by the closed form when class-2 errors are present.
+    pub fn inverse(&self, r: &Vector3<f64>) -> Result<UpJoints, KinematicsError> {
+        let seed = ideal_inverse(self.axis_order, r)?;
+        if self.is_ideal() {
+            return Ok(seed);
+        }
+        let mut j = seed;
+        for _ in 0..30 {
+            let pose = self.pose(&j);
+            let f = pose.position_mm - r;
+            let jac = pose.point_jacobian(&pose.position_mm);
+            let Some(inv) = jac.try_inverse() else {
+                return Err(KinematicsError::Singular {
+                    condition: f64::INFINITY,
+                    limit: crate::SINGULARITY_CONDITION_LIMIT,
+                });
+            };
+            let step = -(inv * f);
+            j = UpJoints::from_array([j.phi_rad + step.x, j.theta_rad + step.y, j.q4_mm + step.z]);
+            if step.z.abs() + j.q4_mm * (step.x.abs() + step.y.abs()) < 1e-11 {
+                return Ok(j);
+            }
+        }
+        Err(KinematicsError::NotConverged {
+            solver: "UP limb inverse",
+            iterations: 30,
+            residual: (self.pose(&j).position_mm - r).norm(),
+        })
+    }
+}
+
+/// Closed-form inverse of an ideal U joint: `r = q4 R e_z`.
+fn ideal_inverse(order: AxisOrder, r: &Vector3<f64>) -> Result<UpJoints, KinematicsError> {
+    let q4 = r.norm();
+    if q4 < 1e-9 {
+        return Err(KinematicsError::OutOfReach {
+            reason: "the platform point coincides with the UP limb's U joint".into(),
+        });
+    }
+    let u = r / q4;
+    let (phi, theta) = match order {
+        // u = (sin t, -sin p cos t, cos p cos t)
+        AxisOrder::XFirst => ((-u.y).atan2(u.z), u.x.clamp(-1.0, 1.0).asin()),
+        // u = (sin t cos p, -sin p, cos t cos p)
+        AxisOrder::YFirst => ((-u.y).clamp(-1.0, 1.0).asin(), u.x.atan2(u.z)),
+    };
+    Ok(UpJoints {
+        phi_rad: phi,
+        theta_rad: theta,
+        q4_mm: q4,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn limbs() -> Vec<UpLimb> {
+        let mut v = vec![
+            UpLimb::ideal(AxisOrder::XFirst),
+            UpLimb::ideal(AxisOrder::YFirst),
+        ];
+        for order in [AxisOrder::XFirst, AxisOrder::YFirst] {
+            v.push(UpLimb {
+                axis_order: order,
+                axis_skew_rad: 2e-4,
+                axis_offset_mm: 0.05,
+                twist_rad_per_mm: 1e-6,
+                twist_reference_mm: 750.0,
+            });
+        }
+        v
+    }
+
+    #[test]
+    fn ideal_x_first_is_the_papers_eq_8() {
+        let limb = UpLimb::ideal(AxisOrder::XFirst);
+        let j = UpJoints {
+            phi_rad: 0.3,
+            theta_rad: -0.2,
+            q4_mm: 800.0,
+        };
+        let pose = limb.pose(&j);
+        let expected = rot(&Vector3::x(), 0.3) * rot(&Vector3::y(), -0.2);
+        assert!((pose.rotation - expected).norm() < 1e-15);
+        assert!((pose.position_mm - 800.0 * expected.column(2)).norm() < 1e-12);
+        // J_theta of eq. 8: [1 0; 0 cos phi; 0 sin phi]
+        assert!((pose.angle_axes[0] - Vector3::x()).norm() < 1e-15);
+        assert!(
+            (pose.angle_axes[1] - Vector3::new(0.0, 0.3f64.cos(), 0.3f64.sin())).norm() < 1e-15
+        );
+    }
+
+    #[test]
+    fn inverse_round_trips_for_every_limb() {
+        for limb in limbs() {
+            for r in [
+                Vector3::new(0.0, 0.0, 750.0),
+                Vector3::new(300.0, -250.0, 650.0),
+                Vector3::new(-400.0, 10.0, 850.0),
+            ] {
+                let j = limb.inverse(&r).unwrap();
+                let back = limb.pose(&j).position_mm;
+                assert!((back - r).norm() < 1e-9, "{limb:?} {r} -> {back}");
+            }
+        }
+    }
+
+    #[test]
+    fn point_jacobian_matches_finite_differences() {
+        for limb in limbs() {
+            let j = UpJoints {
+                phi_rad: 0.25,
+                theta_rad: -0.35,
+                q4_mm: 820.0,
+            };
+            let a = Vector3::new(60.0, -70.0, 5.0);
+            let point = |j: &UpJoints| {
+                let p = limb.pose(j);
+                p.position_mm + p.rotation * a
+            };
+            let analytic = limb.pose(&j).point_jacobian(&point(&j));
+            let x = j.to_array();
+            for k in 0..3 {
+                let h = if k == 2 { 1e-3 } else { 1e-6 };
+                let mut plus = x;
+                let mut minus = x;
+                plus[k] += h;
+                minus[k] -= h;
+                let fd = (point(&UpJoints::from_array(plus)) - point(&UpJoints::from_array(minus)))
+                    / (2.0 * h);
+                let err = (fd - analytic.column(k)).norm() / fd.norm().max(1.0);
+                assert!(err < 1e-7, "{limb:?} column {k}: {err}");
+            }
+        }
+    }
+}

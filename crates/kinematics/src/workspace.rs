@@ -1,0 +1,180 @@
+//! The cylindrical workspace of the platform point O' and pose sampling in it.
+//!
+//! Table 1 of the paper: a cylinder of radius `R = 400` and height `h = 200`
+//! whose near face is `H = 650` mm from the base plane, so O' ranges over
+//! `x^2 + y^2 <= R^2`, `650 <= z <= 850` mm and the "middle plane" of Fig. 3
+//! is `z = 750` mm. Random sampling is seeded (PCG-64 MCG) and reproducible.
+
+use nalgebra::Vector3;
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+use crate::description::WorkspaceDescription;
+
+/// The workspace cylinder, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Workspace {
+    /// Radius, mm.
+    pub radius_mm: f64,
+    /// Lowest z (nearest the base), mm.
+    pub z_min_mm: f64,
+    /// Highest z, mm.
+    pub z_max_mm: f64,
+}
+
+impl Workspace {
+    /// Builds from the description (`z_min = H`, `z_max = H + h`).
+    pub fn from_description(d: &WorkspaceDescription) -> Workspace {
+        Workspace {
+            radius_mm: d.radius_mm,
+            z_min_mm: d.distance_mm,
+            z_max_mm: d.distance_mm + d.height_mm,
+        }
+    }
+
+    /// z of the middle plane, mm.
+    pub fn mid_plane_z_mm(&self) -> f64 {
+        0.5 * (self.z_min_mm + self.z_max_mm)
+    }
+
+    /// Whether `p` lies in the cylinder (with a tolerance of 1e-9 mm).
+    pub fn contains(&self, p: &Vector3<f64>) -> bool {
+        let tol = 1e-9;
+        p.x.hypot(p.y) <= self.radius_mm + tol
+            && p.z >= self.z_min_mm - tol
+            && p.z <= self.z_max_mm + tol
+    }
+
+    /// Polar grid: at each of `levels` equally spaced heights (one level:
+    /// the middle plane), the axis point plus `rings` rings of `per_ring`
+    /// points at radii `R k / rings`.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_kinematics::Machine;
+    /// // The project's default identification pose set: 3 x (1 + 3 x 8) = 75 poses.
+    /// let poses = Machine::paper().workspace.polar_grid(3, 8, 3);
+    /// assert_eq!(poses.len(), 75);
+    /// ```
+    pub fn polar_grid(&self, rings: usize, per_ring: usize, levels: usize) -> Vec<Vector3<f64>> {
+        let mut out = Vec::with_capacity(levels * (1 + rings * per_ring));
+        for z in self.levels(levels) {
+            out.push(Vector3::new(0.0, 0.0, z));
+            for k in 1..=rings {
+                let radius = self.radius_mm * k as f64 / rings as f64;
+                for j in 0..per_ring {
+                    let a = std::f64::consts::TAU * j as f64 / per_ring as f64;
+                    out.push(Vector3::new(radius * a.cos(), radius * a.sin(), z));
+                }
+            }
+        }
+        out
+    }
+
+    /// Heights of `levels` equally spaced planes from `z_min` to `z_max`
+    /// (one level: the middle plane).
+    pub fn levels(&self, levels: usize) -> Vec<f64> {
+        match levels {
+            0 => Vec::new(),
+            1 => vec![self.mid_plane_z_mm()],
+            n => (0..n)
+                .map(|k| {
+                    self.z_min_mm + (self.z_max_mm - self.z_min_mm) * k as f64 / (n - 1) as f64
+                })
+                .collect(),
+        }
+    }
+
+    /// Square grid of spacing `spacing_mm` over the disc `x^2 + y^2 <= R^2` at
+    /// height `z_mm`, centred on the axis (the axis point is always included).
+    pub fn disc_grid(&self, z_mm: f64, spacing_mm: f64) -> Vec<Vector3<f64>> {
+        let n = (self.radius_mm / spacing_mm).floor() as i64;
+        let mut out = Vec::new();
+        for i in -n..=n {
+            for j in -n..=n {
+                let (x, y) = (i as f64 * spacing_mm, j as f64 * spacing_mm);
+                if x.hypot(y) <= self.radius_mm + 1e-9 {
+                    out.push(Vector3::new(x, y, z_mm));
+                }
+            }
+        }
+        out
+    }
+
+    /// Square grid of `n x n` points spanning `[-R, R]^2` at height `z_mm`
+    /// (the square circumscribing the workspace disc).
+    pub fn square_grid(&self, z_mm: f64, n: usize) -> Vec<Vector3<f64>> {
+        let step = if n > 1 {
+            2.0 * self.radius_mm / (n - 1) as f64
+        } else {
+            0.0
+        };
+        let start = if n > 1 { -self.radius_mm } else { 0.0 };
+        let mut out = Vec::with_capacity(n * n);
+        for i in 0..n {
+            for j in 0..n {
+                out.push(Vector3::new(
+                    start + i as f64 * step,
+                    start + j as f64 * step,
+                    z_mm,
+                ));
+            }
+        }
+        out
+    }
+
+    /// `n` points uniformly distributed in the cylinder's volume, reproducible
+    /// from `seed`.
+    pub fn random_poses(&self, n: usize, seed: u64) -> Vec<Vector3<f64>> {
+        let mut rng = Pcg64Mcg::seed_from_u64(seed);
+        (0..n)
+            .map(|_| {
+                // Uniform in the disc: radius ~ R sqrt(U).
+                let rad = self.radius_mm * rng.random::<f64>().sqrt();
+                let a = std::f64::consts::TAU * rng.random::<f64>();
+                let z = self.z_min_mm + (self.z_max_mm - self.z_min_mm) * rng.random::<f64>();
+                Vector3::new(rad * a.cos(), rad * a.sin(), z)
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn paper() -> Workspace {
+        Workspace {
+            radius_mm: 400.0,
+            z_min_mm: 650.0,
+            z_max_mm: 850.0,
+        }
+    }
+
+    #[test]
+    fn grids_stay_inside_and_have_the_expected_size() {
+        let w = paper();
+        let g = w.polar_grid(3, 8, 3);
+        assert_eq!(g.len(), 75);
+        assert!(g.iter().all(|p| w.contains(p)));
+        let d = w.disc_grid(750.0, 100.0);
+        // |i|,|j| <= 4 with i^2 + j^2 <= 16: 49 lattice points.
+        assert_eq!(d.len(), 49);
+        assert!(d.iter().all(|p| w.contains(p)));
+        assert_eq!(w.levels(1), vec![750.0]);
+        assert_eq!(w.square_grid(750.0, 3).len(), 9);
+    }
+
+    #[test]
+    fn random_poses_are_reproducible_and_inside() {
+        let w = paper();
+        let a = w.random_poses(500, 7);
+        let b = w.random_poses(500, 7);
+        assert_eq!(a, b);
+        assert_ne!(a, w.random_poses(500, 8));
+        assert!(a.iter().all(|p| w.contains(p)));
+        // Uniform in area: about a quarter of the points within R/2.
+        let inner = a.iter().filter(|p| p.x.hypot(p.y) < 200.0).count();
+        assert!((90..160).contains(&inner), "{inner}");
+    }
+}
