@@ -40,6 +40,8 @@ pub struct FkSolution {
 }
 
 const MAX_ITERATIONS: u32 = 60;
+/// Trilateration rounds of the cold-start seed (each gains about one digit).
+const SEED_ROUNDS: usize = 1;
 /// Converged when the scaled Newton step is below this, mm.
 const STEP_TOLERANCE_MM: f64 = 1e-10;
 /// A converged solution must close the legs to this, mm.
@@ -81,12 +83,12 @@ impl Machine {
     }
 
     /// Seed: place O' by trilateration with the platform joints rotated by
-    /// the orientation of the previous round (identity first), twice.
+    /// the orientation of the previous round (identity first).
     fn trilateration_seed(&self, lengths: &[f64; 3]) -> UpJoints {
         let z_mid = 0.5 * (self.workspace.z_min_mm + self.workspace.z_max_mm);
         let mut rotation = Matrix3::identity();
         let mut r = Vector3::new(0.0, 0.0, z_mid);
-        for _ in 0..2 {
+        for _ in 0..SEED_ROUNDS {
             let centres: [Vector3<f64>; 3] = std::array::from_fn(|i| {
                 self.base_joints_mm[i] - rotation * self.platform_joints_mm[i]
             });
@@ -94,8 +96,8 @@ impl Machine {
                 Some(p) => r = p,
                 None => break,
             }
-            match self.up_limb.inverse(&r) {
-                Ok(up) => rotation = self.up_limb.pose(&up).rotation,
+            match self.up_limb.rotation_at_point(&r) {
+                Ok(rot) => rotation = rot,
                 Err(_) => break,
             }
         }
@@ -106,10 +108,17 @@ impl Machine {
         })
     }
 
-    fn closure(&self, x: &UpJoints, lengths: &[f64; 3]) -> (LegGeometry, Vector3<f64>) {
-        let g = self.legs_at(x);
-        let f = Vector3::from_fn(|i, _| g.lengths_mm[i] - lengths[i]);
-        (g, f)
+    /// Leg geometry at `x` written into `out`, and the closure residual.
+    /// (In place: the geometry is a few hundred bytes and Newton's loop
+    /// would otherwise spend a tenth of its time copying it.)
+    fn closure_into(
+        &self,
+        x: &UpJoints,
+        lengths: &[f64; 3],
+        out: &mut LegGeometry,
+    ) -> Vector3<f64> {
+        self.legs_into(self.up_limb.pose(x), out);
+        Vector3::from_fn(|i, _| out.lengths_mm[i] - lengths[i])
     }
 
     fn newton(
@@ -119,10 +128,13 @@ impl Machine {
         seed: UpJoints,
     ) -> Result<FkSolution, KinematicsError> {
         let mut x = seed;
-        let (mut geometry, mut f) = self.closure(&x, lengths);
+        // Two geometry buffers: the current iterate's and the trial's.
+        let mut buffers = [self.legs_at(&x); 2];
+        let mut current = 0;
+        let mut f = Vector3::from_fn(|i, _| buffers[0].lengths_mm[i] - lengths[i]);
         let mut merit = f.norm_squared();
         for iteration in 1..=MAX_ITERATIONS {
-            let j1 = geometry.j1();
+            let j1 = buffers[current].j1();
             let Some(j1_inv) = j1.try_inverse() else {
                 return Err(KinematicsError::Singular {
                     condition: f64::INFINITY,
@@ -130,7 +142,7 @@ impl Machine {
                 });
             };
             let step = -(j1_inv * f);
-            let step_mm = step.z.abs() + x.q4_mm.abs() * (step.x.abs() + step.y.abs());
+            let step_mm = scaled_size(&step, x.q4_mm);
             // Backtracking line search on |f|^2 (Armijo with c = 1e-4).
             let mut t = 1.0;
             loop {
@@ -139,11 +151,11 @@ impl Machine {
                     theta_rad: x.theta_rad + t * step.y,
                     q4_mm: x.q4_mm + t * step.z,
                 };
-                let (g, ft) = self.closure(&trial, lengths);
+                let ft = self.closure_into(&trial, lengths, &mut buffers[1 - current]);
                 let m = ft.norm_squared();
                 if m <= (1.0 - 1e-4 * t) * merit || m == 0.0 || step_mm * t < STEP_TOLERANCE_MM {
                     x = trial;
-                    geometry = g;
+                    current = 1 - current;
                     f = ft;
                     merit = m;
                     break;
@@ -155,12 +167,16 @@ impl Machine {
                     });
                 }
             }
-            if step_mm * t < STEP_TOLERANCE_MM || merit == 0.0 {
+            // The next Newton step, predicted with this iteration's inverse
+            // Jacobian: when it is negligible the iterate is converged, and
+            // one Jacobian evaluation is saved.
+            let next_mm = scaled_size(&(j1_inv * f), x.q4_mm);
+            if next_mm < STEP_TOLERANCE_MM || merit == 0.0 {
                 let residual_mm = merit.sqrt();
                 if residual_mm > RESIDUAL_TOLERANCE_MM {
                     return Err(KinematicsError::NoAssembly { residual_mm });
                 }
-                return self.finish(legs_mm, x, &geometry, iteration, residual_mm);
+                return self.finish(legs_mm, x, &buffers[current], &j1, iteration, residual_mm);
             }
         }
         Err(KinematicsError::NotConverged {
@@ -175,17 +191,20 @@ impl Machine {
         legs_mm: &[f64; 3],
         x: UpJoints,
         geometry: &LegGeometry,
+        j1: &Matrix3<f64>,
         iterations: u32,
         residual_mm: f64,
     ) -> Result<FkSolution, KinematicsError> {
-        let condition = unit_free_condition(&geometry.j1(), x.q4_mm);
+        // `j1` is from the last iterate, less than 1e-10 mm away: the same
+        // condition number for every purpose.
+        let condition = unit_free_condition(j1, x.q4_mm);
         if condition > SINGULARITY_CONDITION_LIMIT {
             return Err(KinematicsError::Singular {
                 condition,
                 limit: SINGULARITY_CONDITION_LIMIT,
             });
         }
-        self.check_limits(legs_mm, &x, &geometry.limb)?;
+        self.check_limits(legs_mm, &x, &geometry.limb.limb_axis)?;
         Ok(FkSolution {
             up: x,
             position_mm: geometry.limb.position_mm,
@@ -195,6 +214,11 @@ impl Machine {
             residual_mm,
         })
     }
+}
+
+/// Size of a step in `(phi, theta, q4)` in mm: angles times the limb length.
+fn scaled_size(step: &Vector3<f64>, q4_mm: f64) -> f64 {
+    step.z.abs() + q4_mm.abs() * (step.x.abs() + step.y.abs())
 }
 
 /// Frobenius condition number of `J1 diag(1/q4, 1/q4, 1)`.
@@ -230,7 +254,7 @@ fn trilaterate(c: &[Vector3<f64>; 3], r: &[f64; 3]) -> Option<Vector3<f64>> {
     let x = (r[0] * r[0] - r[1] * r[1] + d * d) / (2.0 * d);
     let y = (r[0] * r[0] - r[2] * r[2] + i * i + j * j) / (2.0 * j) - i / j * x;
     let z2 = r[0] * r[0] - x * x - y * y;
-    if !(z2 >= 0.0) {
+    if z2.is_nan() || z2 < 0.0 {
         return None;
     }
     Some(c[0] + x * ex + y * ey + z2.sqrt() * ez)

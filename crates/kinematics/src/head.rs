@@ -275,7 +275,7 @@ impl Machine {
                 let h = [wrap_angle(h[0]), wrap_angle(h[1])];
                 let geometry = self.legs_at(&up);
                 let legs_mm = self.commands_for(&geometry);
-                self.check_limits(&legs_mm, &up, &geometry.limb)?;
+                self.check_limits(&legs_mm, &up, &geometry.limb.limb_axis)?;
                 return Ok(ToolIkSolution {
                     legs_mm,
                     up,

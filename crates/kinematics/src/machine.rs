@@ -28,8 +28,26 @@ pub struct Limits {
     pub leg_stroke_mm: [f64; 2],
     /// Stroke of the UP limb's prismatic joint `[min, max]`, mm.
     pub up_stroke_mm: [f64; 2],
+    max_tilt_rad: f64,
+    /// `cos(max_tilt_rad + slack)`: the smallest z of the unit limb axis.
+    min_limb_axis_z: f64,
+}
+
+impl Limits {
+    /// Limits from strokes (mm) and the largest tilt of the UP limb (rad).
+    pub fn new(leg_stroke_mm: [f64; 2], up_stroke_mm: [f64; 2], max_tilt_rad: f64) -> Limits {
+        Limits {
+            leg_stroke_mm,
+            up_stroke_mm,
+            max_tilt_rad,
+            min_limb_axis_z: (max_tilt_rad + LIMIT_SLACK).cos(),
+        }
+    }
+
     /// Largest tilt of the UP limb from the base z axis, rad.
-    pub max_tilt_rad: f64,
+    pub fn max_tilt_rad(&self) -> f64 {
+        self.max_tilt_rad
+    }
 }
 
 /// Standard deviations of one *logged* sensor value (the mean of
@@ -93,11 +111,21 @@ impl LegGeometry {
     /// `[(b_i x w_i)^T J_theta, w_i^T w_4]` (eq. 9). It is also the Jacobian
     /// of the leg lengths with respect to the UP joints, used by FK.
     pub fn j1(&self) -> Matrix3<f64> {
+        let limb = &self.limb;
+        let [phi_axis, theta_axis] = limb.angle_axes;
+        let [phi_pivot, theta_pivot] = limb.angle_pivots_mm;
+        let twist = limb.twist_rate_rad_per_mm();
         let mut j1 = Matrix3::zeros();
         for i in 0..3 {
-            let row = self.directions[i].transpose()
-                * self.limb.point_jacobian(&self.platform_joints_mm[i]);
-            j1.set_row(i, &row);
+            // w^T (k x (A - p)) = k . ((A - p) x w): row i of w_i^T dA_i/dx.
+            let a = &self.platform_joints_mm[i];
+            let w = &self.directions[i];
+            j1[(i, 0)] = phi_axis.dot(&(a - phi_pivot).cross(w));
+            j1[(i, 1)] = theta_axis.dot(&(a - theta_pivot).cross(w));
+            j1[(i, 2)] = w.dot(&limb.limb_axis);
+            if twist != 0.0 {
+                j1[(i, 2)] += twist * limb.limb_axis.dot(&(a - limb.position_mm).cross(w));
+            }
         }
         j1
     }
@@ -164,11 +192,11 @@ impl Machine {
             leg_offsets_mm: d.leg_offsets_mm,
             up_limb: UpLimb::from_description(&d.up_limb),
             workspace: Workspace::from_description(&d.workspace),
-            limits: Limits {
-                leg_stroke_mm: d.limits.leg_stroke_mm,
-                up_stroke_mm: d.limits.up_stroke_mm,
-                max_tilt_rad: d.limits.max_tilt_deg.to_radians(),
-            },
+            limits: Limits::new(
+                d.limits.leg_stroke_mm,
+                d.limits.up_stroke_mm,
+                d.limits.max_tilt_deg.to_radians(),
+            ),
             head: Head::from_description(&d.head),
             sensors: SensorNoise::from_description(&d.sensors),
             loads: d.loads.clone(),
@@ -222,25 +250,36 @@ impl Machine {
     }
 
     /// Leg geometry with the UP limb at `up`.
+    #[inline]
     pub fn legs_at(&self, up: &UpJoints) -> LegGeometry {
-        let limb = self.up_limb.pose(up);
-        let mut platform_joints_mm = [Vector3::zeros(); 3];
-        let mut lengths_mm = [0.0; 3];
-        let mut directions = [Vector3::zeros(); 3];
+        self.legs_for(self.up_limb.pose(up))
+    }
+
+    /// Leg geometry with the UP limb in pose `limb`.
+    #[inline]
+    pub fn legs_for(&self, limb: UpLimbPose) -> LegGeometry {
+        let mut g = LegGeometry {
+            limb,
+            platform_joints_mm: [Vector3::zeros(); 3],
+            lengths_mm: [0.0; 3],
+            directions: [Vector3::zeros(); 3],
+        };
+        self.legs_into(limb, &mut g);
+        g
+    }
+
+    /// [`Machine::legs_for`] written into an existing value.
+    #[inline]
+    pub(crate) fn legs_into(&self, limb: UpLimbPose, out: &mut LegGeometry) {
         for i in 0..3 {
             let a = limb.position_mm + limb.rotation * self.platform_joints_mm[i];
             let d = a - self.base_joints_mm[i];
             let n = d.norm();
-            platform_joints_mm[i] = a;
-            lengths_mm[i] = n;
-            directions[i] = d / n;
+            out.platform_joints_mm[i] = a;
+            out.lengths_mm[i] = n;
+            out.directions[i] = d / n;
         }
-        LegGeometry {
-            limb,
-            platform_joints_mm,
-            lengths_mm,
-            directions,
-        }
+        out.limb = limb;
     }
 
     /// Leg commands that put the legs at the geometric lengths of `geometry`.
@@ -256,10 +295,12 @@ impl Machine {
                 return Err(KinematicsError::NotFinite { what, value: v });
             }
         }
-        let up = self.up_limb.inverse(r)?;
-        let geometry = self.legs_at(&up);
-        let legs_mm = self.commands_for(&geometry);
-        self.check_limits(&legs_mm, &up, &geometry.limb)?;
+        let (up, frame) = self.up_limb.inverse_frame(r)?;
+        let legs_mm: [f64; 3] = std::array::from_fn(|i| {
+            let a = frame.position_mm + frame.rotation * self.platform_joints_mm[i];
+            (a - self.base_joints_mm[i]).norm() - self.leg_offsets_mm[i]
+        });
+        self.check_limits(&legs_mm, &up, &frame.limb_axis)?;
         Ok(IkSolution { legs_mm, up })
     }
 
@@ -268,7 +309,7 @@ impl Machine {
         &self,
         legs_mm: &[f64; 3],
         up: &UpJoints,
-        limb: &UpLimbPose,
+        limb_axis: &Vector3<f64>,
     ) -> Result<(), KinematicsError> {
         self.check_leg_stroke(legs_mm)?;
         let [lo, hi] = self.limits.up_stroke_mm;
@@ -280,8 +321,8 @@ impl Machine {
                 ),
             });
         }
-        let tilt = limb.limb_axis.z.clamp(-1.0, 1.0).acos();
-        if tilt > self.limits.max_tilt_rad + LIMIT_SLACK {
+        if limb_axis.z < self.limits.min_limb_axis_z {
+            let tilt = limb_axis.z.clamp(-1.0, 1.0).acos();
             return Err(KinematicsError::OutOfReach {
                 reason: format!(
                     "UP limb tilt {:.3} deg exceeds the limit {:.3} deg",

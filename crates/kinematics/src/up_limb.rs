@@ -72,17 +72,11 @@ pub struct UpLimbPose {
     pub position_mm: Vector3<f64>,
     /// Unit direction of the limb (prismatic) axis, `w4`.
     pub limb_axis: Vector3<f64>,
-    /// Unit direction of the U joint's first (base-fixed) axis, through the origin.
-    pub first_axis: Vector3<f64>,
-    /// Unit direction of the U joint's second axis.
-    pub second_axis: Vector3<f64>,
-    /// A point on the second axis, mm.
-    pub second_axis_point_mm: Vector3<f64>,
     /// `d/dphi` and `d/dtheta` of the orientation as angular-velocity
     /// vectors: columns are the rotation axes of `phi` and `theta`.
     pub angle_axes: [Vector3<f64>; 2],
     /// A point on each of those two axes, mm (the origin for the base-fixed
-    /// axis, [`UpLimbPose::second_axis_point_mm`] for the other).
+    /// axis; for the other, the origin displaced by the axis offset).
     pub angle_pivots_mm: [Vector3<f64>; 2],
     /// Twist rate copied from the limb, rad/mm.
     twist_rad_per_mm: f64,
@@ -102,6 +96,11 @@ impl UpLimbPose {
         Matrix3::from_columns(&[d_phi, d_theta, d_q4])
     }
 
+    /// Platform twist about the limb axis per mm of extension, rad/mm.
+    pub fn twist_rate_rad_per_mm(&self) -> f64 {
+        self.twist_rad_per_mm
+    }
+
     /// Derivatives of a platform-fixed direction `v` (unit) with respect to
     /// `(phi, theta, q4)`.
     pub fn direction_jacobian(&self, v: &Vector3<f64>) -> Matrix3<f64> {
@@ -112,6 +111,16 @@ impl UpLimbPose {
             self.twist_rad_per_mm * self.limb_axis.cross(v),
         ])
     }
+}
+
+/// The part of [`UpLimbPose`] that IK needs, plus the second axis.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LimbFrame {
+    pub rotation: Matrix3<f64>,
+    pub position_mm: Vector3<f64>,
+    pub limb_axis: Vector3<f64>,
+    second_axis: Vector3<f64>,
+    second_axis_point_mm: Vector3<f64>,
 }
 
 fn rot(axis: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
@@ -147,52 +156,153 @@ impl UpLimb {
     }
 
     /// The limb's geometry at joint values `j`.
+    #[inline]
     pub fn pose(&self, j: &UpJoints) -> UpLimbPose {
-        let ex = Vector3::x();
-        let ey = Vector3::y();
-        let ez = Vector3::z();
-        let (first_axis, second_local, first_angle, second_angle) = match self.axis_order {
-            AxisOrder::XFirst => (ex, ey, j.phi_rad, j.theta_rad),
-            AxisOrder::YFirst => (ey, ex, j.theta_rad, j.phi_rad),
+        let (first_angle, second_angle) = match self.axis_order {
+            AxisOrder::XFirst => (j.phi_rad, j.theta_rad),
+            AxisOrder::YFirst => (j.theta_rad, j.phi_rad),
         };
-        let r1 = rot(&first_axis, first_angle);
-        let (s, c) = self.axis_skew_rad.sin_cos();
-        let skew = Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
-        let second_in_first = skew * second_local;
-        let r2 = rot(&second_in_first, second_angle);
-        let limb_rotation = r1 * r2;
-        let second_axis = r1 * second_in_first;
-        let second_axis_point_mm = r1 * (self.axis_offset_mm * ez);
-        let limb_axis = limb_rotation * ez;
-        let position_mm = second_axis_point_mm + j.q4_mm * limb_axis;
-        let twist = self.twist_rad_per_mm * (j.q4_mm - self.twist_reference_mm);
-        let rotation = if twist == 0.0 {
-            limb_rotation
-        } else {
-            limb_rotation * rot(&ez, twist)
-        };
+        let (s1, c1) = first_angle.sin_cos();
+        let (s2, c2) = second_angle.sin_cos();
+        self.pose_from_trig([s1, c1, s2, c2], j.q4_mm)
+    }
+
+    /// [`UpLimb::pose`] from the sines and cosines `[s1, c1, s2, c2]` of the
+    /// first (base-fixed) and second joint angles.
+    #[inline]
+    fn pose_from_trig(&self, trig: [f64; 4], q4_mm: f64) -> UpLimbPose {
+        let frame = self.frame_from_trig(trig, q4_mm);
         let origin = Vector3::zeros();
         let (angle_axes, angle_pivots_mm) = match self.axis_order {
-            AxisOrder::XFirst => ([first_axis, second_axis], [origin, second_axis_point_mm]),
-            AxisOrder::YFirst => ([second_axis, first_axis], [second_axis_point_mm, origin]),
+            AxisOrder::XFirst => (
+                [Vector3::x(), frame.second_axis],
+                [origin, frame.second_axis_point_mm],
+            ),
+            AxisOrder::YFirst => (
+                [frame.second_axis, Vector3::y()],
+                [frame.second_axis_point_mm, origin],
+            ),
         };
         UpLimbPose {
-            rotation,
-            position_mm,
-            limb_axis,
-            first_axis,
-            second_axis,
-            second_axis_point_mm,
+            rotation: frame.rotation,
+            position_mm: frame.position_mm,
+            limb_axis: frame.limb_axis,
             angle_axes,
             angle_pivots_mm,
             twist_rad_per_mm: self.twist_rad_per_mm,
         }
     }
 
+    /// Rotation, position and axes from the sines and cosines of the joint
+    /// angles (the part of the pose that IK needs).
+    #[inline]
+    fn frame_from_trig(&self, trig: [f64; 4], q4_mm: f64) -> LimbFrame {
+        let ez = Vector3::z();
+        let [s1, c1, s2, c2] = trig;
+        // Elementary rotations written out: this is the hot path of IK and FK.
+        let rx = |s: f64, c: f64| Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c);
+        let ry = |s: f64, c: f64| Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c);
+        let (second_local, r1, mut r2) = match self.axis_order {
+            AxisOrder::XFirst => (Vector3::y(), rx(s1, c1), ry(s2, c2)),
+            AxisOrder::YFirst => (Vector3::x(), ry(s1, c1), rx(s2, c2)),
+        };
+        let mut second_in_first = second_local;
+        let limb_rotation = if self.axis_skew_rad != 0.0 {
+            // The second axis turned by the skew about the common normal z:
+            // R2 = S R2_ideal S^T with S = Rz(skew).
+            let (s, c) = self.axis_skew_rad.sin_cos();
+            let skew = Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+            second_in_first = skew * second_local;
+            r2 = skew * r2 * skew.transpose();
+            r1 * r2
+        } else {
+            // The products Rx Ry and Ry Rx written out (4 multiplications).
+            match self.axis_order {
+                AxisOrder::XFirst => {
+                    Matrix3::new(c2, 0.0, s2, s1 * s2, c1, -s1 * c2, -c1 * s2, s1, c1 * c2)
+                }
+                AxisOrder::YFirst => {
+                    Matrix3::new(c1, s1 * s2, s1 * c2, 0.0, c2, -s2, -s1, c1 * s2, c1 * c2)
+                }
+            }
+        };
+        let limb_axis = limb_rotation.column(2).into_owned();
+        let second_axis_point_mm = if self.axis_offset_mm == 0.0 {
+            Vector3::zeros()
+        } else {
+            r1 * (self.axis_offset_mm * ez)
+        };
+        let position_mm = second_axis_point_mm + q4_mm * limb_axis;
+        let twist = self.twist_rad_per_mm * (q4_mm - self.twist_reference_mm);
+        let rotation = if twist == 0.0 {
+            limb_rotation
+        } else {
+            limb_rotation * rot(&ez, twist)
+        };
+        LimbFrame {
+            rotation,
+            position_mm,
+            limb_axis,
+            second_axis: r1 * second_in_first,
+            second_axis_point_mm,
+        }
+    }
+
+    /// The platform orientation when O' is at `r` (no inverse trigonometry
+    /// on an ideal joint: used by FK's seed).
+    pub(crate) fn rotation_at_point(
+        &self,
+        r: &Vector3<f64>,
+    ) -> Result<Matrix3<f64>, KinematicsError> {
+        if self.is_ideal() {
+            let (q4, trig) = ideal_trig(self.axis_order, r)?;
+            Ok(self.frame_from_trig(trig, q4).rotation)
+        } else {
+            Ok(self.pose(&self.inverse(r)?).rotation)
+        }
+    }
+
+    /// Joint values that put O' at `r` (mm), with the limb's frame there.
+    #[inline]
+    pub(crate) fn inverse_frame(
+        &self,
+        r: &Vector3<f64>,
+    ) -> Result<(UpJoints, LimbFrame), KinematicsError> {
+        let (j, trig) = if self.is_ideal() {
+            ideal_inverse_trig(self.axis_order, r)?
+        } else {
+            let j = self.inverse(r)?;
+            let (first, second) = match self.axis_order {
+                AxisOrder::XFirst => (j.phi_rad, j.theta_rad),
+                AxisOrder::YFirst => (j.theta_rad, j.phi_rad),
+            };
+            let (s1, c1) = first.sin_cos();
+            let (s2, c2) = second.sin_cos();
+            (j, [s1, c1, s2, c2])
+        };
+        Ok((j, self.frame_from_trig(trig, j.q4_mm)))
+    }
+
+    /// Joint values that put O' at `r` (mm), with the limb's pose there.
+    /// On an ideal joint the pose is built from the closed form's own sines
+    /// and cosines (no second round of trigonometry: this is IK's hot path).
+    #[inline]
+    pub fn inverse_pose(
+        &self,
+        r: &Vector3<f64>,
+    ) -> Result<(UpJoints, UpLimbPose), KinematicsError> {
+        if self.is_ideal() {
+            let (j, trig) = ideal_inverse_trig(self.axis_order, r)?;
+            return Ok((j, self.pose_from_trig(trig, j.q4_mm)));
+        }
+        let j = self.inverse(r)?;
+        Ok((j, self.pose(&j)))
+    }
+
     /// Joint values that put O' at `r` (mm). Closed form for an ideal joint;
     /// Newton's method seeded by the closed form when class-2 errors are present.
     pub fn inverse(&self, r: &Vector3<f64>) -> Result<UpJoints, KinematicsError> {
-        let seed = ideal_inverse(self.axis_order, r)?;
+        let seed = ideal_inverse_trig(self.axis_order, r)?.0;
         if self.is_ideal() {
             return Ok(seed);
         }
@@ -221,8 +331,31 @@ impl UpLimb {
     }
 }
 
-/// Closed-form inverse of an ideal U joint: `r = q4 R e_z`.
-fn ideal_inverse(order: AxisOrder, r: &Vector3<f64>) -> Result<UpJoints, KinematicsError> {
+/// Closed-form inverse of an ideal U joint, `r = q4 R e_z`, with the sines
+/// and cosines `[s1, c1, s2, c2]` of the first and second joint angles.
+fn ideal_inverse_trig(
+    order: AxisOrder,
+    r: &Vector3<f64>,
+) -> Result<(UpJoints, [f64; 4]), KinematicsError> {
+    let (q4, trig) = ideal_trig(order, r)?;
+    let [s1, c1, s2, c2] = trig;
+    // `+ 0.0` turns the -0.0 of atan2(-0.0, c) into 0.0.
+    let (first, second) = (s1.atan2(c1) + 0.0, s2.atan2(c2) + 0.0);
+    let (phi_rad, theta_rad) = match order {
+        AxisOrder::XFirst => (first, second),
+        AxisOrder::YFirst => (second, first),
+    };
+    let j = UpJoints {
+        phi_rad,
+        theta_rad,
+        q4_mm: q4,
+    };
+    Ok((j, trig))
+}
+
+/// `q4` and the sines and cosines `[s1, c1, s2, c2]` of the first and second
+/// joint angles of an ideal U joint pointing at `r`, without trigonometry.
+fn ideal_trig(order: AxisOrder, r: &Vector3<f64>) -> Result<(f64, [f64; 4]), KinematicsError> {
     let q4 = r.norm();
     if q4 < 1e-9 {
         return Err(KinematicsError::OutOfReach {
@@ -230,17 +363,29 @@ fn ideal_inverse(order: AxisOrder, r: &Vector3<f64>) -> Result<UpJoints, Kinemat
         });
     }
     let u = r / q4;
-    let (phi, theta) = match order {
-        // u = (sin t, -sin p cos t, cos p cos t)
-        AxisOrder::XFirst => ((-u.y).atan2(u.z), u.x.clamp(-1.0, 1.0).asin()),
-        // u = (sin t cos p, -sin p, cos t cos p)
-        AxisOrder::YFirst => ((-u.y).clamp(-1.0, 1.0).asin(), u.x.atan2(u.z)),
+    let trig = match order {
+        // u = (sin t, -sin p cos t, cos p cos t); first angle phi.
+        AxisOrder::XFirst => {
+            let ct = (u.y * u.y + u.z * u.z).sqrt();
+            let (sp, cp) = if ct > 0.0 {
+                (-u.y / ct, u.z / ct)
+            } else {
+                (0.0, 1.0)
+            };
+            [sp, cp, u.x, ct]
+        }
+        // u = (sin t cos p, -sin p, cos t cos p); first angle theta.
+        AxisOrder::YFirst => {
+            let cp = (u.x * u.x + u.z * u.z).sqrt();
+            let (st, ct) = if cp > 0.0 {
+                (u.x / cp, u.z / cp)
+            } else {
+                (0.0, 1.0)
+            };
+            [st, ct, -u.y, cp]
+        }
     };
-    Ok(UpJoints {
-        phi_rad: phi,
-        theta_rad: theta,
-        q4_mm: q4,
-    })
+    Ok((q4, trig))
 }
 
 #[cfg(test)]

@@ -1,0 +1,31 @@
+//! The geometric error model of the Tricept module (Hong 2009, section 1).
+//!
+//! - [`GeometricErrors`] and [`ParameterSet`]: the full 21-parameter vector
+//!   `deps = [db_i; da_0i; dq_i]`, the paper's 15-parameter set
+//!   ([`PAPER15_NAMES`]) and the linear map between them; Table 2 as a fixture.
+//! - [`actual_machine`]: nominal + errors, an exact [`tricept_kinematics::Machine`]
+//!   from which simulated readings are computed.
+//! - [`error_jacobian`]: the analytic `J = J1^{-1} J2` of eq. 9 for both
+//!   U-joint conventions.
+//! - [`volumetric_errors`]: platform error maps (the paper's Fig. 3).
+//! - [`residual_mu`]: the paper's residual error `mu` (Fig. 4).
+//!
+//! All lengths in mm, angles in rad.
+#![cfg_attr(
+    not(test),
+    deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
+)]
+
+mod actual;
+mod error;
+mod jacobian;
+mod params;
+mod volumetric;
+
+pub use actual::{actual_machine, errors_between};
+pub use error::ModelError;
+pub use jacobian::{ErrorJacobian, error_jacobian, error_jacobian_at, j2, position_error_jacobian};
+pub use params::{
+    FULL21_NAMES, GeometricErrors, N_FULL, PAPER15_NAMES, ParameterSet, TABLE2_JSON, residual_mu,
+};
+pub use volumetric::{ErrorMap, MapStats, volumetric_errors};
