@@ -250,16 +250,25 @@ pub struct LoadsDescription {
     /// Axial stiffness of each actuated leg at 1 m length, N/um (stiffness
     /// scales as 1/length).
     pub leg_stiffness_n_per_um_at_1m: f64,
+    /// Centre of mass of the head in the platform frame, mm (the platform's
+    /// own is at O').
+    pub head_com_mm: [f64; 3],
+    /// Unit direction of gravity in the base frame. The default `[0, 0, 1]`
+    /// is a Tricept hanging from its base with the tool pointing down.
+    pub gravity_direction: [f64; 3],
 }
 
 impl Default for LoadsDescription {
-    /// 60 kg platform and tube, 90 kg head: about 1.5 kN carried mostly by
-    /// the legs; 100 N/um at 1 m gives deflections of the order of 5-15 um.
+    /// 60 kg platform and tube, 90 kg head hanging below the base: about
+    /// 1.5 kN, carried along the legs (the UP limb's prismatic joint is
+    /// passive). 50 N/um at 1 m gives leg deflections around 8 um.
     fn default() -> Self {
         LoadsDescription {
             platform_mass_kg: 60.0,
             head_mass_kg: 90.0,
-            leg_stiffness_n_per_um_at_1m: 100.0,
+            leg_stiffness_n_per_um_at_1m: 50.0,
+            head_com_mm: [0.0, 0.0, 150.0],
+            gravity_direction: [0.0, 0.0, 1.0],
         }
     }
 }
@@ -461,6 +470,14 @@ impl MachineDescription {
             "loads.leg_stiffness_n_per_um_at_1m",
             loads.leg_stiffness_n_per_um_at_1m,
         )?;
+        finite("loads.head_com_mm", &loads.head_com_mm)?;
+        finite("loads.gravity_direction", &loads.gravity_direction)?;
+        if norm3(loads.gravity_direction) < 1e-9 {
+            return Err(invalid(
+                "loads.gravity_direction",
+                "direction must not be the zero vector".into(),
+            ));
+        }
         Ok(())
     }
 }

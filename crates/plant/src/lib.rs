@@ -1,0 +1,231 @@
+//! The plant simulator: measured-data files ([`tricept_data::Dataset`])
+//! produced the way a real campaign would produce them, from an exact
+//! Tricept with geometric errors, optional unmodelled effects, sensor zero
+//! offsets and sensor noise.
+//!
+//! For every target pose of a [`Campaign`]:
+//! 1. the drives are commanded with the *nominal* IK (what a controller that
+//!    knows nothing better sends);
+//! 2. the legs reach the commanded lengths plus the geometric leg errors and
+//!    the effects' extra lengths ([`effects`]);
+//! 3. the exact FK of the actual machine gives the UP limb's joints;
+//! 4. the sensors read them with their zero offsets, the effects' reading
+//!    errors, and noise (mean of `readings_per_pose` Gaussian draws);
+//! 5. the logger writes time, temperature and approach directions.
+//!
+//! Nothing here uses the linearised model. Randomness is seeded (PCG-64 MCG).
+#![cfg_attr(
+    not(test),
+    deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
+)]
+
+pub mod campaign;
+pub mod effects;
+
+use nalgebra::Vector3;
+use rand::SeedableRng;
+use rand_distr::{Distribution, StandardNormal};
+use rand_pcg::Pcg64Mcg;
+use thiserror::Error;
+use tricept_data::{Dataset, MeasuredPose, Readings};
+use tricept_kinematics::{KinematicsError, Machine, UpJoints};
+use tricept_model::{GeometricErrors, actual_machine};
+
+pub use campaign::{Campaign, PoseOrder};
+pub use effects::{Effect, EffectName};
+
+/// Why a simulation failed.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum PlantError {
+    /// A target pose the nominal machine cannot reach, or an actual machine
+    /// that cannot assemble at the commands.
+    #[error("pose {index} ({target_mm:?} mm): {source}")]
+    Kinematics {
+        /// Index of the target in the campaign.
+        index: usize,
+        /// The target, mm.
+        target_mm: [f64; 3],
+        /// The kinematic failure.
+        source: KinematicsError,
+    },
+    /// An inconsistent configuration.
+    #[error("invalid plant configuration: {0}")]
+    Invalid(String),
+}
+
+/// The simulated machine: nominal model, geometric errors and effects.
+#[derive(Debug, Clone)]
+pub struct Plant {
+    /// The nominal machine (what the controller believes).
+    pub nominal: Machine,
+    /// The geometric (class 1) errors of the actual machine.
+    pub errors: GeometricErrors,
+    /// Unmodelled effects present in the actual machine and its sensors.
+    pub effects: Vec<Effect>,
+    /// Zero offsets of the sensors `[phi, theta, s]` (rad, rad, mm): the
+    /// readings are joint value + offset.
+    pub sensor_offsets: [f64; 3],
+}
+
+/// Default sensor zero offsets: arbitrary, documented, and far from zero so
+/// that no code can get away with ignoring them.
+pub const DEFAULT_SENSOR_OFFSETS: [f64; 3] = [0.0123, -0.0187, -612.5];
+
+/// The noise-free state of one simulated pose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TruePose {
+    /// Commanded leg lengths, mm.
+    pub commands_mm: [f64; 3],
+    /// True UP joint values reached.
+    pub up: UpJoints,
+    /// True platform point reached, mm.
+    pub position_mm: Vector3<f64>,
+    /// Noise-free readings (with offsets and reading effects).
+    pub readings: Readings,
+    /// True structure temperature, °C.
+    pub temp_c: f64,
+    /// Time of the reading, s.
+    pub time_s: f64,
+    /// Sign of each leg's last motion.
+    pub approach: [i8; 3],
+}
+
+/// Standard deviation of the temperature logger, K.
+pub const TEMPERATURE_LOGGER_NOISE_K: f64 = 0.02;
+
+impl Plant {
+    /// A plant with geometric errors only and the default sensor offsets.
+    pub fn geometric(nominal: Machine, errors: GeometricErrors) -> Plant {
+        Plant {
+            nominal,
+            errors,
+            effects: Vec::new(),
+            sensor_offsets: DEFAULT_SENSOR_OFFSETS,
+        }
+    }
+
+    /// The actual machine's exact kinematic model (geometric errors and the
+    /// effects that change the machine's geometry, such as U-joint axis errors).
+    pub fn actual_machine(&self) -> Machine {
+        let mut m = actual_machine(&self.nominal, &self.errors);
+        for e in &self.effects {
+            e.modify_machine(&mut m);
+        }
+        m
+    }
+
+    /// Simulates a campaign: one [`MeasuredPose`] per logged pose.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_kinematics::Machine;
+    /// use tricept_model::ParameterSet;
+    /// use tricept_plant::{Campaign, Plant};
+    /// let m = Machine::paper();
+    /// let set = ParameterSet::paper15();
+    /// let plant = Plant::geometric(m.clone(), set.to_errors(&set.table2()));
+    /// let campaign = Campaign::grid(&m, 7);
+    /// let data = plant.simulate(&campaign).unwrap();
+    /// assert_eq!(data.poses.len(), 75);
+    /// ```
+    pub fn simulate(&self, campaign: &Campaign) -> Result<Dataset, PlantError> {
+        let truth = self.true_poses(campaign)?;
+        let mut rng = Pcg64Mcg::seed_from_u64(campaign.seed);
+        let k = campaign.noise.readings_per_pose.max(1);
+        let single = [
+            campaign.noise.angle_rad,
+            campaign.noise.angle_rad,
+            campaign.noise.length_mm,
+        ];
+        let mut poses = Vec::with_capacity(truth.len());
+        for t in &truth {
+            let clean = t.readings.to_array();
+            let mut noisy = [0.0; 3];
+            for c in 0..3 {
+                // The mean of k readings, drawn one by one as on the machine.
+                let mut sum = 0.0;
+                for _ in 0..k {
+                    let z: f64 = StandardNormal.sample(&mut rng);
+                    sum += z;
+                }
+                noisy[c] = clean[c] + single[c] * sum / f64::from(k);
+            }
+            let z: f64 = StandardNormal.sample(&mut rng);
+            poses.push(MeasuredPose {
+                commands_mm: t.commands_mm,
+                readings: Readings::from_array(noisy),
+                temp_c: Some(t.temp_c + TEMPERATURE_LOGGER_NOISE_K * z),
+                time_s: Some(t.time_s),
+                approach: Some(t.approach),
+                line: 0,
+            });
+        }
+        let logged = campaign.noise.logged_sigma();
+        for e in &self.effects {
+            e.corrupt_readings(&mut poses, campaign.seed, &logged);
+        }
+        Ok(Dataset {
+            poses,
+            source: "simulated".into(),
+        })
+    }
+
+    /// The noise-free poses of a campaign (commands, true joints, clean
+    /// readings, logged context).
+    pub fn true_poses(&self, campaign: &Campaign) -> Result<Vec<TruePose>, PlantError> {
+        let actual = self.actual_machine();
+        let commands = campaign.commands(&self.nominal)?;
+        let context = campaign.context_for_commands(&commands);
+        let n = commands.len();
+        let mut out = Vec::with_capacity(n);
+        for (j, (q, nominal_up)) in commands.iter().enumerate() {
+            let fraction = if n > 1 {
+                j as f64 / (n - 1) as f64
+            } else {
+                0.0
+            };
+            let delta_temp_k: f64 = self
+                .effects
+                .iter()
+                .map(|e| e.temperature_drift_k(fraction))
+                .sum();
+            let state = effects::PoseState {
+                commands_mm: *q,
+                nominal_up: *nominal_up,
+                delta_temp_k,
+                approach: context.approach[j],
+            };
+            let mut legs = *q;
+            for e in &self.effects {
+                e.extra_leg_length(&self.nominal, &state, &mut legs);
+            }
+            let kinematics = |source| PlantError::Kinematics {
+                index: j,
+                target_mm: campaign.targets_mm[j.min(campaign.targets_mm.len().saturating_sub(1))]
+                    .into(),
+                source,
+            };
+            // The nominal configuration is within a few mm: Newton's seed.
+            let fk = actual.forward_from(&legs, nominal_up).map_err(kinematics)?;
+            let mut r = [
+                fk.up.phi_rad + self.sensor_offsets[0],
+                fk.up.theta_rad + self.sensor_offsets[1],
+                fk.up.q4_mm + self.sensor_offsets[2],
+            ];
+            for e in &self.effects {
+                e.reading_error(&fk.up, &mut r);
+            }
+            out.push(TruePose {
+                commands_mm: *q,
+                up: fk.up,
+                position_mm: fk.position_mm,
+                readings: Readings::from_array(r),
+                temp_c: context.temp_c[j] + delta_temp_k,
+                time_s: context.time_s[j],
+                approach: context.approach[j],
+            });
+        }
+        Ok(out)
+    }
+}
