@@ -42,8 +42,11 @@ pub struct FkSolution {
 const MAX_ITERATIONS: u32 = 60;
 /// Trilateration rounds of the cold-start seed (each gains about one digit).
 const SEED_ROUNDS: usize = 1;
-/// Converged when the scaled Newton step is below this, mm.
+/// A step this small (mm) ends the line search whatever the merit does.
 const STEP_TOLERANCE_MM: f64 = 1e-10;
+/// When the predicted next Newton step is below this (mm), it is applied
+/// without a new Jacobian and the iteration ends.
+const FINAL_STEP_MM: f64 = 1e-6;
 /// A converged solution must close the legs to this, mm.
 const RESIDUAL_TOLERANCE_MM: f64 = 1e-8;
 
@@ -168,10 +171,20 @@ impl Machine {
                 }
             }
             // The next Newton step, predicted with this iteration's inverse
-            // Jacobian: when it is negligible the iterate is converged, and
-            // one Jacobian evaluation is saved.
-            let next_mm = scaled_size(&(j1_inv * f), x.q4_mm);
-            if next_mm < STEP_TOLERANCE_MM || merit == 0.0 {
+            // Jacobian. Once it is small, applying it without a new Jacobian
+            // leaves an error of order |next| |step| / L: below 1e-13 mm.
+            let next = -(j1_inv * f);
+            let next_mm = scaled_size(&next, x.q4_mm);
+            if next_mm < FINAL_STEP_MM || merit == 0.0 {
+                if merit != 0.0 {
+                    x = UpJoints {
+                        phi_rad: x.phi_rad + next.x,
+                        theta_rad: x.theta_rad + next.y,
+                        q4_mm: x.q4_mm + next.z,
+                    };
+                    f = self.closure_into(&x, lengths, &mut buffers[current]);
+                    merit = f.norm_squared();
+                }
                 let residual_mm = merit.sqrt();
                 if residual_mm > RESIDUAL_TOLERANCE_MM {
                     return Err(KinematicsError::NoAssembly { residual_mm });

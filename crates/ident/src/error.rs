@@ -1,0 +1,40 @@
+//! Typed errors of the identification crate.
+
+use thiserror::Error;
+use tricept_kinematics::KinematicsError;
+
+/// Why an identification could not produce a trustworthy answer.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum IdentError {
+    /// Fewer readings than unknowns (plus one for a residual).
+    #[error(
+        "too few poses: {poses} poses give {readings} readings for {unknowns} unknowns (parameters + 3 sensor offsets); at least {needed} poses are needed"
+    )]
+    TooFewPoses {
+        /// Poses given.
+        poses: usize,
+        /// Readings (3 per pose).
+        readings: usize,
+        /// Unknowns.
+        unknowns: usize,
+        /// Minimum number of poses.
+        needed: usize,
+    },
+    /// A pose the model cannot solve (commands out of reach, no assembly...).
+    #[error("pose {pose} (line {line}): {source}")]
+    Kinematics {
+        /// Index of the pose.
+        pose: usize,
+        /// Line of the pose in its file (0 if none).
+        line: u64,
+        /// The kinematic failure.
+        source: KinematicsError,
+    },
+    /// A numerical failure of the linear algebra.
+    #[error("numerical failure: {0}")]
+    Numerical(&'static str),
+    /// Inconsistent arguments.
+    #[error("{0}")]
+    Invalid(String),
+}

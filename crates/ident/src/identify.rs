@@ -1,0 +1,531 @@
+//! Identification: the parameters and sensor offsets that best explain
+//! measured readings, on the exact model.
+//!
+//! The unknowns are the model parameters `p` and the three sensor zero
+//! offsets `c`; the readings of pose `j` are modelled as
+//! `y_j = g(q_j; p) + c + noise`, with `g` the exact FK of the model (never
+//! its linearisation). The paper removes the offsets by differencing every
+//! pose against one reference pose (eq. 10); here they are estimated
+//! jointly. Both give the same offset-free equations, but differencing
+//! correlates every difference through the reference pose's noise, which
+//! ordinary least squares then ignores; joint estimation is the
+//! minimum-variance (Gauss-Markov) treatment and does not depend on which
+//! pose is chosen as the reference.
+//!
+//! The solver is Gauss-Newton with step halving on the exact model, on the
+//! rows weighted by `1/sigma` of each logged reading. The rank decision
+//! (which parameters the data can see; [`crate::lsq`]) is taken once, at the
+//! starting point, and kept: a parameter that is unidentifiable to first
+//! order is held at its prior rather than fitted to second-order effects.
+//! (On the x-first machine `dyA3` is such a parameter: its second-order
+//! cross term with `dzB3` has the shape of `dyB3`'s first-order effect, so a
+//! large `dyA3` biases `dyB3` by about `-dyA3 dzB3 / q4` without any trace in
+//! the residual, and freeing `dyA3` recovers neither its value nor its sign;
+//! see `docs/identifiability.md`.)
+
+use serde_json::{Map, Value};
+use tricept_data::{Dataset, MeasuredPose};
+use tricept_kinematics::{Machine, UpJoints};
+
+use crate::error::IdentError;
+use crate::linalg::TriangularAccumulator;
+use crate::lsq::{DEFAULT_RANK_TOLERANCE, RankDecision, ReducedProblem, Solution};
+use crate::model::ReadingModel;
+use crate::report::IdentifiabilityReport;
+
+/// Options of [`identify`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct IdentifyOptions {
+    /// Standard deviation of one *logged* reading `[phi, theta, s]`
+    /// (rad, rad, mm).
+    pub sigma: [f64; 3],
+    /// Relative singular-value tolerance of the rank decision.
+    pub rank_tolerance: f64,
+    /// `s_i / s_1` below which an identifiable direction is reported weak.
+    pub weak_threshold: f64,
+    /// Gauss-Newton iteration limit.
+    pub max_iterations: u32,
+    /// Starting parameter values (default zero: the nominal machine).
+    pub initial: Option<Vec<f64>>,
+    /// Per-pose weights multiplying `1/sigma` (default all one); robust
+    /// estimation sets them.
+    pub pose_weights: Option<Vec<f64>>,
+}
+
+impl IdentifyOptions {
+    /// Defaults with the logged noise of `machine`'s sensors.
+    pub fn for_machine(machine: &Machine) -> IdentifyOptions {
+        IdentifyOptions {
+            sigma: machine.sensors.logged_sigma(),
+            rank_tolerance: DEFAULT_RANK_TOLERANCE,
+            weak_threshold: 1e-2,
+            max_iterations: 30,
+            initial: None,
+            pose_weights: None,
+        }
+    }
+}
+
+/// Residual statistics of a fit.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ResidualStats {
+    /// RMS of the residuals `[phi, theta, s]` (rad, rad, mm).
+    pub rms: [f64; 3],
+    /// Weighted sum of squared residuals (chi-square).
+    pub chi_square: f64,
+    /// Degrees of freedom: readings - identified parameters - 3 offsets.
+    pub dof: usize,
+    /// `chi_square / dof`: about 1 when the model and noise levels are right.
+    pub reduced_chi_square: f64,
+    /// Largest residual in noise standard deviations, and its pose index.
+    pub max_standardized: (f64, usize),
+}
+
+/// The result of [`identify`].
+#[derive(Debug, Clone)]
+pub struct Identification {
+    /// Parameter names.
+    pub names: Vec<String>,
+    /// Estimated parameter values (fixed parameters at their prior).
+    pub estimate: Vec<f64>,
+    /// Standard deviations from the covariance (`None` for fixed parameters).
+    pub std_dev: Vec<Option<f64>>,
+    /// Covariance of the parameters, row-major `k x k`.
+    pub covariance: Vec<f64>,
+    /// Estimated sensor zero offsets `[phi, theta, s]` (rad, rad, mm).
+    pub offsets: [f64; 3],
+    /// Their standard deviations.
+    pub offsets_std_dev: [f64; 3],
+    /// Identifiability of the problem at the starting point.
+    pub report: IdentifiabilityReport,
+    /// Residuals `y - g(p) - c` of every pose (rad, rad, mm).
+    pub residuals: Vec<[f64; 3]>,
+    /// Residual statistics.
+    pub stats: ResidualStats,
+    /// Gauss-Newton iterations performed.
+    pub iterations: u32,
+    /// Whether the iteration met its tolerance.
+    pub converged: bool,
+    /// The rank decision taken at the start and used throughout.
+    pub decision: RankDecision,
+}
+
+/// One evaluation of the model at fixed parameters over all poses.
+pub struct Evaluation {
+    /// The reduced weighted problem `[offsets | parameters | y - g(p)]`.
+    pub problem: ReducedProblem,
+    /// `y - g(p)` per pose (rad, rad, mm).
+    pub residuals: Vec<[f64; 3]>,
+}
+
+/// Evaluates `model` at `p` on `poses`: predictions, Jacobians and the
+/// reduced weighted problem. `seeds` carries FK starting points between calls.
+pub fn evaluate(
+    model: &dyn ReadingModel,
+    p: &[f64],
+    poses: &[MeasuredPose],
+    sigma: &[f64; 3],
+    pose_weights: Option<&[f64]>,
+    seeds: &mut [Option<UpJoints>],
+) -> Result<Evaluation, IdentError> {
+    let k = model.names().len();
+    let predictor = model.at(p);
+    let mut acc = TriangularAccumulator::new(3 + k + 1);
+    let mut jac = vec![0.0; 3 * k];
+    let mut row = vec![0.0; 3 + k + 1];
+    let mut residuals = Vec::with_capacity(poses.len());
+    for (j, pose) in poses.iter().enumerate() {
+        let g = predictor
+            .predict(pose, &mut seeds[j], &mut jac)
+            .map_err(|source| IdentError::Kinematics {
+                pose: j,
+                line: pose.line,
+                source,
+            })?;
+        let y = pose.readings.to_array();
+        let w_pose = pose_weights.map_or(1.0, |w| w[j]);
+        let mut res = [0.0; 3];
+        for c in 0..3 {
+            res[c] = y[c] - g[c];
+            let w = w_pose / sigma[c];
+            row.iter_mut().for_each(|v| *v = 0.0);
+            row[c] = w;
+            for t in 0..k {
+                row[3 + t] = w * jac[c * k + t];
+            }
+            row[3 + k] = w * res[c];
+            acc.push_row(&row);
+        }
+        residuals.push(res);
+    }
+    Ok(Evaluation {
+        problem: ReducedProblem {
+            rows: acc.rows(),
+            r: acc.finish(),
+            n_nuisance: 3,
+            k,
+        },
+        residuals,
+    })
+}
+
+/// Checks that there are enough readings for the unknowns.
+fn check_size(n_poses: usize, k: usize) -> Result<(), IdentError> {
+    let unknowns = k + 3;
+    if 3 * n_poses < unknowns + 1 {
+        return Err(IdentError::TooFewPoses {
+            poses: n_poses,
+            readings: 3 * n_poses,
+            unknowns,
+            needed: unknowns.div_ceil(3) + 1,
+        });
+    }
+    Ok(())
+}
+
+/// Identifies the parameters of `model` from `data`.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions, identify};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// use tricept_plant::{Campaign, Plant};
+///
+/// let machine = Machine::paper();
+/// let set = ParameterSet::paper15();
+/// let truth = set.table2();
+/// let data = Plant::geometric(machine.clone(), set.to_errors(&truth))
+///     .simulate(&Campaign::grid(&machine, 1))
+///     .unwrap();
+/// let model = GeometricModel::new(machine.clone(), set.clone());
+/// let id = identify(&model, &data, &IdentifyOptions::for_machine(&machine)).unwrap();
+/// // dq2 = 0.7 mm in Table 2, recovered to a few standard deviations:
+/// let j = set.index_of("dq2").unwrap();
+/// assert!((id.estimate[j] - truth[j]).abs() < 4.0 * id.std_dev[j].unwrap());
+/// // With the paper's x-first U joint, dyA3 is invisible to the sensors:
+/// assert_eq!(id.report.fixed, vec!["dyA3".to_string()]);
+/// ```
+pub fn identify(
+    model: &dyn ReadingModel,
+    data: &Dataset,
+    options: &IdentifyOptions,
+) -> Result<Identification, IdentError> {
+    let names = model.names().to_vec();
+    let k = names.len();
+    let poses = &data.poses;
+    check_size(poses.len(), k)?;
+    if let Some(w) = &options.pose_weights
+        && w.len() != poses.len()
+    {
+        return Err(IdentError::Invalid(format!(
+            "{} pose weights for {} poses",
+            w.len(),
+            poses.len()
+        )));
+    }
+    let weights = options.pose_weights.as_deref();
+    let p = match &options.initial {
+        Some(v) if v.len() == k => v.clone(),
+        Some(v) => {
+            return Err(IdentError::Invalid(format!(
+                "{} initial values for {k} parameters",
+                v.len()
+            )));
+        }
+        None => vec![0.0; k],
+    };
+    let mut seeds = vec![None; poses.len()];
+    let eval = evaluate(model, &p, poses, &options.sigma, weights, &mut seeds)?;
+    let decision = eval
+        .problem
+        .decide(options.rank_tolerance)
+        .ok_or(IdentError::Numerical("SVD did not converge"))?;
+    let first = eval.problem.solve(&decision);
+    let report = IdentifiabilityReport::new(
+        &names,
+        &decision,
+        &first,
+        3,
+        eval.problem.rows,
+        poses.len(),
+        options.weak_threshold,
+    );
+
+    let problem = Problem {
+        model,
+        poses,
+        options,
+        weights,
+    };
+    let mut state = GaussNewton {
+        p,
+        seeds,
+        eval,
+        solution: first,
+        iterations: 0,
+        converged: false,
+    };
+    problem.run(&mut state, &decision);
+
+    finish(names, state, decision, report, options)
+}
+
+/// The fixed parts of an identification problem.
+struct Problem<'a> {
+    model: &'a dyn ReadingModel,
+    poses: &'a [MeasuredPose],
+    options: &'a IdentifyOptions,
+    weights: Option<&'a [f64]>,
+}
+
+/// The moving parts of a Gauss-Newton run.
+struct GaussNewton {
+    p: Vec<f64>,
+    seeds: Vec<Option<UpJoints>>,
+    eval: Evaluation,
+    solution: Solution,
+    iterations: u32,
+    converged: bool,
+}
+
+impl Problem<'_> {
+    /// Gauss-Newton with step halving from `state` under `decision`.
+    fn run(&self, state: &mut GaussNewton, decision: &RankDecision) {
+        let options = self.options;
+        for it in 1..=options.max_iterations {
+            state.iterations = it;
+            let step = state.solution.parameters.clone();
+            if step_is_negligible(&step, &state.solution, decision) {
+                state.converged = true;
+                return;
+            }
+            let cost = state.eval.problem.cost_without_parameters();
+            let mut t = 1.0;
+            let accepted = loop {
+                let trial: Vec<f64> = state.p.iter().zip(&step).map(|(a, b)| a + t * b).collect();
+                let mut trial_seeds = state.seeds.clone();
+                match evaluate(
+                    self.model,
+                    &trial,
+                    self.poses,
+                    &options.sigma,
+                    self.weights,
+                    &mut trial_seeds,
+                ) {
+                    Ok(e)
+                        if e.problem.cost_without_parameters() <= cost * (1.0 + 1e-12) + 1e-300 =>
+                    {
+                        state.p = trial;
+                        state.seeds = trial_seeds;
+                        break Some(e);
+                    }
+                    _ => {}
+                }
+                t *= 0.5;
+                if t < 1e-6 {
+                    break None;
+                }
+            };
+            match accepted {
+                Some(e) => state.eval = e,
+                None => {
+                    // No decrease along the step: at the minimum to rounding
+                    // if the step is small against the uncertainty.
+                    state.converged = step_is_within(&step, &state.solution, decision, 1e-2);
+                    return;
+                }
+            }
+            state.solution = state.eval.problem.solve(decision);
+        }
+        state.converged = step_is_negligible(&state.solution.parameters, &state.solution, decision);
+    }
+}
+
+/// A Gauss-Newton step is negligible when every component is below 1e-4 of
+/// its standard deviation (or below 1e-12 mm): further iterations could not
+/// change any conclusion drawn from the estimate.
+fn step_is_negligible(step: &[f64], s: &Solution, d: &RankDecision) -> bool {
+    step_is_within(step, s, d, 1e-4)
+}
+
+fn step_is_within(step: &[f64], s: &Solution, d: &RankDecision, fraction: f64) -> bool {
+    d.identifiable.iter().all(|&j| {
+        let sd = s.covariance[(3 + j, 3 + j)].max(0.0).sqrt();
+        step[j].abs() <= (fraction * sd).max(1e-12)
+    })
+}
+
+fn finish(
+    names: Vec<String>,
+    state: GaussNewton,
+    decision: RankDecision,
+    report: IdentifiabilityReport,
+    options: &IdentifyOptions,
+) -> Result<Identification, IdentError> {
+    let GaussNewton {
+        p,
+        eval,
+        solution,
+        iterations,
+        converged,
+        ..
+    } = state;
+    let k = names.len();
+    // The final solution's offsets and (negligible) step apply at p.
+    let estimate: Vec<f64> = p
+        .iter()
+        .zip(&solution.parameters)
+        .map(|(a, b)| a + b)
+        .collect();
+    let offsets = [
+        solution.nuisance[0],
+        solution.nuisance[1],
+        solution.nuisance[2],
+    ];
+    let offsets_std_dev = [0, 1, 2].map(|c| solution.covariance[(c, c)].max(0.0).sqrt());
+    let std_dev = (0..k)
+        .map(|j| {
+            if decision.fixed.contains(&j) {
+                None
+            } else {
+                Some(solution.covariance[(3 + j, 3 + j)].max(0.0).sqrt())
+            }
+        })
+        .collect();
+    let covariance = (0..k * k)
+        .map(|ij| solution.covariance[(3 + ij / k, 3 + ij % k)])
+        .collect();
+    let residuals: Vec<[f64; 3]> = eval
+        .residuals
+        .iter()
+        .map(|r| [0, 1, 2].map(|c| r[c] - offsets[c]))
+        .collect();
+    let n = residuals.len().max(1) as f64;
+    let rms = [0, 1, 2].map(|c| (residuals.iter().map(|r| r[c] * r[c]).sum::<f64>() / n).sqrt());
+    let weights = options.pose_weights.as_deref();
+    let mut chi_square = 0.0;
+    let mut max_standardized = (0.0, 0);
+    for (j, r) in residuals.iter().enumerate() {
+        let w = weights.map_or(1.0, |w| w[j]);
+        for c in 0..3 {
+            let z = r[c] / options.sigma[c];
+            chi_square += (w * z) * (w * z);
+            if z.abs() > max_standardized.0 {
+                max_standardized = (z.abs(), j);
+            }
+        }
+    }
+    let dof = (3 * residuals.len()).saturating_sub(decision.rank + 3);
+    Ok(Identification {
+        names,
+        estimate,
+        std_dev,
+        covariance,
+        offsets,
+        offsets_std_dev,
+        report,
+        residuals,
+        stats: ResidualStats {
+            rms,
+            chi_square,
+            dof,
+            reduced_chi_square: if dof > 0 {
+                chi_square / dof as f64
+            } else {
+                f64::NAN
+            },
+            max_standardized,
+        },
+        iterations,
+        converged,
+        decision,
+    })
+}
+
+/// The identifiability of a pose set before any data is taken: the
+/// identification matrix of `model` at `p` (usually zero) for the commands
+/// of `poses`, with the given logged noise.
+pub fn identifiability(
+    model: &dyn ReadingModel,
+    p: &[f64],
+    poses: &[MeasuredPose],
+    options: &IdentifyOptions,
+) -> Result<IdentifiabilityReport, IdentError> {
+    let k = model.names().len();
+    check_size(poses.len(), k)?;
+    let mut seeds = vec![None; poses.len()];
+    let eval = evaluate(
+        model,
+        p,
+        poses,
+        &options.sigma,
+        options.pose_weights.as_deref(),
+        &mut seeds,
+    )?;
+    let decision = eval
+        .problem
+        .decide(options.rank_tolerance)
+        .ok_or(IdentError::Numerical("SVD did not converge"))?;
+    let solution = eval.problem.solve(&decision);
+    Ok(IdentifiabilityReport::new(
+        model.names(),
+        &decision,
+        &solution,
+        3,
+        eval.problem.rows,
+        poses.len(),
+        options.weak_threshold,
+    ))
+}
+
+impl Identification {
+    /// JSON with the contract keys: every parameter name with its estimate
+    /// (mm), `std_dev`, `rank`, `n_params`, `unidentifiable`,
+    /// `singular_values`, `condition_number`, `observability`, residual
+    /// statistics, and more.
+    pub fn to_json(&self) -> Value {
+        let mut m = Map::new();
+        for (n, v) in self.names.iter().zip(&self.estimate) {
+            m.insert(n.clone(), (*v).into());
+        }
+        m.insert(
+            "std_dev".into(),
+            Value::Object(
+                self.names
+                    .iter()
+                    .zip(&self.std_dev)
+                    .map(|(n, s)| (n.clone(), s.map_or(Value::Null, Value::from)))
+                    .collect(),
+            ),
+        );
+        m.insert(
+            "offsets".into(),
+            serde_json::json!({
+                "phi_rad": self.offsets[0], "theta_rad": self.offsets[1], "s_mm": self.offsets[2],
+                "std_dev": {"phi_rad": self.offsets_std_dev[0], "theta_rad": self.offsets_std_dev[1], "s_mm": self.offsets_std_dev[2]},
+            }),
+        );
+        if let Value::Object(report) = self.report.to_json() {
+            for (k, v) in report {
+                m.insert(k, v);
+            }
+        }
+        m.insert(
+            "residuals".into(),
+            serde_json::json!({
+                "rms_phi_arcsec": self.stats.rms[0] / tricept_kinematics::SensorNoise::ARCSEC,
+                "rms_theta_arcsec": self.stats.rms[1] / tricept_kinematics::SensorNoise::ARCSEC,
+                "rms_s_um": self.stats.rms[2] * 1e3,
+                "chi_square": self.stats.chi_square,
+                "dof": self.stats.dof,
+                "reduced_chi_square": self.stats.reduced_chi_square,
+                "max_standardized": self.stats.max_standardized.0,
+                "max_standardized_pose": self.stats.max_standardized.1,
+            }),
+        );
+        m.insert("iterations".into(), self.iterations.into());
+        m.insert("converged".into(), self.converged.into());
+        Value::Object(m)
+    }
+}

@@ -1,0 +1,64 @@
+//! Self-calibration of the Tricept from the UP limb's own sensors
+//! (Hong 2009, sections 2-3), done as a numerical-software engineer would.
+//!
+//! The UP limb carries two encoders (`phi`, `theta`) and a linear scale
+//! (`s`), each with an unknown zero offset. Given logged readings at known
+//! leg commands ([`tricept_data::Dataset`]), this crate
+//!
+//! - builds the weighted identification matrix of eqs. 10-11 from the
+//!   analytic Jacobian (`J E`, [`GeometricModel`]), with the three offsets as
+//!   unknowns ([`identify`] explains why that beats the paper's differencing);
+//! - reveals its rank with column scaling, column-pivoted QR and the SVD on
+//!   `faer` ([`lsq`]), and writes what cannot be identified as named
+//!   combinations ([`IdentifiabilityReport`]), with the observability
+//!   indices O1-O5;
+//! - refines on the exact model by Gauss-Newton ([`identify`]), with
+//!   standard deviations from the covariance;
+//! - compensates: corrected commands from the identified machine and the
+//!   volumetric error before and after ([`compensation`]).
+//!
+//! Parameter names are those of [`tricept_model::ParameterSet`]; lengths in
+//! mm, angles in rad.
+//!
+//! # Example
+//! ```
+//! use tricept_ident::{compensation, identify, GeometricModel, IdentifyOptions};
+//! use tricept_kinematics::Machine;
+//! use tricept_model::ParameterSet;
+//! use tricept_plant::{Campaign, Plant};
+//!
+//! let nominal = Machine::paper();
+//! let set = ParameterSet::paper15();
+//! // Data as a machine would log it (here simulated from Table 2's errors).
+//! let plant = Plant::geometric(nominal.clone(), set.to_errors(&set.table2()));
+//! let data = plant.simulate(&Campaign::grid(&nominal, 42)).unwrap();
+//!
+//! let model = GeometricModel::new(nominal.clone(), set.clone());
+//! let id = identify(&model, &data, &IdentifyOptions::for_machine(&nominal)).unwrap();
+//! println!("{}", id.report.to_text());
+//!
+//! let identified = model.machine_at(&id.estimate);
+//! let targets = nominal.workspace.disc_grid(nominal.workspace.mid_plane_z_mm(), 50.0);
+//! let c = compensation(&nominal, &identified, &plant.actual_machine(), &targets).unwrap();
+//! assert!(c.after.stats().max_mm < 0.2 * c.before.stats().max_mm);
+//! ```
+#![cfg_attr(
+    not(test),
+    deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
+)]
+
+mod compensate;
+mod error;
+mod identify;
+pub mod linalg;
+pub mod lsq;
+mod model;
+mod report;
+
+pub use compensate::{Compensation, compensation, corrected_commands};
+pub use error::IdentError;
+pub use identify::{
+    Evaluation, Identification, IdentifyOptions, ResidualStats, evaluate, identifiability, identify,
+};
+pub use model::{GeometricModel, PosePredictor, ReadingModel, project_jacobian, solve_pose};
+pub use report::{Combination, IdentifiabilityReport, Observability};

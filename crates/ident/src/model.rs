@@ -1,0 +1,149 @@
+//! Reading models: what the UP limb's sensors should read at a pose for
+//! given parameter values, and the derivatives of those readings.
+//!
+//! [`GeometricModel`] is the paper's model: the exact FK of the nominal
+//! machine plus `E p` (a [`ParameterSet`]) gives the UP joints, and the
+//! analytic Jacobian `J E` of eq. 9 gives their derivatives. The trait is the
+//! extension point used by `tricept-diagnose` to add unmodelled effects.
+//!
+//! Readings are predicted *without* the sensors' zero offsets: the
+//! identification adds three offset unknowns of its own.
+
+use tricept_data::MeasuredPose;
+use tricept_kinematics::{KinematicsError, Machine, UpJoints};
+use tricept_model::{ParameterSet, actual_machine, error_jacobian_at};
+
+/// A parametric model of the UP limb's readings.
+pub trait ReadingModel: Sync {
+    /// Parameter names, in order.
+    fn names(&self) -> &[String];
+
+    /// The model evaluated at parameter values `p`, ready to predict poses.
+    fn at<'a>(&'a self, p: &[f64]) -> Box<dyn PosePredictor + 'a>;
+}
+
+/// A reading model at fixed parameter values.
+pub trait PosePredictor: Sync {
+    /// Readings `[phi, theta, s]` without offsets (rad, rad, mm) at `pose`,
+    /// and their derivatives with respect to the parameters written
+    /// row-major into `jacobian` (3 rows of `k`). `seed` is a nearby UP
+    /// configuration when one is known (updated with the solution).
+    fn predict(
+        &self,
+        pose: &MeasuredPose,
+        seed: &mut Option<UpJoints>,
+        jacobian: &mut [f64],
+    ) -> Result<[f64; 3], KinematicsError>;
+}
+
+/// The paper's geometric model over a parameter set.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, ReadingModel};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let model = GeometricModel::new(Machine::paper(), ParameterSet::paper15());
+/// assert_eq!(model.names()[0], "dxB1");
+/// ```
+#[derive(Debug, Clone)]
+pub struct GeometricModel {
+    nominal: Machine,
+    set: ParameterSet,
+    names: Vec<String>,
+}
+
+impl GeometricModel {
+    /// The model of `nominal` with the errors of `set`.
+    pub fn new(nominal: Machine, set: ParameterSet) -> GeometricModel {
+        let names = set.names().to_vec();
+        GeometricModel {
+            nominal,
+            set,
+            names,
+        }
+    }
+
+    /// The nominal machine.
+    pub fn nominal(&self) -> &Machine {
+        &self.nominal
+    }
+
+    /// The parameter set.
+    pub fn parameter_set(&self) -> &ParameterSet {
+        &self.set
+    }
+
+    /// The machine described by parameter values `p`.
+    pub fn machine_at(&self, p: &[f64]) -> Machine {
+        actual_machine(&self.nominal, &self.set.to_errors(p))
+    }
+}
+
+/// [`GeometricModel`] at fixed parameters.
+struct GeometricPredictor<'a> {
+    machine: Machine,
+    set: &'a ParameterSet,
+}
+
+impl ReadingModel for GeometricModel {
+    fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    fn at<'a>(&'a self, p: &[f64]) -> Box<dyn PosePredictor + 'a> {
+        Box::new(GeometricPredictor {
+            machine: self.machine_at(p),
+            set: &self.set,
+        })
+    }
+}
+
+/// UP joints of `machine` at `commands`, from `seed` when given (falling
+/// back to a cold start), updating the seed.
+pub fn solve_pose(
+    machine: &Machine,
+    commands_mm: &[f64; 3],
+    seed: &mut Option<UpJoints>,
+) -> Result<UpJoints, KinematicsError> {
+    let fk = match seed {
+        Some(s) => machine
+            .forward_from(commands_mm, s)
+            .or_else(|_| machine.forward(commands_mm))?,
+        None => machine.forward(commands_mm)?,
+    };
+    *seed = Some(fk.up);
+    Ok(fk.up)
+}
+
+/// Writes `J E` (3 x k, row-major) for the 21-column `J`.
+pub fn project_jacobian(j21: &tricept_model::ErrorJacobian, set: &ParameterSet, out: &mut [f64]) {
+    let k = set.len();
+    for c in 0..k {
+        let col = set.column(c);
+        for row in 0..3 {
+            let mut acc = 0.0;
+            for (f, e) in col.iter().enumerate() {
+                if *e != 0.0 {
+                    acc += j21[(row, f)] * e;
+                }
+            }
+            out[row * k + c] = acc;
+        }
+    }
+}
+
+impl PosePredictor for GeometricPredictor<'_> {
+    fn predict(
+        &self,
+        pose: &MeasuredPose,
+        seed: &mut Option<UpJoints>,
+        jacobian: &mut [f64],
+    ) -> Result<[f64; 3], KinematicsError> {
+        let up = solve_pose(&self.machine, &pose.commands_mm, seed)?;
+        let geometry = self.machine.legs_at(&up);
+        let j21 = error_jacobian_at(&geometry)?;
+        project_jacobian(&j21, self.set, jacobian);
+        Ok(up.to_array())
+    }
+}

@@ -1,0 +1,412 @@
+//! The identifiability report: what a pose set and the UP limb's sensors
+//! can and cannot tell about the parameters.
+//!
+//! Everything is computed on the identification matrix after weighting by
+//! the sensor noise (`1/sigma` per reading), projecting out the three sensor
+//! zero offsets, and scaling every parameter column to unit norm, so that
+//! the numbers do not depend on units. With `s_1 >= ... >= s_L` the singular
+//! values of the identifiable columns and `m` the number of rows:
+//!
+//! | index | definition | reference |
+//! |---|---|---|
+//! | `O1` | `(s_1 s_2 ... s_L)^(1/L) / sqrt(m)` | Borm & Menq (D-optimality) |
+//! | `O2` | `s_L / s_1` (inverse condition number) | Driels & Pathre |
+//! | `O3` | `s_L` (minimum singular value) | Nahvi et al. (E-optimality) |
+//! | `O4` | `s_L^2 / s_1` (noise amplification index) | Nahvi & Hollerbach |
+//! | `O5` | `1 / (1/s_1 + ... + 1/s_L)` | Sun & Hollerbach |
+//!
+//! `a_optimality = 1 / sum(1/s_i^2)` is reported beside them.
+
+use serde::Serialize;
+use serde_json::{Map, Value};
+
+use crate::lsq::{RankDecision, Solution};
+
+/// Observability indices (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Observability {
+    /// Borm-Menq: geometric mean of the singular values over sqrt(m).
+    #[serde(rename = "O1")]
+    pub o1: f64,
+    /// Driels-Pathre: inverse condition number.
+    #[serde(rename = "O2")]
+    pub o2: f64,
+    /// Nahvi: minimum singular value.
+    #[serde(rename = "O3")]
+    pub o3: f64,
+    /// Nahvi-Hollerbach: noise amplification index.
+    #[serde(rename = "O4")]
+    pub o4: f64,
+    /// Sun-Hollerbach.
+    #[serde(rename = "O5")]
+    pub o5: f64,
+    /// `1 / sum(1 / s_i^2)`.
+    pub a_optimality: f64,
+}
+
+impl Observability {
+    /// Indices from singular values (any order) and the number of rows.
+    pub fn from_singular_values(s: &[f64], rows: usize) -> Observability {
+        let l = s.len().max(1) as f64;
+        let max = s.iter().copied().fold(0.0, f64::max);
+        let min = s.iter().copied().fold(f64::INFINITY, f64::min);
+        let min = if min.is_finite() { min } else { 0.0 };
+        let log_mean = s.iter().map(|x| x.ln()).sum::<f64>() / l;
+        Observability {
+            o1: log_mean.exp() / (rows.max(1) as f64).sqrt(),
+            o2: if max > 0.0 { min / max } else { 0.0 },
+            o3: min,
+            o4: if max > 0.0 { min * min / max } else { 0.0 },
+            o5: 1.0 / s.iter().map(|x| 1.0 / x).sum::<f64>(),
+            a_optimality: 1.0 / s.iter().map(|x| 1.0 / (x * x)).sum::<f64>(),
+        }
+    }
+}
+
+/// A linear combination of parameters, by name (coefficients scaled so the
+/// largest is 1).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Combination {
+    /// `(name, coefficient)` pairs, largest coefficient first.
+    pub terms: Vec<(String, f64)>,
+    /// Singular value of the direction (scaled units).
+    pub singular_value: f64,
+    /// Standard deviation of `sum(coefficient * parameter)` under the
+    /// sensor noise, mm (absent for unidentifiable combinations).
+    pub std_dev_mm: Option<f64>,
+}
+
+impl Combination {
+    /// The combination as a JSON map `name -> coefficient`.
+    pub fn to_map(&self) -> Map<String, Value> {
+        self.terms
+            .iter()
+            .map(|(n, c)| (n.clone(), Value::from(*c)))
+            .collect()
+    }
+
+    /// `1.000 dyA3 - 0.250 dq1 ...`
+    pub fn to_text(&self) -> String {
+        let mut s = String::new();
+        for (i, (n, c)) in self.terms.iter().enumerate() {
+            let sign = if *c < 0.0 { "-" } else { "+" };
+            if i == 0 {
+                s.push_str(&format!(
+                    "{}{:.3} {n}",
+                    if *c < 0.0 { "-" } else { "" },
+                    c.abs()
+                ));
+            } else {
+                s.push_str(&format!(" {sign} {:.3} {n}", c.abs()));
+            }
+        }
+        s
+    }
+}
+
+/// What a pose set and the sensors can tell about the parameters.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct IdentifiabilityReport {
+    /// Parameter names.
+    pub names: Vec<String>,
+    /// Number of parameters.
+    pub n_params: usize,
+    /// Number of poses.
+    pub n_poses: usize,
+    /// Numerical rank of the offset-projected, weighted, column-scaled matrix.
+    pub rank: usize,
+    /// Relative singular-value tolerance of the rank decision.
+    pub rank_tolerance: f64,
+    /// All singular values, descending (scaled units).
+    pub singular_values: Vec<f64>,
+    /// `s_max / s_min` over the identifiable parameters.
+    pub condition_number: f64,
+    /// Observability indices over the identifiable parameters.
+    pub observability: Observability,
+    /// Combinations the data cannot see (first order), one per fixed parameter.
+    pub unidentifiable: Vec<Combination>,
+    /// Parameters held at their prior by the pivoting rule.
+    pub fixed: Vec<String>,
+    /// Identifiable but weakly determined combinations (`s_i / s_1` below
+    /// the weak threshold), with their standard deviation.
+    pub weak: Vec<Combination>,
+    /// Threshold on `s_i / s_1` for `weak`.
+    pub weak_threshold: f64,
+    /// Pairs of identifiable parameters with `|correlation| >= 0.9`.
+    pub correlated_pairs: Vec<(String, String, f64)>,
+    /// Predicted standard deviation of each parameter under the sensor
+    /// noise, mm (`None` for fixed parameters).
+    pub std_dev_mm: Vec<Option<f64>>,
+}
+
+/// Coefficients below this fraction of the largest are dropped from a
+/// printed combination.
+const COEFFICIENT_CUTOFF: f64 = 1e-4;
+
+fn combination(
+    names: &[String],
+    v: &[f64],
+    singular_value: f64,
+    std_dev_mm: Option<f64>,
+) -> Combination {
+    let largest = v.iter().copied().fold(0.0f64, |a, b| a.max(b.abs()));
+    let pivot = v
+        .iter()
+        .copied()
+        .max_by(|a, b| a.abs().total_cmp(&b.abs()))
+        .unwrap_or(1.0);
+    let sign = if pivot < 0.0 { -1.0 } else { 1.0 };
+    let mut terms: Vec<(String, f64)> = names
+        .iter()
+        .zip(v)
+        .filter(|(_, c)| c.abs() > COEFFICIENT_CUTOFF * largest)
+        .map(|(n, c)| (n.clone(), sign * c / largest))
+        .collect();
+    terms.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+    Combination {
+        terms,
+        singular_value,
+        std_dev_mm,
+    }
+}
+
+impl IdentifiabilityReport {
+    /// Builds the report from a rank decision, the solution's covariance
+    /// (nuisance first, `n_nuisance` of them) and the problem size.
+    pub fn new(
+        names: &[String],
+        decision: &RankDecision,
+        solution: &Solution,
+        n_nuisance: usize,
+        rows: usize,
+        n_poses: usize,
+        weak_threshold: f64,
+    ) -> IdentifiabilityReport {
+        let k = names.len();
+        let cov = |a: usize, b: usize| solution.covariance[(n_nuisance + a, n_nuisance + b)];
+        let identifiable = &decision.identifiable;
+        // Singular values of the identifiable columns only.
+        let sub_values = identifiable_singular_values(decision);
+        let observability = Observability::from_singular_values(&sub_values, rows);
+        let max = sub_values.iter().copied().fold(0.0, f64::max);
+        let min = sub_values.iter().copied().fold(f64::INFINITY, f64::min);
+
+        let unidentifiable = decision
+            .null_space_basis()
+            .iter()
+            .zip(decision.singular_values[decision.rank..].iter())
+            .map(|(v, s)| combination(names, v, *s, None))
+            .collect();
+
+        let top = decision.singular_values.first().copied().unwrap_or(0.0);
+        let weak = (0..decision.rank)
+            .filter(|&i| decision.singular_values[i] < weak_threshold * top)
+            .map(|i| {
+                let v = decision.direction(i);
+                let largest = v.iter().copied().fold(0.0f64, |a, b| a.max(b.abs()));
+                let c: Vec<f64> = v.iter().map(|x| x / largest).collect();
+                let var: f64 = (0..k)
+                    .flat_map(|a| (0..k).map(move |b| (a, b)))
+                    .map(|(a, b)| c[a] * c[b] * cov(a, b))
+                    .sum();
+                combination(
+                    names,
+                    &v,
+                    decision.singular_values[i],
+                    Some(var.max(0.0).sqrt()),
+                )
+            })
+            .collect();
+
+        let mut correlated_pairs = Vec::new();
+        for (ia, &a) in identifiable.iter().enumerate() {
+            for &b in &identifiable[ia + 1..] {
+                let r = cov(a, b) / (cov(a, a) * cov(b, b)).sqrt();
+                if r.abs() >= 0.9 {
+                    correlated_pairs.push((names[a].clone(), names[b].clone(), r));
+                }
+            }
+        }
+        correlated_pairs.sort_by(|x, y| y.2.abs().total_cmp(&x.2.abs()));
+
+        let std_dev_mm = (0..k)
+            .map(|j| {
+                if decision.fixed.contains(&j) {
+                    None
+                } else {
+                    Some(cov(j, j).max(0.0).sqrt())
+                }
+            })
+            .collect();
+        IdentifiabilityReport {
+            names: names.to_vec(),
+            n_params: k,
+            n_poses,
+            rank: decision.rank,
+            rank_tolerance: decision.tolerance,
+            singular_values: decision.singular_values.clone(),
+            condition_number: if min > 0.0 { max / min } else { f64::INFINITY },
+            observability,
+            unidentifiable,
+            fixed: decision.fixed.iter().map(|&j| names[j].clone()).collect(),
+            weak,
+            weak_threshold,
+            correlated_pairs,
+            std_dev_mm,
+        }
+    }
+
+    /// The report as JSON with the contract keys (`rank`, `n_params`,
+    /// `unidentifiable` as a list of name -> coefficient maps,
+    /// `singular_values`, `condition_number`, `observability`) and more.
+    pub fn to_json(&self) -> Value {
+        let mut m = Map::new();
+        m.insert("rank".into(), self.rank.into());
+        m.insert("n_params".into(), self.n_params.into());
+        m.insert("n_poses".into(), self.n_poses.into());
+        m.insert("rank_tolerance".into(), self.rank_tolerance.into());
+        m.insert(
+            "unidentifiable".into(),
+            Value::Array(
+                self.unidentifiable
+                    .iter()
+                    .map(|c| Value::Object(c.to_map()))
+                    .collect(),
+            ),
+        );
+        m.insert(
+            "fixed".into(),
+            Value::Array(self.fixed.iter().map(|s| Value::from(s.clone())).collect()),
+        );
+        m.insert(
+            "singular_values".into(),
+            self.singular_values.clone().into(),
+        );
+        m.insert(
+            "condition_number".into(),
+            finite_or_null(self.condition_number),
+        );
+        m.insert(
+            "observability".into(),
+            serde_json::to_value(self.observability).unwrap_or(Value::Null),
+        );
+        m.insert(
+            "weak".into(),
+            Value::Array(
+                self.weak
+                    .iter()
+                    .map(|c| {
+                        let mut w = Map::new();
+                        w.insert("combination".into(), Value::Object(c.to_map()));
+                        w.insert("singular_value".into(), c.singular_value.into());
+                        w.insert(
+                            "std_dev_mm".into(),
+                            c.std_dev_mm.map_or(Value::Null, Value::from),
+                        );
+                        Value::Object(w)
+                    })
+                    .collect(),
+            ),
+        );
+        m.insert("weak_threshold".into(), self.weak_threshold.into());
+        m.insert(
+            "correlated_pairs".into(),
+            Value::Array(
+                self.correlated_pairs
+                    .iter()
+                    .map(|(a, b, r)| serde_json::json!({"a": a, "b": b, "correlation": r}))
+                    .collect(),
+            ),
+        );
+        m.insert(
+            "std_dev_mm".into(),
+            Value::Object(
+                self.names
+                    .iter()
+                    .zip(&self.std_dev_mm)
+                    .map(|(n, s)| (n.clone(), s.map_or(Value::Null, Value::from)))
+                    .collect(),
+            ),
+        );
+        Value::Object(m)
+    }
+
+    /// A human-readable summary.
+    pub fn to_text(&self) -> String {
+        let mut s = String::new();
+        s.push_str(&format!(
+            "rank {} of {} parameters ({} poses; tolerance {:.0e} on s_i/s_1)\n",
+            self.rank, self.n_params, self.n_poses, self.rank_tolerance
+        ));
+        s.push_str(&format!(
+            "condition number {:.1} over the identifiable parameters\n",
+            self.condition_number
+        ));
+        let o = &self.observability;
+        s.push_str(&format!(
+            "observability O1 {:.4e}  O2 {:.4e}  O3 {:.4e}  O4 {:.4e}  O5 {:.4e}\n",
+            o.o1, o.o2, o.o3, o.o4, o.o5
+        ));
+        if self.unidentifiable.is_empty() {
+            s.push_str("every parameter is identifiable\n");
+        } else {
+            s.push_str("unidentifiable (held at the prior; the data cannot see these):\n");
+            for c in &self.unidentifiable {
+                s.push_str(&format!("  {}\n", c.to_text()));
+            }
+        }
+        if !self.weak.is_empty() {
+            s.push_str(&format!(
+                "weakly identifiable (s_i/s_1 < {:.0e}):\n",
+                self.weak_threshold
+            ));
+            for c in &self.weak {
+                s.push_str(&format!(
+                    "  {}   (s = {:.3e}, sd {:.4} mm)\n",
+                    c.to_text(),
+                    c.singular_value,
+                    c.std_dev_mm.unwrap_or(f64::NAN)
+                ));
+            }
+        }
+        if !self.correlated_pairs.is_empty() {
+            s.push_str("strongly correlated pairs (|r| >= 0.9):\n");
+            for (a, b, r) in &self.correlated_pairs {
+                s.push_str(&format!("  {a} / {b}: {r:+.3}\n"));
+            }
+        }
+        s.push_str("predicted standard deviations (mm):\n");
+        for (n, sd) in self.names.iter().zip(&self.std_dev_mm) {
+            match sd {
+                Some(v) => s.push_str(&format!("  {n:>6} {v:.5}\n")),
+                None => s.push_str(&format!("  {n:>6} fixed\n")),
+            }
+        }
+        s
+    }
+}
+
+fn finite_or_null(x: f64) -> Value {
+    if x.is_finite() {
+        Value::from(x)
+    } else {
+        Value::Null
+    }
+}
+
+/// Singular values of the scaled parameter block restricted to the
+/// identifiable columns, computed from the full SVD: the restricted matrix
+/// is `U S V^T` with the fixed rows of `V^T` removed.
+fn identifiable_singular_values(d: &RankDecision) -> Vec<f64> {
+    let k = d.column_scale.len();
+    let cols = &d.identifiable;
+    // B = S V^T restricted to the identifiable columns: its singular values
+    // equal those of the restricted scaled block (U is orthogonal).
+    let b = faer::Mat::from_fn(k, cols.len(), |i, j| {
+        d.singular_values[i] * d.right_vectors[(cols[j], i)]
+    });
+    match crate::linalg::svd_values_and_vectors(b.as_ref()) {
+        Some((s, _)) => s.into_iter().filter(|x| *x > 0.0).collect(),
+        None => Vec::new(),
+    }
+}

@@ -1,0 +1,359 @@
+//! Identification from simulated data: known errors in, estimates out.
+//!
+//! Every expectation comes from the simulator's inputs (the error vector
+//! handed to the plant), never from the identification's own output.
+
+use nalgebra::Vector3;
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+use tricept_data::{Dataset, MeasuredPose, Readings};
+use tricept_ident::{GeometricModel, IdentError, IdentifyOptions, identifiability, identify};
+use tricept_kinematics::{AxisOrder, Machine};
+use tricept_model::{ParameterSet, error_jacobian};
+use tricept_plant::{Campaign, Plant};
+
+fn machine(order: AxisOrder) -> Machine {
+    Machine::paper().with_axis_order(order)
+}
+
+/// Asserts every identifiable parameter is within 4 of its own standard
+/// deviations of the truth; returns the largest |z|.
+fn assert_within_4_sigma(order: AxisOrder, truth: &[f64], seed: u64) -> f64 {
+    let m = machine(order);
+    let set = ParameterSet::paper15();
+    let plant = Plant::geometric(m.clone(), set.to_errors(truth));
+    let data = plant.simulate(&Campaign::grid(&m, seed)).unwrap();
+    let model = GeometricModel::new(m.clone(), set.clone());
+    let id = identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+    assert!(id.converged, "{order} seed {seed}: did not converge");
+    let mut worst: f64 = 0.0;
+    for (j, name) in set.names().iter().enumerate() {
+        let Some(sd) = id.std_dev[j] else { continue };
+        let z = (id.estimate[j] - truth[j]) / sd;
+        assert!(
+            z.abs() < 4.0,
+            "{order} seed {seed}: {name} = {} vs truth {} (sd {sd:e}, z {z:.2})",
+            id.estimate[j],
+            truth[j]
+        );
+        worst = worst.max(z.abs());
+    }
+    // The sensor offsets the plant applied are found too.
+    let offsets = tricept_plant::DEFAULT_SENSOR_OFFSETS;
+    for c in 0..3 {
+        let z = (id.offsets[c] - offsets[c]) / id.offsets_std_dev[c];
+        assert!(z.abs() < 4.0, "{order} seed {seed}: offset {c} z {z:.2}");
+    }
+    worst
+}
+
+#[test]
+fn table2_is_recovered_within_four_sigma_for_both_conventions() {
+    let t2 = ParameterSet::paper15().table2();
+    for order in [AxisOrder::XFirst, AxisOrder::YFirst] {
+        let mut worst: f64 = 0.0;
+        for seed in 0..8 {
+            worst = worst.max(assert_within_4_sigma(order, &t2, seed));
+        }
+        // Eight seeds x 14 parameters: a healthy estimator reaches |z| > 1.5.
+        assert!(worst > 1.0, "{order}: suspiciously small errors ({worst})");
+    }
+}
+
+#[test]
+fn random_errors_up_to_2_mm_are_recovered_within_four_sigma() {
+    let set = ParameterSet::paper15();
+    let dya3 = set.index_of("dyA3").unwrap();
+    for order in [AxisOrder::XFirst, AxisOrder::YFirst] {
+        for seed in 100..110 {
+            let mut rng = Pcg64Mcg::seed_from_u64(seed);
+            let mut truth: Vec<f64> = (0..set.len())
+                .map(|_| rng.random_range(-2.0..2.0))
+                .collect();
+            if order == AxisOrder::XFirst {
+                // Unidentifiable there; at 2 mm it aliases into dyB3 through
+                // dzB3 (next test), so the identifiable part is tested alone.
+                truth[dya3] = 0.0;
+            }
+            assert_within_4_sigma(order, &truth, seed);
+        }
+    }
+}
+
+#[test]
+fn x_first_dya3_aliases_into_dyb3_through_dzb3_as_predicted() {
+    // The finding behind the previous test's restriction. With the paper's
+    // x-first U joint, leg 3 stays in the plane normal to the second U axis,
+    // so A3's offset e = dyA3 - dyB3 cos(phi) - dzB3 sin(phi) out of that
+    // plane changes the leg length only by e^2 / 2p. Its cross term
+    // -dyA3 dzB3 sin(phi) / p has the shape of dyB3's first-order effect
+    // (0.96 sin(phi) at these poses), so with dyA3 held at zero the fit moves
+    // dyB3 by about -dyA3 dzB3 / (q4 cos(theta)), and the residual shows
+    // nothing. The expected bias is computed from the simulator's inputs.
+    let m = machine(AxisOrder::XFirst);
+    let set = ParameterSet::paper15();
+    let mut truth = set.table2();
+    let (dya3, dyb3, dzb3) = (
+        set.index_of("dyA3").unwrap(),
+        set.index_of("dyB3").unwrap(),
+        set.index_of("dzB3").unwrap(),
+    );
+    truth[dya3] = 1.5;
+    truth[dzb3] = 1.0;
+    let campaign = Campaign::grid(&m, 0);
+    let lever_mm = campaign
+        .targets_mm
+        .iter()
+        .map(|r| {
+            let up = m.inverse(r).unwrap().up;
+            up.q4_mm * up.theta_rad.cos()
+        })
+        .sum::<f64>()
+        / campaign.targets_mm.len() as f64;
+    let predicted_bias = -truth[dya3] * truth[dzb3] / lever_mm;
+    let plant = Plant::geometric(m.clone(), set.to_errors(&truth));
+    let model = GeometricModel::new(m.clone(), set.clone());
+    for seed in 0..6 {
+        let mut c = campaign.clone();
+        c.seed = seed;
+        let data = plant.simulate(&c).unwrap();
+        let id = identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+        assert_eq!(id.report.fixed, vec!["dyA3".to_string()]);
+        assert!(
+            id.stats.reduced_chi_square < 1.4,
+            "{}",
+            id.stats.reduced_chi_square
+        );
+        let sd = id.std_dev[dyb3].unwrap();
+        assert!(
+            predicted_bias.abs() > 4.0 * sd,
+            "the bias must matter: {predicted_bias} vs sd {sd}"
+        );
+        let z = (id.estimate[dyb3] - truth[dyb3] - predicted_bias) / sd;
+        assert!(
+            z.abs() < 4.0,
+            "seed {seed}: dyB3 {} truth {} predicted bias {predicted_bias} sd {sd}",
+            id.estimate[dyb3],
+            truth[dyb3]
+        );
+    }
+}
+
+#[test]
+fn noise_free_exact_data_are_recovered_to_1e_9_mm() {
+    let set = ParameterSet::paper15();
+    let mut t2_x = set.table2();
+    t2_x[set.index_of("dyA3").unwrap()] = 0.0; // in the identifiable subspace
+    for (order, truth) in [(AxisOrder::XFirst, t2_x), (AxisOrder::YFirst, set.table2())] {
+        let m = machine(order);
+        let plant = Plant::geometric(m.clone(), set.to_errors(&truth));
+        let mut campaign = Campaign::grid(&m, 5);
+        campaign.noise.angle_rad = 0.0;
+        campaign.noise.length_mm = 0.0;
+        let data = plant.simulate(&campaign).unwrap();
+        let model = GeometricModel::new(m.clone(), set.clone());
+        let id = identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+        for (j, name) in set.names().iter().enumerate() {
+            assert!(
+                (id.estimate[j] - truth[j]).abs() < 1e-9,
+                "{order}: {name} {} vs {}",
+                id.estimate[j],
+                truth[j]
+            );
+        }
+        for c in 0..3 {
+            assert!((id.offsets[c] - tricept_plant::DEFAULT_SENSOR_OFFSETS[c]).abs() < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn linear_data_are_recovered_exactly_by_the_linear_solve() {
+    // When readings follow the first-order model exactly, one linear solve
+    // (no Gauss-Newton iteration) must return the truth to rounding.
+    let m = machine(AxisOrder::YFirst);
+    let set = ParameterSet::paper15();
+    let truth = set.table2();
+    let deps = nalgebra::SVector::<f64, 21>::from(set.to_errors(&truth).to_array());
+    let offsets = [0.01, -0.02, -600.0];
+    let poses: Vec<MeasuredPose> = m
+        .workspace
+        .polar_grid(3, 8, 3)
+        .iter()
+        .map(|r| {
+            let ik = m.inverse(r).unwrap();
+            let delta = error_jacobian(&m, &ik.up).unwrap() * deps;
+            let up = ik.up.to_array();
+            MeasuredPose {
+                commands_mm: ik.legs_mm,
+                readings: Readings::from_array([0, 1, 2].map(|c| up[c] + delta[c] + offsets[c])),
+                ..Default::default()
+            }
+        })
+        .collect();
+    let data = Dataset {
+        poses,
+        source: "linear".into(),
+    };
+    let model = GeometricModel::new(m.clone(), set.clone());
+    let mut options = IdentifyOptions::for_machine(&m);
+    options.max_iterations = 0;
+    let id = identify(&model, &data, &options).unwrap();
+    for (j, name) in set.names().iter().enumerate() {
+        assert!(
+            (id.estimate[j] - truth[j]).abs() < 1e-9,
+            "{name}: {} vs {}",
+            id.estimate[j],
+            truth[j]
+        );
+    }
+}
+
+fn poses_at(m: &Machine, targets: &[Vector3<f64>]) -> Vec<MeasuredPose> {
+    targets
+        .iter()
+        .map(|r| MeasuredPose {
+            commands_mm: m.inverse(r).unwrap().legs_mm,
+            ..Default::default()
+        })
+        .collect()
+}
+
+#[test]
+fn too_few_poses_is_an_error_that_says_how_many_are_needed() {
+    let m = machine(AxisOrder::YFirst);
+    let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+    let poses = poses_at(&m, &m.workspace.polar_grid(1, 4, 1)[..5]);
+    let e = identifiability(
+        &model,
+        &[0.0; 15],
+        &poses,
+        &IdentifyOptions::for_machine(&m),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            IdentError::TooFewPoses {
+                poses: 5,
+                unknowns: 18,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("at least 7 poses"), "{e}");
+}
+
+#[test]
+fn the_paper_x_first_machine_cannot_see_dya3_and_says_so() {
+    let m = machine(AxisOrder::XFirst);
+    let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+    let poses = poses_at(&m, &m.workspace.polar_grid(3, 8, 3));
+    let report = identifiability(
+        &model,
+        &[0.0; 15],
+        &poses,
+        &IdentifyOptions::for_machine(&m),
+    )
+    .unwrap();
+    assert_eq!(report.rank, 14);
+    assert_eq!(report.unidentifiable.len(), 1);
+    assert_eq!(
+        report.unidentifiable[0].terms,
+        vec![("dyA3".to_string(), 1.0)]
+    );
+    // The y-first joint sees all fifteen (the paper's claim holds there).
+    let y = machine(AxisOrder::YFirst);
+    let model = GeometricModel::new(y.clone(), ParameterSet::paper15());
+    let report = identifiability(
+        &model,
+        &[0.0; 15],
+        &poses_at(&y, &y.workspace.polar_grid(3, 8, 3)),
+        &IdentifyOptions::for_machine(&y),
+    )
+    .unwrap();
+    assert_eq!(report.rank, 15);
+    assert!(report.unidentifiable.is_empty());
+}
+
+#[test]
+fn poses_on_the_axis_only_leave_named_combinations_that_are_truly_invisible() {
+    // Ten poses on the workspace axis: the platform never tilts.
+    let m = machine(AxisOrder::YFirst);
+    let set = ParameterSet::paper15();
+    let model = GeometricModel::new(m.clone(), set.clone());
+    let targets: Vec<Vector3<f64>> = (0..10)
+        .map(|k| Vector3::new(0.0, 0.0, 650.0 + 20.0 * f64::from(k)))
+        .collect();
+    let poses = poses_at(&m, &targets);
+    let report = identifiability(
+        &model,
+        &[0.0; 15],
+        &poses,
+        &IdentifyOptions::for_machine(&m),
+    )
+    .unwrap();
+    assert!(report.rank < 15);
+    assert_eq!(report.unidentifiable.len(), 15 - report.rank);
+    // Each named combination, applied as a 0.05 mm error, changes no reading
+    // at these poses (beyond second order) once offsets are removed.
+    for combo in &report.unidentifiable {
+        let mut p = vec![0.0; 15];
+        for (name, c) in &combo.terms {
+            p[set.index_of(name).unwrap()] = 0.05 * c;
+        }
+        let actual = tricept_model::actual_machine(&m, &set.to_errors(&p));
+        let changes: Vec<[f64; 3]> = poses
+            .iter()
+            .map(|pose| {
+                let a = actual.forward(&pose.commands_mm).unwrap().up.to_array();
+                let n = m.forward(&pose.commands_mm).unwrap().up.to_array();
+                [0, 1, 2].map(|c| a[c] - n[c])
+            })
+            .collect();
+        for c in 0..3 {
+            let mean = changes.iter().map(|d| d[c]).sum::<f64>() / changes.len() as f64;
+            for d in &changes {
+                let scale = if c == 2 { 1.0 } else { 750.0 };
+                assert!(
+                    (d[c] - mean).abs() * scale < 1e-4,
+                    "{}: {d:?}",
+                    combo.to_text()
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_full_21_set_names_the_two_rigid_body_gauges() {
+    let m = machine(AxisOrder::XFirst);
+    let model = GeometricModel::new(m.clone(), ParameterSet::full21());
+    let poses = poses_at(&m, &m.workspace.polar_grid(3, 8, 3));
+    let report = identifiability(
+        &model,
+        &[0.0; 21],
+        &poses,
+        &IdentifyOptions::for_machine(&m),
+    )
+    .unwrap();
+    assert_eq!(report.rank, 18);
+    let texts: Vec<String> = report.unidentifiable.iter().map(|c| c.to_text()).collect();
+    let has = |names: &[&str]| {
+        report.unidentifiable.iter().any(|c| {
+            c.terms.len() == names.len()
+                && names.iter().all(|n| {
+                    c.terms
+                        .iter()
+                        .any(|(t, v)| t == n && (v.abs() - 1.0).abs() < 1e-6)
+                })
+        })
+    };
+    // Rotation of the base about the first U-joint axis (x), absorbed by the
+    // phi offset: B1 and B2 move oppositely in z.
+    assert!(has(&["dzB1", "dzB2"]), "{texts:?}");
+    // O' sliding along the limb, absorbed by the scale offset.
+    assert!(has(&["dzA1", "dzA2", "dzA3"]), "{texts:?}");
+    assert!(has(&["dyA3"]), "{texts:?}");
+}
