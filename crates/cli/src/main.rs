@@ -7,8 +7,10 @@
 //! results go to stdout.
 
 mod cli_error;
+mod ident_cmd;
 mod kinematics_cmd;
 mod output;
+mod simulate_cmd;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -16,6 +18,7 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand};
 
 use crate::cli_error::CliError;
+use crate::ident_cmd::{NoiseArgs, ParamArgs};
 
 /// Calibrate the Tricept parallel kinematic machine from its own sensors.
 ///
@@ -97,6 +100,99 @@ enum Command {
         #[command(flatten)]
         machine: MachineArgs,
     },
+    /// What a pose set and the UP limb's sensors can identify: rank,
+    /// singular values, observability indices, unidentifiable combinations.
+    #[command(
+        after_help = "Pose sets (--poses): grid (75 poses), grid:RINGS,PER_RING,LEVELS, random:N[,SEED], disc:SPACING[,Z], or a CSV file with columns x,y,z (mm).\n\nExamples:\n  tricept identifiability\n  tricept identifiability --poses random:30,1 --json\n  tricept identifiability --params full21"
+    )]
+    Identifiability {
+        /// Pose set (see below).
+        #[arg(long, default_value = "grid")]
+        poses: String,
+        #[command(flatten)]
+        params: ParamArgs,
+        #[command(flatten)]
+        noise: NoiseArgs,
+        #[command(flatten)]
+        machine: MachineArgs,
+    },
+    /// Identify the geometric errors from measured data (CSV: q1,q2,q3,phi,theta,s).
+    #[command(
+        after_help = "Examples:\n  tricept simulate --out data.csv && tricept identify --data data.csv\n  tricept identify --data data.csv --json\n  tricept identify --data data.csv --write-machine identified.json"
+    )]
+    Identify {
+        /// Measured-data CSV (see docs/data-format.md).
+        #[arg(long, value_name = "FILE.csv")]
+        data: PathBuf,
+        /// Also write the identified machine as a description file.
+        #[arg(long, value_name = "FILE.json")]
+        write_machine: Option<PathBuf>,
+        #[command(flatten)]
+        params: ParamArgs,
+        #[command(flatten)]
+        noise: NoiseArgs,
+        #[command(flatten)]
+        machine: MachineArgs,
+    },
+    /// Write a measured-data CSV from a simulated machine (Table 2 errors by
+    /// default) with sensor noise, offsets and optional unmodelled effects.
+    #[command(
+        after_help = "Errors (--errors): table2, zero, random:MAG_MM[,SEED], or a JSON file {name: mm}.\nEffects (--effect, repeatable): a JSON object or @FILE, e.g. '{\"effect\":\"leg-lead\",\"ppm\":[50,-30,40]}'.\n\nExamples:\n  tricept simulate --out data.csv\n  tricept simulate --errors random:1.0,3 --poses random:100,2 --seed 9\n  tricept simulate --effect '{\"effect\":\"backlash\",\"um\":[6,5,8]}' --both-directions"
+    )]
+    Simulate {
+        /// True errors of the simulated machine.
+        #[arg(long, default_value = "table2")]
+        errors: String,
+        /// Pose set (as for `identifiability`).
+        #[arg(long, default_value = "grid")]
+        poses: String,
+        /// Seed of the sensor noise.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Visit every pose twice, approaching from both directions.
+        #[arg(long)]
+        both_directions: bool,
+        /// An unmodelled effect (JSON object or @FILE); repeatable.
+        #[arg(long = "effect", value_name = "JSON")]
+        effects: Vec<String>,
+        /// Output file (default: stdout).
+        #[arg(long, value_name = "FILE.csv")]
+        out: Option<PathBuf>,
+        #[command(flatten)]
+        params: ParamArgs,
+        #[command(flatten)]
+        noise: NoiseArgs,
+        #[command(flatten)]
+        machine: MachineArgs,
+    },
+    /// Identify from data, then compensate: corrected commands and the
+    /// volumetric error on a plane before and after.
+    #[command(
+        after_help = "Without --truth only the correction the identified model predicts is known; with the true errors of simulated data (--truth table2 ...) the before/after error of the actual machine is reported.\n\nExamples:\n  tricept compensate --data data.csv --truth table2\n  tricept compensate --data data.csv --targets points.csv"
+    )]
+    Compensate {
+        /// Measured-data CSV.
+        #[arg(long, value_name = "FILE.csv")]
+        data: PathBuf,
+        /// True errors of the machine that produced the data (simulations).
+        #[arg(long, value_name = "ERRORS")]
+        truth: Option<String>,
+        /// Plane of the error map, mm (default: the workspace's middle plane).
+        #[arg(long, value_name = "Z_MM", allow_negative_numbers = true)]
+        plane_z: Option<f64>,
+        /// Lattice spacing of the error map, mm.
+        #[arg(long, default_value_t = 10.0, value_name = "MM")]
+        spacing: f64,
+        /// Target points (CSV x,y,z) to print corrected leg commands for.
+        #[arg(long, value_name = "FILE.csv")]
+        targets: Option<PathBuf>,
+        #[command(flatten)]
+        params: ParamArgs,
+        #[command(flatten)]
+        noise: NoiseArgs,
+        #[command(flatten)]
+        machine: MachineArgs,
+    },
 }
 
 fn run(cli: Cli) -> Result<(), CliError> {
@@ -118,6 +214,59 @@ fn run(cli: Cli) -> Result<(), CliError> {
             machine,
         } => kinematics_cmd::tool_ik(&machine, [x, y, z], [ax, ay, az]),
         Command::Machine { machine } => kinematics_cmd::print_machine(&machine),
+        Command::Identifiability {
+            poses,
+            params,
+            noise,
+            machine,
+        } => ident_cmd::run_identifiability(&machine, &noise, &params, &poses),
+        Command::Identify {
+            data,
+            write_machine,
+            params,
+            noise,
+            machine,
+        } => ident_cmd::run_identify(&machine, &noise, &params, &data, write_machine.as_deref()),
+        Command::Simulate {
+            errors,
+            poses,
+            seed,
+            both_directions,
+            effects,
+            out,
+            params,
+            noise,
+            machine,
+        } => simulate_cmd::run(simulate_cmd::SimulateArgs {
+            machine: &machine,
+            noise: &noise,
+            params: &params,
+            errors: &errors,
+            poses: &poses,
+            seed,
+            both_directions,
+            effects: &effects,
+            out: out.as_deref(),
+        }),
+        Command::Compensate {
+            data,
+            truth,
+            plane_z,
+            spacing,
+            targets,
+            params,
+            noise,
+            machine,
+        } => ident_cmd::run_compensate(
+            &machine,
+            &noise,
+            &params,
+            &data,
+            truth.as_deref(),
+            plane_z,
+            spacing,
+            targets.as_deref(),
+        ),
     }
 }
 

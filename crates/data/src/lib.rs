@@ -558,6 +558,74 @@ fn check_angle_spans(poses: &[MeasuredPose], file: &str) -> Result<(), DataError
     Ok(())
 }
 
+/// Reads target points from a CSV file with columns `x,y,z` (mm; header
+/// required, `#` comments, other columns ignored).
+pub fn read_targets(path: &Path) -> Result<Vec<[f64; 3]>, DataError> {
+    let file = path.display().to_string();
+    let f = std::fs::File::open(path).map_err(|source| DataError::Io {
+        file: file.clone(),
+        source,
+    })?;
+    let text =
+        std::io::read_to_string(std::io::BufReader::new(f)).map_err(|source| DataError::Io {
+            file: file.clone(),
+            source,
+        })?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i as u64 + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let Some((header_line, header)) = lines.next() else {
+        return Err(DataError::Empty { file });
+    };
+    let names: Vec<String> = header.split(',').map(|s| s.trim().to_string()).collect();
+    let mut idx = [0usize; 3];
+    for (k, name) in ["x", "y", "z"].iter().enumerate() {
+        idx[k] = names
+            .iter()
+            .position(|n| n == name)
+            .ok_or_else(|| DataError::MissingColumn {
+                file: file.clone(),
+                line: header_line,
+                column: name.to_string(),
+                hint: String::new(),
+            })?;
+    }
+    let mut out = Vec::new();
+    for (line, l) in lines {
+        let fields: Vec<&str> = l.split(',').map(str::trim).collect();
+        if fields.len() != names.len() {
+            return Err(DataError::FieldCount {
+                file,
+                line,
+                expected: names.len(),
+                found: fields.len(),
+            });
+        }
+        let mut p = [0.0; 3];
+        for k in 0..3 {
+            let raw = fields[idx[k]];
+            p[k] = raw
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| DataError::BadValue {
+                    file: file.clone(),
+                    line,
+                    column: names[idx[k]].clone(),
+                    value: raw.to_string(),
+                    reason: "not a finite number".into(),
+                })?;
+        }
+        out.push(p);
+    }
+    if out.is_empty() {
+        return Err(DataError::NoRows { file });
+    }
+    Ok(out)
+}
+
 /// Writes `data` as CSV: the required columns, then the context columns
 /// that every pose carries. Values are written with full precision
 /// (shortest representation that reads back to the same `f64`).

@@ -141,3 +141,94 @@ impl Campaign {
         }
     }
 }
+
+/// A pose set named on the command line.
+///
+/// | spec | poses |
+/// |---|---|
+/// | `grid` | the default polar grid, 3 levels x (axis + 3 rings x 8) = 75 |
+/// | `grid:R,P,L` | polar grid with `R` rings of `P` points on `L` levels |
+/// | `random:N` or `random:N,SEED` | `N` points uniform in the workspace |
+/// | `disc:S` or `disc:S,Z` | square lattice of spacing `S` mm on the plane `z = Z` (default: middle plane) |
+/// | any other text | a CSV file with columns `x,y,z` (mm) |
+///
+/// # Example
+/// ```
+/// use tricept_kinematics::Machine;
+/// use tricept_plant::campaign::pose_set;
+/// let m = Machine::paper();
+/// assert_eq!(pose_set("grid", &m).unwrap().len(), 75);
+/// assert_eq!(pose_set("grid:2,6,1", &m).unwrap().len(), 13);
+/// assert_eq!(pose_set("random:40,7", &m).unwrap().len(), 40);
+/// assert!(pose_set("grid:2,x,1", &m).unwrap_err().contains("grid:"));
+/// ```
+pub fn pose_set(spec: &str, machine: &Machine) -> Result<Vec<Vector3<f64>>, String> {
+    let ws = &machine.workspace;
+    let numbers = |rest: &str, what: &str| -> Result<Vec<f64>, String> {
+        rest.split(',')
+            .map(|t| {
+                t.trim()
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite() && *v >= 0.0)
+                    .ok_or_else(|| {
+                        format!("pose set `{spec}`: `{t}` is not a non-negative number ({what})")
+                    })
+            })
+            .collect()
+    };
+    let count = |v: f64, what: &str| -> Result<usize, String> {
+        if v.fract() == 0.0 && v >= 1.0 && v <= 1e7 {
+            Ok(v as usize)
+        } else {
+            Err(format!(
+                "pose set `{spec}`: {what} must be a whole number >= 1"
+            ))
+        }
+    };
+    if spec == "grid" {
+        return Ok(ws.polar_grid(3, 8, 3));
+    }
+    if let Some(rest) = spec.strip_prefix("grid:") {
+        let v = numbers(rest, "grid:RINGS,PER_RING,LEVELS")?;
+        if v.len() != 3 {
+            return Err(format!(
+                "pose set `{spec}`: expected grid:RINGS,PER_RING,LEVELS"
+            ));
+        }
+        return Ok(ws.polar_grid(
+            count(v[0], "RINGS")?,
+            count(v[1], "PER_RING")?,
+            count(v[2], "LEVELS")?,
+        ));
+    }
+    if let Some(rest) = spec.strip_prefix("random:") {
+        let v = numbers(rest, "random:N[,SEED]")?;
+        return match v.as_slice() {
+            [n] => Ok(ws.random_poses(count(*n, "N")?, 0)),
+            [n, seed] => Ok(ws.random_poses(count(*n, "N")?, *seed as u64)),
+            _ => Err(format!(
+                "pose set `{spec}`: expected random:N or random:N,SEED"
+            )),
+        };
+    }
+    if let Some(rest) = spec.strip_prefix("disc:") {
+        let v = numbers(rest, "disc:SPACING[,Z]")?;
+        let (spacing, z) = match v.as_slice() {
+            [s] => (*s, ws.mid_plane_z_mm()),
+            [s, z] => (*s, *z),
+            _ => {
+                return Err(format!(
+                    "pose set `{spec}`: expected disc:SPACING or disc:SPACING,Z"
+                ));
+            }
+        };
+        if spacing < 1.0 {
+            return Err(format!("pose set `{spec}`: spacing must be at least 1 mm"));
+        }
+        return Ok(ws.disc_grid(z, spacing));
+    }
+    tricept_data::read_targets(std::path::Path::new(spec))
+        .map(|t| t.into_iter().map(Vector3::from).collect())
+        .map_err(|e| e.to_string())
+}

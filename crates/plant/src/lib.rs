@@ -229,3 +229,21 @@ impl Plant {
         Ok(out)
     }
 }
+
+/// `n` parameter values drawn uniformly in `[-magnitude_mm, magnitude_mm]`
+/// from `seed` (PCG-64 MCG).
+///
+/// # Example
+/// ```
+/// let e = tricept_plant::random_errors(15, 2.0, 7);
+/// assert_eq!(e.len(), 15);
+/// assert!(e.iter().all(|v| v.abs() <= 2.0));
+/// assert_eq!(e, tricept_plant::random_errors(15, 2.0, 7));
+/// ```
+pub fn random_errors(n: usize, magnitude_mm: f64, seed: u64) -> Vec<f64> {
+    use rand::RngExt;
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    (0..n)
+        .map(|_| magnitude_mm * (2.0 * rng.random::<f64>() - 1.0))
+        .collect()
+}
