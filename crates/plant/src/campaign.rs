@@ -178,7 +178,7 @@ pub fn pose_set(spec: &str, machine: &Machine) -> Result<Vec<Vector3<f64>>, Stri
             .collect()
     };
     let count = |v: f64, what: &str| -> Result<usize, String> {
-        if v.fract() == 0.0 && v >= 1.0 && v <= 1e7 {
+        if v.fract() == 0.0 && (1.0..=1e7).contains(&v) {
             Ok(v as usize)
         } else {
             Err(format!(
