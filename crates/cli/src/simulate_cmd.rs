@@ -113,11 +113,10 @@ pub fn run(a: SimulateArgs<'_>) -> Result<(), CliError> {
             serde_json::to_string(e).unwrap_or_default()
         ));
     }
-    let written = match a.out {
+    match a.out {
         Some(path) => tricept_data::write_path(path, &data, &comments)
             .map_err(|e| CliError::other(format!("{}: {e}", path.display()))),
         None => tricept_data::write_to(std::io::stdout().lock(), &data, &comments)
             .map_err(|e| CliError::other(format!("stdout: {e}"))),
-    };
-    written
+    }
 }
