@@ -25,12 +25,30 @@ enum Command {
         #[arg(long)]
         all: bool,
     },
+    /// Fig. 3 before and after compensation: identification with the
+    /// paper's noise, statistics over noise seeds, SVG maps in docs/figures.
+    Fig3 {
+        /// Number of noise seeds.
+        #[arg(long, default_value_t = 200)]
+        seeds: u64,
+        /// Lattice spacing of the middle-plane map, mm.
+        #[arg(long, default_value_t = 10.0)]
+        spacing: f64,
+        /// Directory of the SVG maps.
+        #[arg(long, default_value = "docs/figures")]
+        out: std::path::PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
     let args = Xtask::parse();
     let result = match args.command {
         Command::Fig3Before { all } => fig3::run(all),
+        Command::Fig3 {
+            seeds,
+            spacing,
+            out,
+        } => fig3::run_compensation(seeds, &out, spacing),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,488 @@
+//! SVG figures for the docs, drawn with `plotters` (SVG backend only, so no
+//! system font or image library is needed).
+//!
+//! - [`heat_map`]: a scalar over a lattice of the workspace plane, with a
+//!   colour bar (the paper's Fig. 3 error maps);
+//! - [`curves`]: lines with optional shaded bands and horizontal reference
+//!   lines, optionally on a log x axis (the paper's Fig. 4);
+//! - [`scatter`]: point clouds (residuals against a regressor).
+#![cfg_attr(
+    not(test),
+    deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
+)]
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use thiserror::Error;
+
+/// A drawing failure (I/O or an empty data set).
+#[derive(Debug, Error)]
+#[error("{path}: {message}")]
+pub struct PlotError {
+    /// The output file.
+    pub path: String,
+    /// What went wrong.
+    pub message: String,
+}
+
+fn err(path: &Path, e: impl std::fmt::Display) -> PlotError {
+    PlotError {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
+/// Viridis-like colour map, `t` in [0, 1].
+pub fn colour(t: f64) -> RGBColor {
+    const STOPS: [(f64, [u8; 3]); 6] = [
+        (0.0, [68, 1, 84]),
+        (0.2, [65, 68, 135]),
+        (0.4, [42, 120, 142]),
+        (0.6, [34, 168, 132]),
+        (0.8, [122, 209, 81]),
+        (1.0, [253, 231, 37]),
+    ];
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    for w in STOPS.windows(2) {
+        let ((t0, c0), (t1, c1)) = (w[0], w[1]);
+        if t <= t1 {
+            let f = (t - t0) / (t1 - t0);
+            let mix =
+                |a: u8, b: u8| (f64::from(a) + f * (f64::from(b) - f64::from(a))).round() as u8;
+            return RGBColor(mix(c0[0], c1[0]), mix(c0[1], c1[1]), mix(c0[2], c1[2]));
+        }
+    }
+    RGBColor(253, 231, 37)
+}
+
+/// One value on a square lattice cell centred at `(x, y)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cell {
+    /// Cell centre x, mm.
+    pub x: f64,
+    /// Cell centre y, mm.
+    pub y: f64,
+    /// The value.
+    pub value: f64,
+}
+
+/// A heat map of `cells` (square cells of side `spacing`) with a colour bar.
+/// `range` fixes the colour scale (default: the data's min..max).
+pub fn heat_map(
+    path: &Path,
+    title: &str,
+    cells: &[Cell],
+    spacing: f64,
+    value_label: &str,
+    range: Option<(f64, f64)>,
+) -> Result<(), PlotError> {
+    if cells.is_empty() {
+        return Err(err(path, "no data"));
+    }
+    let (lo, hi) = range.unwrap_or_else(|| {
+        cells
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), c| {
+                (a.min(c.value), b.max(c.value))
+            })
+    });
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    let half = spacing / 2.0;
+    let (x0, x1, y0, y1) = cells.iter().fold(
+        (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ),
+        |(a, b, c, d), p| {
+            (
+                a.min(p.x - half),
+                b.max(p.x + half),
+                c.min(p.y - half),
+                d.max(p.y + half),
+            )
+        },
+    );
+    let root = SVGBackend::new(path, (760, 620)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(path, e))?;
+    let (main, bar) = root.split_horizontally(620);
+    let mut chart = ChartBuilder::on(&main)
+        .caption(title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(55)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| err(path, e))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("x (mm)")
+        .y_desc("y (mm)")
+        .draw()
+        .map_err(|e| err(path, e))?;
+    chart
+        .draw_series(cells.iter().map(|c| {
+            Rectangle::new(
+                [(c.x - half, c.y - half), (c.x + half, c.y + half)],
+                colour((c.value - lo) / span).filled(),
+            )
+        }))
+        .map_err(|e| err(path, e))?;
+    colour_bar(&bar, lo, hi, value_label).map_err(|e| err(path, e))?;
+    root.present().map_err(|e| err(path, e))
+}
+
+fn colour_bar(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    lo: f64,
+    hi: f64,
+    label: &str,
+) -> Result<(), DrawingAreaErrorKind<std::io::Error>> {
+    let hi = if hi > lo { hi } else { lo + 1.0 };
+    // Enough decimals to tell the ticks apart.
+    let decimals = ((-(hi - lo).log10()).ceil() as i64 + 2).clamp(1, 9) as usize;
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(45)
+        .margin_bottom(52)
+        .margin_right(4)
+        .y_label_area_size(78)
+        .build_cartesian_2d(0.0..1.0, lo..hi)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc(label)
+        .axis_desc_style(("sans-serif", 15))
+        .label_style(("sans-serif", 13))
+        .y_label_formatter(&|v| format!("{v:.decimals$}"))
+        .draw()?;
+    let steps = 100;
+    chart.draw_series((0..steps).map(|k| {
+        let a = lo + (hi - lo) * k as f64 / steps as f64;
+        let b = lo + (hi - lo) * (k + 1) as f64 / steps as f64;
+        Rectangle::new(
+            [(0.0, a), (1.0, b)],
+            colour(k as f64 / (steps - 1) as f64).filled(),
+        )
+    }))?;
+    Ok(())
+}
+
+/// A line with an optional band (`lo`, `hi` per point).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Curve {
+    /// Legend text.
+    pub name: String,
+    /// x values.
+    pub x: Vec<f64>,
+    /// y values.
+    pub y: Vec<f64>,
+    /// Optional band, `(lo, hi)` per point.
+    pub band: Option<Vec<(f64, f64)>>,
+}
+
+/// A horizontal reference line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reference {
+    /// Legend text.
+    pub name: String,
+    /// y value.
+    pub y: f64,
+}
+
+/// A marker at one point (e.g. a figure quoted in a paper).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Marker {
+    /// Legend text.
+    pub name: String,
+    /// Position.
+    pub at: (f64, f64),
+}
+
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+];
+
+/// Axes description for [`curves`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axes<'a> {
+    /// Figure title.
+    pub title: &'a str,
+    /// x axis label.
+    pub x_label: &'a str,
+    /// y axis label.
+    pub y_label: &'a str,
+    /// Log-scale x axis.
+    pub log_x: bool,
+    /// Log-scale y axis.
+    pub log_y: bool,
+}
+
+/// Curves with bands, reference lines and markers.
+pub fn curves(
+    path: &Path,
+    axes: &Axes<'_>,
+    curves: &[Curve],
+    references: &[Reference],
+    markers: &[Marker],
+) -> Result<(), PlotError> {
+    let xs = curves.iter().flat_map(|c| c.x.iter().copied());
+    let ys = curves
+        .iter()
+        .flat_map(|c| {
+            c.y.iter().copied().chain(
+                c.band
+                    .iter()
+                    .flat_map(|b| b.iter().flat_map(|(l, h)| [*l, *h])),
+            )
+        })
+        .chain(references.iter().map(|r| r.y))
+        .chain(markers.iter().map(|m| m.at.1));
+    let (x0, x1) = xs
+        .chain(markers.iter().map(|m| m.at.0))
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    let (y0, y1) = ys
+        .filter(|v| v.is_finite() && (!axes.log_y || *v > 0.0))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if !(x0.is_finite() && y0.is_finite()) {
+        return Err(err(path, "no data"));
+    }
+    let root = SVGBackend::new(path, (820, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(path, e))?;
+    let (y0, y1) = if axes.log_y {
+        (y0 / 1.3, y1 * 1.3)
+    } else {
+        let pad = 0.06 * (y1 - y0).max(1e-12);
+        (
+            (y0 - pad).max(if y0 >= 0.0 { 0.0 } else { f64::NEG_INFINITY }),
+            y1 + pad,
+        )
+    };
+    macro_rules! draw {
+        ($xr:expr, $yr:expr) => {{
+            let mut chart = ChartBuilder::on(&root)
+                .caption(axes.title, ("sans-serif", 20))
+                .margin(15)
+                .x_label_area_size(45)
+                .y_label_area_size(70)
+                .build_cartesian_2d($xr, $yr)
+                .map_err(|e| err(path, e))?;
+            chart
+                .configure_mesh()
+                .x_desc(axes.x_label)
+                .y_desc(axes.y_label)
+                .draw()
+                .map_err(|e| err(path, e))?;
+            for (k, c) in curves.iter().enumerate() {
+                let col = PALETTE[k % PALETTE.len()];
+                if let Some(band) = &c.band {
+                    let mut poly: Vec<(f64, f64)> =
+                        c.x.iter().zip(band).map(|(x, (l, _))| (*x, *l)).collect();
+                    poly.extend(c.x.iter().zip(band).rev().map(|(x, (_, h))| (*x, *h)));
+                    chart
+                        .draw_series(std::iter::once(Polygon::new(poly, col.mix(0.18).filled())))
+                        .map_err(|e| err(path, e))?;
+                }
+                chart
+                    .draw_series(LineSeries::new(
+                        c.x.iter().zip(&c.y).map(|(x, y)| (*x, *y)),
+                        col.stroke_width(2),
+                    ))
+                    .map_err(|e| err(path, e))?
+                    .label(c.name.clone())
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2))
+                    });
+                chart
+                    .draw_series(
+                        c.x.iter()
+                            .zip(&c.y)
+                            .map(|(x, y)| Circle::new((*x, *y), 3, col.filled())),
+                    )
+                    .map_err(|e| err(path, e))?;
+            }
+            for (k, r) in references.iter().enumerate() {
+                let col = if k == 0 {
+                    BLACK
+                } else {
+                    PALETTE[(k + 3) % PALETTE.len()]
+                };
+                chart
+                    .draw_series(DashedLineSeries::new(
+                        vec![(x0, r.y), (x1, r.y)],
+                        8,
+                        5,
+                        col.stroke_width(1),
+                    ))
+                    .map_err(|e| err(path, e))?
+                    .label(r.name.clone())
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(1))
+                    });
+            }
+            for m in markers {
+                chart
+                    .draw_series(std::iter::once(Cross::new(m.at, 7, RED.stroke_width(2))))
+                    .map_err(|e| err(path, e))?
+                    .label(m.name.clone())
+                    .legend(|(x, y)| Cross::new((x + 9, y), 5, RED.stroke_width(2)));
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .position(SeriesLabelPosition::UpperLeft)
+                .draw()
+                .map_err(|e| err(path, e))?;
+        }};
+    }
+    match (axes.log_x, axes.log_y) {
+        (true, true) => draw!((x0..x1).log_scale(), (y0..y1).log_scale()),
+        (true, false) => draw!((x0..x1).log_scale(), y0..y1),
+        (false, true) => draw!(x0..x1, (y0..y1).log_scale()),
+        (false, false) => draw!(x0..x1, y0..y1),
+    }
+    root.present().map_err(|e| err(path, e))
+}
+
+/// Named point clouds on shared axes.
+pub fn scatter(
+    path: &Path,
+    axes: &Axes<'_>,
+    series: &[(String, Vec<(f64, f64)>)],
+) -> Result<(), PlotError> {
+    let all = series.iter().flat_map(|(_, p)| p.iter());
+    let (x0, x1, y0, y1) = all.fold(
+        (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ),
+        |(a, b, c, d), (x, y)| (a.min(*x), b.max(*x), c.min(*y), d.max(*y)),
+    );
+    if !(x0.is_finite() && y0.is_finite()) {
+        return Err(err(path, "no data"));
+    }
+    let padx = 0.04 * (x1 - x0).max(1e-12);
+    let pady = 0.08 * (y1 - y0).max(1e-12);
+    let root = SVGBackend::new(path, (820, 520)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(path, e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(axes.title, ("sans-serif", 20))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x0 - padx)..(x1 + padx), (y0 - pady)..(y1 + pady))
+        .map_err(|e| err(path, e))?;
+    chart
+        .configure_mesh()
+        .x_desc(axes.x_label)
+        .y_desc(axes.y_label)
+        .draw()
+        .map_err(|e| err(path, e))?;
+    for (k, (name, points)) in series.iter().enumerate() {
+        let col = PALETTE[k % PALETTE.len()];
+        chart
+            .draw_series(
+                points
+                    .iter()
+                    .map(|p| Circle::new(*p, 3, col.mix(0.8).filled())),
+            )
+            .map_err(|e| err(path, e))?
+            .label(name.clone())
+            .legend(move |(x, y)| Circle::new((x + 8, y), 4, col.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(path, e))?;
+    root.present().map_err(|e| err(path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn colour_map_ends_and_clamps() {
+        assert_eq!(colour(0.0), RGBColor(68, 1, 84));
+        assert_eq!(colour(1.0), RGBColor(253, 231, 37));
+        assert_eq!(colour(-3.0), colour(0.0));
+        assert_eq!(colour(f64::NAN), colour(0.0));
+    }
+
+    #[test]
+    fn figures_are_written_as_svg() {
+        let dir = std::env::temp_dir().join(format!("tricept-plot-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let cells: Vec<Cell> = (0..10)
+            .flat_map(|i| {
+                (0..10).map(move |j| Cell {
+                    x: i as f64,
+                    y: j as f64,
+                    value: (i * j) as f64,
+                })
+            })
+            .collect();
+        let p = dir.join("heat.svg");
+        heat_map(&p, "t", &cells, 1.0, "v", None).unwrap();
+        let text = std::fs::read_to_string(&p).unwrap();
+        assert!(text.starts_with("<svg") && text.contains("<rect"));
+        let axes = Axes {
+            title: "c",
+            x_label: "x",
+            y_label: "y",
+            log_x: true,
+            log_y: false,
+        };
+        let c = Curve {
+            name: "a".into(),
+            x: vec![1.0, 2.0, 4.0],
+            y: vec![1.0, 2.0, 3.0],
+            band: Some(vec![(0.5, 1.5); 3]),
+        };
+        let p = dir.join("curves.svg");
+        curves(
+            &p,
+            &axes,
+            &[c],
+            &[Reference {
+                name: "r".into(),
+                y: 2.5,
+            }],
+            &[Marker {
+                name: "m".into(),
+                at: (2.0, 2.9),
+            }],
+        )
+        .unwrap();
+        assert!(
+            std::fs::read_to_string(&p).unwrap().contains("<polygon")
+                || std::fs::read_to_string(&p).unwrap().contains("<path")
+        );
+        let p = dir.join("scatter.svg");
+        scatter(&p, &axes, &[("s".into(), vec![(1.0, 2.0), (2.0, 3.0)])]).unwrap();
+        assert!(heat_map(&dir.join("empty.svg"), "t", &[], 1.0, "v", None).is_err());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
