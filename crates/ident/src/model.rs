@@ -51,16 +51,19 @@ pub struct GeometricModel {
     nominal: Machine,
     set: ParameterSet,
     names: Vec<String>,
+    sparse: Vec<Vec<(usize, f64)>>,
 }
 
 impl GeometricModel {
     /// The model of `nominal` with the errors of `set`.
     pub fn new(nominal: Machine, set: ParameterSet) -> GeometricModel {
         let names = set.names().to_vec();
+        let sparse = set.sparse_columns();
         GeometricModel {
             nominal,
             set,
             names,
+            sparse,
         }
     }
 
@@ -83,7 +86,7 @@ impl GeometricModel {
 /// [`GeometricModel`] at fixed parameters.
 struct GeometricPredictor<'a> {
     machine: Machine,
-    set: &'a ParameterSet,
+    sparse: &'a [Vec<(usize, f64)>],
 }
 
 impl ReadingModel for GeometricModel {
@@ -94,7 +97,7 @@ impl ReadingModel for GeometricModel {
     fn at<'a>(&'a self, p: &[f64]) -> Box<dyn PosePredictor + 'a> {
         Box::new(GeometricPredictor {
             machine: self.machine_at(p),
-            set: &self.set,
+            sparse: &self.sparse,
         })
     }
 }
@@ -116,19 +119,17 @@ pub fn solve_pose(
     Ok(fk.up)
 }
 
-/// Writes `J E` (3 x k, row-major) for the 21-column `J`.
-pub fn project_jacobian(j21: &tricept_model::ErrorJacobian, set: &ParameterSet, out: &mut [f64]) {
-    let k = set.len();
-    for c in 0..k {
-        let col = set.column(c);
+/// Writes `J E` (3 x k, row-major) for the 21-column `J`, with `E` given
+/// by its non-zero entries ([`ParameterSet::sparse_columns`]).
+pub fn project_jacobian(
+    j21: &tricept_model::ErrorJacobian,
+    sparse_columns: &[Vec<(usize, f64)>],
+    out: &mut [f64],
+) {
+    let k = sparse_columns.len();
+    for (c, col) in sparse_columns.iter().enumerate() {
         for row in 0..3 {
-            let mut acc = 0.0;
-            for (f, e) in col.iter().enumerate() {
-                if *e != 0.0 {
-                    acc += j21[(row, f)] * e;
-                }
-            }
-            out[row * k + c] = acc;
+            out[row * k + c] = col.iter().map(|&(f, e)| j21[(row, f)] * e).sum();
         }
     }
 }
@@ -143,7 +144,7 @@ impl PosePredictor for GeometricPredictor<'_> {
         let up = solve_pose(&self.machine, &pose.commands_mm, seed)?;
         let geometry = self.machine.legs_at(&up);
         let j21 = error_jacobian_at(&geometry)?;
-        project_jacobian(&j21, self.set, jacobian);
+        project_jacobian(&j21, self.sparse, jacobian);
         Ok(up.to_array())
     }
 }

@@ -184,6 +184,21 @@ impl ParameterSet {
         &self.columns[j]
     }
 
+    /// The non-zero entries `(full index, coefficient)` of every column of
+    /// `E`: the cheap form for projecting Jacobians, `J E`.
+    pub fn sparse_columns(&self) -> Vec<Vec<(usize, f64)>> {
+        self.columns
+            .iter()
+            .map(|c| {
+                c.iter()
+                    .enumerate()
+                    .filter(|(_, v)| **v != 0.0)
+                    .map(|(i, v)| (i, *v))
+                    .collect()
+            })
+            .collect()
+    }
+
     /// The full error vector `E p` for parameter values `p` (mm).
     pub fn to_errors(&self, p: &[f64]) -> GeometricErrors {
         let mut full = [0.0; N_FULL];
