@@ -4,6 +4,7 @@
 //! figure or table that the docs quote, so anyone can rerun it.
 
 mod fig3;
+mod study;
 
 use std::process::ExitCode;
 
@@ -18,6 +19,9 @@ struct Xtask {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// The Monte Carlo encoder-grade study (the paper's Fig. 4): the
+    /// project's main job.
+    EncoderStudy(study::StudyArgs),
     /// Fig. 3 "before compensation" with the default conventions and every
     /// combination of the conventions the paper leaves open.
     Fig3Before {
@@ -43,6 +47,7 @@ enum Command {
 fn main() -> ExitCode {
     let args = Xtask::parse();
     let result = match args.command {
+        Command::EncoderStudy(args) => study::run(args),
         Command::Fig3Before { all } => fig3::run(all),
         Command::Fig3 {
             seeds,

@@ -34,7 +34,7 @@ use crate::model::ReadingModel;
 use crate::report::IdentifiabilityReport;
 
 /// Options of [`identify`].
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct IdentifyOptions {
     /// Standard deviation of one *logged* reading `[phi, theta, s]`
     /// (rad, rad, mm).
@@ -50,6 +50,21 @@ pub struct IdentifyOptions {
     /// Per-pose weights multiplying `1/sigma` (default all one); robust
     /// estimation sets them.
     pub pose_weights: Option<Vec<f64>>,
+    /// A rank decision and report computed once for this pose set and noise
+    /// ([`design`]), reused instead of deciding again (Monte Carlo studies).
+    pub design: Option<Design>,
+    /// FK starting points per pose (default: cold starts).
+    pub start_seeds: Option<Vec<UpJoints>>,
+}
+
+/// The rank decision and identifiability report of a pose set under a
+/// noise model, computed once and reused by many identifications.
+#[derive(Debug, Clone)]
+pub struct Design {
+    /// Which parameters are estimated and which are held.
+    pub decision: RankDecision,
+    /// The report that decision comes from.
+    pub report: IdentifiabilityReport,
 }
 
 impl IdentifyOptions {
@@ -62,6 +77,8 @@ impl IdentifyOptions {
             max_iterations: 30,
             initial: None,
             pose_weights: None,
+            design: None,
+            start_seeds: None,
         }
     }
 }
@@ -130,7 +147,7 @@ pub fn evaluate(
 ) -> Result<Evaluation, IdentError> {
     let k = model.names().len();
     let predictor = model.at(p);
-    let mut acc = TriangularAccumulator::new(3 + k + 1);
+    let mut acc = TriangularAccumulator::with_rows_hint(3 + k + 1, 3 * poses.len());
     let mut jac = vec![0.0; 3 * k];
     let mut row = vec![0.0; 3 + k + 1];
     let mut residuals = Vec::with_capacity(poses.len());
@@ -235,22 +252,34 @@ pub fn identify(
         }
         None => vec![0.0; k],
     };
-    let mut seeds = vec![None; poses.len()];
+    let mut seeds: Vec<Option<UpJoints>> = match &options.start_seeds {
+        Some(s) if s.len() == poses.len() => s.iter().copied().map(Some).collect(),
+        Some(s) => {
+            return Err(IdentError::Invalid(format!(
+                "{} start seeds for {} poses",
+                s.len(),
+                poses.len()
+            )));
+        }
+        None => vec![None; poses.len()],
+    };
     let eval = evaluate(model, &p, poses, &options.sigma, weights, &mut seeds)?;
-    let decision = eval
-        .problem
-        .decide(options.rank_tolerance)
-        .ok_or(IdentError::Numerical("SVD did not converge"))?;
-    let first = eval.problem.solve(&decision);
-    let report = IdentifiabilityReport::new(
-        &names,
-        &decision,
-        &first,
-        3,
-        eval.problem.rows,
-        poses.len(),
-        options.weak_threshold,
-    );
+    let (decision, report, first) = match &options.design {
+        Some(d) if d.decision.column_scale.len() == k => {
+            let first = eval.problem.solve(&d.decision);
+            (d.decision.clone(), d.report.clone(), first)
+        }
+        Some(_) => {
+            return Err(IdentError::Invalid(format!(
+                "the design was computed for another parameter count than {k}"
+            )));
+        }
+        None => {
+            let d = decide_design(&names, &eval, poses.len(), options)?;
+            let first = eval.problem.solve(&d.decision);
+            (d.decision, d.report, first)
+        }
+    };
 
     let problem = Problem {
         model,
@@ -342,11 +371,11 @@ impl Problem<'_> {
     }
 }
 
-/// A Gauss-Newton step is negligible when every component is below 1e-4 of
+/// A Gauss-Newton step is negligible when every component is below 1e-3 of
 /// its standard deviation (or below 1e-12 mm): further iterations could not
 /// change any conclusion drawn from the estimate.
 fn step_is_negligible(step: &[f64], s: &Solution, d: &RankDecision) -> bool {
-    step_is_within(step, s, d, 1e-4)
+    step_is_within(step, s, d, 1e-3)
 }
 
 fn step_is_within(step: &[f64], s: &Solution, d: &RankDecision, fraction: f64) -> bool {
@@ -443,17 +472,39 @@ fn finish(
     })
 }
 
-/// The identifiability of a pose set before any data is taken: the
-/// identification matrix of `model` at `p` (usually zero) for the commands
-/// of `poses`, with the given logged noise.
-pub fn identifiability(
+/// Rank decision and report from one evaluation.
+fn decide_design(
+    names: &[String],
+    eval: &Evaluation,
+    n_poses: usize,
+    options: &IdentifyOptions,
+) -> Result<Design, IdentError> {
+    let decision = eval
+        .problem
+        .decide(options.rank_tolerance)
+        .ok_or(IdentError::Numerical("SVD did not converge"))?;
+    let solution = eval.problem.solve(&decision);
+    let report = IdentifiabilityReport::new(
+        names,
+        &decision,
+        &solution,
+        3,
+        eval.problem.rows,
+        n_poses,
+        options.weak_threshold,
+    );
+    Ok(Design { decision, report })
+}
+
+/// The rank decision and report of a pose set (see [`identifiability`]),
+/// for reuse through [`IdentifyOptions::design`].
+pub fn design(
     model: &dyn ReadingModel,
     p: &[f64],
     poses: &[MeasuredPose],
     options: &IdentifyOptions,
-) -> Result<IdentifiabilityReport, IdentError> {
-    let k = model.names().len();
-    check_size(poses.len(), k)?;
+) -> Result<Design, IdentError> {
+    check_size(poses.len(), model.names().len())?;
     let mut seeds = vec![None; poses.len()];
     let eval = evaluate(
         model,
@@ -463,20 +514,19 @@ pub fn identifiability(
         options.pose_weights.as_deref(),
         &mut seeds,
     )?;
-    let decision = eval
-        .problem
-        .decide(options.rank_tolerance)
-        .ok_or(IdentError::Numerical("SVD did not converge"))?;
-    let solution = eval.problem.solve(&decision);
-    Ok(IdentifiabilityReport::new(
-        model.names(),
-        &decision,
-        &solution,
-        3,
-        eval.problem.rows,
-        poses.len(),
-        options.weak_threshold,
-    ))
+    decide_design(model.names(), &eval, poses.len(), options)
+}
+
+/// The identifiability of a pose set before any data is taken: the
+/// identification matrix of `model` at `p` (usually zero) for the commands
+/// of `poses`, with the given logged noise.
+pub fn identifiability(
+    model: &dyn ReadingModel,
+    p: &[f64],
+    poses: &[MeasuredPose],
+    options: &IdentifyOptions,
+) -> Result<IdentifiabilityReport, IdentError> {
+    Ok(design(model, p, poses, options)?.report)
 }
 
 impl Identification {

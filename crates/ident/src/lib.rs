@@ -58,7 +58,8 @@ mod report;
 pub use compensate::{Compensation, compensation, corrected_commands};
 pub use error::IdentError;
 pub use identify::{
-    Evaluation, Identification, IdentifyOptions, ResidualStats, evaluate, identifiability, identify,
+    Design, Evaluation, Identification, IdentifyOptions, ResidualStats, design, evaluate,
+    identifiability, identify,
 };
 pub use model::{GeometricModel, PosePredictor, ReadingModel, project_jacobian, solve_pose};
 pub use report::{Combination, IdentifiabilityReport, Observability};

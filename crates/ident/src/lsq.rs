@@ -24,6 +24,10 @@ use faer::{Mat, MatRef};
 
 use crate::linalg::{invert_upper, pivot_order, r_factor, solve_upper, svd_values_and_vectors};
 
+/// A parameter column whose norm is below this fraction of the largest
+/// column's is treated as exactly zero (well below any rank tolerance).
+pub const ZERO_COLUMN: f64 = 1e-10;
+
 /// Default relative tolerance on singular values for the numerical rank.
 pub const DEFAULT_RANK_TOLERANCE: f64 = 1e-8;
 
@@ -104,19 +108,27 @@ impl ReducedProblem {
             })
             .collect();
         let largest = norms.iter().copied().fold(0.0, f64::max);
-        // A column that is zero to rounding gets scale 1: it stays zero and
-        // lands in the null space instead of being blown up to unit norm.
+        // A column below ZERO_COLUMN of the largest is rounding noise (a
+        // parameter the readings do not depend on, like dyA3 on the x-first
+        // machine, whose analytic column is exactly zero): it is zeroed, so
+        // that it lands in the null space instead of being blown up to a
+        // random unit direction whose size depends on the weights' magnitude.
+        let zero: Vec<bool> = norms
+            .iter()
+            .map(|&n| n.is_nan() || n <= ZERO_COLUMN * largest)
+            .collect();
         let column_scale: Vec<f64> = norms
             .iter()
-            .map(|&n| {
-                if n > 1e-14 * largest && n > 0.0 {
-                    n
-                } else {
-                    1.0
-                }
-            })
+            .zip(&zero)
+            .map(|(&n, &z)| if z { 1.0 } else { n })
             .collect();
-        let scaled = Mat::from_fn(k, k, |i, j| block[(i, j)] / column_scale[j]);
+        let scaled = Mat::from_fn(k, k, |i, j| {
+            if zero[j] {
+                0.0
+            } else {
+                block[(i, j)] / column_scale[j]
+            }
+        });
         let (singular_values, right_vectors) = svd_values_and_vectors(scaled.as_ref())?;
         let top = singular_values.first().copied().unwrap_or(0.0);
         let rank = singular_values
@@ -334,5 +346,42 @@ mod tests {
         // The first pivot must swap rows (a[0][0] = 0); a singular matrix is refused.
         let singular = Mat::from_fn(2, 2, |i, _| i as f64);
         assert!(solve_dense(singular.as_ref(), &[1.0, 1.0]).is_none());
+    }
+}
+#[cfg(test)]
+mod scale_tests {
+    use super::*;
+    use crate::linalg::TriangularAccumulator;
+
+    #[test]
+    fn solution_is_invariant_to_a_uniform_weight() {
+        let build = |w: f64| {
+            let mut acc = TriangularAccumulator::new(5);
+            for i in 0..40 {
+                let x1 = (i as f64 * 0.3).sin();
+                let x2 = (i as f64 * 0.7).cos();
+                let x3 = x1 * x2 + 0.01 * (i as f64).sqrt();
+                let y = 2.0 + 3.0 * x1 - x2 + 0.5 * x3 + 1e-3 * ((i * 7919) % 13) as f64;
+                acc.push_row(&[w, w * x1, w * x2, w * x3, w * y]);
+            }
+            let p = ReducedProblem {
+                rows: acc.rows(),
+                r: acc.finish(),
+                n_nuisance: 1,
+                k: 3,
+            };
+            let d = p.decide(DEFAULT_RANK_TOLERANCE).unwrap();
+            p.solve(&d).parameters
+        };
+        let base = build(1.0);
+        for w in [1e-8, 1e6, 1e12] {
+            let other = build(w);
+            for j in 0..3 {
+                assert!(
+                    (other[j] - base[j]).abs() < 1e-9 * base[j].abs().max(1.0),
+                    "w {w}: {other:?} vs {base:?}"
+                );
+            }
+        }
     }
 }

@@ -288,6 +288,9 @@ pub fn curves(
                 .configure_mesh()
                 .x_desc(axes.x_label)
                 .y_desc(axes.y_label)
+                .x_label_formatter(&|v| trim_number(*v))
+                .y_label_formatter(&|v| trim_number(*v))
+                .light_line_style(WHITE)
                 .draw()
                 .map_err(|e| err(path, e))?;
             for (k, c) in curves.iter().enumerate() {
@@ -360,6 +363,18 @@ pub fn curves(
         (false, false) => draw!(x0..x1, y0..y1),
     }
     root.present().map_err(|e| err(path, e))
+}
+
+/// A tick label with at most four significant digits and no trailing zeros.
+fn trim_number(v: f64) -> String {
+    let s = format!("{:.4}", v);
+    let s = if v.abs() >= 1.0 { format!("{v:.2}") } else { s };
+    let s = s.trim_end_matches('0').trim_end_matches('.').to_string();
+    if s.is_empty() || s == "-" {
+        "0".into()
+    } else {
+        s
+    }
 }
 
 /// Named point clouds on shared axes.

@@ -1,0 +1,288 @@
+//! The encoder-grade study (the paper's Fig. 4, and beyond): how accurate is
+//! a self-calibrated Tricept as a function of the U-joint encoders' grade?
+//!
+//! For each grade (angle noise of one reading, arcsec), Monte Carlo trials
+//! of simulated self-calibration give the paper's residual error
+//! `mu = ||deps - deps_e||_1 / n_eps` and the compensated volumetric error on
+//! the middle plane. Three estimators run on the same scenario:
+//!
+//! - **fast** ([`fast`]): our identification, linear in the noise around the
+//!   exact noise-free estimate; one factorisation per grade, all trials in
+//!   one matrix product per block (millions of trials per second);
+//! - **exact** ([`exact`]): every trial's readings from the exact model and a
+//!   full nonlinear identification (the check on the fast path);
+//! - **paper** ([`paper`]): the paper's differenced, unweighted
+//!   `(H^T H)^{-1} H^T l`.
+//!
+//! [`optimize`] chooses pose sets that maximise an observability index.
+//! Everything is seeded and bit-reproducible at any thread count.
+#![cfg_attr(
+    not(test),
+    deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
+)]
+
+pub mod exact;
+pub mod fast;
+pub mod optimize;
+pub mod paper;
+mod rng;
+pub mod scenario;
+
+use serde::Serialize;
+use thiserror::Error;
+
+pub use fast::{GradeModel, LinearEstimator};
+pub use scenario::Scenario;
+
+/// Why a study could not run.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum StudyError {
+    /// Identification failed.
+    #[error(transparent)]
+    Ident(#[from] tricept_ident::IdentError),
+    /// The plant simulator failed.
+    #[error(transparent)]
+    Plant(#[from] tricept_plant::PlantError),
+    /// The error model failed (a pose out of reach...).
+    #[error(transparent)]
+    Model(#[from] tricept_model::ModelError),
+    /// Kinematics failed.
+    #[error(transparent)]
+    Kinematics(#[from] tricept_kinematics::KinematicsError),
+    /// An exact trial's Gauss-Newton did not converge.
+    #[error("exact trial {trial}: identification did not converge")]
+    NotConverged {
+        /// The trial.
+        trial: u64,
+    },
+    /// Inconsistent configuration.
+    #[error("{0}")]
+    Invalid(String),
+}
+
+/// What one trial produced.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TrialResult {
+    /// The paper's `mu`, mm.
+    pub mu_mm: f64,
+    /// Mean `|dr|` over the plane after compensation, mm.
+    pub plane_mean_mm: f64,
+    /// Largest `|dr|` over the plane after compensation, mm.
+    pub plane_max_mm: f64,
+    /// Mean `|dr - t|` over the plane after compensation, with `t` the
+    /// best-fit rigid translation removed (touch-off), mm.
+    pub plane_touched_mean_mm: f64,
+}
+
+/// Mean, median and the 5-95 % band of a sample.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Summary {
+    /// Sample mean.
+    pub mean: f64,
+    /// Sample standard deviation.
+    pub std_dev: f64,
+    /// Median.
+    pub median: f64,
+    /// 5 % quantile.
+    pub p05: f64,
+    /// 95 % quantile.
+    pub p95: f64,
+}
+
+impl Summary {
+    /// Summary of `values` (empty: all NaN).
+    pub fn of(values: &[f64]) -> Summary {
+        let n = values.len();
+        if n == 0 {
+            return Summary {
+                mean: f64::NAN,
+                std_dev: f64::NAN,
+                median: f64::NAN,
+                p05: f64::NAN,
+                p95: f64::NAN,
+            };
+        }
+        let mean = values.iter().sum::<f64>() / n as f64;
+        let var =
+            values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n.max(2) - 1) as f64;
+        let mut sorted = values.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        let q = |p: f64| {
+            let x = p * (n - 1) as f64;
+            let (i, f) = (x.floor() as usize, x.fract());
+            if i + 1 < n {
+                sorted[i] * (1.0 - f) + sorted[i + 1] * f
+            } else {
+                sorted[i]
+            }
+        };
+        Summary {
+            mean,
+            std_dev: var.sqrt(),
+            median: q(0.5),
+            p05: q(0.05),
+            p95: q(0.95),
+        }
+    }
+}
+
+/// Statistics of one estimator at one grade.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PathResult {
+    /// Number of trials.
+    pub trials: usize,
+    /// The paper's `mu`, mm.
+    pub mu_mm: Summary,
+    /// Share of trials with `mu > mu_0` (calibration made things worse).
+    pub mu_worse_share: f64,
+    /// Mean `|dr|` over the plane after compensation, mm.
+    pub plane_mean_mm: Summary,
+    /// Largest `|dr|` over the plane after compensation, mm.
+    pub plane_max_mm: Summary,
+    /// Mean `|dr|` after compensation and touch-off, mm.
+    pub plane_touched_mean_mm: Summary,
+    /// Share of trials whose mean plane error after compensation exceeds
+    /// the mean before.
+    pub plane_worse_share: f64,
+}
+
+impl PathResult {
+    /// Statistics of `trials` against the scenario's uncalibrated values.
+    pub fn of(trials: &[TrialResult], s: &Scenario) -> PathResult {
+        let n = trials.len().max(1) as f64;
+        let mu: Vec<f64> = trials.iter().map(|t| t.mu_mm).collect();
+        let mean: Vec<f64> = trials.iter().map(|t| t.plane_mean_mm).collect();
+        let max: Vec<f64> = trials.iter().map(|t| t.plane_max_mm).collect();
+        let touched: Vec<f64> = trials.iter().map(|t| t.plane_touched_mean_mm).collect();
+        PathResult {
+            trials: trials.len(),
+            mu_worse_share: mu.iter().filter(|m| **m > s.mu0_mm).count() as f64 / n,
+            plane_worse_share: mean.iter().filter(|m| **m > s.before_plane_mean_mm).count() as f64
+                / n,
+            mu_mm: Summary::of(&mu),
+            plane_mean_mm: Summary::of(&mean),
+            plane_max_mm: Summary::of(&max),
+            plane_touched_mean_mm: Summary::of(&touched),
+        }
+    }
+}
+
+/// Results at one encoder grade.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GradeResult {
+    /// Angle noise of one encoder reading, arcsec.
+    pub grade_arcsec: f64,
+    /// Our identification, fast path.
+    pub fast: PathResult,
+    /// Our identification, exact path (when run).
+    pub exact: Option<PathResult>,
+    /// The paper's solve (absent when `H^T H` is singular).
+    pub paper: Option<PathResult>,
+    /// Condition number of the paper's `H^T H`.
+    pub paper_condition: f64,
+    /// Numerical rank of our identification at this grade.
+    pub rank: usize,
+}
+
+/// Runs the fast path at every grade; `exact_trials` exact trials and the
+/// paper's solve alongside when asked.
+#[allow(clippy::too_many_arguments)]
+pub fn run_grades(
+    s: &Scenario,
+    grades_arcsec: &[f64],
+    trials: usize,
+    exact_trials: usize,
+    with_paper: bool,
+    seed: u64,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<Vec<GradeResult>, StudyError> {
+    grades_arcsec
+        .iter()
+        .enumerate()
+        .map(|(i, &g)| {
+            let model = GradeModel::new(s, g)?;
+            let fast = PathResult::of(&model.estimator.run(s, trials, seed, i as u64, progress), s);
+            let exact = if exact_trials > 0 {
+                Some(PathResult::of(
+                    &exact::run_exact(s, &model, exact_trials, seed, i as u64, progress)?,
+                    s,
+                ))
+            } else {
+                None
+            };
+            let (paper, paper_condition) = if with_paper {
+                match paper::paper_solve(s, g)? {
+                    paper::PaperSolve::Formed {
+                        estimator,
+                        condition,
+                    } => (
+                        Some(PathResult::of(
+                            &estimator.run(s, trials, seed ^ 0x5a5a, i as u64, progress),
+                            s,
+                        )),
+                        condition,
+                    ),
+                    paper::PaperSolve::Singular { condition } => (None, condition),
+                }
+            } else {
+                (None, f64::NAN)
+            };
+            Ok(GradeResult {
+                grade_arcsec: g,
+                fast,
+                exact,
+                paper,
+                paper_condition,
+                rank: model.design.decision.rank,
+            })
+        })
+        .collect()
+}
+
+/// The grade (arcsec) at which the median `mu` of `estimator(grade)`
+/// reaches `mu_0`, by doubling from `start_arcsec` then bisection in log
+/// space, with `trials` fast trials per evaluation. `None` if it does not
+/// cross below `limit_arcsec`.
+pub fn crossing_grade(
+    s: &Scenario,
+    start_arcsec: f64,
+    limit_arcsec: f64,
+    trials: usize,
+    seed: u64,
+    estimator: &dyn Fn(f64) -> Result<Option<LinearEstimator>, StudyError>,
+) -> Result<Option<f64>, StudyError> {
+    let median_mu = |g: f64| -> Result<Option<f64>, StudyError> {
+        Ok(estimator(g)?.map(|e| {
+            let r = e.run(s, trials, seed, 1000 + g.to_bits() % 1000, &|_| {});
+            Summary::of(&r.iter().map(|t| t.mu_mm).collect::<Vec<_>>()).median
+        }))
+    };
+    let mut lo = start_arcsec;
+    let Some(m) = median_mu(lo)? else {
+        return Ok(None);
+    };
+    if m >= s.mu0_mm {
+        return Ok(Some(lo));
+    }
+    let mut hi = lo;
+    loop {
+        hi *= 2.0;
+        if hi > limit_arcsec {
+            return Ok(None);
+        }
+        match median_mu(hi)? {
+            Some(m) if m >= s.mu0_mm => break,
+            Some(_) => lo = hi,
+            None => return Ok(None),
+        }
+    }
+    for _ in 0..12 {
+        let mid = (lo * hi).sqrt();
+        match median_mu(mid)? {
+            Some(m) if m >= s.mu0_mm => hi = mid,
+            _ => lo = mid,
+        }
+    }
+    Ok(Some((lo * hi).sqrt()))
+}
