@@ -303,7 +303,7 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
         );
         if let (Some(mu), Some(g)) = (reference, equivalent) {
             println!(
-                "the default set's median mu at {PAPER_CHOSEN_ARCSEC} arcsec ({mu:.4} mm) needs only a {g:.2} arcsec encoder with this set"
+                "this set matches the default set's median mu at {PAPER_CHOSEN_ARCSEC} arcsec ({mu:.4} mm) with a {g:.2} arcsec encoder (coarser = cheaper)"
             );
         }
         optimised_json.push(json!({
