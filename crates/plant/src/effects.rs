@@ -345,3 +345,21 @@ impl Effect {
         }
     }
 }
+
+/// The leg stiffness (N/um at 1 m) for which gravity moves the platform
+/// point by `deflection_um` at the centre of the workspace's middle plane
+/// (the magnitude in which the `compliance` effect is quoted).
+pub fn stiffness_for_platform_deflection(machine: &Machine, deflection_um: f64) -> f64 {
+    let r = Vector3::new(0.0, 0.0, machine.workspace.mid_plane_z_mm());
+    let Ok(ik) = machine.inverse(&r) else {
+        return f64::NAN;
+    };
+    let f = gravity_leg_tension_n(machine, &ik.up);
+    // Deflection at unit stiffness (1 N/um at 1 m), through the exact FK.
+    let legs: [f64; 3] =
+        std::array::from_fn(|i| ik.legs_mm[i] + compliance_extra_mm(1.0, f[i], ik.legs_mm[i]));
+    match machine.forward_from(&legs, &ik.up) {
+        Ok(fk) => (fk.position_mm - r).norm() * 1e3 / deflection_um,
+        Err(_) => f64::NAN,
+    }
+}

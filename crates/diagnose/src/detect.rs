@@ -1,0 +1,146 @@
+//! Detectability: for a campaign (its poses, their logged context and the
+//! sensor noise), how large must each effect be before the diagnosis finds
+//! it, and what does it do to the geometric parameters when it is smaller.
+//!
+//! With `W` the noise weighting, `A` the identifiable geometric columns (and
+//! the three offsets) and `S` the effect's columns, the part of the effect
+//! the geometric model cannot absorb is `S_perp = (I - P_A) W S`. For an
+//! effect of parameter vector `v` the likelihood-ratio statistic is
+//! non-central chi-square with `k` degrees of freedom and non-centrality
+//! `lambda = v^T S_perp^T S_perp v`; detection means power 95 % at the
+//! diagnosis' level (`alpha / 8`). The held-out residual RMS of the
+//! geometric model is about `sqrt(1 + lambda / m)` noise units over `m`
+//! readings, so halving it needs `lambda / m >= 3`. Below detection, the
+//! effect biases the geometric parameters by `B v`, `B = (A^T A)^-1 A^T W S`
+//! (read off the triangular factor of `[offsets | A | S]`).
+
+use faer::Mat;
+use serde::Serialize;
+use tricept_data::MeasuredPose;
+use tricept_ident::linalg::{TriangularAccumulator, invert_upper};
+use tricept_ident::{GeometricModel, IdentifyOptions, ReadingModel, design};
+use tricept_kinematics::UpJoints;
+
+use crate::model::{Candidate, ExtendedModel};
+use crate::stats::{chi2_power, required_noncentrality};
+
+/// Detectability of one effect of parameters `v` on a campaign.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Detectability {
+    /// The effect.
+    pub effect: tricept_plant::effects::EffectName,
+    /// The parameter vector analysed (the effect's "realistic" magnitude).
+    pub parameters: Vec<(String, f64)>,
+    /// Non-centrality of the likelihood-ratio test at `v`.
+    pub noncentrality: f64,
+    /// Power of the diagnosis' test at `v`.
+    pub power: f64,
+    /// Smallest multiple of `v` detected with 95 % power.
+    pub detectable_multiple: f64,
+    /// Expected held-out RMS of the geometric model at `v`, noise units.
+    pub expected_rms_geometric: f64,
+    /// Smallest multiple of `v` at which the extended model halves the
+    /// held-out RMS (`lambda / m = 3`).
+    pub halving_multiple: f64,
+    /// Bias of the geometric parameters per `v` (largest first), mm.
+    pub bias: Vec<(String, f64)>,
+}
+
+/// Analyses `candidate` with parameters `v` on the poses `poses` (with
+/// their context), noise `sigma`, at family-wise level `alpha`.
+pub fn detectability(
+    geometric: &GeometricModel,
+    candidate: Candidate,
+    v: &[f64],
+    poses: &[MeasuredPose],
+    sigma: [f64; 3],
+    alpha: f64,
+) -> Option<Detectability> {
+    let kg = geometric.names().len();
+    // The identifiable geometric columns of this pose set.
+    let mut o = IdentifyOptions::for_machine(geometric.nominal());
+    o.sigma = sigma;
+    let d = design(geometric, &vec![0.0; kg], poses, &o).ok()?;
+    let geo_cols = d.decision.identifiable.clone();
+    let model = ExtendedModel::new(geometric.clone(), &[candidate]);
+    let k = model.names().len();
+    let ke = k - kg;
+    let predictor = model.at(&vec![0.0; k]);
+    let width = 3 + geo_cols.len() + ke;
+    let mut acc = TriangularAccumulator::with_rows_hint(width, 3 * poses.len());
+    let mut jac = vec![0.0; 3 * k];
+    let mut row = vec![0.0; width];
+    for p in poses {
+        let mut seed: Option<UpJoints> = None;
+        predictor.predict(p, &mut seed, &mut jac).ok()?;
+        for c in 0..3 {
+            let w = 1.0 / sigma[c];
+            row.iter_mut().for_each(|x| *x = 0.0);
+            row[c] = w;
+            for (t, &g) in geo_cols.iter().enumerate() {
+                row[3 + t] = w * jac[c * k + g];
+            }
+            for e in 0..ke {
+                row[3 + geo_cols.len() + e] = w * jac[c * k + kg + e];
+            }
+            acc.push_row(&row);
+        }
+    }
+    let m = acc.rows() as f64;
+    let r = acc.finish();
+    let ng = 3 + geo_cols.len();
+    // lambda = |R_ee v|^2.
+    let r_ee = r.as_ref().submatrix(ng, ng, ke, ke);
+    let rv: Vec<f64> = (0..ke)
+        .map(|i| (0..ke).map(|j| r_ee[(i, j)] * v[j]).sum())
+        .collect();
+    let lambda: f64 = rv.iter().map(|x| x * x).sum();
+    let dof = (0..ke)
+        .filter(|&i| r_ee[(i, i)].abs() > 1e-9 * r_ee[(0, 0)].abs().max(1e-300))
+        .count()
+        .max(1) as f64;
+    let level = alpha / Candidate::ALL.len() as f64;
+    let needed = required_noncentrality(dof, level, 0.95);
+    // Bias: B = R_gg^-1 R_ge (rows: offsets then geometric parameters).
+    let r_gg = r.as_ref().submatrix(0, 0, ng, ng).to_owned();
+    let r_ge = r.as_ref().submatrix(0, ng, ng, ke).to_owned();
+    let inv = invert_upper(r_gg.as_ref());
+    let b: Mat<f64> = &inv * &r_ge;
+    let names = geometric.names();
+    let mut bias: Vec<(String, f64)> = geo_cols
+        .iter()
+        .enumerate()
+        .map(|(t, &g)| {
+            (
+                names[g].clone(),
+                (0..ke).map(|e| b[(3 + t, e)] * v[e]).sum(),
+            )
+        })
+        .collect();
+    bias.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+    bias.truncate(5);
+    let ratio = |mult: f64| mult * mult * lambda / m;
+    Some(Detectability {
+        effect: candidate.0,
+        parameters: candidate
+            .params()
+            .iter()
+            .map(|s| s.to_string())
+            .zip(v.iter().copied())
+            .collect(),
+        noncentrality: lambda,
+        power: chi2_power(lambda, dof, level),
+        detectable_multiple: if lambda > 0.0 {
+            (needed / lambda).sqrt()
+        } else {
+            f64::INFINITY
+        },
+        expected_rms_geometric: (1.0 + ratio(1.0)).sqrt(),
+        halving_multiple: if lambda > 0.0 {
+            (3.0 * m / lambda).sqrt()
+        } else {
+            f64::INFINITY
+        },
+        bias,
+    })
+}

@@ -1,0 +1,386 @@
+//! The geometric model extended by unmodelled effects: the reading model
+//! that the diagnosis fits for each candidate cause.
+//!
+//! Each [`Candidate`] adds the parameters of one effect, with the same
+//! physics as the plant simulator (`tricept_plant::effects`): leg effects
+//! change the actual leg lengths (their Jacobian columns are
+//! `J1^-1 e_i dq_i/dparam`), reading effects change the readings (direct
+//! columns), class-2 effects change the UP limb's kinematics (columns by
+//! central differences of the exact model). Context-free constant parts
+//! (a leg's mean thermal growth, a constant backlash...) are absorbed by the
+//! geometric `dq_i` and the sensor offsets; thermal growth is referred to
+//! the metrology reference temperature of 20 °C.
+
+use tricept_data::{Dataset, MeasuredPose};
+use tricept_ident::{GeometricModel, PosePredictor, ReadingModel, project_jacobian, solve_pose};
+use tricept_kinematics::{KinematicsError, Machine, SensorNoise, UpJoints};
+use tricept_model::error_jacobian_at;
+use tricept_plant::effects::{
+    EffectName, backlash_extra_mm, compliance_extra_mm, gravity_leg_tension_n, leg_lead_extra_mm,
+    scale_gain_error_mm, thermal_extra_mm, twist_reference_mm,
+};
+
+/// An effect the diagnosis can fit (every name of the vocabulary except
+/// `outliers`, which is handled by row screening).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Candidate(pub EffectName);
+
+/// How a parameter enters the model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Leg,
+    Reading,
+    Kinematic,
+}
+
+impl Candidate {
+    /// Every fittable candidate.
+    pub const ALL: [Candidate; 8] = [
+        Candidate(EffectName::LegLead),
+        Candidate(EffectName::Backlash),
+        Candidate(EffectName::Thermal),
+        Candidate(EffectName::ScaleGain),
+        Candidate(EffectName::EncoderEccentricity),
+        Candidate(EffectName::UjointAxes),
+        Candidate(EffectName::TubeTwist),
+        Candidate(EffectName::Compliance),
+    ];
+
+    /// Parameter names (with their unit in the name).
+    pub fn params(self) -> &'static [&'static str] {
+        match self.0 {
+            EffectName::LegLead => &["lead1_ppm", "lead2_ppm", "lead3_ppm"],
+            EffectName::Backlash => &["backlash1_um", "backlash2_um", "backlash3_um"],
+            EffectName::Thermal => &["expansion_ppm_per_k"],
+            EffectName::ScaleGain => &["scale_gain_ppm"],
+            EffectName::EncoderEccentricity => &[
+                "phi_sin_arcsec",
+                "phi_cos_arcsec",
+                "theta_sin_arcsec",
+                "theta_cos_arcsec",
+            ],
+            EffectName::UjointAxes => &["axis_skew_arcsec", "axis_offset_um"],
+            EffectName::TubeTwist => &["twist_arcsec_per_100mm"],
+            EffectName::Compliance => &["compliance_um_per_kn_at_1m"],
+            EffectName::Outliers => &[],
+        }
+    }
+
+    fn kind(self) -> Kind {
+        match self.0 {
+            EffectName::LegLead
+            | EffectName::Backlash
+            | EffectName::Thermal
+            | EffectName::Compliance => Kind::Leg,
+            EffectName::ScaleGain | EffectName::EncoderEccentricity => Kind::Reading,
+            _ => Kind::Kinematic,
+        }
+    }
+
+    /// The data column the effect needs, if any.
+    pub fn needs(self) -> Option<&'static str> {
+        match self.0 {
+            EffectName::Backlash => Some("dir1,dir2,dir3"),
+            EffectName::Thermal => Some("temp_c"),
+            _ => None,
+        }
+    }
+
+    /// Whether `data` has what the effect needs (and, for the context
+    /// columns, some variation in it).
+    pub fn available(self, data: &Dataset) -> bool {
+        match self.0 {
+            EffectName::Backlash => {
+                data.poses.iter().all(|p| p.approach.is_some())
+                    && (0..3).any(|i| {
+                        let dirs: Vec<i8> = data
+                            .poses
+                            .iter()
+                            .filter_map(|p| p.approach.map(|a| a[i]))
+                            .collect();
+                        dirs.contains(&1) && dirs.contains(&-1)
+                    })
+            }
+            EffectName::Thermal => {
+                let t: Vec<f64> = data.poses.iter().filter_map(|p| p.temp_c).collect();
+                t.len() == data.poses.len()
+                    && t.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                        - t.iter().copied().fold(f64::INFINITY, f64::min)
+                        > 0.05
+            }
+            _ => true,
+        }
+    }
+}
+
+/// The reference temperature of dimensional metrology (ISO 1), °C: the
+/// nominal lengths of the machine are taken to hold at it. (Referring the
+/// thermal growth to the campaign's own mean temperature instead would leave
+/// `alpha (mean - 20 °C) q_i`, a uniform lead error of all legs, unmodelled.)
+pub const REFERENCE_TEMPERATURE_C: f64 = 20.0;
+
+/// The geometric model plus the parameters of some effects.
+#[derive(Debug, Clone)]
+pub struct ExtendedModel {
+    geometric: GeometricModel,
+    effects: Vec<Candidate>,
+    names: Vec<String>,
+    sparse: Vec<Vec<(usize, f64)>>,
+    /// Reference temperature of the nominal lengths, °C.
+    temp_ref_c: f64,
+}
+
+impl ExtendedModel {
+    /// `geometric` extended by `effects`.
+    pub fn new(geometric: GeometricModel, effects: &[Candidate]) -> ExtendedModel {
+        let mut names = geometric.names().to_vec();
+        for e in effects {
+            names.extend(e.params().iter().map(|p| format!("{}.{p}", e.0)));
+        }
+        ExtendedModel {
+            sparse: geometric.parameter_set().sparse_columns(),
+            geometric,
+            effects: effects.to_vec(),
+            names,
+            temp_ref_c: REFERENCE_TEMPERATURE_C,
+        }
+    }
+
+    /// The geometric part.
+    pub fn geometric(&self) -> &GeometricModel {
+        &self.geometric
+    }
+
+    /// The effects included.
+    pub fn effects(&self) -> &[Candidate] {
+        &self.effects
+    }
+
+    /// Number of geometric parameters.
+    pub fn n_geometric(&self) -> usize {
+        self.geometric.names().len()
+    }
+
+    /// Index of the first parameter of each effect.
+    pub fn offsets(&self) -> Vec<usize> {
+        let mut at = self.n_geometric();
+        self.effects
+            .iter()
+            .map(|e| {
+                let here = at;
+                at += e.params().len();
+                here
+            })
+            .collect()
+    }
+
+    /// The machine at parameters `p` (geometric errors and class-2 effects).
+    pub fn machine_at(&self, p: &[f64]) -> Machine {
+        let g = self.n_geometric();
+        let mut m = self.geometric.machine_at(&p[..g]);
+        for (e, at) in self.effects.iter().zip(self.offsets()) {
+            match e.0 {
+                EffectName::UjointAxes => {
+                    m.up_limb.axis_skew_rad += p[at] * SensorNoise::ARCSEC;
+                    m.up_limb.axis_offset_mm += p[at + 1] * 1e-3;
+                }
+                EffectName::TubeTwist => {
+                    m.up_limb.twist_rad_per_mm += p[at] * SensorNoise::ARCSEC / 100.0;
+                    m.up_limb.twist_reference_mm = twist_reference_mm(&m);
+                }
+                _ => {}
+            }
+        }
+        m
+    }
+}
+
+impl ReadingModel for ExtendedModel {
+    fn names(&self) -> &[String] {
+        &self.names
+    }
+
+    fn at<'a>(&'a self, p: &[f64]) -> Box<dyn PosePredictor + 'a> {
+        let kinematic: Vec<(usize, Machine, Machine)> = self
+            .effects
+            .iter()
+            .zip(self.offsets())
+            .filter(|(e, _)| e.kind() == Kind::Kinematic)
+            .flat_map(|(e, at)| {
+                (at..at + e.params().len())
+                    .map(|j| (j, *e))
+                    .collect::<Vec<_>>()
+            })
+            .map(|(j, _)| {
+                let h = FD_STEP;
+                let mut plus = p.to_vec();
+                let mut minus = p.to_vec();
+                plus[j] += h;
+                minus[j] -= h;
+                (j, self.machine_at(&plus), self.machine_at(&minus))
+            })
+            .collect();
+        Box::new(ExtendedPredictor {
+            model: self,
+            p: p.to_vec(),
+            machine: self.machine_at(p),
+            kinematic,
+        })
+    }
+}
+
+/// Step of the central differences for class-2 parameters (arcsec, um).
+const FD_STEP: f64 = 1.0;
+
+/// `(parameter index, derivative of the three legs or readings)`.
+type Derivative = (usize, [f64; 3]);
+
+struct ExtendedPredictor<'a> {
+    model: &'a ExtendedModel,
+    p: Vec<f64>,
+    machine: Machine,
+    /// Class-2 parameters with their machines at `p +- FD_STEP`.
+    kinematic: Vec<(usize, Machine, Machine)>,
+}
+
+impl ExtendedPredictor<'_> {
+    /// Actual leg lengths at `pose` and their derivatives (per parameter,
+    /// per leg) for the leg effects.
+    fn legs(
+        &self,
+        pose: &MeasuredPose,
+    ) -> Result<([f64; 3], Vec<Derivative>), KinematicsError> {
+        let mut legs = pose.commands_mm;
+        let mut derivs = Vec::new();
+        let q = pose.commands_mm;
+        for (e, at) in self.model.effects.iter().zip(self.model.offsets()) {
+            match e.0 {
+                EffectName::LegLead => {
+                    for i in 0..3 {
+                        legs[i] += leg_lead_extra_mm(self.p[at + i], q[i]);
+                        let mut d = [0.0; 3];
+                        d[i] = leg_lead_extra_mm(1.0, q[i]);
+                        derivs.push((at + i, d));
+                    }
+                }
+                EffectName::Backlash => {
+                    let dir = pose.approach.unwrap_or([1, 1, 1]);
+                    for i in 0..3 {
+                        legs[i] += backlash_extra_mm(self.p[at + i], dir[i]);
+                        let mut d = [0.0; 3];
+                        d[i] = backlash_extra_mm(1.0, dir[i]);
+                        derivs.push((at + i, d));
+                    }
+                }
+                EffectName::Thermal => {
+                    let dt = pose.temp_c.map_or(0.0, |t| t - self.model.temp_ref_c);
+                    let d: [f64; 3] = std::array::from_fn(|i| thermal_extra_mm(1.0, q[i], dt));
+                    for i in 0..3 {
+                        legs[i] += self.p[at] * d[i];
+                    }
+                    derivs.push((at, d));
+                }
+                EffectName::Compliance => {
+                    let nominal = self.model.geometric.nominal();
+                    let up = nominal.forward(&q)?.up;
+                    let f = gravity_leg_tension_n(nominal, &up);
+                    // compliance c (um/kN at 1 m) = 1000 / stiffness (N/um at 1 m).
+                    let d: [f64; 3] =
+                        std::array::from_fn(|i| compliance_extra_mm(1000.0, f[i], q[i]));
+                    for i in 0..3 {
+                        legs[i] += self.p[at] * d[i];
+                    }
+                    derivs.push((at, d));
+                }
+                _ => {}
+            }
+        }
+        Ok((legs, derivs))
+    }
+
+    /// Readings from the UP joints, with the reading effects, and the
+    /// derivatives of the readings with respect to the reading parameters.
+    fn readings(&self, up: &UpJoints, p: &[f64]) -> ([f64; 3], Vec<Derivative>) {
+        let mut r = up.to_array();
+        let mut derivs = Vec::new();
+        for (e, at) in self.model.effects.iter().zip(self.model.offsets()) {
+            match e.0 {
+                EffectName::ScaleGain => {
+                    r[2] += scale_gain_error_mm(p[at], up.q4_mm);
+                    derivs.push((at, [0.0, 0.0, scale_gain_error_mm(1.0, up.q4_mm)]));
+                }
+                EffectName::EncoderEccentricity => {
+                    let a = SensorNoise::ARCSEC;
+                    let (sp, cp) = up.phi_rad.sin_cos();
+                    let (st, ct) = up.theta_rad.sin_cos();
+                    r[0] += a * (p[at] * sp + p[at + 1] * cp);
+                    r[1] += a * (p[at + 2] * st + p[at + 3] * ct);
+                    derivs.push((at, [a * sp, 0.0, 0.0]));
+                    derivs.push((at + 1, [a * cp, 0.0, 0.0]));
+                    derivs.push((at + 2, [0.0, a * st, 0.0]));
+                    derivs.push((at + 3, [0.0, a * ct, 0.0]));
+                }
+                _ => {}
+            }
+        }
+        (r, derivs)
+    }
+}
+
+impl PosePredictor for ExtendedPredictor<'_> {
+    fn predict(
+        &self,
+        pose: &MeasuredPose,
+        seed: &mut Option<UpJoints>,
+        jacobian: &mut [f64],
+    ) -> Result<[f64; 3], KinematicsError> {
+        let k = self.p.len();
+        let (legs, leg_derivs) = self.legs(pose)?;
+        let up = solve_pose(&self.machine, &legs, seed)?;
+        let geometry = self.machine.legs_at(&up);
+        let j21 = error_jacobian_at(&geometry)?;
+        let g = self.model.n_geometric();
+        // Geometric columns, written into a k-wide row layout.
+        let mut geo = vec![0.0; 3 * g];
+        project_jacobian(&j21, &self.model.sparse, &mut geo);
+        jacobian.iter_mut().for_each(|v| *v = 0.0);
+        for c in 0..3 {
+            jacobian[c * k..c * k + g].copy_from_slice(&geo[c * g..(c + 1) * g]);
+        }
+        // Leg effects: d(up)/d(leg i) is column i of J1^-1.
+        if !leg_derivs.is_empty() {
+            let j1_inv = geometry
+                .j1()
+                .try_inverse()
+                .ok_or(KinematicsError::Singular {
+                    condition: f64::INFINITY,
+                    limit: tricept_kinematics::SINGULARITY_CONDITION_LIMIT,
+                })?;
+            for (j, d) in &leg_derivs {
+                let v = j1_inv * nalgebra::Vector3::from(*d);
+                for c in 0..3 {
+                    jacobian[c * k + j] = v[c];
+                }
+            }
+        }
+        let (r, reading_derivs) = self.readings(&up, &self.p);
+        for (j, d) in &reading_derivs {
+            for c in 0..3 {
+                jacobian[c * k + j] += d[c];
+            }
+        }
+        // Class-2 effects by central differences of the exact model.
+        for (j, plus, minus) in &self.kinematic {
+            let mut s_plus = Some(up);
+            let mut s_minus = Some(up);
+            let up_p = solve_pose(plus, &legs, &mut s_plus)?;
+            let up_m = solve_pose(minus, &legs, &mut s_minus)?;
+            let (rp, _) = self.readings(&up_p, &self.p);
+            let (rm, _) = self.readings(&up_m, &self.p);
+            for c in 0..3 {
+                jacobian[c * k + j] = (rp[c] - rm[c]) / (2.0 * FD_STEP);
+            }
+        }
+        Ok(r)
+    }
+}

@@ -1,0 +1,182 @@
+//! The few distributions the diagnosis needs: chi-square tail probabilities
+//! and quantiles (through the regularised incomplete gamma function), and
+//! the power of a chi-square test against a non-central alternative.
+
+/// `ln Gamma(x)` for `x > 0` (Lanczos, g = 7; about 15 digits).
+pub fn ln_gamma(x: f64) -> f64 {
+    const G: f64 = 7.0;
+    const C: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    if x < 0.5 {
+        // Reflection.
+        let pi = std::f64::consts::PI;
+        return (pi / (pi * x).sin()).ln() - ln_gamma(1.0 - x);
+    }
+    let x = x - 1.0;
+    let mut a = C[0];
+    let t = x + G + 0.5;
+    for (i, c) in C.iter().enumerate().skip(1) {
+        a += c / (x + i as f64);
+    }
+    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
+}
+
+/// Regularised lower incomplete gamma `P(a, x)`.
+pub fn gamma_p(a: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if x < a + 1.0 {
+        // Series.
+        let mut sum = 1.0 / a;
+        let mut term = sum;
+        let mut n = a;
+        for _ in 0..1000 {
+            n += 1.0;
+            term *= x / n;
+            sum += term;
+            if term.abs() < sum.abs() * 1e-16 {
+                break;
+            }
+        }
+        (sum.ln() - x + a * x.ln() - ln_gamma(a)).exp()
+    } else {
+        1.0 - gamma_q_continued_fraction(a, x)
+    }
+}
+
+/// `Q(a, x) = 1 - P(a, x)` by Lentz's continued fraction (for `x >= a + 1`).
+fn gamma_q_continued_fraction(a: f64, x: f64) -> f64 {
+    let tiny = 1e-300;
+    let mut b = x + 1.0 - a;
+    let mut c = 1.0 / tiny;
+    let mut d = 1.0 / b;
+    let mut h = d;
+    for i in 1..1000 {
+        let an = -(i as f64) * (i as f64 - a);
+        b += 2.0;
+        d = an * d + b;
+        if d.abs() < tiny {
+            d = tiny;
+        }
+        c = b + an / c;
+        if c.abs() < tiny {
+            c = tiny;
+        }
+        d = 1.0 / d;
+        let delta = d * c;
+        h *= delta;
+        if (delta - 1.0).abs() < 1e-16 {
+            break;
+        }
+    }
+    (-x + a * x.ln() - ln_gamma(a)).exp() * h
+}
+
+/// `P(X > x)` for `X ~ chi-square(k)`.
+pub fn chi2_sf(x: f64, k: f64) -> f64 {
+    if x <= 0.0 {
+        return 1.0;
+    }
+    if x >= k / 2.0 + 1.0 {
+        gamma_q_continued_fraction(k / 2.0, x / 2.0)
+    } else {
+        1.0 - gamma_p(k / 2.0, x / 2.0)
+    }
+}
+
+/// The `x` with `P(X > x) = tail` for `X ~ chi-square(k)` (bisection).
+pub fn chi2_isf(tail: f64, k: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0, k.max(1.0));
+    while chi2_sf(hi, k) > tail {
+        hi *= 2.0;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if chi2_sf(mid, k) > tail {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// `P(X > x)` for a non-central chi-square with `k` degrees of freedom and
+/// non-centrality `lambda`: the Poisson mixture of central ones.
+pub fn noncentral_chi2_sf(x: f64, k: f64, lambda: f64) -> f64 {
+    let mu = 0.5 * lambda;
+    let top = (mu + 12.0 * mu.sqrt() + 30.0).ceil() as usize;
+    let mut sum = 0.0;
+    for j in 0..=top {
+        let jf = j as f64;
+        let weight = (-mu + jf * mu.max(1e-300).ln() - ln_gamma(jf + 1.0)).exp();
+        sum += weight * chi2_sf(x, k + 2.0 * jf);
+    }
+    sum.min(1.0)
+}
+
+/// Power of the level-`alpha` chi-square test with `k` degrees of freedom
+/// against non-centrality `lambda`.
+pub fn chi2_power(lambda: f64, k: f64, alpha: f64) -> f64 {
+    noncentral_chi2_sf(chi2_isf(alpha, k), k, lambda)
+}
+
+/// The non-centrality at which the level-`alpha` test with `k` degrees of
+/// freedom has power `power`.
+pub fn required_noncentrality(k: f64, alpha: f64, power: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0, 1.0);
+    while chi2_power(hi, k, alpha) < power {
+        hi *= 2.0;
+    }
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if chi2_power(mid, k, alpha) < power {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn known_values() {
+        // ln Gamma(5) = ln 24, Gamma(0.5) = sqrt(pi).
+        assert!((ln_gamma(5.0) - 24f64.ln()).abs() < 1e-13);
+        assert!((ln_gamma(0.5) - std::f64::consts::PI.sqrt().ln()).abs() < 1e-13);
+        // chi-square(1): P(X > 3.841459) = 0.05; chi-square(10): P(X > 18.307) = 0.05.
+        assert!((chi2_sf(3.841_458_820_694_124, 1.0) - 0.05).abs() < 1e-10);
+        assert!((chi2_sf(18.307_038_053_275_146, 10.0) - 0.05).abs() < 1e-9);
+        assert!((chi2_isf(0.001, 3.0) - 16.266_236_196_238_13).abs() < 1e-7);
+        // chi-square(2) is exponential: P(X > x) = exp(-x / 2).
+        for x in [0.1, 1.0, 7.0, 40.0] {
+            assert!(
+                (chi2_sf(x, 2.0) - (-x / 2.0f64).exp()).abs()
+                    < 1e-14 * 1f64.max((-x / 2.0f64).exp()) + 1e-15
+            );
+        }
+    }
+
+    #[test]
+    fn power_grows_with_noncentrality() {
+        assert!((chi2_power(0.0, 2.0, 0.01) - 0.01).abs() < 2e-3);
+        // One degree of freedom: the classic (z_{a/2} + z_b)^2 = (2.576 + 1.645)^2 = 17.8.
+        let l = required_noncentrality(1.0, 0.01, 0.95);
+        assert!((l - 17.81).abs() < 0.05, "{l}");
+        assert!(required_noncentrality(3.0, 0.01, 0.95) > l);
+    }
+}
