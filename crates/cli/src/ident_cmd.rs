@@ -5,11 +5,11 @@ use nalgebra::Vector3;
 use serde_json::{Map, Value, json};
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_ident::{
-    GeometricModel, IdentError, Identification, IdentifyOptions, compensation, corrected_commands,
+    GeometricModel, IdentError, Identification, IdentifyOptions, corrected_commands,
     identifiability, identify,
 };
 use tricept_kinematics::{Machine, SensorNoise};
-use tricept_model::{MapStats, ParameterSet, actual_machine, volumetric_errors};
+use tricept_model::{ErrorMap, MapStats, ParameterSet, volumetric_errors};
 
 use crate::MachineArgs;
 use crate::cli_error::CliError;
@@ -270,6 +270,7 @@ pub fn run_compensate(
     params: &ParamArgs,
     data: &std::path::Path,
     truth: Option<&str>,
+    truth_effects: &[String],
     plane_z_mm: Option<f64>,
     spacing_mm: f64,
     targets: Option<&std::path::Path>,
@@ -293,13 +294,32 @@ pub fn run_compensate(
     );
     if let Some(spec) = truth {
         let set = model.parameter_set();
-        let actual = actual_machine(&m, &set.to_errors(&parse_errors(spec, set)?));
-        let c = compensation(&m, &identified, &actual, &grid)
-            .map_err(|e| CliError::other(format!("compensation map: {e}")))?;
-        let residual = c.after.without_mean_translation();
-        let t = c.after.mean_translation_mm();
-        out.insert("before".into(), stats_json(&c.before.stats()));
-        out.insert("after".into(), stats_json(&c.after.stats()));
+        let mut plant =
+            tricept_plant::Plant::geometric(m.clone(), set.to_errors(&parse_errors(spec, set)?));
+        plant.effects = crate::simulate_cmd::parse_effects(truth_effects)?;
+        // Where the actual machine goes when commanded by a model's IK.
+        let map = |commanding: &tricept_kinematics::Machine| -> Result<ErrorMap, CliError> {
+            let mut errors = Vec::with_capacity(grid.len());
+            for r in &grid {
+                let q = commanding
+                    .inverse(r)
+                    .map_err(|e| CliError::other(format!("compensation map: {e}")))?
+                    .legs_mm;
+                let reached = plant
+                    .reach(&q)
+                    .map_err(|e| CliError::other(format!("compensation map: {e}")))?;
+                errors.push(reached - r);
+            }
+            Ok(ErrorMap {
+                targets_mm: grid.clone(),
+                errors_mm: errors,
+            })
+        };
+        let (before, after) = (map(&m)?, map(&identified)?);
+        let residual = after.without_mean_translation();
+        let t = after.mean_translation_mm();
+        out.insert("before".into(), stats_json(&before.stats()));
+        out.insert("after".into(), stats_json(&after.stats()));
         out.insert(
             "after_without_translation".into(),
             stats_json(&residual.stats()),

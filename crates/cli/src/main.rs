@@ -7,6 +7,7 @@
 //! results go to stdout.
 
 mod cli_error;
+mod diagnose_cmd;
 mod ident_cmd;
 mod kinematics_cmd;
 mod output;
@@ -165,6 +166,45 @@ enum Command {
         #[command(flatten)]
         machine: MachineArgs,
     },
+    /// Does the geometric model explain the data? If not, which unmodelled
+    /// effect does (leg-lead, backlash, thermal, scale-gain,
+    /// encoder-eccentricity, ujoint-axes, tube-twist, compliance, outliers).
+    #[command(
+        after_help = "Examples:\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n  tricept diagnose --data data.csv --json --plots out/"
+    )]
+    Diagnose {
+        /// Measured-data CSV (context columns temp_c, time_s, dir1..3 are used when present).
+        #[arg(long, value_name = "FILE.csv")]
+        data: PathBuf,
+        /// Write residual plots (SVG) of the named causes into this directory.
+        #[arg(long, value_name = "DIR")]
+        plots: Option<PathBuf>,
+        #[command(flatten)]
+        noise: NoiseArgs,
+        #[command(flatten)]
+        machine: MachineArgs,
+    },
+    /// For a measurement campaign: how large must each unmodelled effect be
+    /// before the diagnosis finds it, and what it does to the geometric
+    /// parameters below that; with advice on the campaign.
+    #[command(
+        after_help = "Examples:\n  tricept detectability\n  tricept detectability --poses random:200,1 --both-directions --readings-per-pose 30 --temperature-drift 2"
+    )]
+    Detectability {
+        /// Pose set (as for `identifiability`).
+        #[arg(long, default_value = "grid")]
+        poses: String,
+        /// Visit every pose twice, approaching from both directions.
+        #[arg(long)]
+        both_directions: bool,
+        /// Temperature change over the campaign, K (0: no thermal signature).
+        #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
+        temperature_drift: f64,
+        #[command(flatten)]
+        noise: NoiseArgs,
+        #[command(flatten)]
+        machine: MachineArgs,
+    },
     /// Identify from data, then compensate: corrected commands and the
     /// volumetric error on a plane before and after.
     #[command(
@@ -177,6 +217,10 @@ enum Command {
         /// True errors of the machine that produced the data (simulations).
         #[arg(long, value_name = "ERRORS")]
         truth: Option<String>,
+        /// An unmodelled effect of the true machine (JSON or @FILE, as for
+        /// `simulate`); repeatable; used with --truth.
+        #[arg(long = "truth-effect", value_name = "JSON")]
+        truth_effects: Vec<String>,
         /// Plane of the error map, mm (default: the workspace's middle plane).
         #[arg(long, value_name = "Z_MM", allow_negative_numbers = true)]
         plane_z: Option<f64>,
@@ -248,9 +292,29 @@ fn run(cli: Cli) -> Result<(), CliError> {
             effects: &effects,
             out: out.as_deref(),
         }),
+        Command::Diagnose {
+            data,
+            plots,
+            noise,
+            machine,
+        } => diagnose_cmd::run_diagnose(&machine, &noise, &data, plots.as_deref()),
+        Command::Detectability {
+            poses,
+            both_directions,
+            temperature_drift,
+            noise,
+            machine,
+        } => diagnose_cmd::run_detectability(
+            &machine,
+            &noise,
+            &poses,
+            both_directions,
+            temperature_drift,
+        ),
         Command::Compensate {
             data,
             truth,
+            truth_effects,
             plane_z,
             spacing,
             targets,
@@ -263,6 +327,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
             &params,
             &data,
             truth.as_deref(),
+            &truth_effects,
             plane_z,
             spacing,
             targets.as_deref(),

@@ -31,7 +31,7 @@ pub struct SimulateArgs<'a> {
     pub out: Option<&'a Path>,
 }
 
-fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, CliError> {
+pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, CliError> {
     let mut out = Vec::new();
     for spec in specs {
         let (text, origin) = match spec.strip_prefix('@') {

@@ -94,7 +94,16 @@ pub fn detectability(
     let rv: Vec<f64> = (0..ke)
         .map(|i| (0..ke).map(|j| r_ee[(i, j)] * v[j]).sum())
         .collect();
-    let lambda: f64 = rv.iter().map(|x| x * x).sum();
+    // An effect whose data columns are absent or constant has no signature.
+    let data = tricept_data::Dataset {
+        poses: poses.to_vec(),
+        source: String::new(),
+    };
+    let lambda: f64 = if candidate.available(&data) {
+        rv.iter().map(|x| x * x).sum()
+    } else {
+        0.0
+    };
     let dof = (0..ke)
         .filter(|&i| r_ee[(i, i)].abs() > 1e-9 * r_ee[(0, 0)].abs().max(1e-300))
         .count()
@@ -143,4 +152,80 @@ pub fn detectability(
         },
         bias,
     })
+}
+
+/// The realistic magnitudes of the issue, in the diagnosis'
+/// parameterisation: leg-lead 50 ppm (alternating signs), backlash 5 um,
+/// thermal 11.5 ppm/K (steel; the 2 K drift is in the data), scale-gain
+/// 50 ppm, encoder eccentricity 5 arcsec (sine and cosine phases),
+/// U-joint axes 30 arcsec skew or 20 um offset, tube twist 30 arcsec over the
+/// 290 mm stroke, compliance 10 um of platform deflection.
+pub fn realistic(
+    machine: &tricept_kinematics::Machine,
+) -> Vec<(Candidate, Vec<f64>, &'static str)> {
+    use tricept_plant::effects::{EffectName as E, stiffness_for_platform_deflection};
+    vec![
+        (Candidate(E::LegLead), vec![50.0, -50.0, 50.0], "50 ppm"),
+        (Candidate(E::Backlash), vec![5.0, 5.0, 5.0], "5 um"),
+        (Candidate(E::Thermal), vec![11.5], "11.5 ppm/K (steel)"),
+        (Candidate(E::ScaleGain), vec![50.0], "50 ppm"),
+        (
+            Candidate(E::EncoderEccentricity),
+            vec![5.0, 0.0, 5.0, 0.0],
+            "5 arcsec, sine phase",
+        ),
+        (
+            Candidate(E::EncoderEccentricity),
+            vec![0.0, 5.0, 0.0, 5.0],
+            "5 arcsec, cosine phase",
+        ),
+        (Candidate(E::UjointAxes), vec![30.0, 0.0], "30 arcsec skew"),
+        (Candidate(E::UjointAxes), vec![0.0, 20.0], "20 um offset"),
+        (
+            Candidate(E::TubeTwist),
+            vec![30.0 / 2.9],
+            "30 arcsec over the stroke",
+        ),
+        (
+            Candidate(E::Compliance),
+            vec![1000.0 / stiffness_for_platform_deflection(machine, 10.0)],
+            "10 um at the platform",
+        ),
+    ]
+}
+
+/// One line of campaign advice for an effect analysed on a campaign of
+/// `poses` logged poses with `readings` readings averaged per value.
+pub fn advise(d: &Detectability, poses: usize, readings: u32) -> String {
+    if !d.detectable_multiple.is_finite() {
+        return match d.effect {
+            tricept_plant::effects::EffectName::Backlash => {
+                "invisible: visit poses from both approach directions (--both-directions)".into()
+            }
+            tricept_plant::effects::EffectName::Thermal => {
+                "invisible: log the structure temperature while it changes".into()
+            }
+            _ => "invisible to these sensors on this pose set".into(),
+        };
+    }
+    let mut parts = Vec::new();
+    if d.detectable_multiple > 1.0 {
+        let factor = d.detectable_multiple * d.detectable_multiple;
+        parts.push(format!(
+            "to detect it, about {:.0} poses or the mean of {:.0} readings",
+            poses as f64 * factor,
+            f64::from(readings) * factor
+        ));
+    }
+    if d.halving_multiple > 1.0 {
+        parts.push(format!(
+            "to halve the residual, the mean of {:.0} readings per pose",
+            (f64::from(readings) * d.halving_multiple * d.halving_multiple).ceil()
+        ));
+    }
+    if parts.is_empty() {
+        "detected and corrected by this campaign".into()
+    } else {
+        parts.join("; ")
+    }
 }

@@ -25,6 +25,11 @@ use tricept_plant::effects::{
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Candidate(pub EffectName);
 
+/// A logged temperature that varies by less than this over the campaign
+/// (K) carries no usable thermal signature: a logger's own noise (0.02 K in
+/// the plant simulator) spans about 0.1 K over a few hundred readings.
+pub const MIN_TEMPERATURE_RANGE_K: f64 = 0.25;
+
 /// How a parameter enters the model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Kind {
@@ -106,7 +111,7 @@ impl Candidate {
                 t.len() == data.poses.len()
                     && t.iter().copied().fold(f64::NEG_INFINITY, f64::max)
                         - t.iter().copied().fold(f64::INFINITY, f64::min)
-                        > 0.05
+                        > MIN_TEMPERATURE_RANGE_K
             }
             _ => true,
         }
@@ -246,10 +251,7 @@ struct ExtendedPredictor<'a> {
 impl ExtendedPredictor<'_> {
     /// Actual leg lengths at `pose` and their derivatives (per parameter,
     /// per leg) for the leg effects.
-    fn legs(
-        &self,
-        pose: &MeasuredPose,
-    ) -> Result<([f64; 3], Vec<Derivative>), KinematicsError> {
+    fn legs(&self, pose: &MeasuredPose) -> Result<([f64; 3], Vec<Derivative>), KinematicsError> {
         let mut legs = pose.commands_mm;
         let mut derivs = Vec::new();
         let q = pose.commands_mm;

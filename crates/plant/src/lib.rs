@@ -230,6 +230,29 @@ impl Plant {
     }
 }
 
+impl Plant {
+    /// Where the actual platform point goes for leg `commands_mm`, with the
+    /// leg effects at the campaign's start (no temperature change, every leg
+    /// approached extending), mm.
+    pub fn reach(&self, commands_mm: &[f64; 3]) -> Result<Vector3<f64>, KinematicsError> {
+        let nominal_up = self.nominal.forward(commands_mm)?.up;
+        let state = effects::PoseState {
+            commands_mm: *commands_mm,
+            nominal_up,
+            delta_temp_k: 0.0,
+            approach: [1, 1, 1],
+        };
+        let mut legs = *commands_mm;
+        for e in &self.effects {
+            e.extra_leg_length(&self.nominal, &state, &mut legs);
+        }
+        Ok(self
+            .actual_machine()
+            .forward_from(&legs, &nominal_up)?
+            .position_mm)
+    }
+}
+
 /// `n` parameter values drawn uniformly in `[-magnitude_mm, magnitude_mm]`
 /// from `seed` (PCG-64 MCG).
 ///

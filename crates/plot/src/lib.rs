@@ -411,6 +411,7 @@ pub fn scatter(
         .configure_mesh()
         .x_desc(axes.x_label)
         .y_desc(axes.y_label)
+        .light_line_style(WHITE)
         .draw()
         .map_err(|e| err(path, e))?;
     for (k, (name, points)) in series.iter().enumerate() {
