@@ -54,10 +54,10 @@ pub fn run_diagnose(
         }
     }
     if machine.json {
-        println!("{}", d.to_json());
+        outln!("{}", d.to_json());
         return Ok(());
     }
-    println!(
+    outln!(
         "{}: the geometric model {}",
         source,
         if d.adequate {
@@ -66,7 +66,7 @@ pub fn run_diagnose(
             "does NOT explain the data"
         }
     );
-    println!(
+    outln!(
         "geometric fit: chi2 {:.1} for {} dof (p = {:.2e}); residual rms phi {:.3} arcsec, theta {:.3} arcsec, s {:.3} um",
         d.chi_square,
         d.dof,
@@ -76,14 +76,17 @@ pub fn run_diagnose(
         d.residual_rms_geometric[2]
     );
     if let Some(s) = d.structure.first() {
-        println!(
+        outln!(
             "strongest residual structure: {} vs {} (r = {:+.2}, p = {:.1e})",
-            s.channel, s.regressor, s.correlation, s.p_value
+            s.channel,
+            s.regressor,
+            s.correlation,
+            s.p_value
         );
     }
     for (i, c) in d.causes.iter().enumerate() {
         let ev = &c.evidence;
-        println!(
+        outln!(
             "cause {}: {}   (chi2 drop {:.1} for {} dof, p = {:.1e}; BIC gain {:.1}{})",
             i + 1,
             c.effect,
@@ -98,16 +101,16 @@ pub fn run_diagnose(
         );
         for p in &c.parameters {
             match p.std_dev {
-                Some(sd) => println!("    {:<40} {:>12.4} +- {:.4}", p.name, p.value, sd),
-                None => println!("    {:<40} {:>12.4}", p.name, p.value),
+                Some(sd) => outln!("    {:<40} {:>12.4} +- {:.4}", p.name, p.value, sd),
+                None => outln!("    {:<40} {:>12.4}", p.name, p.value),
             }
         }
         if !c.rows.is_empty() {
-            println!("    lines: {:?}", c.rows);
+            outln!("    lines: {:?}", c.rows);
         }
     }
     if let Some(u) = &d.unexplained {
-        println!("unexplained: {u}");
+        outln!("unexplained: {u}");
     }
     let mut bias = d.geometric_bias.clone();
     bias.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
@@ -117,13 +120,13 @@ pub fn run_diagnose(
             .take(4)
             .map(|(n, v)| format!("{n} {:+.4}", v))
             .collect();
-        println!(
+        outln!(
             "bias the causes put into the geometric parameters (mm): {}",
             text.join(", ")
         );
     }
     let g = &d.gain;
-    println!(
+    outln!(
         "gain: held-out rms {:.3} -> {:.3} (noise = 1); platform moved on the middle plane by {:.4} mm mean ({:.4} after touch-off), {:.4} mm max",
         g.holdout_rms_geometric,
         g.holdout_rms_extended,
@@ -174,13 +177,13 @@ pub fn run_detectability(
             .iter()
             .map(|(label, d, advice)| serde_json::json!({"magnitude": label, "analysis": d, "advice": advice}))
             .collect();
-        println!(
+        outln!(
             "{}",
             serde_json::json!({"poses": data.poses.len(), "readings_per_pose": campaign.noise.readings_per_pose, "effects": v})
         );
         return Ok(());
     }
-    println!(
+    outln!(
         "{} logged poses ({}{}), mean of {} readings, temperature drift {} K",
         data.poses.len(),
         poses,
@@ -192,18 +195,22 @@ pub fn run_detectability(
         campaign.noise.readings_per_pose,
         drift_k
     );
-    println!(
+    outln!(
         "| effect | magnitude | power | detectable from | geometric held-out rms | halved from | largest bias (mm) | advice |"
     );
-    println!("|---|---|---|---|---|---|---|---|");
+    outln!("|---|---|---|---|---|---|---|---|");
     for (label, d, advice) in rows {
         let bias = d
             .bias
             .first()
             .map_or("-".to_string(), |(n, b)| format!("{n} {b:+.4}"));
-        println!(
+        outln!(
             "| {} | {label} | {:.3} | x{:.2} | {:.2} | x{:.2} | {bias} | {advice} |",
-            d.effect, d.power, d.detectable_multiple, d.expected_rms_geometric, d.halving_multiple
+            d.effect,
+            d.power,
+            d.detectable_multiple,
+            d.expected_rms_geometric,
+            d.halving_multiple
         );
     }
     Ok(())

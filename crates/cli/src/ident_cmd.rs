@@ -5,8 +5,8 @@ use nalgebra::Vector3;
 use serde_json::{Map, Value, json};
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_ident::{
-    GeometricModel, IdentError, Identification, IdentifyOptions, corrected_commands,
-    identifiability, identify,
+    GeometricModel, IdentError, Identification, IdentifyOptions, Rejection, corrected_commands,
+    identifiability, identify, identify_robust,
 };
 use tricept_kinematics::{Machine, SensorNoise};
 use tricept_model::{ErrorMap, MapStats, ParameterSet, volumetric_errors};
@@ -19,10 +19,10 @@ use crate::kinematics_cmd::load_machine;
 #[derive(Debug, Args, Clone, Default)]
 pub struct NoiseArgs {
     /// Encoder noise of one reading, arcsec.
-    #[arg(long, value_name = "ARCSEC")]
+    #[arg(long, value_name = "ARCSEC", allow_hyphen_values = true)]
     pub angle_noise_arcsec: Option<f64>,
     /// Linear-scale noise of one reading, um.
-    #[arg(long, value_name = "UM")]
+    #[arg(long, value_name = "UM", allow_hyphen_values = true)]
     pub length_noise_um: Option<f64>,
     /// Readings averaged into one logged value.
     #[arg(long, value_name = "N")]
@@ -44,6 +44,16 @@ impl ParamArgs {
     pub fn set(&self) -> Result<ParameterSet, CliError> {
         ParameterSet::by_label(&self.params).map_err(|e| CliError::input(format!("--params: {e}")))
     }
+}
+
+/// How to fit.
+#[derive(Debug, Args, Clone, Default)]
+pub struct FitArgs {
+    /// Keep every pose: do not reject gross reading errors (by default,
+    /// poses beyond the Bonferroni-corrected 0.1 % quantile of the
+    /// standardised residuals are rejected and reported).
+    #[arg(long)]
+    pub no_robust: bool,
 }
 
 /// Loads the machine and applies the noise overrides.
@@ -141,9 +151,9 @@ pub fn run_identifiability(
             o.insert("parameter_set".into(), set.label().into());
             o.insert("axis_order".into(), m.up_limb.axis_order.to_string().into());
         }
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!(
+        outln!(
             "{} ({} U joint), parameter set {}, pose set `{poses}`",
             m.name,
             m.up_limb.axis_order,
@@ -159,15 +169,24 @@ fn identify_from_file(
     machine: &MachineArgs,
     noise: &NoiseArgs,
     params: &ParamArgs,
+    fit: &FitArgs,
     data: &std::path::Path,
-) -> Result<(Machine, GeometricModel, Identification), CliError> {
+) -> Result<(Machine, GeometricModel, Identification, Vec<Rejection>), CliError> {
     let m = machine_with_noise(machine, noise)?;
     let set = params.set()?;
     let dataset = read_data(data, &m)?;
     let model = GeometricModel::new(m.clone(), set);
-    let id = identify(&model, &dataset, &IdentifyOptions::for_machine(&m))
-        .map_err(|e| ident_error(&data.display().to_string(), e))?;
-    Ok((m, model, id))
+    let options = IdentifyOptions::for_machine(&m);
+    let source = data.display().to_string();
+    let (id, rejected) = if fit.no_robust {
+        (
+            identify(&model, &dataset, &options).map_err(|e| ident_error(&source, e))?,
+            Vec::new(),
+        )
+    } else {
+        identify_robust(&model, &dataset, &options).map_err(|e| ident_error(&source, e))?
+    };
+    Ok((m, model, id, rejected))
 }
 
 /// `tricept identify`.
@@ -175,10 +194,11 @@ pub fn run_identify(
     machine: &MachineArgs,
     noise: &NoiseArgs,
     params: &ParamArgs,
+    fit: &FitArgs,
     data: &std::path::Path,
     write_machine: Option<&std::path::Path>,
 ) -> Result<(), CliError> {
-    let (_, model, id) = identify_from_file(machine, noise, params, data)?;
+    let (_, model, id, rejected) = identify_from_file(machine, noise, params, fit, data)?;
     if let Some(path) = write_machine {
         let mut d = model.machine_at(&id.estimate).to_description();
         d.notes = Some(format!("identified from {}", data.display()));
@@ -186,10 +206,25 @@ pub fn run_identify(
             .map_err(|e| CliError::other(format!("{}: {e}", path.display())))?;
     }
     if machine.json {
-        println!("{}", id.to_json());
+        let mut v = id.to_json();
+        if let Value::Object(o) = &mut v {
+            o.insert(
+                "rejected".into(),
+                serde_json::to_value(&rejected).unwrap_or(Value::Null),
+            );
+        }
+        outln!("{v}");
         return Ok(());
     }
-    println!(
+    for r in &rejected {
+        outln!(
+            "rejected line {} of {}: a reading {:.1} noise standard deviations off (gross error)",
+            r.line,
+            data.display(),
+            r.residual_sigma
+        );
+    }
+    outln!(
         "{} poses, parameter set {}: {} in {} Gauss-Newton iterations",
         id.residuals.len(),
         model.parameter_set().label(),
@@ -200,19 +235,21 @@ pub fn run_identify(
         },
         id.iterations
     );
-    println!("{:>6} {:>12} {:>10}", "param", "estimate mm", "sd mm");
+    outln!("{:>6} {:>12} {:>10}", "param", "estimate mm", "sd mm");
     for ((n, v), sd) in id.names.iter().zip(&id.estimate).zip(&id.std_dev) {
         match sd {
-            Some(s) => println!("{n:>6} {v:>12.5} {s:>10.5}"),
-            None => println!("{n:>6} {v:>12.5} {:>10}", "fixed"),
+            Some(s) => outln!("{n:>6} {v:>12.5} {s:>10.5}"),
+            None => outln!("{n:>6} {v:>12.5} {:>10}", "fixed"),
         }
     }
     let a = SensorNoise::ARCSEC;
-    println!(
+    outln!(
         "offsets: phi {:.6} rad, theta {:.6} rad, s {:.4} mm",
-        id.offsets[0], id.offsets[1], id.offsets[2]
+        id.offsets[0],
+        id.offsets[1],
+        id.offsets[2]
     );
-    println!(
+    outln!(
         "residual rms: phi {:.3} arcsec, theta {:.3} arcsec, s {:.3} um; chi2/dof {:.3} (dof {}); largest {:.1} sigma at pose {}",
         id.stats.rms[0] / a,
         id.stats.rms[1] / a,
@@ -268,6 +305,7 @@ pub fn run_compensate(
     machine: &MachineArgs,
     noise: &NoiseArgs,
     params: &ParamArgs,
+    fit: &FitArgs,
     data: &std::path::Path,
     truth: Option<&str>,
     truth_effects: &[String],
@@ -275,7 +313,7 @@ pub fn run_compensate(
     spacing_mm: f64,
     targets: Option<&std::path::Path>,
 ) -> Result<(), CliError> {
-    let (m, model, id) = identify_from_file(machine, noise, params, data)?;
+    let (m, model, id, rejected) = identify_from_file(machine, noise, params, fit, data)?;
     let identified = model.machine_at(&id.estimate);
     let z = plane_z_mm.unwrap_or_else(|| m.workspace.mid_plane_z_mm());
     if !(spacing_mm.is_finite() && spacing_mm >= 1.0) {
@@ -287,6 +325,10 @@ pub fn run_compensate(
     let predicted = volumetric_errors(&m, &identified, &grid)
         .map_err(|e| CliError::other(format!("compensation map: {e}")))?;
     out.insert("plane_z_mm".into(), z.into());
+    out.insert(
+        "rejected_lines".into(),
+        Value::Array(rejected.iter().map(|r| Value::from(r.line)).collect()),
+    );
     out.insert("grid_points".into(), grid.len().into());
     out.insert(
         "predicted_correction".into(),
@@ -346,9 +388,9 @@ pub fn run_compensate(
         );
     }
     if machine.json {
-        println!("{}", Value::Object(out));
+        outln!("{}", Value::Object(out));
     } else {
-        println!(
+        outln!(
             "compensation over the plane z = {z} mm ({} points, {spacing_mm} mm lattice)",
             grid.len()
         );
@@ -359,7 +401,7 @@ pub fn run_compensate(
             "after_without_translation",
         ] {
             if let Some(s) = out.get(key) {
-                println!(
+                outln!(
                     "{key:>26}: max {:.4} / min {:.4} / mean {:.4} mm",
                     s["max_mm"].as_f64().unwrap_or(f64::NAN),
                     s["min_mm"].as_f64().unwrap_or(f64::NAN),
@@ -368,14 +410,19 @@ pub fn run_compensate(
             }
         }
         if let Some(t) = out.get("translation_mm") {
-            println!("{:>26}: {t} mm", "rigid translation");
+            outln!("{:>26}: {t} mm", "rigid translation");
         }
         if let Some(Value::Array(rows)) = out.get("corrected_commands") {
-            println!("x,y,z,q1,q2,q3");
+            outln!("x,y,z,q1,q2,q3");
             for r in rows {
-                println!(
+                outln!(
                     "{},{},{},{},{},{}",
-                    r["x"], r["y"], r["z"], r["q1"], r["q2"], r["q3"]
+                    r["x"],
+                    r["y"],
+                    r["z"],
+                    r["q1"],
+                    r["q2"],
+                    r["q3"]
                 );
             }
         }

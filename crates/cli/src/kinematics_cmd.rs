@@ -94,6 +94,6 @@ pub fn print_machine(args: &MachineArgs) -> Result<(), CliError> {
         Some(path) => MachineDescription::from_file(path)
             .map_err(|e| CliError::description(&path.display().to_string(), &e))?,
     };
-    println!("{}", description.to_json());
+    outln!("{}", description.to_json());
     Ok(())
 }

@@ -6,6 +6,17 @@
 //! unreachable commands), 1 anything else. Errors go to stderr as one line;
 //! results go to stdout.
 
+/// `println!` that ends the process quietly when stdout is closed (a
+/// pipe into `head`, say) instead of panicking.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if writeln!(std::io::stdout().lock(), $($arg)*).is_err() {
+            std::process::exit(0);
+        }
+    }};
+}
+
 mod cli_error;
 mod diagnose_cmd;
 mod ident_cmd;
@@ -19,7 +30,7 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand};
 
 use crate::cli_error::CliError;
-use crate::ident_cmd::{NoiseArgs, ParamArgs};
+use crate::ident_cmd::{FitArgs, NoiseArgs, ParamArgs};
 
 /// Calibrate the Tricept parallel kinematic machine from its own sensors.
 ///
@@ -129,6 +140,8 @@ enum Command {
         #[arg(long, value_name = "FILE.json")]
         write_machine: Option<PathBuf>,
         #[command(flatten)]
+        fit: FitArgs,
+        #[command(flatten)]
         params: ParamArgs,
         #[command(flatten)]
         noise: NoiseArgs,
@@ -231,6 +244,8 @@ enum Command {
         #[arg(long, value_name = "FILE.csv")]
         targets: Option<PathBuf>,
         #[command(flatten)]
+        fit: FitArgs,
+        #[command(flatten)]
         params: ParamArgs,
         #[command(flatten)]
         noise: NoiseArgs,
@@ -267,10 +282,18 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Identify {
             data,
             write_machine,
+            fit,
             params,
             noise,
             machine,
-        } => ident_cmd::run_identify(&machine, &noise, &params, &data, write_machine.as_deref()),
+        } => ident_cmd::run_identify(
+            &machine,
+            &noise,
+            &params,
+            &fit,
+            &data,
+            write_machine.as_deref(),
+        ),
         Command::Simulate {
             errors,
             poses,
@@ -318,6 +341,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
             plane_z,
             spacing,
             targets,
+            fit,
             params,
             noise,
             machine,
@@ -325,6 +349,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
             &machine,
             &noise,
             &params,
+            &fit,
             &data,
             truth.as_deref(),
             &truth_effects,

@@ -9,7 +9,7 @@ pub fn print_record(json: bool, pairs: &[(&str, Value)]) {
             .iter()
             .map(|(k, v)| (k.to_string(), v.clone()))
             .collect();
-        println!("{}", Value::Object(map));
+        outln!("{}", Value::Object(map));
     } else {
         let width = pairs.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
         for (k, v) in pairs {
@@ -21,7 +21,7 @@ pub fn print_record(json: bool, pairs: &[(&str, Value)]) {
                 Value::String(s) => s.clone(),
                 other => other.to_string(),
             };
-            println!("{k:>width$} = {text}");
+            outln!("{k:>width$} = {text}");
         }
     }
 }

@@ -22,7 +22,7 @@ use tricept_ident::{GeometricModel, IdentifyOptions, ReadingModel, design};
 use tricept_kinematics::UpJoints;
 
 use crate::model::{Candidate, ExtendedModel};
-use crate::stats::{chi2_power, required_noncentrality};
+use tricept_ident::stats::{chi2_power, required_noncentrality};
 
 /// Detectability of one effect of parameters `v` on a campaign.
 #[derive(Debug, Clone, PartialEq, Serialize)]

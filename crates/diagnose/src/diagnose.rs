@@ -27,13 +27,14 @@ use serde_json::{Map, Value, json};
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_ident::{
     GeometricModel, IdentError, Identification, IdentifyOptions, ReadingModel, identify,
+    residuals_at, screen_gross_errors,
 };
 use tricept_kinematics::{Machine, SensorNoise, UpJoints};
 use tricept_model::ParameterSet;
 use tricept_plant::effects::EffectName;
 
 use crate::model::{Candidate, ExtendedModel};
-use crate::stats::{chi2_isf, chi2_sf};
+use tricept_ident::stats::chi2_sf;
 
 /// Why a diagnosis could not be made.
 #[derive(Debug, thiserror::Error)]
@@ -244,19 +245,7 @@ fn subset(data: &Dataset, keep: impl Fn(usize) -> bool) -> Dataset {
 
 /// Weighted residuals of `poses` under a fitted model (offsets applied).
 fn residuals_of(f: &Fit, poses: &[MeasuredPose], sigma: &[f64; 3]) -> Vec<Option<[f64; 3]>> {
-    let predictor = f.model.at(&f.id.estimate);
-    let k = f.model.names().len();
-    let mut jac = vec![0.0; 3 * k];
-    poses
-        .iter()
-        .map(|p| {
-            let mut seed: Option<UpJoints> = None;
-            predictor.predict(p, &mut seed, &mut jac).ok().map(|g| {
-                let y = p.readings.to_array();
-                [0, 1, 2].map(|c| (y[c] - g[c] - f.id.offsets[c]) / sigma[c])
-            })
-        })
-        .collect()
+    residuals_at(&f.model, &f.id.estimate, &f.id.offsets, poses, sigma)
 }
 
 /// K-fold cross-validated RMS of the weighted held-out residuals of
@@ -313,48 +302,23 @@ fn estimates(f: &Fit) -> Vec<Estimate> {
         .collect()
 }
 
-/// Bonferroni-corrected outlier screen (see the module docs). Returns the
-/// indices of the flagged poses.
+/// The outlier screen of `tricept_ident::robust` with the diagnosis'
+/// options; the indices of the flagged poses.
 fn screen_outliers(
     model: &ExtendedModel,
     data: &Dataset,
     options: &DiagnoseOptions,
 ) -> Result<Vec<usize>, IdentError> {
-    let n = data.poses.len();
-    let z_crit = chi2_isf(options.alpha / (3 * n) as f64, 1.0).sqrt();
-    let mut flagged: Vec<usize> = Vec::new();
-    for _ in 0..4 {
-        let clean = subset(data, |j| !flagged.contains(&j));
-        let f = fit(model.clone(), &clean, options)?;
-        let res = residuals_of(&f, &data.poses, &options.sigma);
-        // Robust scale per channel (MAD of the clean residuals), never
-        // below the stated noise.
-        let scale: [f64; 3] = std::array::from_fn(|c| {
-            let mut v: Vec<f64> = res
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| !flagged.contains(j))
-                .filter_map(|(_, r)| r.map(|r| r[c].abs()))
-                .collect();
-            v.sort_by(f64::total_cmp);
-            let mad = v.get(v.len() / 2).copied().unwrap_or(0.0) * 1.4826;
-            mad.max(1.0)
-        });
-        let next: Vec<usize> = res
-            .iter()
-            .enumerate()
-            .filter(|(_, r)| match r {
-                Some(r) => (0..3).any(|c| r[c].abs() / scale[c] > z_crit),
-                None => true,
-            })
-            .map(|(j, _)| j)
-            .collect();
-        if next == flagged {
-            break;
-        }
-        flagged = next;
-    }
-    Ok(flagged)
+    Ok(screen_gross_errors(
+        model,
+        data,
+        &identify_options(options),
+        options.alpha,
+        options.max_outlier_share,
+    )?
+    .into_iter()
+    .map(|r| r.pose)
+    .collect())
 }
 
 /// Regressors of every pose (name, value per pose).

@@ -9,6 +9,5 @@
 pub mod detect;
 pub mod diagnose;
 pub mod model;
-pub mod stats;
 
 pub use model::{Candidate, ExtendedModel};

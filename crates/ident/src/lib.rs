@@ -54,6 +54,8 @@ pub mod linalg;
 pub mod lsq;
 mod model;
 mod report;
+mod robust;
+pub mod stats;
 
 pub use compensate::{Compensation, compensation, corrected_commands};
 pub use error::IdentError;
@@ -63,3 +65,4 @@ pub use identify::{
 };
 pub use model::{GeometricModel, PosePredictor, ReadingModel, project_jacobian, solve_pose};
 pub use report::{Combination, IdentifiabilityReport, Observability};
+pub use robust::{Rejection, identify_robust, residuals_at, screen_gross_errors};

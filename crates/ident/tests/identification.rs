@@ -357,3 +357,60 @@ fn the_full_21_set_names_the_two_rigid_body_gauges() {
     assert!(has(&["dzA1", "dzA2", "dzA3"]), "{texts:?}");
     assert!(has(&["dyA3"]), "{texts:?}");
 }
+
+#[test]
+fn gross_reading_errors_are_rejected_by_row_and_do_not_wreck_the_estimate() {
+    use tricept_ident::identify_robust;
+    let m = machine(AxisOrder::YFirst);
+    let set = ParameterSet::paper15();
+    let truth = set.table2();
+    let model = GeometricModel::new(m.clone(), set.clone());
+    let plant = Plant::geometric(m.clone(), set.to_errors(&truth));
+    for seed in 0..6u64 {
+        let mut data = plant.simulate(&Campaign::grid(&m, 40 + seed)).unwrap();
+        // Three gross errors on random rows and channels, 50 to 500 sigma.
+        let mut rng = Pcg64Mcg::seed_from_u64(seed);
+        let sigma = m.sensors.logged_sigma();
+        let mut corrupted = Vec::new();
+        while corrupted.len() < 3 {
+            let j = rng.random_range(0..data.poses.len());
+            if corrupted.contains(&j) {
+                continue;
+            }
+            let c = rng.random_range(0..3);
+            let size =
+                rng.random_range(50.0..500.0) * if rng.random::<bool>() { 1.0 } else { -1.0 };
+            let mut r = data.poses[j].readings.to_array();
+            r[c] += size * sigma[c];
+            data.poses[j].readings = Readings::from_array(r);
+            data.poses[j].line = 100 + j as u64;
+            corrupted.push(j);
+        }
+        let options = IdentifyOptions::for_machine(&m);
+        let (id, rejected) = identify_robust(&model, &data, &options).unwrap();
+        let mut found: Vec<usize> = rejected.iter().map(|r| r.pose).collect();
+        found.sort_unstable();
+        corrupted.sort_unstable();
+        assert_eq!(found, corrupted, "seed {seed}");
+        assert!(rejected.iter().all(|r| r.line == 100 + r.pose as u64));
+        for (j, name) in set.names().iter().enumerate() {
+            let z = (id.estimate[j] - truth[j]) / id.std_dev[j].unwrap();
+            assert!(z.abs() < 4.0, "seed {seed}: {name} z {z:.2}");
+        }
+        // Without the screen the same data wreck the fit.
+        let plain = identify(&model, &data, &options).unwrap();
+        assert!(plain.stats.reduced_chi_square > 10.0);
+    }
+    // Clean data lose no pose.
+    let mut false_rejections = 0;
+    for seed in 0..20u64 {
+        let data = plant.simulate(&Campaign::grid(&m, 200 + seed)).unwrap();
+        let (_, rejected) =
+            identify_robust(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+        false_rejections += rejected.len();
+    }
+    assert!(
+        false_rejections <= 1,
+        "{false_rejections} clean poses rejected in 20 data sets"
+    );
+}

@@ -1,0 +1,531 @@
+//! Every input a user can get wrong: the exit code (2 for usage and input
+//! errors, 1 for anything else), one clear line on stderr naming the
+//! problem (file, line and column where there is one), nothing on stdout,
+//! and never a panic.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn tricept() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_tricept"))
+}
+
+fn workdir() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tricept-bad-inputs-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A valid measured-data file (the paper's machine, Table 2), as text.
+fn good_csv(dir: &Path) -> String {
+    let path = dir.join("good.csv");
+    let out = tricept()
+        .args(["simulate", "--poses", "grid:1,8,3", "--out"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    std::fs::read_to_string(path).unwrap()
+}
+
+/// The data lines (after comments and header) of a CSV text.
+fn split(csv: &str) -> (Vec<String>, String, Vec<String>) {
+    let mut comments = Vec::new();
+    let mut lines = csv.lines().map(str::to_string);
+    let header = loop {
+        let l = lines.next().unwrap();
+        if l.starts_with('#') {
+            comments.push(l);
+        } else {
+            break l;
+        }
+    };
+    (comments, header, lines.collect())
+}
+
+struct Case {
+    name: &'static str,
+    args: Vec<String>,
+    files: Vec<(&'static str, Vec<u8>)>,
+    code: i32,
+    needles: Vec<&'static str>,
+}
+
+fn case(
+    name: &'static str,
+    args: &[&str],
+    files: Vec<(&'static str, Vec<u8>)>,
+    code: i32,
+    needles: &[&'static str],
+) -> Case {
+    Case {
+        name,
+        args: args.iter().map(|s| s.to_string()).collect(),
+        files,
+        code,
+        needles: needles.to_vec(),
+    }
+}
+
+fn with_rows(header: &str, rows: &[String]) -> Vec<u8> {
+    let mut s = format!("{header}\n");
+    for r in rows {
+        s.push_str(r);
+        s.push('\n');
+    }
+    s.into_bytes()
+}
+
+fn replace_field(row: &str, index: usize, value: &str) -> String {
+    let mut f: Vec<String> = row.split(',').map(str::to_string).collect();
+    f[index] = value.to_string();
+    f.join(",")
+}
+
+#[test]
+fn bad_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
+    let dir = workdir();
+    let csv = good_csv(&dir);
+    let (_, header, rows) = split(&csv);
+    let base = header.clone();
+    let id = |file: &'static str| {
+        vec![
+            "identify".to_string(),
+            "--data".to_string(),
+            dir.join(file).display().to_string(),
+        ]
+    };
+    let mut cases = vec![
+        // Measured-data files.
+        case(
+            "empty file",
+            &[],
+            vec![("empty.csv", Vec::new())],
+            2,
+            &["empty.csv", "empty file"],
+        ),
+        case(
+            "header only",
+            &[],
+            vec![("header.csv", format!("{base}\n").into_bytes())],
+            2,
+            &["header only"],
+        ),
+        case(
+            "missing column",
+            &[],
+            vec![("missing.csv", with_rows("q1,q2,q3,phi,theta,temp_c", &[]))],
+            2,
+            &["missing required column `s`"],
+        ),
+        case(
+            "misspelt column",
+            &[],
+            vec![(
+                "misspelt.csv",
+                with_rows(&base.replace("theta", "theat"), &rows),
+            )],
+            2,
+            &["missing required column `theta`", "theat"],
+        ),
+        case(
+            "non-numeric field",
+            &[],
+            vec![(
+                "text.csv",
+                with_rows(&base, &[rows[0].clone(), replace_field(&rows[1], 3, "abc")]),
+            )],
+            2,
+            &["text.csv: line 3, column `phi`", "not a number"],
+        ),
+        case(
+            "NaN",
+            &[],
+            vec![(
+                "nan.csv",
+                with_rows(&base, &[replace_field(&rows[0], 5, "NaN")]),
+            )],
+            2,
+            &["line 2, column `s`", "not a finite number"],
+        ),
+        case(
+            "infinity",
+            &[],
+            vec![(
+                "inf.csv",
+                with_rows(&base, &[replace_field(&rows[0], 0, "inf")]),
+            )],
+            2,
+            &["column `q1`", "not a finite number"],
+        ),
+        case(
+            "wrong column count",
+            &[],
+            vec![(
+                "count.csv",
+                with_rows(
+                    &base,
+                    &[
+                        rows[0].clone(),
+                        rows[1].rsplit_once(',').unwrap().0.to_string(),
+                    ],
+                ),
+            )],
+            2,
+            &["line 3", "fields"],
+        ),
+        case(
+            "angles in degrees",
+            &[],
+            vec![(
+                "degrees.csv",
+                with_rows(
+                    &base,
+                    &rows
+                        .iter()
+                        .map(|r| {
+                            let phi: f64 = r.split(',').nth(3).unwrap().parse().unwrap();
+                            replace_field(r, 3, &(phi.to_degrees()).to_string())
+                        })
+                        .collect::<Vec<_>>(),
+                ),
+            )],
+            2,
+            &["column `phi`", "degrees"],
+        ),
+        case(
+            "command beyond the stroke",
+            &[],
+            vec![(
+                "stroke.csv",
+                with_rows(&base, &[rows[0].clone(), replace_field(&rows[1], 1, "100")]),
+            )],
+            2,
+            &["stroke.csv: line 3, column `q2`", "stroke"],
+        ),
+        case(
+            "no assembly for the commands",
+            &[],
+            vec![(
+                "assembly.csv",
+                with_rows(&base, &{
+                    let mut r = rows.clone();
+                    r[4] = replace_field(&replace_field(&r[4], 0, "500"), 1, "1200");
+                    r
+                }),
+            )],
+            2,
+            &["line 6", "cannot be reached"],
+        ),
+        case(
+            "too few poses",
+            &[],
+            vec![("few.csv", with_rows(&base, &rows[..4]))],
+            2,
+            &["too few poses", "at least"],
+        ),
+        case(
+            "duplicate row",
+            &[],
+            vec![(
+                "dup.csv",
+                with_rows(&base, &[rows[0].clone(), rows[1].clone(), rows[0].clone()]),
+            )],
+            2,
+            &["line 4 repeats line 2"],
+        ),
+        case(
+            "negative command",
+            &[],
+            vec![(
+                "neg.csv",
+                with_rows(&base, &[replace_field(&rows[0], 2, "-700")]),
+            )],
+            2,
+            &["column `q3`", "positive"],
+        ),
+        case(
+            "bad approach direction",
+            &[],
+            vec![(
+                "dir.csv",
+                with_rows(&base, &[replace_field(&rows[0], 8, "0")]),
+            )],
+            2,
+            &["column `dir1`", "+1 or -1"],
+        ),
+        case(
+            "partial direction columns",
+            &[],
+            vec![(
+                "partial.csv",
+                with_rows("q1,q2,q3,phi,theta,s,dir1,dir2", &[]),
+            )],
+            2,
+            &["come as a set", "dir3"],
+        ),
+        case(
+            "implausible temperature",
+            &[],
+            vec![(
+                "temp.csv",
+                with_rows(&base, &[replace_field(&rows[0], 6, "2000")]),
+            )],
+            2,
+            &["column `temp_c`", "temperature"],
+        ),
+        case("missing data file", &[], vec![], 2, &["nothere.csv"]),
+        case(
+            "not text",
+            &[],
+            vec![("binary.csv", vec![b'q', b'1', 0xff, 0xfe, b'\n'])],
+            2,
+            &["binary.csv", "UTF-8"],
+        ),
+    ];
+    // The data cases all run `identify` on their first file (or a missing one).
+    for c in cases.iter_mut() {
+        let file = c.files.first().map_or("nothere.csv", |f| f.0);
+        c.args = id(file);
+    }
+    let good = dir.join("good.csv").display().to_string();
+    let machine_cases = vec![
+        case(
+            "unknown machine key",
+            &[],
+            vec![("unknown.json", {
+                let mut v: serde_json::Value =
+                    serde_json::from_str(tricept_kinematics::description::PAPER_MACHINE_JSON)
+                        .unwrap();
+                v["colour"] = "red".into();
+                serde_json::to_vec_pretty(&v).unwrap()
+            })],
+            2,
+            &["unknown.json: line", "unknown field `colour`"],
+        ),
+        case(
+            "negative radius",
+            &[],
+            vec![(
+                "negative.json",
+                tricept_kinematics::description::PAPER_MACHINE_JSON
+                    .replace("288.7", "-288.7")
+                    .into_bytes(),
+            )],
+            2,
+            &["base_radius_mm", "positive"],
+        ),
+        case(
+            "coincident joints",
+            &[],
+            vec![(
+                "coincident.json",
+                tricept_kinematics::description::PAPER_MACHINE_JSON
+                    .replace("[120.0, 240.0, 0.0]", "[120.0, 120.0, 0.0]")
+                    .into_bytes(),
+            )],
+            2,
+            &["coincide"],
+        ),
+        case(
+            "malformed JSON",
+            &[],
+            vec![("malformed.json", b"{ \"name\": ".to_vec())],
+            2,
+            &["malformed.json: line 1"],
+        ),
+        case(
+            "inverted stroke",
+            &[],
+            vec![(
+                "stroke.json",
+                tricept_kinematics::description::PAPER_MACHINE_JSON
+                    .replace("[450.0, 1250.0]", "[1250.0, 450.0]")
+                    .into_bytes(),
+            )],
+            2,
+            &["leg_stroke_mm", "below"],
+        ),
+        case("missing machine file", &[], vec![], 2, &["nomachine.json"]),
+    ];
+    for mut c in machine_cases {
+        let file = c.files.first().map_or("nomachine.json", |f| f.0);
+        c.args = vec![
+            "identify".into(),
+            "--data".into(),
+            good.clone(),
+            "--machine".into(),
+            dir.join(file).display().to_string(),
+        ];
+        cases.push(c);
+    }
+    // Arguments.
+    let args = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let mut arg_cases = vec![
+        (
+            case("ik with a word", &[], vec![], 2, &["invalid value"]),
+            args(&["ik", "0", "x", "750"]),
+        ),
+        (
+            case("ik out of reach", &[], vec![], 2, &["ik:", "stroke"]),
+            args(&["ik", "0", "0", "3000"]),
+        ),
+        (
+            case("fk without assembly", &[], vec![], 2, &["fk:"]),
+            args(&["fk", "500", "1200", "1200"]),
+        ),
+        (
+            case("unknown verb", &[], vec![], 2, &["unrecognized subcommand"]),
+            args(&["calibrate-everything"]),
+        ),
+        (
+            case(
+                "unknown parameter set",
+                &[],
+                vec![],
+                2,
+                &["--params", "paper99"],
+            ),
+            args(&["identifiability", "--params", "paper99"]),
+        ),
+        (
+            case("bad pose set", &[], vec![], 2, &["grid:2,x,1"]),
+            args(&["identifiability", "--poses", "grid:2,x,1"]),
+        ),
+        (
+            case(
+                "negative noise",
+                &[],
+                vec![],
+                2,
+                &["--angle-noise-arcsec", "positive"],
+            ),
+            args(&["identifiability", "--angle-noise-arcsec", "-1"]),
+        ),
+        (
+            case("missing errors file", &[], vec![], 2, &["noerrors.json"]),
+            args(&["simulate", "--errors", "noerrors.json"]),
+        ),
+        (
+            case(
+                "bad effect",
+                &[],
+                vec![],
+                2,
+                &["--effect", "unknown variant"],
+            ),
+            args(&["simulate", "--effect", r#"{"effect":"gremlins"}"#]),
+        ),
+        (
+            case(
+                "too few poses to diagnose",
+                &[],
+                vec![],
+                2,
+                &["too few poses"],
+            ),
+            vec![
+                "diagnose".into(),
+                "--data".into(),
+                dir.join("few10.csv").display().to_string(),
+            ],
+        ),
+        (
+            case("unknown error parameter", &[], vec![], 2, &["dzB1"]),
+            vec![
+                "simulate".into(),
+                "--errors".into(),
+                dir.join("errors.json").display().to_string(),
+            ],
+        ),
+    ];
+    std::fs::write(dir.join("few10.csv"), with_rows(&base, &rows[..10])).unwrap();
+    std::fs::write(dir.join("errors.json"), r#"{"dzB1": 0.1}"#).unwrap();
+    for (mut c, a) in arg_cases.drain(..) {
+        c.args = a;
+        cases.push(c);
+    }
+    assert!(cases.len() >= 25, "{} cases", cases.len());
+
+    for c in &cases {
+        for (name, content) in &c.files {
+            std::fs::write(dir.join(name), content).unwrap();
+        }
+        let out = tricept().args(&c.args).current_dir(&dir).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !stderr.contains("panicked"),
+            "{}: panicked\n{stderr}",
+            c.name
+        );
+        assert_eq!(
+            out.status.code(),
+            Some(c.code),
+            "{}: exit code; stderr: {stderr}",
+            c.name
+        );
+        for n in &c.needles {
+            assert!(
+                stderr.contains(n),
+                "{}: stderr lacks `{n}`:\n{stderr}",
+                c.name
+            );
+        }
+        assert!(out.stdout.is_empty(), "{}: printed to stdout", c.name);
+        // clap's usage errors span a few lines; ours are exactly one.
+        if !c
+            .needles
+            .iter()
+            .any(|n| ["invalid value", "unrecognized subcommand"].contains(n))
+        {
+            assert_eq!(
+                stderr.trim_end().lines().count(),
+                1,
+                "{}: more than one line:\n{stderr}",
+                c.name
+            );
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn results_go_to_stdout_with_exit_code_0() {
+    let out = tricept()
+        .args(["ik", "-120.5", "80", "700", "--json"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    assert!(out.stderr.is_empty());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for k in ["q1", "q2", "q3", "phi", "theta", "q4"] {
+        assert!(v[k].is_number(), "{k}");
+    }
+    let q = [
+        v["q1"].as_f64().unwrap(),
+        v["q2"].as_f64().unwrap(),
+        v["q3"].as_f64().unwrap(),
+    ];
+    let out = tricept()
+        .args([
+            "fk",
+            &q[0].to_string(),
+            &q[1].to_string(),
+            &q[2].to_string(),
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let f: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!((f["x"].as_f64().unwrap() + 120.5).abs() < 1e-9);
+    assert!((f["y"].as_f64().unwrap() - 80.0).abs() < 1e-9);
+    assert!((f["z"].as_f64().unwrap() - 700.0).abs() < 1e-9);
+    let out = tricept().args(["--help"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("identify"));
+}
