@@ -28,7 +28,7 @@ pub struct StudyArgs {
     /// Encoder grades, arcsec (comma separated).
     #[arg(long, value_delimiter = ',', default_values_t = vec![0.25, 0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0])]
     grades: Vec<f64>,
-    /// Pose set: grid, grid:R,P,L, random:N[,SEED], disc:S[,Z] or a CSV of x,y,z.
+    /// Pose set: `grid`, `grid:R,P,L`, `random:N[,SEED]`, `disc:S[,Z]` or a CSV of x,y,z.
     #[arg(long, default_value = "grid")]
     poses: String,
     /// Machine description (default: the paper's Table 1 machine).

@@ -86,7 +86,14 @@ pub fn machine_with_noise(args: &MachineArgs, noise: &NoiseArgs) -> Result<Machi
 /// Reads a measured-data file; every problem is an input error naming
 /// file, line and column.
 pub fn read_data(path: &std::path::Path, machine: &Machine) -> Result<Dataset, CliError> {
-    let data = tricept_data::read_path(path).map_err(|e| CliError::input(e.to_string()))?;
+    let file = path.display().to_string();
+    let f = std::fs::File::open(path).map_err(|e| CliError::input(format!("{file}: {e}")))?;
+    // A progress bar over the bytes read (drawn only on a terminal).
+    let size = f.metadata().map(|m| m.len()).unwrap_or(0);
+    let bar = progress_bar(size, "reading");
+    let data = tricept_data::read_from(bar.wrap_read(std::io::BufReader::new(f)), &file)
+        .map_err(|e| CliError::input(e.to_string()))?;
+    bar.finish_and_clear();
     // Commands the machine cannot take are input errors too, found here
     // with their line rather than deep inside the solver.
     let [lo, hi] = machine.limits.leg_stroke_mm;
@@ -103,6 +110,34 @@ pub fn read_data(path: &std::path::Path, machine: &Machine) -> Result<Dataset, C
         }
     }
     Ok(data)
+}
+
+/// A progress bar on stderr; invisible when stderr is not a terminal or for
+/// small jobs.
+pub fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
+    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    if len < 20_000_000 {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {bytes}/{total_bytes} {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_message(what.to_string());
+    bar
+}
+
+/// A spinner on stderr while a long step runs (terminal only).
+pub fn spinner(what: String, poses: usize) -> indicatif::ProgressBar {
+    use indicatif::{ProgressBar, ProgressDrawTarget};
+    if poses < 50_000 {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    bar.set_message(what);
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
 }
 
 fn ident_error(source: &str, e: IdentError) -> CliError {
@@ -178,6 +213,10 @@ fn identify_from_file(
     let model = GeometricModel::new(m.clone(), set);
     let options = IdentifyOptions::for_machine(&m);
     let source = data.display().to_string();
+    let spin = spinner(
+        format!("identifying from {} poses", dataset.poses.len()),
+        dataset.poses.len(),
+    );
     let (id, rejected) = if fit.no_robust {
         (
             identify(&model, &dataset, &options).map_err(|e| ident_error(&source, e))?,
@@ -186,6 +225,7 @@ fn identify_from_file(
     } else {
         identify_robust(&model, &dataset, &options).map_err(|e| ident_error(&source, e))?
     };
+    spin.finish_and_clear();
     Ok((m, model, id, rejected))
 }
 

@@ -304,7 +304,6 @@ pub fn read_with_progress<R: Read>(
     let columns = locate_columns(&names, file, header_line)?;
 
     let mut poses = Vec::new();
-    let mut seen = std::collections::HashMap::new();
     while let Some(line) = next_line(&mut buf)? {
         let fields = split(&buf, line)?;
         if fields.len() != columns.count {
@@ -316,13 +315,6 @@ pub fn read_with_progress<R: Read>(
             });
         }
         let pose = parse_row(&fields, &columns, &names, file, line)?;
-        if let Some(first_line) = seen.insert(record_key(&pose), line) {
-            return Err(DataError::DuplicateRow {
-                file: file.into(),
-                line,
-                first_line,
-            });
-        }
         poses.push(pose);
         if poses.len() % 65_536 == 0 {
             progress(poses.len() as u64);
@@ -331,6 +323,13 @@ pub fn read_with_progress<R: Read>(
     if poses.is_empty() {
         return Err(DataError::NoRows { file: file.into() });
     }
+    if let Some((first_line, line)) = first_duplicate(&poses) {
+        return Err(DataError::DuplicateRow {
+            file: file.into(),
+            line,
+            first_line,
+        });
+    }
     check_angle_spans(&poses, file)?;
     Ok(Dataset {
         poses,
@@ -338,16 +337,59 @@ pub fn read_with_progress<R: Read>(
     })
 }
 
-fn record_key(p: &MeasuredPose) -> Vec<u64> {
-    let mut key: Vec<u64> = p
-        .commands_mm
+/// The bits of every value of a row.
+fn record_key(p: &MeasuredPose) -> [u64; 8] {
+    let r = p.readings.to_array();
+    [
+        p.commands_mm[0].to_bits(),
+        p.commands_mm[1].to_bits(),
+        p.commands_mm[2].to_bits(),
+        r[0].to_bits(),
+        r[1].to_bits(),
+        r[2].to_bits(),
+        p.temp_c.map_or(u64::MAX, f64::to_bits),
+        p.time_s.map_or(u64::MAX, f64::to_bits),
+    ]
+}
+
+/// The earliest-ending pair of identical rows, as `(first line, repeat
+/// line)`: rows sorted by a hash of their values (16 bytes per row, so a
+/// million-row file needs 16 MB), equal hashes compared exactly.
+fn first_duplicate(poses: &[MeasuredPose]) -> Option<(u64, u64)> {
+    use std::hash::{DefaultHasher, Hash, Hasher};
+    let mut keyed: Vec<(u64, u32)> = poses
         .iter()
-        .chain(&p.readings.to_array())
-        .map(|v| v.to_bits())
+        .enumerate()
+        .map(|(i, p)| {
+            let mut h = DefaultHasher::new();
+            record_key(p).hash(&mut h);
+            (h.finish(), i as u32)
+        })
         .collect();
-    key.push(p.temp_c.map_or(u64::MAX, f64::to_bits));
-    key.push(p.time_s.map_or(u64::MAX, f64::to_bits));
-    key
+    keyed.sort_unstable();
+    let mut best: Option<(u64, u64)> = None;
+    let mut start = 0;
+    while start < keyed.len() {
+        let mut end = start + 1;
+        while end < keyed.len() && keyed[end].0 == keyed[start].0 {
+            end += 1;
+        }
+        // Within a run of equal hashes (indices ascending), find repeats.
+        for a in start..end {
+            for b in a + 1..end {
+                let (i, j) = (keyed[a].1 as usize, keyed[b].1 as usize);
+                if record_key(&poses[i]) == record_key(&poses[j]) {
+                    let pair = (poses[i].line, poses[j].line);
+                    if best.is_none_or(|(_, l)| pair.1 < l) {
+                        best = Some(pair);
+                    }
+                    break;
+                }
+            }
+        }
+        start = end;
+    }
+    best
 }
 
 fn locate_columns(names: &[String], file: &str, line: u64) -> Result<Columns, DataError> {

@@ -4,6 +4,18 @@ use thiserror::Error;
 use tricept_kinematics::KinematicsError;
 
 /// Why an identification could not produce a trustworthy answer.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let m = Machine::paper();
+/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+/// let e = tricept_ident::identify(&model, &tricept_data::Dataset::default(), &IdentifyOptions::for_machine(&m))
+///     .unwrap_err();
+/// assert!(matches!(e, tricept_ident::IdentError::TooFewPoses { poses: 0, .. }));
+/// ```
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum IdentError {

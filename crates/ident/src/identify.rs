@@ -34,6 +34,16 @@ use crate::model::ReadingModel;
 use crate::report::IdentifiabilityReport;
 
 /// Options of [`identify`].
+///
+/// # Example
+/// ```
+/// use tricept_ident::IdentifyOptions;
+/// use tricept_kinematics::{Machine, SensorNoise};
+/// let mut o = IdentifyOptions::for_machine(&Machine::paper());
+/// // The paper's sensors: 0.8 arcsec and 0.5 um per reading, mean of 3.
+/// assert!((o.sigma[0] - 0.8 * SensorNoise::ARCSEC / 3f64.sqrt()).abs() < 1e-15);
+/// o.sigma[0] = 2.0 * SensorNoise::ARCSEC; // a 2 arcsec encoder, one reading
+/// ```
 #[derive(Debug, Clone)]
 pub struct IdentifyOptions {
     /// Standard deviation of one *logged* reading `[phi, theta, s]`
@@ -59,6 +69,27 @@ pub struct IdentifyOptions {
 
 /// The rank decision and identifiability report of a pose set under a
 /// noise model, computed once and reused by many identifications.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let m = Machine::paper();
+/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+/// let poses: Vec<tricept_data::MeasuredPose> = m
+///     .workspace
+///     .polar_grid(3, 8, 3)
+///     .iter()
+///     .map(|r| tricept_data::MeasuredPose {
+///         commands_mm: m.inverse(r).unwrap().legs_mm,
+///         ..Default::default()
+///     })
+///     .collect();
+/// let d = tricept_ident::design(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
+/// assert_eq!(d.decision.rank, 14);
+/// assert_eq!(d.report.fixed, vec!["dyA3".to_string()]);
+/// ```
 #[derive(Debug, Clone)]
 pub struct Design {
     /// Which parameters are estimated and which are held.
@@ -69,6 +100,15 @@ pub struct Design {
 
 impl IdentifyOptions {
     /// Defaults with the logged noise of `machine`'s sensors.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::IdentifyOptions;
+    /// let m = tricept_kinematics::Machine::paper();
+    /// let o = IdentifyOptions::for_machine(&m);
+    /// assert_eq!(o.sigma, m.sensors.logged_sigma());
+    /// assert!(o.initial.is_none() && o.pose_weights.is_none());
+    /// ```
     pub fn for_machine(machine: &Machine) -> IdentifyOptions {
         IdentifyOptions {
             sigma: machine.sensors.logged_sigma(),
@@ -84,6 +124,23 @@ impl IdentifyOptions {
 }
 
 /// Residual statistics of a fit.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let m = Machine::paper();
+/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+/// let set = ParameterSet::paper15();
+/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
+///     .unwrap();
+/// let id = tricept_ident::identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+/// // The model explains the data to the noise: chi-square per degree of freedom near 1.
+/// assert!((id.stats.reduced_chi_square - 1.0).abs() < 0.3);
+/// assert_eq!(id.stats.dof, 3 * 75 - 14 - 3);
+/// ```
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ResidualStats {
     /// RMS of the residuals `[phi, theta, s]` (rad, rad, mm).
@@ -99,6 +156,23 @@ pub struct ResidualStats {
 }
 
 /// The result of [`identify`].
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let m = Machine::paper();
+/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+/// let set = ParameterSet::paper15();
+/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
+///     .unwrap();
+/// let id = tricept_ident::identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+/// let json = id.to_json();
+/// assert_eq!(json["rank"], 14);
+/// assert!(json["dq1"].is_number() && json["std_dev"]["dq1"].is_number());
+/// ```
 #[derive(Debug, Clone)]
 pub struct Identification {
     /// Parameter names.
@@ -128,6 +202,23 @@ pub struct Identification {
 }
 
 /// One evaluation of the model at fixed parameters over all poses.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let m = Machine::paper();
+/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+/// let set = ParameterSet::paper15();
+/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
+///     .unwrap();
+/// let mut seeds = vec![None; data.poses.len()];
+/// let e = tricept_ident::evaluate(&model, &[0.0; 15], &data.poses, &m.sensors.logged_sigma(), None, &mut seeds).unwrap();
+/// assert_eq!(e.problem.rows, 3 * 75);
+/// assert_eq!(e.residuals.len(), 75);
+/// ```
 pub struct Evaluation {
     /// The reduced weighted problem `[offsets | parameters | y - g(p)]`.
     pub problem: ReducedProblem,
@@ -498,6 +589,24 @@ fn decide_design(
 
 /// The rank decision and report of a pose set (see [`identifiability`]),
 /// for reuse through [`IdentifyOptions::design`].
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let m = Machine::paper();
+/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+/// let poses: Vec<tricept_data::MeasuredPose> = m
+///     .workspace
+///     .polar_grid(3, 8, 3)
+///     .iter()
+///     .map(|r| tricept_data::MeasuredPose { commands_mm: m.inverse(r).unwrap().legs_mm, ..Default::default() })
+///     .collect();
+/// let opts = IdentifyOptions::for_machine(&m);
+/// let d = tricept_ident::design(&model, &[0.0; 15], &poses, &opts).unwrap();
+/// assert_eq!(d.report.fixed, vec!["dyA3".to_string()]);
+/// ```
 pub fn design(
     model: &dyn ReadingModel,
     p: &[f64],
@@ -520,6 +629,26 @@ pub fn design(
 /// The identifiability of a pose set before any data is taken: the
 /// identification matrix of `model` at `p` (usually zero) for the commands
 /// of `poses`, with the given logged noise.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let m = Machine::paper();
+/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+/// let poses: Vec<tricept_data::MeasuredPose> = m
+///     .workspace
+///     .polar_grid(3, 8, 3)
+///     .iter()
+///     .map(|r| tricept_data::MeasuredPose {
+///         commands_mm: m.inverse(r).unwrap().legs_mm,
+///         ..Default::default()
+///     })
+///     .collect();
+/// let report = tricept_ident::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
+/// assert_eq!(report.unidentifiable[0].to_text(), "1.000 dyA3");
+/// ```
 pub fn identifiability(
     model: &dyn ReadingModel,
     p: &[f64],
@@ -534,6 +663,24 @@ impl Identification {
     /// (mm), `std_dev`, `rank`, `n_params`, `unidentifiable`,
     /// `singular_values`, `condition_number`, `observability`, residual
     /// statistics, and more.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{GeometricModel, IdentifyOptions, identify};
+    /// use tricept_kinematics::Machine;
+    /// use tricept_model::ParameterSet;
+    /// let m = Machine::paper();
+    /// let set = ParameterSet::paper15();
+    /// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+    ///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
+    ///     .unwrap();
+    /// let id = identify(&GeometricModel::new(m.clone(), set), &data, &IdentifyOptions::for_machine(&m)).unwrap();
+    /// let j = id.to_json();
+    /// // dq1 lies along the weakest direction; judge it by its own uncertainty.
+    /// let (dq1, sd) = (j["dq1"].as_f64().unwrap(), j["std_dev"]["dq1"].as_f64().unwrap());
+    /// assert!((dq1 - 0.45).abs() < 4.0 * sd, "{dq1} ± {sd}");
+    /// assert_eq!(j["rank"], 14);
+    /// ```
     pub fn to_json(&self) -> Value {
         let mut m = Map::new();
         for (n, v) in self.names.iter().zip(&self.estimate) {

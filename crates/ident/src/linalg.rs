@@ -54,6 +54,17 @@ fn qr_in_place(a: faer::MatMut<'_, f64>) {
 
 /// The `n x n` upper-triangular `R` of the QR of `a` (`m >= n` not required:
 /// missing rows are zero).
+///
+/// # Example
+/// ```
+/// use faer::Mat;
+/// let a = Mat::from_fn(5, 2, |i, j| (i + 2 * j) as f64);
+/// let r = tricept_ident::linalg::r_factor(a.as_ref());
+/// // R^T R = A^T A.
+/// let ata = a.transpose() * &a;
+/// let rtr = r.transpose() * &r;
+/// assert!((ata[(0, 1)] - rtr[(0, 1)]).abs() < 1e-10);
+/// ```
 pub fn r_factor(a: MatRef<'_, f64>) -> Mat<f64> {
     let mut work = a.to_owned();
     qr_in_place(work.as_mut());
@@ -68,6 +79,14 @@ pub fn r_factor(a: MatRef<'_, f64>) -> Mat<f64> {
 }
 
 /// Column order chosen by column-pivoted QR (largest remaining norm first).
+///
+/// # Example
+/// ```
+/// use faer::Mat;
+/// // The second column is the largest: it is chosen first.
+/// let a = Mat::from_fn(4, 2, |i, j| if j == 1 { 10.0 * (i as f64 + 1.0) } else { 1.0 });
+/// assert_eq!(tricept_ident::linalg::pivot_order(a.as_ref())[0], 1);
+/// ```
 pub fn pivot_order(a: MatRef<'_, f64>) -> Vec<usize> {
     let (m, n) = a.shape();
     if n == 0 {
@@ -99,6 +118,14 @@ pub fn pivot_order(a: MatRef<'_, f64>) -> Vec<usize> {
 }
 
 /// Singular values (descending) and right singular vectors (columns) of `a`.
+///
+/// # Example
+/// ```
+/// use faer::Mat;
+/// let a = Mat::from_fn(3, 2, |i, j| if i == j { (j + 1) as f64 } else { 0.0 });
+/// let (s, _) = tricept_ident::linalg::svd_values_and_vectors(a.as_ref()).unwrap();
+/// assert!((s[0] - 2.0).abs() < 1e-14 && (s[1] - 1.0).abs() < 1e-14);
+/// ```
 pub fn svd_values_and_vectors(a: MatRef<'_, f64>) -> Option<(Vec<f64>, Mat<f64>)> {
     let (m, n) = a.shape();
     // Work on a square-or-tall matrix: pad short ones with zero rows.
@@ -133,6 +160,14 @@ pub fn svd_values_and_vectors(a: MatRef<'_, f64>) -> Option<(Vec<f64>, Mat<f64>)
 }
 
 /// Solves `R x = b` for upper-triangular `R` (back substitution).
+///
+/// # Example
+/// ```
+/// use faer::Mat;
+/// let r = Mat::from_fn(2, 2, |i, j| [[2.0, 1.0], [0.0, 4.0]][i][j]);
+/// let x = tricept_ident::linalg::solve_upper(r.as_ref(), &[4.0, 8.0]);
+/// assert_eq!(x, vec![1.0, 2.0]);
+/// ```
 pub fn solve_upper(r: MatRef<'_, f64>, b: &[f64]) -> Vec<f64> {
     let n = b.len();
     let mut x = b.to_vec();
@@ -147,6 +182,15 @@ pub fn solve_upper(r: MatRef<'_, f64>, b: &[f64]) -> Vec<f64> {
 }
 
 /// Inverse of an upper-triangular matrix.
+///
+/// # Example
+/// ```
+/// use faer::Mat;
+/// let r = Mat::from_fn(2, 2, |i, j| [[2.0, 1.0], [0.0, 4.0]][i][j]);
+/// let inv = tricept_ident::linalg::invert_upper(r.as_ref());
+/// assert_eq!(inv[(0, 0)], 0.5);
+/// assert_eq!(inv[(0, 1)], -0.125);
+/// ```
 pub fn invert_upper(r: MatRef<'_, f64>) -> Mat<f64> {
     let n = r.nrows();
     let mut inv = Mat::<f64>::zeros(n, n);
@@ -187,12 +231,35 @@ pub struct TriangularAccumulator {
 
 impl TriangularAccumulator {
     /// An accumulator for rows of `n` values.
+    ///
+    /// # Example
+    /// ```
+    /// let mut acc = tricept_ident::linalg::TriangularAccumulator::new(2);
+    /// acc.push_row(&[3.0, 4.0]);
+    /// assert_eq!(acc.rows(), 1);
+    /// assert_eq!(acc.finish().nrows(), 2);
+    /// ```
     pub fn new(n: usize) -> TriangularAccumulator {
         Self::with_rows_hint(n, BLOCK_ROWS)
     }
 
     /// An accumulator sized for about `rows` rows (blocks of at most 512):
     /// small problems then allocate and factor no more than they need.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::linalg::TriangularAccumulator;
+    /// // 2000 rows are folded in blocks of 512; the result does not depend on it.
+    /// let (mut a, mut b) = (TriangularAccumulator::new(2), TriangularAccumulator::with_rows_hint(2, 3));
+    /// for i in 0..2000 {
+    ///     let row = [1.0, (i as f64).sin()];
+    ///     a.push_row(&row);
+    ///     b.push_row(&row);
+    /// }
+    /// let (ra, rb) = (a.finish(), b.finish());
+    /// // R is unique up to the signs of its rows: compare |R|.
+    /// for i in 0..2 { for j in 0..2 { assert!((ra[(i, j)].abs() - rb[(i, j)].abs()).abs() < 1e-9); } }
+    /// ```
     pub fn with_rows_hint(n: usize, rows: usize) -> TriangularAccumulator {
         let block = rows.clamp(1, BLOCK_ROWS);
         TriangularAccumulator {
@@ -204,6 +271,14 @@ impl TriangularAccumulator {
     }
 
     /// Adds one row (length `n`).
+    ///
+    /// # Example
+    /// ```
+    /// let mut acc = tricept_ident::linalg::TriangularAccumulator::new(1);
+    /// acc.push_row(&[3.0]);
+    /// acc.push_row(&[4.0]);
+    /// assert!((acc.finish()[(0, 0)].abs() - 5.0).abs() < 1e-12); // sqrt(9 + 16)
+    /// ```
     pub fn push_row(&mut self, row: &[f64]) {
         let at = self.n + self.pending;
         for (j, v) in row.iter().enumerate().take(self.n) {
@@ -217,6 +292,13 @@ impl TriangularAccumulator {
     }
 
     /// Rows pushed so far.
+    ///
+    /// # Example
+    /// ```
+    /// let mut acc = tricept_ident::linalg::TriangularAccumulator::new(3);
+    /// (0..1000).for_each(|i| acc.push_row(&[1.0, i as f64, 2.0]));
+    /// assert_eq!(acc.rows(), 1000);
+    /// ```
     pub fn rows(&self) -> usize {
         self.rows
     }
@@ -242,6 +324,17 @@ impl TriangularAccumulator {
     }
 
     /// The `n x n` upper-triangular factor with `R^T R = A^T A`.
+    ///
+    /// # Example
+    /// ```
+    /// let mut acc = tricept_ident::linalg::TriangularAccumulator::new(2);
+    /// acc.push_row(&[1.0, 2.0]);
+    /// acc.push_row(&[0.0, 1.0]);
+    /// let r = acc.finish();
+    /// assert_eq!(r[(1, 0)], 0.0); // upper triangular
+    /// // R^T R = A^T A: the (1, 1) entry is 2^2 + 1^2.
+    /// assert!((r[(0, 1)].powi(2) + r[(1, 1)].powi(2) - 5.0).abs() < 1e-12);
+    /// ```
     pub fn finish(mut self) -> Mat<f64> {
         self.flush();
         self.work.as_ref().subrows(0, self.n).to_owned()

@@ -32,6 +32,21 @@ pub const ZERO_COLUMN: f64 = 1e-10;
 pub const DEFAULT_RANK_TOLERANCE: f64 = 1e-8;
 
 /// A weighted least-squares problem reduced to its triangular factor.
+///
+/// # Example
+/// ```
+/// use tricept_ident::linalg::TriangularAccumulator;
+/// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+/// // y = 1 + 2 x with one nuisance (the intercept) and one parameter.
+/// let mut acc = TriangularAccumulator::new(3);
+/// for x in [0.0, 1.0, 2.0, 3.0] {
+///     acc.push_row(&[1.0, x, 1.0 + 2.0 * x]);
+/// }
+/// let p = ReducedProblem { rows: acc.rows(), r: acc.finish(), n_nuisance: 1, k: 1 };
+/// let d = p.decide(DEFAULT_RANK_TOLERANCE).unwrap();
+/// let s = p.solve(&d);
+/// assert!((s.parameters[0] - 2.0).abs() < 1e-12 && (s.nuisance[0] - 1.0).abs() < 1e-12);
+/// ```
 #[derive(Debug, Clone)]
 pub struct ReducedProblem {
     /// `(n_nuisance + k + 1)` square upper-triangular factor of `[N | A | b]`.
@@ -45,6 +60,22 @@ pub struct ReducedProblem {
 }
 
 /// The rank decision for a problem's parameter block.
+///
+/// # Example
+/// ```
+/// use tricept_ident::linalg::TriangularAccumulator;
+/// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+/// // Two identical columns: one of them is held fixed, the combination named.
+/// let mut acc = TriangularAccumulator::new(4);
+/// for x in [0.0, 1.0, 2.0, 3.0, 5.0] {
+///     acc.push_row(&[1.0, x, x, 3.0 * x]);
+/// }
+/// let p = ReducedProblem { rows: acc.rows(), r: acc.finish(), n_nuisance: 1, k: 2 };
+/// let d = p.decide(DEFAULT_RANK_TOLERANCE).unwrap();
+/// assert_eq!(d.rank, 1);
+/// let null = &d.null_space_basis()[0];
+/// assert!((null[0] + null[1]).abs() < 1e-9); // a - b is invisible
+/// ```
 #[derive(Debug, Clone)]
 pub struct RankDecision {
     /// Norm of each parameter column of the weighted, offset-projected matrix.
@@ -64,6 +95,21 @@ pub struct RankDecision {
 }
 
 /// The solution of a reduced problem under a rank decision.
+///
+/// # Example
+/// ```
+/// use tricept_ident::linalg::TriangularAccumulator;
+/// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+/// let mut acc = TriangularAccumulator::new(3);
+/// for x in [0.0, 1.0, 2.0, 3.0] {
+///     acc.push_row(&[1.0, x, 1.0 + 2.0 * x + if x == 1.0 { 0.1 } else { 0.0 }]);
+/// }
+/// let p = ReducedProblem { rows: acc.rows(), r: acc.finish(), n_nuisance: 1, k: 1 };
+/// let s = p.solve(&p.decide(DEFAULT_RANK_TOLERANCE).unwrap());
+/// // Unit-weight rows: the slope's variance is 1 / sum (x - mean)^2 = 1 / 5.
+/// assert!((s.covariance[(1, 1)] - 0.2).abs() < 1e-12);
+/// assert!(s.residual_norm2 > 0.0);
+/// ```
 #[derive(Debug, Clone)]
 pub struct Solution {
     /// Parameter values (zero for fixed parameters).
@@ -80,6 +126,16 @@ pub struct Solution {
 
 impl ReducedProblem {
     /// The parameter block `R_pp` (`k x k`).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::linalg::TriangularAccumulator;
+    /// use tricept_ident::lsq::ReducedProblem;
+    /// let mut acc = TriangularAccumulator::new(4);
+    /// (0..5).for_each(|i| acc.push_row(&[1.0, i as f64, (i * i) as f64, 0.0]));
+    /// let p = ReducedProblem { rows: acc.rows(), r: acc.finish(), n_nuisance: 1, k: 2 };
+    /// assert_eq!(p.parameter_block().nrows(), 2);
+    /// ```
     pub fn parameter_block(&self) -> MatRef<'_, f64> {
         self.r
             .as_ref()
@@ -88,6 +144,20 @@ impl ReducedProblem {
 
     /// Squared norm of the weighted residual after fitting only the nuisance
     /// columns (the cost of the current parameter values).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::linalg::TriangularAccumulator;
+    /// use tricept_ident::lsq::ReducedProblem;
+    /// // Right-hand side 1, 2, 3 with an intercept as nuisance: the residual
+    /// // about the mean is 1 + 0 + 1.
+    /// let mut acc = TriangularAccumulator::new(3);
+    /// for (x, y) in [(0.0, 1.0), (1.0, 2.0), (2.0, 3.0)] {
+    ///     acc.push_row(&[1.0, x, y]);
+    /// }
+    /// let p = ReducedProblem { rows: 3, r: acc.finish(), n_nuisance: 1, k: 1 };
+    /// assert!((p.cost_without_parameters() - 2.0).abs() < 1e-12);
+    /// ```
     pub fn cost_without_parameters(&self) -> f64 {
         let rhs = self.n_nuisance + self.k;
         (self.n_nuisance..=rhs)
@@ -96,6 +166,18 @@ impl ReducedProblem {
     }
 
     /// Scales, ranks and orders the parameter columns (steps 1-3).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::linalg::TriangularAccumulator;
+    /// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+    /// // Two parameters that always appear as their sum: rank 1, one fixed.
+    /// let mut acc = TriangularAccumulator::new(3);
+    /// (0..6).for_each(|i| acc.push_row(&[i as f64, 2.0 * i as f64, 1.0]));
+    /// let p = ReducedProblem { rows: 6, r: acc.finish(), n_nuisance: 0, k: 2 };
+    /// let d = p.decide(DEFAULT_RANK_TOLERANCE).unwrap();
+    /// assert_eq!((d.rank, d.fixed.len()), (1, 1));
+    /// ```
     pub fn decide(&self, tolerance: f64) -> Option<RankDecision> {
         let k = self.k;
         let block = self.parameter_block();
@@ -152,6 +234,21 @@ impl ReducedProblem {
     }
 
     /// Solves for the nuisance and identifiable parameters (step 4).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::linalg::TriangularAccumulator;
+    /// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+    /// // y = a + b with a, b inseparable: the fixed one is held at 0 (its
+    /// // prior) and the other takes the whole sum, never a minimum-norm split.
+    /// let mut acc = TriangularAccumulator::new(3);
+    /// (1..6).for_each(|i| acc.push_row(&[i as f64, i as f64, 3.0 * i as f64]));
+    /// let p = ReducedProblem { rows: 5, r: acc.finish(), n_nuisance: 0, k: 2 };
+    /// let d = p.decide(DEFAULT_RANK_TOLERANCE).unwrap();
+    /// let s = p.solve(&d);
+    /// assert_eq!(s.parameters[d.fixed[0]], 0.0);
+    /// assert!((s.parameters[d.identifiable[0]] - 3.0).abs() < 1e-12);
+    /// ```
     pub fn solve(&self, decision: &RankDecision) -> Solution {
         let nn = self.n_nuisance;
         let rhs = nn + self.k;
@@ -213,6 +310,19 @@ impl ReducedProblem {
 impl RankDecision {
     /// A direction of the scaled parameter space, in parameter units: the
     /// scaled singular vector `i` divided by the column scales.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::linalg::TriangularAccumulator;
+    /// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+    /// // Readings depend on a + 2 b only: the null direction is (2, -1) / ...
+    /// let mut acc = TriangularAccumulator::new(3);
+    /// (1..6).for_each(|i| acc.push_row(&[i as f64, 2.0 * i as f64, 0.0]));
+    /// let p = ReducedProblem { rows: 5, r: acc.finish(), n_nuisance: 0, k: 2 };
+    /// let d = p.decide(DEFAULT_RANK_TOLERANCE).unwrap();
+    /// let v = d.direction(1);
+    /// assert!((v[0] / v[1] + 2.0).abs() < 1e-9);
+    /// ```
     pub fn direction(&self, i: usize) -> Vec<f64> {
         (0..self.column_scale.len())
             .map(|j| self.right_vectors[(j, i)] / self.column_scale[j])
@@ -223,6 +333,21 @@ impl RankDecision {
     /// per fixed parameter: vector `f` moves fixed parameter `f` by 1, the
     /// other fixed parameters by 0, and the identifiable ones so that the
     /// readings do not change (to first order).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::linalg::TriangularAccumulator;
+    /// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+    /// let mut acc = TriangularAccumulator::new(3);
+    /// (1..6).for_each(|i| acc.push_row(&[i as f64, 2.0 * i as f64, 0.0]));
+    /// let p = ReducedProblem { rows: 5, r: acc.finish(), n_nuisance: 0, k: 2 };
+    /// let d = p.decide(DEFAULT_RANK_TOLERANCE).unwrap();
+    /// let basis = d.null_space_basis();
+    /// let f = d.fixed[0];
+    /// // Moves the fixed parameter by exactly 1 and keeps a + 2 b unchanged.
+    /// assert!((basis[0][f] - 1.0).abs() < 1e-12);
+    /// assert!((basis[0][0] + 2.0 * basis[0][1]).abs() < 1e-9);
+    /// ```
     pub fn null_space_basis(&self) -> Vec<Vec<f64>> {
         let k = self.column_scale.len();
         let d = k - self.rank;
@@ -253,6 +378,13 @@ impl RankDecision {
 
 /// Solves a small dense square system by Gaussian elimination with partial
 /// pivoting; `None` when it is singular.
+///
+/// # Example
+/// ```
+/// use faer::Mat;
+/// let a = Mat::from_fn(2, 2, |i, j| [[0.0, 1.0], [2.0, 0.0]][i][j]);
+/// assert_eq!(tricept_ident::lsq::solve_dense(a.as_ref(), &[3.0, 4.0]).unwrap(), vec![2.0, 3.0]);
+/// ```
 pub fn solve_dense(a: MatRef<'_, f64>, b: &[f64]) -> Option<Vec<f64>> {
     let n = b.len();
     let mut m = a.to_owned();

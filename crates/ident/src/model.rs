@@ -14,6 +14,27 @@ use tricept_kinematics::{KinematicsError, Machine, UpJoints};
 use tricept_model::{ParameterSet, actual_machine, error_jacobian_at};
 
 /// A parametric model of the UP limb's readings.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let m = Machine::paper();
+/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+/// let set = ParameterSet::paper15();
+/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
+///     .unwrap();
+/// use tricept_ident::ReadingModel;
+/// let predictor = model.at(&set.table2());
+/// let mut jac = vec![0.0; 3 * 15];
+/// let mut seed = None;
+/// let g = predictor.predict(&data.poses[0], &mut seed, &mut jac).unwrap();
+/// // The readings are the joints plus the sensor offsets (and noise).
+/// let y = data.poses[0].readings.to_array();
+/// assert!((y[2] - g[2] - tricept_plant::DEFAULT_SENSOR_OFFSETS[2]).abs() < 1e-2);
+/// ```
 pub trait ReadingModel: Sync {
     /// Parameter names, in order.
     fn names(&self) -> &[String];
@@ -23,6 +44,21 @@ pub trait ReadingModel: Sync {
 }
 
 /// A reading model at fixed parameter values.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let m = Machine::paper();
+/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+/// use tricept_ident::ReadingModel;
+/// let pose = tricept_data::MeasuredPose { commands_mm: [800.0; 3], ..Default::default() };
+/// let mut jac = vec![0.0; 45];
+/// let mut seed = None;
+/// let g = model.at(&[0.0; 15]).predict(&pose, &mut seed, &mut jac).unwrap();
+/// assert_eq!(g, seed.unwrap().to_array());
+/// ```
 pub trait PosePredictor: Sync {
     /// Readings `[phi, theta, s]` without offsets (rad, rad, mm) at `pose`,
     /// and their derivatives with respect to the parameters written
@@ -56,6 +92,15 @@ pub struct GeometricModel {
 
 impl GeometricModel {
     /// The model of `nominal` with the errors of `set`.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::GeometricModel;
+    /// use tricept_kinematics::Machine;
+    /// use tricept_model::ParameterSet;
+    /// let model = GeometricModel::new(Machine::paper(), ParameterSet::paper15());
+    /// assert_eq!(model.parameter_set().len(), 15);
+    /// ```
     pub fn new(nominal: Machine, set: ParameterSet) -> GeometricModel {
         let names = set.names().to_vec();
         let sparse = set.sparse_columns();
@@ -68,16 +113,43 @@ impl GeometricModel {
     }
 
     /// The nominal machine.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::GeometricModel;
+    /// use tricept_kinematics::Machine;
+    /// let model = GeometricModel::new(Machine::paper(), tricept_model::ParameterSet::paper15());
+    /// assert_eq!(model.nominal().leg_offsets_mm, [0.0; 3]);
+    /// ```
     pub fn nominal(&self) -> &Machine {
         &self.nominal
     }
 
     /// The parameter set.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::GeometricModel;
+    /// use tricept_model::ParameterSet;
+    /// let model = GeometricModel::new(tricept_kinematics::Machine::paper(), ParameterSet::full21());
+    /// assert_eq!(model.parameter_set().names()[0], "dxB1");
+    /// ```
     pub fn parameter_set(&self) -> &ParameterSet {
         &self.set
     }
 
     /// The machine described by parameter values `p`.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::GeometricModel;
+    /// use tricept_model::ParameterSet;
+    /// let set = ParameterSet::paper15();
+    /// let model = GeometricModel::new(tricept_kinematics::Machine::paper(), set.clone());
+    /// let m = model.machine_at(&set.table2());
+    /// // Table 2: the leg-length offsets dq1..dq3 are 0.45, 0.7, 0.5 mm.
+    /// assert_eq!(m.leg_offsets_mm, [0.45, 0.7, 0.5]);
+    /// ```
     pub fn machine_at(&self, p: &[f64]) -> Machine {
         actual_machine(&self.nominal, &self.set.to_errors(p))
     }
@@ -104,6 +176,16 @@ impl ReadingModel for GeometricModel {
 
 /// UP joints of `machine` at `commands`, from `seed` when given (falling
 /// back to a cold start), updating the seed.
+///
+/// # Example
+/// ```
+/// use tricept_kinematics::Machine;
+/// let m = Machine::paper();
+/// let mut seed = None;
+/// let up = tricept_ident::solve_pose(&m, &[800.0; 3], &mut seed).unwrap();
+/// assert_eq!(seed, Some(up));
+/// assert!(up.phi_rad.abs() < 1e-12);
+/// ```
 pub fn solve_pose(
     machine: &Machine,
     commands_mm: &[f64; 3],
@@ -121,6 +203,20 @@ pub fn solve_pose(
 
 /// Writes `J E` (3 x k, row-major) for the 21-column `J`, with `E` given
 /// by its non-zero entries ([`ParameterSet::sparse_columns`]).
+///
+/// # Example
+/// ```
+/// use tricept_kinematics::Machine;
+/// use tricept_model::{error_jacobian, ParameterSet};
+/// let m = Machine::paper();
+/// let up = m.inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0)).unwrap().up;
+/// let j21 = error_jacobian(&m, &up).unwrap();
+/// let set = ParameterSet::paper15();
+/// let mut out = vec![0.0; 3 * 15];
+/// tricept_ident::project_jacobian(&j21, &set.sparse_columns(), &mut out);
+/// // dxB1 moves B1 and B2: its column is the sum of theirs.
+/// assert!((out[0] - (j21[(0, 0)] + j21[(0, 7)])).abs() < 1e-15);
+/// ```
 pub fn project_jacobian(
     j21: &tricept_model::ErrorJacobian,
     sparse_columns: &[Vec<(usize, f64)>],

@@ -22,6 +22,24 @@ use crate::model::ReadingModel;
 use crate::stats::chi2_isf;
 
 /// A rejected pose.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let m = Machine::paper();
+/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+/// let set = ParameterSet::paper15();
+/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
+///     .unwrap();
+/// let mut data = data;
+/// data.poses[3].readings.phi_rad += 1e-3; // a 206 arcsec glitch
+/// data.poses[3].line = 42;
+/// let (_, rejected) = tricept_ident::identify_robust(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+/// assert_eq!(rejected[0].line, 42);
+/// ```
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Rejection {
     /// Index of the pose in the data.
@@ -35,6 +53,23 @@ pub struct Rejection {
 /// Weighted residuals `(y - g(p) - c) / sigma` of `poses` under `model` at
 /// `estimate` with sensor offsets `offsets`; `None` where the pose cannot be
 /// solved.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let m = Machine::paper();
+/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+/// let set = ParameterSet::paper15();
+/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
+///     .unwrap();
+/// let id = tricept_ident::identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+/// let r = tricept_ident::residuals_at(&model, &id.estimate, &id.offsets, &data.poses, &m.sensors.logged_sigma());
+/// // In noise units: of order one.
+/// assert!(r.iter().flatten().all(|v| v.iter().all(|x| x.abs() < 5.0)));
+/// ```
 pub fn residuals_at(
     model: &dyn ReadingModel,
     estimate: &[f64],
@@ -71,6 +106,21 @@ fn subset(data: &Dataset, rejected: &[Rejection]) -> Dataset {
 
 /// The poses whose readings are gross errors (see the module docs), at
 /// family-wise level `alpha`, at most `max_share` of them.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let m = Machine::paper();
+/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+/// let set = ParameterSet::paper15();
+/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
+///     .unwrap();
+/// let rejected = tricept_ident::screen_gross_errors(&model, &data, &IdentifyOptions::for_machine(&m), 1e-3, 0.1).unwrap();
+/// assert!(rejected.is_empty()); // clean data lose nothing
+/// ```
 pub fn screen_gross_errors(
     model: &dyn ReadingModel,
     data: &Dataset,

@@ -3,6 +3,11 @@
 //! the power of a chi-square test against a non-central alternative.
 
 /// `ln Gamma(x)` for `x > 0` (Lanczos, g = 7; about 15 digits).
+///
+/// # Example
+/// ```
+/// assert!((tricept_ident::stats::ln_gamma(4.0) - 6f64.ln()).abs() < 1e-14);
+/// ```
 pub fn ln_gamma(x: f64) -> f64 {
     const G: f64 = 7.0;
     const C: [f64; 9] = [
@@ -31,6 +36,12 @@ pub fn ln_gamma(x: f64) -> f64 {
 }
 
 /// Regularised lower incomplete gamma `P(a, x)`.
+///
+/// # Example
+/// ```
+/// // P(1, x) = 1 - exp(-x).
+/// assert!((tricept_ident::stats::gamma_p(1.0, 2.0) - (1.0 - (-2.0f64).exp())).abs() < 1e-14);
+/// ```
 pub fn gamma_p(a: f64, x: f64) -> f64 {
     if x <= 0.0 {
         return 0.0;
@@ -83,11 +94,18 @@ fn gamma_q_continued_fraction(a: f64, x: f64) -> f64 {
 }
 
 /// `P(X > x)` for `X ~ chi-square(k)`.
+///
+/// # Example
+/// ```
+/// assert!((tricept_ident::stats::chi2_sf(3.841458820694124, 1.0) - 0.05).abs() < 1e-10);
+/// ```
 pub fn chi2_sf(x: f64, k: f64) -> f64 {
     if x <= 0.0 {
         return 1.0;
     }
-    if x >= k / 2.0 + 1.0 {
+    // The continued fraction converges for `x/2 >= k/2 + 1` (and divides by
+    // zero at `x/2 = k/2 - 1`); the series covers the rest.
+    if 0.5 * x >= 0.5 * k + 1.0 {
         gamma_q_continued_fraction(k / 2.0, x / 2.0)
     } else {
         1.0 - gamma_p(k / 2.0, x / 2.0)
@@ -95,6 +113,11 @@ pub fn chi2_sf(x: f64, k: f64) -> f64 {
 }
 
 /// The `x` with `P(X > x) = tail` for `X ~ chi-square(k)` (bisection).
+///
+/// # Example
+/// ```
+/// assert!((tricept_ident::stats::chi2_isf(0.05, 1.0) - 3.841458820694124).abs() < 1e-8);
+/// ```
 pub fn chi2_isf(tail: f64, k: f64) -> f64 {
     let (mut lo, mut hi) = (0.0, k.max(1.0));
     while chi2_sf(hi, k) > tail {
@@ -113,6 +136,14 @@ pub fn chi2_isf(tail: f64, k: f64) -> f64 {
 
 /// `P(X > x)` for a non-central chi-square with `k` degrees of freedom and
 /// non-centrality `lambda`: the Poisson mixture of central ones.
+///
+/// # Example
+/// ```
+/// use tricept_ident::stats::{chi2_sf, noncentral_chi2_sf};
+/// // No non-centrality: the central distribution.
+/// assert!((noncentral_chi2_sf(5.0, 3.0, 0.0) - chi2_sf(5.0, 3.0)).abs() < 1e-14);
+/// assert!(noncentral_chi2_sf(5.0, 3.0, 4.0) > chi2_sf(5.0, 3.0));
+/// ```
 pub fn noncentral_chi2_sf(x: f64, k: f64, lambda: f64) -> f64 {
     let mu = 0.5 * lambda;
     let top = (mu + 12.0 * mu.sqrt() + 30.0).ceil() as usize;
@@ -127,12 +158,24 @@ pub fn noncentral_chi2_sf(x: f64, k: f64, lambda: f64) -> f64 {
 
 /// Power of the level-`alpha` chi-square test with `k` degrees of freedom
 /// against non-centrality `lambda`.
+///
+/// # Example
+/// ```
+/// let p = tricept_ident::stats::chi2_power(17.8, 1.0, 0.01);
+/// assert!((p - 0.95).abs() < 0.005);
+/// ```
 pub fn chi2_power(lambda: f64, k: f64, alpha: f64) -> f64 {
     noncentral_chi2_sf(chi2_isf(alpha, k), k, lambda)
 }
 
 /// The non-centrality at which the level-`alpha` test with `k` degrees of
 /// freedom has power `power`.
+///
+/// # Example
+/// ```
+/// let l = tricept_ident::stats::required_noncentrality(1.0, 0.05, 0.8);
+/// assert!((l - 7.85).abs() < 0.05); // (1.96 + 0.84)^2
+/// ```
 pub fn required_noncentrality(k: f64, alpha: f64, power: f64) -> f64 {
     let (mut lo, mut hi) = (0.0, 1.0);
     while chi2_power(hi, k, alpha) < power {
@@ -169,6 +212,28 @@ mod tests {
                     < 1e-14 * 1f64.max((-x / 2.0f64).exp()) + 1e-15
             );
         }
+    }
+
+    #[test]
+    fn tail_is_finite_and_monotone_everywhere() {
+        // Regression: the branch test once mixed `x` with `a = k/2`, so the
+        // continued fraction ran at `x/2 = k/2 - 1` (chi2_sf(5, 7) was NaN).
+        for k in 1..=80 {
+            let k = k as f64;
+            let mut previous = 1.0;
+            for step in 0..=400 {
+                let x = 0.25 * step as f64;
+                let tail = chi2_sf(x, k);
+                assert!(
+                    tail.is_finite() && (0.0..=1.0).contains(&tail),
+                    "k={k} x={x}: {tail}"
+                );
+                assert!(tail <= previous + 1e-15, "k={k} x={x}: not monotone");
+                previous = tail;
+            }
+        }
+        // chi-square(7) at 5: 1 - P(3.5, 2.5) = 0.659963 (tables).
+        assert!((chi2_sf(5.0, 7.0) - 0.659_963_3).abs() < 1e-6);
     }
 
     #[test]
