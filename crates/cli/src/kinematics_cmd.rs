@@ -2,7 +2,7 @@
 
 use nalgebra::Vector3;
 use serde_json::Value;
-use tricept_kinematics::{HeadBranch, Machine, MachineDescription};
+use tricept_kinematics::{HeadBranch, Machine, MachineDescription, UpJoints};
 
 use crate::MachineArgs;
 use crate::cli_error::CliError;
@@ -20,23 +20,26 @@ pub fn load_machine(args: &MachineArgs) -> Result<Machine, CliError> {
         .map_err(|e| CliError::description("machine", &e))
 }
 
+/// The record keys shared by `ik` and `tool-ik`: `q1 q2 q3` (mm),
+/// `phi theta` (rad), `q4` (mm).
+fn legs_and_up(legs_mm: &[f64; 3], up: &UpJoints) -> Vec<(&'static str, Value)> {
+    vec![
+        ("q1", legs_mm[0].into()),
+        ("q2", legs_mm[1].into()),
+        ("q3", legs_mm[2].into()),
+        ("phi", up.phi_rad.into()),
+        ("theta", up.theta_rad.into()),
+        ("q4", up.q4_mm.into()),
+    ]
+}
+
 /// `tricept ik X Y Z`.
 pub fn ik(args: &MachineArgs, r: [f64; 3]) -> Result<(), CliError> {
     let m = load_machine(args)?;
     let sol = m
         .inverse(&Vector3::from(r))
         .map_err(|e| CliError::kinematics("ik", &e))?;
-    print_record(
-        args.json,
-        &[
-            ("q1", sol.legs_mm[0].into()),
-            ("q2", sol.legs_mm[1].into()),
-            ("q3", sol.legs_mm[2].into()),
-            ("phi", sol.up.phi_rad.into()),
-            ("theta", sol.up.theta_rad.into()),
-            ("q4", sol.up.q4_mm.into()),
-        ],
-    );
+    print_record(args.json, &legs_and_up(&sol.legs_mm, &sol.up));
     Ok(())
 }
 
@@ -70,20 +73,13 @@ pub fn tool_ik(args: &MachineArgs, tip: [f64; 3], axis: [f64; 3]) -> Result<(), 
             HeadBranch::default(),
         )
         .map_err(|e| CliError::kinematics("tool-ik", &e))?;
-    print_record(
-        args.json,
-        &[
-            ("q1", sol.legs_mm[0].into()),
-            ("q2", sol.legs_mm[1].into()),
-            ("q3", sol.legs_mm[2].into()),
-            ("phi", sol.up.phi_rad.into()),
-            ("theta", sol.up.theta_rad.into()),
-            ("q4", sol.up.q4_mm.into()),
-            ("h1", sol.head_rad[0].into()),
-            ("h2", sol.head_rad[1].into()),
-            ("head_singular", Value::Bool(sol.head_singular)),
-        ],
-    );
+    let mut record = legs_and_up(&sol.legs_mm, &sol.up);
+    record.extend([
+        ("h1", sol.head_rad[0].into()),
+        ("h2", sol.head_rad[1].into()),
+        ("head_singular", Value::Bool(sol.head_singular)),
+    ]);
+    print_record(args.json, &record);
     Ok(())
 }
 

@@ -213,16 +213,7 @@ struct Fit {
 }
 
 fn identify_options(options: &DiagnoseOptions) -> IdentifyOptions {
-    IdentifyOptions {
-        sigma: options.sigma,
-        rank_tolerance: tricept_ident::lsq::DEFAULT_RANK_TOLERANCE,
-        weak_threshold: 1e-2,
-        max_iterations: 30,
-        initial: None,
-        pose_weights: None,
-        design: None,
-        start_seeds: None,
-    }
+    IdentifyOptions::with_sigma(options.sigma)
 }
 
 fn fit(model: ExtendedModel, data: &Dataset, options: &DiagnoseOptions) -> Result<Fit, IdentError> {

@@ -110,8 +110,27 @@ impl IdentifyOptions {
     /// assert!(o.initial.is_none() && o.pose_weights.is_none());
     /// ```
     pub fn for_machine(machine: &Machine) -> IdentifyOptions {
+        IdentifyOptions::with_sigma(machine.sensors.logged_sigma())
+    }
+
+    /// Defaults with the given standard deviations of one logged reading
+    /// (`phi` rad, `theta` rad, `s` mm): the stated rank tolerance, weak
+    /// threshold 1e-2, at most 30 iterations, no prior, equal pose weights,
+    /// the rank decision taken from the data.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::IdentifyOptions;
+    /// use tricept_kinematics::SensorNoise;
+    /// // A 2 arcsec encoder and a 0.5 um scale, one reading per pose.
+    /// let arcsec = SensorNoise::ARCSEC;
+    /// let o = IdentifyOptions::with_sigma([2.0 * arcsec, 2.0 * arcsec, 0.5e-3]);
+    /// assert_eq!(o.max_iterations, 30);
+    /// assert!(o.design.is_none());
+    /// ```
+    pub fn with_sigma(sigma: [f64; 3]) -> IdentifyOptions {
         IdentifyOptions {
-            sigma: machine.sensors.logged_sigma(),
+            sigma,
             rank_tolerance: DEFAULT_RANK_TOLERANCE,
             weak_threshold: 1e-2,
             max_iterations: 30,

@@ -219,6 +219,27 @@ fn poses_at(m: &Machine, targets: &[Vector3<f64>]) -> Vec<MeasuredPose> {
         .collect()
 }
 
+/// The identifiability report of `set` on `m` at `poses`, at zero errors.
+fn report_at(
+    m: &Machine,
+    set: &ParameterSet,
+    poses: &[MeasuredPose],
+) -> tricept_ident::IdentifiabilityReport {
+    let model = GeometricModel::new(m.clone(), set.clone());
+    identifiability(
+        &model,
+        &vec![0.0; set.len()],
+        poses,
+        &IdentifyOptions::for_machine(m),
+    )
+    .unwrap()
+}
+
+/// The report on the 3 x 8 x 3 polar grid used by the identifiability tests.
+fn grid_report(m: &Machine, set: &ParameterSet) -> tricept_ident::IdentifiabilityReport {
+    report_at(m, set, &poses_at(m, &m.workspace.polar_grid(3, 8, 3)))
+}
+
 #[test]
 fn too_few_poses_is_an_error_that_says_how_many_are_needed() {
     let m = machine(AxisOrder::YFirst);
@@ -247,16 +268,7 @@ fn too_few_poses_is_an_error_that_says_how_many_are_needed() {
 
 #[test]
 fn the_paper_x_first_machine_cannot_see_dya3_and_says_so() {
-    let m = machine(AxisOrder::XFirst);
-    let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-    let poses = poses_at(&m, &m.workspace.polar_grid(3, 8, 3));
-    let report = identifiability(
-        &model,
-        &[0.0; 15],
-        &poses,
-        &IdentifyOptions::for_machine(&m),
-    )
-    .unwrap();
+    let report = grid_report(&machine(AxisOrder::XFirst), &ParameterSet::paper15());
     assert_eq!(report.rank, 14);
     assert_eq!(report.unidentifiable.len(), 1);
     assert_eq!(
@@ -264,15 +276,7 @@ fn the_paper_x_first_machine_cannot_see_dya3_and_says_so() {
         vec![("dyA3".to_string(), 1.0)]
     );
     // The y-first joint sees all fifteen (the paper's claim holds there).
-    let y = machine(AxisOrder::YFirst);
-    let model = GeometricModel::new(y.clone(), ParameterSet::paper15());
-    let report = identifiability(
-        &model,
-        &[0.0; 15],
-        &poses_at(&y, &y.workspace.polar_grid(3, 8, 3)),
-        &IdentifyOptions::for_machine(&y),
-    )
-    .unwrap();
+    let report = grid_report(&machine(AxisOrder::YFirst), &ParameterSet::paper15());
     assert_eq!(report.rank, 15);
     assert!(report.unidentifiable.is_empty());
 }
@@ -282,18 +286,11 @@ fn poses_on_the_axis_only_leave_named_combinations_that_are_truly_invisible() {
     // Ten poses on the workspace axis: the platform never tilts.
     let m = machine(AxisOrder::YFirst);
     let set = ParameterSet::paper15();
-    let model = GeometricModel::new(m.clone(), set.clone());
     let targets: Vec<Vector3<f64>> = (0..10)
         .map(|k| Vector3::new(0.0, 0.0, 650.0 + 20.0 * f64::from(k)))
         .collect();
     let poses = poses_at(&m, &targets);
-    let report = identifiability(
-        &model,
-        &[0.0; 15],
-        &poses,
-        &IdentifyOptions::for_machine(&m),
-    )
-    .unwrap();
+    let report = report_at(&m, &set, &poses);
     assert!(report.rank < 15);
     assert_eq!(report.unidentifiable.len(), 15 - report.rank);
     // Each named combination, applied as a 0.05 mm error, changes no reading
@@ -328,16 +325,7 @@ fn poses_on_the_axis_only_leave_named_combinations_that_are_truly_invisible() {
 
 #[test]
 fn the_full_21_set_names_the_two_rigid_body_gauges() {
-    let m = machine(AxisOrder::XFirst);
-    let model = GeometricModel::new(m.clone(), ParameterSet::full21());
-    let poses = poses_at(&m, &m.workspace.polar_grid(3, 8, 3));
-    let report = identifiability(
-        &model,
-        &[0.0; 21],
-        &poses,
-        &IdentifyOptions::for_machine(&m),
-    )
-    .unwrap();
+    let report = grid_report(&machine(AxisOrder::XFirst), &ParameterSet::full21());
     assert_eq!(report.rank, 18);
     let texts: Vec<String> = report.unidentifiable.iter().map(|c| c.to_text()).collect();
     let has = |names: &[&str]| {

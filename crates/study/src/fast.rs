@@ -94,11 +94,11 @@ pub fn model_of(s: &Scenario) -> GeometricModel {
 /// Identification options for `s` at `grade_arcsec` (with the shared
 /// design when given, seeds at the true joints).
 pub fn options_for(s: &Scenario, grade_arcsec: f64, design: Option<&Design>) -> IdentifyOptions {
-    let mut o = IdentifyOptions::for_machine(&s.nominal);
-    o.sigma = s.logged_sigma(grade_arcsec);
-    o.design = design.cloned();
-    o.start_seeds = Some(s.true_up.clone());
-    o
+    IdentifyOptions {
+        design: design.cloned(),
+        start_seeds: Some(s.true_up.clone()),
+        ..IdentifyOptions::with_sigma(s.logged_sigma(grade_arcsec))
+    }
 }
 
 impl GradeModel {
