@@ -36,7 +36,13 @@ use crate::ident_cmd::{FitArgs, NoiseArgs, ParamArgs};
 ///
 /// All lengths are in mm and all angles in rad unless a flag says otherwise.
 #[derive(Debug, Parser)]
-#[command(name = "tricept", version, about, long_about = None)]
+#[command(
+    name = "tricept",
+    version,
+    about,
+    long_about = None,
+    after_help = "Examples:\n  tricept ik 0 0 750\n  tricept simulate --out data.csv\n  tricept identify --data data.csv\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n\nExit codes: 0 success, 2 usage or input error, 1 anything else.\nData format: docs/data-format.md"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -108,6 +114,9 @@ enum Command {
         machine: MachineArgs,
     },
     /// Print the machine description in use (JSON), e.g. to start a new file.
+    #[command(
+        after_help = "Examples:\n  tricept machine > my-machine.json\n  tricept machine --machine fixtures/machines/tricept-paper-y-first.json"
+    )]
     Machine {
         #[command(flatten)]
         machine: MachineArgs,
