@@ -6,7 +6,8 @@
 //! Jacobian is the paper's `J1` (see [`crate::LegGeometry::j1`]), so Newton's
 //! method costs one 3x3 solve per iteration. The iteration is safeguarded by
 //! a backtracking line search on `|f|^2`; it starts from a closed-form seed
-//! (two rounds of three-sphere trilateration) unless the caller passes one.
+//! (two rounds of three-sphere trilateration, extrapolated) unless the
+//! caller passes one.
 //!
 //! Every solution carries the condition number of `J1` made unit-free by
 //! scaling its angle columns by `1/q4`, and the solver refuses (with an
@@ -40,8 +41,6 @@ pub struct FkSolution {
 }
 
 const MAX_ITERATIONS: u32 = 60;
-/// Trilateration rounds of the cold-start seed (each gains about one digit).
-const SEED_ROUNDS: usize = 1;
 /// A step this small (mm) ends the line search whatever the merit does.
 const STEP_TOLERANCE_MM: f64 = 1e-10;
 /// When the predicted next Newton step is below this (mm), it is applied
@@ -85,42 +84,56 @@ impl Machine {
         std::array::from_fn(|i| legs_mm[i] + self.leg_offsets_mm[i])
     }
 
-    /// Seed: place O' by trilateration with the platform joints rotated by
-    /// the orientation of the previous round (identity first).
+    /// Seed: place O' by trilateration with the platform level, then again
+    /// with the platform at the orientation the UP limb gives that point,
+    /// and extrapolate the two rounds.
+    ///
+    /// The rounds form a fixed-point iteration on the limb direction
+    /// `u = r / |r|`, started at the level platform (`u_0 = e_z`). It
+    /// converges slowly and with alternating sign (on Table 1 its slope is
+    /// about -0.6: the level-platform point overshoots the tilt by 60 %). The
+    /// slope `s` is estimated from the two rounds' changes of `u` and the
+    /// limit taken as `x_2 + s / (1 - s) (x_2 - x_1)` (Aitken's
+    /// extrapolation) for the direction and the length `|r|`, which leaves
+    /// an error of second order in the tilt: 11 mm on average over the
+    /// workspace instead of 219 mm (`scaled_size`), and Newton needs 2.1
+    /// iterations on average instead of 3.4.
     fn trilateration_seed(&self, lengths: &[f64; 3]) -> UpJoints {
         let z_mid = 0.5 * (self.workspace.z_min_mm + self.workspace.z_max_mm);
-        let mut rotation = Matrix3::identity();
-        let mut r = Vector3::new(0.0, 0.0, z_mid);
-        for _ in 0..SEED_ROUNDS {
-            let centres: [Vector3<f64>; 3] = std::array::from_fn(|i| {
-                self.base_joints_mm[i] - rotation * self.platform_joints_mm[i]
-            });
-            match trilaterate(&centres, lengths) {
-                Some(p) => r = p,
-                None => break,
-            }
-            match self.up_limb.rotation_at_point(&r) {
-                Ok(rot) => rotation = rot,
-                Err(_) => break,
-            }
-        }
-        self.up_limb.inverse(&r).unwrap_or(UpJoints {
+        let level = UpJoints {
             phi_rad: 0.0,
             theta_rad: 0.0,
             q4_mm: z_mid,
-        })
+        };
+        let place = |rotation: &Matrix3<f64>| {
+            let centres: [Vector3<f64>; 3] = std::array::from_fn(|i| {
+                self.base_joints_mm[i] - rotation * self.platform_joints_mm[i]
+            });
+            trilaterate(&centres, lengths)
+        };
+        let Some(r1) = place(&Matrix3::identity()) else {
+            return level;
+        };
+        let r2 = match self.up_limb.rotation_at_point(&r1) {
+            Ok(rotation) => place(&rotation),
+            Err(_) => None,
+        };
+        let r = match r2 {
+            Some(r2) => extrapolate(&r1, &r2).unwrap_or(r2),
+            None => r1,
+        };
+        self.up_limb.inverse(&r).unwrap_or(level)
     }
 
     /// Leg geometry at `x` written into `out`, and the closure residual.
-    /// (In place: the geometry is a few hundred bytes and Newton's loop
-    /// would otherwise spend a tenth of its time copying it.)
     fn closure_into(
         &self,
         x: &UpJoints,
         lengths: &[f64; 3],
         out: &mut LegGeometry,
     ) -> Vector3<f64> {
-        self.legs_into(self.up_limb.pose(x), out);
+        out.limb = self.up_limb.pose(x);
+        self.update_legs(out);
         Vector3::from_fn(|i, _| out.lengths_mm[i] - lengths[i])
     }
 
@@ -247,26 +260,53 @@ pub(crate) fn unit_free_condition(j1: &Matrix3<f64>, q4_mm: f64) -> f64 {
     }
 }
 
+/// Aitken's extrapolation of the seed's fixed-point iteration from its
+/// first two points `r1`, `r2` (the start being the level platform,
+/// direction `e_z`); `None` when the iteration does not contract.
+fn extrapolate(r1: &Vector3<f64>, r2: &Vector3<f64>) -> Option<Vector3<f64>> {
+    let (n1, n2) = (r1.norm(), r2.norm());
+    let (u1, u2) = (r1 * (1.0 / n1), r2 * (1.0 / n2));
+    let d1 = u1 - Vector3::z();
+    let d2 = u2 - u1;
+    let d1d1 = d1.norm_squared();
+    let slope = d1.dot(&d2) / d1d1;
+    // Nothing to extrapolate on a level platform; a slope near or beyond
+    // one is not a contraction.
+    if !(d1d1 > 1e-14 && slope.abs() < 0.95) {
+        return None;
+    }
+    let gain = slope / (1.0 - slope);
+    let u = (u2 + gain * d2).normalize();
+    Some(u * (n2 + gain * (n2 - n1)))
+}
+
 /// The intersection of three spheres on the side of larger z, if any.
 fn trilaterate(c: &[Vector3<f64>; 3], r: &[f64; 3]) -> Option<Vector3<f64>> {
+    // Reciprocals instead of divisions (a third of the cost otherwise).
     let d_vec = c[1] - c[0];
     let d = d_vec.norm();
-    let ex = d_vec / d;
     let c3 = c[2] - c[0];
+    if d < 1e-9 {
+        return None;
+    }
+    let inv_d = 1.0 / d;
+    let ex = d_vec * inv_d;
     let i = ex.dot(&c3);
     let ey_raw = c3 - i * ex;
     let j = ey_raw.norm();
-    if d < 1e-9 || j < 1e-9 {
+    if j < 1e-9 {
         return None;
     }
-    let ey = ey_raw / j;
+    let inv_j = 1.0 / j;
+    let ey = ey_raw * inv_j;
     let mut ez = ex.cross(&ey);
     if ez.z < 0.0 {
         ez = -ez;
     }
-    let x = (r[0] * r[0] - r[1] * r[1] + d * d) / (2.0 * d);
-    let y = (r[0] * r[0] - r[2] * r[2] + i * i + j * j) / (2.0 * j) - i / j * x;
-    let z2 = r[0] * r[0] - x * x - y * y;
+    let r0_sq = r[0] * r[0];
+    let x = 0.5 * (r0_sq - r[1] * r[1] + d * d) * inv_d;
+    let y = (0.5 * (r0_sq - r[2] * r[2] + i * i + j * j) - i * x) * inv_j;
+    let z2 = r0_sq - x * x - y * y;
     if z2.is_nan() || z2 < 0.0 {
         return None;
     }
@@ -288,6 +328,51 @@ mod tests {
         let r = c.map(|ci| (p - ci).norm());
         let found = trilaterate(&c, &r).unwrap();
         assert!((found - p).norm() < 1e-9);
+    }
+
+    /// Distance in mm between two UP joint values (angles times `q4`).
+    fn joint_distance_mm(a: &UpJoints, b: &UpJoints) -> f64 {
+        let d = Vector3::new(
+            a.phi_rad - b.phi_rad,
+            a.theta_rad - b.theta_rad,
+            a.q4_mm - b.q4_mm,
+        );
+        scaled_size(&d, b.q4_mm)
+    }
+
+    #[test]
+    fn the_extrapolated_seed_is_many_times_closer_than_a_level_platform() {
+        for m in [
+            Machine::paper(),
+            Machine::paper().with_axis_order(crate::AxisOrder::YFirst),
+        ] {
+            let (mut worst_level, mut worst_seed) = (0.0f64, 0.0f64);
+            let (mut sum_level, mut sum_seed) = (0.0, 0.0);
+            for r in m.workspace.random_poses(300, 5) {
+                let ik = m.inverse(&r).unwrap();
+                let lengths = m.actual_lengths(&ik.legs_mm);
+                let centres: [Vector3<f64>; 3] =
+                    std::array::from_fn(|i| m.base_joints_mm[i] - m.platform_joints_mm[i]);
+                let level = m
+                    .up_limb
+                    .inverse(&trilaterate(&centres, &lengths).unwrap())
+                    .unwrap();
+                let seed = m.trilateration_seed(&lengths);
+                let (e_level, e_seed) = (
+                    joint_distance_mm(&level, &ik.up),
+                    joint_distance_mm(&seed, &ik.up),
+                );
+                (sum_level, sum_seed) = (sum_level + e_level, sum_seed + e_seed);
+                worst_level = worst_level.max(e_level);
+                worst_seed = worst_seed.max(e_seed);
+            }
+            // Measured (x-first): worst 52 / 413 mm, mean 11 / 219 mm.
+            assert!(
+                worst_seed < 0.2 * worst_level && sum_seed < 0.1 * sum_level,
+                "worst: seed {worst_seed} mm, level platform {worst_level} mm; \
+                 sums {sum_seed} / {sum_level} mm"
+            );
+        }
     }
 
     #[test]

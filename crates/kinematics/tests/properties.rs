@@ -106,6 +106,40 @@ fn fk_beyond_the_workspace_edges_either_solves_exactly_or_says_why() {
 }
 
 #[test]
+fn fk_recovers_every_configuration_ik_reaches_far_beyond_the_workspace() {
+    // A 50 mm lattice out to 1000 mm radius and z from 300 to 1300 mm:
+    // wherever IK gives commands, cold-start FK must return that very point
+    // (not an error, not the other assembly branch).
+    for m in machines() {
+        let (mut solved, mut failed) = (0, Vec::new());
+        for i in -20..=20 {
+            for j in -20..=20 {
+                for k in 0..=20 {
+                    let r = Vector3::new(
+                        50.0 * f64::from(i),
+                        50.0 * f64::from(j),
+                        300.0 + 50.0 * f64::from(k),
+                    );
+                    let Ok(ik) = m.inverse(&r) else { continue };
+                    match m.forward(&ik.legs_mm) {
+                        Ok(fk) if (fk.position_mm - r).norm() < 1e-8 => solved += 1,
+                        other => failed.push((r, other.map(|fk| fk.position_mm))),
+                    }
+                }
+            }
+        }
+        assert!(
+            failed.is_empty(),
+            "{} of {}: {:?}",
+            failed.len(),
+            solved + failed.len(),
+            &failed[..failed.len().min(3)]
+        );
+        assert!(solved > 4000, "{solved}");
+    }
+}
+
+#[test]
 fn fk_of_arbitrary_leg_commands_is_exact_or_an_error() {
     // Leg commands over the whole stroke, most of them inconsistent.
     let m = Machine::paper();
