@@ -93,13 +93,28 @@ fn paper_estimator(
     }
 }
 
-fn median_mu(sc: &Scenario, e: &LinearEstimator, trials: usize, seed: u64) -> f64 {
-    let r = e.run(sc, trials, seed, 7777, &|_| {});
-    Summary::of(&r.iter().map(|t| t.mu_mm).collect::<Vec<_>>()).median
+/// Summary of `mu` over `trials` fast-path trials of `sc` at `grade_arcsec`
+/// (the same trials' noise for every grade: common random numbers).
+fn mu_at_grade(
+    sc: &Scenario,
+    grade_arcsec: f64,
+    trials: usize,
+    seed: u64,
+) -> Result<Summary, String> {
+    let estimator = GradeModel::new(sc, grade_arcsec).map_err(s)?.estimator;
+    let r = estimator.run(sc, trials, seed, 7777, &|_| {});
+    Ok(Summary::of(&r.iter().map(|t| t.mu_mm).collect::<Vec<_>>()))
+}
+
+/// Standard error of a median, from its 95 % interval.
+fn median_standard_error(s: &Summary) -> f64 {
+    (s.median_ci95[1] - s.median_ci95[0]) / (2.0 * 1.96)
 }
 
 /// Grade at which `sc`'s median mu equals `target`, by bisection in log
-/// space between 0.01 and `limit` arcsec.
+/// space between 0.01 and `limit` arcsec. Every evaluation draws the same
+/// trials (common random numbers), so the median is a smooth function of
+/// the grade.
 fn grade_for_mu(
     sc: &Scenario,
     target: f64,
@@ -107,14 +122,7 @@ fn grade_for_mu(
     trials: usize,
     seed: u64,
 ) -> Result<Option<f64>, String> {
-    let f = |g: f64| -> Result<f64, String> {
-        Ok(median_mu(
-            sc,
-            &GradeModel::new(sc, g).map_err(s)?.estimator,
-            trials,
-            seed,
-        ))
-    };
+    let f = |g: f64| -> Result<f64, String> { Ok(mu_at_grade(sc, g, trials, seed)?.median) };
     let (mut lo, mut hi) = (0.01, limit);
     if f(hi)? < target {
         return Ok(None);
@@ -131,6 +139,39 @@ fn grade_for_mu(
         }
     }
     Ok(Some((lo * hi).sqrt()))
+}
+
+/// The grade at which `sc`'s median mu equals the reference median `mu`,
+/// with a 95 % interval: the Monte Carlo standard errors of both medians
+/// (from their order-statistic intervals) combined, and the bisection
+/// repeated at the target moved by 1.96 of them either way.
+fn equivalent_grade(
+    sc: &Scenario,
+    reference: &Summary,
+    trials: usize,
+    seed: u64,
+) -> Result<Option<EquivalentGrade>, String> {
+    let limit = 1e4;
+    let Some(g) = grade_for_mu(sc, reference.median, limit, trials, seed)? else {
+        return Ok(None);
+    };
+    let at_g = mu_at_grade(sc, g, trials, seed)?;
+    let se = median_standard_error(reference).hypot(median_standard_error(&at_g));
+    let lo = grade_for_mu(sc, reference.median - 1.96 * se, limit, trials, seed)?;
+    let hi = grade_for_mu(sc, reference.median + 1.96 * se, limit, trials, seed)?;
+    Ok(Some(EquivalentGrade {
+        grade_arcsec: g,
+        interval95_arcsec: [lo, hi],
+    }))
+}
+
+/// The grade at which a pose set matches a reference median `mu`, with
+/// its 95 % interval (a bound is `None` where no grade below the search
+/// limit reaches it).
+#[derive(Debug, Clone, Copy)]
+struct EquivalentGrade {
+    grade_arcsec: f64,
+    interval95_arcsec: [Option<f64>; 2],
 }
 
 fn table(title: &str, sc: &Scenario, results: &[GradeResult]) {
@@ -285,7 +326,7 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
     let reference = results
         .iter()
         .find(|r| r.grade_arcsec == PAPER_CHOSEN_ARCSEC)
-        .map(|r| r.fast.mu_mm.median);
+        .map(|r| r.fast.mu_mm);
     let mut optimised_json = Vec::new();
     for (criterion, sel, poses, sc, res) in &optimised {
         table(
@@ -293,17 +334,23 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
             sc,
             res,
         );
-        let equivalent = match reference {
-            Some(mu) => grade_for_mu(sc, mu, 1e4, 20_000, a.seed)?,
+        let equivalent = match &reference {
+            Some(mu) => equivalent_grade(sc, mu, 20_000, a.seed)?,
             None => None,
         };
         println!(
             "criterion {:?}: {} -> {} in {} swaps, {} passes",
             criterion, sel.start_value, sel.value, sel.swaps, sel.passes
         );
-        if let (Some(mu), Some(g)) = (reference, equivalent) {
+        if let (Some(mu), Some(eq)) = (&reference, equivalent) {
+            let [lo, hi] = eq.interval95_arcsec;
+            let bound = |b: Option<f64>| b.map_or("-".to_string(), |v| format!("{v:.2}"));
             println!(
-                "this set matches the default set's median mu at {PAPER_CHOSEN_ARCSEC} arcsec ({mu:.4} mm) with a {g:.2} arcsec encoder (coarser = cheaper)"
+                "this set matches the default set's median mu at {PAPER_CHOSEN_ARCSEC} arcsec ({:.4} mm) with a {:.2} arcsec encoder (95 % interval {} to {} arcsec; coarser = cheaper)",
+                mu.median,
+                eq.grade_arcsec,
+                bound(lo),
+                bound(hi)
             );
         }
         optimised_json.push(json!({
@@ -314,7 +361,8 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
             "swaps": sel.swaps,
             "poses_mm": poses.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
             "grades": res,
-            "equivalent_grade_arcsec": equivalent,
+            "equivalent_grade_arcsec": equivalent.map(|e| e.grade_arcsec),
+            "equivalent_grade_interval95_arcsec": equivalent.map(|e| e.interval95_arcsec),
         }));
     }
 
@@ -366,14 +414,8 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
     for n in [8usize, 10, 12, 15, 20, 30, 50, 75] {
         let sc =
             Scenario::paper(machine.clone(), machine.workspace.random_poses(n, 3)).map_err(s)?;
-        let mu_at = |g: f64| -> Result<f64, String> {
-            Ok(median_mu(
-                &sc,
-                &GradeModel::new(&sc, g).map_err(s)?.estimator,
-                20_000,
-                a.seed,
-            ))
-        };
+        let mu_at =
+            |g: f64| -> Result<f64, String> { Ok(mu_at_grade(&sc, g, 20_000, a.seed)?.median) };
         let (m2, m4) = (mu_at(2.0)?, mu_at(4.0)?);
         let cross =
             tricept_study::crossing_grade(&sc, 0.25, 1e5, 10_000, a.seed, &our_estimator(&sc))

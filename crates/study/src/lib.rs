@@ -88,6 +88,10 @@ pub struct Summary {
     pub p05: f64,
     /// 95 % quantile.
     pub p95: f64,
+    /// Distribution-free 95 % confidence interval of the median: the order
+    /// statistics `n/2 -+ 1.96 sqrt(n)/2` (normal approximation to the
+    /// binomial count below the true median).
+    pub median_ci95: [f64; 2],
 }
 
 impl Summary {
@@ -101,6 +105,7 @@ impl Summary {
                 median: f64::NAN,
                 p05: f64::NAN,
                 p95: f64::NAN,
+                median_ci95: [f64::NAN; 2],
             };
         }
         let mean = values.iter().sum::<f64>() / n as f64;
@@ -123,6 +128,13 @@ impl Summary {
             median: q(0.5),
             p05: q(0.05),
             p95: q(0.95),
+            median_ci95: {
+                let half = 1.96 * (n as f64).sqrt() / 2.0;
+                let mid = n as f64 / 2.0;
+                let lo = ((mid - half).floor().max(0.0) as usize).min(n - 1);
+                let hi = ((mid + half).ceil() as usize).min(n - 1);
+                [sorted[lo], sorted[hi]]
+            },
         }
     }
 }
@@ -285,4 +297,36 @@ pub fn crossing_grade(
         }
     }
     Ok(Some((lo * hi).sqrt()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Summary;
+    use rand::{RngExt, SeedableRng};
+    use rand_pcg::Pcg64Mcg;
+
+    #[test]
+    fn the_median_interval_covers_the_true_median_95_percent_of_the_time() {
+        // Exponential samples (skewed like mu), true median ln 2.
+        let mut rng = Pcg64Mcg::seed_from_u64(11);
+        let (runs, mut covered) = (400, 0);
+        for _ in 0..runs {
+            let sample: Vec<f64> = (0..2001)
+                .map(|_| -(1.0 - rng.random::<f64>()).ln())
+                .collect();
+            let [lo, hi] = Summary::of(&sample).median_ci95;
+            if lo <= std::f64::consts::LN_2 && std::f64::consts::LN_2 <= hi {
+                covered += 1;
+            }
+        }
+        // Binomial(400, 0.95): 380 +- 4.4; allow about 3 standard deviations.
+        assert!((367..=393).contains(&covered), "{covered} of {runs}");
+    }
+
+    #[test]
+    fn summaries_of_tiny_samples_are_defined() {
+        let one = Summary::of(&[2.0]);
+        assert_eq!((one.median, one.median_ci95), (2.0, [2.0, 2.0]));
+        assert!(Summary::of(&[]).median_ci95[0].is_nan());
+    }
 }
