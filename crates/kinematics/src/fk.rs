@@ -6,8 +6,8 @@
 //! Jacobian is the paper's `J1` (see [`crate::LegGeometry::j1`]), so Newton's
 //! method costs one 3x3 solve per iteration. The iteration is safeguarded by
 //! a backtracking line search on `|f|^2`; it starts from a closed-form seed
-//! (two rounds of three-sphere trilateration, extrapolated) unless the
-//! caller passes one.
+//! (three-sphere trilateration with the platform level; if that fails, two
+//! rounds extrapolated) unless the caller passes one.
 //!
 //! Every solution carries the condition number of `J1` made unit-free by
 //! scaling its angle columns by `1/q4`, and the solver refuses (with an
@@ -51,11 +51,24 @@ const RESIDUAL_TOLERANCE_MM: f64 = 1e-8;
 
 impl Machine {
     /// Forward kinematics from leg commands (mm), starting from a closed-form seed.
+    ///
+    /// The seed is the level-platform trilateration (cheap, and enough
+    /// everywhere in the workspace); if Newton fails from it, it is retried
+    /// from the extrapolated seed, which is closer near and beyond the
+    /// workspace's edges, where the cheap one can lead to the other assembly
+    /// branch.
     pub fn forward(&self, legs_mm: &[f64; 3]) -> Result<FkSolution, KinematicsError> {
         self.check_leg_stroke(legs_mm)?;
         let lengths = self.actual_lengths(legs_mm);
-        let seed = self.trilateration_seed(&lengths);
-        self.newton(legs_mm, &lengths, seed)
+        let Some(r1) = self.level_trilateration(&lengths) else {
+            let seed = self.level_joints();
+            return self.newton(legs_mm, &lengths, seed);
+        };
+        let seed = self.up_limb.inverse(&r1).unwrap_or(self.level_joints());
+        self.newton(legs_mm, &lengths, seed).or_else(|_| {
+            let seed = self.extrapolated_seed(&lengths, &r1);
+            self.newton(legs_mm, &lengths, seed)
+        })
     }
 
     /// Forward kinematics from leg commands (mm), starting at `seed` (useful
@@ -84,9 +97,32 @@ impl Machine {
         std::array::from_fn(|i| legs_mm[i] + self.leg_offsets_mm[i])
     }
 
-    /// Seed: place O' by trilateration with the platform level, then again
-    /// with the platform at the orientation the UP limb gives that point,
-    /// and extrapolate the two rounds.
+    /// The UP joints of the level platform at mid-height: the seed of last
+    /// resort.
+    fn level_joints(&self) -> UpJoints {
+        UpJoints {
+            phi_rad: 0.0,
+            theta_rad: 0.0,
+            q4_mm: 0.5 * (self.workspace.z_min_mm + self.workspace.z_max_mm),
+        }
+    }
+
+    /// O' placed by trilateration with the platform joints at the
+    /// orientation `rotation`.
+    fn trilaterate_at(&self, rotation: &Matrix3<f64>, lengths: &[f64; 3]) -> Option<Vector3<f64>> {
+        let centres: [Vector3<f64>; 3] =
+            std::array::from_fn(|i| self.base_joints_mm[i] - rotation * self.platform_joints_mm[i]);
+        trilaterate(&centres, lengths)
+    }
+
+    /// O' placed by trilateration with the platform level.
+    fn level_trilateration(&self, lengths: &[f64; 3]) -> Option<Vector3<f64>> {
+        self.trilaterate_at(&Matrix3::identity(), lengths)
+    }
+
+    /// A closer seed: trilateration again with the platform at the
+    /// orientation the UP limb gives the level-platform point `r1`, and the
+    /// two rounds extrapolated.
     ///
     /// The rounds form a fixed-point iteration on the limb direction
     /// `u = r / |r|`, started at the level platform (`u_0 = e_z`). It
@@ -96,44 +132,31 @@ impl Machine {
     /// limit taken as `x_2 + s / (1 - s) (x_2 - x_1)` (Aitken's
     /// extrapolation) for the direction and the length `|r|`, which leaves
     /// an error of second order in the tilt: 11 mm on average over the
-    /// workspace instead of 219 mm (`scaled_size`), and Newton needs 2.1
-    /// iterations on average instead of 3.4.
-    fn trilateration_seed(&self, lengths: &[f64; 3]) -> UpJoints {
-        let z_mid = 0.5 * (self.workspace.z_min_mm + self.workspace.z_max_mm);
-        let level = UpJoints {
-            phi_rad: 0.0,
-            theta_rad: 0.0,
-            q4_mm: z_mid,
-        };
-        let place = |rotation: &Matrix3<f64>| {
-            let centres: [Vector3<f64>; 3] = std::array::from_fn(|i| {
-                self.base_joints_mm[i] - rotation * self.platform_joints_mm[i]
-            });
-            trilaterate(&centres, lengths)
-        };
-        let Some(r1) = place(&Matrix3::identity()) else {
-            return level;
-        };
-        let r2 = match self.up_limb.rotation_at_point(&r1) {
-            Ok(rotation) => place(&rotation),
+    /// workspace instead of 219 mm (`scaled_size`). Newton then needs 2.1
+    /// iterations on average instead of 3.4, but the longer seed costs as
+    /// much time as that saves, so it is the fallback, not the default.
+    fn extrapolated_seed(&self, lengths: &[f64; 3], r1: &Vector3<f64>) -> UpJoints {
+        let r2 = match self.up_limb.rotation_at_point(r1) {
+            Ok(rotation) => self.trilaterate_at(&rotation, lengths),
             Err(_) => None,
         };
         let r = match r2 {
-            Some(r2) => extrapolate(&r1, &r2).unwrap_or(r2),
-            None => r1,
+            Some(r2) => extrapolate(r1, &r2).unwrap_or(r2),
+            None => *r1,
         };
-        self.up_limb.inverse(&r).unwrap_or(level)
+        self.up_limb.inverse(&r).unwrap_or(self.level_joints())
     }
 
     /// Leg geometry at `x` written into `out`, and the closure residual.
+    /// (In place: the geometry is a few hundred bytes and Newton's loop
+    /// would otherwise spend a tenth of its time copying it.)
     fn closure_into(
         &self,
         x: &UpJoints,
         lengths: &[f64; 3],
         out: &mut LegGeometry,
     ) -> Vector3<f64> {
-        out.limb = self.up_limb.pose(x);
-        self.update_legs(out);
+        self.legs_into(self.up_limb.pose(x), out);
         Vector3::from_fn(|i, _| out.lengths_mm[i] - lengths[i])
     }
 
@@ -265,7 +288,7 @@ pub(crate) fn unit_free_condition(j1: &Matrix3<f64>, q4_mm: f64) -> f64 {
 /// direction `e_z`); `None` when the iteration does not contract.
 fn extrapolate(r1: &Vector3<f64>, r2: &Vector3<f64>) -> Option<Vector3<f64>> {
     let (n1, n2) = (r1.norm(), r2.norm());
-    let (u1, u2) = (r1 * (1.0 / n1), r2 * (1.0 / n2));
+    let (u1, u2) = (r1 / n1, r2 / n2);
     let d1 = u1 - Vector3::z();
     let d2 = u2 - u1;
     let d1d1 = d1.norm_squared();
@@ -282,31 +305,24 @@ fn extrapolate(r1: &Vector3<f64>, r2: &Vector3<f64>) -> Option<Vector3<f64>> {
 
 /// The intersection of three spheres on the side of larger z, if any.
 fn trilaterate(c: &[Vector3<f64>; 3], r: &[f64; 3]) -> Option<Vector3<f64>> {
-    // Reciprocals instead of divisions (a third of the cost otherwise).
     let d_vec = c[1] - c[0];
     let d = d_vec.norm();
+    let ex = d_vec / d;
     let c3 = c[2] - c[0];
-    if d < 1e-9 {
-        return None;
-    }
-    let inv_d = 1.0 / d;
-    let ex = d_vec * inv_d;
     let i = ex.dot(&c3);
     let ey_raw = c3 - i * ex;
     let j = ey_raw.norm();
-    if j < 1e-9 {
+    if d < 1e-9 || j < 1e-9 {
         return None;
     }
-    let inv_j = 1.0 / j;
-    let ey = ey_raw * inv_j;
+    let ey = ey_raw / j;
     let mut ez = ex.cross(&ey);
     if ez.z < 0.0 {
         ez = -ez;
     }
-    let r0_sq = r[0] * r[0];
-    let x = 0.5 * (r0_sq - r[1] * r[1] + d * d) * inv_d;
-    let y = (0.5 * (r0_sq - r[2] * r[2] + i * i + j * j) - i * x) * inv_j;
-    let z2 = r0_sq - x * x - y * y;
+    let x = (r[0] * r[0] - r[1] * r[1] + d * d) / (2.0 * d);
+    let y = (r[0] * r[0] - r[2] * r[2] + i * i + j * j) / (2.0 * j) - i / j * x;
+    let z2 = r[0] * r[0] - x * x - y * y;
     if z2.is_nan() || z2 < 0.0 {
         return None;
     }
@@ -351,13 +367,9 @@ mod tests {
             for r in m.workspace.random_poses(300, 5) {
                 let ik = m.inverse(&r).unwrap();
                 let lengths = m.actual_lengths(&ik.legs_mm);
-                let centres: [Vector3<f64>; 3] =
-                    std::array::from_fn(|i| m.base_joints_mm[i] - m.platform_joints_mm[i]);
-                let level = m
-                    .up_limb
-                    .inverse(&trilaterate(&centres, &lengths).unwrap())
-                    .unwrap();
-                let seed = m.trilateration_seed(&lengths);
+                let r1 = m.level_trilateration(&lengths).unwrap();
+                let level = m.up_limb.inverse(&r1).unwrap();
+                let seed = m.extrapolated_seed(&lengths, &r1);
                 let (e_level, e_seed) = (
                     joint_distance_mm(&level, &ik.up),
                     joint_distance_mm(&seed, &ik.up),

@@ -264,25 +264,22 @@ impl Machine {
             lengths_mm: [0.0; 3],
             directions: [Vector3::zeros(); 3],
         };
-        self.update_legs(&mut g);
+        self.legs_into(limb, &mut g);
         g
     }
 
-    /// Recomputes the legs of `out` for the limb pose already in
-    /// `out.limb` (in place: FK's inner loop would otherwise spend a tenth
-    /// of its time copying the few hundred bytes of geometry).
+    /// [`Machine::legs_for`] written into an existing value.
     #[inline]
-    pub(crate) fn update_legs(&self, out: &mut LegGeometry) {
-        let limb = &out.limb;
+    pub(crate) fn legs_into(&self, limb: UpLimbPose, out: &mut LegGeometry) {
         for i in 0..3 {
             let a = limb.position_mm + limb.rotation * self.platform_joints_mm[i];
             let d = a - self.base_joints_mm[i];
             let n = d.norm();
             out.platform_joints_mm[i] = a;
             out.lengths_mm[i] = n;
-            // One division instead of three: this is FK's inner loop.
-            out.directions[i] = d * (1.0 / n);
+            out.directions[i] = d / n;
         }
+        out.limb = limb;
     }
 
     /// Leg commands that put the legs at the geometric lengths of `geometry`.
