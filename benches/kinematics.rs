@@ -7,7 +7,7 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
 use tricept_benches::workspace_points;
-use tricept_kinematics::{HeadBranch, Machine};
+use tricept_kinematics::{FkSeed, HeadBranch, Machine};
 use tricept_model::error_jacobian;
 
 /// Cycles through the inputs without an integer division in the timed loop.
@@ -41,6 +41,15 @@ fn kinematics(c: &mut Criterion) {
         b.iter(|| {
             k = next(k, iks.len());
             black_box(m.forward(black_box(&iks[k].legs_mm)).unwrap())
+        })
+    });
+    c.bench_function("fk_cold_start_extrapolated_seed", |b| {
+        b.iter(|| {
+            k = next(k, iks.len());
+            black_box(
+                m.forward_seeded(black_box(&iks[k].legs_mm), FkSeed::Extrapolated)
+                    .unwrap(),
+            )
         })
     });
     c.bench_function("fk_warm_start", |b| {

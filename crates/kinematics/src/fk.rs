@@ -40,6 +40,25 @@ pub struct FkSolution {
     pub residual_mm: f64,
 }
 
+/// The cold-start seed of [`Machine::forward_seeded`].
+///
+/// Both place O' by three-sphere trilateration of the leg lengths; they
+/// differ in what they assume about the platform's orientation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FkSeed {
+    /// The platform level: cheap, about 20 times farther from the solution
+    /// than `Extrapolated`, and Newton needs 3-4 iterations from it. If
+    /// Newton fails from it (it can lead to the other assembly branch near
+    /// and beyond the workspace's edges), FK is retried from
+    /// `Extrapolated`. The default (the two take the same time).
+    #[default]
+    Level,
+    /// A second trilateration at the tilt the first one implies, and the
+    /// two extrapolated (see `extrapolated_seed` in `fk.rs`): Newton needs
+    /// about 2 iterations, but the longer seed costs as much as that saves.
+    Extrapolated,
+}
+
 const MAX_ITERATIONS: u32 = 60;
 /// A step this small (mm) ends the line search whatever the merit does.
 const STEP_TOLERANCE_MM: f64 = 1e-10;
@@ -50,25 +69,49 @@ const FINAL_STEP_MM: f64 = 1e-6;
 const RESIDUAL_TOLERANCE_MM: f64 = 1e-8;
 
 impl Machine {
-    /// Forward kinematics from leg commands (mm), starting from a closed-form seed.
-    ///
-    /// The seed is the level-platform trilateration (cheap, and enough
-    /// everywhere in the workspace); if Newton fails from it, it is retried
-    /// from the extrapolated seed, which is closer near and beyond the
-    /// workspace's edges, where the cheap one can lead to the other assembly
-    /// branch.
+    /// Forward kinematics from leg commands (mm), starting from a closed-form
+    /// seed ([`FkSeed::Level`]).
     pub fn forward(&self, legs_mm: &[f64; 3]) -> Result<FkSolution, KinematicsError> {
+        self.forward_seeded(legs_mm, FkSeed::Level)
+    }
+
+    /// Forward kinematics from leg commands (mm) with the cold-start seed
+    /// chosen by `seed`. Both strategies give the same solutions; they
+    /// differ in cost (see [`FkSeed`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_kinematics::{FkSeed, Machine};
+    /// let m = Machine::paper();
+    /// let legs = m.inverse(&nalgebra::Vector3::new(300.0, -200.0, 700.0)).unwrap().legs_mm;
+    /// let a = m.forward_seeded(&legs, FkSeed::Level).unwrap();
+    /// let b = m.forward_seeded(&legs, FkSeed::Extrapolated).unwrap();
+    /// assert!((a.position_mm - b.position_mm).norm() < 1e-9);
+    /// assert!(b.iterations <= a.iterations);
+    /// ```
+    pub fn forward_seeded(
+        &self,
+        legs_mm: &[f64; 3],
+        seed: FkSeed,
+    ) -> Result<FkSolution, KinematicsError> {
         self.check_leg_stroke(legs_mm)?;
         let lengths = self.actual_lengths(legs_mm);
         let Some(r1) = self.level_trilateration(&lengths) else {
             let seed = self.level_joints();
             return self.newton(legs_mm, &lengths, seed);
         };
-        let seed = self.up_limb.inverse(&r1).unwrap_or(self.level_joints());
-        self.newton(legs_mm, &lengths, seed).or_else(|_| {
+        let extrapolated = || {
             let seed = self.extrapolated_seed(&lengths, &r1);
             self.newton(legs_mm, &lengths, seed)
-        })
+        };
+        match seed {
+            FkSeed::Level => {
+                let seed = self.up_limb.inverse(&r1).unwrap_or(self.level_joints());
+                self.newton(legs_mm, &lengths, seed)
+                    .or_else(|_| extrapolated())
+            }
+            FkSeed::Extrapolated => extrapolated(),
+        }
     }
 
     /// Forward kinematics from leg commands (mm), starting at `seed` (useful

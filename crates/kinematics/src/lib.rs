@@ -37,7 +37,7 @@ mod workspace;
 
 pub use description::{AxisOrder, HeadDescription, MachineDescription, Placement};
 pub use error::{DescriptionError, KinematicsError};
-pub use fk::FkSolution;
+pub use fk::{FkSeed, FkSolution};
 pub use head::{Head, HeadBranch, ToolIkSolution, ToolPose};
 pub use machine::{
     IkSolution, LegGeometry, Limits, Machine, SINGULARITY_CONDITION_LIMIT, SensorNoise,
