@@ -707,13 +707,7 @@ impl Identification {
         }
         m.insert(
             "std_dev".into(),
-            Value::Object(
-                self.names
-                    .iter()
-                    .zip(&self.std_dev)
-                    .map(|(n, s)| (n.clone(), s.map_or(Value::Null, Value::from)))
-                    .collect(),
-            ),
+            crate::report::named_values(&self.names, &self.std_dev),
         );
         m.insert(
             "offsets".into(),

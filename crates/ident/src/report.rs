@@ -443,13 +443,7 @@ impl IdentifiabilityReport {
         );
         m.insert(
             "std_dev_mm".into(),
-            Value::Object(
-                self.names
-                    .iter()
-                    .zip(&self.std_dev_mm)
-                    .map(|(n, s)| (n.clone(), s.map_or(Value::Null, Value::from)))
-                    .collect(),
-            ),
+            named_values(&self.names, &self.std_dev_mm),
         );
         Value::Object(m)
     }
@@ -549,4 +543,15 @@ fn identifiable_singular_values(d: &RankDecision) -> Vec<f64> {
         Some((s, _)) => s.into_iter().filter(|x| *x > 0.0).collect(),
         None => Vec::new(),
     }
+}
+
+/// A JSON object `name -> value`, `null` where there is no value.
+pub(crate) fn named_values(names: &[String], values: &[Option<f64>]) -> Value {
+    Value::Object(
+        names
+            .iter()
+            .zip(values)
+            .map(|(n, v)| (n.clone(), v.map_or(Value::Null, Value::from)))
+            .collect(),
+    )
 }

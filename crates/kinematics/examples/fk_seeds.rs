@@ -7,7 +7,7 @@
 //! ```
 
 use nalgebra::Vector3;
-use tricept_kinematics::{AxisOrder, FkSeed, Machine};
+use tricept_kinematics::{AxisOrder, FkSeed, Machine, box_lattice};
 
 fn main() {
     for machine in [
@@ -24,21 +24,14 @@ fn main() {
             .collect();
         // A 50 mm lattice out to 1000 mm radius, z from 300 to 1300 mm: the
         // configurations IK reaches there.
-        let mut beyond = Vec::new();
-        for i in -20..=20 {
-            for j in -20..=20 {
-                for k in 0..=20 {
-                    let r = Vector3::new(
-                        50.0 * f64::from(i),
-                        50.0 * f64::from(j),
-                        300.0 + 50.0 * f64::from(k),
-                    );
-                    if let Ok(ik) = machine.inverse(&r) {
-                        beyond.push((r, ik.legs_mm));
-                    }
-                }
-            }
-        }
+        let beyond: Vec<(Vector3<f64>, [f64; 3])> = box_lattice(
+            Vector3::new(-1000.0, -1000.0, 300.0),
+            Vector3::new(1000.0, 1000.0, 1300.0),
+            50.0,
+        )
+        .into_iter()
+        .filter_map(|r| machine.inverse(&r).ok().map(|ik| (r, ik.legs_mm)))
+        .collect();
         for seed in [FkSeed::Level, FkSeed::Extrapolated] {
             let iterations: u32 = inside
                 .iter()

@@ -43,4 +43,4 @@ pub use machine::{
     IkSolution, LegGeometry, Limits, Machine, SINGULARITY_CONDITION_LIMIT, SensorNoise,
 };
 pub use up_limb::{UpJoints, UpLimb, UpLimbPose};
-pub use workspace::Workspace;
+pub use workspace::{Workspace, box_lattice};

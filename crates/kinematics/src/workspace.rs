@@ -139,6 +139,40 @@ impl Workspace {
     }
 }
 
+/// Every point of the lattice of spacing `spacing_mm` in the box from
+/// `min_mm` to `max_mm` (corners included), x slowest and z fastest: for
+/// sweeps that go beyond the workspace cylinder.
+///
+/// # Example
+/// ```
+/// use nalgebra::Vector3;
+/// let l = tricept_kinematics::box_lattice(
+///     Vector3::new(-100.0, -100.0, 600.0),
+///     Vector3::new(100.0, 100.0, 700.0),
+///     50.0,
+/// );
+/// assert_eq!(l.len(), 5 * 5 * 3);
+/// assert_eq!(l[1], Vector3::new(-100.0, -100.0, 650.0));
+/// ```
+pub fn box_lattice(
+    min_mm: Vector3<f64>,
+    max_mm: Vector3<f64>,
+    spacing_mm: f64,
+) -> Vec<Vector3<f64>> {
+    let steps: [usize; 3] =
+        std::array::from_fn(|a| ((max_mm[a] - min_mm[a]) / spacing_mm + 1e-9).floor() as usize);
+    let mut out = Vec::with_capacity((steps[0] + 1) * (steps[1] + 1) * (steps[2] + 1));
+    for i in 0..=steps[0] {
+        for j in 0..=steps[1] {
+            for k in 0..=steps[2] {
+                let offset = Vector3::new(i as f64, j as f64, k as f64) * spacing_mm;
+                out.push(min_mm + offset);
+            }
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
