@@ -401,21 +401,22 @@ fn predicted_translation_sd(
     )
     .map_err(|e| e.to_string())?;
     let mut c = vec![0.0; k];
+    let mut z_row = vec![0.0; k];
     for r in plane {
         let up = nominal.inverse(r).map_err(|e| e.to_string())?.up;
         let jp = tricept_model::position_error_jacobian(&nominal.legs_at(&up))
             .map_err(|e| e.to_string())?;
-        for (j, cj) in c.iter_mut().enumerate() {
-            let col = set.column(j);
-            *cj += (0..21).map(|f| jp[(2, f)] * col[f]).sum::<f64>() / plane.len() as f64;
+        set.project(1, |_, f| jp[(2, f)], &mut z_row);
+        for (cj, zj) in c.iter_mut().zip(&z_row) {
+            *cj += zj / plane.len() as f64;
         }
     }
-    let cov = |a: usize, b: usize| id.covariance[a * k + b];
+    let cov = |a: usize, b: usize| id.covariance[(a, b)];
     let var = if weak_only {
         // Project c on the weakest identifiable direction (in parameter units).
-        let d = &id.decision;
-        let weakest = d.rank - 1;
-        let v = d.direction(weakest);
+        let v = id
+            .direction(id.rank() - 1)
+            .ok_or("no identifiable direction")?;
         let vv: f64 = (0..k)
             .map(|a| (0..k).map(|b| v[a] * v[b] * cov(a, b)).sum::<f64>())
             .sum();

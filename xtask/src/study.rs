@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nalgebra::Vector3;
 use serde_json::{Value, json};
-use tricept_kinematics::{Machine, MachineDescription};
+use tricept_kinematics::{Machine, MachineDescription, PoseSetError};
 use tricept_study::optimize::{Candidates, Criterion, candidate_grid, exchange};
 use tricept_study::paper::{PaperSolve, paper_solve};
 use tricept_study::{GradeModel, GradeResult, LinearEstimator, Scenario, StudyError, Summary};
@@ -233,7 +233,16 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
             .map_err(|e| format!("{}: {e}", p.display()))?,
         None => Machine::paper(),
     };
-    let targets = tricept_plant::campaign::pose_set(&a.poses, &machine)?;
+    let pose_set: tricept_kinematics::PoseSet =
+        a.poses.parse().map_err(|e: PoseSetError| e.to_string())?;
+    let targets = match pose_set.generate(&machine.workspace) {
+        Some(points) => points,
+        None => tricept_data::read_targets(std::path::Path::new(&a.poses))
+            .map_err(|e| e.to_string())?
+            .into_iter()
+            .map(Vector3::from)
+            .collect(),
+    };
     let scenario = Scenario::paper(machine.clone(), targets.clone()).map_err(s)?;
     let exact_trials = if a.exact { a.exact_trials } else { 200 };
     let per_grade = 2 * a.trials + exact_trials;
@@ -297,7 +306,7 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
     if !a.no_optimise {
         let design_grade = PAPER_CHOSEN_ARCSEC;
         let gm = GradeModel::new(&scenario, design_grade).map_err(s)?;
-        let columns = gm.design.decision.identifiable.clone();
+        let columns = gm.design.identifiable().to_vec();
         let mut cands_targets = candidate_grid(&machine);
         cands_targets.extend(targets.iter().copied());
         let cands = Candidates::new(

@@ -1,25 +1,54 @@
 //! `tricept diagnose` and `tricept detectability`.
 
-use std::path::Path;
+use std::path::PathBuf;
 
+use clap::Args;
 use tricept_diagnose::detect::{advise, detectability, realistic};
-use tricept_diagnose::diagnose::{DiagnoseError, DiagnoseOptions, diagnose};
+use tricept_diagnose::{DiagnoseError, DiagnoseOptions, diagnose};
 use tricept_ident::GeometricModel;
 use tricept_model::{GeometricErrors, ParameterSet};
 use tricept_plant::{Campaign, Effect, Plant, PoseOrder};
 
-use crate::MachineArgs;
+use crate::args::{MachineArgs, NoiseArgs, machine_with_noise, pose_targets, read_data};
 use crate::cli_error::CliError;
-use crate::ident_cmd::{NoiseArgs, machine_with_noise, read_data};
 
 /// `tricept diagnose`.
-pub fn run_diagnose(
-    machine: &MachineArgs,
-    noise: &NoiseArgs,
-    data: &Path,
-    plots: Option<&Path>,
-) -> Result<(), CliError> {
-    let m = machine_with_noise(machine, noise)?;
+#[derive(Debug, Args)]
+pub struct DiagnoseArgs {
+    /// Measured-data CSV (context columns temp_c, time_s, dir1..3 are used when present).
+    #[arg(long, value_name = "FILE.csv")]
+    pub data: PathBuf,
+    /// Write residual plots (SVG) of the named causes into this directory.
+    #[arg(long, value_name = "DIR")]
+    pub plots: Option<PathBuf>,
+    #[command(flatten)]
+    pub noise: NoiseArgs,
+    #[command(flatten)]
+    pub machine: MachineArgs,
+}
+
+/// `tricept detectability`.
+#[derive(Debug, Args)]
+pub struct DetectabilityArgs {
+    /// Pose set (as for `identifiability`).
+    #[arg(long, default_value = "grid")]
+    pub poses: String,
+    /// Visit every pose twice, approaching from both directions.
+    #[arg(long)]
+    pub both_directions: bool,
+    /// Temperature change over the campaign, K (0: no thermal signature).
+    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
+    pub temperature_drift: f64,
+    #[command(flatten)]
+    pub noise: NoiseArgs,
+    #[command(flatten)]
+    pub machine: MachineArgs,
+}
+
+/// `tricept diagnose`.
+pub fn run_diagnose(a: &DiagnoseArgs) -> Result<(), CliError> {
+    let (machine, data) = (&a.machine, a.data.as_path());
+    let m = machine_with_noise(machine, &a.noise)?;
     let dataset = read_data(data, &m)?;
     let source = data.display().to_string();
     let d = diagnose(&m, &dataset, &DiagnoseOptions::for_machine(&m)).map_err(|e| match e {
@@ -31,7 +60,7 @@ pub fn run_diagnose(
         )),
         e => CliError::other(format!("{source}: {e}")),
     })?;
-    if let Some(dir) = plots {
+    if let Some(dir) = &a.plots {
         std::fs::create_dir_all(dir)
             .map_err(|e| CliError::other(format!("{}: {e}", dir.display())))?;
         for p in &d.plots {
@@ -57,96 +86,20 @@ pub fn run_diagnose(
         outln!("{}", d.to_json());
         return Ok(());
     }
-    outln!(
-        "{}: the geometric model {}",
-        source,
-        if d.adequate {
-            "explains the data (adequate)"
-        } else {
-            "does NOT explain the data"
-        }
-    );
-    outln!(
-        "geometric fit: chi2 {:.1} for {} dof (p = {:.2e}); residual rms phi {:.3} arcsec, theta {:.3} arcsec, s {:.3} um",
-        d.chi_square,
-        d.dof,
-        d.chi_square_p_value,
-        d.residual_rms_geometric[0],
-        d.residual_rms_geometric[1],
-        d.residual_rms_geometric[2]
-    );
-    if let Some(s) = d.structure.first() {
-        outln!(
-            "strongest residual structure: {} vs {} (r = {:+.2}, p = {:.1e})",
-            s.channel,
-            s.regressor,
-            s.correlation,
-            s.p_value
-        );
-    }
-    for (i, c) in d.causes.iter().enumerate() {
-        let ev = &c.evidence;
-        outln!(
-            "cause {}: {}   (chi2 drop {:.1} for {} dof, p = {:.1e}; BIC gain {:.1}{})",
-            i + 1,
-            c.effect,
-            ev.delta_chi_square,
-            ev.dof,
-            ev.p_value,
-            ev.delta_bic,
-            match (ev.holdout_rms_without, ev.holdout_rms_with) {
-                (Some(a), Some(b)) => format!("; held-out rms {a:.2} -> {b:.2}"),
-                _ => String::new(),
-            }
-        );
-        for p in &c.parameters {
-            match p.std_dev {
-                Some(sd) => outln!("    {:<40} {:>12.4} +- {:.4}", p.name, p.value, sd),
-                None => outln!("    {:<40} {:>12.4}", p.name, p.value),
-            }
-        }
-        if !c.rows.is_empty() {
-            outln!("    lines: {:?}", c.rows);
-        }
-    }
-    if let Some(u) = &d.unexplained {
-        outln!("unexplained: {u}");
-    }
-    let mut bias = d.geometric_bias.clone();
-    bias.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
-    if !d.causes.is_empty() {
-        let text: Vec<String> = bias
-            .iter()
-            .take(4)
-            .map(|(n, v)| format!("{n} {:+.4}", v))
-            .collect();
-        outln!(
-            "bias the causes put into the geometric parameters (mm): {}",
-            text.join(", ")
-        );
-    }
-    let g = &d.gain;
-    outln!(
-        "gain: held-out rms {:.3} -> {:.3} (noise = 1); platform moved on the middle plane by {:.4} mm mean ({:.4} after touch-off), {:.4} mm max",
-        g.holdout_rms_geometric,
-        g.holdout_rms_extended,
-        g.volumetric_mean_mm,
-        g.volumetric_touched_mean_mm,
-        g.volumetric_max_mm
-    );
+    print!("{}", d.to_text(&source));
     Ok(())
 }
 
 /// `tricept detectability`.
-pub fn run_detectability(
-    machine: &MachineArgs,
-    noise: &NoiseArgs,
-    poses: &str,
-    both_directions: bool,
-    drift_k: f64,
-) -> Result<(), CliError> {
-    let m = machine_with_noise(machine, noise)?;
-    let targets = tricept_plant::campaign::pose_set(poses, &m).map_err(CliError::input)?;
+pub fn run_detectability(a: &DetectabilityArgs) -> Result<(), CliError> {
+    let (machine, poses, both_directions, drift_k) = (
+        &a.machine,
+        a.poses.as_str(),
+        a.both_directions,
+        a.temperature_drift,
+    );
+    let m = machine_with_noise(machine, &a.noise)?;
+    let targets = pose_targets(poses, &m)?;
     let mut campaign = Campaign::from_targets(&m, targets, 1);
     if both_directions {
         campaign.order = PoseOrder::BothDirections;

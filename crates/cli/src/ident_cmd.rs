@@ -1,143 +1,86 @@
 //! The self-calibration verbs: `identifiability`, `identify`, `compensate`.
 
+use std::path::PathBuf;
+
 use clap::Args;
 use nalgebra::Vector3;
 use serde_json::{Map, Value, json};
-use tricept_data::{Dataset, MeasuredPose};
+use tricept_data::MeasuredPose;
 use tricept_ident::{
     GeometricModel, IdentError, Identification, IdentifyOptions, Rejection, corrected_commands,
     identifiability, identify, identify_robust,
 };
-use tricept_kinematics::{Machine, SensorNoise};
-use tricept_model::{ErrorMap, MapStats, ParameterSet, volumetric_errors};
+use tricept_kinematics::Machine;
+use tricept_kinematics::units::RAD_PER_ARCSEC;
+use tricept_model::{ErrorMap, MapStats, volumetric_errors};
 
-use crate::MachineArgs;
+use crate::args::{
+    FitArgs, MachineArgs, NoiseArgs, ParamArgs, machine_with_noise, parse_effects, parse_errors,
+    pose_targets, read_data, spinner,
+};
 use crate::cli_error::CliError;
-use crate::kinematics_cmd::load_machine;
 
-/// Sensor-noise overrides (default: the machine description's).
-#[derive(Debug, Args, Clone, Default)]
-pub struct NoiseArgs {
-    /// Encoder noise of one reading, arcsec.
-    #[arg(long, value_name = "ARCSEC", allow_hyphen_values = true)]
-    pub angle_noise_arcsec: Option<f64>,
-    /// Linear-scale noise of one reading, um.
-    #[arg(long, value_name = "UM", allow_hyphen_values = true)]
-    pub length_noise_um: Option<f64>,
-    /// Readings averaged into one logged value.
-    #[arg(long, value_name = "N")]
-    pub readings_per_pose: Option<u32>,
+/// `tricept identifiability`.
+#[derive(Debug, Args)]
+pub struct IdentifiabilityArgs {
+    /// Pose set (see below).
+    #[arg(long, default_value = "grid")]
+    pub poses: String,
+    #[command(flatten)]
+    pub params: ParamArgs,
+    #[command(flatten)]
+    pub noise: NoiseArgs,
+    #[command(flatten)]
+    pub machine: MachineArgs,
 }
 
-/// The parameter set to identify.
-#[derive(Debug, Args, Clone)]
-pub struct ParamArgs {
-    /// Parameter set: `paper15` (the paper's 15, under its frame
-    /// conventions) or `full21` (all joint and length errors; reports the
-    /// rigid-body gauges as unidentifiable).
-    #[arg(long, default_value = "paper15", value_name = "SET")]
-    pub params: String,
+/// The data and fit settings of `identify` and `compensate`.
+#[derive(Debug, Args)]
+pub struct DataFitArgs {
+    /// Measured-data CSV (see docs/data-format.md).
+    #[arg(long, value_name = "FILE.csv")]
+    pub data: PathBuf,
+    #[command(flatten)]
+    pub fit: FitArgs,
+    #[command(flatten)]
+    pub params: ParamArgs,
+    #[command(flatten)]
+    pub noise: NoiseArgs,
+    #[command(flatten)]
+    pub machine: MachineArgs,
 }
 
-impl ParamArgs {
-    /// The parameter set named by `--params`.
-    pub fn set(&self) -> Result<ParameterSet, CliError> {
-        ParameterSet::by_label(&self.params).map_err(|e| CliError::input(format!("--params: {e}")))
-    }
+/// `tricept identify`.
+#[derive(Debug, Args)]
+pub struct IdentifyArgs {
+    #[command(flatten)]
+    pub input: DataFitArgs,
+    /// Also write the identified machine as a description file.
+    #[arg(long, value_name = "FILE.json")]
+    pub write_machine: Option<PathBuf>,
 }
 
-/// How to fit.
-#[derive(Debug, Args, Clone, Default)]
-pub struct FitArgs {
-    /// Keep every pose: do not reject gross reading errors (by default,
-    /// poses beyond the Bonferroni-corrected 0.1 % quantile of the
-    /// standardised residuals are rejected and reported).
-    #[arg(long)]
-    pub no_robust: bool,
-}
-
-/// Loads the machine and applies the noise overrides.
-pub fn machine_with_noise(args: &MachineArgs, noise: &NoiseArgs) -> Result<Machine, CliError> {
-    let mut m = load_machine(args)?;
-    let check = |flag: &str, v: f64| {
-        if v.is_finite() && v > 0.0 {
-            Ok(v)
-        } else {
-            Err(CliError::input(format!(
-                "{flag}: must be a positive number, got {v}"
-            )))
-        }
-    };
-    if let Some(a) = noise.angle_noise_arcsec {
-        m.sensors.angle_rad = check("--angle-noise-arcsec", a)? * SensorNoise::ARCSEC;
-    }
-    if let Some(l) = noise.length_noise_um {
-        m.sensors.length_mm = check("--length-noise-um", l)? * 1e-3;
-    }
-    if let Some(k) = noise.readings_per_pose {
-        if k == 0 {
-            return Err(CliError::input("--readings-per-pose: must be at least 1"));
-        }
-        m.sensors.readings_per_pose = k;
-    }
-    Ok(m)
-}
-
-/// Reads a measured-data file; every problem is an input error naming
-/// file, line and column.
-pub fn read_data(path: &std::path::Path, machine: &Machine) -> Result<Dataset, CliError> {
-    let file = path.display().to_string();
-    let f = std::fs::File::open(path).map_err(|e| CliError::input(format!("{file}: {e}")))?;
-    // A progress bar over the bytes read (drawn only on a terminal).
-    let size = f.metadata().map(|m| m.len()).unwrap_or(0);
-    let bar = progress_bar(size, "reading");
-    let data = tricept_data::read_from(bar.wrap_read(std::io::BufReader::new(f)), &file)
-        .map_err(|e| CliError::input(e.to_string()))?;
-    bar.finish_and_clear();
-    // Commands the machine cannot take are input errors too, found here
-    // with their line rather than deep inside the solver.
-    let [lo, hi] = machine.limits.leg_stroke_mm;
-    for p in &data.poses {
-        for (i, q) in p.commands_mm.iter().enumerate() {
-            if !(lo..=hi).contains(q) {
-                return Err(CliError::input(format!(
-                    "{}: line {}, column `q{}`: command {q} mm is outside the leg stroke [{lo}, {hi}] mm",
-                    data.source,
-                    p.line,
-                    i + 1
-                )));
-            }
-        }
-    }
-    Ok(data)
-}
-
-/// A progress bar on stderr; invisible when stderr is not a terminal or for
-/// small jobs.
-pub fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
-    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-    if len < 20_000_000 {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-    bar.set_style(
-        ProgressStyle::with_template("{msg} [{bar:40}] {bytes}/{total_bytes} {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    bar.set_message(what.to_string());
-    bar
-}
-
-/// A spinner on stderr while a long step runs (terminal only).
-pub fn spinner(what: String, poses: usize) -> indicatif::ProgressBar {
-    use indicatif::{ProgressBar, ProgressDrawTarget};
-    if poses < 50_000 {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
-    bar.set_message(what);
-    bar.enable_steady_tick(std::time::Duration::from_millis(200));
-    bar
+/// `tricept compensate`.
+#[derive(Debug, Args)]
+pub struct CompensateArgs {
+    #[command(flatten)]
+    pub input: DataFitArgs,
+    /// True errors of the machine that produced the data (simulations).
+    #[arg(long, value_name = "ERRORS")]
+    pub truth: Option<String>,
+    /// An unmodelled effect of the true machine (JSON or @FILE, as for
+    /// `simulate`); repeatable; used with --truth.
+    #[arg(long = "truth-effect", value_name = "JSON")]
+    pub truth_effects: Vec<String>,
+    /// Plane of the error map, mm (default: the workspace's middle plane).
+    #[arg(long, value_name = "Z_MM", allow_negative_numbers = true)]
+    pub plane_z: Option<f64>,
+    /// Lattice spacing of the error map, mm.
+    #[arg(long, default_value_t = 10.0, value_name = "MM")]
+    pub spacing: f64,
+    /// Target points (CSV x,y,z) to print corrected leg commands for.
+    #[arg(long, value_name = "FILE.csv")]
+    pub targets: Option<PathBuf>,
 }
 
 fn ident_error(source: &str, e: IdentError) -> CliError {
@@ -153,15 +96,11 @@ fn ident_error(source: &str, e: IdentError) -> CliError {
 }
 
 /// `tricept identifiability`.
-pub fn run_identifiability(
-    machine: &MachineArgs,
-    noise: &NoiseArgs,
-    params: &ParamArgs,
-    poses: &str,
-) -> Result<(), CliError> {
-    let m = machine_with_noise(machine, noise)?;
-    let set = params.set()?;
-    let targets = tricept_plant::campaign::pose_set(poses, &m).map_err(CliError::input)?;
+pub fn run_identifiability(a: &IdentifiabilityArgs) -> Result<(), CliError> {
+    let (machine, poses) = (&a.machine, a.poses.as_str());
+    let m = machine_with_noise(machine, &a.noise)?;
+    let set = a.params.set()?;
+    let targets = pose_targets(poses, &m)?;
     let mut commands = Vec::with_capacity(targets.len());
     for (i, r) in targets.iter().enumerate() {
         let ik = m.inverse(r).map_err(|e| {
@@ -201,14 +140,11 @@ pub fn run_identifiability(
 
 /// Loads data and identifies; shared by `identify` and `compensate`.
 fn identify_from_file(
-    machine: &MachineArgs,
-    noise: &NoiseArgs,
-    params: &ParamArgs,
-    fit: &FitArgs,
-    data: &std::path::Path,
+    a: &DataFitArgs,
 ) -> Result<(Machine, GeometricModel, Identification, Vec<Rejection>), CliError> {
-    let m = machine_with_noise(machine, noise)?;
-    let set = params.set()?;
+    let data = a.data.as_path();
+    let m = machine_with_noise(&a.machine, &a.noise)?;
+    let set = a.params.set()?;
     let dataset = read_data(data, &m)?;
     let model = GeometricModel::new(m.clone(), set);
     let options = IdentifyOptions::for_machine(&m);
@@ -217,7 +153,7 @@ fn identify_from_file(
         format!("identifying from {} poses", dataset.poses.len()),
         dataset.poses.len(),
     );
-    let (id, rejected) = if fit.no_robust {
+    let (id, rejected) = if a.fit.no_robust {
         (
             identify(&model, &dataset, &options).map_err(|e| ident_error(&source, e))?,
             Vec::new(),
@@ -230,16 +166,10 @@ fn identify_from_file(
 }
 
 /// `tricept identify`.
-pub fn run_identify(
-    machine: &MachineArgs,
-    noise: &NoiseArgs,
-    params: &ParamArgs,
-    fit: &FitArgs,
-    data: &std::path::Path,
-    write_machine: Option<&std::path::Path>,
-) -> Result<(), CliError> {
-    let (_, model, id, rejected) = identify_from_file(machine, noise, params, fit, data)?;
-    if let Some(path) = write_machine {
+pub fn run_identify(a: &IdentifyArgs) -> Result<(), CliError> {
+    let (machine, data) = (&a.input.machine, a.input.data.as_path());
+    let (_, model, id, rejected) = identify_from_file(&a.input)?;
+    if let Some(path) = &a.write_machine {
         let mut d = model.machine_at(&id.estimate).to_description();
         d.notes = Some(format!("identified from {}", data.display()));
         std::fs::write(path, d.to_json())
@@ -282,7 +212,7 @@ pub fn run_identify(
             None => outln!("{n:>6} {v:>12.5} {:>10}", "fixed"),
         }
     }
-    let a = SensorNoise::ARCSEC;
+    let a = RAD_PER_ARCSEC;
     outln!(
         "offsets: phi {:.6} rad, theta {:.6} rad, s {:.4} mm",
         id.offsets[0],
@@ -303,57 +233,14 @@ pub fn run_identify(
     Ok(())
 }
 
-/// Parses `table2`, `zero`, `random:MAG[,SEED]` or a JSON file of
-/// parameter values.
-pub fn parse_errors(spec: &str, set: &ParameterSet) -> Result<Vec<f64>, CliError> {
-    match spec {
-        "table2" => Ok(set.table2()),
-        "zero" => Ok(vec![0.0; set.len()]),
-        s if s.starts_with("random:") => {
-            let parts: Vec<&str> = s["random:".len()..].split(',').collect();
-            let mag: f64 = parts[0]
-                .parse()
-                .ok()
-                .filter(|v: &f64| v.is_finite() && *v >= 0.0)
-                .ok_or_else(|| {
-                    CliError::input(format!("errors `{s}`: expected random:MAG_MM[,SEED]"))
-                })?;
-            let seed: u64 = match parts.get(1) {
-                Some(t) => t.parse().map_err(|_| {
-                    CliError::input(format!("errors `{s}`: SEED must be a whole number"))
-                })?,
-                None => 0,
-            };
-            Ok(tricept_plant::random_errors(set.len(), mag, seed))
-        }
-        path => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| CliError::input(format!("{path}: {e}")))?;
-            set.parse_values(&text)
-                .map_err(|e| CliError::input(format!("{path}: {e}")))
-        }
-    }
-}
-
 fn stats_json(s: &MapStats) -> Value {
     json!({"max_mm": s.max_mm, "min_mm": s.min_mm, "mean_mm": s.mean_mm, "rms_mm": s.rms_mm})
 }
 
 /// `tricept compensate`.
-#[allow(clippy::too_many_arguments)]
-pub fn run_compensate(
-    machine: &MachineArgs,
-    noise: &NoiseArgs,
-    params: &ParamArgs,
-    fit: &FitArgs,
-    data: &std::path::Path,
-    truth: Option<&str>,
-    truth_effects: &[String],
-    plane_z_mm: Option<f64>,
-    spacing_mm: f64,
-    targets: Option<&std::path::Path>,
-) -> Result<(), CliError> {
-    let (m, model, id, rejected) = identify_from_file(machine, noise, params, fit, data)?;
+pub fn run_compensate(a: &CompensateArgs) -> Result<(), CliError> {
+    let (machine, plane_z_mm, spacing_mm) = (&a.input.machine, a.plane_z, a.spacing);
+    let (m, model, id, rejected) = identify_from_file(&a.input)?;
     let identified = model.machine_at(&id.estimate);
     let z = plane_z_mm.unwrap_or_else(|| m.workspace.mid_plane_z_mm());
     if !(spacing_mm.is_finite() && spacing_mm >= 1.0) {
@@ -374,11 +261,11 @@ pub fn run_compensate(
         "predicted_correction".into(),
         stats_json(&predicted.stats()),
     );
-    if let Some(spec) = truth {
+    if let Some(spec) = &a.truth {
         let set = model.parameter_set();
         let mut plant =
             tricept_plant::Plant::geometric(m.clone(), set.to_errors(&parse_errors(spec, set)?));
-        plant.effects = crate::simulate_cmd::parse_effects(truth_effects)?;
+        plant.effects = parse_effects(&a.truth_effects)?;
         // Where the actual machine goes when commanded by a model's IK.
         let map = |commanding: &tricept_kinematics::Machine| -> Result<ErrorMap, CliError> {
             let mut errors = Vec::with_capacity(grid.len());
@@ -408,7 +295,7 @@ pub fn run_compensate(
         );
         out.insert("translation_mm".into(), json!([t.x, t.y, t.z]));
     }
-    if let Some(path) = targets {
+    if let Some(path) = &a.targets {
         let points: Vec<Vector3<f64>> = tricept_data::read_targets(path)
             .map_err(|e| CliError::input(e.to_string()))?
             .into_iter()

@@ -1,23 +1,64 @@
 //! The kinematics verbs: `ik`, `fk`, `tool-ik`, `machine`.
 
+use clap::Args;
 use nalgebra::Vector3;
 use serde_json::Value;
-use tricept_kinematics::{HeadBranch, Machine, MachineDescription, UpJoints};
+use tricept_kinematics::{HeadBranch, MachineDescription, UpJoints};
 
-use crate::MachineArgs;
+use crate::args::{MachineArgs, load_machine};
 use crate::cli_error::CliError;
 use crate::output::print_record;
 
-/// Loads the machine named by `--machine`, or the embedded default.
-pub fn load_machine(args: &MachineArgs) -> Result<Machine, CliError> {
-    let description = match &args.machine {
-        None => MachineDescription::paper(),
-        Some(path) => MachineDescription::from_file(path)
-            .map_err(|e| CliError::description(&path.display().to_string(), &e))?,
-    };
-    description
-        .build()
-        .map_err(|e| CliError::description("machine", &e))
+/// `tricept ik X Y Z`.
+#[derive(Debug, Args)]
+pub struct IkArgs {
+    /// x of O' in the base frame, mm.
+    pub x: f64,
+    /// y of O' in the base frame, mm.
+    pub y: f64,
+    /// z of O' in the base frame, mm.
+    pub z: f64,
+    #[command(flatten)]
+    pub machine: MachineArgs,
+}
+
+/// `tricept fk Q1 Q2 Q3`.
+#[derive(Debug, Args)]
+pub struct FkArgs {
+    /// Command of leg 1, mm.
+    pub q1: f64,
+    /// Command of leg 2, mm.
+    pub q2: f64,
+    /// Command of leg 3, mm.
+    pub q3: f64,
+    #[command(flatten)]
+    pub machine: MachineArgs,
+}
+
+/// `tricept tool-ik X Y Z AX AY AZ`.
+#[derive(Debug, Args)]
+pub struct ToolIkArgs {
+    /// Tool tip x, mm.
+    pub x: f64,
+    /// Tool tip y, mm.
+    pub y: f64,
+    /// Tool tip z, mm.
+    pub z: f64,
+    /// Tool axis x component (any length).
+    pub ax: f64,
+    /// Tool axis y component.
+    pub ay: f64,
+    /// Tool axis z component.
+    pub az: f64,
+    #[command(flatten)]
+    pub machine: MachineArgs,
+}
+
+/// `tricept machine`.
+#[derive(Debug, Args)]
+pub struct MachineVerbArgs {
+    #[command(flatten)]
+    pub machine: MachineArgs,
 }
 
 /// The record keys shared by `ik` and `tool-ik`: `q1 q2 q3` (mm),
@@ -34,21 +75,23 @@ fn legs_and_up(legs_mm: &[f64; 3], up: &UpJoints) -> Vec<(&'static str, Value)> 
 }
 
 /// `tricept ik X Y Z`.
-pub fn ik(args: &MachineArgs, r: [f64; 3]) -> Result<(), CliError> {
-    let m = load_machine(args)?;
+pub fn ik(a: &IkArgs) -> Result<(), CliError> {
+    let m = load_machine(&a.machine)?;
     let sol = m
-        .inverse(&Vector3::from(r))
+        .inverse(&Vector3::new(a.x, a.y, a.z))
         .map_err(|e| CliError::kinematics("ik", &e))?;
-    print_record(args.json, &legs_and_up(&sol.legs_mm, &sol.up));
+    print_record(a.machine.json, &legs_and_up(&sol.legs_mm, &sol.up));
     Ok(())
 }
 
 /// `tricept fk Q1 Q2 Q3`.
-pub fn fk(args: &MachineArgs, q: [f64; 3]) -> Result<(), CliError> {
-    let m = load_machine(args)?;
-    let sol = m.forward(&q).map_err(|e| CliError::kinematics("fk", &e))?;
+pub fn fk(a: &FkArgs) -> Result<(), CliError> {
+    let m = load_machine(&a.machine)?;
+    let sol = m
+        .forward(&[a.q1, a.q2, a.q3])
+        .map_err(|e| CliError::kinematics("fk", &e))?;
     print_record(
-        args.json,
+        a.machine.json,
         &[
             ("x", sol.position_mm.x.into()),
             ("y", sol.position_mm.y.into()),
@@ -64,12 +107,12 @@ pub fn fk(args: &MachineArgs, q: [f64; 3]) -> Result<(), CliError> {
 }
 
 /// `tricept tool-ik X Y Z AX AY AZ`.
-pub fn tool_ik(args: &MachineArgs, tip: [f64; 3], axis: [f64; 3]) -> Result<(), CliError> {
-    let m = load_machine(args)?;
+pub fn tool_ik(a: &ToolIkArgs) -> Result<(), CliError> {
+    let m = load_machine(&a.machine)?;
     let sol = m
         .tool_inverse(
-            &Vector3::from(tip),
-            &Vector3::from(axis),
+            &Vector3::new(a.x, a.y, a.z),
+            &Vector3::new(a.ax, a.ay, a.az),
             HeadBranch::default(),
         )
         .map_err(|e| CliError::kinematics("tool-ik", &e))?;
@@ -79,13 +122,13 @@ pub fn tool_ik(args: &MachineArgs, tip: [f64; 3], axis: [f64; 3]) -> Result<(), 
         ("h2", sol.head_rad[1].into()),
         ("head_singular", Value::Bool(sol.head_singular)),
     ]);
-    print_record(args.json, &record);
+    print_record(a.machine.json, &record);
     Ok(())
 }
 
 /// `tricept machine`: prints the description in use.
-pub fn print_machine(args: &MachineArgs) -> Result<(), CliError> {
-    let description = match &args.machine {
+pub fn print_machine(a: &MachineVerbArgs) -> Result<(), CliError> {
+    let description = match &a.machine.machine {
         None => MachineDescription::paper(),
         Some(path) => MachineDescription::from_file(path)
             .map_err(|e| CliError::description(&path.display().to_string(), &e))?,

@@ -1,75 +1,58 @@
 //! `tricept simulate`: a measured-data CSV from a simulated machine.
 
-use std::path::Path;
+use std::path::PathBuf;
 
+use clap::Args;
 use tricept_ident::GeometricModel;
-use tricept_plant::{Campaign, Effect, Plant, PoseOrder};
+use tricept_plant::{Campaign, Plant, PoseOrder};
 
-use crate::MachineArgs;
+use crate::args::{
+    MachineArgs, NoiseArgs, ParamArgs, machine_with_noise, parse_effects, parse_errors,
+    pose_targets,
+};
 use crate::cli_error::CliError;
-use crate::ident_cmd::{NoiseArgs, ParamArgs, machine_with_noise, parse_errors};
 
-/// Everything `simulate` needs.
-pub struct SimulateArgs<'a> {
-    /// Machine and output format.
-    pub machine: &'a MachineArgs,
-    /// Noise overrides.
-    pub noise: &'a NoiseArgs,
-    /// Parameter set of `errors`.
-    pub params: &'a ParamArgs,
-    /// `table2`, `zero`, `random:MAG[,SEED]` or a JSON file.
-    pub errors: &'a str,
-    /// Pose set spec.
-    pub poses: &'a str,
-    /// Seed of the noise.
+/// `tricept simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// True errors of the simulated machine.
+    #[arg(long, default_value = "table2")]
+    pub errors: String,
+    /// Pose set (as for `identifiability`).
+    #[arg(long, default_value = "grid")]
+    pub poses: String,
+    /// Seed of the sensor noise.
+    #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Visit every pose from both directions.
+    /// Visit every pose twice, approaching from both directions.
+    #[arg(long)]
     pub both_directions: bool,
-    /// Effects, as JSON objects (inline or `@file`).
-    pub effects: &'a [String],
-    /// Output file (stdout when absent).
-    pub out: Option<&'a Path>,
-}
-
-pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, CliError> {
-    let mut out = Vec::new();
-    for spec in specs {
-        let (text, origin) = match spec.strip_prefix('@') {
-            Some(path) => (
-                std::fs::read_to_string(path)
-                    .map_err(|e| CliError::input(format!("{path}: {e}")))?,
-                path.to_string(),
-            ),
-            None => (spec.clone(), "--effect".to_string()),
-        };
-        let value: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| CliError::input(format!("{origin}: {e}")))?;
-        let items = match value {
-            serde_json::Value::Array(a) => a,
-            v => vec![v],
-        };
-        for item in items {
-            out.push(
-                serde_json::from_value(item)
-                    .map_err(|e| CliError::input(format!("{origin}: {e}")))?,
-            );
-        }
-    }
-    Ok(out)
+    /// An unmodelled effect (JSON object or @FILE); repeatable.
+    #[arg(long = "effect", value_name = "JSON")]
+    pub effects: Vec<String>,
+    /// Output file (default: stdout).
+    #[arg(long, value_name = "FILE.csv")]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub params: ParamArgs,
+    #[command(flatten)]
+    pub noise: NoiseArgs,
+    #[command(flatten)]
+    pub machine: MachineArgs,
 }
 
 /// `tricept simulate`.
-pub fn run(a: SimulateArgs<'_>) -> Result<(), CliError> {
-    let m = machine_with_noise(a.machine, a.noise)?;
+pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
+    let m = machine_with_noise(&a.machine, &a.noise)?;
     let set = a.params.set()?;
-    let values = parse_errors(a.errors, &set)?;
-    let targets = tricept_plant::campaign::pose_set(a.poses, &m).map_err(CliError::input)?;
+    let values = parse_errors(&a.errors, &set)?;
+    let targets = pose_targets(&a.poses, &m)?;
     let mut campaign = Campaign::from_targets(&m, targets, a.seed);
     if a.both_directions {
         campaign.order = PoseOrder::BothDirections;
     }
     let mut plant = Plant::geometric(m.clone(), set.to_errors(&values));
-    plant.effects = parse_effects(a.effects)?;
+    plant.effects = parse_effects(&a.effects)?;
     let data = plant
         .simulate(&campaign)
         .map_err(|e| CliError::input(format!("simulate: {e}")))?;
@@ -93,7 +76,7 @@ pub fn run(a: SimulateArgs<'_>) -> Result<(), CliError> {
         ),
         format!(
             "noise per reading: {:.3} arcsec, {:.3} um, mean of {}",
-            m.sensors.angle_rad / tricept_kinematics::SensorNoise::ARCSEC,
+            m.sensors.angle_rad / tricept_kinematics::units::RAD_PER_ARCSEC,
             m.sensors.length_mm * 1e3,
             m.sensors.readings_per_pose
         ),
@@ -113,7 +96,7 @@ pub fn run(a: SimulateArgs<'_>) -> Result<(), CliError> {
             serde_json::to_string(e).unwrap_or_default()
         ));
     }
-    match a.out {
+    match &a.out {
         Some(path) => tricept_data::write_path(path, &data, &comments)
             .map_err(|e| CliError::other(format!("{}: {e}", path.display()))),
         None => tricept_data::write_to(std::io::stdout().lock(), &data, &comments)

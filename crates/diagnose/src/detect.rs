@@ -17,18 +17,18 @@
 use faer::Mat;
 use serde::Serialize;
 use tricept_data::MeasuredPose;
-use tricept_ident::linalg::{TriangularAccumulator, invert_upper};
 use tricept_ident::{GeometricModel, IdentifyOptions, ReadingModel, design};
 use tricept_kinematics::UpJoints;
+use tricept_numerics::linalg::{TriangularAccumulator, invert_upper};
 
 use crate::model::{Candidate, ExtendedModel};
-use tricept_ident::stats::{chi2_power, required_noncentrality};
+use tricept_numerics::stats::{chi2_power, required_noncentrality};
 
 /// Detectability of one effect of parameters `v` on a campaign.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Detectability {
     /// The effect.
-    pub effect: tricept_plant::effects::EffectName,
+    pub effect: tricept_model::effects::EffectName,
     /// The parameter vector analysed (the effect's "realistic" magnitude).
     pub parameters: Vec<(String, f64)>,
     /// Non-centrality of the likelihood-ratio test at `v`.
@@ -61,7 +61,7 @@ pub fn detectability(
     let mut o = IdentifyOptions::for_machine(geometric.nominal());
     o.sigma = sigma;
     let d = design(geometric, &vec![0.0; kg], poses, &o).ok()?;
-    let geo_cols = d.decision.identifiable.clone();
+    let geo_cols = d.identifiable().to_vec();
     let model = ExtendedModel::new(geometric.clone(), &[candidate]);
     let k = model.names().len();
     let ke = k - kg;
@@ -109,7 +109,7 @@ pub fn detectability(
         .count()
         .max(1) as f64;
     let level = alpha / Candidate::ALL.len() as f64;
-    let needed = required_noncentrality(dof, level, 0.95);
+    let needed = required_noncentrality(dof, level, 0.95)?;
     // Bias: B = R_gg^-1 R_ge (rows: offsets then geometric parameters).
     let r_gg = r.as_ref().submatrix(0, 0, ng, ng).to_owned();
     let r_ge = r.as_ref().submatrix(0, ng, ng, ke).to_owned();
@@ -154,7 +154,7 @@ pub fn detectability(
     })
 }
 
-/// The realistic magnitudes of the issue, in the diagnosis'
+/// Realistic magnitudes of each effect, in the diagnosis'
 /// parameterisation: leg-lead 50 ppm (alternating signs), backlash 5 um,
 /// thermal 11.5 ppm/K (steel; the 2 K drift is in the data), scale-gain
 /// 50 ppm, encoder eccentricity 5 arcsec (sine and cosine phases),
@@ -163,7 +163,7 @@ pub fn detectability(
 pub fn realistic(
     machine: &tricept_kinematics::Machine,
 ) -> Vec<(Candidate, Vec<f64>, &'static str)> {
-    use tricept_plant::effects::{EffectName as E, stiffness_for_platform_deflection};
+    use tricept_model::effects::{EffectName as E, stiffness_for_platform_deflection};
     vec![
         (Candidate(E::LegLead), vec![50.0, -50.0, 50.0], "50 ppm"),
         (Candidate(E::Backlash), vec![5.0, 5.0, 5.0], "5 um"),
@@ -199,10 +199,10 @@ pub fn realistic(
 pub fn advise(d: &Detectability, poses: usize, readings: u32) -> String {
     if !d.detectable_multiple.is_finite() {
         return match d.effect {
-            tricept_plant::effects::EffectName::Backlash => {
+            tricept_model::effects::EffectName::Backlash => {
                 "invisible: visit poses from both approach directions (--both-directions)".into()
             }
-            tricept_plant::effects::EffectName::Thermal => {
+            tricept_model::effects::EffectName::Thermal => {
                 "invisible: log the structure temperature while it changes".into()
             }
             _ => "invisible to these sensors on this pose set".into(),

@@ -1,13 +1,39 @@
 //! Measured data against the model: does the paper's geometric model
 //! explain the data; if not, which unmodelled effect does, by how much it
 //! biased the geometric parameters, and what the extended model gains.
+//!
+//! - [`diagnose`] (`run.rs`): the pipeline: outlier screen, adequacy of
+//!   the geometric model, selection of causes, report.
+//! - `select.rs`: fitting candidates, the evidence rules, cross-validation.
+//! - `residuals.rs`: residual structure and residual plots.
+//! - [`Diagnosis`] (`report.rs`): the report, as data, JSON and text.
+//! - [`ExtendedModel`] (`model.rs`): the geometric model plus effects of the
+//!   vocabulary ([`tricept_model::effects`]).
+//! - [`detect`]: what a campaign can detect, before it is run.
+//!
+//! # Example
+//! ```no_run
+//! use tricept_diagnose::{DiagnoseOptions, diagnose};
+//! use tricept_kinematics::Machine;
+//! let m = Machine::paper();
+//! let data = tricept_data::read_path("fixtures/data/diagnose-hidden-effect.csv".as_ref()).unwrap();
+//! let d = diagnose(&m, &data, &DiagnoseOptions::for_machine(&m)).unwrap();
+//! println!("adequate: {}, causes: {:?}", d.adequate, d.causes.iter().map(|c| c.effect).collect::<Vec<_>>());
+//! ```
 #![cfg_attr(
     not(test),
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
 pub mod detect;
-pub mod diagnose;
-pub mod model;
+mod model;
+mod report;
+mod residuals;
+mod run;
+mod select;
 
-pub use model::{Candidate, ExtendedModel};
+pub use model::{Candidate, ExtendedModel, MIN_TEMPERATURE_RANGE_K, REFERENCE_TEMPERATURE_C};
+pub use report::{
+    Cause, ChannelRms, Diagnosis, Estimate, Evidence, Gain, ResidualPlot, Structure, Tested,
+};
+pub use run::{DiagnoseError, DiagnoseOptions, diagnose};

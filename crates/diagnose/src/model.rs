@@ -2,7 +2,7 @@
 //! that the diagnosis fits for each candidate cause.
 //!
 //! Each [`Candidate`] adds the parameters of one effect, with the same
-//! physics as the plant simulator (`tricept_plant::effects`): leg effects
+//! physics as the plant simulator ([`tricept_model::effects`]): leg effects
 //! change the actual leg lengths (their Jacobian columns are
 //! `J1^-1 e_i dq_i/dparam`), reading effects change the readings (direct
 //! columns), class-2 effects change the UP limb's kinematics (columns by
@@ -12,12 +12,12 @@
 //! the metrology reference temperature of 20 °C.
 
 use tricept_data::{Dataset, MeasuredPose};
-use tricept_ident::{GeometricModel, PosePredictor, ReadingModel, project_jacobian, solve_pose};
-use tricept_kinematics::{KinematicsError, Machine, SensorNoise, UpJoints};
-use tricept_model::error_jacobian_at;
-use tricept_plant::effects::{
-    EffectName, backlash_extra_mm, compliance_extra_mm, gravity_leg_tension_n, leg_lead_extra_mm,
-    scale_gain_error_mm, thermal_extra_mm, twist_reference_mm,
+use tricept_ident::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
+use tricept_kinematics::units::RAD_PER_ARCSEC;
+use tricept_kinematics::{KinematicsError, Machine, UpJoints};
+use tricept_model::effects::{
+    EffectName, add_tube_twist, add_ujoint_axis_errors, backlash_extra_mm, compliance_extra_mm,
+    gravity_leg_tension_n, leg_lead_extra_mm, scale_gain_error_mm, thermal_extra_mm,
 };
 
 /// An effect the diagnosis can fit (every name of the vocabulary except
@@ -130,7 +130,6 @@ pub struct ExtendedModel {
     geometric: GeometricModel,
     effects: Vec<Candidate>,
     names: Vec<String>,
-    sparse: Vec<Vec<(usize, f64)>>,
     /// Reference temperature of the nominal lengths, °C.
     temp_ref_c: f64,
 }
@@ -143,7 +142,6 @@ impl ExtendedModel {
             names.extend(e.params().iter().map(|p| format!("{}.{p}", e.0)));
         }
         ExtendedModel {
-            sparse: geometric.parameter_set().sparse_columns(),
             geometric,
             effects: effects.to_vec(),
             names,
@@ -185,14 +183,8 @@ impl ExtendedModel {
         let mut m = self.geometric.machine_at(&p[..g]);
         for (e, at) in self.effects.iter().zip(self.offsets()) {
             match e.0 {
-                EffectName::UjointAxes => {
-                    m.up_limb.axis_skew_rad += p[at] * SensorNoise::ARCSEC;
-                    m.up_limb.axis_offset_mm += p[at + 1] * 1e-3;
-                }
-                EffectName::TubeTwist => {
-                    m.up_limb.twist_rad_per_mm += p[at] * SensorNoise::ARCSEC / 100.0;
-                    m.up_limb.twist_reference_mm = twist_reference_mm(&m);
-                }
+                EffectName::UjointAxes => add_ujoint_axis_errors(&mut m, p[at], p[at + 1]),
+                EffectName::TubeTwist => add_tube_twist(&mut m, p[at]),
                 _ => {}
             }
         }
@@ -228,7 +220,7 @@ impl ReadingModel for ExtendedModel {
         Box::new(ExtendedPredictor {
             model: self,
             p: p.to_vec(),
-            machine: self.machine_at(p),
+            geometric: GeometricPredictor::new(self.machine_at(p), self.geometric.parameter_set()),
             kinematic,
         })
     }
@@ -243,7 +235,8 @@ type Derivative = (usize, [f64; 3]);
 struct ExtendedPredictor<'a> {
     model: &'a ExtendedModel,
     p: Vec<f64>,
-    machine: Machine,
+    /// The geometric model at `p` (with the class-2 effects in its machine).
+    geometric: GeometricPredictor<'a>,
     /// Class-2 parameters with their machines at `p +- FD_STEP`.
     kinematic: Vec<(usize, Machine, Machine)>,
 }
@@ -312,7 +305,7 @@ impl ExtendedPredictor<'_> {
                     derivs.push((at, [0.0, 0.0, scale_gain_error_mm(1.0, up.q4_mm)]));
                 }
                 EffectName::EncoderEccentricity => {
-                    let a = SensorNoise::ARCSEC;
+                    let a = RAD_PER_ARCSEC;
                     let (sp, cp) = up.phi_rad.sin_cos();
                     let (st, ct) = up.theta_rad.sin_cos();
                     r[0] += a * (p[at] * sp + p[at + 1] * cp);
@@ -338,17 +331,9 @@ impl PosePredictor for ExtendedPredictor<'_> {
     ) -> Result<[f64; 3], KinematicsError> {
         let k = self.p.len();
         let (legs, leg_derivs) = self.legs(pose)?;
-        let up = solve_pose(&self.machine, &legs, seed)?;
-        let geometry = self.machine.legs_at(&up);
-        let j21 = error_jacobian_at(&geometry)?;
-        let g = self.model.n_geometric();
-        // Geometric columns, written into a k-wide row layout.
-        let mut geo = vec![0.0; 3 * g];
-        project_jacobian(&j21, &self.model.sparse, &mut geo);
         jacobian.iter_mut().for_each(|v| *v = 0.0);
-        for c in 0..3 {
-            jacobian[c * k..c * k + g].copy_from_slice(&geo[c * g..(c + 1) * g]);
-        }
+        // The geometric columns, at the actual leg lengths.
+        let (up, geometry) = self.geometric.solve(&legs, seed, jacobian, k)?;
         // Leg effects: d(up)/d(leg i) is column i of J1^-1.
         if !leg_derivs.is_empty() {
             let j1_inv = geometry

@@ -16,10 +16,12 @@
 
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
-use tricept_diagnose::diagnose::{DiagnoseOptions, Diagnosis, diagnose};
-use tricept_kinematics::{Machine, SensorNoise};
+use tricept_diagnose::{DiagnoseOptions, Diagnosis, diagnose};
+use tricept_kinematics::Machine;
+use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_model::ParameterSet;
-use tricept_plant::effects::{Effect, EffectName as E, stiffness_for_platform_deflection};
+use tricept_model::effects::{EffectName as E, stiffness_for_platform_deflection};
+use tricept_plant::effects::Effect;
 use tricept_plant::{Campaign, Plant, PoseOrder, random_errors};
 
 /// An effect of random magnitude from the stated range.
@@ -313,5 +315,5 @@ fn the_report_names_the_evidence_and_the_bias() {
         .fold(0.0, f64::max);
     assert!(largest > 1e-3, "{largest}");
     assert!(!d.plots.is_empty() && !d.plots[0].before.is_empty());
-    let _ = SensorNoise::ARCSEC;
+    let _ = RAD_PER_ARCSEC;
 }

@@ -23,28 +23,30 @@
 //! the residual, and freeing `dyA3` recovers neither its value nor its sign;
 //! see `docs/identifiability.md`.)
 
+use nalgebra::DMatrix;
 use serde_json::{Map, Value};
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_kinematics::{Machine, UpJoints};
 
 use crate::error::IdentError;
-use crate::linalg::TriangularAccumulator;
-use crate::lsq::{DEFAULT_RANK_TOLERANCE, RankDecision, ReducedProblem, Solution};
 use crate::model::ReadingModel;
 use crate::report::IdentifiabilityReport;
+use tricept_numerics::linalg::TriangularAccumulator;
+use tricept_numerics::lsq::{DEFAULT_RANK_TOLERANCE, RankDecision, ReducedProblem, Solution};
 
-/// Options of [`identify`].
+/// Settings of [`identify`]: the noise model and the solver's tolerances,
+/// the same for every data set they are used on.
 ///
 /// # Example
 /// ```
 /// use tricept_ident::IdentifyOptions;
-/// use tricept_kinematics::{Machine, SensorNoise};
+/// use tricept_kinematics::{Machine, units::arcsec_to_rad};
 /// let mut o = IdentifyOptions::for_machine(&Machine::paper());
 /// // The paper's sensors: 0.8 arcsec and 0.5 um per reading, mean of 3.
-/// assert!((o.sigma[0] - 0.8 * SensorNoise::ARCSEC / 3f64.sqrt()).abs() < 1e-15);
-/// o.sigma[0] = 2.0 * SensorNoise::ARCSEC; // a 2 arcsec encoder, one reading
+/// assert!((o.sigma[0] - arcsec_to_rad(0.8) / 3f64.sqrt()).abs() < 1e-15);
+/// o.sigma[0] = arcsec_to_rad(2.0); // a 2 arcsec encoder, one reading
 /// ```
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct IdentifyOptions {
     /// Standard deviation of one *logged* reading `[phi, theta, s]`
     /// (rad, rad, mm).
@@ -55,20 +57,83 @@ pub struct IdentifyOptions {
     pub weak_threshold: f64,
     /// Gauss-Newton iteration limit.
     pub max_iterations: u32,
+}
+
+/// What a caller knows about one data set before identifying it: where to
+/// start, per-pose weights and FK seeds, and a rank decision taken earlier
+/// for the same poses. Everything is optional ([`Start::default`]: the
+/// nominal machine, equal weights, cold FK starts, the rank decided from
+/// the data) and checked against the data set: a vector of the wrong
+/// length is an [`IdentError::Invalid`], never a panic.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions, Start, identify_from};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// use tricept_plant::{Campaign, Plant};
+/// let m = Machine::paper();
+/// let set = ParameterSet::paper15();
+/// let data = Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+///     .simulate(&Campaign::grid(&m, 1))
+///     .unwrap();
+/// let model = GeometricModel::new(m.clone(), set.clone());
+/// let options = IdentifyOptions::for_machine(&m);
+/// // Start at Table 2 itself (an earlier calibration, say).
+/// let start = Start { parameters: Some(set.table2()), ..Start::default() };
+/// let id = identify_from(&model, &data, &options, &start).unwrap();
+/// assert!(id.converged);
+/// // A weight per pose, but one short: refused.
+/// let short = Start { pose_weights: Some(vec![1.0; 74]), ..Start::default() };
+/// assert!(identify_from(&model, &data, &options, &short).is_err());
+/// ```
+#[derive(Debug, Clone, Default)]
+pub struct Start {
     /// Starting parameter values (default zero: the nominal machine).
-    pub initial: Option<Vec<f64>>,
-    /// Per-pose weights multiplying `1/sigma` (default all one); robust
-    /// estimation sets them.
+    pub parameters: Option<Vec<f64>>,
+    /// Per-pose weights multiplying `1/sigma` (default all one).
     pub pose_weights: Option<Vec<f64>>,
-    /// A rank decision and report computed once for this pose set and noise
-    /// ([`design`]), reused instead of deciding again (Monte Carlo studies).
+    /// FK starting points, one per pose (default: cold starts).
+    pub fk_seeds: Option<Vec<UpJoints>>,
+    /// A rank decision and report computed once for these poses and this
+    /// noise ([`design`]), reused instead of deciding again (Monte Carlo
+    /// studies).
     pub design: Option<Design>,
-    /// FK starting points per pose (default: cold starts).
-    pub start_seeds: Option<Vec<UpJoints>>,
+}
+
+impl Start {
+    /// The same start restricted to the poses whose index passes `keep`
+    /// (the per-pose vectors follow the data set's [`Dataset::subset`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::Start;
+    /// let s = Start { pose_weights: Some(vec![1.0, 2.0, 3.0]), ..Start::default() };
+    /// assert_eq!(s.subset(|j| j != 1).pose_weights, Some(vec![1.0, 3.0]));
+    /// ```
+    pub fn subset(&self, keep: impl Fn(usize) -> bool) -> Start {
+        fn pick<T: Clone>(v: &Option<Vec<T>>, keep: &impl Fn(usize) -> bool) -> Option<Vec<T>> {
+            v.as_ref().map(|v| {
+                v.iter()
+                    .enumerate()
+                    .filter(|(j, _)| keep(*j))
+                    .map(|(_, x)| x.clone())
+                    .collect()
+            })
+        }
+        Start {
+            parameters: self.parameters.clone(),
+            pose_weights: pick(&self.pose_weights, &keep),
+            fk_seeds: pick(&self.fk_seeds, &keep),
+            // A rank decision belongs to the pose set it was taken on.
+            design: None,
+        }
+    }
 }
 
 /// The rank decision and identifiability report of a pose set under a
-/// noise model, computed once and reused by many identifications.
+/// noise model, computed once ([`design`]) and reused by many
+/// identifications ([`Start::design`]).
 ///
 /// # Example
 /// ```
@@ -87,15 +152,36 @@ pub struct IdentifyOptions {
 ///     })
 ///     .collect();
 /// let d = tricept_ident::design(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
-/// assert_eq!(d.decision.rank, 14);
-/// assert_eq!(d.report.fixed, vec!["dyA3".to_string()]);
+/// assert_eq!(d.rank(), 14);
+/// assert_eq!(d.report().fixed, vec!["dyA3".to_string()]);
+/// assert_eq!(d.fixed(), &[11]); // dyA3's index in paper15
 /// ```
 #[derive(Debug, Clone)]
 pub struct Design {
-    /// Which parameters are estimated and which are held.
-    pub decision: RankDecision,
-    /// The report that decision comes from.
-    pub report: IdentifiabilityReport,
+    decision: RankDecision,
+    report: IdentifiabilityReport,
+}
+
+impl Design {
+    /// The identifiability report of the pose set.
+    pub fn report(&self) -> &IdentifiabilityReport {
+        &self.report
+    }
+
+    /// Numerical rank.
+    pub fn rank(&self) -> usize {
+        self.decision.rank
+    }
+
+    /// Indices of the parameters estimated (ascending).
+    pub fn identifiable(&self) -> &[usize] {
+        &self.decision.identifiable
+    }
+
+    /// Indices of the parameters held at their prior (ascending).
+    pub fn fixed(&self) -> &[usize] {
+        &self.decision.fixed
+    }
 }
 
 impl IdentifyOptions {
@@ -107,7 +193,6 @@ impl IdentifyOptions {
     /// let m = tricept_kinematics::Machine::paper();
     /// let o = IdentifyOptions::for_machine(&m);
     /// assert_eq!(o.sigma, m.sensors.logged_sigma());
-    /// assert!(o.initial.is_none() && o.pose_weights.is_none());
     /// ```
     pub fn for_machine(machine: &Machine) -> IdentifyOptions {
         IdentifyOptions::with_sigma(machine.sensors.logged_sigma())
@@ -115,18 +200,15 @@ impl IdentifyOptions {
 
     /// Defaults with the given standard deviations of one logged reading
     /// (`phi` rad, `theta` rad, `s` mm): the stated rank tolerance, weak
-    /// threshold 1e-2, at most 30 iterations, no prior, equal pose weights,
-    /// the rank decision taken from the data.
+    /// threshold 1e-2, at most 30 iterations.
     ///
     /// # Example
     /// ```
     /// use tricept_ident::IdentifyOptions;
-    /// use tricept_kinematics::SensorNoise;
+    /// use tricept_kinematics::units::arcsec_to_rad;
     /// // A 2 arcsec encoder and a 0.5 um scale, one reading per pose.
-    /// let arcsec = SensorNoise::ARCSEC;
-    /// let o = IdentifyOptions::with_sigma([2.0 * arcsec, 2.0 * arcsec, 0.5e-3]);
+    /// let o = IdentifyOptions::with_sigma([arcsec_to_rad(2.0), arcsec_to_rad(2.0), 0.5e-3]);
     /// assert_eq!(o.max_iterations, 30);
-    /// assert!(o.design.is_none());
     /// ```
     pub fn with_sigma(sigma: [f64; 3]) -> IdentifyOptions {
         IdentifyOptions {
@@ -134,10 +216,6 @@ impl IdentifyOptions {
             rank_tolerance: DEFAULT_RANK_TOLERANCE,
             weak_threshold: 1e-2,
             max_iterations: 30,
-            initial: None,
-            pose_weights: None,
-            design: None,
-            start_seeds: None,
         }
     }
 }
@@ -200,8 +278,9 @@ pub struct Identification {
     pub estimate: Vec<f64>,
     /// Standard deviations from the covariance (`None` for fixed parameters).
     pub std_dev: Vec<Option<f64>>,
-    /// Covariance of the parameters, row-major `k x k`.
-    pub covariance: Vec<f64>,
+    /// Covariance of the parameters (`k x k`, zero rows and columns for
+    /// fixed parameters), in the parameters' units squared.
+    pub covariance: DMatrix<f64>,
     /// Estimated sensor zero offsets `[phi, theta, s]` (rad, rad, mm).
     pub offsets: [f64; 3],
     /// Their standard deviations.
@@ -217,37 +296,22 @@ pub struct Identification {
     /// Whether the iteration met its tolerance.
     pub converged: bool,
     /// The rank decision taken at the start and used throughout.
-    pub decision: RankDecision,
+    decision: RankDecision,
 }
 
 /// One evaluation of the model at fixed parameters over all poses.
-///
-/// # Example
-/// ```
-/// use tricept_ident::{GeometricModel, IdentifyOptions};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let m = Machine::paper();
-/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-/// let set = ParameterSet::paper15();
-/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
-///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
-///     .unwrap();
-/// let mut seeds = vec![None; data.poses.len()];
-/// let e = tricept_ident::evaluate(&model, &[0.0; 15], &data.poses, &m.sensors.logged_sigma(), None, &mut seeds).unwrap();
-/// assert_eq!(e.problem.rows, 3 * 75);
-/// assert_eq!(e.residuals.len(), 75);
-/// ```
-pub struct Evaluation {
+struct Evaluation {
     /// The reduced weighted problem `[offsets | parameters | y - g(p)]`.
-    pub problem: ReducedProblem,
+    problem: ReducedProblem,
     /// `y - g(p)` per pose (rad, rad, mm).
-    pub residuals: Vec<[f64; 3]>,
+    residuals: Vec<[f64; 3]>,
 }
 
 /// Evaluates `model` at `p` on `poses`: predictions, Jacobians and the
-/// reduced weighted problem. `seeds` carries FK starting points between calls.
-pub fn evaluate(
+/// reduced weighted problem. `seeds` carries FK starting points between
+/// calls; `seeds` and `pose_weights` have one entry per pose (checked by
+/// the callers).
+fn evaluate(
     model: &dyn ReadingModel,
     p: &[f64],
     poses: &[MeasuredPose],
@@ -261,16 +325,17 @@ pub fn evaluate(
     let mut jac = vec![0.0; 3 * k];
     let mut row = vec![0.0; 3 + k + 1];
     let mut residuals = Vec::with_capacity(poses.len());
-    for (j, pose) in poses.iter().enumerate() {
-        let g = predictor
-            .predict(pose, &mut seeds[j], &mut jac)
-            .map_err(|source| IdentError::Kinematics {
-                pose: j,
-                line: pose.line,
-                source,
-            })?;
+    for ((j, pose), seed) in poses.iter().enumerate().zip(seeds.iter_mut()) {
+        let g =
+            predictor
+                .predict(pose, seed, &mut jac)
+                .map_err(|source| IdentError::Kinematics {
+                    pose: j,
+                    line: pose.line,
+                    source,
+                })?;
         let y = pose.readings.to_array();
-        let w_pose = pose_weights.map_or(1.0, |w| w[j]);
+        let w_pose = pose_weights.and_then(|w| w.get(j)).copied().unwrap_or(1.0);
         let mut res = [0.0; 3];
         for c in 0..3 {
             res[c] = y[c] - g[c];
@@ -338,51 +403,77 @@ pub fn identify(
     data: &Dataset,
     options: &IdentifyOptions,
 ) -> Result<Identification, IdentError> {
+    identify_from(model, data, options, &Start::default())
+}
+
+/// [`identify`] from a [`Start`]: a starting point, pose weights, FK seeds
+/// or a rank decision taken earlier, each checked against `data`.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions, Start, design, identify_from};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// use tricept_plant::{Campaign, Plant};
+/// let m = Machine::paper();
+/// let set = ParameterSet::paper15();
+/// let data = Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+///     .simulate(&Campaign::grid(&m, 1))
+///     .unwrap();
+/// let model = GeometricModel::new(m.clone(), set);
+/// let options = IdentifyOptions::for_machine(&m);
+/// // Decide the rank once for the pose set, then reuse the decision.
+/// let d = design(&model, &[0.0; 15], &data.poses, &options).unwrap();
+/// let start = Start { design: Some(d), ..Start::default() };
+/// let id = identify_from(&model, &data, &options, &start).unwrap();
+/// assert_eq!(id.rank(), 14);
+/// ```
+pub fn identify_from(
+    model: &dyn ReadingModel,
+    data: &Dataset,
+    options: &IdentifyOptions,
+    start: &Start,
+) -> Result<Identification, IdentError> {
     let names = model.names().to_vec();
     let k = names.len();
     let poses = &data.poses;
     check_size(poses.len(), k)?;
-    if let Some(w) = &options.pose_weights
-        && w.len() != poses.len()
-    {
-        return Err(IdentError::Invalid(format!(
-            "{} pose weights for {} poses",
-            w.len(),
-            poses.len()
-        )));
-    }
-    let weights = options.pose_weights.as_deref();
-    let p = match &options.initial {
-        Some(v) if v.len() == k => v.clone(),
-        Some(v) => {
-            return Err(IdentError::Invalid(format!(
-                "{} initial values for {k} parameters",
-                v.len()
-            )));
+    let mismatch = |what: &str, found: usize, expected: usize| {
+        IdentError::Invalid(format!("{found} {what} for {expected}"))
+    };
+    if let Some(w) = &start.pose_weights {
+        if w.len() != poses.len() {
+            return Err(mismatch("pose weights", w.len(), poses.len()));
         }
+        if w.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
+            return Err(IdentError::Invalid(
+                "pose weights must be finite and non-negative".into(),
+            ));
+        }
+    }
+    let weights = start.pose_weights.as_deref();
+    let p = match &start.parameters {
+        Some(v) if v.len() == k => v.clone(),
+        Some(v) => return Err(mismatch("starting values", v.len(), k)),
         None => vec![0.0; k],
     };
-    let mut seeds: Vec<Option<UpJoints>> = match &options.start_seeds {
+    let mut seeds: Vec<Option<UpJoints>> = match &start.fk_seeds {
         Some(s) if s.len() == poses.len() => s.iter().copied().map(Some).collect(),
-        Some(s) => {
-            return Err(IdentError::Invalid(format!(
-                "{} start seeds for {} poses",
-                s.len(),
-                poses.len()
-            )));
-        }
+        Some(s) => return Err(mismatch("FK seeds", s.len(), poses.len())),
         None => vec![None; poses.len()],
     };
     let eval = evaluate(model, &p, poses, &options.sigma, weights, &mut seeds)?;
-    let (decision, report, first) = match &options.design {
+    let (decision, report, first) = match &start.design {
         Some(d) if d.decision.column_scale.len() == k => {
             let first = eval.problem.solve(&d.decision);
             (d.decision.clone(), d.report.clone(), first)
         }
-        Some(_) => {
-            return Err(IdentError::Invalid(format!(
-                "the design was computed for another parameter count than {k}"
-            )));
+        Some(d) => {
+            return Err(mismatch(
+                "parameters in the reused design",
+                d.decision.column_scale.len(),
+                k,
+            ));
         }
         None => {
             let d = decide_design(&names, &eval, poses.len(), options)?;
@@ -407,7 +498,7 @@ pub fn identify(
     };
     problem.run(&mut state, &decision);
 
-    finish(names, state, decision, report, options)
+    Ok(finish(names, state, decision, report, options, weights))
 }
 
 /// The fixed parts of an identification problem.
@@ -501,7 +592,8 @@ fn finish(
     decision: RankDecision,
     report: IdentifiabilityReport,
     options: &IdentifyOptions,
-) -> Result<Identification, IdentError> {
+    weights: Option<&[f64]>,
+) -> Identification {
     let GaussNewton {
         p,
         eval,
@@ -532,9 +624,7 @@ fn finish(
             }
         })
         .collect();
-    let covariance = (0..k * k)
-        .map(|ij| solution.covariance[(3 + ij / k, 3 + ij % k)])
-        .collect();
+    let covariance = DMatrix::from_fn(k, k, |a, b| solution.covariance[(3 + a, 3 + b)]);
     let residuals: Vec<[f64; 3]> = eval
         .residuals
         .iter()
@@ -542,11 +632,10 @@ fn finish(
         .collect();
     let n = residuals.len().max(1) as f64;
     let rms = [0, 1, 2].map(|c| (residuals.iter().map(|r| r[c] * r[c]).sum::<f64>() / n).sqrt());
-    let weights = options.pose_weights.as_deref();
     let mut chi_square = 0.0;
     let mut max_standardized = (0.0, 0);
     for (j, r) in residuals.iter().enumerate() {
-        let w = weights.map_or(1.0, |w| w[j]);
+        let w = weights.and_then(|w| w.get(j)).copied().unwrap_or(1.0);
         for c in 0..3 {
             let z = r[c] / options.sigma[c];
             chi_square += (w * z) * (w * z);
@@ -556,7 +645,7 @@ fn finish(
         }
     }
     let dof = (3 * residuals.len()).saturating_sub(decision.rank + 3);
-    Ok(Identification {
+    Identification {
         names,
         estimate,
         std_dev,
@@ -579,7 +668,7 @@ fn finish(
         iterations,
         converged,
         decision,
-    })
+    }
 }
 
 /// Rank decision and report from one evaluation.
@@ -607,7 +696,7 @@ fn decide_design(
 }
 
 /// The rank decision and report of a pose set (see [`identifiability`]),
-/// for reuse through [`IdentifyOptions::design`].
+/// for reuse through [`Start::design`].
 ///
 /// # Example
 /// ```
@@ -624,7 +713,7 @@ fn decide_design(
 ///     .collect();
 /// let opts = IdentifyOptions::for_machine(&m);
 /// let d = tricept_ident::design(&model, &[0.0; 15], &poses, &opts).unwrap();
-/// assert_eq!(d.report.fixed, vec!["dyA3".to_string()]);
+/// assert_eq!(d.report().fixed, vec!["dyA3".to_string()]);
 /// ```
 pub fn design(
     model: &dyn ReadingModel,
@@ -634,14 +723,14 @@ pub fn design(
 ) -> Result<Design, IdentError> {
     check_size(poses.len(), model.names().len())?;
     let mut seeds = vec![None; poses.len()];
-    let eval = evaluate(
-        model,
-        p,
-        poses,
-        &options.sigma,
-        options.pose_weights.as_deref(),
-        &mut seeds,
-    )?;
+    if p.len() != model.names().len() {
+        return Err(IdentError::Invalid(format!(
+            "{} parameter values for {} parameters",
+            p.len(),
+            model.names().len()
+        )));
+    }
+    let eval = evaluate(model, p, poses, &options.sigma, None, &mut seeds)?;
     decide_design(model.names(), &eval, poses.len(), options)
 }
 
@@ -678,6 +767,46 @@ pub fn identifiability(
 }
 
 impl Identification {
+    /// Numerical rank of the rank decision taken at the start.
+    pub fn rank(&self) -> usize {
+        self.decision.rank
+    }
+
+    /// Indices of the parameters estimated (ascending).
+    pub fn identifiable(&self) -> &[usize] {
+        &self.decision.identifiable
+    }
+
+    /// Indices of the parameters held at their prior (ascending).
+    pub fn fixed(&self) -> &[usize] {
+        &self.decision.fixed
+    }
+
+    /// The `i`-th right singular direction of the column-scaled design
+    /// (`0`: the best determined), in parameter units; `None` beyond the
+    /// number of parameters. Directions `rank()..` span what the data
+    /// cannot see; direction `rank() - 1` is the weakest one they can.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{GeometricModel, IdentifyOptions, identify};
+    /// use tricept_kinematics::Machine;
+    /// use tricept_model::ParameterSet;
+    /// let m = Machine::paper();
+    /// let set = ParameterSet::paper15();
+    /// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+    ///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
+    ///     .unwrap();
+    /// let id = identify(&GeometricModel::new(m.clone(), set.clone()), &data, &IdentifyOptions::for_machine(&m)).unwrap();
+    /// // The weakest visible direction moves the three leg lengths together.
+    /// let v = id.direction(id.rank() - 1).unwrap();
+    /// let dq = ["dq1", "dq2", "dq3"].map(|n| v[set.index_of(n).unwrap()]);
+    /// assert!(dq.iter().all(|x| x.signum() == dq[0].signum()));
+    /// ```
+    pub fn direction(&self, i: usize) -> Option<Vec<f64>> {
+        (i < self.decision.column_scale.len()).then(|| self.decision.direction(i))
+    }
+
     /// JSON with the contract keys: every parameter name with its estimate
     /// (mm), `std_dev`, `rank`, `n_params`, `unidentifiable`,
     /// `singular_values`, `condition_number`, `observability`, residual
@@ -724,8 +853,8 @@ impl Identification {
         m.insert(
             "residuals".into(),
             serde_json::json!({
-                "rms_phi_arcsec": self.stats.rms[0] / tricept_kinematics::SensorNoise::ARCSEC,
-                "rms_theta_arcsec": self.stats.rms[1] / tricept_kinematics::SensorNoise::ARCSEC,
+                "rms_phi_arcsec": self.stats.rms[0] / tricept_kinematics::units::RAD_PER_ARCSEC,
+                "rms_theta_arcsec": self.stats.rms[1] / tricept_kinematics::units::RAD_PER_ARCSEC,
                 "rms_s_um": self.stats.rms[2] * 1e3,
                 "chi_square": self.stats.chi_square,
                 "dof": self.stats.dof,

@@ -9,7 +9,7 @@
 //!   analytic Jacobian (`J E`, [`GeometricModel`]), with the three offsets as
 //!   unknowns ([`identify`] explains why that beats the paper's differencing);
 //! - reveals its rank with column scaling, column-pivoted QR and the SVD on
-//!   `faer` ([`lsq`]), and writes what cannot be identified as named
+//!   `faer`, and writes what cannot be identified as named
 //!   combinations ([`IdentifiabilityReport`]), with the observability
 //!   indices O1-O5;
 //! - refines on the exact model by Gauss-Newton ([`identify`]), with
@@ -50,19 +50,23 @@
 mod compensate;
 mod error;
 mod identify;
-pub mod linalg;
-pub mod lsq;
 mod model;
 mod report;
 mod robust;
-pub mod stats;
 
 pub use compensate::{Compensation, compensation, corrected_commands};
 pub use error::IdentError;
 pub use identify::{
-    Design, Evaluation, Identification, IdentifyOptions, ResidualStats, design, evaluate,
-    identifiability, identify,
+    Design, Identification, IdentifyOptions, ResidualStats, Start, design, identifiability,
+    identify, identify_from,
 };
-pub use model::{GeometricModel, PosePredictor, ReadingModel, project_jacobian, solve_pose};
+pub use model::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
 pub use report::{Combination, IdentifiabilityReport, Observability};
 pub use robust::{Rejection, identify_robust, residuals_at, screen_gross_errors};
+
+// What a downstream crate needs besides this crate's own types, so that one
+// dependency suffices: the data set and its reader, the machine, the
+// parameter sets.
+pub use tricept_data::{DataError, Dataset, MeasuredPose, Readings, read_from, read_path};
+pub use tricept_kinematics::{Machine, MachineDescription};
+pub use tricept_model::ParameterSet;

@@ -4,14 +4,16 @@
 //! [`GeometricModel`] is the paper's model: the exact FK of the nominal
 //! machine plus `E p` (a [`ParameterSet`]) gives the UP joints, and the
 //! analytic Jacobian `J E` of eq. 9 gives their derivatives. The trait is the
-//! extension point used by `tricept-diagnose` to add unmodelled effects.
+//! extension point used by `tricept-diagnose` to add unmodelled effects; its
+//! extended models build on [`GeometricPredictor`], which solves the UP
+//! joints and the geometric columns for any actual leg lengths.
 //!
 //! Readings are predicted *without* the sensors' zero offsets: the
 //! identification adds three offset unknowns of its own.
 
 use tricept_data::MeasuredPose;
-use tricept_kinematics::{KinematicsError, Machine, UpJoints};
-use tricept_model::{ParameterSet, actual_machine, error_jacobian_at};
+use tricept_kinematics::{KinematicsError, LegGeometry, Machine, UpJoints};
+use tricept_model::{N_FULL, ParameterSet, actual_machine, error_jacobian_at};
 
 /// A parametric model of the UP limb's readings.
 ///
@@ -86,8 +88,6 @@ pub trait PosePredictor: Sync {
 pub struct GeometricModel {
     nominal: Machine,
     set: ParameterSet,
-    names: Vec<String>,
-    sparse: Vec<Vec<(usize, f64)>>,
 }
 
 impl GeometricModel {
@@ -102,14 +102,7 @@ impl GeometricModel {
     /// assert_eq!(model.parameter_set().len(), 15);
     /// ```
     pub fn new(nominal: Machine, set: ParameterSet) -> GeometricModel {
-        let names = set.names().to_vec();
-        let sparse = set.sparse_columns();
-        GeometricModel {
-            nominal,
-            set,
-            names,
-            sparse,
-        }
+        GeometricModel { nominal, set }
     }
 
     /// The nominal machine.
@@ -155,22 +148,82 @@ impl GeometricModel {
     }
 }
 
-/// [`GeometricModel`] at fixed parameters.
-struct GeometricPredictor<'a> {
+/// [`GeometricModel`] at fixed parameters: an exact machine and the
+/// parameter set whose Jacobian columns it writes.
+///
+/// Extended models reuse it: [`GeometricPredictor::solve`] takes the
+/// *actual* leg lengths (commands plus whatever an effect adds) and writes
+/// the geometric columns into a wider Jacobian row.
+///
+/// # Example
+/// ```
+/// use tricept_ident::GeometricPredictor;
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let set = ParameterSet::paper15();
+/// let g = GeometricPredictor::new(Machine::paper(), &set);
+/// // 15 geometric columns in a row of width 17 (two more for an effect).
+/// let mut jac = vec![0.0; 3 * 17];
+/// let mut seed = None;
+/// let (up, _) = g.solve(&[800.0; 3], &mut seed, &mut jac, 17).unwrap();
+/// assert!(up.phi_rad.abs() < 1e-12);
+/// assert_eq!(jac[15], 0.0); // the extra columns are left alone
+/// ```
+pub struct GeometricPredictor<'a> {
     machine: Machine,
-    sparse: &'a [Vec<(usize, f64)>],
+    set: &'a ParameterSet,
+}
+
+impl<'a> GeometricPredictor<'a> {
+    /// The predictor of `machine` with the columns of `set`.
+    pub fn new(machine: Machine, set: &'a ParameterSet) -> GeometricPredictor<'a> {
+        GeometricPredictor { machine, set }
+    }
+
+    /// The exact machine it predicts with.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::GeometricPredictor;
+    /// let set = tricept_model::ParameterSet::paper15();
+    /// let g = GeometricPredictor::new(tricept_kinematics::Machine::paper(), &set);
+    /// assert_eq!(g.machine().leg_offsets_mm, [0.0; 3]);
+    /// ```
+    pub fn machine(&self) -> &Machine {
+        &self.machine
+    }
+
+    /// UP joints at actual leg lengths `legs_mm` (from `seed` when given),
+    /// their leg geometry, and `J E` written into the first `k` entries of
+    /// each of the three rows of `jacobian` (row stride `stride >= k`).
+    pub fn solve(
+        &self,
+        legs_mm: &[f64; 3],
+        seed: &mut Option<UpJoints>,
+        jacobian: &mut [f64],
+        stride: usize,
+    ) -> Result<(UpJoints, LegGeometry), KinematicsError> {
+        let up = solve_pose(&self.machine, legs_mm, seed)?;
+        let geometry = self.machine.legs_at(&up);
+        let j21 = error_jacobian_at(&geometry)?;
+        let k = self.set.len();
+        let mut block = [0.0; 3 * N_FULL];
+        self.set
+            .project(3, |row, f| j21[(row, f)], &mut block[..3 * k]);
+        for c in 0..3 {
+            jacobian[c * stride..c * stride + k].copy_from_slice(&block[c * k..(c + 1) * k]);
+        }
+        Ok((up, geometry))
+    }
 }
 
 impl ReadingModel for GeometricModel {
     fn names(&self) -> &[String] {
-        &self.names
+        self.set.names()
     }
 
     fn at<'a>(&'a self, p: &[f64]) -> Box<dyn PosePredictor + 'a> {
-        Box::new(GeometricPredictor {
-            machine: self.machine_at(p),
-            sparse: &self.sparse,
-        })
+        Box::new(GeometricPredictor::new(self.machine_at(p), &self.set))
     }
 }
 
@@ -201,35 +254,6 @@ pub fn solve_pose(
     Ok(fk.up)
 }
 
-/// Writes `J E` (3 x k, row-major) for the 21-column `J`, with `E` given
-/// by its non-zero entries ([`ParameterSet::sparse_columns`]).
-///
-/// # Example
-/// ```
-/// use tricept_kinematics::Machine;
-/// use tricept_model::{error_jacobian, ParameterSet};
-/// let m = Machine::paper();
-/// let up = m.inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0)).unwrap().up;
-/// let j21 = error_jacobian(&m, &up).unwrap();
-/// let set = ParameterSet::paper15();
-/// let mut out = vec![0.0; 3 * 15];
-/// tricept_ident::project_jacobian(&j21, &set.sparse_columns(), &mut out);
-/// // dxB1 moves B1 and B2: its column is the sum of theirs.
-/// assert!((out[0] - (j21[(0, 0)] + j21[(0, 7)])).abs() < 1e-15);
-/// ```
-pub fn project_jacobian(
-    j21: &tricept_model::ErrorJacobian,
-    sparse_columns: &[Vec<(usize, f64)>],
-    out: &mut [f64],
-) {
-    let k = sparse_columns.len();
-    for (c, col) in sparse_columns.iter().enumerate() {
-        for row in 0..3 {
-            out[row * k + c] = col.iter().map(|&(f, e)| j21[(row, f)] * e).sum();
-        }
-    }
-}
-
 impl PosePredictor for GeometricPredictor<'_> {
     fn predict(
         &self,
@@ -237,10 +261,8 @@ impl PosePredictor for GeometricPredictor<'_> {
         seed: &mut Option<UpJoints>,
         jacobian: &mut [f64],
     ) -> Result<[f64; 3], KinematicsError> {
-        let up = solve_pose(&self.machine, &pose.commands_mm, seed)?;
-        let geometry = self.machine.legs_at(&up);
-        let j21 = error_jacobian_at(&geometry)?;
-        project_jacobian(&j21, self.sparse, jacobian);
+        let k = self.set.len();
+        let (up, _) = self.solve(&pose.commands_mm, seed, jacobian, k)?;
         Ok(up.to_array())
     }
 }

@@ -20,7 +20,7 @@
 use serde::Serialize;
 use serde_json::{Map, Value};
 
-use crate::lsq::{RankDecision, Solution};
+use tricept_numerics::lsq::{RankDecision, Solution};
 
 /// Observability indices (see the module docs).
 ///
@@ -257,27 +257,7 @@ fn combination(
 impl IdentifiabilityReport {
     /// Builds the report from a rank decision, the solution's covariance
     /// (nuisance first, `n_nuisance` of them) and the problem size.
-    ///
-    /// # Example
-    /// ```
-    /// use tricept_ident::{GeometricModel, IdentifyOptions};
-    /// use tricept_kinematics::Machine;
-    /// use tricept_model::ParameterSet;
-    /// let m = Machine::paper();
-    /// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-    /// let poses: Vec<tricept_data::MeasuredPose> = m
-    ///     .workspace
-    ///     .polar_grid(3, 8, 3)
-    ///     .iter()
-    ///     .map(|r| tricept_data::MeasuredPose { commands_mm: m.inverse(r).unwrap().legs_mm, ..Default::default() })
-    ///     .collect();
-    /// let opts = IdentifyOptions::for_machine(&m);
-    /// let d = tricept_ident::design(&model, &[0.0; 15], &poses, &opts).unwrap();
-    /// // The Design's report is this constructor's output for its decision.
-    /// assert_eq!(d.report.rank, d.decision.rank);
-    /// assert_eq!(d.report.n_params, 15);
-    /// ```
-    pub fn new(
+    pub(crate) fn new(
         names: &[String],
         decision: &RankDecision,
         solution: &Solution,
@@ -539,7 +519,7 @@ fn identifiable_singular_values(d: &RankDecision) -> Vec<f64> {
     let b = faer::Mat::from_fn(k, cols.len(), |i, j| {
         d.singular_values[i] * d.right_vectors[(cols[j], i)]
     });
-    match crate::linalg::svd_values_and_vectors(b.as_ref()) {
+    match tricept_numerics::linalg::svd_values_and_vectors(b.as_ref()) {
         Some((s, _)) => s.into_iter().filter(|x| *x > 0.0).collect(),
         None => Vec::new(),
     }

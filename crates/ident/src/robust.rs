@@ -19,7 +19,7 @@ use tricept_kinematics::UpJoints;
 use crate::error::IdentError;
 use crate::identify::{Identification, IdentifyOptions, identify};
 use crate::model::ReadingModel;
-use crate::stats::chi2_isf;
+use tricept_numerics::stats::chi2_isf;
 
 /// A rejected pose.
 ///

@@ -94,7 +94,7 @@ impl Machine {
         legs_mm: &[f64; 3],
         seed: FkSeed,
     ) -> Result<FkSolution, KinematicsError> {
-        self.check_leg_stroke(legs_mm)?;
+        self.check_commands(legs_mm)?;
         let lengths = self.actual_lengths(legs_mm);
         let Some(r1) = self.level_trilateration(&lengths) else {
             let seed = self.level_joints();
@@ -122,7 +122,7 @@ impl Machine {
         legs_mm: &[f64; 3],
         seed: &UpJoints,
     ) -> Result<FkSolution, KinematicsError> {
-        self.check_leg_stroke(legs_mm)?;
+        self.check_commands(legs_mm)?;
         for (what, v) in [
             ("seed phi", seed.phi_rad),
             ("seed theta", seed.theta_rad),

@@ -32,6 +32,7 @@ pub mod error;
 mod fk;
 pub mod head;
 mod machine;
+pub mod units;
 mod up_limb;
 mod workspace;
 
@@ -43,4 +44,4 @@ pub use machine::{
     IkSolution, LegGeometry, Limits, Machine, SINGULARITY_CONDITION_LIMIT, SensorNoise,
 };
 pub use up_limb::{UpJoints, UpLimb, UpLimbPose};
-pub use workspace::{Workspace, box_lattice};
+pub use workspace::{PoseSet, PoseSetError, Workspace, box_lattice};

@@ -18,6 +18,7 @@ use crate::description::{
 };
 use crate::error::KinematicsError;
 use crate::head::Head;
+use crate::units::{arcsec_to_rad, rad_to_arcsec};
 use crate::up_limb::{UpJoints, UpLimb, UpLimbPose};
 use crate::workspace::Workspace;
 
@@ -63,13 +64,10 @@ pub struct SensorNoise {
 }
 
 impl SensorNoise {
-    /// One arcsecond in radians.
-    pub const ARCSEC: f64 = std::f64::consts::PI / (180.0 * 3600.0);
-
     /// Builds from the description's units (arcsec, um).
     pub fn from_description(s: &SensorDescription) -> SensorNoise {
         SensorNoise {
-            angle_rad: s.angle_noise_arcsec * Self::ARCSEC,
+            angle_rad: arcsec_to_rad(s.angle_noise_arcsec),
             length_mm: s.length_noise_um * 1e-3,
             readings_per_pose: s.readings_per_pose,
         }
@@ -235,7 +233,7 @@ impl Machine {
             },
             head: self.head.to_description(),
             sensors: SensorDescription {
-                angle_noise_arcsec: self.sensors.angle_rad / SensorNoise::ARCSEC,
+                angle_noise_arcsec: rad_to_arcsec(self.sensors.angle_rad),
                 length_noise_um: self.sensors.length_mm * 1e3,
                 readings_per_pose: self.sensors.readings_per_pose,
             },
@@ -311,7 +309,7 @@ impl Machine {
         up: &UpJoints,
         limb_axis: &Vector3<f64>,
     ) -> Result<(), KinematicsError> {
-        self.check_leg_stroke(legs_mm)?;
+        self.check_commands(legs_mm)?;
         let [lo, hi] = self.limits.up_stroke_mm;
         if !(lo - LIMIT_SLACK..=hi + LIMIT_SLACK).contains(&up.q4_mm) {
             return Err(KinematicsError::OutOfReach {
@@ -334,8 +332,19 @@ impl Machine {
         Ok(())
     }
 
-    /// Checks leg commands against the stroke.
-    pub(crate) fn check_leg_stroke(&self, legs_mm: &[f64; 3]) -> Result<(), KinematicsError> {
+    /// Checks leg commands against the leg stroke (with the same small
+    /// slack as every solver): the one check that the data reader, the
+    /// identification and the kinematics share.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_kinematics::{KinematicsError, Machine};
+    /// let m = Machine::paper();
+    /// assert!(m.check_commands(&[800.0; 3]).is_ok());
+    /// let e = m.check_commands(&[800.0, 100.0, 800.0]).unwrap_err();
+    /// assert!(matches!(e, KinematicsError::OutOfStroke { leg: 2, .. }));
+    /// ```
+    pub fn check_commands(&self, legs_mm: &[f64; 3]) -> Result<(), KinematicsError> {
         let [lo, hi] = self.limits.leg_stroke_mm;
         for (i, &q) in legs_mm.iter().enumerate() {
             if !q.is_finite() {
@@ -412,7 +421,7 @@ mod tests {
     #[test]
     fn logged_sigma_divides_by_root_readings() {
         let s = Machine::paper().sensors.logged_sigma();
-        assert!((s[0] - 0.8 * SensorNoise::ARCSEC / 3f64.sqrt()).abs() < 1e-18);
+        assert!((s[0] - arcsec_to_rad(0.8) / 3f64.sqrt()).abs() < 1e-18);
         assert!((s[2] - 0.5e-3 / 3f64.sqrt()).abs() < 1e-15);
     }
 }

@@ -9,6 +9,10 @@
 //!   U-joint conventions.
 //! - [`volumetric_errors`]: platform error maps (the paper's Fig. 3).
 //! - [`residual_mu`]: the paper's residual error `mu` (Fig. 4).
+//! - [`effects`]: the effects the geometric model leaves out (leg lead,
+//!   backlash, thermal growth, sensor errors, class-2 errors, compliance),
+//!   their names and their physics, shared by the simulator and the
+//!   diagnosis.
 //!
 //! All lengths in mm, angles in rad.
 #![cfg_attr(
@@ -17,6 +21,7 @@
 )]
 
 mod actual;
+pub mod effects;
 mod error;
 mod jacobian;
 mod params;

@@ -96,6 +96,8 @@ pub struct ParameterSet {
     names: Vec<String>,
     /// Column `j` is the 21-vector moved by one mm of parameter `j`.
     columns: Vec<[f64; N_FULL]>,
+    /// The non-zero entries of every column (the cheap form of `E`).
+    sparse: Vec<Vec<(usize, f64)>>,
 }
 
 fn full_index(name: &str) -> Option<usize> {
@@ -103,6 +105,25 @@ fn full_index(name: &str) -> Option<usize> {
 }
 
 impl ParameterSet {
+    fn new(label: &str, names: Vec<String>, columns: Vec<[f64; N_FULL]>) -> ParameterSet {
+        let sparse = columns
+            .iter()
+            .map(|c| {
+                c.iter()
+                    .enumerate()
+                    .filter(|(_, v)| **v != 0.0)
+                    .map(|(i, v)| (i, *v))
+                    .collect()
+            })
+            .collect();
+        ParameterSet {
+            label: label.into(),
+            names,
+            columns,
+            sparse,
+        }
+    }
+
     /// All 21 parameters (includes the two rigid-body "gauge" motions that
     /// internal sensors cannot see; identification reports them).
     pub fn full21() -> ParameterSet {
@@ -113,11 +134,11 @@ impl ParameterSet {
                 c
             })
             .collect();
-        ParameterSet {
-            label: "full21".into(),
-            names: FULL21_NAMES.iter().map(|s| s.to_string()).collect(),
+        ParameterSet::new(
+            "full21",
+            FULL21_NAMES.iter().map(|s| s.to_string()).collect(),
             columns,
-        }
+        )
     }
 
     /// The paper's 15 parameters under its frame conventions.
@@ -138,11 +159,11 @@ impl ParameterSet {
                 c
             })
             .collect();
-        ParameterSet {
-            label: "paper15".into(),
-            names: PAPER15_NAMES.iter().map(|s| s.to_string()).collect(),
+        ParameterSet::new(
+            "paper15",
+            PAPER15_NAMES.iter().map(|s| s.to_string()).collect(),
             columns,
-        }
+        )
     }
 
     /// Looks a set up by its label (`paper15` or `full21`).
@@ -184,19 +205,32 @@ impl ParameterSet {
         &self.columns[j]
     }
 
-    /// The non-zero entries `(full index, coefficient)` of every column of
-    /// `E`: the cheap form for projecting Jacobians, `J E`.
-    pub fn sparse_columns(&self) -> Vec<Vec<(usize, f64)>> {
-        self.columns
-            .iter()
-            .map(|c| {
-                c.iter()
-                    .enumerate()
-                    .filter(|(_, v)| **v != 0.0)
-                    .map(|(i, v)| (i, *v))
-                    .collect()
-            })
-            .collect()
+    /// Projects a Jacobian with respect to the 21 errors onto this set:
+    /// writes `J E` (`rows x k`, row-major) into `out`, where `J` is given
+    /// row by row through `full(row, f)` (`f` in `0..21`). One sparse
+    /// product serves every Jacobian of the project: the readings' eq. 9
+    /// `J` (3 x 21), the platform position's, any subset of rows.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_kinematics::Machine;
+    /// use tricept_model::{error_jacobian, ParameterSet};
+    /// let m = Machine::paper();
+    /// let up = m.inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0)).unwrap().up;
+    /// let j21 = error_jacobian(&m, &up).unwrap();
+    /// let set = ParameterSet::paper15();
+    /// let mut out = vec![0.0; 3 * 15];
+    /// set.project(3, |row, f| j21[(row, f)], &mut out);
+    /// // dxB1 moves B1 and B2: its column is the sum of theirs.
+    /// assert!((out[0] - (j21[(0, 0)] + j21[(0, 7)])).abs() < 1e-15);
+    /// ```
+    pub fn project(&self, rows: usize, full: impl Fn(usize, usize) -> f64, out: &mut [f64]) {
+        let k = self.sparse.len();
+        for (c, col) in self.sparse.iter().enumerate() {
+            for row in 0..rows {
+                out[row * k + c] = col.iter().map(|&(f, e)| full(row, f) * e).sum();
+            }
+        }
     }
 
     /// The full error vector `E p` for parameter values `p` (mm).

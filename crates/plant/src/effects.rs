@@ -1,93 +1,30 @@
-//! Effects that the paper's 15-parameter geometric model leaves out, each
-//! with a physical model, a magnitude in the units a machine builder quotes,
-//! and the name the diagnosis report uses ([`EffectName`]).
+//! How the effects of the vocabulary ([`tricept_model::effects`]) are put
+//! into a simulated machine: each [`Effect`] carries its magnitude, and the
+//! plant applies its physics to the legs, the readings, the machine's
+//! kinematics or the logged rows.
 //!
-//! | name | physics | parameters |
-//! |---|---|---|
-//! | `leg-lead` | ball-screw lead error: extra length `k_i q_i` | `k_i` ppm per leg |
-//! | `backlash` | lost motion: the leg stops `b_i/2` short of the command in the direction it came from | `b_i` um per leg |
-//! | `thermal` | the structure warms by `drift_k` over the campaign; legs grow `alpha q_i dT` | drift K, `alpha` ppm/K |
-//! | `scale-gain` | the linear scale reads `(1 + g) q4` | `g` ppm |
-//! | `encoder-eccentricity` | once-per-revolution error `A sin(angle + psi)` of each encoder | `A` arcsec, `psi` deg per encoder |
-//! | `ujoint-axes` | the UP limb's U-joint axes are not orthogonal (skew) and do not intersect (offset) | arcsec, um |
-//! | `tube-twist` | twisted guide rails turn the platform about the limb axis as it extends | arcsec per 100 mm |
-//! | `compliance` | the legs stretch under the weight of platform and head (`F = J1^-T Q`, stiffness ~ 1/length) | N/um at 1 m |
-//! | `outliers` | a few gross reading errors | count, size in sigmas |
-//!
-//! The functional forms are public so that the diagnosis can fit exactly
-//! the same physics it is asked to find.
+//! | name | magnitude |
+//! |---|---|
+//! | `leg-lead` | `ppm` per leg |
+//! | `backlash` | `um` per leg |
+//! | `thermal` | `drift_k` over the campaign, `expansion_ppm_per_k` |
+//! | `scale-gain` | `ppm` |
+//! | `encoder-eccentricity` | amplitude (arcsec) and phase (deg) per encoder |
+//! | `ujoint-axes` | `skew_arcsec`, `offset_um` |
+//! | `tube-twist` | `arcsec_per_100mm` |
+//! | `compliance` | `stiffness_n_per_um_at_1m` |
+//! | `outliers` | `count`, `size_sigma` |
 
-use nalgebra::{Matrix3, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
 use tricept_data::MeasuredPose;
-use tricept_kinematics::{Machine, SensorNoise, UpJoints};
-
-/// The vocabulary of the diagnosis report.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum EffectName {
-    /// Ball-screw lead error of the actuated legs.
-    LegLead,
-    /// Lost motion of the actuated legs.
-    Backlash,
-    /// Thermal growth of the legs during a temperature drift.
-    Thermal,
-    /// Gain error of the UP limb's linear scale.
-    ScaleGain,
-    /// Once-per-revolution error of the U-joint encoders.
-    EncoderEccentricity,
-    /// Class-2 errors of the UP limb's U joint.
-    UjointAxes,
-    /// Platform twist about the UP limb's axis.
-    TubeTwist,
-    /// Gravity-induced axial deflection of the legs.
-    Compliance,
-    /// Gross reading errors.
-    Outliers,
-}
-
-impl EffectName {
-    /// Every effect, in the order of the vocabulary.
-    pub const ALL: [EffectName; 9] = [
-        EffectName::LegLead,
-        EffectName::Backlash,
-        EffectName::Thermal,
-        EffectName::ScaleGain,
-        EffectName::EncoderEccentricity,
-        EffectName::UjointAxes,
-        EffectName::TubeTwist,
-        EffectName::Compliance,
-        EffectName::Outliers,
-    ];
-
-    /// The report name (`leg-lead`, ...).
-    pub fn as_str(self) -> &'static str {
-        match self {
-            EffectName::LegLead => "leg-lead",
-            EffectName::Backlash => "backlash",
-            EffectName::Thermal => "thermal",
-            EffectName::ScaleGain => "scale-gain",
-            EffectName::EncoderEccentricity => "encoder-eccentricity",
-            EffectName::UjointAxes => "ujoint-axes",
-            EffectName::TubeTwist => "tube-twist",
-            EffectName::Compliance => "compliance",
-            EffectName::Outliers => "outliers",
-        }
-    }
-
-    /// Parses a report name.
-    pub fn parse(s: &str) -> Option<EffectName> {
-        EffectName::ALL.into_iter().find(|e| e.as_str() == s)
-    }
-}
-
-impl std::fmt::Display for EffectName {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
+use tricept_kinematics::{Machine, UpJoints};
+use tricept_model::effects::{
+    EffectName, add_tube_twist, add_ujoint_axis_errors, backlash_extra_mm, compliance_extra_mm,
+    eccentricity_error_rad, gravity_leg_tension_n, leg_lead_extra_mm, scale_gain_error_mm,
+    thermal_extra_mm,
+};
 
 /// One unmodelled effect with its magnitude.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -166,67 +103,6 @@ pub struct PoseState {
     pub approach: [i8; 3],
 }
 
-/// Extra leg length of a ball-screw lead error, mm.
-pub fn leg_lead_extra_mm(ppm: f64, command_mm: f64) -> f64 {
-    ppm * 1e-6 * command_mm
-}
-
-/// Extra leg length from backlash `um` approached in direction `dir`, mm:
-/// the nut lags, so an extending leg stops short and a retracting one long.
-pub fn backlash_extra_mm(um: f64, dir: i8) -> f64 {
-    -f64::from(dir) * 0.5 * um * 1e-3
-}
-
-/// Thermal growth of a leg of length `command_mm` warmed by `delta_k`, mm.
-pub fn thermal_extra_mm(ppm_per_k: f64, command_mm: f64, delta_k: f64) -> f64 {
-    ppm_per_k * 1e-6 * command_mm * delta_k
-}
-
-/// Standard gravity, m/s^2.
-pub const GRAVITY_M_PER_S2: f64 = 9.80665;
-
-/// Axial tension in each leg (N) holding platform and head against gravity
-/// with the UP limb at `up`: `F = J1^-T Q`, where `Q` is the generalised
-/// gravity force on `(phi, theta, q4)`. The UP limb's passive prismatic
-/// joint carries no axial load, so the legs carry all of it.
-pub fn gravity_leg_tension_n(machine: &Machine, up: &UpJoints) -> [f64; 3] {
-    let g = machine.legs_at(up);
-    let loads = &machine.loads;
-    let d = Vector3::from(loads.gravity_direction).normalize() * GRAVITY_M_PER_S2;
-    let limb = &g.limb;
-    let head_com = limb.position_mm + limb.rotation * Vector3::from(loads.head_com_mm);
-    let q = limb.point_jacobian(&limb.position_mm).transpose() * (loads.platform_mass_kg * d)
-        + limb.point_jacobian(&head_com).transpose() * (loads.head_mass_kg * d);
-    let j1t: Matrix3<f64> = g.j1().transpose();
-    match j1t.try_inverse() {
-        Some(inv) => (inv * q).into(),
-        None => [0.0; 3],
-    }
-}
-
-/// Extra leg length (mm) of a leg of length `command_mm` under `tension_n`
-/// with stiffness `stiffness_n_per_um_at_1m` at 1 m.
-pub fn compliance_extra_mm(stiffness_n_per_um_at_1m: f64, tension_n: f64, command_mm: f64) -> f64 {
-    let stiffness = stiffness_n_per_um_at_1m * 1000.0 / command_mm;
-    tension_n / stiffness * 1e-3
-}
-
-/// Reading error of a scale with gain error `ppm` at extension `q4_mm`, mm.
-pub fn scale_gain_error_mm(ppm: f64, q4_mm: f64) -> f64 {
-    ppm * 1e-6 * q4_mm
-}
-
-/// Once-per-revolution encoder error at `angle_rad`, rad.
-pub fn eccentricity_error_rad(amplitude_arcsec: f64, phase_deg: f64, angle_rad: f64) -> f64 {
-    amplitude_arcsec * SensorNoise::ARCSEC * (angle_rad + phase_deg.to_radians()).sin()
-}
-
-/// Extension at which the tube twist is zero: the UP limb length at the
-/// workspace's middle plane on the axis.
-pub fn twist_reference_mm(machine: &Machine) -> f64 {
-    machine.workspace.mid_plane_z_mm()
-}
-
 impl Effect {
     /// The report name of this effect.
     pub fn name(&self) -> EffectName {
@@ -249,14 +125,8 @@ impl Effect {
             Effect::UjointAxes {
                 skew_arcsec,
                 offset_um,
-            } => {
-                m.up_limb.axis_skew_rad += skew_arcsec * SensorNoise::ARCSEC;
-                m.up_limb.axis_offset_mm += offset_um * 1e-3;
-            }
-            Effect::TubeTwist { arcsec_per_100mm } => {
-                m.up_limb.twist_rad_per_mm += arcsec_per_100mm * SensorNoise::ARCSEC / 100.0;
-                m.up_limb.twist_reference_mm = twist_reference_mm(m);
-            }
+            } => add_ujoint_axis_errors(m, *skew_arcsec, *offset_um),
+            Effect::TubeTwist { arcsec_per_100mm } => add_tube_twist(m, *arcsec_per_100mm),
             _ => {}
         }
     }
@@ -343,23 +213,5 @@ impl Effect {
                 poses[j].readings = tricept_data::Readings::from_array(r);
             }
         }
-    }
-}
-
-/// The leg stiffness (N/um at 1 m) for which gravity moves the platform
-/// point by `deflection_um` at the centre of the workspace's middle plane
-/// (the magnitude in which the `compliance` effect is quoted).
-pub fn stiffness_for_platform_deflection(machine: &Machine, deflection_um: f64) -> f64 {
-    let r = Vector3::new(0.0, 0.0, machine.workspace.mid_plane_z_mm());
-    let Ok(ik) = machine.inverse(&r) else {
-        return f64::NAN;
-    };
-    let f = gravity_leg_tension_n(machine, &ik.up);
-    // Deflection at unit stiffness (1 N/um at 1 m), through the exact FK.
-    let legs: [f64; 3] =
-        std::array::from_fn(|i| ik.legs_mm[i] + compliance_extra_mm(1.0, f[i], ik.legs_mm[i]));
-    match machine.forward_from(&legs, &ik.up) {
-        Ok(fk) => (fk.position_mm - r).norm() * 1e3 / deflection_um,
-        Err(_) => f64::NAN,
     }
 }

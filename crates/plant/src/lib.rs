@@ -32,7 +32,8 @@ use tricept_kinematics::{KinematicsError, Machine, UpJoints};
 use tricept_model::{GeometricErrors, actual_machine};
 
 pub use campaign::{Campaign, PoseOrder};
-pub use effects::{Effect, EffectName};
+pub use effects::Effect;
+pub use tricept_model::effects::EffectName;
 
 /// Why a simulation failed.
 #[derive(Debug, Clone, PartialEq, Error)]

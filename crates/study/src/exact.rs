@@ -12,10 +12,10 @@
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use tricept_data::Dataset;
-use tricept_ident::{Identification, identify};
+use tricept_ident::{Identification, Start, identify_from};
 use tricept_model::{residual_mu, volumetric_errors};
 
-use crate::fast::{GradeModel, model_of, options_for};
+use crate::fast::{GradeModel, model_of, options_for, start_for};
 use crate::rng::trial_rng;
 use crate::scenario::Scenario;
 use crate::{StudyError, TrialResult};
@@ -57,9 +57,12 @@ pub fn identify_trial(
     start: Option<Vec<f64>>,
 ) -> Result<Identification, StudyError> {
     let model = model_of(s);
-    let mut options = options_for(s, g.grade_arcsec, Some(&g.design));
-    options.initial = Some(start.unwrap_or_else(|| g.estimator.p_star.clone()));
-    Ok(identify(&model, data, &options)?)
+    let options = options_for(s, g.grade_arcsec);
+    let start = Start {
+        parameters: Some(start.unwrap_or_else(|| g.estimator.p_star.clone())),
+        ..start_for(s, Some(&g.design))
+    };
+    Ok(identify_from(&model, data, &options, &start)?)
 }
 
 /// One exact trial.

@@ -23,7 +23,9 @@ use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
-use tricept_ident::{Design, GeometricModel, IdentifyOptions, ReadingModel, design, identify};
+use tricept_ident::{
+    Design, GeometricModel, IdentifyOptions, ReadingModel, Start, design, identify_from,
+};
 use tricept_kinematics::UpJoints;
 use tricept_model::{position_error_jacobian, residual_mu, volumetric_errors};
 
@@ -72,14 +74,16 @@ pub struct GradeModel {
 /// `G`: platform position error on the plane per unit of each parameter in
 /// `columns`, first order at the nominal machine (3 n_plane x columns).
 pub fn plane_jacobian(s: &Scenario, columns: &[usize]) -> Result<Mat<f64>, StudyError> {
-    let sparse = s.set.sparse_columns();
+    let k = s.set.len();
+    let mut block = vec![0.0; 3 * k];
     let mut g = Mat::<f64>::zeros(3 * s.plane_mm.len(), columns.len());
     for (t, r) in s.plane_mm.iter().enumerate() {
         let up = s.nominal.inverse(r)?.up;
         let jp = position_error_jacobian(&s.nominal.legs_at(&up))?;
+        s.set.project(3, |row, f| jp[(row, f)], &mut block);
         for (u, &col) in columns.iter().enumerate() {
             for row in 0..3 {
-                g[(3 * t + row, u)] = sparse[col].iter().map(|&(f, e)| jp[(row, f)] * e).sum();
+                g[(3 * t + row, u)] = block[row * k + col];
             }
         }
     }
@@ -91,13 +95,18 @@ pub fn model_of(s: &Scenario) -> GeometricModel {
     GeometricModel::new(s.nominal.clone(), s.set.clone())
 }
 
-/// Identification options for `s` at `grade_arcsec` (with the shared
-/// design when given, seeds at the true joints).
-pub fn options_for(s: &Scenario, grade_arcsec: f64, design: Option<&Design>) -> IdentifyOptions {
-    IdentifyOptions {
+/// Identification options for `s` at `grade_arcsec`.
+pub fn options_for(s: &Scenario, grade_arcsec: f64) -> IdentifyOptions {
+    IdentifyOptions::with_sigma(s.logged_sigma(grade_arcsec))
+}
+
+/// The start of every identification of `s`: FK seeds at the true joints
+/// and the shared rank decision when given.
+pub fn start_for(s: &Scenario, design: Option<&Design>) -> Start {
+    Start {
         design: design.cloned(),
-        start_seeds: Some(s.true_up.clone()),
-        ..IdentifyOptions::with_sigma(s.logged_sigma(grade_arcsec))
+        fk_seeds: Some(s.true_up.clone()),
+        ..Start::default()
     }
 }
 
@@ -106,17 +115,16 @@ impl GradeModel {
     pub fn new(s: &Scenario, grade_arcsec: f64) -> Result<GradeModel, StudyError> {
         let model = model_of(s);
         let k = s.set.len();
-        let options = options_for(s, grade_arcsec, None);
+        let options = options_for(s, grade_arcsec);
         let design = design(&model, &vec![0.0; k], &s.clean, &options)?;
-        let options = options_for(s, grade_arcsec, Some(&design));
         let clean = tricept_data::Dataset {
             poses: s.clean.clone(),
             source: "noise-free".into(),
         };
-        let id = identify(&model, &clean, &options)?;
+        let id = identify_from(&model, &clean, &options, &start_for(s, Some(&design)))?;
         let p_star = id.estimate.clone();
         let sigma = options.sigma;
-        let ident = design.decision.identifiable.clone();
+        let ident = design.identifiable().to_vec();
 
         // Weighted [offsets | J E] at p*, identifiable columns only.
         let predictor = model.at(&p_star);
@@ -140,7 +148,7 @@ impl GradeModel {
         let qr = a.qr();
         let q_thin = qr.compute_thin_Q();
         let r = qr.thin_R().to_owned();
-        let r_inv = tricept_ident::linalg::invert_upper(r.as_ref());
+        let r_inv = tricept_numerics::linalg::invert_upper(r.as_ref());
         let pinv = &r_inv * q_thin.transpose(); // q x m
         let operator = pinv.as_ref().subrows(3, ident.len()).to_owned();
 
@@ -184,7 +192,7 @@ impl LinearEstimator {
         plane_clean: Vec<f64>,
     ) -> LinearEstimator {
         let q = operator.nrows();
-        let r = tricept_ident::linalg::r_factor(operator.transpose());
+        let r = tricept_numerics::linalg::r_factor(operator.transpose());
         let factor = Mat::from_fn(q, q, |i, j| r[(j, i)]);
         LinearEstimator {
             p_star,

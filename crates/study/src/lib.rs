@@ -246,7 +246,7 @@ pub fn run_grades(
                 exact,
                 paper,
                 paper_condition,
-                rank: model.design.decision.rank,
+                rank: model.design.rank(),
             })
         })
         .collect()

@@ -25,7 +25,6 @@
 
 use nalgebra::{DMatrix, Vector3};
 use rayon::prelude::*;
-use tricept_ident::project_jacobian;
 use tricept_kinematics::Machine;
 use tricept_model::{ParameterSet, error_jacobian};
 
@@ -61,12 +60,12 @@ impl Candidates {
         sigma: [f64; 3],
     ) -> Result<Candidates, StudyError> {
         let k = set.len();
-        let sparse = set.sparse_columns();
         let mut block = vec![0.0; 3 * k];
         let mut rows = Vec::with_capacity(targets_mm.len());
         for r in &targets_mm {
             let up = machine.inverse(r)?.up;
-            project_jacobian(&error_jacobian(machine, &up)?, &sparse, &mut block);
+            let j21 = error_jacobian(machine, &up)?;
+            set.project(3, |row, f| j21[(row, f)], &mut block);
             rows.push([0, 1, 2].map(|c| {
                 columns
                     .iter()

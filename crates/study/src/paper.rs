@@ -11,7 +11,6 @@
 
 use faer::Mat;
 use nalgebra::DMatrix;
-use tricept_ident::project_jacobian;
 use tricept_model::error_jacobian;
 
 use crate::StudyError;
@@ -40,7 +39,6 @@ pub fn paper_solve(s: &Scenario, grade_arcsec: f64) -> Result<PaperSolve, StudyE
     let k = s.set.len();
     let n = s.clean.len();
     let m = 3 * n;
-    let sparse = s.set.sparse_columns();
     // Nominal predictions and Jacobians at the commanded poses.
     let mut g0 = vec![0.0; m];
     let mut jac = DMatrix::<f64>::zeros(m, k);
@@ -48,7 +46,7 @@ pub fn paper_solve(s: &Scenario, grade_arcsec: f64) -> Result<PaperSolve, StudyE
     for (j, r) in s.targets_mm.iter().enumerate() {
         let ik = s.nominal.inverse(r)?;
         let j21 = error_jacobian(&s.nominal, &ik.up)?;
-        project_jacobian(&j21, &sparse, &mut block);
+        s.set.project(3, |row, f| j21[(row, f)], &mut block);
         let up = ik.up.to_array();
         for c in 0..3 {
             g0[3 * j + c] = up[c];

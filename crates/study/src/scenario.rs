@@ -106,7 +106,7 @@ impl Scenario {
     /// encoder of `grade_arcsec`.
     pub fn logged_sigma(&self, grade_arcsec: f64) -> [f64; 3] {
         let k = f64::from(self.readings_per_pose.max(1)).sqrt();
-        let a = grade_arcsec * tricept_kinematics::SensorNoise::ARCSEC / k;
+        let a = grade_arcsec * tricept_kinematics::units::RAD_PER_ARCSEC / k;
         [a, a, self.length_noise_mm / k]
     }
 

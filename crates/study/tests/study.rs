@@ -112,7 +112,7 @@ fn mu_at_zero_noise_is_the_bias_of_the_unidentifiable_parameters_only() {
         let g = GradeModel::new(&s, 2.0).unwrap();
         // Expected from the simulator's inputs: the true values of the
         // parameters the design holds fixed (they stay at zero).
-        let fixed = g.design.decision.fixed.clone();
+        let fixed = g.design.fixed().to_vec();
         let expected: f64 =
             fixed.iter().map(|&j| s.truth[j].abs()).sum::<f64>() / s.truth.len() as f64;
         if order == AxisOrder::XFirst {

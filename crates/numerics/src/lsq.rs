@@ -20,6 +20,7 @@
 //!    re-factored (column-scaled) and solved by back substitution; the
 //!    covariance is `(R^T R)^{-1}` in the units of the weighted problem.
 
+use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef};
 
 use crate::linalg::{invert_upper, pivot_order, r_factor, solve_upper, svd_values_and_vectors};
@@ -35,8 +36,8 @@ pub const DEFAULT_RANK_TOLERANCE: f64 = 1e-8;
 ///
 /// # Example
 /// ```
-/// use tricept_ident::linalg::TriangularAccumulator;
-/// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+/// use tricept_numerics::linalg::TriangularAccumulator;
+/// use tricept_numerics::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
 /// // y = 1 + 2 x with one nuisance (the intercept) and one parameter.
 /// let mut acc = TriangularAccumulator::new(3);
 /// for x in [0.0, 1.0, 2.0, 3.0] {
@@ -63,8 +64,8 @@ pub struct ReducedProblem {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::linalg::TriangularAccumulator;
-/// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+/// use tricept_numerics::linalg::TriangularAccumulator;
+/// use tricept_numerics::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
 /// // Two identical columns: one of them is held fixed, the combination named.
 /// let mut acc = TriangularAccumulator::new(4);
 /// for x in [0.0, 1.0, 2.0, 3.0, 5.0] {
@@ -98,8 +99,8 @@ pub struct RankDecision {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::linalg::TriangularAccumulator;
-/// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+/// use tricept_numerics::linalg::TriangularAccumulator;
+/// use tricept_numerics::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
 /// let mut acc = TriangularAccumulator::new(3);
 /// for x in [0.0, 1.0, 2.0, 3.0] {
 ///     acc.push_row(&[1.0, x, 1.0 + 2.0 * x + if x == 1.0 { 0.1 } else { 0.0 }]);
@@ -129,8 +130,8 @@ impl ReducedProblem {
     ///
     /// # Example
     /// ```
-    /// use tricept_ident::linalg::TriangularAccumulator;
-    /// use tricept_ident::lsq::ReducedProblem;
+    /// use tricept_numerics::linalg::TriangularAccumulator;
+    /// use tricept_numerics::lsq::ReducedProblem;
     /// let mut acc = TriangularAccumulator::new(4);
     /// (0..5).for_each(|i| acc.push_row(&[1.0, i as f64, (i * i) as f64, 0.0]));
     /// let p = ReducedProblem { rows: acc.rows(), r: acc.finish(), n_nuisance: 1, k: 2 };
@@ -147,8 +148,8 @@ impl ReducedProblem {
     ///
     /// # Example
     /// ```
-    /// use tricept_ident::linalg::TriangularAccumulator;
-    /// use tricept_ident::lsq::ReducedProblem;
+    /// use tricept_numerics::linalg::TriangularAccumulator;
+    /// use tricept_numerics::lsq::ReducedProblem;
     /// // Right-hand side 1, 2, 3 with an intercept as nuisance: the residual
     /// // about the mean is 1 + 0 + 1.
     /// let mut acc = TriangularAccumulator::new(3);
@@ -169,8 +170,8 @@ impl ReducedProblem {
     ///
     /// # Example
     /// ```
-    /// use tricept_ident::linalg::TriangularAccumulator;
-    /// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+    /// use tricept_numerics::linalg::TriangularAccumulator;
+    /// use tricept_numerics::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
     /// // Two parameters that always appear as their sum: rank 1, one fixed.
     /// let mut acc = TriangularAccumulator::new(3);
     /// (0..6).for_each(|i| acc.push_row(&[i as f64, 2.0 * i as f64, 1.0]));
@@ -237,8 +238,8 @@ impl ReducedProblem {
     ///
     /// # Example
     /// ```
-    /// use tricept_ident::linalg::TriangularAccumulator;
-    /// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+    /// use tricept_numerics::linalg::TriangularAccumulator;
+    /// use tricept_numerics::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
     /// // y = a + b with a, b inseparable: the fixed one is held at 0 (its
     /// // prior) and the other takes the whole sum, never a minimum-norm split.
     /// let mut acc = TriangularAccumulator::new(3);
@@ -313,8 +314,8 @@ impl RankDecision {
     ///
     /// # Example
     /// ```
-    /// use tricept_ident::linalg::TriangularAccumulator;
-    /// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+    /// use tricept_numerics::linalg::TriangularAccumulator;
+    /// use tricept_numerics::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
     /// // Readings depend on a + 2 b only: the null direction is (2, -1) / ...
     /// let mut acc = TriangularAccumulator::new(3);
     /// (1..6).for_each(|i| acc.push_row(&[i as f64, 2.0 * i as f64, 0.0]));
@@ -336,8 +337,8 @@ impl RankDecision {
     ///
     /// # Example
     /// ```
-    /// use tricept_ident::linalg::TriangularAccumulator;
-    /// use tricept_ident::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+    /// use tricept_numerics::linalg::TriangularAccumulator;
+    /// use tricept_numerics::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
     /// let mut acc = TriangularAccumulator::new(3);
     /// (1..6).for_each(|i| acc.push_row(&[i as f64, 2.0 * i as f64, 0.0]));
     /// let p = ReducedProblem { rows: 5, r: acc.finish(), n_nuisance: 0, k: 2 };
@@ -363,7 +364,7 @@ impl RankDecision {
         for f in 0..d {
             let mut e = vec![0.0; d];
             e[f] = 1.0;
-            let Some(c) = solve_dense(nf.as_ref(), &e) else {
+            let Some(c) = solve_square(nf.as_ref(), &e) else {
                 // Degenerate fixed block: fall back to the raw null vectors.
                 return null;
             };
@@ -376,48 +377,19 @@ impl RankDecision {
     }
 }
 
-/// Solves a small dense square system by Gaussian elimination with partial
-/// pivoting; `None` when it is singular.
-///
-/// # Example
-/// ```
-/// use faer::Mat;
-/// let a = Mat::from_fn(2, 2, |i, j| [[0.0, 1.0], [2.0, 0.0]][i][j]);
-/// assert_eq!(tricept_ident::lsq::solve_dense(a.as_ref(), &[3.0, 4.0]).unwrap(), vec![2.0, 3.0]);
-/// ```
-pub fn solve_dense(a: MatRef<'_, f64>, b: &[f64]) -> Option<Vec<f64>> {
+/// Solves the small square system `a x = b` by faer's LU with partial
+/// pivoting; `None` when `a` is singular (a zero pivot) or the solution is
+/// not finite.
+fn solve_square(a: MatRef<'_, f64>, b: &[f64]) -> Option<Vec<f64>> {
     let n = b.len();
-    let mut m = a.to_owned();
-    let mut x = b.to_vec();
-    for col in 0..n {
-        let p = (col..n).max_by(|&i, &j| m[(i, col)].abs().total_cmp(&m[(j, col)].abs()))?;
-        if m[(p, col)].abs() < 1e-300 {
-            return None;
-        }
-        if p != col {
-            for j in 0..n {
-                let t = m[(p, j)];
-                m[(p, j)] = m[(col, j)];
-                m[(col, j)] = t;
-            }
-            x.swap(p, col);
-        }
-        for i in col + 1..n {
-            let f = m[(i, col)] / m[(col, col)];
-            for j in col..n {
-                m[(i, j)] -= f * m[(col, j)];
-            }
-            x[i] -= f * x[col];
-        }
+    let lu = a.partial_piv_lu();
+    let u = lu.U();
+    if (0..n).any(|i| u[(i, i)] == 0.0) {
+        return None;
     }
-    for i in (0..n).rev() {
-        let mut acc = x[i];
-        for j in i + 1..n {
-            acc -= m[(i, j)] * x[j];
-        }
-        x[i] = acc / m[(i, i)];
-    }
-    Some(x)
+    let x = lu.solve(Mat::from_fn(n, 1, |i, _| b[i]));
+    let x: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
+    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 #[cfg(test)]
@@ -465,19 +437,19 @@ mod tests {
     }
 
     #[test]
-    fn dense_solve_handles_pivoting() {
+    fn square_solve_handles_pivoting() {
         let a = Mat::from_fn(3, 3, |i, j| {
             [[0.0, 2.0, 1.0], [1.0, 1.0, 0.0], [3.0, 0.0, 1.0]][i][j]
         });
         let b = [5.0, 3.0, 6.0];
-        let x = solve_dense(a.as_ref(), &b).unwrap();
+        let x = solve_square(a.as_ref(), &b).unwrap();
         for i in 0..3 {
             let ax: f64 = (0..3).map(|j| a[(i, j)] * x[j]).sum();
             assert!((ax - b[i]).abs() < 1e-12, "{x:?}");
         }
         // The first pivot must swap rows (a[0][0] = 0); a singular matrix is refused.
         let singular = Mat::from_fn(2, 2, |i, _| i as f64);
-        assert!(solve_dense(singular.as_ref(), &[1.0, 1.0]).is_none());
+        assert!(solve_square(singular.as_ref(), &[1.0, 1.0]).is_none());
     }
 }
 #[cfg(test)]

@@ -59,7 +59,7 @@ fn qr_in_place(a: faer::MatMut<'_, f64>) {
 /// ```
 /// use faer::Mat;
 /// let a = Mat::from_fn(5, 2, |i, j| (i + 2 * j) as f64);
-/// let r = tricept_ident::linalg::r_factor(a.as_ref());
+/// let r = tricept_numerics::linalg::r_factor(a.as_ref());
 /// // R^T R = A^T A.
 /// let ata = a.transpose() * &a;
 /// let rtr = r.transpose() * &r;
@@ -85,7 +85,7 @@ pub fn r_factor(a: MatRef<'_, f64>) -> Mat<f64> {
 /// use faer::Mat;
 /// // The second column is the largest: it is chosen first.
 /// let a = Mat::from_fn(4, 2, |i, j| if j == 1 { 10.0 * (i as f64 + 1.0) } else { 1.0 });
-/// assert_eq!(tricept_ident::linalg::pivot_order(a.as_ref())[0], 1);
+/// assert_eq!(tricept_numerics::linalg::pivot_order(a.as_ref())[0], 1);
 /// ```
 pub fn pivot_order(a: MatRef<'_, f64>) -> Vec<usize> {
     let (m, n) = a.shape();
@@ -123,7 +123,7 @@ pub fn pivot_order(a: MatRef<'_, f64>) -> Vec<usize> {
 /// ```
 /// use faer::Mat;
 /// let a = Mat::from_fn(3, 2, |i, j| if i == j { (j + 1) as f64 } else { 0.0 });
-/// let (s, _) = tricept_ident::linalg::svd_values_and_vectors(a.as_ref()).unwrap();
+/// let (s, _) = tricept_numerics::linalg::svd_values_and_vectors(a.as_ref()).unwrap();
 /// assert!((s[0] - 2.0).abs() < 1e-14 && (s[1] - 1.0).abs() < 1e-14);
 /// ```
 pub fn svd_values_and_vectors(a: MatRef<'_, f64>) -> Option<(Vec<f64>, Mat<f64>)> {
@@ -165,7 +165,7 @@ pub fn svd_values_and_vectors(a: MatRef<'_, f64>) -> Option<(Vec<f64>, Mat<f64>)
 /// ```
 /// use faer::Mat;
 /// let r = Mat::from_fn(2, 2, |i, j| [[2.0, 1.0], [0.0, 4.0]][i][j]);
-/// let x = tricept_ident::linalg::solve_upper(r.as_ref(), &[4.0, 8.0]);
+/// let x = tricept_numerics::linalg::solve_upper(r.as_ref(), &[4.0, 8.0]);
 /// assert_eq!(x, vec![1.0, 2.0]);
 /// ```
 pub fn solve_upper(r: MatRef<'_, f64>, b: &[f64]) -> Vec<f64> {
@@ -187,7 +187,7 @@ pub fn solve_upper(r: MatRef<'_, f64>, b: &[f64]) -> Vec<f64> {
 /// ```
 /// use faer::Mat;
 /// let r = Mat::from_fn(2, 2, |i, j| [[2.0, 1.0], [0.0, 4.0]][i][j]);
-/// let inv = tricept_ident::linalg::invert_upper(r.as_ref());
+/// let inv = tricept_numerics::linalg::invert_upper(r.as_ref());
 /// assert_eq!(inv[(0, 0)], 0.5);
 /// assert_eq!(inv[(0, 1)], -0.125);
 /// ```
@@ -210,7 +210,7 @@ pub fn invert_upper(r: MatRef<'_, f64>) -> Mat<f64> {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::linalg::TriangularAccumulator;
+/// use tricept_numerics::linalg::TriangularAccumulator;
 /// let mut acc = TriangularAccumulator::new(2);
 /// for (x, y) in [(1.0, 2.0), (2.0, 4.1), (3.0, 5.9)] {
 ///     acc.push_row(&[x, y]);
@@ -234,7 +234,7 @@ impl TriangularAccumulator {
     ///
     /// # Example
     /// ```
-    /// let mut acc = tricept_ident::linalg::TriangularAccumulator::new(2);
+    /// let mut acc = tricept_numerics::linalg::TriangularAccumulator::new(2);
     /// acc.push_row(&[3.0, 4.0]);
     /// assert_eq!(acc.rows(), 1);
     /// assert_eq!(acc.finish().nrows(), 2);
@@ -248,7 +248,7 @@ impl TriangularAccumulator {
     ///
     /// # Example
     /// ```
-    /// use tricept_ident::linalg::TriangularAccumulator;
+    /// use tricept_numerics::linalg::TriangularAccumulator;
     /// // 2000 rows are folded in blocks of 512; the result does not depend on it.
     /// let (mut a, mut b) = (TriangularAccumulator::new(2), TriangularAccumulator::with_rows_hint(2, 3));
     /// for i in 0..2000 {
@@ -274,7 +274,7 @@ impl TriangularAccumulator {
     ///
     /// # Example
     /// ```
-    /// let mut acc = tricept_ident::linalg::TriangularAccumulator::new(1);
+    /// let mut acc = tricept_numerics::linalg::TriangularAccumulator::new(1);
     /// acc.push_row(&[3.0]);
     /// acc.push_row(&[4.0]);
     /// assert!((acc.finish()[(0, 0)].abs() - 5.0).abs() < 1e-12); // sqrt(9 + 16)
@@ -295,7 +295,7 @@ impl TriangularAccumulator {
     ///
     /// # Example
     /// ```
-    /// let mut acc = tricept_ident::linalg::TriangularAccumulator::new(3);
+    /// let mut acc = tricept_numerics::linalg::TriangularAccumulator::new(3);
     /// (0..1000).for_each(|i| acc.push_row(&[1.0, i as f64, 2.0]));
     /// assert_eq!(acc.rows(), 1000);
     /// ```
@@ -327,7 +327,7 @@ impl TriangularAccumulator {
     ///
     /// # Example
     /// ```
-    /// let mut acc = tricept_ident::linalg::TriangularAccumulator::new(2);
+    /// let mut acc = tricept_numerics::linalg::TriangularAccumulator::new(2);
     /// acc.push_row(&[1.0, 2.0]);
     /// acc.push_row(&[0.0, 1.0]);
     /// let r = acc.finish();

@@ -1,12 +1,15 @@
-//! The few distributions the diagnosis needs: chi-square tail probabilities
-//! and quantiles (through the regularised incomplete gamma function), and
-//! the power of a chi-square test against a non-central alternative.
+//! The few distributions the project needs: chi-square tail probabilities
+//! and quantiles (through the regularised incomplete gamma function), the
+//! power of a chi-square test against a non-central alternative, and the
+//! one definition of a sample quantile that every figure uses.
+
+use crate::roots::{Spacing, threshold};
 
 /// `ln Gamma(x)` for `x > 0` (Lanczos, g = 7; about 15 digits).
 ///
 /// # Example
 /// ```
-/// assert!((tricept_ident::stats::ln_gamma(4.0) - 6f64.ln()).abs() < 1e-14);
+/// assert!((tricept_numerics::stats::ln_gamma(4.0) - 6f64.ln()).abs() < 1e-14);
 /// ```
 pub fn ln_gamma(x: f64) -> f64 {
     const G: f64 = 7.0;
@@ -40,7 +43,7 @@ pub fn ln_gamma(x: f64) -> f64 {
 /// # Example
 /// ```
 /// // P(1, x) = 1 - exp(-x).
-/// assert!((tricept_ident::stats::gamma_p(1.0, 2.0) - (1.0 - (-2.0f64).exp())).abs() < 1e-14);
+/// assert!((tricept_numerics::stats::gamma_p(1.0, 2.0) - (1.0 - (-2.0f64).exp())).abs() < 1e-14);
 /// ```
 pub fn gamma_p(a: f64, x: f64) -> f64 {
     if x <= 0.0 {
@@ -97,7 +100,7 @@ fn gamma_q_continued_fraction(a: f64, x: f64) -> f64 {
 ///
 /// # Example
 /// ```
-/// assert!((tricept_ident::stats::chi2_sf(3.841458820694124, 1.0) - 0.05).abs() < 1e-10);
+/// assert!((tricept_numerics::stats::chi2_sf(3.841458820694124, 1.0) - 0.05).abs() < 1e-10);
 /// ```
 pub fn chi2_sf(x: f64, k: f64) -> f64 {
     if x <= 0.0 {
@@ -112,26 +115,21 @@ pub fn chi2_sf(x: f64, k: f64) -> f64 {
     }
 }
 
-/// The `x` with `P(X > x) = tail` for `X ~ chi-square(k)` (bisection).
+/// The `x` with `P(X > x) = tail` for `X ~ chi-square(k)` (bracketing and
+/// bisection, [`crate::roots::threshold`]); `0` for `tail >= 1`.
 ///
 /// # Example
 /// ```
-/// assert!((tricept_ident::stats::chi2_isf(0.05, 1.0) - 3.841458820694124).abs() < 1e-8);
+/// assert!((tricept_numerics::stats::chi2_isf(0.05, 1.0) - 3.841458820694124).abs() < 1e-8);
 /// ```
 pub fn chi2_isf(tail: f64, k: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0, k.max(1.0));
-    while chi2_sf(hi, k) > tail {
-        hi *= 2.0;
+    let found = threshold(0.0, k.max(1.0), f64::MAX, Spacing::Linear, 200, |x| {
+        Ok::<_, std::convert::Infallible>(chi2_sf(x, k) <= tail)
+    });
+    match found {
+        Ok(t) => t.value().unwrap_or(f64::INFINITY),
+        Err(never) => match never {},
     }
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if chi2_sf(mid, k) > tail {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
 }
 
 /// `P(X > x)` for a non-central chi-square with `k` degrees of freedom and
@@ -139,7 +137,7 @@ pub fn chi2_isf(tail: f64, k: f64) -> f64 {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::stats::{chi2_sf, noncentral_chi2_sf};
+/// use tricept_numerics::stats::{chi2_sf, noncentral_chi2_sf};
 /// // No non-centrality: the central distribution.
 /// assert!((noncentral_chi2_sf(5.0, 3.0, 0.0) - chi2_sf(5.0, 3.0)).abs() < 1e-14);
 /// assert!(noncentral_chi2_sf(5.0, 3.0, 4.0) > chi2_sf(5.0, 3.0));
@@ -161,7 +159,7 @@ pub fn noncentral_chi2_sf(x: f64, k: f64, lambda: f64) -> f64 {
 ///
 /// # Example
 /// ```
-/// let p = tricept_ident::stats::chi2_power(17.8, 1.0, 0.01);
+/// let p = tricept_numerics::stats::chi2_power(17.8, 1.0, 0.01);
 /// assert!((p - 0.95).abs() < 0.005);
 /// ```
 pub fn chi2_power(lambda: f64, k: f64, alpha: f64) -> f64 {
@@ -169,27 +167,55 @@ pub fn chi2_power(lambda: f64, k: f64, alpha: f64) -> f64 {
 }
 
 /// The non-centrality at which the level-`alpha` test with `k` degrees of
-/// freedom has power `power`.
+/// freedom has power `power`; `None` when no finite non-centrality reaches
+/// it (a power of 1 or more).
 ///
 /// # Example
 /// ```
-/// let l = tricept_ident::stats::required_noncentrality(1.0, 0.05, 0.8);
+/// use tricept_numerics::stats::required_noncentrality;
+/// let l = required_noncentrality(1.0, 0.05, 0.8).unwrap();
 /// assert!((l - 7.85).abs() < 0.05); // (1.96 + 0.84)^2
+/// assert_eq!(required_noncentrality(1.0, 0.05, 1.0), None);
 /// ```
-pub fn required_noncentrality(k: f64, alpha: f64, power: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0, 1.0);
-    while chi2_power(hi, k, alpha) < power {
-        hi *= 2.0;
+pub fn required_noncentrality(k: f64, alpha: f64, power: f64) -> Option<f64> {
+    if power.is_nan() || power >= 1.0 {
+        return None;
     }
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if chi2_power(mid, k, alpha) < power {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
+    let found = threshold(0.0, 1.0, 1e12, Spacing::Linear, 100, |lambda| {
+        Ok::<_, std::convert::Infallible>(chi2_power(lambda, k, alpha) >= power)
+    });
+    match found {
+        Ok(t) => t.value(),
+        Err(never) => match never {},
     }
-    0.5 * (lo + hi)
+}
+
+/// The `p`-quantile (`0 <= p <= 1`) of an ascending sample, interpolated
+/// linearly between order statistics (Hyndman and Fan's type 7, the
+/// default of R and NumPy); NaN for an empty sample. Every percentile the
+/// project reports uses it.
+///
+/// # Example
+/// ```
+/// use tricept_numerics::stats::quantile;
+/// let sorted = [1.0, 2.0, 3.0, 4.0];
+/// assert_eq!(quantile(&sorted, 0.5), 2.5);
+/// assert_eq!(quantile(&sorted, 0.0), 1.0);
+/// assert_eq!(quantile(&sorted, 1.0), 4.0);
+/// assert!(quantile(&[], 0.5).is_nan());
+/// ```
+pub fn quantile(sorted: &[f64], p: f64) -> f64 {
+    let n = sorted.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    let x = p.clamp(0.0, 1.0) * (n - 1) as f64;
+    let (i, f) = (x.floor() as usize, x.fract());
+    if i + 1 < n {
+        sorted[i] * (1.0 - f) + sorted[i + 1] * f
+    } else {
+        sorted[n - 1]
+    }
 }
 
 #[cfg(test)]
@@ -240,8 +266,10 @@ mod tests {
     fn power_grows_with_noncentrality() {
         assert!((chi2_power(0.0, 2.0, 0.01) - 0.01).abs() < 2e-3);
         // One degree of freedom: the classic (z_{a/2} + z_b)^2 = (2.576 + 1.645)^2 = 17.8.
-        let l = required_noncentrality(1.0, 0.01, 0.95);
+        let l = required_noncentrality(1.0, 0.01, 0.95).unwrap();
         assert!((l - 17.81).abs() < 0.05, "{l}");
-        assert!(required_noncentrality(3.0, 0.01, 0.95) > l);
+        assert!(required_noncentrality(3.0, 0.01, 0.95).unwrap() > l);
+        // A power of one is out of reach (the search used to double forever).
+        assert_eq!(required_noncentrality(1.0, 0.01, 1.0), None);
     }
 }

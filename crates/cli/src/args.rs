@@ -1,0 +1,244 @@
+//! Arguments and loaders shared by several verbs: the machine and its
+//! sensor noise, the parameter set, pose sets, measured data, true errors
+//! and effects of simulated machines, progress display.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use nalgebra::Vector3;
+use tricept_data::Dataset;
+use tricept_kinematics::units::RAD_PER_ARCSEC;
+use tricept_kinematics::{KinematicsError, Machine, MachineDescription, PoseSet, PoseSetError};
+use tricept_model::ParameterSet;
+use tricept_plant::Effect;
+
+use crate::cli_error::CliError;
+
+/// Options shared by every verb that works on a machine.
+#[derive(Debug, Args, Clone)]
+pub struct MachineArgs {
+    /// Machine description (JSON); default: the paper's Table 1 machine.
+    #[arg(long, value_name = "FILE")]
+    pub machine: Option<PathBuf>,
+    /// Print machine-readable JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Sensor-noise overrides (default: the machine description's).
+#[derive(Debug, Args, Clone, Default)]
+pub struct NoiseArgs {
+    /// Encoder noise of one reading, arcsec.
+    #[arg(long, value_name = "ARCSEC", allow_hyphen_values = true)]
+    pub angle_noise_arcsec: Option<f64>,
+    /// Linear-scale noise of one reading, um.
+    #[arg(long, value_name = "UM", allow_hyphen_values = true)]
+    pub length_noise_um: Option<f64>,
+    /// Readings averaged into one logged value.
+    #[arg(long, value_name = "N")]
+    pub readings_per_pose: Option<u32>,
+}
+
+/// The parameter set to identify.
+#[derive(Debug, Args, Clone)]
+pub struct ParamArgs {
+    /// Parameter set: `paper15` (the paper's 15, under its frame
+    /// conventions) or `full21` (all joint and length errors; reports the
+    /// rigid-body gauges as unidentifiable).
+    #[arg(long, default_value = "paper15", value_name = "SET")]
+    pub params: String,
+}
+
+impl ParamArgs {
+    /// The parameter set named by `--params`.
+    pub fn set(&self) -> Result<ParameterSet, CliError> {
+        ParameterSet::by_label(&self.params).map_err(|e| CliError::input(format!("--params: {e}")))
+    }
+}
+
+/// How to fit.
+#[derive(Debug, Args, Clone, Default)]
+pub struct FitArgs {
+    /// Keep every pose: do not reject gross reading errors (by default,
+    /// poses beyond the Bonferroni-corrected 0.1 % quantile of the
+    /// standardised residuals are rejected and reported).
+    #[arg(long)]
+    pub no_robust: bool,
+}
+
+/// Loads the machine named by `--machine`, or the embedded default.
+pub fn load_machine(args: &MachineArgs) -> Result<Machine, CliError> {
+    let description = match &args.machine {
+        None => MachineDescription::paper(),
+        Some(path) => MachineDescription::from_file(path)
+            .map_err(|e| CliError::description(&path.display().to_string(), &e))?,
+    };
+    description
+        .build()
+        .map_err(|e| CliError::description("machine", &e))
+}
+
+/// Loads the machine and applies the noise overrides.
+pub fn machine_with_noise(args: &MachineArgs, noise: &NoiseArgs) -> Result<Machine, CliError> {
+    let mut m = load_machine(args)?;
+    let check = |flag: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(CliError::input(format!(
+                "{flag}: must be a positive number, got {v}"
+            )))
+        }
+    };
+    if let Some(a) = noise.angle_noise_arcsec {
+        m.sensors.angle_rad = check("--angle-noise-arcsec", a)? * RAD_PER_ARCSEC;
+    }
+    if let Some(l) = noise.length_noise_um {
+        m.sensors.length_mm = check("--length-noise-um", l)? * 1e-3;
+    }
+    if let Some(k) = noise.readings_per_pose {
+        if k == 0 {
+            return Err(CliError::input("--readings-per-pose: must be at least 1"));
+        }
+        m.sensors.readings_per_pose = k;
+    }
+    Ok(m)
+}
+
+/// Reads a measured-data file; every problem is an input error naming
+/// file, line and column.
+pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, CliError> {
+    let file = path.display().to_string();
+    let f = std::fs::File::open(path).map_err(|e| CliError::input(format!("{file}: {e}")))?;
+    // A progress bar over the bytes read (drawn only on a terminal).
+    let size = f.metadata().map(|m| m.len()).unwrap_or(0);
+    let bar = progress_bar(size, "reading");
+    let data = tricept_data::read_from(bar.wrap_read(std::io::BufReader::new(f)), &file)
+        .map_err(|e| CliError::input(e.to_string()))?;
+    bar.finish_and_clear();
+    // Commands the machine cannot take are input errors too, found here
+    // with their line rather than deep inside the solver.
+    for p in &data.poses {
+        if let Err(e) = machine.check_commands(&p.commands_mm) {
+            let message = match e {
+                KinematicsError::OutOfStroke {
+                    leg,
+                    length_mm,
+                    min_mm,
+                    max_mm,
+                } => format!(
+                    "{}: line {}, column `q{leg}`: command {length_mm} mm is outside the leg stroke [{min_mm}, {max_mm}] mm",
+                    data.source, p.line
+                ),
+                e => format!("{}: line {}: {e}", data.source, p.line),
+            };
+            return Err(CliError::input(message));
+        }
+    }
+    Ok(data)
+}
+
+/// The target points of a `--poses` spec (a generated set or a CSV file
+/// of `x,y,z`); every problem is an input error.
+pub fn pose_targets(spec: &str, machine: &Machine) -> Result<Vec<Vector3<f64>>, CliError> {
+    let set: PoseSet = spec
+        .parse()
+        .map_err(|e: PoseSetError| CliError::input(e.to_string()))?;
+    match set.generate(&machine.workspace) {
+        Some(points) => Ok(points),
+        None => Ok(tricept_data::read_targets(Path::new(spec))
+            .map_err(|e| CliError::input(e.to_string()))?
+            .into_iter()
+            .map(Vector3::from)
+            .collect()),
+    }
+}
+
+/// A progress bar on stderr; invisible when stderr is not a terminal or for
+/// small jobs.
+pub fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
+    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    if len < 20_000_000 {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {bytes}/{total_bytes} {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_message(what.to_string());
+    bar
+}
+
+/// A spinner on stderr while a long step runs (terminal only).
+pub fn spinner(what: String, poses: usize) -> indicatif::ProgressBar {
+    use indicatif::{ProgressBar, ProgressDrawTarget};
+    if poses < 50_000 {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    bar.set_message(what);
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
+}
+
+/// Parses `table2`, `zero`, `random:MAG[,SEED]` or a JSON file of
+/// parameter values.
+pub fn parse_errors(spec: &str, set: &ParameterSet) -> Result<Vec<f64>, CliError> {
+    match spec {
+        "table2" => Ok(set.table2()),
+        "zero" => Ok(vec![0.0; set.len()]),
+        s if s.starts_with("random:") => {
+            let parts: Vec<&str> = s["random:".len()..].split(',').collect();
+            let mag: f64 = parts[0]
+                .parse()
+                .ok()
+                .filter(|v: &f64| v.is_finite() && *v >= 0.0)
+                .ok_or_else(|| {
+                    CliError::input(format!("errors `{s}`: expected random:MAG_MM[,SEED]"))
+                })?;
+            let seed: u64 = match parts.get(1) {
+                Some(t) => t.parse().map_err(|_| {
+                    CliError::input(format!("errors `{s}`: SEED must be a whole number"))
+                })?,
+                None => 0,
+            };
+            Ok(tricept_plant::random_errors(set.len(), mag, seed))
+        }
+        path => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| CliError::input(format!("{path}: {e}")))?;
+            set.parse_values(&text)
+                .map_err(|e| CliError::input(format!("{path}: {e}")))
+        }
+    }
+}
+
+/// Parses `--effect` values: JSON objects (or arrays of them), inline or
+/// from `@FILE`.
+pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, CliError> {
+    let mut out = Vec::new();
+    for spec in specs {
+        let (text, origin) = match spec.strip_prefix('@') {
+            Some(path) => (
+                std::fs::read_to_string(path)
+                    .map_err(|e| CliError::input(format!("{path}: {e}")))?,
+                path.to_string(),
+            ),
+            None => (spec.clone(), "--effect".to_string()),
+        };
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| CliError::input(format!("{origin}: {e}")))?;
+        let items = match value {
+            serde_json::Value::Array(a) => a,
+            v => vec![v],
+        };
+        for item in items {
+            out.push(
+                serde_json::from_value(item)
+                    .map_err(|e| CliError::input(format!("{origin}: {e}")))?,
+            );
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,192 @@
+//! The structure left in residuals: correlations of each reading channel
+//! with every regressor the data offer (platform position, joints, leg
+//! commands, pose order, time, temperature, approach directions), and the
+//! residual plots that show a cause before and after it is modelled.
+
+use tricept_data::Dataset;
+use tricept_kinematics::units::RAD_PER_ARCSEC;
+use tricept_kinematics::{Machine, UpJoints};
+use tricept_model::effects::EffectName;
+use tricept_numerics::stats::chi2_sf;
+
+use crate::report::{ResidualPlot, Structure};
+use crate::run::DiagnoseOptions;
+use crate::select::{Fit, residuals_of};
+
+/// Regressors of every pose (name, value per pose).
+fn regressors(nominal: &Machine, data: &Dataset) -> Vec<(String, Vec<f64>)> {
+    let n = data.poses.len();
+    let mut out: Vec<(String, Vec<f64>)> = Vec::new();
+    let fk: Vec<Option<(UpJoints, nalgebra::Vector3<f64>)>> = data
+        .poses
+        .iter()
+        .map(|p| {
+            nominal
+                .forward(&p.commands_mm)
+                .ok()
+                .map(|f| (f.up, f.position_mm))
+        })
+        .collect();
+    type Solved = (UpJoints, nalgebra::Vector3<f64>);
+    let get = |f: &dyn Fn(&Solved) -> f64| -> Vec<f64> {
+        fk.iter().map(|v| v.as_ref().map_or(f64::NAN, f)).collect()
+    };
+    out.push(("x_mm".into(), get(&|v| v.1.x)));
+    out.push(("y_mm".into(), get(&|v| v.1.y)));
+    out.push(("z_mm".into(), get(&|v| v.1.z)));
+    out.push(("phi_rad".into(), get(&|v| v.0.phi_rad)));
+    out.push(("theta_rad".into(), get(&|v| v.0.theta_rad)));
+    out.push(("q4_mm".into(), get(&|v| v.0.q4_mm)));
+    for i in 0..3 {
+        out.push((
+            format!("q{}_mm", i + 1),
+            data.poses.iter().map(|p| p.commands_mm[i]).collect(),
+        ));
+    }
+    out.push(("pose_index".into(), (0..n).map(|j| j as f64).collect()));
+    if data.poses.iter().all(|p| p.time_s.is_some()) {
+        out.push((
+            "time_s".into(),
+            data.poses.iter().map(|p| p.time_s.unwrap_or(0.0)).collect(),
+        ));
+    }
+    if data.poses.iter().all(|p| p.temp_c.is_some()) {
+        out.push((
+            "temp_c".into(),
+            data.poses.iter().map(|p| p.temp_c.unwrap_or(0.0)).collect(),
+        ));
+    }
+    if data.poses.iter().all(|p| p.approach.is_some()) {
+        for i in 0..3 {
+            out.push((
+                format!("dir{}", i + 1),
+                data.poses
+                    .iter()
+                    .map(|p| f64::from(p.approach.map_or(0, |a| a[i])))
+                    .collect(),
+            ));
+        }
+    }
+    out
+}
+
+fn correlation(x: &[f64], y: &[f64]) -> Option<f64> {
+    let pairs: Vec<(f64, f64)> = x
+        .iter()
+        .zip(y)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .map(|(a, b)| (*a, *b))
+        .collect();
+    let n = pairs.len() as f64;
+    if n < 4.0 {
+        return None;
+    }
+    let (mx, my) = pairs
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
+    for (x, y) in &pairs {
+        sxy += (x - mx) * (y - my);
+        sxx += (x - mx) * (x - mx);
+        syy += (y - my) * (y - my);
+    }
+    (sxx > 0.0 && syy > 0.0).then(|| sxy / (sxx * syy).sqrt())
+}
+
+pub(crate) fn structure(
+    nominal: &Machine,
+    data: &Dataset,
+    residuals: &[Option<[f64; 3]>],
+) -> Vec<Structure> {
+    let regs = regressors(nominal, data);
+    let n = data.poses.len() as f64;
+    let mut out = Vec::new();
+    for (c, channel) in ["phi", "theta", "s"].iter().enumerate() {
+        let y: Vec<f64> = residuals
+            .iter()
+            .map(|r| r.map_or(f64::NAN, |r| r[c]))
+            .collect();
+        for (name, x) in &regs {
+            if let Some(r) = correlation(x, &y) {
+                let z = r.clamp(-0.999_999, 0.999_999).atanh() * (n - 3.0).max(1.0).sqrt();
+                out.push(Structure {
+                    regressor: name.clone(),
+                    channel,
+                    correlation: r,
+                    p_value: chi2_sf(z * z, 1.0),
+                });
+            }
+        }
+    }
+    out.sort_by(|a, b| a.p_value.total_cmp(&b.p_value));
+    out.truncate(6);
+    out
+}
+
+/// Residual plot of `effect`: leg-length residuals (`J1` times the joint
+/// residuals, um) against the leg's regressor for leg effects; reading
+/// residuals against the exposing joint value otherwise.
+pub(crate) fn residual_plot(
+    effect: EffectName,
+    nominal: &Machine,
+    data: &Dataset,
+    geo: &Fit,
+    fin: &Fit,
+    options: &DiagnoseOptions,
+) -> Option<ResidualPlot> {
+    let series = |f: &Fit| -> Vec<(f64, f64)> {
+        let res = residuals_of(f, &data.poses, &options.sigma);
+        data.poses
+            .iter()
+            .zip(res)
+            .filter_map(|(p, r)| {
+                let r = r?;
+                let joint = [0, 1, 2].map(|c| r[c] * options.sigma[c]);
+                let fk = nominal.forward(&p.commands_mm).ok()?;
+                let leg = nominal.legs_at(&fk.up).j1() * nalgebra::Vector3::from(joint);
+                let x_y = match effect {
+                    EffectName::LegLead => (p.commands_mm[0], leg[0] * 1e3),
+                    EffectName::Backlash => (
+                        f64::from(p.approach?[0]) + 0.02 * (p.line % 7) as f64,
+                        leg[0] * 1e3,
+                    ),
+                    EffectName::Thermal => (p.temp_c?, leg.sum() / 3.0 * 1e3),
+                    EffectName::Compliance => (
+                        fk.up.theta_rad.hypot(fk.up.phi_rad).to_degrees(),
+                        leg.sum() / 3.0 * 1e3,
+                    ),
+                    EffectName::ScaleGain => (fk.up.q4_mm, joint[2] * 1e3),
+                    EffectName::EncoderEccentricity => {
+                        (fk.up.phi_rad.to_degrees(), joint[0] / RAD_PER_ARCSEC)
+                    }
+                    EffectName::UjointAxes => {
+                        (fk.up.theta_rad.to_degrees(), joint[0] / RAD_PER_ARCSEC)
+                    }
+                    EffectName::TubeTwist => (fk.up.q4_mm, leg[0] * 1e3),
+                    EffectName::Outliers => {
+                        (p.line as f64, r.iter().fold(0.0f64, |a, v| a.max(v.abs())))
+                    }
+                };
+                Some(x_y)
+            })
+            .collect()
+    };
+    let (x_label, y_label) = match effect {
+        EffectName::LegLead => ("leg 1 command (mm)", "leg 1 length residual (um)"),
+        EffectName::Backlash => ("leg 1 approach direction", "leg 1 length residual (um)"),
+        EffectName::Thermal => ("temperature (°C)", "mean leg length residual (um)"),
+        EffectName::Compliance => ("tilt of the UP limb (deg)", "mean leg length residual (um)"),
+        EffectName::ScaleGain => ("q4 (mm)", "scale residual (um)"),
+        EffectName::EncoderEccentricity => ("phi (deg)", "phi residual (arcsec)"),
+        EffectName::UjointAxes => ("theta (deg)", "phi residual (arcsec)"),
+        EffectName::TubeTwist => ("q4 (mm)", "leg 1 length residual (um)"),
+        EffectName::Outliers => ("line of the data file", "largest |residual| (sigma)"),
+    };
+    Some(ResidualPlot {
+        effect,
+        x_label: x_label.into(),
+        y_label: y_label.into(),
+        before: series(geo),
+        after: series(fin),
+    })
+}
