@@ -1,0 +1,399 @@
+//! The line and record machinery shared by every CSV reader of the crate
+//! (measured data in `read.rs`, target lists in `targets.rs`), so that both
+//! read the same format the same way and report problems with the same
+//! messages.
+//!
+//! [`Records`] turns bytes into records: lines split on `\n`, a UTF-8
+//! byte-order mark at the start of the file stripped, blank lines and `#`
+//! comments skipped (they still count, so line numbers are exact and
+//! 1-based), each remaining line checked to be UTF-8 and split on commas
+//! (the format has no quoting: every field is a number or a column name),
+//! fields trimmed. [`Header`] takes the first record as the column names,
+//! locates the columns a reader needs, checks that each row has as many
+//! fields, and parses fields as finite numbers. Files written with `;` as
+//! separator or with decimal commas are recognised and reported as such.
+
+use std::io::{BufRead, BufReader, Read};
+use std::path::Path;
+
+use crate::DataError;
+
+/// The UTF-8 encoding of U+FEFF, which some editors and spreadsheets write at
+/// the start of a "UTF-8" file.
+const BYTE_ORDER_MARK: &[u8] = b"\xEF\xBB\xBF";
+
+/// Opens `path` for reading; the error names the file.
+pub(crate) fn open(path: &Path) -> Result<(std::fs::File, String), DataError> {
+    let file = path.display().to_string();
+    match std::fs::File::open(path) {
+        Ok(f) => Ok((f, file)),
+        Err(source) => Err(DataError::Io { file, source }),
+    }
+}
+
+/// One line that is neither blank nor a comment.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Record {
+    /// Line in the file, 1-based (comments and blank lines count).
+    pub line: u64,
+    /// The comma-separated fields, trimmed.
+    pub fields: Vec<String>,
+}
+
+/// The records of a CSV source, in file order. Stop at the first error: the
+/// line after an unreadable one is not a meaningful place to go on from.
+pub(crate) struct Records<'f, R> {
+    reader: BufReader<R>,
+    file: &'f str,
+    buf: Vec<u8>,
+    line: u64,
+}
+
+impl<'f, R: Read> Records<'f, R> {
+    /// Records of `reader`; `file` names it in errors.
+    pub fn new(reader: R, file: &'f str) -> Self {
+        Records {
+            reader: BufReader::new(reader),
+            file,
+            buf: Vec::new(),
+            line: 0,
+        }
+    }
+
+    fn next_record(&mut self) -> Result<Option<Record>, DataError> {
+        loop {
+            self.buf.clear();
+            let n = self
+                .reader
+                .read_until(b'\n', &mut self.buf)
+                .map_err(|source| DataError::Io {
+                    file: self.file.to_string(),
+                    source,
+                })?;
+            if n == 0 {
+                return Ok(None);
+            }
+            self.line += 1;
+            let mut bytes = self.buf.as_slice();
+            if self.line == 1 {
+                bytes = bytes.strip_prefix(BYTE_ORDER_MARK).unwrap_or(bytes);
+            }
+            let trimmed = bytes.trim_ascii();
+            if trimmed.is_empty() || trimmed.starts_with(b"#") {
+                continue;
+            }
+            let text = std::str::from_utf8(trimmed).map_err(|_| DataError::NotText {
+                file: self.file.to_string(),
+                line: self.line,
+                message: "not valid UTF-8 text".into(),
+            })?;
+            return Ok(Some(Record {
+                line: self.line,
+                fields: text.split(',').map(|f| f.trim().to_string()).collect(),
+            }));
+        }
+    }
+}
+
+impl<R: Read> Iterator for Records<'_, R> {
+    type Item = Result<Record, DataError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        self.next_record().transpose()
+    }
+}
+
+/// The header of a CSV source: the column names and where they stand.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Header {
+    /// File name, for errors.
+    pub file: String,
+    /// Line of the header.
+    pub line: u64,
+    /// Column names, in file order.
+    pub names: Vec<String>,
+}
+
+impl Header {
+    /// Reads the first record of `records` as the header. Refuses an empty
+    /// file (`expected` says which columns the header should have), a
+    /// header separated by `;` (looking at the first row to tell a
+    /// spreadsheet export with decimal commas), and repeated names.
+    pub fn read<R: Read>(
+        records: &mut Records<'_, R>,
+        expected: &str,
+    ) -> Result<Header, DataError> {
+        let file = records.file.to_string();
+        let Some(record) = records.next().transpose()? else {
+            return Err(DataError::Empty {
+                file,
+                expected: expected.into(),
+            });
+        };
+        if is_semicolon_separated(&record.fields) {
+            // A spreadsheet's export also writes decimal commas: say so, on
+            // the first row, if that is the case.
+            let first_row = records.next().and_then(Result::ok);
+            return Err(match first_row.map(|row| semicolon_problem(&file, &row)) {
+                Some(e @ DataError::SemicolonsAndDecimalCommas { .. }) => e,
+                _ => DataError::SemicolonSeparated {
+                    file,
+                    line: record.line,
+                },
+            });
+        }
+        let names = record.fields;
+        for (i, n) in names.iter().enumerate() {
+            if !n.is_empty() && names[..i].contains(n) {
+                return Err(DataError::DuplicateColumn {
+                    file,
+                    line: record.line,
+                    column: n.clone(),
+                });
+            }
+        }
+        Ok(Header {
+            file,
+            line: record.line,
+            names,
+        })
+    }
+
+    /// Position of the column `name`, if the header has it.
+    pub fn find(&self, name: &str) -> Option<usize> {
+        self.names.iter().position(|n| n == name)
+    }
+
+    /// Positions of the columns `wanted`. A missing one is an error whose
+    /// hint names a header name that is close to it and is not one of the
+    /// reader's `known` columns (a misspelling).
+    pub fn locate<const N: usize>(
+        &self,
+        wanted: [&str; N],
+        known: &[&str],
+    ) -> Result<[usize; N], DataError> {
+        let mut idx = [0; N];
+        for (k, name) in wanted.iter().enumerate() {
+            idx[k] = self.find(name).ok_or_else(|| DataError::MissingColumn {
+                file: self.file.clone(),
+                line: self.line,
+                column: name.to_string(),
+                hint: closest_unknown(&self.names, name, known)
+                    .map(|n| format!(", found `{n}` (misspelt?)"))
+                    .unwrap_or_default(),
+            })?;
+        }
+        Ok(idx)
+    }
+
+    /// Checks that `record` has as many fields as the header; a row that
+    /// does not is reported as `;`-separated or as holding a decimal comma
+    /// when it looks like one.
+    pub fn check(&self, record: &Record) -> Result<(), DataError> {
+        if record.fields.len() == self.names.len() {
+            return Ok(());
+        }
+        Err(self
+            .separator_problem(record)
+            .unwrap_or_else(|| DataError::FieldCount {
+                file: self.file.clone(),
+                line: record.line,
+                expected: self.names.len(),
+                found: record.fields.len(),
+            }))
+    }
+
+    /// Field `idx` of `record` (which passed [`Header::check`]) as a finite
+    /// number.
+    pub fn number(&self, record: &Record, idx: usize) -> Result<f64, DataError> {
+        let text = record.fields[idx].as_str();
+        if text.is_empty() {
+            return Err(self.bad_value(record, idx, "empty field"));
+        }
+        match text.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            Ok(_) => Err(self.bad_value(record, idx, "not a finite number")),
+            Err(_) if text.contains(';') => Err(semicolon_problem(&self.file, record)),
+            Err(_) => Err(self.bad_value(record, idx, "not a number")),
+        }
+    }
+
+    /// The error for field `idx` of `record`: `reason` says what is wrong.
+    pub fn bad_value(&self, record: &Record, idx: usize, reason: impl Into<String>) -> DataError {
+        DataError::BadValue {
+            file: self.file.clone(),
+            line: record.line,
+            column: self.names[idx].clone(),
+            value: record.fields[idx].clone(),
+            reason: reason.into(),
+        }
+    }
+
+    /// Why a row with the wrong number of fields has it, when the cause is
+    /// recognisable: `;` as separator, or a decimal comma splitting a number
+    /// in two (more fields than the header).
+    fn separator_problem(&self, record: &Record) -> Option<DataError> {
+        if record.fields.iter().any(|f| f.contains(';')) {
+            return Some(semicolon_problem(&self.file, record));
+        }
+        if record.fields.len() <= self.names.len() {
+            return None;
+        }
+        let mut pairs = record
+            .fields
+            .windows(2)
+            .filter(|w| is_decimal_comma_number(&w[0], &w[1]));
+        let first = pairs.next()?;
+        // Name the number only when no other pair could be it.
+        let value = match pairs.next() {
+            None => Some(format!("{},{}", first[0], first[1])),
+            Some(_) => None,
+        };
+        Some(DataError::DecimalComma {
+            file: self.file.clone(),
+            line: record.line,
+            expected: self.names.len(),
+            found: record.fields.len(),
+            value,
+        })
+    }
+}
+
+/// Whether a header's comma-split fields hold more `;` than `,`: a header
+/// separated by `;`. (Only for the header: a `;`-separated row with decimal
+/// commas may hold as many `,` as `;`.)
+fn is_semicolon_separated(fields: &[String]) -> bool {
+    let semicolons: usize = fields.iter().map(|f| f.matches(';').count()).sum();
+    semicolons >= fields.len()
+}
+
+/// The error for a row separated by `;`: with decimal commas (a
+/// spreadsheet's export in a locale such as German) if a `;`-separated
+/// field reads as a number with a decimal comma.
+fn semicolon_problem(file: &str, record: &Record) -> DataError {
+    let text = record.fields.join(",");
+    let decimal_comma = text.split(';').map(str::trim).find(|f| {
+        f.split_once(',')
+            .is_some_and(|(whole, fraction)| is_decimal_comma_number(whole, fraction))
+    });
+    match decimal_comma {
+        Some(value) => DataError::SemicolonsAndDecimalCommas {
+            file: file.into(),
+            line: record.line,
+            value: value.into(),
+        },
+        None => DataError::SemicolonSeparated {
+            file: file.into(),
+            line: record.line,
+        },
+    }
+}
+
+/// Whether `whole,fraction` reads as one number written with a decimal
+/// comma: `whole` an optionally signed integer, `fraction` digits with an
+/// optional exponent (`796` and `5`, `-0` and `002`, `1` and `5e-3`).
+fn is_decimal_comma_number(whole: &str, fraction: &str) -> bool {
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    let unsigned = whole.strip_prefix(['+', '-']).unwrap_or(whole);
+    let (mantissa, exponent) = match fraction.split_once(['e', 'E']) {
+        Some((m, e)) => (m, Some(e.strip_prefix(['+', '-']).unwrap_or(e))),
+        None => (fraction, None),
+    };
+    digits(unsigned) && digits(mantissa) && exponent.is_none_or(digits)
+}
+
+/// A header name that is not a `known` column and is within edit distance
+/// 2 of `wanted` (case-insensitive).
+fn closest_unknown<'a>(names: &'a [String], wanted: &str, known: &[&str]) -> Option<&'a str> {
+    names
+        .iter()
+        .filter(|n| !known.contains(&n.as_str()))
+        .map(|n| (n, edit_distance(&n.to_lowercase(), wanted)))
+        .filter(|(n, d)| *d <= 2 && *d < n.len().max(wanted.len()))
+        .min_by_key(|(_, d)| *d)
+        .map(|(n, _)| n.as_str())
+}
+
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            let sub = prev[j] + usize::from(ca != *cb);
+            cur[j + 1] = sub.min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn records(text: &[u8]) -> Vec<(u64, Vec<String>)> {
+        Records::new(text, "t.csv")
+            .map(|r| r.map(|r| (r.line, r.fields)))
+            .collect::<Result<_, _>>()
+            .unwrap()
+    }
+
+    #[test]
+    fn records_skip_comments_and_blanks_but_count_them() {
+        let r = records(b"# c\n\n a , b \n  \n#x\n1,2\r\n3\n");
+        assert_eq!(
+            r,
+            vec![
+                (3, vec!["a".to_string(), "b".into()]),
+                (6, vec!["1".into(), "2".into()]),
+                (7, vec!["3".into()]),
+            ]
+        );
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_stripped_at_the_start_only() {
+        let r = records(b"\xEF\xBB\xBF# comment\nx,y\n");
+        assert_eq!(r, vec![(2, vec!["x".to_string(), "y".into()])]);
+        let r = records(b"\xEF\xBB\xBFx,y\n");
+        assert_eq!(r[0].1[0], "x");
+        // Further in, U+FEFF is text like any other (and not a column name).
+        let r = records(b"x,y\n\xEF\xBB\xBFx,y\n");
+        assert_eq!(r[1].1[0], "\u{feff}x");
+    }
+
+    #[test]
+    fn not_utf8_names_the_line() {
+        let e = Records::new(&b"# ok\nx,\xff\n"[..], "t.csv")
+            .next()
+            .unwrap()
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "t.csv: line 2: not valid UTF-8 text");
+    }
+
+    #[test]
+    fn decimal_comma_numbers() {
+        for (w, f) in [("796", "5"), ("-0", "002"), ("+1", "5e-3"), ("1", "5E7")] {
+            assert!(is_decimal_comma_number(w, f), "{w},{f}");
+        }
+        for (w, f) in [
+            ("", "5"),
+            ("1", ""),
+            ("1.5", "2"),
+            ("a", "1"),
+            ("1", "-2"),
+            ("1", "5e"),
+        ] {
+            assert!(!is_decimal_comma_number(w, f), "{w},{f}");
+        }
+    }
+
+    #[test]
+    fn edit_distance_counts_edits() {
+        assert_eq!(edit_distance("theat", "theta"), 2);
+        assert_eq!(edit_distance("phi", "phi"), 0);
+        assert_eq!(edit_distance("", "s"), 1);
+    }
+}
