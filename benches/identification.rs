@@ -1,6 +1,6 @@
 //! Identification benchmarks: the full nonlinear identification (exact FK,
 //! analytic Jacobian, TSQR + rank decision + Gauss-Newton) of Table 2 from
-//! 75 and 1000 poses. Target (issue 3): 1000 poses in under 1 s.
+//! 75 and 1000 poses. Target: 1000 poses in under 1 s.
 
 use std::hint::black_box;
 

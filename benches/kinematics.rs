@@ -1,5 +1,5 @@
 //! Kinematics benchmarks: module IK, FK (cold and warm start), 5-DOF
-//! tool-pose IK and the eq. 9 Jacobian. Targets (issue 2): IK < 100 ns,
+//! tool-pose IK and the eq. 9 Jacobian. Targets: IK < 100 ns,
 //! FK < 1 us, tool-pose IK < 5 us, Jacobian < 1 us.
 
 use std::hint::black_box;

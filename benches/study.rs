@@ -1,5 +1,5 @@
 //! Monte Carlo throughput of the encoder study on the default 75-pose grid
-//! at 2 arcsec, both cores. Targets (issue 4): fast path at least 1,000,000
+//! at 2 arcsec, both cores. Targets: fast path at least 1,000,000
 //! trials per second, exact path at least 5,000.
 
 use std::hint::black_box;

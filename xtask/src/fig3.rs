@@ -10,6 +10,7 @@
 use nalgebra::Vector3;
 use tricept_kinematics::{AxisOrder, Machine, MachineDescription, Placement};
 use tricept_model::{MapStats, ParameterSet, actual_machine, volumetric_errors};
+use tricept_numerics::stats::quantile;
 
 /// The paper's before-compensation figures (max, min, mean), mm.
 pub const PAPER_BEFORE_MM: [f64; 3] = [1.179, 0.573, 0.693];
@@ -53,7 +54,7 @@ impl Grid {
 }
 
 impl Conventions {
-    /// The project's defaults (the placement, x-first, z = 750 mm,
+    /// The project's defaults (the documented placement, x-first, z = 750 mm,
     /// 10 mm lattice over the disc).
     pub fn default_for(m: &Machine) -> Conventions {
         Conventions {
@@ -276,7 +277,7 @@ fn one_seed(
 
 fn quantiles(mut v: Vec<f64>) -> (f64, f64, f64) {
     v.sort_by(f64::total_cmp);
-    let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+    let q = |p: f64| quantile(&v, p);
     (q(0.05), q(0.5), q(0.95))
 }
 
@@ -415,7 +416,8 @@ fn predicted_translation_sd(
     let var = if weak_only {
         // Project c on the weakest identifiable direction (in parameter units).
         let v = id
-            .direction(id.rank() - 1)
+            .design()
+            .direction(id.design().rank() - 1)
             .ok_or("no identifiable direction")?;
         let vv: f64 = (0..k)
             .map(|a| (0..k).map(|b| v[a] * v[b] * cov(a, b)).sum::<f64>())

@@ -10,9 +10,12 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nalgebra::Vector3;
 use serde_json::{Value, json};
 use tricept_kinematics::{Machine, MachineDescription, PoseSetError};
-use tricept_study::optimize::{Candidates, Criterion, candidate_grid, exchange};
+use tricept_study::grades::mu_at_grade;
+use tricept_study::optimise::{Candidates, Criterion, candidate_grid, exchange};
 use tricept_study::paper::{PaperSolve, paper_solve};
-use tricept_study::{GradeModel, GradeResult, LinearEstimator, Scenario, StudyError, Summary};
+use tricept_study::{
+    GradeModel, GradeResult, LinearEstimator, Scenario, StudyError, equivalent_grade, recommend,
+};
 
 /// The paper's Fig. 4 anchors.
 const PAPER_MU0: f64 = 0.285;
@@ -91,87 +94,6 @@ fn paper_estimator(
             PaperSolve::Singular { .. } => None,
         })
     }
-}
-
-/// Summary of `mu` over `trials` fast-path trials of `sc` at `grade_arcsec`
-/// (the same trials' noise for every grade: common random numbers).
-fn mu_at_grade(
-    sc: &Scenario,
-    grade_arcsec: f64,
-    trials: usize,
-    seed: u64,
-) -> Result<Summary, String> {
-    let estimator = GradeModel::new(sc, grade_arcsec).map_err(s)?.estimator;
-    let r = estimator.run(sc, trials, seed, 7777, &|_| {});
-    Ok(Summary::of(&r.iter().map(|t| t.mu_mm).collect::<Vec<_>>()))
-}
-
-/// Standard error of a median, from its 95 % interval.
-fn median_standard_error(s: &Summary) -> f64 {
-    (s.median_ci95[1] - s.median_ci95[0]) / (2.0 * 1.96)
-}
-
-/// Grade at which `sc`'s median mu equals `target`, by bisection in log
-/// space between 0.01 and `limit` arcsec. Every evaluation draws the same
-/// trials (common random numbers), so the median is a smooth function of
-/// the grade.
-fn grade_for_mu(
-    sc: &Scenario,
-    target: f64,
-    limit: f64,
-    trials: usize,
-    seed: u64,
-) -> Result<Option<f64>, String> {
-    let f = |g: f64| -> Result<f64, String> { Ok(mu_at_grade(sc, g, trials, seed)?.median) };
-    let (mut lo, mut hi) = (0.01, limit);
-    if f(hi)? < target {
-        return Ok(None);
-    }
-    if f(lo)? > target {
-        return Ok(Some(lo));
-    }
-    for _ in 0..14 {
-        let mid = (lo * hi).sqrt();
-        if f(mid)? < target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    Ok(Some((lo * hi).sqrt()))
-}
-
-/// The grade at which `sc`'s median mu equals the reference median `mu`,
-/// with a 95 % interval: the Monte Carlo standard errors of both medians
-/// (from their order-statistic intervals) combined, and the bisection
-/// repeated at the target moved by 1.96 of them either way.
-fn equivalent_grade(
-    sc: &Scenario,
-    reference: &Summary,
-    trials: usize,
-    seed: u64,
-) -> Result<Option<EquivalentGrade>, String> {
-    let limit = 1e4;
-    let Some(g) = grade_for_mu(sc, reference.median, limit, trials, seed)? else {
-        return Ok(None);
-    };
-    let at_g = mu_at_grade(sc, g, trials, seed)?;
-    let se = median_standard_error(reference).hypot(median_standard_error(&at_g));
-    let lo = grade_for_mu(sc, reference.median - 1.96 * se, limit, trials, seed)?;
-    let hi = grade_for_mu(sc, reference.median + 1.96 * se, limit, trials, seed)?;
-    Ok(Some(EquivalentGrade {
-        grade_arcsec: g,
-        interval95_arcsec: [lo, hi],
-    }))
-}
-
-/// The grade at which a pose set matches a reference median `mu`, with
-/// its 95 % interval (a bound is `None` where no grade below the search
-/// limit reaches it).
-#[derive(Debug, Clone, Copy)]
-struct EquivalentGrade {
-    grade_arcsec: f64,
-    interval95_arcsec: [Option<f64>; 2],
 }
 
 fn table(title: &str, sc: &Scenario, results: &[GradeResult]) {
@@ -344,7 +266,7 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
             res,
         );
         let equivalent = match &reference {
-            Some(mu) => equivalent_grade(sc, mu, 20_000, a.seed)?,
+            Some(mu) => equivalent_grade(sc, mu, 20_000, a.seed).map_err(s)?,
             None => None,
         };
         println!(
@@ -423,8 +345,9 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
     for n in [8usize, 10, 12, 15, 20, 30, 50, 75] {
         let sc =
             Scenario::paper(machine.clone(), machine.workspace.random_poses(n, 3)).map_err(s)?;
-        let mu_at =
-            |g: f64| -> Result<f64, String> { Ok(mu_at_grade(&sc, g, 20_000, a.seed)?.median) };
+        let mu_at = |g: f64| -> Result<f64, String> {
+            Ok(mu_at_grade(&sc, g, 20_000, a.seed).map_err(s)?.median)
+        };
         let (m2, m4) = (mu_at(2.0)?, mu_at(4.0)?);
         let cross =
             tricept_study::crossing_grade(&sc, 0.25, 1e5, 10_000, a.seed, &our_estimator(&sc))
@@ -498,20 +421,9 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// The recommendation rule (see `--target-um`).
-fn recommend(results: &[GradeResult], target_um: f64) -> Option<f64> {
-    results
-        .iter()
-        .filter(|r| r.fast.plane_touched_mean_mm.p95 <= target_um * 1e-3)
-        .map(|r| r.grade_arcsec)
-        .fold(None, |acc: Option<f64>, g| {
-            Some(acc.map_or(g, |x: f64| x.max(g)))
-        })
-}
-
 type Optimised = (
     Criterion,
-    tricept_study::optimize::Selection,
+    tricept_study::optimise::Selection,
     Vec<Vector3<f64>>,
     Scenario,
     Vec<GradeResult>,

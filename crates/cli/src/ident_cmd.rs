@@ -226,8 +226,8 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<(), CliError> {
         id.stats.rms[2] * 1e3,
         id.stats.reduced_chi_square,
         id.stats.dof,
-        id.stats.max_standardized.0,
-        id.stats.max_standardized.1 + 1
+        id.stats.max_standardised.0,
+        id.stats.max_standardised.1 + 1
     );
     print!("{}", id.report.to_text());
     Ok(())

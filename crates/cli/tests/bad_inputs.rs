@@ -451,45 +451,50 @@ fn bad_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
     }
     assert!(cases.len() >= 25, "{} cases", cases.len());
 
+    // Every case runs; every broken expectation is collected, so that one
+    // run shows all of them.
+    let mut failures: Vec<String> = Vec::new();
     for c in &cases {
         for (name, content) in &c.files {
             std::fs::write(dir.join(name), content).unwrap();
         }
         let out = tricept().args(&c.args).current_dir(&dir).output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            !stderr.contains("panicked"),
-            "{}: panicked\n{stderr}",
-            c.name
-        );
-        assert_eq!(
-            out.status.code(),
-            Some(c.code),
-            "{}: exit code; stderr: {stderr}",
-            c.name
-        );
-        for n in &c.needles {
-            assert!(
-                stderr.contains(n),
-                "{}: stderr lacks `{n}`:\n{stderr}",
-                c.name
-            );
+        let mut fail = |what: String| failures.push(format!("{}: {what}\n{stderr}", c.name));
+        if stderr.contains("panicked") {
+            fail("panicked".into());
         }
-        assert!(out.stdout.is_empty(), "{}: printed to stdout", c.name);
+        if out.status.code() != Some(c.code) {
+            fail(format!(
+                "exit code {:?}, expected {}",
+                out.status.code(),
+                c.code
+            ));
+        }
+        for n in &c.needles {
+            if !stderr.contains(n) {
+                fail(format!("stderr lacks `{n}`"));
+            }
+        }
+        if !out.stdout.is_empty() {
+            fail("printed to stdout".into());
+        }
         // clap's usage errors span a few lines; ours are exactly one.
-        if !c
+        let from_clap = c
             .needles
             .iter()
-            .any(|n| ["invalid value", "unrecognized subcommand"].contains(n))
-        {
-            assert_eq!(
-                stderr.trim_end().lines().count(),
-                1,
-                "{}: more than one line:\n{stderr}",
-                c.name
-            );
+            .any(|n| ["invalid value", "unrecognized subcommand"].contains(n));
+        if !from_clap && stderr.trim_end().lines().count() != 1 {
+            fail("not exactly one line on stderr".into());
         }
     }
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases failed:\n\n{}",
+        failures.len(),
+        cases.len(),
+        failures.join("\n")
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -33,7 +33,7 @@ use crate::model::ExtendedModel;
 use crate::report::{Cause, ChannelRms, Diagnosis, Estimate, Evidence, Gain};
 use crate::residuals::{residual_plot, structure};
 use crate::select::{
-    Fit, Selection, estimates, fit, holdout_rms, residuals_of, screen_outliers, select, subset,
+    Fit, Selection, estimates, fit, holdout_rms, residuals_of, screen_outliers, select,
 };
 
 /// Why a diagnosis could not be made.
@@ -113,7 +113,7 @@ pub fn diagnose(
         if (flagged.len() as f64) > options.max_outlier_share * n as f64 {
             flagged.clear();
         }
-        let clean = subset(data, |j| !flagged.contains(&j));
+        let clean = data.subset(|j| !flagged.contains(&j));
         selection = select(&geometric, &clean, options)?;
         let model = ExtendedModel::new(geometric.clone(), &selection.chosen);
         let again = screen_outliers(&model, data, options)?;
@@ -124,7 +124,7 @@ pub fn diagnose(
     }
     let outliers = !flagged.is_empty();
     let is_clean = |j: usize| !flagged.contains(&j);
-    let clean = subset(data, is_clean);
+    let clean = data.subset(is_clean);
     let Selection {
         chosen,
         evidences,

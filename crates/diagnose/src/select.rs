@@ -34,26 +34,15 @@ pub(crate) fn fit(
     Ok(Fit { model, id })
 }
 
-pub(crate) fn subset(data: &Dataset, keep: impl Fn(usize) -> bool) -> Dataset {
-    Dataset {
-        poses: data
-            .poses
-            .iter()
-            .enumerate()
-            .filter(|(j, _)| keep(*j))
-            .map(|(_, p)| *p)
-            .collect(),
-        source: data.source.clone(),
-    }
-}
-
 /// Weighted residuals of `poses` under a fitted model (offsets applied).
 pub(crate) fn residuals_of(
     f: &Fit,
     poses: &[MeasuredPose],
     sigma: &[f64; 3],
 ) -> Vec<Option<[f64; 3]>> {
+    // A fit's estimate always has its model's length.
     residuals_at(&f.model, &f.id.estimate, &f.id.offsets, poses, sigma)
+        .unwrap_or_else(|_| vec![None; poses.len()])
 }
 
 /// K-fold cross-validated RMS of the weighted held-out residuals of
@@ -68,7 +57,7 @@ pub(crate) fn holdout_rms(
     let parts: Vec<Option<(f64, usize)>> = (0..k)
         .into_par_iter()
         .map(|fold| {
-            let train = subset(data, |j| j % k != fold);
+            let train = data.subset(|j| j % k != fold);
             let f = fit(model.clone(), &train, options).ok()?;
             let test: Vec<(usize, MeasuredPose)> = data
                 .poses
@@ -158,7 +147,7 @@ pub(crate) fn select(
         .collect();
     let threshold = options.alpha / available.len().max(1) as f64;
     let readings = (3 * clean.poses.len()) as f64;
-    let bic = |f: &Fit| f.id.stats.chi_square + f.id.rank() as f64 * readings.ln();
+    let bic = |f: &Fit| f.id.stats.chi_square + f.id.design().rank() as f64 * readings.ln();
     let mut current = geo.clone();
     let mut current_rms: Option<f64> = None;
     let mut first_candidates = Vec::new();
@@ -183,7 +172,11 @@ pub(crate) fn select(
         for (c, f) in trials {
             let Some(f) = f else { continue };
             let delta = current.id.stats.chi_square - f.id.stats.chi_square;
-            let k = f.id.rank().saturating_sub(current.id.rank()).max(1);
+            let k =
+                f.id.design()
+                    .rank()
+                    .saturating_sub(current.id.design().rank())
+                    .max(1);
             let p = chi2_sf(delta.max(0.0), k as f64);
             let delta_bic = delta - k as f64 * readings.ln();
             tested.push((
@@ -299,7 +292,12 @@ pub(crate) fn select(
                 let mut ev = evidences[slot].clone();
                 if let Some(w) = without {
                     let delta = w.id.stats.chi_square - current.id.stats.chi_square;
-                    let k = current.id.rank().saturating_sub(w.id.rank()).max(1);
+                    let k = current
+                        .id
+                        .design()
+                        .rank()
+                        .saturating_sub(w.id.design().rank())
+                        .max(1);
                     ev.delta_chi_square = delta;
                     ev.dof = k;
                     ev.p_value = chi2_sf(delta.max(0.0), k as f64);

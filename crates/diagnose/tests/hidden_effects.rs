@@ -3,7 +3,7 @@
 //! For every effect of the vocabulary: 20 seeded datasets, each with random
 //! geometric errors (uniform in ±0.5 mm on the 15 parameters), a random
 //! magnitude drawn from the stated range (which starts at the realistic
-//! magnitude of the issue), and a random pose set. Expectations come from
+//! magnitude of each effect), and a random pose set. Expectations come from
 //! the simulator's inputs only: which effect was hidden and with which
 //! parameters.
 //!

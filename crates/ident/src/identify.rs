@@ -30,7 +30,7 @@ use tricept_kinematics::{Machine, UpJoints};
 
 use crate::error::IdentError;
 use crate::model::ReadingModel;
-use crate::report::IdentifiabilityReport;
+use crate::report::{IdentifiabilityReport, NamedValues};
 use tricept_numerics::linalg::TriangularAccumulator;
 use tricept_numerics::lsq::{DEFAULT_RANK_TOLERANCE, RankDecision, ReducedProblem, Solution};
 
@@ -182,6 +182,32 @@ impl Design {
     pub fn fixed(&self) -> &[usize] {
         &self.decision.fixed
     }
+
+    /// The `i`-th right singular direction of the column-scaled design
+    /// (`0`: the best determined), in parameter units; `None` beyond the
+    /// number of parameters. Directions `rank()..` span what the data
+    /// cannot see; direction `rank() - 1` is the weakest one they can.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{GeometricModel, IdentifyOptions, identify};
+    /// use tricept_kinematics::Machine;
+    /// use tricept_model::ParameterSet;
+    /// let m = Machine::paper();
+    /// let set = ParameterSet::paper15();
+    /// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+    ///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
+    ///     .unwrap();
+    /// let id = identify(&GeometricModel::new(m.clone(), set.clone()), &data, &IdentifyOptions::for_machine(&m)).unwrap();
+    /// // The weakest visible direction moves the three leg lengths together.
+    /// let d = id.design();
+    /// let v = d.direction(d.rank() - 1).unwrap();
+    /// let dq = ["dq1", "dq2", "dq3"].map(|n| v[set.index_of(n).unwrap()]);
+    /// assert!(dq.iter().all(|x| x.signum() == dq[0].signum()));
+    /// ```
+    pub fn direction(&self, i: usize) -> Option<Vec<f64>> {
+        (i < self.decision.column_scale.len()).then(|| self.decision.direction(i))
+    }
 }
 
 impl IdentifyOptions {
@@ -249,7 +275,7 @@ pub struct ResidualStats {
     /// `chi_square / dof`: about 1 when the model and noise levels are right.
     pub reduced_chi_square: f64,
     /// Largest residual in noise standard deviations, and its pose index.
-    pub max_standardized: (f64, usize),
+    pub max_standardised: (f64, usize),
 }
 
 /// The result of [`identify`].
@@ -296,7 +322,7 @@ pub struct Identification {
     /// Whether the iteration met its tolerance.
     pub converged: bool,
     /// The rank decision taken at the start and used throughout.
-    decision: RankDecision,
+    design: Design,
 }
 
 /// One evaluation of the model at fixed parameters over all poses.
@@ -426,7 +452,7 @@ pub fn identify(
 /// let d = design(&model, &[0.0; 15], &data.poses, &options).unwrap();
 /// let start = Start { design: Some(d), ..Start::default() };
 /// let id = identify_from(&model, &data, &options, &start).unwrap();
-/// assert_eq!(id.rank(), 14);
+/// assert_eq!(id.design().rank(), 14);
 /// ```
 pub fn identify_from(
     model: &dyn ReadingModel,
@@ -633,14 +659,14 @@ fn finish(
     let n = residuals.len().max(1) as f64;
     let rms = [0, 1, 2].map(|c| (residuals.iter().map(|r| r[c] * r[c]).sum::<f64>() / n).sqrt());
     let mut chi_square = 0.0;
-    let mut max_standardized = (0.0, 0);
+    let mut max_standardised = (0.0, 0);
     for (j, r) in residuals.iter().enumerate() {
         let w = weights.and_then(|w| w.get(j)).copied().unwrap_or(1.0);
         for c in 0..3 {
             let z = r[c] / options.sigma[c];
             chi_square += (w * z) * (w * z);
-            if z.abs() > max_standardized.0 {
-                max_standardized = (z.abs(), j);
+            if z.abs() > max_standardised.0 {
+                max_standardised = (z.abs(), j);
             }
         }
     }
@@ -652,7 +678,7 @@ fn finish(
         covariance,
         offsets,
         offsets_std_dev,
-        report,
+        report: report.clone(),
         residuals,
         stats: ResidualStats {
             rms,
@@ -663,11 +689,11 @@ fn finish(
             } else {
                 f64::NAN
             },
-            max_standardized,
+            max_standardised,
         },
         iterations,
         converged,
-        decision,
+        design: Design { decision, report },
     }
 }
 
@@ -767,44 +793,10 @@ pub fn identifiability(
 }
 
 impl Identification {
-    /// Numerical rank of the rank decision taken at the start.
-    pub fn rank(&self) -> usize {
-        self.decision.rank
-    }
-
-    /// Indices of the parameters estimated (ascending).
-    pub fn identifiable(&self) -> &[usize] {
-        &self.decision.identifiable
-    }
-
-    /// Indices of the parameters held at their prior (ascending).
-    pub fn fixed(&self) -> &[usize] {
-        &self.decision.fixed
-    }
-
-    /// The `i`-th right singular direction of the column-scaled design
-    /// (`0`: the best determined), in parameter units; `None` beyond the
-    /// number of parameters. Directions `rank()..` span what the data
-    /// cannot see; direction `rank() - 1` is the weakest one they can.
-    ///
-    /// # Example
-    /// ```
-    /// use tricept_ident::{GeometricModel, IdentifyOptions, identify};
-    /// use tricept_kinematics::Machine;
-    /// use tricept_model::ParameterSet;
-    /// let m = Machine::paper();
-    /// let set = ParameterSet::paper15();
-    /// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
-    ///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
-    ///     .unwrap();
-    /// let id = identify(&GeometricModel::new(m.clone(), set.clone()), &data, &IdentifyOptions::for_machine(&m)).unwrap();
-    /// // The weakest visible direction moves the three leg lengths together.
-    /// let v = id.direction(id.rank() - 1).unwrap();
-    /// let dq = ["dq1", "dq2", "dq3"].map(|n| v[set.index_of(n).unwrap()]);
-    /// assert!(dq.iter().all(|x| x.signum() == dq[0].signum()));
-    /// ```
-    pub fn direction(&self, i: usize) -> Option<Vec<f64>> {
-        (i < self.decision.column_scale.len()).then(|| self.decision.direction(i))
+    /// The rank decision taken at the start and kept throughout (rank,
+    /// identifiable and fixed parameters, singular directions).
+    pub fn design(&self) -> &Design {
+        &self.design
     }
 
     /// JSON with the contract keys: every parameter name with its estimate
@@ -836,7 +828,8 @@ impl Identification {
         }
         m.insert(
             "std_dev".into(),
-            crate::report::named_values(&self.names, &self.std_dev),
+            serde_json::to_value(NamedValues::new(&self.names, &self.std_dev))
+                .unwrap_or(Value::Null),
         );
         m.insert(
             "offsets".into(),
@@ -859,8 +852,8 @@ impl Identification {
                 "chi_square": self.stats.chi_square,
                 "dof": self.stats.dof,
                 "reduced_chi_square": self.stats.reduced_chi_square,
-                "max_standardized": self.stats.max_standardized.0,
-                "max_standardized_pose": self.stats.max_standardized.1,
+                "max_standardised": self.stats.max_standardised.0,
+                "max_standardised_pose": self.stats.max_standardised.1,
             }),
         );
         m.insert("iterations".into(), self.iterations.into());

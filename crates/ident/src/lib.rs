@@ -61,7 +61,7 @@ pub use identify::{
     identify, identify_from,
 };
 pub use model::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
-pub use report::{Combination, IdentifiabilityReport, Observability};
+pub use report::{Combination, CorrelatedPair, IdentifiabilityReport, NamedValues, Observability};
 pub use robust::{Rejection, identify_robust, residuals_at, screen_gross_errors};
 
 // What a downstream crate needs besides this crate's own types, so that one

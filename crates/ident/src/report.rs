@@ -108,13 +108,19 @@ impl Observability {
 /// ```
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Combination {
-    /// `(name, coefficient)` pairs, largest coefficient first.
+    /// `(name, coefficient)` pairs, largest coefficient first (in JSON: the
+    /// map `combination`).
+    #[serde(rename = "combination", serialize_with = "terms_as_map")]
     pub terms: Vec<(String, f64)>,
     /// Singular value of the direction (scaled units).
     pub singular_value: f64,
     /// Standard deviation of `sum(coefficient * parameter)` under the
     /// sensor noise, mm (absent for unidentifiable combinations).
     pub std_dev_mm: Option<f64>,
+}
+
+fn terms_as_map<S: serde::Serializer>(terms: &[(String, f64)], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_map(terms.iter().map(|(n, c)| (n, c)))
 }
 
 impl Combination {
@@ -192,6 +198,7 @@ impl Combination {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct IdentifiabilityReport {
     /// Parameter names.
+    #[serde(skip)]
     pub names: Vec<String>,
     /// Number of parameters.
     pub n_params: usize,
@@ -203,11 +210,15 @@ pub struct IdentifiabilityReport {
     pub rank_tolerance: f64,
     /// All singular values, descending (scaled units).
     pub singular_values: Vec<f64>,
-    /// `s_max / s_min` over the identifiable parameters.
+    /// `s_max / s_min` over the identifiable parameters (`null` in JSON
+    /// when infinite).
+    #[serde(serialize_with = "finite_or_null")]
     pub condition_number: f64,
     /// Observability indices over the identifiable parameters.
     pub observability: Observability,
-    /// Combinations the data cannot see (first order), one per fixed parameter.
+    /// Combinations the data cannot see (first order), one per fixed
+    /// parameter (in JSON: `name -> coefficient` maps).
+    #[serde(serialize_with = "terms_only")]
     pub unidentifiable: Vec<Combination>,
     /// Parameters held at their prior by the pivoting rule.
     pub fixed: Vec<String>,
@@ -216,11 +227,67 @@ pub struct IdentifiabilityReport {
     pub weak: Vec<Combination>,
     /// Threshold on `s_i / s_1` for `weak`.
     pub weak_threshold: f64,
-    /// Pairs of identifiable parameters with `|correlation| >= 0.9`.
-    pub correlated_pairs: Vec<(String, String, f64)>,
+    /// Pairs of identifiable parameters with `|correlation| >= 0.9`,
+    /// strongest first.
+    pub correlated_pairs: Vec<CorrelatedPair>,
     /// Predicted standard deviation of each parameter under the sensor
     /// noise, mm (`None` for fixed parameters).
-    pub std_dev_mm: Vec<Option<f64>>,
+    pub std_dev_mm: NamedValues,
+}
+
+/// Two strongly correlated parameters.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CorrelatedPair {
+    /// One parameter.
+    pub a: String,
+    /// The other.
+    pub b: String,
+    /// Their correlation.
+    pub correlation: f64,
+}
+
+/// Optional values by parameter name, in parameter order; a JSON object
+/// `name -> value` (`null` where there is none).
+///
+/// # Example
+/// ```
+/// let v = tricept_ident::NamedValues(vec![("dq1".into(), Some(0.5)), ("dyA3".into(), None)]);
+/// assert_eq!(serde_json::to_string(&v).unwrap(), r#"{"dq1":0.5,"dyA3":null}"#);
+/// assert_eq!(v.get("dq1"), Some(0.5));
+/// ```
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct NamedValues(pub Vec<(String, Option<f64>)>);
+
+impl NamedValues {
+    /// Pairs `names` with `values`.
+    pub fn new(names: &[String], values: &[Option<f64>]) -> NamedValues {
+        NamedValues(names.iter().cloned().zip(values.iter().copied()).collect())
+    }
+
+    /// The value of `name`, if it has one.
+    pub fn get(&self, name: &str) -> Option<f64> {
+        self.0.iter().find(|(n, _)| n == name).and_then(|(_, v)| *v)
+    }
+}
+
+impl Serialize for NamedValues {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_map(self.0.iter().map(|(n, v)| (n, v)))
+    }
+}
+
+/// Combinations as `name -> coefficient` maps.
+fn terms_only<S: serde::Serializer>(v: &[Combination], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_seq(v.iter().map(|c| c.to_map()))
+}
+
+/// `null` for a non-finite number (JSON has no infinity).
+fn finite_or_null<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+    if x.is_finite() {
+        s.serialize_f64(*x)
+    } else {
+        s.serialize_none()
+    }
 }
 
 /// Coefficients below this fraction of the largest are dropped from a
@@ -307,13 +374,17 @@ impl IdentifiabilityReport {
             for &b in &identifiable[ia + 1..] {
                 let r = cov(a, b) / (cov(a, a) * cov(b, b)).sqrt();
                 if r.abs() >= 0.9 {
-                    correlated_pairs.push((names[a].clone(), names[b].clone(), r));
+                    correlated_pairs.push(CorrelatedPair {
+                        a: names[a].clone(),
+                        b: names[b].clone(),
+                        correlation: r,
+                    });
                 }
             }
         }
-        correlated_pairs.sort_by(|x, y| y.2.abs().total_cmp(&x.2.abs()));
+        correlated_pairs.sort_by(|x, y| y.correlation.abs().total_cmp(&x.correlation.abs()));
 
-        let std_dev_mm = (0..k)
+        let std_dev_mm: Vec<Option<f64>> = (0..k)
             .map(|j| {
                 if decision.fixed.contains(&j) {
                     None
@@ -336,7 +407,7 @@ impl IdentifiabilityReport {
             weak,
             weak_threshold,
             correlated_pairs,
-            std_dev_mm,
+            std_dev_mm: NamedValues::new(names, &std_dev_mm),
         }
     }
 
@@ -363,69 +434,7 @@ impl IdentifiabilityReport {
     /// assert_eq!(j["unidentifiable"][0]["dyA3"], 1.0);
     /// ```
     pub fn to_json(&self) -> Value {
-        let mut m = Map::new();
-        m.insert("rank".into(), self.rank.into());
-        m.insert("n_params".into(), self.n_params.into());
-        m.insert("n_poses".into(), self.n_poses.into());
-        m.insert("rank_tolerance".into(), self.rank_tolerance.into());
-        m.insert(
-            "unidentifiable".into(),
-            Value::Array(
-                self.unidentifiable
-                    .iter()
-                    .map(|c| Value::Object(c.to_map()))
-                    .collect(),
-            ),
-        );
-        m.insert(
-            "fixed".into(),
-            Value::Array(self.fixed.iter().map(|s| Value::from(s.clone())).collect()),
-        );
-        m.insert(
-            "singular_values".into(),
-            self.singular_values.clone().into(),
-        );
-        m.insert(
-            "condition_number".into(),
-            finite_or_null(self.condition_number),
-        );
-        m.insert(
-            "observability".into(),
-            serde_json::to_value(self.observability).unwrap_or(Value::Null),
-        );
-        m.insert(
-            "weak".into(),
-            Value::Array(
-                self.weak
-                    .iter()
-                    .map(|c| {
-                        let mut w = Map::new();
-                        w.insert("combination".into(), Value::Object(c.to_map()));
-                        w.insert("singular_value".into(), c.singular_value.into());
-                        w.insert(
-                            "std_dev_mm".into(),
-                            c.std_dev_mm.map_or(Value::Null, Value::from),
-                        );
-                        Value::Object(w)
-                    })
-                    .collect(),
-            ),
-        );
-        m.insert("weak_threshold".into(), self.weak_threshold.into());
-        m.insert(
-            "correlated_pairs".into(),
-            Value::Array(
-                self.correlated_pairs
-                    .iter()
-                    .map(|(a, b, r)| serde_json::json!({"a": a, "b": b, "correlation": r}))
-                    .collect(),
-            ),
-        );
-        m.insert(
-            "std_dev_mm".into(),
-            named_values(&self.names, &self.std_dev_mm),
-        );
-        Value::Object(m)
+        serde_json::to_value(self).unwrap_or(Value::Null)
     }
 
     /// A human-readable summary.
@@ -485,26 +494,18 @@ impl IdentifiabilityReport {
         }
         if !self.correlated_pairs.is_empty() {
             s.push_str("strongly correlated pairs (|r| >= 0.9):\n");
-            for (a, b, r) in &self.correlated_pairs {
-                s.push_str(&format!("  {a} / {b}: {r:+.3}\n"));
+            for p in &self.correlated_pairs {
+                s.push_str(&format!("  {} / {}: {:+.3}\n", p.a, p.b, p.correlation));
             }
         }
         s.push_str("predicted standard deviations (mm):\n");
-        for (n, sd) in self.names.iter().zip(&self.std_dev_mm) {
+        for (n, sd) in &self.std_dev_mm.0 {
             match sd {
                 Some(v) => s.push_str(&format!("  {n:>6} {v:.5}\n")),
                 None => s.push_str(&format!("  {n:>6} fixed\n")),
             }
         }
         s
-    }
-}
-
-fn finite_or_null(x: f64) -> Value {
-    if x.is_finite() {
-        Value::from(x)
-    } else {
-        Value::Null
     }
 }
 
@@ -523,15 +524,4 @@ fn identifiable_singular_values(d: &RankDecision) -> Vec<f64> {
         Some((s, _)) => s.into_iter().filter(|x| *x > 0.0).collect(),
         None => Vec::new(),
     }
-}
-
-/// A JSON object `name -> value`, `null` where there is no value.
-pub(crate) fn named_values(names: &[String], values: &[Option<f64>]) -> Value {
-    Value::Object(
-        names
-            .iter()
-            .zip(values)
-            .map(|(n, v)| (n.clone(), v.map_or(Value::Null, Value::from)))
-            .collect(),
-    )
 }

@@ -52,7 +52,7 @@ pub struct Rejection {
 
 /// Weighted residuals `(y - g(p) - c) / sigma` of `poses` under `model` at
 /// `estimate` with sensor offsets `offsets`; `None` where the pose cannot be
-/// solved.
+/// solved. An `estimate` of the wrong length is an [`IdentError::Invalid`].
 ///
 /// # Example
 /// ```
@@ -66,7 +66,7 @@ pub struct Rejection {
 ///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
 ///     .unwrap();
 /// let id = tricept_ident::identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
-/// let r = tricept_ident::residuals_at(&model, &id.estimate, &id.offsets, &data.poses, &m.sensors.logged_sigma());
+/// let r = tricept_ident::residuals_at(&model, &id.estimate, &id.offsets, &data.poses, &m.sensors.logged_sigma()).unwrap();
 /// // In noise units: of order one.
 /// assert!(r.iter().flatten().all(|v| v.iter().all(|x| x.abs() < 5.0)));
 /// ```
@@ -76,10 +76,17 @@ pub fn residuals_at(
     offsets: &[f64; 3],
     poses: &[MeasuredPose],
     sigma: &[f64; 3],
-) -> Vec<Option<[f64; 3]>> {
+) -> Result<Vec<Option<[f64; 3]>>, IdentError> {
+    if estimate.len() != model.names().len() {
+        return Err(IdentError::Invalid(format!(
+            "{} parameter values for {} parameters",
+            estimate.len(),
+            model.names().len()
+        )));
+    }
     let predictor = model.at(estimate);
     let mut jac = vec![0.0; 3 * estimate.len()];
-    poses
+    Ok(poses
         .iter()
         .map(|p| {
             let mut seed: Option<UpJoints> = None;
@@ -88,20 +95,12 @@ pub fn residuals_at(
                 [0, 1, 2].map(|c| (y[c] - g[c] - offsets[c]) / sigma[c])
             })
         })
-        .collect()
+        .collect())
 }
 
-fn subset(data: &Dataset, rejected: &[Rejection]) -> Dataset {
-    Dataset {
-        poses: data
-            .poses
-            .iter()
-            .enumerate()
-            .filter(|(j, _)| !rejected.iter().any(|r| r.pose == *j))
-            .map(|(_, p)| *p)
-            .collect(),
-        source: data.source.clone(),
-    }
+/// `data` without the rejected poses.
+fn kept(data: &Dataset, rejected: &[Rejection]) -> Dataset {
+    data.subset(|j| !rejected.iter().any(|r| r.pose == j))
 }
 
 /// The poses whose readings are gross errors (see the module docs), at
@@ -132,14 +131,14 @@ pub fn screen_gross_errors(
     let z_crit = chi2_isf(alpha / (3 * n) as f64, 1.0).sqrt();
     let mut rejected: Vec<Rejection> = Vec::new();
     for _ in 0..4 {
-        let id = identify(model, &subset(data, &rejected), options)?;
+        let id = identify(model, &kept(data, &rejected), options)?;
         let res = residuals_at(
             model,
             &id.estimate,
             &id.offsets,
             &data.poses,
             &options.sigma,
-        );
+        )?;
         let kept = |j: usize| !rejected.iter().any(|r| r.pose == j);
         let scale: [f64; 3] = std::array::from_fn(|c| {
             let mut v: Vec<f64> = res
@@ -207,6 +206,6 @@ pub fn identify_robust(
     options: &IdentifyOptions,
 ) -> Result<(Identification, Vec<Rejection>), IdentError> {
     let rejected = screen_gross_errors(model, data, options, 1e-3, 0.1)?;
-    let id = identify(model, &subset(data, &rejected), options)?;
+    let id = identify(model, &kept(data, &rejected), options)?;
     Ok((id, rejected))
 }

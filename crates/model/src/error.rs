@@ -4,7 +4,7 @@ use thiserror::Error;
 use tricept_kinematics::KinematicsError;
 
 /// What can go wrong when building or evaluating the error model.
-#[derive(Debug, Clone, PartialEq, Error)]
+#[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum ModelError {
     /// A parameter name that the set does not contain.
@@ -32,9 +32,12 @@ pub enum ModelError {
         /// Its value, mm.
         value: f64,
     },
-    /// Malformed JSON for parameter values.
+    /// Parameter values that are not JSON.
     #[error("parameter values: {0}")]
-    Json(String),
+    Json(#[from] serde_json::Error),
+    /// Parameter values that are JSON but not `{name: value_mm}`.
+    #[error("parameter values: {0}")]
+    Values(String),
     /// The kinematics failed at some pose.
     #[error(transparent)]
     Kinematics(#[from] KinematicsError),

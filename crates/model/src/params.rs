@@ -285,9 +285,9 @@ impl ParameterSet {
     /// Parses a JSON object `{name: value_mm}`. Names must belong to the
     /// set; missing names are zero.
     pub fn parse_values(&self, json: &str) -> Result<Vec<f64>, ModelError> {
-        let v: Value = serde_json::from_str(json).map_err(|e| ModelError::Json(e.to_string()))?;
+        let v: Value = serde_json::from_str(json)?;
         let Value::Object(map) = v else {
-            return Err(ModelError::Json(
+            return Err(ModelError::Values(
                 "expected a JSON object of parameter name -> value in mm".into(),
             ));
         };
@@ -306,7 +306,7 @@ impl ParameterSet {
                 });
             };
             let x = v.as_f64().filter(|x| x.is_finite()).ok_or_else(|| {
-                ModelError::Json(format!("{k}: expected a finite number in mm, got {v}"))
+                ModelError::Values(format!("{k}: expected a finite number in mm, got {v}"))
             })?;
             p[j] = x;
         }

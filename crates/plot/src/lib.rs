@@ -17,20 +17,36 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use thiserror::Error;
 
-/// A drawing failure (I/O or an empty data set).
+/// A drawing failure: an empty data set, or the backend's error (I/O).
 #[derive(Debug, Error)]
-#[error("{path}: {message}")]
-pub struct PlotError {
-    /// The output file.
-    pub path: String,
-    /// What went wrong.
-    pub message: String,
+#[non_exhaustive]
+pub enum PlotError {
+    /// Nothing to draw.
+    #[error("{path}: no data")]
+    NoData {
+        /// The output file.
+        path: String,
+    },
+    /// The drawing backend failed (typically writing the file).
+    #[error("{path}: {source}")]
+    Drawing {
+        /// The output file.
+        path: String,
+        /// The backend's error.
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
 }
 
-fn err(path: &Path, e: impl std::fmt::Display) -> PlotError {
-    PlotError {
+fn err<E: std::error::Error + Send + Sync + 'static>(path: &Path, e: E) -> PlotError {
+    PlotError::Drawing {
         path: path.display().to_string(),
-        message: e.to_string(),
+        source: Box::new(e),
+    }
+}
+
+fn no_data(path: &Path) -> PlotError {
+    PlotError::NoData {
+        path: path.display().to_string(),
     }
 }
 
@@ -83,7 +99,7 @@ pub fn heat_map(
     range: Option<(f64, f64)>,
 ) -> Result<(), PlotError> {
     if cells.is_empty() {
-        return Err(err(path, "no data"));
+        return Err(no_data(path));
     }
     let (lo, hi) = range.unwrap_or_else(|| {
         cells
@@ -262,7 +278,7 @@ pub fn curves(
             (a.min(v), b.max(v))
         });
     if !(x0.is_finite() && y0.is_finite()) {
-        return Err(err(path, "no data"));
+        return Err(no_data(path));
     }
     let root = SVGBackend::new(path, (820, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(path, e))?;
@@ -394,7 +410,7 @@ pub fn scatter(
         |(a, b, c, d), (x, y)| (a.min(*x), b.max(*x), c.min(*y), d.max(*y)),
     );
     if !(x0.is_finite() && y0.is_finite()) {
-        return Err(err(path, "no data"));
+        return Err(no_data(path));
     }
     let padx = 0.04 * (x1 - x0).max(1e-12);
     let pady = 0.08 * (y1 - y0).max(1e-12);

@@ -14,7 +14,9 @@
 //! - **paper** ([`paper`]): the paper's differenced, unweighted
 //!   `(H^T H)^{-1} H^T l`.
 //!
-//! [`optimize`] chooses pose sets that maximise an observability index.
+//! [`optimise`] chooses pose sets that maximise an observability index;
+//! [`grades`] turns results into decisions (where calibration stops paying,
+//! which grade a pose set needs, which grade to buy).
 //! Everything is seeded and bit-reproducible at any thread count.
 #![cfg_attr(
     not(test),
@@ -23,15 +25,18 @@
 
 pub mod exact;
 pub mod fast;
-pub mod optimize;
+pub mod grades;
+pub mod optimise;
 pub mod paper;
 mod rng;
 pub mod scenario;
 
 use serde::Serialize;
 use thiserror::Error;
+use tricept_numerics::stats::quantile;
 
 pub use fast::{GradeModel, LinearEstimator};
+pub use grades::{EquivalentGrade, crossing_grade, equivalent_grade, grade_for_mu, recommend};
 pub use scenario::Scenario;
 
 /// Why a study could not run.
@@ -113,15 +118,7 @@ impl Summary {
             values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n.max(2) - 1) as f64;
         let mut sorted = values.to_vec();
         sorted.sort_by(f64::total_cmp);
-        let q = |p: f64| {
-            let x = p * (n - 1) as f64;
-            let (i, f) = (x.floor() as usize, x.fract());
-            if i + 1 < n {
-                sorted[i] * (1.0 - f) + sorted[i + 1] * f
-            } else {
-                sorted[i]
-            }
-        };
+        let q = |p: f64| quantile(&sorted, p);
         Summary {
             mean,
             std_dev: var.sqrt(),
@@ -250,53 +247,6 @@ pub fn run_grades(
             })
         })
         .collect()
-}
-
-/// The grade (arcsec) at which the median `mu` of `estimator(grade)`
-/// reaches `mu_0`, by doubling from `start_arcsec` then bisection in log
-/// space, with `trials` fast trials per evaluation. `None` if it does not
-/// cross below `limit_arcsec`.
-pub fn crossing_grade(
-    s: &Scenario,
-    start_arcsec: f64,
-    limit_arcsec: f64,
-    trials: usize,
-    seed: u64,
-    estimator: &dyn Fn(f64) -> Result<Option<LinearEstimator>, StudyError>,
-) -> Result<Option<f64>, StudyError> {
-    let median_mu = |g: f64| -> Result<Option<f64>, StudyError> {
-        Ok(estimator(g)?.map(|e| {
-            let r = e.run(s, trials, seed, 1000 + g.to_bits() % 1000, &|_| {});
-            Summary::of(&r.iter().map(|t| t.mu_mm).collect::<Vec<_>>()).median
-        }))
-    };
-    let mut lo = start_arcsec;
-    let Some(m) = median_mu(lo)? else {
-        return Ok(None);
-    };
-    if m >= s.mu0_mm {
-        return Ok(Some(lo));
-    }
-    let mut hi = lo;
-    loop {
-        hi *= 2.0;
-        if hi > limit_arcsec {
-            return Ok(None);
-        }
-        match median_mu(hi)? {
-            Some(m) if m >= s.mu0_mm => break,
-            Some(_) => lo = hi,
-            None => return Ok(None),
-        }
-    }
-    for _ in 0..12 {
-        let mid = (lo * hi).sqrt();
-        match median_mu(mid)? {
-            Some(m) if m >= s.mu0_mm => hi = mid,
-            _ => lo = mid,
-        }
-    }
-    Ok(Some((lo * hi).sqrt()))
 }
 
 #[cfg(test)]

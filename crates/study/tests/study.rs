@@ -222,3 +222,100 @@ fn worse_shares_count_against_the_uncalibrated_machine() {
     assert_eq!(r.plane_worse_share, 0.25);
     assert_eq!(r.trials, 4);
 }
+
+mod grades {
+    //! The decisions drawn from study results, checked against their own
+    //! definitions (never against numbers copied from a run).
+
+    use tricept_kinematics::Machine;
+    use tricept_study::grades::mu_at_grade;
+    use tricept_study::{
+        GradeModel, GradeResult, PathResult, Scenario, crossing_grade, equivalent_grade,
+        grade_for_mu, recommend,
+    };
+
+    fn default_scenario() -> Scenario {
+        let m = Machine::paper();
+        let targets = m.workspace.polar_grid(3, 8, 3);
+        Scenario::paper(m, targets).unwrap()
+    }
+
+    #[test]
+    fn grade_for_mu_inverts_the_median_mu() {
+        let s = default_scenario();
+        let reference = mu_at_grade(&s, 3.0, 4000, 5).unwrap();
+        let target = reference.median;
+        // The median mu is increasing in the grade only up to its Monte
+        // Carlo error (it wobbles near 3 arcsec with 4000 trials): the grade
+        // found must reproduce the target within that error.
+        let half_width = 0.5 * (reference.median_ci95[1] - reference.median_ci95[0]);
+        let g = grade_for_mu(&s, target, 1e4, 4000, 5).unwrap().unwrap();
+        let at_g = mu_at_grade(&s, g, 4000, 5).unwrap().median;
+        assert!(
+            (at_g - target).abs() < half_width,
+            "{g}: {at_g} vs {target}"
+        );
+        assert!((g / 3.0 - 1.0).abs() < 0.2, "{g}");
+        // A target no grade below the limit reaches.
+        assert_eq!(grade_for_mu(&s, 1e9, 100.0, 2000, 5).unwrap(), None);
+        // An equivalent grade of a pose set against itself is its own grade,
+        // inside its interval.
+        let e = equivalent_grade(&s, &reference, 4000, 5).unwrap().unwrap();
+        assert!((e.grade_arcsec / g - 1.0).abs() < 1e-12, "{e:?}");
+        let [lo, hi] = e.interval95_arcsec;
+        assert!(lo.unwrap() < 3.0 && 3.0 < hi.unwrap(), "{e:?}");
+    }
+
+    #[test]
+    fn the_crossing_grade_is_where_the_median_mu_reaches_mu0() {
+        // Few poses: calibration stops paying at a few arcsec.
+        let m = Machine::paper();
+        let s = Scenario::paper(m.clone(), m.workspace.random_poses(8, 3)).unwrap();
+        let ours = |g: f64| Ok(Some(GradeModel::new(&s, g)?.estimator));
+        let g = crossing_grade(&s, 0.25, 1e5, 4000, 9, &ours)
+            .unwrap()
+            .unwrap();
+        let median = |grade: f64| {
+            let e = GradeModel::new(&s, grade).unwrap().estimator;
+            let r = e.run(&s, 4000, 9, 1000 + grade.to_bits() % 1000, &|_| {});
+            tricept_study::Summary::of(&r.iter().map(|t| t.mu_mm).collect::<Vec<_>>()).median
+        };
+        assert!(
+            median(0.8 * g) < s.mu0_mm && median(1.25 * g) > s.mu0_mm,
+            "{g}"
+        );
+        // An estimator that cannot be formed gives no crossing.
+        let never = |_: f64| Ok(None);
+        assert_eq!(crossing_grade(&s, 0.25, 1e5, 100, 9, &never).unwrap(), None);
+    }
+
+    #[test]
+    fn recommend_takes_the_coarsest_grade_meeting_the_target() {
+        let s = default_scenario();
+        let results: Vec<GradeResult> = [1.0, 2.0, 4.0, 8.0]
+            .iter()
+            .map(|&g| {
+                let model = GradeModel::new(&s, g).unwrap();
+                let trials = model.estimator.run(&s, 2000, 3, 0, &|_| {});
+                GradeResult {
+                    grade_arcsec: g,
+                    fast: PathResult::of(&trials, &s),
+                    exact: None,
+                    paper: None,
+                    paper_condition: f64::NAN,
+                    rank: model.design.rank(),
+                }
+            })
+            .collect();
+        for target_um in [1.0, 20.0, 50.0, 200.0, 1e6] {
+            let expected = results
+                .iter()
+                .rev()
+                .find(|r| r.fast.plane_touched_mean_mm.p95 * 1e3 <= target_um)
+                .map(|r| r.grade_arcsec);
+            assert_eq!(recommend(&results, target_um), expected, "{target_um}");
+        }
+        assert_eq!(recommend(&results, 1e6), Some(8.0));
+        assert_eq!(recommend(&results, 0.0), None);
+    }
+}

@@ -1,0 +1,226 @@
+//! The simulator's own guarantees: readings come from the exact model of
+//! the actual machine, the sensors add their offsets and exactly the noise
+//! they are said to have, every effect adds what its physics says, the
+//! logged context (directions, temperature, time) is that of a real
+//! campaign, and a seed always gives the same bits.
+
+use nalgebra::Vector3;
+use tricept_kinematics::{Machine, SensorNoise};
+use tricept_model::ParameterSet;
+use tricept_model::effects::{compliance_extra_mm, gravity_leg_tension_n, scale_gain_error_mm};
+use tricept_plant::{Campaign, DEFAULT_SENSOR_OFFSETS, Effect, Plant, PoseOrder, random_errors};
+
+fn plant(seed: u64) -> Plant {
+    let m = Machine::paper();
+    let set = ParameterSet::paper15();
+    Plant::geometric(m, set.to_errors(&random_errors(15, 0.5, seed)))
+}
+
+fn noise_free(campaign: &mut Campaign) {
+    campaign.noise = SensorNoise {
+        angle_rad: 0.0,
+        length_mm: 0.0,
+        readings_per_pose: 1,
+    };
+}
+
+#[test]
+fn noise_free_readings_are_the_exact_joints_of_the_actual_machine_plus_offsets() {
+    let p = plant(3);
+    let mut c = Campaign::random(&p.nominal, 30, 4);
+    noise_free(&mut c);
+    let data = p.simulate(&c).unwrap();
+    let actual = p.actual_machine();
+    for (pose, target) in data.poses.iter().zip(&c.targets_mm) {
+        // Commanded by the nominal IK...
+        let q = p.nominal.inverse(target).unwrap().legs_mm;
+        assert_eq!(pose.commands_mm, q);
+        // ...reached by the exact FK of the actual machine.
+        let up = actual.forward(&q).unwrap().up.to_array();
+        let r = pose.readings.to_array();
+        for ch in 0..3 {
+            assert!(
+                (r[ch] - up[ch] - DEFAULT_SENSOR_OFFSETS[ch]).abs() < 1e-9,
+                "channel {ch}: {} vs {}",
+                r[ch],
+                up[ch] + DEFAULT_SENSOR_OFFSETS[ch]
+            );
+        }
+    }
+}
+
+#[test]
+fn noise_has_the_stated_size_and_the_same_seed_gives_the_same_bits() {
+    let p = plant(5);
+    let c = Campaign::random(&p.nominal, 400, 8);
+    let mut clean_c = c.clone();
+    noise_free(&mut clean_c);
+    let clean = p.simulate(&clean_c).unwrap();
+    let noisy = p.simulate(&c).unwrap();
+    assert_eq!(noisy, p.simulate(&c).unwrap());
+    let mut other = c.clone();
+    other.seed = 9;
+    assert_ne!(
+        noisy.poses[0].readings,
+        p.simulate(&other).unwrap().poses[0].readings
+    );
+    // The mean of k readings: sigma / sqrt(k) per logged value.
+    let sigma = c.noise.logged_sigma();
+    for ch in 0..3 {
+        let n = noisy.poses.len() as f64;
+        let chi2: f64 = noisy
+            .poses
+            .iter()
+            .zip(&clean.poses)
+            .map(|(a, b)| {
+                let d = (a.readings.to_array()[ch] - b.readings.to_array()[ch]) / sigma[ch];
+                d * d
+            })
+            .sum();
+        // chi-square with n degrees of freedom: n +- 5 sqrt(2 n).
+        assert!(
+            (chi2 - n).abs() < 5.0 * (2.0 * n).sqrt(),
+            "channel {ch}: {chi2} for {n}"
+        );
+    }
+}
+
+#[test]
+fn approach_directions_and_the_logged_context_are_those_of_the_campaign() {
+    let p = plant(1);
+    let mut c = Campaign::random(&p.nominal, 20, 2);
+    let data = p.simulate(&c).unwrap();
+    // Visited once: each leg's direction is the sign of its last move.
+    let mut previous: Option<[f64; 3]> = None;
+    for (j, pose) in data.poses.iter().enumerate() {
+        let expected: [i8; 3] = match previous {
+            None => [1, 1, 1],
+            Some(q) => std::array::from_fn(|i| if pose.commands_mm[i] >= q[i] { 1 } else { -1 }),
+        };
+        assert_eq!(pose.approach, Some(expected), "pose {j}");
+        assert_eq!(pose.time_s, Some(j as f64 * c.seconds_per_pose));
+        previous = Some(pose.commands_mm);
+    }
+    // Visited twice: extending, then retracting, at the same commands.
+    c.order = PoseOrder::BothDirections;
+    let both = p.simulate(&c).unwrap();
+    assert_eq!(both.poses.len(), 40);
+    for pair in both.poses.chunks(2) {
+        assert_eq!(pair[0].commands_mm, pair[1].commands_mm);
+        assert_eq!(
+            (pair[0].approach, pair[1].approach),
+            (Some([1; 3]), Some([-1; 3]))
+        );
+    }
+}
+
+#[test]
+fn effects_add_what_their_physics_says() {
+    let base = plant(7);
+    let mut c = Campaign::random(&base.nominal, 12, 3);
+    noise_free(&mut c);
+    let clean = base.true_poses(&c).unwrap();
+    let actual = base.actual_machine();
+
+    // A scale gain changes the scale reading only, by g q4.
+    let mut gain = base.clone();
+    gain.effects = vec![Effect::ScaleGain { ppm: 120.0 }];
+    for (a, b) in gain.true_poses(&c).unwrap().iter().zip(&clean) {
+        let (ra, rb) = (a.readings.to_array(), b.readings.to_array());
+        assert_eq!((ra[0], ra[1]), (rb[0], rb[1]));
+        assert!((ra[2] - rb[2] - scale_gain_error_mm(120.0, b.up.q4_mm)).abs() < 1e-12);
+    }
+
+    // A lead error lengthens leg i by ppm_i q_i: the platform goes where
+    // the actual machine's FK of the lengthened legs puts it.
+    let ppm = [80.0, -40.0, 60.0];
+    let mut lead = base.clone();
+    lead.effects = vec![Effect::LegLead { ppm }];
+    for t in lead.true_poses(&c).unwrap() {
+        let legs: [f64; 3] = std::array::from_fn(|i| t.commands_mm[i] * (1.0 + ppm[i] * 1e-6));
+        let fk = actual.forward(&legs).unwrap();
+        assert!((fk.position_mm - t.position_mm).norm() < 1e-9);
+    }
+
+    // Compliance: each leg stretches by its gravity tension over its
+    // stiffness (the tension taken at the nominal joints of the command).
+    let stiffness = 40.0;
+    let mut soft = base.clone();
+    soft.effects = vec![Effect::Compliance {
+        stiffness_n_per_um_at_1m: stiffness,
+    }];
+    let mut sag = 0.0;
+    for t in soft.true_poses(&c).unwrap() {
+        let nominal_up = base.nominal.forward(&t.commands_mm).unwrap().up;
+        let f = gravity_leg_tension_n(&base.nominal, &nominal_up);
+        let legs: [f64; 3] = std::array::from_fn(|i| {
+            t.commands_mm[i] + compliance_extra_mm(stiffness, f[i], t.commands_mm[i])
+        });
+        let fk = actual.forward(&legs).unwrap();
+        assert!((fk.position_mm - t.position_mm).norm() < 1e-9);
+        let rigid = actual.forward(&t.commands_mm).unwrap().position_mm;
+        sag += (t.position_mm - rigid).z;
+    }
+    // A hanging machine: gravity along +z stretches the legs, the platform
+    // sags away from the base.
+    assert!(sag > 0.0, "{sag}");
+
+    // A temperature drift: the logged temperature rises linearly by the
+    // drift (to the logger's noise), the legs grow alpha q dT.
+    let mut warm = base.clone();
+    warm.effects = vec![Effect::Thermal {
+        drift_k: 3.0,
+        expansion_ppm_per_k: 11.5,
+    }];
+    let poses = warm.true_poses(&c).unwrap();
+    let n = poses.len();
+    for (j, t) in poses.iter().enumerate() {
+        let dt = 3.0 * j as f64 / (n - 1) as f64;
+        assert!((t.temp_c - c.start_temp_c - dt).abs() < 1e-12);
+        let legs: [f64; 3] = std::array::from_fn(|i| t.commands_mm[i] * (1.0 + 11.5e-6 * dt));
+        assert!((actual.forward(&legs).unwrap().position_mm - t.position_mm).norm() < 1e-9);
+    }
+}
+
+#[test]
+fn outliers_corrupt_exactly_the_stated_number_of_readings_by_the_stated_size() {
+    let base = plant(2);
+    let c = Campaign::random(&base.nominal, 50, 6);
+    let clean = base.simulate(&c).unwrap();
+    let mut bad = base.clone();
+    bad.effects = vec![Effect::Outliers {
+        count: 3,
+        size_sigma: 400.0,
+    }];
+    let corrupted = bad.simulate(&c).unwrap();
+    let sigma = c.noise.logged_sigma();
+    let mut changed = Vec::new();
+    for (j, (a, b)) in corrupted.poses.iter().zip(&clean.poses).enumerate() {
+        let (ra, rb) = (a.readings.to_array(), b.readings.to_array());
+        for ch in 0..3 {
+            if ra[ch] != rb[ch] {
+                let size = ((ra[ch] - rb[ch]) / sigma[ch]).abs();
+                assert!((size - 400.0).abs() < 1e-6, "{size}");
+                changed.push(j);
+            }
+        }
+    }
+    assert_eq!(changed.len(), 3, "{changed:?}");
+    changed.dedup();
+    assert_eq!(changed.len(), 3, "one reading per corrupted row");
+}
+
+#[test]
+fn an_unreachable_target_is_an_error_naming_it() {
+    let p = plant(1);
+    let c = Campaign::from_targets(
+        &p.nominal,
+        vec![
+            Vector3::new(0.0, 0.0, 750.0),
+            Vector3::new(5000.0, 0.0, 750.0),
+        ],
+        1,
+    );
+    let e = p.simulate(&c).unwrap_err().to_string();
+    assert!(e.contains("pose 1") && e.contains("5000"), "{e}");
+}
