@@ -25,15 +25,31 @@
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
+mod alias;
 pub mod detect;
+mod dictionary;
+mod evidence;
+mod finite;
+mod linear;
 mod model;
+mod noise;
+mod plausibility;
 mod report;
 mod residuals;
 mod run;
 mod select;
+mod terms;
 
+pub use dictionary::DictionaryOptions;
+pub use finite::first_non_finite;
 pub use model::{Candidate, ExtendedModel, MIN_TEMPERATURE_RANGE_K, REFERENCE_TEMPERATURE_C};
+pub use noise::NOISE_CHECK_LEVEL;
+pub use plausibility::{Plausibility, PlausibilityError, Range};
 pub use report::{
-    Cause, ChannelRms, Diagnosis, Estimate, Evidence, Gain, ResidualPlot, Structure, Tested,
+    Alias, Cause, CauseKind, ChannelRms, Diagnosis, Estimate, Evidence, FinalFit, Gain,
+    NoiseCheck, NoiseSource, PureError, Rejected, RejectStage, Remainder, ResidualPlot,
+    Structure, TermScore, Tested, Verdict,
 };
-pub use run::{DiagnoseError, DiagnoseOptions, diagnose};
+pub use run::{DiagnoseError, DiagnoseOptions, MIN_PURE_ERROR_DOF, diagnose};
+pub use terms::{Frame, GenericTerm, OrderAxis, Scope, Term};
+pub use tricept_model::effects::{CauseName, GenericFamily};

@@ -143,8 +143,32 @@ fn true_parameters(e: &Effect) -> Option<Vec<f64>> {
         Effect::Compliance {
             stiffness_n_per_um_at_1m,
         } => vec![1000.0 / stiffness_n_per_um_at_1m],
-        Effect::Outliers { .. } => return None,
+        _ => return None,
     })
+}
+
+/// Whether `effect` is named first, or (for a scale gain, which no
+/// campaign of these sensors can tell from an equal lead of the legs) is
+/// the model's member of the first alias set.
+fn found_first(d: &Diagnosis, effect: E) -> bool {
+    d.causes.first().is_some_and(|c| c.effect == effect)
+        || (d.causes.is_empty() || d.causes[0].effect == E::Outliers)
+            && d.aliases.first().is_some_and(|a| a.in_model == effect)
+}
+
+/// Whether `effect` is named or kept in the model as a member of an alias set.
+fn found(d: &Diagnosis, effect: E) -> bool {
+    d.causes.iter().any(|c| c.effect == effect) || d.aliases.iter().any(|a| a.in_model == effect)
+}
+
+/// The estimates of `effect`'s parameters in the final model.
+fn fitted(d: &Diagnosis, effect: E) -> Vec<tricept_diagnose::Estimate> {
+    let prefix = format!("{effect}.");
+    d.extended
+        .iter()
+        .filter(|e| e.name.starts_with(&prefix))
+        .cloned()
+        .collect()
 }
 
 /// 20 datasets with `effect` hidden: named first and held-out RMS halved
@@ -155,7 +179,7 @@ fn check_effect(effect: E) {
     let mut failures = Vec::new();
     for seed in 0..20 {
         let (d, hidden) = run(&[effect], 100 + seed, readings);
-        let named_first = d.causes.first().is_some_and(|c| c.effect == effect);
+        let named_first = found_first(&d, effect);
         let ratio = d.gain.holdout_rms_extended / d.gain.holdout_rms_geometric;
         first += usize::from(named_first);
         halved += usize::from(ratio <= 0.5);
@@ -168,11 +192,10 @@ fn check_effect(effect: E) {
             ));
         }
         if let (true, Some(truth)) = (named_first, true_parameters(&hidden[0])) {
-            let cause = &d.causes[0];
             if effect == E::Outliers {
                 continue;
             }
-            for (est, t) in cause.parameters.iter().zip(&truth) {
+            for (est, t) in fitted(&d, effect).iter().zip(&truth) {
                 let sd = est.std_dev.unwrap_or(f64::INFINITY);
                 // The thermal regressor is the logged temperature, whose
                 // 0.02 K logger noise (errors in variables, not in the
@@ -261,8 +284,7 @@ fn check_pairs(pairs: &[(E, E)]) {
         let mut both = 0;
         for seed in 0..20 {
             let (d, _) = run(&[a, b], 900 + seed, readings);
-            let names: Vec<E> = d.causes.iter().map(|c| c.effect).collect();
-            both += usize::from(names.contains(&a) && names.contains(&b));
+            both += usize::from(found(&d, a) && found(&d, b));
         }
         eprintln!("{a} + {b}: both found {both}/20");
         assert!(both >= 16, "{a} + {b}: both found in {both}/20");
@@ -294,7 +316,14 @@ fn the_report_names_the_evidence_and_the_bias() {
     let (d, hidden) = run(&[E::ScaleGain], 7, 30);
     let json = d.to_json();
     assert_eq!(json["adequate"], false);
-    assert_eq!(json["causes"][0]["effect"], "scale-gain");
+    assert_eq!(json["final_adequate"], true);
+    // A scale gain is never named alone: it is reported with the equal
+    // lead of the legs that reads exactly like it.
+    assert_eq!(json["causes"].as_array().map(Vec::len), Some(0));
+    assert_eq!(json["aliases"][0]["effects"][0], "scale-gain");
+    assert_eq!(json["aliases"][0]["effects"][1], "leg-lead");
+    assert_eq!(json["aliases"][0]["exact"], true);
+    assert!(json["aliases"][0]["separate_by"].as_str().unwrap().contains("external length"));
     assert!(
         json["gain"]["holdout_rms_geometric"].as_f64().unwrap()
             > 2.0 * json["gain"]["holdout_rms_extended"].as_f64().unwrap()
@@ -302,7 +331,7 @@ fn the_report_names_the_evidence_and_the_bias() {
     let Effect::ScaleGain { ppm } = hidden[0] else {
         unreachable!()
     };
-    let est = json["causes"][0]["parameters"]["scale-gain.scale_gain_ppm"]["value"]
+    let est = json["extended"]["scale-gain.scale_gain_ppm"]["value"]
         .as_f64()
         .unwrap();
     assert!((est - ppm).abs() < 0.05 * ppm.abs(), "{est} vs {ppm}");
@@ -314,6 +343,5 @@ fn the_report_names_the_evidence_and_the_bias() {
         .map(|(_, v)| v.abs())
         .fold(0.0, f64::max);
     assert!(largest > 1e-3, "{largest}");
-    assert!(!d.plots.is_empty() && !d.plots[0].before.is_empty());
     let _ = RAD_PER_ARCSEC;
 }

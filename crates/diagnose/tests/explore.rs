@@ -1,0 +1,83 @@
+//! Scratch exploration (deleted before commit).
+mod common;
+use common::*;
+use tricept_plant::effects::Effect;
+use tricept_model::effects::EffectName as E;
+use std::time::Instant;
+
+fn make(kind: &str, n: usize, i: u64) -> Simulated {
+    let seed = 1000 + i;
+    let mut r = rng(0xabc, seed);
+    let e = match kind {
+        "clean" => vec![],
+        "pitch" => {
+            let ph: [f64; 3] = std::array::from_fn(|_| uniform(&mut r, 0.0, 360.0));
+            vec![Effect::LegPeriodic { um: [4.0; 3], period_mm: 10.0, phase_deg: ph, waveform: Default::default() }]
+        }
+        "quad" => {
+            let um: [f64; 3] = std::array::from_fn(|_| sign(&mut r) * uniform(&mut r, 5.0, 15.0));
+            vec![Effect::LegQuadratic { um, centre_mm: 845.0, half_width_mm: 250.0 }]
+        }
+        "drift" => vec![Effect::ScaleDrift { um: sign(&mut r) * uniform(&mut r, 2.0, 6.0) }],
+        "gain" => vec![Effect::EncoderGain { phi_ppm: sign(&mut r) * uniform(&mut r, 100.0, 300.0), theta_ppm: 0.0 }],
+        "lead" => vec![Effect::LegLead { ppm: std::array::from_fn(|_| sign(&mut r) * uniform(&mut r, 50.0, 150.0)) }],
+        "scale" => vec![Effect::ScaleGain { ppm: sign(&mut r) * uniform(&mut r, 50.0, 150.0) }],
+        "thermal" => vec![Effect::Thermal { drift_k: sign(&mut r) * uniform(&mut r, 2.0, 5.0), expansion_ppm_per_k: 11.5 }],
+        "backlash" => vec![Effect::Backlash { um: std::array::from_fn(|_| uniform(&mut r, 5.0, 15.0)) }],
+        "compliance" => vec![Effect::Compliance { stiffness_n_per_um_at_1m: tricept_model::effects::stiffness_for_platform_deflection(&tricept_kinematics::Machine::paper(), uniform(&mut r, 10.0, 30.0)) }],
+        "ujoint" => vec![if sign(&mut r) > 0.0 { Effect::UjointAxes { skew_arcsec: sign(&mut r) * uniform(&mut r, 30.0, 90.0), offset_um: 0.0 } } else { Effect::UjointAxes { skew_arcsec: 0.0, offset_um: sign(&mut r) * uniform(&mut r, 20.0, 60.0) } }],
+        "ecc" => vec![Effect::EncoderEccentricity { phi_arcsec: uniform(&mut r, 20.0, 50.0), phi_phase_deg: uniform(&mut r, 0.0, 360.0), theta_arcsec: uniform(&mut r, 20.0, 50.0), theta_phase_deg: uniform(&mut r, 0.0, 360.0) }],
+        _ => panic!(),
+    };
+    simulate(n, seed, e, CampaignOptions::default())
+}
+
+#[test]
+#[ignore]
+fn explore() {
+    let kinds: Vec<String> = std::env::var("KINDS").unwrap_or("clean,pitch,quad,drift,gain".into()).split(',').map(|s| s.to_string()).collect();
+    let sizes: Vec<usize> = std::env::var("SIZES").unwrap_or("80".into()).split(',').map(|s| s.parse().unwrap()).collect();
+    let count: u64 = std::env::var("COUNT").ok().and_then(|v| v.parse().ok()).unwrap_or(4);
+    for k in &kinds {
+        for &n in &sizes {
+            let t = Instant::now();
+            let res = run_case(count, |i| make(k, n, i));
+            let dt = t.elapsed().as_secs_f64();
+            for (i, (_, d)) in res.iter().enumerate() {
+                eprintln!("{k} n={n} #{i}: {}", summary(d));
+                for c in &d.causes { let e = &c.evidence; eprintln!("      {}: drop {:.1} k {} p_adj {:.1e} G {:.1} cv {:?} -> {:?}", c.effect, e.delta_chi_square, e.dof, e.p_adjusted, e.penalised_gain, e.holdout_rms_without, e.holdout_rms_with); }
+                for a in &d.aliases { eprintln!("      alias {:?}: lambda {:.2} exact {} params {:?}", a.descriptions, a.lambda_unexplained, a.exact, a.parameters.iter().map(|p| format!("{}={:.1}", p.name, p.value)).collect::<Vec<_>>()); }
+                for r in &d.rejected { eprintln!("      rejected {}: {}", r.description, r.reason); }
+                if let Some(r) = &d.remainder { eprintln!("      remainder: {}", r.text); }
+            }
+            let cat = res.iter().filter(|(_, d)| !catalogue_named(d).is_empty()).count();
+            eprintln!("TALLY {k} n={n}: {count} sets in {dt:.1}s; catalogue named {cat}; final adequate {}", res.iter().filter(|(_, d)| d.final_adequate).count());
+        }
+    }
+    let _ = E::LegLead;
+}
+
+#[test]
+#[ignore]
+fn quad_exactness() {
+    use tricept_diagnose::{ExtendedModel, Frame, GenericTerm, Scope, Term, Candidate, GenericFamily};
+    use tricept_ident::{GeometricModel, identify, IdentifyOptions};
+    use std::sync::Arc;
+    let m = tricept_kinematics::Machine::paper();
+    for i in [2u64, 3] {
+        let mut s = make("quad", 80, i);
+        let nf: f64 = std::env::var("NF").ok().and_then(|v| v.parse().ok()).unwrap_or(1e-6);
+        let e = s.effects.clone();
+        s = simulate(80, 1000 + i, e, CampaignOptions { revisits: 0, noise_factor: nf });
+        let frame = Arc::new(Frame::of(&m, &s.data));
+        let g = GeometricModel::new(m.clone(), tricept_model::ParameterSet::paper15());
+        let poly = Term::Generic(GenericTerm::new(GenericFamily::LegPolynomial, Scope::AllLegs));
+        let lead = Term::Catalogue(Candidate(E::LegLead));
+        for terms in [vec![], vec![poly], vec![poly, lead]] {
+            let model = ExtendedModel::with_terms(g.clone(), &terms, frame.clone());
+            let id = identify(&model, &s.data, &IdentifyOptions::with_sigma(s.sigma)).unwrap();
+            eprintln!("#{i} nf={nf} terms {}: chi2 {:.3} conv {} it {} est tail {:?}", terms.len(), id.stats.chi_square, id.converged, id.iterations, &id.estimate[15..]);
+        }
+        eprintln!("{:?}", s.effects);
+    }
+}
