@@ -25,7 +25,9 @@
 
 use nalgebra::{DMatrix, DVector};
 use tricept_data::Dataset;
-use tricept_model::effects::{CauseName, EffectName, GenericFamily};
+use tricept_model::effects::{
+    CauseName, EffectName, GenericFamily, legendre_p4, normalised_coordinate, periodic_extra_mm,
+};
 use tricept_numerics::stats::chi2_isf;
 
 use crate::linear::{Linearisation, canonical_correlation};
@@ -33,7 +35,7 @@ use crate::model::Candidate;
 use crate::plausibility::quantities;
 use crate::report::{Alias, Estimate, RejectStage, Rejected};
 use crate::select::{Fit, Setup, describe_group, term_estimates};
-use crate::terms::{GenericTerm, Term};
+use crate::terms::{Frame, GenericTerm, Term};
 
 /// The outcome of the alias analysis.
 pub(crate) struct Aliases {
@@ -71,6 +73,12 @@ fn explain(a: CauseName, c: CauseName, c_label: &str) -> (String, String) {
     let pair = |x: CauseName, y: CauseName| (a == x && c == y) || (a == y && c == x);
     let external_length = "one external length: a laser interferometer or gauge-block measurement of the UP-limb stroke or of one platform displacement fixes the gain; the machine's own sensors never can";
     let temperature_campaign = "a campaign in which temperature does not follow time: log through warm-up and cool-down, or revisit poses at different temperatures";
+    if c_label.ends_with("(higher order)") {
+        return (
+            format!("{c_label} explains it as well: it is the part of the leg error the generic form leaves, not an effect of its own"),
+            "a campaign that covers more of each leg's stroke, or more readings per pose".into(),
+        );
+    }
     if pair(Cat(EffectName::ScaleGain), Cat(EffectName::LegLead)) {
         return (
             "a scale gain g reads exactly like the machine scaled by 1 + g with a lead g on every leg".into(),
@@ -113,6 +121,43 @@ fn explain(a: CauseName, c: CauseName, c_label: &str) -> (String, String) {
         "their signatures on this campaign differ by less than the noise".into(),
         "a campaign that moves the machine where they differ".into(),
     )
+}
+
+/// Per-pose columns (direction, value) of the refinement of a generic
+/// leg term: the quartic Legendre part of a polynomial, the second
+/// harmonic of a periodic term.
+fn refinement(g: &GenericTerm, frame: &Frame, data: &Dataset) -> Option<Vec<(usize, Vec<f64>)>> {
+    let legs = g.legs();
+    let poses = &data.poses;
+    match g.family {
+        GenericFamily::LegPolynomial => Some(
+            legs.iter()
+                .flat_map(|&i| {
+                    let [lo, hi] = frame.leg_range_mm[i];
+                    let x: Vec<f64> = poses
+                        .iter()
+                        .map(|p| normalised_coordinate(p.commands_mm[i], lo, hi))
+                        .collect();
+                    [(i, x.iter().map(|x| 1e-3 * legendre_p4(*x)).collect())]
+                })
+                .collect(),
+        ),
+        GenericFamily::LegPeriodic => {
+            let half = g.period_mm? / 2.0;
+            Some(
+                legs.iter()
+                    .flat_map(|&i| {
+                        let q: Vec<f64> = poses.iter().map(|p| p.commands_mm[i]).collect();
+                        [
+                            (i, q.iter().map(|q| periodic_extra_mm(1.0, 0.0, half, *q)).collect()),
+                            (i, q.iter().map(|q| periodic_extra_mm(0.0, 1.0, half, *q)).collect()),
+                        ]
+                    })
+                    .collect(),
+            )
+        }
+        _ => None,
+    }
 }
 
 /// The alias analysis of the final model `fit` on `clean`.
@@ -186,6 +231,26 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
                 columns: DMatrix::from_columns(&[sum]),
             });
         }
+        // Refinements of the generic leg terms in the model (the quartic
+        // part of a curved leg error, the second harmonic of a periodic one): a catalogue term that only mops up what the
+        // generic form leaves is not a cause of its own.
+        if matches!(a, Term::Catalogue(_)) {
+            for t in &terms {
+                if let Term::Generic(g) = t
+                    && let Some(cols) = refinement(g, &setup.frame, clean)
+                {
+                    let cols = lin.dense(&cols);
+                    let k = cols.ncols();
+                    alternatives.push(Alternative {
+                        name: t.name(),
+                        label: format!("{} (higher order)", g.label()),
+                        term: *t,
+                        params: (1..=k).map(|j| format!("refinement{j}")).collect(),
+                        columns: cols,
+                    });
+                }
+            }
+        }
         for g in &generic_groups {
             let t = Term::Generic(*g);
             if terms.iter().any(|u| u.overlaps(&t)) || t.overlaps(a) {
@@ -210,6 +275,9 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
                 continue;
             }
             let lambda = (strength - s.explained).max(0.0);
+            if std::env::var("ALIAS_DEBUG").is_ok() {
+                eprintln!("ALIAS {} vs {}: strength {strength:.1} explained {:.1} rank {}", describe_group(a), alt.label, s.explained, s.rank);
+            }
             if lambda >= critical {
                 continue;
             }
@@ -238,9 +306,14 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
             } else {
                 s.covariance.clone()
             };
-            let plausible = setup
-                .plausibility
-                .check(&quantities(&alt.term, &check_values, &check_cov));
+            // A refinement belongs to a term already judged plausible.
+            let plausible = if alt.label.ends_with("(higher order)") {
+                Ok(())
+            } else {
+                setup
+                    .plausibility
+                    .check(&quantities(&alt.term, &check_values, &check_cov))
+            };
             match plausible {
                 Ok(()) => {
                     let projected = lin.project(&alt.columns);
@@ -259,6 +332,10 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
                     stage: RejectStage::ImplausibleAlias,
                 }),
             }
+        }
+        // An equal lead is the full lead's special case: name it alone.
+        if members.iter().any(|m| m.0.label.contains("equal")) {
+            members.retain(|m| !(m.0.name == CauseName::Catalogue(EffectName::LegLead) && !m.0.label.contains("equal")));
         }
         if members.is_empty() {
             continue;

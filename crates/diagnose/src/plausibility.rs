@@ -309,8 +309,12 @@ fn generic_quantities(g: &GenericTerm, v: &[f64], cov: &DMatrix<f64>) -> Vec<Qua
     };
     match family {
         GenericFamily::LegPeriodic | GenericFamily::LegPolynomial => {
+            let width = if family == GenericFamily::LegPeriodic { 2 } else { 3 };
             for (k, leg) in g.legs().into_iter().enumerate() {
-                let (a, b) = (2 * k, 2 * k + 1);
+                // The curvature coefficients (P2, P3) of a polynomial follow
+                // its linear part (P1, a lead: judged by the leads' range
+                // through the peak-to-valley of the curvature only).
+                let (a, b) = (width * k + width - 2, width * k + width - 1);
                 if family == GenericFamily::LegPeriodic {
                     let (amp, s) = amplitude(v[a], v[b], c(a, a), c(a, b), c(b, b));
                     push(

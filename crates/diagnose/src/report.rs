@@ -36,8 +36,8 @@ pub struct Evidence {
     pub multiplicity: usize,
     /// `p_value` times `multiplicity` (at most 1).
     pub p_adjusted: f64,
-    /// `delta_chi_square / s2 - dof ln N - 2 ln m` (`m` the alternatives
-    /// of its family): the penalised gain that ranks admissible candidates.
+    /// `delta_chi_square - dof ln N - 2 ln m` (`m` the alternatives of its
+    /// family): the penalised gain that ranks admissible candidates.
     pub penalised_gain: f64,
 }
 

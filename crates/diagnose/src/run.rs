@@ -366,26 +366,32 @@ fn describe(term: &Term, fit: &Fit, setup: &Setup<'_>, period_sd: Option<f64>, a
                     )
                 }
                 GenericFamily::LegPolynomial => {
-                    let pv: Vec<String> = legs
+                    let parts: Vec<String> = legs
                         .iter()
                         .enumerate()
                         .map(|(k, i)| {
                             let [lo, hi] = setup.frame.leg_range_mm[*i];
-                            let (a, b) = (v[2 * k], v[2 * k + 1]);
-                            let mut ys = (0..=100).map(|s| {
-                                let x = -1.0 + 0.02 * s as f64;
+                            let (c1, a, b) = (v[3 * k], v[3 * k + 1], v[3 * k + 2]);
+                            let curve = |x: f64| {
                                 a * tricept_model::effects::legendre_p2(x)
                                     + b * tricept_model::effects::legendre_p3(x)
-                            });
-                            let first = ys.next().unwrap_or(0.0);
-                            let (mn, mx) = ys.fold((first, first), |(l, h), y| (l.min(y), h.max(y)));
-                            format!("{:.1} um over {lo:.0}-{hi:.0} mm", mx - mn)
+                            };
+                            let (mn, mx) = (0..=100)
+                                .map(|s| curve(-1.0 + 0.02 * s as f64))
+                                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), y| {
+                                    (l.min(y), h.max(y))
+                                });
+                            let lead_ppm = c1 / (0.5 * (hi - lo)).max(1e-9) * 1e3;
+                            format!(
+                                "leg {}: curvature {:.1} um peak-to-valley over {lo:.0}-{hi:.0} mm, linear part {lead_ppm:.0} ppm",
+                                i + 1,
+                                mx - mn
+                            )
                         })
                         .collect();
                     format!(
-                        "{}: length error curved along the stroke (peak-to-valley {}): ball-screw travel variation or a bent guide?",
-                        legs_list(&legs),
-                        pv.join("; ")
+                        "length error curved along the stroke ({}): ball-screw travel variation (and mean travel deviation) or a bent guide?",
+                        parts.join("; ")
                     )
                 }
                 GenericFamily::LegDrift => {

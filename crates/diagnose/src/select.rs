@@ -11,7 +11,7 @@
 //!    candidates (catalogue) or by the dictionary's multiplicity (generic:
 //!    every scan period counts);
 //! 2. its penalised gain is positive:
-//!    `G = X / s2 - k ln(3n) - 2 ln m_c`, the BIC plus an extended-BIC term
+//!    `G = X - k ln(3n) - 2 ln m_c`, the BIC plus an extended-BIC term
 //!    for the `m_c` alternatives of its family (1 for a catalogue effect);
 //! 3. its parameters are physically plausible ([`crate::plausibility`]);
 //!    otherwise it is recorded as rejected with the reason;
@@ -234,9 +234,7 @@ impl Setup<'_> {
             selected: false,
             multiplicity: m,
             p_adjusted: (p * m as f64).min(1.0),
-            penalised_gain: delta / s2
-                - k as f64 * ln_n
-                - 2.0 * (self.alternatives(term) as f64).ln(),
+            penalised_gain: delta - k as f64 * ln_n - 2.0 * (self.alternatives(term) as f64).ln(),
         }
     }
 }

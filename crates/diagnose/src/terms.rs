@@ -162,7 +162,11 @@ impl GenericTerm {
                 .into_iter()
                 .flat_map(|i| {
                     let i = leg_label(i);
-                    [format!("leg{i}_p2_um"), format!("leg{i}_p3_um")]
+                    [
+                        format!("leg{i}_p1_um"),
+                        format!("leg{i}_p2_um"),
+                        format!("leg{i}_p3_um"),
+                    ]
                 })
                 .collect(),
             GenericFamily::LegDrift => self
@@ -201,6 +205,7 @@ impl GenericTerm {
                 for i in self.legs() {
                     let [lo, hi] = frame.leg_range_mm[i];
                     let x = normalised_coordinate(q[i], lo, hi);
+                    out.push((Basis::Leg(i), 1e-3 * x));
                     out.push((Basis::Leg(i), 1e-3 * legendre_p2(x)));
                     out.push((Basis::Leg(i), 1e-3 * legendre_p3(x)));
                 }
@@ -308,8 +313,9 @@ pub struct Frame {
     /// Mean, smallest and largest logged temperature, when it varies by at
     /// least [`MIN_TEMPERATURE_RANGE_K`], °C.
     pub temperature: Option<[f64; 3]>,
-    /// Sign of each sensor's change since the previous pose of the file,
-    /// by line (empty without distinct lines).
+    /// Sign of each sensor's change since the previous pose of the file
+    /// (nominal joints of the commands), by line (empty without distinct
+    /// lines).
     pub directions: BTreeMap<u64, [i8; 3]>,
 }
 
@@ -372,22 +378,33 @@ impl Frame {
                 (hi - lo > MIN_TEMPERATURE_RANGE_K).then_some([mean, lo, hi])
             })
             .flatten();
+        // The direction each sensor moved, from the nominal joints of the
+        // commands (not from the noisy readings, whose noise would leak
+        // into the regressor); moves below a micro-unit are no move.
         let mut directions = BTreeMap::new();
         if distinct_lines {
             let mut by_line: Vec<&MeasuredPose> = poses.iter().collect();
             by_line.sort_by_key(|p| p.line);
-            for w in by_line.windows(2) {
-                let (a, b) = (w[0].readings.to_array(), w[1].readings.to_array());
-                let sign = |d: f64| {
-                    if d > 0.0 {
+            let joints: Vec<Option<[f64; 3]>> = by_line
+                .iter()
+                .map(|p| nominal.forward(&p.commands_mm).ok().map(|f| f.up.to_array()))
+                .collect();
+            for (k, w) in joints.windows(2).enumerate() {
+                let (Some(a), Some(b)) = (w[0], w[1]) else {
+                    continue;
+                };
+                let dead = [1e-9, 1e-9, 1e-6];
+                let dir = std::array::from_fn(|c| {
+                    let d = b[c] - a[c];
+                    if d > dead[c] {
                         1
-                    } else if d < 0.0 {
+                    } else if d < -dead[c] {
                         -1
                     } else {
                         0
                     }
-                };
-                directions.insert(w[1].line, std::array::from_fn(|c| sign(b[c] - a[c])));
+                });
+                directions.insert(by_line[k + 1].line, dir);
             }
         }
         Frame {

@@ -81,3 +81,70 @@ fn quad_exactness() {
         eprintln!("{:?}", s.effects);
     }
 }
+
+#[test]
+#[ignore]
+fn generous() {
+    use tricept_plant::{Campaign, Plant, PoseOrder, random_errors};
+    let m = tricept_kinematics::Machine::paper();
+    let set = tricept_model::ParameterSet::paper15();
+    let which = std::env::var("WHICH").unwrap_or("clean".into());
+    for seed in [500u64, 501, 105, 106] {
+        let mut plant = Plant::geometric(m.clone(), set.to_errors(&random_errors(15, 0.5, seed)));
+        if which == "scale" { plant.effects = vec![Effect::ScaleGain { ppm: 120.0 }]; }
+        let mut campaign = Campaign::random(&m, 200, 7 * seed + 1);
+        campaign.noise.readings_per_pose = if which == "scale" { 30 } else { 3 };
+        campaign.order = PoseOrder::BothDirections;
+        let data = plant.simulate(&campaign).unwrap();
+        let mut o = options(campaign.noise.logged_sigma());
+        o.sigma = campaign.noise.logged_sigma();
+        let d = tricept_diagnose::diagnose(&m, &data, &o).unwrap();
+        eprintln!("{which} seed {seed}: {}", summary(&d));
+        for a in &d.aliases { eprintln!("      alias {:?} in model {}: lambda {:.2}", a.descriptions, a.in_model, a.lambda_unexplained); }
+        for r in &d.rejected { eprintln!("      rejected {}: {}", r.description, r.reason); }
+        if let Some(r) = &d.remainder { eprintln!("      remainder: {}", r.text); }
+    }
+}
+
+#[test]
+#[ignore]
+fn scale_conv() {
+    use tricept_plant::{Campaign, Plant, PoseOrder, random_errors};
+    use tricept_diagnose::{ExtendedModel, Candidate};
+    use tricept_ident::{GeometricModel, identify, IdentifyOptions};
+    let m = tricept_kinematics::Machine::paper();
+    let set = tricept_model::ParameterSet::paper15();
+    for seed in [500u64, 501, 105, 106] {
+        let mut plant = Plant::geometric(m.clone(), set.to_errors(&random_errors(15, 0.5, seed)));
+        plant.effects = vec![Effect::ScaleGain { ppm: 120.0 }];
+        let mut campaign = Campaign::random(&m, 200, 7 * seed + 1);
+        campaign.noise.readings_per_pose = 30;
+        campaign.order = PoseOrder::BothDirections;
+        let data = plant.simulate(&campaign).unwrap();
+        let g = GeometricModel::new(m.clone(), set.clone());
+        for c in [E::ScaleGain, E::LegLead] {
+            let model = ExtendedModel::new(g.clone(), &[Candidate(c)]);
+            let id = identify(&model, &data, &IdentifyOptions::with_sigma(campaign.noise.logged_sigma())).unwrap();
+            eprintln!("seed {seed} {c}: chi2 {:.1} conv {} it {} rank {} tail {:?}", id.stats.chi_square, id.converged, id.iterations, id.design().rank(), &id.estimate[15..]);
+        }
+    }
+}
+
+#[test]
+#[ignore]
+fn repro() {
+    let which = std::env::var("WHICH").unwrap_or("quad".into());
+    let (base, i, n) = if which == "quad" { (0x9a0du64, 10u64, 80) } else { (0x1e15u64, 6u64, 80) };
+    let seed = base + i;
+    let r = &mut rng(base, seed);
+    let e = if which == "quad" {
+        Effect::LegQuadratic { um: std::array::from_fn(|_| sign(r) * uniform(r, 5.0, 15.0)), centre_mm: 845.0, half_width_mm: 250.0 }
+    } else {
+        Effect::LegPower { um: std::array::from_fn(|_| sign(r) * uniform(r, 5.0, 15.0)), exponent: 1.5, centre_mm: 845.0, half_width_mm: 250.0 }
+    };
+    let s = simulate(n, seed, vec![e], CampaignOptions::default());
+    let d = tricept_diagnose::diagnose(&tricept_kinematics::Machine::paper(), &s.data, &options(s.sigma)).unwrap();
+    eprintln!("{}", summary(&d));
+    for c in &d.causes { let e = &c.evidence; eprintln!("      {}: drop {:.1} k {} p_adj {:.1e} G {:.1} cv {:?} -> {:?}", c.effect, e.delta_chi_square, e.dof, e.p_adjusted, e.penalised_gain, e.holdout_rms_without, e.holdout_rms_with); }
+    for r in &d.rejected { eprintln!("      rejected {}: {}", r.description, r.reason); }
+}

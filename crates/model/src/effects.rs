@@ -127,7 +127,7 @@ impl std::fmt::Display for EffectName {
 /// | name | form | a machine builder reads it as |
 /// |---|---|---|
 /// | `leg-periodic` | `a_i sin(2 pi q_i / P) + b_i cos(2 pi q_i / P)` per leg | ball-screw pitch error (period = lead) |
-/// | `leg-polynomial` | `c2_i P2(x_i) + c3_i P3(x_i)`, `x_i` the leg's normalised stroke | screw travel variation, bent guide |
+/// | `leg-polynomial` | `c1_i x_i + c2_i P2(x_i) + c3_i P3(x_i)`, `x_i` the leg's stroke over the campaign on `[-1, 1]` | mean travel deviation and travel variation of a screw, a bent guide |
 /// | `reading-drift` | reading drifts linearly with time (or pose order) | sensor or mounting drift |
 /// | `reading-temperature` | reading changes with the logged temperature | thermal drift of the sensor path |
 /// | `leg-drift` | leg lengths drift linearly with time | creep, drive warm-up |
@@ -382,6 +382,12 @@ pub fn legendre_p2(x: f64) -> f64 {
 /// Legendre polynomial `P3(x) = (5 x^3 - 3 x) / 2`.
 pub fn legendre_p3(x: f64) -> f64 {
     0.5 * (5.0 * x * x * x - 3.0 * x)
+}
+
+/// Legendre polynomial `P4(x) = (35 x^4 - 30 x^2 + 3) / 8`.
+pub fn legendre_p4(x: f64) -> f64 {
+    let x2 = x * x;
+    (35.0 * x2 * x2 - 30.0 * x2 + 3.0) / 8.0
 }
 
 /// Reading error of an encoder with gain error `ppm` at `angle_rad`, rad.

@@ -164,3 +164,43 @@ pub fn named(d: &Diagnosis, name: CauseName) -> bool {
 pub fn in_alias(d: &Diagnosis, name: CauseName) -> bool {
     d.aliases.iter().any(|a| a.effects.contains(&name))
 }
+
+/// Checks every diagnosis must pass: each named cause plausible, and a
+/// named cause never makes the held-out fit worse. Returns the failures.
+pub fn invariants(d: &Diagnosis) -> Vec<String> {
+    let mut out = Vec::new();
+    for c in &d.causes {
+        if !c.plausible {
+            out.push(format!("{} named but not plausible", c.effect));
+        }
+    }
+    let physical = d
+        .causes
+        .iter()
+        .any(|c| c.effect != EffectName::Outliers)
+        || !d.aliases.is_empty();
+    if physical && d.gain.holdout_rms_extended > d.gain.holdout_rms_geometric {
+        out.push(format!(
+            "held-out rms worse with the causes: {} -> {}",
+            d.gain.holdout_rms_geometric, d.gain.holdout_rms_extended
+        ));
+    }
+    out
+}
+
+/// Prints a tally line (quoted in docs/diagnosis.md).
+pub fn tally(case: &str, n: usize, what: &str, k: usize, of: usize) {
+    eprintln!("TALLY {case} n={n}: {what} {k}/{of}");
+}
+
+/// Whether a generic group (`reading-drift:s`) is named or in an alias set.
+pub fn group_found(d: &Diagnosis, label: &str) -> bool {
+    d.aliases
+        .iter()
+        .any(|a| a.descriptions.iter().any(|x| x == label))
+        || d.causes.iter().any(|c| {
+            c.effect.is_generic()
+                && c.channel.is_some()
+                && format!("{}:{}", c.effect, c.channel.unwrap_or_default()) == label
+        })
+}
