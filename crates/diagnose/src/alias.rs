@@ -30,7 +30,7 @@ use tricept_model::effects::{
 };
 use tricept_numerics::stats::chi2_isf;
 
-use crate::linear::{Linearisation, canonical_correlation};
+use crate::linear::{Linearisation, canonical_correlation, nested};
 use crate::model::Candidate;
 use crate::plausibility::quantities;
 use crate::report::{Alias, Estimate, RejectStage, Rejected};
@@ -270,6 +270,11 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
         }
         let mut members: Vec<(Alternative, f64, Vec<Estimate>, bool)> = Vec::new();
         for alt in alternatives {
+            // A term that contains A (a polynomial leg error contains a
+            // lead) generalises it: not another name for it.
+            if nested(&xa, &lin.project(&alt.columns)) && alt.columns.ncols() > xa.ncols() {
+                continue;
+            }
             let s = lin.score_dense(&alt.columns);
             if s.rank == 0 {
                 continue;
