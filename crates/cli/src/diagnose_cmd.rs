@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_diagnose::detect::{advise, detectability, realistic};
-use tricept_diagnose::{DiagnoseError, DiagnoseOptions, diagnose};
+use tricept_diagnose::detect::{advise, realistic, term_detectability};
+use tricept_diagnose::{DiagnoseError, DiagnoseOptions, Plausibility, diagnose};
 use tricept_ident::GeometricModel;
 use tricept_model::{GeometricErrors, ParameterSet};
 use tricept_plant::{Campaign, Effect, Plant, PoseOrder};
@@ -21,6 +21,24 @@ pub struct DiagnoseArgs {
     /// Write residual plots (SVG) of the named causes into this directory.
     #[arg(long, value_name = "DIR")]
     pub plots: Option<PathBuf>,
+    /// Estimate the sensor noise from repeated poses (the same commands
+    /// logged on separate visits, at least 10 degrees of freedom) and test
+    /// against it (F tests) instead of the stated noise.
+    #[arg(long)]
+    pub noise_from_data: bool,
+    /// Standard deviation of the logged temperature, K (default 0.02): its
+    /// noise enters the final adequacy test of temperature terms.
+    #[arg(long, value_name = "K")]
+    pub temperature_noise: Option<f64>,
+    /// Override physical ranges of the plausibility table: a JSON object
+    /// such as `{"thermal.expansion_ppm_per_k": [20, 26]}` (aluminium legs).
+    #[arg(long, value_name = "FILE.json")]
+    pub plausibility: Option<PathBuf>,
+    /// Search the effects of the vocabulary only, not the generic
+    /// dictionary (for comparison; effects outside the vocabulary are then
+    /// reported as unexplained).
+    #[arg(long)]
+    pub no_dictionary: bool,
     #[command(flatten)]
     pub noise: NoiseArgs,
     #[command(flatten)]
@@ -51,15 +69,25 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<(), CliError> {
     let m = machine_with_noise(machine, &a.noise)?;
     let dataset = read_data(data, &m)?;
     let source = data.display().to_string();
-    let d = diagnose(&m, &dataset, &DiagnoseOptions::for_machine(&m)).map_err(|e| match e {
-        DiagnoseError::TooFewPoses(_) => CliError::input(format!("{source}: {e}")),
-        DiagnoseError::Ident(tricept_ident::IdentError::Kinematics {
-            line, source: k, ..
-        }) => CliError::input(format!(
-            "{source}: line {line}: the commands of this pose cannot be reached: {k}"
-        )),
-        e => CliError::other(format!("{source}: {e}")),
-    })?;
+    let mut options = DiagnoseOptions::for_machine(&m);
+    options.noise_from_data = a.noise_from_data;
+    options.dictionary.enabled = !a.no_dictionary;
+    if let Some(k) = a.temperature_noise {
+        if !(k.is_finite() && k >= 0.0) {
+            return Err(CliError::input(format!(
+                "--temperature-noise: must be a non-negative number of kelvin, got {k}"
+            )));
+        }
+        options.temperature_sigma_k = k;
+    }
+    if let Some(path) = &a.plausibility {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| CliError::input(format!("{file}: {e}")))?;
+        options.plausibility = Plausibility::with_overrides(&text)
+            .map_err(|e| CliError::input(format!("{file}: {e}")))?;
+    }
+    let d = diagnose(&m, &dataset, &options).map_err(|e| diagnose_error(&source, e))?;
     if let Some(dir) = &a.plots {
         std::fs::create_dir_all(dir)
             .map_err(|e| CliError::other(format!("{}: {e}", dir.display())))?;
@@ -88,6 +116,20 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<(), CliError> {
     }
     print!("{}", d.to_text(&source));
     Ok(())
+}
+
+/// The CLI error of a failed diagnosis: everything the data cause is an
+/// input error (exit 2), naming the file.
+fn diagnose_error(source: &str, e: DiagnoseError) -> CliError {
+    match e {
+        DiagnoseError::Ident(tricept_ident::IdentError::Kinematics {
+            line, source: k, ..
+        }) => CliError::input(format!(
+            "{source}: line {line}: the commands of this pose cannot be reached: {k}"
+        )),
+        DiagnoseError::Ident(e) => CliError::other(format!("{source}: {e}")),
+        e => CliError::input(format!("{source}: {e}")),
+    }
 }
 
 /// `tricept detectability`.
@@ -120,7 +162,7 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<(), CliError> {
     let geometric = GeometricModel::new(m.clone(), ParameterSet::paper15());
     let mut rows = Vec::new();
     for (c, v, label) in realistic(&m) {
-        if let Some(d) = detectability(&geometric, c, &v, &data.poses, sigma, 1e-3) {
+        if let Some(d) = term_detectability(&geometric, &c, &v, &data.poses, sigma, 1e-3) {
             let advice = advise(&d, data.poses.len(), campaign.noise.readings_per_pose);
             rows.push((label, d, advice));
         }

@@ -27,6 +27,14 @@ pub struct SimulateArgs {
     /// Visit every pose twice, approaching from both directions.
     #[arg(long)]
     pub both_directions: bool,
+    /// Revisit the first N targets at the end of the campaign (separate
+    /// visits of the same commands: what `diagnose --noise-from-data` uses).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub revisit: usize,
+    /// Make the true noise this many times the machine's stated noise
+    /// (vibration, a sensor worse than its data sheet).
+    #[arg(long, value_name = "F", default_value_t = 1.0)]
+    pub noise_factor: f64,
     /// An unmodelled effect (JSON object or @FILE); repeatable.
     #[arg(long = "effect", value_name = "JSON")]
     pub effects: Vec<String>,
@@ -51,6 +59,14 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
     if a.both_directions {
         campaign.order = PoseOrder::BothDirections;
     }
+    if !(a.noise_factor.is_finite() && a.noise_factor > 0.0) {
+        return Err(CliError::input(format!(
+            "--noise-factor: must be a positive number, got {}",
+            a.noise_factor
+        )));
+    }
+    campaign.revisits = a.revisit;
+    campaign.noise_factor = a.noise_factor;
     let mut plant = Plant::geometric(m.clone(), set.to_errors(&values));
     plant.effects = parse_effects(&a.effects)?;
     let data = plant
@@ -64,7 +80,7 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
             m.name
         ),
         format!(
-            "pose set `{}` ({} poses{}), seed {}",
+            "pose set `{}` ({} poses{}{}), seed {}",
             a.poses,
             data.poses.len(),
             if a.both_directions {
@@ -72,13 +88,23 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
             } else {
                 ""
             },
+            if a.revisit > 0 {
+                format!(", the first {} revisited at the end", a.revisit)
+            } else {
+                String::new()
+            },
             a.seed
         ),
         format!(
-            "noise per reading: {:.3} arcsec, {:.3} um, mean of {}",
+            "noise per reading: {:.3} arcsec, {:.3} um, mean of {}{}",
             m.sensors.angle_rad / tricept_kinematics::units::RAD_PER_ARCSEC,
             m.sensors.length_mm * 1e3,
-            m.sensors.readings_per_pose
+            m.sensors.readings_per_pose,
+            if a.noise_factor == 1.0 {
+                String::new()
+            } else {
+                format!(" (stated; the true noise is {} times it)", a.noise_factor)
+            }
         ),
         format!(
             "true errors ({}, mm): {}",
