@@ -28,7 +28,7 @@ pub struct DiagnoseArgs {
     pub noise_from_data: bool,
     /// Standard deviation of the logged temperature, K (default 0.02): its
     /// noise enters the final adequacy test of temperature terms.
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", allow_negative_numbers = true)]
     pub temperature_noise: Option<f64>,
     /// Override physical ranges of the plausibility table: a JSON object
     /// such as `{"thermal.expansion_ppm_per_k": [20, 26]}` (aluminium legs).

@@ -167,6 +167,13 @@ pub fn diagnose(
     let data = numbered(data, &mut limitations);
     let frame = Arc::new(Frame::of(nominal, &data));
     let repeated = repeats(&data, options.repeat_tolerance_mm);
+    let distinct = n - repeated.dof();
+    if distinct < 20 {
+        return Err(DiagnoseError::Degenerate(format!(
+            "only {distinct} distinct pose{} among {n} rows (repeated commands do not count): at least 20 are needed to fit and test the model",
+            if distinct == 1 { "" } else { "s" }
+        )));
+    }
     let geometric = GeometricModel::new(nominal.clone(), ParameterSet::paper15());
     let available: Vec<Candidate> = Candidate::ALL
         .iter()

@@ -18,8 +18,8 @@
 //! 4. the 5-fold cross-validated held-out RMS improves.
 //!
 //! The admissible candidate with the largest `G` enters (ties prefer the
-//! catalogue). Then swaps: a catalogue effect in the model is replaced by
-//! another when that lowers the BIC of the whole model.
+//! catalogue). Then swaps: a term of the model is replaced by a catalogue
+//! effect when that lowers the BIC of the whole model.
 //!
 //! **Admission on the final model.** Backward elimination: every cause must
 //! pass the likelihood-ratio test and the penalised gain against the final
@@ -484,7 +484,10 @@ fn forward_step(
     Some((trials.swap_remove(index), rms))
 }
 
-/// Swaps of catalogue effects that lower the BIC of the whole model.
+/// Swaps: a term of the model (catalogue or generic) replaced by a
+/// catalogue effect when that lowers the BIC of the whole model (a
+/// polynomial leg error that entered for a scale gain while an
+/// eccentricity was still unmodelled is a lead once the eccentricity is in).
 fn swaps(setup: &Setup<'_>, clean: &Dataset, mut current: Fit) -> Fit {
     let readings = (3 * clean.poses.len()) as f64;
     let bic = |f: &Fit| f.id.stats.chi_square + f.id.design().rank() as f64 * readings.ln();
@@ -493,7 +496,6 @@ fn swaps(setup: &Setup<'_>, clean: &Dataset, mut current: Fit) -> Fit {
         let options: Vec<(usize, Term)> = terms
             .iter()
             .enumerate()
-            .filter(|(_, t)| matches!(t, Term::Catalogue(_)))
             .flat_map(|(slot, _)| {
                 setup
                     .available
@@ -600,7 +602,7 @@ pub(crate) fn select(setup: &Setup<'_>, clean: &Dataset) -> Result<Selection, Di
                 None => break,
             }
         }
-        if current.model.terms().len() > 1 {
+        if !current.model.terms().is_empty() {
             let swapped = swaps(setup, clean, current.clone());
             if swapped.model.terms() != current.model.terms() {
                 current = swapped;

@@ -148,3 +148,25 @@ fn repro() {
     for c in &d.causes { let e = &c.evidence; eprintln!("      {}: drop {:.1} k {} p_adj {:.1e} G {:.1} cv {:?} -> {:?}", c.effect, e.delta_chi_square, e.dof, e.p_adjusted, e.penalised_gain, e.holdout_rms_without, e.holdout_rms_with); }
     for r in &d.rejected { eprintln!("      rejected {}: {}", r.description, r.reason); }
 }
+
+#[test]
+#[ignore]
+fn generous_pair() {
+    use tricept_plant::{Campaign, Plant, PoseOrder, random_errors};
+    let m = tricept_kinematics::Machine::paper();
+    let set = tricept_model::ParameterSet::paper15();
+    for seed in [900u64, 901, 902] {
+        let mut plant = Plant::geometric(m.clone(), set.to_errors(&random_errors(15, 0.5, seed)));
+        plant.effects = vec![Effect::ScaleGain { ppm: -90.0 }, Effect::EncoderEccentricity { phi_arcsec: 8.0, phi_phase_deg: 40.0, theta_arcsec: 11.0, theta_phase_deg: 250.0 }];
+        let mut campaign = Campaign::random(&m, 200, 7 * seed + 1);
+        campaign.noise.readings_per_pose = 1000;
+        campaign.order = PoseOrder::BothDirections;
+        let data = plant.simulate(&campaign).unwrap();
+        let o = options(campaign.noise.logged_sigma());
+        let d = tricept_diagnose::diagnose(&m, &data, &o).unwrap();
+        eprintln!("seed {seed}: {}", summary(&d));
+        for a in &d.aliases { eprintln!("      alias {:?} in model {}: lambda {:.2} params {:?}", a.descriptions, a.in_model, a.lambda_unexplained, a.parameters.iter().map(|p| format!("{}={:.1}", p.name, p.value)).collect::<Vec<_>>()); }
+        for r in &d.rejected { eprintln!("      rejected {}: {}", r.description, r.reason); }
+        eprintln!("      extended tail {:?}", d.extended.iter().skip(15).map(|e| format!("{}={:.2}", e.name, e.value)).collect::<Vec<_>>());
+    }
+}
