@@ -75,7 +75,9 @@ fn explain(a: CauseName, c: CauseName, c_label: &str) -> (String, String) {
     let temperature_campaign = "a campaign in which temperature does not follow time: log through warm-up and cool-down, or revisit poses at different temperatures";
     if c_label.ends_with("(higher order)") {
         return (
-            format!("{c_label} explains it as well: it is the part of the leg error the generic form leaves, not an effect of its own"),
+            format!(
+                "{c_label} explains it as well: it is the part of the leg error the generic form leaves, not an effect of its own"
+            ),
             "a campaign that covers more of each leg's stroke, or more readings per pose".into(),
         );
     }
@@ -104,7 +106,9 @@ fn explain(a: CauseName, c: CauseName, c_label: &str) -> (String, String) {
             );
         }
         return (
-            format!("the logged temperature followed time during the campaign, so a change with temperature and a drift with time ({c_label}) look alike"),
+            format!(
+                "the logged temperature followed time during the campaign, so a change with temperature and a drift with time ({c_label}) look alike"
+            ),
             temperature_campaign.into(),
         );
     }
@@ -149,8 +153,18 @@ fn refinement(g: &GenericTerm, frame: &Frame, data: &Dataset) -> Option<Vec<(usi
                     .flat_map(|&i| {
                         let q: Vec<f64> = poses.iter().map(|p| p.commands_mm[i]).collect();
                         [
-                            (i, q.iter().map(|q| periodic_extra_mm(1.0, 0.0, half, *q)).collect()),
-                            (i, q.iter().map(|q| periodic_extra_mm(0.0, 1.0, half, *q)).collect()),
+                            (
+                                i,
+                                q.iter()
+                                    .map(|q| periodic_extra_mm(1.0, 0.0, half, *q))
+                                    .collect(),
+                            ),
+                            (
+                                i,
+                                q.iter()
+                                    .map(|q| periodic_extra_mm(0.0, 1.0, half, *q))
+                                    .collect(),
+                            ),
                         ]
                     })
                     .collect(),
@@ -203,7 +217,8 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
         if columns.is_empty() {
             continue;
         }
-        let theta = DVector::from_iterator(columns.len(), columns.iter().map(|&p| fit.id.estimate[p]));
+        let theta =
+            DVector::from_iterator(columns.len(), columns.iter().map(|&p| fit.id.estimate[p]));
         let xa = lin.projected_columns(&params);
         let signature = &xa * &theta;
         let strength = signature.norm_squared();
@@ -280,9 +295,6 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
                 continue;
             }
             let lambda = (strength - s.explained).max(0.0);
-            if std::env::var("ALIAS_DEBUG").is_ok() {
-                eprintln!("ALIAS {} vs {}: strength {strength:.1} explained {:.1} rank {}", describe_group(a), alt.label, s.explained, s.rank);
-            }
             if lambda >= critical {
                 continue;
             }
@@ -340,7 +352,9 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
         }
         // An equal lead is the full lead's special case: name it alone.
         if members.iter().any(|m| m.0.label.contains("equal")) {
-            members.retain(|m| !(m.0.name == CauseName::Catalogue(EffectName::LegLead) && !m.0.label.contains("equal")));
+            members.retain(|m| {
+                m.0.name != CauseName::Catalogue(EffectName::LegLead) || m.0.label.contains("equal")
+            });
         }
         if members.is_empty() {
             continue;
@@ -385,8 +399,11 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
     let lead_term = Term::Catalogue(lead());
     if let Some(i) = terms.iter().position(|t| *t == lead_term) {
         let already = out.aliases.iter().any(|al| {
-            al.effects.contains(&CauseName::Catalogue(EffectName::ScaleGain))
-                && al.effects.contains(&CauseName::Catalogue(EffectName::LegLead))
+            al.effects
+                .contains(&CauseName::Catalogue(EffectName::ScaleGain))
+                && al
+                    .effects
+                    .contains(&CauseName::Catalogue(EffectName::LegLead))
         });
         let (v, cov) = term_estimates(fit, &lead_term);
         let mean = v.iter().sum::<f64>() / 3.0;

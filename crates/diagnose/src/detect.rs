@@ -64,7 +64,14 @@ pub fn detectability(
     sigma: [f64; 3],
     alpha: f64,
 ) -> Option<Detectability> {
-    term_detectability(geometric, &Term::Catalogue(candidate), v, poses, sigma, alpha)
+    term_detectability(
+        geometric,
+        &Term::Catalogue(candidate),
+        v,
+        poses,
+        sigma,
+        alpha,
+    )
 }
 
 /// [`detectability`] of any term: an effect of the vocabulary or a generic
@@ -205,21 +212,25 @@ pub fn realistic(machine: &tricept_kinematics::Machine) -> Vec<(Term, Vec<f64>, 
         (catalogue(E::Backlash), vec![5.0, 5.0, 5.0], "5 um"),
         (catalogue(E::Thermal), vec![11.5], "11.5 ppm/K (steel)"),
         (catalogue(E::ScaleGain), vec![50.0], "50 ppm"),
-        (catalogue(E::EncoderEccentricity),
+        (
+            catalogue(E::EncoderEccentricity),
             vec![5.0, 0.0, 5.0, 0.0],
             "5 arcsec, sine phase",
         ),
-        (catalogue(E::EncoderEccentricity),
+        (
+            catalogue(E::EncoderEccentricity),
             vec![0.0, 5.0, 0.0, 5.0],
             "5 arcsec, cosine phase",
         ),
         (catalogue(E::UjointAxes), vec![30.0, 0.0], "30 arcsec skew"),
         (catalogue(E::UjointAxes), vec![0.0, 20.0], "20 um offset"),
-        (catalogue(E::TubeTwist),
+        (
+            catalogue(E::TubeTwist),
             vec![30.0 / 2.9],
             "30 arcsec over the stroke",
         ),
-        (catalogue(E::Compliance),
+        (
+            catalogue(E::Compliance),
             vec![1000.0 / stiffness_for_platform_deflection(machine, 10.0)],
             "10 um at the platform",
         ),

@@ -22,9 +22,9 @@
 use tricept_data::Dataset;
 use tricept_model::effects::GenericFamily;
 
+use crate::evidence::Reference;
 use crate::linear::Linearisation;
 use crate::terms::{Frame, GenericTerm, Term};
-use crate::evidence::Reference;
 
 /// Settings of the generic dictionary.
 #[derive(Debug, Clone, PartialEq)]
@@ -63,6 +63,34 @@ pub(crate) struct Scored {
     pub(crate) p_adjusted: f64,
     /// Standard deviation of the period, mm.
     pub(crate) period_sd_mm: Option<f64>,
+}
+
+/// A fit the dictionary is screened at: its linearisation, the campaign
+/// frame and poses, the test reference, and the fit's chi-square.
+pub(crate) struct At<'a> {
+    pub(crate) lin: &'a Linearisation,
+    pub(crate) frame: &'a Frame,
+    pub(crate) data: &'a Dataset,
+    pub(crate) reference: &'a Reference,
+    pub(crate) chi_square: f64,
+    pub(crate) dof: usize,
+}
+
+impl At<'_> {
+    /// Score and rank of a term's columns.
+    fn score(&self, term: &GenericTerm) -> (f64, usize) {
+        let s = self
+            .lin
+            .score_columns(&self.lin.generic_columns(term, self.frame, self.data));
+        (s.explained, s.rank)
+    }
+
+    /// The residual variance factor a term of score `explained` and rank
+    /// `rank` would leave.
+    fn scale(&self, explained: f64, rank: usize) -> f64 {
+        self.reference
+            .scale(self.chi_square - explained, self.dof.saturating_sub(rank))
+    }
 }
 
 /// The dictionary of one campaign.
@@ -142,20 +170,11 @@ impl Dictionary {
 
     /// Scores every group not made redundant by `model_terms`, best first
     /// (smallest adjusted p-value, then largest score).
-    pub(crate) fn screen(
-        &self,
-        lin: &Linearisation,
-        frame: &Frame,
-        data: &Dataset,
-        model_terms: &[Term],
-        reference: &Reference,
-        chi_square: f64,
-        dof: usize,
-    ) -> Vec<Scored> {
+    pub(crate) fn screen(&self, at: &At<'_>, model_terms: &[Term]) -> Vec<Scored> {
         let m = self.multiplicity().max(1) as f64;
         let test = |explained: f64, rank: usize| -> f64 {
-            let s2 = reference.scale(chi_square - explained, dof.saturating_sub(rank));
-            (reference.p_value(explained / s2, rank) * m).min(1.0)
+            let s2 = at.scale(explained, rank);
+            (at.reference.p_value(explained / s2, rank) * m).min(1.0)
         };
         let admitted_frequencies: Vec<f64> = model_terms
             .iter()
@@ -170,30 +189,28 @@ impl Dictionary {
                 continue;
             }
             if g.family == GenericFamily::LegPeriodic {
-                if let Some(s) =
-                    self.scan(lin, frame, data, g, &admitted_frequencies, chi_square, dof, reference)
+                if let Some((explained, rank, term, period_sd_mm)) =
+                    self.scan(at, g, &admitted_frequencies)
                 {
-                    let p_adj = test(s.0, s.1);
                     out.push(Scored {
-                        term: s.2,
-                        explained: s.0,
-                        rank: s.1,
-                        p_adjusted: p_adj,
-                        period_sd_mm: s.3,
+                        term,
+                        explained,
+                        rank,
+                        p_adjusted: test(explained, rank),
+                        period_sd_mm,
                     });
                 }
                 continue;
             }
-            let s = lin.score_columns(&lin.generic_columns(g, frame, data));
-            if s.rank == 0 {
+            let (explained, rank) = at.score(g);
+            if rank == 0 {
                 continue;
             }
-            let p_adj = test(s.explained, s.rank);
             out.push(Scored {
                 term: *g,
-                explained: s.explained,
-                rank: s.rank,
-                p_adjusted: p_adj,
+                explained,
+                rank,
+                p_adjusted: test(explained, rank),
                 period_sd_mm: None,
             });
         }
@@ -207,70 +224,56 @@ impl Dictionary {
 
     /// The best period of the scan, refined: (score, rank, term with its
     /// period, sd of the period).
-    #[allow(clippy::too_many_arguments)]
     fn scan(
         &self,
-        lin: &Linearisation,
-        frame: &Frame,
-        data: &Dataset,
+        at: &At<'_>,
         group: &GenericTerm,
         admitted: &[f64],
-        chi_square: f64,
-        dof: usize,
-        reference: &Reference,
     ) -> Option<(f64, usize, GenericTerm, Option<f64>)> {
-        let at = |f: f64| -> (f64, usize) {
-            let t = GenericTerm {
-                period_mm: Some(1.0 / f),
-                ..*group
-            };
-            let s = lin.score_columns(&lin.generic_columns(&t, frame, data));
-            (s.explained, s.rank)
+        let with = |f: f64| GenericTerm {
+            period_mm: Some(1.0 / f),
+            ..*group
         };
+        let score = |f: f64| at.score(&with(f));
         let near_admitted = |f: f64| admitted.iter().any(|a| (f - a).abs() <= 2.0 * self.step);
-        let mut best: Option<(f64, f64, usize)> = None;
+        let mut best: Option<(f64, f64)> = None;
         for &f in &self.frequencies {
             if near_admitted(f) {
                 continue;
             }
-            let (s, k) = at(f);
+            let (s, k) = score(f);
             if k > 0 && best.is_none_or(|b| s > b.1) {
-                best = Some((f, s, k));
+                best = Some((f, s));
             }
         }
-        let (f0, _, _) = best?;
+        let (f0, _) = best?;
         // Golden-section search of the score within one grid step.
         let (mut a, mut b) = (f0 - self.step, f0 + self.step);
         let ratio = 0.5 * (5f64.sqrt() - 1.0);
         let mut x1 = b - ratio * (b - a);
         let mut x2 = a + ratio * (b - a);
-        let (mut s1, mut s2) = (at(x1).0, at(x2).0);
+        let (mut s1, mut s2) = (score(x1).0, score(x2).0);
         for _ in 0..25 {
             if s1 > s2 {
                 b = x2;
                 x2 = x1;
                 s2 = s1;
                 x1 = b - ratio * (b - a);
-                s1 = at(x1).0;
+                s1 = score(x1).0;
             } else {
                 a = x1;
                 x1 = x2;
                 s1 = s2;
                 x2 = a + ratio * (b - a);
-                s2 = at(x2).0;
+                s2 = score(x2).0;
             }
         }
         let f = 0.5 * (a + b);
-        let (s, k) = at(f);
+        let (s, k) = score(f);
         // Curvature by central differences (a tenth of a grid step).
         let h = 0.1 * self.step;
-        let curvature = (at(f + h).0 - 2.0 * s + at(f - h).0) / (h * h);
-        let scale = reference.scale(chi_square - s, dof.saturating_sub(k));
-        let sd_f = (curvature < 0.0).then(|| (2.0 * scale / -curvature).sqrt());
-        let term = GenericTerm {
-            period_mm: Some(1.0 / f),
-            ..*group
-        };
-        Some((s, k, term, sd_f.map(|sd| sd / (f * f))))
+        let curvature = (score(f + h).0 - 2.0 * s + score(f - h).0) / (h * h);
+        let sd_f = (curvature < 0.0).then(|| (2.0 * at.scale(s, k) / -curvature).sqrt());
+        Some((s, k, with(f), sd_f.map(|sd| sd / (f * f))))
     }
 }

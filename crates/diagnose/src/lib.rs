@@ -46,9 +46,9 @@ pub use model::{Candidate, ExtendedModel, MIN_TEMPERATURE_RANGE_K, REFERENCE_TEM
 pub use noise::NOISE_CHECK_LEVEL;
 pub use plausibility::{Plausibility, PlausibilityError, Range};
 pub use report::{
-    Alias, Cause, CauseKind, ChannelRms, Diagnosis, Estimate, Evidence, FinalFit, Gain,
-    NoiseCheck, NoiseSource, PureError, Rejected, RejectStage, Remainder, ResidualPlot,
-    Structure, TermScore, Tested, Verdict,
+    Alias, Cause, CauseKind, ChannelRms, Diagnosis, Estimate, Evidence, FinalFit, Gain, NoiseCheck,
+    NoiseSource, PureError, RejectStage, Rejected, Remainder, ResidualPlot, Structure, TermScore,
+    Tested, Verdict,
 };
 pub use run::{DiagnoseError, DiagnoseOptions, MIN_PURE_ERROR_DOF, diagnose};
 pub use terms::{Frame, GenericTerm, OrderAxis, Scope, Term};

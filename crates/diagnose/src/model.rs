@@ -14,14 +14,15 @@
 
 use std::sync::Arc;
 
+use crate::terms::{Basis, Frame, Term};
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_ident::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{KinematicsError, Machine, UpJoints};
-use crate::terms::{Basis, Frame, Term};
 use tricept_model::effects::{
-    CauseName, EffectName, add_tube_twist, add_ujoint_axis_errors, backlash_extra_mm, compliance_extra_mm,
-    gravity_leg_tension_n, leg_lead_extra_mm, scale_gain_error_mm, thermal_extra_mm,
+    CauseName, EffectName, add_tube_twist, add_ujoint_axis_errors, backlash_extra_mm,
+    compliance_extra_mm, gravity_leg_tension_n, leg_lead_extra_mm, scale_gain_error_mm,
+    thermal_extra_mm,
 };
 
 /// An effect the diagnosis can fit (every name of the vocabulary except
@@ -159,7 +160,11 @@ impl ExtendedModel {
     }
 
     /// `geometric` extended by `terms`, the generic ones measured in `frame`.
-    pub fn with_terms(geometric: GeometricModel, terms: &[Term], frame: Arc<Frame>) -> ExtendedModel {
+    pub fn with_terms(
+        geometric: GeometricModel,
+        terms: &[Term],
+        frame: Arc<Frame>,
+    ) -> ExtendedModel {
         let mut names = geometric.names().to_vec();
         let mut seen: Vec<CauseName> = Vec::new();
         for t in terms {
@@ -308,7 +313,11 @@ impl ExtendedPredictor<'_> {
             let e = match term {
                 Term::Catalogue(c) => *c,
                 Term::Generic(g) => {
-                    for (k, (basis, v)) in g.leg_values(&self.model.frame, pose).into_iter().enumerate() {
+                    for (k, (basis, v)) in g
+                        .leg_values(&self.model.frame, pose)
+                        .into_iter()
+                        .enumerate()
+                    {
                         if let Basis::Leg(i) = basis {
                             legs[i] += self.p[at + k] * v;
                             let mut d = [0.0; 3];

@@ -41,9 +41,7 @@ impl Repeats {
 pub(crate) fn repeats(data: &Dataset, tolerance_mm: f64) -> Repeats {
     let n = data.poses.len();
     let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&a, &b| {
-        data.poses[a].commands_mm[0].total_cmp(&data.poses[b].commands_mm[0])
-    });
+    order.sort_by(|&a, &b| data.poses[a].commands_mm[0].total_cmp(&data.poses[b].commands_mm[0]));
     let mut group_of = vec![usize::MAX; n];
     let mut groups: Vec<Vec<usize>> = Vec::new();
     for (k, &a) in order.iter().enumerate() {
@@ -57,8 +55,7 @@ pub(crate) fn repeats(data: &Dataset, tolerance_mm: f64) -> Repeats {
             if qb[0] - qa[0] > tolerance_mm {
                 break;
             }
-            if group_of[b] == usize::MAX && (0..3).all(|i| (qa[i] - qb[i]).abs() <= tolerance_mm)
-            {
+            if group_of[b] == usize::MAX && (0..3).all(|i| (qa[i] - qb[i]).abs() <= tolerance_mm) {
                 members.push(b);
             }
         }
@@ -93,7 +90,10 @@ pub(crate) fn pure_error(
     let mut ss = [0.0; 3];
     let mut dof = 0;
     for g in &repeats.groups {
-        let r: Vec<[f64; 3]> = g.iter().filter_map(|&j| residuals.get(j).copied().flatten()).collect();
+        let r: Vec<[f64; 3]> = g
+            .iter()
+            .filter_map(|&j| residuals.get(j).copied().flatten())
+            .collect();
         if r.len() < 2 {
             continue;
         }
@@ -144,7 +144,13 @@ mod tests {
             commands_mm: [q, 800.0, 900.0],
             ..Default::default()
         };
-        let poses = vec![pose(700.0), pose(750.0), pose(700.0005), pose(760.0), pose(750.0)];
+        let poses = vec![
+            pose(700.0),
+            pose(750.0),
+            pose(700.0005),
+            pose(760.0),
+            pose(750.0),
+        ];
         let data = Dataset {
             poses,
             source: String::new(),

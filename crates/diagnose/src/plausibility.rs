@@ -80,10 +80,34 @@ impl Default for Plausibility {
                 },
             );
         };
-        add("leg-lead.lead_ppm", -300.0, 300.0, "ppm", "ball-screw lead deviations are tens of ppm");
-        add("backlash.backlash_um", 0.0, 50.0, "um", "lost motion is positive: the nut lags");
-        add("thermal.expansion_ppm_per_k", 8.0, 16.0, "ppm/K", "steel or cast-iron legs");
-        add("scale-gain.scale_gain_ppm", -300.0, 300.0, "ppm", "glass scales and their mounting");
+        add(
+            "leg-lead.lead_ppm",
+            -300.0,
+            300.0,
+            "ppm",
+            "ball-screw lead deviations are tens of ppm",
+        );
+        add(
+            "backlash.backlash_um",
+            0.0,
+            50.0,
+            "um",
+            "lost motion is positive: the nut lags",
+        );
+        add(
+            "thermal.expansion_ppm_per_k",
+            8.0,
+            16.0,
+            "ppm/K",
+            "steel or cast-iron legs",
+        );
+        add(
+            "scale-gain.scale_gain_ppm",
+            -300.0,
+            300.0,
+            "ppm",
+            "glass scales and their mounting",
+        );
         add(
             "encoder-eccentricity.amplitude_arcsec",
             0.0,
@@ -91,8 +115,20 @@ impl Default for Plausibility {
             "arcsec",
             "10 um of eccentricity on a 35-50 mm graduation radius",
         );
-        add("ujoint-axes.axis_skew_arcsec", -300.0, 300.0, "arcsec", "machining of the U-joint cross");
-        add("ujoint-axes.axis_offset_um", -100.0, 100.0, "um", "bore and cross tolerances");
+        add(
+            "ujoint-axes.axis_skew_arcsec",
+            -300.0,
+            300.0,
+            "arcsec",
+            "machining of the U-joint cross",
+        );
+        add(
+            "ujoint-axes.axis_offset_um",
+            -100.0,
+            100.0,
+            "um",
+            "bore and cross tolerances",
+        );
         add(
             "tube-twist.twist_arcsec_per_100mm",
             -50.0,
@@ -107,14 +143,14 @@ impl Default for Plausibility {
             "um/kN at 1 m",
             "tension stretches the legs; 5 N/um is a very soft leg",
         );
-        add("leg-periodic.amplitude_um", 0.0, 25.0, "um", "pitch errors of precision screws");
         add(
-            "leg-periodic.period_mm",
-            1.0,
-            200.0,
-            "mm",
-            "a screw lead",
+            "leg-periodic.amplitude_um",
+            0.0,
+            25.0,
+            "um",
+            "pitch errors of precision screws",
         );
+        add("leg-periodic.period_mm", 1.0, 200.0, "mm", "a screw lead");
         add(
             "leg-polynomial.peak_to_valley_um",
             0.0,
@@ -122,14 +158,62 @@ impl Default for Plausibility {
             "um",
             "travel variation of transport-grade screws",
         );
-        add("reading-drift.phi_arcsec", -30.0, 30.0, "arcsec", "beyond: a sensor fault, not a drift");
-        add("reading-drift.theta_arcsec", -30.0, 30.0, "arcsec", "beyond: a sensor fault, not a drift");
-        add("reading-drift.s_um", -50.0, 50.0, "um", "beyond: a sensor fault, not a drift");
-        add("reading-temperature.phi_arcsec_per_k", -10.0, 10.0, "arcsec/K", "thermal bending of a sensor mount");
-        add("reading-temperature.theta_arcsec_per_k", -10.0, 10.0, "arcsec/K", "thermal bending of a sensor mount");
-        add("reading-temperature.s_um_per_k", -20.0, 20.0, "um/K", "a 2 m steel path");
-        add("leg-drift.leg_um", -50.0, 50.0, "um", "creep or drive warm-up over a campaign");
-        add("encoder-gain.gain_ppm", -1000.0, 1000.0, "ppm", "encoder scaling or interpolation faults");
+        add(
+            "reading-drift.phi_arcsec",
+            -30.0,
+            30.0,
+            "arcsec",
+            "beyond: a sensor fault, not a drift",
+        );
+        add(
+            "reading-drift.theta_arcsec",
+            -30.0,
+            30.0,
+            "arcsec",
+            "beyond: a sensor fault, not a drift",
+        );
+        add(
+            "reading-drift.s_um",
+            -50.0,
+            50.0,
+            "um",
+            "beyond: a sensor fault, not a drift",
+        );
+        add(
+            "reading-temperature.phi_arcsec_per_k",
+            -10.0,
+            10.0,
+            "arcsec/K",
+            "thermal bending of a sensor mount",
+        );
+        add(
+            "reading-temperature.theta_arcsec_per_k",
+            -10.0,
+            10.0,
+            "arcsec/K",
+            "thermal bending of a sensor mount",
+        );
+        add(
+            "reading-temperature.s_um_per_k",
+            -20.0,
+            20.0,
+            "um/K",
+            "a 2 m steel path",
+        );
+        add(
+            "leg-drift.leg_um",
+            -50.0,
+            50.0,
+            "um",
+            "creep or drive warm-up over a campaign",
+        );
+        add(
+            "encoder-gain.gain_ppm",
+            -1000.0,
+            1000.0,
+            "ppm",
+            "encoder scaling or interpolation faults",
+        );
         add(
             "scale-polynomial.peak_to_valley_um",
             0.0,
@@ -137,9 +221,27 @@ impl Default for Plausibility {
             "um",
             "scale bending or mounting",
         );
-        add("reading-hysteresis.phi_arcsec", 0.0, 5.0, "arcsec", "encoder reversal error (lag)");
-        add("reading-hysteresis.theta_arcsec", 0.0, 5.0, "arcsec", "encoder reversal error (lag)");
-        add("reading-hysteresis.s_um", 0.0, 2.0, "um", "scale reversal error (lag)");
+        add(
+            "reading-hysteresis.phi_arcsec",
+            0.0,
+            5.0,
+            "arcsec",
+            "encoder reversal error (lag)",
+        );
+        add(
+            "reading-hysteresis.theta_arcsec",
+            0.0,
+            5.0,
+            "arcsec",
+            "encoder reversal error (lag)",
+        );
+        add(
+            "reading-hysteresis.s_um",
+            0.0,
+            2.0,
+            "um",
+            "scale reversal error (lag)",
+        );
         Plausibility { ranges }
     }
 }
@@ -262,8 +364,13 @@ pub(crate) fn quantities(term: &Term, v: &[f64], cov: &DMatrix<f64>) -> Vec<Quan
             match e {
                 EffectName::EncoderEccentricity => {
                     for (k, enc) in ["phi", "theta"].iter().enumerate() {
-                        let (a, s) =
-                            amplitude(v[2 * k], v[2 * k + 1], c(2 * k, 2 * k), c(2 * k, 2 * k + 1), c(2 * k + 1, 2 * k + 1));
+                        let (a, s) = amplitude(
+                            v[2 * k],
+                            v[2 * k + 1],
+                            c(2 * k, 2 * k),
+                            c(2 * k, 2 * k + 1),
+                            c(2 * k + 1, 2 * k + 1),
+                        );
                         out.push(q(
                             "encoder-eccentricity.amplitude_arcsec",
                             format!("eccentricity of the {enc} encoder"),
@@ -309,7 +416,11 @@ fn generic_quantities(g: &GenericTerm, v: &[f64], cov: &DMatrix<f64>) -> Vec<Qua
     };
     match family {
         GenericFamily::LegPeriodic | GenericFamily::LegPolynomial => {
-            let width = if family == GenericFamily::LegPeriodic { 2 } else { 3 };
+            let width = if family == GenericFamily::LegPeriodic {
+                2
+            } else {
+                3
+            };
             for (k, leg) in g.legs().into_iter().enumerate() {
                 // The curvature coefficients (P2, P3) of a polynomial follow
                 // its linear part (P1, a lead: judged by the leads' range
@@ -369,7 +480,12 @@ fn generic_quantities(g: &GenericTerm, v: &[f64], cov: &DMatrix<f64>) -> Vec<Qua
         | GenericFamily::ReadingTemperature
         | GenericFamily::ReadingHysteresis => {
             let param = g.params().first().cloned().unwrap_or_default();
-            push(format!("{family}.{param}"), format!("{family} {param}"), v[0], sd(0));
+            push(
+                format!("{family}.{param}"),
+                format!("{family} {param}"),
+                v[0],
+                sd(0),
+            );
         }
     }
     out
@@ -396,10 +512,16 @@ mod tests {
         assert!(p.check(&quantities(&ecc, &v, &cov(5.0, 4))).is_err());
         // A -199 um U-joint offset.
         let uj = Term::Catalogue(Candidate(EffectName::UjointAxes));
-        assert!(p.check(&quantities(&uj, &[0.0, -199.0], &cov(10.0, 2))).is_err());
+        assert!(
+            p.check(&quantities(&uj, &[0.0, -199.0], &cov(10.0, 2)))
+                .is_err()
+        );
         // Negative backlash, far from zero.
         let bl = Term::Catalogue(Candidate(EffectName::Backlash));
-        assert!(p.check(&quantities(&bl, &[5.0, -8.0, 5.0], &cov(1.0, 3))).is_err());
+        assert!(
+            p.check(&quantities(&bl, &[5.0, -8.0, 5.0], &cov(1.0, 3)))
+                .is_err()
+        );
     }
 
     #[test]

@@ -539,7 +539,11 @@ impl Diagnosis {
             );
         }
         let g = &self.gain;
-        let moved = match (g.volumetric_mean_mm, g.volumetric_touched_mean_mm, g.volumetric_max_mm) {
+        let moved = match (
+            g.volumetric_mean_mm,
+            g.volumetric_touched_mean_mm,
+            g.volumetric_max_mm,
+        ) {
             (Some(mean), Some(touched), Some(max)) => format!(
                 "platform moved on the middle plane by {mean:.4} mm mean ({touched:.4} after touch-off), {max:.4} mm max"
             ),

@@ -122,11 +122,43 @@ pub(crate) fn structure(
     out
 }
 
+/// What a residual plot shows: the effect, its first leg (0-2), its
+/// channel (0-2) and, for a periodic term, its period (mm).
+pub(crate) struct PlotOf {
+    pub(crate) effect: CauseName,
+    pub(crate) leg: usize,
+    pub(crate) channel: usize,
+    pub(crate) period_mm: Option<f64>,
+}
+
+impl PlotOf {
+    /// The plot of a named cause.
+    pub(crate) fn cause(cause: &Cause) -> PlotOf {
+        PlotOf {
+            effect: cause.effect,
+            leg: cause
+                .legs
+                .first()
+                .map_or(0, |l| usize::from(*l).saturating_sub(1)),
+            channel: match cause.channel {
+                Some("phi") => 0,
+                Some("theta") => 1,
+                _ => 2,
+            },
+            period_mm: cause
+                .parameters
+                .iter()
+                .find(|p| p.name.ends_with("period_mm"))
+                .map(|p| p.value),
+        }
+    }
+}
+
 /// Residual plot of a cause: leg-length residuals (`J1` times the joint
 /// residuals, um) against the leg's regressor for leg effects; reading
 /// residuals against the exposing joint value or time otherwise.
 pub(crate) fn residual_plot(
-    cause: &Cause,
+    of: &PlotOf,
     nominal: &Machine,
     data: &Dataset,
     geo: &Fit,
@@ -134,18 +166,7 @@ pub(crate) fn residual_plot(
     sigma: &[f64; 3],
 ) -> Option<ResidualPlot> {
     use CauseName::{Catalogue as C, Generic as G};
-    let effect = cause.effect;
-    let leg = cause.legs.first().map_or(0, |l| usize::from(*l).saturating_sub(1));
-    let channel = match cause.channel {
-        Some("phi") => 0,
-        Some("theta") => 1,
-        _ => 2,
-    };
-    let period = cause
-        .parameters
-        .iter()
-        .find(|p| p.name.ends_with("period_mm"))
-        .map(|p| p.value);
+    let (effect, leg, channel, period) = (of.effect, of.leg, of.channel, of.period_mm);
     let unit = |c: usize| if c == 2 { 1e3 } else { 1.0 / RAD_PER_ARCSEC };
     let series = |f: &Fit| -> Vec<(f64, f64)> {
         let res = residuals_of(f, &data.poses, sigma);
@@ -191,7 +212,11 @@ pub(crate) fn residual_plot(
                         (p.temp_c?, joint[channel] * unit(channel))
                     }
                     G(GenericFamily::EncoderGain) => {
-                        let angle = if channel == 0 { fk.up.phi_rad } else { fk.up.theta_rad };
+                        let angle = if channel == 0 {
+                            fk.up.phi_rad
+                        } else {
+                            fk.up.theta_rad
+                        };
                         (angle.to_degrees(), joint[channel] * unit(channel))
                     }
                     G(GenericFamily::ScalePolynomial) => (fk.up.q4_mm, joint[2] * 1e3),
@@ -211,7 +236,10 @@ pub(crate) fn residual_plot(
         )
     };
     let (x_label, y_label): (String, String) = match effect {
-        C(EffectName::LegLead) => ("leg 1 command (mm)".into(), "leg 1 length residual (um)".into()),
+        C(EffectName::LegLead) => (
+            "leg 1 command (mm)".into(),
+            "leg 1 length residual (um)".into(),
+        ),
         C(EffectName::Backlash) => (
             "leg 1 approach direction".into(),
             "leg 1 length residual (um)".into(),

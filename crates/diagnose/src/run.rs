@@ -40,10 +40,9 @@ use crate::report::{
     Cause, CauseKind, ChannelRms, Diagnosis, Estimate, Evidence, FinalFit, Gain, NoiseCheck,
     NoiseSource, Remainder, TermScore, Verdict,
 };
-use crate::residuals::{residual_plot, structure};
+use crate::residuals::{PlotOf, residual_plot, structure};
 use crate::select::{
-    Fit, Selection, Setup, estimates, residuals_of, screen_outliers, select,
-    term_estimates,
+    Fit, Selection, Setup, estimates, residuals_of, screen_outliers, select, term_estimates,
 };
 use crate::terms::{CHANNELS, Frame, Term};
 
@@ -181,6 +180,11 @@ pub fn diagnose(
         .filter(|c| c.available(&data))
         .collect();
     let dictionary = Dictionary::new(&frame, &options.dictionary);
+    if !options.dictionary.enabled {
+        limitations.push(
+            "the generic dictionary was not searched: effects outside the vocabulary can only be reported as unexplained".into(),
+        );
+    }
     if frame.temperature.is_none() {
         limitations.push(
             "the logged temperature is missing or varies by less than 0.25 K: thermal effects cannot be seen".into(),
@@ -316,18 +320,31 @@ const SCREW_LEADS_MM: [f64; 12] = [
 ];
 
 /// One-line description of a named term.
-fn describe(term: &Term, fit: &Fit, setup: &Setup<'_>, period_sd: Option<f64>, alternatives: &[String]) -> String {
+fn describe(
+    term: &Term,
+    fit: &Fit,
+    setup: &Setup<'_>,
+    period_sd: Option<f64>,
+    alternatives: &[String],
+) -> String {
     let (v, cov) = term_estimates(fit, term);
     let sd = |i: usize| cov[(i, i)].max(0.0).sqrt();
     let pm = |i: usize| format!("{:.1} +- {:.1}", v[i], sd(i));
     let legs_list = |legs: &[usize]| {
         let names: Vec<String> = legs.iter().map(|i| (i + 1).to_string()).collect();
-        format!("leg{} {}", if legs.len() > 1 { "s" } else { "" }, names.join(", "))
+        format!(
+            "leg{} {}",
+            if legs.len() > 1 { "s" } else { "" },
+            names.join(", ")
+        )
     };
     let or_alternatives = if alternatives.is_empty() {
         String::new()
     } else {
-        format!(" (or, indistinguishably on this campaign: {})", alternatives.join(", "))
+        format!(
+            " (or, indistinguishably on this campaign: {})",
+            alternatives.join(", ")
+        )
     };
     let text = match term {
         Term::Catalogue(c) => {
@@ -412,7 +429,10 @@ fn describe(term: &Term, fit: &Fit, setup: &Setup<'_>, period_sd: Option<f64>, a
                 GenericFamily::ReadingDrift => {
                     let c = g.channel().unwrap_or(2);
                     let unit = if c == 2 { "um" } else { "arcsec" };
-                    let temperature = if alternatives.iter().any(|a| a.starts_with("reading-temperature") || a == "thermal") {
+                    let temperature = if alternatives
+                        .iter()
+                        .any(|a| a.starts_with("reading-temperature") || a == "thermal")
+                    {
                         "with time or with temperature (they followed each other during the campaign)"
                     } else if setup.frame.temperature.is_some() {
                         "independent of temperature"
@@ -509,7 +529,8 @@ fn why_not_named(s: &Scored, d: &Diagnosis, alpha_share: f64) -> String {
             d.dictionary_tests, s.p_adjusted
         )
     } else {
-        "significant, but it did not improve the held-out fit or the penalised gain when refitted".into()
+        "significant, but it did not improve the held-out fit or the penalised gain when refitted"
+            .into()
     }
 }
 
@@ -788,10 +809,21 @@ fn report(
             text,
         });
     }
-    d.plots = d
-        .causes
+    // Plots of the causes and of the model's member of each alias set.
+    let mut plotted: Vec<PlotOf> = d.causes.iter().map(PlotOf::cause).collect();
+    for a in &d.aliases {
+        if a.in_model.catalogue().is_some() && !plotted.iter().any(|p| p.effect == a.in_model) {
+            plotted.push(PlotOf {
+                effect: a.in_model,
+                leg: 0,
+                channel: 2,
+                period_mm: None,
+            });
+        }
+    }
+    d.plots = plotted
         .iter()
-        .filter_map(|c| residual_plot(c, nominal, &clean, &geo, &current, &setup.sigma))
+        .filter_map(|p| residual_plot(p, nominal, &clean, &geo, &current, &setup.sigma))
         .collect();
     Ok(d)
 }
@@ -799,7 +831,13 @@ fn report(
 /// The period's standard deviation of a periodic term of `fit`: the scan's
 /// curvature at the final model without the term.
 fn period_uncertainty(setup: &Setup<'_>, clean: &Dataset, fit: &Fit, term: &Term) -> Option<f64> {
-    let others: Vec<Term> = fit.model.terms().iter().copied().filter(|t| t != term).collect();
+    let others: Vec<Term> = fit
+        .model
+        .terms()
+        .iter()
+        .copied()
+        .filter(|t| t != term)
+        .collect();
     let without = setup.fit(setup.model(&others), clean).ok()?;
     let Term::Generic(g) = term else { return None };
     let target = g.period_mm?;
@@ -936,7 +974,11 @@ fn volumetric_difference(
     }
     let raw = map.stats();
     let touched = map.without_mean_translation().stats();
-    let note = (reached < targets.len())
-        .then(|| format!("{reached} of {} middle-plane targets reached", targets.len()));
+    let note = (reached < targets.len()).then(|| {
+        format!(
+            "{reached} of {} middle-plane targets reached",
+            targets.len()
+        )
+    });
     (Some((raw.mean_mm, raw.max_mm, touched.mean_mm)), note)
 }

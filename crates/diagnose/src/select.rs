@@ -42,7 +42,7 @@ use tricept_ident::{
     residuals_at, screen_gross_errors,
 };
 
-use crate::dictionary::{Dictionary, Scored};
+use crate::dictionary::{At, Dictionary, Scored};
 use crate::evidence::Reference;
 use crate::linear::Linearisation;
 use crate::model::{Candidate, ExtendedModel};
@@ -128,7 +128,10 @@ impl Setup<'_> {
         let id = identify(&model, data, &self.identify_options()).map_err(FitError::Ident)?;
         let g = model.n_geometric();
         let largest = id.estimate[..g].iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        if !id.converged || !(largest <= self.options.max_error_mm) || !id.stats.chi_square.is_finite()
+        if !id.converged
+            || !largest.is_finite()
+            || largest > self.options.max_error_mm
+            || !id.stats.chi_square.is_finite()
         {
             return Err(FitError::NotConverged {
                 largest_error_mm: largest,
@@ -191,15 +194,15 @@ impl Setup<'_> {
         let Some(lin) = Linearisation::at_fit(fit, data, &self.sigma, &[]) else {
             return Vec::new();
         };
-        self.dictionary.screen(
-            &lin,
-            &self.frame,
+        let at = At {
+            lin: &lin,
+            frame: &self.frame,
             data,
-            fit.model.terms(),
-            &self.reference,
-            fit.id.stats.chi_square,
-            fit.id.stats.dof,
-        )
+            reference: &self.reference,
+            chi_square: fit.id.stats.chi_square,
+            dof: fit.id.stats.dof,
+        };
+        self.dictionary.screen(&at, fit.model.terms())
     }
 
     /// Plausibility of `term` in `fit`.
@@ -209,7 +212,13 @@ impl Setup<'_> {
     }
 
     /// The evidence for `term` from the nested pair `without` / `with`.
-    pub(crate) fn evidence(&self, term: &Term, without: &Fit, with: &Fit, readings: usize) -> Evidence {
+    pub(crate) fn evidence(
+        &self,
+        term: &Term,
+        without: &Fit,
+        with: &Fit,
+        readings: usize,
+    ) -> Evidence {
         let delta = without.id.stats.chi_square - with.id.stats.chi_square;
         let k = with
             .id
@@ -349,7 +358,13 @@ struct Trial {
     evidence: Evidence,
 }
 
-fn reject(rejected: &mut Vec<Rejected>, fit: &Fit, term: &Term, stage: RejectStage, reason: String) {
+fn reject(
+    rejected: &mut Vec<Rejected>,
+    fit: &Fit,
+    term: &Term,
+    stage: RejectStage,
+    reason: String,
+) {
     let (values, cov) = term_estimates(fit, term);
     let names = term.params();
     let parameters = values

@@ -266,10 +266,7 @@ impl GenericTerm {
             GenericFamily::ReadingDrift | GenericFamily::LegDrift => frame.order.is_some(),
             GenericFamily::ReadingTemperature => frame.temperature.is_some(),
             GenericFamily::ReadingHysteresis => !frame.directions.is_empty(),
-            GenericFamily::LegPolynomial => frame
-                .leg_range_mm
-                .iter()
-                .all(|[lo, hi]| hi - lo > 1.0),
+            GenericFamily::LegPolynomial => frame.leg_range_mm.iter().all(|[lo, hi]| hi - lo > 1.0),
             GenericFamily::ScalePolynomial => frame.q4_range_mm[1] - frame.q4_range_mm[0] > 1.0,
             _ => true,
         }
@@ -387,7 +384,12 @@ impl Frame {
             by_line.sort_by_key(|p| p.line);
             let joints: Vec<Option<[f64; 3]>> = by_line
                 .iter()
-                .map(|p| nominal.forward(&p.commands_mm).ok().map(|f| f.up.to_array()))
+                .map(|p| {
+                    nominal
+                        .forward(&p.commands_mm)
+                        .ok()
+                        .map(|f| f.up.to_array())
+                })
                 .collect();
             for (k, w) in joints.windows(2).enumerate() {
                 let (Some(a), Some(b)) = (w[0], w[1]) else {
@@ -491,8 +493,16 @@ mod tests {
         assert_eq!(f.delta_temperature_k(&data.poses[2]), Some(0.0));
         // Leg 2 never moves: no polynomial on it, so none on all legs.
         let groups = f.generic_groups();
-        assert!(!groups.iter().any(|g| g.family == GenericFamily::LegPolynomial));
-        assert!(groups.iter().any(|g| g.family == GenericFamily::ReadingTemperature));
+        assert!(
+            !groups
+                .iter()
+                .any(|g| g.family == GenericFamily::LegPolynomial)
+        );
+        assert!(
+            groups
+                .iter()
+                .any(|g| g.family == GenericFamily::ReadingTemperature)
+        );
         // A periodic term's unit values are its sine and cosine, in mm.
         let t = GenericTerm {
             family: GenericFamily::LegPeriodic,

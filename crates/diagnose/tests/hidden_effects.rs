@@ -17,8 +17,8 @@
 //! in `realistic.rs` and `out_of_vocabulary.rs`.)
 
 use rand::{RngExt, SeedableRng};
-use rayon::prelude::*;
 use rand_pcg::Pcg64Mcg;
+use rayon::prelude::*;
 use tricept_diagnose::{DiagnoseOptions, Diagnosis, diagnose};
 use tricept_kinematics::Machine;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
@@ -162,7 +162,9 @@ fn found_first(d: &Diagnosis, effect: E) -> bool {
 /// Whether `effect` is named or reported in an alias set.
 fn found(d: &Diagnosis, effect: E) -> bool {
     d.causes.iter().any(|c| c.effect == effect)
-        || d.aliases.iter().any(|a| a.effects.iter().any(|e| *e == effect))
+        || d.aliases
+            .iter()
+            .any(|a| a.effects.iter().any(|e| *e == effect))
 }
 
 /// The estimates of `effect`'s parameters in the final model.
@@ -336,7 +338,12 @@ fn the_report_names_the_evidence_and_the_bias() {
     assert_eq!(json["aliases"][0]["effects"][0], "scale-gain");
     assert_eq!(json["aliases"][0]["effects"][1], "leg-lead");
     assert_eq!(json["aliases"][0]["exact"], true);
-    assert!(json["aliases"][0]["separate_by"].as_str().unwrap().contains("external length"));
+    assert!(
+        json["aliases"][0]["separate_by"]
+            .as_str()
+            .unwrap()
+            .contains("external length")
+    );
     assert!(
         json["gain"]["holdout_rms_geometric"].as_f64().unwrap()
             > 2.0 * json["gain"]["holdout_rms_extended"].as_f64().unwrap()
@@ -356,5 +363,7 @@ fn the_report_names_the_evidence_and_the_bias() {
         .map(|(_, v)| v.abs())
         .fold(0.0, f64::max);
     assert!(largest > 1e-3, "{largest}");
+    // The model's member of the alias set is plotted.
+    assert!(!d.plots.is_empty() && !d.plots[0].before.is_empty());
     let _ = RAD_PER_ARCSEC;
 }

@@ -33,10 +33,31 @@ fn worse_noise_is_detected() {
         .filter(|(_, d)| d.noise.agrees == Some(false))
         .count();
     let adequate_stated = stated.iter().filter(|(_, d)| d.adequate).count();
-    tally("true noise 1.5x stated", 80, "noise disagreement reported", disagrees, SETS as usize);
-    tally("true noise 1.5x stated", 80, "adequate against the stated noise", adequate_stated, SETS as usize);
-    let named_stated = stated.iter().filter(|(_, d)| !d.causes.is_empty() || !d.aliases.is_empty()).count();
-    tally("true noise 1.5x stated", 80, "a cause named against the stated noise", named_stated, SETS as usize);
+    tally(
+        "true noise 1.5x stated",
+        80,
+        "noise disagreement reported",
+        disagrees,
+        SETS as usize,
+    );
+    tally(
+        "true noise 1.5x stated",
+        80,
+        "adequate against the stated noise",
+        adequate_stated,
+        SETS as usize,
+    );
+    let named_stated = stated
+        .iter()
+        .filter(|(_, d)| !d.causes.is_empty() || !d.aliases.is_empty())
+        .count();
+    tally(
+        "true noise 1.5x stated",
+        80,
+        "a cause named against the stated noise",
+        named_stated,
+        SETS as usize,
+    );
     for (i, (_, d)) in stated.iter().enumerate() {
         eprintln!("stated noise, set {i}: {}", summary(d));
     }
@@ -59,9 +80,17 @@ fn worse_noise_is_detected() {
             failures.push(format!("set {i}: s noise ratio {ratio}"));
         }
     }
-    tally("true noise 1.5x stated, --noise-from-data", 80, "adequate, nothing named", adequate, SETS as usize);
+    tally(
+        "true noise 1.5x stated, --noise-from-data",
+        80,
+        "adequate, nothing named",
+        adequate,
+        SETS as usize,
+    );
     if disagrees < 19 || adequate < 19 {
-        failures.push(format!("disagreement {disagrees}/20, adequate from data {adequate}/20"));
+        failures.push(format!(
+            "disagreement {disagrees}/20, adequate from data {adequate}/20"
+        ));
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
@@ -70,8 +99,17 @@ fn worse_noise_is_detected() {
 fn stated_noise_is_confirmed() {
     let base = 0x0154;
     let res = run_case(SETS, |i| simulate(60, base + i, Vec::new(), campaign(1.0)));
-    let agrees = res.iter().filter(|(_, d)| d.noise.agrees == Some(true)).count();
-    tally("true noise = stated", 80, "noise agreement reported", agrees, SETS as usize);
+    let agrees = res
+        .iter()
+        .filter(|(_, d)| d.noise.agrees == Some(true))
+        .count();
+    tally(
+        "true noise = stated",
+        80,
+        "noise agreement reported",
+        agrees,
+        SETS as usize,
+    );
     for (i, (_, d)) in res.iter().enumerate() {
         if d.noise.agrees != Some(true) {
             eprintln!("set {i}: {}", d.noise.note);

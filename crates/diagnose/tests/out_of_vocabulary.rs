@@ -67,13 +67,32 @@ fn case(
                 ));
             }
             if !ok {
-                eprintln!("{name} n={n} set {i} not right: {} ({:?})", summary(d), s.effects);
+                eprintln!(
+                    "{name} n={n} set {i} not right: {} ({:?})",
+                    summary(d),
+                    s.effects
+                );
             }
         }
-        tally(name, n, "right family, leg/channel and form", good, SETS as usize);
-        tally(name, n, "catalogue effect named with final_adequate true", dressed, SETS as usize);
+        tally(
+            name,
+            n,
+            "right family, leg/channel and form",
+            good,
+            SETS as usize,
+        );
+        tally(
+            name,
+            n,
+            "catalogue effect named with final_adequate true",
+            dressed,
+            SETS as usize,
+        );
         if good < required(n) {
-            failures.push(format!("{name} n={n}: right in {good}/{SETS}, {} required", required(n)));
+            failures.push(format!(
+                "{name} n={n}: right in {good}/{SETS}, {} required",
+                required(n)
+            ));
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
@@ -168,7 +187,11 @@ fn quadratic_is_named() {
                 1e-3,
             )
             .map_or(0.0, |d| d.noncentrality);
-            if lambda > 24.4 { vec![E::LegLead] } else { Vec::new() }
+            if lambda > 24.4 {
+                vec![E::LegLead]
+            } else {
+                Vec::new()
+            }
         },
         |_| 16,
     );
@@ -233,7 +256,10 @@ fn encoder_gain() {
 
 #[test]
 fn unknown_forms_are_not_dressed_up() {
-    let shapes: [(&str, u64); 2] = [("sawtooth pitch 4 um, 10 mm", 0x5a37), ("legs |x|^1.5, 5-15 um", 0x1e15)];
+    let shapes: [(&str, u64); 2] = [
+        ("sawtooth pitch 4 um, 10 mm", 0x5a37),
+        ("legs |x|^1.5, 5-15 um", 0x1e15),
+    ];
     let mut failures = Vec::new();
     for (k, (name, base)) in shapes.iter().enumerate() {
         let res = run_case(SETS, |i| {
@@ -261,16 +287,30 @@ fn unknown_forms_are_not_dressed_up() {
             let bad = dressed_up(d, &[E::LegLead]);
             dressed += usize::from(bad);
             let generic = d.causes.iter().any(|c| c.effect.is_generic());
-            let ok = matches!(d.verdict, Verdict::PartiallyExplained | Verdict::Unexplained)
-                || (d.verdict == Verdict::Explained && generic);
+            let ok = matches!(
+                d.verdict,
+                Verdict::PartiallyExplained | Verdict::Unexplained
+            ) || (d.verdict == Verdict::Explained && generic);
             honest += usize::from(ok);
             if bad || !ok {
                 failures.push(format!("{name} set {i}: {}", summary(d)));
             }
             failures.extend(invariants(d));
         }
-        tally(name, 80, "catalogue effect named with final_adequate true", dressed, SETS as usize);
-        tally(name, 80, "partially explained, unexplained or explained by a generic term", honest, SETS as usize);
+        tally(
+            name,
+            80,
+            "catalogue effect named with final_adequate true",
+            dressed,
+            SETS as usize,
+        );
+        tally(
+            name,
+            80,
+            "partially explained, unexplained or explained by a generic term",
+            honest,
+            SETS as usize,
+        );
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
@@ -279,7 +319,9 @@ fn unknown_forms_are_not_dressed_up() {
 fn clean_sets_are_adequate() {
     let mut failures = Vec::new();
     for n in SIZES {
-        let res = run_case(40, |i| simulate(n, 0xc1ea + i, Vec::new(), CampaignOptions::default()));
+        let res = run_case(40, |i| {
+            simulate(n, 0xc1ea + i, Vec::new(), CampaignOptions::default())
+        });
         let adequate = res.iter().filter(|(_, d)| d.adequate).count();
         let generic = res
             .iter()
@@ -293,7 +335,9 @@ fn clean_sets_are_adequate() {
             }
         }
         if adequate < 38 || generic > 0 {
-            failures.push(format!("n={n}: adequate {adequate}/40, generic named {generic}"));
+            failures.push(format!(
+                "n={n}: adequate {adequate}/40, generic named {generic}"
+            ));
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));

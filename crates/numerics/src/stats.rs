@@ -393,7 +393,10 @@ mod tests {
             (6.594_539_978, 3.0, 40.0, 0.001),
         ] {
             let got = f_sf(x, d1, d2);
-            assert!((got - p).abs() < 1e-6 * p.max(1e-3) + 1e-9, "F({d1},{d2}) at {x}: {got}");
+            assert!(
+                (got - p).abs() < 1e-6 * p.max(1e-3) + 1e-9,
+                "F({d1},{d2}) at {x}: {got}"
+            );
         }
         // F(1, d2) = t^2: P(F > t^2) = two-sided t tail; F(k, inf) -> chi2_k / k.
         assert!((f_sf(6.0, 3.0, 1e7) - chi2_sf(18.0, 3.0)).abs() < 1e-5);

@@ -251,7 +251,8 @@ fn effects_outside_the_vocabulary_add_what_their_physics_says() {
     }];
     for t in pitch.true_poses(&c).unwrap() {
         let extra: [f64; 3] = std::array::from_fn(|i| {
-            um[i] * 1e-3
+            um[i]
+                * 1e-3
                 * (std::f64::consts::TAU * t.commands_mm[i] / period + phase[i].to_radians()).sin()
         });
         assert!(legs_reach(&t, extra) < 1e-9);
@@ -338,7 +339,11 @@ fn revisits_repeat_commands_and_worse_noise_is_worse() {
     let worse = base.simulate(&noisy).unwrap();
     let truth = base.true_poses(&c).unwrap();
     for ((a, b), t) in worse.poses.iter().zip(&data.poses).zip(&truth) {
-        let (ra, rb, rt) = (a.readings.to_array(), b.readings.to_array(), t.readings.to_array());
+        let (ra, rb, rt) = (
+            a.readings.to_array(),
+            b.readings.to_array(),
+            t.readings.to_array(),
+        );
         for ch in 0..3 {
             assert!(((ra[ch] - rt[ch]) - 2.0 * (rb[ch] - rt[ch])).abs() < 1e-12);
         }

@@ -174,11 +174,8 @@ pub fn invariants(d: &Diagnosis) -> Vec<String> {
             out.push(format!("{} named but not plausible", c.effect));
         }
     }
-    let physical = d
-        .causes
-        .iter()
-        .any(|c| c.effect != EffectName::Outliers)
-        || !d.aliases.is_empty();
+    let physical =
+        d.causes.iter().any(|c| c.effect != EffectName::Outliers) || !d.aliases.is_empty();
     if physical && d.gain.holdout_rms_extended > d.gain.holdout_rms_geometric {
         out.push(format!(
             "held-out rms worse with the causes: {} -> {}",
