@@ -519,7 +519,7 @@ impl Diagnosis {
         if let Some(r) = &self.remainder {
             w!("remainder: {}", r.text);
         }
-        if let Some(u) = &self.unexplained {
+        if let (Some(u), None) = (&self.unexplained, &self.remainder) {
             w!("unexplained: {u}");
         }
         for l in &self.limitations {
