@@ -1,5 +1,6 @@
 //! The few distributions the project needs: chi-square tail probabilities
 //! and quantiles (through the regularised incomplete gamma function), the
+//! F distribution (through the regularised incomplete beta function), the
 //! power of a chi-square test against a non-central alternative, and the
 //! one definition of a sample quantile that every figure uses.
 
