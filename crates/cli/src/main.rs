@@ -94,7 +94,7 @@ enum Command {
     /// effect does (leg-lead, backlash, thermal, scale-gain,
     /// encoder-eccentricity, ujoint-axes, tube-twist, compliance, outliers).
     #[command(
-        after_help = "Examples:\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n  tricept diagnose --data data.csv --json --plots out/"
+        after_help = "Examples:\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n  tricept diagnose --data fixtures/data/diagnose-pitch.csv --json --plots out/\n  tricept diagnose --data fixtures/data/diagnose-noisy.csv --noise-from-data\n\nExit codes: 0 a report (whatever its verdict), 2 data that cannot be diagnosed.\nMethod, vocabulary, generic dictionary, plausibility table: docs/diagnosis.md"
     )]
     Diagnose(diagnose_cmd::DiagnoseArgs),
     /// For a measurement campaign: how large must each unmodelled effect be

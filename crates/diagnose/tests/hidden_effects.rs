@@ -16,6 +16,9 @@
 //! with half the readings, at half the cost; the realistic campaigns are
 //! in `realistic.rs` and `out_of_vocabulary.rs`.)
 
+mod common;
+
+use common::true_parameters;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
@@ -109,45 +112,6 @@ fn run(effects: &[E], seed: u64, readings: u32) -> (Diagnosis, Vec<Effect>) {
     let mut options = DiagnoseOptions::for_machine(&m);
     options.sigma = campaign.noise.logged_sigma();
     (diagnose(&m, &data, &options).unwrap(), plant.effects)
-}
-
-/// The true values of the fitted parameters of a hidden effect, in the
-/// diagnosis' parameterisation (derived from the simulator's inputs).
-fn true_parameters(e: &Effect) -> Option<Vec<f64>> {
-    Some(match e {
-        Effect::LegLead { ppm } => ppm.to_vec(),
-        Effect::Backlash { um } => um.to_vec(),
-        Effect::Thermal {
-            expansion_ppm_per_k,
-            ..
-        } => vec![*expansion_ppm_per_k],
-        Effect::ScaleGain { ppm } => vec![*ppm],
-        Effect::EncoderEccentricity {
-            phi_arcsec,
-            phi_phase_deg,
-            theta_arcsec,
-            theta_phase_deg,
-        } => {
-            // A sin(x + psi) = A cos(psi) sin(x) + A sin(psi) cos(x).
-            let (sp, cp) = phi_phase_deg.to_radians().sin_cos();
-            let (st, ct) = theta_phase_deg.to_radians().sin_cos();
-            vec![
-                phi_arcsec * cp,
-                phi_arcsec * sp,
-                theta_arcsec * ct,
-                theta_arcsec * st,
-            ]
-        }
-        Effect::UjointAxes {
-            skew_arcsec,
-            offset_um,
-        } => vec![*skew_arcsec, *offset_um],
-        Effect::TubeTwist { arcsec_per_100mm } => vec![*arcsec_per_100mm],
-        Effect::Compliance {
-            stiffness_n_per_um_at_1m,
-        } => vec![1000.0 / stiffness_n_per_um_at_1m],
-        _ => return None,
-    })
 }
 
 /// Whether `effect` is named first, or (for a scale gain, which no

@@ -74,43 +74,6 @@ fn hidden(e: E, r: &mut Pcg64Mcg, n: usize) -> Effect {
     }
 }
 
-/// The simulator's parameters in the diagnosis' parameterisation.
-fn truth(e: &Effect) -> Option<Vec<f64>> {
-    Some(match e {
-        Effect::LegLead { ppm } => ppm.to_vec(),
-        Effect::Backlash { um } => um.to_vec(),
-        Effect::Thermal {
-            expansion_ppm_per_k,
-            ..
-        } => vec![*expansion_ppm_per_k],
-        Effect::ScaleGain { ppm } => vec![*ppm],
-        Effect::EncoderEccentricity {
-            phi_arcsec,
-            phi_phase_deg,
-            theta_arcsec,
-            theta_phase_deg,
-        } => {
-            let (sp, cp) = phi_phase_deg.to_radians().sin_cos();
-            let (st, ct) = theta_phase_deg.to_radians().sin_cos();
-            vec![
-                phi_arcsec * cp,
-                phi_arcsec * sp,
-                theta_arcsec * ct,
-                theta_arcsec * st,
-            ]
-        }
-        Effect::UjointAxes {
-            skew_arcsec,
-            offset_um,
-        } => vec![*skew_arcsec, *offset_um],
-        Effect::TubeTwist { arcsec_per_100mm } => vec![*arcsec_per_100mm],
-        Effect::Compliance {
-            stiffness_n_per_um_at_1m,
-        } => vec![1000.0 / stiffness_n_per_um_at_1m],
-        _ => return None,
-    })
-}
-
 /// Whether `e` is the only thing found: named alone, or (for effects with
 /// a near-twin on every campaign) the model's member of the only alias set.
 fn alone(d: &Diagnosis, e: E, s: &Simulated) -> bool {
@@ -138,7 +101,7 @@ fn alone(d: &Diagnosis, e: E, s: &Simulated) -> bool {
 /// logged temperature with 0.02 K of noise, an error in the variable that
 /// the standard deviation does not include).
 fn parameters_match(d: &Diagnosis, e: E, s: &Simulated) -> Result<(), String> {
-    let Some(t) = truth(&s.effects[0]) else {
+    let Some(t) = true_parameters(&s.effects[0]) else {
         return Ok(());
     };
     let prefix = format!("{e}.");

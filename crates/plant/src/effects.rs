@@ -179,6 +179,25 @@ pub enum Effect {
     },
 }
 
+/// Adds `um_i |(q_i - centre) / half_width|^exponent` (um) to each leg (mm).
+fn add_power_law(
+    legs: &mut [f64; 3],
+    commands_mm: &[f64; 3],
+    um: &[f64; 3],
+    exponent: f64,
+    centre_mm: f64,
+    half_width_mm: f64,
+) {
+    for i in 0..3 {
+        let x = normalised_coordinate(
+            commands_mm[i],
+            centre_mm - half_width_mm,
+            centre_mm + half_width_mm,
+        );
+        legs[i] += um[i] * 1e-3 * x.abs().powf(exponent);
+    }
+}
+
 /// What the effects may depend on at one pose.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PoseState {
@@ -304,31 +323,20 @@ impl Effect {
                 um,
                 centre_mm,
                 half_width_mm,
-            } => {
-                for i in 0..3 {
-                    let x = normalised_coordinate(
-                        s.commands_mm[i],
-                        centre_mm - half_width_mm,
-                        centre_mm + half_width_mm,
-                    );
-                    legs[i] += um[i] * 1e-3 * x * x;
-                }
-            }
+            } => add_power_law(legs, &s.commands_mm, um, 2.0, *centre_mm, *half_width_mm),
             Effect::LegPower {
                 um,
                 exponent,
                 centre_mm,
                 half_width_mm,
-            } => {
-                for i in 0..3 {
-                    let x = normalised_coordinate(
-                        s.commands_mm[i],
-                        centre_mm - half_width_mm,
-                        centre_mm + half_width_mm,
-                    );
-                    legs[i] += um[i] * 1e-3 * x.abs().powf(*exponent);
-                }
-            }
+            } => add_power_law(
+                legs,
+                &s.commands_mm,
+                um,
+                *exponent,
+                *centre_mm,
+                *half_width_mm,
+            ),
             _ => {}
         }
     }

@@ -201,3 +201,40 @@ pub fn group_found(d: &Diagnosis, label: &str) -> bool {
                 && format!("{}:{}", c.effect, c.channel.unwrap_or_default()) == label
         })
 }
+
+/// The simulator's parameters in the diagnosis' parameterisation.
+pub fn true_parameters(e: &Effect) -> Option<Vec<f64>> {
+    Some(match e {
+        Effect::LegLead { ppm } => ppm.to_vec(),
+        Effect::Backlash { um } => um.to_vec(),
+        Effect::Thermal {
+            expansion_ppm_per_k,
+            ..
+        } => vec![*expansion_ppm_per_k],
+        Effect::ScaleGain { ppm } => vec![*ppm],
+        Effect::EncoderEccentricity {
+            phi_arcsec,
+            phi_phase_deg,
+            theta_arcsec,
+            theta_phase_deg,
+        } => {
+            let (sp, cp) = phi_phase_deg.to_radians().sin_cos();
+            let (st, ct) = theta_phase_deg.to_radians().sin_cos();
+            vec![
+                phi_arcsec * cp,
+                phi_arcsec * sp,
+                theta_arcsec * ct,
+                theta_arcsec * st,
+            ]
+        }
+        Effect::UjointAxes {
+            skew_arcsec,
+            offset_um,
+        } => vec![*skew_arcsec, *offset_um],
+        Effect::TubeTwist { arcsec_per_100mm } => vec![*arcsec_per_100mm],
+        Effect::Compliance {
+            stiffness_n_per_um_at_1m,
+        } => vec![1000.0 / stiffness_n_per_um_at_1m],
+        _ => return None,
+    })
+}
