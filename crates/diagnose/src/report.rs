@@ -308,7 +308,9 @@ pub struct ResidualPlot {
 /// The diagnosis of a data set.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Diagnosis {
-    /// The geometric model alone explains the data.
+    /// The geometric model alone explains the data: it passes its
+    /// chi-square test, no cause is named and no generic term of the
+    /// dictionary is significant.
     pub adequate: bool,
     /// Adequate, explained, partially explained or unexplained.
     pub verdict: Verdict,
@@ -320,7 +322,8 @@ pub struct Diagnosis {
     /// Its degrees of freedom.
     pub dof: usize,
     /// p-value of the geometric model's adequacy test (`P(chi2_dof >
-    /// chi_square)` with the stated noise).
+    /// chi_square)` with the stated noise; the lack-of-fit F test with the
+    /// data's noise).
     pub chi_square_p_value: f64,
     /// The final model's fit.
     #[serde(rename = "final")]

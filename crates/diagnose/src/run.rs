@@ -379,13 +379,26 @@ fn describe(
                     let lead = SCREW_LEADS_MM.iter().find(|&&l| {
                         (period - l).abs() <= 3.0 * period_sd.unwrap_or(0.0) + 0.005 * l
                     });
+                    // A harmonic of another periodic term of the model: the
+                    // error is periodic but not sinusoidal.
+                    let fundamental = fit.model.terms().iter().find_map(|t| match t {
+                        Term::Generic(o) if o.period_mm.is_some_and(|p| p > 1.5 * period) => {
+                            let p = o.period_mm.unwrap_or(f64::NAN);
+                            let k = (p / period).round();
+                            ((p / period - k).abs() < 0.01 * k).then_some((p, k))
+                        }
+                        _ => None,
+                    });
                     format!(
                         "{}: length error periodic in the leg length, period {period:.3}{sd_text} mm, amplitude {} um: {}",
                         legs_list(&legs),
                         amps.join(" / "),
-                        match lead {
-                            Some(l) => format!("ball-screw pitch error ({l} mm lead)?"),
-                            None => "a periodic error of the drive (screw pitch, gear or encoder of the drive)?".into(),
+                        match (fundamental, lead) {
+                            (Some((p, k)), _) => format!(
+                                "harmonic {k:.0} of the {p:.3} mm period: that periodic error is not a sine"
+                            ),
+                            (None, Some(l)) => format!("ball-screw pitch error ({l} mm lead)?"),
+                            (None, None) => "a periodic error of the drive (screw pitch, gear or encoder of the drive)?".into(),
                         }
                     )
                 }
