@@ -208,5 +208,9 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<(), CliError> {
             d.halving_multiple
         );
     }
+    outln!(
+        "the stated sensor noise can be checked only against repeated poses: revisit at least {} poses on separate visits (`simulate --revisit`) to use `diagnose --noise-from-data`",
+        tricept_diagnose::MIN_PURE_ERROR_DOF
+    );
     Ok(())
 }
