@@ -76,6 +76,19 @@ pub fn detectability(
 
 /// [`detectability`] of any term: an effect of the vocabulary or a generic
 /// term of the dictionary (its coordinates from the campaign `poses`).
+///
+/// # Example
+/// ```
+/// use tricept_diagnose::detect::term_detectability;
+/// use tricept_diagnose::{GenericFamily, GenericTerm, Scope, Term};
+/// let m = tricept_kinematics::Machine::paper();
+/// let data = tricept_data::read_path("../../fixtures/data/diagnose-pitch.csv".as_ref()).unwrap();
+/// let g = tricept_ident::GeometricModel::new(m.clone(), tricept_model::ParameterSet::paper15());
+/// let drift = Term::Generic(GenericTerm::new(GenericFamily::ReadingDrift, Scope::Channel(2)));
+/// // A 3 um drift of the scale over these 80 poses is seen with 95 % power.
+/// let d = term_detectability(&g, &drift, &[3.0], &data.poses, m.sensors.logged_sigma(), 1e-3).unwrap();
+/// assert!(d.detectable_multiple < 1.0, "{}", d.detectable_multiple);
+/// ```
 pub fn term_detectability(
     geometric: &GeometricModel,
     term: &Term,

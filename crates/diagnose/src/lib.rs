@@ -1,14 +1,25 @@
 //! Measured data against the model: does the paper's geometric model
-//! explain the data; if not, which unmodelled effect does, by how much it
-//! biased the geometric parameters, and what the extended model gains.
+//! explain the data; if not, which effects of the vocabulary explain it,
+//! what lies outside the vocabulary (described by a generic dictionary),
+//! what the campaign cannot tell apart, what is implausible, what remains
+//! unexplained; by how much the causes biased the geometric parameters,
+//! and what the extended model gains.
 //!
-//! - [`diagnose`] (`run.rs`): the pipeline: outlier screen, adequacy of
-//!   the geometric model, selection of causes, report.
-//! - `select.rs`: fitting candidates, the evidence rules, cross-validation.
+//! - [`diagnose`] (`run.rs`): the pipeline: checks, noise, outlier screen,
+//!   selection, aliases, final adequacy and remainder, report.
+//! - `terms.rs`: the terms of an extended model ([`Term`]: a [`Candidate`]
+//!   of the vocabulary or a [`GenericTerm`]) and the campaign [`Frame`].
+//! - `dictionary.rs`, `linear.rs`: the generic dictionary, its period scan
+//!   and linear screen.
+//! - `select.rs`: one pool of candidates, the evidence rules, swaps,
+//!   admission on the final model, cross-validation.
+//! - `plausibility.rs` ([`Plausibility`]), `alias.rs`, `noise.rs`,
+//!   `evidence.rs`: physical ranges, aliases, pure error, test references.
 //! - `residuals.rs`: residual structure and residual plots.
-//! - [`Diagnosis`] (`report.rs`): the report, as data, JSON and text.
-//! - [`ExtendedModel`] (`model.rs`): the geometric model plus effects of the
-//!   vocabulary ([`tricept_model::effects`]).
+//! - [`Diagnosis`] (`report.rs`): the report, as data, JSON and text;
+//!   `finite.rs`: no non-finite number leaves it.
+//! - [`ExtendedModel`] (`model.rs`): the geometric model plus any terms
+//!   ([`tricept_model::effects`]).
 //! - [`detect`]: what a campaign can detect, before it is run.
 //!
 //! # Example
@@ -16,9 +27,9 @@
 //! use tricept_diagnose::{DiagnoseOptions, diagnose};
 //! use tricept_kinematics::Machine;
 //! let m = Machine::paper();
-//! let data = tricept_data::read_path("fixtures/data/diagnose-hidden-effect.csv".as_ref()).unwrap();
+//! let data = tricept_data::read_path("fixtures/data/diagnose-pitch.csv".as_ref()).unwrap();
 //! let d = diagnose(&m, &data, &DiagnoseOptions::for_machine(&m)).unwrap();
-//! println!("adequate: {}, causes: {:?}", d.adequate, d.causes.iter().map(|c| c.effect).collect::<Vec<_>>());
+//! println!("{:?}: {:?}", d.verdict, d.causes.iter().map(|c| &c.description).collect::<Vec<_>>());
 //! ```
 #![cfg_attr(
     not(test),

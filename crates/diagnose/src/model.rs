@@ -160,6 +160,24 @@ impl ExtendedModel {
     }
 
     /// `geometric` extended by `terms`, the generic ones measured in `frame`.
+    ///
+    /// # Example
+    /// ```
+    /// use std::sync::Arc;
+    /// use tricept_diagnose::{ExtendedModel, Frame, GenericFamily, GenericTerm, Scope, Term};
+    /// use tricept_ident::{GeometricModel, ReadingModel};
+    /// let m = tricept_kinematics::Machine::paper();
+    /// let data = tricept_data::read_path("../../fixtures/data/diagnose-pitch.csv".as_ref()).unwrap();
+    /// let pitch = Term::Generic(GenericTerm {
+    ///     family: GenericFamily::LegPeriodic,
+    ///     scope: Scope::AllLegs,
+    ///     period_mm: Some(10.0),
+    /// });
+    /// let g = GeometricModel::new(m.clone(), tricept_model::ParameterSet::paper15());
+    /// let model = ExtendedModel::with_terms(g, &[pitch], Arc::new(Frame::of(&m, &data)));
+    /// assert_eq!(model.names().len(), 15 + 6);
+    /// assert_eq!(model.names()[15], "leg-periodic.leg1_sin_um");
+    /// ```
     pub fn with_terms(
         geometric: GeometricModel,
         terms: &[Term],
