@@ -191,7 +191,7 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<(), CliError> {
             "rejected line {} of {}: a reading {:.1} noise standard deviations off (gross error)",
             r.line,
             data.display(),
-            r.residual_sigma
+            r.residual_sigma.unwrap_or(f64::INFINITY)
         );
     }
     outln!(
