@@ -96,6 +96,23 @@ pub struct TouchReading {
     pub line: u64,
 }
 
+/// A pose to measure at (what `tricept plan` writes and `tricept simulate`
+/// reads): the commands and, for information, the nominal tool tip and
+/// ballbar length there.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PlannedPose {
+    /// Where the machine is to stand.
+    pub pose: ExternalPose,
+    /// Known extension of a tracker target along the tool, mm.
+    pub extension_mm: f64,
+    /// The nominal tool tip there, mm (columns `x,y,z`).
+    pub tip_mm: Option<[f64; 3]>,
+    /// The nominal ballbar length there, mm (column `length`).
+    pub length_mm: Option<f64>,
+    /// Line in the file (0 if none).
+    pub line: u64,
+}
+
 /// The records of one external-measurement file and where they came from.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ExternalData<T> {
@@ -111,6 +128,8 @@ pub type TrackerData = ExternalData<TrackerPoint>;
 pub type BallbarData = ExternalData<BallbarReading>;
 /// Touches of a probe.
 pub type TouchData = ExternalData<TouchReading>;
+/// Poses to measure at.
+pub type PlannedPoses = ExternalData<PlannedPose>;
 
 /// The pose columns every external file starts with.
 const POSE_COLUMNS: [&str; 5] = ["q1", "q2", "q3", "h1", "h2"];
@@ -318,6 +337,49 @@ impl ExternalRow for TouchReading {
             "feature" => Some(f64::from(self.feature)),
             "sigma_um" => self.sigma_um,
             "temp_c" => self.temp_c,
+            _ => None,
+        }
+    }
+}
+
+impl ExternalRow for PlannedPose {
+    const MEASURED: &'static [&'static str] = &[];
+    const OPTIONAL: &'static [&'static str] = &["extension_mm", "x", "y", "z", "length"];
+
+    fn from_row(pose: ExternalPose, row: &Row<'_>) -> Result<Self, DataError> {
+        let any = |_: f64| None;
+        let tip = [
+            row.optional("x", any)?,
+            row.optional("y", any)?,
+            row.optional("z", any)?,
+        ];
+        Ok(PlannedPose {
+            pose,
+            extension_mm: row
+                .optional("extension_mm", |v| {
+                    (v.abs() > MAX_EXTENSION_MM).then_some("an extension beyond ±1000 mm (mm?)")
+                })?
+                .unwrap_or(0.0),
+            tip_mm: match tip {
+                [Some(x), Some(y), Some(z)] => Some([x, y, z]),
+                _ => None,
+            },
+            length_mm: row.optional("length", any)?,
+            line: row.record.line,
+        })
+    }
+
+    fn pose(&self) -> &ExternalPose {
+        &self.pose
+    }
+
+    fn value(&self, column: &str) -> Option<f64> {
+        match column {
+            "extension_mm" => (self.extension_mm != 0.0).then_some(self.extension_mm),
+            "x" => self.tip_mm.map(|t| t[0]),
+            "y" => self.tip_mm.map(|t| t[1]),
+            "z" => self.tip_mm.map(|t| t[2]),
+            "length" => self.length_mm,
             _ => None,
         }
     }
@@ -592,6 +654,46 @@ pub fn write_touch_to<W: Write>(
 
 /// Writes touch-offs to a file.
 pub fn write_touch_path(path: &Path, data: &TouchData, comments: &[String]) -> std::io::Result<()> {
+    write_file(path, data, comments)
+}
+
+/// Reads poses to measure at (columns `q1,q2,q3,h1,h2`, optional
+/// `extension_mm`; `x,y,z` and `length` are read as information).
+///
+/// # Example
+/// ```
+/// let csv = "q1,q2,q3,h1,h2,x,y,z\n800,810,790,0.5,-0.3,10,20,1100\n";
+/// let p = tricept_data::read_poses_from(csv.as_bytes(), "plan.csv").unwrap();
+/// assert_eq!(p.records[0].tip_mm, Some([10.0, 20.0, 1100.0]));
+/// let mut out = Vec::new();
+/// tricept_data::write_poses_to(&mut out, &p, &[]).unwrap();
+/// assert_eq!(String::from_utf8(out).unwrap(), csv);
+/// ```
+pub fn read_poses_from<R: Read>(reader: R, file: &str) -> Result<PlannedPoses, DataError> {
+    read_rows(reader, file)
+}
+
+/// Reads a file of poses to measure at (see [`read_poses_from`]).
+pub fn read_poses_path(path: &Path) -> Result<PlannedPoses, DataError> {
+    let (f, file) = open(path)?;
+    read_poses_from(f, &file)
+}
+
+/// Writes poses to measure at.
+pub fn write_poses_to<W: Write>(
+    w: W,
+    data: &PlannedPoses,
+    comments: &[String],
+) -> std::io::Result<()> {
+    write_rows(w, data, comments)
+}
+
+/// Writes poses to measure at to a file.
+pub fn write_poses_path(
+    path: &Path,
+    data: &PlannedPoses,
+    comments: &[String],
+) -> std::io::Result<()> {
     write_file(path, data, comments)
 }
 

@@ -54,10 +54,11 @@ mod write;
 
 pub use error::DataError;
 pub use external::{
-    BallbarData, BallbarReading, ExternalData, ExternalPose, Feature, Features, Stylus, TouchData,
-    TouchReading, TrackerData, TrackerPoint, read_ballbar_from, read_ballbar_path, read_touch_from,
-    read_touch_path, read_tracker_from, read_tracker_path, write_ballbar_path, write_ballbar_to,
-    write_touch_path, write_touch_to, write_tracker_path, write_tracker_to,
+    BallbarData, BallbarReading, ExternalData, ExternalPose, Feature, Features, PlannedPose,
+    PlannedPoses, Stylus, TouchData, TouchReading, TrackerData, TrackerPoint, read_ballbar_from,
+    read_ballbar_path, read_poses_from, read_poses_path, read_touch_from, read_touch_path,
+    read_tracker_from, read_tracker_path, write_ballbar_path, write_ballbar_to, write_poses_path,
+    write_poses_to, write_touch_path, write_touch_to, write_tracker_path, write_tracker_to,
 };
 pub use pose::{Dataset, MeasuredPose, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Readings};
 pub use read::{MAX_ANGLE_SPAN_RAD, read_from, read_path, read_with_progress};

@@ -20,7 +20,7 @@ use nalgebra::DMatrix;
 use serde_json::{Map, Value, json};
 use tricept_data::ExternalPose;
 use tricept_kinematics::{Machine, UpJoints};
-use tricept_numerics::linalg::{r_factor, svd_values_and_vectors};
+use tricept_numerics::linalg::{TriangularAccumulator, r_factor, svd_values_and_vectors};
 use tricept_numerics::lsq::{DEFAULT_RANK_TOLERANCE, RankDecision, ReducedProblem, Solution};
 
 use crate::error::IdentError;
@@ -615,6 +615,96 @@ fn finish(
         converged,
         warnings,
     })
+}
+
+/// The weighted rows of one source at the nominal machine, with its
+/// nuisance at its starting values: what planning scores candidate
+/// measurements with (the rows' Jacobians do not depend on the measured
+/// values, only on where the machine stood).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DesignRows {
+    /// The source's nuisance parameter names (with its label).
+    pub nuisance_names: Vec<String>,
+    /// Per record, its rows `[nuisance | global parameters]`, each weighted
+    /// by `1 / sigma` (`rows per record x (nuisance + parameters)`).
+    pub records: Vec<DMatrix<f64>>,
+    /// The source's prior rows (bar length, target offset, stylus), weighted.
+    pub priors: DMatrix<f64>,
+}
+
+/// The rows of `source` at the nominal machine (see [`DesignRows`]).
+pub fn design_rows(model: &FusedModel, source: &Source) -> Result<DesignRows, IdentError> {
+    let k = model.len();
+    let p = vec![0.0; k];
+    let at = model.at(&p);
+    let rows = source.rows();
+    let contexts = (0..rows.records())
+        .map(|j| {
+            model
+                .leg_context(&rows.pose(j).commands_mm)
+                .map_err(|e| IdentError::Source {
+                    file: source.file().to_string(),
+                    line: Some(rows.line(j)),
+                    message: format!("the commands of this record cannot be reached: {e}"),
+                })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut seeds = vec![None; rows.records()];
+    let nu = rows
+        .initial(&at, &contexts, &mut seeds)
+        .map_err(|e| in_source(source, e))?;
+    let nn = nu.values.len();
+    let mut sink = Sink::keeping(nn, k, rows.data_rows());
+    rows.evaluate(&at, &contexts, &nu, &mut seeds, &mut sink)
+        .map_err(|e| in_source(source, e))?;
+    let kept = sink.take_kept();
+    let width = nn + k;
+    let mut records: Vec<Vec<f64>> = vec![Vec::new(); rows.records()];
+    let mut priors = Vec::new();
+    for (record, row) in kept {
+        match record {
+            Some(j) => records[j].extend_from_slice(&row[..width]),
+            None => priors.extend_from_slice(&row[..width]),
+        }
+    }
+    Ok(DesignRows {
+        nuisance_names: source.nuisance_names(),
+        records: records
+            .into_iter()
+            .map(|r| DMatrix::from_row_slice(r.len() / width.max(1), width, &r))
+            .collect(),
+        priors: DMatrix::from_row_slice(priors.len() / width.max(1), width, &priors),
+    })
+}
+
+/// The information the `sources` together carry on the global parameters
+/// at the nominal machine, their nuisance projected out: `R^T R` of the
+/// union's parameter block (`k x k`, in the parameters' units).
+pub fn information(model: &FusedModel, sources: &[Source]) -> Result<DMatrix<f64>, IdentError> {
+    let k = model.len();
+    let parts = sources
+        .iter()
+        .map(|source| {
+            let rows = source.rows();
+            let d = design_rows(model, source)?;
+            let nn = d.nuisance_names.len();
+            let mut acc = TriangularAccumulator::new(nn + k);
+            for m in d.records.iter().chain(std::iter::once(&d.priors)) {
+                for i in 0..m.nrows() {
+                    let row: Vec<f64> = m.row(i).iter().copied().collect();
+                    acc.push_row(&row);
+                }
+            }
+            let _ = rows;
+            Ok((nn, acc.finish()))
+        })
+        .collect::<Result<Vec<_>, IdentError>>()?;
+    let mut f = DMatrix::zeros(k, k);
+    for (nn, r) in parts {
+        let block = DMatrix::from_fn(k, k, |i, j| r[(nn + i, nn + j)]);
+        f += block.transpose() * block;
+    }
+    Ok(f)
 }
 
 impl Fusion {

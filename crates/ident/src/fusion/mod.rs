@@ -29,7 +29,10 @@ mod touch;
 mod tracker;
 
 pub use ballbar::BallbarOptions;
-pub use estimate::{Fusion, FusionOptions, SourceFit, evaluation_poses, identify_fused};
+pub use estimate::{
+    DesignRows, Fusion, FusionOptions, SourceFit, design_rows, evaluation_poses, identify_fused,
+    information,
+};
 pub use model::{FUSABLE_EFFECTS, FusedModel};
 pub use report::{
     FusionReport, MadeVisible, NamedQuantity, SourceVisibility, TipImpact, ToolTipPrediction,

@@ -76,6 +76,8 @@ pub(crate) struct Sink {
     row: Vec<f64>,
     /// `(record, standardised residual, residual)` of every data row.
     pub standardised: Vec<(usize, f64, f64)>,
+    /// Every weighted row with its record (`None`: a prior), when kept.
+    kept: Option<Vec<(Option<usize>, Vec<f64>)>>,
 }
 
 impl Sink {
@@ -88,7 +90,21 @@ impl Sink {
             k,
             row: vec![0.0; n_nuisance + k + 1],
             standardised: Vec::with_capacity(rows),
+            kept: None,
         }
+    }
+
+    /// A sink that also keeps every weighted row (for planning).
+    pub fn keeping(n_nuisance: usize, k: usize, rows: usize) -> Sink {
+        Sink {
+            kept: Some(Vec::with_capacity(rows)),
+            ..Sink::new(n_nuisance, k, rows)
+        }
+    }
+
+    /// The rows kept by a [`Sink::keeping`] sink.
+    pub fn take_kept(&mut self) -> Vec<(Option<usize>, Vec<f64>)> {
+        self.kept.take().unwrap_or_default()
     }
 
     /// One data row of `record`: weight `w = 1 / sigma`, the derivatives of
@@ -105,6 +121,9 @@ impl Sink {
         self.row[nn + k] = w * residual;
         self.acc.push_row(&self.row);
         self.standardised.push((record, w * residual, residual));
+        if let Some(kept) = &mut self.kept {
+            kept.push((Some(record), self.row.clone()));
+        }
     }
 
     /// A prior on nuisance parameter `column`: `(prior - value) / sigma`.
@@ -113,6 +132,9 @@ impl Sink {
         self.row[column] = 1.0 / sigma;
         self.row[self.n_nuisance + self.k] = residual / sigma;
         self.acc.push_row(&self.row);
+        if let Some(kept) = &mut self.kept {
+            kept.push((None, self.row.clone()));
+        }
     }
 
     /// The reduced problem of the rows pushed.
