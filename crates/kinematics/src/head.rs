@@ -243,6 +243,9 @@ fn wrap_angle(a: f64) -> f64 {
 /// Scale turning unit-vector residuals into mm for the joint residual.
 const AXIS_SCALE_MM: f64 = 100.0;
 const TOOL_MAX_ITERATIONS: u32 = 40;
+/// A tool pose reached to this residual (mm, the axis scaled by 100 mm) is
+/// solved, whatever the last step was.
+const TOOL_RESIDUAL_DONE_MM: f64 = 1e-11;
 
 impl Machine {
     /// Tool tip and axis in the base frame with the UP limb at `up` and the
@@ -299,8 +302,28 @@ impl Machine {
         let d = axis / n;
         let (mut up, mut h, head_singular) = self.tool_seed(tip_mm, &d, branch)?;
 
+        let finish = |up: UpJoints, h: [f64; 2], iterations: u32| {
+            let offsets = self.head.angle_offsets_rad;
+            let h = [wrap_angle(h[0] - offsets[0]), wrap_angle(h[1] - offsets[1])];
+            let geometry = self.legs_at(&up);
+            let legs_mm = self.commands_for(&geometry);
+            self.check_limits(&legs_mm, &up, &geometry.limb.limb_axis)?;
+            Ok(ToolIkSolution {
+                legs_mm,
+                up,
+                head_rad: h,
+                platform_mm: geometry.limb.position_mm,
+                iterations,
+                head_singular,
+            })
+        };
         for iteration in 1..=TOOL_MAX_ITERATIONS {
             let (residual, jac) = self.tool_residual(&up, h, tip_mm, &d);
+            // Reached to rounding: near a head singularity the steps in h1
+            // need not shrink while the pose is already exact.
+            if residual.norm() <= TOOL_RESIDUAL_DONE_MM {
+                return finish(up, h, iteration);
+            }
             // Gauss-Newton with a tiny Levenberg term: at a head singularity
             // the h1 column vanishes and the damping keeps h1 at its seed.
             let jt = jac.transpose();
@@ -334,19 +357,7 @@ impl Machine {
                         ),
                     });
                 }
-                let offsets = self.head.angle_offsets_rad;
-                let h = [wrap_angle(h[0] - offsets[0]), wrap_angle(h[1] - offsets[1])];
-                let geometry = self.legs_at(&up);
-                let legs_mm = self.commands_for(&geometry);
-                self.check_limits(&legs_mm, &up, &geometry.limb.limb_axis)?;
-                return Ok(ToolIkSolution {
-                    legs_mm,
-                    up,
-                    head_rad: h,
-                    platform_mm: geometry.limb.position_mm,
-                    iterations: iteration,
-                    head_singular,
-                });
+                return finish(up, h, iteration);
             }
         }
         Err(KinematicsError::NotConverged {

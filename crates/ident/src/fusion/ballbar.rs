@@ -116,6 +116,14 @@ impl SourceRows for Ballbar {
         self.readings.len()
     }
 
+    fn prior_rows(&self) -> usize {
+        if self.length_sigma_mm.is_some() {
+            self.setups.len()
+        } else {
+            0
+        }
+    }
+
     fn pose(&self, record: usize) -> ExternalPose {
         self.readings[record].pose
     }

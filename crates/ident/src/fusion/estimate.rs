@@ -60,7 +60,9 @@ impl FusionOptions {
     /// Defaults: the rank tolerance and weak threshold of
     /// [`crate::IdentifyOptions`], 30 iterations, 5 um, and the evaluation
     /// grid [`evaluation_poses`] with 2 rings of 8 on 3 levels and head
-    /// angles `h1` in {0, 90, 180, 270} deg, `h2` in {0, 30} deg.
+    /// angles `h1` in {0, 90, 180, 270} deg, `h2` in {15, 35} deg (away
+    /// from the head singularity at `h2 = 0`, where a calibrated head may
+    /// not point exactly along its first axis).
     pub fn for_machine(machine: &Machine) -> FusionOptions {
         FusionOptions {
             rank_tolerance: DEFAULT_RANK_TOLERANCE,
@@ -70,7 +72,7 @@ impl FusionOptions {
                 machine,
                 (2, 8, 3),
                 &[0.0, 90.0, 180.0, 270.0],
-                &[0.0, 30.0],
+                &[15.0, 35.0],
             ),
             harmless_um: 5.0,
         }
@@ -360,7 +362,8 @@ pub fn identify_fused(
         n_nuisance += s.rows().nuisance_names().len();
     }
     let data_rows: usize = sources.iter().map(|s| s.rows().data_rows()).sum();
-    if data_rows < n_nuisance + k + 1 {
+    let prior_rows: usize = sources.iter().map(|s| s.rows().prior_rows()).sum();
+    if data_rows + prior_rows < n_nuisance + k + 1 {
         let records: usize = sources.iter().map(|s| s.records()).sum();
         return Err(IdentError::Source {
             file: sources
@@ -370,7 +373,7 @@ pub fn identify_fused(
                 .join(", "),
             line: None,
             message: format!(
-                "too few measurements: {records} records give {data_rows} values for {} unknowns ({k} parameters, {n_nuisance} nuisance)",
+                "too few measurements: {records} records give {data_rows} values and {prior_rows} priors for {} unknowns ({k} parameters, {n_nuisance} nuisance)",
                 n_nuisance + k
             ),
         });

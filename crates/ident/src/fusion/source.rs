@@ -164,6 +164,11 @@ pub(crate) trait SourceRows: Sync + std::fmt::Debug {
     fn records(&self) -> usize;
     /// Number of data rows (records times rows per record).
     fn data_rows(&self) -> usize;
+    /// Number of prior rows (a known target offset, a certified bar
+    /// length, a stylus radius).
+    fn prior_rows(&self) -> usize {
+        0
+    }
     /// Where the machine stood at a record.
     fn pose(&self, record: usize) -> ExternalPose;
     /// The record's line in its file.

@@ -168,6 +168,10 @@ impl SourceRows for Touch {
         self.touches.len()
     }
 
+    fn prior_rows(&self) -> usize {
+        1
+    }
+
     fn pose(&self, record: usize) -> ExternalPose {
         self.touches[record].pose
     }

@@ -182,6 +182,13 @@ impl SourceRows for Tracker {
         3 * self.points.len()
     }
 
+    fn prior_rows(&self) -> usize {
+        match self.target {
+            TrackerTarget::Free => 0,
+            TrackerTarget::Known { .. } => 3,
+        }
+    }
+
     fn pose(&self, record: usize) -> ExternalPose {
         self.points[record].pose
     }
