@@ -31,11 +31,11 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 use serde_json::{Value, json};
-use tricept_data::{ExternalData, ExternalPose, MeasuredPose};
+use tricept_data::{ExternalData, ExternalPose};
 use tricept_diagnose::{DiagnoseOptions, diagnose};
 use tricept_ident::fusion::{
     BallbarOptions, FUSABLE_EFFECTS, FusedModel, FusionOptions, Source, TrackerOptions,
-    TrackerTarget, identify_fused, information,
+    TrackerTarget, head_angle_poses, identify_fused,
 };
 use tricept_kinematics::{HeadBranch, Machine};
 use tricept_model::effects::{EffectName, stiffness_for_platform_deflection};
@@ -44,8 +44,8 @@ use tricept_numerics::stats::quantile;
 use tricept_plant::{Ballbar, Campaign, Effect, Plant, Tracker, random_head_errors};
 use tricept_plot::{Axes, Curve, Reference, curves};
 use tricept_study::plan::{
-    PlanProblem, ballbar_candidates, candidate_rows, nominal_ballbar_data, nominal_tracker_data,
-    plan, tracker_candidates,
+    PlanProblem, ballbar_candidates, candidate_rows, internal_information, nominal_ballbar_data,
+    nominal_tracker_data, plan,
 };
 
 /// Which instruments to run.
@@ -267,7 +267,7 @@ fn plans(instrument: Instrument, m: &Machine, ks: &[usize]) -> Result<Plans, Str
     let model = FusedModel::new(m.clone(), ParameterSet::paper15(), &[], true)
         .map_err(|e| e.to_string())?;
     let candidates = match instrument {
-        Instrument::Tracker => tracker_candidates(
+        Instrument::Tracker => head_angle_poses(
             m,
             &m.workspace.polar_grid(2, 8, 3),
             &[0.0, 60.0, 120.0, 180.0, 240.0, 300.0],
@@ -275,25 +275,8 @@ fn plans(instrument: Instrument, m: &Machine, ks: &[usize]) -> Result<Plans, Str
         ),
         Instrument::Ballbar => ballbar_candidates(m, &pivot(), 150.0, 300),
     };
-    let grid: Vec<MeasuredPose> = m
-        .workspace
-        .polar_grid(3, 8, 3)
-        .iter()
-        .filter_map(|r| m.inverse(r).ok())
-        .map(|ik| MeasuredPose {
-            commands_mm: ik.legs_mm,
-            ..Default::default()
-        })
-        .collect();
-    let internal = tricept_data::Dataset {
-        poses: grid,
-        source: "grid".into(),
-    };
-    let f_int = information(
-        &model,
-        &[Source::internal(&internal, m.sensors.logged_sigma())],
-    )
-    .map_err(|e| e.to_string())?;
+    let f_int = internal_information(&model, &m.workspace.polar_grid(3, 8, 3))
+        .map_err(|e| e.to_string())?;
     let rows = candidate_rows(&model, &instrument_source(instrument, &model, &candidates)?)
         .map_err(|e| e.to_string())?;
     let eval = FusionOptions::for_machine(m).eval_poses;
@@ -438,7 +421,7 @@ fn run_machine(
     let mut free_target: Vec<Fit> = vec![Err("not run"); ks.len()];
     for (i, _) in ks.iter().enumerate() {
         let (fs, own) = (&plans.fusion[i], &plans.alone[i]);
-        errors[0][i] = self_calibration.clone();
+        errors[0][i] = self_calibration;
         errors[1][i] = fit(&geometric, vec![external(fs, tip)]);
         errors[2][i] = fit(&geometric, vec![external(own, tip)]);
         errors[3][i] = fit(&geometric, vec![Some(internal()), external(fs, tip)]);
@@ -531,7 +514,7 @@ pub fn run(a: HybridArgs) -> Result<(), String> {
             );
             per_scenario.push((scenario, machines));
         }
-        markdown.push_str(&report(instrument, &ks, &per_scenario, &plans, &a)?);
+        markdown.push_str(&report(instrument, &ks, &per_scenario, &a)?);
         results.push(json_of(instrument, &ks, &per_scenario, &plans));
     }
     let inputs = json!({
@@ -618,10 +601,12 @@ fn json_of(
                 .collect();
             let mut named = std::collections::BTreeMap::new();
             for r in machines {
-                let key = if r.named_effects.is_empty() {
+                let mut names: Vec<&str> = r.named_effects.iter().map(|e| e.as_str()).collect();
+                names.sort_unstable();
+                let key = if names.is_empty() {
                     "none".to_string()
                 } else {
-                    r.named_effects.iter().map(|e| e.as_str()).collect::<Vec<_>>().join("+")
+                    names.join("+")
                 };
                 *named.entry(key).or_insert(0usize) += 1;
             }
@@ -644,7 +629,6 @@ fn report(
     instrument: Instrument,
     ks: &[usize],
     per_scenario: &[(Scenario, Vec<MachineResult>)],
-    plans: &Plans,
     a: &HybridArgs,
 ) -> Result<String, String> {
     let mut s = String::new();
@@ -823,6 +807,5 @@ fn report(
         )
         .map_err(|e| e.to_string())?;
     }
-    let _ = plans;
     Ok(s)
 }

@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use serde_json::{Value, json};
-use tricept_data::Features;
+use tricept_data::{
+    BallbarReading, ExternalData, ExternalRecord, Features, TouchReading, TrackerPoint,
+};
 use tricept_ident::IdentError;
 use tricept_ident::fusion::{
     BallbarOptions, FusedModel, Fusion, FusionOptions, Source, TouchOptions, TrackerOptions,
@@ -16,7 +18,7 @@ use tricept_ident::fusion::{
 };
 use tricept_model::effects::EffectName;
 
-use crate::args::{machine_with_noise, read_data};
+use crate::args::{check_commands, machine_with_noise, read_data};
 use crate::cli_error::CliError;
 use crate::ident_cmd::IdentifyArgs;
 
@@ -152,14 +154,6 @@ pub fn fusion_error(e: IdentError) -> CliError {
     }
 }
 
-fn label(kind: &str, k: usize) -> String {
-    if k == 0 {
-        kind.to_string()
-    } else {
-        format!("{kind}{}", k + 1)
-    }
-}
-
 fn data_error(e: tricept_data::DataError) -> CliError {
     CliError::input(e.to_string())
 }
@@ -190,19 +184,13 @@ fn sources(
         sigma_um: positive("--tracker-sigma-um", x.tracker_sigma_um)?,
         target,
     };
-    for (k, path) in x.tracker.iter().enumerate() {
-        let d = tricept_data::read_tracker_path(path).map_err(data_error)?;
-        check_commands(
-            &d.source,
-            d.records.iter().map(|r| (r.line, r.pose.commands_mm)),
-            machine,
-        )?;
-        sources.push(
-            Source::tracker(&d, &tracker)
-                .map_err(fusion_error)?
-                .with_label(label("tracker", k)),
-        );
-    }
+    sources.extend(external_sources(
+        &x.tracker,
+        "tracker",
+        machine,
+        |r: &TrackerPoint| (r.line, r.pose.commands_mm),
+        |d| Source::tracker(d, &tracker),
+    )?);
     let length_sigma_um = match x.ballbar_length_sigma_um.as_str() {
         "free" => None,
         text => Some(positive(
@@ -226,19 +214,13 @@ fn sources(
         length_sigma_um,
         ball_offset_mm: ball,
     };
-    for (k, path) in x.ballbar.iter().enumerate() {
-        let d = tricept_data::read_ballbar_path(path).map_err(data_error)?;
-        check_commands(
-            &d.source,
-            d.records.iter().map(|r| (r.line, r.pose.commands_mm)),
-            machine,
-        )?;
-        sources.push(
-            Source::ballbar(&d, &ballbar)
-                .map_err(fusion_error)?
-                .with_label(label("ballbar", k)),
-        );
-    }
+    sources.extend(external_sources(
+        &x.ballbar,
+        "ballbar",
+        machine,
+        |r: &BallbarReading| (r.line, r.pose.commands_mm),
+        |d| Source::ballbar(d, &ballbar),
+    )?);
     if !x.touch.is_empty() {
         let Some(features) = &x.features else {
             return Err(CliError::input(
@@ -249,46 +231,41 @@ fn sources(
         let touch = TouchOptions {
             sigma_um: positive("--touch-sigma-um", x.touch_sigma_um)?,
         };
-        for (k, path) in x.touch.iter().enumerate() {
-            let d = tricept_data::read_touch_path(path).map_err(data_error)?;
-            check_commands(
-                &d.source,
-                d.records.iter().map(|r| (r.line, r.pose.commands_mm)),
-                machine,
-            )?;
-            sources.push(
-                Source::touch(&d, &features, &touch)
-                    .map_err(fusion_error)?
-                    .with_label(label("touch", k)),
-            );
-        }
+        sources.extend(external_sources(
+            &x.touch,
+            "touch",
+            machine,
+            |r: &TouchReading| (r.line, r.pose.commands_mm),
+            |d| Source::touch(d, &features, &touch),
+        )?);
     }
     Ok(sources)
 }
 
-/// Commands outside the leg stroke are input errors, named by line.
-fn check_commands(
-    file: &str,
-    records: impl Iterator<Item = (u64, [f64; 3])>,
+/// Reads the external files `paths` of one kind, checks their commands
+/// against the leg stroke (`at` gives a record's line and commands) and
+/// makes each a source labelled `kind`, `kind2`, ...
+fn external_sources<T: ExternalRecord>(
+    paths: &[PathBuf],
+    kind: &str,
     machine: &tricept_kinematics::Machine,
-) -> Result<(), CliError> {
-    for (line, q) in records {
-        if let Err(e) = machine.check_commands(&q) {
-            let message = match e {
-                tricept_kinematics::KinematicsError::OutOfStroke {
-                    leg,
-                    length_mm,
-                    min_mm,
-                    max_mm,
-                } => format!(
-                    "{file}: line {line}, column `q{leg}`: command {length_mm} mm is outside the leg stroke [{min_mm}, {max_mm}] mm"
-                ),
-                e => format!("{file}: line {line}: {e}"),
+    at: impl Fn(&T) -> (u64, [f64; 3]),
+    source: impl Fn(&ExternalData<T>) -> Result<Source, IdentError>,
+) -> Result<Vec<Source>, CliError> {
+    paths
+        .iter()
+        .enumerate()
+        .map(|(k, path)| {
+            let d = tricept_data::read_external_path::<T>(path).map_err(data_error)?;
+            check_commands(&d.source, d.records.iter().map(&at), machine)?;
+            let label = if k == 0 {
+                kind.to_string()
+            } else {
+                format!("{kind}{}", k + 1)
             };
-            return Err(CliError::input(message));
-        }
-    }
-    Ok(())
+            Ok(source(&d).map_err(fusion_error)?.with_label(label))
+        })
+        .collect()
 }
 
 /// The fused model of `a`.

@@ -8,11 +8,11 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use nalgebra::Vector3;
 use serde_json::json;
-use tricept_data::{ExternalData, MeasuredPose, PlannedPose};
-use tricept_ident::fusion::{Source, TrackerOptions, TrackerTarget, information};
+use tricept_data::{ExternalData, PlannedPose};
+use tricept_ident::fusion::{Source, TrackerOptions, TrackerTarget, head_angle_poses, information};
 use tricept_study::plan::{
-    PlanProblem, ballbar_candidates, candidate_rows, nominal_ballbar_data, nominal_tracker_data,
-    plan, tracker_candidates,
+    PlanProblem, ballbar_candidates, candidate_rows, internal_information, nominal_ballbar_data,
+    nominal_tracker_data, plan,
 };
 
 use crate::args::{MachineArgs, NoiseArgs, ParamArgs, machine_with_noise, pose_targets, read_data};
@@ -120,39 +120,25 @@ pub fn run(a: &PlanArgs) -> Result<(), CliError> {
     if a.k.is_empty() || a.k.contains(&0) {
         return Err(CliError::input("--k: expected positive whole numbers"));
     }
-    let internal = match &a.data {
-        Some(path) => read_data(path, &m)?,
+    let (f_int, internal_poses) = match &a.data {
+        Some(path) => {
+            let data = read_data(path, &m)?;
+            let f = information(&model, &[Source::internal(&data, m.sensors.logged_sigma())])
+                .map_err(fusion_error)?;
+            (f, data.poses.len())
+        }
         None => {
-            let poses = pose_targets(&a.poses, &m)?
-                .iter()
-                .enumerate()
-                .map(|(i, r)| {
-                    m.inverse(r)
-                        .map(|ik| MeasuredPose {
-                            commands_mm: ik.legs_mm,
-                            ..Default::default()
-                        })
-                        .map_err(|e| {
-                            CliError::input(format!("--poses {}: pose {}: {e}", a.poses, i + 1))
-                        })
-                })
-                .collect::<Result<_, _>>()?;
-            tricept_data::Dataset {
-                poses,
-                source: format!("--poses {}", a.poses),
-            }
+            let targets = pose_targets(&a.poses, &m)?;
+            let f = internal_information(&model, &targets)
+                .map_err(|e| CliError::input(format!("--poses {}: {e}", a.poses)))?;
+            (f, targets.len())
         }
     };
-    let f_int = information(
-        &model,
-        &[Source::internal(&internal, m.sensors.logged_sigma())],
-    )
-    .map_err(fusion_error)?;
     let (poses, source, pivot) = match a.instrument {
         Instrument::Tracker => {
             let (h1, h2) = parse_head_angles("--head-angles-deg", &a.head_angles_deg)?;
             let points = pose_targets(&a.candidates, &m)?;
-            let poses = tracker_candidates(&m, &points, &h1, &h2);
+            let poses = head_angle_poses(&m, &points, &h1, &h2);
             let target = match a.tracker_target.as_str() {
                 "tip" => TrackerTarget::Known {
                     offset_mm: [0.0; 3],
@@ -226,7 +212,7 @@ pub fn run(a: &PlanArgs) -> Result<(), CliError> {
             last.k,
             last.planned_um
         )];
-        tricept_data::write_poses_path(
+        tricept_data::write_external_path(
             path,
             &ExternalData {
                 records,
@@ -263,7 +249,7 @@ pub fn run(a: &PlanArgs) -> Result<(), CliError> {
         outln!(
             "prior only {:.1} um; internal campaign ({} poses) alone {:.1} um",
             result.prior_only_um,
-            internal.poses.len(),
+            internal_poses,
             result.internal_only_um
         );
         outln!(

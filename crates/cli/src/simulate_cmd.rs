@@ -208,12 +208,14 @@ fn parse_head_errors(spec: &str, m: &tricept_kinematics::Machine) -> Result<Vec<
 
 /// The poses of a poses file (every record with its extension).
 fn read_poses(path: &std::path::Path) -> Result<Vec<(tricept_data::ExternalPose, f64)>, CliError> {
-    Ok(tricept_data::read_poses_path(path)
-        .map_err(|e| CliError::input(e.to_string()))?
-        .records
-        .iter()
-        .map(|p| (p.pose, p.extension_mm))
-        .collect())
+    Ok(
+        tricept_data::read_external_path::<tricept_data::PlannedPose>(path)
+            .map_err(|e| CliError::input(e.to_string()))?
+            .records
+            .iter()
+            .map(|p| (p.pose, p.extension_mm))
+            .collect(),
+    )
 }
 
 /// Writes the external instruments' files that were asked for.
@@ -243,7 +245,7 @@ fn simulate_external(a: &SimulateArgs, plant: &Plant, comments: &[String]) -> Re
                 "tracker: frame (mm, rad) {}, target offset (mm) {}, {} um per coordinate",
                 a.tracker_frame_mm_rad, a.tracker_target_mm, a.tracker_sigma_um
             ));
-            tricept_data::write_tracker_path(out, &data, &c).map_err(|e| write_failed(out, e))?;
+            tricept_data::write_external_path(out, &data, &c).map_err(|e| write_failed(out, e))?;
         }
         (None, None) => {}
         _ => {
@@ -269,7 +271,7 @@ fn simulate_external(a: &SimulateArgs, plant: &Plant, comments: &[String]) -> Re
                 "ballbar: pivot (mm) {}, length error {} um, {} um per reading",
                 a.ballbar_pivot_mm, a.ballbar_length_error_um, a.ballbar_sigma_um
             ));
-            tricept_data::write_ballbar_path(out, &data, &c).map_err(|e| write_failed(out, e))?;
+            tricept_data::write_external_path(out, &data, &c).map_err(|e| write_failed(out, e))?;
         }
         (None, None) => {}
         _ => {

@@ -585,7 +585,7 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
     // Good files: internal data, 12 spread tracker points, a ballbar.
     let tips: Vec<[f64; 3]> = (0..12)
         .map(|j| {
-            let a = j as f64 * 0.5236;
+            let a = j as f64 * std::f64::consts::FRAC_PI_6;
             [
                 250.0 * a.cos(),
                 250.0 * a.sin(),
@@ -620,7 +620,7 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
     let (_, t_header, t_rows) = split(&tracker);
     let bar_tips: Vec<[f64; 3]> = (0..8)
         .map(|j| {
-            let a = j as f64 * 0.785;
+            let a = j as f64 * std::f64::consts::FRAC_PI_4;
             [100.0 * a.cos(), 100.0 * a.sin(), 1250.0 - 112.0]
         })
         .collect();

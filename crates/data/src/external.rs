@@ -2,7 +2,8 @@
 //! while the machine stood at known leg commands and head angles. Three CSV
 //! contracts, read as strictly as the measured-data file (same record
 //! machinery, same messages: file, line and column), and the features file
-//! (JSON) that touch-offs refer to.
+//! (JSON) that touch-offs refer to. One reader and one writer serve every
+//! record type: [`read_external_path`]`::<TrackerPoint>`, ...
 //!
 //! | file | required columns | optional columns |
 //! |---|---|---|
@@ -143,9 +144,21 @@ const TEMP_RANGE_C: (f64, f64) = (-60.0, 200.0);
 /// Largest extension along the tool accepted, mm.
 const MAX_EXTENSION_MM: f64 = 1000.0;
 
+/// A record type of an external file ([`TrackerPoint`], [`BallbarReading`],
+/// [`TouchReading`], [`PlannedPose`]): what [`read_external_from`] and
+/// [`write_external_to`] read and write. Sealed: the file formats are the
+/// crate's contract.
+pub trait ExternalRecord: sealed::ExternalRow {}
+
+impl<T: sealed::ExternalRow> ExternalRecord for T {}
+
+mod sealed {
+    pub use super::ExternalRow;
+}
+
 /// A record type of an external file: its columns and how a row reads
 /// and writes.
-trait ExternalRow: Sized {
+pub trait ExternalRow: Sized {
     /// Required columns after the pose columns.
     const MEASURED: &'static [&'static str];
     /// Optional columns.
@@ -168,7 +181,7 @@ trait ExternalRow: Sized {
 }
 
 /// One row being parsed: the header, the record and the located columns.
-struct Row<'a> {
+pub struct Row<'a> {
     header: &'a Header,
     record: &'a Record,
     measured: &'a [usize],
@@ -514,44 +527,50 @@ fn write_rows<W: Write, T: ExternalRow>(
     Ok(())
 }
 
-fn write_file<T: ExternalRow>(
-    path: &Path,
-    data: &ExternalData<T>,
-    comments: &[String],
-) -> std::io::Result<()> {
-    let f = std::fs::File::create(path)?;
-    let mut w = std::io::BufWriter::new(f);
-    write_rows(&mut w, data, comments)?;
-    w.flush()
-}
-
-/// Reads tracker / CMM points from any reader; `file` names it in errors.
+/// Reads external records of type `T` from any reader; `file` names it in
+/// errors.
 ///
 /// # Example
 /// ```
+/// use tricept_data::{BallbarReading, TouchReading, TrackerPoint, read_external_from};
 /// let csv = "q1,q2,q3,h1,h2,x,y,z,sigma_um\n800,810,790,0.5,-0.3,1500.1,-20.2,300.3,12\n";
-/// let t = tricept_data::read_tracker_from(csv.as_bytes(), "t.csv").unwrap();
+/// let t = read_external_from::<TrackerPoint, _>(csv.as_bytes(), "t.csv").unwrap();
 /// assert_eq!(t.records[0].position_mm, [1500.1, -20.2, 300.3]);
 /// assert_eq!((t.records[0].sigma_um, t.records[0].setup), (Some(12.0), 1));
 /// let bad = "q1,q2,q3,h1,h2,x,y,z\n800,810,790,30,-0.3,1,2,3\n";
-/// let e = tricept_data::read_tracker_from(bad.as_bytes(), "t.csv").unwrap_err();
+/// let e = read_external_from::<TrackerPoint, _>(bad.as_bytes(), "t.csv").unwrap_err();
 /// assert!(e.to_string().starts_with("t.csv: line 2, column `h1`: a head angle beyond"));
+///
+/// let csv = "q1,q2,q3,h1,h2,length\n800,810,790,0.5,-0.3,150.0012\n";
+/// let b = read_external_from::<BallbarReading, _>(csv.as_bytes(), "b.csv").unwrap();
+/// assert_eq!(b.records[0].length_mm, 150.0012);
+/// let um = "q1,q2,q3,h1,h2,length\n800,810,790,0.5,-0.3,150001.2\n";
+/// let e = read_external_from::<BallbarReading, _>(um.as_bytes(), "b.csv").unwrap_err();
+/// assert!(e.to_string().contains("column `length`: a ballbar length must be 10-2000 mm"));
+///
+/// let csv = "q1,q2,q3,h1,h2,feature\n800,810,790,0.5,-0.3,2\n";
+/// let t = read_external_from::<TouchReading, _>(csv.as_bytes(), "touch.csv").unwrap();
+/// assert_eq!(t.records[0].feature, 2);
 /// ```
-pub fn read_tracker_from<R: Read>(reader: R, file: &str) -> Result<TrackerData, DataError> {
+pub fn read_external_from<T: ExternalRecord, R: Read>(
+    reader: R,
+    file: &str,
+) -> Result<ExternalData<T>, DataError> {
     read_rows(reader, file)
 }
 
-/// Reads a tracker / CMM file (see [`read_tracker_from`]).
-pub fn read_tracker_path(path: &Path) -> Result<TrackerData, DataError> {
+/// Reads an external-measurement file of records of type `T` (see
+/// [`read_external_from`]).
+pub fn read_external_path<T: ExternalRecord>(path: &Path) -> Result<ExternalData<T>, DataError> {
     let (f, file) = open(path)?;
-    read_tracker_from(f, &file)
+    read_rows(f, &file)
 }
 
-/// Writes tracker points as CSV (they read back exactly).
+/// Writes external records as CSV (they read back exactly).
 ///
 /// # Example
 /// ```
-/// use tricept_data::{ExternalData, ExternalPose, TrackerPoint};
+/// use tricept_data::{ExternalData, ExternalPose, PlannedPose, TrackerPoint};
 /// let data = ExternalData {
 ///     records: vec![TrackerPoint {
 ///         pose: ExternalPose { commands_mm: [800.0; 3], head_rad: [0.1, 0.2] },
@@ -563,138 +582,35 @@ pub fn read_tracker_path(path: &Path) -> Result<TrackerData, DataError> {
 ///     source: "mem".into(),
 /// };
 /// let mut out = Vec::new();
-/// tricept_data::write_tracker_to(&mut out, &data, &[]).unwrap();
+/// tricept_data::write_external_to(&mut out, &data, &[]).unwrap();
 /// let text = String::from_utf8(out).unwrap();
 /// assert_eq!(text, "q1,q2,q3,h1,h2,x,y,z,extension_mm\n800,800,800,0.1,0.2,1,2,3,100\n");
-/// let back = tricept_data::read_tracker_from(text.as_bytes(), "mem").unwrap();
+/// let back = tricept_data::read_external_from::<TrackerPoint, _>(text.as_bytes(), "mem").unwrap();
 /// assert_eq!(back.records[0].position_mm, data.records[0].position_mm);
-/// ```
-pub fn write_tracker_to<W: Write>(
-    w: W,
-    data: &TrackerData,
-    comments: &[String],
-) -> std::io::Result<()> {
-    write_rows(w, data, comments)
-}
-
-/// Writes tracker points to a file.
-pub fn write_tracker_path(
-    path: &Path,
-    data: &TrackerData,
-    comments: &[String],
-) -> std::io::Result<()> {
-    write_file(path, data, comments)
-}
-
-/// Reads ballbar readings from any reader; `file` names it in errors.
 ///
-/// # Example
-/// ```
-/// let csv = "q1,q2,q3,h1,h2,length\n800,810,790,0.5,-0.3,150.0012\n";
-/// let b = tricept_data::read_ballbar_from(csv.as_bytes(), "b.csv").unwrap();
-/// assert_eq!(b.records[0].length_mm, 150.0012);
-/// let um = "q1,q2,q3,h1,h2,length\n800,810,790,0.5,-0.3,150001.2\n";
-/// let e = tricept_data::read_ballbar_from(um.as_bytes(), "b.csv").unwrap_err();
-/// assert!(e.to_string().contains("column `length`: a ballbar length must be 10-2000 mm"));
-/// ```
-pub fn read_ballbar_from<R: Read>(reader: R, file: &str) -> Result<BallbarData, DataError> {
-    read_rows(reader, file)
-}
-
-/// Reads a ballbar file (see [`read_ballbar_from`]).
-pub fn read_ballbar_path(path: &Path) -> Result<BallbarData, DataError> {
-    let (f, file) = open(path)?;
-    read_ballbar_from(f, &file)
-}
-
-/// Writes ballbar readings as CSV.
-pub fn write_ballbar_to<W: Write>(
-    w: W,
-    data: &BallbarData,
-    comments: &[String],
-) -> std::io::Result<()> {
-    write_rows(w, data, comments)
-}
-
-/// Writes ballbar readings to a file.
-pub fn write_ballbar_path(
-    path: &Path,
-    data: &BallbarData,
-    comments: &[String],
-) -> std::io::Result<()> {
-    write_file(path, data, comments)
-}
-
-/// Reads touch-offs from any reader; `file` names it in errors.
-///
-/// # Example
-/// ```
-/// let csv = "q1,q2,q3,h1,h2,feature\n800,810,790,0.5,-0.3,2\n";
-/// let t = tricept_data::read_touch_from(csv.as_bytes(), "touch.csv").unwrap();
-/// assert_eq!(t.records[0].feature, 2);
-/// ```
-pub fn read_touch_from<R: Read>(reader: R, file: &str) -> Result<TouchData, DataError> {
-    read_rows(reader, file)
-}
-
-/// Reads a touch-off file (see [`read_touch_from`]).
-pub fn read_touch_path(path: &Path) -> Result<TouchData, DataError> {
-    let (f, file) = open(path)?;
-    read_touch_from(f, &file)
-}
-
-/// Writes touch-offs as CSV.
-pub fn write_touch_to<W: Write>(
-    w: W,
-    data: &TouchData,
-    comments: &[String],
-) -> std::io::Result<()> {
-    write_rows(w, data, comments)
-}
-
-/// Writes touch-offs to a file.
-pub fn write_touch_path(path: &Path, data: &TouchData, comments: &[String]) -> std::io::Result<()> {
-    write_file(path, data, comments)
-}
-
-/// Reads poses to measure at (columns `q1,q2,q3,h1,h2`, optional
-/// `extension_mm`; `x,y,z` and `length` are read as information).
-///
-/// # Example
-/// ```
+/// // Poses to measure at carry the nominal tool tip for information.
 /// let csv = "q1,q2,q3,h1,h2,x,y,z\n800,810,790,0.5,-0.3,10,20,1100\n";
-/// let p = tricept_data::read_poses_from(csv.as_bytes(), "plan.csv").unwrap();
+/// let p = tricept_data::read_external_from::<PlannedPose, _>(csv.as_bytes(), "plan.csv").unwrap();
 /// assert_eq!(p.records[0].tip_mm, Some([10.0, 20.0, 1100.0]));
-/// let mut out = Vec::new();
-/// tricept_data::write_poses_to(&mut out, &p, &[]).unwrap();
-/// assert_eq!(String::from_utf8(out).unwrap(), csv);
 /// ```
-pub fn read_poses_from<R: Read>(reader: R, file: &str) -> Result<PlannedPoses, DataError> {
-    read_rows(reader, file)
-}
-
-/// Reads a file of poses to measure at (see [`read_poses_from`]).
-pub fn read_poses_path(path: &Path) -> Result<PlannedPoses, DataError> {
-    let (f, file) = open(path)?;
-    read_poses_from(f, &file)
-}
-
-/// Writes poses to measure at.
-pub fn write_poses_to<W: Write>(
+pub fn write_external_to<T: ExternalRecord, W: Write>(
     w: W,
-    data: &PlannedPoses,
+    data: &ExternalData<T>,
     comments: &[String],
 ) -> std::io::Result<()> {
     write_rows(w, data, comments)
 }
 
-/// Writes poses to measure at to a file.
-pub fn write_poses_path(
+/// Writes external records to a file (see [`write_external_to`]).
+pub fn write_external_path<T: ExternalRecord>(
     path: &Path,
-    data: &PlannedPoses,
+    data: &ExternalData<T>,
     comments: &[String],
 ) -> std::io::Result<()> {
-    write_file(path, data, comments)
+    let f = std::fs::File::create(path)?;
+    let mut w = std::io::BufWriter::new(f);
+    write_rows(&mut w, data, comments)?;
+    w.flush()
 }
 
 /// The probe's stylus.
@@ -845,7 +761,7 @@ mod tests {
     use super::*;
 
     fn tracker_error(text: &str) -> String {
-        read_tracker_from(text.as_bytes(), "t.csv")
+        read_external_from::<TrackerPoint, _>(text.as_bytes(), "t.csv")
             .unwrap_err()
             .to_string()
     }
@@ -892,7 +808,7 @@ mod tests {
             let e = tracker_error(&text);
             assert!(e.starts_with(start), "{e}\n expected: {start}");
         }
-        let e = read_touch_from(
+        let e = read_external_from::<TouchReading, _>(
             "q1,q2,q3,h1,h2,feature\n800,800,800,0,0,0\n".as_bytes(),
             "f.csv",
         )
@@ -925,8 +841,8 @@ mod tests {
             source: "mem".into(),
         };
         let mut buf = Vec::new();
-        write_tracker_to(&mut buf, &tracker, &["a comment".into()]).unwrap();
-        let back = read_tracker_from(buf.as_slice(), "mem").unwrap();
+        write_external_to(&mut buf, &tracker, &["a comment".into()]).unwrap();
+        let back = read_external_from::<TrackerPoint, _>(buf.as_slice(), "mem").unwrap();
         for (a, b) in tracker.records.iter().zip(&back.records) {
             assert_eq!(TrackerPoint { line: b.line, ..*a }, *b);
         }
@@ -946,8 +862,8 @@ mod tests {
             source: "mem".into(),
         };
         let mut buf = Vec::new();
-        write_ballbar_to(&mut buf, &ballbar, &[]).unwrap();
-        let back = read_ballbar_from(buf.as_slice(), "mem").unwrap();
+        write_external_to(&mut buf, &ballbar, &[]).unwrap();
+        let back = read_external_from::<BallbarReading, _>(buf.as_slice(), "mem").unwrap();
         for (a, b) in ballbar.records.iter().zip(&back.records) {
             assert_eq!(BallbarReading { line: b.line, ..*a }, *b);
         }
@@ -965,8 +881,8 @@ mod tests {
             source: "mem".into(),
         };
         let mut buf = Vec::new();
-        write_touch_to(&mut buf, &touch, &[]).unwrap();
-        let back = read_touch_from(buf.as_slice(), "mem").unwrap();
+        write_external_to(&mut buf, &touch, &[]).unwrap();
+        let back = read_external_from::<TouchReading, _>(buf.as_slice(), "mem").unwrap();
         for (a, b) in touch.records.iter().zip(&back.records) {
             assert_eq!(TouchReading { line: b.line, ..*a }, *b);
         }

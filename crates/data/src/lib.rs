@@ -21,8 +21,7 @@
 //! External measurements (laser tracker or CMM points, ballbar lengths,
 //! touch-offs on spheres and planes, with the leg commands and head angles
 //! they were taken at) have their own CSV contracts, read by the same
-//! machinery with the same messages ([`read_tracker_path`],
-//! [`read_ballbar_path`], [`read_touch_path`], [`Features`]).
+//! machinery with the same messages ([`read_external_path`], [`Features`]).
 //!
 //! Modules: `pose` (the types: [`Readings`], [`MeasuredPose`], [`Dataset`]),
 //! `error` ([`DataError`]), `records` (the line and record machinery every
@@ -54,11 +53,9 @@ mod write;
 
 pub use error::DataError;
 pub use external::{
-    BallbarData, BallbarReading, ExternalData, ExternalPose, Feature, Features, PlannedPose,
-    PlannedPoses, Stylus, TouchData, TouchReading, TrackerData, TrackerPoint, read_ballbar_from,
-    read_ballbar_path, read_poses_from, read_poses_path, read_touch_from, read_touch_path,
-    read_tracker_from, read_tracker_path, write_ballbar_path, write_ballbar_to, write_poses_path,
-    write_poses_to, write_touch_path, write_touch_to, write_tracker_path, write_tracker_to,
+    BallbarData, BallbarReading, ExternalData, ExternalPose, ExternalRecord, Feature, Features,
+    PlannedPose, PlannedPoses, Stylus, TouchData, TouchReading, TrackerData, TrackerPoint,
+    read_external_from, read_external_path, write_external_path, write_external_to,
 };
 pub use pose::{Dataset, MeasuredPose, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Readings};
 pub use read::{MAX_ANGLE_SPAN_RAD, read_from, read_path, read_with_progress};

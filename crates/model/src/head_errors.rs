@@ -57,7 +57,7 @@ use serde_json::{Map, Value};
 use tricept_kinematics::Head;
 
 use crate::error::ModelError;
-use crate::params::values_from_named_map;
+use crate::params::{values_from_named_map, values_to_named_map};
 
 /// Number of head parameters.
 pub const N_HEAD: usize = 13;
@@ -314,11 +314,7 @@ impl HeadParameterSet {
 
     /// Values as a JSON map in the set's order.
     pub fn values_to_map(&self, p: &[f64]) -> Map<String, Value> {
-        self.names
-            .iter()
-            .zip(p)
-            .map(|(n, v)| (n.clone(), Value::from(*v)))
-            .collect()
+        values_to_named_map(&self.names, p)
     }
 }
 

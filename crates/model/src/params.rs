@@ -301,11 +301,7 @@ impl ParameterSet {
 
     /// Values as a JSON map in the set's order.
     pub fn values_to_map(&self, p: &[f64]) -> Map<String, Value> {
-        self.names
-            .iter()
-            .zip(p)
-            .map(|(n, v)| (n.clone(), Value::from(*v)))
-            .collect()
+        values_to_named_map(&self.names, p)
     }
 }
 
@@ -334,6 +330,15 @@ pub(crate) fn values_from_named_map(
         p[j] = x;
     }
     Ok(p)
+}
+
+/// Values `p` of the parameters `names` as a JSON map, in order.
+pub(crate) fn values_to_named_map(names: &[String], p: &[f64]) -> Map<String, Value> {
+    names
+        .iter()
+        .zip(p)
+        .map(|(n, v)| (n.clone(), Value::from(*v)))
+        .collect()
 }
 
 /// The paper's residual error `mu = ||deps - deps_e||_1 / n_eps` (mm).

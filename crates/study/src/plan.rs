@@ -37,10 +37,11 @@ use rand::SeedableRng;
 use rand::seq::index::sample;
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
+use tricept_data::MeasuredPose;
 use tricept_data::{
     BallbarData, BallbarReading, ExternalData, ExternalPose, TrackerData, TrackerPoint,
 };
-use tricept_ident::fusion::{DesignRows, FusedModel, design_rows};
+use tricept_ident::fusion::{DesignRows, FusedModel, Source, design_rows, information};
 use tricept_kinematics::{HeadBranch, Machine};
 use tricept_model::Effector;
 
@@ -309,29 +310,31 @@ pub fn plan(
     })
 }
 
-/// Tracker candidates: each platform point (nominal IK) with each pair of
-/// head angles (degrees); points the IK cannot reach are left out.
-pub fn tracker_candidates(
-    nominal: &Machine,
-    platform_mm: &[Vector3<f64>],
-    h1_deg: &[f64],
-    h2_deg: &[f64],
-) -> Vec<ExternalPose> {
-    let mut out = Vec::new();
-    for r in platform_mm {
-        let Ok(ik) = nominal.inverse(r) else {
-            continue;
-        };
-        for h1 in h1_deg {
-            for h2 in h2_deg {
-                out.push(ExternalPose {
-                    commands_mm: ik.legs_mm,
-                    head_rad: [h1.to_radians(), h2.to_radians()],
-                });
-            }
-        }
-    }
-    out
+/// The information of an internal campaign at the platform points
+/// `targets_mm` (commanded by the nominal IK) on the global parameters of
+/// `model`, with the machine's sensor noise ([`information`]).
+pub fn internal_information(
+    model: &FusedModel,
+    targets_mm: &[Vector3<f64>],
+) -> Result<DMatrix<f64>, StudyError> {
+    let m = model.nominal();
+    let poses = targets_mm
+        .iter()
+        .map(|r| {
+            Ok(MeasuredPose {
+                commands_mm: m.inverse(r)?.legs_mm,
+                ..Default::default()
+            })
+        })
+        .collect::<Result<_, StudyError>>()?;
+    let data = tricept_data::Dataset {
+        poses,
+        source: "internal campaign".into(),
+    };
+    Ok(information(
+        model,
+        &[Source::internal(&data, m.sensors.logged_sigma())],
+    )?)
 }
 
 /// Ballbar candidates: `n` ball positions spread (Fibonacci lattice) over
@@ -372,28 +375,34 @@ pub fn ballbar_candidates(
         .collect()
 }
 
+/// The nominal tool tips at `poses`.
+fn nominal_tips(
+    model: &FusedModel,
+    poses: &[ExternalPose],
+) -> Result<Vec<Vector3<f64>>, StudyError> {
+    let p = vec![0.0; model.len()];
+    poses
+        .iter()
+        .map(|pose| Ok(model.spindle_point(&p, pose, &Effector::default())?.0))
+        .collect()
+}
+
 /// Tracker data at `poses` as the nominal machine would give them (frame
 /// identity), for [`design_rows`].
 pub fn nominal_tracker_data(
     model: &FusedModel,
     poses: &[ExternalPose],
 ) -> Result<TrackerData, StudyError> {
-    let p = vec![0.0; model.len()];
     let records = poses
         .iter()
-        .map(|pose| {
-            let (x, _) = model.spindle_point(&p, pose, &Effector::default())?;
-            Ok(TrackerPoint {
-                pose: *pose,
-                position_mm: x.into(),
-                sigma_um: None,
-                extension_mm: 0.0,
-                setup: 1,
-                temp_c: None,
-                line: 0,
-            })
+        .zip(nominal_tips(model, poses)?)
+        .map(|(pose, x)| TrackerPoint {
+            pose: *pose,
+            position_mm: x.into(),
+            setup: 1,
+            ..Default::default()
         })
-        .collect::<Result<_, StudyError>>()?;
+        .collect();
     Ok(ExternalData {
         records,
         source: "candidates".into(),
@@ -407,21 +416,16 @@ pub fn nominal_ballbar_data(
     poses: &[ExternalPose],
     pivot_mm: &Vector3<f64>,
 ) -> Result<BallbarData, StudyError> {
-    let p = vec![0.0; model.len()];
     let records = poses
         .iter()
-        .map(|pose| {
-            let (x, _) = model.spindle_point(&p, pose, &Effector::default())?;
-            Ok(BallbarReading {
-                pose: *pose,
-                length_mm: (x - pivot_mm).norm(),
-                sigma_um: None,
-                setup: 1,
-                temp_c: None,
-                line: 0,
-            })
+        .zip(nominal_tips(model, poses)?)
+        .map(|(pose, x)| BallbarReading {
+            pose: *pose,
+            length_mm: (x - pivot_mm).norm(),
+            setup: 1,
+            ..Default::default()
         })
-        .collect::<Result<_, StudyError>>()?;
+        .collect();
     Ok(ExternalData {
         records,
         source: "candidates".into(),

@@ -4,15 +4,15 @@
 //! fused identification run on data simulated at the planned poses.
 
 use nalgebra::{Isometry3, Vector3};
-use tricept_data::MeasuredPose;
 use tricept_ident::fusion::{
-    FusedModel, FusionOptions, Source, TrackerOptions, TrackerTarget, identify_fused, information,
+    FusedModel, FusionOptions, Source, TrackerOptions, TrackerTarget, head_angle_poses,
+    identify_fused,
 };
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_plant::{Campaign, Plant, Tracker, random_head_errors};
 use tricept_study::plan::{
-    PlanProblem, candidate_rows, nominal_tracker_data, plan, tracker_candidates,
+    PlanProblem, candidate_rows, internal_information, nominal_tracker_data, plan,
 };
 
 fn known_target() -> TrackerOptions {
@@ -29,25 +29,8 @@ fn known_target() -> TrackerOptions {
 fn planned_tracker_points_beat_random_ones_and_predict_the_fit() {
     let m = Machine::paper();
     let model = FusedModel::new(m.clone(), ParameterSet::paper15(), &[], true).unwrap();
-    let grid: Vec<MeasuredPose> = m
-        .workspace
-        .polar_grid(3, 8, 3)
-        .iter()
-        .map(|r| MeasuredPose {
-            commands_mm: m.inverse(r).unwrap().legs_mm,
-            ..Default::default()
-        })
-        .collect();
-    let internal = tricept_data::Dataset {
-        poses: grid,
-        source: "grid".into(),
-    };
-    let f_int = information(
-        &model,
-        &[Source::internal(&internal, m.sensors.logged_sigma())],
-    )
-    .unwrap();
-    let candidates = tracker_candidates(
+    let f_int = internal_information(&model, &m.workspace.polar_grid(3, 8, 3)).unwrap();
+    let candidates = head_angle_poses(
         &m,
         &m.workspace.polar_grid(2, 8, 3),
         &[0.0, 60.0, 120.0, 180.0, 240.0, 300.0],

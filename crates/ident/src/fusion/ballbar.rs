@@ -17,7 +17,8 @@ use tricept_model::Effector;
 use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Sink, Source, SourceKind, SourceRows, groups, project_rows, sphere_centre,
+    Nuisance, Sink, Source, SourceKind, SourceRows, for_each_point, groups, project_rows,
+    sphere_centre,
 };
 
 /// How to read a ballbar file.
@@ -57,19 +58,16 @@ struct Ballbar {
 impl Source {
     /// Ballbar readings. Refused: a setup with fewer than four readings.
     pub fn ballbar(data: &BallbarData, options: &BallbarOptions) -> Result<Source, IdentError> {
-        let (setups, setup_of) = groups(data.records.iter().map(|r| r.setup));
-        for (s, id) in setups.iter().enumerate() {
-            let n = setup_of.iter().filter(|&&x| x == s).count();
-            if n < 4 {
-                return Err(IdentError::Source {
-                    file: data.source.clone(),
-                    line: None,
-                    message: format!(
-                        "setup {id} has {n} readings; its pivot needs at least 4 with the ball not in one plane"
-                    ),
-                });
-            }
-        }
+        let (setups, setup_of) = groups(
+            &data.source,
+            data.records.iter().map(|r| r.setup),
+            4,
+            |id, n| {
+                format!(
+                    "setup {id} has {n} readings; its pivot needs at least 4 with the ball not in one plane"
+                )
+            },
+        )?;
         Ok(Source::new(Box::new(Ballbar {
             sigma_mm: data
                 .records
@@ -86,6 +84,15 @@ impl Source {
             setup_of,
             file: data.source.clone(),
         })))
+    }
+}
+
+impl Ballbar {
+    /// Every reading's pose, line and effector (the ball).
+    fn records(&self) -> impl Iterator<Item = (ExternalPose, u64, Effector)> + '_ {
+        self.readings
+            .iter()
+            .map(|r| (r.pose, r.line, self.effector))
     }
 }
 
@@ -138,24 +145,10 @@ impl SourceRows for Ballbar {
         contexts: &[LegContext],
         seeds: &mut [Option<UpJoints>],
     ) -> Result<Nuisance, IdentError> {
-        let mut jac = vec![0.0; 3 * at.len()];
         let mut tips = Vec::with_capacity(self.readings.len());
-        for (j, r) in self.readings.iter().enumerate() {
-            let x = at
-                .spindle_point(
-                    &r.pose,
-                    &contexts[j],
-                    &self.effector,
-                    &mut seeds[j],
-                    &mut jac,
-                )
-                .map_err(|source| IdentError::Kinematics {
-                    pose: j,
-                    line: r.line,
-                    source,
-                })?;
-            tips.push(x.position_mm);
-        }
+        for_each_point(at, contexts, seeds, self.records(), |_, x, _| {
+            tips.push(x.position_mm)
+        })?;
         let mut values = vec![0.0; 4 * self.setups.len()];
         for (s, id) in self.setups.iter().enumerate() {
             let (x, radii): (Vec<Vector3<f64>>, Vec<f64>) = (0..self.readings.len())
@@ -186,23 +179,9 @@ impl SourceRows for Ballbar {
         sink: &mut Sink,
     ) -> Result<(), IdentError> {
         let k = at.len();
-        let mut jac = vec![0.0; 3 * k];
         let mut theta = vec![0.0; k];
         let mut dnu = vec![0.0; nu.values.len()];
-        for (j, r) in self.readings.iter().enumerate() {
-            let x = at
-                .spindle_point(
-                    &r.pose,
-                    &contexts[j],
-                    &self.effector,
-                    &mut seeds[j],
-                    &mut jac,
-                )
-                .map_err(|source| IdentError::Kinematics {
-                    pose: j,
-                    line: r.line,
-                    source,
-                })?;
+        for_each_point(at, contexts, seeds, self.records(), |j, x, jac| {
             let base = 4 * self.setup_of[j];
             let c = Vector3::new(nu.values[base], nu.values[base + 1], nu.values[base + 2]);
             let d = x.position_mm - c;
@@ -213,15 +192,15 @@ impl SourceRows for Ballbar {
                 dnu[base + m] = -u[m];
             }
             dnu[base + 3] = 1.0;
-            project_rows(&u, &jac, k, &mut theta);
+            project_rows(&u, jac, k, &mut theta);
             sink.data(
                 j,
                 1.0 / self.sigma_mm[j],
                 &dnu,
                 &theta,
-                r.length_mm - (rho + nu.values[base + 3]),
+                self.readings[j].length_mm - (rho + nu.values[base + 3]),
             );
-        }
+        })?;
         if let Some(sigma) = self.length_sigma_mm {
             for s in 0..self.setups.len() {
                 sink.prior(4 * s + 3, sigma, -nu.values[4 * s + 3]);

@@ -80,18 +80,39 @@ impl FusionOptions {
 }
 
 /// Tool poses for evaluation: the platform points of the workspace's
-/// `polar_grid(rings, per_ring, levels)` commanded by the nominal IK, each
-/// with every pair of head angles from `h1_deg` x `h2_deg` (degrees).
-/// Points the nominal IK cannot reach are left out.
+/// `polar_grid(rings, per_ring, levels)` with every pair of head angles from
+/// `h1_deg` x `h2_deg` ([`head_angle_poses`]).
 pub fn evaluation_poses(
     machine: &Machine,
     (rings, per_ring, levels): (usize, usize, usize),
     h1_deg: &[f64],
     h2_deg: &[f64],
 ) -> Vec<ExternalPose> {
+    let points = machine.workspace.polar_grid(rings, per_ring, levels);
+    head_angle_poses(machine, &points, h1_deg, h2_deg)
+}
+
+/// Each platform point (commanded by the nominal IK) with each pair of head
+/// angles from `h1_deg` x `h2_deg` (degrees): evaluation poses, tracker
+/// candidates. Points the IK cannot reach are left out.
+///
+/// # Example
+/// ```
+/// use tricept_ident::fusion::head_angle_poses;
+/// let m = tricept_kinematics::Machine::paper();
+/// let poses = head_angle_poses(&m, &[nalgebra::Vector3::new(0.0, 0.0, 750.0)], &[0.0, 90.0], &[30.0]);
+/// assert_eq!(poses.len(), 2);
+/// assert!((poses[1].head_rad[0] - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+/// ```
+pub fn head_angle_poses(
+    machine: &Machine,
+    platform_mm: &[nalgebra::Vector3<f64>],
+    h1_deg: &[f64],
+    h2_deg: &[f64],
+) -> Vec<ExternalPose> {
     let mut out = Vec::new();
-    for r in machine.workspace.polar_grid(rings, per_ring, levels) {
-        let Ok(ik) = machine.inverse(&r) else {
+    for r in platform_mm {
+        let Ok(ik) = machine.inverse(r) else {
             continue;
         };
         for h1 in h1_deg {
@@ -599,7 +620,6 @@ fn finish(
         model,
         problem.sources,
         start_parts,
-        &problem.offsets,
         decision,
         union_report,
         &estimate,
@@ -688,7 +708,6 @@ pub fn information(model: &FusedModel, sources: &[Source]) -> Result<DMatrix<f64
     let parts = sources
         .iter()
         .map(|source| {
-            let rows = source.rows();
             let d = design_rows(model, source)?;
             let nn = d.nuisance_names.len();
             let mut acc = TriangularAccumulator::new(nn + k);
@@ -698,7 +717,6 @@ pub fn information(model: &FusedModel, sources: &[Source]) -> Result<DMatrix<f64
                     acc.push_row(&row);
                 }
             }
-            let _ = rows;
             Ok((nn, acc.finish()))
         })
         .collect::<Result<Vec<_>, IdentError>>()?;

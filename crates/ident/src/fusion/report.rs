@@ -223,7 +223,6 @@ pub(crate) fn build_report(
     model: &FusedModel,
     sources: &[Source],
     start_parts: &[ReducedProblem],
-    _offsets: &[usize],
     union_decision: &RankDecision,
     union_report: IdentifiabilityReport,
     estimate: &[f64],

@@ -24,7 +24,7 @@ use tricept_numerics::linalg::TriangularAccumulator;
 use tricept_numerics::lsq::ReducedProblem;
 
 use crate::error::IdentError;
-use crate::fusion::model::{FusedAt, LegContext};
+use crate::fusion::model::{FusedAt, LegContext, SpindlePoint};
 
 /// What kind of instrument a source is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -426,17 +426,59 @@ pub(crate) fn project_rows(u: &Vector3<f64>, jac: &[f64], k: usize, out: &mut [f
     }
 }
 
-/// Sorted distinct values and each record's index into them.
-pub(crate) fn groups(keys: impl Iterator<Item = u32>) -> (Vec<u32>, Vec<usize>) {
+/// Sorted distinct values of `keys` (stations, setups) and each record's
+/// index into them; a group with fewer than `min` records is refused with
+/// `message(id, count)`.
+pub(crate) fn groups(
+    file: &str,
+    keys: impl Iterator<Item = u32>,
+    min: usize,
+    message: impl Fn(u32, usize) -> String,
+) -> Result<(Vec<u32>, Vec<usize>), IdentError> {
     let keys: Vec<u32> = keys.collect();
     let mut distinct = keys.clone();
     distinct.sort_unstable();
     distinct.dedup();
-    let index = keys
+    let index: Vec<usize> = keys
         .iter()
         .map(|k| distinct.binary_search(k).unwrap_or(0))
         .collect();
-    (distinct, index)
+    for (g, id) in distinct.iter().enumerate() {
+        let n = index.iter().filter(|&&x| x == g).count();
+        if n < min {
+            return Err(IdentError::Source {
+                file: file.to_string(),
+                line: None,
+                message: message(*id, n),
+            });
+        }
+    }
+    Ok((distinct, index))
+}
+
+/// Evaluates the spindle point of every record (`(pose, line, effector)`)
+/// at the model `at` and hands it, with its Jacobian (row-major `3 x k`),
+/// to `f` with the record's index; a pose the model cannot reach is named
+/// by its line.
+pub(crate) fn for_each_point(
+    at: &FusedAt<'_>,
+    contexts: &[LegContext],
+    seeds: &mut [Option<UpJoints>],
+    records: impl Iterator<Item = (ExternalPose, u64, tricept_model::Effector)>,
+    mut f: impl FnMut(usize, &SpindlePoint, &[f64]),
+) -> Result<(), IdentError> {
+    let mut jac = vec![0.0; 3 * at.len()];
+    for (j, (pose, line, effector)) in records.enumerate() {
+        let x = at
+            .spindle_point(&pose, &contexts[j], &effector, &mut seeds[j], &mut jac)
+            .map_err(|source| IdentError::Kinematics {
+                pose: j,
+                line,
+                source,
+            })?;
+        f(j, &x, &jac);
+    }
+    Ok(())
 }
 
 /// Centre of the sphere through points `x_j` whose distances from it are
@@ -455,7 +497,7 @@ pub(crate) fn sphere_centre(points: &[Vector3<f64>], radii: &[f64]) -> Option<Ve
     let svd = a.svd(true, true);
     let s = &svd.singular_values;
     let (max, min) = (s.max(), s.min());
-    if !(min > 1e-6 * max) {
+    if min.is_nan() || min <= 1e-6 * max {
         return None;
     }
     let x = svd.solve(&b, 0.0).ok()?;

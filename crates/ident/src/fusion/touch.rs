@@ -27,7 +27,7 @@ use tricept_model::Effector;
 use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Sink, Source, SourceKind, SourceRows, project_rows, sphere_centre,
+    Nuisance, Sink, Source, SourceKind, SourceRows, for_each_point, project_rows, sphere_centre,
 };
 
 /// How to read a touch-off file.
@@ -138,6 +138,15 @@ fn plane_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     (a, n.cross(&a))
 }
 
+impl Touch {
+    /// Every touch's pose, line and effector (the stylus centre: the tip).
+    fn records(&self) -> impl Iterator<Item = (ExternalPose, u64, Effector)> + '_ {
+        self.touches
+            .iter()
+            .map(|t| (t.pose, t.line, Effector::default()))
+    }
+}
+
 impl SourceRows for Touch {
     fn kind(&self) -> SourceKind {
         SourceKind::Touch
@@ -186,26 +195,13 @@ impl SourceRows for Touch {
         contexts: &[LegContext],
         seeds: &mut [Option<UpJoints>],
     ) -> Result<Nuisance, IdentError> {
-        let mut jac = vec![0.0; 3 * at.len()];
         let mut tips = Vec::with_capacity(self.touches.len());
         let mut axes = Vec::with_capacity(self.touches.len());
-        for (j, t) in self.touches.iter().enumerate() {
-            let x = at
-                .spindle_point(
-                    &t.pose,
-                    &contexts[j],
-                    &Effector::default(),
-                    &mut seeds[j],
-                    &mut jac,
-                )
-                .map_err(|source| IdentError::Kinematics {
-                    pose: j,
-                    line: t.line,
-                    source,
-                })?;
+        let direction = at.tool_direction();
+        for_each_point(at, contexts, seeds, self.records(), |_, x, _| {
             tips.push(x.position_mm);
-            axes.push(x.rotation * at.tool_direction());
-        }
+            axes.push(x.rotation * direction);
+        })?;
         let mut nu = Nuisance {
             values: vec![0.0; 1 + 3 * self.used.len()],
             rotations: Vec::new(),
@@ -241,7 +237,8 @@ impl SourceRows for Touch {
                         o.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
                         o
                     };
-                    if !(eig.eigenvalues[order[1]] > 1e-8 * eig.eigenvalues[order[2]]) {
+                    let (middle, largest) = (eig.eigenvalues[order[1]], eig.eigenvalues[order[2]]);
+                    if middle.is_nan() || middle <= 1e-8 * largest {
                         return Err(degenerate("on one line"));
                     }
                     // The normal points out of the material, towards the
@@ -271,24 +268,10 @@ impl SourceRows for Touch {
         sink: &mut Sink,
     ) -> Result<(), IdentError> {
         let k = at.len();
-        let mut jac = vec![0.0; 3 * k];
         let mut theta = vec![0.0; k];
         let mut dnu = vec![0.0; nu.values.len()];
-        for (j, t) in self.touches.iter().enumerate() {
-            let x = at
-                .spindle_point(
-                    &t.pose,
-                    &contexts[j],
-                    &Effector::default(),
-                    &mut seeds[j],
-                    &mut jac,
-                )
-                .map_err(|source| IdentError::Kinematics {
-                    pose: j,
-                    line: t.line,
-                    source,
-                })?
-                .position_mm;
+        for_each_point(at, contexts, seeds, self.records(), |j, x, jac| {
+            let x = x.position_mm;
             let f = self.feature_of[j];
             let u = &self.used[f];
             let col = u.column;
@@ -303,7 +286,7 @@ impl SourceRows for Touch {
                         dnu[col + m] = -dir[m];
                     }
                     dnu[0] = -1.0;
-                    project_rows(&dir, &jac, k, &mut theta);
+                    project_rows(&dir, jac, k, &mut theta);
                     radius_mm - (rho - nu.values[0])
                 }
                 Feature::Plane { .. } => {
@@ -312,12 +295,12 @@ impl SourceRows for Touch {
                     dnu[col] = a.dot(&x);
                     dnu[col + 1] = b.dot(&x);
                     dnu[col + 2] = -1.0;
-                    project_rows(&n, &jac, k, &mut theta);
+                    project_rows(&n, jac, k, &mut theta);
                     -(n.dot(&x) - nu.values[col + 2])
                 }
             };
             sink.data(j, 1.0 / self.sigma_mm[j], &dnu, &theta, residual);
-        }
+        })?;
         sink.prior(0, self.stylus_sigma_mm, self.stylus_mm - nu.values[0]);
         Ok(())
     }

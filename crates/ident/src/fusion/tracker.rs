@@ -22,7 +22,8 @@ use tricept_model::Effector;
 use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Sink, Source, SourceKind, SourceRows, cross_matrix, groups, rotate_row,
+    Nuisance, Sink, Source, SourceKind, SourceRows, cross_matrix, for_each_point, groups,
+    rotate_row,
 };
 
 /// What is known about the tracker target's offset from the tool tip.
@@ -77,24 +78,19 @@ impl Source {
     /// ```
     /// use tricept_ident::fusion::{Source, TrackerOptions};
     /// let csv = "q1,q2,q3,h1,h2,x,y,z,setup\n800,800,800,0,0,1,2,3,1\n810,800,800,0,0,1,2,3,1\n";
-    /// let data = tricept_data::read_tracker_from(csv.as_bytes(), "t.csv").unwrap();
+    /// let data = tricept_data::read_external_from::<tricept_data::TrackerPoint, _>(csv.as_bytes(), "t.csv").unwrap();
     /// let e = Source::tracker(&data, &TrackerOptions::default()).unwrap_err();
     /// assert!(e.to_string().starts_with("t.csv: station 1 has 2 points"), "{e}");
     /// ```
     pub fn tracker(data: &TrackerData, options: &TrackerOptions) -> Result<Source, IdentError> {
-        let (setups, setup_of) = groups(data.records.iter().map(|p| p.setup));
-        for (s, id) in setups.iter().enumerate() {
-            let n = setup_of.iter().filter(|&&x| x == s).count();
-            if n < 3 {
-                return Err(IdentError::Source {
-                    file: data.source.clone(),
-                    line: None,
-                    message: format!(
-                        "station {id} has {n} points; its frame needs at least 3 not on one line"
-                    ),
-                });
-            }
-        }
+        let (setups, setup_of) = groups(
+            &data.source,
+            data.records.iter().map(|p| p.setup),
+            3,
+            |id, n| {
+                format!("station {id} has {n} points; its frame needs at least 3 not on one line")
+            },
+        )?;
         Ok(Source::new(Box::new(Tracker {
             sigma_mm: data
                 .records
@@ -115,11 +111,18 @@ impl Tracker {
         Vector3::new(nu.values[0], nu.values[1], nu.values[2])
     }
 
-    fn effector(&self, j: usize, nu: &Nuisance) -> Effector {
-        Effector {
-            extension_mm: self.points[j].extension_mm,
-            offset_mm: Tracker::offset(nu),
-        }
+    /// Every point's pose, line and effector under the nuisance `nu`.
+    fn records<'a>(
+        &'a self,
+        nu: &'a Nuisance,
+    ) -> impl Iterator<Item = (ExternalPose, u64, Effector)> + 'a {
+        self.points.iter().map(|p| {
+            let effector = Effector {
+                extension_mm: p.extension_mm,
+                offset_mm: Tracker::offset(nu),
+            };
+            (p.pose, p.line, effector)
+        })
     }
 }
 
@@ -141,7 +144,7 @@ fn horn(x: &[Vector3<f64>], y: &[Vector3<f64>]) -> Option<(Matrix3<f64>, Vector3
         e.iter().copied().fold(0.0, f64::max),
     );
     let mid = e.sum() - lo - hi;
-    if !(mid > 1e-8 * hi) {
+    if mid.is_nan() || mid <= 1e-8 * hi {
         return None;
     }
     let svd = h.svd(true, true);
@@ -212,23 +215,9 @@ impl SourceRows for Tracker {
             nu.values[..3].copy_from_slice(&offset_mm);
         }
         let mut predicted = Vec::with_capacity(self.points.len());
-        let mut jac = vec![0.0; 3 * at.len()];
-        for (j, p) in self.points.iter().enumerate() {
-            let x = at
-                .spindle_point(
-                    &p.pose,
-                    &contexts[j],
-                    &self.effector(j, &nu),
-                    &mut seeds[j],
-                    &mut jac,
-                )
-                .map_err(|source| IdentError::Kinematics {
-                    pose: j,
-                    line: p.line,
-                    source,
-                })?;
-            predicted.push(x.position_mm);
-        }
+        for_each_point(at, contexts, seeds, self.records(&nu), |_, x, _| {
+            predicted.push(x.position_mm)
+        })?;
         for (s, id) in self.setups.iter().enumerate() {
             let (x, y): (Vec<Vector3<f64>>, Vec<Vector3<f64>>) = (0..self.points.len())
                 .filter(|&j| self.setup_of[j] == s)
@@ -257,23 +246,10 @@ impl SourceRows for Tracker {
     ) -> Result<(), IdentError> {
         let k = at.len();
         let nn = nu.values.len();
-        let mut jac = vec![0.0; 3 * k];
         let mut theta = vec![0.0; k];
         let mut dnu = vec![0.0; nn];
-        for (j, p) in self.points.iter().enumerate() {
-            let x = at
-                .spindle_point(
-                    &p.pose,
-                    &contexts[j],
-                    &self.effector(j, nu),
-                    &mut seeds[j],
-                    &mut jac,
-                )
-                .map_err(|source| IdentError::Kinematics {
-                    pose: j,
-                    line: p.line,
-                    source,
-                })?;
+        for_each_point(at, contexts, seeds, self.records(nu), |j, x, jac| {
+            let p = &self.points[j];
             let s = self.setup_of[j];
             let r = nu.rotations[s];
             let base = 3 + 6 * s;
@@ -292,7 +268,7 @@ impl SourceRows for Tracker {
                     dnu[base + m] = d_rotation[(c, m)];
                 }
                 dnu[base + 3 + c] = 1.0;
-                rotate_row(&r, &jac, k, c, &mut theta);
+                rotate_row(&r, jac, k, c, &mut theta);
                 sink.data(
                     j,
                     1.0 / self.sigma_mm[j],
@@ -301,7 +277,7 @@ impl SourceRows for Tracker {
                     p.position_mm[c] - predicted[c],
                 );
             }
-        }
+        })?;
         if let TrackerTarget::Known {
             offset_mm,
             sigma_um,
