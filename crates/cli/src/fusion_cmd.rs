@@ -344,8 +344,7 @@ pub fn run(a: &IdentifyArgs) -> Result<(), CliError> {
     for w in &fit.warnings {
         eprintln!("warning: {w}");
     }
-    let untrusted = !fit.converged || fit.sources.iter().any(|s| s.reduced_chi_square > 3.0);
-    if untrusted {
+    if !fit.is_trustworthy() {
         return Err(CliError {
             code: EXIT_UNTRUSTED,
             message: "the fit completed but must not be trusted as it stands (see the warnings)"

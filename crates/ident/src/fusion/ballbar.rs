@@ -57,6 +57,15 @@ struct Ballbar {
 
 impl Source {
     /// Ballbar readings. Refused: a setup with fewer than four readings.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::fusion::{BallbarOptions, Source};
+    /// let csv = "q1,q2,q3,h1,h2,length\n800,800,800,0,0.3,150\n810,800,800,0,0.3,150\n";
+    /// let data = tricept_data::read_external_from(csv.as_bytes(), "b.csv").unwrap();
+    /// let e = Source::ballbar(&data, &BallbarOptions::default()).unwrap_err();
+    /// assert!(e.to_string().starts_with("b.csv: setup 1 has 2 readings"), "{e}");
+    /// ```
     pub fn ballbar(data: &BallbarData, options: &BallbarOptions) -> Result<Source, IdentError> {
         let (setups, setup_of) = groups(
             &data.source,

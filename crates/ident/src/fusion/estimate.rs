@@ -127,6 +127,12 @@ pub fn head_angle_poses(
     out
 }
 
+/// A source whose reduced chi-square exceeds this is not explained by the
+/// model and its stated noise (a warning, and [`Fusion::is_trustworthy`]
+/// false): the model misses an effect, or the noise is 1.7 times larger
+/// than stated.
+pub const UNEXPLAINED_REDUCED_CHI_SQUARE: f64 = 3.0;
+
 /// The fit of one source.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SourceFit {
@@ -587,7 +593,7 @@ fn finish(
             let sum: f64 = z.iter().map(|(_, _, raw)| raw * raw).sum();
             unit * (sum / z.len().max(1) as f64).sqrt()
         });
-        if reduced > 3.0 {
+        if reduced > UNEXPLAINED_REDUCED_CHI_SQUARE {
             warnings.push(format!(
                 "the model does not explain {} ({}): reduced chi-square {reduced:.1}; run `tricept diagnose` on the internal data and add the effects it names (--effects), or check this instrument's sigma",
                 source.label(),
@@ -703,6 +709,23 @@ pub fn design_rows(model: &FusedModel, source: &Source) -> Result<DesignRows, Id
 /// The information the `sources` together carry on the global parameters
 /// at the nominal machine, their nuisance projected out: `R^T R` of the
 /// union's parameter block (`k x k`, in the parameters' units).
+///
+/// # Example
+/// ```
+/// use tricept_ident::fusion::{FusedModel, Source, information};
+/// use tricept_kinematics::Machine;
+/// let m = Machine::paper();
+/// let model = FusedModel::new(m.clone(), tricept_model::ParameterSet::paper15(), &[], true).unwrap();
+/// let poses = m.workspace.polar_grid(3, 8, 3).iter()
+///     .map(|r| tricept_data::MeasuredPose { commands_mm: m.inverse(r).unwrap().legs_mm, ..Default::default() })
+///     .collect();
+/// let data = tricept_data::Dataset { poses, source: "grid".into() };
+/// let f = information(&model, &[Source::internal(&data, m.sensors.logged_sigma())]).unwrap();
+/// // The UP limb's readings carry nothing on the head.
+/// let head = model.index_of("tool_length_mm").unwrap();
+/// assert_eq!(f[(head, head)], 0.0);
+/// assert!(f[(0, 0)] > 0.0);
+/// ```
 pub fn information(model: &FusedModel, sources: &[Source]) -> Result<DMatrix<f64>, IdentError> {
     let k = model.len();
     let parts = sources
@@ -729,6 +752,17 @@ pub fn information(model: &FusedModel, sources: &[Source]) -> Result<DMatrix<f64
 }
 
 impl Fusion {
+    /// Whether the fit converged and the model explains every source
+    /// (reduced chi-square at most [`UNEXPLAINED_REDUCED_CHI_SQUARE`]). A
+    /// fit that is not must not be deployed as it stands.
+    pub fn is_trustworthy(&self) -> bool {
+        self.converged
+            && self
+                .sources
+                .iter()
+                .all(|s| s.reduced_chi_square <= UNEXPLAINED_REDUCED_CHI_SQUARE)
+    }
+
     /// Index of a global parameter by name.
     pub fn index_of(&self, name: &str) -> Option<usize> {
         self.names.iter().position(|n| n == name)

@@ -30,8 +30,8 @@ mod tracker;
 
 pub use ballbar::BallbarOptions;
 pub use estimate::{
-    DesignRows, Fusion, FusionOptions, SourceFit, design_rows, evaluation_poses, head_angle_poses,
-    identify_fused, information,
+    DesignRows, Fusion, FusionOptions, SourceFit, UNEXPLAINED_REDUCED_CHI_SQUARE, design_rows,
+    evaluation_poses, head_angle_poses, identify_fused, information,
 };
 pub use model::{FUSABLE_EFFECTS, FusedModel};
 pub use report::{

@@ -340,6 +340,22 @@ impl FusedModel {
     /// `tip_mm` along `axis` on the machine at parameters `p`: the tool-pose
     /// IK of [`FusedModel::machine_at`], then the leg effects inverted
     /// (compensation).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::fusion::FusedModel;
+    /// use tricept_kinematics::{HeadBranch, Machine};
+    /// use tricept_model::{ParameterSet, effects::EffectName};
+    /// let model = FusedModel::new(Machine::paper(), ParameterSet::paper15(), &[EffectName::LegLead], true).unwrap();
+    /// let mut p = vec![0.0; model.len()];
+    /// p[model.index_of("leg-lead.lead1_ppm").unwrap()] = 120.0;
+    /// p[model.index_of("h1_zero_rad").unwrap()] = 4e-4;
+    /// let tip = nalgebra::Vector3::new(100.0, -50.0, 1100.0);
+    /// let pose = model.tool_commands(&p, &tip, &nalgebra::Vector3::new(0.2, 0.1, 1.0), HeadBranch::default()).unwrap();
+    /// // Commanded so, the model's tool tip is where it was asked to be.
+    /// let (reached, _) = model.spindle_point(&p, &pose, &Default::default()).unwrap();
+    /// assert!((reached - tip).norm() < 1e-9);
+    /// ```
     pub fn tool_commands(
         &self,
         p: &[f64],

@@ -67,6 +67,23 @@ impl Source {
     /// Touch-offs on the features of `features`. Refused: a touch of a
     /// feature the file does not declare; a sphere with fewer than four
     /// touches, a plane with fewer than three.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::fusion::{Source, TouchOptions};
+    /// let features = tricept_data::Features::from_json(
+    ///     r#"{"stylus": {"radius_mm": 1, "radius_sigma_um": 2}, "features": [{"id": 1, "kind": "plane"}]}"#,
+    ///     "f.json",
+    /// )
+    /// .unwrap();
+    /// let csv = "q1,q2,q3,h1,h2,feature\n800,800,800,0,0.3,4\n";
+    /// let data = tricept_data::read_external_from(csv.as_bytes(), "t.csv").unwrap();
+    /// let e = Source::touch(&data, &features, &TouchOptions::default()).unwrap_err();
+    /// assert_eq!(
+    ///     e.to_string(),
+    ///     "t.csv: line 2: column `feature`: feature 4 is not in the features file"
+    /// );
+    /// ```
     pub fn touch(
         data: &TouchData,
         features: &Features,
