@@ -104,6 +104,9 @@ pub(crate) fn iterate<I: Iteration>(
                 // No decrease along the step: at the minimum to rounding
                 // if the step is small against the uncertainty.
                 run.converged = within(run, &step, 1e-2);
+                if !run.converged {
+                    hold_at_current(problem, run);
+                }
                 return;
             }
         }
@@ -111,6 +114,20 @@ pub(crate) fn iterate<I: Iteration>(
     }
     let step = run.solution.parameters.clone();
     run.converged = within(run, &step, 1e-3);
+    // With no iteration allowed the result is the one linear solve at the
+    // start point (the linearised estimator), which keeps its step.
+    if !run.converged && max_iterations > 0 {
+        hold_at_current(problem, run);
+    }
+}
+
+/// A run that did not converge ends where its last accepted step left it:
+/// the pending step (never tested) is dropped and the nuisance re-fitted
+/// with the parameters held, so that the estimate, the offsets and the
+/// residuals reported all belong to one point.
+fn hold_at_current<I: Iteration>(problem: &I, run: &mut Run<I::State, I::Eval>) {
+    run.solution.nuisance = problem.problem(&run.eval).nuisance_without_parameters();
+    run.solution.parameters.iter_mut().for_each(|x| *x = 0.0);
 }
 
 /// Whether every identifiable component of a parameter step is below
