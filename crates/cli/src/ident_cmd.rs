@@ -58,6 +58,9 @@ pub struct IdentifyArgs {
     /// Also write the identified machine as a description file.
     #[arg(long, value_name = "FILE.json")]
     pub write_machine: Option<PathBuf>,
+    /// External measurements and the head (the fused identification).
+    #[command(flatten)]
+    pub external: crate::fusion_cmd::ExternalArgs,
 }
 
 /// `tricept compensate`.
@@ -167,6 +170,9 @@ fn identify_from_file(
 
 /// `tricept identify`.
 pub fn run_identify(a: &IdentifyArgs) -> Result<(), CliError> {
+    if a.external.any() {
+        return crate::fusion_cmd::run(a);
+    }
     let (machine, data) = (&a.input.machine, a.input.data.as_path());
     let (_, model, id, rejected) = identify_from_file(&a.input)?;
     if let Some(path) = &a.write_machine {
@@ -191,7 +197,7 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<(), CliError> {
             "rejected line {} of {}: a reading {:.1} noise standard deviations off (gross error)",
             r.line,
             data.display(),
-            r.residual_sigma
+            r.residual_sigma.unwrap_or(f64::INFINITY)
         );
     }
     outln!(

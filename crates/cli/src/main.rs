@@ -20,9 +20,11 @@ macro_rules! outln {
 mod args;
 mod cli_error;
 mod diagnose_cmd;
+mod fusion_cmd;
 mod ident_cmd;
 mod kinematics_cmd;
 mod output;
+mod plan_cmd;
 mod simulate_cmd;
 
 use std::process::ExitCode;
@@ -79,9 +81,11 @@ enum Command {
         after_help = "Pose sets (--poses): grid (75 poses), grid:RINGS,PER_RING,LEVELS, random:N[,SEED], disc:SPACING[,Z], or a CSV file with columns x,y,z (mm).\n\nExamples:\n  tricept identifiability\n  tricept identifiability --poses random:30,1 --json\n  tricept identifiability --params full21"
     )]
     Identifiability(ident_cmd::IdentifiabilityArgs),
-    /// Identify the geometric errors from measured data (CSV: q1,q2,q3,phi,theta,s).
+    /// Identify the geometric errors from measured data (CSV: q1,q2,q3,phi,theta,s),
+    /// alone or fused with external measurements (laser tracker, ballbar,
+    /// touch-offs) that also calibrate the head.
     #[command(
-        after_help = "Examples:\n  tricept simulate --out data.csv && tricept identify --data data.csv\n  tricept identify --data data.csv --json\n  tricept identify --data data.csv --write-machine identified.json"
+        after_help = "With --tracker, --ballbar, --touch, --head or --effects the fused identification runs (docs/hybrid.md): module, head (13 parameters) and each instrument's nuisance in one fit; exit code 3 when it completes but a source is not explained (reduced chi-square > 3) or it did not converge.\n\nExamples:\n  tricept simulate --out data.csv && tricept identify --data data.csv\n  tricept identify --data data.csv --json\n  tricept identify --data data.csv --write-machine identified.json\n  tricept identify --data data.csv --tracker points.csv --tracker-target tip --write-machine calibrated.json"
     )]
     Identify(ident_cmd::IdentifyArgs),
     /// Write a measured-data CSV from a simulated machine (Table 2 errors by
@@ -110,6 +114,13 @@ enum Command {
         after_help = "Without --truth only the correction the identified model predicts is known; with the true errors of simulated data (--truth table2 ...) the before/after error of the actual machine is reported.\n\nExamples:\n  tricept compensate --data data.csv --truth table2\n  tricept compensate --data data.csv --targets points.csv"
     )]
     Compensate(ident_cmd::CompensateArgs),
+    /// Plan a few external measurements (tracker points, ballbar readings):
+    /// which to take so that the tool tip is best known after touch-off,
+    /// and the predicted accuracy against their number.
+    #[command(
+        after_help = "Criterion: the RMS over the evaluation tool poses of the predicted tool-tip standard deviation after touch-off (a Bayesian A-optimal design with the parameters' typical sizes as prior; docs/hybrid.md).\n\nExamples:\n  tricept plan --instrument tracker --k 5,12,30 --out points.csv\n  tricept plan --instrument ballbar --ballbar-pivot-mm 0,0,1250 --target-um 15"
+    )]
+    Plan(plan_cmd::PlanArgs),
 }
 
 fn run(cli: Cli) -> Result<(), CliError> {
@@ -124,6 +135,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Diagnose(a) => diagnose_cmd::run_diagnose(&a),
         Command::Detectability(a) => diagnose_cmd::run_detectability(&a),
         Command::Compensate(a) => ident_cmd::run_compensate(&a),
+        Command::Plan(a) => plan_cmd::run(&a),
     }
 }
 

@@ -430,6 +430,26 @@ fn values_by_name<S: Serializer>(v: &[(String, f64)], s: S) -> Result<S::Ok, S::
 }
 
 impl Diagnosis {
+    /// The effects of the vocabulary in the final model: the named causes
+    /// (outliers aside) and the model's member of each alias set (a scale
+    /// gain, for instance, is never named alone but is modelled). What a
+    /// calibration that deploys the diagnosis' model needs.
+    pub fn model_effects(&self) -> Vec<tricept_model::effects::EffectName> {
+        use tricept_model::effects::EffectName;
+        let mut out: Vec<EffectName> = Vec::new();
+        let names = self
+            .causes
+            .iter()
+            .map(|c| c.effect)
+            .chain(self.aliases.iter().map(|a| a.in_model));
+        for e in names.filter_map(|n| n.catalogue()) {
+            if e != EffectName::Outliers && !out.contains(&e) {
+                out.push(e);
+            }
+        }
+        out
+    }
+
     /// JSON with the contract keys `adequate`, `causes` (each with
     /// `effect`, its parameter estimates and evidence) and `gain`
     /// (`holdout_rms_geometric`, `holdout_rms_extended`), and more: the

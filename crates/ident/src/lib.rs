@@ -15,7 +15,9 @@
 //! - refines on the exact model by Gauss-Newton ([`identify`]), with
 //!   standard deviations from the covariance;
 //! - compensates: corrected commands from the identified machine and the
-//!   volumetric error before and after ([`compensation`]).
+//!   volumetric error before and after ([`compensation`]);
+//! - fuses the internal data with external measurements (laser tracker,
+//!   ballbar, touch-offs) and calibrates the head ([`fusion`]).
 //!
 //! Parameter names are those of [`tricept_model::ParameterSet`]; lengths in
 //! mm, angles in rad.
@@ -49,6 +51,8 @@
 
 mod compensate;
 mod error;
+pub mod fusion;
+mod gauss_newton;
 mod identify;
 mod model;
 mod report;
