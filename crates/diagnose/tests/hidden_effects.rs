@@ -203,7 +203,7 @@ fn check_effect(effect: E) {
         }
     }
     // The tally quoted in docs/diagnosis.md (`-- --nocapture` shows it).
-    eprintln!("{effect}: named first {first}/20, held-out RMS halved {halved}/20");
+    eprintln!("TALLY {effect}: named first {first}/20, held-out RMS halved {halved}/20");
     assert!(
         first >= 19 && halved >= 19,
         "{effect}: first {first}/20, halved {halved}/20\n{}",
@@ -247,7 +247,7 @@ fn data_without_hidden_effects_are_reported_adequate() {
             named.push((seed, d.causes.iter().map(|c| c.effect).collect::<Vec<_>>()));
         }
     }
-    eprintln!("no hidden effect: adequate {adequate}/40");
+    eprintln!("TALLY no hidden effect: adequate {adequate}/40");
     assert!(
         adequate >= 38,
         "{adequate}/40 adequate; false causes: {named:?}"
@@ -265,7 +265,7 @@ fn check_pairs(pairs: &[(E, E)]) {
                 found(&d, a) && found(&d, b)
             })
             .count();
-        eprintln!("{a} + {b}: both found {both}/20");
+        eprintln!("TALLY {a} + {b}: both found {both}/20");
         assert!(both >= 16, "{a} + {b}: both found in {both}/20");
     }
 }
