@@ -46,7 +46,7 @@ pub struct DetectabilityArgs {
 }
 
 /// `tricept diagnose`.
-pub fn run_diagnose(a: &DiagnoseArgs) -> Result<(), CliError> {
+pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
     let (machine, data) = (&a.machine, a.data.as_path());
     let m = machine_with_noise(machine, &a.noise)?;
     let dataset = read_data(data, &m)?;
@@ -84,14 +84,14 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<(), CliError> {
     }
     if machine.json {
         outln!("{}", d.to_json());
-        return Ok(());
+        return Ok(0);
     }
-    print!("{}", d.to_text(&source));
-    Ok(())
+    crate::output::write_text(&d.to_text(&source));
+    Ok(0)
 }
 
 /// `tricept detectability`.
-pub fn run_detectability(a: &DetectabilityArgs) -> Result<(), CliError> {
+pub fn run_detectability(a: &DetectabilityArgs) -> Result<u8, CliError> {
     let (machine, poses, both_directions, drift_k) = (
         &a.machine,
         a.poses.as_str(),
@@ -134,7 +134,7 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<(), CliError> {
             "{}",
             serde_json::json!({"poses": data.poses.len(), "readings_per_pose": campaign.noise.readings_per_pose, "effects": v})
         );
-        return Ok(());
+        return Ok(0);
     }
     outln!(
         "{} logged poses ({}{}), mean of {} readings, temperature drift {} K",
@@ -166,5 +166,5 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<(), CliError> {
             d.halving_multiple
         );
     }
-    Ok(())
+    Ok(0)
 }

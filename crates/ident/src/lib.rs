@@ -53,6 +53,9 @@ mod identify;
 mod model;
 mod report;
 mod robust;
+mod suspects;
+mod table;
+mod verdict;
 
 pub use compensate::{Compensation, compensation, corrected_commands};
 pub use error::IdentError;
@@ -63,10 +66,13 @@ pub use identify::{
 pub use model::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
 pub use report::{Combination, CorrelatedPair, IdentifiabilityReport, NamedValues, Observability};
 pub use robust::{Rejection, identify_robust, residuals_at, screen_gross_errors};
+pub use suspects::{LikelyCause, likely_causes};
+pub use table::{CompensationTable, SPACING_LADDER_MM};
+pub use verdict::{ADEQUACY_ALPHA, INCONSISTENT_CHI2_PER_DOF, LARGE_ESTIMATE_MM, Verdict};
 
 // What a downstream crate needs besides this crate's own types, so that one
 // dependency suffices: the data set and its reader, the machine, the
 // parameter sets.
 pub use tricept_data::{DataError, Dataset, MeasuredPose, Readings, read_from, read_path};
 pub use tricept_kinematics::{Machine, MachineDescription};
-pub use tricept_model::ParameterSet;
+pub use tricept_model::{ExtendedMachine, ParameterSet};

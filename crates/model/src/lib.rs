@@ -14,6 +14,9 @@
 //!   their names and their physics, shared by the simulator and the
 //!   diagnosis.
 //!
+//! - [`ExtendedMachine`]: a calibrated machine's kinematics with the static
+//!   leg effects (lead, compliance) a diagnosis named.
+//!
 //! All lengths in mm, angles in rad.
 #![cfg_attr(
     not(test),
@@ -23,12 +26,14 @@
 mod actual;
 pub mod effects;
 mod error;
+mod extended;
 mod jacobian;
 mod params;
 mod volumetric;
 
 pub use actual::{actual_machine, errors_between};
 pub use error::ModelError;
+pub use extended::ExtendedMachine;
 pub use jacobian::{ErrorJacobian, error_jacobian, error_jacobian_at, j2, position_error_jacobian};
 pub use params::{
     FULL21_NAMES, GeometricErrors, N_FULL, PAPER15_NAMES, ParameterSet, TABLE2_JSON, residual_mu,
