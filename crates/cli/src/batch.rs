@@ -216,8 +216,11 @@ impl std::fmt::Display for BatchError {
 }
 
 fn write_cell(out: &mut Vec<u8>, c: Cell) {
-    // Writing into a Vec cannot fail.
+    // Writing into a Vec cannot fail. Numbers are written in the shortest
+    // form that reads back to the same bits, with an exponent for tiny and
+    // huge magnitudes (`-9.47e-15`, not 15 zeros).
     let _ = match c {
+        Cell::Num(x) if x != 0.0 && !(1e-5..1e15).contains(&x.abs()) => write!(out, "{x:e}"),
         Cell::Num(x) => write!(out, "{x}"),
         Cell::Int(i) => write!(out, "{i}"),
         Cell::Bool(b) => write!(out, "{b}"),
