@@ -609,3 +609,136 @@ fn a_single_gross_reading_is_rejected_by_line_not_fatal() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The trilinear lookup of `table.csv` at `r`, read the way a controller
+/// would (this test's own implementation, from the documented format).
+fn lookup(
+    nodes: &std::collections::HashMap<[i64; 3], [f64; 3]>,
+    origin: [f64; 3],
+    h: f64,
+    r: [f64; 3],
+) -> [f64; 3] {
+    let last: Vec<i64> = (0..3)
+        .map(|a| nodes.keys().map(|k| k[a]).max().unwrap())
+        .collect();
+    let mut cell = [0i64; 3];
+    let mut t = [0.0; 3];
+    for a in 0..3 {
+        let u = (r[a] - origin[a]) / h;
+        // A point on the grid's upper face belongs to the last cell.
+        cell[a] = (u.floor() as i64).clamp(0, last[a] - 1);
+        t[a] = u - cell[a] as f64;
+    }
+    let mut out = [0.0; 3];
+    for corner in 0..8 {
+        let b = [corner & 1, corner >> 1 & 1, corner >> 2 & 1];
+        let w: f64 = (0..3)
+            .map(|a| if b[a] == 1 { t[a] } else { 1.0 - t[a] })
+            .product();
+        let v = nodes[&[cell[0] + b[0], cell[1] + b[1], cell[2] + b[2]]];
+        for l in 0..3 {
+            out[l] += w * v[l];
+        }
+    }
+    out
+}
+
+#[test]
+fn the_table_interpolation_error_is_what_the_docs_state() {
+    let dir = workdir("table");
+    let docs = std::fs::read_to_string(format!(
+        "{}/../../docs/data-format.md",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    // The docs' row for the Table 2 data: `| ... table2-grid-seed1.csv ... |
+    // 50 mm | 0.382 um |`.
+    let row = docs
+        .lines()
+        .find(|l| l.starts_with('|') && l.contains("table2-grid-seed1.csv") && l.contains("--table"))
+        .expect("docs/data-format.md states the table of the Table 2 data");
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    let stated_spacing: f64 = cells[cells.len() - 3].trim_end_matches(" mm").parse().unwrap();
+    let stated_um: f64 = cells[cells.len() - 2].trim_end_matches(" um").parse().unwrap();
+
+    let data = fixture("data/table2-grid-seed1.csv");
+    let cal = dir.join("t2.json");
+    let (code, _, _) = identify(Path::new(&data), &[], &cal);
+    assert_eq!(code, 0);
+    let out = run(&[
+        "compensate",
+        "--machine",
+        cal.to_str().unwrap(),
+        "--table",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let v = json(&out);
+    let spacing = v["table"]["spacing_mm"].as_f64().unwrap();
+    let error_um = v["table"]["interpolation_error_um"].as_f64().unwrap();
+    assert_eq!(spacing, stated_spacing);
+    assert_eq!(format!("{error_um:.3}"), format!("{stated_um:.3}"));
+    assert!(error_um < 1.0);
+
+    // Measured again from the file alone: the exact corrections from
+    // `ik --input` on both machines, the lookup from table.csv.
+    let csv = std::fs::read_to_string(dir.join("table.csv")).unwrap();
+    let (_, h, rows) = parts(&csv);
+    let f = |r: &Vec<String>, c: &str| r[col(&h, c)].parse::<f64>().unwrap();
+    let mut nodes = std::collections::HashMap::new();
+    for r in &rows {
+        let idx = ["i", "j", "k"].map(|c| f(r, c) as i64);
+        nodes.insert(idx, ["dq1", "dq2", "dq3"].map(|c| f(r, c)));
+    }
+    let first = &rows[0];
+    let origin = [
+        f(first, "x") - f(first, "i") * spacing,
+        f(first, "y") - f(first, "j") * spacing,
+        f(first, "z") - f(first, "k") * spacing,
+    ];
+    let fine = spacing / 4.0;
+    let mut lattice = String::from("x,y,z\n");
+    let mut points = Vec::new();
+    for k in 0..=((200.0 / fine) as i64) {
+        for j in -((400.0 / fine) as i64)..=((400.0 / fine) as i64) {
+            for i in -((400.0 / fine) as i64)..=((400.0 / fine) as i64) {
+                let p = [i as f64 * fine, j as f64 * fine, 650.0 + k as f64 * fine];
+                if p[0].hypot(p[1]) <= 400.0 {
+                    lattice += &format!("{},{},{}\n", p[0], p[1], p[2]);
+                    points.push(p);
+                }
+            }
+        }
+    }
+    let lattice_file = dir.join("lattice.csv");
+    std::fs::write(&lattice_file, lattice).unwrap();
+    let ik = |machine: Option<&Path>| -> Vec<[f64; 3]> {
+        let mut args = vec!["ik", "--input", lattice_file.to_str().unwrap()];
+        if let Some(m) = machine {
+            args.extend(["--machine", m.to_str().unwrap()]);
+        }
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+        let (_, h, rows) = parts(std::str::from_utf8(&out.stdout).unwrap());
+        rows.iter()
+            .map(|r| ["q1", "q2", "q3"].map(|c| r[col(&h, c)].parse::<f64>().unwrap()))
+            .collect()
+    };
+    let (nominal, calibrated) = (ik(None), ik(Some(&cal)));
+    let mut worst: f64 = 0.0;
+    for (n, (p, (a, b))) in points.iter().zip(nominal.iter().zip(&calibrated)).enumerate() {
+        let looked_up = lookup(&nodes, origin, spacing, *p);
+        for l in 0..3 {
+            let e = (looked_up[l] - (b[l] - a[l])).abs();
+            assert!(e.is_finite(), "point {n}");
+            worst = worst.max(e);
+        }
+    }
+    assert!(
+        (worst * 1e3 - error_um).abs() < 1e-6,
+        "re-measured {} um, stated {error_um} um",
+        worst * 1e3
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -38,10 +38,11 @@ pub const SPACING_LADDER_MM: [f64; 8] = [100.0, 50.0, 40.0, 25.0, 20.0, 10.0, 5.
 /// calibrated.base_joints_mm[0].x += 0.25;
 /// let (n, c) = (ExtendedMachine::new(nominal.clone()), ExtendedMachine::new(calibrated));
 /// let t = CompensationTable::build(&n, &c, &nominal.workspace, 50.0).unwrap();
-/// // A pure leg offset is a constant correction.
+/// // Leg 2 only has a length offset: a constant correction (0.2 mm short,
+/// // 0.2 mm more command), which trilinear lookup reproduces exactly.
 /// let r = nalgebra::Vector3::new(12.0, -80.0, 700.0);
 /// let dq = t.interpolate(&r).unwrap();
-/// assert!((dq[1] + 0.2).abs() < 1e-9);
+/// assert!((dq[1] - 0.2).abs() < 1e-9);
 /// assert!(t.interpolation_error_um(&n, &c, &nominal.workspace).unwrap() < 1.0);
 /// ```
 #[derive(Debug, Clone, PartialEq)]
