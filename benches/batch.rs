@@ -42,8 +42,15 @@ fn batch(c: &mut Criterion) {
         g.bench_function(name, |b| {
             b.iter(|| {
                 let mut out = Vec::with_capacity(POINTS * 160);
-                let n = run(verb, machine, input.as_bytes(), "bench.csv", &mut out, || false)
-                    .unwrap();
+                let n = run(
+                    verb,
+                    machine,
+                    input.as_bytes(),
+                    "bench.csv",
+                    &mut out,
+                    || false,
+                )
+                .unwrap();
                 black_box((n, out))
             })
         });

@@ -307,7 +307,7 @@ pub fn parse_errors(spec: &str, set: &ParameterSet) -> Result<Vec<f64>, CliError
     }
 }
 
-/// Parses `--effect` values: JSON objects (or arrays of them), inline or
+/// Parses `--truth-effect` values: JSON objects (or arrays of them), inline or
 /// from `@FILE`.
 pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, CliError> {
     let mut out = Vec::new();
@@ -318,7 +318,7 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, CliError> {
                     .map_err(|e| CliError::input(format!("{path}: {e}")))?,
                 path.to_string(),
             ),
-            None => (spec.clone(), "--effect".to_string()),
+            None => (spec.clone(), "--truth-effect".to_string()),
         };
         let value: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| CliError::input(format!("{origin}: {e}")))?;

@@ -213,13 +213,10 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
                     .map_err(map_error)?;
                 (t, e)
             }
-            None => CompensationTable::with_error_below(
-                &nominal,
-                &calibrated,
-                w,
-                TABLE_ERROR_LIMIT_UM,
-            )
-            .map_err(map_error)?,
+            None => {
+                CompensationTable::with_error_below(&nominal, &calibrated, w, TABLE_ERROR_LIMIT_UM)
+                    .map_err(map_error)?
+            }
         };
         let path = dir.join("table.csv");
         write_table(&path, &table, error_um, &nominal, &calibrated)?;
@@ -308,10 +305,13 @@ fn truth_maps(
     Ok(Some((map(nominal)?, map(calibrated)?)))
 }
 
+/// A target (mm) and its corrected leg commands (mm).
+type CorrectedTarget = (Vector3<f64>, [f64; 3]);
+
 fn corrected_targets(
     path: &Path,
     calibrated: &ExtendedMachine,
-) -> Result<Vec<(Vector3<f64>, [f64; 3])>, CliError> {
+) -> Result<Vec<CorrectedTarget>, CliError> {
     let points = tricept_data::read_targets(path).map_err(|e| CliError::input(e.to_string()))?;
     let mut rows = Vec::with_capacity(points.len());
     for (k, p) in points.iter().enumerate() {
@@ -370,11 +370,7 @@ fn text_report(
         }
     }
     if let Some(m) = out.get("map").and_then(Value::as_str) {
-        let _ = writeln!(
-            s,
-            "{:>26}: {m}/map.csv and SVG heat maps",
-            "per-point map"
-        );
+        let _ = writeln!(s, "{:>26}: {m}/map.csv and SVG heat maps", "per-point map");
     }
     if let Some(t) = out.get("table") {
         let _ = writeln!(
@@ -462,15 +458,8 @@ fn write_map(
             .collect()
     };
     let plot = |name: &str, title: &str, m: &ErrorMap, range| {
-        tricept_plot::heat_map(
-            &dir.join(name),
-            title,
-            &cells(m),
-            spacing,
-            "mm",
-            range,
-        )
-        .map_err(|e| CliError::other(e.to_string()))
+        tricept_plot::heat_map(&dir.join(name), title, &cells(m), spacing, "mm", range)
+            .map_err(|e| CliError::other(e.to_string()))
     };
     plot(
         "correction.svg",

@@ -3,8 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use tricept_diagnose::detect::{advise, detectability, realistic};
 use serde_json::{Map, json};
+use tricept_diagnose::detect::{advise, detectability, realistic};
 use tricept_diagnose::{
     Candidate, DiagnoseError, DiagnoseOptions, ExtendedModel, REFERENCE_TEMPERATURE_C, diagnose,
 };
@@ -18,8 +18,8 @@ use crate::args::{
     LoadedMachine, MachineArgs, NoiseArgs, load_with_noise, machine_with_noise, pose_targets,
     read_data,
 };
-use crate::machine_file;
 use crate::cli_error::CliError;
+use crate::machine_file;
 
 /// `tricept diagnose`.
 #[derive(Debug, Args)]
@@ -106,10 +106,10 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
             .map_err(|e| CliError::other(e.to_string()))?;
         }
     }
-    let written = match &a.write_machine {
-        Some(path) => Some(write_extended(path, data, &loaded, &dataset, &d, a.force)),
-        None => None,
-    };
+    let written = a
+        .write_machine
+        .as_ref()
+        .map(|path| write_extended(path, data, &loaded, &dataset, &d, a.force));
     if machine.json {
         outln!("{}", d.to_json());
     } else {
@@ -163,7 +163,9 @@ pub fn deploy(
     let mut controller: Option<ControllerDescription> = None;
     for (name, value) in id.names.iter().zip(&id.estimate).skip(model.n_geometric()) {
         let v = *value;
-        let leg = |i: usize| name.ends_with(&format!("{}_ppm", i + 1)) || name.ends_with(&format!("{}_um", i + 1));
+        let leg = |i: usize| {
+            name.ends_with(&format!("{}_ppm", i + 1)) || name.ends_with(&format!("{}_um", i + 1))
+        };
         match name.split_once('.') {
             Some(("leg-lead", _)) => {
                 for i in 0..3 {

@@ -14,8 +14,8 @@ use tricept_kinematics::Machine;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 
 use crate::args::{
-    FitArgs, LoadedMachine, MachineArgs, NoiseArgs, ParamArgs, load_with_noise,
-    machine_with_noise, pose_targets, read_data, spinner,
+    FitArgs, LoadedMachine, MachineArgs, NoiseArgs, ParamArgs, load_with_noise, machine_with_noise,
+    pose_targets, read_data, spinner,
 };
 use crate::cli_error::{CliError, EXIT_INADEQUATE, EXIT_NOT_CONVERGED};
 use crate::machine_file;
@@ -282,7 +282,9 @@ pub fn rejected_json(rejected: &[Rejection]) -> Value {
     Value::Array(
         rejected
             .iter()
-            .map(|r| json!({"pose": r.pose + 1, "line": r.line, "residual_sigma": r.residual_sigma}))
+            .map(
+                |r| json!({"pose": r.pose + 1, "line": r.line, "residual_sigma": r.residual_sigma}),
+            )
             .collect(),
     )
 }
@@ -292,10 +294,10 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
     let data = a.data.as_path();
     let fit = fit_from_file(data, &a.settings)?;
     let code = fit.exit_code();
-    let written = match &a.write_machine {
-        Some(path) => Some(write_calibrated(path, data, &fit, a.force)),
-        None => None,
-    };
+    let written = a
+        .write_machine
+        .as_ref()
+        .map(|path| write_calibrated(path, data, &fit, a.force));
     let id = &fit.id;
     if a.settings.machine.json {
         let mut v = id.to_json();

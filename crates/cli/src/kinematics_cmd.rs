@@ -136,7 +136,14 @@ fn kinematics(
 fn run_batch(verb: Verb, m: &ExtendedMachine, path: &std::path::Path) -> Result<u8, CliError> {
     let out = std::io::BufWriter::with_capacity(1 << 16, crate::output::Stdout);
     let result = if path.as_os_str() == "-" {
-        batch::run(verb, m, std::io::stdin().lock(), "stdin", out, stdout_closed)
+        batch::run(
+            verb,
+            m,
+            std::io::stdin().lock(),
+            "stdin",
+            out,
+            stdout_closed,
+        )
     } else {
         let name = path.display().to_string();
         let f = std::fs::File::open(path).map_err(|e| CliError::input(format!("{name}: {e}")))?;

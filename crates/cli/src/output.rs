@@ -25,7 +25,11 @@ pub fn write_line(args: std::fmt::Arguments<'_>) {
         return;
     }
     let mut out = std::io::stdout().lock();
-    if out.write_fmt(args).and_then(|_| out.write_all(b"\n")).is_err() {
+    if out
+        .write_fmt(args)
+        .and_then(|_| out.write_all(b"\n"))
+        .is_err()
+    {
         STDOUT_CLOSED.store(true, Ordering::Relaxed);
     }
 }

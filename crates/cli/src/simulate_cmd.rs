@@ -7,8 +7,8 @@ use tricept_ident::GeometricModel;
 use tricept_plant::{Campaign, Plant, PoseOrder};
 
 use crate::args::{
-    MachineArgs, NoiseArgs, ParamArgs, TruthArgs, machine_with_noise, parse_effects,
-    parse_errors, pose_targets,
+    MachineArgs, NoiseArgs, ParamArgs, TruthArgs, machine_with_noise, parse_effects, parse_errors,
+    pose_targets,
 };
 use crate::cli_error::CliError;
 

@@ -37,7 +37,15 @@ fn every_verb_survives_a_closed_stdout() {
         (vec!["detectability", "--poses", "grid:1,8,3"], 0),
         (vec!["compensate", "--data", &good, "--spacing", "50"], 0),
         (
-            vec!["compensate", "--data", &good, "--targets", p, "--spacing", "50"],
+            vec![
+                "compensate",
+                "--data",
+                &good,
+                "--targets",
+                p,
+                "--spacing",
+                "50",
+            ],
             0,
         ),
         (vec!["--help"], 0),

@@ -51,7 +51,12 @@ fn text(out: &Output) -> String {
 fn parts(csv: &str) -> (Vec<&str>, Vec<String>, Vec<Vec<String>>) {
     let comments: Vec<&str> = csv.lines().filter(|l| l.starts_with('#')).collect();
     let mut rows = csv.lines().filter(|l| !l.starts_with('#'));
-    let header = rows.next().unwrap().split(',').map(str::to_string).collect();
+    let header = rows
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
     let rows = rows
         .map(|l| l.split(',').map(str::to_string).collect())
         .collect();
@@ -104,7 +109,10 @@ fn identify(data: &Path, extra: &[&str], machine_out: &Path) -> (i32, serde_json
         (Some(true), Some(true)) => 0,
         _ => panic!("no verdict in {v}"),
     };
-    assert_eq!(code, expected, "exit code against the JSON verdict: {stderr}");
+    assert_eq!(
+        code, expected,
+        "exit code against the JSON verdict: {stderr}"
+    );
     (code, v, stderr)
 }
 
@@ -144,8 +152,18 @@ fn data_that_cannot_come_from_the_machine_get_a_non_zero_code_and_a_named_cause(
             },
         );
         vec![
-            ("swapped phi and theta", swap_angles, None, "phi and theta are exchanged"),
-            ("swapped q1 and q2", swap_legs, None, "q1 and q2 are exchanged"),
+            (
+                "swapped phi and theta",
+                swap_angles,
+                None,
+                "phi and theta are exchanged",
+            ),
+            (
+                "swapped q1 and q2",
+                swap_legs,
+                None,
+                "q1 and q2 are exchanged",
+            ),
             ("s in metres", metres, None, "logged in m, not mm"),
             (
                 "the wrong machine file",
@@ -198,7 +216,11 @@ fn data_that_cannot_come_from_the_machine_get_a_non_zero_code_and_a_named_cause(
     std::fs::write(&one, s).unwrap();
     let out = run(&["identify", "--data", one.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2), "{}", text(&out));
-    assert!(text(&out).contains("1 distinct leg commands"), "{}", text(&out));
+    assert!(
+        text(&out).contains("1 distinct leg commands"),
+        "{}",
+        text(&out)
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -243,8 +265,7 @@ fn a_forced_machine_is_marked_and_warned_about_when_loaded() {
     let m = dir.join("forced.json");
     let (code, _, _) = identify(&bad, &["--force"], &m);
     assert_ne!(code, 0);
-    let d: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&m).unwrap()).unwrap();
+    let d: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&m).unwrap()).unwrap();
     assert_eq!(d["calibration"]["forced"], true);
     assert!(d["name"].as_str().unwrap().contains("FORCED"));
     let out = run(&["machine", "--machine", m.to_str().unwrap()]);
@@ -282,7 +303,12 @@ fn the_calibrated_machine_file_is_complete_loads_everywhere_and_round_trips() {
     assert!(d["name"].as_str().unwrap().contains("calibrated"));
     assert_eq!(c["parameter_set"], "paper15");
     assert_eq!(c["held"][0]["name"], "dyA3");
-    assert!(c["held"][0]["reason"].as_str().unwrap().contains("unidentifiable"));
+    assert!(
+        c["held"][0]["reason"]
+            .as_str()
+            .unwrap()
+            .contains("unidentifiable")
+    );
     assert_eq!(c["std_dev_mm"]["dyA3"], serde_json::Value::Null);
     assert_eq!(c["estimates_mm"]["dq2"], id1["dq2"]);
     assert_eq!(c["sensor_offsets"]["s_mm"], id1["offsets"]["s_mm"]);
@@ -403,7 +429,11 @@ fn deploying_the_diagnosis_delivers_its_gain_on_the_simulated_machine() {
         assert_eq!(out.status.code(), Some(0), "{}", text(&out));
         let csv = std::fs::read_to_string(out_dir.join("map.csv")).unwrap();
         let (_, h, rows) = parts(&csv);
-        let (x, y, z) = (col(&h, "after_dx"), col(&h, "after_dy"), col(&h, "after_dz"));
+        let (x, y, z) = (
+            col(&h, "after_dx"),
+            col(&h, "after_dy"),
+            col(&h, "after_dz"),
+        );
         rows.iter()
             .map(|r| [x, y, z].map(|i| r[i].parse::<f64>().unwrap()))
             .collect()
@@ -413,7 +443,9 @@ fn deploying_the_diagnosis_delivers_its_gain_on_the_simulated_machine() {
     let moved: f64 = with_geo
         .iter()
         .zip(&with_ext)
-        .map(|(a, b)| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt())
+        .map(|(a, b)| {
+            ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+        })
         .sum::<f64>()
         / n;
     let norm = |v: &[f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -429,7 +461,10 @@ fn deploying_the_diagnosis_delivers_its_gain_on_the_simulated_machine() {
     );
     // And the gain is real: the extended file puts the machine within a few
     // tenths of a mm where the geometric one is almost 5 mm off.
-    assert!(error_geo > 4.0 && error_ext < 0.2, "{error_geo} {error_ext}");
+    assert!(
+        error_geo > 4.0 && error_ext < 0.2,
+        "{error_geo} {error_ext}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -437,7 +472,11 @@ fn deploying_the_diagnosis_delivers_its_gain_on_the_simulated_machine() {
 fn batch_kinematics_write_the_json_keys_as_csv_columns() {
     let dir = workdir("batch");
     let points = dir.join("points.csv");
-    std::fs::write(&points, "\u{feff}# targets\nz,x,y\n750,0,0\n700,-120.5,80\n").unwrap();
+    std::fs::write(
+        &points,
+        "\u{feff}# targets\nz,x,y\n750,0,0\n700,-120.5,80\n",
+    )
+    .unwrap();
     let out = run(&["ik", "--input", points.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out));
     let csv = String::from_utf8(out.stdout).unwrap();
@@ -448,7 +487,10 @@ fn batch_kinematics_write_the_json_keys_as_csv_columns() {
     // (serde_json reads floats to within an ulp, hence the tolerance.)
     let same = |a: f64, b: f64| (a - b).abs() <= 1e-15 * a.abs().max(b.abs());
     for (k, v) in header.iter().zip(&rows[1]) {
-        assert!(same(v.parse::<f64>().unwrap(), single[k].as_f64().unwrap()), "{k}");
+        assert!(
+            same(v.parse::<f64>().unwrap(), single[k].as_f64().unwrap()),
+            "{k}"
+        );
     }
     // fk from stdin, fed the ik output: back to the points.
     let mut child = tricept()
@@ -478,7 +520,9 @@ fn batch_kinematics_write_the_json_keys_as_csv_columns() {
     let tools = dir.join("tools.csv");
     std::fs::write(&tools, "x,y,z,ax,ay,az\n150,100,1080,0.2,-0.1,1\n").unwrap();
     let out = run(&["tool-ik", "--input", tools.to_str().unwrap()]);
-    let single = json(&run(&["tool-ik", "150", "100", "1080", "0.2", "-0.1", "1", "--json"]));
+    let single = json(&run(&[
+        "tool-ik", "150", "100", "1080", "0.2", "-0.1", "1", "--json",
+    ]));
     let (_, h, r) = parts(std::str::from_utf8(&out.stdout).unwrap());
     assert_eq!(h.len(), single.as_object().unwrap().len());
     assert!(same(
@@ -526,7 +570,12 @@ fn compensate_writes_clean_csv_maps_and_checks_its_arguments() {
     let (_, h, rows) = parts(&map);
     assert!(h.contains(&"before_mm".to_string()) && h.contains(&"after_mm".to_string()));
     let (b, a) = (col(&h, "before_mm"), col(&h, "after_mm"));
-    let mean = |i: usize| rows.iter().map(|r| r[i].parse::<f64>().unwrap()).sum::<f64>() / rows.len() as f64;
+    let mean = |i: usize| {
+        rows.iter()
+            .map(|r| r[i].parse::<f64>().unwrap())
+            .sum::<f64>()
+            / rows.len() as f64
+    };
     assert!(mean(a) < 0.5 * mean(b));
     // Arguments: a real message for a negative spacing, exit 2 off the plane.
     for (args, needle) in [
@@ -554,7 +603,11 @@ fn absurd_machines_and_flags_are_refused_clearly() {
     .unwrap();
     let out = run(&["ik", "0", "0", "750", "--machine", huge.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(text(&out).contains("not the size of a machine"), "{}", text(&out));
+    assert!(
+        text(&out).contains("not the size of a machine"),
+        "{}",
+        text(&out)
+    );
     // --json on machine and simulate.
     let m = json(&run(&["machine", "--json"]));
     assert_eq!(m["workspace"]["radius_mm"], 400.0);
@@ -655,11 +708,19 @@ fn the_table_interpolation_error_is_what_the_docs_state() {
     // 50 mm | 0.382 um |`.
     let row = docs
         .lines()
-        .find(|l| l.starts_with('|') && l.contains("table2-grid-seed1.csv") && l.contains("--table"))
+        .find(|l| {
+            l.starts_with('|') && l.contains("table2-grid-seed1.csv") && l.contains("--table")
+        })
         .expect("docs/data-format.md states the table of the Table 2 data");
     let cells: Vec<&str> = row.split('|').map(str::trim).collect();
-    let stated_spacing: f64 = cells[cells.len() - 3].trim_end_matches(" mm").parse().unwrap();
-    let stated_um: f64 = cells[cells.len() - 2].trim_end_matches(" um").parse().unwrap();
+    let stated_spacing: f64 = cells[cells.len() - 3]
+        .trim_end_matches(" mm")
+        .parse()
+        .unwrap();
+    let stated_um: f64 = cells[cells.len() - 2]
+        .trim_end_matches(" um")
+        .parse()
+        .unwrap();
 
     let data = fixture("data/table2-grid-seed1.csv");
     let cal = dir.join("t2.json");
@@ -727,7 +788,11 @@ fn the_table_interpolation_error_is_what_the_docs_state() {
     };
     let (nominal, calibrated) = (ik(None), ik(Some(&cal)));
     let mut worst: f64 = 0.0;
-    for (n, (p, (a, b))) in points.iter().zip(nominal.iter().zip(&calibrated)).enumerate() {
+    for (n, (p, (a, b))) in points
+        .iter()
+        .zip(nominal.iter().zip(&calibrated))
+        .enumerate()
+    {
         let looked_up = lookup(&nodes, origin, spacing, *p);
         for l in 0..3 {
             let e = (looked_up[l] - (b[l] - a[l])).abs();

@@ -568,7 +568,9 @@ pub fn identify_from(
     problem.run(&mut state, &decision);
 
     let lines = poses.iter().map(|p| p.line).collect();
-    Ok(finish(names, state, decision, report, options, weights, lines))
+    Ok(finish(
+        names, state, decision, report, options, weights, lines,
+    ))
 }
 
 /// The fixed parts of an identification problem.

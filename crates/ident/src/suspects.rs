@@ -65,8 +65,14 @@ fn trials(machine: &Machine) -> Vec<Trial> {
         legs("the columns q1 and q2 are exchanged", [1, 0, 2]),
         legs("the columns q1 and q3 are exchanged", [2, 1, 0]),
         legs("the columns q2 and q3 are exchanged", [0, 2, 1]),
-        legs("the leg columns are rotated (q1,q2,q3 hold legs 2,3,1)", [2, 0, 1]),
-        legs("the leg columns are rotated (q1,q2,q3 hold legs 3,1,2)", [1, 2, 0]),
+        legs(
+            "the leg columns are rotated (q1,q2,q3 hold legs 2,3,1)",
+            [2, 0, 1],
+        ),
+        legs(
+            "the leg columns are rotated (q1,q2,q3 hold legs 3,1,2)",
+            [1, 2, 0],
+        ),
         data("the scale `s` is logged in m, not mm", |r| Readings {
             s_mm: r.s_mm * 1e3,
             ..r
@@ -151,9 +157,7 @@ pub fn likely_causes(
             };
             let id = identify(&GeometricModel::new(m, set.clone()), &d, options).ok()?;
             let chi2 = id.stats.reduced_chi_square;
-            (id.converged
-                && chi2 < INCONSISTENT_CHI2_PER_DOF
-                && chi2 * 100.0 < given_chi2_per_dof)
+            (id.converged && chi2 < INCONSISTENT_CHI2_PER_DOF && chi2 * 100.0 < given_chi2_per_dof)
                 .then_some(LikelyCause {
                     description: t.description,
                     chi2_per_dof: chi2,

@@ -87,11 +87,7 @@ impl CompensationTable {
         let h = spacing_mm;
         let n_xy = (workspace.radius_mm / h).ceil() as usize;
         let n_z = ((workspace.z_max_mm - workspace.z_min_mm) / h).ceil() as usize;
-        let origin_mm = Vector3::new(
-            -(n_xy as f64) * h,
-            -(n_xy as f64) * h,
-            workspace.z_min_mm,
-        );
+        let origin_mm = Vector3::new(-(n_xy as f64) * h, -(n_xy as f64) * h, workspace.z_min_mm);
         let counts = [2 * n_xy + 1, 2 * n_xy + 1, n_z + 1];
         let mut nodes = Vec::with_capacity(counts[0] * counts[1] * counts[2]);
         for k in 0..counts[2] {
@@ -233,11 +229,11 @@ impl CompensationTable {
                         continue;
                     }
                     let exact = correction(nominal, calibrated, &r)?;
-                    let looked_up = self.interpolate(&r).ok_or_else(|| {
-                        KinematicsError::OutOfReach {
-                            reason: format!("no table cell holds the workspace point {r:?}"),
-                        }
-                    })?;
+                    let looked_up =
+                        self.interpolate(&r)
+                            .ok_or_else(|| KinematicsError::OutOfReach {
+                                reason: format!("no table cell holds the workspace point {r:?}"),
+                            })?;
                     for l in 0..3 {
                         worst = worst.max((looked_up[l] - exact[l]).abs());
                     }

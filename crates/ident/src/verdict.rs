@@ -75,7 +75,8 @@ impl Identification {
             f64::NAN
         };
         let adequate = p > ADEQUACY_ALPHA;
-        let inconsistent = !(chi2_per_dof <= INCONSISTENT_CHI2_PER_DOF);
+        // NaN (no degrees of freedom) counts as inconsistent.
+        let inconsistent = chi2_per_dof.is_nan() || chi2_per_dof > INCONSISTENT_CHI2_PER_DOF;
         let largest = self
             .names
             .iter()

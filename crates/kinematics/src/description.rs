@@ -627,10 +627,7 @@ impl MachineDescription {
             if !(-60.0..=200.0).contains(&c.reference_temperature_c) {
                 return Err(invalid(
                     "controller.reference_temperature_c",
-                    format!(
-                        "{} °C is outside -60..200 °C",
-                        c.reference_temperature_c
-                    ),
+                    format!("{} °C is outside -60..200 °C", c.reference_temperature_c),
                 ));
             }
         }

@@ -13,8 +13,8 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::description::{
-    LegEffectsDescription, LoadsDescription, MachineDescription, Placement, SensorDescription, UpLimbDescription,
-    WorkspaceDescription,
+    LegEffectsDescription, LoadsDescription, MachineDescription, Placement, SensorDescription,
+    UpLimbDescription, WorkspaceDescription,
 };
 use crate::error::KinematicsError;
 use crate::head::Head;

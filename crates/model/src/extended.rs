@@ -24,9 +24,9 @@ use tricept_kinematics::{
     FkSolution, HeadBranch, IkSolution, KinematicsError, Machine, ToolIkSolution, UpJoints,
 };
 
-use crate::effects::{leg_lead_extra_mm, static_leg_extra_per_mm};
 #[cfg(test)]
 use crate::effects::{compliance_extra_mm, gravity_leg_tension_n};
+use crate::effects::{leg_lead_extra_mm, static_leg_extra_per_mm};
 
 /// A [`Machine`] whose kinematics include its static leg effects
 /// ([`Machine::leg_effects`]). With no effects it is the machine itself,
@@ -167,10 +167,13 @@ impl ExtendedMachine {
         let mut sol = first;
         let mut iterations = sol.iterations;
         let lead = self.machine.leg_effects.lead_ppm;
-        let mut extra: [f64; 3] = std::array::from_fn(|i| leg_lead_extra_mm(lead[i], commands_mm[i]));
+        let mut extra: [f64; 3] =
+            std::array::from_fn(|i| leg_lead_extra_mm(lead[i], commands_mm[i]));
         for _ in 0..MAX_PASSES {
             let next = self.leg_extra_mm(commands_mm, &sol.up);
-            let change = (0..3).map(|i| (next[i] - extra[i]).abs()).fold(0.0, f64::max);
+            let change = (0..3)
+                .map(|i| (next[i] - extra[i]).abs())
+                .fold(0.0, f64::max);
             if change < PASS_TOLERANCE_MM {
                 break;
             }
@@ -227,7 +230,11 @@ mod tests {
             let ik = x.inverse(&r).unwrap();
             let fk = x.forward(&ik.legs_mm).unwrap();
             // The passes stop at 1e-9 mm of leg length.
-            assert!((fk.position_mm - r).norm() < 1e-8, "{r} {}", (fk.position_mm - r).norm());
+            assert!(
+                (fk.position_mm - r).norm() < 1e-8,
+                "{r} {}",
+                (fk.position_mm - r).norm()
+            );
             // The actual legs, from the physics functions directly: the
             // commands plus lead plus compliance equal the geometric IK.
             let f = gravity_leg_tension_n(&m, &ik.up);
