@@ -205,7 +205,7 @@ pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, CliError> {
     let f = std::fs::File::open(path).map_err(|e| CliError::input(format!("{file}: {e}")))?;
     // A progress bar over the bytes read (drawn only on a terminal).
     let size = f.metadata().map(|m| m.len()).unwrap_or(0);
-    let bar = progress_bar(size, "reading");
+    let bar = progress_bar(size, &format!("reading {file}"));
     let data = tricept_data::read_from(bar.wrap_read(std::io::BufReader::new(f)), &file)
         .map_err(|e| CliError::input(e.to_string()))?;
     bar.finish_and_clear();

@@ -864,4 +864,75 @@ mod tests {
         let e = MachineDescription::from_json(&v.to_string()).unwrap_err();
         assert!(e.to_string().contains("must be below"), "{e}");
     }
+
+    #[test]
+    fn rejects_sizes_no_machine_has() {
+        for (key, value) in [
+            ("/placement/circular/base_radius_mm", 1e200),
+            ("/workspace/radius_mm", 2e5),
+            ("/head/tool_tip_mm/2", -1e6),
+        ] {
+            let mut v: serde_json::Value = serde_json::from_str(PAPER_MACHINE_JSON).unwrap();
+            *v.pointer_mut(key).unwrap() = value.into();
+            let e = MachineDescription::from_json(&v.to_string()).unwrap_err();
+            assert!(
+                e.to_string().contains("not the size of a machine"),
+                "{key}: {e}"
+            );
+        }
+        let mut v: serde_json::Value = serde_json::from_str(PAPER_MACHINE_JSON).unwrap();
+        v["leg_effects"] = serde_json::json!({"lead_ppm": [5e4, 0.0, 0.0]});
+        let e = MachineDescription::from_json(&v.to_string()).unwrap_err();
+        assert!(e.to_string().contains("lead_ppm"), "{e}");
+    }
+
+    #[test]
+    fn a_calibrated_description_round_trips_and_its_nominal_is_validated() {
+        let mut d = MachineDescription::paper();
+        d.leg_effects.compliance_um_per_kn_at_1m = 29.98;
+        d.controller = Some(ControllerDescription {
+            backlash_um: [6.0, 5.0, 8.0],
+            ..ControllerDescription::default()
+        });
+        let mut nominal = MachineDescription::paper();
+        d.calibration = Some(Box::new(CalibrationRecord {
+            method: "identify".into(),
+            parameter_set: "paper15".into(),
+            estimates_mm: serde_json::Map::new(),
+            std_dev_mm: serde_json::Map::new(),
+            correlations: CorrelationsDescription::default(),
+            effects: serde_json::Map::new(),
+            sensor_offsets: SensorOffsetsDescription::default(),
+            held: vec![HeldParameter {
+                name: "dyA3".into(),
+                reason: "unidentifiable".into(),
+            }],
+            chi2_per_dof: 0.95,
+            dof: 208,
+            converged: true,
+            adequate: true,
+            forced: false,
+            warnings: Vec::new(),
+            poses_used: 75,
+            rejected_lines: Vec::new(),
+            data_file: "data.csv".into(),
+            data_sha256: "0".repeat(64),
+            date: "2026-11-23T00:00:00Z".into(),
+            tool_version: "0.1.0".into(),
+            relative_to: nominal.name.clone(),
+            nominal: Box::new(nominal.clone()),
+        }));
+        let again = MachineDescription::from_json(&d.to_json()).unwrap();
+        assert_eq!(d, again);
+        // A broken nominal machine inside is found and named.
+        nominal.workspace.radius_mm = -1.0;
+        if let Some(c) = &mut d.calibration {
+            c.nominal = Box::new(nominal);
+        }
+        let e = MachineDescription::from_json(&d.to_json()).unwrap_err();
+        assert!(
+            e.to_string().contains("calibration.nominal.workspace"),
+            "{e}"
+        );
+    }
 }

@@ -136,10 +136,7 @@ impl ExtendedMachine {
             return self.machine.forward(commands_mm);
         }
         // The lead part needs no pose: start from it.
-        let lead = self.machine.leg_effects.lead_ppm;
-        let legs: [f64; 3] =
-            std::array::from_fn(|i| commands_mm[i] + leg_lead_extra_mm(lead[i], commands_mm[i]));
-        let first = self.machine.forward(&legs)?;
+        let first = self.machine.forward(&self.with_lead(commands_mm))?;
         self.refine(commands_mm, first)
     }
 
@@ -152,11 +149,17 @@ impl ExtendedMachine {
         if !self.has_leg_effects() {
             return self.machine.forward_from(commands_mm, seed);
         }
-        let lead = self.machine.leg_effects.lead_ppm;
-        let legs: [f64; 3] =
-            std::array::from_fn(|i| commands_mm[i] + leg_lead_extra_mm(lead[i], commands_mm[i]));
-        let first = self.machine.forward_from(&legs, seed)?;
+        let first = self
+            .machine
+            .forward_from(&self.with_lead(commands_mm), seed)?;
         self.refine(commands_mm, first)
+    }
+
+    /// The commands plus their lead errors (the part of the effects that
+    /// does not depend on the pose).
+    fn with_lead(&self, commands_mm: &[f64; 3]) -> [f64; 3] {
+        let lead = self.machine.leg_effects.lead_ppm;
+        std::array::from_fn(|i| commands_mm[i] + leg_lead_extra_mm(lead[i], commands_mm[i]))
     }
 
     fn refine(
@@ -166,9 +169,8 @@ impl ExtendedMachine {
     ) -> Result<FkSolution, KinematicsError> {
         let mut sol = first;
         let mut iterations = sol.iterations;
-        let lead = self.machine.leg_effects.lead_ppm;
-        let mut extra: [f64; 3] =
-            std::array::from_fn(|i| leg_lead_extra_mm(lead[i], commands_mm[i]));
+        let with_lead = self.with_lead(commands_mm);
+        let mut extra: [f64; 3] = std::array::from_fn(|i| with_lead[i] - commands_mm[i]);
         for _ in 0..MAX_PASSES {
             let next = self.leg_extra_mm(commands_mm, &sol.up);
             let change = (0..3)
