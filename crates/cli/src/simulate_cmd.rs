@@ -128,8 +128,12 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
             }
         }
         // A closed stdout (`| head`) is not an error: the writer swallows it.
-        None => tricept_data::write_to(crate::output::Stdout, &data, &comments)
-            .map_err(|e| CliError::other(format!("stdout: {e}")))?,
+        None => tricept_data::write_to(
+            std::io::BufWriter::new(crate::output::Stdout),
+            &data,
+            &comments,
+        )
+        .map_err(|e| CliError::other(format!("stdout: {e}")))?,
     }
     Ok(0)
 }
