@@ -807,3 +807,72 @@ fn the_table_interpolation_error_is_what_the_docs_state() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn the_dynamic_effects_are_exported_as_controller_parameters() {
+    // Backlash, a thermal drift and leg lead hidden in a campaign that
+    // visits each pose from both directions and logs the temperature.
+    let dir = workdir("controller");
+    let data = dir.join("dynamic.csv");
+    let (backlash_um, expansion, lead_ppm) = ([6.0, 5.0, 8.0], 11.5, [60.0, -40.0, 30.0]);
+    let out = run(&[
+        "simulate",
+        "--truth",
+        "random:0.3,2",
+        "--poses",
+        "random:150,3",
+        "--both-directions",
+        "--readings-per-pose",
+        "10",
+        "--truth-effect",
+        &format!(r#"{{"effect":"backlash","um":{backlash_um:?}}}"#),
+        "--truth-effect",
+        &format!(r#"{{"effect":"thermal","drift_k":3,"expansion_ppm_per_k":{expansion}}}"#),
+        "--truth-effect",
+        &format!(r#"{{"effect":"leg-lead","ppm":{lead_ppm:?}}}"#),
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let file = dir.join("dynamic.json");
+    let out = run(&[
+        "diagnose",
+        "--data",
+        data.to_str().unwrap(),
+        "--write-machine",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    let effects = &d["calibration"]["effects"];
+    let check = |value: &serde_json::Value, name: &str, truth: f64| {
+        let sd = effects[name]["std_dev"].as_f64().unwrap();
+        let v = value.as_f64().unwrap();
+        assert_eq!(v, effects[name]["value"].as_f64().unwrap(), "{name}");
+        assert!(
+            (v - truth).abs() < 5.0 * sd,
+            "{name}: {v} +- {sd}, truth {truth}"
+        );
+    };
+    let c = &d["controller"];
+    for i in 0..3 {
+        check(
+            &c["backlash_um"][i],
+            &format!("backlash.backlash{}_um", i + 1),
+            backlash_um[i],
+        );
+        check(
+            &d["leg_effects"]["lead_ppm"][i],
+            &format!("leg-lead.lead{}_ppm", i + 1),
+            lead_ppm[i],
+        );
+    }
+    check(
+        &c["thermal_expansion_ppm_per_k"],
+        "thermal.expansion_ppm_per_k",
+        expansion,
+    );
+    assert_eq!(c["reference_temperature_c"], 20.0);
+    std::fs::remove_dir_all(&dir).ok();
+}
