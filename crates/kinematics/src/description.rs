@@ -927,7 +927,7 @@ mod tests {
         // A broken nominal machine inside is found and named.
         nominal.workspace.radius_mm = -1.0;
         if let Some(c) = &mut d.calibration {
-            c.nominal = Box::new(nominal);
+            *c.nominal = nominal;
         }
         let e = MachineDescription::from_json(&d.to_json()).unwrap_err();
         assert!(
