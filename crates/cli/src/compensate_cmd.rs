@@ -53,8 +53,7 @@ pub struct CompensateArgs {
     #[arg(long, value_name = "DIR")]
     pub table: Option<PathBuf>,
     /// Grid spacing of the table, mm (default: the coarsest of 100, 50,
-    /// 40, 25, 20, 10, 5, 2 mm whose measured interpolation error is below
-    /// 1 um).
+    /// 40, 25, 20, 10 mm whose measured interpolation error is below 1 um).
     #[arg(long, value_name = "MM")]
     pub table_spacing: Option<f64>,
     /// Compensate even from a fit that did not converge or data that
@@ -155,7 +154,7 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
         nominal,
         calibrated,
         mut out,
-        warnings,
+        mut warnings,
         code,
     } = machines(a)?;
     let w = &nominal.machine().workspace;
@@ -218,6 +217,12 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
                     .map_err(map_error)?
             }
         };
+        if error_um >= TABLE_ERROR_LIMIT_UM {
+            warnings.push(format!(
+                "the compensation table's interpolation error is {error_um:.3} um at {} mm spacing, above {TABLE_ERROR_LIMIT_UM} um: a finer --table-spacing reduces it",
+                table.spacing_mm
+            ));
+        }
         let path = dir.join("table.csv");
         write_table(&path, &table, error_um, &nominal, &calibrated)?;
         out.insert(

@@ -76,7 +76,11 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
     let source = data.display().to_string();
     let options = DiagnoseOptions::for_machine(&m);
     let d = diagnose(&m, &dataset, &options).map_err(|e| match e {
-        DiagnoseError::TooFewPoses(_) => CliError::input(format!("{source}: {e}")),
+        DiagnoseError::TooFewPoses(_)
+        | DiagnoseError::Ident(
+            tricept_ident::IdentError::TooFewPoses { .. }
+            | tricept_ident::IdentError::TooFewDistinctPoses { .. },
+        ) => CliError::input(format!("{source}: {e}")),
         DiagnoseError::Ident(tricept_ident::IdentError::Kinematics {
             line, source: k, ..
         }) => CliError::input(format!(
