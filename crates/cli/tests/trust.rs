@@ -214,13 +214,15 @@ fn data_that_cannot_come_from_the_machine_get_a_non_zero_code_and_a_named_cause(
         s += &(r.join(",") + "\n");
     }
     std::fs::write(&one, s).unwrap();
-    let out = run(&["identify", "--data", one.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
-    assert!(
-        text(&out).contains("1 distinct leg commands"),
-        "{}",
-        text(&out)
-    );
+    for verb in ["identify", "diagnose"] {
+        let out = run(&[verb, "--data", one.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(2), "{verb}: {}", text(&out));
+        assert!(
+            text(&out).contains("1 distinct leg commands"),
+            "{verb}: {}",
+            text(&out)
+        );
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
 
