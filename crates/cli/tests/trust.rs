@@ -169,7 +169,7 @@ fn data_that_cannot_come_from_the_machine_get_a_non_zero_code_and_a_named_cause(
                 "the wrong machine file",
                 PathBuf::from(fixture("data/table2-grid-seed1.csv")),
                 Some(fixture("machines/tricept-paper-y-first.json")),
-                "the data fit the same machine with a x-first U joint",
+                "the data fit the same machine with the x-first axis order",
             ),
         ]
     };

@@ -95,7 +95,7 @@ fn trials(machine: &Machine) -> Vec<Trial> {
         }),
         Trial {
             description: format!(
-                "the machine file is wrong: its U joint is {}, and the data fit the same machine with a {other} U joint",
+                "the machine file is wrong: its U joint is {}, and the data fit the same machine with the {other} axis order",
                 machine.up_limb.axis_order
             ),
             readings: None,
