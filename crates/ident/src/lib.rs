@@ -99,7 +99,9 @@ pub use report::{Combination, CorrelatedPair, IdentifiabilityReport, NamedValues
 pub use robust::{Rejection, identify_robust, residuals_at, screen_gross_errors};
 pub use suspects::{LikelyCause, likely_causes};
 pub use table::{CompensationTable, SPACING_LADDER_MM};
-pub use verdict::{ADEQUACY_ALPHA, INCONSISTENT_CHI2_PER_DOF, LARGE_ESTIMATE_MM, Verdict};
+pub use verdict::{
+    ADEQUACY_ALPHA, BARELY_SEEN_STD_DEV_MM, INCONSISTENT_CHI2_PER_DOF, LARGE_ESTIMATE_MM, Verdict,
+};
 
 // What a downstream crate needs besides this crate's own types, so that one
 // dependency suffices: the data set and its reader, the machine, the

@@ -32,6 +32,10 @@ pub const INCONSISTENT_CHI2_PER_DOF: f64 = 1000.0;
 /// data fit: machines are built to drawings to better than this.
 pub const LARGE_ESTIMATE_MM: f64 = 10.0;
 
+/// An estimated parameter whose standard deviation exceeds this (mm) is
+/// barely seen by the data: its value means little.
+pub const BARELY_SEEN_STD_DEV_MM: f64 = 1.0;
+
 /// The verdict on an identification.
 ///
 /// # Example
@@ -113,6 +117,22 @@ impl Identification {
         {
             warnings.push(format!(
                 "{n} = {v:.2} mm: an error this large means the machine description is far from this machine; check that it is the right file"
+            ));
+        }
+        let barely: Vec<String> = self
+            .names
+            .iter()
+            .zip(&self.estimate)
+            .zip(&self.std_dev)
+            .filter_map(|((n, v), sd)| {
+                sd.filter(|s| *s > BARELY_SEEN_STD_DEV_MM)
+                    .map(|s| format!("{n} = {v:.3} +- {s:.3} mm"))
+            })
+            .collect();
+        if !barely.is_empty() {
+            warnings.push(format!(
+                "the data barely see {}: these estimates mean little (more or better spread poses help; a machine file that is itself a calibration should keep its `calibration` record, whose nominal machine decides what is held)",
+                barely.join(", ")
             ));
         }
         Verdict {
