@@ -1,6 +1,8 @@
 //! Identification benchmarks: the full nonlinear identification (exact FK,
 //! analytic Jacobian, TSQR + rank decision + Gauss-Newton) of Table 2 from
-//! 75 and 1000 poses. Target: 1000 poses in under 1 s.
+//! 75 and 1000 poses (target: 1000 poses in under 1 s), and the fused
+//! identification of module and head from 1000 internal poses and 100
+//! tracker points (target: under 1 s, report included).
 
 use std::hint::black_box;
 
@@ -30,5 +32,57 @@ fn identification(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, identification);
+fn fused(c: &mut Criterion) {
+    use tricept_ident::fusion::{
+        FusedModel, FusionOptions, Source, TrackerOptions, TrackerTarget, identify_fused,
+    };
+    let m = Machine::paper();
+    let set = ParameterSet::paper15();
+    let mut plant = Plant::geometric(m.clone(), set.to_errors(&set.table2()));
+    plant.head_errors = tricept_plant::random_head_errors(1.0, 1);
+    let internal = plant.simulate(&Campaign::random(&m, 1000, 1)).unwrap();
+    let poses: Vec<_> = m
+        .workspace
+        .random_poses(100, 2)
+        .iter()
+        .enumerate()
+        .map(|(j, r)| {
+            let pose = tricept_data::ExternalPose {
+                commands_mm: m.inverse(r).unwrap().legs_mm,
+                head_rad: [(j % 6) as f64 * 1.047, [-0.7, -0.4, 0.4, 0.7][j % 4]],
+            };
+            (pose, 0.0)
+        })
+        .collect();
+    let tracker = tricept_plant::Tracker {
+        frame: nalgebra::Isometry3::translation(1500.0, -800.0, 200.0),
+        target_offset_mm: nalgebra::Vector3::zeros(),
+        sigma_um: 10.0,
+        setup: 1,
+    };
+    let points = tracker.measure(&plant, &poses, 3).unwrap();
+    let model = FusedModel::new(m.clone(), set, &[], true).unwrap();
+    let options = FusionOptions::for_machine(&m);
+    let known = TrackerOptions {
+        sigma_um: 10.0,
+        target: TrackerTarget::Known {
+            offset_mm: [0.0; 3],
+            sigma_um: 5.0,
+        },
+    };
+    let mut group = c.benchmark_group("identify_fused");
+    group.sample_size(10);
+    group.bench_function("1000_internal_100_tracker", |b| {
+        b.iter(|| {
+            let sources = [
+                Source::internal(&internal, m.sensors.logged_sigma()),
+                Source::tracker(&points, &known).unwrap(),
+            ];
+            black_box(identify_fused(&model, black_box(&sources), &options).unwrap())
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, identification, fused);
 criterion_main!(benches);

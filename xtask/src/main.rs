@@ -4,6 +4,7 @@
 //! figure or table that the docs quote, so anyone can rerun it.
 
 mod fig3;
+mod hybrid;
 mod study;
 
 use std::process::ExitCode;
@@ -22,6 +23,10 @@ enum Command {
     /// The Monte Carlo encoder-grade study (the paper's Fig. 4): the
     /// project's main job.
     EncoderStudy(study::StudyArgs),
+    /// The gain of fusing the self-calibration with a few external
+    /// measurements, on simulated machines: the tables and figures of
+    /// docs/hybrid.md.
+    Hybrid(hybrid::HybridArgs),
     /// Fig. 3 "before compensation" with the default conventions and every
     /// combination of the conventions the paper leaves open.
     Fig3Before {
@@ -48,6 +53,7 @@ fn main() -> ExitCode {
     let args = Xtask::parse();
     let result = match args.command {
         Command::EncoderStudy(args) => study::run(args),
+        Command::Hybrid(args) => hybrid::run(args),
         Command::Fig3Before { all } => fig3::run(all),
         Command::Fig3 {
             seeds,

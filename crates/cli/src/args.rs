@@ -211,8 +211,23 @@ pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, CliError> {
     bar.finish_and_clear();
     // Commands the machine cannot take are input errors too, found here
     // with their line rather than deep inside the solver.
-    for p in &data.poses {
-        if let Err(e) = machine.check_commands(&p.commands_mm) {
+    check_commands(
+        &data.source,
+        data.poses.iter().map(|p| (p.line, p.commands_mm)),
+        machine,
+    )?;
+    Ok(data)
+}
+
+/// Refuses leg commands outside the machine's stroke: an input error naming
+/// the file, the line and the column (`records` give line and commands).
+pub fn check_commands(
+    file: &str,
+    records: impl Iterator<Item = (u64, [f64; 3])>,
+    machine: &Machine,
+) -> Result<(), CliError> {
+    for (line, q) in records {
+        if let Err(e) = machine.check_commands(&q) {
             let message = match e {
                 KinematicsError::OutOfStroke {
                     leg,
@@ -220,15 +235,14 @@ pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, CliError> {
                     min_mm,
                     max_mm,
                 } => format!(
-                    "{}: line {}, column `q{leg}`: command {length_mm} mm is outside the leg stroke [{min_mm}, {max_mm}] mm",
-                    data.source, p.line
+                    "{file}: line {line}, column `q{leg}`: command {length_mm} mm is outside the leg stroke [{min_mm}, {max_mm}] mm"
                 ),
-                e => format!("{}: line {}: {e}", data.source, p.line),
+                e => format!("{file}: line {line}: {e}"),
             };
             return Err(CliError::input(message));
         }
     }
-    Ok(data)
+    Ok(())
 }
 
 /// The target points of a `--poses` spec (a generated set or a CSV file

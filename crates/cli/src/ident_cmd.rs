@@ -65,6 +65,9 @@ pub struct IdentifyArgs {
     /// says so (`calibration.forced`, its name).
     #[arg(long, requires = "write_machine")]
     pub force: bool,
+    /// External measurements and the head (the fused identification).
+    #[command(flatten)]
+    pub external: crate::fusion_cmd::ExternalArgs,
 }
 
 fn ident_error(source: &str, e: IdentError) -> CliError {
@@ -291,6 +294,9 @@ pub fn rejected_json(rejected: &[Rejection]) -> Value {
 
 /// `tricept identify`.
 pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
+    if a.external.any() {
+        return crate::fusion_cmd::run(a);
+    }
     let data = a.data.as_path();
     let fit = fit_from_file(data, &a.settings)?;
     let code = fit.exit_code();
@@ -321,12 +327,15 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
 fn print_identification(fit: &Fit, data: &Path) {
     let id = &fit.id;
     for r in &fit.rejected {
+        let why = match r.residual_sigma {
+            Some(z) => format!("a reading {z:.1} noise standard deviations off (gross error)"),
+            None => "the fitted machine cannot reach its commands".to_string(),
+        };
         outln!(
-            "rejected pose {} (line {} of {}): a reading {:.1} noise standard deviations off (gross error)",
+            "rejected pose {} (line {} of {}): {why}",
             r.pose + 1,
             r.line,
-            data.display(),
-            r.residual_sigma
+            data.display()
         );
     }
     outln!(

@@ -25,10 +25,12 @@ mod args;
 mod cli_error;
 mod compensate_cmd;
 mod diagnose_cmd;
+mod fusion_cmd;
 mod ident_cmd;
 mod kinematics_cmd;
 mod machine_file;
 mod output;
+mod plan_cmd;
 mod simulate_cmd;
 
 use std::process::ExitCode;
@@ -89,10 +91,12 @@ enum Command {
         after_help = "Pose sets (--poses): grid (75 poses), grid:RINGS,PER_RING,LEVELS, random:N[,SEED], disc:SPACING[,Z], or a CSV file with columns x,y,z (mm).\n\nExamples:\n  tricept identifiability\n  tricept identifiability --poses random:30,1 --json\n  tricept identifiability --params full21"
     )]
     Identifiability(ident_cmd::IdentifiabilityArgs),
-    /// Identify the geometric errors from measured data (CSV: q1,q2,q3,phi,theta,s).
+    /// Identify the geometric errors from measured data (CSV: q1,q2,q3,phi,theta,s),
+    /// alone or fused with external measurements (laser tracker, ballbar,
+    /// touch-offs) that also calibrate the head.
     #[command(
         allow_negative_numbers = true,
-        after_help = "Exit codes: 0 converged and adequate (the model explains the data to the sensor noise); 3 converged but the model does not explain the data (the report names `tricept diagnose`); 4 did not converge; 2 bad input. --write-machine refuses a fit that did not converge or data that cannot come from the machine (--force writes it, marked as forced).\n\nExamples:\n  tricept simulate --out data.csv && tricept identify --data data.csv\n  tricept identify --data data.csv --json\n  tricept identify --data data.csv --write-machine calibrated.json"
+        after_help = "Exit codes: 0 converged and adequate (the model explains the data to the sensor noise); 3 converged but the model does not explain the data (the report names `tricept diagnose`); 4 did not converge; 2 bad input. --write-machine refuses a fit that did not converge or data that cannot come from the machine (--force writes it, marked as forced).\n\nWith --tracker, --ballbar, --touch, --head or --effects the fused identification runs (docs/hybrid.md): module, head (13 parameters) and each instrument's nuisance in one fit; exit code 3 when it converges but a source is not explained (reduced chi-square > 3), 4 when it does not converge.\n\nExamples:\n  tricept simulate --out data.csv && tricept identify --data data.csv\n  tricept identify --data data.csv --json\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept identify --data data.csv --tracker points.csv --tracker-target tip --write-machine calibrated.json"
     )]
     Identify(ident_cmd::IdentifyArgs),
     /// Write a measured-data CSV from a simulated machine (Table 2 errors by
@@ -125,6 +129,14 @@ enum Command {
         after_help = "Without --truth only the correction the identified model predicts is known; with the true errors of simulated data (--truth table2 ...) the before/after error of the actual machine is reported. Exit codes as for identify (0, 3, 4, 2).\n\nExamples:\n  tricept compensate --data data.csv --truth table2 --map out/\n  tricept compensate --data data.csv --targets points.csv > commands.csv\n  tricept compensate --machine calibrated.json --table out/"
     )]
     Compensate(compensate_cmd::CompensateArgs),
+    /// Plan a few external measurements (tracker points, ballbar readings):
+    /// which to take so that the tool tip is best known after touch-off,
+    /// and the predicted accuracy against their number.
+    #[command(
+        allow_negative_numbers = true,
+        after_help = "Criterion: the RMS over the evaluation tool poses of the predicted tool-tip standard deviation after touch-off (a Bayesian A-optimal design with the parameters' typical sizes as prior; docs/hybrid.md).\n\nExamples:\n  tricept plan --instrument tracker --k 5,12,30 --out points.csv\n  tricept plan --instrument ballbar --ballbar-pivot-mm 0,0,1250 --target-um 15"
+    )]
+    Plan(plan_cmd::PlanArgs),
 }
 
 /// Runs the verb; `Ok` carries the exit code of a result (0, or the
@@ -141,6 +153,7 @@ fn run(cli: Cli) -> Result<u8, CliError> {
         Command::Diagnose(a) => diagnose_cmd::run_diagnose(&a),
         Command::Detectability(a) => diagnose_cmd::run_detectability(&a),
         Command::Compensate(a) => compensate_cmd::run_compensate(&a),
+        Command::Plan(a) => plan_cmd::run(&a),
     }
 }
 

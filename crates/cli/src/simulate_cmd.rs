@@ -11,6 +11,7 @@ use crate::args::{
     pose_targets,
 };
 use crate::cli_error::CliError;
+use crate::fusion_cmd::{parse_numbers, positive};
 
 /// `tricept simulate`.
 #[derive(Debug, Args)]
@@ -29,6 +30,65 @@ pub struct SimulateArgs {
     /// Output file (default: stdout; with --json, a summary goes to stdout).
     #[arg(long, value_name = "FILE.csv")]
     pub out: Option<PathBuf>,
+    /// Head errors of the simulated machine: `zero`, `random:SCALE[,SEED]`
+    /// (each of the 13 parameters SCALE times its typical size, times 0.5-1,
+    /// random sign), or a JSON file `{name: value}` (docs/hybrid.md).
+    #[arg(long, default_value = "zero", value_name = "HEAD")]
+    pub head_errors: String,
+    /// Also write laser-tracker points (CSV) measured at the poses of
+    /// --tracker-poses.
+    #[arg(long, value_name = "FILE.csv")]
+    pub tracker_out: Option<PathBuf>,
+    /// Poses for the tracker (CSV `q1,q2,q3,h1,h2[,extension_mm]`, as
+    /// `tricept plan --out` writes them).
+    #[arg(long, value_name = "FILE.csv")]
+    pub tracker_poses: Option<PathBuf>,
+    /// The tracker's frame: translation (mm) and rotation vector (rad) that
+    /// map the machine's base frame into the tracker's.
+    #[arg(
+        long,
+        default_value = "1500,-800,200,0.1,0.2,0.3",
+        value_name = "X,Y,Z,RX,RY,RZ",
+        allow_hyphen_values = true
+    )]
+    pub tracker_frame_mm_rad: String,
+    /// The tracker target's offset from the tool tip, mm (spindle frame at
+    /// zero head angles).
+    #[arg(
+        long,
+        default_value = "0,0,0",
+        value_name = "X,Y,Z",
+        allow_hyphen_values = true
+    )]
+    pub tracker_target_mm: String,
+    /// Noise of a tracker coordinate, um.
+    #[arg(long, default_value_t = 10.0, value_name = "UM")]
+    pub tracker_sigma_um: f64,
+    /// Also write ballbar readings (CSV) at the poses of --ballbar-poses.
+    #[arg(long, value_name = "FILE.csv")]
+    pub ballbar_out: Option<PathBuf>,
+    /// Poses for the ballbar (CSV `q1,q2,q3,h1,h2`).
+    #[arg(long, value_name = "FILE.csv")]
+    pub ballbar_poses: Option<PathBuf>,
+    /// The ballbar's pivot on the table, mm.
+    #[arg(
+        long,
+        default_value = "0,0,1250",
+        value_name = "X,Y,Z",
+        allow_hyphen_values = true
+    )]
+    pub ballbar_pivot_mm: String,
+    /// The bar's reading minus the true distance, um.
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        value_name = "UM",
+        allow_hyphen_values = true
+    )]
+    pub ballbar_length_error_um: f64,
+    /// Noise of a ballbar reading, um.
+    #[arg(long, default_value_t = 1.0, value_name = "UM")]
+    pub ballbar_sigma_um: f64,
     #[command(flatten)]
     pub params: ParamArgs,
     #[command(flatten)]
@@ -55,6 +115,7 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
     }
     let mut plant = Plant::geometric(m.clone(), set.to_errors(&values));
     plant.effects = parse_effects(&a.truth.truth_effects)?;
+    plant.head_errors = parse_head_errors(&a.head_errors, &m)?;
     let data = plant
         .simulate(&campaign)
         .map_err(|e| CliError::input(format!("simulate: {e}")))?;
@@ -98,6 +159,15 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
             serde_json::to_string(e).unwrap_or_default()
         ));
     }
+    if !plant.head_errors.is_empty() {
+        comments.push(format!(
+            "head errors (head13): {}",
+            serde_json::Value::Object(
+                tricept_model::HeadParameterSet::head13(&m.head).values_to_map(&plant.head_errors)
+            )
+        ));
+    }
+    simulate_external(a, &plant, &comments)?;
     match &a.out {
         Some(path) => {
             tricept_data::write_path(path, &data, &comments)
@@ -136,4 +206,113 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
         .map_err(|e| CliError::other(format!("stdout: {e}")))?,
     }
     Ok(0)
+}
+
+/// Parses `--head-errors`.
+fn parse_head_errors(spec: &str, m: &tricept_kinematics::Machine) -> Result<Vec<f64>, CliError> {
+    let flag = "--head-errors";
+    match spec {
+        "zero" => Ok(Vec::new()),
+        s if s.starts_with("random:") => {
+            let parts: Vec<&str> = s["random:".len()..].split(',').collect();
+            let scale: f64 = parts[0]
+                .parse()
+                .ok()
+                .filter(|v: &f64| v.is_finite() && *v >= 0.0)
+                .ok_or_else(|| {
+                    CliError::input(format!("{flag} `{s}`: expected random:SCALE[,SEED]"))
+                })?;
+            let seed: u64 = match parts.get(1) {
+                Some(t) => t.parse().map_err(|_| {
+                    CliError::input(format!("{flag} `{s}`: SEED must be a whole number"))
+                })?,
+                None => 0,
+            };
+            Ok(tricept_plant::random_head_errors(scale, seed))
+        }
+        path => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| CliError::input(format!("{flag}: {path}: {e}")))?;
+            tricept_model::HeadParameterSet::head13(&m.head)
+                .parse_values(&text)
+                .map_err(|e| CliError::input(format!("{flag}: {path}: {e}")))
+        }
+    }
+}
+
+/// The poses of a poses file (every record with its extension).
+fn read_poses(path: &std::path::Path) -> Result<Vec<(tricept_data::ExternalPose, f64)>, CliError> {
+    Ok(
+        tricept_data::read_external_path::<tricept_data::PlannedPose>(path)
+            .map_err(|e| CliError::input(e.to_string()))?
+            .records
+            .iter()
+            .map(|p| (p.pose, p.extension_mm))
+            .collect(),
+    )
+}
+
+/// Writes the external instruments' files that were asked for.
+fn simulate_external(a: &SimulateArgs, plant: &Plant, comments: &[String]) -> Result<(), CliError> {
+    let failed = |e: tricept_plant::PlantError| CliError::input(format!("simulate: {e}"));
+    let write_failed = |path: &std::path::Path, e: std::io::Error| {
+        CliError::other(format!("{}: {e}", path.display()))
+    };
+    match (&a.tracker_out, &a.tracker_poses) {
+        (Some(out), Some(poses)) => {
+            let f = parse_numbers("--tracker-frame-mm-rad", &a.tracker_frame_mm_rad, 6)?;
+            let t = parse_numbers("--tracker-target-mm", &a.tracker_target_mm, 3)?;
+            let tracker = tricept_plant::Tracker {
+                frame: nalgebra::Isometry3::new(
+                    nalgebra::Vector3::new(f[0], f[1], f[2]),
+                    nalgebra::Vector3::new(f[3], f[4], f[5]),
+                ),
+                target_offset_mm: nalgebra::Vector3::new(t[0], t[1], t[2]),
+                sigma_um: positive("--tracker-sigma-um", a.tracker_sigma_um)?,
+                setup: 1,
+            };
+            let data = tracker
+                .measure(plant, &read_poses(poses)?, a.seed)
+                .map_err(failed)?;
+            let mut c = comments.to_vec();
+            c.push(format!(
+                "tracker: frame (mm, rad) {}, target offset (mm) {}, {} um per coordinate",
+                a.tracker_frame_mm_rad, a.tracker_target_mm, a.tracker_sigma_um
+            ));
+            tricept_data::write_external_path(out, &data, &c).map_err(|e| write_failed(out, e))?;
+        }
+        (None, None) => {}
+        _ => {
+            return Err(CliError::input(
+                "--tracker-out and --tracker-poses go together",
+            ));
+        }
+    }
+    match (&a.ballbar_out, &a.ballbar_poses) {
+        (Some(out), Some(poses)) => {
+            let p = parse_numbers("--ballbar-pivot-mm", &a.ballbar_pivot_mm, 3)?;
+            let bar = tricept_plant::Ballbar {
+                pivot_mm: nalgebra::Vector3::new(p[0], p[1], p[2]),
+                length_error_um: a.ballbar_length_error_um,
+                ball_offset_mm: nalgebra::Vector3::zeros(),
+                sigma_um: positive("--ballbar-sigma-um", a.ballbar_sigma_um)?,
+                setup: 1,
+            };
+            let poses: Vec<_> = read_poses(poses)?.into_iter().map(|(p, _)| p).collect();
+            let data = bar.measure(plant, &poses, a.seed).map_err(failed)?;
+            let mut c = comments.to_vec();
+            c.push(format!(
+                "ballbar: pivot (mm) {}, length error {} um, {} um per reading",
+                a.ballbar_pivot_mm, a.ballbar_length_error_um, a.ballbar_sigma_um
+            ));
+            tricept_data::write_external_path(out, &data, &c).map_err(|e| write_failed(out, e))?;
+        }
+        (None, None) => {}
+        _ => {
+            return Err(CliError::input(
+                "--ballbar-out and --ballbar-poses go together",
+            ));
+        }
+    }
+    Ok(())
 }

@@ -450,15 +450,19 @@ fn bad_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
         cases.push(c);
     }
     assert!(cases.len() >= 25, "{} cases", cases.len());
+    run_cases(&dir, &cases);
+    std::fs::remove_dir_all(&dir).ok();
+}
 
-    // Every case runs; every broken expectation is collected, so that one
-    // run shows all of them.
+/// Runs every case in `dir`; every broken expectation is collected, so
+/// that one run shows all of them.
+fn run_cases(dir: &Path, cases: &[Case]) {
     let mut failures: Vec<String> = Vec::new();
-    for c in &cases {
+    for c in cases {
         for (name, content) in &c.files {
             std::fs::write(dir.join(name), content).unwrap();
         }
-        let out = tricept().args(&c.args).current_dir(&dir).output().unwrap();
+        let out = tricept().args(&c.args).current_dir(dir).output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         let mut fail = |what: String| failures.push(format!("{}: {what}\n{stderr}", c.name));
         if stderr.contains("panicked") {
@@ -495,7 +499,6 @@ fn bad_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
         cases.len(),
         failures.join("\n")
     );
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
@@ -533,4 +536,399 @@ fn results_go_to_stdout_with_exit_code_0() {
     let out = tricept().args(["--help"]).output().unwrap();
     assert_eq!(out.status.code(), Some(0));
     assert!(String::from_utf8_lossy(&out.stdout).contains("identify"));
+}
+
+/// A file of poses (`q1,q2,q3,h1,h2`) for the nominal machine at tool tips
+/// `tips` with tool axes `axes`.
+fn poses_csv(tips: &[[f64; 3]], axes: &[[f64; 3]], extension: Option<&[f64]>) -> Vec<u8> {
+    let m = tricept_kinematics::Machine::paper();
+    let mut s = String::from("q1,q2,q3,h1,h2");
+    s.push_str(if extension.is_some() {
+        ",extension_mm\n"
+    } else {
+        "\n"
+    });
+    for (j, (t, a)) in tips.iter().zip(axes).enumerate() {
+        let ik = m
+            .tool_inverse(
+                &nalgebra::Vector3::from(*t),
+                &nalgebra::Vector3::from(*a),
+                tricept_kinematics::HeadBranch::default(),
+            )
+            .unwrap();
+        let [q1, q2, q3] = ik.legs_mm;
+        let [h1, h2] = ik.head_rad;
+        s.push_str(&format!("{q1},{q2},{q3},{h1},{h2}"));
+        if let Some(e) = extension {
+            s.push_str(&format!(",{}", e[j]));
+        }
+        s.push('\n');
+    }
+    s.into_bytes()
+}
+
+/// Runs `tricept` in `dir`, asserting success.
+fn ok(dir: &Path, args: &[&str]) -> Vec<u8> {
+    let out = tricept().args(args).current_dir(dir).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out.stdout
+}
+
+#[test]
+fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
+    let dir = std::env::temp_dir().join(format!("tricept-bad-external-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // Good files: internal data, 12 spread tracker points, a ballbar.
+    let tips: Vec<[f64; 3]> = (0..12)
+        .map(|j| {
+            let a = j as f64 * std::f64::consts::FRAC_PI_6;
+            [
+                250.0 * a.cos(),
+                250.0 * a.sin(),
+                1050.0 + 10.0 * (j % 3) as f64,
+            ]
+        })
+        .collect();
+    let axes: Vec<[f64; 3]> = (0..12)
+        .map(|j| {
+            let a = j as f64 * 1.9;
+            [0.4 * a.cos(), 0.4 * a.sin(), 1.0]
+        })
+        .collect();
+    std::fs::write(dir.join("poses.csv"), poses_csv(&tips, &axes, None)).unwrap();
+    ok(
+        &dir,
+        &[
+            "simulate",
+            "--poses",
+            "grid:1,8,3",
+            "--head-errors",
+            "random:1,3",
+            "--out",
+            "good.csv",
+            "--tracker-out",
+            "tracker.csv",
+            "--tracker-poses",
+            "poses.csv",
+        ],
+    );
+    let tracker = std::fs::read_to_string(dir.join("tracker.csv")).unwrap();
+    let (_, t_header, t_rows) = split(&tracker);
+    let bar_tips: Vec<[f64; 3]> = (0..8)
+        .map(|j| {
+            let a = j as f64 * std::f64::consts::FRAC_PI_4;
+            [100.0 * a.cos(), 100.0 * a.sin(), 1250.0 - 112.0]
+        })
+        .collect();
+    std::fs::write(dir.join("flat.csv"), poses_csv(&bar_tips, &axes[..8], None)).unwrap();
+    ok(
+        &dir,
+        &[
+            "simulate",
+            "--poses",
+            "grid:1,8,3",
+            "--out",
+            "unused.csv",
+            "--ballbar-out",
+            "flat-ballbar.csv",
+            "--ballbar-poses",
+            "flat.csv",
+        ],
+    );
+    // One pose, three extensions along the tool: collinear points.
+    let one = [tips[0]; 3];
+    std::fs::write(
+        dir.join("line.csv"),
+        poses_csv(&one, &[axes[0]; 3], Some(&[0.0, 50.0, 100.0])),
+    )
+    .unwrap();
+    ok(
+        &dir,
+        &[
+            "simulate",
+            "--poses",
+            "grid:1,8,3",
+            "--out",
+            "unused.csv",
+            "--tracker-out",
+            "line-tracker.csv",
+            "--tracker-poses",
+            "line.csv",
+        ],
+    );
+    // Five tips, one tool orientation: the target's offset along the tool
+    // is a translation of the tracker.
+    let z = [[0.0, 0.0, 1.0]; 5];
+    std::fs::write(dir.join("still.csv"), poses_csv(&tips[..5], &z, None)).unwrap();
+    ok(
+        &dir,
+        &[
+            "simulate",
+            "--poses",
+            "grid:1,8,3",
+            "--out",
+            "unused.csv",
+            "--tracker-out",
+            "still-tracker.csv",
+            "--tracker-poses",
+            "still.csv",
+        ],
+    );
+    let features = r#"{"stylus": {"radius_mm": 1.0, "radius_sigma_um": 2.0}, "features": [{"id": 1, "kind": "plane"}]}"#;
+    let fused = |extra: &[&str]| -> Vec<String> {
+        ["identify", "--data", "good.csv"]
+            .iter()
+            .chain(extra)
+            .map(|s| s.to_string())
+            .collect()
+    };
+    let mut cases = vec![
+        case(
+            "tracker: missing column",
+            &[],
+            vec![("t1.csv", with_rows(&t_header.replace(",z", ""), &t_rows))],
+            2,
+            &["t1.csv: line 1: missing required column `z`"],
+        ),
+        case(
+            "tracker: not a number",
+            &[],
+            vec![(
+                "t2.csv",
+                with_rows(
+                    &t_header,
+                    &[t_rows[0].clone(), replace_field(&t_rows[1], 6, "NaN")],
+                ),
+            )],
+            2,
+            &["t2.csv: line 3, column `y`: not a finite number"],
+        ),
+        case(
+            "tracker: head angles in degrees",
+            &[],
+            vec![(
+                "t3.csv",
+                with_rows(&t_header, &[replace_field(&t_rows[0], 3, "90")]),
+            )],
+            2,
+            &["t3.csv: line 2, column `h1`", "degrees"],
+        ),
+        case(
+            "tracker: non-positive sigma",
+            &[],
+            vec![(
+                "t4.csv",
+                with_rows(&t_header, &[replace_field(&t_rows[0], 8, "0")]),
+            )],
+            2,
+            &["t4.csv: line 2, column `sigma_um`: a standard deviation must be positive"],
+        ),
+        case(
+            "tracker: repeated row",
+            &[],
+            vec![(
+                "t5.csv",
+                with_rows(&t_header, &[t_rows[0].clone(), t_rows[0].clone()]),
+            )],
+            2,
+            &["t5.csv: line 3 repeats line 2"],
+        ),
+        case(
+            "tracker: command outside the stroke",
+            &[],
+            vec![(
+                "t6.csv",
+                with_rows(&t_header, &[replace_field(&t_rows[0], 1, "100")]),
+            )],
+            2,
+            &["t6.csv: line 2, column `q2`: command 100 mm is outside the leg stroke"],
+        ),
+        case(
+            "tracker: two points",
+            &[],
+            vec![("t7.csv", with_rows(&t_header, &t_rows[..2]))],
+            2,
+            &["t7.csv: station 1 has 2 points"],
+        ),
+        case(
+            "tracker: points on one line",
+            &[],
+            vec![],
+            2,
+            &["line-tracker.csv", "lie on one line"],
+        ),
+        case(
+            "tracker: one tool orientation",
+            &[],
+            vec![],
+            2,
+            &[
+                "still-tracker.csv",
+                "cannot be determined",
+                "vary the spindle's orientation",
+            ],
+        ),
+        case(
+            "ballbar: length in um",
+            &[],
+            vec![(
+                "b1.csv",
+                b"q1,q2,q3,h1,h2,length\n800,800,800,0,0,150000\n".to_vec(),
+            )],
+            2,
+            &["b1.csv: line 2, column `length`: a ballbar length must be 10-2000 mm"],
+        ),
+        case(
+            "ballbar: ball in one plane",
+            &[],
+            vec![],
+            2,
+            &["flat-ballbar.csv", "lie in one plane"],
+        ),
+        case(
+            "touch: unknown feature",
+            &[],
+            vec![
+                (
+                    "touch.csv",
+                    format!(
+                        "q1,q2,q3,h1,h2,feature\n{},7\n",
+                        t_rows[0].split(',').take(5).collect::<Vec<_>>().join(",")
+                    )
+                    .into_bytes(),
+                ),
+                ("features.json", features.as_bytes().to_vec()),
+            ],
+            2,
+            &["touch.csv: line 2: column `feature`: feature 7 is not in the features file"],
+        ),
+        case(
+            "touch: no features file",
+            &[],
+            vec![],
+            2,
+            &["--touch needs --features"],
+        ),
+        case(
+            "features: not JSON",
+            &[],
+            vec![(
+                "bad-features.json",
+                b"{\"stylus\": {\"radius_mm\": 1.0,\n \"radius_sigma_um\": }}".to_vec(),
+            )],
+            2,
+            &["bad-features.json: line 2, column"],
+        ),
+        case(
+            "unknown effect",
+            &[],
+            vec![],
+            2,
+            &["--effects: unknown effect `gravity`"],
+        ),
+        case(
+            "bad tracker target",
+            &[],
+            vec![],
+            2,
+            &["--tracker-target: expected 3 comma-separated numbers"],
+        ),
+        case(
+            "bad head",
+            &[],
+            vec![],
+            2,
+            &["--head: expected head13 or none"],
+        ),
+        case(
+            "write-machine with effects",
+            &[],
+            vec![],
+            2,
+            &["--write-machine: leg-lead fitted, but the machine format cannot carry it"],
+        ),
+        case(
+            "plan: zero measurements",
+            &[],
+            vec![],
+            2,
+            &["--k: expected positive whole numbers"],
+        ),
+        case(
+            "plan: unreachable pivot",
+            &[],
+            vec![],
+            2,
+            &["--ballbar-pivot-mm 0,0,3000: the machine reaches only 0 ball positions"],
+        ),
+        case(
+            "simulate: tracker output without poses",
+            &[],
+            vec![],
+            2,
+            &["--tracker-out and --tracker-poses go together"],
+        ),
+        case(
+            "simulate: unknown head parameter",
+            &[],
+            vec![("head.json", br#"{"tool_lenght_mm": 0.3}"#.to_vec())],
+            2,
+            &["--head-errors: head.json: unknown parameter `tool_lenght_mm`"],
+        ),
+    ];
+    let args: Vec<Vec<String>> = vec![
+        fused(&["--tracker", "t1.csv"]),
+        fused(&["--tracker", "t2.csv"]),
+        fused(&["--tracker", "t3.csv"]),
+        fused(&["--tracker", "t4.csv"]),
+        fused(&["--tracker", "t5.csv"]),
+        fused(&["--tracker", "t6.csv"]),
+        fused(&["--tracker", "t7.csv"]),
+        fused(&["--tracker", "line-tracker.csv"]),
+        fused(&["--tracker", "still-tracker.csv"]),
+        fused(&["--ballbar", "b1.csv"]),
+        fused(&["--ballbar", "flat-ballbar.csv"]),
+        fused(&["--touch", "touch.csv", "--features", "features.json"]),
+        fused(&["--touch", "touch.csv"]),
+        fused(&["--touch", "touch.csv", "--features", "bad-features.json"]),
+        fused(&["--effects", "gravity"]),
+        fused(&["--tracker", "tracker.csv", "--tracker-target", "1,2"]),
+        fused(&["--head", "head15"]),
+        fused(&[
+            "--tracker",
+            "tracker.csv",
+            "--effects",
+            "leg-lead",
+            "--write-machine",
+            "m.json",
+        ]),
+        ["plan", "--instrument", "tracker", "--k", "0"]
+            .map(String::from)
+            .to_vec(),
+        [
+            "plan",
+            "--instrument",
+            "ballbar",
+            "--ballbar-pivot-mm",
+            "0,0,3000",
+        ]
+        .map(String::from)
+        .to_vec(),
+        ["simulate", "--tracker-out", "x.csv"]
+            .map(String::from)
+            .to_vec(),
+        ["simulate", "--head-errors", "head.json"]
+            .map(String::from)
+            .to_vec(),
+    ];
+    assert_eq!(args.len(), cases.len());
+    for (c, a) in cases.iter_mut().zip(args) {
+        c.args = a;
+    }
+    run_cases(&dir, &cases);
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -636,7 +636,6 @@ fn absurd_machines_and_flags_are_refused_clearly() {
 }
 
 #[test]
-#[ignore = "needs the robust screen of tricept-ident (robust.rs, being rewritten)"]
 fn a_single_gross_reading_is_rejected_by_line_not_fatal() {
     // A 10 mm scale glitch on the first data row (line 7) and a 0.1 rad
     // encoder jump: rejected by line, the fit converged and adequate.

@@ -181,6 +181,26 @@ pub enum DataError {
         /// (e.g. `0,5`), when only one pair of the row does.
         value: Option<String>,
     },
+    /// A JSON file (the features of a touch-off campaign) that does not parse.
+    #[error("{file}: line {line}, column {column}: {message}")]
+    Json {
+        /// File name.
+        file: String,
+        /// Line of the problem.
+        line: u64,
+        /// Column of the problem.
+        column: u64,
+        /// What is wrong.
+        message: String,
+    },
+    /// A file that parses but describes something impossible.
+    #[error("{file}: {message}")]
+    Invalid {
+        /// File name.
+        file: String,
+        /// What is wrong.
+        message: String,
+    },
 }
 
 /// The end of the [`DataError::DecimalComma`] message.

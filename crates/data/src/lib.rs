@@ -18,10 +18,16 @@
 //! panic and never a silently skipped row. Target lists (columns `x,y,z`,
 //! [`read_targets`]) follow the same rules and get the same messages.
 //!
+//! External measurements (laser tracker or CMM points, ballbar lengths,
+//! touch-offs on spheres and planes, with the leg commands and head angles
+//! they were taken at) have their own CSV contracts, read by the same
+//! machinery with the same messages ([`read_external_path`], [`Features`]).
+//!
 //! Modules: `pose` (the types: [`Readings`], [`MeasuredPose`], [`Dataset`]),
-//! `error` ([`DataError`]), `records` (the line and record machinery both
-//! readers share), `read` (the measured-data reader), `targets` (the
-//! target-list reader), `write` (the writer). Everything is re-exported
+//! `error` ([`DataError`]), `records` (the line and record machinery every
+//! reader shares), `read` (the measured-data reader), `targets` (the
+//! target-list reader), `external` (the external-measurement files), `write`
+//! (the writer). Everything is re-exported
 //! here: use `tricept_data::X`.
 //!
 //! # Example
@@ -38,6 +44,7 @@
 )]
 
 mod error;
+mod external;
 mod pose;
 mod read;
 mod records;
@@ -45,6 +52,11 @@ mod targets;
 mod write;
 
 pub use error::DataError;
+pub use external::{
+    BallbarData, BallbarReading, ExternalData, ExternalPose, ExternalRecord, Feature, Features,
+    PlannedPose, PlannedPoses, Stylus, TouchData, TouchReading, TrackerData, TrackerPoint,
+    read_external_from, read_external_path, write_external_path, write_external_to,
+};
 pub use pose::{Dataset, MeasuredPose, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Readings};
 pub use read::{MAX_ANGLE_SPAN_RAD, read_from, read_path, read_with_progress};
 pub use targets::{NumericRows, read_targets, read_targets_from};

@@ -1,5 +1,6 @@
 //! The line and record machinery shared by every CSV reader of the crate
-//! (measured data in `read.rs`, target lists in `targets.rs`), so that both
+//! (measured data in `read.rs`, target lists in `targets.rs`, external
+//! measurements in `external.rs`), so that all
 //! read the same format the same way and report problems with the same
 //! messages.
 //!
@@ -174,16 +175,21 @@ impl Header {
     ) -> Result<[usize; N], DataError> {
         let mut idx = [0; N];
         for (k, name) in wanted.iter().enumerate() {
-            idx[k] = self.find(name).ok_or_else(|| DataError::MissingColumn {
-                file: self.file.clone(),
-                line: self.line,
-                column: name.to_string(),
-                hint: closest_unknown(&self.names, name, known)
-                    .map(|n| format!(", found `{n}` (misspelt?)"))
-                    .unwrap_or_default(),
-            })?;
+            idx[k] = self.locate_one(name, known)?;
         }
         Ok(idx)
+    }
+
+    /// Position of the required column `name` (see [`Header::locate`]).
+    pub fn locate_one(&self, name: &str, known: &[&str]) -> Result<usize, DataError> {
+        self.find(name).ok_or_else(|| DataError::MissingColumn {
+            file: self.file.clone(),
+            line: self.line,
+            column: name.to_string(),
+            hint: closest_unknown(&self.names, name, known)
+                .map(|n| format!(", found `{n}` (misspelt?)"))
+                .unwrap_or_default(),
+        })
     }
 
     /// Checks that `record` has as many fields as the header; a row that

@@ -53,22 +53,7 @@ impl Candidate {
 
     /// Parameter names (with their unit in the name).
     pub fn params(self) -> &'static [&'static str] {
-        match self.0 {
-            EffectName::LegLead => &["lead1_ppm", "lead2_ppm", "lead3_ppm"],
-            EffectName::Backlash => &["backlash1_um", "backlash2_um", "backlash3_um"],
-            EffectName::Thermal => &["expansion_ppm_per_k"],
-            EffectName::ScaleGain => &["scale_gain_ppm"],
-            EffectName::EncoderEccentricity => &[
-                "phi_sin_arcsec",
-                "phi_cos_arcsec",
-                "theta_sin_arcsec",
-                "theta_cos_arcsec",
-            ],
-            EffectName::UjointAxes => &["axis_skew_arcsec", "axis_offset_um"],
-            EffectName::TubeTwist => &["twist_arcsec_per_100mm"],
-            EffectName::Compliance => &["compliance_um_per_kn_at_1m"],
-            EffectName::Outliers => &[],
-        }
+        self.0.parameter_names()
     }
 
     fn kind(self) -> Kind {

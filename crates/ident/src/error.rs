@@ -64,4 +64,28 @@ pub enum IdentError {
     /// Inconsistent arguments.
     #[error("{0}")]
     Invalid(String),
+    /// External data that cannot be used as given (too few records, a
+    /// degenerate geometry), naming the source and, where one record is at
+    /// fault, its line.
+    #[error("{file}{}: {message}", line.map(|l| format!(": line {l}")).unwrap_or_default())]
+    Source {
+        /// The source's file or label.
+        file: String,
+        /// The line at fault, if one is.
+        line: Option<u64>,
+        /// What is wrong and what to do.
+        message: String,
+    },
+    /// A source's own nuisance parameters (an instrument's frame, a pivot,
+    /// a target offset) cannot be told apart from its data: the estimate
+    /// would divide by rounding noise.
+    #[error("{file}: {combination} cannot be determined from its data: {hint}")]
+    NuisanceUnidentifiable {
+        /// The source's file or label.
+        file: String,
+        /// The invisible combination of its nuisance parameters.
+        combination: String,
+        /// What to measure differently.
+        hint: String,
+    },
 }

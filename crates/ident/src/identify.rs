@@ -29,10 +29,11 @@ use tricept_data::{Dataset, MeasuredPose};
 use tricept_kinematics::{Machine, UpJoints};
 
 use crate::error::IdentError;
+use crate::gauss_newton::{Iteration, Run, iterate};
 use crate::model::ReadingModel;
 use crate::report::{IdentifiabilityReport, NamedValues};
 use tricept_numerics::linalg::TriangularAccumulator;
-use tricept_numerics::lsq::{DEFAULT_RANK_TOLERANCE, RankDecision, ReducedProblem, Solution};
+use tricept_numerics::lsq::{DEFAULT_RANK_TOLERANCE, RankDecision, ReducedProblem};
 
 /// Settings of [`identify`]: the noise model and the solver's tolerances,
 /// the same for every data set they are used on.
@@ -557,15 +558,15 @@ pub fn identify_from(
         options,
         weights,
     };
-    let mut state = GaussNewton {
+    let mut state = Run {
         p,
-        seeds,
+        state: seeds,
         eval,
         solution: first,
         iterations: 0,
         converged: false,
     };
-    problem.run(&mut state, &decision);
+    iterate(&problem, &mut state, &decision, options.max_iterations);
 
     let lines = poses.iter().map(|p| p.line).collect();
     Ok(finish(
@@ -581,93 +582,36 @@ struct Problem<'a> {
     weights: Option<&'a [f64]>,
 }
 
-/// The moving parts of a Gauss-Newton run.
-struct GaussNewton {
-    p: Vec<f64>,
-    seeds: Vec<Option<UpJoints>>,
-    eval: Evaluation,
-    solution: Solution,
-    iterations: u32,
-    converged: bool,
-}
+impl Iteration for Problem<'_> {
+    type State = Vec<Option<UpJoints>>;
+    type Eval = Evaluation;
 
-impl Problem<'_> {
-    /// Gauss-Newton with step halving from `state` under `decision`.
-    fn run(&self, state: &mut GaussNewton, decision: &RankDecision) {
-        let options = self.options;
-        for it in 1..=options.max_iterations {
-            state.iterations = it;
-            let step = state.solution.parameters.clone();
-            if step_is_negligible(&step, &state.solution, decision) {
-                state.converged = true;
-                return;
-            }
-            let cost = state.eval.problem.cost_without_parameters();
-            let mut t = 1.0;
-            let accepted = loop {
-                let trial: Vec<f64> = state.p.iter().zip(&step).map(|(a, b)| a + t * b).collect();
-                let mut trial_seeds = state.seeds.clone();
-                match evaluate(
-                    self.model,
-                    &trial,
-                    self.poses,
-                    &options.sigma,
-                    self.weights,
-                    &mut trial_seeds,
-                ) {
-                    Ok(e)
-                        if e.problem.cost_without_parameters() <= cost * (1.0 + 1e-12) + 1e-300 =>
-                    {
-                        state.p = trial;
-                        state.seeds = trial_seeds;
-                        break Some(e);
-                    }
-                    _ => {}
-                }
-                t *= 0.5;
-                if t < 1e-6 {
-                    break None;
-                }
-            };
-            match accepted {
-                Some(e) => state.eval = e,
-                None => {
-                    // No decrease along the step: at the minimum to rounding
-                    // if the step is small against the uncertainty.
-                    state.converged = step_is_within(&step, &state.solution, decision, 1e-2);
-                    return;
-                }
-            }
-            state.solution = state.eval.problem.solve(decision);
-        }
-        state.converged = step_is_negligible(&state.solution.parameters, &state.solution, decision);
+    fn evaluate(&self, p: &[f64], seeds: &mut Self::State) -> Result<Evaluation, IdentError> {
+        evaluate(
+            self.model,
+            p,
+            self.poses,
+            &self.options.sigma,
+            self.weights,
+            seeds,
+        )
     }
-}
 
-/// A Gauss-Newton step is negligible when every component is below 1e-3 of
-/// its standard deviation (or below 1e-12 mm): further iterations could not
-/// change any conclusion drawn from the estimate.
-fn step_is_negligible(step: &[f64], s: &Solution, d: &RankDecision) -> bool {
-    step_is_within(step, s, d, 1e-3)
-}
-
-fn step_is_within(step: &[f64], s: &Solution, d: &RankDecision, fraction: f64) -> bool {
-    d.identifiable.iter().all(|&j| {
-        let sd = s.covariance[(3 + j, 3 + j)].max(0.0).sqrt();
-        step[j].abs() <= (fraction * sd).max(1e-12)
-    })
+    fn problem<'e>(&self, eval: &'e Evaluation) -> &'e ReducedProblem {
+        &eval.problem
+    }
 }
 
 fn finish(
     names: Vec<String>,
-    state: GaussNewton,
+    state: Run<Vec<Option<UpJoints>>, Evaluation>,
     decision: RankDecision,
     report: IdentifiabilityReport,
     options: &IdentifyOptions,
     weights: Option<&[f64]>,
     lines: Vec<u64>,
 ) -> Identification {
-    let GaussNewton {
+    let Run {
         p,
         eval,
         solution,

@@ -19,7 +19,9 @@
 //!   which usual mistake explains them ([`likely_causes`]);
 //! - compensates: corrected commands from the identified machine, the
 //!   volumetric error before and after ([`compensation`]), and a table of
-//!   leg-command corrections for a controller ([`CompensationTable`]).
+//!   leg-command corrections for a controller ([`CompensationTable`]);
+//! - fuses the internal data with external measurements (laser tracker,
+//!   ballbar, touch-offs) and calibrates the head ([`fusion`]).
 //!
 //! Parameter names are those of [`tricept_model::ParameterSet`]; lengths in
 //! mm, angles in rad.
@@ -80,6 +82,8 @@
 
 mod compensate;
 mod error;
+pub mod fusion;
+mod gauss_newton;
 mod identify;
 mod model;
 mod report;

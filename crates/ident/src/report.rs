@@ -294,7 +294,7 @@ fn finite_or_null<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error
 /// printed combination.
 const COEFFICIENT_CUTOFF: f64 = 1e-4;
 
-fn combination(
+pub(crate) fn combination(
     names: &[String],
     v: &[f64],
     singular_value: f64,

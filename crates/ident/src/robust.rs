@@ -1,25 +1,52 @@
-//! Robust estimation: a gross reading error must not wreck the
-//! identification.
+//! Robust estimation: a gross reading error of any size must not wreck the
+//! identification, in a campaign of any size.
 //!
-//! After a fit, every pose's readings are standardised by the sensor noise
-//! and by a robust scale of the residuals (1.4826 times their median
-//! absolute value per channel, never below the noise, so that a systematic
-//! misfit is not mistaken for gross errors). A pose with a reading beyond the
-//! Bonferroni-corrected normal quantile for the `3 n` readings (family-wise
-//! level 0.001 by default) is rejected and the fit repeated on the others,
-//! until the set of rejected poses no longer changes. Rejected rows are
-//! reported by their line in the data file; at most a stated share of the
-//! poses may be rejected (more is a model problem, not gross errors, and
-//! nothing is rejected).
+//! The screen ([`screen_gross_errors`]) works in two stages, so that its
+//! breakdown does not depend on the number of poses:
+//!
+//! 1. **Robust start.** Every pose is predicted by the *nominal* machine;
+//!    per channel the residuals are centred on their median and scaled by
+//!    1.4826 times their median absolute deviation (never below the sensor
+//!    noise). Geometric errors move these residuals smoothly over the
+//!    workspace, so an ordinary pose stays within a few scale units, while
+//!    a misread scale, an encoder jump, swapped columns or a unit slip lies
+//!    tens to thousands of units away. The first fit uses only the poses
+//!    within [`START_Z`] units (at least half of them: the ones nearest the
+//!    median, as a least-trimmed-squares start would).
+//! 2. **Deleted residuals, one pose at a time.** At the current fit every
+//!    pose gets the statistic `T_j = e_j^T (I -+ H_jj)^-1 e_j / s^2`: for a
+//!    pose in the fit its deleted (leave-one-pose-out) residual, with
+//!    `H_jj = X_j C X_j^T` the pose's 3 x 3 block of the hat matrix; for a
+//!    pose outside, its prediction residual; `s^2` the fit's reduced
+//!    chi-square (never below 1, externally studentised), so that a
+//!    systematic misfit is not taken for gross errors. Poses outside the fit
+//!    whose `T_j` is below the Bonferroni criterion `chi2_3(1 - alpha / n)`
+//!    are taken back; otherwise the single worst pose in the fit above it is
+//!    set aside; the fit is repeated until nothing changes.
+//!
+//! At most a stated share of the poses (and never fewer than two) may end
+//! up rejected: more is a model problem, not gross errors, and then nothing
+//! is rejected (the fit on all poses tells the rest). The cap is applied to
+//! the final set, not to an intermediate one, so that one gross reading
+//! that smears an early fit cannot hide itself behind the poses it drags
+//! along. Rejected rows are reported by their line in the data file. The
+//! same screen serves `tricept identify` and `tricept diagnose`.
 
+use nalgebra::Matrix3;
 use serde::Serialize;
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_kinematics::UpJoints;
+use tricept_numerics::linalg::{TriangularAccumulator, invert_upper};
+use tricept_numerics::stats::chi2_isf;
 
 use crate::error::IdentError;
 use crate::identify::{Identification, IdentifyOptions, identify};
 use crate::model::ReadingModel;
-use tricept_numerics::stats::chi2_isf;
+
+/// Largest robust z-score (residual at the nominal machine, in units of
+/// the larger of the sensor noise and 1.4826 MAD) of a pose in the first
+/// fit of the screen.
+pub const START_Z: f64 = 10.0;
 
 /// A rejected pose.
 ///
@@ -46,8 +73,10 @@ pub struct Rejection {
     pub pose: usize,
     /// Its line in the data file.
     pub line: u64,
-    /// Its largest standardised residual.
-    pub residual_sigma: f64,
+    /// Its deleted residual in noise standard deviations (`sqrt(T_j)`,
+    /// see the module docs); `None` when the fitted model cannot solve the
+    /// pose at all (its commands cannot be reached).
+    pub residual_sigma: Option<f64>,
 }
 
 /// Weighted residuals `(y - g(p) - c) / sigma` of `poses` under `model` at
@@ -104,7 +133,8 @@ fn kept(data: &Dataset, rejected: &[Rejection]) -> Dataset {
 }
 
 /// The poses whose readings are gross errors (see the module docs), at
-/// family-wise level `alpha`, at most `max_share` of them.
+/// family-wise level `alpha`, at most `max_share` of them (and never fewer
+/// than two may be).
 ///
 /// # Example
 /// ```
@@ -114,11 +144,15 @@ fn kept(data: &Dataset, rejected: &[Rejection]) -> Dataset {
 /// let m = Machine::paper();
 /// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
 /// let set = ParameterSet::paper15();
-/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+/// let mut data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
 ///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
 ///     .unwrap();
-/// let rejected = tricept_ident::screen_gross_errors(&model, &data, &IdentifyOptions::for_machine(&m), 1e-3, 0.1).unwrap();
+/// let options = IdentifyOptions::for_machine(&m);
+/// let rejected = tricept_ident::screen_gross_errors(&model, &data, &options, 1e-3, 0.1).unwrap();
 /// assert!(rejected.is_empty()); // clean data lose nothing
+/// data.poses[6].readings.s_mm += 10.0; // a 10 mm misread of the scale
+/// let rejected = tricept_ident::screen_gross_errors(&model, &data, &options, 1e-3, 0.1).unwrap();
+/// assert_eq!(rejected.iter().map(|r| r.pose).collect::<Vec<_>>(), vec![6]);
 /// ```
 pub fn screen_gross_errors(
     model: &dyn ReadingModel,
@@ -128,59 +162,229 @@ pub fn screen_gross_errors(
     max_share: f64,
 ) -> Result<Vec<Rejection>, IdentError> {
     let n = data.poses.len();
-    let z_crit = chi2_isf(alpha / (3 * n) as f64, 1.0).sqrt();
-    let mut rejected: Vec<Rejection> = Vec::new();
-    for _ in 0..4 {
-        let id = identify(model, &kept(data, &rejected), options)?;
-        let res = residuals_at(
-            model,
-            &id.estimate,
-            &id.offsets,
-            &data.poses,
-            &options.sigma,
-        )?;
-        let kept = |j: usize| !rejected.iter().any(|r| r.pose == j);
-        let scale: [f64; 3] = std::array::from_fn(|c| {
-            let mut v: Vec<f64> = res
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| kept(*j))
-                .filter_map(|(_, r)| r.map(|r| r[c].abs()))
-                .collect();
-            v.sort_by(f64::total_cmp);
-            (v.get(v.len() / 2).copied().unwrap_or(0.0) * 1.4826).max(1.0)
-        });
-        let next: Vec<Rejection> = res
-            .iter()
-            .enumerate()
-            .filter_map(|(j, r)| {
-                let z = match r {
-                    Some(r) => (0..3).map(|c| r[c].abs() / scale[c]).fold(0.0, f64::max),
-                    None => f64::INFINITY,
-                };
-                (z > z_crit).then(|| Rejection {
-                    pose: j,
-                    line: data.poses[j].line,
-                    residual_sigma: z,
-                })
-            })
-            .collect();
-        if (next.len() as f64) > max_share * n as f64 {
-            return Ok(Vec::new());
-        }
-        let same = next.len() == rejected.len()
-            && next.iter().zip(&rejected).all(|(a, b)| a.pose == b.pose);
-        rejected = next;
-        if same {
+    let cap = ((max_share * n as f64).floor() as usize).max(2);
+    let crit = chi2_isf(alpha / n.max(1) as f64, 3.0);
+    let mut inside = robust_start(model, data, options)?;
+    let mut seen: Vec<Vec<bool>> = Vec::new();
+    let mut last: Option<(Vec<bool>, Vec<Option<f64>>)> = None;
+    for _ in 0..(2 * n + 4) {
+        if seen.contains(&inside) {
             break;
         }
+        seen.push(inside.clone());
+        // Every fit starts from the nominal machine, where the rank decision
+        // is taken (a start at an earlier estimate would decide the rank at
+        // another point and could free a parameter that is invisible to
+        // first order).
+        let subset = data.subset(|j| inside[j]);
+        let id = match identify(model, &subset, options) {
+            Ok(id) => id,
+            // Too few poses left, or a pose the start set cannot solve:
+            // fall back to the previous set.
+            Err(_) if last.is_some() => break,
+            Err(e) => return Err(e),
+        };
+        let t = deleted_residuals(model, &id, data, &inside, options)?;
+        let mut next = inside.clone();
+        let mut changed = false;
+        for j in 0..n {
+            if !inside[j] && t[j].is_some_and(|t| t <= crit) {
+                next[j] = true;
+                changed = true;
+            }
+        }
+        if !changed {
+            let worst = (0..n)
+                .filter(|&j| inside[j])
+                .filter_map(|j| t[j].map(|t| (j, t)))
+                .filter(|(_, t)| *t > crit)
+                .max_by(|a, b| a.1.total_cmp(&b.1));
+            if let Some((j, _)) = worst {
+                next[j] = false;
+                changed = true;
+            }
+        }
+        last = Some((inside.clone(), t));
+        if !changed {
+            break;
+        }
+        inside = next;
+    }
+    let Some((inside, t)) = last else {
+        return Ok(Vec::new());
+    };
+    let rejected: Vec<Rejection> = (0..n)
+        .filter(|&j| !inside[j])
+        .map(|j| Rejection {
+            pose: j,
+            line: data.poses[j].line,
+            residual_sigma: t[j].map(f64::sqrt),
+        })
+        .collect();
+    if rejected.len() > cap {
+        return Ok(Vec::new());
     }
     Ok(rejected)
 }
 
-/// [`identify`] after rejecting gross errors (family-wise level 0.001, at
-/// most 10 % of the poses); returns the identification on the kept poses
-/// and the rejected ones.
+/// Which poses enter the first fit (stage 1 of the module docs). A pose
+/// the nominal machine cannot solve is an input error (its commands cannot
+/// be reached), not a gross reading.
+fn robust_start(
+    model: &dyn ReadingModel,
+    data: &Dataset,
+    options: &IdentifyOptions,
+) -> Result<Vec<bool>, IdentError> {
+    let n = data.poses.len();
+    let k = model.names().len();
+    let predictor = model.at(&vec![0.0; k]);
+    let mut jac = vec![0.0; 3 * k];
+    let mut nominal: Vec<Option<[f64; 3]>> = Vec::with_capacity(n);
+    for (j, p) in data.poses.iter().enumerate() {
+        let mut seed: Option<UpJoints> = None;
+        let g = predictor
+            .predict(p, &mut seed, &mut jac)
+            .map_err(|source| IdentError::Kinematics {
+                pose: j,
+                line: p.line,
+                source,
+            })?;
+        let y = p.readings.to_array();
+        nominal.push(Some([0, 1, 2].map(|c| y[c] - g[c])));
+    }
+    let median = |mut v: Vec<f64>| -> f64 {
+        v.sort_by(f64::total_cmp);
+        tricept_numerics::stats::quantile(&v, 0.5)
+    };
+    let centre: [f64; 3] =
+        std::array::from_fn(|c| median(nominal.iter().flatten().map(|r| r[c]).collect()));
+    let scale: [f64; 3] = std::array::from_fn(|c| {
+        let mad = median(
+            nominal
+                .iter()
+                .flatten()
+                .map(|r| (r[c] - centre[c]).abs())
+                .collect(),
+        );
+        let s = 1.4826 * mad;
+        if s.is_finite() {
+            s.max(options.sigma[c])
+        } else {
+            options.sigma[c]
+        }
+    });
+    let z: Vec<f64> = nominal
+        .iter()
+        .map(|r| match r {
+            Some(r) => (0..3)
+                .map(|c| (r[c] - centre[c]).abs() / scale[c])
+                .fold(0.0, f64::max),
+            None => f64::INFINITY,
+        })
+        .collect();
+    let mut inside: Vec<bool> = z.iter().map(|z| *z <= START_Z).collect();
+    let half = n.div_ceil(2);
+    if inside.iter().filter(|x| **x).count() < half {
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|a, b| z[*a].total_cmp(&z[*b]));
+        inside = vec![false; n];
+        for &j in &order[..half] {
+            inside[j] = z[j].is_finite();
+        }
+    }
+    Ok(inside)
+}
+
+/// The statistic `T_j` of every pose at fit `id` made on the poses marked
+/// `inside` (stage 2 of the module docs); `None` where the fitted model
+/// cannot solve the pose.
+fn deleted_residuals(
+    model: &dyn ReadingModel,
+    id: &Identification,
+    data: &Dataset,
+    inside: &[bool],
+    options: &IdentifyOptions,
+) -> Result<Vec<Option<f64>>, IdentError> {
+    let k = model.names().len();
+    let columns = id.design().identifiable().to_vec();
+    let q = 3 + columns.len();
+    let predictor = model.at(&id.estimate);
+    let mut jac = vec![0.0; 3 * k];
+    // Weighted residual and weighted Jacobian rows [offsets | identifiable] of every pose.
+    let rows: Vec<Option<([f64; 3], Vec<f64>)>> = data
+        .poses
+        .iter()
+        .map(|p| {
+            let mut seed: Option<UpJoints> = None;
+            let g = predictor.predict(p, &mut seed, &mut jac).ok()?;
+            let y = p.readings.to_array();
+            let e = [0, 1, 2].map(|c| (y[c] - g[c] - id.offsets[c]) / options.sigma[c]);
+            let mut x = vec![0.0; 3 * q];
+            for c in 0..3 {
+                let w = 1.0 / options.sigma[c];
+                x[c * q + c] = w;
+                for (t, &col) in columns.iter().enumerate() {
+                    x[c * q + 3 + t] = w * jac[c * k + col];
+                }
+            }
+            Some((e, x))
+        })
+        .collect();
+    // C = (X^T X)^-1 over the poses of the fit, through the R factor.
+    let mut acc = TriangularAccumulator::with_rows_hint(q, 3 * data.poses.len());
+    let mut chi2 = 0.0;
+    let mut m = 0usize;
+    for (j, row) in rows.iter().enumerate() {
+        if let (true, Some((e, x))) = (inside[j], row) {
+            for c in 0..3 {
+                acc.push_row(&x[c * q..(c + 1) * q]);
+                chi2 += e[c] * e[c];
+            }
+            m += 3;
+        }
+    }
+    let r_inv = invert_upper(acc.finish().as_ref());
+    let nu = m.saturating_sub(q);
+    Ok(rows
+        .iter()
+        .enumerate()
+        .map(|(j, row)| {
+            let (e, x) = row.as_ref()?;
+            // W = X_j R^-1 (3 x q); H_jj = W W^T.
+            let w: Vec<f64> = (0..3 * q)
+                .map(|cq| {
+                    let (c, a) = (cq / q, cq % q);
+                    (0..=a).map(|b| x[c * q + b] * r_inv[(b, a)]).sum()
+                })
+                .collect();
+            let h = Matrix3::from_fn(|a, b| (0..q).map(|t| w[a * q + t] * w[b * q + t]).sum());
+            let e = nalgebra::Vector3::from(*e);
+            let (m3, scale) = if inside[j] {
+                // Deleted residual, externally studentised.
+                let d = (Matrix3::identity() - h)
+                    .try_inverse()
+                    .map_or(0.0, |inv| (e.transpose() * inv * e)[0]);
+                let s2 = if nu > 3 {
+                    (chi2 - d) / (nu - 3) as f64
+                } else {
+                    1.0
+                };
+                (d, s2)
+            } else {
+                let d = (Matrix3::identity() + h)
+                    .try_inverse()
+                    .map_or(f64::INFINITY, |inv| (e.transpose() * inv * e)[0]);
+                let s2 = if nu > 0 { chi2 / nu as f64 } else { 1.0 };
+                (d, s2)
+            };
+            Some(m3 / scale.max(1.0))
+        })
+        .collect())
+}
+
+/// [`identify`] after rejecting gross errors ([`screen_gross_errors`] at
+/// family-wise level 0.001, at most 10 % of the poses); returns the
+/// identification on the kept poses and the rejected ones.
 ///
 /// # Example
 /// ```
@@ -194,10 +398,10 @@ pub fn screen_gross_errors(
 ///     .simulate(&Campaign::grid(&m, 3))
 ///     .unwrap();
 /// data.poses[10].readings.s_mm += 0.05; // a 50 um misread of the scale
+/// data.poses[30].readings.phi_rad += 0.1; // a 0.1 rad encoder jump
 /// let model = GeometricModel::new(m.clone(), set);
 /// let (id, rejected) = identify_robust(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
-/// assert_eq!(rejected.len(), 1);
-/// assert_eq!(rejected[0].pose, 10);
+/// assert_eq!(rejected.iter().map(|r| r.pose).collect::<Vec<_>>(), vec![10, 30]);
 /// assert!(id.stats.reduced_chi_square < 1.5);
 /// ```
 pub fn identify_robust(

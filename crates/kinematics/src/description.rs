@@ -375,7 +375,23 @@ pub struct HeadDescription {
     pub tool_tip_mm: [f64; 3],
     /// Tool axis direction at `h1 = h2 = 0` (need not be unit).
     pub tool_direction: [f64; 3],
+    /// Zero offsets of the two head angles, rad: the kinematic angle about
+    /// each axis is the commanded angle plus its offset (as the actual leg
+    /// length is the command plus `leg_offsets_mm`). Zero on a nominal head;
+    /// a calibrated head carries its identified angle zeros here. Omitted
+    /// from the JSON when both are zero.
+    #[serde(skip_serializing_if = "is_zero2")]
+    pub angle_offsets_rad: [f64; 2],
 }
+
+fn is_zero2(v: &[f64; 2]) -> bool {
+    v.iter().all(|x| *x == 0.0)
+}
+
+/// Largest head angle offset accepted, rad: an offset is a calibration of an
+/// encoder's zero, not a change of the head's kinematics (a larger value is
+/// most likely degrees, or a wrong sign convention).
+pub const MAX_HEAD_ANGLE_OFFSET_RAD: f64 = 0.1;
 
 impl Default for HeadDescription {
     /// An A/C head: C axis along z' through O', A axis along x' 150 mm
@@ -388,6 +404,7 @@ impl Default for HeadDescription {
             axis2_point_mm: [0.0, 0.0, 150.0],
             tool_tip_mm: [0.0, 0.0, 350.0],
             tool_direction: [0.0, 0.0, 1.0],
+            angle_offsets_rad: [0.0, 0.0],
         }
     }
 }
@@ -717,6 +734,25 @@ impl MachineDescription {
                 "the two head axes are parallel: the head would have one degree of freedom".into(),
             ));
         }
+        if norm3(cross3(a2, unit3(h.tool_direction))) < 1e-6 {
+            return Err(invalid(
+                "head.tool_direction",
+                "the tool lies along the second head axis: that axis could not turn it".into(),
+            ));
+        }
+        finite("head.angle_offsets_rad", &h.angle_offsets_rad)?;
+        if let Some(v) = h
+            .angle_offsets_rad
+            .iter()
+            .find(|v| v.abs() > MAX_HEAD_ANGLE_OFFSET_RAD)
+        {
+            return Err(invalid(
+                "head.angle_offsets_rad",
+                format!(
+                    "{v} rad is not a zero offset of a head encoder (limit {MAX_HEAD_ANGLE_OFFSET_RAD} rad; degrees?)"
+                ),
+            ));
+        }
 
         let s = &self.sensors;
         positive("sensors.angle_noise_arcsec", s.angle_noise_arcsec)?;
@@ -840,6 +876,13 @@ mod tests {
         let d = MachineDescription::paper();
         let again = MachineDescription::from_json(&d.to_json()).unwrap();
         assert_eq!(d, again);
+        // Zero head angle offsets are not written, so that nominal files stay as they were.
+        assert!(!d.to_json().contains("angle_offsets_rad"));
+        let mut calibrated = d.clone();
+        calibrated.head.angle_offsets_rad = [1e-4, -2e-4];
+        let text = calibrated.to_json();
+        assert!(text.contains("angle_offsets_rad"));
+        assert_eq!(MachineDescription::from_json(&text).unwrap(), calibrated);
     }
 
     #[test]
@@ -858,6 +901,16 @@ mod tests {
         v["placement"]["circular"]["joint_angles_deg"] = serde_json::json!([0.0, 0.0, 120.0]);
         let e = MachineDescription::from_json(&v.to_string()).unwrap_err();
         assert!(e.to_string().contains("coincide"), "{e}");
+
+        let mut v: serde_json::Value = serde_json::from_str(PAPER_MACHINE_JSON).unwrap();
+        v["head"]["angle_offsets_rad"] = serde_json::json!([0.0, 5.0]);
+        let e = MachineDescription::from_json(&v.to_string()).unwrap_err();
+        assert!(e.to_string().contains("head.angle_offsets_rad"), "{e}");
+
+        let mut v: serde_json::Value = serde_json::from_str(PAPER_MACHINE_JSON).unwrap();
+        v["head"]["tool_direction"] = serde_json::json!([2.0, 0.0, 0.0]);
+        let e = MachineDescription::from_json(&v.to_string()).unwrap_err();
+        assert!(e.to_string().contains("second head axis"), "{e}");
 
         let mut v: serde_json::Value = serde_json::from_str(PAPER_MACHINE_JSON).unwrap();
         v["limits"] = serde_json::json!({"leg_stroke_mm": [900.0, 500.0]});

@@ -2,7 +2,10 @@
 //! and the 5-DOF tool-pose inverse kinematics of the whole Tricept.
 //!
 //! The head is written in product-of-exponentials form in the platform frame
-//! (see [`crate::HeadDescription`]). Because the platform orientation `R`
+//! (see [`crate::HeadDescription`]). Head angles in every public function
+//! are *commanded* angles, what a controller sends and `tricept tool-ik`
+//! prints; the kinematic angle about each axis is the command plus the
+//! head's `angle_offsets_rad` (zero on a nominal head). Because the platform orientation `R`
 //! depends on where the platform is, a tool pose (tip + axis) cannot be
 //! solved by first placing the platform and then the head: the tool-pose IK
 //! solves the five unknowns `(phi, theta, q4, h1, h2)` jointly by a
@@ -32,6 +35,8 @@ pub struct Head {
     pub tool_tip_mm: Vector3<f64>,
     /// Unit tool axis at zero head angles.
     pub tool_direction: Vector3<f64>,
+    /// Zero offsets of the head angles: kinematic = command + offset, rad.
+    pub angle_offsets_rad: [f64; 2],
 }
 
 /// A tool pose: tip position and unit tool axis, in the base frame.
@@ -86,6 +91,7 @@ impl Head {
             axis2_point_mm: v(d.axis2_point_mm),
             tool_tip_mm: v(d.tool_tip_mm),
             tool_direction: v(d.tool_direction).normalize(),
+            angle_offsets_rad: d.angle_offsets_rad,
         }
     }
 
@@ -99,11 +105,66 @@ impl Head {
             axis2_point_mm: a(&self.axis2_point_mm),
             tool_tip_mm: a(&self.tool_tip_mm),
             tool_direction: a(&self.tool_direction),
+            angle_offsets_rad: self.angle_offsets_rad,
         }
     }
 
-    /// Tool tip and axis in the platform frame at head angles `h` (rad).
+    /// Kinematic angles for commanded head angles `h` (rad): `h + offsets`.
+    pub fn kinematic_angles(&self, h: [f64; 2]) -> [f64; 2] {
+        [
+            h[0] + self.angle_offsets_rad[0],
+            h[1] + self.angle_offsets_rad[1],
+        ]
+    }
+
+    /// Tool tip and axis in the platform frame at commanded head angles `h`
+    /// (rad).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_kinematics::Machine;
+    /// let mut head = Machine::paper().head;
+    /// let a = head.tool_in_platform([0.3, 0.2]);
+    /// // An angle zero offset of 0.01 rad: the command 0.29 reaches the same pose.
+    /// head.angle_offsets_rad = [0.01, 0.0];
+    /// let b = head.tool_in_platform([0.29, 0.2]);
+    /// assert!((a.tip_mm - b.tip_mm).norm() < 1e-12);
+    /// ```
     pub fn tool_in_platform(&self, h: [f64; 2]) -> ToolPose {
+        self.tool_at_kinematic(self.kinematic_angles(h))
+    }
+
+    /// Where a point fixed to the spindle goes, in the platform frame, at
+    /// commanded head angles `h` (rad); `point_mm` is the point at zero
+    /// kinematic head angles (a tracker target or a ballbar ball mounted in
+    /// the spindle: the tool tip plus its offset), mm.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_kinematics::Machine;
+    /// let head = Machine::paper().head;
+    /// let h = [0.7, -0.4];
+    /// let p = head.spindle_point(h, &head.tool_tip_mm);
+    /// assert!((p - head.tool_in_platform(h).tip_mm).norm() < 1e-12);
+    /// ```
+    pub fn spindle_point(&self, h: [f64; 2], point_mm: &Vector3<f64>) -> Vector3<f64> {
+        let [h1, h2] = self.kinematic_angles(h);
+        let r1 = rot(&self.axis1, h1);
+        let r2 = rot(&self.axis2, h2);
+        let p2 = self.axis2_point_mm + r2 * (point_mm - self.axis2_point_mm);
+        self.axis1_point_mm + r1 * (p2 - self.axis1_point_mm)
+    }
+
+    /// Rotation of the spindle relative to the platform at commanded head
+    /// angles `h` (rad): `Rot(axis1, h1) Rot(axis2, h2)` at the kinematic
+    /// angles.
+    pub fn spindle_rotation(&self, h: [f64; 2]) -> Matrix3<f64> {
+        let [h1, h2] = self.kinematic_angles(h);
+        rot(&self.axis1, h1) * rot(&self.axis2, h2)
+    }
+
+    /// Tool tip and axis in the platform frame at kinematic angles `h`.
+    fn tool_at_kinematic(&self, h: [f64; 2]) -> ToolPose {
         let r1 = rot(&self.axis1, h[0]);
         let r2 = rot(&self.axis2, h[1]);
         let tip2 = self.axis2_point_mm + r2 * (self.tool_tip_mm - self.axis2_point_mm);
@@ -182,10 +243,13 @@ fn wrap_angle(a: f64) -> f64 {
 /// Scale turning unit-vector residuals into mm for the joint residual.
 const AXIS_SCALE_MM: f64 = 100.0;
 const TOOL_MAX_ITERATIONS: u32 = 40;
+/// A tool pose reached to this residual (mm, the axis scaled by 100 mm) is
+/// solved, whatever the last step was.
+const TOOL_RESIDUAL_DONE_MM: f64 = 1e-11;
 
 impl Machine {
     /// Tool tip and axis in the base frame with the UP limb at `up` and the
-    /// head at `h` (rad).
+    /// head at commanded angles `h` (rad).
     pub fn tool_forward(&self, up: &UpJoints, h: [f64; 2]) -> ToolPose {
         let limb = self.up_limb.pose(up);
         let local = self.head.tool_in_platform(h);
@@ -196,7 +260,8 @@ impl Machine {
     }
 
     /// 5-DOF tool-pose inverse kinematics: tool tip (mm) and tool axis
-    /// (any non-zero length) to leg commands and head angles.
+    /// (any non-zero length) to leg commands and commanded head angles
+    /// (kinematic angles minus the head's angle offsets).
     ///
     /// # Example
     /// ```
@@ -237,8 +302,28 @@ impl Machine {
         let d = axis / n;
         let (mut up, mut h, head_singular) = self.tool_seed(tip_mm, &d, branch)?;
 
+        let finish = |up: UpJoints, h: [f64; 2], iterations: u32| {
+            let offsets = self.head.angle_offsets_rad;
+            let h = [wrap_angle(h[0] - offsets[0]), wrap_angle(h[1] - offsets[1])];
+            let geometry = self.legs_at(&up);
+            let legs_mm = self.commands_for(&geometry);
+            self.check_limits(&legs_mm, &up, &geometry.limb.limb_axis)?;
+            Ok(ToolIkSolution {
+                legs_mm,
+                up,
+                head_rad: h,
+                platform_mm: geometry.limb.position_mm,
+                iterations,
+                head_singular,
+            })
+        };
         for iteration in 1..=TOOL_MAX_ITERATIONS {
             let (residual, jac) = self.tool_residual(&up, h, tip_mm, &d);
+            // Reached to rounding: near a head singularity the steps in h1
+            // need not shrink while the pose is already exact.
+            if residual.norm() <= TOOL_RESIDUAL_DONE_MM {
+                return finish(up, h, iteration);
+            }
             // Gauss-Newton with a tiny Levenberg term: at a head singularity
             // the h1 column vanishes and the damping keeps h1 at its seed.
             let jt = jac.transpose();
@@ -272,18 +357,7 @@ impl Machine {
                         ),
                     });
                 }
-                let h = [wrap_angle(h[0]), wrap_angle(h[1])];
-                let geometry = self.legs_at(&up);
-                let legs_mm = self.commands_for(&geometry);
-                self.check_limits(&legs_mm, &up, &geometry.limb.limb_axis)?;
-                return Ok(ToolIkSolution {
-                    legs_mm,
-                    up,
-                    head_rad: h,
-                    platform_mm: geometry.limb.position_mm,
-                    iterations: iteration,
-                    head_singular,
-                });
+                return finish(up, h, iteration);
             }
         }
         Err(KinematicsError::NotConverged {
@@ -294,7 +368,7 @@ impl Machine {
     }
 
     /// Residual `[tip - p; 100 mm (axis - d)]` and its Jacobian with respect
-    /// to `(phi, theta, q4, h1, h2)`.
+    /// to `(phi, theta, q4, h1, h2)`, at kinematic head angles `h`.
     fn tool_residual(
         &self,
         up: &UpJoints,
@@ -305,7 +379,7 @@ impl Machine {
         let limb = self.up_limb.pose(up);
         let rot_p = limb.rotation;
         let r1 = rot(&self.head.axis1, h[0]);
-        let local = self.head.tool_in_platform(h);
+        let local = self.head.tool_at_kinematic(h);
         let tip = limb.position_mm + rot_p * local.tip_mm;
         let axis = rot_p * local.axis;
 
@@ -339,7 +413,7 @@ impl Machine {
 
     /// Seed for the tool-pose IK: three fixed-point rounds of "orientation
     /// from the platform point, head angles in closed form, platform point
-    /// from the tip".
+    /// from the tip". Angles are kinematic throughout.
     fn tool_seed(
         &self,
         tip_mm: &Vector3<f64>,
@@ -350,6 +424,10 @@ impl Machine {
         let mut r = tip_mm - reach * d;
         let mut h = [0.0, 0.0];
         let mut singular = false;
+        let branch = match branch {
+            HeadBranch::Nearest(h0) => HeadBranch::Nearest(self.head.kinematic_angles(h0)),
+            b => b,
+        };
         let reference = match branch {
             HeadBranch::Nearest(h0) => h0,
             HeadBranch::PositiveSecondAxis => [0.0, 0.0],
@@ -387,7 +465,7 @@ impl Machine {
                 sol[0] = reference[0];
             }
             h = sol;
-            r = tip_mm - rot_p * self.head.tool_in_platform(h).tip_mm;
+            r = tip_mm - rot_p * self.head.tool_at_kinematic(h).tip_mm;
         }
         Ok((self.up_limb.inverse(&r)?, h, singular))
     }
@@ -427,6 +505,30 @@ mod tests {
             let err = (fd - jac.column(k)).norm() / fd.norm().max(1.0);
             assert!(err < 1e-6, "column {k}: {err}");
         }
+    }
+
+    #[test]
+    fn angle_offsets_turn_commands_into_kinematic_angles_both_ways() {
+        let nominal = Machine::paper();
+        let mut m = nominal.clone();
+        m.head.angle_offsets_rad = [0.02, -0.015];
+        let tip = Vector3::new(150.0, 100.0, 1080.0);
+        let axis = Vector3::new(0.2, -0.1, 1.0);
+        let a = nominal
+            .tool_inverse(&tip, &axis, HeadBranch::default())
+            .unwrap();
+        let b = m.tool_inverse(&tip, &axis, HeadBranch::default()).unwrap();
+        // Same kinematic angles, commands shifted by the offsets.
+        assert!((a.head_rad[0] - (b.head_rad[0] + 0.02)).abs() < 1e-12);
+        assert!((a.head_rad[1] - (b.head_rad[1] - 0.015)).abs() < 1e-12);
+        assert!((a.legs_mm[0] - b.legs_mm[0]).abs() < 1e-9);
+        let back = m.tool_forward(&b.up, b.head_rad);
+        assert!((back.tip_mm - tip).norm() < 1e-9);
+        // The nearest branch is chosen in commanded angles too.
+        let c = m
+            .tool_inverse(&tip, &axis, HeadBranch::Nearest(b.head_rad))
+            .unwrap();
+        assert!((c.head_rad[0] - b.head_rad[0]).abs() < 1e-9);
     }
 
     #[test]

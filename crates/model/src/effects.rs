@@ -63,6 +63,35 @@ impl EffectName {
         EffectName::Outliers,
     ];
 
+    /// Names of the parameters that describe the effect in a model, with
+    /// their units (the diagnosis and the fused identification prefix them
+    /// with the effect's name: `leg-lead.lead1_ppm`).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_model::effects::EffectName;
+    /// assert_eq!(EffectName::ScaleGain.parameter_names(), ["scale_gain_ppm"]);
+    /// assert!(EffectName::Outliers.parameter_names().is_empty());
+    /// ```
+    pub fn parameter_names(self) -> &'static [&'static str] {
+        match self {
+            EffectName::LegLead => &["lead1_ppm", "lead2_ppm", "lead3_ppm"],
+            EffectName::Backlash => &["backlash1_um", "backlash2_um", "backlash3_um"],
+            EffectName::Thermal => &["expansion_ppm_per_k"],
+            EffectName::ScaleGain => &["scale_gain_ppm"],
+            EffectName::EncoderEccentricity => &[
+                "phi_sin_arcsec",
+                "phi_cos_arcsec",
+                "theta_sin_arcsec",
+                "theta_cos_arcsec",
+            ],
+            EffectName::UjointAxes => &["axis_skew_arcsec", "axis_offset_um"],
+            EffectName::TubeTwist => &["twist_arcsec_per_100mm"],
+            EffectName::Compliance => &["compliance_um_per_kn_at_1m"],
+            EffectName::Outliers => &[],
+        }
+    }
+
     /// The report name (`leg-lead`, ...).
     pub fn as_str(self) -> &'static str {
         match self {

@@ -75,8 +75,36 @@ pub fn error_jacobian(machine: &Machine, up: &UpJoints) -> Result<ErrorJacobian,
 
 /// First-order error of the platform point: `dr = (dr/dx) J deps`, 3 x 21 (mm/mm).
 pub fn position_error_jacobian(geometry: &LegGeometry) -> Result<ErrorJacobian, KinematicsError> {
-    let dr_dx = geometry.limb.point_jacobian(&geometry.limb.position_mm);
-    Ok(dr_dx * error_jacobian_at(geometry)?)
+    point_error_jacobian(geometry, &geometry.limb.position_mm)
+}
+
+/// First-order error of any point fixed to the platform (a tool tip, a
+/// tracker target), at world position `point_mm`: `dp = (dp/dx) J deps`,
+/// 3 x 21 (mm/mm), where `dp/dx` is the point's derivative with respect to
+/// the UP joints. At the platform point O' this is
+/// [`position_error_jacobian`].
+///
+/// # Example
+/// ```
+/// use nalgebra::Vector3;
+/// use tricept_kinematics::Machine;
+/// use tricept_model::{point_error_jacobian, position_error_jacobian};
+/// let m = Machine::paper();
+/// let up = m.inverse(&Vector3::new(100.0, 50.0, 700.0)).unwrap().up;
+/// let g = m.legs_at(&up);
+/// let at_o = point_error_jacobian(&g, &g.limb.position_mm).unwrap();
+/// assert_eq!(at_o, position_error_jacobian(&g).unwrap());
+/// // A point 350 mm down the tool also turns with the platform: it moves more.
+/// let tip = g.limb.position_mm + g.limb.rotation * Vector3::new(0.0, 0.0, 350.0);
+/// let at_tip = point_error_jacobian(&g, &tip).unwrap();
+/// assert!(at_tip.norm() > at_o.norm());
+/// ```
+pub fn point_error_jacobian(
+    geometry: &LegGeometry,
+    point_mm: &nalgebra::Vector3<f64>,
+) -> Result<ErrorJacobian, KinematicsError> {
+    let dp_dx = geometry.limb.point_jacobian(point_mm);
+    Ok(dp_dx * error_jacobian_at(geometry)?)
 }
 
 fn invert_j1(j1: &Matrix3<f64>) -> Result<Matrix3<f64>, KinematicsError> {

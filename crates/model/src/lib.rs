@@ -7,6 +7,10 @@
 //!   from which simulated readings are computed.
 //! - [`error_jacobian`]: the analytic `J = J1^{-1} J2` of eq. 9 for both
 //!   U-joint conventions.
+//! - [`point_error_jacobian`]: the same for any platform-fixed point (a
+//!   tool tip, a tracker target).
+//! - [`HeadParameterSet`]: the 13 error parameters of the 2-DOF head, exact
+//!   and with the analytic Jacobian of any spindle point.
 //! - [`volumetric_errors`]: platform error maps (the paper's Fig. 3).
 //! - [`residual_mu`]: the paper's residual error `mu` (Fig. 4).
 //! - [`effects`]: the effects the geometric model leaves out (leg lead,
@@ -27,6 +31,7 @@ mod actual;
 pub mod effects;
 mod error;
 mod extended;
+mod head_errors;
 mod jacobian;
 mod params;
 mod volumetric;
@@ -34,7 +39,13 @@ mod volumetric;
 pub use actual::{actual_machine, errors_between};
 pub use error::ModelError;
 pub use extended::ExtendedMachine;
-pub use jacobian::{ErrorJacobian, error_jacobian, error_jacobian_at, j2, position_error_jacobian};
+pub use head_errors::{
+    Effector, HEAD13_NAMES, HeadAt, HeadJacobian, HeadParameterSet, N_HEAD, TYPICAL_HEAD_ERRORS,
+};
+pub use jacobian::{
+    ErrorJacobian, error_jacobian, error_jacobian_at, j2, point_error_jacobian,
+    position_error_jacobian,
+};
 pub use params::{
     FULL21_NAMES, GeometricErrors, N_FULL, PAPER15_NAMES, ParameterSet, TABLE2_JSON, residual_mu,
 };

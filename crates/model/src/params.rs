@@ -296,31 +296,49 @@ impl ParameterSet {
 
     /// Values from a JSON map `{name: value_mm}` (missing names are zero).
     pub fn values_from_map(&self, map: &Map<String, Value>) -> Result<Vec<f64>, ModelError> {
-        let mut p = vec![0.0; self.len()];
-        for (k, v) in map {
-            let Some(j) = self.index_of(k) else {
-                return Err(ModelError::UnknownParameter {
-                    name: k.clone(),
-                    set: self.label.clone(),
-                    known: self.names.join(" "),
-                });
-            };
-            let x = v.as_f64().filter(|x| x.is_finite()).ok_or_else(|| {
-                ModelError::Values(format!("{k}: expected a finite number in mm, got {v}"))
-            })?;
-            p[j] = x;
-        }
-        Ok(p)
+        values_from_named_map(&self.names, &self.label, map)
     }
 
     /// Values as a JSON map in the set's order.
     pub fn values_to_map(&self, p: &[f64]) -> Map<String, Value> {
-        self.names
-            .iter()
-            .zip(p)
-            .map(|(n, v)| (n.clone(), Value::from(*v)))
-            .collect()
+        values_to_named_map(&self.names, p)
     }
+}
+
+/// Values of the parameters `names` of set `label` from a JSON map
+/// `{name: value}` (missing names are zero; an unknown name or a value that
+/// is not a finite number is an error).
+pub(crate) fn values_from_named_map(
+    names: &[String],
+    label: &str,
+    map: &Map<String, Value>,
+) -> Result<Vec<f64>, ModelError> {
+    let mut p = vec![0.0; names.len()];
+    for (k, v) in map {
+        let Some(j) = names.iter().position(|n| n == k) else {
+            return Err(ModelError::UnknownParameter {
+                name: k.clone(),
+                set: label.to_string(),
+                known: names.join(" "),
+            });
+        };
+        let x = v.as_f64().filter(|x| x.is_finite()).ok_or_else(|| {
+            ModelError::Values(format!(
+                "{k}: expected a finite number (in the unit its name carries), got {v}"
+            ))
+        })?;
+        p[j] = x;
+    }
+    Ok(p)
+}
+
+/// Values `p` of the parameters `names` as a JSON map, in order.
+pub(crate) fn values_to_named_map(names: &[String], p: &[f64]) -> Map<String, Value> {
+    names
+        .iter()
+        .zip(p)
+        .map(|(n, v)| (n.clone(), Value::from(*v)))
+        .collect()
 }
 
 /// The paper's residual error `mu = ||deps - deps_e||_1 / n_eps` (mm).

@@ -166,6 +166,29 @@ impl ReducedProblem {
             .sum()
     }
 
+    /// The nuisance values that fit best with the parameters held at their
+    /// current values (zero step): `R_nn c = r_n`.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_numerics::linalg::TriangularAccumulator;
+    /// use tricept_numerics::lsq::ReducedProblem;
+    /// // y = 1 + 2 x: with the slope held at zero, the intercept is the mean, 4.
+    /// let mut acc = TriangularAccumulator::new(3);
+    /// for x in [0.0, 1.0, 2.0, 3.0] {
+    ///     acc.push_row(&[1.0, x, 1.0 + 2.0 * x]);
+    /// }
+    /// let p = ReducedProblem { rows: 4, r: acc.finish(), n_nuisance: 1, k: 1 };
+    /// assert!((p.nuisance_without_parameters()[0] - 4.0).abs() < 1e-12);
+    /// ```
+    pub fn nuisance_without_parameters(&self) -> Vec<f64> {
+        let nn = self.n_nuisance;
+        let rhs = nn + self.k;
+        let r_nn = self.r.as_ref().submatrix(0, 0, nn, nn);
+        let b: Vec<f64> = (0..nn).map(|i| self.r[(i, rhs)]).collect();
+        solve_upper(r_nn, &b)
+    }
+
     /// Scales, ranks and orders the parameter columns (steps 1-3).
     ///
     /// # Example

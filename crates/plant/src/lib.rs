@@ -13,6 +13,12 @@
 //!    errors, and noise (mean of `readings_per_pose` Gaussian draws);
 //! 5. the logger writes time, temperature and approach directions.
 //!
+//! The actual machine also carries head errors ([`Plant::head_errors`], the
+//! 13 parameters of [`tricept_model::HeadParameterSet`]), which no internal
+//! sensor sees, and external instruments ([`instruments`]: a laser tracker,
+//! a ballbar, a touch probe on reference spheres and planes) measure the
+//! exact spindle point of the actual machine ([`Plant::spindle_point`]).
+//!
 //! Nothing here uses the linearised model. Randomness is seeded (PCG-64 MCG).
 #![cfg_attr(
     not(test),
@@ -21,6 +27,7 @@
 
 pub mod campaign;
 pub mod effects;
+pub mod instruments;
 
 use nalgebra::Vector3;
 use rand::SeedableRng;
@@ -29,10 +36,13 @@ use rand_pcg::Pcg64Mcg;
 use thiserror::Error;
 use tricept_data::{Dataset, MeasuredPose, Readings};
 use tricept_kinematics::{KinematicsError, Machine, UpJoints};
-use tricept_model::{GeometricErrors, actual_machine};
+use tricept_model::{
+    Effector, GeometricErrors, HeadParameterSet, N_HEAD, TYPICAL_HEAD_ERRORS, actual_machine,
+};
 
 pub use campaign::{Campaign, PoseOrder};
 pub use effects::Effect;
+pub use instruments::{Ballbar, TouchFeature, TouchProbe, TouchTarget, Tracker};
 pub use tricept_model::effects::EffectName;
 
 /// Why a simulation failed.
@@ -67,6 +77,10 @@ pub struct Plant {
     /// Zero offsets of the sensors `[phi, theta, s]` (rad, rad, mm): the
     /// readings are joint value + offset.
     pub sensor_offsets: [f64; 3],
+    /// Errors of the head: values of the 13 parameters of
+    /// [`HeadParameterSet::head13`] of the nominal head (empty: the nominal
+    /// head).
+    pub head_errors: Vec<f64>,
 }
 
 /// Default sensor zero offsets: arbitrary, documented, and far from zero so
@@ -103,13 +117,18 @@ impl Plant {
             errors,
             effects: Vec::new(),
             sensor_offsets: DEFAULT_SENSOR_OFFSETS,
+            head_errors: Vec::new(),
         }
     }
 
-    /// The actual machine's exact kinematic model (geometric errors and the
-    /// effects that change the machine's geometry, such as U-joint axis errors).
+    /// The actual machine's exact kinematic model (geometric errors, head
+    /// errors and the effects that change the machine's geometry, such as
+    /// U-joint axis errors).
     pub fn actual_machine(&self) -> Machine {
         let mut m = actual_machine(&self.nominal, &self.errors);
+        if !self.head_errors.is_empty() {
+            m.head = HeadParameterSet::head13(&self.nominal.head).head_at(&self.head_errors);
+        }
         for e in &self.effects {
             e.modify_machine(&mut m);
         }
@@ -236,6 +255,18 @@ impl Plant {
     /// leg effects at the campaign's start (no temperature change, every leg
     /// approached extending), mm.
     pub fn reach(&self, commands_mm: &[f64; 3]) -> Result<Vector3<f64>, KinematicsError> {
+        Ok(self
+            .reach_on(&self.actual_machine(), commands_mm)?
+            .position_mm)
+    }
+
+    /// The actual machine `actual` (this plant's [`Plant::actual_machine`])
+    /// at leg `commands_mm`, with the leg effects of [`Plant::reach`].
+    fn reach_on(
+        &self,
+        actual: &Machine,
+        commands_mm: &[f64; 3],
+    ) -> Result<tricept_kinematics::FkSolution, KinematicsError> {
         let nominal_up = self.nominal.forward(commands_mm)?.up;
         let state = effects::PoseState {
             commands_mm: *commands_mm,
@@ -247,11 +278,82 @@ impl Plant {
         for e in &self.effects {
             e.extra_leg_length(&self.nominal, &state, &mut legs);
         }
-        Ok(self
-            .actual_machine()
-            .forward_from(&legs, &nominal_up)?
-            .position_mm)
+        actual.forward_from(&legs, &nominal_up)
     }
+
+    /// Where a point fixed to the spindle (`effector`: the tool tip, a
+    /// tracker target, a ballbar ball) of the actual machine goes for leg
+    /// `commands_mm` and commanded head angles `head_rad`, in the base
+    /// frame, mm: exact FK of the actual module with the leg effects of
+    /// [`Plant::reach`], then the actual head at the commanded angles plus
+    /// its actual zero offsets. The effector's extension runs along the
+    /// actual tool axis.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_kinematics::{HeadBranch, Machine};
+    /// use tricept_model::Effector;
+    /// use tricept_plant::Plant;
+    /// let m = Machine::paper();
+    /// let mut plant = Plant::geometric(m.clone(), Default::default());
+    /// let tip = nalgebra::Vector3::new(100.0, -50.0, 1100.0);
+    /// let ik = m.tool_inverse(&tip, &nalgebra::Vector3::z(), HeadBranch::default()).unwrap();
+    /// let at = |p: &Plant| p.spindle_point(&ik.legs_mm, ik.head_rad, &Effector::default()).unwrap();
+    /// assert!((at(&plant) - tip).norm() < 1e-9);
+    /// // A 0.3 mm longer tool, seen by no internal sensor, moves the tip.
+    /// plant.head_errors = vec![0.0; 13];
+    /// plant.head_errors[9] = 0.3;
+    /// assert!(((at(&plant) - tip).norm() - 0.3).abs() < 1e-9);
+    /// ```
+    pub fn spindle_point(
+        &self,
+        commands_mm: &[f64; 3],
+        head_rad: [f64; 2],
+        effector: &Effector,
+    ) -> Result<Vector3<f64>, KinematicsError> {
+        self.spindle_point_on(&self.actual_machine(), commands_mm, head_rad, effector)
+    }
+
+    /// [`Plant::spindle_point`] on an actual machine computed once.
+    pub(crate) fn spindle_point_on(
+        &self,
+        actual: &Machine,
+        commands_mm: &[f64; 3],
+        head_rad: [f64; 2],
+        effector: &Effector,
+    ) -> Result<Vector3<f64>, KinematicsError> {
+        let fk = self.reach_on(actual, commands_mm)?;
+        let head = &actual.head;
+        let local = head.spindle_point(
+            head_rad,
+            &(head.tool_tip_mm + head.tool_direction * effector.extension_mm + effector.offset_mm),
+        );
+        Ok(fk.position_mm + fk.rotation * local)
+    }
+}
+
+/// Head errors for a simulated machine: every parameter of
+/// [`HeadParameterSet::head13`] `scale` times its typical size
+/// ([`TYPICAL_HEAD_ERRORS`]) times a factor drawn uniformly in [0.5, 1],
+/// with a random sign, from `seed` (PCG-64 MCG).
+///
+/// # Example
+/// ```
+/// let e = tricept_plant::random_head_errors(1.0, 7);
+/// assert_eq!(e.len(), 13);
+/// assert!(e.iter().zip(tricept_model::TYPICAL_HEAD_ERRORS).all(|(v, s)| v.abs() >= 0.5 * s && v.abs() <= s));
+/// assert_eq!(e, tricept_plant::random_head_errors(1.0, 7));
+/// ```
+pub fn random_head_errors(scale: f64, seed: u64) -> Vec<f64> {
+    use rand::RngExt;
+    let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x4ead_e770);
+    (0..N_HEAD)
+        .map(|j| {
+            let size = 0.5 + 0.5 * rng.random::<f64>();
+            let sign = if rng.random::<bool>() { 1.0 } else { -1.0 };
+            scale * TYPICAL_HEAD_ERRORS[j] * size * sign
+        })
+        .collect()
 }
 
 /// `n` parameter values drawn uniformly in `[-magnitude_mm, magnitude_mm]`

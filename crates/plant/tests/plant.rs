@@ -225,3 +225,133 @@ fn an_unreachable_target_is_an_error_naming_it() {
     // The second target, numbered from 1.
     assert!(e.contains("pose 2") && e.contains("5000"), "{e}");
 }
+
+/// A plant with module and head errors.
+fn plant_with_head(seed: u64) -> Plant {
+    let mut p = plant(seed);
+    p.head_errors = tricept_plant::random_head_errors(1.0, seed);
+    p
+}
+
+/// Tracker poses spread over the workspace and the head's angles.
+fn external_poses(m: &Machine, n: usize) -> Vec<tricept_data::ExternalPose> {
+    m.workspace
+        .random_poses(n, 9)
+        .iter()
+        .enumerate()
+        .map(|(j, r)| tricept_data::ExternalPose {
+            commands_mm: m.inverse(r).unwrap().legs_mm,
+            head_rad: [0.9 * j as f64, 0.6 * ((j % 5) as f64 - 2.0) / 2.0],
+        })
+        .collect()
+}
+
+#[test]
+fn a_tracker_measures_the_exact_target_in_its_frame_with_the_stated_noise() {
+    let p = plant_with_head(4);
+    let poses: Vec<_> = external_poses(&p.nominal, 400)
+        .into_iter()
+        .enumerate()
+        .map(|(j, pose)| (pose, if j % 2 == 0 { 0.0 } else { 80.0 }))
+        .collect();
+    let mut tracker = tricept_plant::Tracker {
+        frame: nalgebra::Isometry3::new(
+            Vector3::new(900.0, -300.0, 50.0),
+            Vector3::new(0.3, -0.2, 0.1),
+        ),
+        target_offset_mm: Vector3::new(0.5, -0.3, 20.0),
+        sigma_um: 0.0,
+        setup: 2,
+    };
+    let clean = tracker.measure(&p, &poses, 7).unwrap();
+    let actual = p.actual_machine();
+    for (r, (pose, extension)) in clean.records.iter().zip(&poses) {
+        // The exact point: FK of the actual machine, the actual head at the
+        // commands plus its zeros, the target along the actual tool axis.
+        let fk = actual.forward(&pose.commands_mm).unwrap();
+        let h = &actual.head;
+        let local = h.spindle_point(
+            pose.head_rad,
+            &(h.tool_tip_mm + h.tool_direction * *extension + tracker.target_offset_mm),
+        );
+        let x = fk.position_mm + fk.rotation * local;
+        let y = tracker.frame * nalgebra::Point3::from(x);
+        for c in 0..3 {
+            assert!((r.position_mm[c] - y[c]).abs() < 1e-9);
+        }
+        assert_eq!((r.setup, r.extension_mm), (2, *extension));
+    }
+    tracker.sigma_um = 10.0;
+    let noisy = tracker.measure(&p, &poses, 7).unwrap();
+    assert_eq!(noisy, tracker.measure(&p, &poses, 7).unwrap());
+    let d: Vec<f64> = noisy
+        .records
+        .iter()
+        .zip(&clean.records)
+        .flat_map(|(a, b)| (0..3).map(move |c| 1e3 * (a.position_mm[c] - b.position_mm[c])))
+        .collect();
+    let sd = (d.iter().map(|v| v * v).sum::<f64>() / d.len() as f64).sqrt();
+    assert!((sd / 10.0 - 1.0).abs() < 0.08, "{sd} um");
+}
+
+#[test]
+fn a_ballbar_reads_the_exact_distance_plus_its_length_error() {
+    let p = plant_with_head(5);
+    let pivot = Vector3::new(30.0, -20.0, 1250.0);
+    let bar = tricept_plant::Ballbar {
+        pivot_mm: pivot,
+        length_error_um: 2.5,
+        ball_offset_mm: Vector3::new(0.0, 0.0, 5.0),
+        sigma_um: 0.0,
+        setup: 1,
+    };
+    let poses = external_poses(&p.nominal, 20);
+    let data = bar.measure(&p, &poses, 3).unwrap();
+    for (r, pose) in data.records.iter().zip(&poses) {
+        let effector = tricept_model::Effector {
+            extension_mm: 0.0,
+            offset_mm: bar.ball_offset_mm,
+        };
+        let x = p
+            .spindle_point(&pose.commands_mm, pose.head_rad, &effector)
+            .unwrap();
+        assert!((r.length_mm - (x - pivot).norm() - 2.5e-3).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn a_touch_latches_the_commands_where_the_actual_stylus_meets_the_true_feature() {
+    let p = plant_with_head(6);
+    let (centre, radius, r) = (Vector3::new(100.0, 50.0, 1150.0), 12.7, 1.0);
+    let probe = tricept_plant::TouchProbe {
+        stylus_radius_mm: r,
+        stylus_radius_error_um: 4.0,
+        stylus_radius_sigma_um: 5.0,
+        sigma_um: 0.0,
+        features: vec![tricept_plant::TouchFeature::Sphere {
+            id: 1,
+            centre_mm: centre,
+            radius_mm: radius,
+        }],
+    };
+    let targets: Vec<_> = (0..8)
+        .map(|j| {
+            let a = j as f64 * 0.8;
+            let u = Vector3::new(0.5 * a.cos(), 0.5 * a.sin(), -0.8).normalize();
+            tricept_plant::TouchTarget {
+                feature: 1,
+                tip_mm: centre + u * (radius + r),
+                axis: Vector3::new(0.2 * a.sin(), 0.2 * a.cos(), 1.0),
+                approach: -u,
+            }
+        })
+        .collect();
+    let data = probe.measure(&p, &targets, 1).unwrap();
+    for t in &data.records {
+        let x = p
+            .spindle_point(&t.pose.commands_mm, t.pose.head_rad, &Default::default())
+            .unwrap();
+        let clearance = (x - centre).norm() - radius - (r + 4e-3);
+        assert!(clearance.abs() < 1e-9, "{clearance:e} mm");
+    }
+}

@@ -15,6 +15,9 @@
 //!   `(H^T H)^{-1} H^T l`.
 //!
 //! [`optimise`] chooses pose sets that maximise an observability index;
+//! [`plan`] chooses a few external measurements (tracker points, ballbar
+//! readings) that minimise the predicted tool-tip error, with the same
+//! exchange;
 //! [`grades`] turns results into decisions (where calibration stops paying,
 //! which grade a pose set needs, which grade to buy).
 //! Everything is seeded and bit-reproducible at any thread count.
@@ -28,6 +31,7 @@ pub mod fast;
 pub mod grades;
 pub mod optimise;
 pub mod paper;
+pub mod plan;
 mod rng;
 pub mod scenario;
 

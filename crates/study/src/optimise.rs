@@ -22,6 +22,11 @@
 //! made if it improves the criterion; passes repeat until none does. Swaps
 //! update `F` in `O(q^2)`; candidates of a swap are scored in parallel, the
 //! choice is deterministic.
+//!
+//! The exchange (and the greedy construction that can seed it) is written
+//! once, for any criterion that implements [`ExchangeCriterion`]: the
+//! observability indices here, and the predicted tool-tip uncertainty of
+//! planned external measurements ([`crate::plan`]).
 
 use nalgebra::{DMatrix, Vector3};
 use rayon::prelude::*;
@@ -115,7 +120,7 @@ impl Sums {
         let mut sums = Sums {
             g: DMatrix::zeros(c.q, c.q),
             s: [vec![0.0; c.q], vec![0.0; c.q], vec![0.0; c.q]],
-            n: selection.len(),
+            n: 0,
         };
         for &j in selection {
             sums.add(c, j, 1.0);
@@ -124,6 +129,11 @@ impl Sums {
     }
 
     fn add(&mut self, c: &Candidates, j: usize, sign: f64) {
+        if sign > 0.0 {
+            self.n += 1;
+        } else {
+            self.n = self.n.saturating_sub(1);
+        }
         for ch in 0..3 {
             let a = &c.rows[j][ch];
             for u in 0..c.q {
@@ -190,16 +200,62 @@ pub struct Selection {
     pub passes: usize,
 }
 
-/// Sequential exchange from `start` (indices into `c`), at most `max_passes`.
-pub fn exchange(
-    c: &Candidates,
+/// A design criterion that the sequential exchange can improve: larger is
+/// better. The state of a selection is whatever makes adding and removing
+/// one candidate cheap (running sums, an information matrix).
+pub trait ExchangeCriterion: Sync {
+    /// What is kept about a selection.
+    type State: Clone + Send + Sync;
+    /// Number of candidates.
+    fn candidates(&self) -> usize;
+    /// The state of a selection.
+    fn state(&self, selection: &[usize]) -> Self::State;
+    /// The criterion's value (larger is better; `-inf` for a degenerate one).
+    fn value(&self, state: &Self::State) -> f64;
+    /// The state with candidate `c` removed (it is in the selection).
+    fn without(&self, state: &Self::State, c: usize) -> Self::State;
+    /// The state with candidate `c` added.
+    fn with(&self, state: &Self::State, c: usize) -> Self::State;
+    /// The value of `state` plus each of `candidates` (default: [`with`]
+    /// then [`value`], candidates in parallel).
+    ///
+    /// [`with`]: ExchangeCriterion::with
+    /// [`value`]: ExchangeCriterion::value
+    fn values_with(&self, state: &Self::State, candidates: &[usize]) -> Vec<f64> {
+        candidates
+            .par_iter()
+            .map(|&c| self.value(&self.with(state, c)))
+            .collect()
+    }
+}
+
+/// The best of `values` (paired with `candidates`): largest value, lowest
+/// index on ties; `(-inf, usize::MAX)` when there is none.
+fn best_of(candidates: &[usize], values: &[f64]) -> (f64, usize) {
+    candidates
+        .iter()
+        .zip(values)
+        .fold((f64::NEG_INFINITY, usize::MAX), |a, (&c, &v)| {
+            if v > a.0 || (v == a.0 && c < a.1) {
+                (v, c)
+            } else {
+                a
+            }
+        })
+}
+
+/// Sequential exchange from `start` (indices of candidates), at most
+/// `max_passes` passes: for each selected candidate in turn, the best swap
+/// with an unselected one is made if it improves the criterion by more than
+/// a relative 1e-9; passes repeat until none does.
+pub fn exchange_with<C: ExchangeCriterion>(
+    criterion: &C,
     start: &[usize],
-    criterion: Criterion,
     max_passes: usize,
 ) -> Selection {
     let mut selected: Vec<usize> = start.to_vec();
-    let mut sums = Sums::of(c, &selected);
-    let start_value = score(criterion, &sums.information());
+    let mut state = criterion.state(&selected);
+    let start_value = criterion.value(&state);
     let mut value = start_value;
     let mut swaps = 0;
     let mut passes = 0;
@@ -208,28 +264,13 @@ pub fn exchange(
         let mut improved = false;
         for pos in 0..selected.len() {
             let out = selected[pos];
-            let best = (0..c.len())
-                .into_par_iter()
-                .filter(|cand| !selected.contains(cand))
-                .map(|cand| {
-                    let mut trial = sums.clone();
-                    trial.add(c, out, -1.0);
-                    trial.add(c, cand, 1.0);
-                    (score(criterion, &trial.information()), cand)
-                })
-                .reduce(
-                    || (f64::NEG_INFINITY, usize::MAX),
-                    |a, b| {
-                        if b.0 > a.0 || (b.0 == a.0 && b.1 < a.1) {
-                            b
-                        } else {
-                            a
-                        }
-                    },
-                );
+            let reduced = criterion.without(&state, out);
+            let free: Vec<usize> = (0..criterion.candidates())
+                .filter(|c| !selected.contains(c))
+                .collect();
+            let best = best_of(&free, &criterion.values_with(&reduced, &free));
             if best.0 > value * (1.0 + 1e-9 * value.signum()) + 1e-12 && best.1 != usize::MAX {
-                sums.add(c, out, -1.0);
-                sums.add(c, best.1, 1.0);
+                state = criterion.with(&reduced, best.1);
                 selected[pos] = best.1;
                 value = best.0;
                 swaps += 1;
@@ -247,6 +288,77 @@ pub fn exchange(
         swaps,
         passes,
     }
+}
+
+/// Greedy construction: from `start`, add the best candidate one at a time
+/// until `k` are selected. The selections along the way are nested: the
+/// first `j` of the result are the greedy selection of size `j`.
+pub fn greedy<C: ExchangeCriterion>(criterion: &C, start: &[usize], k: usize) -> Vec<usize> {
+    let mut selected = start.to_vec();
+    let mut state = criterion.state(&selected);
+    while selected.len() < k {
+        let free: Vec<usize> = (0..criterion.candidates())
+            .filter(|c| !selected.contains(c))
+            .collect();
+        let best = best_of(&free, &criterion.values_with(&state, &free));
+        if best.1 == usize::MAX {
+            break;
+        }
+        state = criterion.with(&state, best.1);
+        selected.push(best.1);
+    }
+    selected
+}
+
+/// The observability indices of [`Candidates`] as an exchange criterion.
+struct Observability<'a> {
+    candidates: &'a Candidates,
+    criterion: Criterion,
+}
+
+impl ExchangeCriterion for Observability<'_> {
+    type State = Sums;
+
+    fn candidates(&self) -> usize {
+        self.candidates.len()
+    }
+
+    fn state(&self, selection: &[usize]) -> Sums {
+        Sums::of(self.candidates, selection)
+    }
+
+    fn value(&self, state: &Sums) -> f64 {
+        score(self.criterion, &state.information())
+    }
+
+    fn without(&self, state: &Sums, c: usize) -> Sums {
+        let mut s = state.clone();
+        s.add(self.candidates, c, -1.0);
+        s
+    }
+
+    fn with(&self, state: &Sums, c: usize) -> Sums {
+        let mut s = state.clone();
+        s.add(self.candidates, c, 1.0);
+        s
+    }
+}
+
+/// Sequential exchange from `start` (indices into `c`), at most `max_passes`.
+pub fn exchange(
+    c: &Candidates,
+    start: &[usize],
+    criterion: Criterion,
+    max_passes: usize,
+) -> Selection {
+    exchange_with(
+        &Observability {
+            candidates: c,
+            criterion,
+        },
+        start,
+        max_passes,
+    )
 }
 
 /// The default candidate grid: 5 levels x (axis + 5 rings x 16) = 405 points.

@@ -1,0 +1,462 @@
+//! `tricept identify` with external measurements: the fused identification
+//! of the module, the head and every instrument's nuisance
+//! (`tricept_ident::fusion`). `identify` dispatches here when a tracker,
+//! ballbar or touch file, a head option or an effect is given; without them
+//! it runs the internal-only path unchanged.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use serde_json::{Value, json};
+use tricept_data::{
+    BallbarReading, ExternalData, ExternalRecord, Features, TouchReading, TrackerPoint,
+};
+use tricept_ident::IdentError;
+use tricept_ident::fusion::{
+    BallbarOptions, FusedModel, Fusion, FusionOptions, Source, TouchOptions, TrackerOptions,
+    TrackerTarget, evaluation_poses, identify_fused,
+};
+use tricept_model::effects::EffectName;
+
+use crate::args::{check_commands, machine_with_noise, read_data};
+use crate::cli_error::{CliError, EXIT_NOT_CONVERGED};
+use crate::ident_cmd::IdentifyArgs;
+
+/// Exit code of a fit that converged but that the user must not trust as
+/// it stands: a source the model does not explain (`identify`'s 3).
+pub const EXIT_UNTRUSTED: u8 = crate::cli_error::EXIT_INADEQUATE;
+
+/// External measurements and the head (options of `tricept identify`).
+#[derive(Debug, Args, Clone, Default)]
+pub struct ExternalArgs {
+    /// Laser-tracker or CMM points (CSV `q1,q2,q3,h1,h2,x,y,z`); repeatable.
+    #[arg(long, value_name = "FILE.csv")]
+    pub tracker: Vec<PathBuf>,
+    /// Standard deviation of a tracker coordinate for rows without `sigma_um`, um.
+    #[arg(long, default_value_t = 10.0, value_name = "UM")]
+    pub tracker_sigma_um: f64,
+    /// The tracker target's offset from the tool tip: `free` (unknown: the
+    /// tool tip is then not calibrated), `tip` (at the tip), or `X,Y,Z` mm
+    /// in the spindle frame at zero head angles.
+    #[arg(long, default_value = "free", value_name = "free|tip|X,Y,Z")]
+    pub tracker_target: String,
+    /// Standard deviation of a known target offset, um.
+    #[arg(long, default_value_t = 5.0, value_name = "UM")]
+    pub tracker_target_sigma_um: f64,
+    /// Ballbar readings (CSV `q1,q2,q3,h1,h2,length`); repeatable.
+    #[arg(long, value_name = "FILE.csv")]
+    pub ballbar: Vec<PathBuf>,
+    /// Standard deviation of a ballbar reading for rows without `sigma_um`, um.
+    #[arg(long, default_value_t = 1.0, value_name = "UM")]
+    pub ballbar_sigma_um: f64,
+    /// Standard deviation of the bar's length (its certificate), um, or
+    /// `free` (the machine's scale then stays invisible to the ballbar).
+    #[arg(long, default_value = "1", value_name = "UM|free")]
+    pub ballbar_length_sigma_um: String,
+    /// Offset of the spindle ball from the tool tip, mm (spindle frame at
+    /// zero head angles).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub ballbar_ball_mm: Option<String>,
+    /// Touch-offs (CSV `q1,q2,q3,h1,h2,feature`); repeatable; needs --features.
+    #[arg(long, value_name = "FILE.csv")]
+    pub touch: Vec<PathBuf>,
+    /// The features file of the touch-offs (JSON: stylus, spheres, planes).
+    #[arg(long, value_name = "FILE.json")]
+    pub features: Option<PathBuf>,
+    /// Standard deviation of a touch for rows without `sigma_um`, um.
+    #[arg(long, default_value_t = 1.5, value_name = "UM")]
+    pub touch_sigma_um: f64,
+    /// The head's parameters: `head13` (default with external data) or
+    /// `none` (the head held nominal).
+    #[arg(long, value_name = "head13|none")]
+    pub head: Option<String>,
+    /// Effects to fit with the geometry (names from `tricept diagnose`):
+    /// any of leg-lead, scale-gain, compliance, comma-separated.
+    #[arg(long, value_name = "NAMES", value_delimiter = ',')]
+    pub effects: Vec<String>,
+    /// Evaluation grid of the predicted tool tip: platform points of
+    /// `polar_grid(RINGS, PER_RING, LEVELS)`.
+    #[arg(long, default_value = "2,8,3", value_name = "RINGS,PER_RING,LEVELS")]
+    pub eval_grid: String,
+    /// Head angles of the evaluation grid, deg: `H1,H1,...:H2,H2,...`.
+    #[arg(long, default_value = "0,90,180,270:15,35", value_name = "H1S:H2S")]
+    pub eval_head_angles_deg: String,
+}
+
+impl ExternalArgs {
+    /// Whether the fused path is asked for.
+    pub fn any(&self) -> bool {
+        !self.tracker.is_empty()
+            || !self.ballbar.is_empty()
+            || !self.touch.is_empty()
+            || self.head.is_some()
+            || !self.effects.is_empty()
+    }
+}
+
+/// `X,Y,Z` (or any count) as numbers.
+pub fn parse_numbers(flag: &str, text: &str, count: usize) -> Result<Vec<f64>, CliError> {
+    let values: Result<Vec<f64>, _> = text.split(',').map(|t| t.trim().parse::<f64>()).collect();
+    match values {
+        Ok(v) if v.len() == count && v.iter().all(|x| x.is_finite()) => Ok(v),
+        _ => Err(CliError::input(format!(
+            "{flag}: expected {count} comma-separated numbers, got `{text}`"
+        ))),
+    }
+}
+
+/// A list of angles in degrees, `a,b,c`.
+fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>, CliError> {
+    let n = text.split(',').count();
+    parse_numbers(flag, text, n)
+}
+
+/// `H1S:H2S` lists of degrees.
+pub fn parse_head_angles(flag: &str, text: &str) -> Result<(Vec<f64>, Vec<f64>), CliError> {
+    let Some((a, b)) = text.split_once(':') else {
+        return Err(CliError::input(format!(
+            "{flag}: expected `H1,H1,...:H2,H2,...` in degrees, got `{text}`"
+        )));
+    };
+    Ok((parse_list(flag, a)?, parse_list(flag, b)?))
+}
+
+pub fn positive(flag: &str, v: f64) -> Result<f64, CliError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(CliError::input(format!(
+            "{flag}: must be a positive number, got {v}"
+        )))
+    }
+}
+
+/// The effects named by `--effects`.
+pub fn parse_effect_names(names: &[String]) -> Result<Vec<EffectName>, CliError> {
+    names
+        .iter()
+        .filter(|n| !n.is_empty())
+        .map(|n| {
+            n.parse::<EffectName>()
+                .map_err(|e| CliError::input(format!("--effects: {e}")))
+        })
+        .collect()
+}
+
+/// An identification error as the CLI reports it.
+pub fn fusion_error(e: IdentError) -> CliError {
+    match e {
+        IdentError::Source { .. } | IdentError::NuisanceUnidentifiable { .. } => {
+            CliError::input(e.to_string())
+        }
+        IdentError::Invalid(m) => CliError::input(m),
+        e => CliError::other(e.to_string()),
+    }
+}
+
+fn data_error(e: tricept_data::DataError) -> CliError {
+    CliError::input(e.to_string())
+}
+
+/// The sources of `a`: the internal data and every external file.
+fn sources(
+    a: &IdentifyArgs,
+    machine: &tricept_kinematics::Machine,
+) -> Result<Vec<Source>, CliError> {
+    let x = &a.external;
+    let data = read_data(a.data.as_path(), machine)?;
+    let mut sources = vec![Source::internal(&data, machine.sensors.logged_sigma())];
+    let target = match x.tracker_target.as_str() {
+        "free" => TrackerTarget::Free,
+        "tip" => TrackerTarget::Known {
+            offset_mm: [0.0; 3],
+            sigma_um: positive("--tracker-target-sigma-um", x.tracker_target_sigma_um)?,
+        },
+        text => {
+            let v = parse_numbers("--tracker-target", text, 3)?;
+            TrackerTarget::Known {
+                offset_mm: [v[0], v[1], v[2]],
+                sigma_um: positive("--tracker-target-sigma-um", x.tracker_target_sigma_um)?,
+            }
+        }
+    };
+    let tracker = TrackerOptions {
+        sigma_um: positive("--tracker-sigma-um", x.tracker_sigma_um)?,
+        target,
+    };
+    sources.extend(external_sources(
+        &x.tracker,
+        "tracker",
+        machine,
+        |r: &TrackerPoint| (r.line, r.pose.commands_mm),
+        |d| Source::tracker(d, &tracker),
+    )?);
+    let length_sigma_um = match x.ballbar_length_sigma_um.as_str() {
+        "free" => None,
+        text => Some(positive(
+            "--ballbar-length-sigma-um",
+            text.parse().map_err(|_| {
+                CliError::input(format!(
+                    "--ballbar-length-sigma-um: expected a number of um or `free`, got `{text}`"
+                ))
+            })?,
+        )?),
+    };
+    let ball = match &x.ballbar_ball_mm {
+        Some(t) => {
+            let v = parse_numbers("--ballbar-ball-mm", t, 3)?;
+            [v[0], v[1], v[2]]
+        }
+        None => [0.0; 3],
+    };
+    let ballbar = BallbarOptions {
+        sigma_um: positive("--ballbar-sigma-um", x.ballbar_sigma_um)?,
+        length_sigma_um,
+        ball_offset_mm: ball,
+    };
+    sources.extend(external_sources(
+        &x.ballbar,
+        "ballbar",
+        machine,
+        |r: &BallbarReading| (r.line, r.pose.commands_mm),
+        |d| Source::ballbar(d, &ballbar),
+    )?);
+    if !x.touch.is_empty() {
+        let Some(features) = &x.features else {
+            return Err(CliError::input(
+                "--touch needs --features FILE.json (the spheres and planes touched)",
+            ));
+        };
+        let features = Features::from_path(features).map_err(data_error)?;
+        let touch = TouchOptions {
+            sigma_um: positive("--touch-sigma-um", x.touch_sigma_um)?,
+        };
+        sources.extend(external_sources(
+            &x.touch,
+            "touch",
+            machine,
+            |r: &TouchReading| (r.line, r.pose.commands_mm),
+            |d| Source::touch(d, &features, &touch),
+        )?);
+    }
+    Ok(sources)
+}
+
+/// Reads the external files `paths` of one kind, checks their commands
+/// against the leg stroke (`at` gives a record's line and commands) and
+/// makes each a source labelled `kind`, `kind2`, ...
+fn external_sources<T: ExternalRecord>(
+    paths: &[PathBuf],
+    kind: &str,
+    machine: &tricept_kinematics::Machine,
+    at: impl Fn(&T) -> (u64, [f64; 3]),
+    source: impl Fn(&ExternalData<T>) -> Result<Source, IdentError>,
+) -> Result<Vec<Source>, CliError> {
+    paths
+        .iter()
+        .enumerate()
+        .map(|(k, path)| {
+            let d = tricept_data::read_external_path::<T>(path).map_err(data_error)?;
+            check_commands(&d.source, d.records.iter().map(&at), machine)?;
+            let label = if k == 0 {
+                kind.to_string()
+            } else {
+                format!("{kind}{}", k + 1)
+            };
+            Ok(source(&d).map_err(fusion_error)?.with_label(label))
+        })
+        .collect()
+}
+
+/// The fused model of `a`.
+pub fn fused_model(
+    machine: &tricept_kinematics::Machine,
+    params: &tricept_model::ParameterSet,
+    effects: &[String],
+    head: Option<&str>,
+) -> Result<FusedModel, CliError> {
+    let head = match head.unwrap_or("head13") {
+        "head13" => true,
+        "none" => false,
+        other => {
+            return Err(CliError::input(format!(
+                "--head: expected head13 or none, got `{other}`"
+            )));
+        }
+    };
+    FusedModel::new(
+        machine.clone(),
+        params.clone(),
+        &parse_effect_names(effects)?,
+        head,
+    )
+    .map_err(fusion_error)
+}
+
+/// The evaluation poses of `--eval-grid` and `--eval-head-angles-deg`.
+pub fn eval_options(
+    machine: &tricept_kinematics::Machine,
+    grid: &str,
+    angles: &str,
+) -> Result<FusionOptions, CliError> {
+    let g = parse_numbers("--eval-grid", grid, 3)?;
+    if g.iter().any(|v| *v < 0.0 || v.fract() != 0.0) || g[2] < 1.0 {
+        return Err(CliError::input(format!(
+            "--eval-grid: expected whole numbers RINGS,PER_RING,LEVELS, got `{grid}`"
+        )));
+    }
+    let (h1, h2) = parse_head_angles("--eval-head-angles-deg", angles)?;
+    let mut options = FusionOptions::for_machine(machine);
+    options.eval_poses = evaluation_poses(
+        machine,
+        (g[0] as usize, g[1] as usize, g[2] as usize),
+        &h1,
+        &h2,
+    );
+    if options.eval_poses.is_empty() {
+        return Err(CliError::input("--eval-grid: no reachable evaluation pose"));
+    }
+    Ok(options)
+}
+
+/// `tricept identify` with external data.
+pub fn run(a: &IdentifyArgs) -> Result<u8, CliError> {
+    let machine = machine_with_noise(&a.settings.machine, &a.settings.noise)?;
+    let set = a.settings.params.set()?;
+    let x = &a.external;
+    let model = fused_model(&machine, &set, &x.effects, x.head.as_deref())?;
+    let options = eval_options(&machine, &x.eval_grid, &x.eval_head_angles_deg)?;
+    let sources = sources(a, &machine)?;
+    let fit = identify_fused(&model, &sources, &options).map_err(fusion_error)?;
+    let deployed = match &a.write_machine {
+        Some(path) => Some(write_machine(path, &model, &fit, &sources)?),
+        None => None,
+    };
+    if a.settings.machine.json {
+        let mut v = fit.to_json(&model);
+        if let (Value::Object(o), Some(d)) = (&mut v, &deployed) {
+            o.insert("deployed".into(), d.clone());
+        }
+        outln!("{v}");
+    } else {
+        print_text(&model, &fit, &sources);
+    }
+    for w in &fit.warnings {
+        errln!("warning: {w}");
+    }
+    // The exit codes of `identify`: 4 not converged, 3 converged but a
+    // source not explained.
+    if !fit.converged {
+        errln!("identify: exit {EXIT_NOT_CONVERGED}: the fused fit did not converge");
+        return Ok(EXIT_NOT_CONVERGED);
+    }
+    if !fit.is_trustworthy() {
+        errln!(
+            "identify: exit {EXIT_UNTRUSTED}: the fit completed but must not be trusted as it stands (see the warnings)"
+        );
+        return Ok(EXIT_UNTRUSTED);
+    }
+    Ok(0)
+}
+
+fn print_text(model: &FusedModel, fit: &Fusion, sources: &[Source]) {
+    let list: Vec<String> = sources
+        .iter()
+        .map(|s| format!("{} {} ({} records)", s.label(), s.file(), s.records()))
+        .collect();
+    outln!("fused identification: {}", list.join(", "));
+    let effects: Vec<&str> = model.effects().iter().map(|e| e.as_str()).collect();
+    outln!(
+        "model: {}{}{}; {} in {} Gauss-Newton iterations",
+        model.module().label(),
+        if effects.is_empty() {
+            String::new()
+        } else {
+            format!(" + {}", effects.join(", "))
+        },
+        if model.head().is_some() {
+            " + head13"
+        } else {
+            ""
+        },
+        if fit.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        },
+        fit.iterations
+    );
+    outln!("{:>34} {:>14} {:>12}", "parameter", "estimate", "sd");
+    for ((n, v), sd) in fit.names.iter().zip(&fit.estimate).zip(&fit.std_dev) {
+        match sd {
+            Some(s) => outln!("{n:>34} {v:>14.6e} {s:>12.3e}"),
+            None => outln!("{n:>34} {v:>14.6e} {:>12}", "held"),
+        }
+    }
+    for s in &fit.sources {
+        outln!(
+            "{} ({}): chi2/dof {:.3} (dof {:.1}){}; largest {:.1} sigma at line {}",
+            s.label,
+            s.file,
+            s.reduced_chi_square,
+            s.dof_share,
+            s.rms_um
+                .map(|r| format!(", rms {r:.2} um"))
+                .unwrap_or_default(),
+            s.max_standardised.0,
+            s.max_standardised.1
+        );
+        for ((n, v), sd) in s
+            .nuisance_names
+            .iter()
+            .zip(&s.nuisance)
+            .zip(&s.nuisance_std_dev)
+        {
+            outln!("  {n:>32} {v:>14.6e} {sd:>12.3e}");
+        }
+    }
+    crate::output::write_text(&fit.report.to_text());
+    for w in &fit.warnings {
+        outln!("warning: {w}");
+    }
+}
+
+/// Writes the calibrated machine: the module explicit, the head's fields
+/// and angle offsets from the estimate. Refuses fitted effects, which the
+/// machine format cannot carry.
+fn write_machine(
+    path: &Path,
+    model: &FusedModel,
+    fit: &Fusion,
+    sources: &[Source],
+) -> Result<Value, CliError> {
+    if !model.effects().is_empty() {
+        let names: Vec<&str> = model.effects().iter().map(|e| e.as_str()).collect();
+        return Err(CliError::input(format!(
+            "--write-machine: {} fitted, but the machine format cannot carry {}; write a geometric fit (without --effects) or compensate with the fused model",
+            names.join(", "),
+            if names.len() == 1 { "it" } else { "them" }
+        )));
+    }
+    let held: Vec<String> = fit
+        .std_dev
+        .iter()
+        .zip(&fit.names)
+        .filter(|(sd, _)| sd.is_none())
+        .map(|(_, n)| n.clone())
+        .collect();
+    let mut d = model.machine_at(&fit.estimate).to_description();
+    let files: Vec<&str> = sources.iter().map(|s| s.file()).collect();
+    d.notes = Some(format!(
+        "identified from {}; held at nominal (not seen by the data): {}",
+        files.join(", "),
+        if held.is_empty() {
+            "none".to_string()
+        } else {
+            held.join(", ")
+        }
+    ));
+    std::fs::write(path, d.to_json())
+        .map_err(|e| CliError::other(format!("{}: {e}", path.display())))?;
+    Ok(json!({"written": path.display().to_string(), "held_at_nominal": held}))
+}

@@ -1,0 +1,42 @@
+//! Fusing the self-calibration with a few external measurements, and
+//! calibrating the head.
+//!
+//! The UP limb's sensors cannot see the head at all, nor the machine's
+//! scale when leg-lead and scale-gain are modelled, and they see one
+//! combination (all three leg lengths together) only weakly. A laser
+//! tracker, a ballbar or touch-offs on reference features measure the tool
+//! (or a point in the spindle) from outside. [`identify_fused`] fits the
+//! module's parameters, the effects a diagnosis named, the head's 13
+//! parameters ([`tricept_model::HeadParameterSet`]) and every instrument's
+//! nuisance parameters in one weighted least-squares problem on the exact
+//! model, each source with its own noise, and reports what each source and
+//! their union can see ([`FusionReport`]) and how uncertain the tool tip
+//! is.
+//!
+//! - [`FusedModel`]: the global parameters `[module | effects | head]`.
+//! - [`Source`]: one data source; `Source::internal`, `Source::tracker`,
+//!   `Source::ballbar`, `Source::touch`.
+//! - [`identify_fused`] and its result [`Fusion`].
+//!
+//! Lengths in mm, angles in rad, instrument noise in um.
+
+mod ballbar;
+mod estimate;
+mod model;
+mod report;
+mod source;
+mod touch;
+mod tracker;
+
+pub use ballbar::BallbarOptions;
+pub use estimate::{
+    DesignRows, Fusion, FusionOptions, SourceFit, UNEXPLAINED_REDUCED_CHI_SQUARE, design_rows,
+    evaluation_poses, head_angle_poses, identify_fused, information,
+};
+pub use model::{FUSABLE_EFFECTS, FusedModel};
+pub use report::{
+    FusionReport, MadeVisible, NamedQuantity, SourceVisibility, TipImpact, ToolTipPrediction,
+};
+pub use source::{Source, SourceKind};
+pub use touch::TouchOptions;
+pub use tracker::{TrackerOptions, TrackerTarget};

@@ -1,0 +1,516 @@
+//! What the sources of a fused identification can see, alone and together,
+//! and what it means for the tool tip.
+//!
+//! Everything is computed on the weighted problems at the starting point
+//! (each source's nuisance projected out, columns scaled to unit norm),
+//! like [`crate::IdentifiabilityReport`]:
+//!
+//! - **each source alone and the union**: rank, unidentifiable and weak
+//!   combinations (one `IdentifiabilityReport` each);
+//! - **made visible**: with an internal source, which parameters it holds
+//!   at the prior alone but the union with each other source determines;
+//! - **named quantities**: every head and effect parameter and
+//!   `dq1 + dq2 + dq3` (the internal weak direction's core), each a linear
+//!   function `c . p` of the parameters; its standard deviation per source
+//!   and in the union when the source can see it (`c` orthogonal to the
+//!   source's null space, checked on the rank-revealing basis; otherwise
+//!   reported as invisible, never as a pseudo-inverse number);
+//! - **tool-tip impact** of every weak combination (per standard deviation
+//!   along it) and every invisible one (with its largest term at its
+//!   parameter's typical size, [`FusedModel::typical_sizes`]): the RMS over
+//!   the evaluation poses of the tool tip's displacement, raw and after
+//!   touch-off (the mean displacement removed: what locating the part with
+//!   the machine itself makes irrelevant);
+//! - **the tool tip's predicted uncertainty** over the evaluation poses,
+//!   raw and after touch-off, from the covariance of the estimate, and the
+//!   held parameters that move the tip (not calibrated).
+
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+use serde_json::Value;
+use tricept_model::Effector;
+use tricept_numerics::lsq::{RankDecision, ReducedProblem};
+
+use crate::error::IdentError;
+use crate::fusion::estimate::{FusionOptions, merge};
+use crate::fusion::model::FusedModel;
+use crate::fusion::source::{Source, SourceKind};
+use crate::report::{Combination, IdentifiabilityReport, NamedValues, combination};
+
+/// One source's identifiability on its own.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SourceVisibility {
+    /// The source's label.
+    pub label: String,
+    /// Its identifiability report (its own nuisance projected out).
+    pub report: IdentifiabilityReport,
+}
+
+/// What one external source adds to the internal data.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MadeVisible {
+    /// The external source's label.
+    pub label: String,
+    /// Rank of the internal data alone.
+    pub internal_rank: usize,
+    /// Rank of the internal data with this source.
+    pub rank_with_internal: usize,
+    /// Parameters the internal data hold at the prior that the union with
+    /// this source determines.
+    pub parameters: Vec<String>,
+}
+
+/// A named linear function of the parameters and how well each source
+/// determines it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NamedQuantity {
+    /// Name (a parameter's, or a sum such as `dq1 + dq2 + dq3`).
+    pub name: String,
+    /// Standard deviation by source label (`null`: invisible to it), in the
+    /// quantity's unit.
+    pub std_dev: NamedValues,
+    /// Standard deviation in the union (`None`: invisible).
+    pub union: Option<f64>,
+    /// `std_dev[internal] / union` (`None` when either is invisible).
+    pub gain: Option<f64>,
+}
+
+/// How much a combination of parameters moves the tool tip.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TipImpact {
+    /// `union` or a source label: whose weak or invisible combination.
+    pub scope: String,
+    /// The combination (largest coefficient 1).
+    pub combination: Combination,
+    /// True for a weak combination (impact per standard deviation along
+    /// it); false for an invisible one (impact when its largest term is at
+    /// its parameter's typical size, [`FusedModel::typical_sizes`]).
+    pub per_std_dev: bool,
+    /// RMS tool-tip displacement over the evaluation poses, um.
+    pub raw_um: f64,
+    /// The same after touch-off (mean displacement removed), um.
+    pub touch_off_um: f64,
+    /// Whether `touch_off_um` is below the harmless threshold.
+    pub harmless: bool,
+}
+
+/// The tool tip's predicted standard deviation over the evaluation poses.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ToolTipPrediction {
+    /// Number of evaluation poses.
+    pub poses: usize,
+    /// RMS over the poses of the tip's standard deviation (square root of
+    /// the covariance's trace), um.
+    pub raw_rms_um: f64,
+    /// Largest over the poses, um.
+    pub raw_max_um: f64,
+    /// RMS after touch-off, um.
+    pub touch_off_rms_um: f64,
+    /// Largest after touch-off, um.
+    pub touch_off_max_um: f64,
+    /// Parameters held at nominal whose invisible combination, at typical
+    /// size, moves the tool tip by the harmless threshold or more: the tip
+    /// is not calibrated in those directions, whatever the numbers above
+    /// say.
+    pub held_moving_tip: Vec<String>,
+}
+
+/// The fused identifiability report (see the module docs).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FusionReport {
+    /// The union of every source.
+    pub union: IdentifiabilityReport,
+    /// Each source alone.
+    pub sources: Vec<SourceVisibility>,
+    /// What each external source adds to the internal data.
+    pub made_visible: Vec<MadeVisible>,
+    /// Named quantities, per source and in the union.
+    pub named: Vec<NamedQuantity>,
+    /// Tool-tip impact of the weak combinations of the union and of the
+    /// internal data alone.
+    pub weak: Vec<TipImpact>,
+    /// Tool-tip impact of the union's invisible combinations.
+    pub invisible: Vec<TipImpact>,
+    /// The tool tip's predicted uncertainty.
+    pub tool_tip: ToolTipPrediction,
+}
+
+/// A reduced problem's rank decision and the covariance of its global
+/// parameters (basic solution: held parameters zero).
+struct Decided {
+    decision: RankDecision,
+    covariance: DMatrix<f64>,
+    report: IdentifiabilityReport,
+}
+
+fn decide(
+    names: &[String],
+    problem: &ReducedProblem,
+    records: usize,
+    options: &FusionOptions,
+) -> Result<Decided, IdentError> {
+    let decision = problem
+        .decide(options.rank_tolerance)
+        .ok_or(IdentError::Numerical("SVD did not converge"))?;
+    let solution = problem.solve(&decision);
+    let nn = problem.n_nuisance;
+    let k = problem.k;
+    let report = IdentifiabilityReport::new(
+        names,
+        &decision,
+        &solution,
+        nn,
+        problem.rows,
+        records,
+        options.weak_threshold,
+    );
+    Ok(Decided {
+        covariance: DMatrix::from_fn(k, k, |a, b| solution.covariance[(nn + a, nn + b)]),
+        decision,
+        report,
+    })
+}
+
+/// Standard deviation of `c . p` under a decision, or `None` when `c` is
+/// not orthogonal to the null space (the data cannot see it).
+fn functional_std(decision: &RankDecision, covariance: &DMatrix<f64>, c: &[f64]) -> Option<f64> {
+    // In the column-scaled coordinates of the rank decision, where the
+    // comparison does not depend on units: c / scale against n * scale.
+    let scale = &decision.column_scale;
+    let norm = |v: &mut dyn Iterator<Item = f64>| v.map(|x| x * x).sum::<f64>().sqrt();
+    let c_norm = norm(&mut c.iter().zip(scale).map(|(a, s)| a / s));
+    for n in decision.null_space_basis() {
+        let dot: f64 = c.iter().zip(&n).map(|(a, b)| a * b).sum();
+        let n_norm = norm(&mut n.iter().zip(scale).map(|(a, s)| a * s));
+        if dot.abs() > 1e-6 * c_norm * n_norm {
+            return None;
+        }
+    }
+    let v = DVector::from_column_slice(c);
+    Some((v.transpose() * covariance * &v)[(0, 0)].max(0.0).sqrt())
+}
+
+/// The tool tip's Jacobians over the evaluation poses at `p` (3 x k each).
+fn tip_jacobians(
+    model: &FusedModel,
+    p: &[f64],
+    options: &FusionOptions,
+) -> Result<Vec<DMatrix<f64>>, IdentError> {
+    options
+        .eval_poses
+        .iter()
+        .map(|pose| Ok(model.spindle_point(p, pose, &Effector::default())?.1))
+        .collect()
+}
+
+/// `(raw, after touch-off)` RMS over the poses of `G_e v`, in the units of
+/// `G v` (mm).
+fn impact(g: &[DMatrix<f64>], mean: &DMatrix<f64>, v: &[f64]) -> (f64, f64) {
+    let v = DVector::from_column_slice(v);
+    let n = g.len().max(1) as f64;
+    let centre = mean * &v;
+    let (mut raw, mut touched) = (0.0, 0.0);
+    for ge in g {
+        let d = ge * &v;
+        raw += d.norm_squared();
+        touched += (d - &centre).norm_squared();
+    }
+    ((raw / n).sqrt(), (touched / n).sqrt())
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn build_report(
+    model: &FusedModel,
+    sources: &[Source],
+    start_parts: &[ReducedProblem],
+    union_decision: &RankDecision,
+    union_report: IdentifiabilityReport,
+    estimate: &[f64],
+    covariance: &DMatrix<f64>,
+    options: &FusionOptions,
+) -> Result<FusionReport, IdentError> {
+    let names = model.names();
+    let k = names.len();
+    let alone: Vec<Decided> = sources
+        .iter()
+        .zip(start_parts)
+        .map(|(s, part)| decide(names, part, s.records(), options))
+        .collect::<Result<_, _>>()?;
+    let internal = sources
+        .iter()
+        .position(|s| s.kind() == SourceKind::Internal);
+
+    let mut made_visible = Vec::new();
+    if let Some(i) = internal {
+        for (s, source) in sources.iter().enumerate() {
+            if s == i {
+                continue;
+            }
+            let both = merge(&[&start_parts[i], &start_parts[s]]);
+            let d = decide(
+                names,
+                &both,
+                sources[i].records() + source.records(),
+                options,
+            )?;
+            made_visible.push(MadeVisible {
+                label: source.label().to_string(),
+                internal_rank: alone[i].decision.rank,
+                rank_with_internal: d.decision.rank,
+                parameters: alone[i]
+                    .decision
+                    .fixed
+                    .iter()
+                    .filter(|j| d.decision.identifiable.contains(j))
+                    .map(|&j| names[j].clone())
+                    .collect(),
+            });
+        }
+    }
+
+    let mut functionals: Vec<(String, Vec<f64>)> = Vec::new();
+    let dq: Vec<usize> = ["dq1", "dq2", "dq3"]
+        .iter()
+        .filter_map(|n| model.index_of(n))
+        .collect();
+    if dq.len() == 3 {
+        let mut c = vec![0.0; k];
+        dq.iter().for_each(|&j| c[j] = 1.0);
+        functionals.push(("dq1 + dq2 + dq3".into(), c));
+    }
+    for j in model.effect_range().chain(model.head_range()) {
+        let mut c = vec![0.0; k];
+        c[j] = 1.0;
+        functionals.push((names[j].clone(), c));
+    }
+    let named = functionals
+        .into_iter()
+        .map(|(name, c)| {
+            let per: Vec<Option<f64>> = alone
+                .iter()
+                .map(|d| functional_std(&d.decision, &d.covariance, &c))
+                .collect();
+            let union = functional_std(union_decision, covariance, &c);
+            let labels: Vec<String> = sources.iter().map(|s| s.label().to_string()).collect();
+            let gain = internal.and_then(|i| per[i]).zip(union).map(|(a, b)| a / b);
+            NamedQuantity {
+                name,
+                std_dev: NamedValues::new(&labels, &per),
+                union,
+                gain,
+            }
+        })
+        .collect();
+
+    let g = tip_jacobians(model, estimate, options)?;
+    let n_poses = g.len().max(1) as f64;
+    let mean = g.iter().fold(DMatrix::zeros(3, k), |a, b| a + b) / n_poses;
+    let harmless = |touch_off_um: f64| touch_off_um < options.harmless_um;
+    let mut weak = Vec::new();
+    let mut scopes: Vec<(String, &RankDecision, &IdentifiabilityReport)> =
+        vec![("union".to_string(), union_decision, &union_report)];
+    if let Some(i) = internal {
+        if sources.len() > 1 {
+            scopes.push((
+                sources[i].label().to_string(),
+                &alone[i].decision,
+                &alone[i].report,
+            ));
+        }
+    }
+    for (scope, d, report) in &scopes {
+        let top = d.singular_values.first().copied().unwrap_or(0.0);
+        for i in 0..d.rank {
+            let s = d.singular_values[i];
+            if s >= report.weak_threshold * top {
+                continue;
+            }
+            let v: Vec<f64> = d.direction(i).iter().map(|x| x / s).collect();
+            let (raw, touched) = impact(&g, &mean, &v);
+            weak.push(TipImpact {
+                scope: scope.clone(),
+                combination: combination(names, &v, s, None),
+                per_std_dev: true,
+                raw_um: 1e3 * raw,
+                touch_off_um: 1e3 * touched,
+                harmless: harmless(1e3 * touched),
+            });
+        }
+    }
+    let typical = model.typical_sizes();
+    let invisible: Vec<TipImpact> = union_decision
+        .null_space_basis()
+        .iter()
+        .zip(&union_decision.singular_values[union_decision.rank..])
+        .map(|(v, s)| {
+            let largest = v
+                .iter()
+                .zip(&typical)
+                .fold(0.0f64, |a, (b, t)| a.max((b / t).abs()));
+            let unit: Vec<f64> = v.iter().map(|x| x / largest).collect();
+            let (raw, touched) = impact(&g, &mean, &unit);
+            TipImpact {
+                scope: "union".into(),
+                combination: combination(names, v, *s, None),
+                per_std_dev: false,
+                raw_um: 1e3 * raw,
+                touch_off_um: 1e3 * touched,
+                harmless: harmless(1e3 * touched),
+            }
+        })
+        .collect();
+
+    let (mut raw2, mut touched2, mut raw_max, mut touched_max) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for ge in &g {
+        let a = (ge * covariance * ge.transpose()).trace().max(0.0);
+        let gt = ge - &mean;
+        let b = (&gt * covariance * gt.transpose()).trace().max(0.0);
+        raw2 += a;
+        touched2 += b;
+        raw_max = raw_max.max(a.sqrt());
+        touched_max = touched_max.max(b.sqrt());
+    }
+    // A held parameter leaves the tip uncalibrated when its invisible
+    // combination, at typical size, moves the tip more than is harmless.
+    let held_moving_tip = union_decision
+        .fixed
+        .iter()
+        .zip(&invisible)
+        .filter(|(_, t)| t.raw_um >= options.harmless_um)
+        .map(|(&j, _)| names[j].clone())
+        .collect();
+    Ok(FusionReport {
+        union: union_report,
+        sources: sources
+            .iter()
+            .zip(alone)
+            .map(|(s, d)| SourceVisibility {
+                label: s.label().to_string(),
+                report: d.report,
+            })
+            .collect(),
+        made_visible,
+        named,
+        weak,
+        invisible,
+        tool_tip: ToolTipPrediction {
+            poses: g.len(),
+            raw_rms_um: 1e3 * (raw2 / n_poses).sqrt(),
+            raw_max_um: 1e3 * raw_max,
+            touch_off_rms_um: 1e3 * (touched2 / n_poses).sqrt(),
+            touch_off_max_um: 1e3 * touched_max,
+            held_moving_tip,
+        },
+    })
+}
+
+impl FusionReport {
+    /// Warnings a user must read: held parameters that move the tool tip.
+    pub fn warnings(&self) -> Vec<String> {
+        let held = &self.tool_tip.held_moving_tip;
+        if held.is_empty() {
+            return Vec::new();
+        }
+        vec![format!(
+            "the tool tip is not calibrated in every direction: {} held at nominal (no source sees {}); the predicted tool-tip uncertainty leaves them out",
+            held.join(", "),
+            if held.len() == 1 { "it" } else { "them" }
+        )]
+    }
+
+    /// The report as JSON (`union`, `per_source`, `made_visible`, `named`,
+    /// `weak`, `invisible`, `tool_tip`).
+    pub fn to_json(&self) -> Value {
+        let mut v = serde_json::to_value(self).unwrap_or(Value::Null);
+        if let Value::Object(o) = &mut v {
+            if let Some(s) = o.remove("sources") {
+                o.insert("per_source".into(), s);
+            }
+        }
+        v
+    }
+
+    /// A human-readable summary.
+    pub fn to_text(&self) -> String {
+        let mut s = String::new();
+        let ranks: Vec<String> = self
+            .sources
+            .iter()
+            .map(|v| format!("{} {}/{}", v.label, v.report.rank, v.report.n_params))
+            .collect();
+        s.push_str(&format!(
+            "rank: {}, union {}/{} (tolerance {:.0e})\n",
+            ranks.join(", "),
+            self.union.rank,
+            self.union.n_params,
+            self.union.rank_tolerance
+        ));
+        for m in &self.made_visible {
+            s.push_str(&format!(
+                "made visible by {} (internal rank {} -> {}): {}\n",
+                m.label,
+                m.internal_rank,
+                m.rank_with_internal,
+                if m.parameters.is_empty() {
+                    "nothing".to_string()
+                } else {
+                    m.parameters.join(" ")
+                }
+            ));
+        }
+        if !self.invisible.is_empty() {
+            s.push_str(
+                "still invisible (held at the prior), tool-tip impact at the parameters' typical size:\n",
+            );
+            for t in &self.invisible {
+                s.push_str(&format!(
+                    "  {}   raw {:.1} um, after touch-off {:.1} um{}\n",
+                    t.combination.to_text(),
+                    t.raw_um,
+                    t.touch_off_um,
+                    if t.harmless { ": harmless" } else { "" }
+                ));
+            }
+        }
+        if !self.weak.is_empty() {
+            s.push_str("weak combinations, tool-tip impact per standard deviation:\n");
+            for t in &self.weak {
+                s.push_str(&format!(
+                    "  [{}] {}\n      raw {:.1} um, after touch-off {:.1} um{}\n",
+                    t.scope,
+                    t.combination.to_text(),
+                    t.raw_um,
+                    t.touch_off_um,
+                    if t.harmless {
+                        ": nearly harmless to the tool tip"
+                    } else {
+                        ""
+                    }
+                ));
+            }
+        }
+        if !self.named.is_empty() {
+            let labels: Vec<&str> = self.sources.iter().map(|v| v.label.as_str()).collect();
+            s.push_str(&format!(
+                "standard deviations ({} | union; - = invisible):\n",
+                labels.join(" | ")
+            ));
+            let show = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.3e}"));
+            for q in &self.named {
+                let per: Vec<String> = q.std_dev.0.iter().map(|(_, v)| show(*v)).collect();
+                s.push_str(&format!(
+                    "  {:<34} {} | {}\n",
+                    q.name,
+                    per.join(" | "),
+                    show(q.union)
+                ));
+            }
+        }
+        let t = &self.tool_tip;
+        s.push_str(&format!(
+            "predicted tool tip ({} poses): raw rms {:.1} um (max {:.1}), after touch-off rms {:.1} um (max {:.1})\n",
+            t.poses, t.raw_rms_um, t.raw_max_um, t.touch_off_rms_um, t.touch_off_max_um
+        ));
+        s
+    }
+}
