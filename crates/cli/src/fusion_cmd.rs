@@ -19,12 +19,12 @@ use tricept_ident::fusion::{
 use tricept_model::effects::EffectName;
 
 use crate::args::{check_commands, machine_with_noise, read_data};
-use crate::cli_error::CliError;
+use crate::cli_error::{CliError, EXIT_NOT_CONVERGED};
 use crate::ident_cmd::IdentifyArgs;
 
-/// Exit code of a fit that completed but that the user must not trust as
-/// it stands: a source the model does not explain, or no convergence.
-pub const EXIT_UNTRUSTED: u8 = 3;
+/// Exit code of a fit that converged but that the user must not trust as
+/// it stands: a source the model does not explain (`identify`'s 3).
+pub const EXIT_UNTRUSTED: u8 = crate::cli_error::EXIT_INADEQUATE;
 
 /// External measurements and the head (options of `tricept identify`).
 #[derive(Debug, Args, Clone, Default)]
@@ -164,7 +164,7 @@ fn sources(
     machine: &tricept_kinematics::Machine,
 ) -> Result<Vec<Source>, CliError> {
     let x = &a.external;
-    let data = read_data(a.input.data.as_path(), machine)?;
+    let data = read_data(a.data.as_path(), machine)?;
     let mut sources = vec![Source::internal(&data, machine.sensors.logged_sigma())];
     let target = match x.tracker_target.as_str() {
         "free" => TrackerTarget::Free,
@@ -320,9 +320,9 @@ pub fn eval_options(
 }
 
 /// `tricept identify` with external data.
-pub fn run(a: &IdentifyArgs) -> Result<(), CliError> {
-    let machine = machine_with_noise(&a.input.machine, &a.input.noise)?;
-    let set = a.input.params.set()?;
+pub fn run(a: &IdentifyArgs) -> Result<u8, CliError> {
+    let machine = machine_with_noise(&a.settings.machine, &a.settings.noise)?;
+    let set = a.settings.params.set()?;
     let x = &a.external;
     let model = fused_model(&machine, &set, &x.effects, x.head.as_deref())?;
     let options = eval_options(&machine, &x.eval_grid, &x.eval_head_angles_deg)?;
@@ -332,7 +332,7 @@ pub fn run(a: &IdentifyArgs) -> Result<(), CliError> {
         Some(path) => Some(write_machine(path, &model, &fit, &sources)?),
         None => None,
     };
-    if a.input.machine.json {
+    if a.settings.machine.json {
         let mut v = fit.to_json(&model);
         if let (Value::Object(o), Some(d)) = (&mut v, &deployed) {
             o.insert("deployed".into(), d.clone());
@@ -342,16 +342,21 @@ pub fn run(a: &IdentifyArgs) -> Result<(), CliError> {
         print_text(&model, &fit, &sources);
     }
     for w in &fit.warnings {
-        eprintln!("warning: {w}");
+        errln!("warning: {w}");
+    }
+    // The exit codes of `identify`: 4 not converged, 3 converged but a
+    // source not explained.
+    if !fit.converged {
+        errln!("identify: exit {EXIT_NOT_CONVERGED}: the fused fit did not converge");
+        return Ok(EXIT_NOT_CONVERGED);
     }
     if !fit.is_trustworthy() {
-        return Err(CliError {
-            code: EXIT_UNTRUSTED,
-            message: "the fit completed but must not be trusted as it stands (see the warnings)"
-                .into(),
-        });
+        errln!(
+            "identify: exit {EXIT_UNTRUSTED}: the fit completed but must not be trusted as it stands (see the warnings)"
+        );
+        return Ok(EXIT_UNTRUSTED);
     }
-    Ok(())
+    Ok(0)
 }
 
 fn print_text(model: &FusedModel, fit: &Fusion, sources: &[Source]) {
@@ -410,7 +415,7 @@ fn print_text(model: &FusedModel, fit: &Fusion, sources: &[Source]) {
             outln!("  {n:>32} {v:>14.6e} {sd:>12.3e}");
         }
     }
-    print!("{}", fit.report.to_text());
+    crate::output::write_text(&fit.report.to_text());
     for w in &fit.warnings {
         outln!("warning: {w}");
     }
