@@ -253,7 +253,7 @@ fn write_extended(
     let description = machine_file::calibrated_description(
         loaded,
         &deployed.machine,
-        &deployed.id,
+        &machine_file::FitRecord::of_identification(&deployed.id),
         machine_file::Provenance {
             method: "diagnose",
             data_file: data,
@@ -264,6 +264,7 @@ fn write_extended(
             warnings,
             effects,
             n_geometric: g,
+            external: Vec::new(),
         },
         deployed.controller,
     )?;

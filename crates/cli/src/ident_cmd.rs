@@ -263,7 +263,7 @@ fn write_calibrated(path: &Path, data: &Path, fit: &Fit, force: bool) -> Result<
     let d = machine_file::calibrated_description(
         &fit.loaded,
         &fit.identified(),
-        &fit.id,
+        &machine_file::FitRecord::of_identification(&fit.id),
         machine_file::Provenance {
             method: "identify",
             data_file: data,
@@ -274,6 +274,7 @@ fn write_calibrated(path: &Path, data: &Path, fit: &Fit, force: bool) -> Result<
             warnings: fit.verdict.warnings.clone(),
             effects: Map::new(),
             n_geometric: fit.id.names.len(),
+            external: Vec::new(),
         },
         None,
     )?;

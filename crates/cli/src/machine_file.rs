@@ -5,11 +5,14 @@
 
 use std::path::Path;
 
+use nalgebra::DMatrix;
 use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
-use tricept_ident::Identification;
+use tricept_ident::fusion::{Fusion, SourceKind};
+use tricept_ident::{IdentifiabilityReport, Identification};
 use tricept_kinematics::description::{
-    CalibrationRecord, CorrelationsDescription, HeldParameter, SensorOffsetsDescription,
+    CalibrationRecord, CorrelationsDescription, ExternalSourceRecord, HeldParameter,
+    SensorOffsetsDescription,
 };
 use tricept_kinematics::{Machine, MachineDescription};
 
@@ -34,9 +37,73 @@ pub struct Provenance<'a> {
     pub warnings: Vec<String>,
     /// Effect parameters (`{name: {"value", "std_dev"}}`), for `diagnose`.
     pub effects: Map<String, Value>,
-    /// How many of the fit's parameters are geometric (the rest are
-    /// effects, recorded under `effects`).
+    /// How many of the fit's parameters are recorded as estimates (the
+    /// geometric ones, and the head's of a fused fit; the rest are effects,
+    /// recorded under `effects`).
     pub n_geometric: usize,
+    /// External measurement files of a fused fit: kind, file, records,
+    /// chi-square per degree of freedom.
+    pub external: Vec<(String, &'a Path, usize, f64)>,
+}
+
+/// What the record needs of a fit, whether from the UP limb's data alone
+/// ([`Identification`]) or fused with external measurements ([`Fusion`]).
+pub struct FitRecord<'a> {
+    names: &'a [String],
+    estimate: &'a [f64],
+    std_dev: &'a [Option<f64>],
+    covariance: &'a DMatrix<f64>,
+    report: &'a IdentifiabilityReport,
+    offsets: [f64; 3],
+    offsets_std_dev: [f64; 3],
+    chi2_per_dof: f64,
+    dof: usize,
+    converged: bool,
+    poses_used: usize,
+}
+
+impl<'a> FitRecord<'a> {
+    /// The record of an identification from the UP limb's data.
+    pub fn of_identification(id: &'a Identification) -> FitRecord<'a> {
+        FitRecord {
+            names: &id.names,
+            estimate: &id.estimate,
+            std_dev: &id.std_dev,
+            covariance: &id.covariance,
+            report: &id.report,
+            offsets: id.offsets,
+            offsets_std_dev: id.offsets_std_dev,
+            chi2_per_dof: id.stats.reduced_chi_square,
+            dof: id.stats.dof,
+            converged: id.converged,
+            poses_used: id.residuals.len(),
+        }
+    }
+
+    /// The record of a fused fit: the union's report, the internal
+    /// source's sensor offsets, the chi-square per degree of freedom of all
+    /// sources together.
+    pub fn of_fusion(fit: &'a Fusion) -> FitRecord<'a> {
+        let internal = fit.sources.iter().find(|s| s.kind == SourceKind::Internal);
+        let pick = |v: &[f64]| -> [f64; 3] {
+            std::array::from_fn(|c| v.get(c).copied().unwrap_or(f64::NAN))
+        };
+        let chi2: f64 = fit.sources.iter().map(|s| s.chi_square).sum();
+        let dof: f64 = fit.sources.iter().map(|s| s.dof_share).sum();
+        FitRecord {
+            names: &fit.names,
+            estimate: &fit.estimate,
+            std_dev: &fit.std_dev,
+            covariance: &fit.covariance,
+            report: &fit.report.union,
+            offsets: internal.map_or([0.0; 3], |s| pick(&s.nuisance)),
+            offsets_std_dev: internal.map_or([0.0; 3], |s| pick(&s.nuisance_std_dev)),
+            chi2_per_dof: if dof > 0.0 { chi2 / dof } else { 0.0 },
+            dof: dof.round().max(0.0) as usize,
+            converged: fit.converged,
+            poses_used: internal.map_or(0, |s| s.records),
+        }
+    }
 }
 
 /// SHA-256 of a file's bytes, lower-case hex.
@@ -78,8 +145,8 @@ fn civil_from_days(z: i64) -> (i64, u32, u32) {
 }
 
 /// Why each held parameter was held, from the identifiability report.
-fn held(id: &Identification, reference: &str) -> Vec<HeldParameter> {
-    let r = &id.report;
+fn held(id: &FitRecord<'_>, reference: &str) -> Vec<HeldParameter> {
+    let r = id.report;
     let s1 = r.singular_values.first().copied().unwrap_or(0.0);
     r.fixed
         .iter()
@@ -111,11 +178,11 @@ fn held(id: &Identification, reference: &str) -> Vec<HeldParameter> {
 
 /// The correlation matrix of the estimated (not held) parameters among the
 /// first `n` of the fit.
-fn correlations(id: &Identification, n: usize) -> CorrelationsDescription {
+fn correlations(id: &FitRecord<'_>, n: usize) -> CorrelationsDescription {
     let free: Vec<usize> = (0..n.min(id.names.len()))
         .filter(|&j| id.std_dev[j].is_some())
         .collect();
-    let c = &id.covariance;
+    let c = id.covariance;
     CorrelationsDescription {
         names: free.iter().map(|&j| id.names[j].clone()).collect(),
         matrix: free
@@ -138,7 +205,7 @@ fn correlations(id: &Identification, n: usize) -> CorrelationsDescription {
 pub fn calibrated_description(
     base: &LoadedMachine,
     identified: &Machine,
-    id: &Identification,
+    id: &FitRecord<'_>,
     p: Provenance<'_>,
     controller: Option<tricept_kinematics::description::ControllerDescription>,
 ) -> Result<MachineDescription, CliError> {
@@ -194,13 +261,26 @@ pub fn calibrated_description(
             std_dev: id.offsets_std_dev,
         },
         held: held(id, &reference),
-        chi2_per_dof: id.stats.reduced_chi_square,
-        dof: id.stats.dof,
+        chi2_per_dof: id.chi2_per_dof,
+        dof: id.dof,
         converged: id.converged,
         adequate: p.adequate,
         forced: p.forced,
         warnings: p.warnings,
-        poses_used: id.residuals.len(),
+        poses_used: id.poses_used,
+        external_sources: p
+            .external
+            .iter()
+            .map(|(kind, file, records, chi2)| {
+                Ok(ExternalSourceRecord {
+                    kind: kind.clone(),
+                    file: file.display().to_string(),
+                    sha256: sha256_file(file)?,
+                    records: *records,
+                    chi2_per_dof: *chi2,
+                })
+            })
+            .collect::<Result<_, CliError>>()?,
         rejected_lines: p.rejected_lines,
         data_file: data_name,
         data_sha256: sha256_file(p.data_file)?,

@@ -225,6 +225,10 @@ pub struct CalibrationRecord {
     /// Lines of the data file rejected as gross errors.
     #[serde(default)]
     pub rejected_lines: Vec<u64>,
+    /// External measurements fused with the UP limb's data (tracker,
+    /// ballbar, touch-off files), when there were any.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub external_sources: Vec<ExternalSourceRecord>,
     /// The data file, as given on the command line.
     pub data_file: String,
     /// SHA-256 of the data file's bytes, hex.
@@ -237,6 +241,22 @@ pub struct CalibrationRecord {
     pub relative_to: String,
     /// The nominal machine of the rank rule.
     pub nominal: Box<MachineDescription>,
+}
+
+/// An external measurement file of a fused calibration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExternalSourceRecord {
+    /// `tracker`, `ballbar` or `touch`.
+    pub kind: String,
+    /// The file, as given on the command line.
+    pub file: String,
+    /// SHA-256 of its bytes, hex.
+    pub sha256: String,
+    /// Records used.
+    pub records: usize,
+    /// Its weighted chi-square per degree of freedom in the fused fit.
+    pub chi2_per_dof: f64,
 }
 
 fn is_zero3(v: &[f64; 3]) -> bool {
@@ -968,6 +988,7 @@ mod tests {
             warnings: Vec::new(),
             poses_used: 75,
             rejected_lines: Vec::new(),
+            external_sources: Vec::new(),
             data_file: "data.csv".into(),
             data_sha256: "0".repeat(64),
             date: "2026-11-23T00:00:00Z".into(),
