@@ -1,16 +1,26 @@
 //! `tricept diagnose` and `tricept detectability`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
+use serde_json::{Map, json};
 use tricept_diagnose::detect::{advise, realistic, term_detectability};
-use tricept_diagnose::{DiagnoseError, DiagnoseOptions, Plausibility, diagnose};
-use tricept_ident::GeometricModel;
+use tricept_diagnose::{
+    Candidate, DiagnoseError, DiagnoseOptions, ExtendedModel, Plausibility,
+    REFERENCE_TEMPERATURE_C, diagnose,
+};
+use tricept_ident::{GeometricModel, IdentifyOptions, identify};
+use tricept_kinematics::description::ControllerDescription;
+use tricept_model::effects::{CauseName, EffectName};
 use tricept_model::{GeometricErrors, ParameterSet};
 use tricept_plant::{Campaign, Effect, Plant, PoseOrder};
 
-use crate::args::{MachineArgs, NoiseArgs, machine_with_noise, pose_targets, read_data};
+use crate::args::{
+    LoadedMachine, MachineArgs, NoiseArgs, load_with_noise, machine_with_noise, pose_targets,
+    read_data,
+};
 use crate::cli_error::CliError;
+use crate::machine_file;
 
 /// `tricept diagnose`.
 #[derive(Debug, Args)]
@@ -39,6 +49,18 @@ pub struct DiagnoseArgs {
     /// reported as unexplained).
     #[arg(long)]
     pub no_dictionary: bool,
+    /// Write the calibrated machine of the final model: the geometric
+    /// estimate with the static effects named (leg-lead, compliance: applied
+    /// by ik, fk, tool-ik and compensate; ujoint-axes, tube-twist: in the
+    /// UP limb's description), the dynamic ones as controller parameters
+    /// (backlash per leg axis in um, thermal expansion in ppm/K from 20 °C),
+    /// and a `calibration` record. Refused when the data are not explained.
+    #[arg(long, value_name = "FILE.json")]
+    pub write_machine: Option<PathBuf>,
+    /// Write the machine even when the data are not explained; the file
+    /// says so.
+    #[arg(long, requires = "write_machine")]
+    pub force: bool,
     #[command(flatten)]
     pub noise: NoiseArgs,
     #[command(flatten)]
@@ -48,14 +70,15 @@ pub struct DiagnoseArgs {
 /// `tricept detectability`.
 #[derive(Debug, Args)]
 pub struct DetectabilityArgs {
-    /// Pose set (as for `identifiability`).
+    /// Pose set (as for `identifiability`; positions in mm).
     #[arg(long, default_value = "grid")]
     pub poses: String,
     /// Visit every pose twice, approaching from both directions.
     #[arg(long)]
     pub both_directions: bool,
-    /// Temperature change over the campaign, K (0: no thermal signature).
-    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
+    /// Temperature change over the campaign, K (0: no thermal signature;
+    /// negative: cooling).
+    #[arg(long, default_value_t = 2.0, value_name = "K")]
     pub temperature_drift: f64,
     #[command(flatten)]
     pub noise: NoiseArgs,
@@ -64,13 +87,15 @@ pub struct DetectabilityArgs {
 }
 
 /// `tricept diagnose`.
-pub fn run_diagnose(a: &DiagnoseArgs) -> Result<(), CliError> {
+pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
     let (machine, data) = (&a.machine, a.data.as_path());
-    let m = machine_with_noise(machine, &a.noise)?;
+    let loaded = load_with_noise(machine, &a.noise)?;
+    let m = loaded.machine.clone();
     let dataset = read_data(data, &m)?;
     let source = data.display().to_string();
     let mut options = DiagnoseOptions::for_machine(&m);
     options.noise_from_data = a.noise_from_data;
+    options.rank_reference = loaded.rank_reference()?;
     options.dictionary.enabled = !a.no_dictionary;
     if let Some(k) = a.temperature_noise {
         if !(k.is_finite() && k >= 0.0) {
@@ -110,12 +135,211 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<(), CliError> {
             .map_err(|e| CliError::other(e.to_string()))?;
         }
     }
+    let written = a
+        .write_machine
+        .as_ref()
+        .map(|path| write_extended(path, data, &loaded, &dataset, &d, a.force));
     if machine.json {
         outln!("{}", d.to_json());
-        return Ok(());
+    } else {
+        crate::output::write_text(&d.to_text(&source));
     }
-    print!("{}", d.to_text(&source));
-    Ok(())
+    match written {
+        Some(Err(e)) => Err(e),
+        // The verdict in the exit code as in identify's: 3 when the final
+        // model (geometric plus the named causes) leaves a misfit.
+        _ if !d.final_adequate => Ok(crate::cli_error::EXIT_INADEQUATE),
+        _ => Ok(0),
+    }
+}
+
+/// The deployable model of a diagnosis, refitted on its clean poses for
+/// the record's offsets, covariance and fit quality.
+pub struct Deployed {
+    /// The final model's identification.
+    pub id: tricept_ident::Identification,
+    /// The calibrated machine: geometry, class-2 effects, leg effects.
+    pub machine: tricept_kinematics::Machine,
+    /// The controller parameters of the dynamic effects, when any is named.
+    pub controller: Option<ControllerDescription>,
+}
+
+/// Fits the diagnosis' final model (its named causes on the geometric
+/// model) on the poses it kept, with the rank decision of `rank_reference`
+/// when `nominal` is itself calibrated, and maps every parameter to where
+/// it goes in a machine file.
+pub fn deploy(
+    nominal: &tricept_kinematics::Machine,
+    rank_reference: Option<tricept_kinematics::Machine>,
+    data: &tricept_data::Dataset,
+    d: &tricept_diagnose::Diagnosis,
+) -> Result<Deployed, CliError> {
+    let flagged: Vec<u64> = d
+        .causes
+        .iter()
+        .filter(|c| c.effect == CauseName::Catalogue(EffectName::Outliers))
+        .flat_map(|c| c.rows.iter().copied())
+        .collect();
+    let clean = data.subset(|j| !flagged.contains(&data.poses[j].line));
+    let candidates: Vec<Candidate> = d.model_effects().into_iter().map(Candidate).collect();
+    let mut geometric = GeometricModel::new(nominal.clone(), ParameterSet::paper15());
+    if let Some(reference) = rank_reference {
+        geometric = geometric.with_rank_reference(reference);
+    }
+    let model = ExtendedModel::new(geometric, &candidates);
+    let id = identify(&model, &clean, &IdentifyOptions::for_machine(nominal))
+        .map_err(|e| CliError::other(format!("the diagnosis' final model: {e}")))?;
+    let mut machine = model.machine_at(&id.estimate);
+    let mut controller: Option<ControllerDescription> = None;
+    for (name, value) in id.names.iter().zip(&id.estimate).skip(model.n_geometric()) {
+        let v = *value;
+        let leg = |i: usize| {
+            name.ends_with(&format!("{}_ppm", i + 1)) || name.ends_with(&format!("{}_um", i + 1))
+        };
+        match name.split_once('.') {
+            Some(("leg-lead", _)) => {
+                for i in 0..3 {
+                    if leg(i) {
+                        machine.leg_effects.lead_ppm[i] = v;
+                    }
+                }
+            }
+            Some(("compliance", "compliance_um_per_kn_at_1m")) => {
+                machine.leg_effects.compliance_um_per_kn_at_1m = v;
+            }
+            Some(("backlash", _)) => {
+                let c = controller.get_or_insert_with(ControllerDescription::default);
+                for i in 0..3 {
+                    if leg(i) {
+                        c.backlash_um[i] = v;
+                    }
+                }
+            }
+            Some(("thermal", "expansion_ppm_per_k")) => {
+                let c = controller.get_or_insert_with(ControllerDescription::default);
+                c.thermal_expansion_ppm_per_k = v;
+                c.reference_temperature_c = REFERENCE_TEMPERATURE_C;
+            }
+            // In the machine's UP limb already (model.machine_at), or
+            // sensor-side (they change readings, not where the platform
+            // goes): recorded under `calibration.effects`.
+            Some(("ujoint-axes" | "tube-twist" | "scale-gain" | "encoder-eccentricity", _)) => {}
+            _ => {
+                return Err(CliError::other(format!(
+                    "the diagnosis named a parameter `{name}` that a machine file cannot hold"
+                )));
+            }
+        }
+    }
+    Ok(Deployed {
+        id,
+        machine,
+        controller,
+    })
+}
+
+fn write_extended(
+    path: &Path,
+    data: &Path,
+    loaded: &LoadedMachine,
+    dataset: &tricept_data::Dataset,
+    d: &tricept_diagnose::Diagnosis,
+    force: bool,
+) -> Result<(), CliError> {
+    // What a machine file cannot hold: a misfit the final model leaves, or
+    // a generic term of the dictionary (its physics is not in the
+    // kinematics; the report says what to look for).
+    let mut problems = Vec::new();
+    if !d.final_adequate {
+        problems.push(match &d.unexplained {
+            Some(u) => u.clone(),
+            None => "the final model does not explain the data (a remainder is reported)".into(),
+        });
+    }
+    for c in d
+        .causes
+        .iter()
+        .filter(|c| matches!(c.effect, CauseName::Generic(_)))
+    {
+        problems.push(format!(
+            "the generic term `{}` ({}) is not part of the written model",
+            c.effect.as_str(),
+            c.description
+        ));
+    }
+    // An alias is deployed with the member the final model carries; the
+    // file's warnings name the alternatives and what would separate them
+    // (an exact alias, such as a lead common to all legs against a scale
+    // gain, is never separated by the machine's own sensors).
+    let notes: Vec<String> = d
+        .aliases
+        .iter()
+        .map(|a| {
+            let names: Vec<&str> = a.effects.iter().map(|e| e.as_str()).collect();
+            format!(
+                "{} cannot be told apart{} ({}); the file deploys {}; to separate them: {}",
+                names.join(" / "),
+                if a.exact {
+                    " by these sensors"
+                } else {
+                    " on this campaign"
+                },
+                a.why,
+                a.in_model.as_str(),
+                a.separate_by
+            )
+        })
+        .collect();
+    let forced = !problems.is_empty();
+    if forced && !force {
+        return Err(CliError {
+            code: crate::cli_error::EXIT_INADEQUATE,
+            message: format!(
+                "--write-machine {}: not written: {}; --force writes the model of the catalogued causes anyway, marked as forced",
+                path.display(),
+                problems.join("; ")
+            ),
+        });
+    }
+    let deployed = deploy(&loaded.machine, loaded.rank_reference()?, dataset, d)?;
+    let g = ParameterSet::paper15().len();
+    let mut effects = Map::new();
+    for ((name, v), sd) in deployed
+        .id
+        .names
+        .iter()
+        .zip(&deployed.id.estimate)
+        .zip(&deployed.id.std_dev)
+        .skip(g)
+    {
+        effects.insert(name.clone(), json!({"value": v, "std_dev": sd}));
+    }
+    let rejected_lines = d
+        .causes
+        .iter()
+        .filter(|c| c.effect == CauseName::Catalogue(EffectName::Outliers))
+        .flat_map(|c| c.rows.iter().copied())
+        .collect();
+    let warnings = problems.into_iter().chain(notes).collect();
+    let description = machine_file::calibrated_description(
+        loaded,
+        &deployed.machine,
+        &machine_file::FitRecord::of_identification(&deployed.id),
+        machine_file::Provenance {
+            method: "diagnose",
+            data_file: data,
+            parameter_set: "paper15",
+            rejected_lines,
+            adequate: !forced,
+            forced,
+            warnings,
+            effects,
+            n_geometric: g,
+            external: Vec::new(),
+        },
+        deployed.controller,
+    )?;
+    machine_file::write(path, &description)
 }
 
 /// The CLI error of a failed diagnosis: everything the data cause is an
@@ -127,13 +351,17 @@ fn diagnose_error(source: &str, e: DiagnoseError) -> CliError {
         }) => CliError::input(format!(
             "{source}: line {line}: the commands of this pose cannot be reached: {k}"
         )),
+        DiagnoseError::Ident(
+            tricept_ident::IdentError::TooFewPoses { .. }
+            | tricept_ident::IdentError::TooFewDistinctPoses { .. },
+        ) => CliError::input(format!("{source}: {e}")),
         DiagnoseError::Ident(e) => CliError::other(format!("{source}: {e}")),
         e => CliError::input(format!("{source}: {e}")),
     }
 }
 
 /// `tricept detectability`.
-pub fn run_detectability(a: &DetectabilityArgs) -> Result<(), CliError> {
+pub fn run_detectability(a: &DetectabilityArgs) -> Result<u8, CliError> {
     let (machine, poses, both_directions, drift_k) = (
         &a.machine,
         a.poses.as_str(),
@@ -176,7 +404,7 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<(), CliError> {
             "{}",
             serde_json::json!({"poses": data.poses.len(), "readings_per_pose": campaign.noise.readings_per_pose, "effects": v})
         );
-        return Ok(());
+        return Ok(0);
     }
     outln!(
         "{} logged poses ({}{}), mean of {} readings, temperature drift {} K",
@@ -212,5 +440,5 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<(), CliError> {
         "the stated sensor noise can be checked only against repeated poses: revisit at least {} poses on separate visits (`simulate --revisit`) to use `diagnose --noise-from-data`",
         tricept_diagnose::MIN_PURE_ERROR_DOF
     );
-    Ok(())
+    Ok(0)
 }

@@ -125,6 +125,9 @@ pub struct ExtendedModel {
     frame: Arc<Frame>,
     /// Reference temperature of the nominal lengths, °C.
     temp_ref_c: f64,
+    /// The same terms on the geometric model's rank reference, when it has
+    /// one: the rank decision of a calibrated machine is the nominal's.
+    rank_reference: Option<Box<ExtendedModel>>,
 }
 
 impl ExtendedModel {
@@ -181,12 +184,20 @@ impl ExtendedModel {
             };
             names.extend(t.params().iter().map(|p| format!("{prefix}.{p}")));
         }
+        let rank_reference = geometric.rank_reference_machine().map(|m| {
+            Box::new(ExtendedModel::with_terms(
+                GeometricModel::new(m.clone(), geometric.parameter_set().clone()),
+                terms,
+                frame.clone(),
+            ))
+        });
         ExtendedModel {
             geometric,
             terms: terms.to_vec(),
             names,
             frame,
             temp_ref_c: REFERENCE_TEMPERATURE_C,
+            rank_reference,
         }
     }
 
@@ -287,6 +298,12 @@ impl ReadingModel for ExtendedModel {
             geometric: GeometricPredictor::new(self.machine_at(p), self.geometric.parameter_set()),
             kinematic,
         })
+    }
+
+    fn rank_reference(&self) -> Option<&dyn ReadingModel> {
+        self.rank_reference
+            .as_deref()
+            .map(|m| m as &dyn ReadingModel)
     }
 }
 

@@ -115,6 +115,10 @@ pub struct DiagnoseOptions {
     pub temperature_sigma_k: f64,
     /// A fit needing a geometric error larger than this has failed, mm.
     pub max_error_mm: f64,
+    /// The machine whose rank decision the fits use (the nominal machine
+    /// of a calibrated one: docs/identifiability.md); `None`: the machine
+    /// diagnosed.
+    pub rank_reference: Option<Machine>,
 }
 
 /// Smallest degrees of freedom of pure error per channel for
@@ -137,6 +141,7 @@ impl DiagnoseOptions {
             repeat_tolerance_mm: 1e-3,
             temperature_sigma_k: 0.02,
             max_error_mm: 20.0,
+            rank_reference: None,
         }
     }
 }
@@ -169,11 +174,13 @@ pub fn diagnose(
     let distinct = n - repeated.dof();
     if distinct < 20 {
         return Err(DiagnoseError::Degenerate(format!(
-            "only {distinct} distinct pose{} among {n} rows (repeated commands do not count): at least 20 are needed to fit and test the model",
-            if distinct == 1 { "" } else { "s" }
+            "only {distinct} distinct leg commands among {n} rows (repeated commands do not count): at least 20 distinct poses are needed to fit and test the model",
         )));
     }
-    let geometric = GeometricModel::new(nominal.clone(), ParameterSet::paper15());
+    let mut geometric = GeometricModel::new(nominal.clone(), ParameterSet::paper15());
+    if let Some(reference) = &options.rank_reference {
+        geometric = geometric.with_rank_reference(reference.clone());
+    }
     let available: Vec<Candidate> = Candidate::ALL
         .iter()
         .copied()
