@@ -225,21 +225,59 @@ impl LinearEstimator {
         per_block.into_iter().flatten().collect()
     }
 
-    fn run_block(
+    /// The part of `mu` that is noise alone, `||p_hat - p*||_1 / n_params`,
+    /// for `trials` trials drawn exactly as [`LinearEstimator::run`] draws
+    /// them (same seed, same `grade_index`: the same trials). Two
+    /// estimators with the same number of columns, run with the same seed,
+    /// see the same standard-normal draws (common random numbers).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_kinematics::Machine;
+    /// use tricept_study::{GradeModel, Scenario};
+    /// let m = Machine::paper();
+    /// let s = Scenario::paper(m.clone(), m.workspace.polar_grid(2, 8, 3)).unwrap();
+    /// let g = GradeModel::new(&s, 2.0).unwrap();
+    /// let noise = g.estimator.noise_mu(15, 1000, 1, 0);
+    /// let full = g.estimator.run(&s, 1000, 1, 0, &|_| {});
+    /// // mu = |truth - p* - dp|_1 / 15 and noise part = |dp|_1 / 15:
+    /// // they differ by at most mu(p*).
+    /// let bias = tricept_model::residual_mu(&s.truth, &g.estimator.p_star);
+    /// for (a, t) in noise.iter().zip(&full) {
+    ///     assert!((a - t.mu_mm).abs() <= bias + 1e-12);
+    /// }
+    /// ```
+    pub fn noise_mu(
         &self,
-        s: &Scenario,
-        n: usize,
+        n_params: usize,
+        trials: usize,
         seed: u64,
         grade_index: u64,
-        block: u64,
-    ) -> Vec<TrialResult> {
+    ) -> Vec<f64> {
+        let blocks = trials.div_ceil(BLOCK);
+        let per_block: Vec<Vec<f64>> = (0..blocks)
+            .into_par_iter()
+            .map(|b| {
+                let n = BLOCK.min(trials - b * BLOCK);
+                let dp = self.deviations(n, seed, grade_index, b as u64);
+                (0..n)
+                    .map(|t| {
+                        (0..dp.nrows()).map(|u| dp[(u, t)].abs()).sum::<f64>() / n_params as f64
+                    })
+                    .collect()
+            })
+            .collect();
+        per_block.into_iter().flatten().collect()
+    }
+
+    /// `p_hat - p*` on the columns for the `n` trials of one block.
+    fn deviations(&self, n: usize, seed: u64, grade_index: u64, block: u64) -> Mat<f64> {
         let kid = self.factor.nrows();
-        let m = kid;
         let mut rng = block_rng(seed, grade_index, block);
-        let noise: Vec<f64> = (0..m * n)
+        let noise: Vec<f64> = (0..kid * n)
             .map(|_| StandardNormal.sample(&mut rng))
             .collect();
-        let z = faer::MatRef::from_column_major_slice(&noise, m, n);
+        let z = faer::MatRef::from_column_major_slice(&noise, kid, n);
         let mut dp = Mat::<f64>::zeros(kid, n);
         matmul(
             dp.as_mut(),
@@ -249,6 +287,18 @@ impl LinearEstimator {
             1.0,
             Par::Seq,
         );
+        dp
+    }
+
+    fn run_block(
+        &self,
+        s: &Scenario,
+        n: usize,
+        seed: u64,
+        grade_index: u64,
+        block: u64,
+    ) -> Vec<TrialResult> {
+        let dp = self.deviations(n, seed, grade_index, block);
         let rows = self.plane_jacobian.nrows();
         let mut dr = Mat::<f64>::zeros(rows, n);
         matmul(
