@@ -17,8 +17,9 @@ use crate::cli_error::CliError;
 /// Options shared by every verb that works on a machine.
 #[derive(Debug, Args, Clone)]
 pub struct MachineArgs {
-    /// Machine description (JSON); default: the paper's Table 1 machine.
-    #[arg(long, value_name = "FILE")]
+    /// Machine description (JSON; a calibrated machine file too); default:
+    /// the paper's Table 1 machine.
+    #[arg(long, value_name = "FILE.json")]
     pub machine: Option<PathBuf>,
     /// Print machine-readable JSON instead of text.
     #[arg(long)]
@@ -28,13 +29,13 @@ pub struct MachineArgs {
 /// Sensor-noise overrides (default: the machine description's).
 #[derive(Debug, Args, Clone, Default)]
 pub struct NoiseArgs {
-    /// Encoder noise of one reading, arcsec.
-    #[arg(long, value_name = "ARCSEC", allow_hyphen_values = true)]
+    /// Encoder noise of one reading (standard deviation), arcsec.
+    #[arg(long, value_name = "ARCSEC")]
     pub angle_noise_arcsec: Option<f64>,
-    /// Linear-scale noise of one reading, um.
-    #[arg(long, value_name = "UM", allow_hyphen_values = true)]
+    /// Linear-scale noise of one reading (standard deviation), um.
+    #[arg(long, value_name = "UM")]
     pub length_noise_um: Option<f64>,
-    /// Readings averaged into one logged value.
+    /// Readings averaged into one logged value (a count).
     #[arg(long, value_name = "N")]
     pub readings_per_pose: Option<u32>,
 }
@@ -56,31 +57,123 @@ impl ParamArgs {
     }
 }
 
+/// The true machine behind simulated data: `simulate` simulates it,
+/// `compensate` measures the compensation on it.
+#[derive(Debug, Args, Clone, Default)]
+pub struct TruthArgs {
+    /// True geometric errors of the simulated machine: `table2`, `zero`,
+    /// `random:MAG_MM[,SEED]` (uniform in +-MAG_MM) or a JSON file
+    /// `{name: mm}` (simulate's default: table2).
+    #[arg(long, value_name = "ERRORS", alias = "errors")]
+    pub truth: Option<String>,
+    /// An unmodelled effect of the true machine: a JSON object (or @FILE),
+    /// e.g. '{"effect":"leg-lead","ppm":[50,-30,40]}' (magnitudes in the
+    /// units their keys name: ppm, um, K, arcsec, N/um); repeatable.
+    #[arg(long = "truth-effect", value_name = "JSON", alias = "effect")]
+    pub truth_effects: Vec<String>,
+}
+
 /// How to fit.
 #[derive(Debug, Args, Clone, Default)]
 pub struct FitArgs {
     /// Keep every pose: do not reject gross reading errors (by default,
-    /// poses beyond the Bonferroni-corrected 0.1 % quantile of the
-    /// standardised residuals are rejected and reported).
+    /// poses with a gross reading error are rejected and reported by their
+    /// file line).
     #[arg(long)]
     pub no_robust: bool,
 }
 
-/// Loads the machine named by `--machine`, or the embedded default.
-pub fn load_machine(args: &MachineArgs) -> Result<Machine, CliError> {
-    let description = match &args.machine {
-        None => MachineDescription::paper(),
-        Some(path) => MachineDescription::from_file(path)
-            .map_err(|e| CliError::description(&path.display().to_string(), &e))?,
+/// A machine as loaded: its description (with the calibration record of a
+/// calibrated machine), the machine built from it, and where it came from.
+#[derive(Debug, Clone)]
+pub struct LoadedMachine {
+    /// The description as read.
+    pub description: MachineDescription,
+    /// The validated machine.
+    pub machine: Machine,
+    /// The file name, or `the built-in Table 1 machine`.
+    pub source: String,
+}
+
+impl LoadedMachine {
+    /// The machine whose structure decides the rank rule: the nominal
+    /// machine a calibrated file was calibrated from, else this machine.
+    pub fn rank_reference(&self) -> Result<Option<Machine>, CliError> {
+        match &self.description.calibration {
+            None => Ok(None),
+            Some(c) => c
+                .nominal
+                .build()
+                .map(Some)
+                .map_err(|e| CliError::description(&self.source, &e)),
+        }
+    }
+
+    /// The nominal machine a calibrated file records, as a description
+    /// without calibration of its own.
+    pub fn nominal_description(&self) -> MachineDescription {
+        match &self.description.calibration {
+            Some(c) => (*c.nominal).clone(),
+            None => {
+                let mut d = self.description.clone();
+                d.calibration = None;
+                d
+            }
+        }
+    }
+}
+
+/// Loads the machine named by `--machine`, or the embedded default; warns
+/// on stderr when it holds a calibration that was forced or did not
+/// explain its data.
+pub fn load(args: &MachineArgs) -> Result<LoadedMachine, CliError> {
+    let (description, source) = match &args.machine {
+        None => (
+            MachineDescription::paper(),
+            "the built-in Table 1 machine".to_string(),
+        ),
+        Some(path) => {
+            let source = path.display().to_string();
+            (
+                MachineDescription::from_file(path)
+                    .map_err(|e| CliError::description(&source, &e))?,
+                source,
+            )
+        }
     };
-    description
+    let machine = description
         .build()
-        .map_err(|e| CliError::description("machine", &e))
+        .map_err(|e| CliError::description(&source, &e))?;
+    if let Some(c) = &description.calibration {
+        if c.forced {
+            errln!(
+                "warning: {source} holds a calibration written with --force although it is not to be trusted (converged: {}, adequate: {})",
+                c.converged,
+                c.adequate
+            );
+        } else if !c.adequate {
+            errln!(
+                "warning: {source} holds a calibration whose model did not explain its data (chi2/dof {:.2})",
+                c.chi2_per_dof
+            );
+        }
+    }
+    Ok(LoadedMachine {
+        description,
+        machine,
+        source,
+    })
 }
 
 /// Loads the machine and applies the noise overrides.
 pub fn machine_with_noise(args: &MachineArgs, noise: &NoiseArgs) -> Result<Machine, CliError> {
-    let mut m = load_machine(args)?;
+    Ok(load_with_noise(args, noise)?.machine)
+}
+
+/// [`load`] with the noise overrides applied to the machine.
+pub fn load_with_noise(args: &MachineArgs, noise: &NoiseArgs) -> Result<LoadedMachine, CliError> {
+    let mut loaded = load(args)?;
+    let m = &mut loaded.machine;
     let check = |flag: &str, v: f64| {
         if v.is_finite() && v > 0.0 {
             Ok(v)
@@ -102,7 +195,7 @@ pub fn machine_with_noise(args: &MachineArgs, noise: &NoiseArgs) -> Result<Machi
         }
         m.sensors.readings_per_pose = k;
     }
-    Ok(m)
+    Ok(loaded)
 }
 
 /// Reads a measured-data file; every problem is an input error naming
@@ -112,7 +205,7 @@ pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, CliError> {
     let f = std::fs::File::open(path).map_err(|e| CliError::input(format!("{file}: {e}")))?;
     // A progress bar over the bytes read (drawn only on a terminal).
     let size = f.metadata().map(|m| m.len()).unwrap_or(0);
-    let bar = progress_bar(size, "reading");
+    let bar = progress_bar(size, &format!("reading {file}"));
     let data = tricept_data::read_from(bar.wrap_read(std::io::BufReader::new(f)), &file)
         .map_err(|e| CliError::input(e.to_string()))?;
     bar.finish_and_clear();
@@ -228,7 +321,7 @@ pub fn parse_errors(spec: &str, set: &ParameterSet) -> Result<Vec<f64>, CliError
     }
 }
 
-/// Parses `--effect` values: JSON objects (or arrays of them), inline or
+/// Parses `--truth-effect` values: JSON objects (or arrays of them), inline or
 /// from `@FILE`.
 pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, CliError> {
     let mut out = Vec::new();
@@ -239,7 +332,7 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, CliError> {
                     .map_err(|e| CliError::input(format!("{path}: {e}")))?,
                 path.to_string(),
             ),
-            None => (spec.clone(), "--effect".to_string()),
+            None => (spec.clone(), "--truth-effect".to_string()),
         };
         let value: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| CliError::input(format!("{origin}: {e}")))?;

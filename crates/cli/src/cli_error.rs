@@ -6,6 +6,11 @@ use tricept_kinematics::{DescriptionError, KinematicsError};
 pub const EXIT_INPUT: u8 = 2;
 /// Exit code for every other failure.
 pub const EXIT_OTHER: u8 = 1;
+/// Exit code of a fit that converged but whose model does not explain the
+/// data (`identify`, `compensate`).
+pub const EXIT_INADEQUATE: u8 = 3;
+/// Exit code of a fit that did not converge.
+pub const EXIT_NOT_CONVERGED: u8 = 4;
 
 /// A failure to report: printed as `error: <message>` on stderr.
 #[derive(Debug)]

@@ -13,18 +13,19 @@ use tricept_data::{
 };
 use tricept_ident::IdentError;
 use tricept_ident::fusion::{
-    BallbarOptions, FusedModel, Fusion, FusionOptions, Source, TouchOptions, TrackerOptions,
-    TrackerTarget, evaluation_poses, identify_fused,
+    BallbarOptions, FusedModel, Fusion, FusionOptions, Source, SourceKind, TouchOptions,
+    TrackerOptions, TrackerTarget, evaluation_poses, identify_fused,
 };
 use tricept_model::effects::EffectName;
 
-use crate::args::{check_commands, machine_with_noise, read_data};
-use crate::cli_error::CliError;
+use crate::args::{check_commands, load_with_noise, machine_with_noise, read_data};
+use crate::cli_error::{CliError, EXIT_NOT_CONVERGED};
 use crate::ident_cmd::IdentifyArgs;
+use crate::machine_file;
 
-/// Exit code of a fit that completed but that the user must not trust as
-/// it stands: a source the model does not explain, or no convergence.
-pub const EXIT_UNTRUSTED: u8 = 3;
+/// Exit code of a fit that converged but that the user must not trust as
+/// it stands: a source the model does not explain (`identify`'s 3).
+pub const EXIT_UNTRUSTED: u8 = crate::cli_error::EXIT_INADEQUATE;
 
 /// External measurements and the head (options of `tricept identify`).
 #[derive(Debug, Args, Clone, Default)]
@@ -164,7 +165,7 @@ fn sources(
     machine: &tricept_kinematics::Machine,
 ) -> Result<Vec<Source>, CliError> {
     let x = &a.external;
-    let data = read_data(a.input.data.as_path(), machine)?;
+    let data = read_data(a.data.as_path(), machine)?;
     let mut sources = vec![Source::internal(&data, machine.sensors.logged_sigma())];
     let target = match x.tracker_target.as_str() {
         "free" => TrackerTarget::Free,
@@ -320,19 +321,19 @@ pub fn eval_options(
 }
 
 /// `tricept identify` with external data.
-pub fn run(a: &IdentifyArgs) -> Result<(), CliError> {
-    let machine = machine_with_noise(&a.input.machine, &a.input.noise)?;
-    let set = a.input.params.set()?;
+pub fn run(a: &IdentifyArgs) -> Result<u8, CliError> {
+    let machine = machine_with_noise(&a.settings.machine, &a.settings.noise)?;
+    let set = a.settings.params.set()?;
     let x = &a.external;
     let model = fused_model(&machine, &set, &x.effects, x.head.as_deref())?;
     let options = eval_options(&machine, &x.eval_grid, &x.eval_head_angles_deg)?;
     let sources = sources(a, &machine)?;
     let fit = identify_fused(&model, &sources, &options).map_err(fusion_error)?;
     let deployed = match &a.write_machine {
-        Some(path) => Some(write_machine(path, &model, &fit, &sources)?),
+        Some(path) => Some(write_machine(a, path, &model, &fit, &sources)?),
         None => None,
     };
-    if a.input.machine.json {
+    if a.settings.machine.json {
         let mut v = fit.to_json(&model);
         if let (Value::Object(o), Some(d)) = (&mut v, &deployed) {
             o.insert("deployed".into(), d.clone());
@@ -342,16 +343,21 @@ pub fn run(a: &IdentifyArgs) -> Result<(), CliError> {
         print_text(&model, &fit, &sources);
     }
     for w in &fit.warnings {
-        eprintln!("warning: {w}");
+        errln!("warning: {w}");
+    }
+    // The exit codes of `identify`: 4 not converged, 3 converged but a
+    // source not explained.
+    if !fit.converged {
+        errln!("identify: exit {EXIT_NOT_CONVERGED}: the fused fit did not converge");
+        return Ok(EXIT_NOT_CONVERGED);
     }
     if !fit.is_trustworthy() {
-        return Err(CliError {
-            code: EXIT_UNTRUSTED,
-            message: "the fit completed but must not be trusted as it stands (see the warnings)"
-                .into(),
-        });
+        errln!(
+            "identify: exit {EXIT_UNTRUSTED}: the fit completed but must not be trusted as it stands (see the warnings)"
+        );
+        return Ok(EXIT_UNTRUSTED);
     }
-    Ok(())
+    Ok(0)
 }
 
 fn print_text(model: &FusedModel, fit: &Fusion, sources: &[Source]) {
@@ -410,16 +416,19 @@ fn print_text(model: &FusedModel, fit: &Fusion, sources: &[Source]) {
             outln!("  {n:>32} {v:>14.6e} {sd:>12.3e}");
         }
     }
-    print!("{}", fit.report.to_text());
+    crate::output::write_text(&fit.report.to_text());
     for w in &fit.warnings {
         outln!("warning: {w}");
     }
 }
 
 /// Writes the calibrated machine: the module explicit, the head's fields
-/// and angle offsets from the estimate. Refuses fitted effects, which the
-/// machine format cannot carry.
+/// and angle offsets from the estimate, and the `calibration` record (as
+/// `identify` writes it, with every external file and its hash). Refuses
+/// fitted effects, which the geometric machine format cannot carry, and a
+/// fit that is not to be trusted unless `--force` (then marked forced).
 fn write_machine(
+    a: &IdentifyArgs,
     path: &Path,
     model: &FusedModel,
     fit: &Fusion,
@@ -433,6 +442,25 @@ fn write_machine(
             if names.len() == 1 { "it" } else { "them" }
         )));
     }
+    let refusal = if !fit.converged {
+        Some((EXIT_NOT_CONVERGED, "the fused fit did not converge"))
+    } else if !fit.is_trustworthy() {
+        Some((
+            EXIT_UNTRUSTED,
+            "the model does not explain every source (see the warnings)",
+        ))
+    } else {
+        None
+    };
+    if let (Some((code, why)), false) = (refusal, a.force) {
+        return Err(CliError {
+            code,
+            message: format!(
+                "--write-machine {}: not written: {why}; --force writes it anyway, marked as forced",
+                path.display()
+            ),
+        });
+    }
     let held: Vec<String> = fit
         .std_dev
         .iter()
@@ -440,10 +468,42 @@ fn write_machine(
         .filter(|(sd, _)| sd.is_none())
         .map(|(_, n)| n.clone())
         .collect();
-    let mut d = model.machine_at(&fit.estimate).to_description();
+    let loaded = load_with_noise(&a.settings.machine, &a.settings.noise)?;
+    let external: Vec<(String, &Path, usize, f64)> = sources
+        .iter()
+        .zip(&fit.sources)
+        .filter(|(s, _)| s.kind() != SourceKind::Internal)
+        .map(|(s, f)| {
+            (
+                s.kind().as_str().to_string(),
+                Path::new(s.file()),
+                s.records(),
+                f.reduced_chi_square,
+            )
+        })
+        .collect();
+    let mut d = machine_file::calibrated_description(
+        &loaded,
+        &model.machine_at(&fit.estimate),
+        &machine_file::FitRecord::of_fusion(fit),
+        machine_file::Provenance {
+            method: "identify (fused)",
+            data_file: a.data.as_path(),
+            parameter_set: &format!("{} + head", a.settings.params.set()?.label()),
+            rejected_lines: Vec::new(),
+            adequate: fit.is_trustworthy(),
+            forced: refusal.is_some(),
+            warnings: fit.warnings.clone(),
+            effects: serde_json::Map::new(),
+            n_geometric: fit.names.len(),
+            external,
+        },
+        None,
+    )?;
     let files: Vec<&str> = sources.iter().map(|s| s.file()).collect();
     d.notes = Some(format!(
-        "identified from {}; held at nominal (not seen by the data): {}",
+        "{}; identified from {}; held at nominal (not seen by the data): {}",
+        d.notes.unwrap_or_default(),
         files.join(", "),
         if held.is_empty() {
             "none".to_string()
@@ -451,7 +511,6 @@ fn write_machine(
             held.join(", ")
         }
     ));
-    std::fs::write(path, d.to_json())
-        .map_err(|e| CliError::other(format!("{}: {e}", path.display())))?;
+    machine_file::write(path, &d)?;
     Ok(json!({"written": path.display().to_string(), "held_at_nominal": held}))
 }

@@ -1,24 +1,24 @@
-//! The self-calibration verbs: `identifiability`, `identify`, `compensate`.
+//! The self-calibration verbs `identifiability` and `identify`, and the
+//! fit from a data file that `compensate` shares.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
-use nalgebra::Vector3;
 use serde_json::{Map, Value, json};
 use tricept_data::MeasuredPose;
 use tricept_ident::{
-    GeometricModel, IdentError, Identification, IdentifyOptions, Rejection, corrected_commands,
-    identifiability, identify, identify_robust,
+    GeometricModel, IdentError, Identification, IdentifyOptions, Rejection, Verdict,
+    identifiability, identify, identify_robust, likely_causes,
 };
 use tricept_kinematics::Machine;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
-use tricept_model::{ErrorMap, MapStats, volumetric_errors};
 
 use crate::args::{
-    FitArgs, MachineArgs, NoiseArgs, ParamArgs, machine_with_noise, parse_effects, parse_errors,
+    FitArgs, LoadedMachine, MachineArgs, NoiseArgs, ParamArgs, load_with_noise, machine_with_noise,
     pose_targets, read_data, spinner,
 };
-use crate::cli_error::CliError;
+use crate::cli_error::{CliError, EXIT_INADEQUATE, EXIT_NOT_CONVERGED};
+use crate::machine_file;
 
 /// `tricept identifiability`.
 #[derive(Debug, Args)]
@@ -34,12 +34,9 @@ pub struct IdentifiabilityArgs {
     pub machine: MachineArgs,
 }
 
-/// The data and fit settings of `identify` and `compensate`.
+/// The fit settings of `identify` and `compensate`.
 #[derive(Debug, Args)]
-pub struct DataFitArgs {
-    /// Measured-data CSV (see docs/data-format.md).
-    #[arg(long, value_name = "FILE.csv")]
-    pub data: PathBuf,
+pub struct FitSettings {
     #[command(flatten)]
     pub fit: FitArgs,
     #[command(flatten)]
@@ -53,42 +50,31 @@ pub struct DataFitArgs {
 /// `tricept identify`.
 #[derive(Debug, Args)]
 pub struct IdentifyArgs {
+    /// Measured-data CSV (see docs/data-format.md).
+    #[arg(long, value_name = "FILE.csv")]
+    pub data: PathBuf,
     #[command(flatten)]
-    pub input: DataFitArgs,
-    /// Also write the identified machine as a description file.
+    pub settings: FitSettings,
+    /// Also write the calibrated machine as a description file (loadable
+    /// by every --machine), with a `calibration` record of the estimates,
+    /// their uncertainties and the fit's quality. Refused when the fit did
+    /// not converge or the data cannot come from the machine.
     #[arg(long, value_name = "FILE.json")]
     pub write_machine: Option<PathBuf>,
+    /// Write the machine even when the fit is not to be trusted; the file
+    /// says so (`calibration.forced`, its name).
+    #[arg(long, requires = "write_machine")]
+    pub force: bool,
     /// External measurements and the head (the fused identification).
     #[command(flatten)]
     pub external: crate::fusion_cmd::ExternalArgs,
 }
 
-/// `tricept compensate`.
-#[derive(Debug, Args)]
-pub struct CompensateArgs {
-    #[command(flatten)]
-    pub input: DataFitArgs,
-    /// True errors of the machine that produced the data (simulations).
-    #[arg(long, value_name = "ERRORS")]
-    pub truth: Option<String>,
-    /// An unmodelled effect of the true machine (JSON or @FILE, as for
-    /// `simulate`); repeatable; used with --truth.
-    #[arg(long = "truth-effect", value_name = "JSON")]
-    pub truth_effects: Vec<String>,
-    /// Plane of the error map, mm (default: the workspace's middle plane).
-    #[arg(long, value_name = "Z_MM", allow_negative_numbers = true)]
-    pub plane_z: Option<f64>,
-    /// Lattice spacing of the error map, mm.
-    #[arg(long, default_value_t = 10.0, value_name = "MM")]
-    pub spacing: f64,
-    /// Target points (CSV x,y,z) to print corrected leg commands for.
-    #[arg(long, value_name = "FILE.csv")]
-    pub targets: Option<PathBuf>,
-}
-
 fn ident_error(source: &str, e: IdentError) -> CliError {
     match &e {
-        IdentError::TooFewPoses { .. } => CliError::input(format!("{source}: {e}")),
+        IdentError::TooFewPoses { .. } | IdentError::TooFewDistinctPoses { .. } => {
+            CliError::input(format!("{source}: {e}"))
+        }
         IdentError::Kinematics {
             line, source: k, ..
         } => CliError::input(format!(
@@ -99,7 +85,7 @@ fn ident_error(source: &str, e: IdentError) -> CliError {
 }
 
 /// `tricept identifiability`.
-pub fn run_identifiability(a: &IdentifiabilityArgs) -> Result<(), CliError> {
+pub fn run_identifiability(a: &IdentifiabilityArgs) -> Result<u8, CliError> {
     let (machine, poses) = (&a.machine, a.poses.as_str());
     let m = machine_with_noise(machine, &a.noise)?;
     let set = a.params.set()?;
@@ -107,7 +93,13 @@ pub fn run_identifiability(a: &IdentifiabilityArgs) -> Result<(), CliError> {
     let mut commands = Vec::with_capacity(targets.len());
     for (i, r) in targets.iter().enumerate() {
         let ik = m.inverse(r).map_err(|e| {
-            CliError::input(format!("--poses {poses}: pose {} ({r:?}): {e}", i + 1))
+            CliError::input(format!(
+                "--poses {poses}: pose {} ({:.3}, {:.3}, {:.3} mm): {e}",
+                i + 1,
+                r.x,
+                r.y,
+                r.z
+            ))
         })?;
         commands.push(MeasuredPose {
             commands_mm: ik.legs_mm,
@@ -136,27 +128,86 @@ pub fn run_identifiability(a: &IdentifiabilityArgs) -> Result<(), CliError> {
             m.up_limb.axis_order,
             set.label()
         );
-        print!("{}", report.to_text());
+        crate::output::write_text(&report.to_text());
     }
-    Ok(())
+    Ok(0)
 }
 
-/// Loads data and identifies; shared by `identify` and `compensate`.
-fn identify_from_file(
-    a: &DataFitArgs,
-) -> Result<(Machine, GeometricModel, Identification, Vec<Rejection>), CliError> {
-    let data = a.data.as_path();
-    let m = machine_with_noise(&a.machine, &a.noise)?;
-    let set = a.params.set()?;
+/// A fit from a data file, with everything the outputs need.
+pub struct Fit {
+    /// The machine identified against.
+    pub loaded: LoadedMachine,
+    /// The model (increments on the loaded machine, with its rank rule).
+    pub model: GeometricModel,
+    /// The identification on the kept poses.
+    pub id: Identification,
+    /// Poses rejected as gross errors.
+    pub rejected: Vec<Rejection>,
+    /// The verdict, with the likely causes of an inconsistent fit added to
+    /// its warnings.
+    pub verdict: Verdict,
+}
+
+impl Fit {
+    /// The exit code the verdict calls for: 0 converged and adequate, 3
+    /// converged but inadequate, 4 not converged.
+    pub fn exit_code(&self) -> u8 {
+        if !self.verdict.converged {
+            EXIT_NOT_CONVERGED
+        } else if !self.verdict.adequate {
+            EXIT_INADEQUATE
+        } else {
+            0
+        }
+    }
+
+    /// Why the fit must not be deployed (`None` when it may): not converged,
+    /// or data that cannot come from the machine.
+    pub fn refusal(&self) -> Option<&'static str> {
+        if !self.verdict.converged {
+            Some("the fit did not converge")
+        } else if self.verdict.inconsistent {
+            Some("the data cannot come from the described machine")
+        } else {
+            None
+        }
+    }
+
+    /// The identified machine.
+    pub fn identified(&self) -> Machine {
+        self.model.machine_at(&self.id.estimate)
+    }
+}
+
+/// Reads `data` and identifies against the machine of `settings` (robust
+/// unless `--no-robust`); the rank rule of a calibrated machine is its
+/// nominal machine's.
+pub fn fit_from_file(data: &Path, settings: &FitSettings) -> Result<Fit, CliError> {
+    let loaded = load_with_noise(&settings.machine, &settings.noise)?;
+    let m = loaded.machine.clone();
+    let set = settings.params.set()?;
     let dataset = read_data(data, &m)?;
-    let model = GeometricModel::new(m.clone(), set);
+    let mut model = GeometricModel::new(m.clone(), set.clone());
+    if let Some(reference) = loaded.rank_reference()? {
+        model = model.with_rank_reference(reference);
+    }
     let options = IdentifyOptions::for_machine(&m);
     let source = data.display().to_string();
     let spin = spinner(
-        format!("identifying from {} poses", dataset.poses.len()),
+        format!(
+            "identify: {} geometric parameters ({}) and 3 sensor offsets from {} poses: {}Gauss-Newton on the exact model",
+            set.len(),
+            set.label(),
+            dataset.poses.len(),
+            if settings.fit.no_robust {
+                ""
+            } else {
+                "gross-error screen, then "
+            }
+        ),
         dataset.poses.len(),
     );
-    let (id, rejected) = if a.fit.no_robust {
+    let (id, rejected) = if settings.fit.no_robust {
         (
             identify(&model, &dataset, &options).map_err(|e| ident_error(&source, e))?,
             Vec::new(),
@@ -165,45 +216,135 @@ fn identify_from_file(
         identify_robust(&model, &dataset, &options).map_err(|e| ident_error(&source, e))?
     };
     spin.finish_and_clear();
-    Ok((m, model, id, rejected))
+    let mut verdict = id.verdict();
+    if verdict.inconsistent {
+        for c in likely_causes(&m, &set, &dataset, &options, id.stats.reduced_chi_square) {
+            verdict.warnings.push(format!(
+                "likely cause: {} (undone, the data fit with chi2/dof {:.2})",
+                c.description, c.chi2_per_dof
+            ));
+        }
+    }
+    Ok(Fit {
+        loaded,
+        model,
+        id,
+        rejected,
+        verdict,
+    })
+}
+
+/// One-line stderr summary of a non-zero verdict (scripts read the code,
+/// people read this).
+pub fn report_exit(verb: &str, code: u8) {
+    match code {
+        EXIT_INADEQUATE => errln!(
+            "{verb}: exit {code}: the fit converged but the model does not explain the data (see the warnings)"
+        ),
+        EXIT_NOT_CONVERGED => errln!("{verb}: exit {code}: the fit did not converge"),
+        _ => {}
+    }
+}
+
+/// Writes a calibrated machine file unless the fit must not be deployed
+/// (then only with `force`, marked as forced). Returns an error when it
+/// refuses.
+fn write_calibrated(path: &Path, data: &Path, fit: &Fit, force: bool) -> Result<(), CliError> {
+    let refusal = fit.refusal();
+    if let (Some(why), false) = (refusal, force) {
+        return Err(CliError {
+            code: fit.exit_code().max(EXIT_INADEQUATE),
+            message: format!(
+                "--write-machine {}: not written: {why}; --force writes it anyway, marked as forced",
+                path.display()
+            ),
+        });
+    }
+    let d = machine_file::calibrated_description(
+        &fit.loaded,
+        &fit.identified(),
+        &machine_file::FitRecord::of_identification(&fit.id),
+        machine_file::Provenance {
+            method: "identify",
+            data_file: data,
+            parameter_set: fit.model.parameter_set().label(),
+            rejected_lines: fit.rejected.iter().map(|r| r.line).collect(),
+            adequate: fit.verdict.adequate,
+            forced: refusal.is_some(),
+            warnings: fit.verdict.warnings.clone(),
+            effects: Map::new(),
+            n_geometric: fit.id.names.len(),
+            external: Vec::new(),
+        },
+        None,
+    )?;
+    machine_file::write(path, &d)
+}
+
+/// The rejected poses as JSON: 1-based pose number, file line, size.
+pub fn rejected_json(rejected: &[Rejection]) -> Value {
+    Value::Array(
+        rejected
+            .iter()
+            .map(
+                |r| json!({"pose": r.pose + 1, "line": r.line, "residual_sigma": r.residual_sigma}),
+            )
+            .collect(),
+    )
 }
 
 /// `tricept identify`.
-pub fn run_identify(a: &IdentifyArgs) -> Result<(), CliError> {
+pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
     if a.external.any() {
         return crate::fusion_cmd::run(a);
     }
-    let (machine, data) = (&a.input.machine, a.input.data.as_path());
-    let (_, model, id, rejected) = identify_from_file(&a.input)?;
-    if let Some(path) = &a.write_machine {
-        let mut d = model.machine_at(&id.estimate).to_description();
-        d.notes = Some(format!("identified from {}", data.display()));
-        std::fs::write(path, d.to_json())
-            .map_err(|e| CliError::other(format!("{}: {e}", path.display())))?;
-    }
-    if machine.json {
+    let data = a.data.as_path();
+    let fit = fit_from_file(data, &a.settings)?;
+    let code = fit.exit_code();
+    let written = a
+        .write_machine
+        .as_ref()
+        .map(|path| write_calibrated(path, data, &fit, a.force));
+    let id = &fit.id;
+    if a.settings.machine.json {
         let mut v = id.to_json();
         if let Value::Object(o) = &mut v {
-            o.insert(
-                "rejected".into(),
-                serde_json::to_value(&rejected).unwrap_or(Value::Null),
-            );
+            o.insert("rejected".into(), rejected_json(&fit.rejected));
+            o.insert("warnings".into(), fit.verdict.warnings.clone().into());
+            o.insert("machine".into(), fit.loaded.description.name.clone().into());
+            o.insert("data_file".into(), data.display().to_string().into());
         }
         outln!("{v}");
-        return Ok(());
+    } else {
+        print_identification(&fit, data);
     }
-    for r in &rejected {
+    if let Some(Err(e)) = written {
+        return Err(e);
+    }
+    report_exit("identify", code);
+    Ok(code)
+}
+
+fn print_identification(fit: &Fit, data: &Path) {
+    let id = &fit.id;
+    for r in &fit.rejected {
+        let why = match r.residual_sigma {
+            Some(z) => format!("a reading {z:.1} noise standard deviations off (gross error)"),
+            None => "the fitted machine cannot reach its commands".to_string(),
+        };
         outln!(
-            "rejected line {} of {}: a reading {:.1} noise standard deviations off (gross error)",
+            "rejected pose {} (line {} of {}): {why}",
+            r.pose + 1,
             r.line,
-            data.display(),
-            r.residual_sigma.unwrap_or(f64::INFINITY)
+            data.display()
         );
     }
     outln!(
-        "{} poses, parameter set {}: {} in {} Gauss-Newton iterations",
+        "{} poses of {} against `{}`, parameter set {}: {} in {} Gauss-Newton iterations",
         id.residuals.len(),
-        model.parameter_set().label(),
+        data.display(),
+        fit.loaded.description.name,
+        fit.model.parameter_set().label(),
         if id.converged {
             "converged"
         } else {
@@ -215,150 +356,43 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<(), CliError> {
     for ((n, v), sd) in id.names.iter().zip(&id.estimate).zip(&id.std_dev) {
         match sd {
             Some(s) => outln!("{n:>6} {v:>12.5} {s:>10.5}"),
-            None => outln!("{n:>6} {v:>12.5} {:>10}", "fixed"),
+            None => outln!("{n:>6} {v:>12.5} {:>10}", "held"),
         }
     }
     let a = RAD_PER_ARCSEC;
     outln!(
-        "offsets: phi {:.6} rad, theta {:.6} rad, s {:.4} mm",
+        "sensor offsets: phi {:.6} rad, theta {:.6} rad, s {:.4} mm",
         id.offsets[0],
         id.offsets[1],
         id.offsets[2]
     );
+    let (z, j) = id.stats.max_standardised;
     outln!(
-        "residual rms: phi {:.3} arcsec, theta {:.3} arcsec, s {:.3} um; chi2/dof {:.3} (dof {}); largest {:.1} sigma at pose {}",
+        "residual rms: phi {:.3} arcsec, theta {:.3} arcsec, s {:.3} um; chi2/dof {:.3} (dof {}, p = {:.2e}); largest {z:.1} sigma at pose {} (line {})",
         id.stats.rms[0] / a,
         id.stats.rms[1] / a,
         id.stats.rms[2] * 1e3,
         id.stats.reduced_chi_square,
         id.stats.dof,
-        id.stats.max_standardised.0,
-        id.stats.max_standardised.1 + 1
+        fit.verdict.chi_square_p_value,
+        j + 1,
+        id.lines.get(j).copied().unwrap_or(0)
     );
-    print!("{}", id.report.to_text());
-    Ok(())
-}
-
-fn stats_json(s: &MapStats) -> Value {
-    json!({"max_mm": s.max_mm, "min_mm": s.min_mm, "mean_mm": s.mean_mm, "rms_mm": s.rms_mm})
-}
-
-/// `tricept compensate`.
-pub fn run_compensate(a: &CompensateArgs) -> Result<(), CliError> {
-    let (machine, plane_z_mm, spacing_mm) = (&a.input.machine, a.plane_z, a.spacing);
-    let (m, model, id, rejected) = identify_from_file(&a.input)?;
-    let identified = model.machine_at(&id.estimate);
-    let z = plane_z_mm.unwrap_or_else(|| m.workspace.mid_plane_z_mm());
-    if !(spacing_mm.is_finite() && spacing_mm >= 1.0) {
-        return Err(CliError::input("--spacing: must be at least 1 mm"));
-    }
-    let grid = m.workspace.disc_grid(z, spacing_mm);
-    let mut out = Map::new();
-    // What compensation changes, as the identified model sees it.
-    let predicted = volumetric_errors(&m, &identified, &grid)
-        .map_err(|e| CliError::other(format!("compensation map: {e}")))?;
-    out.insert("plane_z_mm".into(), z.into());
-    out.insert(
-        "rejected_lines".into(),
-        Value::Array(rejected.iter().map(|r| Value::from(r.line)).collect()),
+    crate::output::write_text(&id.report.to_text());
+    outln!(
+        "verdict: {}, {}",
+        if fit.verdict.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        },
+        if fit.verdict.adequate {
+            "adequate (the model explains the data to the sensor noise)"
+        } else {
+            "NOT adequate (the model does not explain the data)"
+        }
     );
-    out.insert("grid_points".into(), grid.len().into());
-    out.insert(
-        "predicted_correction".into(),
-        stats_json(&predicted.stats()),
-    );
-    if let Some(spec) = &a.truth {
-        let set = model.parameter_set();
-        let mut plant =
-            tricept_plant::Plant::geometric(m.clone(), set.to_errors(&parse_errors(spec, set)?));
-        plant.effects = parse_effects(&a.truth_effects)?;
-        // Where the actual machine goes when commanded by a model's IK.
-        let map = |commanding: &tricept_kinematics::Machine| -> Result<ErrorMap, CliError> {
-            let mut errors = Vec::with_capacity(grid.len());
-            for r in &grid {
-                let q = commanding
-                    .inverse(r)
-                    .map_err(|e| CliError::other(format!("compensation map: {e}")))?
-                    .legs_mm;
-                let reached = plant
-                    .reach(&q)
-                    .map_err(|e| CliError::other(format!("compensation map: {e}")))?;
-                errors.push(reached - r);
-            }
-            Ok(ErrorMap {
-                targets_mm: grid.clone(),
-                errors_mm: errors,
-            })
-        };
-        let (before, after) = (map(&m)?, map(&identified)?);
-        let residual = after.without_mean_translation();
-        let t = after.mean_translation_mm();
-        out.insert("before".into(), stats_json(&before.stats()));
-        out.insert("after".into(), stats_json(&after.stats()));
-        out.insert(
-            "after_without_translation".into(),
-            stats_json(&residual.stats()),
-        );
-        out.insert("translation_mm".into(), json!([t.x, t.y, t.z]));
+    for w in &fit.verdict.warnings {
+        outln!("WARNING: {w}");
     }
-    if let Some(path) = &a.targets {
-        let points: Vec<Vector3<f64>> = tricept_data::read_targets(path)
-            .map_err(|e| CliError::input(e.to_string()))?
-            .into_iter()
-            .map(Vector3::from)
-            .collect();
-        let commands = corrected_commands(&identified, &points)
-            .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
-        out.insert(
-            "corrected_commands".into(),
-            Value::Array(
-                points
-                    .iter()
-                    .zip(&commands)
-                    .map(|(r, q)| json!({"x": r.x, "y": r.y, "z": r.z, "q1": q[0], "q2": q[1], "q3": q[2]}))
-                    .collect(),
-            ),
-        );
-    }
-    if machine.json {
-        outln!("{}", Value::Object(out));
-    } else {
-        outln!(
-            "compensation over the plane z = {z} mm ({} points, {spacing_mm} mm lattice)",
-            grid.len()
-        );
-        for key in [
-            "predicted_correction",
-            "before",
-            "after",
-            "after_without_translation",
-        ] {
-            if let Some(s) = out.get(key) {
-                outln!(
-                    "{key:>26}: max {:.4} / min {:.4} / mean {:.4} mm",
-                    s["max_mm"].as_f64().unwrap_or(f64::NAN),
-                    s["min_mm"].as_f64().unwrap_or(f64::NAN),
-                    s["mean_mm"].as_f64().unwrap_or(f64::NAN)
-                );
-            }
-        }
-        if let Some(t) = out.get("translation_mm") {
-            outln!("{:>26}: {t} mm", "rigid translation");
-        }
-        if let Some(Value::Array(rows)) = out.get("corrected_commands") {
-            outln!("x,y,z,q1,q2,q3");
-            for r in rows {
-                outln!(
-                    "{},{},{},{},{},{}",
-                    r["x"],
-                    r["y"],
-                    r["z"],
-                    r["q1"],
-                    r["q2"],
-                    r["q3"]
-                );
-            }
-        }
-    }
-    Ok(())
 }

@@ -1,23 +1,44 @@
-//! The kinematics verbs: `ik`, `fk`, `tool-ik`, `machine`.
+//! The kinematics verbs: `ik`, `fk`, `tool-ik` (one point from the command
+//! line, or many from `--input FILE.csv|-`), and `machine`.
+//!
+//! A calibrated machine file's static leg effects (lead, compliance) are
+//! applied ([`tricept_model::ExtendedMachine`]).
+
+use std::path::PathBuf;
 
 use clap::Args;
-use nalgebra::Vector3;
-use serde_json::Value;
-use tricept_kinematics::{HeadBranch, MachineDescription, UpJoints};
+use tricept_cli::batch::{self, BatchError, Verb};
+use tricept_kinematics::{Machine, MachineDescription};
+use tricept_model::ExtendedMachine;
 
-use crate::args::{MachineArgs, load_machine};
+use crate::args::{MachineArgs, load};
 use crate::cli_error::CliError;
-use crate::output::print_record;
+use crate::output::{Field, print_record, stdout_closed};
+
+/// Where the points of a batch come from.
+#[derive(Debug, Args, Clone)]
+pub struct InputArgs {
+    /// Read many points from a CSV file (`-`: stdin) with the verb's input
+    /// columns (ik: x,y,z in mm; fk: q1,q2,q3 in mm; tool-ik: x,y,z in mm
+    /// and ax,ay,az) and write CSV to stdout, the keys of --json as columns.
+    #[arg(long, value_name = "FILE.csv")]
+    pub input: Option<PathBuf>,
+}
 
 /// `tricept ik X Y Z`.
 #[derive(Debug, Args)]
 pub struct IkArgs {
     /// x of O' in the base frame, mm.
-    pub x: f64,
+    #[arg(required_unless_present = "input")]
+    pub x: Option<f64>,
     /// y of O' in the base frame, mm.
-    pub y: f64,
+    #[arg(required_unless_present = "input")]
+    pub y: Option<f64>,
     /// z of O' in the base frame, mm.
-    pub z: f64,
+    #[arg(required_unless_present = "input")]
+    pub z: Option<f64>,
+    #[command(flatten)]
+    pub input: InputArgs,
     #[command(flatten)]
     pub machine: MachineArgs,
 }
@@ -26,11 +47,16 @@ pub struct IkArgs {
 #[derive(Debug, Args)]
 pub struct FkArgs {
     /// Command of leg 1, mm.
-    pub q1: f64,
+    #[arg(required_unless_present = "input")]
+    pub q1: Option<f64>,
     /// Command of leg 2, mm.
-    pub q2: f64,
+    #[arg(required_unless_present = "input")]
+    pub q2: Option<f64>,
     /// Command of leg 3, mm.
-    pub q3: f64,
+    #[arg(required_unless_present = "input")]
+    pub q3: Option<f64>,
+    #[command(flatten)]
+    pub input: InputArgs,
     #[command(flatten)]
     pub machine: MachineArgs,
 }
@@ -39,17 +65,25 @@ pub struct FkArgs {
 #[derive(Debug, Args)]
 pub struct ToolIkArgs {
     /// Tool tip x, mm.
-    pub x: f64,
+    #[arg(required_unless_present = "input")]
+    pub x: Option<f64>,
     /// Tool tip y, mm.
-    pub y: f64,
+    #[arg(required_unless_present = "input")]
+    pub y: Option<f64>,
     /// Tool tip z, mm.
-    pub z: f64,
-    /// Tool axis x component (any length).
-    pub ax: f64,
-    /// Tool axis y component.
-    pub ay: f64,
-    /// Tool axis z component.
-    pub az: f64,
+    #[arg(required_unless_present = "input")]
+    pub z: Option<f64>,
+    /// Tool axis x component (unitless, any length).
+    #[arg(required_unless_present = "input")]
+    pub ax: Option<f64>,
+    /// Tool axis y component (unitless).
+    #[arg(required_unless_present = "input")]
+    pub ay: Option<f64>,
+    /// Tool axis z component (unitless).
+    #[arg(required_unless_present = "input")]
+    pub az: Option<f64>,
+    #[command(flatten)]
+    pub input: InputArgs,
     #[command(flatten)]
     pub machine: MachineArgs,
 }
@@ -61,78 +95,182 @@ pub struct MachineVerbArgs {
     pub machine: MachineArgs,
 }
 
-/// The record keys shared by `ik` and `tool-ik`: `q1 q2 q3` (mm),
-/// `phi theta` (rad), `q4` (mm).
-fn legs_and_up(legs_mm: &[f64; 3], up: &UpJoints) -> Vec<(&'static str, Value)> {
-    vec![
-        ("q1", legs_mm[0].into()),
-        ("q2", legs_mm[1].into()),
-        ("q3", legs_mm[2].into()),
-        ("phi", up.phi_rad.into()),
-        ("theta", up.theta_rad.into()),
-        ("q4", up.q4_mm.into()),
-    ]
+/// One point or a batch, for any of the three verbs.
+fn kinematics(
+    verb: Verb,
+    point: &[Option<f64>],
+    input: &InputArgs,
+    machine: &MachineArgs,
+) -> Result<u8, CliError> {
+    let m = ExtendedMachine::new(load(machine)?.machine);
+    if let Some(path) = &input.input {
+        if point.iter().any(Option::is_some) {
+            return Err(CliError::input(format!(
+                "{}: give either a point on the command line or --input, not both",
+                verb.name()
+            )));
+        }
+        if machine.json {
+            return Err(CliError::input(format!(
+                "{} --input: the output is CSV (the --json keys as columns); leave out --json",
+                verb.name()
+            )));
+        }
+        return run_batch(verb, &m, path);
+    }
+    let values: Vec<f64> = point.iter().map(|v| v.unwrap_or(f64::NAN)).collect();
+    let cells = verb
+        .solve(&m, &values)
+        .map_err(|e| CliError::kinematics(verb.name(), &e))?;
+    let fields: Vec<Field> = verb
+        .keys()
+        .iter()
+        .zip(verb.units())
+        .zip(cells)
+        .map(|((k, u), c)| (*k, c.to_json(), *u))
+        .collect();
+    print_record(machine.json, &fields);
+    Ok(0)
+}
+
+fn run_batch(verb: Verb, m: &ExtendedMachine, path: &std::path::Path) -> Result<u8, CliError> {
+    let out = std::io::BufWriter::with_capacity(1 << 16, crate::output::Stdout);
+    let result = if path.as_os_str() == "-" {
+        batch::run(
+            verb,
+            m,
+            std::io::stdin().lock(),
+            "stdin",
+            out,
+            stdout_closed,
+        )
+    } else {
+        let name = path.display().to_string();
+        let f = std::fs::File::open(path).map_err(|e| CliError::input(format!("{name}: {e}")))?;
+        batch::run(verb, m, f, &name, out, stdout_closed)
+    };
+    let file = path.display().to_string();
+    match result {
+        Ok(_) => Ok(0),
+        Err(BatchError::Input(message)) => Err(CliError::input(message)),
+        Err(BatchError::Point { line, source }) => Err(CliError::kinematics(
+            &format!("{} --input {file}: line {line}", verb.name()),
+            &source,
+        )),
+        Err(BatchError::Output(message)) => Err(CliError::other(format!("stdout: {message}"))),
+    }
 }
 
 /// `tricept ik X Y Z`.
-pub fn ik(a: &IkArgs) -> Result<(), CliError> {
-    let m = load_machine(&a.machine)?;
-    let sol = m
-        .inverse(&Vector3::new(a.x, a.y, a.z))
-        .map_err(|e| CliError::kinematics("ik", &e))?;
-    print_record(a.machine.json, &legs_and_up(&sol.legs_mm, &sol.up));
-    Ok(())
+pub fn ik(a: &IkArgs) -> Result<u8, CliError> {
+    kinematics(Verb::Ik, &[a.x, a.y, a.z], &a.input, &a.machine)
 }
 
 /// `tricept fk Q1 Q2 Q3`.
-pub fn fk(a: &FkArgs) -> Result<(), CliError> {
-    let m = load_machine(&a.machine)?;
-    let sol = m
-        .forward(&[a.q1, a.q2, a.q3])
-        .map_err(|e| CliError::kinematics("fk", &e))?;
-    print_record(
-        a.machine.json,
-        &[
-            ("x", sol.position_mm.x.into()),
-            ("y", sol.position_mm.y.into()),
-            ("z", sol.position_mm.z.into()),
-            ("phi", sol.up.phi_rad.into()),
-            ("theta", sol.up.theta_rad.into()),
-            ("q4", sol.up.q4_mm.into()),
-            ("condition", sol.condition.into()),
-            ("iterations", sol.iterations.into()),
-        ],
-    );
-    Ok(())
+pub fn fk(a: &FkArgs) -> Result<u8, CliError> {
+    kinematics(Verb::Fk, &[a.q1, a.q2, a.q3], &a.input, &a.machine)
 }
 
 /// `tricept tool-ik X Y Z AX AY AZ`.
-pub fn tool_ik(a: &ToolIkArgs) -> Result<(), CliError> {
-    let m = load_machine(&a.machine)?;
-    let sol = m
-        .tool_inverse(
-            &Vector3::new(a.x, a.y, a.z),
-            &Vector3::new(a.ax, a.ay, a.az),
-            HeadBranch::default(),
-        )
-        .map_err(|e| CliError::kinematics("tool-ik", &e))?;
-    let mut record = legs_and_up(&sol.legs_mm, &sol.up);
-    record.extend([
-        ("h1", sol.head_rad[0].into()),
-        ("h2", sol.head_rad[1].into()),
-        ("head_singular", Value::Bool(sol.head_singular)),
-    ]);
-    print_record(a.machine.json, &record);
-    Ok(())
+pub fn tool_ik(a: &ToolIkArgs) -> Result<u8, CliError> {
+    kinematics(
+        Verb::ToolIk,
+        &[a.x, a.y, a.z, a.ax, a.ay, a.az],
+        &a.input,
+        &a.machine,
+    )
 }
 
-/// `tricept machine`: prints the description in use.
-pub fn print_machine(a: &MachineVerbArgs) -> Result<(), CliError> {
-    let description = match &a.machine.machine {
-        None => MachineDescription::paper(),
-        Some(path) => MachineDescription::from_file(path)
-            .map_err(|e| CliError::description(&path.display().to_string(), &e))?,
-    };
-    outln!("{}", description.to_json());
-    Ok(())
+/// `tricept machine`: the description in use, as JSON (`--json`, the file
+/// format) or as a summary with units.
+pub fn print_machine(a: &MachineVerbArgs) -> Result<u8, CliError> {
+    let loaded = load(&a.machine)?;
+    if a.machine.json {
+        outln!("{}", loaded.description.to_json());
+        return Ok(0);
+    }
+    summary(&loaded.description, &loaded.machine, &loaded.source);
+    Ok(0)
+}
+
+fn summary(d: &MachineDescription, m: &Machine, source: &str) {
+    let v = |p: &nalgebra::Vector3<f64>| format!("({:.3}, {:.3}, {:.3})", p.x, p.y, p.z);
+    outln!("{} (from {source})", d.name);
+    if let Some(n) = &d.notes {
+        outln!("  notes: {n}");
+    }
+    for i in 0..3 {
+        outln!(
+            "  leg {}: base joint B{} {} mm, platform joint A{} {} mm, length offset {:.4} mm",
+            i + 1,
+            i + 1,
+            v(&m.base_joints_mm[i]),
+            i + 1,
+            v(&m.platform_joints_mm[i]),
+            m.leg_offsets_mm[i]
+        );
+    }
+    let u = &m.up_limb;
+    outln!(
+        "  UP limb: {} U joint; axis skew {:.3e} rad, axis offset {:.4} mm, twist {:.3e} rad/mm about {:.1} mm",
+        u.axis_order,
+        u.axis_skew_rad,
+        u.axis_offset_mm,
+        u.twist_rad_per_mm,
+        u.twist_reference_mm
+    );
+    let w = &m.workspace;
+    outln!(
+        "  workspace: cylinder of radius {} mm, z from {} to {} mm",
+        w.radius_mm,
+        w.z_min_mm,
+        w.z_max_mm
+    );
+    let l = &d.limits;
+    outln!(
+        "  limits: leg stroke {:?} mm, UP stroke {:?} mm, tilt {} deg",
+        l.leg_stroke_mm,
+        l.up_stroke_mm,
+        l.max_tilt_deg
+    );
+    let s = &d.sensors;
+    outln!(
+        "  sensors: encoder noise {} arcsec, scale noise {} um per reading, mean of {}",
+        s.angle_noise_arcsec,
+        s.length_noise_um,
+        s.readings_per_pose
+    );
+    let e = &d.leg_effects;
+    if !e.is_zero() {
+        outln!(
+            "  leg effects (applied by ik, fk, tool-ik, compensate): lead {:?} ppm, compliance {} um/kN at 1 m",
+            e.lead_ppm,
+            e.compliance_um_per_kn_at_1m
+        );
+    }
+    if let Some(c) = &d.controller {
+        outln!(
+            "  controller parameters: backlash {:?} um per leg axis, thermal expansion {} ppm/K from {} °C",
+            c.backlash_um,
+            c.thermal_expansion_ppm_per_k,
+            c.reference_temperature_c
+        );
+    }
+    if let Some(c) = &d.calibration {
+        outln!(
+            "  calibration: {} from {} ({}, sha256 {}), {}: {} parameters, {} held, chi2/dof {:.3}, converged {}, adequate {}{}",
+            c.method,
+            c.data_file,
+            c.date,
+            &c.data_sha256[..c.data_sha256.len().min(12)],
+            c.parameter_set,
+            c.estimates_mm.len(),
+            c.held.len(),
+            c.chi2_per_dof,
+            c.converged,
+            c.adequate,
+            if c.forced { ", FORCED" } else { "" }
+        );
+    }
+    outln!("  (tricept machine --json prints the description file)");
 }

@@ -112,7 +112,7 @@ pub struct PlanArgs {
 }
 
 /// `tricept plan`.
-pub fn run(a: &PlanArgs) -> Result<(), CliError> {
+pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
     let m = machine_with_noise(&a.machine, &a.noise)?;
     let set = a.params.set()?;
     let model = fused_model(&m, &set, &a.effects, Some("head13"))?;
@@ -278,7 +278,7 @@ pub fn run(a: &PlanArgs) -> Result<(), CliError> {
             "note: a linear-Gaussian prediction of variance only; an unmodelled effect's bias is not in it (docs/hybrid.md)"
         );
     }
-    Ok(())
+    Ok(0)
 }
 
 fn study_error(e: tricept_study::StudyError) -> CliError {

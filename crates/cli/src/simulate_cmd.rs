@@ -7,7 +7,7 @@ use tricept_ident::GeometricModel;
 use tricept_plant::{Campaign, Plant, PoseOrder};
 
 use crate::args::{
-    MachineArgs, NoiseArgs, ParamArgs, machine_with_noise, parse_effects, parse_errors,
+    MachineArgs, NoiseArgs, ParamArgs, TruthArgs, machine_with_noise, parse_effects, parse_errors,
     pose_targets,
 };
 use crate::cli_error::CliError;
@@ -16,22 +16,18 @@ use crate::fusion_cmd::{parse_numbers, positive};
 /// `tricept simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
-    /// True errors of the simulated machine.
-    #[arg(long, default_value = "table2")]
-    pub errors: String,
-    /// Pose set (as for `identifiability`).
+    #[command(flatten)]
+    pub truth: TruthArgs,
+    /// Pose set (as for `identifiability`; positions in mm).
     #[arg(long, default_value = "grid")]
     pub poses: String,
-    /// Seed of the sensor noise.
-    #[arg(long, default_value_t = 1)]
+    /// Seed of the sensor noise (a whole number).
+    #[arg(long, default_value_t = 1, value_name = "N")]
     pub seed: u64,
     /// Visit every pose twice, approaching from both directions.
     #[arg(long)]
     pub both_directions: bool,
-    /// An unmodelled effect (JSON object or @FILE); repeatable.
-    #[arg(long = "effect", value_name = "JSON")]
-    pub effects: Vec<String>,
-    /// Output file (default: stdout).
+    /// Output file (default: stdout; with --json, a summary goes to stdout).
     #[arg(long, value_name = "FILE.csv")]
     pub out: Option<PathBuf>,
     /// Head errors of the simulated machine: `zero`, `random:SCALE[,SEED]`
@@ -102,17 +98,23 @@ pub struct SimulateArgs {
 }
 
 /// `tricept simulate`.
-pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
+pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
+    if a.machine.json && a.out.is_none() {
+        return Err(CliError::input(
+            "--json: needs --out FILE.csv (without it the CSV itself goes to stdout)",
+        ));
+    }
     let m = machine_with_noise(&a.machine, &a.noise)?;
     let set = a.params.set()?;
-    let values = parse_errors(&a.errors, &set)?;
+    let truth = a.truth.truth.as_deref().unwrap_or("table2");
+    let values = parse_errors(truth, &set)?;
     let targets = pose_targets(&a.poses, &m)?;
     let mut campaign = Campaign::from_targets(&m, targets, a.seed);
     if a.both_directions {
         campaign.order = PoseOrder::BothDirections;
     }
     let mut plant = Plant::geometric(m.clone(), set.to_errors(&values));
-    plant.effects = parse_effects(&a.effects)?;
+    plant.effects = parse_effects(&a.truth.truth_effects)?;
     plant.head_errors = parse_head_errors(&a.head_errors, &m)?;
     let data = plant
         .simulate(&campaign)
@@ -167,11 +169,43 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
     }
     simulate_external(a, &plant, &comments)?;
     match &a.out {
-        Some(path) => tricept_data::write_path(path, &data, &comments)
-            .map_err(|e| CliError::other(format!("{}: {e}", path.display()))),
-        None => tricept_data::write_to(std::io::stdout().lock(), &data, &comments)
-            .map_err(|e| CliError::other(format!("stdout: {e}"))),
+        Some(path) => {
+            tricept_data::write_path(path, &data, &comments)
+                .map_err(|e| CliError::other(format!("{}: {e}", path.display())))?;
+            if a.machine.json {
+                outln!(
+                    "{}",
+                    serde_json::json!({
+                        "out": path.display().to_string(),
+                        "poses": data.poses.len(),
+                        "seed": a.seed,
+                        "machine": m.name,
+                        "parameter_set": set.label(),
+                        "truth_mm": serde_json::Value::Object(set.values_to_map(&values)),
+                        "truth_effects": plant.effects,
+                        "sensor_offsets": {"phi_rad": plant.sensor_offsets[0], "theta_rad": plant.sensor_offsets[1], "s_mm": plant.sensor_offsets[2]},
+                    })
+                );
+            } else {
+                outln!(
+                    "wrote {} poses to {} (machine `{}`, true errors `{truth}`, {} effect(s), seed {})",
+                    data.poses.len(),
+                    path.display(),
+                    m.name,
+                    plant.effects.len(),
+                    a.seed
+                );
+            }
+        }
+        // A closed stdout (`| head`) is not an error: the writer swallows it.
+        None => tricept_data::write_to(
+            std::io::BufWriter::new(crate::output::Stdout),
+            &data,
+            &comments,
+        )
+        .map_err(|e| CliError::other(format!("stdout: {e}")))?,
     }
+    Ok(0)
 }
 
 /// Parses `--head-errors`.

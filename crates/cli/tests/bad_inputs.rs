@@ -416,9 +416,9 @@ fn bad_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
                 &[],
                 vec![],
                 2,
-                &["--effect", "unknown variant"],
+                &["--truth-effect", "unknown variant"],
             ),
-            args(&["simulate", "--effect", r#"{"effect":"gremlins"}"#]),
+            args(&["simulate", "--truth-effect", r#"{"effect":"gremlins"}"#]),
         ),
         (
             case(

@@ -123,6 +123,39 @@ fn the_calibrated_machine_file_carries_the_head_and_tool_ik_uses_it() {
             (reached - tip).norm()
         );
     }
+    // The calibration record: the fused fit's provenance, every external
+    // file with its hash, the nominal machine of the rank rule.
+    let file: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let record = &file["calibration"];
+    assert_eq!(record["method"], "identify (fused)");
+    assert_eq!(record["data_file"], "internal.csv");
+    assert_eq!(record["external_sources"][0]["kind"], "tracker");
+    assert_eq!(record["external_sources"][0]["file"], "tracker.csv");
+    assert_eq!(record["external_sources"][0]["records"], 20);
+    assert_eq!(
+        record["external_sources"][0]["sha256"]
+            .as_str()
+            .unwrap()
+            .len(),
+        64
+    );
+    assert!(record["estimates_mm"]["h1_zero_rad"].is_number());
+    assert!(file["name"].as_str().unwrap().contains("calibrated"));
+    // Identifying the internal data again against it keeps the rank rule
+    // of the nominal machine: dyA3 stays held.
+    let again: serde_json::Value = serde_json::from_slice(&ok(
+        &dir,
+        &[
+            "identify",
+            "--data",
+            "internal.csv",
+            "--machine",
+            "calibrated.json",
+            "--json",
+        ],
+    ))
+    .unwrap();
+    assert_eq!(again["fixed"], serde_json::json!(["dyA3"]));
     // A nominal file is printed as it always was: no head angle offsets.
     let nominal = String::from_utf8(ok(&dir, &["machine"])).unwrap();
     assert!(!nominal.contains("angle_offsets_rad"));

@@ -59,5 +59,5 @@ pub use external::{
 };
 pub use pose::{Dataset, MeasuredPose, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Readings};
 pub use read::{MAX_ANGLE_SPAN_RAD, read_from, read_path, read_with_progress};
-pub use targets::{read_targets, read_targets_from};
+pub use targets::{NumericRows, read_targets, read_targets_from};
 pub use write::{write_path, write_to};

@@ -48,23 +48,76 @@ pub fn read_targets(path: &Path) -> Result<Vec<[f64; 3]>, DataError> {
 /// assert_eq!(err.to_string(), "t.csv: line 2, column `z`: not a number (got `abc`)");
 /// ```
 pub fn read_targets_from<R: Read>(reader: R, file: &str) -> Result<Vec<[f64; 3]>, DataError> {
-    let mut records = Records::new(reader, file);
-    let header = Header::read(&mut records, &TARGET_COLUMNS.join(","))?;
-    let columns = header.locate(TARGET_COLUMNS, &TARGET_COLUMNS)?;
-    let mut points = Vec::new();
-    for record in records {
-        let record = record?;
-        header.check(&record)?;
-        let mut p = [0.0; 3];
-        for (v, &idx) in p.iter_mut().zip(&columns) {
-            *v = header.number(&record, idx)?;
-        }
-        points.push(p);
-    }
+    let points = NumericRows::new(reader, file, TARGET_COLUMNS)?
+        .map(|row| row.map(|(_, p)| p))
+        .collect::<Result<Vec<_>, _>>()?;
     if points.is_empty() {
         return Err(DataError::NoRows { file: file.into() });
     }
     Ok(points)
+}
+
+/// The rows of a CSV source as the numbers of `N` named columns, streamed
+/// one row at a time with its 1-based file line (for batch inputs that need
+/// not fit in memory). The format rules and messages are those of
+/// [`read_targets_from`]; an empty file is an error, a header without rows
+/// yields nothing.
+///
+/// # Example
+/// ```
+/// use tricept_data::NumericRows;
+/// let csv = "\u{feff}q2,q1,q3\n# a comment\n700,701,702.5\n";
+/// let rows: Vec<_> = NumericRows::new(csv.as_bytes(), "legs.csv", ["q1", "q2", "q3"])
+///     .unwrap()
+///     .collect::<Result<_, _>>()
+///     .unwrap();
+/// assert_eq!(rows, vec![(3, [701.0, 700.0, 702.5])]);
+/// let bad = NumericRows::new("q1;q2;q3\n1;2;3\n".as_bytes(), "legs.csv", ["q1", "q2", "q3"]);
+/// assert!(bad.is_err());
+/// ```
+pub struct NumericRows<'f, R, const N: usize> {
+    records: Records<'f, R>,
+    header: Header,
+    columns: [usize; N],
+}
+
+impl<'f, R: Read, const N: usize> NumericRows<'f, R, N> {
+    /// Reads the header of `reader` (`file` names it in errors) and locates
+    /// `columns`.
+    pub fn new(
+        reader: R,
+        file: &'f str,
+        columns: [&str; N],
+    ) -> Result<NumericRows<'f, R, N>, DataError> {
+        let mut records = Records::new(reader, file);
+        let header = Header::read(&mut records, &columns.join(","))?;
+        let located = header.locate(columns, &columns)?;
+        Ok(NumericRows {
+            records,
+            header,
+            columns: located,
+        })
+    }
+}
+
+impl<R: Read, const N: usize> Iterator for NumericRows<'_, R, N> {
+    type Item = Result<(u64, [f64; N]), DataError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let record = match self.records.next()? {
+            Ok(r) => r,
+            Err(e) => return Some(Err(e)),
+        };
+        let row = (|| {
+            self.header.check(&record)?;
+            let mut v = [0.0; N];
+            for (x, &idx) in v.iter_mut().zip(&self.columns) {
+                *x = self.header.number(&record, idx)?;
+            }
+            Ok((record.line, v))
+        })();
+        Some(row)
+    }
 }
 
 #[cfg(test)]

@@ -33,10 +33,25 @@ pub enum IdentError {
         /// Minimum number of poses.
         needed: usize,
     },
+    /// Enough rows, but too few distinct poses: rows repeating the same
+    /// commands average the noise and add no geometry.
+    #[error(
+        "too few distinct poses: the {poses} rows hold {distinct} distinct leg commands, and {unknowns} unknowns (parameters + 3 sensor offsets) need at least {needed} distinct poses"
+    )]
+    TooFewDistinctPoses {
+        /// Rows given.
+        poses: usize,
+        /// Distinct command triples among them (counted up to `needed`).
+        distinct: usize,
+        /// Unknowns.
+        unknowns: usize,
+        /// Minimum number of distinct poses.
+        needed: usize,
+    },
     /// A pose the model cannot solve (commands out of reach, no assembly...).
-    #[error("pose {pose} (line {line}): {source}")]
+    #[error("pose {} (line {line}): {source}", pose + 1)]
     Kinematics {
-        /// Index of the pose.
+        /// Index of the pose (0-based; shown 1-based).
         pose: usize,
         /// Line of the pose in its file (0 if none).
         line: u64,

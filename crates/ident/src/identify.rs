@@ -275,7 +275,8 @@ pub struct ResidualStats {
     pub dof: usize,
     /// `chi_square / dof`: about 1 when the model and noise levels are right.
     pub reduced_chi_square: f64,
-    /// Largest residual in noise standard deviations, and its pose index.
+    /// Largest residual in noise standard deviations, and its pose index
+    /// (0-based; [`Identification::lines`] gives its file line).
     pub max_standardised: (f64, usize),
 }
 
@@ -322,6 +323,8 @@ pub struct Identification {
     pub iterations: u32,
     /// Whether the iteration met its tolerance.
     pub converged: bool,
+    /// The line of each pose in its data file (0 where there is none).
+    pub lines: Vec<u64>,
     /// The rank decision taken at the start and used throughout.
     design: Design,
 }
@@ -388,18 +391,46 @@ fn evaluate(
     })
 }
 
-/// Checks that there are enough readings for the unknowns.
-fn check_size(n_poses: usize, k: usize) -> Result<(), IdentError> {
+/// Checks that there are enough readings, and enough distinct poses, for
+/// the unknowns: repeated commands average the noise but add no geometry.
+fn check_size(poses: &[MeasuredPose], k: usize) -> Result<(), IdentError> {
+    let n_poses = poses.len();
     let unknowns = k + 3;
+    let needed = unknowns.div_ceil(3) + 1;
     if 3 * n_poses < unknowns + 1 {
         return Err(IdentError::TooFewPoses {
             poses: n_poses,
             readings: 3 * n_poses,
             unknowns,
-            needed: unknowns.div_ceil(3) + 1,
+            needed,
+        });
+    }
+    let distinct = distinct_commands(poses, needed);
+    if distinct < needed {
+        return Err(IdentError::TooFewDistinctPoses {
+            poses: n_poses,
+            distinct,
+            unknowns,
+            needed,
         });
     }
     Ok(())
+}
+
+/// The number of distinct command triples among `poses`, counted up to
+/// `enough` (the count stops there: a large file costs one pass).
+fn distinct_commands(poses: &[MeasuredPose], enough: usize) -> usize {
+    let mut seen: Vec<[u64; 3]> = Vec::with_capacity(enough);
+    for p in poses {
+        let key = p.commands_mm.map(f64::to_bits);
+        if !seen.contains(&key) {
+            seen.push(key);
+            if seen.len() >= enough {
+                break;
+            }
+        }
+    }
+    seen.len()
 }
 
 /// Identifies the parameters of `model` from `data`.
@@ -464,7 +495,7 @@ pub fn identify_from(
     let names = model.names().to_vec();
     let k = names.len();
     let poses = &data.poses;
-    check_size(poses.len(), k)?;
+    check_size(poses, k)?;
     let mismatch = |what: &str, found: usize, expected: usize| {
         IdentError::Invalid(format!("{found} {what} for {expected}"))
     };
@@ -503,7 +534,19 @@ pub fn identify_from(
             ));
         }
         None => {
-            let d = decide_design(&names, &eval, poses.len(), options)?;
+            let d = match model.rank_reference() {
+                Some(reference) if reference.names() == names.as_slice() => {
+                    design(reference, &vec![0.0; k], poses, options)?
+                }
+                Some(reference) => {
+                    return Err(IdentError::Invalid(format!(
+                        "the rank reference has parameters {:?}, the model {:?}",
+                        reference.names(),
+                        names
+                    )));
+                }
+                None => decide_design(&names, &eval, poses.len(), options)?,
+            };
             let first = eval.problem.solve(&d.decision);
             (d.decision, d.report, first)
         }
@@ -525,7 +568,10 @@ pub fn identify_from(
     };
     iterate(&problem, &mut state, &decision, options.max_iterations);
 
-    Ok(finish(names, state, decision, report, options, weights))
+    let lines = poses.iter().map(|p| p.line).collect();
+    Ok(finish(
+        names, state, decision, report, options, weights, lines,
+    ))
 }
 
 /// The fixed parts of an identification problem.
@@ -563,6 +609,7 @@ fn finish(
     report: IdentifiabilityReport,
     options: &IdentifyOptions,
     weights: Option<&[f64]>,
+    lines: Vec<u64>,
 ) -> Identification {
     let Run {
         p,
@@ -637,6 +684,7 @@ fn finish(
         },
         iterations,
         converged,
+        lines,
         design: Design { decision, report },
     }
 }
@@ -691,7 +739,7 @@ pub fn design(
     poses: &[MeasuredPose],
     options: &IdentifyOptions,
 ) -> Result<Design, IdentError> {
-    check_size(poses.len(), model.names().len())?;
+    check_size(poses, model.names().len())?;
     let mut seeds = vec![None; poses.len()];
     if p.len() != model.names().len() {
         return Err(IdentError::Invalid(format!(
@@ -746,7 +794,9 @@ impl Identification {
     /// JSON with the contract keys: every parameter name with its estimate
     /// (mm), `std_dev`, `rank`, `n_params`, `unidentifiable`,
     /// `singular_values`, `condition_number`, `observability`, residual
-    /// statistics, and more.
+    /// statistics (poses numbered from 1, with their file line), the
+    /// [`Verdict`](crate::Verdict) (`converged`, `adequate`, `warnings`),
+    /// and more.
     ///
     /// # Example
     /// ```
@@ -797,11 +847,23 @@ impl Identification {
                 "dof": self.stats.dof,
                 "reduced_chi_square": self.stats.reduced_chi_square,
                 "max_standardised": self.stats.max_standardised.0,
-                "max_standardised_pose": self.stats.max_standardised.1,
+                "max_standardised_pose": self.stats.max_standardised.1 + 1,
+                "max_standardised_line": self.lines.get(self.stats.max_standardised.1).copied().unwrap_or(0),
             }),
         );
         m.insert("iterations".into(), self.iterations.into());
-        m.insert("converged".into(), self.converged.into());
+        let verdict = self.verdict();
+        m.insert("converged".into(), verdict.converged.into());
+        m.insert("adequate".into(), verdict.adequate.into());
+        m.insert(
+            "chi_square_p_value".into(),
+            verdict.chi_square_p_value.into(),
+        );
+        m.insert(
+            "consistent_with_machine".into(),
+            (!verdict.inconsistent).into(),
+        );
+        m.insert("warnings".into(), verdict.warnings.into());
         Value::Object(m)
     }
 }

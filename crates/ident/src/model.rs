@@ -13,6 +13,7 @@
 
 use tricept_data::MeasuredPose;
 use tricept_kinematics::{KinematicsError, LegGeometry, Machine, UpJoints};
+use tricept_model::effects::static_leg_extra_per_mm;
 use tricept_model::{N_FULL, ParameterSet, actual_machine, error_jacobian_at};
 
 /// A parametric model of the UP limb's readings.
@@ -43,6 +44,15 @@ pub trait ReadingModel: Sync {
 
     /// The model evaluated at parameter values `p`, ready to predict poses.
     fn at<'a>(&'a self, p: &[f64]) -> Box<dyn PosePredictor + 'a>;
+
+    /// The model whose design at zero decides which parameters the data can
+    /// see, when that is not this model at the starting point: a model
+    /// built on a calibrated machine keeps the rank rule of the nominal
+    /// machine it was calibrated from (see
+    /// [`GeometricModel::with_rank_reference`]). Default: none.
+    fn rank_reference(&self) -> Option<&dyn ReadingModel> {
+        None
+    }
 }
 
 /// A reading model at fixed parameter values.
@@ -88,6 +98,7 @@ pub trait PosePredictor: Sync {
 pub struct GeometricModel {
     nominal: Machine,
     set: ParameterSet,
+    rank_reference: Option<Box<GeometricModel>>,
 }
 
 impl GeometricModel {
@@ -102,7 +113,50 @@ impl GeometricModel {
     /// assert_eq!(model.parameter_set().len(), 15);
     /// ```
     pub fn new(nominal: Machine, set: ParameterSet) -> GeometricModel {
-        GeometricModel { nominal, set }
+        GeometricModel {
+            nominal,
+            set,
+            rank_reference: None,
+        }
+    }
+
+    /// The same model, with the rank decision taken on `structural` (at
+    /// zero errors) instead of on this model's machine at the starting
+    /// point.
+    ///
+    /// A calibrated machine differs from its nominal one by the calibrated
+    /// errors, and those break the symmetries that make a parameter
+    /// invisible: on the x-first machine `dyA3` is invisible because B3
+    /// lies on the fixed U-joint axis, and a calibrated `dyB3` of 0.27 mm
+    /// moves it off that axis by just enough for `dyA3` to pass the rank
+    /// tolerance with a standard deviation of metres. Identifying again
+    /// against the calibrated machine must hold the same parameters as the
+    /// first calibration did; the structure that decides it is the nominal
+    /// machine's.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{GeometricModel, IdentifyOptions, identify};
+    /// use tricept_kinematics::Machine;
+    /// use tricept_model::ParameterSet;
+    /// use tricept_plant::{Campaign, Plant};
+    /// let m = Machine::paper();
+    /// let set = ParameterSet::paper15();
+    /// let data = Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+    ///     .simulate(&Campaign::grid(&m, 1))
+    ///     .unwrap();
+    /// let options = IdentifyOptions::for_machine(&m);
+    /// let first = GeometricModel::new(m.clone(), set.clone());
+    /// let id = identify(&first, &data, &options).unwrap();
+    /// let calibrated = first.machine_at(&id.estimate);
+    /// // Against the calibrated machine, with the nominal one's rank rule:
+    /// let again = GeometricModel::new(calibrated, set.clone()).with_rank_reference(m.clone());
+    /// let id2 = identify(&again, &data, &options).unwrap();
+    /// assert_eq!(id2.report.fixed, vec!["dyA3".to_string()]);
+    /// ```
+    pub fn with_rank_reference(mut self, structural: Machine) -> GeometricModel {
+        self.rank_reference = Some(Box::new(GeometricModel::new(structural, self.set.clone())));
+        self
     }
 
     /// The nominal machine.
@@ -225,6 +279,12 @@ impl ReadingModel for GeometricModel {
     fn at<'a>(&'a self, p: &[f64]) -> Box<dyn PosePredictor + 'a> {
         Box::new(GeometricPredictor::new(self.machine_at(p), &self.set))
     }
+
+    fn rank_reference(&self) -> Option<&dyn ReadingModel> {
+        self.rank_reference
+            .as_deref()
+            .map(|m| m as &dyn ReadingModel)
+    }
 }
 
 /// UP joints of `machine` at `commands`, from `seed` when given (falling
@@ -262,7 +322,20 @@ impl PosePredictor for GeometricPredictor<'_> {
         jacobian: &mut [f64],
     ) -> Result<[f64; 3], KinematicsError> {
         let k = self.set.len();
-        let (up, _) = self.solve(&pose.commands_mm, seed, jacobian, k)?;
+        let legs = if self.machine.leg_effects.is_zero() {
+            pose.commands_mm
+        } else {
+            // The machine's static leg effects (a calibrated machine that a
+            // diagnosis wrote) are known: the legs are the commands plus
+            // them, with the gravity tension at the pose the plain geometry
+            // reaches (a few um away, which changes the effect by 1e-5 of
+            // itself).
+            let mut probe = *seed;
+            let up = solve_pose(&self.machine, &pose.commands_mm, &mut probe)?;
+            let rate = static_leg_extra_per_mm(&self.machine, &up);
+            std::array::from_fn(|i| pose.commands_mm[i] * (1.0 + rate[i]))
+        };
+        let (up, _) = self.solve(&legs, seed, jacobian, k)?;
         Ok(up.to_array())
     }
 }

@@ -20,6 +20,9 @@ pub const PAPER_MACHINE_JSON: &str = include_str!(concat!(
     "/../../fixtures/machines/tricept-paper.json"
 ));
 
+/// The largest length (mm) any key of a description may hold: 100 m.
+pub const MAX_LENGTH_MM: f64 = 1e5;
+
 /// A complete machine description, as stored in JSON.
 ///
 /// # Example
@@ -58,9 +61,202 @@ pub struct MachineDescription {
     /// Noise of the UP limb's sensors (used by identification).
     #[serde(default)]
     pub sensors: SensorDescription,
-    /// Masses and stiffness, used by the compliance model of the plant simulator.
+    /// Masses and stiffness, used by the compliance model of the plant
+    /// simulator and by the `compliance` leg effect.
     #[serde(default)]
     pub loads: LoadsDescription,
+    /// Static leg effects a calibration found (ball-screw lead, gravity
+    /// compliance), applied by the kinematics of `tricept-model`'s
+    /// `ExtendedMachine`; zero (and not written) on a nominal machine.
+    #[serde(default, skip_serializing_if = "LegEffectsDescription::is_zero")]
+    pub leg_effects: LegEffectsDescription,
+    /// Dynamic effects a CNC controller compensates itself (backlash,
+    /// thermal expansion), exported as the parameters it takes; tricept's
+    /// own kinematics do not apply them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub controller: Option<ControllerDescription>,
+    /// Where a calibrated machine came from: estimates, uncertainties, fit
+    /// quality and provenance. Absent on a nominal machine.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<Box<CalibrationRecord>>,
+}
+
+/// Static effects of the actuated legs: the actual length of leg `i` for
+/// command `q_i` is `q_i + dq_i + lead_i 1e-6 q_i + c F_i q_i 1e-9` (mm),
+/// with `F_i` the gravity tension of the leg (N) at the pose and `c` the
+/// compliance of a 1 m leg (um/kN; stiffness scales as 1/length).
+///
+/// # Example
+/// ```
+/// use tricept_kinematics::description::LegEffectsDescription;
+/// let e = LegEffectsDescription { lead_ppm: [50.0, 0.0, 0.0], ..Default::default() };
+/// assert!(!e.is_zero());
+/// assert!(LegEffectsDescription::default().is_zero());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct LegEffectsDescription {
+    /// Ball-screw lead error of each leg, ppm of the command.
+    pub lead_ppm: [f64; 3],
+    /// Axial compliance of a leg of 1 m under its gravity tension, um/kN
+    /// (1000 / stiffness in N/um).
+    pub compliance_um_per_kn_at_1m: f64,
+}
+
+impl LegEffectsDescription {
+    /// No effect at all (what a nominal machine has).
+    pub fn is_zero(&self) -> bool {
+        is_zero3(&self.lead_ppm) && self.compliance_um_per_kn_at_1m == 0.0
+    }
+}
+
+/// Parameters a CNC controller takes for its own compensation of the
+/// dynamic leg effects: lost motion at each reversal of a leg axis, and
+/// thermal expansion of the legs relative to a reference temperature.
+///
+/// # Example
+/// ```
+/// use tricept_kinematics::description::ControllerDescription;
+/// let c = ControllerDescription::default();
+/// assert_eq!(c.reference_temperature_c, 20.0);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ControllerDescription {
+    /// Backlash (lost motion at reversal) of each leg axis, um: the leg
+    /// stops `backlash/2` short of the command in the direction it came from.
+    pub backlash_um: [f64; 3],
+    /// Effective thermal expansion coefficient of the legs, ppm/K: a leg of
+    /// command `q` grows by `alpha q (T - T_ref)`.
+    pub thermal_expansion_ppm_per_k: f64,
+    /// The temperature `T_ref` at which the calibrated lengths hold, °C.
+    pub reference_temperature_c: f64,
+}
+
+impl Default for ControllerDescription {
+    /// No backlash, no expansion, the ISO 1 reference temperature of 20 °C.
+    fn default() -> Self {
+        ControllerDescription {
+            backlash_um: [0.0; 3],
+            thermal_expansion_ppm_per_k: 0.0,
+            reference_temperature_c: 20.0,
+        }
+    }
+}
+
+/// A parameter held at its prior value, and why.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HeldParameter {
+    /// Parameter name.
+    pub name: String,
+    /// Why the fit did not estimate it.
+    pub reason: String,
+}
+
+/// Estimated zero offsets of the UP limb's sensors with their standard
+/// deviations.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SensorOffsetsDescription {
+    /// Encoder `phi` zero offset, rad.
+    pub phi_rad: f64,
+    /// Encoder `theta` zero offset, rad.
+    pub theta_rad: f64,
+    /// Linear scale zero offset, mm.
+    pub s_mm: f64,
+    /// Standard deviations `[phi rad, theta rad, s mm]`.
+    pub std_dev: [f64; 3],
+}
+
+/// Correlation matrix of the estimated parameters (held ones left out).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct CorrelationsDescription {
+    /// Row and column names.
+    pub names: Vec<String>,
+    /// Row-major correlations, `names.len()` rows of `names.len()`.
+    pub matrix: Vec<Vec<f64>>,
+}
+
+/// What a calibrated machine file records about its calibration. The
+/// parameter values are relative to `relative_to`, the machine the data
+/// were identified against; `nominal` is the machine whose structure
+/// decides which parameters the sensors can see (the rank rule), carried
+/// from calibration to calibration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrationRecord {
+    /// The verb that wrote it (`identify` or `diagnose`).
+    pub method: String,
+    /// Parameter set (`paper15`, `full21`).
+    pub parameter_set: String,
+    /// Estimated geometric parameters, mm (held ones at their prior).
+    pub estimates_mm: serde_json::Map<String, serde_json::Value>,
+    /// Their standard deviations, mm (`null` where held).
+    pub std_dev_mm: serde_json::Map<String, serde_json::Value>,
+    /// Correlations of the estimated parameters.
+    pub correlations: CorrelationsDescription,
+    /// Parameters of the effects a diagnosis named, with standard deviations
+    /// (`{name: {"value": v, "std_dev": s}}`, units in the names).
+    #[serde(default, skip_serializing_if = "serde_json::Map::is_empty")]
+    pub effects: serde_json::Map<String, serde_json::Value>,
+    /// Sensor zero offsets.
+    pub sensor_offsets: SensorOffsetsDescription,
+    /// Parameters held at their prior, with the reason.
+    pub held: Vec<HeldParameter>,
+    /// Weighted chi-square per degree of freedom of the fit (1 when the
+    /// model explains the data to the stated sensor noise).
+    pub chi2_per_dof: f64,
+    /// Degrees of freedom of the fit.
+    pub dof: usize,
+    /// Whether the fit converged.
+    pub converged: bool,
+    /// Whether the model explains the data (chi-square test at 0.001).
+    pub adequate: bool,
+    /// Written with `--force` although the fit is not to be trusted.
+    #[serde(default)]
+    pub forced: bool,
+    /// Warnings of the fit, as printed.
+    #[serde(default)]
+    pub warnings: Vec<String>,
+    /// Poses used by the fit.
+    pub poses_used: usize,
+    /// Lines of the data file rejected as gross errors.
+    #[serde(default)]
+    pub rejected_lines: Vec<u64>,
+    /// External measurements fused with the UP limb's data (tracker,
+    /// ballbar, touch-off files), when there were any.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub external_sources: Vec<ExternalSourceRecord>,
+    /// The data file, as given on the command line.
+    pub data_file: String,
+    /// SHA-256 of the data file's bytes, hex.
+    pub data_sha256: String,
+    /// When the file was written, UTC (ISO 8601).
+    pub date: String,
+    /// `tricept` version that wrote it.
+    pub tool_version: String,
+    /// Name of the machine the estimates are relative to.
+    pub relative_to: String,
+    /// The nominal machine of the rank rule.
+    pub nominal: Box<MachineDescription>,
+}
+
+/// An external measurement file of a fused calibration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExternalSourceRecord {
+    /// `tracker`, `ballbar` or `touch`.
+    pub kind: String,
+    /// The file, as given on the command line.
+    pub file: String,
+    /// SHA-256 of its bytes, hex.
+    pub sha256: String,
+    /// Records used.
+    pub records: usize,
+    /// Its weighted chi-square per degree of freedom in the fused fit.
+    pub chi2_per_dof: f64,
 }
 
 fn is_zero3(v: &[f64; 3]) -> bool {
@@ -385,6 +581,103 @@ impl MachineDescription {
                 )?;
             }
         }
+        // Finite is not enough: 1e200 mm would pass every check below and
+        // overflow inside the solvers.
+        let size = |key: &str, values: &[f64]| -> Result<(), DescriptionError> {
+            finite(key, values)?;
+            match values.iter().find(|v| v.abs() > MAX_LENGTH_MM) {
+                Some(v) => Err(invalid(
+                    key,
+                    format!(
+                        "{v} mm is not the size of a machine (lengths are limited to {MAX_LENGTH_MM} mm)"
+                    ),
+                )),
+                None => Ok(()),
+            }
+        };
+        match &self.placement {
+            Placement::Circular(c) => size(
+                "placement.circular",
+                &[c.base_radius_mm, c.platform_radius_mm],
+            )?,
+            Placement::Explicit(e) => {
+                size(
+                    "placement.explicit.base_joints_mm",
+                    e.base_joints_mm.as_flattened(),
+                )?;
+                size(
+                    "placement.explicit.platform_joints_mm",
+                    e.platform_joints_mm.as_flattened(),
+                )?;
+            }
+        }
+        size("leg_offsets_mm", &self.leg_offsets_mm)?;
+        size(
+            "up_limb",
+            &[self.up_limb.axis_offset_mm, self.up_limb.twist_reference_mm],
+        )?;
+        size(
+            "workspace",
+            &[
+                self.workspace.radius_mm,
+                self.workspace.height_mm,
+                self.workspace.distance_mm,
+            ],
+        )?;
+        size("limits.leg_stroke_mm", &self.limits.leg_stroke_mm)?;
+        size("limits.up_stroke_mm", &self.limits.up_stroke_mm)?;
+        for (key, v) in [
+            ("head.axis1_point_mm", self.head.axis1_point_mm),
+            ("head.axis2_point_mm", self.head.axis2_point_mm),
+            ("head.tool_tip_mm", self.head.tool_tip_mm),
+            ("loads.head_com_mm", self.loads.head_com_mm),
+        ] {
+            size(key, &v)?;
+        }
+        let e = &self.leg_effects;
+        finite("leg_effects.lead_ppm", &e.lead_ppm)?;
+        finite(
+            "leg_effects.compliance_um_per_kn_at_1m",
+            &[e.compliance_um_per_kn_at_1m],
+        )?;
+        if let Some(v) = e.lead_ppm.iter().find(|v| v.abs() > 1e4) {
+            return Err(invalid(
+                "leg_effects.lead_ppm",
+                format!("{v} ppm is not a lead error (limit 10000 ppm, 1 %)"),
+            ));
+        }
+        if e.compliance_um_per_kn_at_1m.abs() > 1e4 {
+            return Err(invalid(
+                "leg_effects.compliance_um_per_kn_at_1m",
+                format!(
+                    "{} um/kN is not the compliance of a machine leg (limit 10000 um/kN)",
+                    e.compliance_um_per_kn_at_1m
+                ),
+            ));
+        }
+        if let Some(c) = &self.controller {
+            finite("controller.backlash_um", &c.backlash_um)?;
+            finite(
+                "controller",
+                &[c.thermal_expansion_ppm_per_k, c.reference_temperature_c],
+            )?;
+            if !(-60.0..=200.0).contains(&c.reference_temperature_c) {
+                return Err(invalid(
+                    "controller.reference_temperature_c",
+                    format!("{} °C is outside -60..200 °C", c.reference_temperature_c),
+                ));
+            }
+        }
+        if let Some(c) = &self.calibration {
+            c.nominal.validate().map_err(|e| match e {
+                DescriptionError::Invalid { key, reason } => DescriptionError::Invalid {
+                    key: format!("calibration.nominal.{key}"),
+                    reason,
+                },
+                e => e,
+            })?;
+        }
+
         let (base, platform) = self.joints_mm();
         check_triangle("base joints B1..B3", &base, Some([0.0; 3]))
             .map_err(|r| invalid("placement", r))?;
@@ -643,5 +936,77 @@ mod tests {
         v["limits"] = serde_json::json!({"leg_stroke_mm": [900.0, 500.0]});
         let e = MachineDescription::from_json(&v.to_string()).unwrap_err();
         assert!(e.to_string().contains("must be below"), "{e}");
+    }
+
+    #[test]
+    fn rejects_sizes_no_machine_has() {
+        for (key, value) in [
+            ("/placement/circular/base_radius_mm", 1e200),
+            ("/workspace/radius_mm", 2e5),
+            ("/head/tool_tip_mm/2", -1e6),
+        ] {
+            let mut v: serde_json::Value = serde_json::from_str(PAPER_MACHINE_JSON).unwrap();
+            *v.pointer_mut(key).unwrap() = value.into();
+            let e = MachineDescription::from_json(&v.to_string()).unwrap_err();
+            assert!(
+                e.to_string().contains("not the size of a machine"),
+                "{key}: {e}"
+            );
+        }
+        let mut v: serde_json::Value = serde_json::from_str(PAPER_MACHINE_JSON).unwrap();
+        v["leg_effects"] = serde_json::json!({"lead_ppm": [5e4, 0.0, 0.0]});
+        let e = MachineDescription::from_json(&v.to_string()).unwrap_err();
+        assert!(e.to_string().contains("lead_ppm"), "{e}");
+    }
+
+    #[test]
+    fn a_calibrated_description_round_trips_and_its_nominal_is_validated() {
+        let mut d = MachineDescription::paper();
+        d.leg_effects.compliance_um_per_kn_at_1m = 29.98;
+        d.controller = Some(ControllerDescription {
+            backlash_um: [6.0, 5.0, 8.0],
+            ..ControllerDescription::default()
+        });
+        let mut nominal = MachineDescription::paper();
+        d.calibration = Some(Box::new(CalibrationRecord {
+            method: "identify".into(),
+            parameter_set: "paper15".into(),
+            estimates_mm: serde_json::Map::new(),
+            std_dev_mm: serde_json::Map::new(),
+            correlations: CorrelationsDescription::default(),
+            effects: serde_json::Map::new(),
+            sensor_offsets: SensorOffsetsDescription::default(),
+            held: vec![HeldParameter {
+                name: "dyA3".into(),
+                reason: "unidentifiable".into(),
+            }],
+            chi2_per_dof: 0.95,
+            dof: 208,
+            converged: true,
+            adequate: true,
+            forced: false,
+            warnings: Vec::new(),
+            poses_used: 75,
+            rejected_lines: Vec::new(),
+            external_sources: Vec::new(),
+            data_file: "data.csv".into(),
+            data_sha256: "0".repeat(64),
+            date: "2026-11-23T00:00:00Z".into(),
+            tool_version: "0.1.0".into(),
+            relative_to: nominal.name.clone(),
+            nominal: Box::new(nominal.clone()),
+        }));
+        let again = MachineDescription::from_json(&d.to_json()).unwrap();
+        assert_eq!(d, again);
+        // A broken nominal machine inside is found and named.
+        nominal.workspace.radius_mm = -1.0;
+        if let Some(c) = &mut d.calibration {
+            *c.nominal = nominal;
+        }
+        let e = MachineDescription::from_json(&d.to_json()).unwrap_err();
+        assert!(
+            e.to_string().contains("calibration.nominal.workspace"),
+            "{e}"
+        );
     }
 }

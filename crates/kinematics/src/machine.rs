@@ -13,8 +13,8 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::description::{
-    LoadsDescription, MachineDescription, Placement, SensorDescription, UpLimbDescription,
-    WorkspaceDescription,
+    LegEffectsDescription, LoadsDescription, MachineDescription, Placement, SensorDescription,
+    UpLimbDescription, WorkspaceDescription,
 };
 use crate::error::KinematicsError;
 use crate::head::Head;
@@ -161,8 +161,12 @@ pub struct Machine {
     pub head: Head,
     /// Sensor noise (one reading).
     pub sensors: SensorNoise,
-    /// Masses and stiffness (for the plant simulator's compliance effect).
+    /// Masses and stiffness (for the compliance effect).
     pub loads: LoadsDescription,
+    /// Static leg effects of a calibrated machine (lead, compliance). Plain
+    /// data here: this crate's IK and FK are the geometric ones, and
+    /// `tricept_model::ExtendedMachine` applies the effects.
+    pub leg_effects: LegEffectsDescription,
 }
 
 /// Largest condition number (of the unit-free `J1`, see
@@ -198,6 +202,7 @@ impl Machine {
             head: Head::from_description(&d.head),
             sensors: SensorNoise::from_description(&d.sensors),
             loads: d.loads.clone(),
+            leg_effects: d.leg_effects,
         }
     }
 
@@ -233,11 +238,16 @@ impl Machine {
             },
             head: self.head.to_description(),
             sensors: SensorDescription {
-                angle_noise_arcsec: rad_to_arcsec(self.sensors.angle_rad),
+                // Rounded to 1e-9 arcsec so that 0.8 arcsec survives the
+                // round trip through rad as 0.8.
+                angle_noise_arcsec: (rad_to_arcsec(self.sensors.angle_rad) * 1e9).round() / 1e9,
                 length_noise_um: self.sensors.length_mm * 1e3,
                 readings_per_pose: self.sensors.readings_per_pose,
             },
             loads: self.loads.clone(),
+            leg_effects: self.leg_effects,
+            controller: None,
+            calibration: None,
         }
     }
 

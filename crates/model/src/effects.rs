@@ -250,3 +250,30 @@ pub fn stiffness_for_platform_deflection(machine: &Machine, deflection_um: f64) 
         Err(_) => f64::NAN,
     }
 }
+
+/// Extra length (mm) per mm of command of each leg of `machine` from its
+/// static leg effects ([`Machine::leg_effects`]) with the UP limb at `up`:
+/// `lead_i 1e-6 + c F_i 1e-9`, the lead error plus the compliance `c`
+/// (um/kN at 1 m) under the gravity tension `F_i` (N). Zero without effects.
+///
+/// # Example
+/// ```
+/// use tricept_kinematics::Machine;
+/// let mut m = Machine::paper();
+/// let up = m.forward(&[800.0; 3]).unwrap().up;
+/// assert_eq!(tricept_model::effects::static_leg_extra_per_mm(&m, &up), [0.0; 3]);
+/// m.leg_effects.lead_ppm = [50.0, 0.0, 0.0];
+/// assert!((tricept_model::effects::static_leg_extra_per_mm(&m, &up)[0] - 5e-5).abs() < 1e-18);
+/// ```
+pub fn static_leg_extra_per_mm(machine: &Machine, up: &UpJoints) -> [f64; 3] {
+    let e = &machine.leg_effects;
+    let tension = if e.compliance_um_per_kn_at_1m != 0.0 {
+        gravity_leg_tension_n(machine, up)
+    } else {
+        [0.0; 3]
+    };
+    std::array::from_fn(|i| {
+        leg_lead_extra_mm(e.lead_ppm[i], 1.0)
+            + e.compliance_um_per_kn_at_1m * compliance_extra_mm(1000.0, tension[i], 1.0)
+    })
+}

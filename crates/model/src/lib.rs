@@ -18,6 +18,9 @@
 //!   their names and their physics, shared by the simulator and the
 //!   diagnosis.
 //!
+//! - [`ExtendedMachine`]: a calibrated machine's kinematics with the static
+//!   leg effects (lead, compliance) a diagnosis named.
+//!
 //! All lengths in mm, angles in rad.
 #![cfg_attr(
     not(test),
@@ -27,6 +30,7 @@
 mod actual;
 pub mod effects;
 mod error;
+mod extended;
 mod head_errors;
 mod jacobian;
 mod params;
@@ -34,6 +38,7 @@ mod volumetric;
 
 pub use actual::{actual_machine, errors_between};
 pub use error::ModelError;
+pub use extended::ExtendedMachine;
 pub use head_errors::{
     Effector, HEAD13_NAMES, HeadAt, HeadJacobian, HeadParameterSet, N_HEAD, TYPICAL_HEAD_ERRORS,
 };

@@ -51,9 +51,9 @@ pub use tricept_model::effects::EffectName;
 pub enum PlantError {
     /// A target pose the nominal machine cannot reach, or an actual machine
     /// that cannot assemble at the commands.
-    #[error("pose {index} ({target_mm:?} mm): {source}")]
+    #[error("pose {} ({target_mm:?} mm): {source}", index + 1)]
     Kinematics {
-        /// Index of the target in the campaign.
+        /// Index of the target in the campaign (0-based; shown 1-based).
         index: usize,
         /// The target, mm.
         target_mm: [f64; 3],

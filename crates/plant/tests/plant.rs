@@ -222,7 +222,8 @@ fn an_unreachable_target_is_an_error_naming_it() {
         1,
     );
     let e = p.simulate(&c).unwrap_err().to_string();
-    assert!(e.contains("pose 1") && e.contains("5000"), "{e}");
+    // The second target, numbered from 1.
+    assert!(e.contains("pose 2") && e.contains("5000"), "{e}");
 }
 
 /// A plant with module and head errors.

@@ -136,7 +136,7 @@ impl GradeModel {
             let mut seed: Option<UpJoints> = Some(s.true_up[j]);
             predictor
                 .predict(pose, &mut seed, &mut jac)
-                .map_err(|e| StudyError::Invalid(format!("pose {j}: {e}")))?;
+                .map_err(|e| StudyError::Invalid(format!("pose {}: {e}", j + 1)))?;
             for c in 0..3 {
                 let w = 1.0 / sigma[c];
                 a[(3 * j + c, c)] = w;

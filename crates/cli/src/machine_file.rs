@@ -1,0 +1,314 @@
+//! Calibrated machine files: the identified geometry in the description
+//! format that every `--machine` loads, with a `calibration` record of the
+//! estimates, their uncertainties and correlations, the sensor offsets,
+//! what was held and why, the fit's quality and its provenance.
+
+use std::path::Path;
+
+use nalgebra::DMatrix;
+use serde_json::{Map, Value};
+use sha2::{Digest, Sha256};
+use tricept_ident::fusion::{Fusion, SourceKind};
+use tricept_ident::{IdentifiabilityReport, Identification};
+use tricept_kinematics::description::{
+    CalibrationRecord, CorrelationsDescription, ExternalSourceRecord, HeldParameter,
+    SensorOffsetsDescription,
+};
+use tricept_kinematics::{Machine, MachineDescription};
+
+use crate::args::LoadedMachine;
+use crate::cli_error::CliError;
+
+/// What the record says beyond the fit itself.
+pub struct Provenance<'a> {
+    /// `identify` or `diagnose`.
+    pub method: &'static str,
+    /// The data file as given.
+    pub data_file: &'a Path,
+    /// Parameter set label.
+    pub parameter_set: &'a str,
+    /// Lines rejected as gross errors.
+    pub rejected_lines: Vec<u64>,
+    /// Adequacy of the model.
+    pub adequate: bool,
+    /// Written with `--force`.
+    pub forced: bool,
+    /// Warnings of the fit.
+    pub warnings: Vec<String>,
+    /// Effect parameters (`{name: {"value", "std_dev"}}`), for `diagnose`.
+    pub effects: Map<String, Value>,
+    /// How many of the fit's parameters are recorded as estimates (the
+    /// geometric ones, and the head's of a fused fit; the rest are effects,
+    /// recorded under `effects`).
+    pub n_geometric: usize,
+    /// External measurement files of a fused fit: kind, file, records,
+    /// chi-square per degree of freedom.
+    pub external: Vec<(String, &'a Path, usize, f64)>,
+}
+
+/// What the record needs of a fit, whether from the UP limb's data alone
+/// ([`Identification`]) or fused with external measurements ([`Fusion`]).
+pub struct FitRecord<'a> {
+    names: &'a [String],
+    estimate: &'a [f64],
+    std_dev: &'a [Option<f64>],
+    covariance: &'a DMatrix<f64>,
+    report: &'a IdentifiabilityReport,
+    offsets: [f64; 3],
+    offsets_std_dev: [f64; 3],
+    chi2_per_dof: f64,
+    dof: usize,
+    converged: bool,
+    poses_used: usize,
+}
+
+impl<'a> FitRecord<'a> {
+    /// The record of an identification from the UP limb's data.
+    pub fn of_identification(id: &'a Identification) -> FitRecord<'a> {
+        FitRecord {
+            names: &id.names,
+            estimate: &id.estimate,
+            std_dev: &id.std_dev,
+            covariance: &id.covariance,
+            report: &id.report,
+            offsets: id.offsets,
+            offsets_std_dev: id.offsets_std_dev,
+            chi2_per_dof: id.stats.reduced_chi_square,
+            dof: id.stats.dof,
+            converged: id.converged,
+            poses_used: id.residuals.len(),
+        }
+    }
+
+    /// The record of a fused fit: the union's report, the internal
+    /// source's sensor offsets, the chi-square per degree of freedom of all
+    /// sources together.
+    pub fn of_fusion(fit: &'a Fusion) -> FitRecord<'a> {
+        let internal = fit.sources.iter().find(|s| s.kind == SourceKind::Internal);
+        let pick = |v: &[f64]| -> [f64; 3] {
+            std::array::from_fn(|c| v.get(c).copied().unwrap_or(f64::NAN))
+        };
+        let chi2: f64 = fit.sources.iter().map(|s| s.chi_square).sum();
+        let dof: f64 = fit.sources.iter().map(|s| s.dof_share).sum();
+        FitRecord {
+            names: &fit.names,
+            estimate: &fit.estimate,
+            std_dev: &fit.std_dev,
+            covariance: &fit.covariance,
+            report: &fit.report.union,
+            offsets: internal.map_or([0.0; 3], |s| pick(&s.nuisance)),
+            offsets_std_dev: internal.map_or([0.0; 3], |s| pick(&s.nuisance_std_dev)),
+            chi2_per_dof: if dof > 0.0 { chi2 / dof } else { 0.0 },
+            dof: dof.round().max(0.0) as usize,
+            converged: fit.converged,
+            poses_used: internal.map_or(0, |s| s.records),
+        }
+    }
+}
+
+/// SHA-256 of a file's bytes, lower-case hex.
+pub fn sha256_file(path: &Path) -> Result<String, CliError> {
+    let bytes =
+        std::fs::read(path).map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    let digest = Sha256::digest(&bytes);
+    Ok(digest.iter().map(|b| format!("{b:02x}")).collect())
+}
+
+/// The current UTC time as ISO 8601 (`2026-11-23T09:38:00Z`).
+pub fn utc_now() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let (days, rem) = (secs / 86_400, secs % 86_400);
+    let (y, m, d) = civil_from_days(days as i64);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem % 3600 / 60,
+        rem % 60
+    )
+}
+
+/// Proleptic Gregorian date of a day count from 1970-01-01 (H. Hinnant's
+/// `civil_from_days`).
+fn civil_from_days(z: i64) -> (i64, u32, u32) {
+    let z = z + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    (y, m, d)
+}
+
+/// Why each held parameter was held, from the identifiability report.
+fn held(id: &FitRecord<'_>, reference: &str) -> Vec<HeldParameter> {
+    let r = id.report;
+    let s1 = r.singular_values.first().copied().unwrap_or(0.0);
+    r.fixed
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let value = id
+                .names
+                .iter()
+                .position(|n| n == name)
+                .map_or(0.0, |j| id.estimate[j]);
+            let reason = match r.unidentifiable.get(i) {
+                Some(c) => format!(
+                    "unidentifiable from the UP limb's sensors on {reference}: the combination {} has singular value {:.1e} of the largest, below the rank tolerance {:.0e}; held at its prior value {value} mm",
+                    c.to_text(),
+                    if s1 > 0.0 { c.singular_value / s1 } else { 0.0 },
+                    r.rank_tolerance
+                ),
+                None => format!(
+                    "held at its prior value {value} mm by the rank decision on {reference}"
+                ),
+            };
+            HeldParameter {
+                name: name.clone(),
+                reason,
+            }
+        })
+        .collect()
+}
+
+/// The correlation matrix of the estimated (not held) parameters among the
+/// first `n` of the fit.
+fn correlations(id: &FitRecord<'_>, n: usize) -> CorrelationsDescription {
+    let free: Vec<usize> = (0..n.min(id.names.len()))
+        .filter(|&j| id.std_dev[j].is_some())
+        .collect();
+    let c = id.covariance;
+    CorrelationsDescription {
+        names: free.iter().map(|&j| id.names[j].clone()).collect(),
+        matrix: free
+            .iter()
+            .map(|&a| {
+                free.iter()
+                    .map(|&b| {
+                        let d = (c[(a, a)] * c[(b, b)]).sqrt();
+                        if d > 0.0 { c[(a, b)] / d } else { 0.0 }
+                    })
+                    .collect()
+            })
+            .collect(),
+    }
+}
+
+/// The calibrated machine's description: `identified` (its geometry and
+/// leg effects) with the controller parameters of `base` unless given, a
+/// name that says it is calibrated, and the calibration record.
+pub fn calibrated_description(
+    base: &LoadedMachine,
+    identified: &Machine,
+    id: &FitRecord<'_>,
+    p: Provenance<'_>,
+    controller: Option<tricept_kinematics::description::ControllerDescription>,
+) -> Result<MachineDescription, CliError> {
+    let nominal = base.nominal_description();
+    let date = utc_now();
+    let data_name = p.data_file.display().to_string();
+    let mut d = identified.to_description();
+    d.controller = controller.or(base.description.controller);
+    let status = if !id.converged {
+        " (FORCED: the fit did not converge)"
+    } else if p.forced {
+        " (FORCED: the data do not fit the machine)"
+    } else if !p.adequate {
+        " (the model does not explain the data)"
+    } else {
+        ""
+    };
+    d.name = format!(
+        "{}, calibrated {} from {}{status}",
+        nominal.name,
+        &date[..10],
+        data_name
+    );
+    d.notes = Some(format!(
+        "written by tricept {} {} from {}; the `calibration` record holds the estimates relative to `{}`, their standard deviations and correlations, and the fit's quality",
+        env!("CARGO_PKG_VERSION"),
+        p.method,
+        data_name,
+        base.description.name
+    ));
+    let n = p.n_geometric.min(id.names.len());
+    let mut estimates = Map::new();
+    let mut std_dev = Map::new();
+    for j in 0..n {
+        estimates.insert(id.names[j].clone(), id.estimate[j].into());
+        std_dev.insert(
+            id.names[j].clone(),
+            id.std_dev[j].map_or(Value::Null, Value::from),
+        );
+    }
+    let reference = format!("`{}`", nominal.name);
+    d.calibration = Some(Box::new(CalibrationRecord {
+        method: p.method.to_string(),
+        parameter_set: p.parameter_set.to_string(),
+        estimates_mm: estimates,
+        std_dev_mm: std_dev,
+        correlations: correlations(id, n),
+        effects: p.effects,
+        sensor_offsets: SensorOffsetsDescription {
+            phi_rad: id.offsets[0],
+            theta_rad: id.offsets[1],
+            s_mm: id.offsets[2],
+            std_dev: id.offsets_std_dev,
+        },
+        held: held(id, &reference),
+        chi2_per_dof: id.chi2_per_dof,
+        dof: id.dof,
+        converged: id.converged,
+        adequate: p.adequate,
+        forced: p.forced,
+        warnings: p.warnings,
+        poses_used: id.poses_used,
+        external_sources: p
+            .external
+            .iter()
+            .map(|(kind, file, records, chi2)| {
+                Ok(ExternalSourceRecord {
+                    kind: kind.clone(),
+                    file: file.display().to_string(),
+                    sha256: sha256_file(file)?,
+                    records: *records,
+                    chi2_per_dof: *chi2,
+                })
+            })
+            .collect::<Result<_, CliError>>()?,
+        rejected_lines: p.rejected_lines,
+        data_file: data_name,
+        data_sha256: sha256_file(p.data_file)?,
+        date,
+        tool_version: env!("CARGO_PKG_VERSION").to_string(),
+        relative_to: base.description.name.clone(),
+        nominal: Box::new(nominal),
+    }));
+    // What is written must load back.
+    d.validate()
+        .map_err(|e| CliError::other(format!("the calibrated machine is not valid: {e}")))?;
+    Ok(d)
+}
+
+/// Writes a description to `path`.
+pub fn write(path: &Path, d: &MachineDescription) -> Result<(), CliError> {
+    std::fs::write(path, d.to_json() + "\n")
+        .map_err(|e| CliError::other(format!("{}: {e}", path.display())))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::civil_from_days;
+
+    #[test]
+    fn civil_dates() {
+        assert_eq!(civil_from_days(0), (1970, 1, 1));
+        assert_eq!(civil_from_days(11_016), (2000, 2, 29));
+        assert_eq!(civil_from_days(20_780), (2026, 11, 23));
+    }
+}

@@ -1,0 +1,879 @@
+//! A calibration a user can trust, against the real binary: exit codes that
+//! mean something (0 converged and adequate, 3 converged but inadequate, 4
+//! not converged, 2 bad input), messages that name the likely cause, a
+//! machine file that records its calibration and round-trips, and the
+//! deployed extended model doing on the simulated machine what the
+//! diagnosis said it would.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn tricept() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_tricept"))
+}
+
+fn workdir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tricept-trust-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn fixture(name: &str) -> String {
+    format!("{}/../../fixtures/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn run(args: &[&str]) -> Output {
+    let out = tricept().args(args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    out
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!(
+            "{e}: {}\n{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        )
+    })
+}
+
+fn text(out: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
+}
+
+/// The comments, header and rows of a CSV text.
+fn parts(csv: &str) -> (Vec<&str>, Vec<String>, Vec<Vec<String>>) {
+    let comments: Vec<&str> = csv.lines().filter(|l| l.starts_with('#')).collect();
+    let mut rows = csv.lines().filter(|l| !l.starts_with('#'));
+    let header = rows
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let rows = rows
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    (comments, header, rows)
+}
+
+/// Writes `csv` with each row passed through `f` (header names in `h`).
+fn rewrite(
+    csv: &str,
+    path: &Path,
+    header: impl Fn(&mut Vec<String>),
+    f: impl Fn(usize, &[String], &mut Vec<String>),
+) {
+    let (comments, mut h, rows) = parts(csv);
+    let names = h.clone();
+    header(&mut h);
+    let mut s = comments.join("\n") + "\n" + &h.join(",") + "\n";
+    for (j, r) in rows.iter().enumerate() {
+        let mut r = r.clone();
+        f(j, &names, &mut r);
+        s += &(r.join(",") + "\n");
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+fn col(names: &[String], c: &str) -> usize {
+    names.iter().position(|n| n == c).unwrap()
+}
+
+/// Identify with `--json` and `--write-machine`; asserts the exit code
+/// matches the JSON verdict and returns (code, json, stderr).
+fn identify(data: &Path, extra: &[&str], machine_out: &Path) -> (i32, serde_json::Value, String) {
+    let mut args = vec![
+        "identify".to_string(),
+        "--data".into(),
+        data.display().to_string(),
+        "--json".into(),
+        "--write-machine".into(),
+        machine_out.display().to_string(),
+    ];
+    args.extend(extra.iter().map(|s| s.to_string()));
+    let out = tricept().args(&args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let code = out.status.code().unwrap();
+    let v = json(&out);
+    let expected = match (v["converged"].as_bool(), v["adequate"].as_bool()) {
+        (Some(false), _) => 4,
+        (Some(true), Some(false)) => 3,
+        (Some(true), Some(true)) => 0,
+        _ => panic!("no verdict in {v}"),
+    };
+    assert_eq!(
+        code, expected,
+        "exit code against the JSON verdict: {stderr}"
+    );
+    (code, v, stderr)
+}
+
+#[test]
+fn data_that_cannot_come_from_the_machine_get_a_non_zero_code_and_a_named_cause() {
+    let dir = workdir("causes");
+    let good = std::fs::read_to_string(fixture("data/table2-grid-seed1.csv")).unwrap();
+    let cases: Vec<(&str, PathBuf, Option<String>, &str)> = {
+        let swap_angles = dir.join("swap-angles.csv");
+        rewrite(
+            &good,
+            &swap_angles,
+            |h| {
+                let (i, j) = (col(h, "phi"), col(h, "theta"));
+                h.swap(i, j);
+            },
+            |_, _, _| {},
+        );
+        let swap_legs = dir.join("swap-legs.csv");
+        rewrite(
+            &good,
+            &swap_legs,
+            |h| {
+                let (i, j) = (col(h, "q1"), col(h, "q2"));
+                h.swap(i, j);
+            },
+            |_, _, _| {},
+        );
+        let metres = dir.join("metres.csv");
+        rewrite(
+            &good,
+            &metres,
+            |_| {},
+            |_, names, r| {
+                let s = col(names, "s");
+                r[s] = (r[s].parse::<f64>().unwrap() / 1000.0).to_string();
+            },
+        );
+        vec![
+            (
+                "swapped phi and theta",
+                swap_angles,
+                None,
+                "phi and theta are exchanged",
+            ),
+            (
+                "swapped q1 and q2",
+                swap_legs,
+                None,
+                "q1 and q2 are exchanged",
+            ),
+            ("s in metres", metres, None, "logged in m, not mm"),
+            (
+                "the wrong machine file",
+                PathBuf::from(fixture("data/table2-grid-seed1.csv")),
+                Some(fixture("machines/tricept-paper-y-first.json")),
+                "the data fit the same machine with the x-first axis order",
+            ),
+        ]
+    };
+    for (name, data, machine, cause) in cases {
+        let out_machine = dir.join(format!("{name}.json"));
+        let extra: Vec<&str> = match &machine {
+            Some(m) => vec!["--machine", m.as_str()],
+            None => vec![],
+        };
+        let (code, v, stderr) = identify(&data, &extra, &out_machine);
+        assert!(code == 3 || code == 4, "{name}: exit {code}");
+        assert_eq!(v["consistent_with_machine"], false, "{name}");
+        let warnings = v["warnings"].to_string();
+        assert!(
+            warnings.contains("wrong machine file") && warnings.contains("swapped columns"),
+            "{name}: {warnings}"
+        );
+        assert!(warnings.contains(cause), "{name}: {warnings}");
+        // Such a fit is never written without --force.
+        assert!(!out_machine.exists(), "{name}: machine written");
+        assert!(stderr.contains("not written"), "{name}: {stderr}");
+    }
+    // The issue's wrong-machine case converges: exit 3, not 4.
+    let (code, _, _) = identify(
+        Path::new(&fixture("data/table2-grid-seed1.csv")),
+        &["--machine", &fixture("machines/tricept-paper-y-first.json")],
+        &dir.join("wrong.json"),
+    );
+    assert_eq!(code, 3);
+
+    // Twenty rows at one pose: no geometry to identify; an input error.
+    // Same commands, the readings of twenty rows (as a logger stuck on one
+    // pose would write them).
+    let one = dir.join("one-pose.csv");
+    let (comments, header, rows) = parts(&good);
+    let mut s = comments.join("\n") + "\n" + &header.join(",") + "\n";
+    for r in rows.iter().take(20) {
+        let mut r = r.clone();
+        for c in ["q1", "q2", "q3"] {
+            r[col(&header, c)] = "773".into();
+        }
+        s += &(r.join(",") + "\n");
+    }
+    std::fs::write(&one, s).unwrap();
+    for verb in ["identify", "diagnose"] {
+        let out = run(&[verb, "--data", one.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(2), "{verb}: {}", text(&out));
+        assert!(
+            text(&out).contains("1 distinct leg commands"),
+            "{verb}: {}",
+            text(&out)
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_converged_fit_that_does_not_explain_the_data_exits_3_and_names_diagnose() {
+    let dir = workdir("inadequate");
+    let data = fixture("data/diagnose-hidden-effect.csv");
+    let (code, v, _) = identify(Path::new(&data), &[], &dir.join("m.json"));
+    assert_eq!(code, 3);
+    assert!(v["warnings"].to_string().contains("tricept diagnose"));
+    // Written (the fit converged), and marked: not adequate.
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("m.json")).unwrap()).unwrap();
+    assert_eq!(m["calibration"]["adequate"], false);
+    assert!(
+        m["name"]
+            .as_str()
+            .unwrap()
+            .contains("does not explain the data")
+    );
+    // The text report names the diagnosis too.
+    let out = run(&["identify", "--data", &data]);
+    assert_eq!(out.status.code(), Some(3));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("run `tricept diagnose`"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_forced_machine_is_marked_and_warned_about_when_loaded() {
+    let dir = workdir("forced");
+    let good = std::fs::read_to_string(fixture("data/table2-grid-seed1.csv")).unwrap();
+    let bad = dir.join("swap.csv");
+    rewrite(
+        &good,
+        &bad,
+        |h| {
+            let (i, j) = (col(h, "phi"), col(h, "theta"));
+            h.swap(i, j);
+        },
+        |_, _, _| {},
+    );
+    let m = dir.join("forced.json");
+    let (code, _, _) = identify(&bad, &["--force"], &m);
+    assert_ne!(code, 0);
+    let d: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&m).unwrap()).unwrap();
+    assert_eq!(d["calibration"]["forced"], true);
+    assert!(d["name"].as_str().unwrap().contains("FORCED"));
+    let out = run(&["machine", "--machine", m.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--force"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn the_calibrated_machine_file_is_complete_loads_everywhere_and_round_trips() {
+    let dir = workdir("roundtrip");
+    let data = fixture("data/table2-grid-seed1.csv");
+    let m1 = dir.join("calibrated.json");
+    let (code, id1, _) = identify(Path::new(&data), &[], &m1);
+    assert_eq!(code, 0);
+    let text1 = std::fs::read_to_string(&m1).unwrap();
+    let d: serde_json::Value = serde_json::from_str(&text1).unwrap();
+    let c = &d["calibration"];
+    for key in [
+        "estimates_mm",
+        "std_dev_mm",
+        "correlations",
+        "sensor_offsets",
+        "parameter_set",
+        "held",
+        "chi2_per_dof",
+        "data_file",
+        "data_sha256",
+        "date",
+        "tool_version",
+        "nominal",
+    ] {
+        assert!(!c[key].is_null(), "calibration.{key} missing");
+    }
+    assert!(d["name"].as_str().unwrap().contains("calibrated"));
+    assert_eq!(c["parameter_set"], "paper15");
+    assert_eq!(c["held"][0]["name"], "dyA3");
+    assert!(
+        c["held"][0]["reason"]
+            .as_str()
+            .unwrap()
+            .contains("unidentifiable")
+    );
+    assert_eq!(c["std_dev_mm"]["dyA3"], serde_json::Value::Null);
+    assert_eq!(c["estimates_mm"]["dq2"], id1["dq2"]);
+    assert_eq!(c["sensor_offsets"]["s_mm"], id1["offsets"]["s_mm"]);
+    assert_eq!(c["data_sha256"].as_str().unwrap().len(), 64);
+    let corr = &c["correlations"];
+    assert_eq!(corr["names"].as_array().unwrap().len(), 14);
+    assert!((corr["matrix"][0][0].as_f64().unwrap() - 1.0).abs() < 1e-12);
+
+    // Loadable by every --machine.
+    let m = m1.to_str().unwrap();
+    for args in [
+        vec!["ik", "0", "0", "750", "--machine", m],
+        vec!["fk", "773", "773", "773", "--machine", m],
+        vec!["tool-ik", "0", "0", "1100", "0", "0", "1", "--machine", m],
+        vec!["machine", "--machine", m],
+        vec!["identifiability", "--machine", m],
+        vec!["simulate", "--poses", "grid:1,8,3", "--machine", m],
+        vec!["detectability", "--poses", "grid:1,8,3", "--machine", m],
+        vec!["compensate", "--machine", m, "--spacing", "100"],
+        vec!["diagnose", "--data", &data, "--machine", m],
+    ] {
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {}", text(&out));
+    }
+    // The calibrated IK moves the commands by the calibration (dq2 0.7 mm
+    // in Table 2, against the nominal machine).
+    let nominal = json(&run(&["ik", "0", "0", "750", "--json"]));
+    let calibrated = json(&run(&["ik", "0", "0", "750", "--json", "--machine", m]));
+    let shift = nominal["q2"].as_f64().unwrap() - calibrated["q2"].as_f64().unwrap();
+    assert!(shift > 0.3 && shift < 1.2, "{shift}");
+
+    // Identifying again against it keeps the rank rule: dyA3 held, and the
+    // increments are zero within their uncertainty.
+    let m2 = dir.join("again.json");
+    let (code, id2, _) = identify(Path::new(&data), &["--machine", m], &m2);
+    assert_eq!(code, 0);
+    assert_eq!(id2["rank"], 14);
+    assert_eq!(id2["std_dev"]["dyA3"], serde_json::Value::Null);
+    assert_eq!(id2["dyA3"], 0.0);
+    for name in ["dxB1", "dyB3", "dxA3", "dq1", "dq2", "dq3"] {
+        let (v, sd) = (
+            id2[name].as_f64().unwrap(),
+            id2["std_dev"][name].as_f64().unwrap(),
+        );
+        assert!(v.abs() < 0.1 * sd, "{name}: {v} +- {sd}");
+    }
+    // The second file records the first one's nominal machine, and its
+    // commands agree with the first one's to far below the uncertainty.
+    let d2: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&m2).unwrap()).unwrap();
+    assert_eq!(d2["calibration"]["nominal"], c["nominal"]);
+    let again = json(&run(&[
+        "ik",
+        "0",
+        "0",
+        "750",
+        "--json",
+        "--machine",
+        m2.to_str().unwrap(),
+    ]));
+    for q in ["q1", "q2", "q3"] {
+        let d = (again[q].as_f64().unwrap() - calibrated[q].as_f64().unwrap()).abs();
+        assert!(d < 1e-3, "{q}: {d}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn deploying_the_diagnosis_delivers_its_gain_on_the_simulated_machine() {
+    // The worked example of docs/diagnosis.md: random geometric errors up
+    // to 0.5 mm (seed 4) and legs of 33.6 N/um at 1 m, which the geometric
+    // model absorbs into a 5 mm leg-length error.
+    let dir = workdir("deploy");
+    let data = fixture("data/diagnose-hidden-effect.csv");
+    let (truth, effect) = (
+        "random:0.5,4",
+        r#"{"effect":"compliance","stiffness_n_per_um_at_1m":33.6}"#,
+    );
+    let ext = dir.join("extended.json");
+    let geo = dir.join("geometric.json");
+    let d = json(&run(&[
+        "diagnose",
+        "--data",
+        &data,
+        "--json",
+        "--write-machine",
+        ext.to_str().unwrap(),
+    ]));
+    let (code, _, _) = identify(Path::new(&data), &[], &geo);
+    assert_eq!(code, 3);
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&ext).unwrap()).unwrap();
+    // The named static effect is in the file, as the diagnosis estimated it.
+    let c = file["leg_effects"]["compliance_um_per_kn_at_1m"]
+        .as_f64()
+        .unwrap();
+    let reported = d["extended"]["compliance.compliance_um_per_kn_at_1m"]["value"]
+        .as_f64()
+        .unwrap();
+    assert!((c - reported).abs() < 1e-6 * reported, "{c} vs {reported}");
+
+    // The maps of the true machine commanded through each file.
+    let map = |machine: &Path, name: &str| -> Vec<[f64; 3]> {
+        let out_dir = dir.join(name);
+        let out = run(&[
+            "compensate",
+            "--machine",
+            machine.to_str().unwrap(),
+            "--truth",
+            truth,
+            "--truth-effect",
+            effect,
+            "--spacing",
+            "50",
+            "--map",
+            out_dir.to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+        let csv = std::fs::read_to_string(out_dir.join("map.csv")).unwrap();
+        let (_, h, rows) = parts(&csv);
+        let (x, y, z) = (
+            col(&h, "after_dx"),
+            col(&h, "after_dy"),
+            col(&h, "after_dz"),
+        );
+        rows.iter()
+            .map(|r| [x, y, z].map(|i| r[i].parse::<f64>().unwrap()))
+            .collect()
+    };
+    let (with_geo, with_ext) = (map(&geo, "geo"), map(&ext, "ext"));
+    let n = with_geo.len() as f64;
+    let moved: f64 = with_geo
+        .iter()
+        .zip(&with_ext)
+        .map(|(a, b)| {
+            ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+        })
+        .sum::<f64>()
+        / n;
+    let norm = |v: &[f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let error_geo = with_geo.iter().map(norm).sum::<f64>() / n;
+    let error_ext = with_ext.iter().map(norm).sum::<f64>() / n;
+    // What the diagnosis said the extended calibration changes (platform
+    // displacement on the middle plane, 50 mm lattice) is what commanding
+    // the simulated machine through the written file changes.
+    let predicted = d["gain"]["volumetric_mean_mm"].as_f64().unwrap();
+    assert!(
+        (moved - predicted).abs() < 0.01 * predicted,
+        "moved {moved} mm, diagnosis {predicted} mm"
+    );
+    // And the gain is real: the extended file puts the machine within a few
+    // tenths of a mm where the geometric one is almost 5 mm off.
+    assert!(
+        error_geo > 4.0 && error_ext < 0.2,
+        "{error_geo} {error_ext}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn batch_kinematics_write_the_json_keys_as_csv_columns() {
+    let dir = workdir("batch");
+    let points = dir.join("points.csv");
+    std::fs::write(
+        &points,
+        "\u{feff}# targets\nz,x,y\n750,0,0\n700,-120.5,80\n",
+    )
+    .unwrap();
+    let out = run(&["ik", "--input", points.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let csv = String::from_utf8(out.stdout).unwrap();
+    let (_, header, rows) = parts(&csv);
+    let single = json(&run(&["ik", "-120.5", "80", "700", "--json"]));
+    let keys: Vec<String> = single.as_object().unwrap().keys().cloned().collect();
+    assert_eq!(header, keys);
+    // (serde_json reads floats to within an ulp, hence the tolerance.)
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-15 * a.abs().max(b.abs());
+    for (k, v) in header.iter().zip(&rows[1]) {
+        assert!(
+            same(v.parse::<f64>().unwrap(), single[k].as_f64().unwrap()),
+            "{k}"
+        );
+    }
+    // fk from stdin, fed the ik output: back to the points.
+    let mut child = tricept()
+        .args(["fk", "--input", "-"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    {
+        use std::io::Write;
+        let mut stdin = child.stdin.take().unwrap();
+        let q: Vec<String> = rows
+            .iter()
+            .map(|r| format!("{},{},{}", r[3], r[4], r[5]))
+            .collect();
+        write!(stdin, "q1,q2,q3\n{}\n", q.join("\n")).unwrap();
+    }
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let (_, h, back) = parts(std::str::from_utf8(&out.stdout).unwrap());
+    let single_fk = json(&run(&["fk", "773", "773", "773", "--json"]));
+    let keys: Vec<String> = single_fk.as_object().unwrap().keys().cloned().collect();
+    assert_eq!(h, keys);
+    let x = col(&h, "x");
+    assert!((back[1][x].parse::<f64>().unwrap() + 120.5).abs() < 1e-9);
+    // tool-ik too.
+    let tools = dir.join("tools.csv");
+    std::fs::write(&tools, "x,y,z,ax,ay,az\n150,100,1080,0.2,-0.1,1\n").unwrap();
+    let out = run(&["tool-ik", "--input", tools.to_str().unwrap()]);
+    let single = json(&run(&[
+        "tool-ik", "150", "100", "1080", "0.2", "-0.1", "1", "--json",
+    ]));
+    let (_, h, r) = parts(std::str::from_utf8(&out.stdout).unwrap());
+    assert_eq!(h.len(), single.as_object().unwrap().len());
+    assert!(same(
+        r[0][col(&h, "h2")].parse::<f64>().unwrap(),
+        single["h2"].as_f64().unwrap()
+    ));
+    // A point out of reach stops the batch with its line, exit 2.
+    std::fs::write(&points, "x,y,z\n0,0,750\n\n0,0,3000\n").unwrap();
+    let out = run(&["ik", "--input", points.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out).contains("line 4"), "{}", text(&out));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn compensate_writes_clean_csv_maps_and_checks_its_arguments() {
+    let dir = workdir("compensate");
+    let data = fixture("data/table2-grid-seed1.csv");
+    let targets = dir.join("targets.csv");
+    std::fs::write(&targets, "x,y,z\n0,0,750\n100,-50,700\n").unwrap();
+    let out = run(&[
+        "compensate",
+        "--data",
+        &data,
+        "--targets",
+        targets.to_str().unwrap(),
+        "--truth",
+        "table2",
+        "--map",
+        dir.join("map").to_str().unwrap(),
+        "--spacing",
+        "50",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    // stdout is the CSV and nothing else; the report is on stderr.
+    let csv = String::from_utf8(out.stdout).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("x,y,z,q1,q2,q3"));
+    assert_eq!(lines.count(), 2);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("after"));
+    for f in ["map.csv", "correction.svg", "before.svg", "after.svg"] {
+        assert!(dir.join("map").join(f).exists(), "{f}");
+    }
+    let map = std::fs::read_to_string(dir.join("map/map.csv")).unwrap();
+    let (_, h, rows) = parts(&map);
+    assert!(h.contains(&"before_mm".to_string()) && h.contains(&"after_mm".to_string()));
+    let (b, a) = (col(&h, "before_mm"), col(&h, "after_mm"));
+    let mean = |i: usize| {
+        rows.iter()
+            .map(|r| r[i].parse::<f64>().unwrap())
+            .sum::<f64>()
+            / rows.len() as f64
+    };
+    assert!(mean(a) < 0.5 * mean(b));
+    // Arguments: a real message for a negative spacing, exit 2 off the plane.
+    for (args, needle) in [
+        (vec!["--spacing", "-5"], "--spacing"),
+        (vec!["--plane-z", "3000"], "outside the workspace"),
+        (vec!["--plane-z", "-700"], "outside the workspace"),
+    ] {
+        let mut all = vec!["compensate", "--data", &data];
+        all.extend(args);
+        let out = run(&all);
+        assert_eq!(out.status.code(), Some(2), "{all:?}");
+        assert!(text(&out).contains(needle), "{}", text(&out));
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn absurd_machines_and_flags_are_refused_clearly() {
+    let dir = workdir("absurd");
+    let huge = dir.join("huge.json");
+    std::fs::write(
+        &huge,
+        tricept_kinematics::description::PAPER_MACHINE_JSON.replace("288.7", "1e200"),
+    )
+    .unwrap();
+    let out = run(&["ik", "0", "0", "750", "--machine", huge.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out).contains("not the size of a machine"),
+        "{}",
+        text(&out)
+    );
+    // --json on machine and simulate.
+    let m = json(&run(&["machine", "--json"]));
+    assert_eq!(m["workspace"]["radius_mm"], 400.0);
+    let out_csv = dir.join("s.csv");
+    let s = json(&run(&[
+        "simulate",
+        "--poses",
+        "grid:1,8,3",
+        "--json",
+        "--out",
+        out_csv.to_str().unwrap(),
+    ]));
+    let rows = std::fs::read_to_string(&out_csv)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .count()
+        - 1;
+    assert_eq!(s["poses"], rows as u64);
+    // Text output carries units.
+    let out = run(&["ik", "0", "0", "750"]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains(" mm\n"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_single_gross_reading_is_rejected_by_line_not_fatal() {
+    // A 10 mm scale glitch on the first data row (line 7) and a 0.1 rad
+    // encoder jump: rejected by line, the fit converged and adequate.
+    let dir = workdir("glitch");
+    let good = std::fs::read_to_string(fixture("data/table2-grid-seed1.csv")).unwrap();
+    let first_data_line = good.lines().position(|l| !l.starts_with('#')).unwrap() + 2;
+    for (name, column, size, row) in [("glitch", "s", 10.0, 0usize), ("jump", "phi", 0.1, 10)] {
+        let path = dir.join(format!("{name}.csv"));
+        rewrite(
+            &good,
+            &path,
+            |_| {},
+            |j, names, r| {
+                if j == row {
+                    let c = col(names, column);
+                    r[c] = (r[c].parse::<f64>().unwrap() + size).to_string();
+                }
+            },
+        );
+        let (code, v, _) = identify(&path, &[], &dir.join(format!("{name}.json")));
+        assert_eq!(code, 0, "{name}: {v}");
+        let line = (first_data_line + row) as u64;
+        assert_eq!(v["rejected"][0]["line"], line, "{name}");
+        assert_eq!(v["rejected"][0]["pose"], row as u64 + 1, "{name}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The trilinear lookup of `table.csv` at `r`, read the way a controller
+/// would (this test's own implementation, from the documented format).
+fn lookup(
+    nodes: &std::collections::HashMap<[i64; 3], [f64; 3]>,
+    origin: [f64; 3],
+    h: f64,
+    r: [f64; 3],
+) -> [f64; 3] {
+    let last: Vec<i64> = (0..3)
+        .map(|a| nodes.keys().map(|k| k[a]).max().unwrap())
+        .collect();
+    let mut cell = [0i64; 3];
+    let mut t = [0.0; 3];
+    for a in 0..3 {
+        let u = (r[a] - origin[a]) / h;
+        // A point on the grid's upper face belongs to the last cell.
+        cell[a] = (u.floor() as i64).clamp(0, last[a] - 1);
+        t[a] = u - cell[a] as f64;
+    }
+    let mut out = [0.0; 3];
+    for corner in 0..8 {
+        let b = [corner & 1, corner >> 1 & 1, corner >> 2 & 1];
+        let w: f64 = (0..3)
+            .map(|a| if b[a] == 1 { t[a] } else { 1.0 - t[a] })
+            .product();
+        let v = nodes[&[cell[0] + b[0], cell[1] + b[1], cell[2] + b[2]]];
+        for l in 0..3 {
+            out[l] += w * v[l];
+        }
+    }
+    out
+}
+
+#[test]
+fn the_table_interpolation_error_is_what_the_docs_state() {
+    let dir = workdir("table");
+    let docs = std::fs::read_to_string(format!(
+        "{}/../../docs/data-format.md",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    // The docs' row for the Table 2 data: `| ... table2-grid-seed1.csv ... |
+    // 50 mm | 0.382 um |`.
+    let row = docs
+        .lines()
+        .find(|l| {
+            l.starts_with('|') && l.contains("table2-grid-seed1.csv") && l.contains("--table")
+        })
+        .expect("docs/data-format.md states the table of the Table 2 data");
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    let stated_spacing: f64 = cells[cells.len() - 3]
+        .trim_end_matches(" mm")
+        .parse()
+        .unwrap();
+    let stated_um: f64 = cells[cells.len() - 2]
+        .trim_end_matches(" um")
+        .parse()
+        .unwrap();
+
+    let data = fixture("data/table2-grid-seed1.csv");
+    let cal = dir.join("t2.json");
+    let (code, _, _) = identify(Path::new(&data), &[], &cal);
+    assert_eq!(code, 0);
+    let out = run(&[
+        "compensate",
+        "--machine",
+        cal.to_str().unwrap(),
+        "--table",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let v = json(&out);
+    let spacing = v["table"]["spacing_mm"].as_f64().unwrap();
+    let error_um = v["table"]["interpolation_error_um"].as_f64().unwrap();
+    assert_eq!(spacing, stated_spacing);
+    assert_eq!(format!("{error_um:.3}"), format!("{stated_um:.3}"));
+    assert!(error_um < 1.0);
+
+    // Measured again from the file alone: the exact corrections from
+    // `ik --input` on both machines, the lookup from table.csv.
+    let csv = std::fs::read_to_string(dir.join("table.csv")).unwrap();
+    let (_, h, rows) = parts(&csv);
+    let f = |r: &Vec<String>, c: &str| r[col(&h, c)].parse::<f64>().unwrap();
+    let mut nodes = std::collections::HashMap::new();
+    for r in &rows {
+        let idx = ["i", "j", "k"].map(|c| f(r, c) as i64);
+        nodes.insert(idx, ["dq1", "dq2", "dq3"].map(|c| f(r, c)));
+    }
+    let first = &rows[0];
+    let origin = [
+        f(first, "x") - f(first, "i") * spacing,
+        f(first, "y") - f(first, "j") * spacing,
+        f(first, "z") - f(first, "k") * spacing,
+    ];
+    let fine = spacing / 4.0;
+    let mut lattice = String::from("x,y,z\n");
+    let mut points = Vec::new();
+    for k in 0..=((200.0 / fine) as i64) {
+        for j in -((400.0 / fine) as i64)..=((400.0 / fine) as i64) {
+            for i in -((400.0 / fine) as i64)..=((400.0 / fine) as i64) {
+                let p = [i as f64 * fine, j as f64 * fine, 650.0 + k as f64 * fine];
+                if p[0].hypot(p[1]) <= 400.0 {
+                    lattice += &format!("{},{},{}\n", p[0], p[1], p[2]);
+                    points.push(p);
+                }
+            }
+        }
+    }
+    let lattice_file = dir.join("lattice.csv");
+    std::fs::write(&lattice_file, lattice).unwrap();
+    let ik = |machine: Option<&Path>| -> Vec<[f64; 3]> {
+        let mut args = vec!["ik", "--input", lattice_file.to_str().unwrap()];
+        if let Some(m) = machine {
+            args.extend(["--machine", m.to_str().unwrap()]);
+        }
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+        let (_, h, rows) = parts(std::str::from_utf8(&out.stdout).unwrap());
+        rows.iter()
+            .map(|r| ["q1", "q2", "q3"].map(|c| r[col(&h, c)].parse::<f64>().unwrap()))
+            .collect()
+    };
+    let (nominal, calibrated) = (ik(None), ik(Some(&cal)));
+    let mut worst: f64 = 0.0;
+    for (n, (p, (a, b))) in points
+        .iter()
+        .zip(nominal.iter().zip(&calibrated))
+        .enumerate()
+    {
+        let looked_up = lookup(&nodes, origin, spacing, *p);
+        for l in 0..3 {
+            let e = (looked_up[l] - (b[l] - a[l])).abs();
+            assert!(e.is_finite(), "point {n}");
+            worst = worst.max(e);
+        }
+    }
+    assert!(
+        (worst * 1e3 - error_um).abs() < 1e-6,
+        "re-measured {} um, stated {error_um} um",
+        worst * 1e3
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn the_dynamic_effects_are_exported_as_controller_parameters() {
+    // Backlash, a thermal drift and leg lead hidden in a campaign that
+    // visits each pose from both directions and logs the temperature.
+    let dir = workdir("controller");
+    let data = dir.join("dynamic.csv");
+    let (backlash_um, expansion, lead_ppm) = ([6.0, 5.0, 8.0], 11.5, [60.0, -40.0, 30.0]);
+    let out = run(&[
+        "simulate",
+        "--truth",
+        "random:0.3,2",
+        "--poses",
+        "random:150,3",
+        "--both-directions",
+        "--readings-per-pose",
+        "10",
+        "--truth-effect",
+        &format!(r#"{{"effect":"backlash","um":{backlash_um:?}}}"#),
+        "--truth-effect",
+        &format!(r#"{{"effect":"thermal","drift_k":3,"expansion_ppm_per_k":{expansion}}}"#),
+        "--truth-effect",
+        &format!(r#"{{"effect":"leg-lead","ppm":{lead_ppm:?}}}"#),
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let file = dir.join("dynamic.json");
+    let out = run(&[
+        "diagnose",
+        "--data",
+        data.to_str().unwrap(),
+        "--write-machine",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    let effects = &d["calibration"]["effects"];
+    let check = |value: &serde_json::Value, name: &str, truth: f64| {
+        let sd = effects[name]["std_dev"].as_f64().unwrap();
+        let v = value.as_f64().unwrap();
+        assert_eq!(v, effects[name]["value"].as_f64().unwrap(), "{name}");
+        assert!(
+            (v - truth).abs() < 5.0 * sd,
+            "{name}: {v} +- {sd}, truth {truth}"
+        );
+    };
+    let c = &d["controller"];
+    for i in 0..3 {
+        check(
+            &c["backlash_um"][i],
+            &format!("backlash.backlash{}_um", i + 1),
+            backlash_um[i],
+        );
+        check(
+            &d["leg_effects"]["lead_ppm"][i],
+            &format!("leg-lead.lead{}_ppm", i + 1),
+            lead_ppm[i],
+        );
+    }
+    check(
+        &c["thermal_expansion_ppm_per_k"],
+        "thermal.expansion_ppm_per_k",
+        expansion,
+    );
+    assert_eq!(c["reference_temperature_c"], 20.0);
+    std::fs::remove_dir_all(&dir).ok();
+}
