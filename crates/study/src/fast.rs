@@ -36,6 +36,18 @@ use crate::{StudyError, TrialResult};
 /// Trials per block (the unit of parallel work and of seeding).
 pub const BLOCK: usize = 512;
 
+/// `trials` results computed a block of [`BLOCK`] trials at a time in
+/// parallel, `per_block(block, n)` giving the `n` results of block `block`,
+/// collected in block order (the same result at any thread count).
+fn in_blocks<T: Send>(trials: usize, per_block: impl Fn(u64, usize) -> Vec<T> + Sync) -> Vec<T> {
+    let blocks = trials.div_ceil(BLOCK);
+    let results: Vec<Vec<T>> = (0..blocks)
+        .into_par_iter()
+        .map(|b| per_block(b as u64, BLOCK.min(trials - b * BLOCK)))
+        .collect();
+    results.into_iter().flatten().collect()
+}
+
 /// An estimator that is linear in the noise: `p_hat = p* + M z` on the
 /// parameters `columns` (the others stay at `p*`), with the compensated
 /// plane error `dr0 - G (p_hat - p*)`.
@@ -212,17 +224,11 @@ impl LinearEstimator {
         grade_index: u64,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Vec<TrialResult> {
-        let blocks = trials.div_ceil(BLOCK);
-        let per_block: Vec<Vec<TrialResult>> = (0..blocks)
-            .into_par_iter()
-            .map(|b| {
-                let n = BLOCK.min(trials - b * BLOCK);
-                let out = self.run_block(s, n, seed, grade_index, b as u64);
-                progress(n as u64);
-                out
-            })
-            .collect();
-        per_block.into_iter().flatten().collect()
+        in_blocks(trials, |block, n| {
+            let out = self.run_block(s, n, seed, grade_index, block);
+            progress(n as u64);
+            out
+        })
     }
 
     /// The part of `mu` that is noise alone, `||p_hat - p*||_1 / n_params`,
@@ -254,20 +260,12 @@ impl LinearEstimator {
         seed: u64,
         grade_index: u64,
     ) -> Vec<f64> {
-        let blocks = trials.div_ceil(BLOCK);
-        let per_block: Vec<Vec<f64>> = (0..blocks)
-            .into_par_iter()
-            .map(|b| {
-                let n = BLOCK.min(trials - b * BLOCK);
-                let dp = self.deviations(n, seed, grade_index, b as u64);
-                (0..n)
-                    .map(|t| {
-                        (0..dp.nrows()).map(|u| dp[(u, t)].abs()).sum::<f64>() / n_params as f64
-                    })
-                    .collect()
-            })
-            .collect();
-        per_block.into_iter().flatten().collect()
+        in_blocks(trials, |block, n| {
+            let dp = self.deviations(n, seed, grade_index, block);
+            (0..n)
+                .map(|t| (0..dp.nrows()).map(|u| dp[(u, t)].abs()).sum::<f64>() / n_params as f64)
+                .collect()
+        })
     }
 
     /// `p_hat - p*` on the columns for the `n` trials of one block.

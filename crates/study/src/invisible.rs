@@ -22,8 +22,8 @@
 //! loses none.
 //!
 //! The rule is for an ideal U joint: with class-2 errors (axis skew or
-//! offset) the limb leaves the plane by their size and the error becomes
-//! weakly visible instead.
+//! offset) the limb no longer stays in one plane and the argument does not
+//! apply (the error is then expected to be weakly visible; not measured).
 
 use tricept_kinematics::{AxisOrder, Machine};
 

@@ -6,10 +6,12 @@
 //! The solve is built from two parts so that its variants can be studied
 //! one change at a time: the [`NominalLinearisation`] of the readings (one
 //! per scenario) and a [`DifferencedSolve`] on it, which names the
-//! parameters estimated, the reference pose and the weight of each sensor's
-//! rows. [`paper_solve`] is the paper's choice (every parameter, pose 0,
-//! unit weights); weighting the rows by `1 / sigma^2` instead isolates the
-//! cost of differencing from the cost of not weighting.
+//! parameters estimated, the reference pose and the [`RowWeights`].
+//! [`paper_solve`] is the paper's choice (every parameter, pose 0, unit
+//! weights). Weighting each differenced row by `1 / sigma^2` isolates the
+//! cost of not weighting; weighting by the inverse covariance of the
+//! differenced rows gives the solve that estimates the offsets instead,
+//! which isolates the cost of treating differenced rows as independent.
 //!
 //! A differenced solve is linear in the readings, so it runs as a
 //! [`LinearEstimator`] through the same fast Monte Carlo as ours: `p_hat =
@@ -102,7 +104,7 @@ impl NominalLinearisation {
 
 /// A differenced least-squares solve on a [`NominalLinearisation`]: the
 /// readings of every pose minus those of `reference` (which removes the
-/// sensors' zero offsets), rows weighted per sensor, the parameters
+/// sensors' zero offsets), rows weighted by [`RowWeights`], the parameters
 /// `columns` estimated by `(H^T W H)^{-1} H^T W l`, every other parameter
 /// held at zero.
 #[derive(Debug, Clone)]
@@ -129,21 +131,40 @@ pub enum Differenced {
     },
 }
 
+/// The weight matrix `W` of a differenced solve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RowWeights {
+    /// Every differenced row of sensor `c` (`phi`, `theta`, `s`) weighted
+    /// by `w[c]`, the rows treated as independent. The paper: all 1.
+    /// Differenced rows are not independent (each carries the reference
+    /// pose's noise), so this loses information even with `w[c] = 1 /
+    /// sigma_c^2`.
+    PerSensor([f64; 3]),
+    /// The inverse of the covariance the differencing gives readings of
+    /// standard deviation `sigma` (`[phi, theta, s]`, rad, rad, mm): per
+    /// sensor `sigma_c^2 (I + 1 1^T)` over its `n - 1` differenced rows,
+    /// whose inverse is `(I - 1 1^T / n) / sigma_c^2`. This is the
+    /// generalised least-squares solve, identical to estimating the three
+    /// offsets with rows weighted by `1 / sigma^2`, whatever the reference
+    /// pose.
+    DifferencedCovariance([f64; 3]),
+}
+
 impl DifferencedSolve {
     /// Forms the solve of `columns` with the readings differenced against
-    /// pose `reference` and the rows of sensor `c` (`phi`, `theta`, `s`)
-    /// weighted by `weights[c]` (the paper: all 1).
+    /// pose `reference`, the rows weighted by `weights`.
     ///
     /// # Example
     /// ```
     /// use tricept_kinematics::{AxisOrder, Machine};
     /// use tricept_study::Scenario;
-    /// use tricept_study::paper::{Differenced, DifferencedSolve, NominalLinearisation};
+    /// use tricept_study::paper::{Differenced, DifferencedSolve, NominalLinearisation, RowWeights};
     /// let m = Machine::paper().with_axis_order(AxisOrder::YFirst);
     /// let s = Scenario::paper(m.clone(), m.workspace.polar_grid(2, 8, 3)).unwrap();
     /// let lin = NominalLinearisation::new(&s).unwrap();
     /// let all: Vec<usize> = (0..15).collect();
-    /// let Differenced::Formed(solve) = DifferencedSolve::form(&lin, &all, 0, [1.0; 3]).unwrap() else {
+    /// let paper = RowWeights::PerSensor([1.0; 3]);
+    /// let Differenced::Formed(solve) = DifferencedSolve::form(&lin, &all, 0, paper).unwrap() else {
     ///     panic!("the y-first machine's 15 parameters are identifiable");
     /// };
     /// // Noise-free readings linear in the truth are solved exactly, offsets or not.
@@ -151,14 +172,25 @@ impl DifferencedSolve {
     /// let y: Vec<f64> = (0..lin.rows())
     ///     .map(|r| lin.predictions[r] + (0..15).map(|t| lin.jacobian[(r, t)] * truth[t]).sum::<f64>() + [0.1, -0.2, 600.0][r % 3])
     ///     .collect();
-    /// let p = solve.estimate(&lin, 15, &y);
+    /// let p = solve.estimate(&lin, 15, &y).unwrap();
     /// assert!(p.iter().zip(&truth).all(|(a, b)| (a - b).abs() < 1e-6));
+    ///
+    /// // With the covariance of the differenced rows, the solve is the one
+    /// // that estimates the offsets: the same operator for every reference.
+    /// let gls = |reference| match DifferencedSolve::form(
+    ///     &lin, &all, reference, RowWeights::DifferencedCovariance([4e-6, 4e-6, 3e-4]),
+    /// ).unwrap() {
+    ///     Differenced::Formed(d) => d.operator,
+    ///     Differenced::Singular { .. } => panic!("identifiable"),
+    /// };
+    /// let (a, b) = (gls(0), gls(17));
+    /// assert!((&a - &b).amax() <= 1e-8 * a.amax());
     /// ```
     pub fn form(
         lin: &NominalLinearisation,
         columns: &[usize],
         reference: usize,
-        weights: [f64; 3],
+        weights: RowWeights,
     ) -> Result<Differenced, StudyError> {
         let m = lin.rows();
         let n = m / 3;
@@ -174,7 +206,8 @@ impl DifferencedSolve {
             )));
         }
         let q = columns.len();
-        // D: row (j, c) -> reading (j, c) - reading (reference, c), j != reference.
+        // D: row (i, c) -> reading (j, c) - reading (reference, c), the
+        // i-th pose j other than the reference.
         let others: Vec<usize> = (0..n).filter(|&j| j != reference).collect();
         let mut d = DMatrix::<f64>::zeros(m - 3, m);
         for (i, &j) in others.iter().enumerate() {
@@ -185,7 +218,22 @@ impl DifferencedSolve {
         }
         let jac = DMatrix::from_fn(m, q, |r, t| lin.jacobian[(r, columns[t])]);
         let h = &d * jac;
-        let wh = DMatrix::from_fn(h.nrows(), q, |r, t| weights[r % 3] * h[(r, t)]);
+        let wh = match weights {
+            RowWeights::PerSensor(w) => DMatrix::from_fn(h.nrows(), q, |r, t| w[r % 3] * h[(r, t)]),
+            RowWeights::DifferencedCovariance(sigma) => {
+                // (I - 1 1^T / n) / sigma_c^2 on each sensor's rows.
+                let mut sums = DMatrix::<f64>::zeros(3, q);
+                for r in 0..h.nrows() {
+                    for t in 0..q {
+                        sums[(r % 3, t)] += h[(r, t)];
+                    }
+                }
+                DMatrix::from_fn(h.nrows(), q, |r, t| {
+                    let c = r % 3;
+                    (h[(r, t)] - sums[(c, t)] / n as f64) / (sigma[c] * sigma[c])
+                })
+            }
+        };
         let hth = h.transpose() * &wh;
         let sv = hth.singular_values();
         let (max, min) = (sv.max(), sv.min());
@@ -206,15 +254,33 @@ impl DifferencedSolve {
 
     /// The estimate (all `k` parameters of the set, zero where not
     /// estimated) from the readings `y` (`[phi, theta, s]` per pose, in the
-    /// order of the linearisation's poses, offsets included).
-    pub fn estimate(&self, lin: &NominalLinearisation, k: usize, y: &[f64]) -> Vec<f64> {
+    /// order of the linearisation's poses, offsets included). An error if
+    /// `y` does not have one reading per row of `lin` and of the solve, or
+    /// `k` does not cover the estimated parameters.
+    pub fn estimate(
+        &self,
+        lin: &NominalLinearisation,
+        k: usize,
+        y: &[f64],
+    ) -> Result<Vec<f64>, StudyError> {
+        let m = lin.rows();
+        if y.len() != m || self.operator.ncols() != m {
+            return Err(StudyError::Invalid(format!(
+                "{} readings for a solve of {} rows on a linearisation of {m}",
+                y.len(),
+                self.operator.ncols()
+            )));
+        }
+        if let Some(&bad) = self.columns.iter().find(|&&c| c >= k) {
+            return Err(StudyError::Invalid(format!("parameter {bad} of {k}")));
+        }
         let mut p = vec![0.0; k];
         for (u, &col) in self.columns.iter().enumerate() {
-            p[col] = (0..lin.rows())
+            p[col] = (0..m)
                 .map(|r| self.operator[(u, r)] * (y[r] - lin.predictions[r]))
                 .sum();
         }
-        p
+        Ok(p)
     }
 
     /// The solve as a [`LinearEstimator`] for readings with the logged noise
@@ -228,7 +294,7 @@ impl DifferencedSolve {
     ) -> Result<LinearEstimator, StudyError> {
         let k = s.set.len();
         let y: Vec<f64> = s.clean.iter().flat_map(|p| p.readings.to_array()).collect();
-        let p_star = self.estimate(lin, k, &y);
+        let p_star = self.estimate(lin, k, &y)?;
         let operator = Mat::from_fn(self.columns.len(), lin.rows(), |i, r| {
             self.operator[(i, r)] * sigma[r % 3]
         });
@@ -266,11 +332,13 @@ pub fn paper_solve(s: &Scenario, grade_arcsec: f64) -> Result<PaperSolve, StudyE
 pub fn paper_solve_with_sigma(s: &Scenario, sigma: [f64; 3]) -> Result<PaperSolve, StudyError> {
     let lin = NominalLinearisation::new(s)?;
     let all: Vec<usize> = (0..s.set.len()).collect();
-    Ok(match DifferencedSolve::form(&lin, &all, 0, [1.0; 3])? {
-        Differenced::Formed(solve) => PaperSolve::Formed {
-            estimator: Box::new(solve.estimator(s, &lin, sigma)?),
-            condition: solve.condition,
+    Ok(
+        match DifferencedSolve::form(&lin, &all, 0, RowWeights::PerSensor([1.0; 3]))? {
+            Differenced::Formed(solve) => PaperSolve::Formed {
+                estimator: Box::new(solve.estimator(s, &lin, sigma)?),
+                condition: solve.condition,
+            },
+            Differenced::Singular { condition } => PaperSolve::Singular { condition },
         },
-        Differenced::Singular { condition } => PaperSolve::Singular { condition },
-    })
+    )
 }
