@@ -5,6 +5,7 @@
 
 mod fig3;
 mod hybrid;
+mod reproduction;
 mod study;
 
 use std::process::ExitCode;
@@ -27,6 +28,11 @@ enum Command {
     /// measurements, on simulated machines: the tables and figures of
     /// docs/hybrid.md.
     Hybrid(hybrid::HybridArgs),
+    /// The numbers behind the corrections of docs/reproduction.md and
+    /// docs/identifiability.md: the paper's solve split by noise source,
+    /// Fig. 3b with the paper's solve, mu over many random pose sets, the
+    /// cost of differencing, the invisible-joint rule.
+    Reproduction(reproduction::ReproductionArgs),
     /// Fig. 3 "before compensation" with the default conventions and every
     /// combination of the conventions the paper leaves open.
     Fig3Before {
@@ -54,6 +60,7 @@ fn main() -> ExitCode {
     let result = match args.command {
         Command::EncoderStudy(args) => study::run(args),
         Command::Hybrid(args) => hybrid::run(args),
+        Command::Reproduction(args) => reproduction::run(args),
         Command::Fig3Before { all } => fig3::run(all),
         Command::Fig3 {
             seeds,

@@ -36,6 +36,18 @@ use crate::{StudyError, TrialResult};
 /// Trials per block (the unit of parallel work and of seeding).
 pub const BLOCK: usize = 512;
 
+/// `trials` results computed a block of [`BLOCK`] trials at a time in
+/// parallel, `per_block(block, n)` giving the `n` results of block `block`,
+/// collected in block order (the same result at any thread count).
+fn in_blocks<T: Send>(trials: usize, per_block: impl Fn(u64, usize) -> Vec<T> + Sync) -> Vec<T> {
+    let blocks = trials.div_ceil(BLOCK);
+    let results: Vec<Vec<T>> = (0..blocks)
+        .into_par_iter()
+        .map(|b| per_block(b as u64, BLOCK.min(trials - b * BLOCK)))
+        .collect();
+    results.into_iter().flatten().collect()
+}
+
 /// An estimator that is linear in the noise: `p_hat = p* + M z` on the
 /// parameters `columns` (the others stay at `p*`), with the compensated
 /// plane error `dr0 - G (p_hat - p*)`.
@@ -212,17 +224,68 @@ impl LinearEstimator {
         grade_index: u64,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Vec<TrialResult> {
-        let blocks = trials.div_ceil(BLOCK);
-        let per_block: Vec<Vec<TrialResult>> = (0..blocks)
-            .into_par_iter()
-            .map(|b| {
-                let n = BLOCK.min(trials - b * BLOCK);
-                let out = self.run_block(s, n, seed, grade_index, b as u64);
-                progress(n as u64);
-                out
-            })
+        in_blocks(trials, |block, n| {
+            let out = self.run_block(s, n, seed, grade_index, block);
+            progress(n as u64);
+            out
+        })
+    }
+
+    /// The part of `mu` that is noise alone, `||p_hat - p*||_1 / n_params`,
+    /// for `trials` trials drawn exactly as [`LinearEstimator::run`] draws
+    /// them (same seed, same `grade_index`: the same trials). Two
+    /// estimators with the same number of columns, run with the same seed,
+    /// see the same standard-normal draws (common random numbers).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_kinematics::Machine;
+    /// use tricept_study::{GradeModel, Scenario};
+    /// let m = Machine::paper();
+    /// let s = Scenario::paper(m.clone(), m.workspace.polar_grid(2, 8, 3)).unwrap();
+    /// let g = GradeModel::new(&s, 2.0).unwrap();
+    /// let noise = g.estimator.noise_mu(15, 1000, 1, 0);
+    /// let full = g.estimator.run(&s, 1000, 1, 0, &|_| {});
+    /// // mu = |truth - p* - dp|_1 / 15 and noise part = |dp|_1 / 15:
+    /// // they differ by at most mu(p*).
+    /// let bias = tricept_model::residual_mu(&s.truth, &g.estimator.p_star);
+    /// for (a, t) in noise.iter().zip(&full) {
+    ///     assert!((a - t.mu_mm).abs() <= bias + 1e-12);
+    /// }
+    /// ```
+    pub fn noise_mu(
+        &self,
+        n_params: usize,
+        trials: usize,
+        seed: u64,
+        grade_index: u64,
+    ) -> Vec<f64> {
+        in_blocks(trials, |block, n| {
+            let dp = self.deviations(n, seed, grade_index, block);
+            (0..n)
+                .map(|t| (0..dp.nrows()).map(|u| dp[(u, t)].abs()).sum::<f64>() / n_params as f64)
+                .collect()
+        })
+    }
+
+    /// `p_hat - p*` on the columns for the `n` trials of one block.
+    fn deviations(&self, n: usize, seed: u64, grade_index: u64, block: u64) -> Mat<f64> {
+        let kid = self.factor.nrows();
+        let mut rng = block_rng(seed, grade_index, block);
+        let noise: Vec<f64> = (0..kid * n)
+            .map(|_| StandardNormal.sample(&mut rng))
             .collect();
-        per_block.into_iter().flatten().collect()
+        let z = faer::MatRef::from_column_major_slice(&noise, kid, n);
+        let mut dp = Mat::<f64>::zeros(kid, n);
+        matmul(
+            dp.as_mut(),
+            Accum::Replace,
+            self.factor.as_ref(),
+            z.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+        dp
     }
 
     fn run_block(
@@ -233,22 +296,7 @@ impl LinearEstimator {
         grade_index: u64,
         block: u64,
     ) -> Vec<TrialResult> {
-        let kid = self.factor.nrows();
-        let m = kid;
-        let mut rng = block_rng(seed, grade_index, block);
-        let noise: Vec<f64> = (0..m * n)
-            .map(|_| StandardNormal.sample(&mut rng))
-            .collect();
-        let z = faer::MatRef::from_column_major_slice(&noise, m, n);
-        let mut dp = Mat::<f64>::zeros(kid, n);
-        matmul(
-            dp.as_mut(),
-            Accum::Replace,
-            self.factor.as_ref(),
-            z.as_ref(),
-            1.0,
-            Par::Seq,
-        );
+        let dp = self.deviations(n, seed, grade_index, block);
         let rows = self.plane_jacobian.nrows();
         let mut dr = Mat::<f64>::zeros(rows, n);
         matmul(

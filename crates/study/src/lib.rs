@@ -19,7 +19,8 @@
 //! readings) that minimise the predicted tool-tip error, with the same
 //! exchange;
 //! [`grades`] turns results into decisions (where calibration stops paying,
-//! which grade a pose set needs, which grade to buy).
+//! which grade a pose set needs, which grade to buy); [`invisible`] states
+//! from the geometry which platform-joint error the sensors cannot see.
 //! Everything is seeded and bit-reproducible at any thread count.
 #![cfg_attr(
     not(test),
@@ -29,6 +30,7 @@
 pub mod exact;
 pub mod fast;
 pub mod grades;
+pub mod invisible;
 pub mod optimise;
 pub mod paper;
 pub mod plan;
