@@ -391,9 +391,8 @@ fn run_machine(
     let module_only = FusedModel::new(m.clone(), set.clone(), &[], false).ok();
     let named: Vec<EffectName> = diagnose(m, &data, &DiagnoseOptions::for_machine(m))
         .map(|d| {
-            d.causes
-                .iter()
-                .map(|c| c.effect)
+            d.model_effects()
+                .into_iter()
                 .filter(|e| FUSABLE_EFFECTS.contains(e))
                 .collect()
         })

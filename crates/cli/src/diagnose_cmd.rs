@@ -4,13 +4,14 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use serde_json::{Map, json};
-use tricept_diagnose::detect::{advise, detectability, realistic};
+use tricept_diagnose::detect::{advise, realistic, term_detectability};
 use tricept_diagnose::{
-    Candidate, DiagnoseError, DiagnoseOptions, ExtendedModel, REFERENCE_TEMPERATURE_C, diagnose,
+    Candidate, DiagnoseError, DiagnoseOptions, ExtendedModel, Plausibility,
+    REFERENCE_TEMPERATURE_C, diagnose,
 };
 use tricept_ident::{GeometricModel, IdentifyOptions, identify};
 use tricept_kinematics::description::ControllerDescription;
-use tricept_model::effects::EffectName;
+use tricept_model::effects::{CauseName, EffectName};
 use tricept_model::{GeometricErrors, ParameterSet};
 use tricept_plant::{Campaign, Effect, Plant, PoseOrder};
 
@@ -30,6 +31,24 @@ pub struct DiagnoseArgs {
     /// Write residual plots (SVG) of the named causes into this directory.
     #[arg(long, value_name = "DIR")]
     pub plots: Option<PathBuf>,
+    /// Estimate the sensor noise from repeated poses (the same commands
+    /// logged on separate visits, at least 10 degrees of freedom) and test
+    /// against it (F tests) instead of the stated noise.
+    #[arg(long)]
+    pub noise_from_data: bool,
+    /// Standard deviation of the logged temperature, K (default 0.02): its
+    /// noise enters the final adequacy test of temperature terms.
+    #[arg(long, value_name = "K", allow_negative_numbers = true)]
+    pub temperature_noise: Option<f64>,
+    /// Override physical ranges of the plausibility table: a JSON object
+    /// such as `{"thermal.expansion_ppm_per_k": [20, 26]}` (aluminium legs).
+    #[arg(long, value_name = "FILE.json")]
+    pub plausibility: Option<PathBuf>,
+    /// Search the effects of the vocabulary only, not the generic
+    /// dictionary (for comparison; effects outside the vocabulary are then
+    /// reported as unexplained).
+    #[arg(long)]
+    pub no_dictionary: bool,
     /// Write the calibrated machine of the final model: the geometric
     /// estimate with the static effects named (leg-lead, compliance: applied
     /// by ik, fk, tool-ik and compensate; ujoint-axes, tube-twist: in the
@@ -74,20 +93,26 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
     let m = loaded.machine.clone();
     let dataset = read_data(data, &m)?;
     let source = data.display().to_string();
-    let options = DiagnoseOptions::for_machine(&m);
-    let d = diagnose(&m, &dataset, &options).map_err(|e| match e {
-        DiagnoseError::TooFewPoses(_)
-        | DiagnoseError::Ident(
-            tricept_ident::IdentError::TooFewPoses { .. }
-            | tricept_ident::IdentError::TooFewDistinctPoses { .. },
-        ) => CliError::input(format!("{source}: {e}")),
-        DiagnoseError::Ident(tricept_ident::IdentError::Kinematics {
-            line, source: k, ..
-        }) => CliError::input(format!(
-            "{source}: line {line}: the commands of this pose cannot be reached: {k}"
-        )),
-        e => CliError::other(format!("{source}: {e}")),
-    })?;
+    let mut options = DiagnoseOptions::for_machine(&m);
+    options.noise_from_data = a.noise_from_data;
+    options.rank_reference = loaded.rank_reference()?;
+    options.dictionary.enabled = !a.no_dictionary;
+    if let Some(k) = a.temperature_noise {
+        if !(k.is_finite() && k >= 0.0) {
+            return Err(CliError::input(format!(
+                "--temperature-noise: must be a non-negative number of kelvin, got {k}"
+            )));
+        }
+        options.temperature_sigma_k = k;
+    }
+    if let Some(path) = &a.plausibility {
+        let file = path.display().to_string();
+        let text =
+            std::fs::read_to_string(path).map_err(|e| CliError::input(format!("{file}: {e}")))?;
+        options.plausibility = Plausibility::with_overrides(&text)
+            .map_err(|e| CliError::input(format!("{file}: {e}")))?;
+    }
+    let d = diagnose(&m, &dataset, &options).map_err(|e| diagnose_error(&source, e))?;
     if let Some(dir) = &a.plots {
         std::fs::create_dir_all(dir)
             .map_err(|e| CliError::other(format!("{}: {e}", dir.display())))?;
@@ -121,6 +146,9 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
     }
     match written {
         Some(Err(e)) => Err(e),
+        // The verdict in the exit code as in identify's: 3 when the final
+        // model (geometric plus the named causes) leaves a misfit.
+        _ if !d.final_adequate => Ok(crate::cli_error::EXIT_INADEQUATE),
         _ => Ok(0),
     }
 }
@@ -137,30 +165,28 @@ pub struct Deployed {
 }
 
 /// Fits the diagnosis' final model (its named causes on the geometric
-/// model) on the poses it kept, and maps every parameter to where it goes
-/// in a machine file.
+/// model) on the poses it kept, with the rank decision of `rank_reference`
+/// when `nominal` is itself calibrated, and maps every parameter to where
+/// it goes in a machine file.
 pub fn deploy(
     nominal: &tricept_kinematics::Machine,
+    rank_reference: Option<tricept_kinematics::Machine>,
     data: &tricept_data::Dataset,
     d: &tricept_diagnose::Diagnosis,
 ) -> Result<Deployed, CliError> {
     let flagged: Vec<u64> = d
         .causes
         .iter()
-        .filter(|c| c.effect == EffectName::Outliers)
+        .filter(|c| c.effect == CauseName::Catalogue(EffectName::Outliers))
         .flat_map(|c| c.rows.iter().copied())
         .collect();
     let clean = data.subset(|j| !flagged.contains(&data.poses[j].line));
-    let candidates: Vec<Candidate> = d
-        .causes
-        .iter()
-        .filter(|c| c.effect != EffectName::Outliers)
-        .map(|c| Candidate(c.effect))
-        .collect();
-    let model = ExtendedModel::new(
-        GeometricModel::new(nominal.clone(), ParameterSet::paper15()),
-        &candidates,
-    );
+    let candidates: Vec<Candidate> = d.model_effects().into_iter().map(Candidate).collect();
+    let mut geometric = GeometricModel::new(nominal.clone(), ParameterSet::paper15());
+    if let Some(reference) = rank_reference {
+        geometric = geometric.with_rank_reference(reference);
+    }
+    let model = ExtendedModel::new(geometric, &candidates);
     let id = identify(&model, &clean, &IdentifyOptions::for_machine(nominal))
         .map_err(|e| CliError::other(format!("the diagnosis' final model: {e}")))?;
     let mut machine = model.machine_at(&id.estimate);
@@ -220,14 +246,62 @@ fn write_extended(
     d: &tricept_diagnose::Diagnosis,
     force: bool,
 ) -> Result<(), CliError> {
-    let unexplained = d.unexplained.is_some();
-    if unexplained && !force {
-        return Err(CliError::other(format!(
-            "--write-machine {}: not written: no cause the diagnosis knows explains the data; --force writes the geometric fit anyway, marked as forced",
-            path.display()
-        )));
+    // What a machine file cannot hold: a misfit the final model leaves, or
+    // a generic term of the dictionary (its physics is not in the
+    // kinematics; the report says what to look for).
+    let mut problems = Vec::new();
+    if !d.final_adequate {
+        problems.push(match &d.unexplained {
+            Some(u) => u.clone(),
+            None => "the final model does not explain the data (a remainder is reported)".into(),
+        });
     }
-    let deployed = deploy(&loaded.machine, dataset, d)?;
+    for c in d
+        .causes
+        .iter()
+        .filter(|c| matches!(c.effect, CauseName::Generic(_)))
+    {
+        problems.push(format!(
+            "the generic term `{}` ({}) is not part of the written model",
+            c.effect.as_str(),
+            c.description
+        ));
+    }
+    // An alias is deployed with the member the final model carries; the
+    // file's warnings name the alternatives and what would separate them
+    // (an exact alias, such as a lead common to all legs against a scale
+    // gain, is never separated by the machine's own sensors).
+    let notes: Vec<String> = d
+        .aliases
+        .iter()
+        .map(|a| {
+            let names: Vec<&str> = a.effects.iter().map(|e| e.as_str()).collect();
+            format!(
+                "{} cannot be told apart{} ({}); the file deploys {}; to separate them: {}",
+                names.join(" / "),
+                if a.exact {
+                    " by these sensors"
+                } else {
+                    " on this campaign"
+                },
+                a.why,
+                a.in_model.as_str(),
+                a.separate_by
+            )
+        })
+        .collect();
+    let forced = !problems.is_empty();
+    if forced && !force {
+        return Err(CliError {
+            code: crate::cli_error::EXIT_INADEQUATE,
+            message: format!(
+                "--write-machine {}: not written: {}; --force writes the model of the catalogued causes anyway, marked as forced",
+                path.display(),
+                problems.join("; ")
+            ),
+        });
+    }
+    let deployed = deploy(&loaded.machine, loaded.rank_reference()?, dataset, d)?;
     let g = ParameterSet::paper15().len();
     let mut effects = Map::new();
     for ((name, v), sd) in deployed
@@ -243,13 +317,10 @@ fn write_extended(
     let rejected_lines = d
         .causes
         .iter()
-        .filter(|c| c.effect == EffectName::Outliers)
+        .filter(|c| c.effect == CauseName::Catalogue(EffectName::Outliers))
         .flat_map(|c| c.rows.iter().copied())
         .collect();
-    let mut warnings = Vec::new();
-    if let Some(u) = &d.unexplained {
-        warnings.push(u.clone());
-    }
+    let warnings = problems.into_iter().chain(notes).collect();
     let description = machine_file::calibrated_description(
         loaded,
         &deployed.machine,
@@ -259,8 +330,8 @@ fn write_extended(
             data_file: data,
             parameter_set: "paper15",
             rejected_lines,
-            adequate: !unexplained,
-            forced: unexplained,
+            adequate: !forced,
+            forced,
             warnings,
             effects,
             n_geometric: g,
@@ -269,6 +340,24 @@ fn write_extended(
         deployed.controller,
     )?;
     machine_file::write(path, &description)
+}
+
+/// The CLI error of a failed diagnosis: everything the data cause is an
+/// input error (exit 2), naming the file.
+fn diagnose_error(source: &str, e: DiagnoseError) -> CliError {
+    match e {
+        DiagnoseError::Ident(tricept_ident::IdentError::Kinematics {
+            line, source: k, ..
+        }) => CliError::input(format!(
+            "{source}: line {line}: the commands of this pose cannot be reached: {k}"
+        )),
+        DiagnoseError::Ident(
+            tricept_ident::IdentError::TooFewPoses { .. }
+            | tricept_ident::IdentError::TooFewDistinctPoses { .. },
+        ) => CliError::input(format!("{source}: {e}")),
+        DiagnoseError::Ident(e) => CliError::other(format!("{source}: {e}")),
+        e => CliError::input(format!("{source}: {e}")),
+    }
 }
 
 /// `tricept detectability`.
@@ -301,7 +390,7 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<u8, CliError> {
     let geometric = GeometricModel::new(m.clone(), ParameterSet::paper15());
     let mut rows = Vec::new();
     for (c, v, label) in realistic(&m) {
-        if let Some(d) = detectability(&geometric, c, &v, &data.poses, sigma, 1e-3) {
+        if let Some(d) = term_detectability(&geometric, &c, &v, &data.poses, sigma, 1e-3) {
             let advice = advise(&d, data.poses.len(), campaign.noise.readings_per_pose);
             rows.push((label, d, advice));
         }
@@ -347,5 +436,9 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<u8, CliError> {
             d.halving_multiple
         );
     }
+    outln!(
+        "the stated sensor noise can be checked only against repeated poses: revisit at least {} poses on separate visits (`simulate --revisit`) to use `diagnose --noise-from-data`",
+        tricept_diagnose::MIN_PURE_ERROR_DOF
+    );
     Ok(0)
 }

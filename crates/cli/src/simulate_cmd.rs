@@ -27,6 +27,14 @@ pub struct SimulateArgs {
     /// Visit every pose twice, approaching from both directions.
     #[arg(long)]
     pub both_directions: bool,
+    /// Revisit the first N targets at the end of the campaign (separate
+    /// visits of the same commands: what `diagnose --noise-from-data` uses).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub revisit: usize,
+    /// Make the true noise this many times the machine's stated noise
+    /// (vibration, a sensor worse than its data sheet).
+    #[arg(long, value_name = "F", default_value_t = 1.0)]
+    pub noise_factor: f64,
     /// Output file (default: stdout; with --json, a summary goes to stdout).
     #[arg(long, value_name = "FILE.csv")]
     pub out: Option<PathBuf>,
@@ -113,6 +121,14 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
     if a.both_directions {
         campaign.order = PoseOrder::BothDirections;
     }
+    if !(a.noise_factor.is_finite() && a.noise_factor > 0.0) {
+        return Err(CliError::input(format!(
+            "--noise-factor: must be a positive number, got {}",
+            a.noise_factor
+        )));
+    }
+    campaign.revisits = a.revisit;
+    campaign.noise_factor = a.noise_factor;
     let mut plant = Plant::geometric(m.clone(), set.to_errors(&values));
     plant.effects = parse_effects(&a.truth.truth_effects)?;
     plant.head_errors = parse_head_errors(&a.head_errors, &m)?;
@@ -127,7 +143,7 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
             m.name
         ),
         format!(
-            "pose set `{}` ({} poses{}), seed {}",
+            "pose set `{}` ({} poses{}{}), seed {}",
             a.poses,
             data.poses.len(),
             if a.both_directions {
@@ -135,13 +151,23 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
             } else {
                 ""
             },
+            if a.revisit > 0 {
+                format!(", the first {} revisited at the end", a.revisit)
+            } else {
+                String::new()
+            },
             a.seed
         ),
         format!(
-            "noise per reading: {:.3} arcsec, {:.3} um, mean of {}",
+            "noise per reading: {:.3} arcsec, {:.3} um, mean of {}{}",
             m.sensors.angle_rad / tricept_kinematics::units::RAD_PER_ARCSEC,
             m.sensors.length_mm * 1e3,
-            m.sensors.readings_per_pose
+            m.sensors.readings_per_pose,
+            if a.noise_factor == 1.0 {
+                String::new()
+            } else {
+                format!(" (stated; the true noise is {} times it)", a.noise_factor)
+            }
         ),
         format!(
             "true errors ({}, mm): {}",

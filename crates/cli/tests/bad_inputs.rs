@@ -444,6 +444,64 @@ fn bad_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
         ),
     ];
     std::fs::write(dir.join("few10.csv"), with_rows(&base, &rows[..10])).unwrap();
+    // Degenerate data for the diagnosis.
+    let swap = |row: &String| {
+        let mut f: Vec<&str> = row.split(',').collect();
+        f.swap(0, 1);
+        f.join(",")
+    };
+    let swapped: Vec<String> = rows.iter().map(swap).collect();
+    std::fs::write(dir.join("swapped.csv"), with_rows(&base, &swapped)).unwrap();
+    let repeated: Vec<String> = (0..25)
+        .map(|k| {
+            let f: Vec<&str> = rows[0].split(',').collect();
+            let s: f64 = f[5].parse().unwrap();
+            replace_field(&rows[0], 5, &(s + 1e-4 * k as f64).to_string())
+        })
+        .collect();
+    std::fs::write(dir.join("repeated.csv"), with_rows(&base, &repeated)).unwrap();
+    std::fs::write(dir.join("good.csv"), &csv).unwrap();
+    std::fs::write(dir.join("ranges.json"), r#"{"thermal.alpha": [20, 26]}"#).unwrap();
+    let diag = |file: &str, extra: &[&str]| {
+        let mut v = vec![
+            "diagnose".to_string(),
+            "--data".to_string(),
+            dir.join(file).display().to_string(),
+        ];
+        v.extend(extra.iter().map(|s| s.to_string()));
+        v
+    };
+    for (name, args, needles) in [
+        (
+            "diagnose: every row with q1 and q2 swapped",
+            diag("swapped.csv", &[]),
+            &["swapped.csv", "cannot be fitted"][..],
+        ),
+        (
+            "diagnose: one pose logged again and again",
+            diag("repeated.csv", &[]),
+            &["repeated.csv", "distinct pose"][..],
+        ),
+        (
+            "diagnose: noise from data without repeated poses",
+            diag("good.csv", &["--noise-from-data"]),
+            &["repeated poses"][..],
+        ),
+        (
+            "diagnose: unknown plausibility quantity",
+            diag("good.csv", &["--plausibility", "ranges.json"]),
+            &["ranges.json", "unknown quantity `thermal.alpha`"][..],
+        ),
+        (
+            "diagnose: negative temperature noise",
+            diag("good.csv", &["--temperature-noise", "-1"]),
+            &["--temperature-noise"][..],
+        ),
+    ] {
+        let mut c = case(name, &[], vec![], 2, needles);
+        c.args = args;
+        cases.push(c);
+    }
     std::fs::write(dir.join("errors.json"), r#"{"dzB1": 0.1}"#).unwrap();
     for (mut c, a) in arg_cases.drain(..) {
         c.args = a;
@@ -499,6 +557,63 @@ fn run_cases(dir: &Path, cases: &[Case]) {
         cases.len(),
         failures.join("\n")
     );
+}
+
+/// One row of a 40-pose file logged again with two commands swapped: a
+/// gross inconsistency, flagged by its line; the report is finite and the
+/// exit code 0.
+#[test]
+fn a_duplicated_row_with_swapped_commands_is_flagged_not_fatal() {
+    let dir = workdir().join("swapped-row");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("dup.csv");
+    let out = tricept()
+        .args([
+            "simulate",
+            "--errors",
+            "random:0.25,4",
+            "--poses",
+            "random:40,11",
+            "--effect",
+            r#"{"effect":"thermal","drift_k":2,"expansion_ppm_per_k":0}"#,
+            "--out",
+        ])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = std::fs::read_to_string(&path).unwrap();
+    let (comments, header, rows) = split(&text);
+    let mut f: Vec<&str> = rows[5].split(',').collect();
+    f.swap(0, 1);
+    let mut all = rows.clone();
+    all.push(f.join(","));
+    let mut body = comments.join("\n");
+    body.push('\n');
+    body.push_str(&String::from_utf8(with_rows(&header, &all)).unwrap());
+    std::fs::write(&path, body).unwrap();
+    let line = (comments.len() + 1 + all.len()) as u64;
+    let out = tricept()
+        .args(["diagnose", "--json", "--data"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let outliers = v["causes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["effect"] == "outliers")
+        .expect("the swapped row is an outlier");
+    assert_eq!(outliers["rows"], serde_json::json!([line]));
+    for k in ["holdout_rms_geometric", "holdout_rms_extended"] {
+        assert!(v["gain"][k].as_f64().is_some_and(f64::is_finite), "{k}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]

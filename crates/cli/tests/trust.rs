@@ -877,3 +877,76 @@ fn the_dynamic_effects_are_exported_as_controller_parameters() {
     assert_eq!(c["reference_temperature_c"], 20.0);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn diagnose_says_in_its_exit_code_and_its_machine_file_what_it_cannot_deploy() {
+    let dir = workdir("diagnose-deploy");
+    let file = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    // Explained by a generic term: exit 0, but a machine file cannot hold
+    // a pitch error, so --write-machine refuses (3) unless forced.
+    let pitch = fixture("data/diagnose-pitch.csv");
+    let out = run(&[
+        "diagnose",
+        "--data",
+        &pitch,
+        "--write-machine",
+        &file("p.json"),
+    ]);
+    assert_eq!(out.status.code(), Some(3), "{}", text(&out));
+    assert!(text(&out).contains("leg-periodic"), "{}", text(&out));
+    assert!(!dir.join("p.json").exists());
+    let out = run(&[
+        "diagnose",
+        "--data",
+        &pitch,
+        "--write-machine",
+        &file("p.json"),
+        "--force",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("p.json")).unwrap()).unwrap();
+    assert_eq!(m["calibration"]["forced"], true);
+    assert_eq!(m["calibration"]["adequate"], false);
+    assert!(
+        m["calibration"]["warnings"]
+            .to_string()
+            .contains("leg-periodic")
+    );
+    // Worse noise than stated and nothing to name: the verdict in the exit
+    // code.
+    let noisy = fixture("data/diagnose-noisy.csv");
+    let out = run(&["diagnose", "--data", &noisy, "--json"]);
+    assert_eq!(out.status.code(), Some(3), "{}", text(&out));
+    assert_eq!(json(&out)["final_adequate"], false);
+    // A scale gain reads exactly like an equal lead on every leg but puts
+    // the platform elsewhere: the file deploys one and says so.
+    let sim = run(&[
+        "simulate",
+        "--truth",
+        "random:0.25,3",
+        "--truth-effect",
+        r#"{"effect":"scale-gain","ppm":80}"#,
+        "--poses",
+        "random:80",
+        "--seed",
+        "5",
+        "--out",
+        &file("sg.csv"),
+    ]);
+    assert_eq!(sim.status.code(), Some(0), "{}", text(&sim));
+    let out = run(&[
+        "diagnose",
+        "--data",
+        &file("sg.csv"),
+        "--write-machine",
+        &file("sg.json"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("sg.json")).unwrap()).unwrap();
+    let warnings = m["calibration"]["warnings"].to_string();
+    assert!(warnings.contains("scale-gain / leg-lead"), "{warnings}");
+    assert!(warnings.contains("external length"), "{warnings}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,5 +1,6 @@
 //! The geometric model extended by unmodelled effects: the reading model
-//! that the diagnosis fits for each candidate cause.
+//! that the diagnosis fits for each candidate cause, effects of the
+//! vocabulary and generic terms of the dictionary ([`crate::terms`]) alike.
 //!
 //! Each [`Candidate`] adds the parameters of one effect, with the same
 //! physics as the plant simulator ([`tricept_model::effects`]): leg effects
@@ -11,13 +12,17 @@
 //! geometric `dq_i` and the sensor offsets; thermal growth is referred to
 //! the metrology reference temperature of 20 °C.
 
+use std::sync::Arc;
+
+use crate::terms::{Basis, Frame, Term};
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_ident::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{KinematicsError, Machine, UpJoints};
 use tricept_model::effects::{
-    EffectName, add_tube_twist, add_ujoint_axis_errors, backlash_extra_mm, compliance_extra_mm,
-    gravity_leg_tension_n, leg_lead_extra_mm, scale_gain_error_mm, thermal_extra_mm,
+    CauseName, EffectName, add_tube_twist, add_ujoint_axis_errors, backlash_extra_mm,
+    compliance_extra_mm, gravity_leg_tension_n, leg_lead_extra_mm, scale_gain_error_mm,
+    thermal_extra_mm,
 };
 
 /// An effect the diagnosis can fit (every name of the vocabulary except
@@ -32,7 +37,7 @@ pub const MIN_TEMPERATURE_RANGE_K: f64 = 0.25;
 
 /// How a parameter enters the model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Kind {
+pub(crate) enum Kind {
     Leg,
     Reading,
     Kinematic,
@@ -56,7 +61,7 @@ impl Candidate {
         self.0.parameter_names()
     }
 
-    fn kind(self) -> Kind {
+    pub(crate) fn kind(self) -> Kind {
         match self.0 {
             EffectName::LegLead
             | EffectName::Backlash
@@ -109,29 +114,96 @@ impl Candidate {
 /// `alpha (mean - 20 °C) q_i`, a uniform lead error of all legs, unmodelled.)
 pub const REFERENCE_TEMPERATURE_C: f64 = 20.0;
 
-/// The geometric model plus the parameters of some effects.
+/// The geometric model plus the parameters of some terms: effects of the
+/// vocabulary and generic terms of the dictionary.
 #[derive(Debug, Clone)]
 pub struct ExtendedModel {
     geometric: GeometricModel,
-    effects: Vec<Candidate>,
+    terms: Vec<Term>,
     names: Vec<String>,
+    /// The campaign frame of the generic terms.
+    frame: Arc<Frame>,
     /// Reference temperature of the nominal lengths, °C.
     temp_ref_c: f64,
+    /// The same terms on the geometric model's rank reference, when it has
+    /// one: the rank decision of a calibrated machine is the nominal's.
+    rank_reference: Option<Box<ExtendedModel>>,
 }
 
 impl ExtendedModel {
-    /// `geometric` extended by `effects`.
+    /// `geometric` extended by `effects` of the vocabulary.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_diagnose::{Candidate, ExtendedModel};
+    /// use tricept_ident::{GeometricModel, ReadingModel};
+    /// use tricept_model::effects::EffectName;
+    /// let g = GeometricModel::new(tricept_kinematics::Machine::paper(), tricept_model::ParameterSet::paper15());
+    /// let m = ExtendedModel::new(g, &[Candidate(EffectName::Thermal)]);
+    /// assert_eq!(m.names().last().unwrap(), "thermal.expansion_ppm_per_k");
+    /// ```
     pub fn new(geometric: GeometricModel, effects: &[Candidate]) -> ExtendedModel {
+        let terms: Vec<Term> = effects.iter().map(|c| Term::Catalogue(*c)).collect();
+        ExtendedModel::with_terms(geometric, &terms, Arc::new(Frame::empty()))
+    }
+
+    /// `geometric` extended by `terms`, the generic ones measured in `frame`.
+    ///
+    /// # Example
+    /// ```
+    /// use std::sync::Arc;
+    /// use tricept_diagnose::{ExtendedModel, Frame, GenericFamily, GenericTerm, Scope, Term};
+    /// use tricept_ident::{GeometricModel, ReadingModel};
+    /// let m = tricept_kinematics::Machine::paper();
+    /// let data = tricept_data::read_path("../../fixtures/data/diagnose-pitch.csv".as_ref()).unwrap();
+    /// let pitch = Term::Generic(GenericTerm {
+    ///     family: GenericFamily::LegPeriodic,
+    ///     scope: Scope::AllLegs,
+    ///     period_mm: Some(10.0),
+    /// });
+    /// let g = GeometricModel::new(m.clone(), tricept_model::ParameterSet::paper15());
+    /// let model = ExtendedModel::with_terms(g, &[pitch], Arc::new(Frame::of(&m, &data)));
+    /// assert_eq!(model.names().len(), 15 + 6);
+    /// assert_eq!(model.names()[15], "leg-periodic.leg1_sin_um");
+    /// ```
+    pub fn with_terms(
+        geometric: GeometricModel,
+        terms: &[Term],
+        frame: Arc<Frame>,
+    ) -> ExtendedModel {
         let mut names = geometric.names().to_vec();
-        for e in effects {
-            names.extend(e.params().iter().map(|p| format!("{}.{p}", e.0)));
+        let mut seen: Vec<CauseName> = Vec::new();
+        for t in terms {
+            let n = t.name();
+            let count = seen.iter().filter(|s| **s == n).count();
+            seen.push(n);
+            let prefix = if count == 0 {
+                n.to_string()
+            } else {
+                format!("{n}#{}", count + 1)
+            };
+            names.extend(t.params().iter().map(|p| format!("{prefix}.{p}")));
         }
+        let rank_reference = geometric.rank_reference_machine().map(|m| {
+            Box::new(ExtendedModel::with_terms(
+                GeometricModel::new(m.clone(), geometric.parameter_set().clone()),
+                terms,
+                frame.clone(),
+            ))
+        });
         ExtendedModel {
             geometric,
-            effects: effects.to_vec(),
+            terms: terms.to_vec(),
             names,
+            frame,
             temp_ref_c: REFERENCE_TEMPERATURE_C,
+            rank_reference,
         }
+    }
+
+    /// The same geometric model and frame with other terms.
+    pub fn with(&self, terms: &[Term]) -> ExtendedModel {
+        ExtendedModel::with_terms(self.geometric.clone(), terms, self.frame.clone())
     }
 
     /// The geometric part.
@@ -139,9 +211,25 @@ impl ExtendedModel {
         &self.geometric
     }
 
-    /// The effects included.
-    pub fn effects(&self) -> &[Candidate] {
-        &self.effects
+    /// The effects of the vocabulary included.
+    pub fn effects(&self) -> Vec<Candidate> {
+        self.terms
+            .iter()
+            .filter_map(|t| match t {
+                Term::Catalogue(c) => Some(*c),
+                Term::Generic(_) => None,
+            })
+            .collect()
+    }
+
+    /// Every term included.
+    pub fn terms(&self) -> &[Term] {
+        &self.terms
+    }
+
+    /// The campaign frame of the generic terms.
+    pub fn frame(&self) -> &Frame {
+        &self.frame
     }
 
     /// Number of geometric parameters.
@@ -149,10 +237,10 @@ impl ExtendedModel {
         self.geometric.names().len()
     }
 
-    /// Index of the first parameter of each effect.
+    /// Index of the first parameter of each term.
     pub fn offsets(&self) -> Vec<usize> {
         let mut at = self.n_geometric();
-        self.effects
+        self.terms
             .iter()
             .map(|e| {
                 let here = at;
@@ -166,15 +254,21 @@ impl ExtendedModel {
     pub fn machine_at(&self, p: &[f64]) -> Machine {
         let g = self.n_geometric();
         let mut m = self.geometric.machine_at(&p[..g]);
-        for (e, at) in self.effects.iter().zip(self.offsets()) {
-            match e.0 {
-                EffectName::UjointAxes => add_ujoint_axis_errors(&mut m, p[at], p[at + 1]),
-                EffectName::TubeTwist => add_tube_twist(&mut m, p[at]),
+        for (e, at) in self.terms.iter().zip(self.offsets()) {
+            match e {
+                Term::Catalogue(Candidate(EffectName::UjointAxes)) => {
+                    add_ujoint_axis_errors(&mut m, p[at], p[at + 1])
+                }
+                Term::Catalogue(Candidate(EffectName::TubeTwist)) => add_tube_twist(&mut m, p[at]),
                 _ => {}
             }
         }
         m
     }
+}
+
+fn is_kinematic(t: &Term) -> bool {
+    matches!(t, Term::Catalogue(c) if c.kind() == Kind::Kinematic)
 }
 
 impl ReadingModel for ExtendedModel {
@@ -184,16 +278,12 @@ impl ReadingModel for ExtendedModel {
 
     fn at<'a>(&'a self, p: &[f64]) -> Box<dyn PosePredictor + 'a> {
         let kinematic: Vec<(usize, Machine, Machine)> = self
-            .effects
+            .terms
             .iter()
             .zip(self.offsets())
-            .filter(|(e, _)| e.kind() == Kind::Kinematic)
-            .flat_map(|(e, at)| {
-                (at..at + e.params().len())
-                    .map(|j| (j, *e))
-                    .collect::<Vec<_>>()
-            })
-            .map(|(j, _)| {
+            .filter(|(e, _)| is_kinematic(e))
+            .flat_map(|(e, at)| (at..at + e.params().len()).collect::<Vec<_>>())
+            .map(|j| {
                 let h = FD_STEP;
                 let mut plus = p.to_vec();
                 let mut minus = p.to_vec();
@@ -208,6 +298,12 @@ impl ReadingModel for ExtendedModel {
             geometric: GeometricPredictor::new(self.machine_at(p), self.geometric.parameter_set()),
             kinematic,
         })
+    }
+
+    fn rank_reference(&self) -> Option<&dyn ReadingModel> {
+        self.rank_reference
+            .as_deref()
+            .map(|m| m as &dyn ReadingModel)
     }
 }
 
@@ -233,7 +329,25 @@ impl ExtendedPredictor<'_> {
         let mut legs = pose.commands_mm;
         let mut derivs = Vec::new();
         let q = pose.commands_mm;
-        for (e, at) in self.model.effects.iter().zip(self.model.offsets()) {
+        for (term, at) in self.model.terms.iter().zip(self.model.offsets()) {
+            let e = match term {
+                Term::Catalogue(c) => *c,
+                Term::Generic(g) => {
+                    for (k, (basis, v)) in g
+                        .leg_values(&self.model.frame, pose)
+                        .into_iter()
+                        .enumerate()
+                    {
+                        if let Basis::Leg(i) = basis {
+                            legs[i] += self.p[at + k] * v;
+                            let mut d = [0.0; 3];
+                            d[i] = v;
+                            derivs.push((at + k, d));
+                        }
+                    }
+                    continue;
+                }
+            };
             match e.0 {
                 EffectName::LegLead => {
                     for i in 0..3 {
@@ -280,10 +394,33 @@ impl ExtendedPredictor<'_> {
 
     /// Readings from the UP joints, with the reading effects, and the
     /// derivatives of the readings with respect to the reading parameters.
-    fn readings(&self, up: &UpJoints, p: &[f64]) -> ([f64; 3], Vec<Derivative>) {
+    fn readings(
+        &self,
+        pose: &MeasuredPose,
+        up: &UpJoints,
+        p: &[f64],
+    ) -> ([f64; 3], Vec<Derivative>) {
         let mut r = up.to_array();
         let mut derivs = Vec::new();
-        for (e, at) in self.model.effects.iter().zip(self.model.offsets()) {
+        for (term, at) in self.model.terms.iter().zip(self.model.offsets()) {
+            let e = match term {
+                Term::Catalogue(c) => *c,
+                Term::Generic(g) => {
+                    for (k, (basis, v)) in g
+                        .reading_values(&self.model.frame, pose, up)
+                        .into_iter()
+                        .enumerate()
+                    {
+                        if let Basis::Reading(c) = basis {
+                            r[c] += p[at + k] * v;
+                            let mut d = [0.0; 3];
+                            d[c] = v;
+                            derivs.push((at + k, d));
+                        }
+                    }
+                    continue;
+                }
+            };
             match e.0 {
                 EffectName::ScaleGain => {
                     r[2] += scale_gain_error_mm(p[at], up.q4_mm);
@@ -335,7 +472,7 @@ impl PosePredictor for ExtendedPredictor<'_> {
                 }
             }
         }
-        let (r, reading_derivs) = self.readings(&up, &self.p);
+        let (r, reading_derivs) = self.readings(pose, &up, &self.p);
         for (j, d) in &reading_derivs {
             for c in 0..3 {
                 jacobian[c * k + j] += d[c];
@@ -347,8 +484,8 @@ impl PosePredictor for ExtendedPredictor<'_> {
             let mut s_minus = Some(up);
             let up_p = solve_pose(plus, &legs, &mut s_plus)?;
             let up_m = solve_pose(minus, &legs, &mut s_minus)?;
-            let (rp, _) = self.readings(&up_p, &self.p);
-            let (rm, _) = self.readings(&up_m, &self.p);
+            let (rp, _) = self.readings(pose, &up_p, &self.p);
+            let (rm, _) = self.readings(pose, &up_m, &self.p);
             for c in 0..3 {
                 jacobian[c * k + j] = (rp[c] - rm[c]) / (2.0 * FD_STEP);
             }

@@ -6,7 +6,8 @@
 use serde::Serialize;
 use serde::ser::{SerializeMap, Serializer};
 use serde_json::Value;
-use tricept_model::effects::EffectName;
+use tricept_kinematics::units::RAD_PER_ARCSEC;
+use tricept_model::effects::CauseName;
 
 /// The statistical evidence for one candidate.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -15,18 +16,29 @@ pub struct Evidence {
     pub delta_chi_square: f64,
     /// Identifiable parameters the effect adds (the test's degrees of freedom).
     pub dof: usize,
-    /// Likelihood-ratio p-value.
+    /// Likelihood-ratio p-value (of the drop divided by the residual
+    /// variance factor of the larger model, never below 1).
     pub p_value: f64,
-    /// The p-value it had to beat (alpha / candidates).
+    /// The p-value it had to beat (its half of `alpha` divided by the
+    /// multiplicity).
     pub threshold: f64,
     /// BIC improvement (`delta_chi_square - dof ln N`; positive favours the effect).
     pub delta_bic: f64,
-    /// Held-out weighted residual RMS without the effect (noise = 1).
+    /// Held-out weighted residual RMS without the effect (noise = 1);
+    /// `null` when a fold could not be fitted.
     pub holdout_rms_without: Option<f64>,
     /// Held-out weighted residual RMS with the effect.
     pub holdout_rms_with: Option<f64>,
     /// Whether every criterion passed.
     pub selected: bool,
+    /// Number of tests of its half of the pool (catalogue candidates, or
+    /// the dictionary's groups with every scan period).
+    pub multiplicity: usize,
+    /// `p_value` times `multiplicity` (at most 1).
+    pub p_adjusted: f64,
+    /// `delta_chi_square - dof ln N - 2 ln m` (`m` the alternatives of its
+    /// family): the penalised gain that ranks admissible candidates.
+    pub penalised_gain: f64,
 }
 
 /// An estimated parameter.
@@ -40,18 +52,206 @@ pub struct Estimate {
     pub std_dev: Option<f64>,
 }
 
+/// What kind of cause.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CauseKind {
+    /// An effect of the vocabulary.
+    Catalogue,
+    /// A term of the generic dictionary: an effect outside the vocabulary,
+    /// described by its form.
+    Generic,
+    /// Gross reading errors.
+    Outliers,
+}
+
 /// A named cause.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Cause {
-    /// The effect, from the vocabulary.
-    pub effect: EffectName,
+    /// The effect: a name of the vocabulary or a generic family.
+    pub effect: CauseName,
+    /// Catalogue, generic or outliers.
+    pub kind: CauseKind,
+    /// What was found, in words a machine builder can act on.
+    pub description: String,
+    /// Every quantity within its physical range (always true for a named
+    /// cause: implausible fits are listed under `rejected`).
+    pub plausible: bool,
     /// Its parameters in the final model.
     #[serde(serialize_with = "estimates_by_name")]
     pub parameters: Vec<Estimate>,
-    /// The evidence when it was selected.
+    /// Its evidence in the final model (the final model against the final
+    /// model without it).
     pub evidence: Evidence,
     /// Lines of the data file flagged (outliers only).
     pub rows: Vec<u64>,
+    /// The reading channel of a generic reading term (`phi`, `theta`, `s`).
+    pub channel: Option<&'static str>,
+    /// The legs of a generic leg term (1-3).
+    pub legs: Vec<u8>,
+}
+
+/// Candidates that this campaign cannot tell apart.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Alias {
+    /// The member in the final model first, then its alternatives.
+    pub effects: Vec<CauseName>,
+    /// The groups, in words (`reading-drift:s`, `leg-lead (equal on all legs)`).
+    pub descriptions: Vec<String>,
+    /// Why they cannot be told apart.
+    pub why: String,
+    /// What measurement would separate them.
+    pub separate_by: String,
+    /// True when the signatures are identical for any campaign of these
+    /// sensors (not just this one).
+    pub exact: bool,
+    /// The part of the fitted signature the best alternative leaves
+    /// unexplained (chi-square units; below the 1-dof critical value at
+    /// `alpha` no test could prefer one member).
+    pub lambda_unexplained: f64,
+    /// The member kept in the final model (its predictions equal the
+    /// alternatives' to within the noise).
+    pub in_model: CauseName,
+    /// The alternatives' parameters that reproduce the fitted signature.
+    #[serde(serialize_with = "estimates_by_name")]
+    pub parameters: Vec<Estimate>,
+}
+
+/// Where a fit was turned down.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RejectStage {
+    /// A quantity outside its physical range.
+    Plausibility,
+    /// Significant, but no better on held-out poses.
+    Holdout,
+    /// Removed by the admission on the final model.
+    FinalEvidence,
+    /// An alternative of an alias whose implied parameters are implausible.
+    ImplausibleAlias,
+}
+
+/// A fit that was not named as a cause, with the reason.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Rejected {
+    /// The effect or family.
+    pub effect: CauseName,
+    /// The group (`reading-drift:s`).
+    pub description: String,
+    /// Its fitted parameters.
+    #[serde(serialize_with = "estimates_by_name")]
+    pub parameters: Vec<Estimate>,
+    /// Why it is not a cause.
+    pub reason: String,
+    /// Where it was turned down.
+    pub stage: RejectStage,
+}
+
+/// The best generic term at the final model.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TermScore {
+    /// Its family.
+    pub effect: CauseName,
+    /// The group.
+    pub description: String,
+    /// Linearised drop of chi-square it would give.
+    pub delta_chi_square: f64,
+    /// Its degrees of freedom.
+    pub dof: usize,
+    /// Adjusted p-value (dictionary multiplicity).
+    pub p_adjusted: f64,
+    /// Why it is not a named cause.
+    pub why_not_named: String,
+}
+
+/// What the final model leaves unexplained.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Remainder {
+    /// Chi-square of the final model.
+    pub chi_square: f64,
+    /// Its degrees of freedom.
+    pub dof: usize,
+    /// Its p-value.
+    pub p_value: f64,
+    /// Cross-validated held-out RMS of the final model (noise = 1).
+    pub holdout_rms: f64,
+    /// Strongest residual correlations of the final model.
+    pub structure: Vec<Structure>,
+    /// The best generic term at the final model.
+    pub strongest_term: Option<TermScore>,
+    /// One line for people.
+    pub text: String,
+}
+
+/// The final model's fit.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FinalFit {
+    /// Chi-square (with the temperature logger's noise in the variance of
+    /// readings that depend on temperature).
+    pub chi_square: f64,
+    /// Degrees of freedom.
+    pub dof: usize,
+    /// p-value of the adequacy test.
+    pub p_value: f64,
+}
+
+/// Which noise the tests used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NoiseSource {
+    /// The stated sensor noise.
+    Stated,
+    /// The noise estimated from repeated poses (`--noise-from-data`).
+    Data,
+}
+
+/// The pure error of repeated poses.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PureError {
+    /// Groups of poses with the same commands.
+    pub groups: usize,
+    /// Degrees of freedom per channel (poses in groups minus groups).
+    pub dof: usize,
+    /// The data's noise of one logged reading.
+    pub sigma: ChannelRms,
+    /// Data's noise over the stated noise, per channel `[phi, theta, s]`.
+    pub ratio: [f64; 3],
+    /// Two-sided p-value of each ratio against 1 (chi-square).
+    pub p_value: [f64; 3],
+    /// Repeats logged in consecutive rows with the same approach: they
+    /// miss repositioning and vibration between visits.
+    pub within_visit: usize,
+}
+
+/// The check of the stated noise against the data.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NoiseCheck {
+    /// The stated noise of one logged reading.
+    pub stated: ChannelRms,
+    /// The noise the tests used.
+    pub used: NoiseSource,
+    /// The pure error, when poses were repeated.
+    pub pure_error: Option<PureError>,
+    /// Whether the stated noise and the data's agree (`null` without
+    /// repeated poses).
+    pub agrees: Option<bool>,
+    /// One line for people.
+    pub note: String,
+}
+
+/// The verdict of a diagnosis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Verdict {
+    /// The geometric model explains the data; nothing is named.
+    Adequate,
+    /// Causes (or an alias set) are named and the final model explains the data.
+    Explained,
+    /// Causes are named but the final model does not explain the data: a
+    /// remainder is reported.
+    PartiallyExplained,
+    /// The data are not explained and nothing admissible is found.
+    Unexplained,
 }
 
 /// A residual correlation with a regressor.
@@ -76,14 +276,17 @@ pub struct Gain {
     pub holdout_rms_extended: f64,
     /// Mean platform displacement on the middle plane between the
     /// geometric-only and the final calibration (commands of the former,
-    /// positions predicted by both), mm.
-    pub volumetric_mean_mm: f64,
+    /// positions predicted by both), mm; `null` when no target can be
+    /// reached (see `volumetric_note`).
+    pub volumetric_mean_mm: Option<f64>,
     /// Largest such displacement, mm.
-    pub volumetric_max_mm: f64,
+    pub volumetric_max_mm: Option<f64>,
     /// Mean displacement after removing the best-fit rigid translation
     /// (touch-off): most of the raw figure is often a translation along the
     /// weak leg-length direction that the sensors cannot see, mm.
-    pub volumetric_touched_mean_mm: f64,
+    pub volumetric_touched_mean_mm: Option<f64>,
+    /// Why the displacement is missing or partial.
+    pub volumetric_note: Option<String>,
 }
 
 /// A residual plot: weighted residuals of a channel (or implied leg-length
@@ -91,7 +294,7 @@ pub struct Gain {
 #[derive(Debug, Clone, PartialEq)]
 pub struct ResidualPlot {
     /// The cause it illustrates.
-    pub effect: EffectName,
+    pub effect: CauseName,
     /// x-axis label.
     pub x_label: String,
     /// y-axis label.
@@ -105,24 +308,48 @@ pub struct ResidualPlot {
 /// The diagnosis of a data set.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Diagnosis {
-    /// The geometric model alone explains the data.
+    /// The geometric model alone explains the data: it passes its
+    /// chi-square test, no cause is named and no generic term of the
+    /// dictionary is significant.
     pub adequate: bool,
+    /// Adequate, explained, partially explained or unexplained.
+    pub verdict: Verdict,
+    /// The final model (geometric plus the named causes and aliases)
+    /// explains the data.
+    pub final_adequate: bool,
     /// Chi-square of the geometric fit (clean poses).
     pub chi_square: f64,
     /// Its degrees of freedom.
     pub dof: usize,
-    /// `P(chi2_dof > chi_square)`.
+    /// p-value of the geometric model's adequacy test (`P(chi2_dof >
+    /// chi_square)` with the stated noise; the lack-of-fit F test with the
+    /// data's noise).
     pub chi_square_p_value: f64,
+    /// The final model's fit.
+    #[serde(rename = "final")]
+    pub final_fit: FinalFit,
     /// RMS residual of the geometric fit.
     pub residual_rms_geometric: ChannelRms,
     /// Strongest residual correlations of the geometric fit.
     pub structure: Vec<Structure>,
     /// Named causes, strongest first.
     pub causes: Vec<Cause>,
+    /// Candidates this campaign cannot tell apart.
+    pub aliases: Vec<Alias>,
+    /// Fits that are not causes, with the reason.
+    pub rejected: Vec<Rejected>,
+    /// What the final model leaves unexplained, when it is not adequate.
+    pub remainder: Option<Remainder>,
+    /// The noise check.
+    pub noise: NoiseCheck,
     /// Every candidate tested at the first selection step.
     pub candidates: Vec<Tested>,
+    /// Number of tests of the generic dictionary (every scan period counts).
+    pub dictionary_tests: usize,
     /// When the data are not explained and no cause is found: what is seen.
     pub unexplained: Option<String>,
+    /// Stated limitations of this diagnosis (data it could not use, ...).
+    pub limitations: Vec<String>,
     /// Gain of the final model.
     pub gain: Gain,
     /// Geometric parameters of the geometric-only fit.
@@ -140,7 +367,7 @@ pub struct Diagnosis {
     pub plots: Vec<ResidualPlot>,
 }
 
-/// RMS residual of each reading channel.
+/// RMS (or standard deviation) of each reading channel.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ChannelRms {
     /// Encoder `phi`, arcsec.
@@ -151,11 +378,24 @@ pub struct ChannelRms {
     pub s_um: f64,
 }
 
-/// A candidate effect with the evidence it had when tested.
+impl ChannelRms {
+    /// From `[phi rad, theta rad, s mm]`.
+    pub fn from_internal(v: [f64; 3]) -> ChannelRms {
+        ChannelRms {
+            phi_arcsec: v[0] / RAD_PER_ARCSEC,
+            theta_arcsec: v[1] / RAD_PER_ARCSEC,
+            s_um: v[2] * 1e3,
+        }
+    }
+}
+
+/// A candidate with the evidence it had when tested.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Tested {
-    /// The effect.
-    pub effect: EffectName,
+    /// The effect or family.
+    pub effect: CauseName,
+    /// The group.
+    pub description: String,
     /// Its evidence.
     pub evidence: Evidence,
 }
@@ -190,6 +430,26 @@ fn values_by_name<S: Serializer>(v: &[(String, f64)], s: S) -> Result<S::Ok, S::
 }
 
 impl Diagnosis {
+    /// The effects of the vocabulary in the final model: the named causes
+    /// (outliers aside) and the model's member of each alias set (a scale
+    /// gain, for instance, is never named alone but is modelled). What a
+    /// calibration that deploys the diagnosis' model needs.
+    pub fn model_effects(&self) -> Vec<tricept_model::effects::EffectName> {
+        use tricept_model::effects::EffectName;
+        let mut out: Vec<EffectName> = Vec::new();
+        let names = self
+            .causes
+            .iter()
+            .map(|c| c.effect)
+            .chain(self.aliases.iter().map(|a| a.in_model));
+        for e in names.filter_map(|n| n.catalogue()) {
+            if e != EffectName::Outliers && !out.contains(&e) {
+                out.push(e);
+            }
+        }
+        out
+    }
+
     /// JSON with the contract keys `adequate`, `causes` (each with
     /// `effect`, its parameter estimates and evidence) and `gain`
     /// (`holdout_rms_geometric`, `holdout_rms_extended`), and more: the
@@ -210,15 +470,19 @@ impl Diagnosis {
                 let _ = writeln!(out, $($arg)*);
             }};
         }
-        w!(
-            "{}: the geometric model {}",
-            source,
-            if self.adequate {
-                "explains the data (adequate)"
-            } else {
-                "does NOT explain the data"
+        let verdict = match self.verdict {
+            Verdict::Adequate => "the geometric model explains the data (adequate)",
+            Verdict::Explained => {
+                "the geometric model does NOT explain the data; the named causes do"
             }
-        );
+            Verdict::PartiallyExplained => {
+                "the geometric model does NOT explain the data; the named causes explain it only PARTIALLY (see remainder)"
+            }
+            Verdict::Unexplained => {
+                "the geometric model does NOT explain the data, and no cause is found"
+            }
+        };
+        w!("{source}: {verdict}");
         w!(
             "geometric fit: chi2 {:.1} for {} dof (p = {:.2e}); residual rms phi {:.3} arcsec, theta {:.3} arcsec, s {:.3} um",
             self.chi_square,
@@ -228,6 +492,7 @@ impl Diagnosis {
             self.residual_rms_geometric.theta_arcsec,
             self.residual_rms_geometric.s_um
         );
+        w!("noise: {}", self.noise.note);
         if let Some(s) = self.structure.first() {
             w!(
                 "strongest residual structure: {} vs {} (r = {:+.2}, p = {:.1e})",
@@ -239,14 +504,14 @@ impl Diagnosis {
         }
         for (i, c) in self.causes.iter().enumerate() {
             let ev = &c.evidence;
+            w!("cause {}: {}: {}", i + 1, c.effect, c.description);
             w!(
-                "cause {}: {}   (chi2 drop {:.1} for {} dof, p = {:.1e}; BIC gain {:.1}{})",
-                i + 1,
-                c.effect,
+                "    evidence: chi2 drop {:.1} for {} dof, adjusted p = {:.1e} ({} tests); penalised gain {:.1}{}",
                 ev.delta_chi_square,
                 ev.dof,
-                ev.p_value,
-                ev.delta_bic,
+                ev.p_adjusted,
+                ev.multiplicity,
+                ev.penalised_gain,
                 match (ev.holdout_rms_without, ev.holdout_rms_with) {
                     (Some(a), Some(b)) => format!("; held-out rms {a:.2} -> {b:.2}"),
                     _ => String::new(),
@@ -262,12 +527,30 @@ impl Diagnosis {
                 w!("    lines: {:?}", c.rows);
             }
         }
-        if let Some(u) = &self.unexplained {
+        for a in &self.aliases {
+            w!(
+                "alias: {} cannot be told apart on this campaign{}: {}",
+                a.descriptions.join(" ~ "),
+                if a.exact { " (exactly)" } else { "" },
+                a.why
+            );
+            w!("    separate by: {}", a.separate_by);
+        }
+        for r in &self.rejected {
+            w!("rejected: {}: {}", r.description, r.reason);
+        }
+        if let Some(r) = &self.remainder {
+            w!("remainder: {}", r.text);
+        }
+        if let (Some(u), None) = (&self.unexplained, &self.remainder) {
             w!("unexplained: {u}");
+        }
+        for l in &self.limitations {
+            w!("limitation: {l}");
         }
         let mut bias = self.geometric_bias.clone();
         bias.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
-        if !self.causes.is_empty() {
+        if !self.causes.is_empty() || !self.aliases.is_empty() {
             let text: Vec<String> = bias
                 .iter()
                 .take(4)
@@ -279,13 +562,23 @@ impl Diagnosis {
             );
         }
         let g = &self.gain;
-        w!(
-            "gain: held-out rms {:.3} -> {:.3} (noise = 1); platform moved on the middle plane by {:.4} mm mean ({:.4} after touch-off), {:.4} mm max",
-            g.holdout_rms_geometric,
-            g.holdout_rms_extended,
+        let moved = match (
             g.volumetric_mean_mm,
             g.volumetric_touched_mean_mm,
-            g.volumetric_max_mm
+            g.volumetric_max_mm,
+        ) {
+            (Some(mean), Some(touched), Some(max)) => format!(
+                "platform moved on the middle plane by {mean:.4} mm mean ({touched:.4} after touch-off), {max:.4} mm max"
+            ),
+            _ => "platform displacement not computed".into(),
+        };
+        w!(
+            "gain: held-out rms {:.3} -> {:.3} (noise = 1); {moved}{}",
+            g.holdout_rms_geometric,
+            g.holdout_rms_extended,
+            g.volumetric_note
+                .as_ref()
+                .map_or(String::new(), |n| format!(" ({n})"))
         );
         out
     }

@@ -6,11 +6,10 @@
 use tricept_data::Dataset;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{Machine, UpJoints};
-use tricept_model::effects::EffectName;
+use tricept_model::effects::{CauseName, EffectName, GenericFamily};
 use tricept_numerics::stats::chi2_sf;
 
-use crate::report::{ResidualPlot, Structure};
-use crate::run::DiagnoseOptions;
+use crate::report::{Cause, ResidualPlot, Structure};
 use crate::select::{Fit, residuals_of};
 
 /// Regressors of every pose (name, value per pose).
@@ -123,69 +122,170 @@ pub(crate) fn structure(
     out
 }
 
-/// Residual plot of `effect`: leg-length residuals (`J1` times the joint
+/// What a residual plot shows: the effect, its first leg (0-2), its
+/// channel (0-2) and, for a periodic term, its period (mm).
+pub(crate) struct PlotOf {
+    pub(crate) effect: CauseName,
+    pub(crate) leg: usize,
+    pub(crate) channel: usize,
+    pub(crate) period_mm: Option<f64>,
+}
+
+impl PlotOf {
+    /// The plot of a named cause.
+    pub(crate) fn cause(cause: &Cause) -> PlotOf {
+        PlotOf {
+            effect: cause.effect,
+            leg: cause
+                .legs
+                .first()
+                .map_or(0, |l| usize::from(*l).saturating_sub(1)),
+            channel: match cause.channel {
+                Some("phi") => 0,
+                Some("theta") => 1,
+                _ => 2,
+            },
+            period_mm: cause
+                .parameters
+                .iter()
+                .find(|p| p.name.ends_with("period_mm"))
+                .map(|p| p.value),
+        }
+    }
+}
+
+/// Residual plot of a cause: leg-length residuals (`J1` times the joint
 /// residuals, um) against the leg's regressor for leg effects; reading
-/// residuals against the exposing joint value otherwise.
+/// residuals against the exposing joint value or time otherwise.
 pub(crate) fn residual_plot(
-    effect: EffectName,
+    of: &PlotOf,
     nominal: &Machine,
     data: &Dataset,
     geo: &Fit,
     fin: &Fit,
-    options: &DiagnoseOptions,
+    sigma: &[f64; 3],
 ) -> Option<ResidualPlot> {
+    use CauseName::{Catalogue as C, Generic as G};
+    let (effect, leg, channel, period) = (of.effect, of.leg, of.channel, of.period_mm);
+    let unit = |c: usize| if c == 2 { 1e3 } else { 1.0 / RAD_PER_ARCSEC };
     let series = |f: &Fit| -> Vec<(f64, f64)> {
-        let res = residuals_of(f, &data.poses, &options.sigma);
+        let res = residuals_of(f, &data.poses, sigma);
         data.poses
             .iter()
+            .enumerate()
             .zip(res)
-            .filter_map(|(p, r)| {
+            .filter_map(|((j, p), r)| {
                 let r = r?;
-                let joint = [0, 1, 2].map(|c| r[c] * options.sigma[c]);
+                let joint = [0, 1, 2].map(|c| r[c] * sigma[c]);
                 let fk = nominal.forward(&p.commands_mm).ok()?;
-                let leg = nominal.legs_at(&fk.up).j1() * nalgebra::Vector3::from(joint);
+                let legs = nominal.legs_at(&fk.up).j1() * nalgebra::Vector3::from(joint);
+                let order = p.time_s.unwrap_or(j as f64);
                 let x_y = match effect {
-                    EffectName::LegLead => (p.commands_mm[0], leg[0] * 1e3),
-                    EffectName::Backlash => (
+                    C(EffectName::LegLead) => (p.commands_mm[0], legs[0] * 1e3),
+                    C(EffectName::Backlash) => (
                         f64::from(p.approach?[0]) + 0.02 * (p.line % 7) as f64,
-                        leg[0] * 1e3,
+                        legs[0] * 1e3,
                     ),
-                    EffectName::Thermal => (p.temp_c?, leg.sum() / 3.0 * 1e3),
-                    EffectName::Compliance => (
+                    C(EffectName::Thermal) => (p.temp_c?, legs.sum() / 3.0 * 1e3),
+                    C(EffectName::Compliance) => (
                         fk.up.theta_rad.hypot(fk.up.phi_rad).to_degrees(),
-                        leg.sum() / 3.0 * 1e3,
+                        legs.sum() / 3.0 * 1e3,
                     ),
-                    EffectName::ScaleGain => (fk.up.q4_mm, joint[2] * 1e3),
-                    EffectName::EncoderEccentricity => {
+                    C(EffectName::ScaleGain) => (fk.up.q4_mm, joint[2] * 1e3),
+                    C(EffectName::EncoderEccentricity) => {
                         (fk.up.phi_rad.to_degrees(), joint[0] / RAD_PER_ARCSEC)
                     }
-                    EffectName::UjointAxes => {
+                    C(EffectName::UjointAxes) => {
                         (fk.up.theta_rad.to_degrees(), joint[0] / RAD_PER_ARCSEC)
                     }
-                    EffectName::TubeTwist => (fk.up.q4_mm, leg[0] * 1e3),
-                    EffectName::Outliers => {
+                    C(EffectName::TubeTwist) => (fk.up.q4_mm, legs[0] * 1e3),
+                    C(EffectName::Outliers) => {
                         (p.line as f64, r.iter().fold(0.0f64, |a, v| a.max(v.abs())))
+                    }
+                    G(GenericFamily::LegPeriodic) => (
+                        p.commands_mm[leg].rem_euclid(period.unwrap_or(f64::INFINITY)),
+                        legs[leg] * 1e3,
+                    ),
+                    G(GenericFamily::LegPolynomial) => (p.commands_mm[leg], legs[leg] * 1e3),
+                    G(GenericFamily::LegDrift) => (order, legs[leg] * 1e3),
+                    G(GenericFamily::ReadingTemperature) => {
+                        (p.temp_c?, joint[channel] * unit(channel))
+                    }
+                    G(GenericFamily::EncoderGain) => {
+                        let angle = if channel == 0 {
+                            fk.up.phi_rad
+                        } else {
+                            fk.up.theta_rad
+                        };
+                        (angle.to_degrees(), joint[channel] * unit(channel))
+                    }
+                    G(GenericFamily::ScalePolynomial) => (fk.up.q4_mm, joint[2] * 1e3),
+                    G(GenericFamily::ReadingDrift) | G(GenericFamily::ReadingHysteresis) => {
+                        (order, joint[channel] * unit(channel))
                     }
                 };
                 Some(x_y)
             })
             .collect()
     };
-    let (x_label, y_label) = match effect {
-        EffectName::LegLead => ("leg 1 command (mm)", "leg 1 length residual (um)"),
-        EffectName::Backlash => ("leg 1 approach direction", "leg 1 length residual (um)"),
-        EffectName::Thermal => ("temperature (°C)", "mean leg length residual (um)"),
-        EffectName::Compliance => ("tilt of the UP limb (deg)", "mean leg length residual (um)"),
-        EffectName::ScaleGain => ("q4 (mm)", "scale residual (um)"),
-        EffectName::EncoderEccentricity => ("phi (deg)", "phi residual (arcsec)"),
-        EffectName::UjointAxes => ("theta (deg)", "phi residual (arcsec)"),
-        EffectName::TubeTwist => ("q4 (mm)", "leg 1 length residual (um)"),
-        EffectName::Outliers => ("line of the data file", "largest |residual| (sigma)"),
+    let reading = |c: usize| {
+        format!(
+            "{} residual ({})",
+            ["phi", "theta", "s"][c],
+            if c == 2 { "um" } else { "arcsec" }
+        )
+    };
+    let (x_label, y_label): (String, String) = match effect {
+        C(EffectName::LegLead) => (
+            "leg 1 command (mm)".into(),
+            "leg 1 length residual (um)".into(),
+        ),
+        C(EffectName::Backlash) => (
+            "leg 1 approach direction".into(),
+            "leg 1 length residual (um)".into(),
+        ),
+        C(EffectName::Thermal) => (
+            "temperature (°C)".into(),
+            "mean leg length residual (um)".into(),
+        ),
+        C(EffectName::Compliance) => (
+            "tilt of the UP limb (deg)".into(),
+            "mean leg length residual (um)".into(),
+        ),
+        C(EffectName::ScaleGain) => ("q4 (mm)".into(), "scale residual (um)".into()),
+        C(EffectName::EncoderEccentricity) => ("phi (deg)".into(), "phi residual (arcsec)".into()),
+        C(EffectName::UjointAxes) => ("theta (deg)".into(), "phi residual (arcsec)".into()),
+        C(EffectName::TubeTwist) => ("q4 (mm)".into(), "leg 1 length residual (um)".into()),
+        C(EffectName::Outliers) => (
+            "line of the data file".into(),
+            "largest |residual| (sigma)".into(),
+        ),
+        G(GenericFamily::LegPeriodic) => (
+            format!("leg {} command modulo the period (mm)", leg + 1),
+            format!("leg {} length residual (um)", leg + 1),
+        ),
+        G(GenericFamily::LegPolynomial) => (
+            format!("leg {} command (mm)", leg + 1),
+            format!("leg {} length residual (um)", leg + 1),
+        ),
+        G(GenericFamily::LegDrift) => (
+            "time (s) or pose".into(),
+            format!("leg {} length residual (um)", leg + 1),
+        ),
+        G(GenericFamily::ReadingTemperature) => ("temperature (°C)".into(), reading(channel)),
+        G(GenericFamily::EncoderGain) => (
+            format!("{} (deg)", ["phi", "theta", "s"][channel]),
+            reading(channel),
+        ),
+        G(GenericFamily::ScalePolynomial) => ("q4 (mm)".into(), reading(2)),
+        G(GenericFamily::ReadingDrift) | G(GenericFamily::ReadingHysteresis) => {
+            ("time (s) or pose".into(), reading(channel))
+        }
     };
     Some(ResidualPlot {
         effect,
-        x_label: x_label.into(),
-        y_label: y_label.into(),
+        x_label,
+        y_label,
         before: series(geo),
         after: series(fin),
     })

@@ -1,37 +1,290 @@
-//! Selection of causes: every candidate effect fitted on top of the current
-//! model, admitted by the likelihood-ratio test, the BIC and the
-//! cross-validated held-out residual, then swaps that lower the BIC of the
-//! whole model; the outlier screen with the diagnosis' options.
+//! Selection of causes from one pool: the effects of the vocabulary and
+//! the generic dictionary.
+//!
+//! **Forward steps.** Every available catalogue effect not yet in the model
+//! is refitted exactly; the dictionary is screened linearly at the current
+//! fit and its best `refit_top` groups are refitted exactly too. A refitted
+//! candidate `c` is admissible when
+//! 1. the likelihood-ratio test passes: its drop of chi-square, divided by
+//!    the residual variance of the larger model (never below the noise), is
+//!    significant at `alpha / 2` divided by the number of catalogue
+//!    candidates (catalogue) or by the dictionary's multiplicity (generic:
+//!    every scan period counts);
+//! 2. its penalised gain is positive:
+//!    `G = X - k ln(3n) - 2 ln m_c`, the BIC plus an extended-BIC term
+//!    for the `m_c` alternatives of its family (1 for a catalogue effect);
+//! 3. its parameters are physically plausible ([`crate::plausibility`]);
+//!    otherwise it is recorded as rejected with the reason;
+//! 4. the 5-fold cross-validated held-out RMS improves.
+//!
+//! The admissible candidate with the largest `G` enters (ties prefer the
+//! catalogue). Then swaps: a term of the model is replaced by a catalogue
+//! effect when that lowers the BIC of the whole model.
+//!
+//! **Admission on the final model.** Backward elimination: every cause must
+//! pass the likelihood-ratio test and the penalised gain against the final
+//! model without it, and the final model must predict held-out poses
+//! strictly better with it than without it; the least useful failing cause
+//! is removed and the test repeated. Finally the final model's held-out RMS
+//! must not exceed the geometric model's, else the least useful cause goes.
+//! If anything was removed, one more forward step is tried from the pruned
+//! model. The evidence reported for each cause is this final-model test,
+//! and the reported gain uses the very same cross-validation, so a named
+//! cause never makes the held-out fit worse.
 
+use std::sync::Arc;
+
+use nalgebra::DMatrix;
 use rayon::prelude::*;
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_ident::{
     GeometricModel, IdentError, Identification, IdentifyOptions, ReadingModel, identify,
     residuals_at, screen_gross_errors,
 };
-use tricept_numerics::stats::chi2_sf;
 
+use crate::dictionary::{At, Dictionary, Scored};
+use crate::evidence::Reference;
+use crate::linear::Linearisation;
 use crate::model::{Candidate, ExtendedModel};
-use crate::report::{Estimate, Evidence, Tested};
-use crate::run::DiagnoseOptions;
+use crate::plausibility::{Plausibility, quantities};
+use crate::report::{Estimate, Evidence, RejectStage, Rejected, Tested};
+use crate::run::{DiagnoseError, DiagnoseOptions};
+use crate::terms::{Frame, Term};
 
+/// A model fitted to data.
 #[derive(Clone)]
 pub(crate) struct Fit {
     pub(crate) model: ExtendedModel,
     pub(crate) id: Identification,
 }
 
-pub(crate) fn identify_options(options: &DiagnoseOptions) -> IdentifyOptions {
-    IdentifyOptions::with_sigma(options.sigma)
+/// Everything the selection works with, fixed for one diagnosis.
+pub(crate) struct Setup<'a> {
+    pub(crate) options: &'a DiagnoseOptions,
+    /// Noise of one logged reading used by every fit (stated or estimated).
+    pub(crate) sigma: [f64; 3],
+    pub(crate) reference: Reference,
+    pub(crate) frame: Arc<Frame>,
+    pub(crate) dictionary: Dictionary,
+    pub(crate) plausibility: &'a Plausibility,
+    pub(crate) geometric: GeometricModel,
+    /// Catalogue candidates whose data columns are present.
+    pub(crate) available: Vec<Candidate>,
 }
 
-pub(crate) fn fit(
-    model: ExtendedModel,
-    data: &Dataset,
-    options: &DiagnoseOptions,
-) -> Result<Fit, IdentError> {
-    let id = identify(&model, data, &identify_options(options))?;
-    Ok(Fit { model, id })
+impl Setup<'_> {
+    /// The geometric model with the frame and no terms.
+    pub(crate) fn base_model(&self) -> ExtendedModel {
+        ExtendedModel::with_terms(self.geometric.clone(), &[], self.frame.clone())
+    }
+
+    pub(crate) fn model(&self, terms: &[Term]) -> ExtendedModel {
+        ExtendedModel::with_terms(self.geometric.clone(), terms, self.frame.clone())
+    }
+
+    pub(crate) fn identify_options(&self) -> IdentifyOptions {
+        IdentifyOptions::with_sigma(self.sigma)
+    }
+
+    /// The family-wise level of each half of the pool.
+    pub(crate) fn alpha_share(&self) -> f64 {
+        if self.dictionary.is_empty() {
+            self.options.alpha
+        } else {
+            0.5 * self.options.alpha
+        }
+    }
+
+    /// Number of tests of the half of the pool `term` belongs to.
+    pub(crate) fn multiplicity(&self, term: &Term) -> usize {
+        match term {
+            Term::Catalogue(_) => self.available.len().max(1),
+            Term::Generic(_) => self.dictionary.multiplicity().max(1),
+        }
+    }
+
+    /// Alternatives of `term` within its family (for the penalised gain).
+    fn alternatives(&self, term: &Term) -> usize {
+        match term {
+            Term::Catalogue(_) => 1,
+            Term::Generic(g) => {
+                if g.period_mm.is_some() {
+                    self.dictionary.scan_len().max(1)
+                } else {
+                    self.frame
+                        .generic_groups()
+                        .iter()
+                        .filter(|h| h.family == g.family)
+                        .count()
+                        .max(1)
+                }
+            }
+        }
+    }
+
+    /// Fits `model` to `data`: a fit that does not converge, or whose
+    /// geometric errors exceed `max_error_mm`, is not a fit.
+    pub(crate) fn fit(&self, model: ExtendedModel, data: &Dataset) -> Result<Fit, FitError> {
+        let id = identify(&model, data, &self.identify_options()).map_err(FitError::Ident)?;
+        let g = model.n_geometric();
+        let largest = id.estimate[..g].iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if !id.converged
+            || !largest.is_finite()
+            || largest > self.options.max_error_mm
+            || !id.stats.chi_square.is_finite()
+        {
+            return Err(FitError::NotConverged {
+                largest_error_mm: largest,
+                iterations: id.iterations,
+            });
+        }
+        Ok(Fit { model, id })
+    }
+
+    /// K-fold cross-validated RMS of the weighted held-out residuals of
+    /// `model` on `data`, evaluated on the poses `evaluate` accepts;
+    /// `Err(fold)` when a fold cannot be fitted.
+    pub(crate) fn holdout_rms(
+        &self,
+        model: &ExtendedModel,
+        data: &Dataset,
+        evaluate: &(dyn Fn(usize) -> bool + Sync),
+    ) -> Result<f64, usize> {
+        let k = self.options.folds.max(2);
+        let parts: Vec<Result<(f64, usize), usize>> = (0..k)
+            .into_par_iter()
+            .map(|fold| {
+                let train = data.subset(|j| j % k != fold);
+                let f = self.fit(model.clone(), &train).map_err(|_| fold + 1)?;
+                let poses: Vec<MeasuredPose> = data
+                    .poses
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, _)| j % k == fold && evaluate(*j))
+                    .map(|(_, p)| *p)
+                    .collect();
+                let mut sum = 0.0;
+                let mut n = 0;
+                for r in residuals_of(&f, &poses, &self.sigma) {
+                    let r = r.ok_or(fold + 1)?;
+                    sum += r.iter().map(|v| v * v).sum::<f64>();
+                    n += 3;
+                }
+                Ok((sum, n))
+            })
+            .collect();
+        let (mut sum, mut n) = (0.0, 0);
+        for part in parts {
+            let (s, c) = part?;
+            sum += s;
+            n += c;
+        }
+        if n == 0 {
+            return Err(0);
+        }
+        Ok((sum / n as f64).sqrt())
+    }
+
+    /// The dictionary screen at `fit` (empty when the fit cannot be
+    /// linearised or the dictionary is empty).
+    pub(crate) fn screen(&self, fit: &Fit, data: &Dataset) -> Vec<Scored> {
+        if self.dictionary.is_empty() {
+            return Vec::new();
+        }
+        let Some(lin) = Linearisation::at_fit(fit, data, &self.sigma, &[]) else {
+            return Vec::new();
+        };
+        let at = At {
+            lin: &lin,
+            frame: &self.frame,
+            data,
+            reference: &self.reference,
+            chi_square: fit.id.stats.chi_square,
+            dof: fit.id.stats.dof,
+        };
+        self.dictionary.screen(&at, fit.model.terms())
+    }
+
+    /// Plausibility of `term` in `fit`.
+    pub(crate) fn plausible(&self, fit: &Fit, term: &Term) -> Result<(), String> {
+        let (values, cov) = term_estimates(fit, term);
+        self.plausibility.check(&quantities(term, &values, &cov))
+    }
+
+    /// The evidence for `term` from the nested pair `without` / `with`.
+    pub(crate) fn evidence(
+        &self,
+        term: &Term,
+        without: &Fit,
+        with: &Fit,
+        readings: usize,
+    ) -> Evidence {
+        let delta = without.id.stats.chi_square - with.id.stats.chi_square;
+        let k = with
+            .id
+            .design()
+            .rank()
+            .saturating_sub(without.id.design().rank())
+            .max(1);
+        let s2 = self
+            .reference
+            .scale(with.id.stats.chi_square, with.id.stats.dof);
+        let p = self.reference.p_value(delta / s2, k);
+        let m = self.multiplicity(term);
+        let ln_n = (readings as f64).ln();
+        Evidence {
+            delta_chi_square: delta,
+            dof: k,
+            p_value: p,
+            threshold: self.alpha_share() / m as f64,
+            delta_bic: delta - k as f64 * ln_n,
+            holdout_rms_without: None,
+            holdout_rms_with: None,
+            selected: false,
+            multiplicity: m,
+            p_adjusted: (p * m as f64).min(1.0),
+            penalised_gain: delta - k as f64 * ln_n - 2.0 * (self.alternatives(term) as f64).ln(),
+        }
+    }
+}
+
+/// Why a model could not be fitted.
+#[derive(Debug)]
+pub(crate) enum FitError {
+    Ident(IdentError),
+    NotConverged {
+        largest_error_mm: f64,
+        iterations: u32,
+    },
+}
+
+impl From<FitError> for DiagnoseError {
+    fn from(e: FitError) -> DiagnoseError {
+        match e {
+            FitError::Ident(e) => DiagnoseError::Ident(e),
+            FitError::NotConverged {
+                largest_error_mm,
+                iterations,
+            } => DiagnoseError::NotConverged {
+                largest_error_mm,
+                iterations,
+            },
+        }
+    }
+}
+
+/// Values and covariance of `term`'s parameters in `fit`.
+pub(crate) fn term_estimates(fit: &Fit, term: &Term) -> (Vec<f64>, DMatrix<f64>) {
+    let terms = fit.model.terms();
+    let offsets = fit.model.offsets();
+    let Some(i) = terms.iter().position(|t| t == term) else {
+        return (Vec::new(), DMatrix::zeros(0, 0));
+    };
+    let at = offsets[i];
+    let k = term.params().len();
+    let values = fit.id.estimate[at..at + k].to_vec();
+    let cov = fit.id.covariance.view((at, at), (k, k)).into_owned();
+    (values, cov)
 }
 
 /// Weighted residuals of `poses` under a fitted model (offsets applied).
@@ -43,46 +296,6 @@ pub(crate) fn residuals_of(
     // A fit's estimate always has its model's length.
     residuals_at(&f.model, &f.id.estimate, &f.id.offsets, poses, sigma)
         .unwrap_or_else(|_| vec![None; poses.len()])
-}
-
-/// K-fold cross-validated RMS of the weighted held-out residuals of
-/// `model` on `data`, evaluated on the poses `evaluate` accepts.
-pub(crate) fn holdout_rms(
-    model: &ExtendedModel,
-    data: &Dataset,
-    options: &DiagnoseOptions,
-    evaluate: &(dyn Fn(usize) -> bool + Sync),
-) -> Option<f64> {
-    let k = options.folds.max(2);
-    let parts: Vec<Option<(f64, usize)>> = (0..k)
-        .into_par_iter()
-        .map(|fold| {
-            let train = data.subset(|j| j % k != fold);
-            let f = fit(model.clone(), &train, options).ok()?;
-            let test: Vec<(usize, MeasuredPose)> = data
-                .poses
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| j % k == fold && evaluate(*j))
-                .map(|(j, p)| (j, *p))
-                .collect();
-            let poses: Vec<MeasuredPose> = test.iter().map(|(_, p)| *p).collect();
-            let res = residuals_of(&f, &poses, &options.sigma);
-            let mut sum = 0.0;
-            let mut n = 0;
-            for r in res.into_iter().flatten() {
-                sum += r.iter().map(|v| v * v).sum::<f64>();
-                n += 3;
-            }
-            Some((sum, n))
-        })
-        .collect();
-    let (mut sum, mut n) = (0.0, 0);
-    for (s, c) in parts.into_iter().flatten() {
-        sum += s;
-        n += c;
-    }
-    (n > 0).then(|| (sum / n as f64).sqrt())
 }
 
 pub(crate) fn estimates(f: &Fit) -> Vec<Estimate> {
@@ -102,221 +315,400 @@ pub(crate) fn estimates(f: &Fit) -> Vec<Estimate> {
 /// The outlier screen of `tricept_ident::robust` with the diagnosis'
 /// options; the indices of the flagged poses.
 pub(crate) fn screen_outliers(
+    setup: &Setup<'_>,
     model: &ExtendedModel,
     data: &Dataset,
-    options: &DiagnoseOptions,
 ) -> Result<Vec<usize>, IdentError> {
     Ok(screen_gross_errors(
         model,
         data,
-        &identify_options(options),
-        options.alpha,
-        options.max_outlier_share,
+        &setup.identify_options(),
+        setup.options.alpha,
+        setup.options.max_outlier_share,
     )?
     .into_iter()
     .map(|r| r.pose)
     .collect())
 }
 
-/// The outcome of the selection of effects on clean data.
+/// The outcome of the selection on clean data.
 pub(crate) struct Selection {
-    pub(crate) chosen: Vec<Candidate>,
+    /// The causes, in the order they entered.
+    pub(crate) terms: Vec<Term>,
+    /// Each cause's evidence on the final model.
     pub(crate) evidences: Vec<Evidence>,
+    /// The final model.
     pub(crate) current: Fit,
-    pub(crate) current_rms: Option<f64>,
+    /// Its cross-validated held-out RMS.
+    pub(crate) current_rms: f64,
+    /// The geometric model's.
+    pub(crate) geometric_rms: f64,
+    /// The candidates tested at the first step.
     pub(crate) first_candidates: Vec<Tested>,
+    /// The geometric fit.
     pub(crate) geo: Fit,
+    /// Fits that failed plausibility or the held-out test.
+    pub(crate) rejected: Vec<Rejected>,
 }
 
-/// Forward selection of effects (see the module docs), followed by swaps:
-/// a selected effect is replaced by an unselected one when that lowers the
-/// BIC of the whole model (forward selection alone can let an effect that
-/// mimics two others in; `scale-gain` with `encoder-eccentricity` present
-/// is first mistaken for `leg-lead`).
-pub(crate) fn select(
-    geometric: &GeometricModel,
-    clean: &Dataset,
-    options: &DiagnoseOptions,
-) -> Result<Selection, IdentError> {
-    let base_model = ExtendedModel::new(geometric.clone(), &[]);
-    let geo = fit(base_model, clean, options)?;
-    let available: Vec<Candidate> = Candidate::ALL
+/// A candidate refitted on top of the current model.
+struct Trial {
+    term: Term,
+    fit: Fit,
+    evidence: Evidence,
+}
+
+fn reject(
+    rejected: &mut Vec<Rejected>,
+    fit: &Fit,
+    term: &Term,
+    stage: RejectStage,
+    reason: String,
+) {
+    let (values, cov) = term_estimates(fit, term);
+    let names = term.params();
+    let parameters = values
         .iter()
-        .copied()
-        .filter(|c| c.available(clean))
+        .enumerate()
+        .map(|(i, v)| Estimate {
+            name: format!("{}.{}", term.name(), names[i]),
+            value: *v,
+            std_dev: Some(cov[(i, i)].max(0.0).sqrt()),
+        })
         .collect();
-    let threshold = options.alpha / available.len().max(1) as f64;
-    let readings = (3 * clean.poses.len()) as f64;
-    let bic = |f: &Fit| f.id.stats.chi_square + f.id.design().rank() as f64 * readings.ln();
-    let mut current = geo.clone();
-    let mut current_rms: Option<f64> = None;
-    let mut first_candidates = Vec::new();
-    let mut chosen: Vec<Candidate> = Vec::new();
-    let mut evidences: Vec<Evidence> = Vec::new();
-    for step in 0..options.max_causes {
-        let remaining: Vec<Candidate> = available
-            .iter()
-            .copied()
-            .filter(|c| !chosen.contains(c))
-            .collect();
-        let trials: Vec<(Candidate, Option<Fit>)> = remaining
-            .par_iter()
-            .map(|c| {
-                let mut effects = chosen.clone();
-                effects.push(*c);
-                let m = ExtendedModel::new(geometric.clone(), &effects);
-                (*c, fit(m, clean, options).ok())
+    let description = describe_group(term);
+    rejected.retain(|r| !(r.description == description && r.stage == stage));
+    rejected.push(Rejected {
+        effect: term.name(),
+        description,
+        parameters,
+        reason,
+        stage,
+    });
+}
+
+/// A short description of a term's group for messages.
+pub(crate) fn describe_group(term: &Term) -> String {
+    match term {
+        Term::Catalogue(c) => c.0.to_string(),
+        Term::Generic(g) => g.label(),
+    }
+}
+
+/// One forward step from `current`: the winning trial and its held-out
+/// RMS, or `None`.
+fn forward_step(
+    setup: &Setup<'_>,
+    clean: &Dataset,
+    current: &Fit,
+    current_rms: &mut Option<f64>,
+    rejected: &mut Vec<Rejected>,
+    excluded: &[Term],
+    tested: Option<&mut Vec<Tested>>,
+) -> Option<(Trial, f64)> {
+    let terms = current.model.terms().to_vec();
+    let mut pool: Vec<Term> = setup
+        .available
+        .iter()
+        .map(|c| Term::Catalogue(*c))
+        .filter(|t| !terms.iter().any(|u| u.overlaps(t)))
+        .collect();
+    let alpha_share = setup.alpha_share();
+    pool.extend(
+        setup
+            .screen(current, clean)
+            .into_iter()
+            .filter(|s| s.p_adjusted < alpha_share)
+            .take(setup.options.dictionary.refit_top)
+            .map(|s| Term::Generic(s.term)),
+    );
+    pool.retain(|t| !excluded.iter().any(|e| e.overlaps(t) || e == t));
+    let readings = 3 * clean.poses.len();
+    let mut trials: Vec<Trial> = pool
+        .par_iter()
+        .filter_map(|t| {
+            let mut with = terms.clone();
+            with.push(*t);
+            let fit = setup.fit(setup.model(&with), clean).ok()?;
+            if fit.id.stats.dof == 0 {
+                return None;
+            }
+            let evidence = setup.evidence(t, current, &fit, readings);
+            Some(Trial {
+                term: *t,
+                fit,
+                evidence,
             })
-            .collect();
-        let mut tested: Vec<(Candidate, Evidence, Option<Fit>)> = Vec::new();
-        for (c, f) in trials {
-            let Some(f) = f else { continue };
-            let delta = current.id.stats.chi_square - f.id.stats.chi_square;
-            let k =
-                f.id.design()
-                    .rank()
-                    .saturating_sub(current.id.design().rank())
-                    .max(1);
-            let p = chi2_sf(delta.max(0.0), k as f64);
-            let delta_bic = delta - k as f64 * readings.ln();
-            tested.push((
-                c,
-                Evidence {
-                    delta_chi_square: delta,
-                    dof: k,
-                    p_value: p,
-                    threshold,
-                    delta_bic,
-                    holdout_rms_without: None,
-                    holdout_rms_with: None,
-                    selected: false,
-                },
-                Some(f),
-            ));
+        })
+        .collect();
+    // Strongest first; among equals the catalogue.
+    trials.sort_by(|a, b| {
+        b.evidence
+            .penalised_gain
+            .total_cmp(&a.evidence.penalised_gain)
+            .then(a.term.name().is_generic().cmp(&b.term.name().is_generic()))
+    });
+    let mut winner = None;
+    for t in trials.iter_mut() {
+        if winner.is_some()
+            || t.evidence.p_adjusted >= alpha_share
+            || t.evidence.penalised_gain <= 0.0
+        {
+            continue;
         }
-        // Strongest first by BIC: among effects that explain the same
-        // signature (a gain of the scale and an equal lead of the three legs
-        // both scale the machine), the one with fewer parameters wins.
-        tested.sort_by(|a, b| b.1.delta_bic.total_cmp(&a.1.delta_bic));
-        // Cross-validate the candidates that pass the likelihood-ratio test
-        // and the BIC, strongest first, and take the first that also
-        // predicts held-out poses better.
-        let mut winner: Option<(Candidate, Evidence, Fit)> = None;
-        for (c, ev, f) in tested.iter_mut() {
-            if ev.p_value >= threshold || ev.delta_bic <= 0.0 || winner.is_some() {
-                continue;
-            }
-            if current_rms.is_none() {
-                current_rms = holdout_rms(&current.model, clean, options, &|_| true);
-            }
-            let Some(f) = f.take() else { continue };
-            let with = holdout_rms(&f.model, clean, options, &|_| true);
-            ev.holdout_rms_without = current_rms;
-            ev.holdout_rms_with = with;
-            if let (Some(a), Some(b)) = (current_rms, with)
-                && b < a
-            {
-                ev.selected = true;
-                winner = Some((*c, ev.clone(), f));
-                current_rms = with;
-            }
+        if let Err(reason) = setup.plausible(&t.fit, &t.term) {
+            reject(rejected, &t.fit, &t.term, RejectStage::Plausibility, reason);
+            continue;
         }
-        if step == 0 {
-            first_candidates = tested
-                .iter()
-                .map(|(c, e, _)| Tested {
-                    effect: c.0,
-                    evidence: e.clone(),
-                })
-                .collect();
+        if current_rms.is_none() {
+            *current_rms = setup.holdout_rms(&current.model, clean, &|_| true).ok();
         }
-        match winner {
-            Some((c, ev, f)) => {
-                chosen.push(c);
-                evidences.push(ev);
-                current = f;
+        let with = setup.holdout_rms(&t.fit.model, clean, &|_| true).ok();
+        t.evidence.holdout_rms_without = *current_rms;
+        t.evidence.holdout_rms_with = with;
+        match (*current_rms, with) {
+            (Some(a), Some(b)) if b < a => {
+                t.evidence.selected = true;
+                winner = Some((t.term, b));
             }
-            None => break,
+            (a, b) => reject(
+                rejected,
+                &t.fit,
+                &t.term,
+                RejectStage::Holdout,
+                format!(
+                    "significant, but the held-out rms does not improve ({} -> {})",
+                    a.map_or("-".into(), |v| format!("{v:.3}")),
+                    b.map_or("-".into(), |v| format!("{v:.3}"))
+                ),
+            ),
         }
     }
-    // Swaps.
-    let mut improved = !chosen.is_empty();
-    while improved {
-        improved = false;
-        let options_swap: Vec<(usize, Candidate)> = (0..chosen.len())
-            .flat_map(|slot| {
-                available
+    if let Some(tested) = tested {
+        *tested = trials
+            .iter()
+            .map(|t| Tested {
+                effect: t.term.name(),
+                description: describe_group(&t.term),
+                evidence: t.evidence.clone(),
+            })
+            .collect();
+    }
+    let (term, rms) = winner?;
+    let index = trials.iter().position(|t| t.term == term)?;
+    Some((trials.swap_remove(index), rms))
+}
+
+/// Swaps: a term of the model (catalogue or generic) replaced by a
+/// catalogue effect when that lowers the BIC of the whole model (a
+/// polynomial leg error that entered for a scale gain while an
+/// eccentricity was still unmodelled is a lead once the eccentricity is in).
+fn swaps(setup: &Setup<'_>, clean: &Dataset, mut current: Fit) -> Fit {
+    let readings = (3 * clean.poses.len()) as f64;
+    let bic = |f: &Fit| f.id.stats.chi_square + f.id.design().rank() as f64 * readings.ln();
+    loop {
+        let terms = current.model.terms().to_vec();
+        let options: Vec<(usize, Term)> = terms
+            .iter()
+            .enumerate()
+            .flat_map(|(slot, _)| {
+                setup
+                    .available
                     .iter()
-                    .copied()
-                    .filter(|c| !chosen.contains(c))
+                    .map(|c| Term::Catalogue(*c))
+                    .filter(|c| !terms.contains(c))
                     .map(move |c| (slot, c))
             })
             .collect();
-        let best = options_swap
+        let best = options
             .par_iter()
             .filter_map(|&(slot, c)| {
-                let mut effects = chosen.clone();
-                effects[slot] = c;
-                let f = fit(
-                    ExtendedModel::new(geometric.clone(), &effects),
-                    clean,
-                    options,
-                )
-                .ok()?;
-                Some((bic(&f), slot, c, f))
+                let mut with = terms.clone();
+                with[slot] = c;
+                let f = setup.fit(setup.model(&with), clean).ok()?;
+                setup.plausible(&f, &c).ok()?;
+                Some((bic(&f), f))
             })
             .min_by(|a, b| a.0.total_cmp(&b.0));
-        if let Some((value, slot, c, f)) = best
-            && value < bic(&current) - 1e-6
-        {
-            chosen[slot] = c;
-            current = f;
-            current_rms = holdout_rms(&current.model, clean, options, &|_| true);
-            improved = true;
+        match best {
+            Some((value, f)) if value < bic(&current) - 1e-6 => current = f,
+            _ => return current,
         }
     }
-    // The evidence of each cause is its contribution to the final model:
-    // the final model against the final model without it.
-    let evidences: Vec<Evidence> = if chosen.len() == evidences.len() && chosen.len() > 1 {
-        (0..chosen.len())
-            .into_par_iter()
-            .map(|slot| {
-                let effects: Vec<Candidate> = chosen
-                    .iter()
-                    .enumerate()
-                    .filter(|(i, _)| *i != slot)
-                    .map(|(_, c)| *c)
-                    .collect();
-                let model = ExtendedModel::new(geometric.clone(), &effects);
-                let without = fit(model.clone(), clean, options).ok();
-                let mut ev = evidences[slot].clone();
-                if let Some(w) = without {
-                    let delta = w.id.stats.chi_square - current.id.stats.chi_square;
-                    let k = current
-                        .id
-                        .design()
-                        .rank()
-                        .saturating_sub(w.id.design().rank())
-                        .max(1);
-                    ev.delta_chi_square = delta;
-                    ev.dof = k;
-                    ev.p_value = chi2_sf(delta.max(0.0), k as f64);
-                    ev.delta_bic = delta - k as f64 * readings.ln();
-                    ev.holdout_rms_without = holdout_rms(&model, clean, options, &|_| true);
-                    ev.holdout_rms_with = current_rms;
+}
+
+/// The final-model test of every cause: (evidence, held-out RMS without
+/// it, whether it passes).
+fn final_tests(
+    setup: &Setup<'_>,
+    clean: &Dataset,
+    current: &Fit,
+    current_rms: f64,
+) -> Vec<(Evidence, Option<f64>, bool)> {
+    let terms = current.model.terms().to_vec();
+    let readings = 3 * clean.poses.len();
+    (0..terms.len())
+        .into_par_iter()
+        .map(|slot| {
+            let others: Vec<Term> = terms
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| *i != slot)
+                .map(|(_, t)| *t)
+                .collect();
+            let model = setup.model(&others);
+            let Ok(without) = setup.fit(model.clone(), clean) else {
+                // The model without the cause cannot be fitted: the cause
+                // is needed.
+                let mut ev = setup.evidence(&terms[slot], current, current, readings);
+                ev.selected = true;
+                return (ev, None, true);
+            };
+            let mut ev = setup.evidence(&terms[slot], &without, current, readings);
+            let rms_without = setup.holdout_rms(&model, clean, &|_| true).ok();
+            ev.holdout_rms_without = rms_without;
+            ev.holdout_rms_with = Some(current_rms);
+            let pass = ev.p_adjusted < setup.alpha_share()
+                && ev.penalised_gain > 0.0
+                && rms_without.is_none_or(|w| current_rms < w);
+            ev.selected = pass;
+            (ev, rms_without, pass)
+        })
+        .collect()
+}
+
+/// Forward selection, swaps and admission on the final model (see the
+/// module docs).
+pub(crate) fn select(setup: &Setup<'_>, clean: &Dataset) -> Result<Selection, DiagnoseError> {
+    let geo = setup.fit(setup.base_model(), clean)?;
+    if geo.id.stats.dof == 0 {
+        return Err(DiagnoseError::Degenerate(
+            "as many unknowns as readings: no degree of freedom is left to test the model".into(),
+        ));
+    }
+    let geometric_rms = setup
+        .holdout_rms(&geo.model, clean, &|_| true)
+        .map_err(cv_failure)?;
+    let mut rejected = Vec::new();
+    let mut first_candidates = Vec::new();
+    let mut current = geo.clone();
+    let mut current_rms = Some(geometric_rms);
+    let mut pruned_once = false;
+    let mut first_step = true;
+    let mut excluded: Vec<Term> = Vec::new();
+    loop {
+        // Forward steps.
+        while current.model.terms().len() < setup.options.max_causes {
+            let tested = first_step.then_some(&mut first_candidates);
+            first_step = false;
+            match forward_step(
+                setup,
+                clean,
+                &current,
+                &mut current_rms,
+                &mut rejected,
+                &excluded,
+                tested,
+            ) {
+                Some((trial, rms)) => {
+                    current = trial.fit;
+                    current_rms = Some(rms);
                 }
-                ev
-            })
-            .collect()
+                None => break,
+            }
+        }
+        if !current.model.terms().is_empty() {
+            let swapped = swaps(setup, clean, current.clone());
+            if swapped.model.terms() != current.model.terms() {
+                current = swapped;
+                current_rms = None;
+            }
+        }
+        // Admission on the final model.
+        let mut removed = false;
+        loop {
+            if current.model.terms().is_empty() {
+                break;
+            }
+            let rms = match current_rms {
+                Some(r) => r,
+                None => setup
+                    .holdout_rms(&current.model, clean, &|_| true)
+                    .map_err(cv_failure)?,
+            };
+            current_rms = Some(rms);
+            let tests = final_tests(setup, clean, &current, rms);
+            let failing = tests
+                .iter()
+                .enumerate()
+                .filter(|(_, t)| !t.2 || rms > geometric_rms)
+                .min_by(|a, b| usefulness(a.1, rms).total_cmp(&usefulness(b.1, rms)))
+                .map(|(i, _)| i);
+            let Some(slot) = failing else {
+                break;
+            };
+            let terms = current.model.terms().to_vec();
+            let term = terms[slot];
+            let (ev, _, _) = &tests[slot];
+            reject(
+                &mut rejected,
+                &current,
+                &term,
+                RejectStage::FinalEvidence,
+                format!(
+                    "does not hold up in the final model (chi2 drop {:.1} for {} dof, adjusted p = {:.1e}, penalised gain {:.1}, held-out rms {} without it -> {:.3} with it)",
+                    ev.delta_chi_square,
+                    ev.dof,
+                    ev.p_adjusted,
+                    ev.penalised_gain,
+                    ev.holdout_rms_without
+                        .map_or("-".into(), |v| format!("{v:.3}")),
+                    rms
+                ),
+            );
+            excluded.push(term);
+            let others: Vec<Term> = terms.into_iter().filter(|t| *t != term).collect();
+            current = setup.fit(setup.model(&others), clean)?;
+            current_rms = if others.is_empty() {
+                Some(geometric_rms)
+            } else {
+                None
+            };
+            removed = true;
+        }
+        if !removed || pruned_once {
+            break;
+        }
+        pruned_once = true;
+    }
+    let current_rms = current_rms.unwrap_or(geometric_rms);
+    let evidences = if current.model.terms().is_empty() {
+        Vec::new()
     } else {
-        evidences
+        final_tests(setup, clean, &current, current_rms)
+            .into_iter()
+            .map(|t| t.0)
+            .collect()
     };
     Ok(Selection {
-        chosen,
+        terms: current.model.terms().to_vec(),
         evidences,
-        current,
         current_rms,
+        current,
+        geometric_rms,
         first_candidates,
         geo,
+        rejected,
     })
+}
+
+/// How much a cause helps held-out prediction (larger is more useful).
+fn usefulness(test: &(Evidence, Option<f64>, bool), rms: f64) -> f64 {
+    test.1.map_or(f64::INFINITY, |w| w - rms)
+}
+
+fn cv_failure(fold: usize) -> DiagnoseError {
+    DiagnoseError::Degenerate(format!(
+        "cross-validation fold {fold} cannot be fitted: too few or too similar poses in it"
+    ))
 }

@@ -159,6 +159,22 @@ impl GeometricModel {
         self
     }
 
+    /// The machine whose rank decision this model uses, when set by
+    /// [`GeometricModel::with_rank_reference`].
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::GeometricModel;
+    /// use tricept_kinematics::Machine;
+    /// let model = GeometricModel::new(Machine::paper(), tricept_model::ParameterSet::paper15());
+    /// assert!(model.rank_reference_machine().is_none());
+    /// let model = model.with_rank_reference(Machine::paper());
+    /// assert!(model.rank_reference_machine().is_some());
+    /// ```
+    pub fn rank_reference_machine(&self) -> Option<&Machine> {
+        self.rank_reference.as_deref().map(|m| &m.nominal)
+    }
+
     /// The nominal machine.
     ///
     /// # Example

@@ -19,6 +19,16 @@
 //! simulated machine) and the diagnosis (which fits them to measured data),
 //! so that what is looked for is exactly what is simulated. Neither needs
 //! the other: diagnosing real data does not depend on the simulator.
+//!
+//! Beyond the vocabulary, the diagnosis searches a dictionary of *generic*
+//! terms ([`GenericFamily`]: periodic and polynomial leg-length errors,
+//! drifts with time or temperature, encoder gains, scale non-linearity,
+//! sensor reversal errors) so that an effect outside the vocabulary is
+//! described in physical words rather than mistaken for a known one. Their
+//! functional forms ([`periodic_extra_mm`], [`legendre_p2`],
+//! [`encoder_gain_error_rad`], [`linear_drift`], ...) are here too: the
+//! simulator's out-of-vocabulary effects use them. A report names either
+//! kind by a [`CauseName`].
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -140,6 +150,175 @@ impl std::fmt::Display for EffectName {
     }
 }
 
+/// Families of generic terms: physically readable forms that are not
+/// effects of the vocabulary, searched when the vocabulary leaves a misfit.
+///
+/// | name | form | a machine builder reads it as |
+/// |---|---|---|
+/// | `leg-periodic` | `a_i sin(2 pi q_i / P) + b_i cos(2 pi q_i / P)` per leg | ball-screw pitch error (period = lead) |
+/// | `leg-polynomial` | `c1_i x_i + c2_i P2(x_i) + c3_i P3(x_i)`, `x_i` the leg's stroke over the campaign on `[-1, 1]` | mean travel deviation and travel variation of a screw, a bent guide |
+/// | `reading-drift` | reading drifts linearly with time (or pose order) | sensor or mounting drift |
+/// | `reading-temperature` | reading changes with the logged temperature | thermal drift of the sensor path |
+/// | `leg-drift` | leg lengths drift linearly with time | creep, drive warm-up |
+/// | `encoder-gain` | encoder reads `(1 + g) angle` | encoder scaling or interpolation fault |
+/// | `scale-polynomial` | `h2 P2(x_4) + h3 P3(x_4)` on the scale | scale bending or mounting |
+/// | `reading-hysteresis` | reading offset by `h/2` in the direction the sensor moved | sensor reversal error |
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GenericFamily {
+    /// Leg-length error periodic in the leg length.
+    LegPeriodic,
+    /// Leg-length error quadratic and cubic in the leg length.
+    LegPolynomial,
+    /// A reading drifting with time.
+    ReadingDrift,
+    /// A reading changing with temperature.
+    ReadingTemperature,
+    /// Leg lengths drifting with time.
+    LegDrift,
+    /// Gain error of an encoder.
+    EncoderGain,
+    /// Quadratic and cubic error of the linear scale.
+    ScalePolynomial,
+    /// Reversal error of a sensor.
+    ReadingHysteresis,
+}
+
+impl GenericFamily {
+    /// Every family, in the order of the table.
+    pub const ALL: [GenericFamily; 8] = [
+        GenericFamily::LegPeriodic,
+        GenericFamily::LegPolynomial,
+        GenericFamily::ReadingDrift,
+        GenericFamily::ReadingTemperature,
+        GenericFamily::LegDrift,
+        GenericFamily::EncoderGain,
+        GenericFamily::ScalePolynomial,
+        GenericFamily::ReadingHysteresis,
+    ];
+
+    /// The report name (`leg-periodic`, ...).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_model::effects::GenericFamily;
+    /// assert_eq!(GenericFamily::LegPeriodic.as_str(), "leg-periodic");
+    /// assert_eq!("encoder-gain".parse(), Ok(GenericFamily::EncoderGain));
+    /// ```
+    pub fn as_str(self) -> &'static str {
+        match self {
+            GenericFamily::LegPeriodic => "leg-periodic",
+            GenericFamily::LegPolynomial => "leg-polynomial",
+            GenericFamily::ReadingDrift => "reading-drift",
+            GenericFamily::ReadingTemperature => "reading-temperature",
+            GenericFamily::LegDrift => "leg-drift",
+            GenericFamily::EncoderGain => "encoder-gain",
+            GenericFamily::ScalePolynomial => "scale-polynomial",
+            GenericFamily::ReadingHysteresis => "reading-hysteresis",
+        }
+    }
+}
+
+impl std::str::FromStr for GenericFamily {
+    type Err = UnknownEffect;
+
+    fn from_str(s: &str) -> Result<GenericFamily, UnknownEffect> {
+        GenericFamily::ALL
+            .into_iter()
+            .find(|e| e.as_str() == s)
+            .ok_or_else(|| UnknownEffect(s.to_string()))
+    }
+}
+
+impl std::fmt::Display for GenericFamily {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// The name of a cause in a report: an effect of the vocabulary or a
+/// generic family. Serialised as the bare kebab-case name.
+///
+/// # Example
+/// ```
+/// use tricept_model::effects::{CauseName, EffectName, GenericFamily};
+/// let c = CauseName::Catalogue(EffectName::Thermal);
+/// assert!(c == EffectName::Thermal);
+/// assert_eq!(serde_json::to_value(CauseName::Generic(GenericFamily::LegPeriodic)).unwrap(), "leg-periodic");
+/// assert_eq!("reading-drift".parse::<CauseName>().unwrap().to_string(), "reading-drift");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum CauseName {
+    /// An effect of the vocabulary.
+    Catalogue(EffectName),
+    /// A generic family.
+    Generic(GenericFamily),
+}
+
+impl CauseName {
+    /// The report name.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            CauseName::Catalogue(e) => e.as_str(),
+            CauseName::Generic(g) => g.as_str(),
+        }
+    }
+
+    /// The effect of the vocabulary, if it is one.
+    pub fn catalogue(self) -> Option<EffectName> {
+        match self {
+            CauseName::Catalogue(e) => Some(e),
+            CauseName::Generic(_) => None,
+        }
+    }
+
+    /// Whether this is a generic family.
+    pub fn is_generic(self) -> bool {
+        matches!(self, CauseName::Generic(_))
+    }
+}
+
+impl PartialEq<EffectName> for CauseName {
+    fn eq(&self, other: &EffectName) -> bool {
+        *self == CauseName::Catalogue(*other)
+    }
+}
+
+impl PartialEq<GenericFamily> for CauseName {
+    fn eq(&self, other: &GenericFamily) -> bool {
+        *self == CauseName::Generic(*other)
+    }
+}
+
+impl From<EffectName> for CauseName {
+    fn from(e: EffectName) -> CauseName {
+        CauseName::Catalogue(e)
+    }
+}
+
+impl From<GenericFamily> for CauseName {
+    fn from(g: GenericFamily) -> CauseName {
+        CauseName::Generic(g)
+    }
+}
+
+impl std::str::FromStr for CauseName {
+    type Err = UnknownEffect;
+
+    fn from_str(s: &str) -> Result<CauseName, UnknownEffect> {
+        s.parse::<EffectName>()
+            .map(CauseName::Catalogue)
+            .or_else(|_| s.parse::<GenericFamily>().map(CauseName::Generic))
+    }
+}
+
+impl std::fmt::Display for CauseName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 /// Extra leg length of a ball-screw lead error, mm.
 pub fn leg_lead_extra_mm(ppm: f64, command_mm: f64) -> f64 {
     ppm * 1e-6 * command_mm
@@ -188,6 +367,73 @@ pub fn compliance_extra_mm(stiffness_n_per_um_at_1m: f64, tension_n: f64, comman
 /// Reading error of a scale with gain error `ppm` at extension `q4_mm`, mm.
 pub fn scale_gain_error_mm(ppm: f64, q4_mm: f64) -> f64 {
     ppm * 1e-6 * q4_mm
+}
+
+/// Extra leg length (mm) of a periodic error of period `period_mm` in the
+/// leg length `command_mm`, with sine and cosine amplitudes in um (a
+/// ball-screw pitch error: `A sin(2 pi q / P + psi)` has sine amplitude
+/// `A cos psi` and cosine amplitude `A sin psi`).
+///
+/// # Example
+/// ```
+/// use tricept_model::effects::periodic_extra_mm;
+/// // 4 um sine amplitude, a quarter period in: the full 4 um.
+/// assert!((periodic_extra_mm(4.0, 0.0, 10.0, 802.5) - 0.004).abs() < 1e-12);
+/// ```
+pub fn periodic_extra_mm(sin_um: f64, cos_um: f64, period_mm: f64, command_mm: f64) -> f64 {
+    let (s, c) = (std::f64::consts::TAU * command_mm / period_mm).sin_cos();
+    (sin_um * s + cos_um * c) * 1e-3
+}
+
+/// `x` in `[lo, hi]` mapped linearly onto `[-1, 1]` (`0` when the range is
+/// empty).
+///
+/// # Example
+/// ```
+/// assert_eq!(tricept_model::effects::normalised_coordinate(750.0, 600.0, 900.0), 0.0);
+/// assert_eq!(tricept_model::effects::normalised_coordinate(900.0, 600.0, 900.0), 1.0);
+/// ```
+pub fn normalised_coordinate(x: f64, lo: f64, hi: f64) -> f64 {
+    if hi > lo {
+        (2.0 * x - lo - hi) / (hi - lo)
+    } else {
+        0.0
+    }
+}
+
+/// Legendre polynomial `P2(x) = (3 x^2 - 1) / 2`: the quadratic shape with
+/// no constant or linear part over `[-1, 1]` (those are absorbed by a leg
+/// offset and a lead).
+pub fn legendre_p2(x: f64) -> f64 {
+    0.5 * (3.0 * x * x - 1.0)
+}
+
+/// Legendre polynomial `P3(x) = (5 x^3 - 3 x) / 2`.
+pub fn legendre_p3(x: f64) -> f64 {
+    0.5 * (5.0 * x * x * x - 3.0 * x)
+}
+
+/// Legendre polynomial `P4(x) = (35 x^4 - 30 x^2 + 3) / 8`.
+pub fn legendre_p4(x: f64) -> f64 {
+    let x2 = x * x;
+    (35.0 * x2 * x2 - 30.0 * x2 + 3.0) / 8.0
+}
+
+/// Reading error of an encoder with gain error `ppm` at `angle_rad`, rad.
+///
+/// # Example
+/// ```
+/// // 200 ppm at 0.3 rad: 60 urad, 12.4 arcsec.
+/// assert!((tricept_model::effects::encoder_gain_error_rad(200.0, 0.3) - 6e-5).abs() < 1e-18);
+/// ```
+pub fn encoder_gain_error_rad(ppm: f64, angle_rad: f64) -> f64 {
+    ppm * 1e-6 * angle_rad
+}
+
+/// A quantity drifting linearly by `amount` over the campaign, at
+/// `fraction` of it (any unit: the result has `amount`'s).
+pub fn linear_drift(amount: f64, fraction: f64) -> f64 {
+    amount * fraction
 }
 
 /// Once-per-revolution encoder error at `angle_rad`, rad.

@@ -5,6 +5,9 @@
 //! sign of its last motion), exactly as on a real machine; a campaign can
 //! also visit every target twice, once approaching with all legs extending
 //! and once with all legs retracting, which is what makes backlash visible.
+//! It can revisit some targets at its end (the same commands logged again
+//! on a separate visit: what lets a diagnosis measure the noise from the
+//! data), and its sensors can be noisier than their data sheet says.
 
 use nalgebra::Vector3;
 use tricept_kinematics::{Machine, SensorNoise, UpJoints};
@@ -39,6 +42,13 @@ pub struct Campaign {
     pub seconds_per_pose: f64,
     /// Structure temperature at the start, °C.
     pub start_temp_c: f64,
+    /// The first `revisits` targets are visited again, in order, after the
+    /// last one (separate visits of the same commands).
+    pub revisits: usize,
+    /// The true noise of every reading is `noise_factor` times `noise`
+    /// (vibration, a sensor worse than its data sheet); the data sheet
+    /// (`noise`) is what a diagnosis is told.
+    pub noise_factor: f64,
 }
 
 /// Logged context of each pose: time, temperature, approach directions.
@@ -69,6 +79,8 @@ impl Campaign {
             order: PoseOrder::AsGiven,
             seconds_per_pose: 30.0,
             start_temp_c: 20.0,
+            revisits: 0,
+            noise_factor: 1.0,
         }
     }
 
@@ -78,12 +90,24 @@ impl Campaign {
         Campaign::from_targets(machine, targets, seed)
     }
 
-    /// Number of logged poses (twice the targets for [`PoseOrder::BothDirections`]).
+    /// Number of logged poses (the targets and the revisits; twice as many
+    /// for [`PoseOrder::BothDirections`]).
     pub fn len(&self) -> usize {
+        let visits = self.visits().count();
         match self.order {
-            PoseOrder::AsGiven => self.targets_mm.len(),
-            PoseOrder::BothDirections => 2 * self.targets_mm.len(),
+            PoseOrder::AsGiven => visits,
+            PoseOrder::BothDirections => 2 * visits,
         }
+    }
+
+    /// The targets in the order they are visited: every target, then the
+    /// first `revisits` again.
+    fn visits(&self) -> impl Iterator<Item = (usize, &Vector3<f64>)> {
+        let again = self.revisits.min(self.targets_mm.len());
+        self.targets_mm
+            .iter()
+            .enumerate()
+            .chain(self.targets_mm.iter().enumerate().take(again))
     }
 
     /// True when there is nothing to log.
@@ -94,7 +118,7 @@ impl Campaign {
     /// Commands (nominal IK) and nominal UP joints of every logged pose.
     pub fn commands(&self, nominal: &Machine) -> Result<Vec<([f64; 3], UpJoints)>, PlantError> {
         let mut out = Vec::with_capacity(self.len());
-        for (index, r) in self.targets_mm.iter().enumerate() {
+        for (index, r) in self.visits() {
             let ik = nominal
                 .inverse(r)
                 .map_err(|source| PlantError::Kinematics {

@@ -14,6 +14,18 @@
 //! | `tube-twist` | `arcsec_per_100mm` |
 //! | `compliance` | `stiffness_n_per_um_at_1m` |
 //! | `outliers` | `count`, `size_sigma` |
+//!
+//! and effects *outside* the vocabulary, which the diagnosis can only
+//! describe through its generic dictionary
+//! ([`tricept_model::effects::GenericFamily`]) or report as unknown:
+//!
+//! | name | magnitude |
+//! |---|---|
+//! | `leg-periodic` | `um` per leg, `period_mm`, `phase_deg` per leg, `waveform` (`sine` or `sawtooth`) |
+//! | `leg-quadratic` | `um` per leg at `half_width_mm` from `centre_mm` |
+//! | `leg-power` | `um` per leg at `half_width_mm` from `centre_mm`, `exponent` (a shape outside the dictionary for 1.5) |
+//! | `scale-drift` | `um` over the campaign, linear in time |
+//! | `encoder-gain` | `phi_ppm`, `theta_ppm` |
 
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -21,10 +33,32 @@ use serde::{Deserialize, Serialize};
 use tricept_data::MeasuredPose;
 use tricept_kinematics::{Machine, UpJoints};
 use tricept_model::effects::{
-    EffectName, add_tube_twist, add_ujoint_axis_errors, backlash_extra_mm, compliance_extra_mm,
-    eccentricity_error_rad, gravity_leg_tension_n, leg_lead_extra_mm, scale_gain_error_mm,
-    thermal_extra_mm,
+    CauseName, EffectName, GenericFamily, add_tube_twist, add_ujoint_axis_errors,
+    backlash_extra_mm, compliance_extra_mm, eccentricity_error_rad, encoder_gain_error_rad,
+    gravity_leg_tension_n, leg_lead_extra_mm, linear_drift, normalised_coordinate,
+    periodic_extra_mm, scale_gain_error_mm, thermal_extra_mm,
 };
+
+/// Shape of a periodic leg-length error.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Waveform {
+    /// `A sin(2 pi q / P + psi)`.
+    #[default]
+    Sine,
+    /// A sawtooth of amplitude `A` (rising linearly from `-A` to `A` over
+    /// each period, then dropping): a shape outside the dictionary, with
+    /// harmonics.
+    Sawtooth,
+}
+
+fn default_centre_mm() -> f64 {
+    845.0
+}
+
+fn default_half_width_mm() -> f64 {
+    250.0
+}
 
 /// One unmodelled effect with its magnitude.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -81,6 +115,61 @@ pub enum Effect {
         /// Axial stiffness of a leg of 1 m, N/um (scales as 1/length).
         stiffness_n_per_um_at_1m: f64,
     },
+    /// Out of the vocabulary: a leg-length error periodic in the leg length
+    /// (ball-screw pitch error), `um_i w(2 pi q_i / P + psi_i)`.
+    LegPeriodic {
+        /// Amplitude of each leg, um.
+        um: [f64; 3],
+        /// Period (the screw lead), mm.
+        period_mm: f64,
+        /// Phase of each leg, deg.
+        phase_deg: [f64; 3],
+        /// Shape `w` (default sine).
+        #[serde(default)]
+        waveform: Waveform,
+    },
+    /// Out of the vocabulary: a leg-length error quadratic in the leg
+    /// length, `um_i ((q_i - centre) / half_width)^2`.
+    LegQuadratic {
+        /// Error of each leg at `half_width_mm` from the centre, um.
+        um: [f64; 3],
+        /// Leg length of zero error, mm (default 845: the middle of the
+        /// paper machine's workspace leg lengths).
+        #[serde(default = "default_centre_mm")]
+        centre_mm: f64,
+        /// Distance from the centre at which the error is `um`, mm
+        /// (default 250).
+        #[serde(default = "default_half_width_mm")]
+        half_width_mm: f64,
+    },
+    /// Out of the vocabulary (and of the dictionary's forms unless
+    /// `exponent` is 2): `um_i |(q_i - centre) / half_width|^exponent`.
+    LegPower {
+        /// Error of each leg at `half_width_mm` from the centre, um.
+        um: [f64; 3],
+        /// Exponent of the shape.
+        exponent: f64,
+        /// Leg length of zero error, mm (default 845).
+        #[serde(default = "default_centre_mm")]
+        centre_mm: f64,
+        /// Distance from the centre at which the error is `um`, mm (default 250).
+        #[serde(default = "default_half_width_mm")]
+        half_width_mm: f64,
+    },
+    /// Out of the vocabulary: the scale reading drifts linearly with time,
+    /// by `um` from the first to the last pose, whatever the temperature.
+    ScaleDrift {
+        /// Drift over the campaign, um.
+        um: f64,
+    },
+    /// Out of the vocabulary: gain errors of the encoders, which read
+    /// `(1 + g) angle`.
+    EncoderGain {
+        /// Gain error of the phi encoder, ppm.
+        phi_ppm: f64,
+        /// Gain error of the theta encoder, ppm.
+        theta_ppm: f64,
+    },
     /// Gross reading errors in a few rows.
     Outliers {
         /// Number of corrupted rows.
@@ -88,6 +177,25 @@ pub enum Effect {
         /// Size of each error in noise standard deviations (random sign).
         size_sigma: f64,
     },
+}
+
+/// Adds `um_i |(q_i - centre) / half_width|^exponent` (um) to each leg (mm).
+fn add_power_law(
+    legs: &mut [f64; 3],
+    commands_mm: &[f64; 3],
+    um: &[f64; 3],
+    exponent: f64,
+    centre_mm: f64,
+    half_width_mm: f64,
+) {
+    for i in 0..3 {
+        let x = normalised_coordinate(
+            commands_mm[i],
+            centre_mm - half_width_mm,
+            centre_mm + half_width_mm,
+        );
+        legs[i] += um[i] * 1e-3 * x.abs().powf(exponent);
+    }
 }
 
 /// What the effects may depend on at one pose.
@@ -101,21 +209,42 @@ pub struct PoseState {
     pub delta_temp_k: f64,
     /// Sign of each leg's last motion.
     pub approach: [i8; 3],
+    /// Fraction of the campaign elapsed (0 at the first pose, 1 at the last).
+    pub fraction: f64,
 }
 
 impl Effect {
-    /// The report name of this effect.
-    pub fn name(&self) -> EffectName {
+    /// The name a perfect diagnosis would give this effect: its name in
+    /// the vocabulary, or for an effect outside it the generic family of
+    /// its form (`leg-power` and the sawtooth `leg-periodic` only
+    /// approximately: their shapes are outside the dictionary).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_plant::Effect;
+    /// use tricept_model::effects::{EffectName, GenericFamily};
+    /// assert!(Effect::ScaleGain { ppm: 50.0 }.name() == EffectName::ScaleGain);
+    /// assert!(Effect::ScaleDrift { um: 3.0 }.name() == GenericFamily::ReadingDrift);
+    /// ```
+    pub fn name(&self) -> CauseName {
+        let catalogue = |e| CauseName::Catalogue(e);
+        let generic = |g| CauseName::Generic(g);
         match self {
-            Effect::LegLead { .. } => EffectName::LegLead,
-            Effect::Backlash { .. } => EffectName::Backlash,
-            Effect::Thermal { .. } => EffectName::Thermal,
-            Effect::ScaleGain { .. } => EffectName::ScaleGain,
-            Effect::EncoderEccentricity { .. } => EffectName::EncoderEccentricity,
-            Effect::UjointAxes { .. } => EffectName::UjointAxes,
-            Effect::TubeTwist { .. } => EffectName::TubeTwist,
-            Effect::Compliance { .. } => EffectName::Compliance,
-            Effect::Outliers { .. } => EffectName::Outliers,
+            Effect::LegLead { .. } => catalogue(EffectName::LegLead),
+            Effect::Backlash { .. } => catalogue(EffectName::Backlash),
+            Effect::Thermal { .. } => catalogue(EffectName::Thermal),
+            Effect::ScaleGain { .. } => catalogue(EffectName::ScaleGain),
+            Effect::EncoderEccentricity { .. } => catalogue(EffectName::EncoderEccentricity),
+            Effect::UjointAxes { .. } => catalogue(EffectName::UjointAxes),
+            Effect::TubeTwist { .. } => catalogue(EffectName::TubeTwist),
+            Effect::Compliance { .. } => catalogue(EffectName::Compliance),
+            Effect::Outliers { .. } => catalogue(EffectName::Outliers),
+            Effect::LegPeriodic { .. } => generic(GenericFamily::LegPeriodic),
+            Effect::LegQuadratic { .. } | Effect::LegPower { .. } => {
+                generic(GenericFamily::LegPolynomial)
+            }
+            Effect::ScaleDrift { .. } => generic(GenericFamily::ReadingDrift),
+            Effect::EncoderGain { .. } => generic(GenericFamily::EncoderGain),
         }
     }
 
@@ -170,15 +299,58 @@ impl Effect {
                         compliance_extra_mm(*stiffness_n_per_um_at_1m, f[i], s.commands_mm[i]);
                 }
             }
+            Effect::LegPeriodic {
+                um,
+                period_mm,
+                phase_deg,
+                waveform,
+            } => {
+                for i in 0..3 {
+                    let q = s.commands_mm[i];
+                    legs[i] += match waveform {
+                        Waveform::Sine => {
+                            let (sp, cp) = phase_deg[i].to_radians().sin_cos();
+                            periodic_extra_mm(um[i] * cp, um[i] * sp, *period_mm, q)
+                        }
+                        Waveform::Sawtooth => {
+                            let turns = q / period_mm + phase_deg[i] / 360.0;
+                            um[i] * 1e-3 * (2.0 * (turns - turns.floor()) - 1.0)
+                        }
+                    };
+                }
+            }
+            Effect::LegQuadratic {
+                um,
+                centre_mm,
+                half_width_mm,
+            } => add_power_law(legs, &s.commands_mm, um, 2.0, *centre_mm, *half_width_mm),
+            Effect::LegPower {
+                um,
+                exponent,
+                centre_mm,
+                half_width_mm,
+            } => add_power_law(
+                legs,
+                &s.commands_mm,
+                um,
+                *exponent,
+                *centre_mm,
+                *half_width_mm,
+            ),
             _ => {}
         }
     }
 
     /// Adds this effect's reading errors to clean readings `r` (rad, rad, mm)
-    /// taken with the UP limb truly at `up`.
-    pub(crate) fn reading_error(&self, up: &UpJoints, r: &mut [f64; 3]) {
+    /// taken with the UP limb truly at `up`, at pose state `s`.
+    pub(crate) fn reading_error(&self, s: &PoseState, up: &UpJoints, r: &mut [f64; 3]) {
         match self {
             Effect::ScaleGain { ppm } => r[2] += scale_gain_error_mm(*ppm, up.q4_mm),
+            Effect::ScaleDrift { um } => r[2] += linear_drift(um * 1e-3, s.fraction),
+            Effect::EncoderGain { phi_ppm, theta_ppm } => {
+                r[0] += encoder_gain_error_rad(*phi_ppm, up.phi_rad);
+                r[1] += encoder_gain_error_rad(*theta_ppm, up.theta_rad);
+            }
             Effect::EncoderEccentricity {
                 phi_arcsec,
                 phi_phase_deg,

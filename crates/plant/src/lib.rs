@@ -157,7 +157,8 @@ impl Plant {
             campaign.noise.angle_rad,
             campaign.noise.angle_rad,
             campaign.noise.length_mm,
-        ];
+        ]
+        .map(|s| s * campaign.noise_factor);
         let mut poses = Vec::with_capacity(truth.len());
         for t in &truth {
             let clean = t.readings.to_array();
@@ -215,6 +216,7 @@ impl Plant {
                 nominal_up: *nominal_up,
                 delta_temp_k,
                 approach: context.approach[j],
+                fraction,
             };
             let mut legs = *q;
             for e in &self.effects {
@@ -234,7 +236,7 @@ impl Plant {
                 fk.up.q4_mm + self.sensor_offsets[2],
             ];
             for e in &self.effects {
-                e.reading_error(&fk.up, &mut r);
+                e.reading_error(&state, &fk.up, &mut r);
             }
             out.push(TruePose {
                 commands_mm: *q,
@@ -273,6 +275,7 @@ impl Plant {
             nominal_up,
             delta_temp_k: 0.0,
             approach: [1, 1, 1],
+            fraction: 0.0,
         };
         let mut legs = *commands_mm;
         for e in &self.effects {

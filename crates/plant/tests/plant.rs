@@ -7,7 +7,10 @@
 use nalgebra::Vector3;
 use tricept_kinematics::{Machine, SensorNoise};
 use tricept_model::ParameterSet;
-use tricept_model::effects::{compliance_extra_mm, gravity_leg_tension_n, scale_gain_error_mm};
+use tricept_model::effects::{
+    GenericFamily, compliance_extra_mm, gravity_leg_tension_n, scale_gain_error_mm,
+};
+use tricept_plant::effects::Waveform;
 use tricept_plant::{Campaign, DEFAULT_SENSOR_OFFSETS, Effect, Plant, PoseOrder, random_errors};
 
 fn plant(seed: u64) -> Plant {
@@ -224,6 +227,128 @@ fn an_unreachable_target_is_an_error_naming_it() {
     let e = p.simulate(&c).unwrap_err().to_string();
     // The second target, numbered from 1.
     assert!(e.contains("pose 2") && e.contains("5000"), "{e}");
+}
+
+#[test]
+fn effects_outside_the_vocabulary_add_what_their_physics_says() {
+    let base = plant(9);
+    let mut c = Campaign::random(&base.nominal, 15, 4);
+    noise_free(&mut c);
+    let clean = base.true_poses(&c).unwrap();
+    let actual = base.actual_machine();
+    let legs_reach = |t: &tricept_plant::TruePose, extra: [f64; 3]| {
+        let legs: [f64; 3] = std::array::from_fn(|i| t.commands_mm[i] + extra[i]);
+        (actual.forward(&legs).unwrap().position_mm - t.position_mm).norm()
+    };
+
+    // Ball-screw pitch error: A sin(2 pi q / P + psi) on each leg, in mm.
+    let (um, period, phase) = ([4.0, 3.0, 5.0], 10.0, [0.0, 90.0, 200.0]);
+    let mut pitch = base.clone();
+    pitch.effects = vec![Effect::LegPeriodic {
+        um,
+        period_mm: period,
+        phase_deg: phase,
+        waveform: Waveform::Sine,
+    }];
+    for t in pitch.true_poses(&c).unwrap() {
+        let extra: [f64; 3] = std::array::from_fn(|i| {
+            um[i]
+                * 1e-3
+                * (std::f64::consts::TAU * t.commands_mm[i] / period + phase[i].to_radians()).sin()
+        });
+        assert!(legs_reach(&t, extra) < 1e-9);
+    }
+    // A sawtooth rises from -A to A over each period.
+    pitch.effects = vec![Effect::LegPeriodic {
+        um,
+        period_mm: period,
+        phase_deg: [0.0; 3],
+        waveform: Waveform::Sawtooth,
+    }];
+    for t in pitch.true_poses(&c).unwrap() {
+        let extra: [f64; 3] = std::array::from_fn(|i| {
+            let frac = (t.commands_mm[i] / period).rem_euclid(1.0);
+            um[i] * 1e-3 * (2.0 * frac - 1.0)
+        });
+        assert!(legs_reach(&t, extra) < 1e-9);
+    }
+
+    // Quadratic and power-law leg errors about a centre.
+    let mut quad = base.clone();
+    quad.effects = vec![Effect::LegQuadratic {
+        um: [10.0, -8.0, 6.0],
+        centre_mm: 845.0,
+        half_width_mm: 250.0,
+    }];
+    for t in quad.true_poses(&c).unwrap() {
+        let extra: [f64; 3] = std::array::from_fn(|i| {
+            [10.0, -8.0, 6.0][i] * 1e-3 * ((t.commands_mm[i] - 845.0) / 250.0).powi(2)
+        });
+        assert!(legs_reach(&t, extra) < 1e-9);
+    }
+    quad.effects = vec![Effect::LegPower {
+        um: [10.0, -8.0, 6.0],
+        exponent: 1.5,
+        centre_mm: 845.0,
+        half_width_mm: 250.0,
+    }];
+    for t in quad.true_poses(&c).unwrap() {
+        let extra: [f64; 3] = std::array::from_fn(|i| {
+            [10.0, -8.0, 6.0][i] * 1e-3 * ((t.commands_mm[i] - 845.0) / 250.0).abs().powf(1.5)
+        });
+        assert!(legs_reach(&t, extra) < 1e-9);
+    }
+
+    // A scale drifting linearly with time, whatever the temperature; an
+    // encoder reading (1 + g) times its angle.
+    let mut drift = base.clone();
+    drift.effects = vec![
+        Effect::ScaleDrift { um: 3.0 },
+        Effect::EncoderGain {
+            phi_ppm: 200.0,
+            theta_ppm: -100.0,
+        },
+    ];
+    let poses = drift.true_poses(&c).unwrap();
+    let n = poses.len();
+    for (j, (a, b)) in poses.iter().zip(&clean).enumerate() {
+        let (ra, rb) = (a.readings.to_array(), b.readings.to_array());
+        assert_eq!(a.position_mm, b.position_mm);
+        assert!((ra[0] - rb[0] - 200e-6 * b.up.phi_rad).abs() < 1e-15);
+        assert!((ra[1] - rb[1] + 100e-6 * b.up.theta_rad).abs() < 1e-15);
+        let expected = 3e-3 * j as f64 / (n - 1) as f64;
+        assert!((ra[2] - rb[2] - expected).abs() < 1e-12);
+    }
+    // Their names are the generic families a perfect diagnosis would give.
+    assert!(Effect::ScaleDrift { um: 1.0 }.name() == GenericFamily::ReadingDrift);
+}
+
+#[test]
+fn revisits_repeat_commands_and_worse_noise_is_worse() {
+    let base = plant(3);
+    let mut c = Campaign::random(&base.nominal, 30, 8);
+    c.revisits = 10;
+    let data = base.simulate(&c).unwrap();
+    assert_eq!(data.poses.len(), 40);
+    for k in 0..10 {
+        assert_eq!(data.poses[30 + k].commands_mm, data.poses[k].commands_mm);
+    }
+    // The true noise scales with the factor; the same seed draws the same
+    // normal deviates.
+    let mut noisy = c.clone();
+    noisy.noise_factor = 2.0;
+    let worse = base.simulate(&noisy).unwrap();
+    let truth = base.true_poses(&c).unwrap();
+    for ((a, b), t) in worse.poses.iter().zip(&data.poses).zip(&truth) {
+        let (ra, rb, rt) = (
+            a.readings.to_array(),
+            b.readings.to_array(),
+            t.readings.to_array(),
+        );
+        for ch in 0..3 {
+            assert!(((ra[ch] - rt[ch]) - 2.0 * (rb[ch] - rt[ch])).abs() < 1e-12);
+        }
+    }
 }
 
 /// A plant with module and head errors.

@@ -1,0 +1,441 @@
+//! Aliases: candidates that this campaign cannot tell apart.
+//!
+//! For every term `A` of the final model, with `B0` the rest of the model
+//! (offsets, identifiable geometric parameters, the other terms) at the
+//! final estimate:
+//!
+//! ```text
+//! s_A    = P_perp(B0) W J_A theta_A          A's fitted signature (noise units)
+//! C_perp = P_perp(B0) W J_C                  for every candidate C not in the model
+//! lambda(A, C) = min_w |s_A - C_perp w|^2    what no test could use to prefer A over C
+//! ```
+//!
+//! `C` is an alias of `A` when `lambda(A, C) < chi2_1(1 - alpha)` (10.8 at
+//! `alpha = 0.001`) and the parameters `w` it needs are plausible; exactly
+//! so when the largest canonical correlation of the two projected spans is
+//! 1 (to 1e-9). Candidates are the catalogue effects not in the model, an
+//! equal lead on all legs, and the dictionary's groups without a period.
+//! A catalogue term with a plausible alias is not named: the set is
+//! reported instead (the final model keeps `A`, whose predictions equal the
+//! alternatives' to within the noise). A generic term stays named, with its
+//! alternatives in its description. Structurally, a leg lead whose common
+//! part (the mean over the legs) is significant is always reported with
+//! `scale-gain`: a scale gain `g` reads exactly like the machine scaled by
+//! `1 + g` with a lead `g` on every leg.
+
+use nalgebra::{DMatrix, DVector};
+use tricept_data::Dataset;
+use tricept_model::effects::{
+    CauseName, EffectName, GenericFamily, legendre_p4, normalised_coordinate, periodic_extra_mm,
+};
+use tricept_numerics::stats::chi2_isf;
+
+use crate::linear::{Linearisation, canonical_correlation, nested};
+use crate::model::Candidate;
+use crate::plausibility::quantities;
+use crate::report::{Alias, Estimate, RejectStage, Rejected};
+use crate::select::{Fit, Setup, describe_group, term_estimates};
+use crate::terms::{Frame, GenericTerm, Term};
+
+/// The outcome of the alias analysis.
+pub(crate) struct Aliases {
+    /// The alias sets.
+    pub(crate) aliases: Vec<Alias>,
+    /// Terms of the model that are not named (catalogue terms with a
+    /// plausible alias).
+    pub(crate) unnamed: Vec<Term>,
+    /// For each generic term, the descriptions of its alternatives.
+    pub(crate) alternatives: Vec<(Term, Vec<String>)>,
+    /// Alternatives that would need implausible parameters.
+    pub(crate) rejected: Vec<Rejected>,
+}
+
+/// A candidate alternative: its term (or a declared combination), label
+/// and weighted columns at zero.
+struct Alternative {
+    name: CauseName,
+    label: String,
+    term: Term,
+    /// How the columns combine into the alternative's parameters (equal
+    /// lead: one column, the sum of the three).
+    columns: DMatrix<f64>,
+    /// Parameter names of `columns`.
+    params: Vec<String>,
+}
+
+fn lead() -> Candidate {
+    Candidate(EffectName::LegLead)
+}
+
+/// Why two candidates cannot be told apart, and what separates them.
+fn explain(a: CauseName, c: CauseName, c_label: &str) -> (String, String) {
+    use CauseName::{Catalogue as Cat, Generic as Gen};
+    let pair = |x: CauseName, y: CauseName| (a == x && c == y) || (a == y && c == x);
+    let external_length = "one external length: a laser interferometer or gauge-block measurement of the UP-limb stroke or of one platform displacement fixes the gain; the machine's own sensors never can";
+    let temperature_campaign = "a campaign in which temperature does not follow time: log through warm-up and cool-down, or revisit poses at different temperatures";
+    if c_label.ends_with("(higher order)") {
+        return (
+            format!(
+                "{c_label} explains it as well: it is the part of the leg error the generic form leaves, not an effect of its own"
+            ),
+            "a campaign that covers more of each leg's stroke, or more readings per pose".into(),
+        );
+    }
+    if pair(Cat(EffectName::ScaleGain), Cat(EffectName::LegLead)) {
+        return (
+            "a scale gain g reads exactly like the machine scaled by 1 + g with a lead g on every leg".into(),
+            external_length.into(),
+        );
+    }
+    let timelike = |x: CauseName| {
+        matches!(
+            x,
+            Gen(GenericFamily::ReadingDrift)
+                | Gen(GenericFamily::LegDrift)
+                | Gen(GenericFamily::ReadingTemperature)
+                | Cat(EffectName::Thermal)
+        )
+    };
+    if timelike(a) && timelike(c) {
+        if (a == Gen(GenericFamily::ReadingDrift) && c == Gen(GenericFamily::LegDrift))
+            || (a == Gen(GenericFamily::LegDrift) && c == Gen(GenericFamily::ReadingDrift))
+        {
+            return (
+                "a drifting scale and uniformly growing legs move the readings alike".into(),
+                "an external reading of the platform at a repeated pose (dial indicator or touch probe): the machine's own sensors cannot tell a drifting scale from growing legs".into(),
+            );
+        }
+        return (
+            format!(
+                "the logged temperature followed time during the campaign, so a change with temperature and a drift with time ({c_label}) look alike"
+            ),
+            temperature_campaign.into(),
+        );
+    }
+    if pair(
+        Cat(EffectName::EncoderEccentricity),
+        Gen(GenericFamily::EncoderGain),
+    ) {
+        return (
+            "over the encoders' small angles (|angle| < 0.6 rad) a gain error and the sine part of an eccentricity are nearly the same curve".into(),
+            "an external angle reference (autocollimator or inclinometer) at about +-30 deg of the U joint".into(),
+        );
+    }
+    (
+        "their signatures on this campaign differ by less than the noise".into(),
+        "a campaign that moves the machine where they differ".into(),
+    )
+}
+
+/// Per-pose columns (direction, value) of the refinement of a generic
+/// leg term: the quartic Legendre part of a polynomial, the second
+/// harmonic of a periodic term.
+fn refinement(g: &GenericTerm, frame: &Frame, data: &Dataset) -> Option<Vec<(usize, Vec<f64>)>> {
+    let legs = g.legs();
+    let poses = &data.poses;
+    match g.family {
+        GenericFamily::LegPolynomial => Some(
+            legs.iter()
+                .flat_map(|&i| {
+                    let [lo, hi] = frame.leg_range_mm[i];
+                    let x: Vec<f64> = poses
+                        .iter()
+                        .map(|p| normalised_coordinate(p.commands_mm[i], lo, hi))
+                        .collect();
+                    [(i, x.iter().map(|x| 1e-3 * legendre_p4(*x)).collect())]
+                })
+                .collect(),
+        ),
+        GenericFamily::LegPeriodic => {
+            let half = g.period_mm? / 2.0;
+            Some(
+                legs.iter()
+                    .flat_map(|&i| {
+                        let q: Vec<f64> = poses.iter().map(|p| p.commands_mm[i]).collect();
+                        [
+                            (
+                                i,
+                                q.iter()
+                                    .map(|q| periodic_extra_mm(1.0, 0.0, half, *q))
+                                    .collect(),
+                            ),
+                            (
+                                i,
+                                q.iter()
+                                    .map(|q| periodic_extra_mm(0.0, 1.0, half, *q))
+                                    .collect(),
+                            ),
+                        ]
+                    })
+                    .collect(),
+            )
+        }
+        _ => None,
+    }
+}
+
+/// The alias analysis of the final model `fit` on `clean`.
+pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases {
+    let mut out = Aliases {
+        aliases: Vec::new(),
+        unnamed: Vec::new(),
+        alternatives: Vec::new(),
+        rejected: Vec::new(),
+    };
+    let terms = fit.model.terms().to_vec();
+    if terms.is_empty() {
+        return out;
+    }
+    let extra: Vec<Term> = setup
+        .available
+        .iter()
+        .map(|c| Term::Catalogue(*c))
+        .filter(|t| !terms.contains(t))
+        .collect();
+    let Some(mut lin) = Linearisation::at_fit(fit, clean, &setup.sigma, &extra) else {
+        return out;
+    };
+    let critical = chi2_isf(setup.options.alpha, 1.0);
+    let offsets = fit.model.offsets();
+    let generic_groups: Vec<GenericTerm> = setup
+        .frame
+        .generic_groups()
+        .into_iter()
+        .filter(|g| g.period_mm.is_none() && g.family != GenericFamily::LegPeriodic)
+        .collect();
+    for (i, a) in terms.iter().enumerate() {
+        let k = a.params().len();
+        let params: Vec<usize> = (offsets[i]..offsets[i] + k).collect();
+        lin.set_basis(&params);
+        // A's signature: its projected columns times its estimate.
+        let columns: Vec<usize> = lin
+            .x_params
+            .iter()
+            .copied()
+            .filter(|p| params.contains(p))
+            .collect();
+        if columns.is_empty() {
+            continue;
+        }
+        let theta =
+            DVector::from_iterator(columns.len(), columns.iter().map(|&p| fit.id.estimate[p]));
+        let xa = lin.projected_columns(&params);
+        let signature = &xa * &theta;
+        let strength = signature.norm_squared();
+        lin.set_target(signature);
+        // The alternatives.
+        let mut alternatives: Vec<Alternative> = Vec::new();
+        for t in &extra {
+            if let Some(cols) = lin.extra_columns(t) {
+                alternatives.push(Alternative {
+                    name: t.name(),
+                    label: describe_group(t),
+                    term: *t,
+                    params: t.params(),
+                    columns: cols,
+                });
+            }
+        }
+        if let Some(cols) = lin.extra_columns(&Term::Catalogue(lead())) {
+            let sum = cols.column(0) + cols.column(1) + cols.column(2);
+            alternatives.push(Alternative {
+                name: CauseName::Catalogue(EffectName::LegLead),
+                label: "leg-lead (equal on all legs)".into(),
+                term: Term::Catalogue(lead()),
+                params: vec!["lead_ppm (every leg)".into()],
+                columns: DMatrix::from_columns(&[sum]),
+            });
+        }
+        // Refinements of the generic leg terms in the model (the quartic
+        // part of a curved leg error, the second harmonic of a periodic one): a catalogue term that only mops up what the
+        // generic form leaves is not a cause of its own.
+        if matches!(a, Term::Catalogue(_)) {
+            for t in &terms {
+                if let Term::Generic(g) = t
+                    && let Some(cols) = refinement(g, &setup.frame, clean)
+                {
+                    let cols = lin.dense(&cols);
+                    let k = cols.ncols();
+                    alternatives.push(Alternative {
+                        name: t.name(),
+                        label: format!("{} (higher order)", g.label()),
+                        term: *t,
+                        params: (1..=k).map(|j| format!("refinement{j}")).collect(),
+                        columns: cols,
+                    });
+                }
+            }
+        }
+        for g in &generic_groups {
+            let t = Term::Generic(*g);
+            if terms.iter().any(|u| u.overlaps(&t)) || t.overlaps(a) {
+                continue;
+            }
+            let cols = lin.generic_columns(g, &setup.frame, clean);
+            if cols.is_empty() {
+                continue;
+            }
+            alternatives.push(Alternative {
+                name: t.name(),
+                label: g.label(),
+                term: t,
+                params: g.params(),
+                columns: lin.dense(&cols),
+            });
+        }
+        let mut members: Vec<(Alternative, f64, Vec<Estimate>, bool)> = Vec::new();
+        for alt in alternatives {
+            // A term that contains A (a polynomial leg error contains a
+            // lead) generalises it: not another name for it.
+            if nested(&xa, &lin.project(&alt.columns)) && alt.columns.ncols() > xa.ncols() {
+                continue;
+            }
+            let s = lin.score_dense(&alt.columns);
+            if s.rank == 0 {
+                continue;
+            }
+            let lambda = (strength - s.explained).max(0.0);
+            if lambda >= critical {
+                continue;
+            }
+            let values: Vec<f64> = s.coefficients.iter().copied().collect();
+            let sds: Vec<f64> = (0..values.len())
+                .map(|j| s.covariance[(j, j)].max(0.0).sqrt())
+                .collect();
+            let estimates: Vec<Estimate> = alt
+                .params
+                .iter()
+                .zip(values.iter().zip(&sds))
+                .map(|(n, (v, sd))| Estimate {
+                    name: format!("{}.{n}", alt.name),
+                    value: *v,
+                    std_dev: Some(*sd),
+                })
+                .collect();
+            // The equal lead's plausibility is that of each leg's lead.
+            let check_values: Vec<f64> = if alt.label.contains("equal") {
+                vec![values[0]; 3]
+            } else {
+                values.clone()
+            };
+            let check_cov = if alt.label.contains("equal") {
+                DMatrix::from_diagonal_element(3, 3, s.covariance[(0, 0)])
+            } else {
+                s.covariance.clone()
+            };
+            // A refinement belongs to a term already judged plausible.
+            let plausible = if alt.label.ends_with("(higher order)") {
+                Ok(())
+            } else {
+                setup
+                    .plausibility
+                    .check(&quantities(&alt.term, &check_values, &check_cov))
+            };
+            match plausible {
+                Ok(()) => {
+                    let projected = lin.project(&alt.columns);
+                    let exact = canonical_correlation(&xa, &projected) > 1.0 - 1e-9;
+                    members.push((alt, lambda, estimates, exact));
+                }
+                Err(reason) => out.rejected.push(Rejected {
+                    effect: alt.name,
+                    description: alt.label.clone(),
+                    parameters: estimates,
+                    reason: format!(
+                        "would explain {} as well (unexplained {:.1}), but {reason}",
+                        describe_group(a),
+                        lambda
+                    ),
+                    stage: RejectStage::ImplausibleAlias,
+                }),
+            }
+        }
+        // An equal lead is the full lead's special case: name it alone.
+        if members.iter().any(|m| m.0.label.contains("equal")) {
+            members.retain(|m| {
+                m.0.name != CauseName::Catalogue(EffectName::LegLead) || m.0.label.contains("equal")
+            });
+        }
+        if members.is_empty() {
+            continue;
+        }
+        members.sort_by(|x, y| x.1.total_cmp(&y.1));
+        let (best, lambda, _, exact) = &members[0];
+        let (why, mut separate_by) = explain(a.name(), best.name, &best.label);
+        if !*exact && *lambda > 0.0 {
+            let factor = (critical / lambda).ceil();
+            if factor.is_finite() && factor < 1e6 {
+                separate_by.push_str(&format!(
+                    "; or about {factor:.0} times the readings (poses or readings per pose)"
+                ));
+            }
+        }
+        let mut effects = vec![a.name()];
+        let mut descriptions = vec![describe_group(a)];
+        let mut parameters = Vec::new();
+        for (alt, _, est, _) in &members {
+            if !effects.contains(&alt.name) || alt.name.is_generic() {
+                effects.push(alt.name);
+            }
+            descriptions.push(alt.label.clone());
+            parameters.extend(est.iter().cloned());
+        }
+        out.aliases.push(Alias {
+            effects,
+            descriptions: descriptions.clone(),
+            why,
+            separate_by,
+            exact: members.iter().any(|m| m.3),
+            lambda_unexplained: *lambda,
+            in_model: a.name(),
+            parameters,
+        });
+        match a {
+            Term::Catalogue(_) => out.unnamed.push(*a),
+            Term::Generic(_) => out.alternatives.push((*a, descriptions[1..].to_vec())),
+        }
+    }
+    // Structural: a significant common lead is a scale gain.
+    let lead_term = Term::Catalogue(lead());
+    if let Some(i) = terms.iter().position(|t| *t == lead_term) {
+        let already = out.aliases.iter().any(|al| {
+            al.effects
+                .contains(&CauseName::Catalogue(EffectName::ScaleGain))
+                && al
+                    .effects
+                    .contains(&CauseName::Catalogue(EffectName::LegLead))
+        });
+        let (v, cov) = term_estimates(fit, &lead_term);
+        let mean = v.iter().sum::<f64>() / 3.0;
+        let var = cov.iter().sum::<f64>() / 9.0;
+        let sd = var.max(0.0).sqrt();
+        let scale_in_model = terms.contains(&Term::Catalogue(Candidate(EffectName::ScaleGain)));
+        if !already && !scale_in_model && mean.abs() > 3.0 * sd && offsets.get(i).is_some() {
+            let (why, separate_by) = explain(
+                CauseName::Catalogue(EffectName::LegLead),
+                CauseName::Catalogue(EffectName::ScaleGain),
+                "scale-gain",
+            );
+            out.aliases.push(Alias {
+                effects: vec![
+                    CauseName::Catalogue(EffectName::LegLead),
+                    CauseName::Catalogue(EffectName::ScaleGain),
+                ],
+                descriptions: vec!["leg-lead (common part)".into(), "scale-gain".into()],
+                why: format!(
+                    "{why}: the mean lead {mean:.1} +- {sd:.1} ppm is indistinguishable from a scale gain of {mean:.1} ppm with every lead reduced by it"
+                ),
+                separate_by,
+                exact: true,
+                lambda_unexplained: 0.0,
+                in_model: CauseName::Catalogue(EffectName::LegLead),
+                parameters: vec![Estimate {
+                    name: "scale-gain.scale_gain_ppm".into(),
+                    value: mean,
+                    std_dev: Some(sd),
+                }],
+            });
+        }
+    }
+    out
+}

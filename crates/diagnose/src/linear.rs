@@ -1,0 +1,452 @@
+//! The fitted model linearised at its estimate: what a further term could
+//! still explain, without refitting.
+//!
+//! With `X` the weighted design of the fit (the three sensor offsets and
+//! the identifiable parameters, `3n` rows in noise units), `Q` an
+//! orthonormal basis of it and `t` a target (the weighted residuals, or a
+//! fitted term's signature), the columns `G` of a candidate term explain
+//!
+//! ```text
+//! S(G) = v^T M^+ v,   M = G^T G - (Q^T G)^T (Q^T G),   v = G^T t - (Q^T G)^T (Q^T t)
+//! ```
+//!
+//! of `|t|^2`: the Rao score statistic, the linearised drop of chi-square
+//! (its degrees of freedom the numerical rank of `M`). Generic terms are
+//! combinations of six per-pose directions (the three legs through
+//! `W J1^-1 e_i`, the three readings through `e_c / sigma_c`) times scalar
+//! functions of the pose, so every product above reduces to sums over poses
+//! of precomputed 3-vectors: a period of the ball-screw scan costs a few
+//! hundred flops per pose.
+
+use nalgebra::{DMatrix, DVector, Matrix3};
+use tricept_data::Dataset;
+use tricept_ident::ReadingModel;
+use tricept_kinematics::UpJoints;
+
+use crate::select::Fit;
+use crate::terms::{Basis, GenericTerm, Term};
+
+/// Numerical rank threshold of a term's projected columns: an eigenvalue of
+/// `M` below this share of the largest squared column norm of `G` is a
+/// direction the fitted model already absorbs.
+const ABSORBED: f64 = 1e-10;
+
+/// How much a term explains of a target.
+#[derive(Debug, Clone)]
+pub(crate) struct Score {
+    /// Explained sum of squares (noise units squared).
+    pub(crate) explained: f64,
+    /// Numerical rank of the term's new directions.
+    pub(crate) rank: usize,
+    /// Least-squares coefficients of the term's columns (its parameters).
+    pub(crate) coefficients: DVector<f64>,
+    /// Their covariance in noise units (`M^+`).
+    pub(crate) covariance: DMatrix<f64>,
+}
+
+/// The score from the three products (see the module docs).
+pub(crate) fn score_from(
+    qtg: &DMatrix<f64>,
+    gtg: &DMatrix<f64>,
+    gtt: &DVector<f64>,
+    qtt: &DVector<f64>,
+) -> Score {
+    let k = gtg.nrows();
+    let m = gtg - qtg.transpose() * qtg;
+    let v = gtt - qtg.transpose() * qtt;
+    let scale = (0..k).map(|i| gtg[(i, i)]).fold(0.0, f64::max);
+    let mut out = Score {
+        explained: 0.0,
+        rank: 0,
+        coefficients: DVector::zeros(k),
+        covariance: DMatrix::zeros(k, k),
+    };
+    if !(scale > 0.0 && scale.is_finite()) {
+        return out;
+    }
+    let m = (&m + m.transpose()) * 0.5;
+    let eig = m.symmetric_eigen();
+    for (i, &lambda) in eig.eigenvalues.iter().enumerate() {
+        if lambda > ABSORBED * scale {
+            let u = eig.eigenvectors.column(i);
+            let c = u.dot(&v);
+            out.explained += c * c / lambda;
+            out.rank += 1;
+            out.coefficients += u * (c / lambda);
+            out.covariance += u * u.transpose() / lambda;
+        }
+    }
+    out
+}
+
+/// The linearisation of a fit on its poses.
+#[derive(Debug, Clone)]
+pub(crate) struct Linearisation {
+    /// Weighted design `[offsets | identifiable parameters]`, `3n x p`.
+    pub(crate) x: DMatrix<f64>,
+    /// Model parameter index of each column of `x` after the three offsets.
+    pub(crate) x_params: Vec<usize>,
+    /// Orthonormal basis of the columns of `x` kept (all, or all but a term's).
+    q: DMatrix<f64>,
+    /// The target: weighted residuals of the fit unless replaced.
+    pub(crate) target: DVector<f64>,
+    /// Solved UP joints of every pose at the estimate.
+    pub(crate) ups: Vec<UpJoints>,
+    /// Per pose, the six weighted directions: legs 1-3, readings phi, theta, s.
+    directions: Vec<[[f64; 3]; 6]>,
+    /// Per direction, `Q_j^T d_j` for every pose (`p x n`).
+    projected: Vec<DMatrix<f64>>,
+    /// Per pose, the Gram matrix of the six directions.
+    gram: Vec<[[f64; 6]; 6]>,
+    /// Per pose, the directions' products with the target.
+    target_products: Vec<[f64; 6]>,
+    /// `Q^T t`.
+    qtt: DVector<f64>,
+    /// Weighted columns of extra terms at zero (`3n x m`).
+    pub(crate) extra: DMatrix<f64>,
+    /// Each extra term with its columns in `extra`.
+    pub(crate) extra_terms: Vec<(Term, std::ops::Range<usize>)>,
+}
+
+fn basis_index(b: Basis) -> usize {
+    match b {
+        Basis::Leg(i) => i,
+        Basis::Reading(c) => 3 + c,
+    }
+}
+
+impl Linearisation {
+    /// Linearises `fit` on `data` (the poses it was fitted on), with the
+    /// columns of `extra` terms (at zero) alongside. `None` when a pose
+    /// cannot be solved at the estimate.
+    pub(crate) fn at_fit(
+        fit: &Fit,
+        data: &Dataset,
+        sigma: &[f64; 3],
+        extra: &[Term],
+    ) -> Option<Linearisation> {
+        let mut terms = fit.model.terms().to_vec();
+        terms.extend_from_slice(extra);
+        let model = fit.model.with(&terms);
+        let k = fit.model.names().len();
+        let kf = model.names().len();
+        let mut p = fit.id.estimate.clone();
+        p.resize(kf, 0.0);
+        let predictor = model.at(&p);
+        let machine = model.machine_at(&p);
+        let identifiable = fit.id.design().identifiable().to_vec();
+        let n = data.poses.len();
+        let cols = 3 + identifiable.len();
+        let mut x = DMatrix::zeros(3 * n, cols);
+        let mut ext = DMatrix::zeros(3 * n, kf - k);
+        let mut target = DVector::zeros(3 * n);
+        let mut ups = Vec::with_capacity(n);
+        let mut directions = Vec::with_capacity(n);
+        let mut jac = vec![0.0; 3 * kf];
+        for (j, pose) in data.poses.iter().enumerate() {
+            let mut seed = None;
+            let g = predictor.predict(pose, &mut seed, &mut jac).ok()?;
+            let up = seed?;
+            let legs = machine.legs_at(&up);
+            let j1_inv: Matrix3<f64> = legs.j1().try_inverse()?;
+            let y = pose.readings.to_array();
+            let mut dirs = [[0.0; 3]; 6];
+            for c in 0..3 {
+                let w = 1.0 / sigma[c];
+                let row = 3 * j + c;
+                x[(row, c)] = w;
+                for (t, &gi) in identifiable.iter().enumerate() {
+                    x[(row, 3 + t)] = w * jac[c * kf + gi];
+                }
+                for e in 0..kf - k {
+                    ext[(row, e)] = w * jac[c * kf + k + e];
+                }
+                target[row] = w * (y[c] - g[c] - fit.id.offsets[c]);
+                for i in 0..3 {
+                    dirs[i][c] = w * j1_inv[(c, i)];
+                }
+                dirs[3 + c][c] = w;
+            }
+            ups.push(up);
+            directions.push(dirs);
+        }
+        let mut at = 0;
+        let extra_terms = extra
+            .iter()
+            .map(|t| {
+                let len = t.params().len();
+                let r = at..at + len;
+                at += len;
+                (*t, r)
+            })
+            .collect();
+        let gram = directions
+            .iter()
+            .map(|d| {
+                std::array::from_fn(|a| {
+                    std::array::from_fn(|b| (0..3).map(|c| d[a][c] * d[b][c]).sum())
+                })
+            })
+            .collect();
+        let mut lin = Linearisation {
+            q: DMatrix::zeros(0, 0),
+            x,
+            x_params: identifiable,
+            target,
+            ups,
+            directions,
+            projected: Vec::new(),
+            gram,
+            target_products: Vec::new(),
+            qtt: DVector::zeros(0),
+            extra: ext,
+            extra_terms,
+        };
+        lin.set_basis(&[]);
+        let t = lin.target.clone();
+        lin.set_target(t);
+        Some(lin)
+    }
+
+    /// Number of poses.
+    pub(crate) fn poses(&self) -> usize {
+        self.directions.len()
+    }
+
+    /// Uses the columns of `x` except those of the model parameters `drop`
+    /// as the fitted model.
+    pub(crate) fn set_basis(&mut self, drop: &[usize]) {
+        let keep: Vec<usize> = (0..self.x.ncols())
+            .filter(|&c| c < 3 || !drop.contains(&self.x_params[c - 3]))
+            .collect();
+        let xk = self.x.select_columns(&keep);
+        self.q = orthonormal_basis(&xk);
+        let p = self.q.ncols();
+        let n = self.poses();
+        self.projected = (0..6)
+            .map(|b| {
+                let mut m = DMatrix::zeros(p, n);
+                for j in 0..n {
+                    for c in 0..3 {
+                        let d = self.directions[j][b][c];
+                        if d != 0.0 {
+                            for r in 0..p {
+                                m[(r, j)] += self.q[(3 * j + c, r)] * d;
+                            }
+                        }
+                    }
+                }
+                m
+            })
+            .collect();
+        let t = self.target.clone();
+        self.set_target(t);
+    }
+
+    /// Replaces the target.
+    pub(crate) fn set_target(&mut self, target: DVector<f64>) {
+        self.qtt = self.q.transpose() * &target;
+        self.target_products = self
+            .directions
+            .iter()
+            .enumerate()
+            .map(|(j, d)| {
+                std::array::from_fn(|b| (0..3).map(|c| d[b][c] * target[3 * j + c]).sum())
+            })
+            .collect();
+        self.target = target;
+    }
+
+    /// Columns of `x` for the model parameters `params`, projected onto the
+    /// complement of the current basis (the part the rest cannot absorb).
+    pub(crate) fn projected_columns(&self, params: &[usize]) -> DMatrix<f64> {
+        let cols: Vec<usize> = (0..self.x_params.len())
+            .filter(|&c| params.contains(&self.x_params[c]))
+            .map(|c| c + 3)
+            .collect();
+        let g = self.x.select_columns(&cols);
+        &g - &self.q * (self.q.transpose() * &g)
+    }
+
+    /// Projects dense columns onto the complement of the basis.
+    pub(crate) fn project(&self, g: &DMatrix<f64>) -> DMatrix<f64> {
+        g - &self.q * (self.q.transpose() * g)
+    }
+
+    /// Per-pose values of every parameter of a generic term, with its
+    /// direction.
+    pub(crate) fn generic_columns(
+        &self,
+        term: &GenericTerm,
+        frame: &crate::terms::Frame,
+        data: &Dataset,
+    ) -> Vec<(usize, Vec<f64>)> {
+        let mut cols: Vec<(usize, Vec<f64>)> = Vec::new();
+        for (j, pose) in data.poses.iter().enumerate() {
+            let values = if term.acts_on_legs() {
+                term.leg_values(frame, pose)
+            } else {
+                term.reading_values(frame, pose, &self.ups[j])
+            };
+            if cols.is_empty() {
+                cols = values
+                    .iter()
+                    .map(|(b, _)| (basis_index(*b), vec![0.0; data.poses.len()]))
+                    .collect();
+            }
+            for (k, (_, v)) in values.into_iter().enumerate() {
+                if let Some(c) = cols.get_mut(k) {
+                    c.1[j] = v;
+                }
+            }
+        }
+        cols
+    }
+
+    /// The score of columns given as (direction, per-pose value).
+    pub(crate) fn score_columns(&self, cols: &[(usize, Vec<f64>)]) -> Score {
+        let k = cols.len();
+        let p = self.q.ncols();
+        let mut qtg = DMatrix::zeros(p, k);
+        let mut gtg = DMatrix::zeros(k, k);
+        let mut gtt = DVector::zeros(k);
+        for (a, (ba, fa)) in cols.iter().enumerate() {
+            qtg.set_column(a, &(&self.projected[*ba] * DVector::from_column_slice(fa)));
+            gtt[a] = fa
+                .iter()
+                .zip(&self.target_products)
+                .map(|(f, t)| f * t[*ba])
+                .sum();
+            for (b, (bb, fb)) in cols.iter().enumerate().skip(a) {
+                let v: f64 = fa
+                    .iter()
+                    .zip(fb)
+                    .zip(&self.gram)
+                    .map(|((x, y), g)| x * y * g[*ba][*bb])
+                    .sum();
+                gtg[(a, b)] = v;
+                gtg[(b, a)] = v;
+            }
+        }
+        score_from(&qtg, &gtg, &gtt, &self.qtt)
+    }
+
+    /// Dense weighted columns (`3n x k`) of per-pose values.
+    pub(crate) fn dense(&self, cols: &[(usize, Vec<f64>)]) -> DMatrix<f64> {
+        let n = self.poses();
+        let mut g = DMatrix::zeros(3 * n, cols.len());
+        for (a, (b, f)) in cols.iter().enumerate() {
+            for j in 0..n {
+                for c in 0..3 {
+                    g[(3 * j + c, a)] = f[j] * self.directions[j][*b][c];
+                }
+            }
+        }
+        g
+    }
+
+    /// The score of dense weighted columns.
+    pub(crate) fn score_dense(&self, g: &DMatrix<f64>) -> Score {
+        let qtg = self.q.transpose() * g;
+        let gtg = g.transpose() * g;
+        let gtt = g.transpose() * &self.target;
+        score_from(&qtg, &gtg, &gtt, &self.qtt)
+    }
+
+    /// The columns of an extra term.
+    pub(crate) fn extra_columns(&self, term: &Term) -> Option<DMatrix<f64>> {
+        self.extra_terms
+            .iter()
+            .find(|(t, _)| t == term)
+            .map(|(_, r)| self.extra.columns(r.start, r.len()).into_owned())
+    }
+}
+
+/// An orthonormal basis of the column space of `a` (thin QR; `a` has full
+/// column rank by construction: identifiable columns only).
+pub(crate) fn orthonormal_basis(a: &DMatrix<f64>) -> DMatrix<f64> {
+    if a.ncols() == 0 {
+        return DMatrix::zeros(a.nrows(), 0);
+    }
+    a.clone().qr().q()
+}
+
+/// Whether the column space of `a` lies inside that of `b` (every
+/// canonical correlation 1 to `1e-6`): `b` generalises `a`.
+pub(crate) fn nested(a: &DMatrix<f64>, b: &DMatrix<f64>) -> bool {
+    let (Some(ua), Some(ub)) = (column_basis(a), column_basis(b)) else {
+        return false;
+    };
+    ua.ncols() <= ub.ncols()
+        && (ua.transpose() * ub)
+            .singular_values()
+            .iter()
+            .all(|s| *s > 1.0 - 1e-6)
+}
+
+/// An orthonormal basis of the numerically independent columns of `m`.
+fn column_basis(m: &DMatrix<f64>) -> Option<DMatrix<f64>> {
+    let svd = m.clone().svd(true, false);
+    let top = svd.singular_values.iter().copied().fold(0.0, f64::max);
+    let keep: Vec<usize> = (0..svd.singular_values.len())
+        .filter(|&i| svd.singular_values[i] > 1e-8 * top && top > 0.0)
+        .collect();
+    let u = svd.u?;
+    (!keep.is_empty()).then(|| u.select_columns(&keep))
+}
+
+/// Largest canonical correlation between the column spaces of `a` and `b`
+/// (1 when they share a direction).
+pub(crate) fn canonical_correlation(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    match (column_basis(a), column_basis(b)) {
+        (Some(ua), Some(ub)) => (ua.transpose() * ub)
+            .singular_values()
+            .iter()
+            .copied()
+            .fold(0.0, f64::max)
+            .min(1.0),
+        _ => 0.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn score_is_the_explained_sum_of_squares() {
+        // x = [1, 1, 1, 1]^T (fitted), g = [0, 1, 2, 3]^T, t = g - mean(g) + noise.
+        let x = DMatrix::from_column_slice(4, 1, &[1.0, 1.0, 1.0, 1.0]);
+        let q = orthonormal_basis(&x);
+        let g = DMatrix::from_column_slice(4, 1, &[0.0, 1.0, 2.0, 3.0]);
+        let t = DVector::from_column_slice(&[-1.5, -0.5, 0.5, 1.5]) * 2.0;
+        let s = score_from(
+            &(q.transpose() * &g),
+            &(g.transpose() * &g),
+            &(g.transpose() * &t),
+            &(q.transpose() * &t),
+        );
+        // t lies in span(x, g): everything is explained, with coefficient 2.
+        assert!((s.explained - t.norm_squared()).abs() < 1e-12);
+        assert_eq!(s.rank, 1);
+        assert!((s.coefficients[0] - 2.0).abs() < 1e-12);
+        // A column inside span(x) explains nothing and has no rank.
+        let s = score_from(
+            &(q.transpose() * &x),
+            &(x.transpose() * &x),
+            &(x.transpose() * &t),
+            &(q.transpose() * &t),
+        );
+        assert_eq!(s.rank, 0);
+        assert_eq!(s.explained, 0.0);
+    }
+
+    #[test]
+    fn canonical_correlation_of_shared_and_orthogonal_spaces() {
+        let a = DMatrix::from_column_slice(3, 1, &[1.0, 0.0, 0.0]);
+        let b = DMatrix::from_column_slice(3, 2, &[2.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
+        let c = DMatrix::from_column_slice(3, 1, &[0.0, 0.0, 1.0]);
+        assert!((canonical_correlation(&a, &b) - 1.0).abs() < 1e-12);
+        assert!(canonical_correlation(&a, &c).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,344 @@
+//! Effects outside the vocabulary, on realistic campaigns (40, 80, 200
+//! random poses, one approach direction, the mean of 3 readings): the
+//! diagnosis must never dress them up as a known effect, and its generic
+//! dictionary must describe them (family, leg or channel, period).
+//!
+//! Expectations come from the simulator's inputs only. Each case prints
+//! `TALLY` lines (`cargo test -p tricept-diagnose --test out_of_vocabulary
+//! -- --nocapture`), quoted in `docs/diagnosis.md`.
+//!
+//! What is asserted is what the campaigns can physically show (design and
+//! detectability numbers in `docs/diagnosis.md`): a 100-300 ppm encoder
+//! gain is named only at 200 poses (at 40 and 80 poses its signature is
+//! below detection in most sets); at every size it must not be named as
+//! an eccentricity alone.
+
+mod common;
+
+use common::*;
+use tricept_diagnose::detect::detectability;
+use tricept_diagnose::{Candidate, Diagnosis, Verdict};
+use tricept_ident::GeometricModel;
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+use tricept_model::effects::{CauseName, EffectName as E, GenericFamily as G};
+use tricept_plant::effects::{Effect, Waveform};
+
+const SIZES: [usize; 3] = [40, 80, 200];
+const SETS: u64 = 20;
+
+/// A catalogue effect named while the final model claims to explain the
+/// data: an out-of-vocabulary effect dressed up as a known one.
+fn dressed_up(d: &Diagnosis, allowed: &[E]) -> bool {
+    d.final_adequate && catalogue_named(d).iter().any(|e| !allowed.contains(e))
+}
+
+/// Runs one out-of-vocabulary case at every size; `right` judges a
+/// diagnosis from the simulator's inputs.
+fn case(
+    name: &str,
+    base: u64,
+    sizes: &[usize],
+    make: impl Fn(&mut rand_pcg::Pcg64Mcg) -> Effect + Sync,
+    right: impl Fn(&Simulated, &Diagnosis) -> bool,
+    allowed: impl Fn(&Simulated, &Diagnosis) -> Vec<E>,
+    required: impl Fn(usize) -> usize,
+) {
+    let mut failures = Vec::new();
+    for &n in sizes {
+        let res = run_case(SETS, |i| {
+            let seed = base + i;
+            let e = make(&mut rng(base, seed));
+            simulate(n, seed, vec![e], CampaignOptions::default())
+        });
+        let (mut good, mut dressed) = (0, 0);
+        for (i, (s, d)) in res.iter().enumerate() {
+            let ok = right(s, d);
+            good += usize::from(ok);
+            let bad = dressed_up(d, &allowed(s, d));
+            dressed += usize::from(bad);
+            for v in invariants(d) {
+                failures.push(format!("{name} n={n} set {i}: {v}"));
+            }
+            if bad {
+                failures.push(format!(
+                    "{name} n={n} set {i}: a catalogue effect explains it: {}",
+                    summary(d)
+                ));
+            }
+            if !ok {
+                eprintln!(
+                    "{name} n={n} set {i} not right: {} ({:?})",
+                    summary(d),
+                    s.effects
+                );
+            }
+        }
+        tally(
+            name,
+            n,
+            "right family, leg/channel and form",
+            good,
+            SETS as usize,
+        );
+        tally(
+            name,
+            n,
+            "catalogue effect named with final_adequate true",
+            dressed,
+            SETS as usize,
+        );
+        if good < required(n) {
+            failures.push(format!(
+                "{name} n={n}: right in {good}/{SETS}, {} required",
+                required(n)
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn pitch_is_named() {
+    case(
+        "leg-periodic 4 um, 10 mm",
+        0x9170,
+        &SIZES,
+        |r| Effect::LegPeriodic {
+            um: [4.0; 3],
+            period_mm: 10.0,
+            phase_deg: std::array::from_fn(|_| uniform(r, 0.0, 360.0)),
+            waveform: Waveform::Sine,
+        },
+        |_, d| {
+            d.causes.iter().any(|c| {
+                let period = c.parameters.iter().find(|p| p.name.ends_with("period_mm"));
+                c.effect == G::LegPeriodic
+                    && c.legs == vec![1, 2, 3]
+                    && period.is_some_and(|p| {
+                        (p.value - 10.0).abs() <= 3.0 * p.std_dev.unwrap_or(0.0) + 0.05
+                    })
+            })
+        },
+        |_, _| Vec::new(),
+        |_| 16,
+    );
+}
+
+/// The lead error implied by a quadratic centred away from the campaign's
+/// middle: its linear part over the campaign's commands (least squares).
+fn implied_leads(s: &Simulated) -> Vec<f64> {
+    let Effect::LegQuadratic {
+        um,
+        centre_mm,
+        half_width_mm,
+    } = s.effects[0]
+    else {
+        return vec![0.0; 3];
+    };
+    (0..3)
+        .map(|i| {
+            let q: Vec<f64> = s.data.poses.iter().map(|p| p.commands_mm[i]).collect();
+            let y: Vec<f64> = q
+                .iter()
+                .map(|v| um[i] * ((v - centre_mm) / half_width_mm).powi(2))
+                .collect();
+            let n = q.len() as f64;
+            let (mq, my) = (q.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+            let sxy: f64 = q.iter().zip(&y).map(|(a, b)| (a - mq) * (b - my)).sum();
+            let sxx: f64 = q.iter().map(|a| (a - mq).powi(2)).sum();
+            // um per mm = ppm * 1e-3.
+            sxy / sxx * 1e3
+        })
+        .collect()
+}
+
+#[test]
+fn quadratic_is_named() {
+    let m = Machine::paper();
+    let geometric = GeometricModel::new(m.clone(), ParameterSet::paper15());
+    case(
+        "leg-quadratic 5-15 um",
+        0x9a0d,
+        &SIZES,
+        |r| Effect::LegQuadratic {
+            um: std::array::from_fn(|_| sign(r) * uniform(r, 5.0, 15.0)),
+            centre_mm: 845.0,
+            half_width_mm: 250.0,
+        },
+        |_, d| {
+            d.causes
+                .iter()
+                .filter(|c| c.effect == G::LegPolynomial)
+                .flat_map(|c| c.legs.clone())
+                .collect::<std::collections::BTreeSet<u8>>()
+                .len()
+                == 3
+        },
+        // The lead a quadratic centred away from the campaign implies may
+        // be named when it is detectable (95 % power at alpha).
+        |s, _| {
+            let lambda = detectability(
+                &geometric,
+                Candidate(E::LegLead),
+                &implied_leads(s),
+                &s.data.poses,
+                s.sigma,
+                1e-3,
+            )
+            .map_or(0.0, |d| d.noncentrality);
+            if lambda > 24.4 {
+                vec![E::LegLead]
+            } else {
+                Vec::new()
+            }
+        },
+        |_| 16,
+    );
+}
+
+#[test]
+fn scale_drift_is_named() {
+    case(
+        "scale drift 2-6 um",
+        0xd21f,
+        &SIZES,
+        |r| Effect::ScaleDrift {
+            um: sign(r) * uniform(r, 2.0, 6.0),
+        },
+        |_, d| {
+            // The temperature follows time in these campaigns: a drift with
+            // time and a change with temperature are one alias set.
+            (group_found(d, "reading-drift:s") || group_found(d, "reading-temperature:s"))
+                && !named(d, CauseName::Catalogue(E::Thermal))
+        },
+        |_, _| Vec::new(),
+        |_| 16,
+    );
+}
+
+#[test]
+fn encoder_gain() {
+    case(
+        "encoder gain 100-300 ppm",
+        0x9a1e,
+        &SIZES,
+        |r| {
+            let g = sign(r) * uniform(r, 100.0, 300.0);
+            if uniform(r, 0.0, 1.0) < 0.5 {
+                Effect::EncoderGain {
+                    phi_ppm: g,
+                    theta_ppm: 0.0,
+                }
+            } else {
+                Effect::EncoderGain {
+                    phi_ppm: 0.0,
+                    theta_ppm: g,
+                }
+            }
+        },
+        |s, d| {
+            let Effect::EncoderGain { phi_ppm, .. } = s.effects[0] else {
+                return false;
+            };
+            let label = if phi_ppm != 0.0 {
+                "encoder-gain:phi"
+            } else {
+                "encoder-gain:theta"
+            };
+            group_found(d, label)
+        },
+        |_, _| Vec::new(),
+        // Infeasible below 200 poses (docs/diagnosis.md): tallied only.
+        |n| if n >= 200 { 16 } else { 0 },
+    );
+}
+
+#[test]
+fn unknown_forms_are_not_dressed_up() {
+    let shapes: [(&str, u64); 2] = [
+        ("sawtooth pitch 4 um, 10 mm", 0x5a37),
+        ("legs |x|^1.5, 5-15 um", 0x1e15),
+    ];
+    let mut failures = Vec::new();
+    for (k, (name, base)) in shapes.iter().enumerate() {
+        let res = run_case(SETS, |i| {
+            let seed = base + i;
+            let r = &mut rng(*base, seed);
+            let e = if k == 0 {
+                Effect::LegPeriodic {
+                    um: [4.0; 3],
+                    period_mm: 10.0,
+                    phase_deg: std::array::from_fn(|_| uniform(r, 0.0, 360.0)),
+                    waveform: Waveform::Sawtooth,
+                }
+            } else {
+                Effect::LegPower {
+                    um: std::array::from_fn(|_| sign(r) * uniform(r, 5.0, 15.0)),
+                    exponent: 1.5,
+                    centre_mm: 845.0,
+                    half_width_mm: 250.0,
+                }
+            };
+            simulate(80, seed, vec![e], CampaignOptions::default())
+        });
+        let (mut dressed, mut honest) = (0, 0);
+        for (i, (_, d)) in res.iter().enumerate() {
+            let bad = dressed_up(d, &[E::LegLead]);
+            dressed += usize::from(bad);
+            let generic = d.causes.iter().any(|c| c.effect.is_generic());
+            let ok = matches!(
+                d.verdict,
+                Verdict::PartiallyExplained | Verdict::Unexplained
+            ) || (d.verdict == Verdict::Explained && generic);
+            honest += usize::from(ok);
+            if bad || !ok {
+                failures.push(format!("{name} set {i}: {}", summary(d)));
+            }
+            failures.extend(invariants(d));
+        }
+        tally(
+            name,
+            80,
+            "catalogue effect named with final_adequate true",
+            dressed,
+            SETS as usize,
+        );
+        tally(
+            name,
+            80,
+            "partially explained, unexplained or explained by a generic term",
+            honest,
+            SETS as usize,
+        );
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn clean_sets_are_adequate() {
+    let mut failures = Vec::new();
+    for n in SIZES {
+        let res = run_case(40, |i| {
+            simulate(n, 0xc1ea + i, Vec::new(), CampaignOptions::default())
+        });
+        let adequate = res.iter().filter(|(_, d)| d.adequate).count();
+        let generic = res
+            .iter()
+            .filter(|(_, d)| d.causes.iter().any(|c| c.effect.is_generic()))
+            .count();
+        tally("no hidden effect", n, "adequate", adequate, 40);
+        tally("no hidden effect", n, "a generic term named", generic, 40);
+        for (i, (_, d)) in res.iter().enumerate() {
+            if !d.adequate {
+                eprintln!("clean n={n} set {i}: {}", summary(d));
+            }
+        }
+        if adequate < 38 || generic > 0 {
+            failures.push(format!(
+                "n={n}: adequate {adequate}/40, generic named {generic}"
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
