@@ -18,7 +18,7 @@ use tricept_ident::fusion::{
 };
 use tricept_model::effects::EffectName;
 
-use crate::args::{check_commands, load_with_noise, machine_with_noise, read_data};
+use crate::args::{check_commands, load_with_noise, read_data};
 use crate::cli_error::{CliError, EXIT_NOT_CONVERGED};
 use crate::ident_cmd::IdentifyArgs;
 use crate::machine_file;
@@ -322,10 +322,16 @@ pub fn eval_options(
 
 /// `tricept identify` with external data.
 pub fn run(a: &IdentifyArgs) -> Result<u8, CliError> {
-    let machine = machine_with_noise(&a.settings.machine, &a.settings.noise)?;
+    let loaded = load_with_noise(&a.settings.machine, &a.settings.noise)?;
+    let machine = loaded.machine.clone();
     let set = a.settings.params.set()?;
     let x = &a.external;
-    let model = fused_model(&machine, &set, &x.effects, x.head.as_deref())?;
+    let mut model = fused_model(&machine, &set, &x.effects, x.head.as_deref())?;
+    // A calibrated machine: the rank decision of its nominal machine, as in
+    // `identify` (docs/identifiability.md).
+    if let Some(reference) = loaded.rank_reference()? {
+        model = model.with_rank_reference(reference).map_err(fusion_error)?;
+    }
     let options = eval_options(&machine, &x.eval_grid, &x.eval_head_angles_deg)?;
     let sources = sources(a, &machine)?;
     let fit = identify_fused(&model, &sources, &options).map_err(fusion_error)?;

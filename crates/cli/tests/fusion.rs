@@ -226,3 +226,73 @@ fn an_unexplained_source_ends_with_exit_code_3_and_a_warning() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("run `tricept diagnose`"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn fusing_against_a_calibrated_machine_keeps_the_nominal_rank_rule() {
+    // A machine calibrated by `identify`, then re-calibrated with a tracker:
+    // on the calibrated geometry dyA3 is weakly visible; the fused fit must
+    // hold it as `identify` does, not chase it.
+    let dir = workdir("fusion-recalibrate");
+    ok(
+        &dir,
+        &[
+            "plan",
+            "--instrument",
+            "tracker",
+            "--k",
+            "20",
+            "--random-baseline",
+            "0",
+            "--passes",
+            "2",
+            "--out",
+            "points.csv",
+        ],
+    );
+    ok(
+        &dir,
+        &[
+            "simulate",
+            "--head-errors",
+            "random:1,5",
+            "--out",
+            "internal.csv",
+            "--tracker-out",
+            "tracker.csv",
+            "--tracker-poses",
+            "points.csv",
+        ],
+    );
+    ok(
+        &dir,
+        &[
+            "identify",
+            "--data",
+            "internal.csv",
+            "--write-machine",
+            "calibrated.json",
+        ],
+    );
+    let fused = |machine: Option<&str>| -> serde_json::Value {
+        let mut args = vec![
+            "identify",
+            "--data",
+            "internal.csv",
+            "--tracker",
+            "tracker.csv",
+            "--tracker-target",
+            "tip",
+            "--json",
+        ];
+        if let Some(m) = machine {
+            args.extend(["--machine", m]);
+        }
+        serde_json::from_slice(&ok(&dir, &args)).unwrap()
+    };
+    let (nominal, calibrated) = (fused(None), fused(Some("calibrated.json")));
+    assert_eq!(calibrated["converged"], true);
+    assert_eq!(calibrated["rank"], nominal["rank"]);
+    assert_eq!(calibrated["fixed"], nominal["fixed"]);
+    assert!(calibrated["fixed"].to_string().contains("dyA3"));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -405,6 +405,59 @@ pub fn identify_fused(
             ),
         });
     }
+    let (problem, state, eval) = start(model, sources, offsets.clone(), n_nuisance)?;
+    // The rank decision: on this model, or on its reference (the nominal
+    // machine of a calibrated one) with the same sources.
+    let reference = match model.rank_reference() {
+        Some(r) => Some(start(r, sources, offsets, n_nuisance)?.2),
+        None => None,
+    };
+    let names = model.names().to_vec();
+    let decision = reference
+        .as_ref()
+        .unwrap_or(&eval)
+        .union
+        .decide(options.rank_tolerance)
+        .ok_or(IdentError::Numerical("SVD did not converge"))?;
+    let first = eval.union.solve(&decision);
+    let records: usize = sources.iter().map(|s| s.records()).sum();
+    let union_report = IdentifiabilityReport::new(
+        &names,
+        &decision,
+        &first,
+        n_nuisance,
+        eval.union.rows,
+        records,
+        options.weak_threshold,
+    );
+    let start_parts = eval.parts.clone();
+    let mut run = Run {
+        p: vec![0.0; k],
+        state,
+        eval,
+        solution: first,
+        iterations: 0,
+        converged: false,
+    };
+    iterate(&problem, &mut run, &decision, options.max_iterations);
+    finish(
+        &problem,
+        run,
+        &decision,
+        union_report,
+        &start_parts,
+        options,
+    )
+}
+
+/// The problem of `model` on `sources`, its starting state (nuisance
+/// initialised from the data at zero errors) and its evaluation there.
+fn start<'a>(
+    model: &'a FusedModel,
+    sources: &'a [Source],
+    offsets: Vec<usize>,
+    n_nuisance: usize,
+) -> Result<(Problem<'a>, State, Evaluation), IdentError> {
     let mut contexts = Vec::with_capacity(sources.len());
     for source in sources {
         let rows = source.rows();
@@ -428,7 +481,7 @@ pub fn identify_fused(
         offsets,
         n_nuisance,
     };
-    let p = vec![0.0; k];
+    let p = vec![0.0; model.len()];
     let mut state = State {
         seeds: sources.iter().map(|s| vec![None; s.records()]).collect(),
         nuisance: Vec::with_capacity(sources.len()),
@@ -447,40 +500,7 @@ pub fn identify_fused(
     for (s, source) in sources.iter().enumerate() {
         check_nuisance(source, &eval.parts[s])?;
     }
-    let names = model.names().to_vec();
-    let decision = eval
-        .union
-        .decide(options.rank_tolerance)
-        .ok_or(IdentError::Numerical("SVD did not converge"))?;
-    let first = eval.union.solve(&decision);
-    let records: usize = sources.iter().map(|s| s.records()).sum();
-    let union_report = IdentifiabilityReport::new(
-        &names,
-        &decision,
-        &first,
-        n_nuisance,
-        eval.union.rows,
-        records,
-        options.weak_threshold,
-    );
-    let start_parts = eval.parts.clone();
-    let mut run = Run {
-        p,
-        state,
-        eval,
-        solution: first,
-        iterations: 0,
-        converged: false,
-    };
-    iterate(&problem, &mut run, &decision, options.max_iterations);
-    finish(
-        &problem,
-        run,
-        &decision,
-        union_report,
-        &start_parts,
-        options,
-    )
+    Ok((problem, state, eval))
 }
 
 /// Refuses a source whose own nuisance its data cannot determine.

@@ -59,6 +59,7 @@ pub struct FusedModel {
     effects: Vec<EffectName>,
     head: Option<HeadParameterSet>,
     names: Vec<String>,
+    rank_reference: Option<Box<FusedModel>>,
 }
 
 /// What the leg effects need at one record, computed once from the
@@ -106,7 +107,48 @@ impl FusedModel {
             effects: seen,
             head,
             names,
+            rank_reference: None,
         })
+    }
+
+    /// The same model, with the rank decision taken on `structural` (at
+    /// zero errors) instead of on this model's machine: what a calibrated
+    /// machine needs, whose perturbed geometry turns a structurally
+    /// invisible parameter (`dyA3` of the paper's machine) into a weakly
+    /// visible one that the fit would chase (docs/identifiability.md).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::fusion::FusedModel;
+    /// use tricept_kinematics::Machine;
+    /// use tricept_model::ParameterSet;
+    /// let m = FusedModel::new(Machine::paper(), ParameterSet::paper15(), &[], true)
+    ///     .unwrap()
+    ///     .with_rank_reference(Machine::paper())
+    ///     .unwrap();
+    /// assert!(m.rank_reference().is_some());
+    /// ```
+    pub fn with_rank_reference(mut self, structural: Machine) -> Result<FusedModel, IdentError> {
+        let reference = FusedModel::new(
+            structural,
+            self.module.clone(),
+            &self.effects,
+            self.head.is_some(),
+        )?;
+        if reference.names != self.names {
+            return Err(IdentError::Invalid(format!(
+                "the rank reference has parameters {:?}, the model {:?}",
+                reference.names, self.names
+            )));
+        }
+        self.rank_reference = Some(Box::new(reference));
+        Ok(self)
+    }
+
+    /// The model whose rank decision this one uses, when set by
+    /// [`FusedModel::with_rank_reference`].
+    pub fn rank_reference(&self) -> Option<&FusedModel> {
+        self.rank_reference.as_deref()
     }
 
     /// Parameter names, `[module | effects | head]`.
