@@ -11,7 +11,7 @@ use tricept_diagnose::{
 };
 use tricept_ident::{GeometricModel, IdentifyOptions, identify};
 use tricept_kinematics::description::ControllerDescription;
-use tricept_model::effects::{CauseName, EffectName};
+use tricept_model::effects::CauseName;
 use tricept_model::{GeometricErrors, ParameterSet};
 use tricept_plant::{Campaign, Effect, Plant, PoseOrder};
 
@@ -174,12 +174,7 @@ pub fn deploy(
     data: &tricept_data::Dataset,
     d: &tricept_diagnose::Diagnosis,
 ) -> Result<Deployed, CliError> {
-    let flagged: Vec<u64> = d
-        .causes
-        .iter()
-        .filter(|c| c.effect == CauseName::Catalogue(EffectName::Outliers))
-        .flat_map(|c| c.rows.iter().copied())
-        .collect();
+    let flagged = d.outlier_lines();
     let clean = data.subset(|j| !flagged.contains(&data.poses[j].line));
     let candidates: Vec<Candidate> = d.model_effects().into_iter().map(Candidate).collect();
     let mut geometric = GeometricModel::new(nominal.clone(), ParameterSet::paper15());
@@ -314,12 +309,7 @@ fn write_extended(
     {
         effects.insert(name.clone(), json!({"value": v, "std_dev": sd}));
     }
-    let rejected_lines = d
-        .causes
-        .iter()
-        .filter(|c| c.effect == CauseName::Catalogue(EffectName::Outliers))
-        .flat_map(|c| c.rows.iter().copied())
-        .collect();
+    let rejected_lines = d.outlier_lines();
     let warnings = problems.into_iter().chain(notes).collect();
     let description = machine_file::calibrated_description(
         loaded,

@@ -37,11 +37,12 @@ fn workdir(name: &str) -> PathBuf {
     dir
 }
 
-#[test]
-fn the_calibrated_machine_file_carries_the_head_and_tool_ik_uses_it() {
-    let dir = workdir("fusion-deploy");
+/// In `dir`: 20 planned tracker poses (`points.csv`), then the simulated
+/// machine's internal data (`internal.csv`, head errors `random:1,5`) and
+/// its tracker points at those poses (`tracker.csv`).
+fn simulate_tracker_campaign(dir: &Path) {
     ok(
-        &dir,
+        dir,
         &[
             "plan",
             "--instrument",
@@ -57,7 +58,7 @@ fn the_calibrated_machine_file_carries_the_head_and_tool_ik_uses_it() {
         ],
     );
     ok(
-        &dir,
+        dir,
         &[
             "simulate",
             "--head-errors",
@@ -70,6 +71,12 @@ fn the_calibrated_machine_file_carries_the_head_and_tool_ik_uses_it() {
             "points.csv",
         ],
     );
+}
+
+#[test]
+fn the_calibrated_machine_file_carries_the_head_and_tool_ik_uses_it() {
+    let dir = workdir("fusion-deploy");
+    simulate_tracker_campaign(&dir);
     let json = ok(
         &dir,
         &[
@@ -233,36 +240,7 @@ fn fusing_against_a_calibrated_machine_keeps_the_nominal_rank_rule() {
     // on the calibrated geometry dyA3 is weakly visible; the fused fit must
     // hold it as `identify` does, not chase it.
     let dir = workdir("fusion-recalibrate");
-    ok(
-        &dir,
-        &[
-            "plan",
-            "--instrument",
-            "tracker",
-            "--k",
-            "20",
-            "--random-baseline",
-            "0",
-            "--passes",
-            "2",
-            "--out",
-            "points.csv",
-        ],
-    );
-    ok(
-        &dir,
-        &[
-            "simulate",
-            "--head-errors",
-            "random:1,5",
-            "--out",
-            "internal.csv",
-            "--tracker-out",
-            "tracker.csv",
-            "--tracker-poses",
-            "points.csv",
-        ],
-    );
+    simulate_tracker_campaign(&dir);
     ok(
         &dir,
         &[

@@ -430,6 +430,27 @@ fn values_by_name<S: Serializer>(v: &[(String, f64)], s: S) -> Result<S::Ok, S::
 }
 
 impl Diagnosis {
+    /// The file lines of the poses the outlier screen set aside (empty when
+    /// `outliers` is not a named cause): the poses the final model was not
+    /// fitted to.
+    ///
+    /// # Example
+    /// ```no_run
+    /// use tricept_diagnose::{diagnose, DiagnoseOptions};
+    /// let m = tricept_kinematics::Machine::paper();
+    /// let data = tricept_data::read_path("fixtures/data/diagnose-hidden-effect.csv".as_ref()).unwrap();
+    /// let d = diagnose(&m, &data, &DiagnoseOptions::for_machine(&m)).unwrap();
+    /// let clean = data.subset(|j| !d.outlier_lines().contains(&data.poses[j].line));
+    /// ```
+    pub fn outlier_lines(&self) -> Vec<u64> {
+        use tricept_model::effects::{CauseName, EffectName};
+        self.causes
+            .iter()
+            .filter(|c| c.effect == CauseName::Catalogue(EffectName::Outliers))
+            .flat_map(|c| c.rows.iter().copied())
+            .collect()
+    }
+
     /// The effects of the vocabulary in the final model: the named causes
     /// (outliers aside) and the model's member of each alias set (a scale
     /// gain, for instance, is never named alone but is modelled). What a
