@@ -135,10 +135,17 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
             .map_err(|e| CliError::other(e.to_string()))?;
         }
     }
-    let written = a
-        .write_machine
-        .as_ref()
-        .map(|path| write_extended(path, data, &loaded, &dataset, &d, a.force));
+    let written = a.write_machine.as_ref().map(|path| {
+        write_extended(
+            path,
+            data,
+            &loaded,
+            options.rank_reference.as_ref(),
+            &dataset,
+            &d,
+            a.force,
+        )
+    });
     if machine.json {
         outln!("{}", d.to_json());
     } else {
@@ -170,7 +177,7 @@ pub struct Deployed {
 /// it goes in a machine file.
 pub fn deploy(
     nominal: &tricept_kinematics::Machine,
-    rank_reference: Option<tricept_kinematics::Machine>,
+    rank_reference: Option<&tricept_kinematics::Machine>,
     data: &tricept_data::Dataset,
     d: &tricept_diagnose::Diagnosis,
 ) -> Result<Deployed, CliError> {
@@ -179,7 +186,7 @@ pub fn deploy(
     let candidates: Vec<Candidate> = d.model_effects().into_iter().map(Candidate).collect();
     let mut geometric = GeometricModel::new(nominal.clone(), ParameterSet::paper15());
     if let Some(reference) = rank_reference {
-        geometric = geometric.with_rank_reference(reference);
+        geometric = geometric.with_rank_reference(reference.clone());
     }
     let model = ExtendedModel::new(geometric, &candidates);
     let id = identify(&model, &clean, &IdentifyOptions::for_machine(nominal))
@@ -237,6 +244,7 @@ fn write_extended(
     path: &Path,
     data: &Path,
     loaded: &LoadedMachine,
+    rank_reference: Option<&tricept_kinematics::Machine>,
     dataset: &tricept_data::Dataset,
     d: &tricept_diagnose::Diagnosis,
     force: bool,
@@ -296,7 +304,7 @@ fn write_extended(
             ),
         });
     }
-    let deployed = deploy(&loaded.machine, loaded.rank_reference()?, dataset, d)?;
+    let deployed = deploy(&loaded.machine, rank_reference, dataset, d)?;
     let g = ParameterSet::paper15().len();
     let mut effects = Map::new();
     for ((name, v), sd) in deployed
