@@ -448,25 +448,22 @@ fn write_machine(
             if names.len() == 1 { "it" } else { "them" }
         )));
     }
-    let refusal = if !fit.converged {
-        Some((EXIT_NOT_CONVERGED, "the fused fit did not converge"))
+    let (code, why) = if !fit.converged {
+        (EXIT_NOT_CONVERGED, "the fused fit did not converge")
     } else if !fit.is_trustworthy() {
-        Some((
+        (
             EXIT_UNTRUSTED,
             "the model does not explain every source (see the warnings)",
-        ))
+        )
     } else {
-        None
+        (0, "")
     };
-    if let (Some((code, why)), false) = (refusal, a.force) {
-        return Err(CliError {
-            code,
-            message: format!(
-                "--write-machine {}: not written: {why}; --force writes it anyway, marked as forced",
-                path.display()
-            ),
-        });
-    }
+    let forced = machine_file::write_rule(
+        &format!("--write-machine {}", path.display()),
+        code,
+        why,
+        a.force,
+    )?;
     let held: Vec<String> = fit
         .std_dev
         .iter()
@@ -498,7 +495,7 @@ fn write_machine(
             parameter_set: &format!("{} + head", a.settings.params.set()?.label()),
             rejected_lines: Vec::new(),
             adequate: fit.is_trustworthy(),
-            forced: refusal.is_some(),
+            forced,
             warnings: fit.warnings.clone(),
             effects: serde_json::Map::new(),
             n_geometric: fit.names.len(),

@@ -25,6 +25,7 @@ mod args;
 mod cli_error;
 mod compensate_cmd;
 mod diagnose_cmd;
+mod files;
 mod fusion_cmd;
 mod ident_cmd;
 mod kinematics_cmd;
@@ -139,9 +140,113 @@ enum Command {
     Plan(plan_cmd::PlanArgs),
 }
 
+/// The files a verb reads and writes, by flag (checked before it runs:
+/// no output may be an input).
+fn file_roles(command: &Command) -> files::FileRoles {
+    let mut r = files::FileRoles::default();
+    let machine = |r: &mut files::FileRoles, m: &args::MachineArgs| {
+        if let Some(p) = &m.machine {
+            r.input("--machine", p);
+        }
+    };
+    match command {
+        Command::Ik(a) => {
+            machine(&mut r, &a.machine);
+            r.inputs("--input", &a.input.input);
+        }
+        Command::Fk(a) => {
+            machine(&mut r, &a.machine);
+            r.inputs("--input", &a.input.input);
+        }
+        Command::ToolIk(a) => {
+            machine(&mut r, &a.machine);
+            r.inputs("--input", &a.input.input);
+        }
+        Command::Machine(a) => machine(&mut r, &a.machine),
+        Command::Identifiability(a) => {
+            machine(&mut r, &a.machine);
+            r.input_if_file("--poses", &a.poses);
+        }
+        Command::Identify(a) => {
+            machine(&mut r, &a.settings.machine);
+            r.input("--data", &a.data);
+            let x = &a.external;
+            r.inputs("--tracker", &x.tracker);
+            r.inputs("--ballbar", &x.ballbar);
+            r.inputs("--touch", &x.touch);
+            r.inputs("--features", &x.features);
+            if let Some(p) = &a.write_machine {
+                r.output("--write-machine", p);
+            }
+        }
+        Command::Simulate(a) => {
+            machine(&mut r, &a.machine);
+            r.input_if_file("--poses", &a.poses);
+            if let Some(t) = &a.truth.truth {
+                r.input_if_file("--truth", t);
+            }
+            for e in &a.truth.truth_effects {
+                r.input_if_file("--truth-effect", e);
+            }
+            r.input_if_file("--head-errors", &a.head_errors);
+            r.inputs("--tracker-poses", &a.tracker_poses);
+            r.inputs("--ballbar-poses", &a.ballbar_poses);
+            for (flag, p) in [
+                ("--out", &a.out),
+                ("--tracker-out", &a.tracker_out),
+                ("--ballbar-out", &a.ballbar_out),
+            ] {
+                if let Some(p) = p {
+                    r.output(flag, p);
+                }
+            }
+        }
+        Command::Diagnose(a) => {
+            machine(&mut r, &a.machine);
+            r.input("--data", &a.data);
+            r.inputs("--plausibility", &a.plausibility);
+            if let Some(p) = &a.write_machine {
+                r.output("--write-machine", p);
+            }
+        }
+        Command::Detectability(a) => {
+            machine(&mut r, &a.machine);
+            r.input_if_file("--poses", &a.poses);
+        }
+        Command::Compensate(a) => {
+            machine(&mut r, &a.settings.machine);
+            r.inputs("--data", &a.data);
+            r.inputs("--targets", &a.targets);
+            if let Some(t) = &a.truth.truth {
+                r.input_if_file("--truth", t);
+            }
+            for e in &a.truth.truth_effects {
+                r.input_if_file("--truth-effect", e);
+            }
+            if let Some(d) = &a.map {
+                r.outputs_in("--map", d, compensate_cmd::MAP_FILES);
+            }
+            if let Some(d) = &a.table {
+                r.outputs_in("--table", d, compensate_cmd::TABLE_FILES);
+            }
+        }
+        Command::Plan(a) => {
+            machine(&mut r, &a.machine);
+            r.inputs("--data", &a.data);
+            r.input_if_file("--poses", &a.poses);
+            r.input_if_file("--candidates", &a.candidates);
+            if let Some(p) = &a.out {
+                r.output("--out", p);
+            }
+        }
+    }
+    r
+}
+
 /// Runs the verb; `Ok` carries the exit code of a result (0, or the
 /// verdict of a fit: 3 inadequate, 4 not converged).
 fn run(cli: Cli) -> Result<u8, CliError> {
+    file_roles(&cli.command).check()?;
     match cli.command {
         Command::Ik(a) => kinematics_cmd::ik(&a),
         Command::Fk(a) => kinematics_cmd::fk(&a),
@@ -167,11 +272,20 @@ fn main() -> ExitCode {
             return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
         }
     };
-    match run(cli) {
-        Ok(code) => ExitCode::from(code),
+    let code = match run(cli) {
+        Ok(code) => code,
         Err(e) => {
             errln!("error: {}", e.message);
-            ExitCode::from(e.code)
+            e.code
         }
+    };
+    // Output that did not reach stdout (a full disk, an I/O error; not a
+    // closed pipe) makes the run a failure whatever it computed.
+    match output::finish() {
+        Some(e) => {
+            errln!("error: stdout: {e}: the output is incomplete");
+            ExitCode::from(cli_error::EXIT_OTHER)
+        }
+        None => ExitCode::from(code),
     }
 }

@@ -601,16 +601,14 @@ pub fn write_external_to<T: ExternalRecord, W: Write>(
     write_rows(w, data, comments)
 }
 
-/// Writes external records to a file (see [`write_external_to`]).
+/// Writes external records to a file (see [`write_external_to`]),
+/// atomically ([`crate::write_atomic`]).
 pub fn write_external_path<T: ExternalRecord>(
     path: &Path,
     data: &ExternalData<T>,
     comments: &[String],
 ) -> std::io::Result<()> {
-    let f = std::fs::File::create(path)?;
-    let mut w = std::io::BufWriter::new(f);
-    write_rows(&mut w, data, comments)?;
-    w.flush()
+    crate::write_atomic(path, |w| write_rows(w, data, comments))
 }
 
 /// The probe's stylus.

@@ -27,7 +27,7 @@
 //! `error` ([`DataError`]), `records` (the line and record machinery every
 //! reader shares), `read` (the measured-data reader), `targets` (the
 //! target-list reader), `external` (the external-measurement files), `write`
-//! (the writer). Everything is re-exported
+//! (the writer), `atomic` (every file written whole or not at all). Everything is re-exported
 //! here: use `tricept_data::X`.
 //!
 //! # Example
@@ -43,6 +43,7 @@
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
+mod atomic;
 mod error;
 mod external;
 mod pose;
@@ -51,6 +52,7 @@ mod records;
 mod targets;
 mod write;
 
+pub use atomic::write_atomic;
 pub use error::DataError;
 pub use external::{
     BallbarData, BallbarReading, ExternalData, ExternalPose, ExternalRecord, Feature, Features,
