@@ -152,6 +152,13 @@ pub fn load(args: &MachineArgs) -> Result<LoadedMachine, CliError> {
     let machine = description
         .build()
         .map_err(|e| CliError::description(&source, &e))?;
+    if let Some((r, why)) = machine.unreachable_workspace_point() {
+        let w = &machine.workspace;
+        return Err(CliError::input(format!(
+            "{source}: the workspace (radius {} mm, z from {} to {} mm) is not within the machine's reach: at ({:.1}, {:.1}, {:.1}) mm: {why}; shrink `workspace` or correct `limits`",
+            w.radius_mm, w.z_min_mm, w.z_max_mm, r.x, r.y, r.z
+        )));
+    }
     tricept_ident::check_calibration_record(&description)
         .map_err(|e| CliError::input(format!("{source}: {e}")))?;
     if let Some(c) = &description.calibration {
@@ -327,9 +334,14 @@ pub fn parse_errors(spec: &str, set: &ParameterSet) -> Result<Vec<f64>, CliError
             let mag: f64 = parts[0]
                 .parse()
                 .ok()
-                .filter(|v: &f64| v.is_finite() && *v >= 0.0)
+                .filter(|v: &f64| {
+                    v.is_finite() && (0.0..=tricept_model::MAX_PARAMETER_ERROR.0).contains(v)
+                })
                 .ok_or_else(|| {
-                    CliError::input(format!("errors `{s}`: expected random:MAG_MM[,SEED]"))
+                    CliError::input(format!(
+                        "errors `{s}`: expected random:MAG_MM[,SEED] with MAG_MM from 0 to {} mm",
+                        tricept_model::MAX_PARAMETER_ERROR.0
+                    ))
                 })?;
             let seed: u64 = match parts.get(1) {
                 Some(t) => t.parse().map_err(|_| {
@@ -368,10 +380,12 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, CliError> {
             v => vec![v],
         };
         for item in items {
-            out.push(
-                serde_json::from_value(item)
-                    .map_err(|e| CliError::input(format!("{origin}: {e}")))?,
-            );
+            let effect: Effect = serde_json::from_value(item)
+                .map_err(|e| CliError::input(format!("{origin}: {e}")))?;
+            effect
+                .validate()
+                .map_err(|why| CliError::input(format!("{origin}: {why}")))?;
+            out.push(effect);
         }
     }
     Ok(out)

@@ -271,6 +271,11 @@ pub fn run<R: Read, W: Write>(
         }
     }
     out.flush().map_err(io)?;
+    if written == 0 {
+        return Err(BatchError::Input(format!(
+            "{file}: header only, no data rows"
+        )));
+    }
     Ok(written)
 }
 

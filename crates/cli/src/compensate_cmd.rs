@@ -185,6 +185,14 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
             w.z_min_mm, w.z_max_mm
         )));
     }
+    let points = std::f64::consts::PI * (w.radius_mm / a.spacing + 1.0).powi(2);
+    if points > crate::limits::MAX_MAP_POINTS as f64 {
+        return Err(CliError::input(format!(
+            "--spacing {} mm: about {points:.0} map points, more than {}; a coarser spacing is needed",
+            a.spacing,
+            crate::limits::MAX_MAP_POINTS
+        )));
+    }
     let grid = w.disc_grid(z, a.spacing);
     // What compensation changes, as the calibrated model sees it: nominal
     // commands, positions by the calibrated machine.

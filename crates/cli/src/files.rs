@@ -90,6 +90,18 @@ impl FileRoles {
     /// that is a directory, and one whose directory does not exist (unless
     /// the verb creates it).
     pub fn check(&self) -> Result<(), CliError> {
+        for (i, (flag, input)) in self.inputs.iter().enumerate() {
+            if let Some((_, first)) = self.inputs[..i]
+                .iter()
+                .find(|(f, p)| f == flag && same_file(p, input))
+            {
+                return Err(CliError::input(format!(
+                    "{flag} {}: the same file as {flag} {} given before; each file counts once (a repeated tracker file would pass for a second station)",
+                    input.display(),
+                    first.display()
+                )));
+            }
+        }
         for (i, (out_flag, out)) in self.outputs.iter().enumerate() {
             if out.is_dir() {
                 return Err(CliError::input(format!(
@@ -197,9 +209,10 @@ mod tests {
             let mut r = FileRoles::default();
             r.input("--data", &data).output("--write-machine", &clash);
             if clash.starts_with(d.join("sub")) {
-                // A path through a directory that does not exist is not
-                // the input (it cannot be written either).
-                assert!(r.check().is_ok());
+                // A path through a directory that does not exist cannot be
+                // written: refused as such.
+                let e = r.check().unwrap_err();
+                assert!(e.message.contains("does not exist"), "{}", e.message);
                 continue;
             }
             let e = r.check().unwrap_err();

@@ -192,6 +192,12 @@ impl Fit {
 /// unless `--no-robust`); the rank rule of a calibrated machine is its
 /// nominal machine's.
 pub fn fit_from_file(data: &Path, settings: &FitSettings) -> Result<Fit, CliError> {
+    let tolerance_mm = settings.fit.tolerance_mm;
+    if !(tolerance_mm.is_finite() && tolerance_mm > 0.0 && tolerance_mm <= 10.0) {
+        return Err(CliError::input(format!(
+            "--tolerance-mm: the manufacturing tolerance must be a number of mm above 0 and at most 10, got {tolerance_mm}"
+        )));
+    }
     let loaded = load_with_noise(&settings.machine, &settings.noise)?;
     let m = loaded.machine.clone();
     let set = settings.params.set()?;

@@ -29,6 +29,7 @@ mod files;
 mod fusion_cmd;
 mod ident_cmd;
 mod kinematics_cmd;
+mod limits;
 mod machine_file;
 mod output;
 mod plan_cmd;

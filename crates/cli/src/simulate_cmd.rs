@@ -244,9 +244,11 @@ fn parse_head_errors(spec: &str, m: &tricept_kinematics::Machine) -> Result<Vec<
             let scale: f64 = parts[0]
                 .parse()
                 .ok()
-                .filter(|v: &f64| v.is_finite() && *v >= 0.0)
+                .filter(|v: &f64| v.is_finite() && (0.0..=100.0).contains(v))
                 .ok_or_else(|| {
-                    CliError::input(format!("{flag} `{s}`: expected random:SCALE[,SEED]"))
+                    CliError::input(format!(
+                        "{flag} `{s}`: expected random:SCALE[,SEED] with SCALE (times the typical sizes) from 0 to 100"
+                    ))
                 })?;
             let seed: u64 = match parts.get(1) {
                 Some(t) => t.parse().map_err(|_| {

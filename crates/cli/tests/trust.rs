@@ -103,10 +103,14 @@ fn identify(data: &Path, extra: &[&str], machine_out: &Path) -> (i32, serde_json
     assert!(!stderr.contains("panicked"), "{stderr}");
     let code = out.status.code().unwrap();
     let v = json(&out);
-    let expected = match (v["converged"].as_bool(), v["adequate"].as_bool()) {
-        (Some(false), _) => 4,
-        (Some(true), Some(false)) => 3,
-        (Some(true), Some(true)) => 0,
+    let expected = match (
+        v["converged"].as_bool(),
+        v["adequate"].as_bool(),
+        v["worthwhile"].as_bool(),
+    ) {
+        (Some(false), _, _) => 4,
+        (Some(true), Some(false), _) | (Some(true), Some(true), Some(false)) => 3,
+        (Some(true), Some(true), Some(true)) => 0,
         _ => panic!("no verdict in {v}"),
     };
     assert_eq!(
@@ -230,13 +234,19 @@ fn data_that_cannot_come_from_the_machine_get_a_non_zero_code_and_a_named_cause(
 fn a_converged_fit_that_does_not_explain_the_data_exits_3_and_names_diagnose() {
     let dir = workdir("inadequate");
     let data = fixture("data/diagnose-hidden-effect.csv");
-    let (code, v, _) = identify(Path::new(&data), &[], &dir.join("m.json"));
+    let (code, v, stderr) = identify(Path::new(&data), &[], &dir.join("m.json"));
     assert_eq!(code, 3);
     assert!(v["warnings"].to_string().contains("tricept diagnose"));
-    // Written (the fit converged), and marked: not adequate.
+    // Not written: an exit-3 fit is deployed only with --force.
+    assert!(!dir.join("m.json").exists());
+    assert!(stderr.contains("not written"), "{stderr}");
+    let (code, _, _) = identify(Path::new(&data), &["--force"], &dir.join("m.json"));
+    assert_eq!(code, 3);
+    // Written with --force, and marked: forced, not adequate.
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("m.json")).unwrap()).unwrap();
     assert_eq!(m["calibration"]["adequate"], false);
+    assert_eq!(m["calibration"]["forced"], true);
     assert!(
         m["name"]
             .as_str()
@@ -399,7 +409,8 @@ fn deploying_the_diagnosis_delivers_its_gain_on_the_simulated_machine() {
         "--write-machine",
         ext.to_str().unwrap(),
     ]));
-    let (code, _, _) = identify(Path::new(&data), &[], &geo);
+    // The geometric-only calibration is exit 3: written only when forced.
+    let (code, _, _) = identify(Path::new(&data), &["--force"], &geo);
     assert_eq!(code, 3);
     let file: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&ext).unwrap()).unwrap();
@@ -413,9 +424,10 @@ fn deploying_the_diagnosis_delivers_its_gain_on_the_simulated_machine() {
     assert!((c - reported).abs() < 1e-6 * reported, "{c} vs {reported}");
 
     // The maps of the true machine commanded through each file.
-    let map = |machine: &Path, name: &str| -> Vec<[f64; 3]> {
+    // The forced geometric file is compensated only with --force too.
+    let map = |machine: &Path, name: &str, force: &str| -> Vec<[f64; 3]> {
         let out_dir = dir.join(name);
-        let out = run(&[
+        let mut args = vec![
             "compensate",
             "--machine",
             machine.to_str().unwrap(),
@@ -427,8 +439,14 @@ fn deploying_the_diagnosis_delivers_its_gain_on_the_simulated_machine() {
             "50",
             "--map",
             out_dir.to_str().unwrap(),
-        ]);
-        assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+        ];
+        if !force.is_empty() {
+            args.push(force);
+        }
+        let out = run(&args);
+        // A forced compensation still says in its code that it is untrusted.
+        let expected = if force.is_empty() { 0 } else { 3 };
+        assert_eq!(out.status.code(), Some(expected), "{}", text(&out));
         let csv = std::fs::read_to_string(out_dir.join("map.csv")).unwrap();
         let (_, h, rows) = parts(&csv);
         let (x, y, z) = (
@@ -440,7 +458,7 @@ fn deploying_the_diagnosis_delivers_its_gain_on_the_simulated_machine() {
             .map(|r| [x, y, z].map(|i| r[i].parse::<f64>().unwrap()))
             .collect()
     };
-    let (with_geo, with_ext) = (map(&geo, "geo"), map(&ext, "ext"));
+    let (with_geo, with_ext) = (map(&geo, "geo", "--force"), map(&ext, "ext", ""));
     let n = with_geo.len() as f64;
     let moved: f64 = with_geo
         .iter()

@@ -60,6 +60,7 @@ pub use external::{
     read_external_from, read_external_path, write_external_path, write_external_to,
 };
 pub use pose::{Dataset, MeasuredPose, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Readings};
-pub use read::{MAX_ANGLE_SPAN_RAD, read_from, read_path, read_with_progress};
+pub use read::{MAX_ANGLE_SPAN_RAD, MAX_LENGTH_MM, read_from, read_path, read_with_progress};
+pub use records::{MAX_LINE_BYTES, MAX_MAGNITUDE};
 pub use targets::{NumericRows, read_targets, read_targets_from};
 pub use write::{write_path, write_to};

@@ -112,10 +112,14 @@ impl AccuracyModel {
         let mut block = vec![0.0; 3 * k];
         let mut jacobians = Vec::with_capacity(points_mm.len());
         for (j, r) in points_mm.iter().enumerate() {
-            let kinematics = |source| IdentError::Kinematics {
-                pose: j,
-                line: 0,
-                source,
+            let kinematics = |e: tricept_kinematics::KinematicsError| {
+                IdentError::Invalid(format!(
+                    "evaluation point {} ({:.1}, {:.1}, {:.1}) mm: {e}",
+                    j + 1,
+                    r.x,
+                    r.y,
+                    r.z
+                ))
             };
             let up = machine.inverse(r).map_err(kinematics)?.up;
             let p21 = position_error_jacobian(&machine.legs_at(&up)).map_err(kinematics)?;

@@ -106,7 +106,7 @@ pub use record::{RECORD_METHODS, RecordError, check_calibration_record};
 pub use report::{Combination, CorrelatedPair, IdentifiabilityReport, NamedValues, Observability};
 pub use robust::{Rejection, identify_robust, residuals_at, screen_gross_errors};
 pub use suspects::{LikelyCause, likely_causes};
-pub use table::{CompensationTable, SPACING_LADDER_MM};
+pub use table::{CompensationTable, MAX_TABLE_NODES, SPACING_LADDER_MM};
 pub use verdict::{
     ADEQUACY_ALPHA, BARELY_SEEN_STD_DEV_MM, INCONSISTENT_CHI2_PER_DOF, LARGE_ESTIMATE_MM, Verdict,
 };

@@ -171,7 +171,8 @@ fn effect(c: &CalibrationRecord, name: &str) -> Option<f64> {
 fn differences(file: &Machine, rebuilt: &Machine, c: &CalibrationRecord) -> Vec<String> {
     let mut out = Vec::new();
     let mut compare = |field: String, a: f64, b: f64, source: String| {
-        if !((a - b).abs() <= TOLERANCE * (1.0 + b.abs())) {
+        let equal = (a - b).abs() <= TOLERANCE * (1.0 + b.abs());
+        if !equal {
             out.push(format!(
                 "{field} is {a} in the file but {b} from the record{source}"
             ));

@@ -504,6 +504,8 @@ impl MachineDescription {
 
     /// Parses and validates a description from JSON text.
     pub fn from_json(text: &str) -> Result<MachineDescription, DescriptionError> {
+        // A byte-order mark, as some editors write, is not part of the JSON.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let d: MachineDescription = serde_json::from_str(text)?;
         d.validate()?;
         Ok(d)
