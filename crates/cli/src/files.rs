@@ -19,8 +19,14 @@ pub fn write_with<F>(path: &Path, content: F) -> Result<(), CliError>
 where
     F: FnOnce(&mut dyn Write) -> std::io::Result<()>,
 {
-    tricept_data::write_atomic(path, content)
-        .map_err(|e| CliError::other(format!("{}: not written: {e}", path.display())))
+    written(path, tricept_data::write_atomic(path, content))
+}
+
+/// The outcome of an atomic write of `path` by a library writer
+/// (`tricept_data::write_path`, ...), as the CLI reports it: exit 1 naming
+/// the file, which is as it was before.
+pub fn written(path: &Path, result: std::io::Result<()>) -> Result<(), CliError> {
+    result.map_err(|e| CliError::other(format!("{}: not written: {e}", path.display())))
 }
 
 /// Writes `text` to `path` atomically (see [`write_with`]).

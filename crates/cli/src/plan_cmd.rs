@@ -248,15 +248,17 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
             last.k,
             last.planned_um
         )];
-        tricept_data::write_external_path(
+        crate::files::written(
             path,
-            &ExternalData {
-                records,
-                source: String::new(),
-            },
-            &comments,
-        )
-        .map_err(|e| CliError::other(format!("{}: {e}", path.display())))?;
+            tricept_data::write_external_path(
+                path,
+                &ExternalData {
+                    records,
+                    source: String::new(),
+                },
+                &comments,
+            ),
+        )?;
     }
     if a.machine.json {
         outln!(
