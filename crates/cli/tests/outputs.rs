@@ -70,7 +70,10 @@ impl Tmpfs {
         if ok {
             Some(Tmpfs(dir.to_path_buf()))
         } else {
-            eprintln!("SKIP: cannot mount a tmpfs at {} (not root?)", dir.display());
+            eprintln!(
+                "SKIP: cannot mount a tmpfs at {} (not root?)",
+                dir.display()
+            );
             None
         }
     }
@@ -139,7 +142,13 @@ fn a_full_file_system_leaves_every_previous_output_intact() {
     fill(&small);
     let keep = ["calibrated.json", "table.csv", "filler"];
     for args in [
-        vec!["identify", "--data", &data, "--write-machine", m.to_str().unwrap()],
+        vec![
+            "identify",
+            "--data",
+            &data,
+            "--write-machine",
+            m.to_str().unwrap(),
+        ],
         vec![
             "diagnose",
             "--data",
@@ -167,7 +176,11 @@ fn a_full_file_system_leaves_every_previous_output_intact() {
         );
         assert_eq!(std::fs::read(&m).unwrap(), old_machine, "{args:?}");
         assert_eq!(std::fs::read(&table).unwrap(), old_table, "{args:?}");
-        assert!(others(&small, &keep).is_empty(), "{:?}", others(&small, &keep));
+        assert!(
+            others(&small, &keep).is_empty(),
+            "{:?}",
+            others(&small, &keep)
+        );
     }
     drop(fs);
     std::fs::remove_dir_all(&dir).ok();
@@ -259,7 +272,10 @@ fn kill_9_at_any_moment_leaves_the_old_machine_file_or_a_complete_new_one() {
     }
     eprintln!("TALLY kill -9: {kept_old} old, {complete_new} new, 0 damaged of 100");
     // Both outcomes happened: the kills did land before and after the rename.
-    assert!(kept_old > 0 && complete_new > 0, "{kept_old} {complete_new}");
+    assert!(
+        kept_old > 0 && complete_new > 0,
+        "{kept_old} {complete_new}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -270,7 +286,11 @@ fn a_stdout_that_cannot_be_written_is_exit_1_with_a_message() {
     let points = dir.join("points.csv");
     let mut csv = "x,y,z\n".to_string();
     for i in 0..20_000 {
-        csv.push_str(&format!("{},{},760\n", (i % 200) as f64 - 100.0, (i / 200) as f64));
+        csv.push_str(&format!(
+            "{},{},760\n",
+            (i % 200) as f64 - 100.0,
+            (i / 200) as f64
+        ));
     }
     std::fs::write(&points, csv).unwrap();
     let p = points.to_str().unwrap();
@@ -331,15 +351,38 @@ fn an_output_that_is_an_input_is_refused_before_anything_is_computed() {
     std::fs::write(&machine, run(&["machine", "--json"]).stdout).unwrap();
     let mj = machine.to_str().unwrap();
     let cases: Vec<(Vec<&str>, &str)> = vec![
-        (vec!["identify", "--data", d, "--write-machine", d], "--data"),
-        (vec!["identify", "--data", d, "--write-machine", l], "--data"),
-        (vec!["identify", "--data", d, "--write-machine", h], "--data"),
         (
-            vec!["identify", "--data", d, "--machine", mj, "--write-machine", mj],
+            vec!["identify", "--data", d, "--write-machine", d],
+            "--data",
+        ),
+        (
+            vec!["identify", "--data", d, "--write-machine", l],
+            "--data",
+        ),
+        (
+            vec!["identify", "--data", d, "--write-machine", h],
+            "--data",
+        ),
+        (
+            vec![
+                "identify",
+                "--data",
+                d,
+                "--machine",
+                mj,
+                "--write-machine",
+                mj,
+            ],
             "--machine",
         ),
-        (vec!["diagnose", "--data", d, "--write-machine", l], "--data"),
-        (vec!["plan", "--instrument", "tracker", "--data", d, "--out", h], "--data"),
+        (
+            vec!["diagnose", "--data", d, "--write-machine", l],
+            "--data",
+        ),
+        (
+            vec!["plan", "--instrument", "tracker", "--data", d, "--out", h],
+            "--data",
+        ),
         (
             vec!["simulate", "--tracker-poses", p, "--tracker-out", p],
             "--tracker-poses",

@@ -968,3 +968,182 @@ fn diagnose_says_in_its_exit_code_and_its_machine_file_what_it_cannot_deploy() {
     assert!(warnings.contains("external length"), "{warnings}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The mean platform error (mm) of the simulated Table 2 machine on the
+/// middle plane: uncalibrated, and commanded through `machine`.
+fn true_errors(machine: &Path, extra: &[&str]) -> (f64, f64) {
+    let mut args = vec![
+        "compensate",
+        "--machine",
+        machine.to_str().unwrap(),
+        "--truth",
+        "table2",
+        "--spacing",
+        "50",
+        "--json",
+    ];
+    args.extend(extra);
+    let v = json(&run(&args));
+    (
+        v["before"]["mean_mm"].as_f64().unwrap(),
+        v["after"]["mean_mm"].as_f64().unwrap(),
+    )
+}
+
+#[test]
+fn a_campaign_too_small_to_calibrate_is_refused_and_told_what_would_do() {
+    let dir = workdir("small");
+    // Eight poses: one on the axis and one off it on each of four planes.
+    let data = dir.join("eight.csv");
+    let out = run(&[
+        "simulate",
+        "--poses",
+        "grid:1,1,4",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let m = dir.join("m.json");
+    let (code, v, stderr) = identify(&data, &[], &m);
+    assert_eq!(code, 3, "{stderr}");
+    assert_eq!(v["adequate"], true);
+    assert_eq!(v["worthwhile"], false);
+    let a = &v["predicted_accuracy"];
+    assert!(
+        a["after_rms_mm"].as_f64().unwrap() > 0.5 * a["before_rms_mm"].as_f64().unwrap(),
+        "{a}"
+    );
+    assert!(!m.exists(), "a refused campaign must not be written");
+    assert!(
+        stderr.contains("not written: the campaign is too small to calibrate"),
+        "{stderr}"
+    );
+    let w = v["warnings"].to_string();
+    assert!(
+        w.contains("`--poses optimal:") && w.contains("`--poses random:"),
+        "{w}"
+    );
+    // Forced, the file makes the true machine worse than no calibration.
+    let (code, _, _) = identify(&data, &["--force"], &m);
+    assert_eq!(code, 3);
+    let (before, after) = true_errors(&m, &["--force"]);
+    assert!(
+        after > before,
+        "forced: {after} mm against {before} mm uncalibrated"
+    );
+    // The advised campaign is worthwhile, and in truth it is: on three
+    // noise seeds it beats the uncalibrated machine by half.
+    let advice = w
+        .split("`--poses optimal:")
+        .nth(1)
+        .and_then(|s| s.split('`').next())
+        .unwrap()
+        .to_string();
+    for seed in ["1", "2", "3"] {
+        let out = run(&[
+            "simulate",
+            "--poses",
+            &format!("optimal:{advice}"),
+            "--seed",
+            seed,
+            "--out",
+            data.to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+        let (code, v, stderr) = identify(&data, &[], &m);
+        assert_eq!(code, 0, "optimal:{advice}, seed {seed}: {stderr}");
+        assert_eq!(v["worthwhile"], true);
+        let (before, after) = true_errors(&m, &[]);
+        assert!(
+            after < 0.5 * before,
+            "optimal:{advice}, seed {seed}: {after} mm against {before} mm"
+        );
+    }
+    // A realistic campaign (40 random poses) is worthwhile without advice.
+    run(&[
+        "simulate",
+        "--poses",
+        "random:40,7",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    let (code, v, _) = identify(&data, &[], &m);
+    assert_eq!(code, 0);
+    assert!(!v["warnings"].to_string().contains("cannot calibrate"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn compensate_refuses_a_fit_or_a_file_that_is_not_to_be_trusted() {
+    let dir = workdir("compensate-rule");
+    // The compliance fixture: exit 3 (a 12 um sag the geometry absorbs).
+    let data = fixture("data/diagnose-hidden-effect.csv");
+    let table = dir.join("table");
+    let out = run(&[
+        "compensate",
+        "--data",
+        &data,
+        "--table",
+        table.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(3), "{}", text(&out));
+    assert!(text(&out).contains("not written: the model does not explain the data"));
+    assert!(!table.join("table.csv").exists());
+    let out = run(&[
+        "compensate",
+        "--data",
+        &data,
+        "--table",
+        table.to_str().unwrap(),
+        "--force",
+    ]);
+    assert_eq!(out.status.code(), Some(3));
+    assert!(table.join("table.csv").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_recalibration_keeps_a_record_the_file_is_checked_against() {
+    let dir = workdir("chain");
+    let data = fixture("data/table2-grid-seed1.csv");
+    let (m1, m2) = (dir.join("m1.json"), dir.join("m2.json"));
+    assert_eq!(identify(Path::new(&data), &[], &m1).0, 0);
+    let out = run(&[
+        "identify",
+        "--data",
+        &data,
+        "--machine",
+        m1.to_str().unwrap(),
+        "--write-machine",
+        m2.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&m2).unwrap()).unwrap();
+    // Relative to the first calibration, which the record keeps.
+    assert!(d["calibration"]["relative_to_machine"]["calibration"].is_null());
+    assert!(d["calibration"]["relative_to_machine"]["placement"].is_object());
+    assert_eq!(
+        run(&["ik", "0", "0", "750", "--machine", m2.to_str().unwrap()])
+            .status
+            .code(),
+        Some(0)
+    );
+    // A hand edit of the second file is caught as the first one's would be.
+    let mut e = d.clone();
+    let q = e["leg_offsets_mm"][2].as_f64().unwrap();
+    e["leg_offsets_mm"][2] = (q + 0.01).into();
+    std::fs::write(&m2, serde_json::to_string(&e).unwrap()).unwrap();
+    let out = run(&["ik", "0", "0", "750", "--machine", m2.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out).contains("leg_offsets_mm[2]"), "{}", text(&out));
+    // A record that says the fit did not converge loads with a warning.
+    let mut c: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&m1).unwrap()).unwrap();
+    c["calibration"]["converged"] = false.into();
+    std::fs::write(&m1, serde_json::to_string(&c).unwrap()).unwrap();
+    let out = run(&["ik", "0", "0", "750", "--machine", m1.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("did not converge"));
+    std::fs::remove_dir_all(&dir).ok();
+}
