@@ -154,7 +154,16 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
         Some(Err(e)) => Err(e),
         // The verdict in the exit code as in identify's: 3 when the final
         // model (geometric plus the named causes) leaves a misfit.
-        _ if !d.final_adequate => Ok(crate::cli_error::EXIT_INADEQUATE),
+        _ if !d.final_adequate => {
+            errln!(
+                "diagnose: exit {}: the final model does not explain the data: {}",
+                crate::cli_error::EXIT_INADEQUATE,
+                d.unexplained
+                    .as_deref()
+                    .unwrap_or("a remainder is reported (see the report)")
+            );
+            Ok(crate::cli_error::EXIT_INADEQUATE)
+        }
         _ => Ok(0),
     }
 }

@@ -50,7 +50,7 @@ use crate::cli_error::CliError;
     version,
     about,
     long_about = None,
-    after_help = "Examples:\n  tricept ik 0 0 750\n  tricept simulate --out data.csv\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept ik 0 0 750 --machine calibrated.json\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n\nExit codes: 0 success; 2 usage or input error; 3 (identify, compensate) the fit converged but the model does not explain the data (run `tricept diagnose`); 4 (identify, compensate) the fit did not converge; 1 anything else.\nData format: docs/data-format.md"
+    after_help = "Examples:\n  tricept ik 0 0 750\n  tricept simulate --out data.csv\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept ik 0 0 750 --machine calibrated.json\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n\nExit codes: 0 success; 2 usage or input error; 3 (identify, compensate, diagnose) the fit converged but the model does not explain the data (run `tricept diagnose`), or the campaign is too small to calibrate; 4 (identify, compensate) the fit did not converge; 1 anything else, including a stdout that cannot be written (a full disk).\nData format: docs/data-format.md"
 )]
 #[command(subcommand_required = true)]
 struct Cli {
@@ -98,7 +98,7 @@ enum Command {
     /// touch-offs) that also calibrate the head.
     #[command(
         allow_negative_numbers = true,
-        after_help = "Exit codes: 0 converged and adequate (the model explains the data to the sensor noise); 3 converged but the model does not explain the data (the report names `tricept diagnose`); 4 did not converge; 2 bad input. --write-machine refuses a fit that did not converge or data that cannot come from the machine (--force writes it, marked as forced).\n\nWith --tracker, --ballbar, --touch, --head or --effects the fused identification runs (docs/hybrid.md): module, head (13 parameters) and each instrument's nuisance in one fit; exit code 3 when it converges but a source is not explained (reduced chi-square > 3), 4 when it does not converge.\n\nExamples:\n  tricept simulate --out data.csv && tricept identify --data data.csv\n  tricept identify --data data.csv --json\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept identify --data data.csv --tracker points.csv --tracker-target tip --write-machine calibrated.json"
+        after_help = "Exit codes: 0 converged, adequate (the model explains the data to the sensor noise) and worthwhile; 3 converged but the model does not explain the data (the report names `tricept diagnose`), or the campaign is too small to calibrate (the report names the poses that would); 4 did not converge; 2 bad input. --write-machine writes only an exit-0 fit (--force writes any, marked as forced).\n\nWith --tracker, --ballbar, --touch, --head or --effects the fused identification runs (docs/hybrid.md): module, head (13 parameters) and each instrument's nuisance in one fit; exit code 3 when it converges but a source is not explained (reduced chi-square > 3), 4 when it does not converge.\n\nExamples:\n  tricept simulate --out data.csv && tricept identify --data data.csv\n  tricept identify --data data.csv --json\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept identify --data data.csv --tracker points.csv --tracker-target tip --write-machine calibrated.json"
     )]
     Identify(ident_cmd::IdentifyArgs),
     /// Write a measured-data CSV from a simulated machine (Table 2 errors by
