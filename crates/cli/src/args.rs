@@ -8,7 +8,9 @@ use clap::Args;
 use nalgebra::Vector3;
 use tricept_data::Dataset;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
-use tricept_kinematics::{KinematicsError, Machine, MachineDescription, PoseSet, PoseSetError};
+use tricept_kinematics::{
+    KinematicsError, MAX_POSES, Machine, MachineDescription, PoseSet, PoseSetError,
+};
 use tricept_model::ParameterSet;
 use tricept_plant::Effect;
 
@@ -81,6 +83,12 @@ pub struct FitArgs {
     /// file line).
     #[arg(long)]
     pub no_robust: bool,
+    /// Manufacturing tolerance of each geometric parameter, mm: the error a
+    /// machine has without calibration. A campaign whose predicted platform
+    /// accuracy is not at most half of what this tolerance gives is
+    /// refused (exit 3; docs/reliability.md).
+    #[arg(long, default_value_t = tricept_ident::DEFAULT_TOLERANCE_MM, value_name = "MM")]
+    pub tolerance_mm: f64,
 }
 
 /// A machine as loaded: its description (with the calibration record of a
@@ -144,12 +152,25 @@ pub fn load(args: &MachineArgs) -> Result<LoadedMachine, CliError> {
     let machine = description
         .build()
         .map_err(|e| CliError::description(&source, &e))?;
+    if let Some((r, why)) = machine.unreachable_workspace_point() {
+        let w = &machine.workspace;
+        return Err(CliError::input(format!(
+            "{source}: the workspace (radius {} mm, z from {} to {} mm) is not within the machine's reach: at ({:.1}, {:.1}, {:.1}) mm: {why}; shrink `workspace` or correct `limits`",
+            w.radius_mm, w.z_min_mm, w.z_max_mm, r.x, r.y, r.z
+        )));
+    }
+    tricept_ident::check_calibration_record(&description)
+        .map_err(|e| CliError::input(format!("{source}: {e}")))?;
     if let Some(c) = &description.calibration {
         if c.forced {
             errln!(
                 "warning: {source} holds a calibration written with --force although it is not to be trusted (converged: {}, adequate: {})",
                 c.converged,
                 c.adequate
+            );
+        } else if !c.converged {
+            errln!(
+                "warning: {source} holds a calibration whose fit did not converge: its estimates are not a calibration"
             );
         } else if !c.adequate {
             errln!(
@@ -248,6 +269,19 @@ pub fn check_commands(
 /// The target points of a `--poses` spec (a generated set or a CSV file
 /// of `x,y,z`); every problem is an input error.
 pub fn pose_targets(spec: &str, machine: &Machine) -> Result<Vec<Vector3<f64>>, CliError> {
+    if let Some(n) = spec.strip_prefix("optimal:") {
+        let n: usize = n
+            .parse()
+            .ok()
+            .filter(|n| (1..=MAX_POSES).contains(n))
+            .ok_or_else(|| {
+                CliError::input(format!(
+                    "--poses `{spec}`: expected optimal:N with N a whole number from 1 to {MAX_POSES}"
+                ))
+            })?;
+        return tricept_study::campaign::d_optimal_targets(machine, &ParameterSet::paper15(), n)
+            .map_err(|e| CliError::other(format!("--poses `{spec}`: {e}")));
+    }
     let set: PoseSet = spec
         .parse()
         .map_err(|e: PoseSetError| CliError::input(e.to_string()))?;
@@ -300,9 +334,14 @@ pub fn parse_errors(spec: &str, set: &ParameterSet) -> Result<Vec<f64>, CliError
             let mag: f64 = parts[0]
                 .parse()
                 .ok()
-                .filter(|v: &f64| v.is_finite() && *v >= 0.0)
+                .filter(|v: &f64| {
+                    v.is_finite() && (0.0..=tricept_model::MAX_PARAMETER_ERROR.0).contains(v)
+                })
                 .ok_or_else(|| {
-                    CliError::input(format!("errors `{s}`: expected random:MAG_MM[,SEED]"))
+                    CliError::input(format!(
+                        "errors `{s}`: expected random:MAG_MM[,SEED] with MAG_MM from 0 to {} mm",
+                        tricept_model::MAX_PARAMETER_ERROR.0
+                    ))
                 })?;
             let seed: u64 = match parts.get(1) {
                 Some(t) => t.parse().map_err(|_| {
@@ -341,10 +380,12 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, CliError> {
             v => vec![v],
         };
         for item in items {
-            out.push(
-                serde_json::from_value(item)
-                    .map_err(|e| CliError::input(format!("{origin}: {e}")))?,
-            );
+            let effect: Effect = serde_json::from_value(item)
+                .map_err(|e| CliError::input(format!("{origin}: {e}")))?;
+            effect
+                .validate()
+                .map_err(|why| CliError::input(format!("{origin}: {why}")))?;
+            out.push(effect);
         }
     }
     Ok(out)

@@ -252,25 +252,31 @@ pub fn run<R: Read, W: Write>(
 ) -> Result<usize, BatchError> {
     let io = |e: std::io::Error| BatchError::Output(e.to_string());
     let mut written = 0;
+    // The header goes out with the first block: an input without rows
+    // prints nothing and is an error.
     let header = verb.keys().join(",") + "\n";
-    out.write_all(header.as_bytes()).map_err(io)?;
     let input_error = |e: tricept_data::DataError| BatchError::Input(e.to_string());
     match verb {
         Verb::Ik => {
             let rows = NumericRows::new(input, file, ["x", "y", "z"]).map_err(input_error)?;
-            stream(verb, machine, rows, &mut out, &stop, &mut written)?;
+            stream(verb, machine, rows, &header, &mut out, &stop, &mut written)?;
         }
         Verb::Fk => {
             let rows = NumericRows::new(input, file, ["q1", "q2", "q3"]).map_err(input_error)?;
-            stream(verb, machine, rows, &mut out, &stop, &mut written)?;
+            stream(verb, machine, rows, &header, &mut out, &stop, &mut written)?;
         }
         Verb::ToolIk => {
             let rows = NumericRows::new(input, file, ["x", "y", "z", "ax", "ay", "az"])
                 .map_err(input_error)?;
-            stream(verb, machine, rows, &mut out, &stop, &mut written)?;
+            stream(verb, machine, rows, &header, &mut out, &stop, &mut written)?;
         }
     }
     out.flush().map_err(io)?;
+    if written == 0 {
+        return Err(BatchError::Input(format!(
+            "{file}: header only, no data rows"
+        )));
+    }
     Ok(written)
 }
 
@@ -278,6 +284,7 @@ fn stream<const N: usize, R: Read, W: Write>(
     verb: Verb,
     machine: &ExtendedMachine,
     mut rows: NumericRows<'_, R, N>,
+    header: &str,
     out: &mut W,
     stop: &impl Fn() -> bool,
     written: &mut usize,
@@ -321,6 +328,9 @@ fn stream<const N: usize, R: Read, W: Write>(
             })
             .collect();
         text.clear();
+        if *written == 0 && !block.is_empty() {
+            text.extend_from_slice(header.as_bytes());
+        }
         let mut failed = None;
         for r in solved {
             match r {

@@ -13,11 +13,17 @@ use tricept_ident::{CompensationTable, ExtendedMachine};
 use tricept_model::{ErrorMap, MapStats};
 
 use crate::args::{TruthArgs, load, parse_effects, parse_errors};
-use crate::cli_error::{CliError, EXIT_INADEQUATE};
+use crate::cli_error::{CliError, EXIT_INADEQUATE, EXIT_NOT_CONVERGED};
 use crate::ident_cmd::{FitSettings, fit_from_file, rejected_json, report_exit};
+use crate::machine_file;
 
 /// The largest interpolation error (um) the default table spacing allows.
 pub const TABLE_ERROR_LIMIT_UM: f64 = 1.0;
+
+/// The files `--map DIR` writes into DIR.
+pub const MAP_FILES: &[&str] = &["map.csv", "correction.svg", "before.svg", "after.svg"];
+/// The files `--table DIR` writes into DIR.
+pub const TABLE_FILES: &[&str] = &["table.csv"];
 
 /// `tricept compensate`.
 #[derive(Debug, Args)]
@@ -56,8 +62,9 @@ pub struct CompensateArgs {
     /// 40, 25, 20, 10 mm whose measured interpolation error is below 1 um).
     #[arg(long, value_name = "MM")]
     pub table_spacing: Option<f64>,
-    /// Compensate even from a fit that did not converge or data that
-    /// cannot come from the machine.
+    /// Compensate even from a fit that is not to be trusted (exit code 3
+    /// or 4 of `identify`), or from a calibrated machine file that says it
+    /// is not.
     #[arg(long)]
     pub force: bool,
 }
@@ -72,6 +79,8 @@ struct Pair {
     out: Map<String, Value>,
     warnings: Vec<String>,
     code: u8,
+    /// Why the code is not 0.
+    why: String,
 }
 
 fn machines(a: &CompensateArgs) -> Result<Pair, CliError> {
@@ -80,15 +89,7 @@ fn machines(a: &CompensateArgs) -> Result<Pair, CliError> {
         Some(data) => {
             let fit = fit_from_file(data, &a.settings)?;
             let code = fit.exit_code();
-            if let (Some(why), false) = (fit.refusal(), a.force) {
-                return Err(CliError {
-                    code: code.max(EXIT_INADEQUATE),
-                    message: format!(
-                        "compensate: {why} ({}); --force compensates anyway",
-                        fit.verdict.warnings.join("; ")
-                    ),
-                });
-            }
+            machine_file::write_rule("compensate", code, fit.refusal().unwrap_or(""), a.force)?;
             out.insert("data_file".into(), data.display().to_string().into());
             out.insert("converged".into(), fit.verdict.converged.into());
             out.insert("adequate".into(), fit.verdict.adequate.into());
@@ -99,6 +100,7 @@ fn machines(a: &CompensateArgs) -> Result<Pair, CliError> {
                 out,
                 warnings: fit.verdict.warnings.clone(),
                 code,
+                why: fit.refusal().unwrap_or("").to_string(),
             })
         }
         None => {
@@ -113,6 +115,22 @@ fn machines(a: &CompensateArgs) -> Result<Pair, CliError> {
                 .nominal
                 .build()
                 .map_err(|e| CliError::description(&loaded.source, &e))?;
+            let (code, why) = if !c.converged {
+                (EXIT_NOT_CONVERGED, "its calibration did not converge")
+            } else if c.forced || !c.adequate {
+                (
+                    EXIT_INADEQUATE,
+                    "its calibration is not to be trusted (written with --force, or its model did not explain its data)",
+                )
+            } else {
+                (0, "")
+            };
+            machine_file::write_rule(
+                &format!("compensate --machine {}", loaded.source),
+                code,
+                why,
+                a.force,
+            )?;
             out.insert("machine".into(), loaded.description.name.clone().into());
             out.insert("converged".into(), c.converged.into());
             out.insert("adequate".into(), c.adequate.into());
@@ -121,7 +139,8 @@ fn machines(a: &CompensateArgs) -> Result<Pair, CliError> {
                 calibrated: ExtendedMachine::new(loaded.machine),
                 out,
                 warnings: Vec::new(),
-                code: 0,
+                code,
+                why: why.to_string(),
             })
         }
     }
@@ -156,6 +175,7 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
         mut out,
         mut warnings,
         code,
+        why,
     } = machines(a)?;
     let w = &nominal.machine().workspace;
     let z = a.plane_z.unwrap_or_else(|| w.mid_plane_z_mm());
@@ -163,6 +183,14 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
         return Err(CliError::input(format!(
             "--plane-z: {z} mm is outside the workspace, whose z runs from {} to {} mm",
             w.z_min_mm, w.z_max_mm
+        )));
+    }
+    let points = std::f64::consts::PI * (w.radius_mm / a.spacing + 1.0).powi(2);
+    if points > crate::limits::MAX_MAP_POINTS as f64 {
+        return Err(CliError::input(format!(
+            "--spacing {} mm: about {points:.0} map points, more than {}; a coarser spacing is needed",
+            a.spacing,
+            crate::limits::MAX_MAP_POINTS
         )));
     }
     let grid = w.disc_grid(z, a.spacing);
@@ -223,7 +251,7 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
                 table.spacing_mm
             ));
         }
-        let path = dir.join("table.csv");
+        let path = dir.join(TABLE_FILES[0]);
         write_table(&path, &table, error_um, &nominal, &calibrated)?;
         out.insert(
             "table".into(),
@@ -270,7 +298,7 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
             None => crate::output::write_text(&report),
         }
     }
-    report_exit("compensate", code);
+    report_exit("compensate", code, &why);
     Ok(code)
 }
 
@@ -400,8 +428,7 @@ fn write_map(
     truth: Option<&(ErrorMap, ErrorMap)>,
     spacing: f64,
 ) -> Result<(), CliError> {
-    let io = |e: std::io::Error| CliError::other(format!("{}: {e}", dir.display()));
-    std::fs::create_dir_all(dir).map_err(io)?;
+    crate::files::create_dir(dir)?;
     let mut csv = String::new();
     let _ = writeln!(
         csv,
@@ -450,7 +477,7 @@ fn write_map(
         }
         csv.push('\n');
     }
-    std::fs::write(dir.join("map.csv"), csv).map_err(io)?;
+    crate::files::write_text(&dir.join(MAP_FILES[0]), &csv)?;
     let cells = |m: &ErrorMap| -> Vec<tricept_plot::Cell> {
         m.targets_mm
             .iter()
@@ -498,9 +525,8 @@ fn write_table(
     nominal: &ExtendedMachine,
     calibrated: &ExtendedMachine,
 ) -> Result<(), CliError> {
-    let io = |e: std::io::Error| CliError::other(format!("{}: {e}", path.display()));
     if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(io)?;
+        crate::files::create_dir(dir)?;
     }
     let o = t.origin_mm;
     let mut s = String::new();
@@ -545,5 +571,5 @@ fn write_table(
             }
         }
     }
-    std::fs::write(path, s).map_err(io)
+    crate::files::write_text(path, &s)
 }

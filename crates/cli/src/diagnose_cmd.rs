@@ -114,8 +114,7 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
     }
     let d = diagnose(&m, &dataset, &options).map_err(|e| diagnose_error(&source, e))?;
     if let Some(dir) = &a.plots {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| CliError::other(format!("{}: {e}", dir.display())))?;
+        crate::files::create_dir(dir)?;
         for p in &d.plots {
             let path = dir.join(format!("residual-{}.svg", p.effect));
             tricept_plot::scatter(
@@ -155,7 +154,16 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
         Some(Err(e)) => Err(e),
         // The verdict in the exit code as in identify's: 3 when the final
         // model (geometric plus the named causes) leaves a misfit.
-        _ if !d.final_adequate => Ok(crate::cli_error::EXIT_INADEQUATE),
+        _ if !d.final_adequate => {
+            errln!(
+                "diagnose: exit {}: the final model does not explain the data: {}",
+                crate::cli_error::EXIT_INADEQUATE,
+                d.unexplained
+                    .as_deref()
+                    .unwrap_or("a remainder is reported (see the report)")
+            );
+            Ok(crate::cli_error::EXIT_INADEQUATE)
+        }
         _ => Ok(0),
     }
 }
@@ -293,17 +301,16 @@ fn write_extended(
             )
         })
         .collect();
-    let forced = !problems.is_empty();
-    if forced && !force {
-        return Err(CliError {
-            code: crate::cli_error::EXIT_INADEQUATE,
-            message: format!(
-                "--write-machine {}: not written: {}; --force writes the model of the catalogued causes anyway, marked as forced",
-                path.display(),
-                problems.join("; ")
-            ),
-        });
-    }
+    let forced = machine_file::write_rule(
+        &format!("--write-machine {}", path.display()),
+        if problems.is_empty() {
+            0
+        } else {
+            crate::cli_error::EXIT_INADEQUATE
+        },
+        &problems.join("; "),
+        force,
+    )?;
     let deployed = deploy(&loaded.machine, rank_reference, dataset, d)?;
     let g = ParameterSet::paper15().len();
     let mut effects = Map::new();
@@ -328,7 +335,7 @@ fn write_extended(
             data_file: data,
             parameter_set: "paper15",
             rejected_lines,
-            adequate: !forced,
+            adequate: forced.is_none(),
             forced,
             warnings,
             effects,

@@ -21,6 +21,7 @@ use tricept_model::effects::EffectName;
 use crate::args::{check_commands, load_with_noise, read_data};
 use crate::cli_error::{CliError, EXIT_NOT_CONVERGED};
 use crate::ident_cmd::IdentifyArgs;
+use crate::limits;
 use crate::machine_file;
 
 /// Exit code of a fit that converged but that the user must not trust as
@@ -99,7 +100,15 @@ impl ExternalArgs {
 pub fn parse_numbers(flag: &str, text: &str, count: usize) -> Result<Vec<f64>, CliError> {
     let values: Result<Vec<f64>, _> = text.split(',').map(|t| t.trim().parse::<f64>()).collect();
     match values {
-        Ok(v) if v.len() == count && v.iter().all(|x| x.is_finite()) => Ok(v),
+        Ok(v) if v.len() == count && v.iter().all(|x| x.is_finite()) => {
+            if let Some(x) = v.iter().find(|x| x.abs() > limits::MAX_COORDINATE) {
+                return Err(CliError::input(format!(
+                    "{flag}: {x} is beyond ±{} (mm, deg or rad): not a value for this machine",
+                    limits::MAX_COORDINATE
+                )));
+            }
+            Ok(v)
+        }
         _ => Err(CliError::input(format!(
             "{flag}: expected {count} comma-separated numbers, got `{text}`"
         ))),
@@ -109,6 +118,12 @@ pub fn parse_numbers(flag: &str, text: &str, count: usize) -> Result<Vec<f64>, C
 /// A list of angles in degrees, `a,b,c`.
 fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>, CliError> {
     let n = text.split(',').count();
+    if n > limits::MAX_HEAD_ANGLES {
+        return Err(CliError::input(format!(
+            "{flag}: {n} angles; at most {} per head axis",
+            limits::MAX_HEAD_ANGLES
+        )));
+    }
     parse_numbers(flag, text, n)
 }
 
@@ -206,6 +221,12 @@ fn sources(
     let ball = match &x.ballbar_ball_mm {
         Some(t) => {
             let v = parse_numbers("--ballbar-ball-mm", t, 3)?;
+            if let Some(x) = v.iter().find(|x| x.abs() > limits::MAX_TOOL_OFFSET_MM) {
+                return Err(CliError::input(format!(
+                    "--ballbar-ball-mm: {x} mm is beyond ±{} mm from the tool tip",
+                    limits::MAX_TOOL_OFFSET_MM
+                )));
+            }
             [v[0], v[1], v[2]]
         }
         None => [0.0; 3],
@@ -307,6 +328,13 @@ pub fn eval_options(
         )));
     }
     let (h1, h2) = parse_head_angles("--eval-head-angles-deg", angles)?;
+    let poses = (g[0] * g[1] + 1.0) * g[2] * (h1.len() * h2.len()) as f64;
+    if poses > limits::MAX_EVAL_POSES as f64 {
+        return Err(CliError::input(format!(
+            "--eval-grid {grid} with --eval-head-angles-deg {angles}: {poses} evaluation poses; at most {}",
+            limits::MAX_EVAL_POSES
+        )));
+    }
     let mut options = FusionOptions::for_machine(machine);
     options.eval_poses = evaluation_poses(
         machine,
@@ -448,25 +476,22 @@ fn write_machine(
             if names.len() == 1 { "it" } else { "them" }
         )));
     }
-    let refusal = if !fit.converged {
-        Some((EXIT_NOT_CONVERGED, "the fused fit did not converge"))
+    let (code, why) = if !fit.converged {
+        (EXIT_NOT_CONVERGED, "the fused fit did not converge")
     } else if !fit.is_trustworthy() {
-        Some((
+        (
             EXIT_UNTRUSTED,
             "the model does not explain every source (see the warnings)",
-        ))
+        )
     } else {
-        None
+        (0, "")
     };
-    if let (Some((code, why)), false) = (refusal, a.force) {
-        return Err(CliError {
-            code,
-            message: format!(
-                "--write-machine {}: not written: {why}; --force writes it anyway, marked as forced",
-                path.display()
-            ),
-        });
-    }
+    let forced = machine_file::write_rule(
+        &format!("--write-machine {}", path.display()),
+        code,
+        why,
+        a.force,
+    )?;
     let held: Vec<String> = fit
         .std_dev
         .iter()
@@ -498,7 +523,7 @@ fn write_machine(
             parameter_set: &format!("{} + head", a.settings.params.set()?.label()),
             rejected_lines: Vec::new(),
             adequate: fit.is_trustworthy(),
-            forced: refusal.is_some(),
+            forced,
             warnings: fit.warnings.clone(),
             effects: serde_json::Map::new(),
             n_geometric: fit.names.len(),

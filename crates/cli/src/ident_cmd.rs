@@ -7,11 +7,12 @@ use clap::Args;
 use serde_json::{Map, Value, json};
 use tricept_data::MeasuredPose;
 use tricept_ident::{
-    GeometricModel, IdentError, Identification, IdentifyOptions, Rejection, Verdict,
-    identifiability, identify, identify_robust, likely_causes,
+    AccuracyModel, GeometricModel, IdentError, Identification, IdentifyOptions, PredictedAccuracy,
+    Rejection, Verdict, identifiability, identify, identify_robust, likely_causes,
 };
 use tricept_kinematics::Machine;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
+use tricept_model::ParameterSet;
 
 use crate::args::{
     FitArgs, LoadedMachine, MachineArgs, NoiseArgs, ParamArgs, load_with_noise, machine_with_noise,
@@ -143,31 +144,39 @@ pub struct Fit {
     pub id: Identification,
     /// Poses rejected as gross errors.
     pub rejected: Vec<Rejection>,
-    /// The verdict, with the likely causes of an inconsistent fit added to
-    /// its warnings.
+    /// The verdict, with the likely causes of an inconsistent fit and the
+    /// advice of a campaign too small to calibrate added to its warnings.
     pub verdict: Verdict,
+    /// The platform accuracy the fit predicts, against the machine's
+    /// tolerance.
+    pub accuracy: PredictedAccuracy,
 }
 
 impl Fit {
-    /// The exit code the verdict calls for: 0 converged and adequate, 3
-    /// converged but inadequate, 4 not converged.
+    /// The exit code the verdict calls for: 0 converged, adequate and
+    /// worthwhile; 3 converged but inadequate, or a campaign too small to
+    /// calibrate; 4 not converged.
     pub fn exit_code(&self) -> u8 {
         if !self.verdict.converged {
             EXIT_NOT_CONVERGED
-        } else if !self.verdict.adequate {
+        } else if !self.verdict.adequate || !self.accuracy.worthwhile {
             EXIT_INADEQUATE
         } else {
             0
         }
     }
 
-    /// Why the fit must not be deployed (`None` when it may): not converged,
-    /// or data that cannot come from the machine.
+    /// Why the fit must not be deployed (`None` when it may): every exit
+    /// code but 0 (see [`machine_file::write_rule`]).
     pub fn refusal(&self) -> Option<&'static str> {
         if !self.verdict.converged {
             Some("the fit did not converge")
         } else if self.verdict.inconsistent {
             Some("the data cannot come from the described machine")
+        } else if !self.verdict.adequate {
+            Some("the model does not explain the data")
+        } else if !self.accuracy.worthwhile {
+            Some("the campaign is too small to calibrate the machine")
         } else {
             None
         }
@@ -183,6 +192,12 @@ impl Fit {
 /// unless `--no-robust`); the rank rule of a calibrated machine is its
 /// nominal machine's.
 pub fn fit_from_file(data: &Path, settings: &FitSettings) -> Result<Fit, CliError> {
+    let tolerance_mm = settings.fit.tolerance_mm;
+    if !(tolerance_mm.is_finite() && tolerance_mm > 0.0 && tolerance_mm <= 10.0) {
+        return Err(CliError::input(format!(
+            "--tolerance-mm: the manufacturing tolerance must be a number of mm above 0 and at most 10, got {tolerance_mm}"
+        )));
+    }
     let loaded = load_with_noise(&settings.machine, &settings.noise)?;
     let m = loaded.machine.clone();
     let set = settings.params.set()?;
@@ -225,24 +240,79 @@ pub fn fit_from_file(data: &Path, settings: &FitSettings) -> Result<Fit, CliErro
             ));
         }
     }
+    let accuracy = predicted_accuracy(&m, &set, &id, settings.fit.tolerance_mm)?;
+    if !accuracy.worthwhile {
+        verdict
+            .warnings
+            .push(campaign_advice(&m, &set, &accuracy, id.residuals.len())?);
+    }
     Ok(Fit {
         loaded,
         model,
         id,
         rejected,
         verdict,
+        accuracy,
     })
 }
 
-/// One-line stderr summary of a non-zero verdict (scripts read the code,
-/// people read this).
-pub fn report_exit(verb: &str, code: u8) {
-    match code {
-        EXIT_INADEQUATE => errln!(
-            "{verb}: exit {code}: the fit converged but the model does not explain the data (see the warnings)"
+/// Evaluation points of the predicted platform accuracy: the workspace's
+/// polar grid of 2 rings of 8 points on 3 levels (51 points).
+pub fn accuracy_points(m: &Machine) -> Vec<nalgebra::Vector3<f64>> {
+    m.workspace.polar_grid(2, 8, 3)
+}
+
+/// The platform accuracy `id` predicts on `m`'s workspace against the
+/// tolerance `tolerance_mm` per parameter.
+fn predicted_accuracy(
+    m: &Machine,
+    set: &ParameterSet,
+    id: &Identification,
+    tolerance_mm: f64,
+) -> Result<PredictedAccuracy, CliError> {
+    let model =
+        AccuracyModel::new(m, set, &accuracy_points(m), tolerance_mm).map_err(|e| match e {
+            IdentError::Invalid(why) => CliError::input(format!("--tolerance-mm: {why}")),
+            e => CliError::other(format!("predicted accuracy: {e}")),
+        })?;
+    model
+        .assess(&id.covariance, id.design().fixed())
+        .map_err(|e| CliError::other(format!("predicted accuracy: {e}")))
+}
+
+/// Why a campaign cannot calibrate, and how many and which poses would.
+fn campaign_advice(
+    m: &Machine,
+    set: &ParameterSet,
+    a: &PredictedAccuracy,
+    poses: usize,
+) -> Result<String, CliError> {
+    let model = AccuracyModel::new(m, set, &accuracy_points(m), a.tolerance_mm)
+        .map_err(|e| CliError::other(format!("campaign advice: {e}")))?;
+    let (optimal, random) = tricept_study::campaign::worthwhile_campaigns(m, set, &model)
+        .map_err(|e| CliError::other(format!("campaign advice: {e}")))?;
+    let fix = match (optimal, random) {
+        (Some(o), Some(r)) => format!(
+            "{} D-optimal poses (`--poses optimal:{}`, predicted {:.3} mm) or {} random poses over the workspace (`--poses random:{},1`, predicted {:.3} mm) would be worthwhile",
+            o.poses, o.poses, o.predicted.after_rms_mm, r.poses, r.poses, r.predicted.after_rms_mm
         ),
-        EXIT_NOT_CONVERGED => errln!("{verb}: exit {code}: the fit did not converge"),
-        _ => {}
+        (Some(o), None) => format!(
+            "{} D-optimal poses (`--poses optimal:{}`, predicted {:.3} mm) would be worthwhile",
+            o.poses, o.poses, o.predicted.after_rms_mm
+        ),
+        _ => "no campaign of up to 200 poses of these sensors would be: better sensors or external measurements are needed (docs/hybrid.md)".to_string(),
+    };
+    Ok(format!(
+        "this campaign cannot calibrate the machine: the predicted platform error after calibration is {:.3} mm rms (up to {:.3} mm), against {:.3} mm for a machine built to {} mm per parameter and not calibrated; a calibration must at least halve it. {poses} poses are too few or too poorly spread: {fix}",
+        a.after_rms_mm, a.after_max_mm, a.before_rms_mm, a.tolerance_mm
+    ))
+}
+
+/// One-line stderr summary of a non-zero verdict (scripts read the code,
+/// people read this): the verb, the code and why.
+pub fn report_exit(verb: &str, code: u8, why: &str) {
+    if code == EXIT_INADEQUATE || code == EXIT_NOT_CONVERGED {
+        errln!("{verb}: exit {code}: {why} (see the warnings)");
     }
 }
 
@@ -250,16 +320,12 @@ pub fn report_exit(verb: &str, code: u8) {
 /// (then only with `force`, marked as forced). Returns an error when it
 /// refuses.
 fn write_calibrated(path: &Path, data: &Path, fit: &Fit, force: bool) -> Result<(), CliError> {
-    let refusal = fit.refusal();
-    if let (Some(why), false) = (refusal, force) {
-        return Err(CliError {
-            code: fit.exit_code().max(EXIT_INADEQUATE),
-            message: format!(
-                "--write-machine {}: not written: {why}; --force writes it anyway, marked as forced",
-                path.display()
-            ),
-        });
-    }
+    let forced = machine_file::write_rule(
+        &format!("--write-machine {}", path.display()),
+        fit.exit_code(),
+        fit.refusal().unwrap_or(""),
+        force,
+    )?;
     let d = machine_file::calibrated_description(
         &fit.loaded,
         &fit.identified(),
@@ -270,7 +336,7 @@ fn write_calibrated(path: &Path, data: &Path, fit: &Fit, force: bool) -> Result<
             parameter_set: fit.model.parameter_set().label(),
             rejected_lines: fit.rejected.iter().map(|r| r.line).collect(),
             adequate: fit.verdict.adequate,
-            forced: refusal.is_some(),
+            forced,
             warnings: fit.verdict.warnings.clone(),
             effects: Map::new(),
             n_geometric: fit.id.names.len(),
@@ -311,6 +377,11 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
         if let Value::Object(o) = &mut v {
             o.insert("rejected".into(), rejected_json(&fit.rejected));
             o.insert("warnings".into(), fit.verdict.warnings.clone().into());
+            o.insert(
+                "predicted_accuracy".into(),
+                serde_json::to_value(fit.accuracy).unwrap_or(Value::Null),
+            );
+            o.insert("worthwhile".into(), fit.accuracy.worthwhile.into());
             o.insert("machine".into(), fit.loaded.description.name.clone().into());
             o.insert("data_file".into(), data.display().to_string().into());
         }
@@ -321,7 +392,7 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
     if let Some(Err(e)) = written {
         return Err(e);
     }
-    report_exit("identify", code);
+    report_exit("identify", code, fit.refusal().unwrap_or(""));
     Ok(code)
 }
 
@@ -379,8 +450,17 @@ fn print_identification(fit: &Fit, data: &Path) {
         id.lines.get(j).copied().unwrap_or(0)
     );
     crate::output::write_text(&id.report.to_text());
+    let a = &fit.accuracy;
     outln!(
-        "verdict: {}, {}",
+        "predicted platform error after calibration: {:.4} mm rms (up to {:.4} mm at one of {} points), against {:.4} mm without calibration ({} mm per parameter)",
+        a.after_rms_mm,
+        a.after_max_mm,
+        a.points,
+        a.before_rms_mm,
+        a.tolerance_mm
+    );
+    outln!(
+        "verdict: {}, {}, {}",
         if fit.verdict.converged {
             "converged"
         } else {
@@ -390,6 +470,11 @@ fn print_identification(fit: &Fit, data: &Path) {
             "adequate (the model explains the data to the sensor noise)"
         } else {
             "NOT adequate (the model does not explain the data)"
+        },
+        if a.worthwhile {
+            "worthwhile (it at least halves the platform error)"
+        } else {
+            "NOT worthwhile (the campaign is too small to calibrate)"
         }
     );
     for w in &fit.verdict.warnings {

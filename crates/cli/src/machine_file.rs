@@ -31,8 +31,9 @@ pub struct Provenance<'a> {
     pub rejected_lines: Vec<u64>,
     /// Adequacy of the model.
     pub adequate: bool,
-    /// Written with `--force`.
-    pub forced: bool,
+    /// Why the fit is not to be trusted, when it was written with
+    /// `--force` anyway ([`write_rule`]).
+    pub forced: Option<String>,
     /// Warnings of the fit.
     pub warnings: Vec<String>,
     /// Effect parameters (`{name: {"value", "std_dev"}}`), for `diagnose`.
@@ -103,6 +104,36 @@ impl<'a> FitRecord<'a> {
             converged: fit.converged,
             poses_used: internal.map_or(0, |s| s.records),
         }
+    }
+}
+
+/// The one rule for writing a calibration, shared by `identify`,
+/// `diagnose`, the fused path and `compensate`: a fit whose exit code is 0
+/// is deployed; one whose code is 3 (the model does not explain the data,
+/// or the campaign cannot calibrate) or 4 (the fit did not converge) only
+/// with `--force`, and the file then says so (`calibration.forced`, its
+/// name, its first warning). `why` is the reason of a non-zero code.
+///
+/// Returns the reason a forced write carries (`None` for a trusted fit),
+/// or refuses with the fit's exit code, naming `what` (the flag and file).
+pub fn write_rule(
+    what: &str,
+    code: u8,
+    why: &str,
+    force: bool,
+) -> Result<Option<String>, CliError> {
+    match (code, force) {
+        (0, _) => Ok(None),
+        (_, true) => {
+            errln!("warning: {what}: written with --force although {why}");
+            Ok(Some(why.to_string()))
+        }
+        (_, false) => Err(CliError {
+            code,
+            message: format!(
+                "{what}: not written: {why}; --force writes it anyway, marked as forced"
+            ),
+        }),
     }
 }
 
@@ -214,14 +245,10 @@ pub fn calibrated_description(
     let data_name = p.data_file.display().to_string();
     let mut d = identified.to_description();
     d.controller = controller.or(base.description.controller);
-    let status = if !id.converged {
-        " (FORCED: the fit did not converge)"
-    } else if p.forced {
-        " (FORCED: the data do not fit the machine)"
-    } else if !p.adequate {
-        " (the model does not explain the data)"
-    } else {
-        ""
+    let status = match (&p.forced, p.adequate) {
+        (Some(why), _) => format!(" (FORCED: {why})"),
+        (None, false) => " (the model does not explain the data)".to_string(),
+        (None, true) => String::new(),
     };
     d.name = format!(
         "{}, calibrated {} from {}{status}",
@@ -265,8 +292,13 @@ pub fn calibrated_description(
         dof: id.dof,
         converged: id.converged,
         adequate: p.adequate,
-        forced: p.forced,
-        warnings: p.warnings,
+        forced: p.forced.is_some(),
+        warnings: p
+            .forced
+            .iter()
+            .map(|why| format!("written with --force although {why}"))
+            .chain(p.warnings)
+            .collect(),
         poses_used: id.poses_used,
         external_sources: p
             .external
@@ -287,6 +319,11 @@ pub fn calibrated_description(
         date,
         tool_version: env!("CARGO_PKG_VERSION").to_string(),
         relative_to: base.description.name.clone(),
+        relative_to_machine: base.description.calibration.as_ref().map(|_| {
+            let mut b = base.description.clone();
+            b.calibration = None;
+            Box::new(b)
+        }),
         nominal: Box::new(nominal),
     }));
     // What is written must load back.
@@ -297,8 +334,7 @@ pub fn calibrated_description(
 
 /// Writes a description to `path`.
 pub fn write(path: &Path, d: &MachineDescription) -> Result<(), CliError> {
-    std::fs::write(path, d.to_json() + "\n")
-        .map_err(|e| CliError::other(format!("{}: {e}", path.display())))
+    crate::files::write_text(path, &(d.to_json() + "\n"))
 }
 
 #[cfg(test)]

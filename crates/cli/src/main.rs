@@ -25,9 +25,11 @@ mod args;
 mod cli_error;
 mod compensate_cmd;
 mod diagnose_cmd;
+mod files;
 mod fusion_cmd;
 mod ident_cmd;
 mod kinematics_cmd;
+mod limits;
 mod machine_file;
 mod output;
 mod plan_cmd;
@@ -48,7 +50,7 @@ use crate::cli_error::CliError;
     version,
     about,
     long_about = None,
-    after_help = "Examples:\n  tricept ik 0 0 750\n  tricept simulate --out data.csv\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept ik 0 0 750 --machine calibrated.json\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n\nExit codes: 0 success; 2 usage or input error; 3 (identify, compensate) the fit converged but the model does not explain the data (run `tricept diagnose`); 4 (identify, compensate) the fit did not converge; 1 anything else.\nData format: docs/data-format.md"
+    after_help = "Examples:\n  tricept ik 0 0 750\n  tricept simulate --out data.csv\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept ik 0 0 750 --machine calibrated.json\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n\nExit codes: 0 success; 2 usage or input error; 3 (identify, compensate, diagnose) the fit converged but the model does not explain the data (run `tricept diagnose`), or the campaign is too small to calibrate; 4 (identify, compensate) the fit did not converge; 1 anything else, including a stdout that cannot be written (a full disk).\nData format: docs/data-format.md"
 )]
 #[command(subcommand_required = true)]
 struct Cli {
@@ -96,7 +98,7 @@ enum Command {
     /// touch-offs) that also calibrate the head.
     #[command(
         allow_negative_numbers = true,
-        after_help = "Exit codes: 0 converged and adequate (the model explains the data to the sensor noise); 3 converged but the model does not explain the data (the report names `tricept diagnose`); 4 did not converge; 2 bad input. --write-machine refuses a fit that did not converge or data that cannot come from the machine (--force writes it, marked as forced).\n\nWith --tracker, --ballbar, --touch, --head or --effects the fused identification runs (docs/hybrid.md): module, head (13 parameters) and each instrument's nuisance in one fit; exit code 3 when it converges but a source is not explained (reduced chi-square > 3), 4 when it does not converge.\n\nExamples:\n  tricept simulate --out data.csv && tricept identify --data data.csv\n  tricept identify --data data.csv --json\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept identify --data data.csv --tracker points.csv --tracker-target tip --write-machine calibrated.json"
+        after_help = "Exit codes: 0 converged, adequate (the model explains the data to the sensor noise) and worthwhile; 3 converged but the model does not explain the data (the report names `tricept diagnose`), or the campaign is too small to calibrate (the report names the poses that would); 4 did not converge; 2 bad input. --write-machine writes only an exit-0 fit (--force writes any, marked as forced).\n\nWith --tracker, --ballbar, --touch, --head or --effects the fused identification runs (docs/hybrid.md): module, head (13 parameters) and each instrument's nuisance in one fit; exit code 3 when it converges but a source is not explained (reduced chi-square > 3), 4 when it does not converge.\n\nExamples:\n  tricept simulate --out data.csv && tricept identify --data data.csv\n  tricept identify --data data.csv --json\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept identify --data data.csv --tracker points.csv --tracker-target tip --write-machine calibrated.json"
     )]
     Identify(ident_cmd::IdentifyArgs),
     /// Write a measured-data CSV from a simulated machine (Table 2 errors by
@@ -139,9 +141,113 @@ enum Command {
     Plan(plan_cmd::PlanArgs),
 }
 
+/// The files a verb reads and writes, by flag (checked before it runs:
+/// no output may be an input).
+fn file_roles(command: &Command) -> files::FileRoles {
+    let mut r = files::FileRoles::default();
+    let machine = |r: &mut files::FileRoles, m: &args::MachineArgs| {
+        if let Some(p) = &m.machine {
+            r.input("--machine", p);
+        }
+    };
+    match command {
+        Command::Ik(a) => {
+            machine(&mut r, &a.machine);
+            r.inputs("--input", &a.input.input);
+        }
+        Command::Fk(a) => {
+            machine(&mut r, &a.machine);
+            r.inputs("--input", &a.input.input);
+        }
+        Command::ToolIk(a) => {
+            machine(&mut r, &a.machine);
+            r.inputs("--input", &a.input.input);
+        }
+        Command::Machine(a) => machine(&mut r, &a.machine),
+        Command::Identifiability(a) => {
+            machine(&mut r, &a.machine);
+            r.input_if_file("--poses", &a.poses);
+        }
+        Command::Identify(a) => {
+            machine(&mut r, &a.settings.machine);
+            r.input("--data", &a.data);
+            let x = &a.external;
+            r.inputs("--tracker", &x.tracker);
+            r.inputs("--ballbar", &x.ballbar);
+            r.inputs("--touch", &x.touch);
+            r.inputs("--features", &x.features);
+            if let Some(p) = &a.write_machine {
+                r.output("--write-machine", p);
+            }
+        }
+        Command::Simulate(a) => {
+            machine(&mut r, &a.machine);
+            r.input_if_file("--poses", &a.poses);
+            if let Some(t) = &a.truth.truth {
+                r.input_if_file("--truth", t);
+            }
+            for e in &a.truth.truth_effects {
+                r.input_if_file("--truth-effect", e);
+            }
+            r.input_if_file("--head-errors", &a.head_errors);
+            r.inputs("--tracker-poses", &a.tracker_poses);
+            r.inputs("--ballbar-poses", &a.ballbar_poses);
+            for (flag, p) in [
+                ("--out", &a.out),
+                ("--tracker-out", &a.tracker_out),
+                ("--ballbar-out", &a.ballbar_out),
+            ] {
+                if let Some(p) = p {
+                    r.output(flag, p);
+                }
+            }
+        }
+        Command::Diagnose(a) => {
+            machine(&mut r, &a.machine);
+            r.input("--data", &a.data);
+            r.inputs("--plausibility", &a.plausibility);
+            if let Some(p) = &a.write_machine {
+                r.output("--write-machine", p);
+            }
+        }
+        Command::Detectability(a) => {
+            machine(&mut r, &a.machine);
+            r.input_if_file("--poses", &a.poses);
+        }
+        Command::Compensate(a) => {
+            machine(&mut r, &a.settings.machine);
+            r.inputs("--data", &a.data);
+            r.inputs("--targets", &a.targets);
+            if let Some(t) = &a.truth.truth {
+                r.input_if_file("--truth", t);
+            }
+            for e in &a.truth.truth_effects {
+                r.input_if_file("--truth-effect", e);
+            }
+            if let Some(d) = &a.map {
+                r.outputs_in("--map", d, compensate_cmd::MAP_FILES);
+            }
+            if let Some(d) = &a.table {
+                r.outputs_in("--table", d, compensate_cmd::TABLE_FILES);
+            }
+        }
+        Command::Plan(a) => {
+            machine(&mut r, &a.machine);
+            r.inputs("--data", &a.data);
+            r.input_if_file("--poses", &a.poses);
+            r.input_if_file("--candidates", &a.candidates);
+            if let Some(p) = &a.out {
+                r.output("--out", p);
+            }
+        }
+    }
+    r
+}
+
 /// Runs the verb; `Ok` carries the exit code of a result (0, or the
 /// verdict of a fit: 3 inadequate, 4 not converged).
 fn run(cli: Cli) -> Result<u8, CliError> {
+    file_roles(&cli.command).check()?;
     match cli.command {
         Command::Ik(a) => kinematics_cmd::ik(&a),
         Command::Fk(a) => kinematics_cmd::fk(&a),
@@ -167,11 +273,20 @@ fn main() -> ExitCode {
             return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
         }
     };
-    match run(cli) {
-        Ok(code) => ExitCode::from(code),
+    let code = match run(cli) {
+        Ok(code) => code,
         Err(e) => {
             errln!("error: {}", e.message);
-            ExitCode::from(e.code)
+            e.code
         }
+    };
+    // Output that did not reach stdout (a full disk, an I/O error; not a
+    // closed pipe) makes the run a failure whatever it computed.
+    match output::finish() {
+        Some(e) => {
+            errln!("error: stdout: {e}: the output is incomplete");
+            ExitCode::from(cli_error::EXIT_OTHER)
+        }
+        None => ExitCode::from(code),
     }
 }

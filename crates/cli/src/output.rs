@@ -1,22 +1,56 @@
 //! Printing results: aligned text for people, JSON for programs, CSV for
-//! batches; every path safe on a closed stdout.
+//! batches; every path safe on a closed stdout, and loud on a failed one.
 //!
-//! When stdout is closed (`tricept identify ... | head -1`), printing stops
-//! quietly: the first failed write marks stdout closed, later writes are
-//! skipped, and the command finishes its other work (a machine file to
-//! write, its exit code) as if it had printed everything. Nothing here
-//! panics on a write error, on stdout or stderr.
+//! Two failures of stdout are told apart:
+//!
+//! - **a closed pipe** (`tricept identify ... | head -1`): the reader has
+//!   what it wanted. Printing stops quietly: the first failed write marks
+//!   stdout closed, later writes are skipped, and the command finishes its
+//!   other work (a machine file to write, its exit code) as if it had
+//!   printed everything;
+//! - **any other error** (a full disk, an I/O error, `/dev/full`): the output
+//!   is incomplete, and a controller fed it would get a silently short
+//!   program. Printing stops the same way, the error is kept, and
+//!   [`finish`] turns it into exit code 1 with a message.
+//!
+//! Nothing here panics on a write error, on stdout or stderr.
 
 use std::io::Write;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use serde_json::{Map, Value};
 
 static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
+static STDOUT_ERROR: Mutex<Option<String>> = Mutex::new(None);
 
-/// Whether a write to stdout has failed (a closed pipe).
+/// Whether a write to stdout has failed (a closed pipe or an error): loops
+/// producing output check this to stop early.
 pub fn stdout_closed() -> bool {
     STDOUT_CLOSED.load(Ordering::Relaxed)
+}
+
+/// Records a failed write to stdout: a broken pipe only closes it, any
+/// other error is kept for [`finish`].
+fn failed(e: &std::io::Error) {
+    STDOUT_CLOSED.store(true, Ordering::Relaxed);
+    if e.kind() != std::io::ErrorKind::BrokenPipe
+        && let Ok(mut slot) = STDOUT_ERROR.lock()
+        && slot.is_none()
+    {
+        *slot = Some(e.to_string());
+    }
+}
+
+/// Flushes stdout and returns the first write error that was not a closed
+/// pipe (`None` when everything printed, or the reader went away).
+pub fn finish() -> Option<String> {
+    if !stdout_closed()
+        && let Err(e) = std::io::stdout().lock().flush()
+    {
+        failed(&e);
+    }
+    STDOUT_ERROR.lock().ok().and_then(|slot| slot.clone())
 }
 
 /// Writes `args` and a newline to stdout unless it is closed.
@@ -25,12 +59,8 @@ pub fn write_line(args: std::fmt::Arguments<'_>) {
         return;
     }
     let mut out = std::io::stdout().lock();
-    if out
-        .write_fmt(args)
-        .and_then(|_| out.write_all(b"\n"))
-        .is_err()
-    {
-        STDOUT_CLOSED.store(true, Ordering::Relaxed);
+    if let Err(e) = out.write_fmt(args).and_then(|_| out.write_all(b"\n")) {
+        failed(&e);
     }
 }
 
@@ -39,8 +69,8 @@ pub fn write_text(text: &str) {
     if stdout_closed() {
         return;
     }
-    if std::io::stdout().lock().write_all(text.as_bytes()).is_err() {
-        STDOUT_CLOSED.store(true, Ordering::Relaxed);
+    if let Err(e) = std::io::stdout().lock().write_all(text.as_bytes()) {
+        failed(&e);
     }
 }
 
@@ -51,22 +81,27 @@ pub fn write_err_line(args: std::fmt::Arguments<'_>) {
     let _ = err.write_fmt(args).and_then(|_| err.write_all(b"\n"));
 }
 
-/// Stdout as a [`Write`] for bulk output (CSV): a write to a closed stdout
-/// marks it closed and reports success, so that a writer stops caring; a
-/// loop producing the output should check [`stdout_closed`] to stop early.
+/// Stdout as a [`Write`] for bulk output (CSV): a failed write marks stdout
+/// closed (keeping an error that is not a closed pipe for [`finish`]) and
+/// reports success, so that a writer stops caring; a loop producing the
+/// output should check [`stdout_closed`] to stop early.
 pub struct Stdout;
 
 impl Write for Stdout {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        if !stdout_closed() && std::io::stdout().lock().write_all(buf).is_err() {
-            STDOUT_CLOSED.store(true, Ordering::Relaxed);
+        if !stdout_closed()
+            && let Err(e) = std::io::stdout().lock().write_all(buf)
+        {
+            failed(&e);
         }
         Ok(buf.len())
     }
 
     fn flush(&mut self) -> std::io::Result<()> {
-        if !stdout_closed() && std::io::stdout().lock().flush().is_err() {
-            STDOUT_CLOSED.store(true, Ordering::Relaxed);
+        if !stdout_closed()
+            && let Err(e) = std::io::stdout().lock().flush()
+        {
+            failed(&e);
         }
         Ok(())
     }

@@ -20,6 +20,7 @@ use crate::cli_error::CliError;
 use crate::fusion_cmd::{
     eval_options, fused_model, fusion_error, parse_head_angles, parse_numbers, positive,
 };
+use crate::limits;
 
 /// The instrument to plan for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -120,6 +121,25 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
     if a.k.is_empty() || a.k.contains(&0) {
         return Err(CliError::input("--k: expected positive whole numbers"));
     }
+    if let Some(t) = a.target_um
+        && !(t.is_finite() && t > 0.0)
+    {
+        return Err(CliError::input(format!(
+            "--target-um: the accuracy to reach must be a positive number of um, got {t}"
+        )));
+    }
+    for (flag, n, max) in [
+        ("--passes", a.passes, limits::MAX_PASSES),
+        (
+            "--random-baseline",
+            a.random_baseline,
+            limits::MAX_RANDOM_BASELINE,
+        ),
+    ] {
+        if n > max {
+            return Err(CliError::input(format!("{flag}: {n}; at most {max}")));
+        }
+    }
     let (f_int, internal_poses) = match &a.data {
         Some(path) => {
             let data = read_data(path, &m)?;
@@ -138,6 +158,15 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
         Instrument::Tracker => {
             let (h1, h2) = parse_head_angles("--head-angles-deg", &a.head_angles_deg)?;
             let points = pose_targets(&a.candidates, &m)?;
+            let count = points.len() * h1.len() * h2.len();
+            if count > limits::MAX_CANDIDATES {
+                return Err(CliError::input(format!(
+                    "--candidates {} with --head-angles-deg {}: {count} candidate poses; at most {}",
+                    a.candidates,
+                    a.head_angles_deg,
+                    limits::MAX_CANDIDATES
+                )));
+            }
             let poses = head_angle_poses(&m, &points, &h1, &h2);
             let target = match a.tracker_target.as_str() {
                 "tip" => TrackerTarget::Known {
@@ -163,6 +192,13 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
             let p = parse_numbers("--ballbar-pivot-mm", &a.ballbar_pivot_mm, 3)?;
             let pivot = Vector3::new(p[0], p[1], p[2]);
             let length = positive("--ballbar-length-mm", a.ballbar_length_mm)?;
+            if a.ballbar_candidates > limits::MAX_CANDIDATES {
+                return Err(CliError::input(format!(
+                    "--ballbar-candidates: {}; at most {}",
+                    a.ballbar_candidates,
+                    limits::MAX_CANDIDATES
+                )));
+            }
             let poses = ballbar_candidates(&m, &pivot, length, a.ballbar_candidates);
             if poses.len() < 4 {
                 return Err(CliError::input(format!(
@@ -212,15 +248,17 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
             last.k,
             last.planned_um
         )];
-        tricept_data::write_external_path(
+        crate::files::written(
             path,
-            &ExternalData {
-                records,
-                source: String::new(),
-            },
-            &comments,
-        )
-        .map_err(|e| CliError::other(format!("{}: {e}", path.display())))?;
+            tricept_data::write_external_path(
+                path,
+                &ExternalData {
+                    records,
+                    source: String::new(),
+                },
+                &comments,
+            ),
+        )?;
     }
     if a.machine.json {
         outln!(

@@ -196,8 +196,7 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
     simulate_external(a, &plant, &comments)?;
     match &a.out {
         Some(path) => {
-            tricept_data::write_path(path, &data, &comments)
-                .map_err(|e| CliError::other(format!("{}: {e}", path.display())))?;
+            crate::files::written(path, tricept_data::write_path(path, &data, &comments))?;
             if a.machine.json {
                 outln!(
                     "{}",
@@ -244,9 +243,11 @@ fn parse_head_errors(spec: &str, m: &tricept_kinematics::Machine) -> Result<Vec<
             let scale: f64 = parts[0]
                 .parse()
                 .ok()
-                .filter(|v: &f64| v.is_finite() && *v >= 0.0)
+                .filter(|v: &f64| v.is_finite() && (0.0..=100.0).contains(v))
                 .ok_or_else(|| {
-                    CliError::input(format!("{flag} `{s}`: expected random:SCALE[,SEED]"))
+                    CliError::input(format!(
+                        "{flag} `{s}`: expected random:SCALE[,SEED] with SCALE (times the typical sizes) from 0 to 100"
+                    ))
                 })?;
             let seed: u64 = match parts.get(1) {
                 Some(t) => t.parse().map_err(|_| {
@@ -281,9 +282,6 @@ fn read_poses(path: &std::path::Path) -> Result<Vec<(tricept_data::ExternalPose,
 /// Writes the external instruments' files that were asked for.
 fn simulate_external(a: &SimulateArgs, plant: &Plant, comments: &[String]) -> Result<(), CliError> {
     let failed = |e: tricept_plant::PlantError| CliError::input(format!("simulate: {e}"));
-    let write_failed = |path: &std::path::Path, e: std::io::Error| {
-        CliError::other(format!("{}: {e}", path.display()))
-    };
     match (&a.tracker_out, &a.tracker_poses) {
         (Some(out), Some(poses)) => {
             let f = parse_numbers("--tracker-frame-mm-rad", &a.tracker_frame_mm_rad, 6)?;
@@ -305,7 +303,7 @@ fn simulate_external(a: &SimulateArgs, plant: &Plant, comments: &[String]) -> Re
                 "tracker: frame (mm, rad) {}, target offset (mm) {}, {} um per coordinate",
                 a.tracker_frame_mm_rad, a.tracker_target_mm, a.tracker_sigma_um
             ));
-            tricept_data::write_external_path(out, &data, &c).map_err(|e| write_failed(out, e))?;
+            crate::files::written(out, tricept_data::write_external_path(out, &data, &c))?;
         }
         (None, None) => {}
         _ => {
@@ -331,7 +329,7 @@ fn simulate_external(a: &SimulateArgs, plant: &Plant, comments: &[String]) -> Re
                 "ballbar: pivot (mm) {}, length error {} um, {} um per reading",
                 a.ballbar_pivot_mm, a.ballbar_length_error_um, a.ballbar_sigma_um
             ));
-            tricept_data::write_external_path(out, &data, &c).map_err(|e| write_failed(out, e))?;
+            crate::files::written(out, tricept_data::write_external_path(out, &data, &c))?;
         }
         (None, None) => {}
         _ => {

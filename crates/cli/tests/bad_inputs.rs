@@ -1047,3 +1047,592 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
     run_cases(&dir, &cases);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Values, sizes and files no verb can use (issue 17): numbers beyond
+/// any unit of the format, plausible-looking magnitudes that would
+/// overflow, sizes that would exhaust the memory or run without end, files
+/// in another format, calibrated machine files edited by hand; each an
+/// exit code 2 with one line naming the file, line and column or the flag.
+#[test]
+fn values_sizes_and_files_no_verb_can_use_get_exit_code_2() {
+    let dir = std::env::temp_dir().join(format!("tricept-bad-limits-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = good_csv(&dir);
+    std::fs::write(dir.join("good.csv"), &csv).unwrap();
+    let (_, header, rows) = split(&csv);
+    // A tracker file of this campaign (12 tool poses).
+    let tips: Vec<[f64; 3]> = (0..12)
+        .map(|j| {
+            let a = j as f64 * std::f64::consts::FRAC_PI_6;
+            [
+                250.0 * a.cos(),
+                250.0 * a.sin(),
+                1050.0 + 10.0 * (j % 3) as f64,
+            ]
+        })
+        .collect();
+    let axes: Vec<[f64; 3]> = (0..12)
+        .map(|j| {
+            let a = j as f64 * 1.9;
+            [0.4 * a.cos(), 0.4 * a.sin(), 1.0]
+        })
+        .collect();
+    std::fs::write(dir.join("poses.csv"), poses_csv(&tips, &axes, None)).unwrap();
+    ok(
+        &dir,
+        &[
+            "simulate",
+            "--poses",
+            "grid:1,8,3",
+            "--out",
+            "unused.csv",
+            "--tracker-out",
+            "tracker.csv",
+            "--tracker-poses",
+            "poses.csv",
+        ],
+    );
+    let tracker = std::fs::read_to_string(dir.join("tracker.csv")).unwrap();
+    let (_, t_header, t_rows) = split(&tracker);
+    let tx = t_header.split(',').position(|c| c == "x").unwrap();
+    let mut big_x = t_rows.clone();
+    big_x[3] = replace_field(&big_x[3], tx, "1e300");
+    let s_col = header.split(',').position(|c| c == "s").unwrap();
+    let mut big_s = rows.clone();
+    big_s[4] = replace_field(&big_s[4], s_col, "1e308");
+    let mut long_field = rows.clone();
+    long_field[2] = replace_field(&long_field[2], 0, &format!("{}x", "7".repeat(100_000)));
+    let mut long_line = rows.clone();
+    long_line[2] = replace_field(&long_line[2], 0, &"7".repeat(10_000_000));
+    let mut control = rows.clone();
+    control[1] = replace_field(&control[1], 0, "7\u{1b}[2J7");
+    // A calibrated machine file and hand edits of it.
+    ok(
+        &dir,
+        &[
+            "identify",
+            "--data",
+            "good.csv",
+            "--write-machine",
+            "cal.json",
+        ],
+    );
+    let cal: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("cal.json")).unwrap()).unwrap();
+    let edited = |edit: &dyn Fn(&mut serde_json::Value)| {
+        let mut v = cal.clone();
+        edit(&mut v);
+        serde_json::to_vec_pretty(&v).unwrap()
+    };
+    let mut unreachable: serde_json::Value =
+        serde_json::from_str(tricept_kinematics::description::PAPER_MACHINE_JSON).unwrap();
+    unreachable["workspace"]["radius_mm"] = 900.0.into();
+    let features = br#"{"stylus": {"radius_mm": 1.0, "radius_sigma_um": 2.0},
+      "features": [{"id": 1, "kind": "sphere", "radius_mm": 1e308, "radius_sigma_um": 0.5}]}"#;
+    let a = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<String>>();
+    let rows_of = |r: &[String]| with_rows(&header, r);
+    let cases: Vec<(Case, Vec<String>)> = vec![
+        // Numbers beyond any unit (exit 1 or a panic before).
+        (
+            case(
+                "tracker x of 1e300",
+                &[],
+                vec![("big-x.csv", with_rows(&t_header, &big_x))],
+                2,
+                &["big-x.csv: line", "column `x`", "1e300", "beyond"],
+            ),
+            a(&[
+                "identify",
+                "--data",
+                "good.csv",
+                "--tracker",
+                "big-x.csv",
+                "--tracker-target",
+                "tip",
+            ]),
+        ),
+        (
+            case(
+                "features radius of 1e308",
+                &[],
+                vec![("big-f.json", features.to_vec())],
+                2,
+                &[
+                    "big-f.json",
+                    "radius_mm must be positive and at most 1000 mm",
+                ],
+            ),
+            a(&[
+                "identify",
+                "--data",
+                "good.csv",
+                "--touch",
+                "tracker.csv",
+                "--features",
+                "big-f.json",
+            ]),
+        ),
+        (
+            case(
+                "truth of 1e308",
+                &[],
+                vec![("big-truth.json", br#"{"dq1": 1e308}"#.to_vec())],
+                2,
+                &["big-truth.json", "dq1", "beyond ±50 mm"],
+            ),
+            a(&[
+                "compensate",
+                "--data",
+                "good.csv",
+                "--truth",
+                "big-truth.json",
+            ]),
+        ),
+        (
+            case(
+                "workspace beyond the stroke",
+                &[],
+                vec![("far.json", serde_json::to_vec_pretty(&unreachable).unwrap())],
+                2,
+                &[
+                    "far.json",
+                    "not within the machine's reach",
+                    "shrink `workspace`",
+                ],
+            ),
+            a(&["identify", "--data", "good.csv", "--machine", "far.json"]),
+        ),
+        (
+            case(
+                "plan output in a missing directory",
+                &[],
+                vec![],
+                2,
+                &["--out", "does not exist"],
+            ),
+            a(&[
+                "plan",
+                "--instrument",
+                "tracker",
+                "--out",
+                "/nonexistent/dir/p.csv",
+            ]),
+        ),
+        (
+            case(
+                "s of 1e308 for the diagnosis",
+                &[],
+                vec![("big-s.csv", rows_of(&big_s))],
+                2,
+                &["big-s.csv: line", "column `s`", "beyond"],
+            ),
+            a(&["diagnose", "--data", "big-s.csv"]),
+        ),
+        // Bad values that used to be accepted.
+        (
+            case(
+                "head errors of 1e300",
+                &[],
+                vec![("he.json", br#"{"tool_length_mm": 1e300}"#.to_vec())],
+                2,
+                &["--head-errors", "he.json", "tool_length_mm", "beyond"],
+            ),
+            a(&["simulate", "--head-errors", "he.json"]),
+        ),
+        (
+            case(
+                "negative stiffness",
+                &[],
+                vec![],
+                2,
+                &["--truth-effect", "stiffness_n_per_um_at_1m", "positive"],
+            ),
+            a(&[
+                "simulate",
+                "--truth-effect",
+                r#"{"effect":"compliance","stiffness_n_per_um_at_1m":-5}"#,
+            ]),
+        ),
+        (
+            case(
+                "duplicate key in a truth file",
+                &[],
+                vec![("dup.json", br#"{"dq1": 0.1, "dq1": 0.2}"#.to_vec())],
+                2,
+                &["dup.json", "the key `dq1` appears twice"],
+            ),
+            a(&["simulate", "--truth", "dup.json"]),
+        ),
+        (
+            case(
+                "negative accuracy target",
+                &[],
+                vec![],
+                2,
+                &["--target-um", "positive"],
+            ),
+            a(&["plan", "--instrument", "tracker", "--target-um", "-1"]),
+        ),
+        (
+            case(
+                "accuracy target not a number",
+                &[],
+                vec![],
+                2,
+                &["--target-um", "positive"],
+            ),
+            a(&["plan", "--instrument", "tracker", "--target-um", "nan"]),
+        ),
+        (
+            case(
+                "the same tracker file twice",
+                &[],
+                vec![],
+                2,
+                &["--tracker", "tracker.csv", "counts once"],
+            ),
+            a(&[
+                "identify",
+                "--data",
+                "good.csv",
+                "--tracker",
+                "tracker.csv",
+                "--tracker",
+                "./tracker.csv",
+                "--tracker-target",
+                "tip",
+            ]),
+        ),
+        (
+            case(
+                "header-only batch file",
+                &[],
+                vec![("points.csv", b"x,y,z\n".to_vec())],
+                2,
+                &["points.csv: header only"],
+            ),
+            a(&["ik", "--input", "points.csv"]),
+        ),
+        (
+            case("tolerance of -1 mm", &[], vec![], 2, &["--tolerance-mm"]),
+            a(&["identify", "--data", "good.csv", "--tolerance-mm", "-1"]),
+        ),
+        (
+            case("no optimal poses", &[], vec![], 2, &["--poses `optimal:0`"]),
+            a(&["simulate", "--poses", "optimal:0"]),
+        ),
+        // Sizes that would exhaust the memory or run without end.
+        (
+            case(
+                "huge evaluation grid",
+                &[],
+                vec![],
+                2,
+                &["--eval-grid", "evaluation poses; at most 10000"],
+            ),
+            a(&[
+                "plan",
+                "--instrument",
+                "tracker",
+                "--eval-grid",
+                "1000,1000,1000",
+            ]),
+        ),
+        (
+            case(
+                "huge candidate grid",
+                &[],
+                vec![],
+                2,
+                &["grid:1000,1000,100", "at most 1000000"],
+            ),
+            a(&[
+                "plan",
+                "--instrument",
+                "tracker",
+                "--candidates",
+                "grid:1000,1000,100",
+            ]),
+        ),
+        (
+            case(
+                "ten million ballbar candidates",
+                &[],
+                vec![],
+                2,
+                &["--ballbar-candidates", "at most 50000"],
+            ),
+            a(&[
+                "plan",
+                "--instrument",
+                "ballbar",
+                "--ballbar-candidates",
+                "10000000",
+            ]),
+        ),
+        (
+            case(
+                "a ball 1e308 mm from the tip",
+                &[],
+                vec![],
+                2,
+                &["--ballbar-ball-mm", "beyond"],
+            ),
+            a(&[
+                "identify",
+                "--data",
+                "good.csv",
+                "--ballbar",
+                "tracker.csv",
+                "--ballbar-ball-mm",
+                "1e308,0,0",
+            ]),
+        ),
+        (
+            case(
+                "a 1 mm table",
+                &[],
+                vec![],
+                2,
+                &["--table-spacing 1", "coarser spacing"],
+            ),
+            a(&[
+                "compensate",
+                "--data",
+                "good.csv",
+                "--table",
+                "out",
+                "--table-spacing",
+                "1",
+            ]),
+        ),
+        (
+            case(
+                "/dev/zero as data",
+                &[],
+                vec![],
+                2,
+                &["/dev/zero: line 1", "longer than 1048576 bytes"],
+            ),
+            a(&["identify", "--data", "/dev/zero"]),
+        ),
+        // Files in another format; fields that would flood the terminal.
+        (
+            case(
+                "old Mac line ends",
+                &[],
+                vec![("cr.csv", csv.replace('\n', "\r").into_bytes())],
+                2,
+                &["cr.csv: line", "carriage returns"],
+            ),
+            a(&["identify", "--data", "cr.csv"]),
+        ),
+        (
+            case(
+                "tab-separated",
+                &[],
+                vec![(
+                    "tabs.csv",
+                    csv.lines()
+                        .filter(|l| !l.starts_with('#'))
+                        .map(|l| l.replace(',', "\t") + "\n")
+                        .collect::<String>()
+                        .into_bytes(),
+                )],
+                2,
+                &["tabs.csv: line 1", "separated by tabs"],
+            ),
+            a(&["identify", "--data", "tabs.csv"]),
+        ),
+        (
+            case(
+                "no header",
+                &[],
+                vec![(
+                    "noheader.csv",
+                    rows.iter()
+                        .map(|r| r.clone() + "\n")
+                        .collect::<String>()
+                        .into_bytes(),
+                )],
+                2,
+                &[
+                    "noheader.csv: line 1",
+                    "not column names",
+                    "needs a header line",
+                ],
+            ),
+            a(&["identify", "--data", "noheader.csv"]),
+        ),
+        (
+            case(
+                "a 100 kB field",
+                &[],
+                vec![("long.csv", rows_of(&long_field))],
+                2,
+                &[
+                    "long.csv: line 4, column `q1`",
+                    "… (99921 more bytes)",
+                    "not a number",
+                ],
+            ),
+            a(&["identify", "--data", "long.csv"]),
+        ),
+        (
+            case(
+                "a 10 MB line",
+                &[],
+                vec![("longer.csv", rows_of(&long_line))],
+                2,
+                &["longer.csv: line 4", "longer than 1048576 bytes"],
+            ),
+            a(&["identify", "--data", "longer.csv"]),
+        ),
+        (
+            case(
+                "control characters",
+                &[],
+                vec![("ctl.csv", rows_of(&control))],
+                2,
+                &["ctl.csv: line", "\\u{1b}[2J"],
+            ),
+            a(&["identify", "--data", "ctl.csv"]),
+        ),
+        // Calibrated machine files that do not match their record.
+        (
+            case(
+                "leg offset edited",
+                &[],
+                vec![(
+                    "e1.json",
+                    edited(&|v| {
+                        let x = v["leg_offsets_mm"][0].as_f64().unwrap();
+                        v["leg_offsets_mm"][0] = (x + 5.0).into();
+                    }),
+                )],
+                2,
+                &[
+                    "e1.json",
+                    "does not match its calibration record",
+                    "leg_offsets_mm[0]",
+                ],
+            ),
+            a(&["compensate", "--machine", "e1.json", "--table", "out"]),
+        ),
+        (
+            case(
+                "nominal edited",
+                &[],
+                vec![(
+                    "e2.json",
+                    edited(&|v| {
+                        let p = &mut v["calibration"]["nominal"]["placement"]["circular"];
+                        let r = p["base_radius_mm"].as_f64().unwrap();
+                        p["base_radius_mm"] = (r + 2.0).into();
+                    }),
+                )],
+                2,
+                &[
+                    "e2.json",
+                    "does not match its calibration record",
+                    "base joint 1",
+                ],
+            ),
+            a(&["ik", "0", "0", "750", "--machine", "e2.json"]),
+        ),
+        (
+            case(
+                "estimate edited",
+                &[],
+                vec![(
+                    "e3.json",
+                    edited(&|v| {
+                        let x = v["calibration"]["estimates_mm"]["dq2"].as_f64().unwrap();
+                        v["calibration"]["estimates_mm"]["dq2"] = (x + 0.5).into();
+                    }),
+                )],
+                2,
+                &["e3.json", "leg_offsets_mm[1]", "(dq2 = "],
+            ),
+            a(&["ik", "0", "0", "750", "--machine", "e3.json"]),
+        ),
+        (
+            case(
+                "unknown method",
+                &[],
+                vec![(
+                    "e4.json",
+                    edited(&|v| v["calibration"]["method"] = "guess".into()),
+                )],
+                2,
+                &["e4.json", "unknown method `guess`"],
+            ),
+            a(&["machine", "--machine", "e4.json"]),
+        ),
+        (
+            case(
+                "unknown parameter set",
+                &[],
+                vec![(
+                    "e5.json",
+                    edited(&|v| v["calibration"]["parameter_set"] = "paper16".into()),
+                )],
+                2,
+                &["e5.json", "unknown parameter set `paper16`"],
+            ),
+            a(&["machine", "--machine", "e5.json"]),
+        ),
+    ];
+    let cases: Vec<Case> = cases
+        .into_iter()
+        .map(|(mut c, args)| {
+            c.args = args;
+            c
+        })
+        .collect();
+    run_cases(&dir, &cases);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Inputs that look odd but are fine: a machine file with a byte-order
+/// mark, a noise level of a nanometre (whose detectability search used to
+/// grow as 1/noise^2 and take minutes).
+#[test]
+fn odd_but_valid_inputs_are_accepted() {
+    let dir = std::env::temp_dir().join(format!("tricept-odd-valid-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bom = dir.join("bom.json");
+    let mut text = "\u{feff}".to_string();
+    text.push_str(tricept_kinematics::description::PAPER_MACHINE_JSON);
+    std::fs::write(&bom, text).unwrap();
+    let out = tricept()
+        .args(["ik", "0", "0", "750", "--machine", bom.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = tricept()
+        .args([
+            "detectability",
+            "--length-noise-um",
+            "0.001",
+            "--angle-noise-arcsec",
+            "0.001",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v.to_string().contains("detectable_multiple"), "{v}");
+    std::fs::remove_dir_all(&dir).ok();
+}

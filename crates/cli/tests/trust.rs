@@ -103,10 +103,14 @@ fn identify(data: &Path, extra: &[&str], machine_out: &Path) -> (i32, serde_json
     assert!(!stderr.contains("panicked"), "{stderr}");
     let code = out.status.code().unwrap();
     let v = json(&out);
-    let expected = match (v["converged"].as_bool(), v["adequate"].as_bool()) {
-        (Some(false), _) => 4,
-        (Some(true), Some(false)) => 3,
-        (Some(true), Some(true)) => 0,
+    let expected = match (
+        v["converged"].as_bool(),
+        v["adequate"].as_bool(),
+        v["worthwhile"].as_bool(),
+    ) {
+        (Some(false), _, _) => 4,
+        (Some(true), Some(false), _) | (Some(true), Some(true), Some(false)) => 3,
+        (Some(true), Some(true), Some(true)) => 0,
         _ => panic!("no verdict in {v}"),
     };
     assert_eq!(
@@ -230,13 +234,19 @@ fn data_that_cannot_come_from_the_machine_get_a_non_zero_code_and_a_named_cause(
 fn a_converged_fit_that_does_not_explain_the_data_exits_3_and_names_diagnose() {
     let dir = workdir("inadequate");
     let data = fixture("data/diagnose-hidden-effect.csv");
-    let (code, v, _) = identify(Path::new(&data), &[], &dir.join("m.json"));
+    let (code, v, stderr) = identify(Path::new(&data), &[], &dir.join("m.json"));
     assert_eq!(code, 3);
     assert!(v["warnings"].to_string().contains("tricept diagnose"));
-    // Written (the fit converged), and marked: not adequate.
+    // Not written: an exit-3 fit is deployed only with --force.
+    assert!(!dir.join("m.json").exists());
+    assert!(stderr.contains("not written"), "{stderr}");
+    let (code, _, _) = identify(Path::new(&data), &["--force"], &dir.join("m.json"));
+    assert_eq!(code, 3);
+    // Written with --force, and marked: forced, not adequate.
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("m.json")).unwrap()).unwrap();
     assert_eq!(m["calibration"]["adequate"], false);
+    assert_eq!(m["calibration"]["forced"], true);
     assert!(
         m["name"]
             .as_str()
@@ -399,7 +409,8 @@ fn deploying_the_diagnosis_delivers_its_gain_on_the_simulated_machine() {
         "--write-machine",
         ext.to_str().unwrap(),
     ]));
-    let (code, _, _) = identify(Path::new(&data), &[], &geo);
+    // The geometric-only calibration is exit 3: written only when forced.
+    let (code, _, _) = identify(Path::new(&data), &["--force"], &geo);
     assert_eq!(code, 3);
     let file: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&ext).unwrap()).unwrap();
@@ -413,9 +424,10 @@ fn deploying_the_diagnosis_delivers_its_gain_on_the_simulated_machine() {
     assert!((c - reported).abs() < 1e-6 * reported, "{c} vs {reported}");
 
     // The maps of the true machine commanded through each file.
-    let map = |machine: &Path, name: &str| -> Vec<[f64; 3]> {
+    // The forced geometric file is compensated only with --force too.
+    let map = |machine: &Path, name: &str, force: &str| -> Vec<[f64; 3]> {
         let out_dir = dir.join(name);
-        let out = run(&[
+        let mut args = vec![
             "compensate",
             "--machine",
             machine.to_str().unwrap(),
@@ -427,8 +439,14 @@ fn deploying_the_diagnosis_delivers_its_gain_on_the_simulated_machine() {
             "50",
             "--map",
             out_dir.to_str().unwrap(),
-        ]);
-        assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+        ];
+        if !force.is_empty() {
+            args.push(force);
+        }
+        let out = run(&args);
+        // A forced compensation still says in its code that it is untrusted.
+        let expected = if force.is_empty() { 0 } else { 3 };
+        assert_eq!(out.status.code(), Some(expected), "{}", text(&out));
         let csv = std::fs::read_to_string(out_dir.join("map.csv")).unwrap();
         let (_, h, rows) = parts(&csv);
         let (x, y, z) = (
@@ -440,7 +458,7 @@ fn deploying_the_diagnosis_delivers_its_gain_on_the_simulated_machine() {
             .map(|r| [x, y, z].map(|i| r[i].parse::<f64>().unwrap()))
             .collect()
     };
-    let (with_geo, with_ext) = (map(&geo, "geo"), map(&ext, "ext"));
+    let (with_geo, with_ext) = (map(&geo, "geo", "--force"), map(&ext, "ext", ""));
     let n = with_geo.len() as f64;
     let moved: f64 = with_geo
         .iter()
@@ -948,5 +966,184 @@ fn diagnose_says_in_its_exit_code_and_its_machine_file_what_it_cannot_deploy() {
     let warnings = m["calibration"]["warnings"].to_string();
     assert!(warnings.contains("scale-gain / leg-lead"), "{warnings}");
     assert!(warnings.contains("external length"), "{warnings}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The mean platform error (mm) of the simulated Table 2 machine on the
+/// middle plane: uncalibrated, and commanded through `machine`.
+fn true_errors(machine: &Path, extra: &[&str]) -> (f64, f64) {
+    let mut args = vec![
+        "compensate",
+        "--machine",
+        machine.to_str().unwrap(),
+        "--truth",
+        "table2",
+        "--spacing",
+        "50",
+        "--json",
+    ];
+    args.extend(extra);
+    let v = json(&run(&args));
+    (
+        v["before"]["mean_mm"].as_f64().unwrap(),
+        v["after"]["mean_mm"].as_f64().unwrap(),
+    )
+}
+
+#[test]
+fn a_campaign_too_small_to_calibrate_is_refused_and_told_what_would_do() {
+    let dir = workdir("small");
+    // Eight poses: one on the axis and one off it on each of four planes.
+    let data = dir.join("eight.csv");
+    let out = run(&[
+        "simulate",
+        "--poses",
+        "grid:1,1,4",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let m = dir.join("m.json");
+    let (code, v, stderr) = identify(&data, &[], &m);
+    assert_eq!(code, 3, "{stderr}");
+    assert_eq!(v["adequate"], true);
+    assert_eq!(v["worthwhile"], false);
+    let a = &v["predicted_accuracy"];
+    assert!(
+        a["after_rms_mm"].as_f64().unwrap() > 0.5 * a["before_rms_mm"].as_f64().unwrap(),
+        "{a}"
+    );
+    assert!(!m.exists(), "a refused campaign must not be written");
+    assert!(
+        stderr.contains("not written: the campaign is too small to calibrate"),
+        "{stderr}"
+    );
+    let w = v["warnings"].to_string();
+    assert!(
+        w.contains("`--poses optimal:") && w.contains("`--poses random:"),
+        "{w}"
+    );
+    // Forced, the file makes the true machine worse than no calibration.
+    let (code, _, _) = identify(&data, &["--force"], &m);
+    assert_eq!(code, 3);
+    let (before, after) = true_errors(&m, &["--force"]);
+    assert!(
+        after > before,
+        "forced: {after} mm against {before} mm uncalibrated"
+    );
+    // The advised campaign is worthwhile, and in truth it is: on three
+    // noise seeds it beats the uncalibrated machine by half.
+    let advice = w
+        .split("`--poses optimal:")
+        .nth(1)
+        .and_then(|s| s.split('`').next())
+        .unwrap()
+        .to_string();
+    for seed in ["1", "2", "3"] {
+        let out = run(&[
+            "simulate",
+            "--poses",
+            &format!("optimal:{advice}"),
+            "--seed",
+            seed,
+            "--out",
+            data.to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+        let (code, v, stderr) = identify(&data, &[], &m);
+        assert_eq!(code, 0, "optimal:{advice}, seed {seed}: {stderr}");
+        assert_eq!(v["worthwhile"], true);
+        let (before, after) = true_errors(&m, &[]);
+        assert!(
+            after < 0.5 * before,
+            "optimal:{advice}, seed {seed}: {after} mm against {before} mm"
+        );
+    }
+    // A realistic campaign (40 random poses) is worthwhile without advice.
+    run(&[
+        "simulate",
+        "--poses",
+        "random:40,7",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    let (code, v, _) = identify(&data, &[], &m);
+    assert_eq!(code, 0);
+    assert!(!v["warnings"].to_string().contains("cannot calibrate"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn compensate_refuses_a_fit_or_a_file_that_is_not_to_be_trusted() {
+    let dir = workdir("compensate-rule");
+    // The compliance fixture: exit 3 (a 12 um sag the geometry absorbs).
+    let data = fixture("data/diagnose-hidden-effect.csv");
+    let table = dir.join("table");
+    let out = run(&[
+        "compensate",
+        "--data",
+        &data,
+        "--table",
+        table.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(3), "{}", text(&out));
+    assert!(text(&out).contains("not written: the model does not explain the data"));
+    assert!(!table.join("table.csv").exists());
+    let out = run(&[
+        "compensate",
+        "--data",
+        &data,
+        "--table",
+        table.to_str().unwrap(),
+        "--force",
+    ]);
+    assert_eq!(out.status.code(), Some(3));
+    assert!(table.join("table.csv").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_recalibration_keeps_a_record_the_file_is_checked_against() {
+    let dir = workdir("chain");
+    let data = fixture("data/table2-grid-seed1.csv");
+    let (m1, m2) = (dir.join("m1.json"), dir.join("m2.json"));
+    assert_eq!(identify(Path::new(&data), &[], &m1).0, 0);
+    let out = run(&[
+        "identify",
+        "--data",
+        &data,
+        "--machine",
+        m1.to_str().unwrap(),
+        "--write-machine",
+        m2.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&m2).unwrap()).unwrap();
+    // Relative to the first calibration, which the record keeps.
+    assert!(d["calibration"]["relative_to_machine"]["calibration"].is_null());
+    assert!(d["calibration"]["relative_to_machine"]["placement"].is_object());
+    assert_eq!(
+        run(&["ik", "0", "0", "750", "--machine", m2.to_str().unwrap()])
+            .status
+            .code(),
+        Some(0)
+    );
+    // A hand edit of the second file is caught as the first one's would be.
+    let mut e = d.clone();
+    let q = e["leg_offsets_mm"][2].as_f64().unwrap();
+    e["leg_offsets_mm"][2] = (q + 0.01).into();
+    std::fs::write(&m2, serde_json::to_string(&e).unwrap()).unwrap();
+    let out = run(&["ik", "0", "0", "750", "--machine", m2.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out).contains("leg_offsets_mm[2]"), "{}", text(&out));
+    // A record that says the fit did not converge loads with a warning.
+    let mut c: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&m1).unwrap()).unwrap();
+    c["calibration"]["converged"] = false.into();
+    std::fs::write(&m1, serde_json::to_string(&c).unwrap()).unwrap();
+    let out = run(&["ik", "0", "0", "750", "--machine", m1.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("did not converge"));
     std::fs::remove_dir_all(&dir).ok();
 }

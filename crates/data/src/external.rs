@@ -32,8 +32,8 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::DataError;
 use crate::records::{Header, Record, Records, open};
+use crate::{DataError, MAX_LENGTH_MM};
 
 /// Where the machine stood when an instrument measured.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -194,6 +194,19 @@ impl Row<'_> {
         self.header.number(self.record, self.measured[k])
     }
 
+    /// A measured length or coordinate, mm, within ±[`MAX_LENGTH_MM`].
+    fn measured_mm(&self, k: usize) -> Result<f64, DataError> {
+        let v = self.measured(k)?;
+        if v.abs() > MAX_LENGTH_MM {
+            return Err(self.header.bad_value(
+                self.record,
+                self.measured[k],
+                format!("beyond ±{MAX_LENGTH_MM} mm: not a measurement of this machine"),
+            ));
+        }
+        Ok(v)
+    }
+
     fn measured_column(&self, k: usize) -> usize {
         self.measured[k]
     }
@@ -252,7 +265,11 @@ impl ExternalRow for TrackerPoint {
     fn from_row(pose: ExternalPose, row: &Row<'_>) -> Result<Self, DataError> {
         Ok(TrackerPoint {
             pose,
-            position_mm: [row.measured(0)?, row.measured(1)?, row.measured(2)?],
+            position_mm: [
+                row.measured_mm(0)?,
+                row.measured_mm(1)?,
+                row.measured_mm(2)?,
+            ],
             sigma_um: row.sigma_um()?,
             extension_mm: row
                 .optional("extension_mm", |v| {
@@ -601,16 +618,14 @@ pub fn write_external_to<T: ExternalRecord, W: Write>(
     write_rows(w, data, comments)
 }
 
-/// Writes external records to a file (see [`write_external_to`]).
+/// Writes external records to a file (see [`write_external_to`]),
+/// atomically ([`crate::write_atomic`]).
 pub fn write_external_path<T: ExternalRecord>(
     path: &Path,
     data: &ExternalData<T>,
     comments: &[String],
 ) -> std::io::Result<()> {
-    let f = std::fs::File::create(path)?;
-    let mut w = std::io::BufWriter::new(f);
-    write_rows(&mut w, data, comments)?;
-    w.flush()
+    crate::write_atomic(path, |w| write_rows(w, data, comments))
 }
 
 /// The probe's stylus.
@@ -675,9 +690,15 @@ pub struct Features {
     pub features: Vec<Feature>,
 }
 
+/// The largest stylus ball radius a features file may state, mm.
+pub const MAX_STYLUS_RADIUS_MM: f64 = 50.0;
+/// The largest sphere radius a features file may state, mm.
+pub const MAX_SPHERE_RADIUS_MM: f64 = 1000.0;
+
 impl Features {
     /// Parses and checks a features file's text; `file` names it in errors.
     pub fn from_json(text: &str, file: &str) -> Result<Features, DataError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let f: Features = serde_json::from_str(text).map_err(|e| DataError::Json {
             file: file.into(),
             line: e.line() as u64,
@@ -689,9 +710,9 @@ impl Features {
             message,
         };
         let s = f.stylus;
-        if !(s.radius_mm.is_finite() && s.radius_mm >= 0.0) {
+        if !(s.radius_mm.is_finite() && (0.0..=MAX_STYLUS_RADIUS_MM).contains(&s.radius_mm)) {
             return Err(invalid(format!(
-                "stylus.radius_mm must be a non-negative number of mm, got {}",
+                "stylus.radius_mm must be a number of mm from 0 to {MAX_STYLUS_RADIUS_MM}, got {}",
                 s.radius_mm
             )));
         }
@@ -714,9 +735,12 @@ impl Features {
                 id,
             } = feature
             {
-                if !(radius_mm.is_finite() && *radius_mm > 0.0) {
+                if !(radius_mm.is_finite()
+                    && *radius_mm > 0.0
+                    && *radius_mm <= MAX_SPHERE_RADIUS_MM)
+                {
                     return Err(invalid(format!(
-                        "feature {id}: radius_mm must be positive, got {radius_mm}"
+                        "feature {id}: radius_mm must be positive and at most {MAX_SPHERE_RADIUS_MM} mm, got {radius_mm}"
                     )));
                 }
                 if !(radius_sigma_um.is_finite() && *radius_sigma_um >= 0.0) {

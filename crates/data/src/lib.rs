@@ -27,7 +27,7 @@
 //! `error` ([`DataError`]), `records` (the line and record machinery every
 //! reader shares), `read` (the measured-data reader), `targets` (the
 //! target-list reader), `external` (the external-measurement files), `write`
-//! (the writer). Everything is re-exported
+//! (the writer), `atomic` (every file written whole or not at all). Everything is re-exported
 //! here: use `tricept_data::X`.
 //!
 //! # Example
@@ -43,6 +43,7 @@
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
+mod atomic;
 mod error;
 mod external;
 mod pose;
@@ -51,6 +52,7 @@ mod records;
 mod targets;
 mod write;
 
+pub use atomic::write_atomic;
 pub use error::DataError;
 pub use external::{
     BallbarData, BallbarReading, ExternalData, ExternalPose, ExternalRecord, Feature, Features,
@@ -58,6 +60,7 @@ pub use external::{
     read_external_from, read_external_path, write_external_path, write_external_to,
 };
 pub use pose::{Dataset, MeasuredPose, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Readings};
-pub use read::{MAX_ANGLE_SPAN_RAD, read_from, read_path, read_with_progress};
+pub use read::{MAX_ANGLE_SPAN_RAD, MAX_LENGTH_MM, read_from, read_path, read_with_progress};
+pub use records::{MAX_LINE_BYTES, MAX_MAGNITUDE};
 pub use targets::{NumericRows, read_targets, read_targets_from};
 pub use write::{write_path, write_to};

@@ -15,6 +15,10 @@ use crate::{DataError, Dataset, MeasuredPose, OPTIONAL_COLUMNS, REQUIRED_COLUMNS
 /// Tricept turns well under 100 degrees in all.
 pub const MAX_ANGLE_SPAN_RAD: f64 = 1.75;
 
+/// The largest length (a leg command, a scale reading, a tracker
+/// coordinate), mm: 100 m, beyond any machine the format describes.
+pub const MAX_LENGTH_MM: f64 = 1e5;
+
 /// Plausible structure temperatures, °C.
 const TEMP_RANGE_C: (f64, f64) = (-60.0, 200.0);
 
@@ -226,6 +230,15 @@ fn parse_row(record: &Record, c: &Columns, header: &Header) -> Result<MeasuredPo
                 record,
                 c.required[k],
                 "a leg length command must be positive (mm)",
+            ));
+        }
+    }
+    for k in [0, 1, 2, 5] {
+        if v[k].abs() > MAX_LENGTH_MM {
+            return Err(header.bad_value(
+                record,
+                c.required[k],
+                format!("a length beyond {MAX_LENGTH_MM} mm: not a reading of this machine"),
             ));
         }
     }

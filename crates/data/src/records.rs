@@ -19,6 +19,37 @@ use std::path::Path;
 
 use crate::DataError;
 
+/// The longest line a reader accepts, in bytes: far longer than any row of
+/// numbers, short enough that `/dev/zero` or a binary file is refused
+/// without reading it whole.
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// The largest magnitude any number in a data file may have: beyond it a
+/// value is not a reading in any unit of the format, and its square would
+/// lose all precision in a fit.
+pub const MAX_MAGNITUDE: f64 = 1e12;
+
+/// The longest field a message repeats, in characters.
+const SHOWN_CHARS: usize = 80;
+
+/// A field as messages show it: control characters escaped, cut to
+/// [`SHOWN_CHARS`] characters with the length of the rest.
+pub(crate) fn shown(field: &str) -> String {
+    let mut out = String::new();
+    for (count, (i, c)) in field.char_indices().enumerate() {
+        if count == SHOWN_CHARS {
+            out.push_str(&format!("… ({} more bytes)", field.len() - i));
+            return out;
+        }
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
 /// The UTF-8 encoding of U+FEFF, which some editors and spreadsheets write at
 /// the start of a "UTF-8" file.
 const BYTE_ORDER_MARK: &[u8] = b"\xEF\xBB\xBF";
@@ -64,8 +95,8 @@ impl<'f, R: Read> Records<'f, R> {
     fn next_record(&mut self) -> Result<Option<Record>, DataError> {
         loop {
             self.buf.clear();
-            let n = self
-                .reader
+            let n = (&mut self.reader)
+                .take(MAX_LINE_BYTES as u64 + 1)
                 .read_until(b'\n', &mut self.buf)
                 .map_err(|source| DataError::Io {
                     file: self.file.to_string(),
@@ -75,19 +106,35 @@ impl<'f, R: Read> Records<'f, R> {
                 return Ok(None);
             }
             self.line += 1;
+            let not_text = |line, message: String| DataError::NotText {
+                file: self.file.to_string(),
+                line,
+                message,
+            };
+            if self.buf.len() > MAX_LINE_BYTES {
+                return Err(not_text(
+                    self.line,
+                    format!(
+                        "a line longer than {MAX_LINE_BYTES} bytes: not a data file of numbers"
+                    ),
+                ));
+            }
             let mut bytes = self.buf.as_slice();
             if self.line == 1 {
                 bytes = bytes.strip_prefix(BYTE_ORDER_MARK).unwrap_or(bytes);
             }
             let trimmed = bytes.trim_ascii();
+            if trimmed.contains(&b'\r') {
+                return Err(not_text(
+                    self.line,
+                    "carriage returns (\\r) inside the line: the file has old Mac line ends; save it with \\n (or \\r\\n) line ends".into(),
+                ));
+            }
             if trimmed.is_empty() || trimmed.starts_with(b"#") {
                 continue;
             }
-            let text = std::str::from_utf8(trimmed).map_err(|_| DataError::NotText {
-                file: self.file.to_string(),
-                line: self.line,
-                message: "not valid UTF-8 text".into(),
-            })?;
+            let text = std::str::from_utf8(trimmed)
+                .map_err(|_| not_text(self.line, "not valid UTF-8 text".into()))?;
             return Ok(Some(Record {
                 line: self.line,
                 fields: text.split(',').map(|f| f.trim().to_string()).collect(),
@@ -143,13 +190,35 @@ impl Header {
                 },
             });
         }
+        if record.fields.len() == 1 && record.fields[0].contains('\t') {
+            return Err(DataError::NotText {
+                file,
+                line: record.line,
+                message:
+                    "the fields are separated by tabs; tricept needs commas (`,`) between fields"
+                        .into(),
+            });
+        }
+        if record
+            .fields
+            .iter()
+            .all(|f| !f.is_empty() && f.parse::<f64>().is_ok())
+        {
+            return Err(DataError::NotText {
+                file,
+                line: record.line,
+                message: format!(
+                    "the first line holds numbers, not column names: the file needs a header line ({expected})"
+                ),
+            });
+        }
         let names = record.fields;
         for (i, n) in names.iter().enumerate() {
             if !n.is_empty() && names[..i].contains(n) {
                 return Err(DataError::DuplicateColumn {
                     file,
                     line: record.line,
-                    column: n.clone(),
+                    column: shown(n),
                 });
             }
         }
@@ -187,7 +256,7 @@ impl Header {
             line: self.line,
             column: name.to_string(),
             hint: closest_unknown(&self.names, name, known)
-                .map(|n| format!(", found `{n}` (misspelt?)"))
+                .map(|n| format!(", found `{}` (misspelt?)", shown(n)))
                 .unwrap_or_default(),
         })
     }
@@ -217,7 +286,12 @@ impl Header {
             return Err(self.bad_value(record, idx, "empty field"));
         }
         match text.parse::<f64>() {
-            Ok(v) if v.is_finite() => Ok(v),
+            Ok(v) if v.is_finite() && v.abs() <= MAX_MAGNITUDE => Ok(v),
+            Ok(v) if v.is_finite() => Err(self.bad_value(
+                record,
+                idx,
+                format!("beyond ±{MAX_MAGNITUDE:e}: not a value in any unit of the format"),
+            )),
             Ok(_) => Err(self.bad_value(record, idx, "not a finite number")),
             Err(_) if text.contains(';') => Err(semicolon_problem(&self.file, record)),
             Err(_) => Err(self.bad_value(record, idx, "not a number")),
@@ -229,8 +303,8 @@ impl Header {
         DataError::BadValue {
             file: self.file.clone(),
             line: record.line,
-            column: self.names[idx].clone(),
-            value: record.fields[idx].clone(),
+            column: shown(&self.names[idx]),
+            value: shown(&record.fields[idx]),
             reason: reason.into(),
         }
     }
@@ -377,6 +451,70 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert_eq!(e, "t.csv: line 2: not valid UTF-8 text");
+    }
+
+    fn first_error(text: &[u8]) -> String {
+        let mut r = Records::new(text, "t.csv");
+        match Header::read(&mut r, "x,y,z") {
+            Err(e) => e.to_string(),
+            Ok(h) => {
+                for rec in r {
+                    match rec {
+                        Err(e) => return e.to_string(),
+                        Ok(rec) => {
+                            if let Err(e) = h.check(&rec).and_then(|_| h.number(&rec, 0)) {
+                                return e.to_string();
+                            }
+                        }
+                    }
+                }
+                String::new()
+            }
+        }
+    }
+
+    #[test]
+    fn files_that_are_not_comma_separated_text_are_named_as_such() {
+        // A line of a megabyte and more: /dev/zero, a binary file.
+        let mut long = b"x,y\n".to_vec();
+        long.extend(std::iter::repeat_n(b'0', MAX_LINE_BYTES + 10));
+        assert_eq!(
+            first_error(&long),
+            format!(
+                "t.csv: line 2: a line longer than {MAX_LINE_BYTES} bytes: not a data file of numbers"
+            )
+        );
+        // Old Mac line ends: one line with carriage returns inside.
+        let e = first_error(b"x,y,z\r1,2,3\r4,5,6\r");
+        assert!(e.starts_with("t.csv: line 1: carriage returns"), "{e}");
+        // Windows line ends are fine.
+        assert_eq!(first_error(b"x,y,z\r\n1,2,3\r\n"), "");
+        // Tabs.
+        let e = first_error(b"x\ty\tz\n1\t2\t3\n");
+        assert!(e.contains("separated by tabs"), "{e}");
+        // No header: the first line holds numbers.
+        let e = first_error(b"676.83,1.5,2\n676.9,1.6,2.1\n");
+        assert_eq!(
+            e,
+            "t.csv: line 1: the first line holds numbers, not column names: the file needs a header line (x,y,z)"
+        );
+        // A number too large for any unit of the format.
+        let e = first_error(b"x,y,z\n1e300,2,3\n");
+        assert!(
+            e.contains("line 2, column `x`") && e.contains("beyond"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn messages_cut_long_fields_and_escape_control_characters() {
+        let long = "9".repeat(10_000) + "x";
+        let e = first_error(format!("x,y,z\n{long},2,3\n").as_bytes());
+        assert!(e.len() < 300, "{} bytes: {}", e.len(), &e[..200]);
+        assert!(e.contains("… (9921 more bytes)"), "{e}");
+        let e = first_error(b"x,y,z\n1\x1b[31m,2,3\n");
+        assert!(e.contains("1\\u{1b}[31m"), "{e}");
+        assert!(!e.contains('\x1b'));
     }
 
     #[test]

@@ -72,7 +72,8 @@ pub fn write_to<W: Write>(mut w: W, data: &Dataset, comments: &[String]) -> std:
     Ok(())
 }
 
-/// Writes `data` to a file (see [`write_to`]).
+/// Writes `data` to a file (see [`write_to`]), atomically: on any failure
+/// the previous file is left as it was ([`crate::write_atomic`]).
 ///
 /// # Example
 /// ```
@@ -83,10 +84,7 @@ pub fn write_to<W: Write>(mut w: W, data: &Dataset, comments: &[String]) -> std:
 /// # std::fs::remove_file(&path).unwrap();
 /// ```
 pub fn write_path(path: &Path, data: &Dataset, comments: &[String]) -> std::io::Result<()> {
-    let f = std::fs::File::create(path)?;
-    let mut w = std::io::BufWriter::new(f);
-    write_to(&mut w, data, comments)?;
-    w.flush()
+    crate::write_atomic(path, |w| write_to(w, data, comments))
 }
 
 #[cfg(test)]

@@ -80,18 +80,21 @@
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
+mod accuracy;
 mod compensate;
 mod error;
 pub mod fusion;
 mod gauss_newton;
 mod identify;
 mod model;
+mod record;
 mod report;
 mod robust;
 mod suspects;
 mod table;
 mod verdict;
 
+pub use accuracy::{AccuracyModel, DEFAULT_TOLERANCE_MM, PredictedAccuracy, WORTHWHILE_RATIO};
 pub use compensate::{Compensation, compensation, corrected_commands};
 pub use error::IdentError;
 pub use identify::{
@@ -99,10 +102,11 @@ pub use identify::{
     identify, identify_from,
 };
 pub use model::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
+pub use record::{RECORD_METHODS, RecordError, check_calibration_record};
 pub use report::{Combination, CorrelatedPair, IdentifiabilityReport, NamedValues, Observability};
 pub use robust::{Rejection, identify_robust, residuals_at, screen_gross_errors};
 pub use suspects::{LikelyCause, likely_causes};
-pub use table::{CompensationTable, SPACING_LADDER_MM};
+pub use table::{CompensationTable, MAX_TABLE_NODES, SPACING_LADDER_MM};
 pub use verdict::{
     ADEQUACY_ALPHA, BARELY_SEEN_STD_DEV_MM, INCONSISTENT_CHI2_PER_DOF, LARGE_ESTIMATE_MM, Verdict,
 };

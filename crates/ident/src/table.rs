@@ -73,6 +73,10 @@ fn correction(
     Ok(std::array::from_fn(|i| b[i] - a[i]))
 }
 
+/// The most nodes a compensation table may have (checked before any is
+/// computed).
+pub const MAX_TABLE_NODES: usize = 2_000_000;
+
 impl CompensationTable {
     /// The table of `calibrated` against `nominal` over `workspace` at
     /// `spacing_mm` (at least 1 mm). Fails when a node of a cell that
@@ -91,6 +95,14 @@ impl CompensationTable {
         let h = spacing_mm;
         let n_xy = (workspace.radius_mm / h).ceil() as usize;
         let n_z = ((workspace.z_max_mm - workspace.z_min_mm) / h).ceil() as usize;
+        let total = (2.0 * n_xy as f64 + 1.0).powi(2) * (n_z as f64 + 1.0);
+        if total > MAX_TABLE_NODES as f64 {
+            return Err(KinematicsError::OutOfReach {
+                reason: format!(
+                    "table spacing {spacing_mm} mm: {total} nodes, more than the {MAX_TABLE_NODES} a table may have; a coarser spacing is needed"
+                ),
+            });
+        }
         let origin_mm = Vector3::new(-(n_xy as f64) * h, -(n_xy as f64) * h, workspace.z_min_mm);
         let counts = [2 * n_xy + 1, 2 * n_xy + 1, n_z + 1];
         let mut nodes = Vec::with_capacity(counts[0] * counts[1] * counts[2]);

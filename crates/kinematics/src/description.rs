@@ -239,6 +239,11 @@ pub struct CalibrationRecord {
     pub tool_version: String,
     /// Name of the machine the estimates are relative to.
     pub relative_to: String,
+    /// The machine the estimates are relative to, when it is not `nominal`
+    /// (a recalibration of a calibrated machine: that machine, without its
+    /// own record), so that the geometry can be rebuilt from the record.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relative_to_machine: Option<Box<MachineDescription>>,
     /// The nominal machine of the rank rule.
     pub nominal: Box<MachineDescription>,
 }
@@ -499,6 +504,8 @@ impl MachineDescription {
 
     /// Parses and validates a description from JSON text.
     pub fn from_json(text: &str) -> Result<MachineDescription, DescriptionError> {
+        // A byte-order mark, as some editors write, is not part of the JSON.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let d: MachineDescription = serde_json::from_str(text)?;
         d.validate()?;
         Ok(d)
@@ -994,6 +1001,7 @@ mod tests {
             date: "2026-11-23T00:00:00Z".into(),
             tool_version: "0.1.0".into(),
             relative_to: nominal.name.clone(),
+            relative_to_machine: None,
             nominal: Box::new(nominal.clone()),
         }));
         let again = MachineDescription::from_json(&d.to_json()).unwrap();

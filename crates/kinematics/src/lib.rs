@@ -44,4 +44,4 @@ pub use machine::{
     IkSolution, LegGeometry, Limits, Machine, SINGULARITY_CONDITION_LIMIT, SensorNoise,
 };
 pub use up_limb::{UpJoints, UpLimb, UpLimbPose};
-pub use workspace::{PoseSet, PoseSetError, Workspace, box_lattice};
+pub use workspace::{MAX_POSES, PoseSet, PoseSetError, Workspace, box_lattice};

@@ -206,6 +206,27 @@ impl Machine {
         }
     }
 
+    /// The first point of the workspace the machine cannot reach (its rim
+    /// and half radius on the lowest, middle and highest planes, and the
+    /// axis), with why; `None` when it reaches them all. A description
+    /// whose workspace lies beyond its legs' stroke or its UP limb's tilt
+    /// is wrong, and every verb would fail on it somewhere else.
+    ///
+    /// # Example
+    /// ```
+    /// let mut m = tricept_kinematics::Machine::paper();
+    /// assert!(m.unreachable_workspace_point().is_none());
+    /// m.workspace.radius_mm = 900.0;
+    /// let (p, why) = m.unreachable_workspace_point().unwrap();
+    /// assert!(p.x.hypot(p.y) > 400.0, "{p} {why}");
+    /// ```
+    pub fn unreachable_workspace_point(&self) -> Option<(Vector3<f64>, KinematicsError)> {
+        self.workspace
+            .polar_grid(2, 16, 3)
+            .into_iter()
+            .find_map(|r| self.inverse(&r).err().map(|e| (r, e)))
+    }
+
     /// The description of this machine, with explicit joint coordinates
     /// (so that an identified machine can be written out and loaded again).
     pub fn to_description(&self) -> MachineDescription {

@@ -193,6 +193,10 @@ pub enum PoseSet {
     File(std::path::PathBuf),
 }
 
+/// The most points a generated pose set may have (`grid:` and `random:`),
+/// checked before anything is allocated.
+pub const MAX_POSES: usize = 1_000_000;
+
 /// A pose-set spec that cannot be parsed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("pose set `{spec}`: {reason}")]
@@ -241,14 +245,34 @@ impl std::str::FromStr for PoseSet {
             let [rings, per_ring, levels] = v.as_slice() else {
                 return Err(bad("expected grid:RINGS,PER_RING,LEVELS".into()));
             };
+            let (rings, per_ring, levels) = (
+                count(*rings, "RINGS")?,
+                count(*per_ring, "PER_RING")?,
+                count(*levels, "LEVELS")?,
+            );
+            let points = rings
+                .saturating_mul(per_ring)
+                .saturating_add(1)
+                .saturating_mul(levels);
+            if points > MAX_POSES {
+                return Err(bad(format!(
+                    "{points} points; a generated pose set has at most {MAX_POSES}"
+                )));
+            }
             return Ok(PoseSet::Grid {
-                rings: count(*rings, "RINGS")?,
-                per_ring: count(*per_ring, "PER_RING")?,
-                levels: count(*levels, "LEVELS")?,
+                rings,
+                per_ring,
+                levels,
             });
         }
         if let Some(rest) = spec.strip_prefix("random:") {
             let v = numbers(rest, "random:N[,SEED]")?;
+            if v.first().is_some_and(|&n| n > MAX_POSES as f64) {
+                return Err(bad(format!(
+                    "{} points; a generated pose set has at most {MAX_POSES}",
+                    v[0]
+                )));
+            }
             return match v.as_slice() {
                 [n] => Ok(PoseSet::Random {
                     n: count(*n, "N")?,

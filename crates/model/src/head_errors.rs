@@ -303,12 +303,10 @@ impl HeadParameterSet {
     /// assert!(set.parse_values(r#"{"dq1": 1}"#).is_err());
     /// ```
     pub fn parse_values(&self, json: &str) -> Result<Vec<f64>, ModelError> {
-        let v: Value = serde_json::from_str(json)?;
-        let Value::Object(map) = v else {
-            return Err(ModelError::Values(
-                "expected a JSON object of head parameter name -> value".into(),
-            ));
-        };
+        let map = crate::params::parse_object(
+            json,
+            "expected a JSON object of head parameter name -> value",
+        )?;
         values_from_named_map(&self.names, "head13", &map)
     }
 

@@ -47,6 +47,7 @@ pub use jacobian::{
     position_error_jacobian,
 };
 pub use params::{
-    FULL21_NAMES, GeometricErrors, N_FULL, PAPER15_NAMES, ParameterSet, TABLE2_JSON, residual_mu,
+    FULL21_NAMES, GeometricErrors, MAX_PARAMETER_ERROR, N_FULL, PAPER15_NAMES, ParameterSet,
+    TABLE2_JSON, residual_mu,
 };
 pub use volumetric::{ErrorMap, MapStats, volumetric_errors};

@@ -285,12 +285,10 @@ impl ParameterSet {
     /// Parses a JSON object `{name: value_mm}`. Names must belong to the
     /// set; missing names are zero.
     pub fn parse_values(&self, json: &str) -> Result<Vec<f64>, ModelError> {
-        let v: Value = serde_json::from_str(json)?;
-        let Value::Object(map) = v else {
-            return Err(ModelError::Values(
-                "expected a JSON object of parameter name -> value in mm".into(),
-            ));
-        };
+        let map = parse_object(
+            json,
+            "expected a JSON object of parameter name -> value in mm",
+        )?;
         self.values_from_map(&map)
     }
 
@@ -305,9 +303,54 @@ impl ParameterSet {
     }
 }
 
+/// The largest error a parameter may be given, mm (or rad for a name
+/// ending in `_rad`): beyond it a machine is not the one described, and a
+/// simulation of it means nothing.
+pub const MAX_PARAMETER_ERROR: (f64, f64) = (50.0, 0.5);
+
+/// A JSON object `{name: value}` (a byte-order mark allowed before it),
+/// refusing a key that appears twice (`serde_json` would keep the last).
+pub(crate) fn parse_object(json: &str, expected: &str) -> Result<Map<String, Value>, ModelError> {
+    struct Entries(Vec<(String, Value)>);
+    impl<'de> serde::Deserialize<'de> for Entries {
+        fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            struct V;
+            impl<'de> serde::de::Visitor<'de> for V {
+                type Value = Entries;
+                fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                    f.write_str("a JSON object")
+                }
+                fn visit_map<A: serde::de::MapAccess<'de>>(
+                    self,
+                    mut a: A,
+                ) -> Result<Entries, A::Error> {
+                    let mut v: Vec<(String, Value)> = Vec::new();
+                    while let Some((k, x)) = a.next_entry::<String, Value>()? {
+                        if v.iter().any(|(e, _)| *e == k) {
+                            return Err(serde::de::Error::custom(format!(
+                                "the key `{k}` appears twice"
+                            )));
+                        }
+                        v.push((k, x));
+                    }
+                    Ok(Entries(v))
+                }
+            }
+            d.deserialize_any(V)
+        }
+    }
+    let json = json.strip_prefix('\u{feff}').unwrap_or(json);
+    if !json.trim_start().starts_with('{') {
+        return Err(ModelError::Values(expected.into()));
+    }
+    let Entries(v) = serde_json::from_str(json)?;
+    Ok(v.into_iter().collect())
+}
+
 /// Values of the parameters `names` of set `label` from a JSON map
-/// `{name: value}` (missing names are zero; an unknown name or a value that
-/// is not a finite number is an error).
+/// `{name: value}` (missing names are zero; an unknown name, a value that
+/// is not a finite number, or one beyond [`MAX_PARAMETER_ERROR`] is an
+/// error).
 pub(crate) fn values_from_named_map(
     names: &[String],
     label: &str,
@@ -327,6 +370,16 @@ pub(crate) fn values_from_named_map(
                 "{k}: expected a finite number (in the unit its name carries), got {v}"
             ))
         })?;
+        let (limit, unit) = if k.ends_with("_rad") {
+            (MAX_PARAMETER_ERROR.1, "rad")
+        } else {
+            (MAX_PARAMETER_ERROR.0, "mm")
+        };
+        if x.abs() > limit {
+            return Err(ModelError::Values(format!(
+                "{k}: {x} is beyond ±{limit} {unit}: not an error of the machine described"
+            )));
+        }
         p[j] = x;
     }
     Ok(p)

@@ -214,6 +214,49 @@ pub struct PoseState {
 }
 
 impl Effect {
+    /// Checks the magnitudes: every number finite and within ±1e6 (in its
+    /// key's unit), stiffnesses, periods, widths and exponents positive;
+    /// the error says which key is wrong.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_plant::Effect;
+    /// assert!(Effect::Compliance { stiffness_n_per_um_at_1m: 33.6 }.validate().is_ok());
+    /// let e = Effect::Compliance { stiffness_n_per_um_at_1m: -5.0 }.validate().unwrap_err();
+    /// assert!(e.contains("stiffness_n_per_um_at_1m"), "{e}");
+    /// ```
+    pub fn validate(&self) -> Result<(), String> {
+        const LIMIT: f64 = 1e6;
+        let value = serde_json::to_value(self).map_err(|e| e.to_string())?;
+        let serde_json::Value::Object(map) = value else {
+            return Ok(());
+        };
+        for (key, v) in &map {
+            let numbers: Vec<f64> = match v {
+                serde_json::Value::Number(n) => n.as_f64().into_iter().collect(),
+                serde_json::Value::Array(a) => a.iter().filter_map(|x| x.as_f64()).collect(),
+                // A non-finite number serialises as null.
+                serde_json::Value::Null => vec![f64::NAN],
+                _ => continue,
+            };
+            for x in numbers {
+                if !(x.is_finite() && x.abs() <= LIMIT) {
+                    return Err(format!(
+                        "`{key}`: {x} is not a finite number within ±{LIMIT:e}"
+                    ));
+                }
+                let positive = matches!(
+                    key.as_str(),
+                    "stiffness_n_per_um_at_1m" | "period_mm" | "half_width_mm" | "exponent"
+                );
+                if positive && x <= 0.0 {
+                    return Err(format!("`{key}` must be positive, got {x}"));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The name a perfect diagnosis would give this effect: its name in
     /// the vocabulary, or for an effect outside it the generic family of
     /// its form (`leg-power` and the sawtooth `leg-periodic` only

@@ -44,6 +44,23 @@ fn err<E: std::error::Error + Send + Sync + 'static>(path: &Path, e: E) -> PlotE
     }
 }
 
+/// Draws a figure of `size` pixels with `draw` and writes it to `path`
+/// atomically (`tricept_data::write_atomic`: a failed write leaves the
+/// previous figure as it was).
+fn render(
+    path: &Path,
+    size: (u32, u32),
+    draw: impl FnOnce(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), PlotError>,
+) -> Result<(), PlotError> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        draw(&root)?;
+        root.present().map_err(|e| err(path, e))?;
+    }
+    tricept_data::write_atomic(path, |w| w.write_all(svg.as_bytes())).map_err(|e| err(path, e))
+}
+
 fn no_data(path: &Path) -> PlotError {
     PlotError::NoData {
         path: path.display().to_string(),
@@ -126,33 +143,34 @@ pub fn heat_map(
             )
         },
     );
-    let root = SVGBackend::new(path, (760, 620)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(path, e))?;
-    let (main, bar) = root.split_horizontally(620);
-    let mut chart = ChartBuilder::on(&main)
-        .caption(title, ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(55)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(|e| err(path, e))?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("x (mm)")
-        .y_desc("y (mm)")
-        .draw()
-        .map_err(|e| err(path, e))?;
-    chart
-        .draw_series(cells.iter().map(|c| {
-            Rectangle::new(
-                [(c.x - half, c.y - half), (c.x + half, c.y + half)],
-                colour((c.value - lo) / span).filled(),
-            )
-        }))
-        .map_err(|e| err(path, e))?;
-    colour_bar(&bar, lo, hi, value_label).map_err(|e| err(path, e))?;
-    root.present().map_err(|e| err(path, e))
+    render(path, (760, 620), |root| {
+        root.fill(&WHITE).map_err(|e| err(path, e))?;
+        let (main, bar) = root.split_horizontally(620);
+        let mut chart = ChartBuilder::on(&main)
+            .caption(title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(55)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|e| err(path, e))?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("x (mm)")
+            .y_desc("y (mm)")
+            .draw()
+            .map_err(|e| err(path, e))?;
+        chart
+            .draw_series(cells.iter().map(|c| {
+                Rectangle::new(
+                    [(c.x - half, c.y - half), (c.x + half, c.y + half)],
+                    colour((c.value - lo) / span).filled(),
+                )
+            }))
+            .map_err(|e| err(path, e))?;
+        colour_bar(&bar, lo, hi, value_label).map_err(|e| err(path, e))?;
+        Ok(())
+    })
 }
 
 fn colour_bar(
@@ -280,105 +298,109 @@ pub fn curves(
     if !(x0.is_finite() && y0.is_finite()) {
         return Err(no_data(path));
     }
-    let root = SVGBackend::new(path, (820, 560)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(path, e))?;
-    let (y0, y1) = if axes.log_y {
-        (y0 / 1.3, y1 * 1.3)
-    } else {
-        let pad = 0.06 * (y1 - y0).max(1e-12);
-        (
-            (y0 - pad).max(if y0 >= 0.0 { 0.0 } else { f64::NEG_INFINITY }),
-            y1 + pad,
-        )
-    };
-    macro_rules! draw {
-        ($xr:expr, $yr:expr) => {{
-            let mut chart = ChartBuilder::on(&root)
-                .caption(axes.title, ("sans-serif", 20))
-                .margin(15)
-                .x_label_area_size(45)
-                .y_label_area_size(70)
-                .build_cartesian_2d($xr, $yr)
-                .map_err(|e| err(path, e))?;
-            chart
-                .configure_mesh()
-                .x_desc(axes.x_label)
-                .y_desc(axes.y_label)
-                .x_label_formatter(&|v| trim_number(*v))
-                .y_label_formatter(&|v| trim_number(*v))
-                .light_line_style(WHITE)
-                .draw()
-                .map_err(|e| err(path, e))?;
-            for (k, c) in curves.iter().enumerate() {
-                let col = PALETTE[k % PALETTE.len()];
-                if let Some(band) = &c.band {
-                    let mut poly: Vec<(f64, f64)> =
-                        c.x.iter().zip(band).map(|(x, (l, _))| (*x, *l)).collect();
-                    poly.extend(c.x.iter().zip(band).rev().map(|(x, (_, h))| (*x, *h)));
+    render(path, (820, 560), |root| {
+        root.fill(&WHITE).map_err(|e| err(path, e))?;
+        let (y0, y1) = if axes.log_y {
+            (y0 / 1.3, y1 * 1.3)
+        } else {
+            let pad = 0.06 * (y1 - y0).max(1e-12);
+            (
+                (y0 - pad).max(if y0 >= 0.0 { 0.0 } else { f64::NEG_INFINITY }),
+                y1 + pad,
+            )
+        };
+        macro_rules! draw {
+            ($xr:expr, $yr:expr) => {{
+                let mut chart = ChartBuilder::on(&root)
+                    .caption(axes.title, ("sans-serif", 20))
+                    .margin(15)
+                    .x_label_area_size(45)
+                    .y_label_area_size(70)
+                    .build_cartesian_2d($xr, $yr)
+                    .map_err(|e| err(path, e))?;
+                chart
+                    .configure_mesh()
+                    .x_desc(axes.x_label)
+                    .y_desc(axes.y_label)
+                    .x_label_formatter(&|v| trim_number(*v))
+                    .y_label_formatter(&|v| trim_number(*v))
+                    .light_line_style(WHITE)
+                    .draw()
+                    .map_err(|e| err(path, e))?;
+                for (k, c) in curves.iter().enumerate() {
+                    let col = PALETTE[k % PALETTE.len()];
+                    if let Some(band) = &c.band {
+                        let mut poly: Vec<(f64, f64)> =
+                            c.x.iter().zip(band).map(|(x, (l, _))| (*x, *l)).collect();
+                        poly.extend(c.x.iter().zip(band).rev().map(|(x, (_, h))| (*x, *h)));
+                        chart
+                            .draw_series(std::iter::once(Polygon::new(
+                                poly,
+                                col.mix(0.18).filled(),
+                            )))
+                            .map_err(|e| err(path, e))?;
+                    }
                     chart
-                        .draw_series(std::iter::once(Polygon::new(poly, col.mix(0.18).filled())))
+                        .draw_series(LineSeries::new(
+                            c.x.iter().zip(&c.y).map(|(x, y)| (*x, *y)),
+                            col.stroke_width(2),
+                        ))
+                        .map_err(|e| err(path, e))?
+                        .label(c.name.clone())
+                        .legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2))
+                        });
+                    chart
+                        .draw_series(
+                            c.x.iter()
+                                .zip(&c.y)
+                                .map(|(x, y)| Circle::new((*x, *y), 3, col.filled())),
+                        )
                         .map_err(|e| err(path, e))?;
                 }
+                for (k, r) in references.iter().enumerate() {
+                    let col = if k == 0 {
+                        BLACK
+                    } else {
+                        PALETTE[(k + 3) % PALETTE.len()]
+                    };
+                    chart
+                        .draw_series(DashedLineSeries::new(
+                            vec![(x0, r.y), (x1, r.y)],
+                            8,
+                            5,
+                            col.stroke_width(1),
+                        ))
+                        .map_err(|e| err(path, e))?
+                        .label(r.name.clone())
+                        .legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(1))
+                        });
+                }
+                for m in markers {
+                    chart
+                        .draw_series(std::iter::once(Cross::new(m.at, 7, RED.stroke_width(2))))
+                        .map_err(|e| err(path, e))?
+                        .label(m.name.clone())
+                        .legend(|(x, y)| Cross::new((x + 9, y), 5, RED.stroke_width(2)));
+                }
                 chart
-                    .draw_series(LineSeries::new(
-                        c.x.iter().zip(&c.y).map(|(x, y)| (*x, *y)),
-                        col.stroke_width(2),
-                    ))
-                    .map_err(|e| err(path, e))?
-                    .label(c.name.clone())
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2))
-                    });
-                chart
-                    .draw_series(
-                        c.x.iter()
-                            .zip(&c.y)
-                            .map(|(x, y)| Circle::new((*x, *y), 3, col.filled())),
-                    )
+                    .configure_series_labels()
+                    .background_style(WHITE.mix(0.85))
+                    .border_style(BLACK)
+                    .position(SeriesLabelPosition::UpperLeft)
+                    .draw()
                     .map_err(|e| err(path, e))?;
-            }
-            for (k, r) in references.iter().enumerate() {
-                let col = if k == 0 {
-                    BLACK
-                } else {
-                    PALETTE[(k + 3) % PALETTE.len()]
-                };
-                chart
-                    .draw_series(DashedLineSeries::new(
-                        vec![(x0, r.y), (x1, r.y)],
-                        8,
-                        5,
-                        col.stroke_width(1),
-                    ))
-                    .map_err(|e| err(path, e))?
-                    .label(r.name.clone())
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(1))
-                    });
-            }
-            for m in markers {
-                chart
-                    .draw_series(std::iter::once(Cross::new(m.at, 7, RED.stroke_width(2))))
-                    .map_err(|e| err(path, e))?
-                    .label(m.name.clone())
-                    .legend(|(x, y)| Cross::new((x + 9, y), 5, RED.stroke_width(2)));
-            }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .position(SeriesLabelPosition::UpperLeft)
-                .draw()
-                .map_err(|e| err(path, e))?;
-        }};
-    }
-    match (axes.log_x, axes.log_y) {
-        (true, true) => draw!((x0..x1).log_scale(), (y0..y1).log_scale()),
-        (true, false) => draw!((x0..x1).log_scale(), y0..y1),
-        (false, true) => draw!(x0..x1, (y0..y1).log_scale()),
-        (false, false) => draw!(x0..x1, y0..y1),
-    }
-    root.present().map_err(|e| err(path, e))
+            }};
+        }
+        match (axes.log_x, axes.log_y) {
+            (true, true) => draw!((x0..x1).log_scale(), (y0..y1).log_scale()),
+            (true, false) => draw!((x0..x1).log_scale(), y0..y1),
+            (false, true) => draw!(x0..x1, (y0..y1).log_scale()),
+            (false, false) => draw!(x0..x1, y0..y1),
+        }
+        Ok(())
+    })
 }
 
 /// A tick label with at most four significant digits and no trailing zeros.
@@ -414,41 +436,42 @@ pub fn scatter(
     }
     let padx = 0.04 * (x1 - x0).max(1e-12);
     let pady = 0.08 * (y1 - y0).max(1e-12);
-    let root = SVGBackend::new(path, (820, 520)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(path, e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(axes.title, ("sans-serif", 20))
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d((x0 - padx)..(x1 + padx), (y0 - pady)..(y1 + pady))
-        .map_err(|e| err(path, e))?;
-    chart
-        .configure_mesh()
-        .x_desc(axes.x_label)
-        .y_desc(axes.y_label)
-        .light_line_style(WHITE)
-        .draw()
-        .map_err(|e| err(path, e))?;
-    for (k, (name, points)) in series.iter().enumerate() {
-        let col = PALETTE[k % PALETTE.len()];
+    render(path, (820, 520), |root| {
+        root.fill(&WHITE).map_err(|e| err(path, e))?;
+        let mut chart = ChartBuilder::on(root)
+            .caption(axes.title, ("sans-serif", 20))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d((x0 - padx)..(x1 + padx), (y0 - pady)..(y1 + pady))
+            .map_err(|e| err(path, e))?;
         chart
-            .draw_series(
-                points
-                    .iter()
-                    .map(|p| Circle::new(*p, 3, col.mix(0.8).filled())),
-            )
-            .map_err(|e| err(path, e))?
-            .label(name.clone())
-            .legend(move |(x, y)| Circle::new((x + 8, y), 4, col.filled()));
-    }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(path, e))?;
-    root.present().map_err(|e| err(path, e))
+            .configure_mesh()
+            .x_desc(axes.x_label)
+            .y_desc(axes.y_label)
+            .light_line_style(WHITE)
+            .draw()
+            .map_err(|e| err(path, e))?;
+        for (k, (name, points)) in series.iter().enumerate() {
+            let col = PALETTE[k % PALETTE.len()];
+            chart
+                .draw_series(
+                    points
+                        .iter()
+                        .map(|p| Circle::new(*p, 3, col.mix(0.8).filled())),
+                )
+                .map_err(|e| err(path, e))?
+                .label(name.clone())
+                .legend(move |(x, y)| Circle::new((x + 8, y), 4, col.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| err(path, e))?;
+        Ok(())
+    })
 }
 
 #[cfg(test)]

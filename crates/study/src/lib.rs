@@ -27,6 +27,7 @@
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
+pub mod campaign;
 pub mod exact;
 pub mod fast;
 pub mod grades;

@@ -95,6 +95,12 @@ impl Candidates {
         self.rows.is_empty()
     }
 
+    /// The information matrix `F(S)` of a selection (indices, repeats
+    /// allowed), the three sensor offsets eliminated (see the module docs).
+    pub fn information(&self, selection: &[usize]) -> DMatrix<f64> {
+        Sums::of(self, selection).information()
+    }
+
     /// Index of the candidate nearest to `p`.
     pub fn nearest(&self, p: &Vector3<f64>) -> usize {
         (0..self.len())

@@ -1,0 +1,247 @@
+//! The files a verb writes: each one atomically (a temporary file in the
+//! same directory, synced, renamed over the target:
+//! [`tricept_data::write_atomic`]), and never one of the verb's inputs.
+//!
+//! [`FileRoles`] lists a verb's input and output files; [`FileRoles::check`]
+//! runs before any computation and refuses (exit 2) an output that is an
+//! input, whether by the same name, through a symbolic link or as a hard
+//! link: `identify --data data.csv --write-machine data.csv` would
+//! otherwise replace the measured data by a machine file.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::cli_error::CliError;
+
+/// Writes `path` atomically; on failure the previous file is intact and
+/// the error (exit 1) names the file.
+pub fn write_with<F>(path: &Path, content: F) -> Result<(), CliError>
+where
+    F: FnOnce(&mut dyn Write) -> std::io::Result<()>,
+{
+    written(path, tricept_data::write_atomic(path, content))
+}
+
+/// The outcome of an atomic write of `path` by a library writer
+/// (`tricept_data::write_path`, ...), as the CLI reports it: exit 1 naming
+/// the file, which is as it was before.
+pub fn written(path: &Path, result: std::io::Result<()>) -> Result<(), CliError> {
+    result.map_err(|e| CliError::other(format!("{}: not written: {e}", path.display())))
+}
+
+/// Writes `text` to `path` atomically (see [`write_with`]).
+pub fn write_text(path: &Path, text: &str) -> Result<(), CliError> {
+    write_with(path, |w| w.write_all(text.as_bytes()))
+}
+
+/// Creates an output directory and its parents (exit 1 naming it on
+/// failure).
+pub fn create_dir(dir: &Path) -> Result<(), CliError> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        CliError::other(format!(
+            "{}: cannot create the directory: {e}",
+            dir.display()
+        ))
+    })
+}
+
+/// The files a verb reads and writes, by the flag that names them.
+#[derive(Debug, Default)]
+pub struct FileRoles {
+    inputs: Vec<(String, PathBuf)>,
+    outputs: Vec<(String, PathBuf)>,
+    /// Output directories the verb creates when they do not exist.
+    created_dirs: Vec<PathBuf>,
+}
+
+impl FileRoles {
+    /// A file the verb reads.
+    pub fn input(&mut self, flag: &str, path: &Path) -> &mut Self {
+        self.inputs.push((flag.to_string(), path.to_path_buf()));
+        self
+    }
+
+    /// Every file of `paths`, read under `flag`.
+    pub fn inputs<'a>(&mut self, flag: &str, paths: impl IntoIterator<Item = &'a PathBuf>) {
+        for p in paths {
+            self.input(flag, p);
+        }
+    }
+
+    /// A file the verb reads if `path` is one (an option that is either a
+    /// spec such as `table2` or a file name).
+    pub fn input_if_file(&mut self, flag: &str, spec: &str) {
+        let path = Path::new(spec.strip_prefix('@').unwrap_or(spec));
+        if path.is_file() {
+            self.input(flag, path);
+        }
+    }
+
+    /// A file the verb writes.
+    pub fn output(&mut self, flag: &str, path: &Path) -> &mut Self {
+        self.outputs.push((flag.to_string(), path.to_path_buf()));
+        self
+    }
+
+    /// The files `names` the verb writes into the directory `dir`.
+    pub fn outputs_in(&mut self, flag: &str, dir: &Path, names: &[&str]) {
+        self.created_dirs.push(dir.to_path_buf());
+        for n in names {
+            self.output(flag, &dir.join(n));
+        }
+    }
+
+    /// Refuses (exit 2) an output that is one of the inputs or another
+    /// output, by name, through a symbolic link or as a hard link, an output
+    /// that is a directory, and one whose directory does not exist (unless
+    /// the verb creates it).
+    pub fn check(&self) -> Result<(), CliError> {
+        for (i, (flag, input)) in self.inputs.iter().enumerate() {
+            if let Some((_, first)) = self.inputs[..i]
+                .iter()
+                .find(|(f, p)| f == flag && same_file(p, input))
+            {
+                return Err(CliError::input(format!(
+                    "{flag} {}: the same file as {flag} {} given before; each file counts once (a repeated tracker file would pass for a second station)",
+                    input.display(),
+                    first.display()
+                )));
+            }
+        }
+        for (i, (out_flag, out)) in self.outputs.iter().enumerate() {
+            if out.is_dir() {
+                return Err(CliError::input(format!(
+                    "{out_flag} {}: is a directory; give a file name",
+                    out.display()
+                )));
+            }
+            let dir = match out.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d,
+                _ => Path::new("."),
+            };
+            let created = self.created_dirs.iter().any(|d| d == dir);
+            if created && dir.exists() && !dir.is_dir() {
+                return Err(CliError::input(format!(
+                    "{out_flag} {}: is a file, not a directory",
+                    dir.display()
+                )));
+            }
+            if !created && !dir.is_dir() {
+                return Err(CliError::input(format!(
+                    "{out_flag} {}: the directory {} does not exist",
+                    out.display(),
+                    dir.display()
+                )));
+            }
+            let clash = self
+                .inputs
+                .iter()
+                .map(|(f, p)| (f, p, "the input"))
+                .chain(self.outputs[..i].iter().map(|(f, p)| (f, p, "the output")))
+                .find(|(_, p, _)| same_file(out, p));
+            if let Some((flag, path, role)) = clash {
+                return Err(CliError::input(format!(
+                    "{out_flag} {}: is also {role} {flag} {}; writing it would destroy that file: choose another name",
+                    out.display(),
+                    path.display()
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Whether two paths name the same file: the same device and inode where
+/// both exist (symbolic and hard links included), else the same path once
+/// the directories are resolved.
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (std::fs::metadata(a), std::fs::metadata(b)) {
+        (Ok(ma), Ok(mb)) => same_inode(&ma, &mb).unwrap_or_else(|| canonical(a) == canonical(b)),
+        _ => canonical(a) == canonical(b),
+    }
+}
+
+#[cfg(unix)]
+fn same_inode(a: &std::fs::Metadata, b: &std::fs::Metadata) -> Option<bool> {
+    use std::os::unix::fs::MetadataExt;
+    Some(a.dev() == b.dev() && a.ino() == b.ino())
+}
+
+#[cfg(not(unix))]
+fn same_inode(_: &std::fs::Metadata, _: &std::fs::Metadata) -> Option<bool> {
+    None
+}
+
+/// `p` with its directory resolved (the file itself may not exist yet).
+fn canonical(p: &Path) -> PathBuf {
+    if let Ok(c) = std::fs::canonicalize(p) {
+        return c;
+    }
+    match (p.parent(), p.file_name()) {
+        (Some(dir), Some(name)) => {
+            let dir = if dir.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                dir
+            };
+            std::fs::canonicalize(dir).map_or_else(|_| p.to_path_buf(), |d| d.join(name))
+        }
+        _ => p.to_path_buf(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outputs_that_are_inputs_are_found_by_name_link_and_hard_link() {
+        let d = std::env::temp_dir().join(format!("tricept-roles-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let data = d.join("data.csv");
+        std::fs::write(&data, "x").unwrap();
+        let hard = d.join("hard.csv");
+        let _ = std::fs::remove_file(&hard);
+        std::fs::hard_link(&data, &hard).unwrap();
+        let mut roles = FileRoles::default();
+        roles.input("--data", &data);
+        assert!(roles.check().is_ok());
+        for clash in [
+            data.clone(),
+            d.join(".").join("data.csv"),
+            hard.clone(),
+            d.join("sub").join("..").join("data.csv"),
+        ] {
+            let mut r = FileRoles::default();
+            r.input("--data", &data).output("--write-machine", &clash);
+            if clash.starts_with(d.join("sub")) {
+                // A path through a directory that does not exist cannot be
+                // written: refused as such.
+                let e = r.check().unwrap_err();
+                assert!(e.message.contains("does not exist"), "{}", e.message);
+                continue;
+            }
+            let e = r.check().unwrap_err();
+            assert_eq!(e.code, 2);
+            assert!(
+                e.message.contains("is also the input --data"),
+                "{}",
+                e.message
+            );
+        }
+        #[cfg(unix)]
+        {
+            let link = d.join("link.csv");
+            let _ = std::fs::remove_file(&link);
+            std::os::unix::fs::symlink(&data, &link).unwrap();
+            let mut r = FileRoles::default();
+            r.input("--data", &data).output("--out", &link);
+            assert!(r.check().is_err());
+        }
+        let mut r = FileRoles::default();
+        r.output("--out", &d.join("a.csv"))
+            .output("--tracker-out", &d.join("a.csv"));
+        assert!(r.check().unwrap_err().message.contains("the output --out"));
+        std::fs::remove_dir_all(&d).ok();
+    }
+}
