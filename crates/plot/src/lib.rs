@@ -2,9 +2,11 @@
 //! system font or image library is needed).
 //!
 //! - [`heat_map`]: a scalar over a lattice of the workspace plane, with a
-//!   colour bar (the paper's Fig. 3 error maps);
+//!   colour bar (the paper's Fig. 3 error maps); [`plane_z`] names the
+//!   plane in its title;
 //! - [`curves`]: lines with optional shaded bands and horizontal reference
-//!   lines, optionally on a log x axis (the paper's Fig. 4);
+//!   lines, optionally on log axes labelled where the data are (the paper's
+//!   Fig. 4);
 //! - [`scatter`]: point clouds (residuals against a regressor).
 #![cfg_attr(
     not(test),
@@ -155,6 +157,29 @@ pub fn heat_map(
     root.present().map_err(|e| err(path, e))
 }
 
+/// The plane a map lies in, for its title: `z = 750 mm`, or the range of z
+/// when the points do not share one (`z = 700 to 800 mm`).
+///
+/// ```
+/// assert_eq!(tricept_plot::plane_z([750.0, 750.0]), "z = 750 mm");
+/// assert_eq!(tricept_plot::plane_z([700.0, 812.5]), "z = 700 to 812.5 mm");
+/// ```
+pub fn plane_z(z_mm: impl IntoIterator<Item = f64>) -> String {
+    let (lo, hi) = z_mm
+        .into_iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), z| {
+            (a.min(z), b.max(z))
+        });
+    if !(lo.is_finite() && hi.is_finite()) {
+        return "z unknown".into();
+    }
+    if hi - lo < 1e-6 {
+        format!("z = {} mm", trim_number(lo))
+    } else {
+        format!("z = {} to {} mm", trim_number(lo), trim_number(hi))
+    }
+}
+
 fn colour_bar(
     area: &DrawingArea<SVGBackend<'_>, Shift>,
     lo: f64,
@@ -282,6 +307,7 @@ pub fn curves(
     }
     let root = SVGBackend::new(path, (820, 560)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(path, e))?;
+    let (yd0, yd1) = (y0, y1);
     let (y0, y1) = if axes.log_y {
         (y0 / 1.3, y1 * 1.3)
     } else {
@@ -372,13 +398,68 @@ pub fn curves(
                 .map_err(|e| err(path, e))?;
         }};
     }
+    // Log axes are labelled where the data are (plotters labels only the
+    // powers of ten, which may all lie outside the curves).
+    let log_axis = |lo: f64, hi: f64, data: (f64, f64)| {
+        (lo..hi)
+            .log_scale()
+            .with_key_points(log_ticks(lo, hi, data))
+    };
+    let (xd, yd) = ((x0, x1), (yd0, yd1));
     match (axes.log_x, axes.log_y) {
-        (true, true) => draw!((x0..x1).log_scale(), (y0..y1).log_scale()),
-        (true, false) => draw!((x0..x1).log_scale(), y0..y1),
-        (false, true) => draw!(x0..x1, (y0..y1).log_scale()),
+        (true, true) => draw!(log_axis(x0, x1, xd), log_axis(y0, y1, yd)),
+        (true, false) => draw!(log_axis(x0, x1, xd), y0..y1),
+        (false, true) => draw!(x0..x1, log_axis(y0, y1, yd)),
         (false, false) => draw!(x0..x1, y0..y1),
     }
     root.present().map_err(|e| err(path, e))
+}
+
+/// Tick positions on a log axis over `lo..hi` whose data span `data`:
+/// `{1, 2, 5} x 10^k` (every integer mantissa when the axis spans at most a
+/// decade, powers of ten beyond four decades), and the data's ends (to two
+/// significant digits) where no tick lies within a tenth of a decade of
+/// them, so that the labels span the data.
+fn log_ticks(lo: f64, hi: f64, data: (f64, f64)) -> Vec<f64> {
+    if !(lo > 0.0 && hi > lo && lo.is_finite() && hi.is_finite()) {
+        return Vec::new();
+    }
+    let decades = (hi / lo).log10();
+    let mantissas: &[f64] = if decades <= 1.0 {
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]
+    } else if decades <= 4.0 {
+        &[1.0, 2.0, 5.0]
+    } else {
+        &[1.0]
+    };
+    let inside = |v: f64| v >= lo * (1.0 - 1e-9) && v <= hi * (1.0 + 1e-9);
+    let mut ticks: Vec<f64> = (lo.log10().floor() as i32..=hi.log10().ceil() as i32)
+        .flat_map(|k| {
+            mantissas
+                .iter()
+                .map(move |m| round_significant(m * 10f64.powi(k), 2))
+        })
+        .filter(|v| inside(*v))
+        .collect();
+    for end in [data.0, data.1] {
+        let end = round_significant(end, 2);
+        let far = ticks.iter().all(|t| (t / end).log10().abs() > 0.1);
+        if end > 0.0 && inside(end) && far {
+            ticks.push(end);
+        }
+    }
+    ticks.sort_by(f64::total_cmp);
+    ticks
+}
+
+/// `v` rounded to `digits` significant digits (and free of the binary noise
+/// of `m * 10^k`, so that labels print short).
+fn round_significant(v: f64, digits: i32) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let scale = 10f64.powi(digits - 1 - v.abs().log10().floor() as i32);
+    (v * scale).round() / scale
 }
 
 /// A tick label with at most four significant digits and no trailing zeros.
@@ -461,6 +542,37 @@ mod tests {
         assert_eq!(colour(1.0), RGBColor(253, 231, 37));
         assert_eq!(colour(-3.0), colour(0.0));
         assert_eq!(colour(f64::NAN), colour(0.0));
+    }
+
+    #[test]
+    fn log_ticks_label_the_data() {
+        // Fig. 4: grades 0.25-8 arcsec; mu 0.015-0.29 mm on an axis padded by 1.3.
+        let x = log_ticks(0.25, 8.0, (0.25, 8.0));
+        assert_eq!(x, vec![0.25, 0.5, 1.0, 2.0, 5.0, 8.0]);
+        let y = log_ticks(0.015 / 1.3, 0.291 * 1.3, (0.015, 0.291));
+        assert_eq!(y, vec![0.015, 0.02, 0.05, 0.1, 0.2, 0.29]);
+        // Within one decade every mantissa is a tick.
+        assert_eq!(
+            log_ticks(0.02, 0.05, (0.021, 0.05)),
+            vec![0.02, 0.03, 0.04, 0.05]
+        );
+        // Many decades: powers of ten only.
+        assert_eq!(
+            log_ticks(1e-3, 1e3, (1e-3, 1e3)),
+            vec![1e-3, 1e-2, 0.1, 1.0, 10.0, 100.0, 1e3]
+        );
+        assert!(log_ticks(0.0, 1.0, (0.0, 1.0)).is_empty());
+        // Every tick lies on the axis, and the labels reach both data ends
+        // within a tenth of a decade.
+        for (lo, hi) in [(0.011, 0.4), (3.0, 7.0), (0.7, 130.0), (5.0, 12.0)] {
+            let t = log_ticks(lo, hi, (lo, hi));
+            assert!(
+                t.iter().all(|v| *v >= lo * 0.999 && *v <= hi * 1.001),
+                "{t:?}"
+            );
+            assert!((t[0] / lo).log10() <= 0.1, "{lo}..{hi}: {t:?}");
+            assert!((hi / t[t.len() - 1]).log10() <= 0.1, "{lo}..{hi}: {t:?}");
+        }
     }
 
     #[test]
