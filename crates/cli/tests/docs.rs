@@ -77,7 +77,7 @@ fn every_page_a_help_text_names_is_there() {
                 continue;
             }
             assert_eq!(
-                tricept(&["docs", &page]).0,
+                tricept(&["docs", page]).0,
                 0,
                 "a help text names `tricept docs {page}`"
             );
