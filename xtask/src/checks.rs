@@ -31,11 +31,23 @@ const BUILDS: [&[&str]; 4] = [
 /// The workspace root (xtask's parent directory).
 const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
 
-/// The cargo that runs this xtask, in the workspace root.
-fn cargo() -> Command {
-    let mut command = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
-    command.current_dir(ROOT);
-    command
+/// Runs the cargo that runs this xtask, in the workspace root, with
+/// `args` (and `--locked`); returns its stdout, or its stderr as the error.
+fn cargo(args: &[&str]) -> Result<Vec<u8>, String> {
+    let command = format!("cargo {}", args.join(" "));
+    let output = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
+        .current_dir(ROOT)
+        .args(args)
+        .arg("--locked")
+        .output()
+        .map_err(|e| format!("{command}: {e}"))?;
+    if !output.status.success() {
+        return Err(format!(
+            "{command} --locked failed:\n{}",
+            String::from_utf8_lossy(&output.stderr)
+        ));
+    }
+    Ok(output.stdout)
 }
 
 /// One compiled third-party target: its package and target, and cargo's
@@ -50,21 +62,10 @@ struct Artifact {
 /// The third-party artifacts one build produces (compiling what is stale),
 /// and how many of them it had to compile.
 fn artifacts(args: &[&str]) -> Result<(BTreeMap<Unit, Artifact>, usize), String> {
-    let command = format!("cargo {}", args.join(" "));
-    let output = cargo()
-        .args(args)
-        .args(["--locked", "--message-format=json"])
-        .output()
-        .map_err(|e| format!("{command}: {e}"))?;
-    if !output.status.success() {
-        return Err(format!(
-            "{command} failed:\n{}",
-            String::from_utf8_lossy(&output.stderr)
-        ));
-    }
+    let stdout = cargo(&[args, &["--message-format=json"]].concat())?;
     let mut units = BTreeMap::new();
     let mut compiled = 0;
-    for line in String::from_utf8_lossy(&output.stdout).lines() {
+    for line in String::from_utf8_lossy(&stdout).lines() {
         let Ok(message) = serde_json::from_str::<Value>(line) else {
             continue;
         };
@@ -161,18 +162,9 @@ fn version(text: &str) -> Result<Vec<u64>, String> {
 
 /// `cargo xtask msrv`.
 pub fn msrv() -> Result<(), String> {
-    let output = cargo()
-        .args(["metadata", "--locked", "--format-version", "1"])
-        .output()
-        .map_err(|e| format!("cargo metadata: {e}"))?;
-    if !output.status.success() {
-        return Err(format!(
-            "cargo metadata --locked failed:\n{}",
-            String::from_utf8_lossy(&output.stderr)
-        ));
-    }
-    let metadata: Value = serde_json::from_slice(&output.stdout)
-        .map_err(|e| format!("cargo metadata: not JSON: {e}"))?;
+    let stdout = cargo(&["metadata", "--format-version", "1"])?;
+    let metadata: Value =
+        serde_json::from_slice(&stdout).map_err(|e| format!("cargo metadata: not JSON: {e}"))?;
     let members: Vec<&str> = metadata["workspace_members"]
         .as_array()
         .map(|a| a.iter().filter_map(Value::as_str).collect())
