@@ -93,8 +93,10 @@ pub use verdict::{
 
 // What a downstream crate needs besides this crate's own types, so that one
 // dependency suffices: every crate whose types the public API takes or
-// returns (found from rustdoc's JSON of this crate, docs/performance.md
-// "One dependency"), and those types at the root.
+// returns, and those types at the root. Found from rustdoc's JSON of this
+// crate (`RUSTC_BOOTSTRAP=1 cargo rustdoc -p tricept-ident --lib -- -Z
+// unstable-options --output-format json`: every `resolved_path` in a public
+// item whose crate is not std); recheck it when a signature changes.
 pub use nalgebra;
 pub use serde_json;
 pub use tricept_data;
