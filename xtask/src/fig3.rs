@@ -347,19 +347,21 @@ pub fn run_compensation(
     std::fs::create_dir_all(out_dir).map_err(|e| format!("{}: {e}", out_dir.display()))?;
     let (_, c) = one_seed(&nominal, &plant, &targets, &plane, 1)?;
     let residual = c.after.without_mean_translation();
-    for (file, map, title) in [
+    for (file, map, what) in [
+        ("fig3-before.svg", &c.before, "Error before compensation"),
         (
-            "fig3-before.svg",
-            &c.before,
-            "Before compensation, z = 750 mm",
+            "fig3-after.svg",
+            &c.after,
+            "Error after compensation (seed 1)",
         ),
-        ("fig3-after.svg", &c.after, "After compensation (seed 1)"),
         (
             "fig3-after-no-translation.svg",
             &residual,
-            "After compensation, rigid translation removed",
+            "After compensation, rigid shift removed",
         ),
     ] {
+        let z = tricept_plot::plane_z(map.targets_mm.iter().map(|p| p.z));
+        let title = format!("{what} |dr| (mm), {z}");
         let cells: Vec<tricept_plot::Cell> = map
             .targets_mm
             .iter()
@@ -371,7 +373,7 @@ pub fn run_compensation(
             })
             .collect();
         let path = out_dir.join(file);
-        tricept_plot::heat_map(&path, title, &cells, spacing_mm, "|dr| (mm)", None)
+        tricept_plot::heat_map(&path, &title, &cells, spacing_mm, "|dr| (mm)", None)
             .map_err(|e| e.to_string())?;
         println!("wrote {}", path.display());
     }

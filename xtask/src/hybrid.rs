@@ -783,7 +783,7 @@ fn report(
             scenario.name()
         ));
         let title = format!(
-            "{}, scenario {}: tool-tip error after touch-off ({} machines)",
+            "{}, scenario {}: tool-tip error after touch-off (um, {} machines)",
             instrument.name(),
             scenario.name(),
             a.machines

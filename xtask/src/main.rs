@@ -3,6 +3,7 @@
 //! `cargo xtask <verb>`; see `cargo xtask --help`. Each verb reproduces a
 //! figure or table that the docs quote, so anyone can rerun it.
 
+mod checks;
 mod fig3;
 mod hybrid;
 mod reproduction;
@@ -53,6 +54,14 @@ enum Command {
         #[arg(long, default_value = "docs/figures")]
         out: std::path::PathBuf,
     },
+    /// Check that `cargo xtask encoder-study`, `cargo test --workspace`,
+    /// `cargo run -p tricept-cli` and `cargo run -p
+    /// tricept-example-downstream` build every third-party crate with the
+    /// same features (one build); run by .ci/run after the tests.
+    OneBuild,
+    /// Check that Cargo.toml's rust-version (and the README's) is at least
+    /// that of every locked dependency (`cargo metadata --locked`).
+    Msrv,
 }
 
 fn main() -> ExitCode {
@@ -67,6 +76,8 @@ fn main() -> ExitCode {
             spacing,
             out,
         } => fig3::run_compensation(seeds, &out, spacing),
+        Command::OneBuild => checks::one_build(),
+        Command::Msrv => checks::msrv(),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

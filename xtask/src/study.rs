@@ -484,7 +484,7 @@ fn plot(
     curves(
         path,
         &Axes {
-            title: "Fig. 4: residual error mu vs encoder grade",
+            title: "Fig. 4: parameter error mu (mm) vs encoder noise (arcsec)",
             x_label: "encoder noise per reading (arcsec)",
             y_label: "mu = |deps - deps_e|_1 / 15 (mm)",
             log_x: true,

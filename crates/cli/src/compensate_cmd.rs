@@ -489,31 +489,25 @@ fn write_map(
             })
             .collect()
     };
-    let plot = |name: &str, title: &str, m: &ErrorMap, range| {
-        tricept_plot::heat_map(&dir.join(name), title, &cells(m), spacing, "mm", range)
-            .map_err(|e| CliError::other(e.to_string()))
+    // Each map on its own colour scale (its min..max): an after map is often
+    // ten times smaller than the before map and flat on the before's scale.
+    let plot = |name: &str, what: &str, m: &ErrorMap| {
+        let z = tricept_plot::plane_z(m.targets_mm.iter().map(|r| r.z));
+        let title = format!("{what} |dr| (mm), {z}");
+        tricept_plot::heat_map(
+            &dir.join(name),
+            &title,
+            &cells(m),
+            spacing,
+            "|dr| (mm)",
+            None,
+        )
+        .map_err(|e| CliError::other(e.to_string()))
     };
-    plot(
-        "correction.svg",
-        "predicted correction |dr| (mm)",
-        predicted,
-        None,
-    )?;
+    plot("correction.svg", "Predicted correction", predicted)?;
     if let Some((b, a)) = truth {
-        // One colour scale for both, so that the maps compare at a glance.
-        let hi = b.stats().max_mm.max(a.stats().max_mm);
-        plot(
-            "before.svg",
-            "error before compensation (mm)",
-            b,
-            Some((0.0, hi)),
-        )?;
-        plot(
-            "after.svg",
-            "error after compensation (mm)",
-            a,
-            Some((0.0, hi)),
-        )?;
+        plot("before.svg", "Error before compensation", b)?;
+        plot("after.svg", "Error after compensation", a)?;
     }
     Ok(())
 }

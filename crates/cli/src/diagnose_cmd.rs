@@ -120,7 +120,7 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
             tricept_plot::scatter(
                 &path,
                 &tricept_plot::Axes {
-                    title: &format!("{}: residuals before and after", p.effect),
+                    title: &format!("{}: {}, before and after", p.effect, p.y_label),
                     x_label: &p.x_label,
                     y_label: &p.y_label,
                     log_x: false,

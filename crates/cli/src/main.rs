@@ -25,6 +25,7 @@ mod args;
 mod cli_error;
 mod compensate_cmd;
 mod diagnose_cmd;
+mod docs_cmd;
 mod files;
 mod fusion_cmd;
 mod ident_cmd;
@@ -50,7 +51,7 @@ use crate::cli_error::CliError;
     version,
     about,
     long_about = None,
-    after_help = "Examples:\n  tricept ik 0 0 750\n  tricept simulate --out data.csv\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept ik 0 0 750 --machine calibrated.json\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n\nExit codes: 0 success; 2 usage or input error; 3 (identify, compensate, diagnose) the fit converged but the model does not explain the data (run `tricept diagnose`), or the campaign is too small to calibrate; 4 (identify, compensate) the fit did not converge; 1 anything else, including a stdout that cannot be written (a full disk).\nData format: docs/data-format.md"
+    after_help = "Examples:\n  tricept ik 0 0 750\n  tricept simulate --out data.csv\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept ik 0 0 750 --machine calibrated.json\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n\nExit codes: 0 success; 2 usage or input error; 3 (identify, compensate, diagnose) the fit converged but the model does not explain the data (run `tricept diagnose`), or the campaign is too small to calibrate; 4 (identify, compensate) the fit did not converge; 1 anything else, including a stdout that cannot be written (a full disk).\nDocumentation: `tricept docs` lists the pages (docs/*.md of the source, embedded); the data formats: `tricept docs data-format`."
 )]
 #[command(subcommand_required = true)]
 struct Cli {
@@ -98,14 +99,14 @@ enum Command {
     /// touch-offs) that also calibrate the head.
     #[command(
         allow_negative_numbers = true,
-        after_help = "Exit codes: 0 converged, adequate (the model explains the data to the sensor noise) and worthwhile; 3 converged but the model does not explain the data (the report names `tricept diagnose`), or the campaign is too small to calibrate (the report names the poses that would); 4 did not converge; 2 bad input. --write-machine writes only an exit-0 fit (--force writes any, marked as forced).\n\nWith --tracker, --ballbar, --touch, --head or --effects the fused identification runs (docs/hybrid.md): module, head (13 parameters) and each instrument's nuisance in one fit; exit code 3 when it converges but a source is not explained (reduced chi-square > 3), 4 when it does not converge.\n\nExamples:\n  tricept simulate --out data.csv && tricept identify --data data.csv\n  tricept identify --data data.csv --json\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept identify --data data.csv --tracker points.csv --tracker-target tip --write-machine calibrated.json"
+        after_help = "Exit codes: 0 converged, adequate (the model explains the data to the sensor noise) and worthwhile; 3 converged but the model does not explain the data (the report names `tricept diagnose`), or the campaign is too small to calibrate (the report names the poses that would); 4 did not converge; 2 bad input. --write-machine writes only an exit-0 fit (--force writes any, marked as forced).\n\nWith --tracker, --ballbar, --touch, --head or --effects the fused identification runs (`tricept docs hybrid`): module, head (13 parameters) and each instrument's nuisance in one fit; exit code 3 when it converges but a source is not explained (reduced chi-square > 3), 4 when it does not converge.\n\nExamples:\n  tricept simulate --out data.csv && tricept identify --data data.csv\n  tricept identify --data data.csv --json\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept identify --data data.csv --tracker points.csv --tracker-target tip --write-machine calibrated.json"
     )]
     Identify(ident_cmd::IdentifyArgs),
     /// Write a measured-data CSV from a simulated machine (Table 2 errors by
     /// default) with sensor noise, offsets and optional unmodelled effects.
     #[command(
         allow_negative_numbers = true,
-        after_help = "True errors (--truth): table2, zero, random:MAG_MM[,SEED], or a JSON file {name: mm}.\nEffects (--truth-effect, repeatable): a JSON object or @FILE, e.g. '{\"effect\":\"leg-lead\",\"ppm\":[50,-30,40]}' (see docs/diagnosis.md for every effect and its units).\n\nExamples:\n  tricept simulate --out data.csv\n  tricept simulate --truth random:1.0,3 --poses random:100,2 --seed 9 --out data.csv\n  tricept simulate --truth-effect '{\"effect\":\"backlash\",\"um\":[6,5,8]}' --both-directions --out data.csv"
+        after_help = "True errors (--truth): table2, zero, random:MAG_MM[,SEED], or a JSON file {name: mm}.\nEffects (--truth-effect, repeatable): a JSON object or @FILE, e.g. '{\"effect\":\"leg-lead\",\"ppm\":[50,-30,40]}' (see `tricept docs diagnosis` for every effect and its units).\n\nExamples:\n  tricept simulate --out data.csv\n  tricept simulate --truth random:1.0,3 --poses random:100,2 --seed 9 --out data.csv\n  tricept simulate --truth-effect '{\"effect\":\"backlash\",\"um\":[6,5,8]}' --both-directions --out data.csv"
     )]
     Simulate(simulate_cmd::SimulateArgs),
     /// Does the geometric model explain the data? If not, which unmodelled
@@ -113,7 +114,7 @@ enum Command {
     /// encoder-eccentricity, ujoint-axes, tube-twist, compliance, outliers).
     #[command(
         allow_negative_numbers = true,
-        after_help = "Examples:\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n  tricept diagnose --data data.csv --json --plots out/\n  tricept diagnose --data fixtures/data/diagnose-noisy.csv --noise-from-data\n  tricept diagnose --data data.csv --write-machine extended.json && tricept ik 0 0 750 --machine extended.json\n\nExit codes: 0 the final model explains the data (verdict adequate or explained), 3 it does not (partially-explained, unexplained: the report says what remains), 2 data that cannot be diagnosed.\nMethod, vocabulary, generic dictionary, plausibility table: docs/diagnosis.md"
+        after_help = "Examples:\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n  tricept diagnose --data data.csv --json --plots out/\n  tricept diagnose --data fixtures/data/diagnose-noisy.csv --noise-from-data\n  tricept diagnose --data data.csv --write-machine extended.json && tricept ik 0 0 750 --machine extended.json\n\nExit codes: 0 the final model explains the data (verdict adequate or explained), 3 it does not (partially-explained, unexplained: the report says what remains), 2 data that cannot be diagnosed.\nMethod, vocabulary, generic dictionary, plausibility table: `tricept docs diagnosis`"
     )]
     Diagnose(diagnose_cmd::DiagnoseArgs),
     /// For a measurement campaign: how large must each unmodelled effect be
@@ -136,9 +137,15 @@ enum Command {
     /// and the predicted accuracy against their number.
     #[command(
         allow_negative_numbers = true,
-        after_help = "Criterion: the RMS over the evaluation tool poses of the predicted tool-tip standard deviation after touch-off (a Bayesian A-optimal design with the parameters' typical sizes as prior; docs/hybrid.md).\n\nExamples:\n  tricept plan --instrument tracker --k 5,12,30 --out points.csv\n  tricept plan --instrument ballbar --ballbar-pivot-mm 0,0,1250 --target-um 15"
+        after_help = "Criterion: the RMS over the evaluation tool poses of the predicted tool-tip standard deviation after touch-off (a Bayesian A-optimal design with the parameters' typical sizes as prior; `tricept docs hybrid`).\n\nExamples:\n  tricept plan --instrument tracker --k 5,12,30 --out points.csv\n  tricept plan --instrument ballbar --ballbar-pivot-mm 0,0,1250 --target-um 15"
     )]
     Plan(plan_cmd::PlanArgs),
+    /// The documentation pages (data formats, conventions, diagnosis, ...),
+    /// embedded: print one, or list them.
+    #[command(
+        after_help = "Examples:\n  tricept docs\n  tricept docs data-format | less\n  tricept docs docs/diagnosis.md"
+    )]
+    Docs(docs_cmd::DocsArgs),
 }
 
 /// The files a verb reads and writes, by flag (checked before it runs:
@@ -164,6 +171,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
             r.inputs("--input", &a.input.input);
         }
         Command::Machine(a) => machine(&mut r, &a.machine),
+        Command::Docs(_) => {}
         Command::Identifiability(a) => {
             machine(&mut r, &a.machine);
             r.input_if_file("--poses", &a.poses);
@@ -260,6 +268,7 @@ fn run(cli: Cli) -> Result<u8, CliError> {
         Command::Detectability(a) => diagnose_cmd::run_detectability(&a),
         Command::Compensate(a) => compensate_cmd::run_compensate(&a),
         Command::Plan(a) => plan_cmd::run(&a),
+        Command::Docs(a) => docs_cmd::run(&a),
     }
 }
 

@@ -50,6 +50,7 @@ fn every_verb_survives_a_closed_stdout() {
         ),
         (vec!["--help"], 0),
         (vec!["identify", "--help"], 0),
+        (vec!["docs", "diagnosis"], 0),
     ];
     let mut failures = Vec::new();
     for (args, code) in &cases {

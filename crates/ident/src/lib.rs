@@ -26,32 +26,16 @@
 //! Parameter names are those of [`tricept_model::ParameterSet`]; lengths in
 //! mm, angles in rad.
 //!
-//! One dependency suffices: the crate re-exports the data reader
-//! ([`read_path`], [`Dataset`]), the machine ([`Machine`],
-//! [`MachineDescription`], [`ExtendedMachine`]) and the parameter sets
-//! ([`ParameterSet`]); `examples/downstream` in the repository is a crate
-//! built on it alone.
+//! One dependency suffices: the crate re-exports every crate whose types its
+//! public API takes or returns ([`nalgebra`], [`serde_json`],
+//! [`tricept_data`], [`tricept_kinematics`], [`tricept_model`]), so every such
+//! type and its methods' types are reachable as `tricept_ident::CRATE::...`,
+//! and the types its functions take and return directly at the root
+//! ([`read_path`], [`Dataset`], [`Machine`], [`ParameterSet`], [`ErrorMap`],
+//! ...). `examples/downstream` in the repository is a crate built on it
+//! alone; its doc test is the first example below.
 //!
-//! # Example: calibrating from a measured file
-//! ```
-//! use tricept_ident::{GeometricModel, IdentifyOptions, Machine, ParameterSet, identify_robust, read_path};
-//!
-//! let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/table2-grid-seed1.csv");
-//! let data = read_path(file.as_ref())?;
-//! let machine = Machine::paper();
-//! let model = GeometricModel::new(machine.clone(), ParameterSet::paper15());
-//! let (id, rejected) = identify_robust(&model, &data, &IdentifyOptions::for_machine(&machine))?;
-//! // Trust the result only if the fit converged and the model explains the
-//! // data to the sensor noise; otherwise the warnings say why.
-//! let verdict = id.verdict();
-//! assert!(verdict.converged && verdict.adequate, "{:?}", verdict.warnings);
-//! assert!(rejected.is_empty());
-//! // The calibrated machine's leg commands for a target (mm).
-//! let calibrated = model.machine_at(&id.estimate);
-//! let q = calibrated.inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0))?.legs_mm;
-//! assert!((q[1] - machine.inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0))?.legs_mm[1] + 0.6).abs() < 0.3);
-//! # Ok::<(), Box<dyn std::error::Error>>(())
-//! ```
+#![doc = include_str!("first_example.md")]
 //!
 //! # Example: simulated data and the compensation they give
 //! ```
@@ -112,8 +96,24 @@ pub use verdict::{
 };
 
 // What a downstream crate needs besides this crate's own types, so that one
-// dependency suffices: the data set and its reader, the machine, the
-// parameter sets.
-pub use tricept_data::{DataError, Dataset, MeasuredPose, Readings, read_from, read_path};
-pub use tricept_kinematics::{Machine, MachineDescription};
-pub use tricept_model::{ExtendedMachine, ParameterSet};
+// dependency suffices: every crate whose types the public API takes or
+// returns, and those types at the root. Found from rustdoc's JSON of this
+// crate (`RUSTC_BOOTSTRAP=1 cargo rustdoc -p tricept-ident --lib -- -Z
+// unstable-options --output-format json`: every `resolved_path` in a public
+// item whose crate is not std); recheck it when a signature changes.
+pub use nalgebra;
+pub use serde_json;
+pub use tricept_data;
+pub use tricept_data::{
+    BallbarData, DataError, Dataset, ExternalPose, Features, MeasuredPose, Readings, TouchData,
+    TrackerData, read_from, read_path,
+};
+pub use tricept_kinematics;
+pub use tricept_kinematics::{
+    HeadBranch, KinematicsError, LegGeometry, Machine, MachineDescription, UpJoints, Workspace,
+};
+pub use tricept_model;
+pub use tricept_model::effects::EffectName;
+pub use tricept_model::{
+    Effector, ErrorMap, ExtendedMachine, HeadParameterSet, MapStats, ModelError, ParameterSet,
+};

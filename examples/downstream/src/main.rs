@@ -9,7 +9,7 @@
 
 use std::process::ExitCode;
 
-use nalgebra::Vector3;
+use tricept_ident::nalgebra::Vector3;
 use tricept_ident::{
     ExtendedMachine, GeometricModel, IdentifyOptions, Machine, ParameterSet, identify_robust,
     read_path,

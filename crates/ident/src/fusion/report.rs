@@ -309,14 +309,14 @@ pub(crate) fn build_report(
     let mut weak = Vec::new();
     let mut scopes: Vec<(String, &RankDecision, &IdentifiabilityReport)> =
         vec![("union".to_string(), union_decision, &union_report)];
-    if let Some(i) = internal {
-        if sources.len() > 1 {
-            scopes.push((
-                sources[i].label().to_string(),
-                &alone[i].decision,
-                &alone[i].report,
-            ));
-        }
+    if let Some(i) = internal
+        && sources.len() > 1
+    {
+        scopes.push((
+            sources[i].label().to_string(),
+            &alone[i].decision,
+            &alone[i].report,
+        ));
     }
     for (scope, d, report) in &scopes {
         let top = d.singular_values.first().copied().unwrap_or(0.0);
@@ -422,10 +422,10 @@ impl FusionReport {
     /// `weak`, `invisible`, `tool_tip`).
     pub fn to_json(&self) -> Value {
         let mut v = serde_json::to_value(self).unwrap_or(Value::Null);
-        if let Value::Object(o) = &mut v {
-            if let Some(s) = o.remove("sources") {
-                o.insert("per_source".into(), s);
-            }
+        if let Value::Object(o) = &mut v
+            && let Some(s) = o.remove("sources")
+        {
+            o.insert("per_source".into(), s);
         }
         v
     }
