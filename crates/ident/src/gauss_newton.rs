@@ -9,6 +9,11 @@
 //! increase. The iteration has converged when every identifiable
 //! parameter's step (and every step of a nuisance parameter carried from
 //! one evaluation to the next) is below 1e-3 of its standard deviation.
+//! A converged run then takes that last step and evaluates the model
+//! there: the estimate is the last point evaluated, with the nuisance
+//! re-fitted at it, so that the residuals, chi-square and covariance
+//! reported are all of the estimate (the step after it, of second order,
+//! is not taken).
 
 use tricept_numerics::lsq::{RankDecision, ReducedProblem, Solution};
 
@@ -75,6 +80,7 @@ pub(crate) fn iterate<I: Iteration>(
         let step = run.solution.parameters.clone();
         if within(run, &step, 1e-3) {
             run.converged = true;
+            take_last_step(problem, run, decision);
             return;
         }
         let cost = problem.problem(&run.eval).cost_without_parameters();
@@ -102,11 +108,10 @@ pub(crate) fn iterate<I: Iteration>(
             Some(e) => run.eval = e,
             None => {
                 // No decrease along the step: at the minimum to rounding
-                // if the step is small against the uncertainty.
+                // if the step is small against the uncertainty. Either way
+                // the rejected step is not part of the estimate.
                 run.converged = within(run, &step, 1e-2);
-                if !run.converged {
-                    hold_at_current(problem, run);
-                }
+                hold_at_current(problem, run);
                 return;
             }
         }
@@ -116,15 +121,45 @@ pub(crate) fn iterate<I: Iteration>(
     run.converged = within(run, &step, 1e-3);
     // With no iteration allowed the result is the one linear solve at the
     // start point (the linearised estimator), which keeps its step.
-    if !run.converged && max_iterations > 0 {
+    if run.converged && max_iterations > 0 {
+        take_last_step(problem, run, decision);
+    } else if max_iterations > 0 {
         hold_at_current(problem, run);
     }
 }
 
-/// A run that did not converge ends where its last accepted step left it:
-/// the pending step (never tested) is dropped and the nuisance re-fitted
-/// with the parameters held, so that the estimate, the offsets and the
-/// residuals reported all belong to one point.
+/// A converged run takes its last step, below 1e-3 of every standard
+/// deviation, if it does not increase the cost: the estimate is then
+/// evaluated (its residuals and covariance are those reported) and the
+/// step after it, of second order, is dropped. A step that increases the
+/// cost (rounding at the minimum) is dropped instead.
+fn take_last_step<I: Iteration>(
+    problem: &I,
+    run: &mut Run<I::State, I::Eval>,
+    decision: &RankDecision,
+) {
+    let step = &run.solution.parameters;
+    if step.iter().any(|s| *s != 0.0) {
+        let cost = problem.problem(&run.eval).cost_without_parameters();
+        let trial: Vec<f64> = run.p.iter().zip(step).map(|(a, b)| a + b).collect();
+        let mut state = problem.trial_state(&run.state, &run.solution, 1.0);
+        if let Ok(e) = problem.evaluate(&trial, &mut state) {
+            if problem.problem(&e).cost_without_parameters() <= cost * (1.0 + 1e-12) + 1e-300 {
+                run.p = trial;
+                run.state = state;
+                run.eval = e;
+                run.solution = problem.problem(&run.eval).solve(decision);
+            }
+        }
+    }
+    hold_at_current(problem, run);
+}
+
+/// A run ends where its last accepted step left it: the pending step
+/// (never tested; below 1e-3 of every standard deviation when the run has
+/// converged) is dropped and the nuisance re-fitted with the parameters
+/// held, so that the estimate, the offsets and the residual statistics
+/// reported all belong to one point, the last one evaluated.
 fn hold_at_current<I: Iteration>(problem: &I, run: &mut Run<I::State, I::Eval>) {
     run.solution.nuisance = problem.problem(&run.eval).nuisance_without_parameters();
     run.solution.parameters.iter_mut().for_each(|x| *x = 0.0);

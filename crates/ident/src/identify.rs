@@ -56,7 +56,10 @@ pub struct IdentifyOptions {
     pub rank_tolerance: f64,
     /// `s_i / s_1` below which an identifiable direction is reported weak.
     pub weak_threshold: f64,
-    /// Gauss-Newton iteration limit.
+    /// Gauss-Newton iteration limit. With 0 the estimate is the one linear
+    /// solve at the starting point (the linearised estimator) and the
+    /// residual statistics are those of the starting point; otherwise they
+    /// are those of the estimate.
     pub max_iterations: u32,
 }
 
@@ -620,7 +623,9 @@ fn finish(
         ..
     } = state;
     let k = names.len();
-    // The final solution's offsets and (negligible) step apply at p.
+    // The iteration ends on an evaluated point: its step is zero (and the
+    // offsets re-fitted at p), except for the linearised estimator
+    // (`max_iterations` 0), whose one step from the start is its estimate.
     let estimate: Vec<f64> = p
         .iter()
         .zip(&solution.parameters)

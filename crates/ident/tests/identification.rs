@@ -518,3 +518,53 @@ fn a_non_converged_fit_reports_one_consistent_point() {
         }
     }
 }
+
+/// The fit's statistics are those of the point it reports: chi-square, rms
+/// and the largest standardised residual recomputed from the reported
+/// estimate and offsets with the public model agree with the reported
+/// ones to rounding, on a realistic campaign (80 random poses, the mean of
+/// three readings: the paper's logged noise) and a large one.
+#[test]
+fn the_reported_statistics_are_those_of_the_reported_estimate() {
+    let m = machine(AxisOrder::XFirst);
+    let set = ParameterSet::paper15();
+    let plant = Plant::geometric(m.clone(), set.to_errors(&set.table2()));
+    let model = GeometricModel::new(m.clone(), set.clone());
+    let options = IdentifyOptions::for_machine(&m);
+    let sigma = options.sigma;
+    for (poses, seed) in [(80, 3), (80, 4), (3000, 5)] {
+        let data = plant.simulate(&Campaign::random(&m, poses, seed)).unwrap();
+        let id = identify(&model, &data, &options).unwrap();
+        assert!(id.converged);
+        let z: Vec<[f64; 3]> =
+            tricept_ident::residuals_at(&model, &id.estimate, &id.offsets, &data.poses, &sigma)
+                .unwrap()
+                .into_iter()
+                .map(|r| r.unwrap())
+                .collect();
+        let chi_square: f64 = z.iter().flatten().map(|v| v * v).sum();
+        let max = z.iter().flatten().fold(0.0f64, |a, v| a.max(v.abs()));
+        let rms = [0, 1, 2].map(|c| {
+            (z.iter().map(|r| (r[c] * sigma[c]).powi(2)).sum::<f64>() / z.len() as f64).sqrt()
+        });
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs();
+        assert!(
+            close(id.stats.chi_square, chi_square),
+            "{poses} poses: reported chi-square {} but {chi_square} at the reported estimate",
+            id.stats.chi_square
+        );
+        assert!(
+            close(id.stats.max_standardised.0, max),
+            "{poses} poses: reported max |z| {} but {max}",
+            id.stats.max_standardised.0
+        );
+        for c in 0..3 {
+            assert!(
+                close(id.stats.rms[c], rms[c]),
+                "{poses} poses: rms[{c}] {} but {}",
+                id.stats.rms[c],
+                rms[c]
+            );
+        }
+    }
+}
