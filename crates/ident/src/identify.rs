@@ -31,8 +31,8 @@ use tricept_kinematics::{Machine, UpJoints};
 use crate::error::IdentError;
 use crate::gauss_newton::{Iteration, Run, iterate};
 use crate::model::{PosePredictor, ReadingModel};
-use rayon::prelude::*;
 use crate::report::{IdentifiabilityReport, NamedValues};
+use rayon::prelude::*;
 use tricept_numerics::linalg::TriangularAccumulator;
 use tricept_numerics::lsq::{DEFAULT_RANK_TOLERANCE, RankDecision, ReducedProblem};
 

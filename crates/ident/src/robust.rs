@@ -367,8 +367,7 @@ fn deleted_residuals(
                         xc[a * q + t] = (0..q).map(|s| x[a * q + s] * cov[s * q + t]).sum();
                     }
                 }
-                let h =
-                    Matrix3::from_fn(|a, b| (0..q).map(|t| xc[a * q + t] * x[b * q + t]).sum());
+                let h = Matrix3::from_fn(|a, b| (0..q).map(|t| xc[a * q + t] * x[b * q + t]).sum());
                 let d = if inside {
                     (Matrix3::identity() - h)
                         .try_inverse()

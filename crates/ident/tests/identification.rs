@@ -590,13 +590,22 @@ fn a_fit_of_several_blocks_is_bit_identical_on_one_and_two_threads() {
     };
     let ((one, rejected_one), (two, rejected_two)) = (run(1), run(2));
     assert_eq!(rejected_one, rejected_two);
-    assert_eq!(rejected_one.iter().map(|r| r.pose).collect::<Vec<_>>(), vec![5000]);
+    assert_eq!(
+        rejected_one.iter().map(|r| r.pose).collect::<Vec<_>>(),
+        vec![5000]
+    );
     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&one.estimate), bits(&two.estimate));
     assert_eq!(bits(&one.offsets), bits(&two.offsets));
-    assert_eq!(one.stats.chi_square.to_bits(), two.stats.chi_square.to_bits());
+    assert_eq!(
+        one.stats.chi_square.to_bits(),
+        two.stats.chi_square.to_bits()
+    );
     // The screen's last fit is the identification of the poses kept.
     let kept = identify(&model, &data.subset(|j| j != 5000), &options).unwrap();
     assert_eq!(bits(&one.estimate), bits(&kept.estimate));
-    assert_eq!(one.stats.chi_square.to_bits(), kept.stats.chi_square.to_bits());
+    assert_eq!(
+        one.stats.chi_square.to_bits(),
+        kept.stats.chi_square.to_bits()
+    );
 }

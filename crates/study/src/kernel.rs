@@ -70,7 +70,10 @@ impl Kernel {
         let mut t = Vec::new();
         let mut factor_start = vec![0];
         for u in 0..q {
-            let len = (0..q).rev().find(|&k| factor(u, k) != 0.0).map_or(0, |k| k + 1);
+            let len = (0..q)
+                .rev()
+                .find(|&k| factor(u, k) != 0.0)
+                .map_or(0, |k| k + 1);
             t.extend((0..len).map(|k| factor(u, k)));
             factor_start.push(t.len());
         }
@@ -247,12 +250,7 @@ struct PlaneSums<S: Simd> {
 /// square and translation, and keeps them in `d` (`3 W` vectors a point)
 /// for the second pass.
 #[inline(always)]
-fn reduce_points<S: Simd>(
-    simd: S,
-    a: &[[S::f64s; W]],
-    acc: &mut PlaneSums<S>,
-    d: &mut [S::f64s],
-) {
+fn reduce_points<S: Simd>(simd: S, a: &[[S::f64s; W]], acc: &mut PlaneSums<S>, d: &mut [S::f64s]) {
     for (a, d) in a.chunks_exact(3).zip(d.chunks_exact_mut(3 * W)) {
         for h in 0..W {
             let n2 = norm2(simd, a[0][h], a[1][h], a[2][h]);
@@ -348,11 +346,7 @@ mod tests {
         let t: Vec<f64> = (0..q * q).map(|i| factor(i / q, i % q)).collect();
         let g: Vec<f64> = (0..21 * q).map(|i| plane(i / q, i % q)).collect();
         let offset = vec![0.3, -0.2, 0.1, 0.0, 0.05];
-        (
-            Kernel::new(factor, q, plane, clean, offset, 0.25, 9),
-            t,
-            g,
-        )
+        (Kernel::new(factor, q, plane, clean, offset, 0.25, 9), t, g)
     }
 
     /// The fast path's formulas written out for one trial.
@@ -361,11 +355,8 @@ mod tests {
         let dp: Vec<f64> = (0..q)
             .map(|u| (0..q).map(|k| t[u * q + k] * z[k]).sum())
             .collect();
-        let mu = (kn.held
-            + (0..q)
-                .map(|u| (kn.offset[u] - dp[u]).abs())
-                .sum::<f64>())
-            / kn.n_params;
+        let mu =
+            (kn.held + (0..q).map(|u| (kn.offset[u] - dp[u]).abs()).sum::<f64>()) / kn.n_params;
         let rows = kn.clean.len();
         let d: Vec<f64> = (0..rows)
             .map(|r| kn.clean[r] - (0..q).map(|u| g[r * q + u] * dp[u]).sum::<f64>())
@@ -401,7 +392,9 @@ mod tests {
         // 37 trials: several steps of any width and a partial last one.
         let n = 37;
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
-        let z: Vec<f64> = (0..n * kn.q).map(|_| StandardNormal.sample(&mut rng)).collect();
+        let z: Vec<f64> = (0..n * kn.q)
+            .map(|_| StandardNormal.sample(&mut rng))
+            .collect();
         let expected: Vec<[f64; 4]> = z.chunks(kn.q).map(|z| by_hand(&kn, &t, &g, z)).collect();
         let trials = |rng: &mut Xoshiro256PlusPlus, simd: Option<pulp::Scalar>| {
             let op = Trials {
