@@ -19,9 +19,9 @@
 //! order is held at its prior rather than fitted to second-order effects.
 //! (On the x-first machine `dyA3` is such a parameter: its second-order
 //! cross term with `dzB3` has the shape of `dyB3`'s first-order effect, so a
-//! large `dyA3` biases `dyB3` by about `-dyA3 dzB3 / q4` without any trace in
-//! the residual, and freeing `dyA3` recovers neither its value nor its sign;
-//! see `docs/identifiability.md`.)
+//! large `dyA3` biases `dyB3` by about `-dyA3 dzB3 / q4` (and every other
+//! parameter by less) without any trace in the residual, and freeing `dyA3`
+//! recovers neither its value nor its sign; see `docs/identifiability.md`.)
 
 use nalgebra::DMatrix;
 use serde_json::{Map, Value};
