@@ -46,6 +46,10 @@ pub(crate) struct Kernel {
     plane: Vec<f64>,
     /// `dr0`, `3 P`.
     clean: Vec<f64>,
+    /// The mean of `G`'s rows per component (`3 x q`, column after column).
+    plane_mean: Vec<f64>,
+    /// The mean of `dr0` per component.
+    clean_mean: Vec<f64>,
     /// `truth - p*` on the moving columns.
     offset: Vec<f64>,
     /// `sum |truth - p*|` over the parameters that do not move.
@@ -78,6 +82,16 @@ impl Kernel {
             factor_start.push(t.len());
         }
         let rows = clean.len() / 3 * 3;
+        let points = (rows / 3).max(1) as f64;
+        let mut plane_mean = Vec::with_capacity(3 * q);
+        for u in 0..q {
+            plane_mean.extend(
+                (0..3).map(|c| (c..rows).step_by(3).map(|r| plane(r, u)).sum::<f64>() / points),
+            );
+        }
+        let clean_mean = (0..3)
+            .map(|c| (c..rows).step_by(3).map(|r| clean[r]).sum::<f64>() / points)
+            .collect();
         let mut g = Vec::with_capacity(rows * q);
         for first in (0..rows).step_by(3 * GROUP) {
             let last = rows.min(first + 3 * GROUP);
@@ -91,6 +105,8 @@ impl Kernel {
             factor_start,
             plane: g,
             clean,
+            plane_mean,
+            clean_mean,
             offset,
             held,
             n_params: n_params.max(1) as f64,
@@ -131,24 +147,19 @@ impl<R: Rng> WithSimd for Trials<'_, R> {
         let width = W * lanes;
         let q = kn.q;
         let zero = simd.splat_f64s(0.0);
-        // Normals of one step, `z[(k * W + h) * lanes + l]` for trial
-        // `h * lanes + l` of the step.
+        // Normals of one step, `z[k * width + t]` for trial `t` of the
+        // step: vector `k * W + h` holds normal `k` of trials `h * lanes..`.
         let mut z = vec![0.0; q * width];
         let mut dp = vec![zero; q * W];
         let points = kn.clean.len() / 3;
-        let mut d = vec![zero; 3 * points * W];
         let mut out = Vec::with_capacity(n);
         let mut start = 0;
         while start < n {
             let m = width.min(n - start);
+            // Trial after trial, as the normals are drawn.
             for t in 0..width {
-                let (h, l) = (t / lanes, t % lanes);
-                for k in 0..q {
-                    z[(k * W + h) * lanes + l] = if t < m {
-                        StandardNormal.sample(rng)
-                    } else {
-                        0.0
-                    };
+                for v in z[t..].iter_mut().step_by(width) {
+                    *v = if t < m { StandardNormal.sample(rng) } else { 0.0 };
                 }
             }
             let zv = S::as_simd_f64s(&z).0;
@@ -181,7 +192,7 @@ impl<R: Rng> WithSimd for Trials<'_, R> {
 
             let mut stats = [[zero; W]; 3];
             if plane && points > 0 {
-                stats = plane_stats(simd, kn, &dp, &mut d);
+                stats = plane_stats(simd, kn, &dp);
             }
             for h in 0..W.min(m.div_ceil(lanes)) {
                 let mut fields = [[0.0; 8]; 4];
@@ -239,86 +250,72 @@ fn norm2<S: Simd>(simd: S, x: S::f64s, y: S::f64s, z: S::f64s) -> S::f64s {
     )
 }
 
-/// Running sums of the first pass over the plane.
+/// Running sums over the plane points: `|d_p|`, its largest square, and
+/// `|d_p - t|`.
 struct PlaneSums<S: Simd> {
     sum: [S::f64s; W],
     max2: [S::f64s; W],
-    translation: [[S::f64s; W]; 3],
+    touched: [S::f64s; W],
 }
 
-/// Adds the points of `a` (three rows each) to the running sum, largest
-/// square and translation, and keeps them in `d` (`3 W` vectors a point)
-/// for the second pass.
+/// Adds the points of `a` (three rows each) to the running sums, `t3` the
+/// best-fit translation of the step's trials.
 #[inline(always)]
-fn reduce_points<S: Simd>(simd: S, a: &[[S::f64s; W]], acc: &mut PlaneSums<S>, d: &mut [S::f64s]) {
-    for (a, d) in a.chunks_exact(3).zip(d.chunks_exact_mut(3 * W)) {
+fn reduce_points<S: Simd>(
+    simd: S,
+    a: &[[S::f64s; W]],
+    t3: &[[S::f64s; W]; 3],
+    acc: &mut PlaneSums<S>,
+) {
+    for a in a.chunks_exact(3) {
         for h in 0..W {
             let n2 = norm2(simd, a[0][h], a[1][h], a[2][h]);
             acc.sum[h] = simd.add_f64s(acc.sum[h], simd.sqrt_f64s(n2));
             acc.max2[h] = simd.max_f64s(acc.max2[h], n2);
-            for c in 0..3 {
-                acc.translation[c][h] = simd.add_f64s(acc.translation[c][h], a[c][h]);
-                d[c * W + h] = a[c][h];
-            }
+            let x = simd.sub_f64s(a[0][h], t3[0][h]);
+            let y = simd.sub_f64s(a[1][h], t3[1][h]);
+            let z = simd.sub_f64s(a[2][h], t3[2][h]);
+            acc.touched[h] = simd.add_f64s(acc.touched[h], simd.sqrt_f64s(norm2(simd, x, y, z)));
         }
     }
 }
 
 /// Mean, largest and translation-removed mean `|d_p|` over the plane, per
-/// trial of the step (`[mean, max, touched]`), `d` the scratch for the
-/// step's plane errors.
+/// trial of the step (`[mean, max, touched]`). The best-fit translation
+/// (the mean of `d_p`) is `mean(dr0) - mean(G) dp`, known before any
+/// point: one pass over the points computes both norms, so that the square
+/// roots overlap the products.
 #[inline(always)]
-fn plane_stats<S: Simd>(
-    simd: S,
-    kn: &Kernel,
-    dp: &[S::f64s],
-    d: &mut [S::f64s],
-) -> [[S::f64s; W]; 3] {
+fn plane_stats<S: Simd>(simd: S, kn: &Kernel, dp: &[S::f64s]) -> [[S::f64s; W]; 3] {
     let zero = simd.splat_f64s(0.0);
     let q = kn.q;
     let points = kn.clean.len() / 3;
+    let t3 = rows::<S, 3>(simd, &kn.clean_mean, &kn.plane_mean, dp);
     let mut acc = PlaneSums::<S> {
         sum: [zero; W],
         max2: [zero; W],
-        translation: [[zero; W]; 3],
+        touched: [zero; W],
     };
     let full = points / GROUP;
     let (panels, tail) = kn.plane.split_at(full * 3 * GROUP * q);
     let (clean, clean_tail) = kn.clean.split_at(full * 3 * GROUP);
-    let (d_full, d_tail) = d.split_at_mut(full * 3 * GROUP * W);
-    for ((panel, clean), d) in panels
+    for (panel, clean) in panels
         .chunks_exact(3 * GROUP * q)
         .zip(clean.chunks_exact(3 * GROUP))
-        .zip(d_full.chunks_exact_mut(3 * GROUP * W))
     {
         let a = rows::<S, { 3 * GROUP }>(simd, clean, panel, dp);
-        reduce_points(simd, &a, &mut acc, d);
+        reduce_points(simd, &a, &t3, &mut acc);
     }
     if points % GROUP == 1 {
         let a = rows::<S, 3>(simd, clean_tail, tail, dp);
-        reduce_points(simd, &a, &mut acc, d_tail);
+        reduce_points(simd, &a, &t3, &mut acc);
     }
     let inv = simd.splat_f64s(1.0 / points as f64);
-    let mut t3 = acc.translation;
-    for c in &mut t3 {
-        for v in c.iter_mut() {
-            *v = simd.mul_f64s(*v, inv);
-        }
-    }
-    let mut touched = [zero; W];
-    for d in d.chunks_exact(3 * W) {
-        for h in 0..W {
-            let x = simd.sub_f64s(d[h], t3[0][h]);
-            let y = simd.sub_f64s(d[W + h], t3[1][h]);
-            let z = simd.sub_f64s(d[2 * W + h], t3[2][h]);
-            touched[h] = simd.add_f64s(touched[h], simd.sqrt_f64s(norm2(simd, x, y, z)));
-        }
-    }
     let mut out = [[zero; W]; 3];
     for h in 0..W {
         out[0][h] = simd.mul_f64s(acc.sum[h], inv);
         out[1][h] = simd.sqrt_f64s(acc.max2[h]);
-        out[2][h] = simd.mul_f64s(touched[h], inv);
+        out[2][h] = simd.mul_f64s(acc.touched[h], inv);
     }
     out
 }
