@@ -12,9 +12,12 @@ every core).
     cargo run --release -p tricept-study --example fast_path_matrices -- fast_path.json
     python benches/peers/fast_path.py fast_path.json
 
-The script times the numpy peer, then (unless --no-rust) runs the
-criterion bench `cargo bench -p tricept-benches --bench study -- fast_path`
-and prints the ratio of the two throughputs, measured in one run. It also
+The script times the numpy peer (wall and CPU time), then (unless
+--no-rust) runs the criterion bench `cargo bench -p tricept-benches --bench
+study -- fast_path` and prints the ratio of the two throughputs, measured
+in one run. On a machine shared with other work, compare CPU time per trial
+instead: `cargo run --release -p tricept-study --example fast_path_profile`
+gives the Rust path's on one thread. It also
 checks that its Monte Carlo means agree with the Rust ones the example
 wrote (same algorithm, other random numbers: within 5 standard errors).
 """
@@ -111,14 +114,16 @@ def main():
     for threads in sorted({1, blas[0][2] if blas else 1}):
         with threadpool_limits(limits=threads):
             for batch in [int(b) for b in a.batches.split(",")]:
-                times = []
+                times, cpu = [], []
                 for _ in range(a.repeats):
-                    t = time.perf_counter()
+                    t, c = time.perf_counter(), time.process_time()
                     run(model, a.trials, batch, rng)
                     times.append(time.perf_counter() - t)
+                    cpu.append(time.process_time() - c)
                 best[(threads, batch)] = a.trials / min(times)
                 print(f"numpy, {threads} BLAS thread(s), batches of {batch}: "
-                      f"{best[(threads, batch)] / 1e6:.3f} M trials/s (best of {a.repeats})", flush=True)
+                      f"{best[(threads, batch)] / 1e6:.3f} M trials/s (best of {a.repeats}), "
+                      f"{min(cpu) / a.trials * 1e9:.0f} ns CPU per trial", flush=True)
     (threads, batch), numpy_rate = max(best.items(), key=lambda kv: kv[1])
     print(f"numpy peer: {numpy_rate / 1e6:.3f} M trials/s ({threads} BLAS thread(s), batches of {batch})")
     if a.no_rust:
