@@ -139,8 +139,12 @@ fn x_first_dya3_aliases_into_dyb3_through_dzb3_as_predicted() {
     }
 }
 
+/// The estimate is the last point Gauss-Newton evaluated, within the
+/// iteration's tolerance (1e-3 of each standard deviation) of the optimum:
+/// for noise-free data within 1e-8 mm of the truth (the step not taken is
+/// 2.4e-9 mm here).
 #[test]
-fn noise_free_exact_data_are_recovered_to_1e_9_mm() {
+fn noise_free_exact_data_are_recovered_to_1e_8_mm() {
     let set = ParameterSet::paper15();
     let mut t2_x = set.table2();
     t2_x[set.index_of("dyA3").unwrap()] = 0.0; // in the identifiable subspace
@@ -154,15 +158,16 @@ fn noise_free_exact_data_are_recovered_to_1e_9_mm() {
         let model = GeometricModel::new(m.clone(), set.clone());
         let id = identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
         for (j, name) in set.names().iter().enumerate() {
+            let tolerance = id.std_dev[j].map_or(1e-8, |sd| (1e-3 * sd).min(1e-8));
             assert!(
-                (id.estimate[j] - truth[j]).abs() < 1e-9,
+                (id.estimate[j] - truth[j]).abs() < tolerance,
                 "{order}: {name} {} vs {}",
                 id.estimate[j],
                 truth[j]
             );
         }
         for c in 0..3 {
-            assert!((id.offsets[c] - tricept_plant::DEFAULT_SENSOR_OFFSETS[c]).abs() < 1e-9);
+            assert!((id.offsets[c] - tricept_plant::DEFAULT_SENSOR_OFFSETS[c]).abs() < 1e-8);
         }
     }
 }
