@@ -34,7 +34,8 @@ fn cpu_s() -> Result<f64, String> {
 fn main() -> Result<(), String> {
     let m = Machine::paper();
     // The scenario of `benches/study.rs`.
-    let s = Scenario::paper(m.clone(), m.workspace.polar_grid(3, 8, 3)).map_err(|e| e.to_string())?;
+    let s =
+        Scenario::paper(m.clone(), m.workspace.polar_grid(3, 8, 3)).map_err(|e| e.to_string())?;
     let g = GradeModel::new(&s, 2.0).map_err(|e| e.to_string())?;
     let e = &g.estimator;
     let pool = rayon::ThreadPoolBuilder::new()

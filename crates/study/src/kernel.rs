@@ -159,7 +159,11 @@ impl<R: Rng> WithSimd for Trials<'_, R> {
             // Trial after trial, as the normals are drawn.
             for t in 0..width {
                 for v in z[t..].iter_mut().step_by(width) {
-                    *v = if t < m { StandardNormal.sample(rng) } else { 0.0 };
+                    *v = if t < m {
+                        StandardNormal.sample(rng)
+                    } else {
+                        0.0
+                    };
                 }
             }
             let zv = S::as_simd_f64s(&z).0;
