@@ -784,24 +784,18 @@ fn held(a: &ReproductionArgs) -> Result<Value, String> {
     let options = IdentifyOptions::for_machine(&m);
     let mut at_truth = vec![0.0; set.len()];
     at_truth[dya3] = truth[dya3];
-    let campaigns: Vec<(String, Box<dyn Fn(u64) -> Campaign + Sync>)> = vec![
-        (
-            "75 (grid)".into(),
-            Box::new(|seed| Campaign::grid(&m, seed)),
-        ),
-        (
-            "200".into(),
-            Box::new(|seed| Campaign::random(&m, 200, 11 + 1000 * seed)),
-        ),
-        (
-            "1000".into(),
-            Box::new(|seed| Campaign::random(&m, 1000, 12 + 1000 * seed)),
-        ),
-        (
-            "10000".into(),
-            Box::new(|seed| Campaign::random(&m, 10_000, 13 + 1000 * seed)),
-        ),
+    // The default grid (75 poses) and random campaigns of each size; a
+    // noise seed per campaign, and for the random ones new poses too.
+    let sizes: [(&str, Option<usize>); 4] = [
+        ("75 (grid)", None),
+        ("200", Some(200)),
+        ("1000", Some(1000)),
+        ("10000", Some(10_000)),
     ];
+    let campaign = |size: Option<usize>, seed: u64| match size {
+        None => Campaign::grid(&m, seed),
+        Some(n) => Campaign::random(&m, n, n as u64 + 1000 * seed),
+    };
     let names = set.names();
     let fits = |c: &Campaign| -> Result<_, String> {
         let data = plant.simulate(c).map_err(|e| e.to_string())?;
@@ -832,8 +826,8 @@ fn held(a: &ReproductionArgs) -> Result<Value, String> {
         "{header} check | b^T C^-1 b | d^2, dyA3 at zero | d^2, dyA3 true | chi2/dof |\n{rule}---|---|---|---|---|"
     );
     let mut rows = Vec::new();
-    for (label, campaign) in &campaigns {
-        let mut clean = campaign(0);
+    for (label, size) in sizes {
+        let mut clean = campaign(size, 0);
         clean.noise.angle_rad = 0.0;
         clean.noise.length_mm = 0.0;
         let (zero, truth_held) = fits(&clean)?;
@@ -851,7 +845,7 @@ fn held(a: &ReproductionArgs) -> Result<Value, String> {
         let noisy: Vec<(f64, f64, f64)> = (1..=a.held_campaigns)
             .into_par_iter()
             .map(|seed| {
-                let (z, t) = fits(&campaign(seed))?;
+                let (z, t) = fits(&campaign(size, seed))?;
                 let e = |id: &tricept_ident::Identification| -> Vec<f64> {
                     (0..set.len()).map(|j| id.estimate[j] - truth[j]).collect()
                 };
