@@ -9,7 +9,10 @@
 //! ```
 
 use tricept_kinematics::Machine;
-use tricept_study::{GradeModel, Scenario};
+use tricept_study::{GradeModel, Scenario, TrialResult};
+
+/// One field of a trial's result.
+type Field = fn(&TrialResult) -> f64;
 
 fn main() -> Result<(), String> {
     let path = std::env::args()
@@ -28,14 +31,12 @@ fn main() -> Result<(), String> {
     };
     let trials = 200_000;
     let results = e.run(&s, trials, 1, 0, &|_| {});
-    let mean = |f: fn(&tricept_study::TrialResult) -> f64| {
-        results.iter().map(f).sum::<f64>() / trials as f64
-    };
-    let sd = |f: fn(&tricept_study::TrialResult) -> f64| {
+    let mean = |f: Field| results.iter().map(f).sum::<f64>() / trials as f64;
+    let sd = |f: Field| {
         let m = mean(f);
         (results.iter().map(|t| (f(t) - m).powi(2)).sum::<f64>() / (trials - 1) as f64).sqrt()
     };
-    let fields: [(&str, fn(&tricept_study::TrialResult) -> f64); 4] = [
+    let fields: [(&str, Field); 4] = [
         ("mu_mm", |t| t.mu_mm),
         ("plane_mean_mm", |t| t.plane_mean_mm),
         ("plane_max_mm", |t| t.plane_max_mm),
