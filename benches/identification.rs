@@ -2,7 +2,10 @@
 //! analytic Jacobian, TSQR + rank decision + Gauss-Newton) of Table 2 from
 //! 75 and 1000 poses (target: 1000 poses in under 1 s), and the fused
 //! identification of module and head from 1000 internal poses and 100
-//! tracker points (target: under 1 s, report included).
+//! tracker points (target: under 1 s, report included), and what `tricept
+//! identify` runs on large logs (the gross-error screen and the fit) on
+//! 100 000 and 1 000 000 poses (target: a million in under 5 s with the
+//! file read, see `docs/performance.md`).
 
 use std::hint::black_box;
 
@@ -27,6 +30,28 @@ fn identification(c: &mut Criterion) {
         let data = plant.simulate(&campaign).unwrap();
         group.bench_function(label, |b| {
             b.iter(|| black_box(identify(&model, black_box(&data), &options).unwrap()))
+        });
+    }
+    group.finish();
+}
+
+fn large(c: &mut Criterion) {
+    let m = Machine::paper();
+    let set = ParameterSet::paper15();
+    let plant = Plant::geometric(m.clone(), set.to_errors(&set.table2()));
+    let model = GeometricModel::new(m.clone(), set.clone());
+    let options = IdentifyOptions::for_machine(&m);
+    let mut group = c.benchmark_group("identify_large");
+    group.sample_size(10);
+    for n in [100_000, 1_000_000] {
+        let data = plant.simulate(&Campaign::random(&m, n, 9)).unwrap();
+        group.throughput(criterion::Throughput::Elements(n as u64));
+        group.bench_function(format!("{n}_poses_robust"), |b| {
+            b.iter(|| {
+                black_box(
+                    tricept_ident::identify_robust(&model, black_box(&data), &options).unwrap(),
+                )
+            })
         });
     }
     group.finish();
@@ -84,5 +109,5 @@ fn fused(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, identification, fused);
+criterion_group!(benches, identification, large, fused);
 criterion_main!(benches);

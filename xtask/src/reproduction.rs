@@ -15,7 +15,11 @@
 //! - `differencing`: what differencing against a reference pose costs
 //!   against estimating the sensor offsets, per grade and reference pose,
 //!   with the differenced rows treated as independent and with their
-//!   covariance.
+//!   covariance;
+//! - `held`: what holding the invisible `dyA3` at zero biases, by campaign
+//!   size: the bias of every other parameter in its standard deviations
+//!   (exact noise-free readings, held at zero against held at the truth)
+//!   and the Mahalanobis distance of noisy fits from the truth.
 //!
 //! Seeded and reproducible; all sections together take about 20 s on two
 //! cores (release build), `poses` most of it.
@@ -42,20 +46,21 @@ const PAPER_MU_AT_4: f64 = 0.291;
 const PAPER_GRADE: f64 = 0.8;
 
 /// The sections, in the order they run.
-const SECTIONS: [&str; 6] = [
+const SECTIONS: [&str; 7] = [
     "singular",
     "invisible",
     "noise",
     "fig3b",
     "poses",
     "differencing",
+    "held",
 ];
 
 /// Options of `cargo xtask reproduction`.
 #[derive(Debug, clap::Args)]
 pub struct ReproductionArgs {
     /// Sections to run (comma separated; default all): singular, invisible,
-    /// noise, fig3b, poses, differencing.
+    /// noise, fig3b, poses, differencing, held.
     #[arg(long, value_delimiter = ',')]
     only: Vec<String>,
     /// Fast-path trials per estimator and grade (noise, differencing).
@@ -70,6 +75,9 @@ pub struct ReproductionArgs {
     /// Noise seeds of the Fig. 3b maps.
     #[arg(long, default_value_t = 200)]
     seeds: u64,
+    /// Noisy campaigns per size (held).
+    #[arg(long, default_value_t = 20)]
+    held_campaigns: u64,
     /// Seed of all Monte Carlo noise.
     #[arg(long, default_value_t = 2009)]
     seed: u64,
@@ -111,8 +119,11 @@ pub fn run(a: ReproductionArgs) -> Result<(), String> {
             SECTIONS.join(", ")
         ));
     }
-    if a.trials == 0 || a.set_trials == 0 || a.sets == 0 || a.seeds == 0 {
-        return Err("--trials, --set-trials, --sets and --seeds must be at least 1".into());
+    if a.trials == 0 || a.set_trials == 0 || a.sets == 0 || a.seeds == 0 || a.held_campaigns == 0 {
+        return Err(
+            "--trials, --set-trials, --sets, --seeds and --held-campaigns must be at least 1"
+                .into(),
+        );
     }
     let wanted = |name: &str| a.only.is_empty() || a.only.iter().any(|o| o == name);
     let mut report = serde_json::Map::new();
@@ -124,6 +135,7 @@ pub fn run(a: ReproductionArgs) -> Result<(), String> {
             "noise" => noise(&a)?,
             "fig3b" => fig3b(&a)?,
             "poses" => poses(&a)?,
+            "held" => held(&a)?,
             _ => differencing(&a)?,
         };
         println!("\n({name}: {:.1} s)", t.elapsed().as_secs_f64());
@@ -727,4 +739,147 @@ fn argmin(v: &[f64], key: impl Fn(f64) -> f64) -> usize {
     (0..v.len())
         .min_by(|&i, &j| key(v[i]).total_cmp(&key(v[j])))
         .unwrap_or(0)
+}
+
+/// `b^T C^-1 b` over the identifiable parameters `ident`, `C` the fit's
+/// covariance.
+fn mahalanobis2(
+    id: &tricept_ident::Identification,
+    ident: &[usize],
+    b: &[f64],
+) -> Result<f64, String> {
+    let c = nalgebra::DMatrix::from_fn(ident.len(), ident.len(), |u, v| {
+        id.covariance[(ident[u], ident[v])]
+    });
+    let x = nalgebra::DVector::from_fn(ident.len(), |u, _| b[ident[u]]);
+    let chol = c
+        .cholesky()
+        .ok_or("the covariance of the identifiable parameters is not positive definite")?;
+    Ok(x.dot(&chol.solve(&x)))
+}
+
+/// What holding `dyA3` at zero biases (`docs/identifiability.md`): Table 2
+/// (dyA3 = 0.2 mm) on the x-first machine, random campaigns of each size
+/// (the default grid too), the paper's noise. The bias is the estimate
+/// from exact noise-free readings with `dyA3` held at zero (the rank
+/// rule) minus the truth, in each parameter's standard deviation at that
+/// campaign; holding `dyA3` at its true value instead recovers the truth
+/// (the check column). The noisy fits give the Mahalanobis distance
+/// `d^2 = (p_hat - p)^T C^-1 (p_hat - p)` from the truth over the 14
+/// identifiable parameters: 14 on average for an unbiased fit, `14 +
+/// b^T C^-1 b` with the bias `b`.
+fn held(a: &ReproductionArgs) -> Result<Value, String> {
+    use tricept_ident::{Start, identify, identify_from};
+    use tricept_plant::{Campaign, Plant};
+    println!(
+        "## What holding dyA3 at zero biases (`cargo xtask reproduction --only held`)\n\nTable 2 on the x-first machine (dyA3 = 0.2 mm), paper noise. Bias: noise-free exact readings fitted with dyA3 held at zero, minus the truth, in standard deviations of that campaign; `check`: the largest |error| / sd with dyA3 held at its true value. d^2: mean Mahalanobis distance from the truth of {} noisy campaigns per size (14 identifiable parameters), with dyA3 at zero and at the truth, the bias's own b^T C^-1 b, and the fits' mean chi-square per degree of freedom.\n",
+        a.held_campaigns
+    );
+    let m = Machine::paper();
+    let set = ParameterSet::paper15();
+    let truth = set.table2();
+    let dya3 = set.index_of("dyA3").ok_or("no dyA3 in paper15")?;
+    let plant = Plant::geometric(m.clone(), set.to_errors(&truth));
+    let model = GeometricModel::new(m.clone(), set.clone());
+    let options = IdentifyOptions::for_machine(&m);
+    let mut at_truth = vec![0.0; set.len()];
+    at_truth[dya3] = truth[dya3];
+    // The default grid (75 poses) and random campaigns of each size; a
+    // noise seed per campaign, and for the random ones new poses too.
+    let sizes: [(&str, Option<usize>); 4] = [
+        ("75 (grid)", None),
+        ("200", Some(200)),
+        ("1000", Some(1000)),
+        ("10000", Some(10_000)),
+    ];
+    let campaign = |size: Option<usize>, seed: u64| match size {
+        None => Campaign::grid(&m, seed),
+        Some(n) => Campaign::random(&m, n, n as u64 + 1000 * seed),
+    };
+    let names = set.names();
+    let fits = |c: &Campaign| -> Result<_, String> {
+        let data = plant.simulate(c).map_err(|e| e.to_string())?;
+        let zero = identify(&model, &data, &options).map_err(|e| e.to_string())?;
+        let d = design(&model, &vec![0.0; set.len()], &data.poses, &options)
+            .map_err(|e| e.to_string())?;
+        let start = Start {
+            parameters: Some(at_truth.clone()),
+            design: Some(d),
+            ..Start::default()
+        };
+        let truth_held =
+            identify_from(&model, &data, &options, &start).map_err(|e| e.to_string())?;
+        if !(zero.converged && truth_held.converged) {
+            return Err(format!("{}: a fit did not converge", data.source));
+        }
+        Ok((zero, truth_held))
+    };
+    let mut header = String::from("| poses |");
+    let mut rule = String::from("|---|");
+    for (j, n) in names.iter().enumerate() {
+        if j != dya3 {
+            header += &format!(" {n} |");
+            rule += "---|";
+        }
+    }
+    println!(
+        "{header} check | b^T C^-1 b | d^2, dyA3 at zero | d^2, dyA3 true | chi2/dof |\n{rule}---|---|---|---|---|"
+    );
+    let mut rows = Vec::new();
+    for (label, size) in sizes {
+        let mut clean = campaign(size, 0);
+        clean.noise.angle_rad = 0.0;
+        clean.noise.length_mm = 0.0;
+        let (zero, truth_held) = fits(&clean)?;
+        let ident = zero.design().identifiable().to_vec();
+        let sd = |id: &tricept_ident::Identification, j: usize| id.std_dev[j].unwrap_or(f64::NAN);
+        let bias: Vec<f64> = (0..set.len())
+            .map(|j| zero.estimate[j] - truth[j])
+            .collect();
+        let bias_sd: Vec<f64> = (0..set.len()).map(|j| bias[j] / sd(&zero, j)).collect();
+        let check = ident
+            .iter()
+            .map(|&j| ((truth_held.estimate[j] - truth[j]) / sd(&truth_held, j)).abs())
+            .fold(0.0, f64::max);
+        let b2 = mahalanobis2(&zero, &ident, &bias)?;
+        let noisy: Vec<(f64, f64, f64)> = (1..=a.held_campaigns)
+            .into_par_iter()
+            .map(|seed| {
+                let (z, t) = fits(&campaign(size, seed))?;
+                let e = |id: &tricept_ident::Identification| -> Vec<f64> {
+                    (0..set.len()).map(|j| id.estimate[j] - truth[j]).collect()
+                };
+                Ok((
+                    mahalanobis2(&z, &ident, &e(&z))?,
+                    mahalanobis2(&t, &ident, &e(&t))?,
+                    t.stats.reduced_chi_square,
+                ))
+            })
+            .collect::<Result<_, String>>()?;
+        let n = noisy.len() as f64;
+        let d2_zero = noisy.iter().map(|x| x.0).sum::<f64>() / n;
+        let d2_true = noisy.iter().map(|x| x.1).sum::<f64>() / n;
+        let chi2 = noisy.iter().map(|x| x.2).sum::<f64>() / n;
+        let mut line = format!("| {label} |");
+        for &j in &ident {
+            line += &format!(" {:+.2} |", bias_sd[j]);
+        }
+        println!("{line} {check:.1e} | {b2:.1} | {d2_zero:.1} | {d2_true:.1} | {chi2:.3} |");
+        let by_name: serde_json::Map<String, Value> = ident
+            .iter()
+            .map(|&j| {
+                (
+                    names[j].to_string(),
+                    json!({"bias_mm": bias[j], "bias_sd": bias_sd[j]}),
+                )
+            })
+            .collect();
+        rows.push(
+            json!({"poses": label, "bias": by_name, "check_max_abs_sd": check,
+                         "bias_mahalanobis2": b2, "mean_d2_dya3_zero": d2_zero,
+                         "mean_d2_dya3_true": d2_true, "mean_reduced_chi_square": chi2,
+                         "campaigns": a.held_campaigns}),
+        );
+    }
+    Ok(json!({"rows": rows}))
 }

@@ -9,6 +9,11 @@
 //! increase. The iteration has converged when every identifiable
 //! parameter's step (and every step of a nuisance parameter carried from
 //! one evaluation to the next) is below 1e-3 of its standard deviation.
+//! The estimate is then the last point evaluated, with the nuisance
+//! re-fitted at it, so that the residuals, chi-square and covariance
+//! reported are all of the estimate; the step not taken is below the
+//! tolerance (evaluating it too would cost one more pass over the data,
+//! a quarter of an exact Monte Carlo trial).
 
 use tricept_numerics::lsq::{RankDecision, ReducedProblem, Solution};
 
@@ -75,6 +80,7 @@ pub(crate) fn iterate<I: Iteration>(
         let step = run.solution.parameters.clone();
         if within(run, &step, 1e-3) {
             run.converged = true;
+            hold_at_current(problem, run);
             return;
         }
         let cost = problem.problem(&run.eval).cost_without_parameters();
@@ -102,11 +108,10 @@ pub(crate) fn iterate<I: Iteration>(
             Some(e) => run.eval = e,
             None => {
                 // No decrease along the step: at the minimum to rounding
-                // if the step is small against the uncertainty.
+                // if the step is small against the uncertainty. Either way
+                // the rejected step is not part of the estimate.
                 run.converged = within(run, &step, 1e-2);
-                if !run.converged {
-                    hold_at_current(problem, run);
-                }
+                hold_at_current(problem, run);
                 return;
             }
         }
@@ -116,15 +121,16 @@ pub(crate) fn iterate<I: Iteration>(
     run.converged = within(run, &step, 1e-3);
     // With no iteration allowed the result is the one linear solve at the
     // start point (the linearised estimator), which keeps its step.
-    if !run.converged && max_iterations > 0 {
+    if max_iterations > 0 {
         hold_at_current(problem, run);
     }
 }
 
-/// A run that did not converge ends where its last accepted step left it:
-/// the pending step (never tested) is dropped and the nuisance re-fitted
-/// with the parameters held, so that the estimate, the offsets and the
-/// residuals reported all belong to one point.
+/// A run ends where its last accepted step left it: the pending step
+/// (never tested; below 1e-3 of every standard deviation when the run has
+/// converged) is dropped and the nuisance re-fitted with the parameters
+/// held, so that the estimate, the offsets and the residual statistics
+/// reported all belong to one point, the last one evaluated.
 fn hold_at_current<I: Iteration>(problem: &I, run: &mut Run<I::State, I::Eval>) {
     run.solution.nuisance = problem.problem(&run.eval).nuisance_without_parameters();
     run.solution.parameters.iter_mut().for_each(|x| *x = 0.0);

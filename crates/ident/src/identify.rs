@@ -19,9 +19,9 @@
 //! order is held at its prior rather than fitted to second-order effects.
 //! (On the x-first machine `dyA3` is such a parameter: its second-order
 //! cross term with `dzB3` has the shape of `dyB3`'s first-order effect, so a
-//! large `dyA3` biases `dyB3` by about `-dyA3 dzB3 / q4` without any trace in
-//! the residual, and freeing `dyA3` recovers neither its value nor its sign;
-//! see `docs/identifiability.md`.)
+//! large `dyA3` biases `dyB3` by about `-dyA3 dzB3 / q4` (and every other
+//! parameter by less) without any trace in the residual, and freeing `dyA3`
+//! recovers neither its value nor its sign; see `docs/identifiability.md`.)
 
 use nalgebra::DMatrix;
 use serde_json::{Map, Value};
@@ -30,8 +30,9 @@ use tricept_kinematics::{Machine, UpJoints};
 
 use crate::error::IdentError;
 use crate::gauss_newton::{Iteration, Run, iterate};
-use crate::model::ReadingModel;
+use crate::model::{PosePredictor, ReadingModel};
 use crate::report::{IdentifiabilityReport, NamedValues};
+use rayon::prelude::*;
 use tricept_numerics::linalg::TriangularAccumulator;
 use tricept_numerics::lsq::{DEFAULT_RANK_TOLERANCE, RankDecision, ReducedProblem};
 
@@ -56,7 +57,10 @@ pub struct IdentifyOptions {
     pub rank_tolerance: f64,
     /// `s_i / s_1` below which an identifiable direction is reported weak.
     pub weak_threshold: f64,
-    /// Gauss-Newton iteration limit.
+    /// Gauss-Newton iteration limit. With 0 the estimate is the one linear
+    /// solve at the starting point (the linearised estimator) and the
+    /// residual statistics are those of the starting point; otherwise they
+    /// are those of the estimate.
     pub max_iterations: u32,
 }
 
@@ -327,6 +331,9 @@ pub struct Identification {
     pub lines: Vec<u64>,
     /// The rank decision taken at the start and used throughout.
     design: Design,
+    /// Covariance of `[offsets | parameters]` (`3 + k` square), for the
+    /// gross-error screen's hat matrix.
+    pub(crate) full_covariance: faer::Mat<f64>,
 }
 
 /// One evaluation of the model at fixed parameters over all poses.
@@ -336,6 +343,12 @@ struct Evaluation {
     /// `y - g(p)` per pose (rad, rad, mm).
     residuals: Vec<[f64; 3]>,
 }
+
+/// Poses per block of an evaluation: each block is predicted and reduced
+/// to its triangular factor on its own, the blocks in parallel, and the
+/// factors are merged in block order, so the result does not depend on
+/// the number of threads. Up to one block the evaluation is sequential.
+pub(crate) const EVALUATION_BLOCK: usize = 4096;
 
 /// Evaluates `model` at `p` on `poses`: predictions, Jacobians and the
 /// reduced weighted problem. `seeds` carries FK starting points between
@@ -351,11 +364,99 @@ fn evaluate(
 ) -> Result<Evaluation, IdentError> {
     let k = model.names().len();
     let predictor = model.at(p);
+    let block = |first: usize, poses: &[MeasuredPose], seeds: &mut [Option<UpJoints>]| {
+        evaluate_block(&*predictor, k, first, poses, sigma, pose_weights, seeds)
+    };
+    let blocks: Vec<Result<Block, IdentError>> = if poses.len() <= EVALUATION_BLOCK {
+        vec![block(0, poses, seeds)]
+    } else {
+        poses
+            .par_chunks(EVALUATION_BLOCK)
+            .zip(seeds.par_chunks_mut(EVALUATION_BLOCK))
+            .enumerate()
+            .map(|(b, (poses, seeds))| block(b * EVALUATION_BLOCK, poses, seeds))
+            .collect()
+    };
+    let mut residuals = Vec::with_capacity(poses.len());
+    let mut factors = Vec::with_capacity(blocks.len());
+    let mut rows = 0;
+    for b in blocks {
+        let b = b?;
+        rows += b.rows;
+        residuals.extend(b.residuals);
+        factors.push(b.r);
+    }
+    let r = match factors.pop() {
+        Some(r) if factors.is_empty() => r,
+        last => {
+            let n = 3 + k + 1;
+            let mut acc = TriangularAccumulator::with_rows_hint(n, n * (factors.len() + 1));
+            let mut row = vec![0.0; n];
+            for f in factors.iter().chain(&last) {
+                for i in 0..f.nrows() {
+                    row.iter_mut().enumerate().for_each(|(j, v)| *v = f[(i, j)]);
+                    acc.push_row(&row);
+                }
+            }
+            acc.finish()
+        }
+    };
+    Ok(Evaluation {
+        problem: ReducedProblem {
+            rows,
+            r,
+            n_nuisance: 3,
+            k,
+        },
+        residuals,
+    })
+}
+
+/// `f(first, block)` over the poses a block of [`EVALUATION_BLOCK`] at a
+/// time (in parallel beyond one block), the results in pose order; the
+/// first error in pose order is the one returned.
+pub(crate) fn map_blocks<T: Send>(
+    poses: &[MeasuredPose],
+    f: impl Fn(usize, &[MeasuredPose]) -> Result<Vec<T>, IdentError> + Sync,
+) -> Result<Vec<T>, IdentError> {
+    if poses.len() <= EVALUATION_BLOCK {
+        return f(0, poses);
+    }
+    let blocks: Vec<Result<Vec<T>, IdentError>> = poses
+        .par_chunks(EVALUATION_BLOCK)
+        .enumerate()
+        .map(|(b, block)| f(b * EVALUATION_BLOCK, block))
+        .collect();
+    let mut out = Vec::with_capacity(poses.len());
+    for b in blocks {
+        out.extend(b?);
+    }
+    Ok(out)
+}
+
+/// One block of an evaluation: its triangular factor, rows and residuals.
+struct Block {
+    r: faer::Mat<f64>,
+    rows: usize,
+    residuals: Vec<[f64; 3]>,
+}
+
+/// The poses `first..first + poses.len()` of an evaluation.
+fn evaluate_block(
+    predictor: &dyn PosePredictor,
+    k: usize,
+    first: usize,
+    poses: &[MeasuredPose],
+    sigma: &[f64; 3],
+    pose_weights: Option<&[f64]>,
+    seeds: &mut [Option<UpJoints>],
+) -> Result<Block, IdentError> {
     let mut acc = TriangularAccumulator::with_rows_hint(3 + k + 1, 3 * poses.len());
     let mut jac = vec![0.0; 3 * k];
     let mut row = vec![0.0; 3 + k + 1];
     let mut residuals = Vec::with_capacity(poses.len());
-    for ((j, pose), seed) in poses.iter().enumerate().zip(seeds.iter_mut()) {
+    for ((i, pose), seed) in poses.iter().enumerate().zip(seeds.iter_mut()) {
+        let j = first + i;
         let g =
             predictor
                 .predict(pose, seed, &mut jac)
@@ -380,13 +481,9 @@ fn evaluate(
         }
         residuals.push(res);
     }
-    Ok(Evaluation {
-        problem: ReducedProblem {
-            rows: acc.rows(),
-            r: acc.finish(),
-            n_nuisance: 3,
-            k,
-        },
+    Ok(Block {
+        rows: acc.rows(),
+        r: acc.finish(),
         residuals,
     })
 }
@@ -492,6 +589,46 @@ pub fn identify_from(
     options: &IdentifyOptions,
     start: &Start,
 ) -> Result<Identification, IdentError> {
+    Ok(fit(model, data, options, start, None)?.0)
+}
+
+/// The model evaluated over a data set at a starting point, with the FK
+/// solutions found: the first evaluation of a fit, when a caller has made
+/// it already (the gross-error screen's robust start).
+pub(crate) struct FirstEvaluation {
+    eval: Evaluation,
+    seeds: Vec<Option<UpJoints>>,
+}
+
+impl FirstEvaluation {
+    /// `model` at `p` over `poses`, from cold FK starts.
+    pub(crate) fn new(
+        model: &dyn ReadingModel,
+        p: &[f64],
+        poses: &[MeasuredPose],
+        sigma: &[f64; 3],
+    ) -> Result<FirstEvaluation, IdentError> {
+        let mut seeds = vec![None; poses.len()];
+        let eval = evaluate(model, p, poses, sigma, None, &mut seeds)?;
+        Ok(FirstEvaluation { eval, seeds })
+    }
+
+    /// `y - g(p)` of every pose (rad, rad, mm).
+    pub(crate) fn residuals(&self) -> &[[f64; 3]] {
+        &self.eval.residuals
+    }
+}
+
+/// [`identify_from`], optionally from its first evaluation made already
+/// (at the start's parameters, from cold FK starts, without weights: the
+/// caller's promise), and with the FK solutions at the estimate.
+pub(crate) fn fit(
+    model: &dyn ReadingModel,
+    data: &Dataset,
+    options: &IdentifyOptions,
+    start: &Start,
+    first_eval: Option<FirstEvaluation>,
+) -> Result<(Identification, Vec<Option<UpJoints>>), IdentError> {
     let names = model.names().to_vec();
     let k = names.len();
     let poses = &data.poses;
@@ -520,7 +657,13 @@ pub fn identify_from(
         Some(s) => return Err(mismatch("FK seeds", s.len(), poses.len())),
         None => vec![None; poses.len()],
     };
-    let eval = evaluate(model, &p, poses, &options.sigma, weights, &mut seeds)?;
+    let eval = match first_eval {
+        Some(f) if f.seeds.len() == poses.len() => {
+            seeds = f.seeds;
+            f.eval
+        }
+        _ => evaluate(model, &p, poses, &options.sigma, weights, &mut seeds)?,
+    };
     let (decision, report, first) = match &start.design {
         Some(d) if d.decision.column_scale.len() == k => {
             let first = eval.problem.solve(&d.decision);
@@ -569,8 +712,10 @@ pub fn identify_from(
     iterate(&problem, &mut state, &decision, options.max_iterations);
 
     let lines = poses.iter().map(|p| p.line).collect();
-    Ok(finish(
-        names, state, decision, report, options, weights, lines,
+    let seeds = std::mem::take(&mut state.state);
+    Ok((
+        finish(names, state, decision, report, options, weights, lines),
+        seeds,
     ))
 }
 
@@ -620,7 +765,9 @@ fn finish(
         ..
     } = state;
     let k = names.len();
-    // The final solution's offsets and (negligible) step apply at p.
+    // The iteration ends on an evaluated point: its step is zero (and the
+    // offsets re-fitted at p), except for the linearised estimator
+    // (`max_iterations` 0), whose one step from the start is its estimate.
     let estimate: Vec<f64> = p
         .iter()
         .zip(&solution.parameters)
@@ -686,6 +833,7 @@ fn finish(
         converged,
         lines,
         design: Design { decision, report },
+        full_covariance: solution.covariance,
     }
 }
 

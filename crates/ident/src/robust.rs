@@ -36,11 +36,12 @@ use nalgebra::Matrix3;
 use serde::Serialize;
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_kinematics::UpJoints;
-use tricept_numerics::linalg::{TriangularAccumulator, invert_upper};
 use tricept_numerics::stats::chi2_isf;
 
 use crate::error::IdentError;
-use crate::identify::{Identification, IdentifyOptions, identify};
+use crate::identify::{
+    FirstEvaluation, Identification, IdentifyOptions, Start, fit, identify, map_blocks,
+};
 use crate::model::ReadingModel;
 
 /// Largest robust z-score (residual at the nominal machine, in units of
@@ -161,12 +162,25 @@ pub fn screen_gross_errors(
     alpha: f64,
     max_share: f64,
 ) -> Result<Vec<Rejection>, IdentError> {
+    Ok(screen(model, data, options, alpha, max_share)?.0)
+}
+
+/// [`screen_gross_errors`], with the screen's last fit when it was made on
+/// exactly the poses kept (the identification [`identify_robust`] would
+/// otherwise repeat).
+fn screen(
+    model: &dyn ReadingModel,
+    data: &Dataset,
+    options: &IdentifyOptions,
+    alpha: f64,
+    max_share: f64,
+) -> Result<(Vec<Rejection>, Option<Identification>), IdentError> {
     let n = data.poses.len();
     let cap = ((max_share * n as f64).floor() as usize).max(2);
     let crit = chi2_isf(alpha / n.max(1) as f64, 3.0);
-    let mut inside = robust_start(model, data, options)?;
+    let (mut inside, mut first) = robust_start(model, data, options)?;
     let mut seen: Vec<Vec<bool>> = Vec::new();
-    let mut last: Option<(Vec<bool>, Vec<Option<f64>>)> = None;
+    let mut last: Option<(Vec<bool>, Vec<Option<f64>>, Identification)> = None;
     for _ in 0..(2 * n + 4) {
         if seen.contains(&inside) {
             break;
@@ -176,15 +190,29 @@ pub fn screen_gross_errors(
         // is taken (a start at an earlier estimate would decide the rank at
         // another point and could free a parameter that is invisible to
         // first order).
-        let subset = data.subset(|j| inside[j]);
-        let id = match identify(model, &subset, options) {
-            Ok(id) => id,
+        let subset;
+        let (fitted, first) = if inside.iter().all(|x| *x) {
+            // The robust start's evaluation at the nominal machine is this
+            // fit's first one.
+            (data, first.take())
+        } else {
+            subset = data.subset(|j| inside[j]);
+            (&subset, None)
+        };
+        let (id, fk) = match fit(model, fitted, options, &Start::default(), first) {
+            Ok(fit) => fit,
             // Too few poses left, or a pose the start set cannot solve:
             // fall back to the previous set.
             Err(_) if last.is_some() => break,
             Err(e) => return Err(e),
         };
-        let t = deleted_residuals(model, &id, data, &inside, options)?;
+        // The fit's FK solutions start the FK of its poses again.
+        let mut fk = fk.into_iter();
+        let seeds: Vec<Option<UpJoints>> = inside
+            .iter()
+            .map(|&i| if i { fk.next().flatten() } else { None })
+            .collect();
+        let t = deleted_residuals(model, &id, data, &inside, &seeds, options)?;
         let mut next = inside.clone();
         let mut changed = false;
         for j in 0..n {
@@ -204,14 +232,14 @@ pub fn screen_gross_errors(
                 changed = true;
             }
         }
-        last = Some((inside.clone(), t));
+        last = Some((inside.clone(), t, id));
         if !changed {
             break;
         }
         inside = next;
     }
-    let Some((inside, t)) = last else {
-        return Ok(Vec::new());
+    let Some((inside, t, id)) = last else {
+        return Ok((Vec::new(), None));
     };
     let rejected: Vec<Rejection> = (0..n)
         .filter(|&j| !inside[j])
@@ -222,36 +250,25 @@ pub fn screen_gross_errors(
         })
         .collect();
     if rejected.len() > cap {
-        return Ok(Vec::new());
+        return Ok((Vec::new(), None));
     }
-    Ok(rejected)
+    Ok((rejected, Some(id)))
 }
 
-/// Which poses enter the first fit (stage 1 of the module docs). A pose
-/// the nominal machine cannot solve is an input error (its commands cannot
-/// be reached), not a gross reading.
+/// Which poses enter the first fit (stage 1 of the module docs), and the
+/// evaluation of the model at the nominal machine over all poses that
+/// gave their residuals (the first evaluation of a fit on all of them). A
+/// pose the nominal machine cannot solve is an input error (its commands
+/// cannot be reached), not a gross reading.
 fn robust_start(
     model: &dyn ReadingModel,
     data: &Dataset,
     options: &IdentifyOptions,
-) -> Result<Vec<bool>, IdentError> {
+) -> Result<(Vec<bool>, Option<FirstEvaluation>), IdentError> {
     let n = data.poses.len();
     let k = model.names().len();
-    let predictor = model.at(&vec![0.0; k]);
-    let mut jac = vec![0.0; 3 * k];
-    let mut nominal: Vec<Option<[f64; 3]>> = Vec::with_capacity(n);
-    for (j, p) in data.poses.iter().enumerate() {
-        let mut seed: Option<UpJoints> = None;
-        let g = predictor
-            .predict(p, &mut seed, &mut jac)
-            .map_err(|source| IdentError::Kinematics {
-                pose: j,
-                line: p.line,
-                source,
-            })?;
-        let y = p.readings.to_array();
-        nominal.push(Some([0, 1, 2].map(|c| y[c] - g[c])));
-    }
+    let first = FirstEvaluation::new(model, &vec![0.0; k], &data.poses, &options.sigma)?;
+    let nominal: Vec<Option<[f64; 3]>> = first.residuals().iter().map(|r| Some(*r)).collect();
     let median = |mut v: Vec<f64>| -> f64 {
         v.sort_by(f64::total_cmp);
         tricept_numerics::stats::quantile(&v, 0.5)
@@ -292,92 +309,96 @@ fn robust_start(
             inside[j] = z[j].is_finite();
         }
     }
-    Ok(inside)
+    Ok((inside, Some(first)))
 }
 
 /// The statistic `T_j` of every pose at fit `id` made on the poses marked
 /// `inside` (stage 2 of the module docs); `None` where the fitted model
-/// cannot solve the pose.
+/// cannot solve the pose. One pass over the poses, with the fit's own
+/// covariance `C` of `[offsets | identifiable parameters]`: nothing per
+/// pose is kept but its statistic.
 fn deleted_residuals(
     model: &dyn ReadingModel,
     id: &Identification,
     data: &Dataset,
     inside: &[bool],
+    seeds: &[Option<UpJoints>],
     options: &IdentifyOptions,
 ) -> Result<Vec<Option<f64>>, IdentError> {
     let k = model.names().len();
-    let columns = id.design().identifiable().to_vec();
-    let q = 3 + columns.len();
-    let predictor = model.at(&id.estimate);
-    let mut jac = vec![0.0; 3 * k];
-    // Weighted residual and weighted Jacobian rows [offsets | identifiable] of every pose.
-    let rows: Vec<Option<([f64; 3], Vec<f64>)>> = data
-        .poses
-        .iter()
-        .map(|p| {
-            let mut seed: Option<UpJoints> = None;
-            let g = predictor.predict(p, &mut seed, &mut jac).ok()?;
-            let y = p.readings.to_array();
-            let e = [0, 1, 2].map(|c| (y[c] - g[c] - id.offsets[c]) / options.sigma[c]);
-            let mut x = vec![0.0; 3 * q];
-            for c in 0..3 {
-                let w = 1.0 / options.sigma[c];
-                x[c * q + c] = w;
-                for (t, &col) in columns.iter().enumerate() {
-                    x[c * q + 3 + t] = w * jac[c * k + col];
-                }
-            }
-            Some((e, x))
-        })
+    let columns: Vec<usize> = (0..3)
+        .chain(id.design().identifiable().iter().map(|&j| 3 + j))
         .collect();
-    // C = (X^T X)^-1 over the poses of the fit, through the R factor.
-    let mut acc = TriangularAccumulator::with_rows_hint(q, 3 * data.poses.len());
-    let mut chi2 = 0.0;
-    let mut m = 0usize;
-    for (j, row) in rows.iter().enumerate() {
-        if let (true, Some((e, x))) = (inside[j], row) {
-            for c in 0..3 {
-                acc.push_row(&x[c * q..(c + 1) * q]);
-                chi2 += e[c] * e[c];
-            }
-            m += 3;
-        }
-    }
-    let r_inv = invert_upper(acc.finish().as_ref());
-    let nu = m.saturating_sub(q);
-    Ok(rows
-        .iter()
-        .enumerate()
-        .map(|(j, row)| {
-            let (e, x) = row.as_ref()?;
-            // W = X_j R^-1 (3 x q); H_jj = W W^T.
-            let w: Vec<f64> = (0..3 * q)
-                .map(|cq| {
-                    let (c, a) = (cq / q, cq % q);
-                    (0..=a).map(|b| x[c * q + b] * r_inv[(b, a)]).sum()
-                })
-                .collect();
-            let h = Matrix3::from_fn(|a, b| (0..q).map(|t| w[a * q + t] * w[b * q + t]).sum());
-            let e = nalgebra::Vector3::from(*e);
-            let (m3, scale) = if inside[j] {
-                // Deleted residual, externally studentised.
-                let d = (Matrix3::identity() - h)
-                    .try_inverse()
-                    .map_or(0.0, |inv| (e.transpose() * inv * e)[0]);
-                let s2 = if nu > 3 {
-                    (chi2 - d) / (nu - 3) as f64
+    let q = columns.len();
+    let c = &id.full_covariance;
+    let cov: Vec<f64> = (0..q * q)
+        .map(|i| c[(columns[i / q], columns[i % q])])
+        .collect();
+    let predictor = model.at(&id.estimate);
+    // (e^T (I -+ H)^-1 e, |e|^2, inside) of every pose that can be solved.
+    let forms: Vec<Option<(f64, f64, bool)>> = map_blocks(&data.poses, |first, poses| {
+        let mut jac = vec![0.0; 3 * k];
+        let mut x = vec![0.0; 3 * q];
+        let mut xc = vec![0.0; 3 * q];
+        let range = first..first + poses.len();
+        Ok(poses
+            .iter()
+            .zip(&inside[range.clone()])
+            .zip(&seeds[range])
+            .map(|((p, &inside), &seed)| {
+                let mut seed = seed;
+                let g = predictor.predict(p, &mut seed, &mut jac).ok()?;
+                let y = p.readings.to_array();
+                let e = nalgebra::Vector3::from_fn(|c, _| {
+                    (y[c] - g[c] - id.offsets[c]) / options.sigma[c]
+                });
+                // X_j: the pose's weighted rows [offsets | identifiable].
+                x.iter_mut().for_each(|v| *v = 0.0);
+                for c in 0..3 {
+                    let w = 1.0 / options.sigma[c];
+                    x[c * q + c] = w;
+                    for (t, &col) in columns[3..].iter().enumerate() {
+                        x[c * q + 3 + t] = w * jac[c * k + col - 3];
+                    }
+                }
+                // H_jj = X_j C X_j^T.
+                for a in 0..3 {
+                    for t in 0..q {
+                        xc[a * q + t] = (0..q).map(|s| x[a * q + s] * cov[s * q + t]).sum();
+                    }
+                }
+                let h = Matrix3::from_fn(|a, b| (0..q).map(|t| xc[a * q + t] * x[b * q + t]).sum());
+                let d = if inside {
+                    (Matrix3::identity() - h)
+                        .try_inverse()
+                        .map_or(0.0, |inv| (e.transpose() * inv * e)[0])
                 } else {
-                    1.0
+                    (Matrix3::identity() + h)
+                        .try_inverse()
+                        .map_or(f64::INFINITY, |inv| (e.transpose() * inv * e)[0])
                 };
-                (d, s2)
-            } else {
-                let d = (Matrix3::identity() + h)
-                    .try_inverse()
-                    .map_or(f64::INFINITY, |inv| (e.transpose() * inv * e)[0]);
-                let s2 = if nu > 0 { chi2 / nu as f64 } else { 1.0 };
-                (d, s2)
+                Some((d, e.norm_squared(), inside))
+            })
+            .collect())
+    })?;
+    let (mut chi2, mut m) = (0.0, 0usize);
+    for (_, e2, _) in forms.iter().flatten().filter(|f| f.2) {
+        chi2 += e2;
+        m += 3;
+    }
+    let nu = m.saturating_sub(q);
+    Ok(forms
+        .into_iter()
+        .map(|f| {
+            let (d, _, inside) = f?;
+            // Deleted residuals externally studentised; prediction
+            // residuals against the fit's scale.
+            let scale = match (inside, nu) {
+                (true, nu) if nu > 3 => (chi2 - d) / (nu - 3) as f64,
+                (false, nu) if nu > 0 => chi2 / nu as f64,
+                _ => 1.0,
             };
-            Some(m3 / scale.max(1.0))
+            Some(d / scale.max(1.0))
         })
         .collect())
 }
@@ -409,7 +430,10 @@ pub fn identify_robust(
     data: &Dataset,
     options: &IdentifyOptions,
 ) -> Result<(Identification, Vec<Rejection>), IdentError> {
-    let rejected = screen_gross_errors(model, data, options, 1e-3, 0.1)?;
-    let id = identify(model, &kept(data, &rejected), options)?;
+    let (rejected, fit) = screen(model, data, options, 1e-3, 0.1)?;
+    let id = match fit {
+        Some(id) => id,
+        None => identify(model, &kept(data, &rejected), options)?,
+    };
     Ok((id, rejected))
 }

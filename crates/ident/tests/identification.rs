@@ -139,8 +139,12 @@ fn x_first_dya3_aliases_into_dyb3_through_dzb3_as_predicted() {
     }
 }
 
+/// The estimate is the last point Gauss-Newton evaluated, within the
+/// iteration's tolerance (1e-3 of each standard deviation) of the optimum:
+/// for noise-free data within 1e-8 mm of the truth (the step not taken is
+/// 2.4e-9 mm here).
 #[test]
-fn noise_free_exact_data_are_recovered_to_1e_9_mm() {
+fn noise_free_exact_data_are_recovered_to_1e_8_mm() {
     let set = ParameterSet::paper15();
     let mut t2_x = set.table2();
     t2_x[set.index_of("dyA3").unwrap()] = 0.0; // in the identifiable subspace
@@ -154,15 +158,16 @@ fn noise_free_exact_data_are_recovered_to_1e_9_mm() {
         let model = GeometricModel::new(m.clone(), set.clone());
         let id = identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
         for (j, name) in set.names().iter().enumerate() {
+            let tolerance = id.std_dev[j].map_or(1e-8, |sd| (1e-3 * sd).min(1e-8));
             assert!(
-                (id.estimate[j] - truth[j]).abs() < 1e-9,
+                (id.estimate[j] - truth[j]).abs() < tolerance,
                 "{order}: {name} {} vs {}",
                 id.estimate[j],
                 truth[j]
             );
         }
         for c in 0..3 {
-            assert!((id.offsets[c] - tricept_plant::DEFAULT_SENSOR_OFFSETS[c]).abs() < 1e-9);
+            assert!((id.offsets[c] - tricept_plant::DEFAULT_SENSOR_OFFSETS[c]).abs() < 1e-8);
         }
     }
 }
@@ -517,4 +522,95 @@ fn a_non_converged_fit_reports_one_consistent_point() {
             }
         }
     }
+}
+
+/// The fit's statistics are those of the point it reports: chi-square, rms
+/// and the largest standardised residual recomputed from the reported
+/// estimate and offsets with the public model agree with the reported
+/// ones to rounding, on a realistic campaign (80 random poses, the mean of
+/// three readings: the paper's logged noise) and a large one.
+#[test]
+fn the_reported_statistics_are_those_of_the_reported_estimate() {
+    let m = machine(AxisOrder::XFirst);
+    let set = ParameterSet::paper15();
+    let plant = Plant::geometric(m.clone(), set.to_errors(&set.table2()));
+    let model = GeometricModel::new(m.clone(), set.clone());
+    let options = IdentifyOptions::for_machine(&m);
+    let sigma = options.sigma;
+    for (poses, seed) in [(80, 3), (80, 4), (3000, 5)] {
+        let data = plant.simulate(&Campaign::random(&m, poses, seed)).unwrap();
+        let id = identify(&model, &data, &options).unwrap();
+        assert!(id.converged);
+        let z: Vec<[f64; 3]> =
+            tricept_ident::residuals_at(&model, &id.estimate, &id.offsets, &data.poses, &sigma)
+                .unwrap()
+                .into_iter()
+                .map(|r| r.unwrap())
+                .collect();
+        let chi_square: f64 = z.iter().flatten().map(|v| v * v).sum();
+        let max = z.iter().flatten().fold(0.0f64, |a, v| a.max(v.abs()));
+        let rms = [0, 1, 2].map(|c| {
+            (z.iter().map(|r| (r[c] * sigma[c]).powi(2)).sum::<f64>() / z.len() as f64).sqrt()
+        });
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs();
+        assert!(
+            close(id.stats.chi_square, chi_square),
+            "{poses} poses: reported chi-square {} but {chi_square} at the reported estimate",
+            id.stats.chi_square
+        );
+        assert!(
+            close(id.stats.max_standardised.0, max),
+            "{poses} poses: reported max |z| {} but {max}",
+            id.stats.max_standardised.0
+        );
+        for c in 0..3 {
+            assert!(
+                close(id.stats.rms[c], rms[c]),
+                "{poses} poses: rms[{c}] {} but {}",
+                id.stats.rms[c],
+                rms[c]
+            );
+        }
+    }
+}
+
+/// Beyond one block of poses the model is evaluated in parallel blocks:
+/// the fit (and the gross-error screen around it) gives the same bits on
+/// one thread and on two.
+#[test]
+fn a_fit_of_several_blocks_is_bit_identical_on_one_and_two_threads() {
+    let m = machine(AxisOrder::XFirst);
+    let set = ParameterSet::paper15();
+    let plant = Plant::geometric(m.clone(), set.to_errors(&set.table2()));
+    let mut data = plant.simulate(&Campaign::random(&m, 9000, 21)).unwrap();
+    data.poses[5000].readings.s_mm += 0.05; // one gross reading, in the second block
+    let model = GeometricModel::new(m.clone(), set.clone());
+    let options = IdentifyOptions::for_machine(&m);
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| tricept_ident::identify_robust(&model, &data, &options).unwrap())
+    };
+    let ((one, rejected_one), (two, rejected_two)) = (run(1), run(2));
+    assert_eq!(rejected_one, rejected_two);
+    assert_eq!(
+        rejected_one.iter().map(|r| r.pose).collect::<Vec<_>>(),
+        vec![5000]
+    );
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&one.estimate), bits(&two.estimate));
+    assert_eq!(bits(&one.offsets), bits(&two.offsets));
+    assert_eq!(
+        one.stats.chi_square.to_bits(),
+        two.stats.chi_square.to_bits()
+    );
+    // The screen's last fit is the identification of the poses kept.
+    let kept = identify(&model, &data.subset(|j| j != 5000), &options).unwrap();
+    assert_eq!(bits(&one.estimate), bits(&kept.estimate));
+    assert_eq!(
+        one.stats.chi_square.to_bits(),
+        kept.stats.chi_square.to_bits()
+    );
 }

@@ -1,5 +1,6 @@
-//! The fast Monte Carlo path: one factorisation per encoder grade, then all
-//! trials' noise through one matrix product.
+//! The fast Monte Carlo path: one factorisation per encoder grade, then
+//! every trial's noise through two small products and the plane's norms, in
+//! SIMD lanes (the trial kernel, `kernel.rs`).
 //!
 //! The identification matrix depends only on the poses (not on the noise),
 //! so around the noise-free estimate `p*` the estimate of a trial is
@@ -7,8 +8,7 @@
 //! readings and `M` the parameter rows of the pseudo-inverse of the weighted
 //! `[offsets | J E]` restricted to the identifiable columns (computed once
 //! from a thin QR). `M z` is sampled exactly through the triangular factor
-//! of `M M^T` ([`LinearEstimator::new`]), a block of trials at a time by one
-//! matrix product. `p*` itself comes from the exact nonlinear
+//! of `M M^T` ([`LinearEstimator::new`]), a block of trials at a time. `p*` itself comes from the exact nonlinear
 //! identification of the noise-free readings, so the deterministic part
 //! (unidentifiable parameters held at zero, second-order effects) is exact;
 //! only the noise is propagated to first order, which the exact path checks.
@@ -19,16 +19,15 @@
 //! seeded from (seed, grade, block), so results are bit-identical at any
 //! thread count.
 
-use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, Par};
-use rand_distr::{Distribution, StandardNormal};
+use faer::Mat;
 use rayon::prelude::*;
 use tricept_ident::{
     Design, GeometricModel, IdentifyOptions, ReadingModel, Start, design, identify_from,
 };
 use tricept_kinematics::UpJoints;
-use tricept_model::{position_error_jacobian, residual_mu, volumetric_errors};
+use tricept_model::{position_error_jacobian, volumetric_errors};
 
+use crate::kernel::Kernel;
 use crate::rng::block_rng;
 use crate::scenario::Scenario;
 use crate::{StudyError, TrialResult};
@@ -224,11 +223,37 @@ impl LinearEstimator {
         grade_index: u64,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Vec<TrialResult> {
+        let mut offset = Vec::with_capacity(self.columns.len());
+        let mut moving = vec![false; s.truth.len()];
+        for &col in &self.columns {
+            offset.push(s.truth[col] - self.p_star[col]);
+            moving[col] = true;
+        }
+        let held = (0..s.truth.len().min(self.p_star.len()))
+            .filter(|&i| !moving[i])
+            .map(|i| (s.truth[i] - self.p_star[i]).abs())
+            .sum();
+        let kernel = self.kernel(offset, held, s.truth.len());
         in_blocks(trials, |block, n| {
-            let out = self.run_block(s, n, seed, grade_index, block);
+            let mut rng = block_rng(seed, grade_index, block);
+            let out = kernel.trials(&mut rng, n, true);
             progress(n as u64);
             out
         })
+    }
+
+    /// The trial kernel of this estimator, `mu` measured as `(held +
+    /// sum_u |offset_u - dp_u|) / n_params`.
+    fn kernel(&self, offset: Vec<f64>, held: f64, n_params: usize) -> Kernel {
+        Kernel::new(
+            |u, k| self.factor[(u, k)],
+            self.factor.nrows(),
+            |r, u| self.plane_jacobian[(r, u)],
+            self.plane_clean.clone(),
+            offset,
+            held,
+            n_params,
+        )
     }
 
     /// The part of `mu` that is noise alone, `||p_hat - p*||_1 / n_params`,
@@ -260,91 +285,14 @@ impl LinearEstimator {
         seed: u64,
         grade_index: u64,
     ) -> Vec<f64> {
+        let kernel = self.kernel(vec![0.0; self.columns.len()], 0.0, n_params);
         in_blocks(trials, |block, n| {
-            let dp = self.deviations(n, seed, grade_index, block);
-            (0..n)
-                .map(|t| (0..dp.nrows()).map(|u| dp[(u, t)].abs()).sum::<f64>() / n_params as f64)
+            let mut rng = block_rng(seed, grade_index, block);
+            kernel
+                .trials(&mut rng, n, false)
+                .into_iter()
+                .map(|t| t.mu_mm)
                 .collect()
         })
-    }
-
-    /// `p_hat - p*` on the columns for the `n` trials of one block.
-    fn deviations(&self, n: usize, seed: u64, grade_index: u64, block: u64) -> Mat<f64> {
-        let kid = self.factor.nrows();
-        let mut rng = block_rng(seed, grade_index, block);
-        let noise: Vec<f64> = (0..kid * n)
-            .map(|_| StandardNormal.sample(&mut rng))
-            .collect();
-        let z = faer::MatRef::from_column_major_slice(&noise, kid, n);
-        let mut dp = Mat::<f64>::zeros(kid, n);
-        matmul(
-            dp.as_mut(),
-            Accum::Replace,
-            self.factor.as_ref(),
-            z.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-        dp
-    }
-
-    fn run_block(
-        &self,
-        s: &Scenario,
-        n: usize,
-        seed: u64,
-        grade_index: u64,
-        block: u64,
-    ) -> Vec<TrialResult> {
-        let dp = self.deviations(n, seed, grade_index, block);
-        let rows = self.plane_jacobian.nrows();
-        let mut dr = Mat::<f64>::zeros(rows, n);
-        matmul(
-            dr.as_mut(),
-            Accum::Replace,
-            self.plane_jacobian.as_ref(),
-            dp.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-        let ident = &self.columns;
-        let points = rows / 3;
-        let mut estimate = self.p_star.clone();
-        let mut diff = vec![0.0; rows];
-        (0..n)
-            .map(|t| {
-                for (u, &col) in ident.iter().enumerate() {
-                    estimate[col] = self.p_star[col] + dp[(u, t)];
-                }
-                let column = dr.col(t);
-                let mut translation = [0.0; 3];
-                let (mut sum, mut max) = (0.0, 0.0f64);
-                for (pnt, d) in diff.chunks_exact_mut(3).enumerate() {
-                    for c in 0..3 {
-                        d[c] = self.plane_clean[3 * pnt + c] - column[3 * pnt + c];
-                        translation[c] += d[c];
-                    }
-                    let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                    sum += norm;
-                    max = max.max(norm);
-                }
-                let inv = 1.0 / points as f64;
-                let t3 = translation.map(|v| v * inv);
-                let touched: f64 = diff
-                    .chunks_exact(3)
-                    .map(|d| {
-                        let e = [d[0] - t3[0], d[1] - t3[1], d[2] - t3[2]];
-                        (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt()
-                    })
-                    .sum::<f64>()
-                    * inv;
-                TrialResult {
-                    mu_mm: residual_mu(&s.truth, &estimate),
-                    plane_mean_mm: sum * inv,
-                    plane_max_mm: max,
-                    plane_touched_mean_mm: touched,
-                }
-            })
-            .collect()
     }
 }

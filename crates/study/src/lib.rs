@@ -32,6 +32,7 @@ pub mod exact;
 pub mod fast;
 pub mod grades;
 pub mod invisible;
+mod kernel;
 pub mod optimise;
 pub mod paper;
 pub mod plan;

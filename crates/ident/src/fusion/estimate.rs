@@ -591,7 +591,7 @@ fn finish(
         let nuisance_std_dev = (at..at + n_s)
             .map(|j| solution.covariance[(j, j)].max(0.0).sqrt())
             .collect();
-        // The final evaluation's residuals (the last step is negligible),
+        // The residuals at the estimate (the final evaluation: the run ends on it),
         // with a linear nuisance's values taken off.
         let mut z = eval.standardised[s].clone();
         if rows.linear_nuisance() {
