@@ -157,14 +157,14 @@ fn assert_recovered(fit: &Fusion, truth: &[f64], what: &str) -> f64 {
 /// Asserts a source's chi-square lies in its two-sided 99.9 % interval.
 fn assert_chi_square_plausible(fit: &Fusion) {
     for s in &fit.sources {
-        let lo = chi2_isf(1.0 - 5e-4, s.dof_share);
-        let hi = chi2_isf(5e-4, s.dof_share);
+        let lo = chi2_isf(1.0 - 5e-4, s.redundancy);
+        let hi = chi2_isf(5e-4, s.redundancy);
         assert!(
             (lo..=hi).contains(&s.chi_square),
             "{}: chi-square {} outside [{lo}, {hi}] (dof {})",
             s.label,
             s.chi_square,
-            s.dof_share
+            s.redundancy
         );
     }
 }

@@ -44,7 +44,7 @@ impl Default for BallbarOptions {
     }
 }
 
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct Ballbar {
     readings: Vec<BallbarReading>,
     sigma_mm: Vec<f64>,
@@ -140,6 +140,17 @@ impl SourceRows for Ballbar {
         }
     }
 
+
+    fn min_redundancy(&self) -> f64 {
+        4.0 * self.setups.len() as f64
+    }
+
+    fn judged_nuisance(&self, values: &[f64]) -> Vec<(&'static str, usize, f64)> {
+        (0..self.setups.len())
+            .map(|s| ("ballbar.length_error_mm", 4 * s + 3, values[4 * s + 3]))
+            .collect()
+    }
+
     fn pose(&self, record: usize) -> ExternalPose {
         self.readings[record].pose
     }
@@ -153,6 +164,7 @@ impl SourceRows for Ballbar {
         at: &FusedAt<'_>,
         contexts: &[LegContext],
         seeds: &mut [Option<UpJoints>],
+        active: &[bool],
     ) -> Result<Nuisance, IdentError> {
         let mut tips = Vec::with_capacity(self.readings.len());
         for_each_point(at, contexts, seeds, self.records(), |_, x, _| {
@@ -161,7 +173,7 @@ impl SourceRows for Ballbar {
         let mut values = vec![0.0; 4 * self.setups.len()];
         for (s, id) in self.setups.iter().enumerate() {
             let (x, radii): (Vec<Vector3<f64>>, Vec<f64>) = (0..self.readings.len())
-                .filter(|&j| self.setup_of[j] == s)
+                .filter(|&j| self.setup_of[j] == s && active[j])
                 .map(|j| (tips[j], self.readings[j].length_mm))
                 .unzip();
             let c = sphere_centre(&x, &radii).ok_or_else(|| IdentError::Source {
@@ -226,5 +238,9 @@ impl SourceRows for Ballbar {
 
     fn nuisance_hint(&self) -> &'static str {
         "spread the ball over the sphere around the pivot (different directions, not one plane)"
+    }
+
+    fn boxed_clone(&self) -> Box<dyn SourceRows> {
+        Box::new(self.clone())
     }
 }

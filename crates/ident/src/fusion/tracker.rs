@@ -61,7 +61,7 @@ impl Default for TrackerOptions {
     }
 }
 
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct Tracker {
     points: Vec<TrackerPoint>,
     sigma_mm: Vec<f64>,
@@ -192,6 +192,33 @@ impl SourceRows for Tracker {
         }
     }
 
+
+    fn min_redundancy(&self) -> f64 {
+        6.0 * self.setups.len() as f64
+    }
+
+    fn judged_nuisance(&self, values: &[f64]) -> Vec<(&'static str, usize, f64)> {
+        (0..3)
+            .map(|c| match self.target {
+                TrackerTarget::Free => ("tracker.target_free_mm", c, values[c]),
+                TrackerTarget::Known { offset_mm, .. } => {
+                    ("tracker.target_change_mm", c, values[c] - offset_mm[c])
+                }
+            })
+            .collect()
+    }
+
+    fn tracker_target(&self) -> Option<TrackerTarget> {
+        Some(self.target)
+    }
+
+    fn with_tracker_target(&self, target: TrackerTarget) -> Option<Box<dyn SourceRows>> {
+        Some(Box::new(Tracker {
+            target,
+            ..self.clone()
+        }))
+    }
+
     fn pose(&self, record: usize) -> ExternalPose {
         self.points[record].pose
     }
@@ -205,6 +232,7 @@ impl SourceRows for Tracker {
         at: &FusedAt<'_>,
         contexts: &[LegContext],
         seeds: &mut [Option<UpJoints>],
+        active: &[bool],
     ) -> Result<Nuisance, IdentError> {
         let mut nu = Nuisance {
             values: vec![0.0; 3 + 6 * self.setups.len()],
@@ -220,7 +248,7 @@ impl SourceRows for Tracker {
         })?;
         for (s, id) in self.setups.iter().enumerate() {
             let (x, y): (Vec<Vector3<f64>>, Vec<Vector3<f64>>) = (0..self.points.len())
-                .filter(|&j| self.setup_of[j] == s)
+                .filter(|&j| self.setup_of[j] == s && active[j])
                 .map(|j| (predicted[j], Vector3::from(self.points[j].position_mm)))
                 .unzip();
             let (r, t) = horn(&x, &y).ok_or_else(|| IdentError::Source {
@@ -320,5 +348,9 @@ impl SourceRows for Tracker {
 
     fn nuisance_hint(&self) -> &'static str {
         "the target offset and the tracker frame cannot be separated: vary the spindle's orientation (h1, h2 and the platform tilt) between the points"
+    }
+
+    fn boxed_clone(&self) -> Box<dyn SourceRows> {
+        Box::new(self.clone())
     }
 }
