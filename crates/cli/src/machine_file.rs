@@ -41,9 +41,9 @@ pub struct Provenance<'a> {
     /// geometric ones, and the head's of a fused fit; the rest are effects,
     /// recorded under `effects`).
     pub n_geometric: usize,
-    /// External measurement files of a fused fit: kind, file, records,
-    /// chi-square per degree of freedom.
-    pub external: Vec<(String, &'a Path, usize, f64)>,
+    /// External measurement files of a fused fit: the file and its record
+    /// (the hash is filled in when written).
+    pub external: Vec<(&'a Path, ExternalSourceRecord)>,
 }
 
 /// What the record needs of a fit, whether from the UP limb's data alone
@@ -89,7 +89,7 @@ impl<'a> FitRecord<'a> {
             std::array::from_fn(|c| v.get(c).copied().unwrap_or(f64::NAN))
         };
         let chi2: f64 = fit.sources.iter().map(|s| s.chi_square).sum();
-        let dof: f64 = fit.sources.iter().map(|s| s.dof_share).sum();
+        let dof: f64 = fit.sources.iter().map(|s| s.redundancy).sum();
         FitRecord {
             names: &fit.names,
             estimate: &fit.estimate,
@@ -271,13 +271,10 @@ pub fn calibrated_description(
         external_sources: p
             .external
             .iter()
-            .map(|(kind, file, records, chi2)| {
+            .map(|(file, record)| {
                 Ok(ExternalSourceRecord {
-                    kind: kind.clone(),
-                    file: file.display().to_string(),
                     sha256: sha256_file(file)?,
-                    records: *records,
-                    chi2_per_dof: *chi2,
+                    ..record.clone()
                 })
             })
             .collect::<Result<_, CliError>>()?,

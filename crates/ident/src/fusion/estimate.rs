@@ -746,6 +746,9 @@ pub struct DesignRows {
     pub records: Vec<DMatrix<f64>>,
     /// The source's prior rows (bar length, target offset, stylus), weighted.
     pub priors: DMatrix<f64>,
+    /// The redundancy its rows need to check a fit
+    /// ([`SourceFit::min_redundancy`]).
+    pub min_redundancy: f64,
 }
 
 /// The rows of `source` at the nominal machine (see [`DesignRows`]).
@@ -790,6 +793,7 @@ pub fn design_rows(model: &FusedModel, source: &Source) -> Result<DesignRows, Id
             .map(|r| DMatrix::from_row_slice(r.len() / width.max(1), width, &r))
             .collect(),
         priors: DMatrix::from_row_slice(priors.len() / width.max(1), width, &priors),
+        min_redundancy: rows.min_redundancy(),
     })
 }
 
