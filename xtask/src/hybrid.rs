@@ -44,8 +44,8 @@ use tricept_numerics::stats::quantile;
 use tricept_plant::{Ballbar, Campaign, Effect, Plant, Tracker, random_head_errors};
 use tricept_plot::{Axes, Curve, Reference, curves};
 use tricept_study::plan::{
-    PlanProblem, ballbar_candidates, candidate_rows, internal_information, nominal_ballbar_data,
-    nominal_tracker_data, plan,
+    PlanProblem, candidate_rows, internal_factor, nominal_ballbar_data, nominal_tracker_data, plan,
+    sphere_candidates,
 };
 
 /// Which instruments to run.
@@ -239,7 +239,8 @@ fn instrument_source(
 ) -> Result<Source, String> {
     match instrument {
         Instrument::Tracker => {
-            let data = nominal_tracker_data(model, poses).map_err(|e| e.to_string())?;
+            let at: Vec<(ExternalPose, f64)> = poses.iter().map(|p| (*p, 0.0)).collect();
+            let data = nominal_tracker_data(model, &at).map_err(|e| e.to_string())?;
             Source::tracker(
                 &data,
                 &tracker_options(TrackerTarget::Known {
@@ -273,15 +274,15 @@ fn plans(instrument: Instrument, m: &Machine, ks: &[usize]) -> Result<Plans, Str
             &[0.0, 60.0, 120.0, 180.0, 240.0, 300.0],
             &[-45.0, -25.0, 25.0, 45.0],
         ),
-        Instrument::Ballbar => ballbar_candidates(m, &pivot(), 150.0, 300),
+        Instrument::Ballbar => sphere_candidates(m, &pivot(), 150.0, 300),
     };
-    let f_int = internal_information(&model, &m.workspace.polar_grid(3, 8, 3))
+    let f_int = internal_factor(&model, &m.workspace.polar_grid(3, 8, 3))
         .map_err(|e| e.to_string())?;
     let rows = candidate_rows(&model, &instrument_source(instrument, &model, &candidates)?)
         .map_err(|e| e.to_string())?;
     let eval = FusionOptions::for_machine(m).eval_poses;
     let fused = PlanProblem::new(&model, &f_int, &rows, &eval).map_err(|e| e.to_string())?;
-    let zero = nalgebra::DMatrix::zeros(model.len(), model.len());
+    let zero = nalgebra::DMatrix::zeros(0, model.len());
     let lone = PlanProblem::new(&model, &zero, &rows, &eval).map_err(|e| e.to_string())?;
     let (a, b) = rayon::join(
         || plan(&fused, ks, 10, 50, 1),

@@ -363,6 +363,14 @@ pub fn run(a: &IdentifyArgs) -> Result<u8, CliError> {
         ));
     }
     let mut model = fused_model(&machine, &set, &x.effects, x.head.as_deref())?;
+    if a.write_machine.is_some() && !model.effects().is_empty() {
+        let names: Vec<&str> = model.effects().iter().map(|e| e.as_str()).collect();
+        return Err(CliError::input(format!(
+            "--write-machine: {} fitted, but the machine format cannot carry {}; write a geometric fit (without --effects) or compensate with the fused model",
+            names.join(", "),
+            if names.len() == 1 { "it" } else { "them" }
+        )));
+    }
     // A calibrated machine: the rank decision of its nominal machine, as in
     // `identify` (docs/identifiability.md).
     if let Some(reference) = loaded.rank_reference()? {
@@ -576,9 +584,9 @@ fn print_text(model: &FusedModel, fit: &Fusion, sources: &[Source]) {
 /// Writes the calibrated machine: the module explicit, the head's fields
 /// and angle offsets from the estimate, and the `calibration` record (as
 /// `identify` writes it, with every external file, its hash and its
-/// fitted nuisance). Refuses fitted effects, which the geometric machine
-/// format cannot carry; a fit with a non-zero exit `code` is written only
-/// with `--force` (the caller refuses it otherwise), marked forced.
+/// fitted nuisance); the caller refuses fitted effects, which the geometric
+/// machine format cannot carry, and a fit with a non-zero exit `code`
+/// unless `--force` (then it is marked forced).
 fn write_machine(
     a: &IdentifyArgs,
     path: &Path,
@@ -587,14 +595,6 @@ fn write_machine(
     sources: &[Source],
     code: u8,
 ) -> Result<Value, CliError> {
-    if !model.effects().is_empty() {
-        let names: Vec<&str> = model.effects().iter().map(|e| e.as_str()).collect();
-        return Err(CliError::input(format!(
-            "--write-machine: {} fitted, but the machine format cannot carry {}; write a geometric fit (without --effects) or compensate with the fused model",
-            names.join(", "),
-            if names.len() == 1 { "it" } else { "them" }
-        )));
-    }
     let held: Vec<String> = fit
         .std_dev
         .iter()

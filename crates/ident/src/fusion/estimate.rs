@@ -621,9 +621,14 @@ fn record_checks(
                 let sign = if active { -1.0 } else { 1.0 };
                 let middle: DMatrix<f64> = DMatrix::identity(m, m) + &h * sign;
                 let ev = DVector::from_column_slice(&e[j]);
-                let quadratic = middle
-                    .try_inverse()
-                    .map_or(f64::INFINITY, |inv| (ev.transpose() * inv * &ev)[(0, 0)]);
+                // e^T M^-1 e over the directions the other records check: a
+                // direction with leverage 1 (eigenvalue of I - H near 0) is
+                // fitted exactly whatever it holds and tests nothing.
+                let eig = middle.symmetric_eigen();
+                let quadratic: f64 = (0..m)
+                    .filter(|&i| eig.eigenvalues[i] > 1e-6)
+                    .map(|i| eig.eigenvectors.column(i).dot(&ev).powi(2) / eig.eigenvalues[i])
+                    .sum();
                 RecordCheck {
                     line: source.line(j),
                     active,

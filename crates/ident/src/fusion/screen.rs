@@ -231,6 +231,17 @@ pub(crate) fn screened_fit(
     let Some((mut active, mut fit)) = last else {
         return Err(IdentError::Numerical("the gross-error screen found no fit"));
     };
+    // A record left out by a cycle or a failed refit whose statistic is
+    // below the criterion is not a gross error: back in.
+    let mut back = false;
+    for (s, checks) in fit.checks.iter().enumerate() {
+        for (j, c) in checks.iter().enumerate() {
+            if !c.active && statistic(c, &fit.sources[s]) <= crit[s] {
+                active[s][j] = true;
+                back = true;
+            }
+        }
+    }
     // The cap, on the final set.
     let mut overflow = Vec::new();
     for (s, source) in sources.iter().enumerate() {
@@ -242,7 +253,7 @@ pub(crate) fn screened_fit(
             overflow.push(format!("{} ({})", source.label(), source.file()));
         }
     }
-    if !overflow.is_empty() {
+    if back || !overflow.is_empty() {
         fit = fit_masked(model, sources, &active, options)?;
     }
     let rejected = fit
