@@ -147,5 +147,5 @@ pub(crate) fn likely_causes(
 
 /// `X,Y,Z` as `--tracker-target` takes it.
 fn triple(v: &[f64; 3]) -> String {
-    format!("{},{},{}", v[0], v[1], v[2])
+    format!("{},{},{}", v[0] + 0.0, v[1] + 0.0, v[2] + 0.0)
 }

@@ -184,8 +184,8 @@ impl Implausible {
             round3(self.value),
             round3(self.std_dev),
             self.range.unit,
-            self.range.min,
-            self.range.max,
+            round3(self.range.min),
+            round3(self.range.max),
             self.range.unit,
             self.range.why
         )

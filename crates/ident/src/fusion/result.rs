@@ -356,7 +356,7 @@ impl Fusion {
         }
         for label in &self.screen_overflow {
             w.push(format!(
-                "{label}: more records look like gross errors than the screen may reject (10 %, at least 2): nothing rejected there; a model or setup problem, not a few bad rows"
+                "{label}: more records look like gross errors than the screen may reject (10 %, at least 2): nothing rejected there; a model or setup problem, not a few bad rows (a tracker moved without a new `setup` number, a file of another machine)"
             ));
         }
         for s in &self.sources {
@@ -388,10 +388,21 @@ impl Fusion {
                 ));
             }
         }
-        for i in &self.implausible {
+        for i in self.implausible.iter().take(3) {
             w.push(format!(
                 "{}: the estimate absorbs a mistake, not a machine error",
                 i.to_text()
+            ));
+        }
+        if self.implausible.len() > 3 {
+            let rest: Vec<&str> = self.implausible[3..]
+                .iter()
+                .map(|i| i.name.as_str())
+                .collect();
+            w.push(format!(
+                "{} more estimates are far outside their plausible ranges: {}",
+                rest.len(),
+                rest.join(", ")
             ));
         }
         for c in &self.likely_causes {
