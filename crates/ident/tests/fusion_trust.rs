@@ -235,7 +235,7 @@ fn a_target_not_at_the_tip_is_implausible_and_the_cause_is_named() {
     // With the target free the data put it where it is, to the size of the
     // tool tip's own errors (0.3 mm).
     let mode = &fits[0].likely_causes[0].description;
-    assert!(mode.contains("0.0") && mode.contains("20."), "{mode}");
+    assert!(mode.contains(", 20.") || mode.contains(", 19.9"), "{mode}");
     // The sign: named first, and the found offset's refit explains the data.
     assert!(fits[1].likely_causes[0].description.contains("0,0,20"));
     // Stated correctly, nothing is implausible and no cause is searched.

@@ -17,8 +17,8 @@ use tricept_model::Effector;
 use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Sink, Source, SourceKind, SourceRows, for_each_point, groups, project_rows,
-    sphere_centre,
+    Nuisance, Sink, Source, SourceKind, SourceRows, for_each_point, groups, lines_text,
+    project_rows, sphere_centre,
 };
 
 /// How to read a ballbar file.
@@ -69,7 +69,7 @@ impl Source {
     pub fn ballbar(data: &BallbarData, options: &BallbarOptions) -> Result<Source, IdentError> {
         let (setups, setup_of) = groups(
             &data.source,
-            data.records.iter().map(|r| r.setup),
+            data.records.iter().map(|r| (r.setup, r.line)),
             4,
             |id, n| {
                 format!(
@@ -180,7 +180,12 @@ impl SourceRows for Ballbar {
                 file: self.file.clone(),
                 line: None,
                 message: format!(
-                    "the ball positions of setup {id} lie in one plane: the pivot cannot be found"
+                    "the ball positions of setup {id} ({}) lie in one plane: the pivot cannot be found",
+                    lines_text(
+                        (0..self.readings.len())
+                            .filter(|&j| self.setup_of[j] == s && active[j])
+                            .map(|j| self.readings[j].line)
+                    )
                 ),
             })?;
             values[4 * s..4 * s + 3].copy_from_slice(c.as_slice());

@@ -117,9 +117,11 @@ pub(crate) fn likely_causes(
                     source: source.label().to_string(),
                     mistake: "target-mode",
                     description: format!(
-                        "{file}: the tracker target is not where --tracker-target says (stated {}), or the tool is not the internal data's: with the target free the data put it at {} from the nominal tool tip ({size:.3} mm; spindle frame at zero head angles) and every estimate is plausible (chi2/dof {:.2}); measure the target's offset from the tip and state it with --tracker-target X,Y,Z",
+                        "{file}: the tracker target is not where --tracker-target says (stated {}), or the tool is not the internal data's: with the target free the data put it at ({:.3}, {:.3}, {:.3}) mm from the nominal tool tip ({size:.3} mm; spindle frame at zero head angles) and every estimate is plausible (chi2/dof {:.2}); measure the target's offset from the tip and state it with --tracker-target X,Y,Z",
                         triple(&offset_mm),
-                        triple(&offset),
+                        offset[0],
+                        offset[1],
+                        offset[2],
                         f.sources[s].reduced_chi_square
                     ),
                     chi2_per_dof: f.sources[s].reduced_chi_square,

@@ -249,11 +249,9 @@ fn tip_and_axis_jacobians(
     for (i, pose) in options.eval_poses.iter().enumerate() {
         let at = |e: &Effector| {
             model.spindle_point(p, pose, e).map(|x| x.1).map_err(|e| match e {
-                IdentError::Kinematics { source, .. } => IdentError::Kinematics {
-                    pose: i,
-                    line: 0,
-                    source,
-                },
+                IdentError::Kinematics { source, .. } => {
+                    IdentError::Invalid(format!("evaluation pose {}: {source}", i + 1))
+                }
                 e => e,
             })
         };

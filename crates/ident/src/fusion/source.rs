@@ -519,16 +519,31 @@ pub(crate) fn project_rows(u: &Vector3<f64>, jac: &[f64], k: usize, out: &mut [f
     }
 }
 
-/// Sorted distinct values of `keys` (stations, setups) and each record's
-/// index into them; a group with fewer than `min` records is refused with
-/// `message(id, count)`.
+/// `lines 3, 7, 9` (at most eight, then `...`) for messages about a group
+/// of records.
+pub(crate) fn lines_text(lines: impl Iterator<Item = u64>) -> String {
+    let all: Vec<u64> = lines.collect();
+    let mut shown: Vec<String> = all.iter().take(8).map(|l| l.to_string()).collect();
+    if all.len() > 8 {
+        shown.push("...".into());
+    }
+    format!(
+        "{} {}",
+        if all.len() == 1 { "line" } else { "lines" },
+        shown.join(", ")
+    )
+}
+
+/// Sorted distinct values of `keys` (stations, setups; with each record's
+/// line) and each record's index into them; a group with fewer than `min`
+/// records is refused with `message(id, count)` and the group's lines.
 pub(crate) fn groups(
     file: &str,
-    keys: impl Iterator<Item = u32>,
+    keyed: impl Iterator<Item = (u32, u64)>,
     min: usize,
     message: impl Fn(u32, usize) -> String,
 ) -> Result<(Vec<u32>, Vec<usize>), IdentError> {
-    let keys: Vec<u32> = keys.collect();
+    let (keys, lines): (Vec<u32>, Vec<u64>) = keyed.unzip();
     let mut distinct = keys.clone();
     distinct.sort_unstable();
     distinct.dedup();
@@ -539,10 +554,17 @@ pub(crate) fn groups(
     for (g, id) in distinct.iter().enumerate() {
         let n = index.iter().filter(|&&x| x == g).count();
         if n < min {
+            let at = lines_text(
+                index
+                    .iter()
+                    .zip(&lines)
+                    .filter(|(x, _)| **x == g)
+                    .map(|(_, l)| *l),
+            );
             return Err(IdentError::Source {
                 file: file.to_string(),
                 line: None,
-                message: message(*id, n),
+                message: format!("{} ({at})", message(*id, n)),
             });
         }
     }

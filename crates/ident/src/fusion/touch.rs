@@ -27,7 +27,8 @@ use tricept_model::Effector;
 use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Sink, Source, SourceKind, SourceRows, for_each_point, project_rows, sphere_centre,
+    Nuisance, Sink, Source, SourceKind, SourceRows, for_each_point, lines_text, project_rows,
+    sphere_centre,
 };
 
 /// How to read a touch-off file.
@@ -122,8 +123,15 @@ impl Source {
                     file: data.source.clone(),
                     line: None,
                     message: format!(
-                        "{what} {} has {n} touches; it needs at least {needed}",
-                        u.feature.id()
+                        "{what} {} has {n} touches ({}); it needs at least {needed}",
+                        u.feature.id(),
+                        lines_text(
+                            data.records
+                                .iter()
+                                .zip(&feature_of)
+                                .filter(|(_, f)| **f == k)
+                                .map(|(t, _)| t.line)
+                        )
                     ),
                 });
             }
@@ -244,8 +252,13 @@ impl SourceRows for Touch {
                 file: self.file.clone(),
                 line: None,
                 message: format!(
-                    "the touches of feature {} lie {shape}: it cannot be located",
-                    u.feature.id()
+                    "the touches of feature {} ({}) lie {shape}: it cannot be located",
+                    u.feature.id(),
+                    lines_text(
+                        (0..self.touches.len())
+                            .filter(|&j| self.feature_of[j] == k && active[j])
+                            .map(|j| self.touches[j].line)
+                    )
                 ),
             };
             match u.feature {

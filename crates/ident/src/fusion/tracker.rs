@@ -23,7 +23,7 @@ use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
     Nuisance, Sink, Source, SourceKind, SourceRows, cross_matrix, for_each_point, groups,
-    rotate_row,
+    lines_text, rotate_row,
 };
 
 /// What is known about the tracker target's offset from the tool tip.
@@ -81,11 +81,12 @@ impl Source {
     /// let data = tricept_data::read_external_from::<tricept_data::TrackerPoint, _>(csv.as_bytes(), "t.csv").unwrap();
     /// let e = Source::tracker(&data, &TrackerOptions::default()).unwrap_err();
     /// assert!(e.to_string().starts_with("t.csv: station 1 has 2 points"), "{e}");
+/// assert!(e.to_string().ends_with("(lines 2, 3)"), "{e}");
     /// ```
     pub fn tracker(data: &TrackerData, options: &TrackerOptions) -> Result<Source, IdentError> {
         let (setups, setup_of) = groups(
             &data.source,
-            data.records.iter().map(|p| p.setup),
+            data.records.iter().map(|p| (p.setup, p.line)),
             3,
             |id, n| {
                 format!("station {id} has {n} points; its frame needs at least 3 not on one line")
@@ -255,7 +256,12 @@ impl SourceRows for Tracker {
                 file: self.file.clone(),
                 line: None,
                 message: format!(
-                    "the points of station {id} lie on one line: the tracker's frame cannot be found"
+                    "the points of station {id} ({}) lie on one line: the tracker's frame cannot be found",
+                    lines_text(
+                        (0..self.points.len())
+                            .filter(|&j| self.setup_of[j] == s && active[j])
+                            .map(|j| self.points[j].line)
+                    )
                 ),
             })?;
             nu.rotations[s] = r;
