@@ -93,4 +93,19 @@ fn planned_tracker_points_beat_random_ones_and_predict_the_fit() {
         "planned {} um vs fit {fitted} um",
         planned.planned_um
     );
+    // The redundancy the plan predicts is the fit's (taken at the estimate
+    // instead of the nominal machine).
+    let tracker = &fit.sources[1];
+    assert!(
+        (planned.redundancy - tracker.redundancy).abs() < 0.05 * tracker.redundancy,
+        "planned redundancy {} vs fit {}",
+        planned.redundancy,
+        tracker.redundancy
+    );
+    // Five planned points reach 25 um but cannot be checked; the
+    // recommendation is the smallest checkable k that reaches it.
+    let five = &result.rows[0];
+    assert!(five.planned_um < 25.0 && !five.checkable, "{five:?}");
+    let k = result.recommended(Some(25.0), None).unwrap();
+    assert!(k > 5 && result.rows.iter().any(|r| r.k == k && r.checkable));
 }
