@@ -16,7 +16,9 @@ use tricept_study::plan::{
     nominal_tracker_data, plan, sphere_candidates, with_extensions,
 };
 
-use crate::args::{MachineArgs, NoiseArgs, ParamArgs, machine_with_noise, pose_targets, read_data};
+use crate::args::{
+    MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs, machine_with_noise, pose_targets, read_data,
+};
 use crate::cli_error::CliError;
 use crate::fusion_cmd::{
     eval_options, fused_model, fusion_error, parse_head_angles, parse_numbers, positive,
@@ -71,9 +73,6 @@ pub struct PlanArgs {
     /// Noise of a ballbar reading, um.
     #[arg(long, default_value_t = 1.0, value_name = "UM")]
     pub ballbar_sigma_um: f64,
-    /// Noise of a touch along the surface normal, um.
-    #[arg(long, default_value_t = 1.5, value_name = "UM")]
-    pub touch_sigma_um: f64,
     /// The instrument's noise (old name of the three flags above).
     #[arg(long, hide = true, value_name = "UM")]
     pub sigma_um: Option<f64>,
@@ -99,23 +98,9 @@ pub struct PlanArgs {
     /// Number of ballbar (or touch) candidate positions.
     #[arg(long, default_value_t = 300, value_name = "N")]
     pub ballbar_candidates: usize,
-    /// The reference sphere's nominal centre, mm (touch-offs).
-    #[arg(
-        long,
-        default_value = "0,0,1150",
-        value_name = "X,Y,Z",
-        allow_hyphen_values = true
-    )]
-    pub touch_sphere_mm: String,
-    /// The reference sphere's radius, mm.
-    #[arg(long, default_value_t = 12.7, value_name = "MM")]
-    pub touch_sphere_radius_mm: f64,
-    /// The probe's stylus radius, mm.
-    #[arg(long, default_value_t = 1.0, value_name = "MM")]
-    pub touch_stylus_radius_mm: f64,
-    /// Standard deviation of the stylus radius (its calibration), um.
-    #[arg(long, default_value_t = 2.0, value_name = "UM")]
-    pub touch_stylus_sigma_um: f64,
+    /// The reference sphere (touch-offs).
+    #[command(flatten)]
+    pub touch: TouchSphereArgs,
     /// Effects in the model (as for `identify --effects`).
     #[arg(long, value_name = "NAMES", value_delimiter = ',')]
     pub effects: Vec<String>,
@@ -225,15 +210,15 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
         Instrument::Ballbar | Instrument::Touch => {
             let touch = a.instrument == Instrument::Touch;
             let (flag, text) = if touch {
-                ("--touch-sphere-mm", &a.touch_sphere_mm)
+                ("--touch-sphere-mm", &a.touch.touch_sphere_mm)
             } else {
                 ("--ballbar-pivot-mm", &a.ballbar_pivot_mm)
             };
             let p = parse_numbers(flag, text, 3)?;
             let centre = Vector3::new(p[0], p[1], p[2]);
             let radius = if touch {
-                positive("--touch-sphere-radius-mm", a.touch_sphere_radius_mm)?
-                    + positive("--touch-stylus-radius-mm", a.touch_stylus_radius_mm)?
+                positive("--touch-sphere-radius-mm", a.touch.touch_sphere_radius_mm)?
+                    + positive("--touch-stylus-radius-mm", a.touch.touch_stylus_radius_mm)?
             } else {
                 positive("--ballbar-length-mm", a.ballbar_length_mm)?
             };
@@ -247,12 +232,12 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
             let source = if touch {
                 let data = nominal_touch_data(&poses, 1).map_err(study_error)?;
                 let features = touch_features(
-                    a.touch_sphere_radius_mm,
-                    a.touch_stylus_radius_mm,
-                    positive("--touch-stylus-sigma-um", a.touch_stylus_sigma_um)?,
+                    a.touch.touch_sphere_radius_mm,
+                    a.touch.touch_stylus_radius_mm,
+                    positive("--touch-stylus-sigma-um", a.touch.touch_stylus_sigma_um)?,
                 );
                 let options = tricept_ident::fusion::TouchOptions {
-                    sigma_um: instrument_sigma(a, a.touch_sigma_um, "--touch-sigma-um")?,
+                    sigma_um: instrument_sigma(a, a.touch.touch_sigma_um, "--touch-sigma-um")?,
                 };
                 Source::touch(&data, &features, &options).map_err(fusion_error)?
             } else {

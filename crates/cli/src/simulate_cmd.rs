@@ -7,8 +7,8 @@ use tricept_ident::GeometricModel;
 use tricept_plant::{Campaign, Plant, PoseOrder};
 
 use crate::args::{
-    MachineArgs, NoiseArgs, ParamArgs, TruthArgs, machine_with_noise, parse_effects, parse_errors,
-    pose_targets,
+    MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs, TruthArgs, machine_with_noise,
+    parse_effects, parse_errors, pose_targets,
 };
 use crate::cli_error::CliError;
 use crate::fusion_cmd::{parse_numbers, positive};
@@ -109,20 +109,10 @@ pub struct SimulateArgs {
     /// --instrument touch --out` writes them).
     #[arg(long, value_name = "FILE.csv")]
     pub touch_poses: Option<PathBuf>,
-    /// The reference sphere's true centre, mm (feature 1).
-    #[arg(
-        long,
-        default_value = "0,0,1150",
-        value_name = "X,Y,Z",
-        allow_hyphen_values = true
-    )]
-    pub touch_sphere_mm: String,
-    /// The reference sphere's radius, mm.
-    #[arg(long, default_value_t = 12.7, value_name = "MM")]
-    pub touch_sphere_radius_mm: f64,
-    /// The stylus' nominal radius (written to the features file), mm.
-    #[arg(long, default_value_t = 1.0, value_name = "MM")]
-    pub touch_stylus_radius_mm: f64,
+    /// The reference sphere as it truly is (feature 1), the stylus' nominal
+    /// radius and noise.
+    #[command(flatten)]
+    pub touch: TouchSphereArgs,
     /// The stylus' true radius minus the nominal one, um.
     #[arg(
         long,
@@ -131,12 +121,6 @@ pub struct SimulateArgs {
         allow_hyphen_values = true
     )]
     pub touch_stylus_error_um: f64,
-    /// Standard deviation of the stylus radius written to the features file, um.
-    #[arg(long, default_value_t = 2.0, value_name = "UM")]
-    pub touch_stylus_sigma_um: f64,
-    /// Trigger noise of a touch along the surface normal, um.
-    #[arg(long, default_value_t = 1.5, value_name = "UM")]
-    pub touch_sigma_um: f64,
     #[command(flatten)]
     pub params: ParamArgs,
     #[command(flatten)]
@@ -404,17 +388,17 @@ fn simulate_touches(
     features_out: &std::path::Path,
     poses: &std::path::Path,
 ) -> Result<(), CliError> {
-    let c = parse_numbers("--touch-sphere-mm", &a.touch_sphere_mm, 3)?;
+    let c = parse_numbers("--touch-sphere-mm", &a.touch.touch_sphere_mm, 3)?;
     let centre = nalgebra::Vector3::new(c[0], c[1], c[2]);
     let probe = tricept_plant::TouchProbe {
-        stylus_radius_mm: positive("--touch-stylus-radius-mm", a.touch_stylus_radius_mm)?,
+        stylus_radius_mm: positive("--touch-stylus-radius-mm", a.touch.touch_stylus_radius_mm)?,
         stylus_radius_error_um: a.touch_stylus_error_um,
-        stylus_radius_sigma_um: positive("--touch-stylus-sigma-um", a.touch_stylus_sigma_um)?,
-        sigma_um: positive("--touch-sigma-um", a.touch_sigma_um)?,
+        stylus_radius_sigma_um: positive("--touch-stylus-sigma-um", a.touch.touch_stylus_sigma_um)?,
+        sigma_um: positive("--touch-sigma-um", a.touch.touch_sigma_um)?,
         features: vec![tricept_plant::TouchFeature::Sphere {
             id: 1,
             centre_mm: centre,
-            radius_mm: positive("--touch-sphere-radius-mm", a.touch_sphere_radius_mm)?,
+            radius_mm: positive("--touch-sphere-radius-mm", a.touch.touch_sphere_radius_mm)?,
         }],
     };
     let planned = tricept_data::read_external_path::<tricept_data::PlannedPose>(poses)
@@ -449,11 +433,11 @@ fn simulate_touches(
     let mut c = comments.to_vec();
     c.push(format!(
         "touch probe: sphere 1 at (mm) {}, radius {} mm; stylus {} mm ({} um off); {} um per touch",
-        a.touch_sphere_mm,
-        a.touch_sphere_radius_mm,
-        a.touch_stylus_radius_mm,
+        a.touch.touch_sphere_mm,
+        a.touch.touch_sphere_radius_mm,
+        a.touch.touch_stylus_radius_mm,
         a.touch_stylus_error_um,
-        a.touch_sigma_um
+        a.touch.touch_sigma_um
     ));
     tricept_data::write_external_path(out, &data, &c)
         .map_err(|e| CliError::other(format!("{}: {e}", out.display())))?;

@@ -41,38 +41,7 @@ fn workdir(name: &str) -> PathBuf {
 /// machine's internal data (`internal.csv`, head errors `random:1,5`) and
 /// its tracker points at those poses (`tracker.csv`).
 fn simulate_tracker_campaign(dir: &Path) {
-    ok(
-        dir,
-        &[
-            "plan",
-            "--instrument",
-            "tracker",
-            "--tracker-target",
-            "tip",
-            "--k",
-            "20",
-            "--random-baseline",
-            "0",
-            "--passes",
-            "2",
-            "--out",
-            "points.csv",
-        ],
-    );
-    ok(
-        dir,
-        &[
-            "simulate",
-            "--head-errors",
-            "random:1,5",
-            "--out",
-            "internal.csv",
-            "--tracker-out",
-            "tracker.csv",
-            "--tracker-poses",
-            "points.csv",
-        ],
-    );
+    plan_and_simulate(dir, "20", &[]);
 }
 
 #[test]
@@ -200,24 +169,7 @@ fn the_calibrated_machine_file_carries_the_head_and_tool_ik_uses_it() {
 #[test]
 fn an_unexplained_source_ends_with_exit_code_3_and_a_warning() {
     let dir = workdir("fusion-untrusted");
-    ok(
-        &dir,
-        &[
-            "plan",
-            "--instrument",
-            "tracker",
-            "--tracker-target",
-            "tip",
-            "--k",
-            "12",
-            "--random-baseline",
-            "0",
-            "--passes",
-            "1",
-            "--out",
-            "points.csv",
-        ],
-    );
+    plan_tracker(&dir, "12");
     // Leg leads of a few hundred ppm: the geometric model cannot explain
     // the readings.
     ok(
@@ -305,7 +257,8 @@ fn fusing_against_a_calibrated_machine_keeps_the_nominal_rank_rule() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-fn plan_and_simulate(dir: &Path, k: &str, simulate_extra: &[&str]) {
+/// `points.csv`: `k` planned tracker points, target at the tip.
+fn plan_tracker(dir: &Path, k: &str) {
     ok(
         dir,
         &[
@@ -324,6 +277,13 @@ fn plan_and_simulate(dir: &Path, k: &str, simulate_extra: &[&str]) {
             "points.csv",
         ],
     );
+}
+
+/// `points.csv` (`k` planned points), then the simulated machine's
+/// internal data (`internal.csv`, head errors `random:1,5`) and its tracker
+/// points there (`tracker.csv`), with `simulate_extra` arguments.
+fn plan_and_simulate(dir: &Path, k: &str, simulate_extra: &[&str]) {
+    plan_tracker(dir, k);
     let mut args = vec![
         "simulate",
         "--head-errors",

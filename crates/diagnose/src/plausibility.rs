@@ -17,7 +17,7 @@ use tricept_model::effects::{EffectName, GenericFamily, legendre_p2, legendre_p3
 use crate::terms::{CHANNELS, GenericTerm, Term};
 
 pub use tricept_model::plausibility::{PlausibilityError, Range};
-use tricept_model::plausibility::round3;
+use tricept_model::plausibility::{insert_range, round3};
 
 /// The plausibility table: quantity key (`effect.quantity`) to range.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -43,15 +43,7 @@ impl Default for Plausibility {
     fn default() -> Plausibility {
         let mut ranges = BTreeMap::new();
         let mut add = |key: &str, min: f64, max: f64, unit: &'static str, why: &str| {
-            ranges.insert(
-                key.to_string(),
-                Range {
-                    min,
-                    max,
-                    unit,
-                    why: why.to_string(),
-                },
-            );
+            insert_range(&mut ranges, key, min, max, unit, why)
         };
         add(
             "leg-lead.lead_ppm",

@@ -282,6 +282,13 @@ fn robust_start(
             None => f64::INFINITY,
         })
         .collect();
+    Ok(start_set(&z))
+}
+
+/// The records of the first fit from their robust scores `z`: those within
+/// [`START_Z`], or the half with the smallest scores when fewer are.
+pub(crate) fn start_set(z: &[f64]) -> Vec<bool> {
+    let n = z.len();
     let mut inside: Vec<bool> = z.iter().map(|z| *z <= START_Z).collect();
     let half = n.div_ceil(2);
     if inside.iter().filter(|x| **x).count() < half {
@@ -292,7 +299,7 @@ fn robust_start(
             inside[j] = z[j].is_finite();
         }
     }
-    Ok(inside)
+    inside
 }
 
 /// The statistic `T_j` of every pose at fit `id` made on the poses marked

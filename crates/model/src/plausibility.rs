@@ -44,6 +44,35 @@ impl Range {
     }
 }
 
+/// Inserts the range `[min, max]` of `key` (in `unit`, for the reason
+/// `why`) into `table`.
+///
+/// # Example
+/// ```
+/// use std::collections::BTreeMap;
+/// let mut t = BTreeMap::new();
+/// tricept_model::plausibility::insert_range(&mut t, "tool_length_mm", -3.0, 3.0, "mm", "10 typical sizes");
+/// assert_eq!(t["tool_length_mm"].unit, "mm");
+/// ```
+pub fn insert_range(
+    table: &mut BTreeMap<String, Range>,
+    key: &str,
+    min: f64,
+    max: f64,
+    unit: &'static str,
+    why: impl Into<String>,
+) {
+    table.insert(
+        key.to_string(),
+        Range {
+            min,
+            max,
+            unit,
+            why: why.into(),
+        },
+    );
+}
+
 /// Why an override file was refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]

@@ -200,13 +200,10 @@ impl Problem<'_> {
         merge(&parts.iter().collect::<Vec<_>>())
     }
 
-    /// Every weighted row of every record (in the fit or not) and every
-    /// prior of each source at `p`: `(record, [nuisance_s | k | residual])`.
-    fn rows_at(
-        &self,
-        p: &[f64],
-        state: &mut State,
-    ) -> Result<Vec<Vec<(Option<usize>, Vec<f64>)>>, IdentError> {
+    /// Every source evaluated at `p` into a sink: accumulating the records
+    /// in the fit, or (`keep`) keeping every row of every record (in the
+    /// fit or not) and every prior, `(record, [nuisance_s | k | residual])`.
+    fn sinks(&self, p: &[f64], state: &mut State, keep: bool) -> Result<Vec<Sink>, IdentError> {
         let at = self.model.at(p);
         let k = self.model.len();
         self.sources
@@ -214,7 +211,12 @@ impl Problem<'_> {
             .enumerate()
             .map(|(s, source)| {
                 let rows = source.rows();
-                let mut sink = Sink::keeping(self.nuisance_len(s), k, rows.data_rows());
+                let (nn, n) = (self.nuisance_len(s), rows.data_rows());
+                let mut sink = if keep {
+                    Sink::keeping(nn, k, n)
+                } else {
+                    Sink::new(nn, k, n).with_active(&self.active[s])
+                };
                 rows.evaluate(
                     &at,
                     &self.contexts[s],
@@ -223,7 +225,7 @@ impl Problem<'_> {
                     &mut sink,
                 )
                 .map_err(|e| in_source(source, e))?;
-                Ok(sink.take_kept())
+                Ok(sink)
             })
             .collect()
     }
@@ -267,22 +269,9 @@ impl Iteration for Problem<'_> {
     type Eval = Evaluation;
 
     fn evaluate(&self, p: &[f64], state: &mut State) -> Result<Evaluation, IdentError> {
-        let at = self.model.at(p);
-        let k = self.model.len();
         let mut parts = Vec::with_capacity(self.sources.len());
         let mut standardised = Vec::with_capacity(self.sources.len());
-        for (s, source) in self.sources.iter().enumerate() {
-            let rows = source.rows();
-            let mut sink =
-                Sink::new(self.nuisance_len(s), k, rows.data_rows()).with_active(&self.active[s]);
-            rows.evaluate(
-                &at,
-                &self.contexts[s],
-                &state.nuisance[s],
-                &mut state.seeds[s],
-                &mut sink,
-            )
-            .map_err(|e| in_source(source, e))?;
+        for sink in self.sinks(p, state, false)? {
             let (part, z) = sink.finish();
             parts.push(part);
             standardised.push(z);
@@ -679,7 +668,11 @@ fn finish(
         })
         .collect();
     let covariance = DMatrix::from_fn(k, k, |a, b| solution.covariance[(nn + a, nn + b)]);
-    let rows = problem.rows_at(&p, &mut state)?;
+    let rows: Vec<Vec<(Option<usize>, Vec<f64>)>> = problem
+        .sinks(&p, &mut state, true)?
+        .iter_mut()
+        .map(Sink::take_kept)
+        .collect();
     let hat = eval.union.hat_factor(decision);
     let (checks, redundancy) = record_checks(problem, &rows, &hat, &solution);
     let mut sources = Vec::with_capacity(problem.sources.len());

@@ -18,7 +18,9 @@
 use std::collections::BTreeMap;
 
 use serde::Serialize;
-use tricept_model::plausibility::{PlausibilityError, Range, override_ranges, round3};
+use tricept_model::plausibility::{
+    PlausibilityError, Range, insert_range, override_ranges, round3,
+};
 use tricept_model::{HEAD13_NAMES, TYPICAL_HEAD_ERRORS};
 
 use crate::fusion::model::FusedModel;
@@ -48,15 +50,7 @@ impl Default for FusionPlausibility {
     fn default() -> FusionPlausibility {
         let mut ranges = BTreeMap::new();
         let mut add = |key: &str, min: f64, max: f64, unit: &'static str, why: String| {
-            ranges.insert(
-                key.to_string(),
-                Range {
-                    min,
-                    max,
-                    unit,
-                    why,
-                },
-            );
+            insert_range(&mut ranges, key, min, max, unit, why)
         };
         let limit = crate::verdict::LARGE_ESTIMATE_MM;
         add(

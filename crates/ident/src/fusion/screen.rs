@@ -33,7 +33,7 @@ use crate::fusion::estimate::{FusionOptions, fit_masked, start};
 use crate::fusion::model::FusedModel;
 use crate::fusion::result::{Fusion, RecordCheck, SourceFit};
 use crate::fusion::source::Source;
-use crate::robust::START_Z;
+use crate::robust::start_set;
 
 /// Settings of the gross-error screen.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -141,17 +141,7 @@ fn robust_start(
                     }
                 }
             }
-            let mut inside: Vec<bool> = score.iter().map(|s| *s <= START_Z).collect();
-            let half = n.div_ceil(2);
-            if inside.iter().filter(|x| **x).count() < half {
-                let mut order: Vec<usize> = (0..n).collect();
-                order.sort_by(|a, b| score[*a].total_cmp(&score[*b]));
-                inside = vec![false; n];
-                for &j in &order[..half] {
-                    inside[j] = true;
-                }
-            }
-            inside
+            start_set(&score)
         })
         .collect())
 }
