@@ -251,10 +251,13 @@ impl PlanProblem {
             return 0.0;
         };
         let hat = problem.hat_factor(&decision);
-        selected
+        let redundancy: f64 = selected
             .iter()
             .map(|x| 1.0 - hat.whiten(x).iter().map(|w| w * w).sum::<f64>())
-            .sum()
+            .sum();
+        // Below one row per unknown the rounding of saturated leverages can
+        // leave a small negative sum: nothing is redundant.
+        redundancy.max(0.0)
     }
 
     /// The redundancy a selection needs to check a fit.

@@ -632,7 +632,8 @@ fn record_checks(
             })
             .collect();
         checks.push(list);
-        redundancy.push(red);
+        // A saturated source's leverages are 1 to rounding: never below 0.
+        redundancy.push(red.max(0.0));
     }
     (checks, redundancy)
 }
