@@ -451,14 +451,12 @@ fn refusal_reason(fit: &Fusion) -> String {
     if !v.converged {
         why.push("the fused fit did not converge".to_string());
     }
-    let not: Vec<&str> = fit
-        .sources
-        .iter()
-        .filter(|s| !s.checkable)
-        .map(|s| s.label.as_str())
-        .collect();
-    if !not.is_empty() {
-        why.push(format!("{} cannot be checked (too few redundant rows)", not.join(", ")));
+    for s in fit.sources.iter().filter(|s| !s.checkable) {
+        why.push(format!(
+            "{} cannot be checked: at least {} more records make it checkable",
+            s.label,
+            s.more_records.unwrap_or(1)
+        ));
     }
     let unexplained: Vec<&str> = fit
         .sources

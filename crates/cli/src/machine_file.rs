@@ -144,8 +144,20 @@ fn civil_from_days(z: i64) -> (i64, u32, u32) {
     (y, m, d)
 }
 
-/// Why each held parameter was held, from the identifiability report.
-fn held(id: &FitRecord<'_>, reference: &str) -> Vec<HeldParameter> {
+/// The unit of a parameter, from its name (`_rad`, `_ppm`; else mm).
+fn unit_of(name: &str) -> &'static str {
+    if name.ends_with("_rad") {
+        "rad"
+    } else if name.ends_with("_ppm") {
+        "ppm"
+    } else {
+        "mm"
+    }
+}
+
+/// Why each held parameter was held, from the identifiability report;
+/// `seen_by` names the data (the UP limb's sensors, or every fused source).
+fn held(id: &FitRecord<'_>, reference: &str, seen_by: &str) -> Vec<HeldParameter> {
     let r = id.report;
     let s1 = r.singular_values.first().copied().unwrap_or(0.0);
     r.fixed
@@ -159,13 +171,15 @@ fn held(id: &FitRecord<'_>, reference: &str) -> Vec<HeldParameter> {
                 .map_or(0.0, |j| id.estimate[j]);
             let reason = match r.unidentifiable.get(i) {
                 Some(c) => format!(
-                    "unidentifiable from the UP limb's sensors on {reference}: the combination {} has singular value {:.1e} of the largest, below the rank tolerance {:.0e}; held at its prior value {value} mm",
+                    "unidentifiable from {seen_by} on {reference}: the combination {} has singular value {:.1e} of the largest, below the rank tolerance {:.0e}; held at its prior value {value} {}",
                     c.to_text(),
                     if s1 > 0.0 { c.singular_value / s1 } else { 0.0 },
-                    r.rank_tolerance
+                    r.rank_tolerance,
+                    unit_of(name)
                 ),
                 None => format!(
-                    "held at its prior value {value} mm by the rank decision on {reference}"
+                    "held at its prior value {value} {} by the rank decision on {reference}",
+                    unit_of(name)
                 ),
             };
             HeldParameter {
@@ -260,7 +274,15 @@ pub fn calibrated_description(
             s_mm: id.offsets[2],
             std_dev: id.offsets_std_dev,
         },
-        held: held(id, &reference),
+        held: held(
+            id,
+            &reference,
+            if p.external.is_empty() {
+                "the UP limb's sensors"
+            } else {
+                "the internal and external data together"
+            },
+        ),
         chi2_per_dof: id.chi2_per_dof,
         dof: id.dof,
         converged: id.converged,

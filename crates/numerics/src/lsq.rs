@@ -20,8 +20,9 @@
 //!    re-factored (column-scaled) and solved by back substitution; the
 //!    covariance is `(R^T R)^{-1}` in the units of the weighted problem.
 
+use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::Solve;
-use faer::{Mat, MatRef};
+use faer::{Accum, Mat, MatRef, Par};
 
 use crate::linalg::{invert_upper, pivot_order, r_factor, solve_upper, svd_values_and_vectors};
 
@@ -436,15 +437,33 @@ impl HatFactor {
             .collect()
     }
 
+    /// [`HatFactor::whiten`] of many rows at once (one matrix product):
+    /// `w_i` for each row `x_i` of `rows` (`n x (n_nuisance + k)`, row-major
+    /// slices), as the rows of an `n x q` matrix.
+    pub fn whiten_rows(&self, rows: &[&[f64]]) -> Mat<f64> {
+        let q = self.columns.len();
+        let x = Mat::from_fn(rows.len(), q, |i, j| {
+            rows[i].get(self.columns[j]).copied().unwrap_or(0.0) / self.scale[j]
+        });
+        let mut w = Mat::<f64>::zeros(rows.len(), q);
+        matmul(
+            w.as_mut(),
+            Accum::Replace,
+            x.as_ref(),
+            self.r_inv.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+        w
+    }
+
     /// The step of the estimated unknowns a row predicts: `x . delta` for
     /// the solution's `delta` (`[nuisance | parameters]`, held ones zero).
     pub fn predict(row: &[f64], solution: &Solution) -> f64 {
-        let nn = solution.nuisance.len();
         solution
             .nuisance
             .iter()
             .chain(&solution.parameters)
-            .take(nn + solution.parameters.len())
             .zip(row)
             .map(|(d, x)| d * x)
             .sum()

@@ -145,16 +145,15 @@ impl PlanProblem {
         let priors = whiten(&candidates.priors);
         lambda0 += priors.transpose() * &priors;
         let rows: Vec<DMatrix<f64>> = candidates.records.iter().map(whiten).collect();
-        let zero = vec![0.0; k];
         let lever = Effector {
             extension_mm: AXIS_LEVER_MM,
             ..Effector::default()
         };
         let mut g = Vec::with_capacity(eval.len());
         let mut ga = Vec::with_capacity(eval.len());
-        for pose in eval {
-            let g0 = model.spindle_point(&zero, pose, &Effector::default())?.1;
-            let g1 = model.spindle_point(&zero, pose, &lever)?.1;
+        for mut pair in model.spindle_jacobians(&vec![0.0; k], eval, &[Effector::default(), lever])? {
+            let g1 = pair.pop().unwrap_or_default();
+            let g0 = pair.pop().unwrap_or_default();
             ga.push((g1 - &g0) / AXIS_LEVER_MM);
             g.push(g0);
         }

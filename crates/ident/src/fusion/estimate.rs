@@ -39,7 +39,7 @@ use crate::fusion::plausibility::FusionPlausibility;
 use crate::fusion::report::build_report;
 use crate::fusion::result::{Fusion, RecordCheck, SourceFit, judge};
 use crate::fusion::screen::ScreenOptions;
-use crate::fusion::source::{Nuisance, Sink, Source};
+use crate::fusion::source::{KeptRows, Nuisance, Sink, Source};
 use crate::gauss_newton::{Iteration, Run, iterate};
 use crate::report::IdentifiabilityReport;
 
@@ -184,6 +184,8 @@ pub(crate) struct Evaluation {
     pub union: ReducedProblem,
     pub parts: Vec<ReducedProblem>,
     pub standardised: Vec<Vec<(usize, f64, f64)>>,
+    /// Every source's weighted rows (of records outside the fit too).
+    pub kept: Vec<KeptRows>,
 }
 
 impl Problem<'_> {
@@ -200,35 +202,6 @@ impl Problem<'_> {
         merge(&parts.iter().collect::<Vec<_>>())
     }
 
-    /// Every source evaluated at `p` into a sink: accumulating the records
-    /// in the fit, or (`keep`) keeping every row of every record (in the
-    /// fit or not) and every prior, `(record, [nuisance_s | k | residual])`.
-    fn sinks(&self, p: &[f64], state: &mut State, keep: bool) -> Result<Vec<Sink>, IdentError> {
-        let at = self.model.at(p);
-        let k = self.model.len();
-        self.sources
-            .iter()
-            .enumerate()
-            .map(|(s, source)| {
-                let rows = source.rows();
-                let (nn, n) = (self.nuisance_len(s), rows.data_rows());
-                let mut sink = if keep {
-                    Sink::keeping(nn, k, n)
-                } else {
-                    Sink::new(nn, k, n).with_active(&self.active[s])
-                };
-                rows.evaluate(
-                    &at,
-                    &self.contexts[s],
-                    &state.nuisance[s],
-                    &mut state.seeds[s],
-                    &mut sink,
-                )
-                .map_err(|e| in_source(source, e))?;
-                Ok(sink)
-            })
-            .collect()
-    }
 }
 
 /// The union of reduced problems over the same global parameters: their
@@ -269,17 +242,33 @@ impl Iteration for Problem<'_> {
     type Eval = Evaluation;
 
     fn evaluate(&self, p: &[f64], state: &mut State) -> Result<Evaluation, IdentError> {
+        let at = self.model.at(p);
+        let k = self.model.len();
         let mut parts = Vec::with_capacity(self.sources.len());
         let mut standardised = Vec::with_capacity(self.sources.len());
-        for sink in self.sinks(p, state, false)? {
-            let (part, z) = sink.finish();
+        let mut kept = Vec::with_capacity(self.sources.len());
+        for (s, source) in self.sources.iter().enumerate() {
+            let rows = source.rows();
+            let mut sink =
+                Sink::new(self.nuisance_len(s), k, rows.data_rows()).with_active(&self.active[s]);
+            rows.evaluate(
+                &at,
+                &self.contexts[s],
+                &state.nuisance[s],
+                &mut state.seeds[s],
+                &mut sink,
+            )
+            .map_err(|e| in_source(source, e))?;
+            let (part, z, rows) = sink.finish();
             parts.push(part);
             standardised.push(z);
+            kept.push(rows);
         }
         Ok(Evaluation {
             union: self.merge(&parts),
             parts,
             standardised,
+            kept,
         })
     }
 
@@ -392,13 +381,31 @@ pub(crate) fn fit_masked(
     active: &[Vec<bool>],
     options: &FusionOptions,
 ) -> Result<Fusion, IdentError> {
-    let k = model.len();
+    check_counts(model, sources, active)?;
+    let (offsets, n_nuisance) = nuisance_layout(sources);
+    let started = start(model, sources, offsets, n_nuisance, active)?;
+    fit_started(started, options)
+}
+
+/// Each source's first union nuisance column, and their total.
+pub(crate) fn nuisance_layout(sources: &[Source]) -> (Vec<usize>, usize) {
     let mut offsets = Vec::with_capacity(sources.len());
     let mut n_nuisance = 0;
     for s in sources {
         offsets.push(n_nuisance);
         n_nuisance += s.rows().nuisance_names().len();
     }
+    (offsets, n_nuisance)
+}
+
+/// Refuses fewer rows in the fit than unknowns.
+pub(crate) fn check_counts(
+    model: &FusedModel,
+    sources: &[Source],
+    active: &[Vec<bool>],
+) -> Result<(), IdentError> {
+    let k = model.len();
+    let (_, n_nuisance) = nuisance_layout(sources);
     let in_fit = |s: usize| active[s].iter().filter(|a| **a).count();
     let data_rows: usize = sources
         .iter()
@@ -421,7 +428,19 @@ pub(crate) fn fit_masked(
             ),
         });
     }
-    let (problem, state, eval) = start(model, sources, offsets.clone(), n_nuisance, active)?;
+    Ok(())
+}
+
+/// The fit from a problem's start ([`start`]): the rank decision, the
+/// iteration, the judged result.
+pub(crate) fn fit_started(
+    (problem, state, eval): (Problem<'_>, State, Evaluation),
+    options: &FusionOptions,
+) -> Result<Fusion, IdentError> {
+    let (model, sources, active) = (problem.model, problem.sources, problem.active);
+    let k = model.len();
+    let (offsets, n_nuisance) = (problem.offsets.clone(), problem.n_nuisance);
+    let in_fit = |s: usize| active[s].iter().filter(|a| **a).count();
     // The rank decision: on this model, or on its reference (the nominal
     // machine of a calibrated one) with the same sources; which parameter
     // of an invisible set is held is chosen on the columns scaled by the
@@ -571,7 +590,7 @@ fn check_nuisance(source: &Source, part: &ReducedProblem) -> Result<(), IdentErr
 /// `sum (1 - h_ii)` over its data rows in the fit.
 fn record_checks(
     problem: &Problem<'_>,
-    rows: &[Vec<(Option<usize>, Vec<f64>)>],
+    rows: &[KeptRows],
     hat: &HatFactor,
     solution: &Solution,
 ) -> (Vec<Vec<RecordCheck>>, Vec<f64>) {
@@ -586,14 +605,22 @@ fn record_checks(
         let n = source.records();
         let mut e: Vec<Vec<f64>> = vec![Vec::new(); n];
         let mut w: Vec<Vec<Vec<f64>>> = vec![Vec::new(); n];
-        for (record, row) in source_rows {
-            let Some(j) = *record else { continue };
-            // The row in the union's column order.
+        // The data rows in the union's column order, whitened at once.
+        let mut records = Vec::new();
+        let mut union_rows: Vec<Vec<f64>> = Vec::new();
+        for (record, row) in source_rows.iter() {
+            let Some(j) = record else { continue };
             let mut u = vec![0.0; width];
             u[at..at + nn].copy_from_slice(&row[..nn]);
             u[problem.n_nuisance..].copy_from_slice(&row[nn..nn + k]);
             e[j].push(row[nn + k] - HatFactor::predict(&u, solution));
-            w[j].push(hat.whiten(&u));
+            records.push(j);
+            union_rows.push(u);
+        }
+        let slices: Vec<&[f64]> = union_rows.iter().map(|u| u.as_slice()).collect();
+        let whitened = hat.whiten_rows(&slices);
+        for (i, &j) in records.iter().enumerate() {
+            w[j].push((0..whitened.ncols()).map(|c| whitened[(i, c)]).collect());
         }
         let mut red = 0.0;
         let list: Vec<RecordCheck> = (0..n)
@@ -651,7 +678,7 @@ fn finish(
     let nn = problem.n_nuisance;
     let Run {
         p,
-        mut state,
+        state,
         eval,
         solution,
         iterations,
@@ -669,13 +696,8 @@ fn finish(
         })
         .collect();
     let covariance = DMatrix::from_fn(k, k, |a, b| solution.covariance[(nn + a, nn + b)]);
-    let rows: Vec<Vec<(Option<usize>, Vec<f64>)>> = problem
-        .sinks(&p, &mut state, true)?
-        .iter_mut()
-        .map(Sink::take_kept)
-        .collect();
     let hat = eval.union.hat_factor(decision);
-    let (checks, redundancy) = record_checks(problem, &rows, &hat, &solution);
+    let (checks, redundancy) = record_checks(problem, &eval.kept, &hat, &solution);
     let mut sources = Vec::with_capacity(problem.sources.len());
     for (s, source) in problem.sources.iter().enumerate() {
         let rows = source.rows();
@@ -772,7 +794,7 @@ pub fn design_rows(model: &FusedModel, source: &Source) -> Result<DesignRows, Id
         .initial(&at, &contexts, &mut seeds, &vec![true; rows.records()])
         .map_err(|e| in_source(source, e))?;
     let nn = nu.values.len();
-    let mut sink = Sink::keeping(nn, k, rows.data_rows());
+    let mut sink = Sink::new(nn, k, rows.data_rows());
     rows.evaluate(&at, &contexts, &nu, &mut seeds, &mut sink)
         .map_err(|e| in_source(source, e))?;
     let kept = sink.take_kept();

@@ -244,23 +244,23 @@ fn tip_and_axis_jacobians(
         extension_mm: AXIS_LEVER_MM,
         ..Effector::default()
     };
-    let mut tip = Vec::with_capacity(options.eval_poses.len());
-    let mut axis = Vec::with_capacity(options.eval_poses.len());
-    for (i, pose) in options.eval_poses.iter().enumerate() {
-        let at = |e: &Effector| {
-            model.spindle_point(p, pose, e).map(|x| x.1).map_err(|e| match e {
-                IdentError::Kinematics { source, .. } => {
-                    IdentError::Invalid(format!("evaluation pose {}: {source}", i + 1))
-                }
-                e => e,
-            })
-        };
-        let g0 = at(&Effector::default())?;
-        let g1 = at(&lever)?;
-        axis.push((g1 - &g0) / AXIS_LEVER_MM);
-        tip.push(g0);
-    }
-    Ok((tip, axis))
+    let jacobians = model
+        .spindle_jacobians(p, &options.eval_poses, &[Effector::default(), lever])
+        .map_err(|e| match e {
+            IdentError::Kinematics { pose, source, .. } => {
+                IdentError::Invalid(format!("evaluation pose {}: {source}", pose + 1))
+            }
+            e => e,
+        })?;
+    Ok(jacobians
+        .into_iter()
+        .map(|mut g| {
+            let g1 = g.pop().unwrap_or_default();
+            let g0 = g.pop().unwrap_or_default();
+            let axis = (g1 - &g0) / AXIS_LEVER_MM;
+            (g0, axis)
+        })
+        .unzip())
 }
 
 /// `(raw, after touch-off)` RMS over the poses of `G_e v`, in the units of

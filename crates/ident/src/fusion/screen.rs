@@ -29,7 +29,9 @@ use serde::Serialize;
 use tricept_numerics::stats::{chi2_isf, quantile};
 
 use crate::error::IdentError;
-use crate::fusion::estimate::{FusionOptions, fit_masked, start};
+use crate::fusion::estimate::{
+    Evaluation, FusionOptions, check_counts, fit_masked, fit_started, nuisance_layout, start,
+};
 use crate::fusion::model::FusedModel;
 use crate::fusion::result::{Fusion, RecordCheck, SourceFit};
 use crate::fusion::source::Source;
@@ -99,20 +101,10 @@ fn statistic(check: &RecordCheck, fit: &SourceFit) -> f64 {
     check.quadratic / s2.max(1.0)
 }
 
-/// The robust start (stage 1 of the module docs).
-fn robust_start(
-    model: &FusedModel,
-    sources: &[Source],
-) -> Result<Vec<Vec<bool>>, IdentError> {
-    let all: Vec<Vec<bool>> = sources.iter().map(|s| vec![true; s.records()]).collect();
-    let mut offsets = Vec::with_capacity(sources.len());
-    let mut n_nuisance = 0;
-    for s in sources {
-        offsets.push(n_nuisance);
-        n_nuisance += s.rows().nuisance_names().len();
-    }
-    let (_, _, eval) = start(model, sources, offsets, n_nuisance, &all)?;
-    Ok(sources
+/// The robust start (stage 1 of the module docs) from the evaluation of
+/// every record at the starting point.
+fn robust_start(sources: &[Source], eval: &Evaluation) -> Vec<Vec<bool>> {
+    sources
         .iter()
         .zip(&eval.standardised)
         .map(|(source, z)| {
@@ -143,7 +135,7 @@ fn robust_start(
             }
             start_set(&score)
         })
-        .collect())
+        .collect()
 }
 
 /// The screened fit (see the module docs): the records kept and the fit on
@@ -165,7 +157,13 @@ pub(crate) fn screened_fit(
             )
         })
         .collect();
-    let mut active = robust_start(model, sources)?;
+    check_counts(model, sources, &all)?;
+    let (offsets, n_nuisance) = nuisance_layout(sources);
+    let started = start(model, sources, offsets, n_nuisance, &all)?;
+    let mut active = robust_start(sources, &started.2);
+    // Every record in the first fit (the usual case): it starts from the
+    // evaluation the robust start already made.
+    let mut started = (active == all).then_some(started);
     let mut seen: Vec<Vec<Vec<bool>>> = Vec::new();
     let mut last: Option<(Vec<Vec<bool>>, Fusion)> = None;
     for _ in 0..(2 * total + 4) {
@@ -173,7 +171,11 @@ pub(crate) fn screened_fit(
             break;
         }
         seen.push(active.clone());
-        let fit = match fit_masked(model, sources, &active, options) {
+        let attempt = match started.take() {
+            Some(s) => fit_started(s, options),
+            None => fit_masked(model, sources, &active, options),
+        };
+        let fit = match attempt {
             Ok(f) => f,
             // Too few records left, or a station that cannot be located
             // without them: fall back to the previous set.

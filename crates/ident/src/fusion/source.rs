@@ -77,11 +77,34 @@ pub(crate) struct Sink {
     row: Vec<f64>,
     /// `(record, standardised residual, residual)` of every data row in the fit.
     pub standardised: Vec<(usize, f64, f64)>,
-    /// Every weighted row with its record (`None`: a prior), when kept;
-    /// rows of records outside the fit too.
-    kept: Option<Vec<(Option<usize>, Vec<f64>)>>,
+    /// Every weighted row, of records outside the fit too, and every prior.
+    kept: KeptRows,
     /// Which records are in the fit (`None`: all).
     active: Option<Vec<bool>>,
+}
+
+/// The weighted rows `[nuisance | parameters | residual]` a sink saw, each
+/// with its record (`None`: a prior), stored flat.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct KeptRows {
+    width: usize,
+    values: Vec<f64>,
+    records: Vec<Option<usize>>,
+}
+
+impl KeptRows {
+    fn push(&mut self, record: Option<usize>, row: &[f64]) {
+        self.values.extend_from_slice(row);
+        self.records.push(record);
+    }
+
+    /// Every row with its record.
+    pub fn iter(&self) -> impl Iterator<Item = (Option<usize>, &[f64])> {
+        self.records
+            .iter()
+            .zip(self.values.chunks_exact(self.width.max(1)))
+            .map(|(r, v)| (*r, v))
+    }
 }
 
 impl Sink {
@@ -94,7 +117,11 @@ impl Sink {
             k,
             row: vec![0.0; n_nuisance + k + 1],
             standardised: Vec::with_capacity(rows),
-            kept: None,
+            kept: KeptRows {
+                width: n_nuisance + k + 1,
+                values: Vec::with_capacity(rows * (n_nuisance + k + 1)),
+                records: Vec::with_capacity(rows),
+            },
             active: None,
         }
     }
@@ -105,17 +132,10 @@ impl Sink {
         self
     }
 
-    /// A sink that also keeps every weighted row (for planning).
-    pub fn keeping(n_nuisance: usize, k: usize, rows: usize) -> Sink {
-        Sink {
-            kept: Some(Vec::with_capacity(rows)),
-            ..Sink::new(n_nuisance, k, rows)
-        }
-    }
-
-    /// The rows kept by a [`Sink::keeping`] sink.
+    /// Every row the sink saw, with its record (`None`: a prior).
     pub fn take_kept(&mut self) -> Vec<(Option<usize>, Vec<f64>)> {
-        self.kept.take().unwrap_or_default()
+        let kept = std::mem::take(&mut self.kept);
+        kept.iter().map(|(r, v)| (r, v.to_vec())).collect()
     }
 
     /// One data row of `record`: weight `w = 1 / sigma`, the derivatives of
@@ -130,9 +150,7 @@ impl Sink {
             *r = w * v;
         }
         self.row[nn + k] = w * residual;
-        if let Some(kept) = &mut self.kept {
-            kept.push((Some(record), self.row.clone()));
-        }
+        self.kept.push(Some(record), &self.row);
         if self
             .active
             .as_ref()
@@ -150,13 +168,12 @@ impl Sink {
         self.row[column] = 1.0 / sigma;
         self.row[self.n_nuisance + self.k] = residual / sigma;
         self.acc.push_row(&self.row);
-        if let Some(kept) = &mut self.kept {
-            kept.push((None, self.row.clone()));
-        }
+        self.kept.push(None, &self.row);
     }
 
-    /// The reduced problem of the rows pushed.
-    pub fn finish(self) -> (ReducedProblem, Vec<(usize, f64, f64)>) {
+    /// The reduced problem of the rows pushed, their standardised residuals
+    /// and every row seen.
+    pub fn finish(self) -> (ReducedProblem, Vec<(usize, f64, f64)>, KeptRows) {
         let rows = self.acc.rows();
         (
             ReducedProblem {
@@ -166,6 +183,7 @@ impl Sink {
                 k: self.k,
             },
             self.standardised,
+            self.kept,
         )
     }
 }
