@@ -635,16 +635,7 @@ fn record_checks(
                     red += m as f64 - leverage;
                 }
                 let sign = if active { -1.0 } else { 1.0 };
-                let middle: DMatrix<f64> = DMatrix::identity(m, m) + &h * sign;
-                let ev = DVector::from_column_slice(&e[j]);
-                // e^T M^-1 e over the directions the other records check: a
-                // direction with leverage 1 (eigenvalue of I - H near 0) is
-                // fitted exactly whatever it holds and tests nothing.
-                let eig = middle.symmetric_eigen();
-                let quadratic: f64 = (0..m)
-                    .filter(|&i| eig.eigenvalues[i] > 1e-6)
-                    .map(|i| eig.eigenvectors.column(i).dot(&ev).powi(2) / eig.eigenvalues[i])
-                    .sum();
+                let quadratic = checked_quadratic(&h, sign, &e[j]);
                 RecordCheck {
                     line: source.line(j),
                     active,
@@ -663,6 +654,40 @@ fn record_checks(
         redundancy.push(red.max(0.0));
     }
     (checks, redundancy)
+}
+
+/// `e^T (I + sign H)^-1 e` over the directions the other records check: a
+/// direction with leverage 1 (an eigenvalue of `I - H` near 0) is fitted
+/// exactly whatever it holds and tests nothing. Closed form for one row,
+/// a fixed-size eigen-decomposition for three.
+fn checked_quadratic(h: &DMatrix<f64>, sign: f64, e: &[f64]) -> f64 {
+    const CHECKED: f64 = 1e-6;
+    match e.len() {
+        1 => {
+            let d = 1.0 + sign * h[(0, 0)];
+            if d > CHECKED { e[0] * e[0] / d } else { 0.0 }
+        }
+        3 => {
+            let m = nalgebra::Matrix3::from_fn(|a, b| {
+                f64::from(u8::from(a == b)) + sign * h[(a, b)]
+            });
+            let eig = m.symmetric_eigen();
+            let ev = nalgebra::Vector3::new(e[0], e[1], e[2]);
+            (0..3)
+                .filter(|&i| eig.eigenvalues[i] > CHECKED)
+                .map(|i| eig.eigenvectors.column(i).dot(&ev).powi(2) / eig.eigenvalues[i])
+                .sum()
+        }
+        n => {
+            let m: DMatrix<f64> = DMatrix::identity(n, n) + h * sign;
+            let eig = m.symmetric_eigen();
+            let ev = DVector::from_column_slice(e);
+            (0..n)
+                .filter(|&i| eig.eigenvalues[i] > CHECKED)
+                .map(|i| eig.eigenvectors.column(i).dot(&ev).powi(2) / eig.eigenvalues[i])
+                .sum()
+        }
+    }
 }
 
 fn finish(

@@ -278,24 +278,30 @@ fn impact(g: &[DMatrix<f64>], mean: &DMatrix<f64>, v: &[f64]) -> (f64, f64) {
     ((raw / n).sqrt(), (touched / n).sqrt())
 }
 
-/// RMS and largest over the poses of `sqrt(tr(G_e C G_e^T))`, with `G_e`
-/// centred on `mean` when given (after touch-off).
-fn spread(g: &[DMatrix<f64>], mean: Option<&DMatrix<f64>>, c: &DMatrix<f64>) -> (f64, f64) {
-    let n = g.len().max(1) as f64;
+/// The Jacobians `G_e` (3 x k each) stacked into one `3E x k` matrix,
+/// each centred on `mean` when given (after touch-off).
+fn stacked(g: &[DMatrix<f64>], mean: Option<&DMatrix<f64>>) -> DMatrix<f64> {
+    let k = g.first().map_or(0, |x| x.ncols());
+    DMatrix::from_fn(3 * g.len(), k, |r, c| {
+        g[r / 3][(r % 3, c)] - mean.map_or(0.0, |m| m[(r % 3, c)])
+    })
+}
+
+/// RMS and largest over the poses of `sqrt(tr(G_e C G_e^T))` for the
+/// stacked Jacobians `g` ([`stacked`]): one matrix product.
+fn spread(g: &DMatrix<f64>, c: &DMatrix<f64>) -> (f64, f64) {
+    let gc = g * c;
+    let poses = g.nrows() / 3;
     let (mut sum, mut max) = (0.0f64, 0.0f64);
-    for ge in g {
-        let a = match mean {
-            Some(m) => {
-                let gt = ge - m;
-                (&gt * c * gt.transpose()).trace()
-            }
-            None => (ge * c * ge.transpose()).trace(),
-        }
-        .max(0.0);
+    for e in 0..poses {
+        let a: f64 = (3 * e..3 * e + 3)
+            .map(|r| gc.row(r).dot(&g.row(r)))
+            .sum::<f64>()
+            .max(0.0);
         sum += a;
         max = max.max(a.sqrt());
     }
-    ((sum / n).sqrt(), max)
+    ((sum / poses.max(1) as f64).sqrt(), max)
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -467,12 +473,17 @@ pub(crate) fn build_report(
         held_cov += &n * n.transpose();
     }
     let total = covariance + &held_cov;
-    let (raw_rms, raw_max) = spread(&g, None, &total);
-    let (touched_rms, touched_max) = spread(&g, Some(&mean), &total);
-    let (held_raw, _) = spread(&g, None, &held_cov);
-    let (held_touched, _) = spread(&g, Some(&mean), &held_cov);
-    let (axis_rms, axis_max) = spread(&ga, None, &total);
-    let (held_axis, _) = spread(&ga, None, &held_cov);
+    let (raw, touched, axis) = (
+        stacked(&g, None),
+        stacked(&g, Some(&mean)),
+        stacked(&ga, None),
+    );
+    let (raw_rms, raw_max) = spread(&raw, &total);
+    let (touched_rms, touched_max) = spread(&touched, &total);
+    let (held_raw, _) = spread(&raw, &held_cov);
+    let (held_touched, _) = spread(&touched, &held_cov);
+    let (axis_rms, axis_max) = spread(&axis, &total);
+    let (held_axis, _) = spread(&axis, &held_cov);
     // A held parameter leaves the tip (the axis) uncalibrated when its
     // invisible combination, at typical size, moves the tip more than is
     // harmless (turns the axis by HARMLESS_AXIS_ARCSEC or more).
