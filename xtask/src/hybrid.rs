@@ -255,7 +255,12 @@ fn tip_error(
         let up = nominal.forward(&pose.commands_mm).ok()?.up;
         let axis = nominal.tool_forward(&up, pose.head_rad).axis;
         let command = model
-            .tool_commands(&fit.estimate, &tip, &axis, HeadBranch::Nearest(pose.head_rad))
+            .tool_commands(
+                &fit.estimate,
+                &tip,
+                &axis,
+                HeadBranch::Nearest(pose.head_rad),
+            )
             .ok()?;
         let reached = plant
             .spindle_point(&command.commands_mm, command.head_rad, &Effector::default())
@@ -349,8 +354,8 @@ fn plans(instrument: Instrument, m: &Machine, ks: &[usize]) -> Result<Plans, Str
             sphere_candidates(m, &sphere(), SPHERE_RADIUS_MM + STYLUS_RADIUS_MM, 300)
         }
     };
-    let f_int = internal_factor(&model, &m.workspace.polar_grid(3, 8, 3))
-        .map_err(|e| e.to_string())?;
+    let f_int =
+        internal_factor(&model, &m.workspace.polar_grid(3, 8, 3)).map_err(|e| e.to_string())?;
     let rows = candidate_rows(&model, &instrument_source(instrument, &model, &candidates)?)
         .map_err(|e| e.to_string())?;
     let eval = FusionOptions::for_machine(m).eval_poses;
@@ -606,7 +611,12 @@ fn k_star(ks: &[usize], medians: &[Option<f64>], checkable: &[bool]) -> Option<u
 }
 
 /// RMS over the machines of `f` of the fits that exist.
-fn rms_of(machines: &[MachineResult], method: usize, i: usize, f: fn(&TipError) -> f64) -> Option<f64> {
+fn rms_of(
+    machines: &[MachineResult],
+    method: usize,
+    i: usize,
+    f: fn(&TipError) -> f64,
+) -> Option<f64> {
     let v: Vec<f64> = machines
         .iter()
         .filter_map(|r| r.errors[method][i].as_ref().ok().map(f))
@@ -719,7 +729,13 @@ pub fn run(a: HybridArgs) -> Result<(), String> {
         // The predictions at twice the head table's sizes (no hidden effect).
         let doubled = run_all(Scenario::None, 2.0);
         markdown.push_str(&report(instrument, &ks, &per_scenario, &plans, &a)?);
-        markdown.push_str(&predictions_table(instrument, &ks, &per_scenario[0].1, &doubled, &plans));
+        markdown.push_str(&predictions_table(
+            instrument,
+            &ks,
+            &per_scenario[0].1,
+            &doubled,
+            &plans,
+        ));
         results.push(json_of(instrument, &ks, &per_scenario, &doubled, &plans));
     }
     let inputs = json!({

@@ -402,7 +402,9 @@ pub fn run(a: &IdentifyArgs) -> Result<u8, CliError> {
     let refused = a.write_machine.as_ref().filter(|_| code != 0 && !a.force);
     let deployed = match (&a.write_machine, refused) {
         (Some(path), None) => Some(write_machine(a, path, &model, &fit, &sources, code)?),
-        (Some(path), Some(_)) => Some(json!({"written": Value::Null, "refused": path.display().to_string()})),
+        (Some(path), Some(_)) => {
+            Some(json!({"written": Value::Null, "refused": path.display().to_string()}))
+        }
         (None, _) => None,
     };
     if a.settings.machine.json {
@@ -465,7 +467,10 @@ fn refusal_reason(fit: &Fusion) -> String {
         .map(|s| s.label.as_str())
         .collect();
     if !unexplained.is_empty() {
-        why.push(format!("the model does not explain {}", unexplained.join(", ")));
+        why.push(format!(
+            "the model does not explain {}",
+            unexplained.join(", ")
+        ));
     }
     if !fit.implausible.is_empty() {
         let names: Vec<&str> = fit.implausible.iter().map(|i| i.name.as_str()).collect();
@@ -617,7 +622,10 @@ fn write_machine(
                 file: s.file().to_string(),
                 sha256: String::new(),
                 records: f.records,
-                chi2_per_dof: f.reduced_chi_square.is_finite().then_some(f.reduced_chi_square),
+                chi2_per_dof: f
+                    .reduced_chi_square
+                    .is_finite()
+                    .then_some(f.reduced_chi_square),
                 redundancy: f.redundancy,
                 checkable: f.checkable,
                 rejected_lines: fit

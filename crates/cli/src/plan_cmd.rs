@@ -65,7 +65,12 @@ pub struct PlanArgs {
     /// Known extensions of the tracker target along the tool, mm: every
     /// candidate pose is offered at each; with two or more the plan fixes
     /// the tool's direction too (its criterion adds the tool axis).
-    #[arg(long, default_value = "0", value_delimiter = ',', value_name = "MM,...")]
+    #[arg(
+        long,
+        default_value = "0",
+        value_delimiter = ',',
+        value_name = "MM,..."
+    )]
     pub extensions: Vec<f64>,
     /// Noise of a tracker coordinate, um.
     #[arg(long, default_value_t = 10.0, value_name = "UM")]
@@ -192,7 +197,10 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
         Instrument::Tracker => {
             let target = tracker_target(a.tracker_target.as_deref(), a.tracker_target_sigma_um)?;
             let (h1, h2) = parse_head_angles("--head-angles-deg", &a.head_angles_deg)?;
-            if a.extensions.iter().any(|e| !e.is_finite() || e.abs() > 1000.0) {
+            if a.extensions
+                .iter()
+                .any(|e| !e.is_finite() || e.abs() > 1000.0)
+            {
                 return Err(CliError::input(
                     "--extensions: expected extensions along the tool in mm, within ±1000",
                 ));
@@ -387,9 +395,9 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
                 "recommended: {k} planned measurements (the smallest k asked for that predicts {t} um and leaves {:.0} redundant rows)",
                 result.min_redundancy
             ),
-            (Some(t), None) => outln!(
-                "{t} um is not predicted with enough redundancy by any k asked for"
-            ),
+            (Some(t), None) => {
+                outln!("{t} um is not predicted with enough redundancy by any k asked for")
+            }
             (None, Some(k)) => outln!(
                 "recommended: at least {k} measurements (the smallest k asked for that leaves {:.0} redundant rows; --target-um adds an accuracy target)",
                 result.min_redundancy

@@ -965,7 +965,11 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
             &[],
             vec![],
             2,
-            &["--tracker-target is required with a tracker", "`tip`", "`free`"],
+            &[
+                "--tracker-target is required with a tracker",
+                "`tip`",
+                "`free`",
+            ],
         ),
         case(
             "plan: tracker target not stated",

@@ -134,11 +134,20 @@ fn the_calibrated_machine_file_carries_the_head_and_tool_ik_uses_it() {
             nuisance[name]["value"].as_f64().unwrap(),
             nuisance[name]["std_dev"].as_f64().unwrap(),
         );
-        assert!((v - expected).abs() < 5.0 * sd, "{name} = {v} +- {sd}, expected {expected}");
+        assert!(
+            (v - expected).abs() < 5.0 * sd,
+            "{name} = {v} +- {sd}, expected {expected}"
+        );
     }
     assert_eq!(record["external_sources"][0]["checkable"], true);
     // The verdict fields of `identify`, and the fused fit's own.
-    for key in ["converged", "adequate", "consistent_with_machine", "checkable", "plausible"] {
+    for key in [
+        "converged",
+        "adequate",
+        "consistent_with_machine",
+        "checkable",
+        "plausible",
+    ] {
         assert_eq!(v[key], true, "{key}");
     }
     assert!(v["chi_square_p_value"].as_f64().unwrap() > 1e-3);
@@ -320,7 +329,10 @@ fn five_tracker_points_cannot_be_checked_exit_3_and_the_file_is_refused_with_its
     assert!(tracker["redundancy"].as_f64().unwrap() < 1.0, "{tracker}");
     let more = tracker["more_records"].as_u64().unwrap();
     assert!(more >= 1);
-    assert_eq!((v["checkable"].clone(), v["adequate"].clone()), (false.into(), false.into()));
+    assert_eq!(
+        (v["checkable"].clone(), v["adequate"].clone()),
+        (false.into(), false.into())
+    );
     let stderr = String::from_utf8_lossy(&json.stderr);
     assert!(
         stderr.contains(&format!("at least {more} more points make it checkable")),
@@ -332,21 +344,32 @@ fn five_tracker_points_cannot_be_checked_exit_3_and_the_file_is_refused_with_its
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stdout.contains("fused identification") && stdout.contains("NOT checkable"));
-    assert!(stderr.contains("warning: tracker (tracker.csv) cannot be checked"), "{stderr}");
+    assert!(
+        stderr.contains("warning: tracker (tracker.csv) cannot be checked"),
+        "{stderr}"
+    );
     let last = stderr.lines().last().unwrap();
     assert!(
         last.contains("--write-machine m.json: not written")
-            && last.contains(&format!("tracker cannot be checked: at least {more} more records")),
+            && last.contains(&format!(
+                "tracker cannot be checked: at least {more} more records"
+            )),
         "{last}"
     );
     assert!(!dir.join("m.json").exists());
     // --force writes it, marked forced.
-    let out = tricept(&dir, &[&fused[..], &["--write-machine", "m.json", "--force"]].concat());
+    let out = tricept(
+        &dir,
+        &[&fused[..], &["--write-machine", "m.json", "--force"]].concat(),
+    );
     assert_eq!(out.status.code(), Some(3));
     let file: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("m.json")).unwrap()).unwrap();
     assert_eq!(file["calibration"]["forced"], true);
-    assert_eq!(file["calibration"]["external_sources"][0]["checkable"], false);
+    assert_eq!(
+        file["calibration"]["external_sources"][0]["checkable"],
+        false
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -378,16 +401,27 @@ fn a_target_beyond_the_tip_stated_as_tip_is_implausible_and_the_cause_is_named()
         stderr.contains("tool_length_mm = ") && stderr.contains("far outside its plausible range"),
         "{stderr}"
     );
-    assert!(stderr.contains("likely cause (tested)") && stderr.contains("not where --tracker-target says"));
+    assert!(
+        stderr.contains("likely cause (tested)")
+            && stderr.contains("not where --tracker-target says")
+    );
     assert!(stderr.contains("not written") && !dir.join("m.json").exists());
     // The sign wrong: named as such.
     let out = fused("0,0,-20");
     assert_eq!(out.status.code(), Some(3));
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("the target offset's sign is wrong"), "{stderr}");
+    assert!(
+        stderr.contains("the target offset's sign is wrong"),
+        "{stderr}"
+    );
     // Stated as it is: plausible, written.
     let out = fused("0,0,20");
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(dir.join("m.json").exists());
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -480,8 +514,18 @@ fn the_old_noise_flag_of_plan_still_works() {
         serde_json::from_slice(&ok(
             &dir,
             &[
-                "plan", "--instrument", "ballbar", "--k", "30", "--random-baseline", "0",
-                "--passes", "1", "--json", flag, "2",
+                "plan",
+                "--instrument",
+                "ballbar",
+                "--k",
+                "30",
+                "--random-baseline",
+                "0",
+                "--passes",
+                "1",
+                "--json",
+                flag,
+                "2",
             ],
         ))
         .unwrap()

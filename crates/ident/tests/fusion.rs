@@ -28,9 +28,7 @@ use tricept_model::effects::EffectName;
 use tricept_model::{HeadParameterSet, ParameterSet};
 use tricept_numerics::stats::chi2_isf;
 use tricept_plant::instruments::commanded;
-use tricept_plant::{
-    Ballbar, Effect, Plant, TouchFeature, TouchProbe, TouchTarget,
-};
+use tricept_plant::{Ballbar, Effect, Plant, TouchFeature, TouchProbe, TouchTarget};
 
 /// The truth in the fused model's parameters `[paper15 | effects | head13]`.
 fn truth_of(model: &FusedModel, module: &[f64], effects: &[f64], head: &[f64]) -> Vec<f64> {

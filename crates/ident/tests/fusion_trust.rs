@@ -44,7 +44,12 @@ fn points(plant: &Plant, n: usize, target: Vector3<f64>, seed: u64) -> TrackerDa
     data
 }
 
-fn fit(plant: &Plant, data: &TrackerData, target: TrackerTarget, options: &FusionOptions) -> Fusion {
+fn fit(
+    plant: &Plant,
+    data: &TrackerData,
+    target: TrackerTarget,
+    options: &FusionOptions,
+) -> Fusion {
     let m = &plant.nominal;
     let sources = [
         internal(plant, 1),
@@ -75,8 +80,18 @@ fn tip() -> TrackerTarget {
 fn a_saturated_tracker_is_reported_as_unchecked_and_twelve_points_are_checkable() {
     let plant = table2_plant();
     let options = FusionOptions::for_machine(&plant.nominal);
-    let five = fit(&plant, &points(&plant, 5, Vector3::zeros(), 1), tip(), &options);
-    let twelve = fit(&plant, &points(&plant, 12, Vector3::zeros(), 1), tip(), &options);
+    let five = fit(
+        &plant,
+        &points(&plant, 5, Vector3::zeros(), 1),
+        tip(),
+        &options,
+    );
+    let twelve = fit(
+        &plant,
+        &points(&plant, 12, Vector3::zeros(), 1),
+        tip(),
+        &options,
+    );
     let (t5, t12) = (tracker_fit(&five), tracker_fit(&twelve));
     eprintln!(
         "TALLY redundancy: 5 points {:.2} (rows {}), 12 points {:.2} (rows {}); internal {:.1}",
@@ -90,9 +105,8 @@ fn a_saturated_tracker_is_reported_as_unchecked_and_twelve_points_are_checkable(
     let more = t5.more_records.unwrap();
     assert!(more >= 1);
     assert!(
-        five.warnings
-            .iter()
-            .any(|w| w.contains("cannot be checked") && w.contains(&format!("at least {more} more points"))),
+        five.warnings.iter().any(|w| w.contains("cannot be checked")
+            && w.contains(&format!("at least {more} more points"))),
         "{:?}",
         five.warnings
     );
@@ -217,7 +231,11 @@ fn a_target_not_at_the_tip_is_implausible_and_the_cause_is_named() {
     };
     let cases = [
         ("stated at the tip", stated([0.0; 3]), "target-mode"),
-        ("the offset's sign wrong", stated([0.0, 0.0, -20.0]), "target-sign"),
+        (
+            "the offset's sign wrong",
+            stated([0.0, 0.0, -20.0]),
+            "target-sign",
+        ),
     ];
     let fits: Vec<Fusion> = cases
         .par_iter()
@@ -246,9 +264,14 @@ fn a_target_not_at_the_tip_is_implausible_and_the_cause_is_named() {
     // accepts the stated-at-the-tip fit (it then calibrates the target's
     // point as the tip, as asked).
     let mut wide = options.clone();
-    wide.plausibility = FusionPlausibility::with_overrides(r#"{"tool_length_mm": [-30, 30]}"#).unwrap();
+    wide.plausibility =
+        FusionPlausibility::with_overrides(r#"{"tool_length_mm": [-30, 30]}"#).unwrap();
     let accepted = fit(&plant, &data, stated([0.0; 3]), &wide);
-    assert!(accepted.implausible.is_empty(), "{:?}", accepted.implausible);
+    assert!(
+        accepted.implausible.is_empty(),
+        "{:?}",
+        accepted.implausible
+    );
 }
 
 #[test]
@@ -273,8 +296,10 @@ fn the_tool_axis_gets_a_prediction_that_tip_data_leave_large_and_extensions_fix(
     let plant = table2_plant();
     let m = &plant.nominal;
     let options = FusionOptions::for_machine(m);
-    let poses: Vec<ExternalPose> = spread_poses(m, 15, &[-120.0, 0.0, 120.0], &[-40.0, 5.0, 40.0], 9);
-    let tip_only: Vec<(ExternalPose, f64)> = poses.iter().chain(&poses).map(|p| (*p, 0.0)).collect();
+    let poses: Vec<ExternalPose> =
+        spread_poses(m, 15, &[-120.0, 0.0, 120.0], &[-40.0, 5.0, 40.0], 9);
+    let tip_only: Vec<(ExternalPose, f64)> =
+        poses.iter().chain(&poses).map(|p| (*p, 0.0)).collect();
     let extended: Vec<(ExternalPose, f64)> = poses
         .iter()
         .flat_map(|p| [(*p, 0.0), (*p, 100.0)])
@@ -282,10 +307,15 @@ fn the_tool_axis_gets_a_prediction_that_tip_data_leave_large_and_extensions_fix(
     let fits: Vec<Fusion> = [tip_only, extended]
         .par_iter()
         .map(|records| {
-            let data = tracker(Vector3::zeros()).measure(&plant, records, 10).unwrap();
+            let data = tracker(Vector3::zeros())
+                .measure(&plant, records, 10)
+                .unwrap();
             identify_fused(
                 &model(m),
-                &[internal(&plant, 1), Source::tracker(&data, &known_target()).unwrap()],
+                &[
+                    internal(&plant, 1),
+                    Source::tracker(&data, &known_target()).unwrap(),
+                ],
                 &options,
             )
             .unwrap()
@@ -315,7 +345,10 @@ fn the_tool_axis_gets_a_prediction_that_tip_data_leave_large_and_extensions_fix(
             f.report.tool_axis.rms_arcsec,
             delivered(f)
         );
-        assert!(delivered(f) <= 1.5 * f.report.tool_axis.rms_arcsec, "{what}");
+        assert!(
+            delivered(f) <= 1.5 * f.report.tool_axis.rms_arcsec,
+            "{what}"
+        );
     }
     let (tip, two) = (&fits[0], &fits[1]);
     assert!(tip.report.tool_axis.rms_arcsec > options.tool_axis_arcsec);
@@ -326,7 +359,12 @@ fn the_tool_axis_gets_a_prediction_that_tip_data_leave_large_and_extensions_fix(
         "{:?}",
         tip.warnings
     );
-    assert!(tip.report.tool_axis.held_moving_axis.contains(&"tool_tilt_e_rad".to_string()));
+    assert!(
+        tip.report
+            .tool_axis
+            .held_moving_axis
+            .contains(&"tool_tilt_e_rad".to_string())
+    );
     assert!(two.report.tool_axis.rms_arcsec < options.tool_axis_arcsec);
     assert!(!two.warnings.iter().any(|w| w.contains("tool axis")));
 }

@@ -59,10 +59,10 @@ use tricept_data::{
 };
 use tricept_ident::fusion::{DesignRows, FusedModel, Source, design_rows, information_factor};
 use tricept_kinematics::units::RAD_PER_ARCSEC;
-use tricept_numerics::linalg::TriangularAccumulator;
-use tricept_numerics::lsq::{DEFAULT_RANK_TOLERANCE, ReducedProblem};
 use tricept_kinematics::{HeadBranch, Machine};
 use tricept_model::Effector;
+use tricept_numerics::linalg::TriangularAccumulator;
+use tricept_numerics::lsq::{DEFAULT_RANK_TOLERANCE, ReducedProblem};
 
 use crate::StudyError;
 use crate::optimise::{ExchangeCriterion, exchange_with, greedy};
@@ -151,7 +151,9 @@ impl PlanProblem {
         };
         let mut g = Vec::with_capacity(eval.len());
         let mut ga = Vec::with_capacity(eval.len());
-        for mut pair in model.spindle_jacobians(&vec![0.0; k], eval, &[Effector::default(), lever])? {
+        for mut pair in
+            model.spindle_jacobians(&vec![0.0; k], eval, &[Effector::default(), lever])?
+        {
             let g1 = pair.pop().unwrap_or_default();
             let g0 = pair.pop().unwrap_or_default();
             ga.push((g1 - &g0) / AXIS_LEVER_MM);
@@ -641,10 +643,7 @@ pub fn nominal_ballbar_data(
 /// Touch-offs on a reference sphere (feature `feature`) at `poses` as the
 /// nominal machine would give them, for [`design_rows`] with the features
 /// file `features` (which declares the sphere).
-pub fn nominal_touch_data(
-    poses: &[ExternalPose],
-    feature: u32,
-) -> Result<TouchData, StudyError> {
+pub fn nominal_touch_data(poses: &[ExternalPose], feature: u32) -> Result<TouchData, StudyError> {
     let records = poses
         .iter()
         .map(|pose| TouchReading {

@@ -26,8 +26,8 @@ use tricept_ident::fusion::{
 use tricept_kinematics::{HeadBranch, Machine, MachineDescription};
 use tricept_model::ParameterSet;
 use tricept_study::plan::{
-    PlanProblem, candidate_rows, internal_factor, nominal_ballbar_data, nominal_tracker_data,
-    plan, sphere_candidates, with_extensions,
+    PlanProblem, candidate_rows, internal_factor, nominal_ballbar_data, nominal_tracker_data, plan,
+    sphere_candidates, with_extensions,
 };
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,8 +50,11 @@ fn tip_target() -> TrackerTarget {
     }
 }
 
+/// A campaign: each pose with the extension measured there, mm.
+type Campaign = Vec<(ExternalPose, f64)>;
+
 /// The planned poses (with extensions) for each of `ks`.
-fn planned(m: &Machine, instrument: Instrument, ks: &[usize]) -> Vec<Vec<(ExternalPose, f64)>> {
+fn planned(m: &Machine, instrument: Instrument, ks: &[usize]) -> Vec<Campaign> {
     let model = model(m);
     let candidates: Vec<(ExternalPose, f64)> = match instrument {
         Instrument::Tracker => with_extensions(
@@ -167,7 +170,8 @@ fn calibrate(
                 .iter()
                 .enumerate()
                 .map(|(j, (pose, extension))| {
-                    let x = truth.spindle_point(&pose.commands_mm, pose.head_rad, *extension, &offset);
+                    let x =
+                        truth.spindle_point(&pose.commands_mm, pose.head_rad, *extension, &offset);
                     TrackerPoint {
                         pose: *pose,
                         position_mm: station.measure(&x, &mut rng),
@@ -197,7 +201,12 @@ fn calibrate(
                 .iter()
                 .enumerate()
                 .map(|(j, (pose, _))| {
-                    let x = truth.spindle_point(&pose.commands_mm, pose.head_rad, 0.0, &Vector3::zeros());
+                    let x = truth.spindle_point(
+                        &pose.commands_mm,
+                        pose.head_rad,
+                        0.0,
+                        &Vector3::zeros(),
+                    );
                     let z = normal(&mut rng);
                     BallbarReading {
                         pose: *pose,
@@ -229,21 +238,38 @@ fn calibrate(
     .unwrap();
     // The deployed machine file, as `--write-machine` writes its geometry.
     let text = model.machine_at(&fit.estimate).to_description().to_json();
-    let deployed = MachineDescription::from_json(&text).unwrap().build().unwrap();
+    let deployed = MachineDescription::from_json(&text)
+        .unwrap()
+        .build()
+        .unwrap();
     let mut errors = Vec::with_capacity(eval.len());
     let mut axis2 = 0.0;
     for pose in eval {
         let up = m.forward(&pose.commands_mm).unwrap().up;
         let target = m.tool_forward(&up, pose.head_rad);
         let ik = deployed
-            .tool_inverse(&target.tip_mm, &target.axis, HeadBranch::Nearest(pose.head_rad))
+            .tool_inverse(
+                &target.tip_mm,
+                &target.axis,
+                HeadBranch::Nearest(pose.head_rad),
+            )
             .unwrap();
-        errors.push(truth.spindle_point(&ik.legs_mm, ik.head_rad, 0.0, &Vector3::zeros()) - target.tip_mm);
-        axis2 += truth.tool_axis(&ik.legs_mm, ik.head_rad).angle(&target.axis).powi(2);
+        errors.push(
+            truth.spindle_point(&ik.legs_mm, ik.head_rad, 0.0, &Vector3::zeros()) - target.tip_mm,
+        );
+        axis2 += truth
+            .tool_axis(&ik.legs_mm, ik.head_rad)
+            .angle(&target.axis)
+            .powi(2);
     }
     let n = errors.len() as f64;
     let mean = errors.iter().sum::<Vector3<f64>>() / n;
-    let delivered = (errors.iter().map(|e| (e - mean).norm_squared()).sum::<f64>() / n).sqrt();
+    let delivered = (errors
+        .iter()
+        .map(|e| (e - mean).norm_squared())
+        .sum::<f64>()
+        / n)
+        .sqrt();
     Outcome {
         predicted_um: fit.report.tool_tip.touch_off_rms_um,
         delivered_um: 1e3 * delivered,
@@ -265,7 +291,7 @@ fn the_predicted_tool_tip_holds_on_machines_the_project_did_not_generate() {
     let m = Machine::paper();
     let eval = held_out(&m);
     let ks = [12, 30];
-    let plans: Vec<(Instrument, Vec<Vec<(ExternalPose, f64)>>)> = [Instrument::Tracker, Instrument::Ballbar]
+    let plans: Vec<(Instrument, Vec<Campaign>)> = [Instrument::Tracker, Instrument::Ballbar]
         .par_iter()
         .map(|&i| (i, planned(&m, i, &ks)))
         .collect();
@@ -283,7 +309,15 @@ fn the_predicted_tool_tip_holds_on_machines_the_project_did_not_generate() {
             (0..MACHINES)
                 .map(|i| {
                     let truth = TrueMachine::random(*scale, 100 + i);
-                    calibrate(&truth, *instrument, poses, Vector3::zeros(), tip_target(), &eval, 500 + i)
+                    calibrate(
+                        &truth,
+                        *instrument,
+                        poses,
+                        Vector3::zeros(),
+                        tip_target(),
+                        &eval,
+                        500 + i,
+                    )
                 })
                 .collect()
         })
@@ -300,7 +334,9 @@ fn the_predicted_tool_tip_holds_on_machines_the_project_did_not_generate() {
             delivered / predicted
         );
         if delivered > 1.5 * predicted {
-            failures.push(format!("{instrument:?} k = {k} x{scale}: {delivered:.1} um > 1.5 x {predicted:.1} um"));
+            failures.push(format!(
+                "{instrument:?} k = {k} x{scale}: {delivered:.1} um > 1.5 x {predicted:.1} um"
+            ));
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
@@ -332,8 +368,24 @@ fn a_known_target_offset_stated_correctly_does_not_bias_the_tip() {
                 .map(|i| {
                     let truth = TrueMachine::random(1.0, 100 + i);
                     (
-                        calibrate(&truth, Instrument::Tracker, poses, Vector3::zeros(), tip_target(), &eval, 500 + i),
-                        calibrate(&truth, Instrument::Tracker, poses, offset, stated, &eval, 500 + i),
+                        calibrate(
+                            &truth,
+                            Instrument::Tracker,
+                            poses,
+                            Vector3::zeros(),
+                            tip_target(),
+                            &eval,
+                            500 + i,
+                        ),
+                        calibrate(
+                            &truth,
+                            Instrument::Tracker,
+                            poses,
+                            offset,
+                            stated,
+                            &eval,
+                            500 + i,
+                        ),
                     )
                 })
                 .unzip();
@@ -352,8 +404,14 @@ fn a_known_target_offset_stated_correctly_does_not_bias_the_tip() {
             "TALLY tracker k = {k}: target at the tip {at_tip:.1} um, 20 mm beyond (stated) {beyond:.1} um (ratio {:.2}; predicted {predicted:.1}, of which the invisible w/h2 combination {held:.1}; allowed {allowed:.1})",
             beyond / at_tip
         );
-        assert!(beyond <= allowed, "k = {k}: {beyond} vs {at_tip} (held {held})");
-        assert!(beyond <= 1.5 * predicted, "k = {k}: {beyond} vs predicted {predicted}");
+        assert!(
+            beyond <= allowed,
+            "k = {k}: {beyond} vs {at_tip} (held {held})"
+        );
+        assert!(
+            beyond <= 1.5 * predicted,
+            "k = {k}: {beyond} vs predicted {predicted}"
+        );
     }
 }
 
@@ -366,12 +424,27 @@ fn the_independent_machine_without_errors_is_the_documented_one() {
     for pose in held_out(&m).iter().take(20) {
         let up = m.forward(&pose.commands_mm).unwrap().up;
         let joints = truth.forward(&pose.commands_mm);
-        assert!((joints[0] - up.phi_rad).abs() < 1e-10, "{joints:?} vs {up:?}");
-        assert!((joints[1] - up.theta_rad).abs() < 1e-10, "{joints:?} vs {up:?}");
+        assert!(
+            (joints[0] - up.phi_rad).abs() < 1e-10,
+            "{joints:?} vs {up:?}"
+        );
+        assert!(
+            (joints[1] - up.theta_rad).abs() < 1e-10,
+            "{joints:?} vs {up:?}"
+        );
         assert!((joints[2] - up.q4_mm).abs() < 1e-8, "{joints:?} vs {up:?}");
         let tool = m.tool_forward(&up, pose.head_rad);
         let tip = truth.spindle_point(&pose.commands_mm, pose.head_rad, 0.0, &Vector3::zeros());
-        assert!((tip - tool.tip_mm).norm() < 1e-8, "{tip} vs {}", tool.tip_mm);
-        assert!(truth.tool_axis(&pose.commands_mm, pose.head_rad).angle(&tool.axis) < 1e-10);
+        assert!(
+            (tip - tool.tip_mm).norm() < 1e-8,
+            "{tip} vs {}",
+            tool.tip_mm
+        );
+        assert!(
+            truth
+                .tool_axis(&pose.commands_mm, pose.head_rad)
+                .angle(&tool.axis)
+                < 1e-10
+        );
     }
 }

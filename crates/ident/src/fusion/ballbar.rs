@@ -140,7 +140,6 @@ impl SourceRows for Ballbar {
         }
     }
 
-
     fn min_redundancy(&self) -> f64 {
         4.0 * self.setups.len() as f64
     }

@@ -49,7 +49,9 @@ pub struct FusionCause {
 fn passes(f: &Fusion, s: usize) -> bool {
     f.converged
         && f.implausible.is_empty()
-        && f.sources.get(s).is_some_and(|x| x.checkable && x.explained())
+        && f.sources
+            .get(s)
+            .is_some_and(|x| x.checkable && x.explained())
 }
 
 /// The likely causes (see the module docs), most specific first.

@@ -158,7 +158,6 @@ pub fn head_angle_poses(
     out
 }
 
-
 /// The fixed parts of a fused problem.
 pub(crate) struct Problem<'a> {
     pub model: &'a FusedModel,
@@ -201,7 +200,6 @@ impl Problem<'_> {
         }
         merge(&parts.iter().collect::<Vec<_>>())
     }
-
 }
 
 /// The union of reduced problems over the same global parameters: their
@@ -668,9 +666,8 @@ fn checked_quadratic(h: &DMatrix<f64>, sign: f64, e: &[f64]) -> f64 {
             if d > CHECKED { e[0] * e[0] / d } else { 0.0 }
         }
         3 => {
-            let m = nalgebra::Matrix3::from_fn(|a, b| {
-                f64::from(u8::from(a == b)) + sign * h[(a, b)]
-            });
+            let m =
+                nalgebra::Matrix3::from_fn(|a, b| f64::from(u8::from(a == b)) + sign * h[(a, b)]);
             let eig = m.symmetric_eigen();
             let ev = nalgebra::Vector3::new(e[0], e[1], e[2]);
             (0..3)
@@ -763,7 +760,14 @@ fn finish(
         &covariance,
         options,
     )?;
-    let implausible = judge(model, &estimate, &std_dev, problem.sources, &sources, options);
+    let implausible = judge(
+        model,
+        &estimate,
+        &std_dev,
+        problem.sources,
+        &sources,
+        options,
+    );
     Ok(Fusion::assemble(
         model,
         estimate,

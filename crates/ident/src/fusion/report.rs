@@ -233,13 +233,16 @@ fn functional_std(decision: &RankDecision, covariance: &DMatrix<f64>, c: &[f64])
     Some((v.transpose() * covariance * &v)[(0, 0)].max(0.0).sqrt())
 }
 
+/// Per evaluation pose, a `3 x k` Jacobian.
+type PoseJacobians = Vec<DMatrix<f64>>;
+
 /// The tool tip's and the tool axis' Jacobians over the evaluation poses
 /// at `p` (3 x k each; the axis' in rad per unit).
 fn tip_and_axis_jacobians(
     model: &FusedModel,
     p: &[f64],
     options: &FusionOptions,
-) -> Result<(Vec<DMatrix<f64>>, Vec<DMatrix<f64>>), IdentError> {
+) -> Result<(PoseJacobians, PoseJacobians), IdentError> {
     let lever = Effector {
         extension_mm: AXIS_LEVER_MM,
         ..Effector::default()
@@ -498,38 +501,41 @@ pub(crate) fn build_report(
     };
     let held_moving_tip = held_moving(&|t| t.raw_um >= options.harmless_um);
     let held_moving_axis = held_moving(&|t| t.axis_arcsec >= HARMLESS_AXIS_ARCSEC);
-    Ok((FusionReport {
-        union: union_report,
-        sources: sources
-            .iter()
-            .zip(alone)
-            .map(|(s, d)| SourceVisibility {
-                label: s.label().to_string(),
-                report: d.report,
-            })
-            .collect(),
-        made_visible,
-        named,
-        weak,
-        invisible,
-        tool_tip: ToolTipPrediction {
-            poses: g.len(),
-            raw_rms_um: 1e3 * raw_rms,
-            raw_max_um: 1e3 * raw_max,
-            touch_off_rms_um: 1e3 * touched_rms,
-            touch_off_max_um: 1e3 * touched_max,
-            held_raw_rms_um: 1e3 * held_raw,
-            held_touch_off_rms_um: 1e3 * held_touched,
-            held_moving_tip,
+    Ok((
+        FusionReport {
+            union: union_report,
+            sources: sources
+                .iter()
+                .zip(alone)
+                .map(|(s, d)| SourceVisibility {
+                    label: s.label().to_string(),
+                    report: d.report,
+                })
+                .collect(),
+            made_visible,
+            named,
+            weak,
+            invisible,
+            tool_tip: ToolTipPrediction {
+                poses: g.len(),
+                raw_rms_um: 1e3 * raw_rms,
+                raw_max_um: 1e3 * raw_max,
+                touch_off_rms_um: 1e3 * touched_rms,
+                touch_off_max_um: 1e3 * touched_max,
+                held_raw_rms_um: 1e3 * held_raw,
+                held_touch_off_rms_um: 1e3 * held_touched,
+                held_moving_tip,
+            },
+            tool_axis: ToolAxisPrediction {
+                poses: ga.len(),
+                rms_arcsec: axis_rms / RAD_PER_ARCSEC,
+                max_arcsec: axis_max / RAD_PER_ARCSEC,
+                held_rms_arcsec: held_axis / RAD_PER_ARCSEC,
+                held_moving_axis,
+            },
         },
-        tool_axis: ToolAxisPrediction {
-            poses: ga.len(),
-            rms_arcsec: axis_rms / RAD_PER_ARCSEC,
-            max_arcsec: axis_max / RAD_PER_ARCSEC,
-            held_rms_arcsec: held_axis / RAD_PER_ARCSEC,
-            held_moving_axis,
-        },
-    }, warnings))
+        warnings,
+    ))
 }
 
 impl FusionReport {

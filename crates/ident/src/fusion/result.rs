@@ -288,9 +288,9 @@ impl Fusion {
             } else {
                 f64::NAN
             },
-            consistent_with_machine: sources
-                .iter()
-                .all(|s| s.reduced_chi_square.is_nan() || s.reduced_chi_square <= INCONSISTENT_CHI2_PER_DOF),
+            consistent_with_machine: sources.iter().all(|s| {
+                s.reduced_chi_square.is_nan() || s.reduced_chi_square <= INCONSISTENT_CHI2_PER_DOF
+            }),
             checkable: sources.iter().all(|s| s.checkable),
             plausible: implausible.is_empty(),
         };

@@ -427,7 +427,6 @@ impl SourceRows for Internal {
         3 * self.poses.len()
     }
 
-
     fn min_redundancy(&self) -> f64 {
         6.0
     }

@@ -206,13 +206,16 @@ impl SourceRows for Touch {
         1
     }
 
-
     fn min_redundancy(&self) -> f64 {
         4.0 * self.used.len() as f64
     }
 
     fn judged_nuisance(&self, values: &[f64]) -> Vec<(&'static str, usize, f64)> {
-        vec![("touch.stylus_radius_change_mm", 0, values[0] - self.stylus_mm)]
+        vec![(
+            "touch.stylus_radius_change_mm",
+            0,
+            values[0] - self.stylus_mm,
+        )]
     }
 
     fn pose(&self, record: usize) -> ExternalPose {

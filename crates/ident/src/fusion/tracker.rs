@@ -81,7 +81,7 @@ impl Source {
     /// let data = tricept_data::read_external_from::<tricept_data::TrackerPoint, _>(csv.as_bytes(), "t.csv").unwrap();
     /// let e = Source::tracker(&data, &TrackerOptions::default()).unwrap_err();
     /// assert!(e.to_string().starts_with("t.csv: station 1 has 2 points"), "{e}");
-/// assert!(e.to_string().ends_with("(lines 2, 3)"), "{e}");
+    /// assert!(e.to_string().ends_with("(lines 2, 3)"), "{e}");
     /// ```
     pub fn tracker(data: &TrackerData, options: &TrackerOptions) -> Result<Source, IdentError> {
         let (setups, setup_of) = groups(
@@ -192,7 +192,6 @@ impl SourceRows for Tracker {
             TrackerTarget::Known { .. } => 3,
         }
     }
-
 
     fn min_redundancy(&self) -> f64 {
         6.0 * self.setups.len() as f64

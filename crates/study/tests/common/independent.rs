@@ -185,9 +185,13 @@ impl TrueMachine {
         let k2 = tilted(&vec3(&h["axis2_direction"]).normalize(), 3e-4 * s, &mut rng);
         let direction0 = vec3(&h["tool_direction"]).normalize();
         let direction = tilted(&direction0, 3e-4 * s, &mut rng);
-        let along = (0.1 + 0.4 * rng.random::<f64>()) * if rng.random::<bool>() { 1.0 } else { -1.0 };
+        let along =
+            (0.1 + 0.4 * rng.random::<f64>()) * if rng.random::<bool>() { 1.0 } else { -1.0 };
         let across = perpendicular(&direction0);
-        let (e1, e2): (f64, f64) = (StandardNormal.sample(&mut rng), StandardNormal.sample(&mut rng));
+        let (e1, e2): (f64, f64) = (
+            StandardNormal.sample(&mut rng),
+            StandardNormal.sample(&mut rng),
+        );
         let tip = vec3(&h["tool_tip_mm"])
             + direction0 * along * s
             + across * 0.05 * s * e1
@@ -218,7 +222,8 @@ impl TrueMachine {
             let r_mat = rx(x[0]) * ry(x[1]);
             let r = r_mat * Vector3::new(0.0, 0.0, x[2]);
             Vector3::from_fn(|i, _| {
-                (r + r_mat * self.platform[i] - self.base[i]).norm() - (q[i] + self.leg_offsets_mm[i])
+                (r + r_mat * self.platform[i] - self.base[i]).norm()
+                    - (q[i] + self.leg_offsets_mm[i])
             })
         };
         let mut x = [0.0, 0.0, (q[0] + q[1] + q[2]) / 3.0];
@@ -310,9 +315,10 @@ impl TrueTracker {
         let dir = normal3(&mut rng, 1.0).normalize();
         let distance = 1000.0 + 2000.0 * rng.random::<f64>();
         let q: [f64; 4] = std::array::from_fn(|_| StandardNormal.sample(&mut rng));
-        let rotation = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]))
-            .to_rotation_matrix()
-            .into_inner();
+        let rotation =
+            UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]))
+                .to_rotation_matrix()
+                .into_inner();
         TrueTracker {
             rotation,
             position_mm: Vector3::new(0.0, 0.0, 1100.0) + dir * distance,
