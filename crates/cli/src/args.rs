@@ -75,6 +75,34 @@ pub struct TruthArgs {
     pub truth_effects: Vec<String>,
 }
 
+/// A reference sphere touched by a probe in the spindle (feature 1 of the
+/// features file) and the probe's stylus: nominal for `plan`, the simulated
+/// truth for `simulate`.
+#[derive(Debug, Args, Clone)]
+pub struct TouchSphereArgs {
+    /// The reference sphere's centre, mm.
+    #[arg(
+        long,
+        default_value = "0,0,1150",
+        value_name = "X,Y,Z",
+        allow_hyphen_values = true
+    )]
+    pub touch_sphere_mm: String,
+    /// The reference sphere's radius, mm.
+    #[arg(long, default_value_t = 12.7, value_name = "MM")]
+    pub touch_sphere_radius_mm: f64,
+    /// The stylus' nominal radius, mm.
+    #[arg(long, default_value_t = 1.0, value_name = "MM")]
+    pub touch_stylus_radius_mm: f64,
+    /// Standard deviation of the stylus radius (its calibration, as the
+    /// features file states it), um.
+    #[arg(long, default_value_t = 2.0, value_name = "UM")]
+    pub touch_stylus_sigma_um: f64,
+    /// Noise of a touch along the surface normal, um.
+    #[arg(long, default_value_t = 1.5, value_name = "UM")]
+    pub touch_sigma_um: f64,
+}
+
 /// How to fit.
 #[derive(Debug, Args, Clone, Default)]
 pub struct FitArgs {

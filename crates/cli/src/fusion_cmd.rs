@@ -13,9 +13,10 @@ use tricept_data::{
 };
 use tricept_ident::IdentError;
 use tricept_ident::fusion::{
-    BallbarOptions, FusedModel, Fusion, FusionOptions, Source, SourceKind, TouchOptions,
-    TrackerOptions, TrackerTarget, evaluation_poses, identify_fused,
+    BallbarOptions, FusedModel, Fusion, FusionOptions, FusionPlausibility, Source, SourceKind,
+    TouchOptions, TrackerOptions, TrackerTarget, evaluation_poses, identify_fused,
 };
+use tricept_kinematics::description::ExternalSourceRecord;
 use tricept_model::effects::EffectName;
 
 use crate::args::{check_commands, load_with_noise, read_data};
@@ -37,11 +38,12 @@ pub struct ExternalArgs {
     /// Standard deviation of a tracker coordinate for rows without `sigma_um`, um.
     #[arg(long, default_value_t = 10.0, value_name = "UM")]
     pub tracker_sigma_um: f64,
-    /// The tracker target's offset from the tool tip: `free` (unknown: the
-    /// tool tip is then not calibrated), `tip` (at the tip), or `X,Y,Z` mm
-    /// in the spindle frame at zero head angles.
-    #[arg(long, default_value = "free", value_name = "free|tip|X,Y,Z")]
-    pub tracker_target: String,
+    /// Where the tracker's target sits (required with --tracker; no
+    /// default): `tip` (in a nest at the tool tip), `X,Y,Z` (a known offset
+    /// from the tip, mm, spindle frame at zero head angles) or `free`
+    /// (unknown: the tool tip is then not calibrated).
+    #[arg(long, value_name = "tip|X,Y,Z|free", allow_hyphen_values = true)]
+    pub tracker_target: Option<String>,
     /// Standard deviation of a known target offset, um.
     #[arg(long, default_value_t = 5.0, value_name = "UM")]
     pub tracker_target_sigma_um: f64,
@@ -83,6 +85,14 @@ pub struct ExternalArgs {
     /// Head angles of the evaluation grid, deg: `H1,H1,...:H2,H2,...`.
     #[arg(long, default_value = "0,90,180,270:15,35", value_name = "H1S:H2S")]
     pub eval_head_angles_deg: String,
+    /// Override plausible ranges of the head, tool and instrument
+    /// estimates: a JSON object `{"tool_length_mm": [-5, 5]}` (keys and
+    /// defaults in docs/hybrid.md).
+    #[arg(long, value_name = "FILE.json")]
+    pub plausibility: Option<PathBuf>,
+    /// Warn when the predicted tool-axis uncertainty exceeds this, arcsec.
+    #[arg(long, default_value_t = 30.0, value_name = "ARCSEC")]
+    pub tool_axis_warn_arcsec: f64,
 }
 
 impl ExternalArgs {
@@ -174,6 +184,36 @@ fn data_error(e: tricept_data::DataError) -> CliError {
     CliError::input(e.to_string())
 }
 
+/// `--tracker-target` as a target statement, with the standard deviation
+/// of a known offset; an input error when it is not given (there is no
+/// default: following `plan` or not, the statement changes what is
+/// calibrated).
+pub fn tracker_target(text: Option<&str>, sigma_um: f64) -> Result<TrackerTarget, CliError> {
+    let Some(text) = text else {
+        return Err(CliError::input(
+            "--tracker-target is required with a tracker: state where its target sits: `tip` (in a nest at the tool tip), `X,Y,Z` (a known offset from the tip, mm, spindle frame at zero head angles) or `free` (unknown: the tool tip is then not calibrated)",
+        ));
+    };
+    Ok(match text {
+        "free" => TrackerTarget::Free,
+        "tip" => TrackerTarget::Known {
+            offset_mm: [0.0; 3],
+            sigma_um: positive("--tracker-target-sigma-um", sigma_um)?,
+        },
+        text => {
+            let v = parse_numbers("--tracker-target", text, 3).map_err(|_| {
+                CliError::input(format!(
+                    "--tracker-target: expected `tip`, `free` or X,Y,Z in mm, got `{text}`"
+                ))
+            })?;
+            TrackerTarget::Known {
+                offset_mm: [v[0], v[1], v[2]],
+                sigma_um: positive("--tracker-target-sigma-um", sigma_um)?,
+            }
+        }
+    })
+}
+
 /// The sources of `a`: the internal data and every external file.
 fn sources(
     a: &IdentifyArgs,
@@ -182,19 +222,10 @@ fn sources(
     let x = &a.external;
     let data = read_data(a.data.as_path(), machine)?;
     let mut sources = vec![Source::internal(&data, machine.sensors.logged_sigma())];
-    let target = match x.tracker_target.as_str() {
-        "free" => TrackerTarget::Free,
-        "tip" => TrackerTarget::Known {
-            offset_mm: [0.0; 3],
-            sigma_um: positive("--tracker-target-sigma-um", x.tracker_target_sigma_um)?,
-        },
-        text => {
-            let v = parse_numbers("--tracker-target", text, 3)?;
-            TrackerTarget::Known {
-                offset_mm: [v[0], v[1], v[2]],
-                sigma_um: positive("--tracker-target-sigma-um", x.tracker_target_sigma_um)?,
-            }
-        }
+    let target = if x.tracker.is_empty() {
+        TrackerTarget::Free
+    } else {
+        tracker_target(x.tracker_target.as_deref(), x.tracker_target_sigma_um)?
     };
     let tracker = TrackerOptions {
         sigma_um: positive("--tracker-sigma-um", x.tracker_sigma_um)?,
@@ -354,23 +385,64 @@ pub fn run(a: &IdentifyArgs) -> Result<u8, CliError> {
     let machine = loaded.machine.clone();
     let set = a.settings.params.set()?;
     let x = &a.external;
+    if x.tracker.is_empty() && x.tracker_target.is_some() {
+        return Err(CliError::input(
+            "--tracker-target: there is no --tracker file to state the target of",
+        ));
+    }
     let mut model = fused_model(&machine, &set, &x.effects, x.head.as_deref())?;
+    if a.write_machine.is_some() && !model.effects().is_empty() {
+        let names: Vec<&str> = model.effects().iter().map(|e| e.as_str()).collect();
+        return Err(CliError::input(format!(
+            "--write-machine: {} fitted, but the machine format cannot carry {}; write a geometric fit (without --effects) or compensate with the fused model",
+            names.join(", "),
+            if names.len() == 1 { "it" } else { "them" }
+        )));
+    }
     // A calibrated machine: the rank decision of its nominal machine, as in
     // `identify` (docs/identifiability.md).
     if let Some(reference) = loaded.rank_reference()? {
         model = model.with_rank_reference(reference).map_err(fusion_error)?;
     }
-    let options = eval_options(&machine, &x.eval_grid, &x.eval_head_angles_deg)?;
+    let mut options = eval_options(&machine, &x.eval_grid, &x.eval_head_angles_deg)?;
+    if a.settings.fit.no_robust {
+        options.screen = None;
+    }
+    if let Some(path) = &x.plausibility {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| CliError::input(format!("--plausibility {}: {e}", path.display())))?;
+        options.plausibility = FusionPlausibility::with_overrides(&text)
+            .map_err(|e| CliError::input(format!("--plausibility {}: {e}", path.display())))?;
+    }
+    options.tool_axis_arcsec = positive("--tool-axis-warn-arcsec", x.tool_axis_warn_arcsec)?;
     let sources = sources(a, &machine)?;
     let fit = identify_fused(&model, &sources, &options).map_err(fusion_error)?;
-    let deployed = match &a.write_machine {
-        Some(path) => Some(write_machine(a, path, &model, &fit, &sources)?),
-        None => None,
+    // The exit codes of `identify`: 4 not converged, 3 converged but not to
+    // be trusted (a source not explained or not checkable, an implausible
+    // estimate).
+    let code = if !fit.converged {
+        EXIT_NOT_CONVERGED
+    } else if !fit.is_trustworthy() {
+        EXIT_UNTRUSTED
+    } else {
+        0
+    };
+    let refused = a.write_machine.as_ref().filter(|_| code != 0 && !a.force);
+    let deployed = match (&a.write_machine, refused) {
+        (Some(path), None) => Some(write_machine(a, path, &model, &fit, &sources, code)?),
+        (Some(path), Some(_)) => {
+            Some(json!({"written": Value::Null, "refused": path.display().to_string()}))
+        }
+        (None, _) => None,
     };
     if a.settings.machine.json {
         let mut v = fit.to_json(&model);
-        if let (Value::Object(o), Some(d)) = (&mut v, &deployed) {
-            o.insert("deployed".into(), d.clone());
+        if let Value::Object(o) = &mut v {
+            o.insert("machine".into(), loaded.description.name.clone().into());
+            o.insert("data_file".into(), a.data.display().to_string().into());
+            if let Some(d) = &deployed {
+                o.insert("deployed".into(), d.clone());
+            }
         }
         outln!("{v}");
     } else {
@@ -379,19 +451,64 @@ pub fn run(a: &IdentifyArgs) -> Result<u8, CliError> {
     for w in &fit.warnings {
         errln!("warning: {w}");
     }
-    // The exit codes of `identify`: 4 not converged, 3 converged but a
-    // source not explained.
-    if !fit.converged {
-        errln!("identify: exit {EXIT_NOT_CONVERGED}: the fused fit did not converge");
-        return Ok(EXIT_NOT_CONVERGED);
+    if let Some(path) = refused {
+        return Err(CliError {
+            code,
+            message: format!(
+                "--write-machine {}: not written: {}; --force writes it anyway, marked as forced",
+                path.display(),
+                refusal_reason(&fit)
+            ),
+        });
     }
-    if !fit.is_trustworthy() {
-        errln!(
-            "identify: exit {EXIT_UNTRUSTED}: the fit completed but must not be trusted as it stands (see the warnings)"
-        );
-        return Ok(EXIT_UNTRUSTED);
+    match code {
+        EXIT_NOT_CONVERGED => {
+            errln!("identify: exit {code}: the fused fit did not converge");
+        }
+        EXIT_UNTRUSTED => errln!(
+            "identify: exit {code}: the fit completed but must not be trusted as it stands: {}",
+            refusal_reason(&fit)
+        ),
+        _ => {}
     }
-    Ok(0)
+    Ok(code)
+}
+
+/// Why a fused fit must not be deployed, in one clause per reason.
+fn refusal_reason(fit: &Fusion) -> String {
+    let v = &fit.verdict;
+    let mut why = Vec::new();
+    if !v.converged {
+        why.push("the fused fit did not converge".to_string());
+    }
+    for s in fit.sources.iter().filter(|s| !s.checkable) {
+        why.push(format!(
+            "{} cannot be checked: at least {} more records make it checkable",
+            s.label,
+            s.more_records.unwrap_or(1)
+        ));
+    }
+    let unexplained: Vec<&str> = fit
+        .sources
+        .iter()
+        .filter(|s| s.checkable && !s.explained())
+        .map(|s| s.label.as_str())
+        .collect();
+    if !unexplained.is_empty() {
+        why.push(format!(
+            "the model does not explain {}",
+            unexplained.join(", ")
+        ));
+    }
+    if !fit.implausible.is_empty() {
+        let names: Vec<&str> = fit.implausible.iter().map(|i| i.name.as_str()).collect();
+        why.push(format!("implausible estimates: {}", names.join(", ")));
+    }
+    if why.is_empty() {
+        "see the warnings".into()
+    } else {
+        format!("{} (see the warnings)", why.join("; "))
+    }
 }
 
 fn print_text(model: &FusedModel, fit: &Fusion, sources: &[Source]) {
@@ -400,6 +517,9 @@ fn print_text(model: &FusedModel, fit: &Fusion, sources: &[Source]) {
         .map(|s| format!("{} {} ({} records)", s.label(), s.file(), s.records()))
         .collect();
     outln!("fused identification: {}", list.join(", "));
+    for r in &fit.rejected {
+        outln!("{}", r.to_text());
+    }
     let effects: Vec<&str> = model.effects().iter().map(|e| e.as_str()).collect();
     outln!(
         "model: {}{}{}; {} in {} Gauss-Newton iterations",
@@ -429,12 +549,24 @@ fn print_text(model: &FusedModel, fit: &Fusion, sources: &[Source]) {
         }
     }
     for s in &fit.sources {
+        let check = if s.checkable {
+            format!(
+                "chi2/dof {:.3} (p = {:.2e})",
+                s.reduced_chi_square, s.p_value
+            )
+        } else {
+            format!(
+                "NOT checkable (needs {:.0}; at least {} more records)",
+                s.min_redundancy,
+                s.more_records.unwrap_or(1)
+            )
+        };
         outln!(
-            "{} ({}): chi2/dof {:.3} (dof {:.1}){}; largest {:.1} sigma at line {}",
+            "{} ({}): {} records, redundancy {:.1}: {check}{}; largest {:.1} sigma at line {}",
             s.label,
             s.file,
-            s.reduced_chi_square,
-            s.dof_share,
+            s.records,
+            s.redundancy,
             s.rms_um
                 .map(|r| format!(", rms {r:.2} um"))
                 .unwrap_or_default(),
@@ -451,45 +583,55 @@ fn print_text(model: &FusedModel, fit: &Fusion, sources: &[Source]) {
         }
     }
     crate::output::write_text(&fit.report.to_text());
+    let v = &fit.verdict;
+    outln!(
+        "verdict: {}, {}, {}, {}",
+        if v.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        },
+        if v.checkable {
+            "every source checkable"
+        } else {
+            "NOT every source checkable"
+        },
+        if v.adequate {
+            "adequate (the model explains every source to its stated noise)"
+        } else {
+            "NOT adequate"
+        },
+        if v.plausible {
+            "every estimate plausible"
+        } else {
+            "implausible estimates"
+        }
+    );
     for w in &fit.warnings {
-        outln!("warning: {w}");
+        outln!("WARNING: {w}");
     }
 }
 
 /// Writes the calibrated machine: the module explicit, the head's fields
 /// and angle offsets from the estimate, and the `calibration` record (as
-/// `identify` writes it, with every external file and its hash). Refuses
-/// fitted effects, which the geometric machine format cannot carry, and a
-/// fit that is not to be trusted unless `--force` (then marked forced).
+/// `identify` writes it, with every external file, its hash and its
+/// fitted nuisance); the caller refuses fitted effects, which the geometric
+/// machine format cannot carry, and a fit with a non-zero exit `code`
+/// unless `--force` (then it is marked forced).
 fn write_machine(
     a: &IdentifyArgs,
     path: &Path,
     model: &FusedModel,
     fit: &Fusion,
     sources: &[Source],
+    code: u8,
 ) -> Result<Value, CliError> {
-    if !model.effects().is_empty() {
-        let names: Vec<&str> = model.effects().iter().map(|e| e.as_str()).collect();
-        return Err(CliError::input(format!(
-            "--write-machine: {} fitted, but the machine format cannot carry {}; write a geometric fit (without --effects) or compensate with the fused model",
-            names.join(", "),
-            if names.len() == 1 { "it" } else { "them" }
-        )));
-    }
-    let (code, why) = if !fit.converged {
-        (EXIT_NOT_CONVERGED, "the fused fit did not converge")
-    } else if !fit.is_trustworthy() {
-        (
-            EXIT_UNTRUSTED,
-            "the model does not explain every source (see the warnings)",
-        )
-    } else {
-        (0, "")
-    };
+    // The caller refused a non-zero code without --force; with it the
+    // file says it was forced (the one rule of `machine_file::write_rule`).
     let forced = machine_file::write_rule(
         &format!("--write-machine {}", path.display()),
         code,
-        why,
+        &refusal_reason(fit),
         a.force,
     )?;
     let held: Vec<String> = fit
@@ -500,17 +642,37 @@ fn write_machine(
         .map(|(_, n)| n.clone())
         .collect();
     let loaded = load_with_noise(&a.settings.machine, &a.settings.noise)?;
-    let external: Vec<(String, &Path, usize, f64)> = sources
+    let external: Vec<(&Path, ExternalSourceRecord)> = sources
         .iter()
         .zip(&fit.sources)
         .filter(|(s, _)| s.kind() != SourceKind::Internal)
         .map(|(s, f)| {
-            (
-                s.kind().as_str().to_string(),
-                Path::new(s.file()),
-                s.records(),
-                f.reduced_chi_square,
-            )
+            let nuisance = f
+                .nuisance_names
+                .iter()
+                .zip(f.nuisance.iter().zip(&f.nuisance_std_dev))
+                .map(|(n, (v, sd))| (n.clone(), json!({"value": v, "std_dev": sd})))
+                .collect();
+            let record = ExternalSourceRecord {
+                kind: s.kind().as_str().to_string(),
+                file: s.file().to_string(),
+                sha256: String::new(),
+                records: f.records,
+                chi2_per_dof: f
+                    .reduced_chi_square
+                    .is_finite()
+                    .then_some(f.reduced_chi_square),
+                redundancy: f.redundancy,
+                checkable: f.checkable,
+                rejected_lines: fit
+                    .rejected
+                    .iter()
+                    .filter(|r| r.label == f.label)
+                    .map(|r| r.line)
+                    .collect(),
+                nuisance,
+            };
+            (Path::new(s.file()), record)
         })
         .collect();
     let mut d = machine_file::calibrated_description(
@@ -521,7 +683,12 @@ fn write_machine(
             method: "identify (fused)",
             data_file: a.data.as_path(),
             parameter_set: &format!("{} + head", a.settings.params.set()?.label()),
-            rejected_lines: Vec::new(),
+            rejected_lines: fit
+                .rejected
+                .iter()
+                .filter(|r| r.label == "internal")
+                .map(|r| r.line)
+                .collect(),
             adequate: fit.is_trustworthy(),
             forced,
             warnings: fit.warnings.clone(),

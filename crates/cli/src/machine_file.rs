@@ -42,9 +42,9 @@ pub struct Provenance<'a> {
     /// geometric ones, and the head's of a fused fit; the rest are effects,
     /// recorded under `effects`).
     pub n_geometric: usize,
-    /// External measurement files of a fused fit: kind, file, records,
-    /// chi-square per degree of freedom.
-    pub external: Vec<(String, &'a Path, usize, f64)>,
+    /// External measurement files of a fused fit: the file and its record
+    /// (the hash is filled in when written).
+    pub external: Vec<(&'a Path, ExternalSourceRecord)>,
 }
 
 /// What the record needs of a fit, whether from the UP limb's data alone
@@ -90,7 +90,7 @@ impl<'a> FitRecord<'a> {
             std::array::from_fn(|c| v.get(c).copied().unwrap_or(f64::NAN))
         };
         let chi2: f64 = fit.sources.iter().map(|s| s.chi_square).sum();
-        let dof: f64 = fit.sources.iter().map(|s| s.dof_share).sum();
+        let dof: f64 = fit.sources.iter().map(|s| s.redundancy).sum();
         FitRecord {
             names: &fit.names,
             estimate: &fit.estimate,
@@ -175,8 +175,20 @@ fn civil_from_days(z: i64) -> (i64, u32, u32) {
     (y, m, d)
 }
 
-/// Why each held parameter was held, from the identifiability report.
-fn held(id: &FitRecord<'_>, reference: &str) -> Vec<HeldParameter> {
+/// The unit of a parameter, from its name (`_rad`, `_ppm`; else mm).
+fn unit_of(name: &str) -> &'static str {
+    if name.ends_with("_rad") {
+        "rad"
+    } else if name.ends_with("_ppm") {
+        "ppm"
+    } else {
+        "mm"
+    }
+}
+
+/// Why each held parameter was held, from the identifiability report;
+/// `seen_by` names the data (the UP limb's sensors, or every fused source).
+fn held(id: &FitRecord<'_>, reference: &str, seen_by: &str) -> Vec<HeldParameter> {
     let r = id.report;
     let s1 = r.singular_values.first().copied().unwrap_or(0.0);
     r.fixed
@@ -190,13 +202,15 @@ fn held(id: &FitRecord<'_>, reference: &str) -> Vec<HeldParameter> {
                 .map_or(0.0, |j| id.estimate[j]);
             let reason = match r.unidentifiable.get(i) {
                 Some(c) => format!(
-                    "unidentifiable from the UP limb's sensors on {reference}: the combination {} has singular value {:.1e} of the largest, below the rank tolerance {:.0e}; held at its prior value {value} mm",
+                    "unidentifiable from {seen_by} on {reference}: the combination {} has singular value {:.1e} of the largest, below the rank tolerance {:.0e}; held at its prior value {value} {}",
                     c.to_text(),
                     if s1 > 0.0 { c.singular_value / s1 } else { 0.0 },
-                    r.rank_tolerance
+                    r.rank_tolerance,
+                    unit_of(name)
                 ),
                 None => format!(
-                    "held at its prior value {value} mm by the rank decision on {reference}"
+                    "held at its prior value {value} {} by the rank decision on {reference}",
+                    unit_of(name)
                 ),
             };
             HeldParameter {
@@ -287,7 +301,15 @@ pub fn calibrated_description(
             s_mm: id.offsets[2],
             std_dev: id.offsets_std_dev,
         },
-        held: held(id, &reference),
+        held: held(
+            id,
+            &reference,
+            if p.external.is_empty() {
+                "the UP limb's sensors"
+            } else {
+                "the internal and external data together"
+            },
+        ),
         chi2_per_dof: id.chi2_per_dof,
         dof: id.dof,
         converged: id.converged,
@@ -303,13 +325,10 @@ pub fn calibrated_description(
         external_sources: p
             .external
             .iter()
-            .map(|(kind, file, records, chi2)| {
+            .map(|(file, record)| {
                 Ok(ExternalSourceRecord {
-                    kind: kind.clone(),
-                    file: file.display().to_string(),
                     sha256: sha256_file(file)?,
-                    records: *records,
-                    chi2_per_dof: *chi2,
+                    ..record.clone()
                 })
             })
             .collect::<Result<_, CliError>>()?,

@@ -99,14 +99,14 @@ enum Command {
     /// touch-offs) that also calibrate the head.
     #[command(
         allow_negative_numbers = true,
-        after_help = "Exit codes: 0 converged, adequate (the model explains the data to the sensor noise) and worthwhile; 3 converged but the model does not explain the data (the report names `tricept diagnose`), or the campaign is too small to calibrate (the report names the poses that would); 4 did not converge; 2 bad input. --write-machine writes only an exit-0 fit (--force writes any, marked as forced).\n\nWith --tracker, --ballbar, --touch, --head or --effects the fused identification runs (`tricept docs hybrid`): module, head (13 parameters) and each instrument's nuisance in one fit; exit code 3 when it converges but a source is not explained (reduced chi-square > 3), 4 when it does not converge.\n\nExamples:\n  tricept simulate --out data.csv && tricept identify --data data.csv\n  tricept identify --data data.csv --json\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept identify --data data.csv --tracker points.csv --tracker-target tip --write-machine calibrated.json"
+        after_help = "Exit codes: 0 converged, adequate (the model explains the data to the sensor noise) and worthwhile; 3 converged but the model does not explain the data (the report names `tricept diagnose`), or the campaign is too small to calibrate (the report names the poses that would); 4 did not converge; 2 bad input. --write-machine writes only an exit-0 fit (--force writes any, marked as forced).\n\nWith --tracker, --ballbar, --touch, --head or --effects the fused identification runs (`tricept docs hybrid`): module, head (13 parameters) and each instrument's nuisance in one fit, every source's records screened for gross errors (rejected by file and line); a tracker states where its target sits (--tracker-target tip|X,Y,Z|free, no default). Exit code 3 when it converges but is not to be trusted: a source whose rows cannot check the fit (too few redundant rows; the report says how many more points), a source the model does not explain (chi-square test at 0.001), or an estimate outside its plausible range (the likely cause, tested by refitting, is named); 4 when it does not converge. --write-machine prints the report and the warnings, then refuses such a fit unless --force.\n\nExamples:\n  tricept simulate --out data.csv && tricept identify --data data.csv\n  tricept identify --data data.csv --json\n  tricept identify --data data.csv --write-machine calibrated.json\n  tricept identify --data data.csv --tracker points.csv --tracker-target tip --write-machine calibrated.json"
     )]
     Identify(ident_cmd::IdentifyArgs),
     /// Write a measured-data CSV from a simulated machine (Table 2 errors by
     /// default) with sensor noise, offsets and optional unmodelled effects.
     #[command(
         allow_negative_numbers = true,
-        after_help = "True errors (--truth): table2, zero, random:MAG_MM[,SEED], or a JSON file {name: mm}.\nEffects (--truth-effect, repeatable): a JSON object or @FILE, e.g. '{\"effect\":\"leg-lead\",\"ppm\":[50,-30,40]}' (see `tricept docs diagnosis` for every effect and its units).\n\nExamples:\n  tricept simulate --out data.csv\n  tricept simulate --truth random:1.0,3 --poses random:100,2 --seed 9 --out data.csv\n  tricept simulate --truth-effect '{\"effect\":\"backlash\",\"um\":[6,5,8]}' --both-directions --out data.csv"
+        after_help = "True errors (--truth): table2, zero, random:MAG_MM[,SEED], or a JSON file {name: mm}.\nEffects (--truth-effect, repeatable): a JSON object or @FILE, e.g. '{\"effect\":\"leg-lead\",\"ppm\":[50,-30,40]}' (see `tricept docs diagnosis` for every effect and its units).\n\nExamples:\n  tricept simulate --out data.csv\n  tricept simulate --truth random:1.0,3 --poses random:100,2 --seed 9 --out data.csv\n  tricept simulate --truth-effect '{\"effect\":\"backlash\",\"um\":[6,5,8]}' --both-directions --out data.csv\n  tricept simulate --head-errors random:1,3 --out data.csv --tracker-out t.csv --tracker-poses points.csv\n  tricept simulate --out data.csv --touch-out touch.csv --features-out features.json --touch-poses touches.csv"
     )]
     Simulate(simulate_cmd::SimulateArgs),
     /// Does the geometric model explain the data? If not, which unmodelled
@@ -132,12 +132,14 @@ enum Command {
         after_help = "Without --truth only the correction the identified model predicts is known; with the true errors of simulated data (--truth table2 ...) the before/after error of the actual machine is reported. Exit codes as for identify (0, 3, 4, 2).\n\nExamples:\n  tricept compensate --data data.csv --truth table2 --map out/\n  tricept compensate --data data.csv --targets points.csv > commands.csv\n  tricept compensate --machine calibrated.json --table out/"
     )]
     Compensate(compensate_cmd::CompensateArgs),
-    /// Plan a few external measurements (tracker points, ballbar readings):
-    /// which to take so that the tool tip is best known after touch-off,
-    /// and the predicted accuracy against their number.
+    /// Plan a few external measurements (tracker points, ballbar readings,
+    /// touch-offs on a reference sphere): which to take so that the tool tip
+    /// (and with --extensions the tool axis) is best known after touch-off,
+    /// the predicted accuracy against their number, the redundancy each
+    /// leaves to check the fit, and the recommended number.
     #[command(
         allow_negative_numbers = true,
-        after_help = "Criterion: the RMS over the evaluation tool poses of the predicted tool-tip standard deviation after touch-off (a Bayesian A-optimal design with the parameters' typical sizes as prior; `tricept docs hybrid`).\n\nExamples:\n  tricept plan --instrument tracker --k 5,12,30 --out points.csv\n  tricept plan --instrument ballbar --ballbar-pivot-mm 0,0,1250 --target-um 15"
+        after_help = "Criterion: the RMS over the evaluation tool poses of the predicted tool-tip standard deviation after touch-off (a Bayesian A-optimal design with the parameters' typical sizes as prior; with two or more --extensions the tool axis too; `tricept docs hybrid`). Recommended: the smallest k asked for that reaches --target-um and leaves at least 6 redundant rows per tracker station (4 per ballbar setup or touched sphere).\n\nExamples:\n  tricept plan --instrument tracker --tracker-target tip --k 5,12,30 --target-um 25 --out points.csv\n  tricept plan --instrument tracker --tracker-target tip --extensions 0,100 --k 20 --out points.csv\n  tricept plan --instrument ballbar --ballbar-pivot-mm 0,0,1250 --target-um 15\n  tricept plan --instrument touch --k 30 --out touches.csv"
     )]
     Plan(plan_cmd::PlanArgs),
     /// The documentation pages (data formats, conventions, diagnosis, ...),
@@ -184,6 +186,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
             r.inputs("--ballbar", &x.ballbar);
             r.inputs("--touch", &x.touch);
             r.inputs("--features", &x.features);
+            r.inputs("--plausibility", &x.plausibility);
             if let Some(p) = &a.write_machine {
                 r.output("--write-machine", p);
             }
@@ -200,10 +203,13 @@ fn file_roles(command: &Command) -> files::FileRoles {
             r.input_if_file("--head-errors", &a.head_errors);
             r.inputs("--tracker-poses", &a.tracker_poses);
             r.inputs("--ballbar-poses", &a.ballbar_poses);
+            r.inputs("--touch-poses", &a.touch_poses);
             for (flag, p) in [
                 ("--out", &a.out),
                 ("--tracker-out", &a.tracker_out),
                 ("--ballbar-out", &a.ballbar_out),
+                ("--touch-out", &a.touch_out),
+                ("--features-out", &a.features_out),
             ] {
                 if let Some(p) = p {
                     r.output(flag, p);

@@ -1,7 +1,8 @@
-//! `tricept plan`: which few tracker points or ballbar readings to take,
-//! given the internal campaign, so that the tool tip is best known after
-//! touch-off; and the predicted accuracy against their number
-//! (`tricept_study::plan`).
+//! `tricept plan`: which few tracker points, ballbar readings or touch-offs
+//! to take, given the internal campaign, so that the tool tip (and with
+//! known extensions the tool axis) is best known after touch-off; the
+//! predicted accuracy against their number, the redundancy each leaves to
+//! check the fit, and the recommended number (`tricept_study::plan`).
 
 use std::path::PathBuf;
 
@@ -9,16 +10,19 @@ use clap::{Args, ValueEnum};
 use nalgebra::Vector3;
 use serde_json::json;
 use tricept_data::{ExternalData, PlannedPose};
-use tricept_ident::fusion::{Source, TrackerOptions, TrackerTarget, head_angle_poses, information};
+use tricept_ident::fusion::{Source, TrackerOptions, head_angle_poses, information_factor};
 use tricept_study::plan::{
-    PlanProblem, ballbar_candidates, candidate_rows, internal_information, nominal_ballbar_data,
-    nominal_tracker_data, plan,
+    PlanProblem, candidate_rows, internal_factor, nominal_ballbar_data, nominal_touch_data,
+    nominal_tracker_data, plan, sphere_candidates, with_extensions,
 };
 
-use crate::args::{MachineArgs, NoiseArgs, ParamArgs, machine_with_noise, pose_targets, read_data};
+use crate::args::{
+    MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs, machine_with_noise, pose_targets, read_data,
+};
 use crate::cli_error::CliError;
 use crate::fusion_cmd::{
     eval_options, fused_model, fusion_error, parse_head_angles, parse_numbers, positive,
+    tracker_target,
 };
 use crate::limits;
 
@@ -29,6 +33,8 @@ pub enum Instrument {
     Tracker,
     /// A ballbar from the spindle ball to a pivot on the table.
     Ballbar,
+    /// A touch probe in the spindle on a reference sphere.
+    Touch,
 }
 
 /// `tricept plan`.
@@ -57,13 +63,33 @@ pub struct PlanArgs {
         value_name = "H1S:H2S"
     )]
     pub head_angles_deg: String,
-    /// Noise of the instrument, um (default: 10 for a tracker coordinate,
-    /// 1 for a ballbar reading).
-    #[arg(long, value_name = "UM")]
+    /// Known extensions of the tracker target along the tool, mm: every
+    /// candidate pose is offered at each; with two or more the plan fixes
+    /// the tool's direction too (its criterion adds the tool axis).
+    #[arg(
+        long,
+        default_value = "0",
+        value_delimiter = ',',
+        value_name = "MM,..."
+    )]
+    pub extensions: Vec<f64>,
+    /// Noise of a tracker coordinate, um.
+    #[arg(long, default_value_t = 10.0, value_name = "UM")]
+    pub tracker_sigma_um: f64,
+    /// Noise of a ballbar reading, um.
+    #[arg(long, default_value_t = 1.0, value_name = "UM")]
+    pub ballbar_sigma_um: f64,
+    /// The instrument's noise (old name of the three flags above).
+    #[arg(long, hide = true, value_name = "UM")]
     pub sigma_um: Option<f64>,
-    /// A tracker target `tip` (at the tool tip, 5 um) or `free`.
-    #[arg(long, default_value = "tip", value_name = "tip|free")]
-    pub tracker_target: String,
+    /// Where the tracker's target sits (required for a tracker; no
+    /// default): `tip`, `X,Y,Z` (a known offset, mm, spindle frame at zero
+    /// head angles) or `free`.
+    #[arg(long, value_name = "tip|X,Y,Z|free", allow_hyphen_values = true)]
+    pub tracker_target: Option<String>,
+    /// Standard deviation of a known target offset, um.
+    #[arg(long, default_value_t = 5.0, value_name = "UM")]
+    pub tracker_target_sigma_um: f64,
     /// The ballbar's pivot, mm.
     #[arg(
         long,
@@ -75,14 +101,18 @@ pub struct PlanArgs {
     /// The ballbar's nominal length, mm.
     #[arg(long, default_value_t = 150.0, value_name = "MM")]
     pub ballbar_length_mm: f64,
-    /// Number of ballbar candidate ball positions.
+    /// Number of ballbar (or touch) candidate positions.
     #[arg(long, default_value_t = 300, value_name = "N")]
     pub ballbar_candidates: usize,
+    /// The reference sphere (touch-offs).
+    #[command(flatten)]
+    pub touch: TouchSphereArgs,
     /// Effects in the model (as for `identify --effects`).
     #[arg(long, value_name = "NAMES", value_delimiter = ',')]
     pub effects: Vec<String>,
-    /// The accuracy to reach, um: the report names the smallest planned k
-    /// that predicts it.
+    /// The accuracy to reach, um: the report recommends the smallest
+    /// planned k that predicts it and leaves its rows enough redundancy to
+    /// check the fit.
     #[arg(long, value_name = "UM")]
     pub target_um: Option<f64>,
     /// Random selections per k for the baseline (0: none).
@@ -101,7 +131,8 @@ pub struct PlanArgs {
     #[arg(long, default_value = "0,90,180,270:15,35", value_name = "H1S:H2S")]
     pub eval_head_angles_deg: String,
     /// Write the planned poses for the largest k (CSV
-    /// `q1,q2,q3,h1,h2,x,y,z[,length]`, nominal tool tip and bar length).
+    /// `q1,q2,q3,h1,h2[,extension_mm],x,y,z[,length][,feature]`: nominal
+    /// tool tip, bar length, feature touched).
     #[arg(long, value_name = "FILE.csv")]
     pub out: Option<PathBuf>,
     #[command(flatten)]
@@ -110,6 +141,33 @@ pub struct PlanArgs {
     pub noise: NoiseArgs,
     #[command(flatten)]
     pub machine: MachineArgs,
+}
+
+/// The instrument's noise: its own flag, or the old `--sigma-um`.
+fn instrument_sigma(a: &PlanArgs, own: f64, flag: &str) -> Result<f64, CliError> {
+    match a.sigma_um {
+        Some(v) => positive("--sigma-um", v),
+        None => positive(flag, own),
+    }
+}
+
+/// The features file of a touch plan: one sphere (id 1) and the stylus.
+pub fn touch_features(
+    sphere_radius_mm: f64,
+    stylus_radius_mm: f64,
+    stylus_sigma_um: f64,
+) -> tricept_data::Features {
+    tricept_data::Features {
+        stylus: tricept_data::Stylus {
+            radius_mm: stylus_radius_mm,
+            radius_sigma_um: stylus_sigma_um,
+        },
+        features: vec![tricept_data::Feature::Sphere {
+            id: 1,
+            radius_mm: sphere_radius_mm,
+            radius_sigma_um: 0.5,
+        }],
+    }
 }
 
 /// `tricept plan`.
@@ -143,22 +201,32 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
     let (f_int, internal_poses) = match &a.data {
         Some(path) => {
             let data = read_data(path, &m)?;
-            let f = information(&model, &[Source::internal(&data, m.sensors.logged_sigma())])
-                .map_err(fusion_error)?;
+            let f =
+                information_factor(&model, &[Source::internal(&data, m.sensors.logged_sigma())])
+                    .map_err(fusion_error)?;
             (f, data.poses.len())
         }
         None => {
             let targets = pose_targets(&a.poses, &m)?;
-            let f = internal_information(&model, &targets)
+            let f = internal_factor(&model, &targets)
                 .map_err(|e| CliError::input(format!("--poses {}: {e}", a.poses)))?;
             (f, targets.len())
         }
     };
-    let (poses, source, pivot) = match a.instrument {
+    let (poses, source, centre) = match a.instrument {
         Instrument::Tracker => {
+            let target = tracker_target(a.tracker_target.as_deref(), a.tracker_target_sigma_um)?;
             let (h1, h2) = parse_head_angles("--head-angles-deg", &a.head_angles_deg)?;
+            if a.extensions
+                .iter()
+                .any(|e| !e.is_finite() || e.abs() > 1000.0)
+            {
+                return Err(CliError::input(
+                    "--extensions: expected extensions along the tool in mm, within ±1000",
+                ));
+            }
             let points = pose_targets(&a.candidates, &m)?;
-            let count = points.len() * h1.len() * h2.len();
+            let count = points.len() * h1.len() * h2.len() * a.extensions.len().max(1);
             if count > limits::MAX_CANDIDATES {
                 return Err(CliError::input(format!(
                     "--candidates {} with --head-angles-deg {}: {count} candidate poses; at most {}",
@@ -167,31 +235,30 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
                     limits::MAX_CANDIDATES
                 )));
             }
-            let poses = head_angle_poses(&m, &points, &h1, &h2);
-            let target = match a.tracker_target.as_str() {
-                "tip" => TrackerTarget::Known {
-                    offset_mm: [0.0; 3],
-                    sigma_um: 5.0,
-                },
-                "free" => TrackerTarget::Free,
-                other => {
-                    return Err(CliError::input(format!(
-                        "--tracker-target: expected tip or free, got `{other}`"
-                    )));
-                }
-            };
+            let poses = with_extensions(&head_angle_poses(&m, &points, &h1, &h2), &a.extensions);
             let data = nominal_tracker_data(&model, &poses).map_err(study_error)?;
             let options = TrackerOptions {
-                sigma_um: positive("--sigma-um", a.sigma_um.unwrap_or(10.0))?,
+                sigma_um: instrument_sigma(a, a.tracker_sigma_um, "--tracker-sigma-um")?,
                 target,
             };
             let source = Source::tracker(&data, &options).map_err(fusion_error)?;
             (poses, source, None)
         }
-        Instrument::Ballbar => {
-            let p = parse_numbers("--ballbar-pivot-mm", &a.ballbar_pivot_mm, 3)?;
-            let pivot = Vector3::new(p[0], p[1], p[2]);
-            let length = positive("--ballbar-length-mm", a.ballbar_length_mm)?;
+        Instrument::Ballbar | Instrument::Touch => {
+            let touch = a.instrument == Instrument::Touch;
+            let (flag, text) = if touch {
+                ("--touch-sphere-mm", &a.touch.touch_sphere_mm)
+            } else {
+                ("--ballbar-pivot-mm", &a.ballbar_pivot_mm)
+            };
+            let p = parse_numbers(flag, text, 3)?;
+            let centre = Vector3::new(p[0], p[1], p[2]);
+            let radius = if touch {
+                positive("--touch-sphere-radius-mm", a.touch.touch_sphere_radius_mm)?
+                    + positive("--touch-stylus-radius-mm", a.touch.touch_stylus_radius_mm)?
+            } else {
+                positive("--ballbar-length-mm", a.ballbar_length_mm)?
+            };
             if a.ballbar_candidates > limits::MAX_CANDIDATES {
                 return Err(CliError::input(format!(
                     "--ballbar-candidates: {}; at most {}",
@@ -199,54 +266,85 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
                     limits::MAX_CANDIDATES
                 )));
             }
-            let poses = ballbar_candidates(&m, &pivot, length, a.ballbar_candidates);
+            let poses = sphere_candidates(&m, &centre, radius, a.ballbar_candidates);
             if poses.len() < 4 {
                 return Err(CliError::input(format!(
-                    "--ballbar-pivot-mm {}: the machine reaches only {} ball positions around this pivot",
-                    a.ballbar_pivot_mm,
+                    "{flag} {text}: the machine reaches only {} positions around this point",
                     poses.len()
                 )));
             }
-            let data = nominal_ballbar_data(&model, &poses, &pivot).map_err(study_error)?;
-            let options = tricept_ident::fusion::BallbarOptions {
-                sigma_um: positive("--sigma-um", a.sigma_um.unwrap_or(1.0))?,
-                ..Default::default()
+            let source = if touch {
+                let data = nominal_touch_data(&poses, 1).map_err(study_error)?;
+                let features = touch_features(
+                    a.touch.touch_sphere_radius_mm,
+                    a.touch.touch_stylus_radius_mm,
+                    positive("--touch-stylus-sigma-um", a.touch.touch_stylus_sigma_um)?,
+                );
+                let options = tricept_ident::fusion::TouchOptions {
+                    sigma_um: instrument_sigma(a, a.touch.touch_sigma_um, "--touch-sigma-um")?,
+                };
+                Source::touch(&data, &features, &options).map_err(fusion_error)?
+            } else {
+                let data = nominal_ballbar_data(&model, &poses, &centre).map_err(study_error)?;
+                let options = tricept_ident::fusion::BallbarOptions {
+                    sigma_um: instrument_sigma(a, a.ballbar_sigma_um, "--ballbar-sigma-um")?,
+                    ..Default::default()
+                };
+                Source::ballbar(&data, &options).map_err(fusion_error)?
             };
-            let source = Source::ballbar(&data, &options).map_err(fusion_error)?;
-            (poses, source, Some(pivot))
+            let poses = poses.into_iter().map(|p| (p, 0.0)).collect();
+            (poses, source, Some(centre))
         }
     };
+    let axis = a.instrument == Instrument::Tracker && {
+        let mut e = a.extensions.clone();
+        e.sort_by(f64::total_cmp);
+        e.dedup();
+        e.len() >= 2
+    };
     let rows = candidate_rows(&model, &source).map_err(study_error)?;
-    let problem =
+    let mut problem =
         PlanProblem::new(&model, &f_int, &rows, &options.eval_poses).map_err(study_error)?;
+    if axis {
+        problem = problem.with_tool_axis();
+    }
     let result = plan(&problem, &a.k, a.passes, a.random_baseline, a.seed).map_err(study_error)?;
-    let reached = a
-        .target_um
-        .and_then(|t| result.rows.iter().find(|r| r.planned_um <= t).map(|r| r.k));
+    let recommended = result.recommended(a.target_um, None);
     if let (Some(path), Some(last)) = (&a.out, result.rows.last()) {
         let p = vec![0.0; model.len()];
         let records = last
             .selection
             .iter()
             .map(|&c| {
+                let (pose, extension_mm) = poses[c];
+                let effector = tricept_model::Effector {
+                    extension_mm,
+                    ..Default::default()
+                };
                 let (x, _) = model
-                    .spindle_point(&p, &poses[c], &Default::default())
+                    .spindle_point(&p, &pose, &effector)
                     .map_err(fusion_error)?;
                 Ok(PlannedPose {
-                    pose: poses[c],
-                    extension_mm: 0.0,
+                    pose,
+                    extension_mm,
                     tip_mm: Some(x.into()),
-                    length_mm: pivot.map(|c| (x - c).norm()),
+                    length_mm: match a.instrument {
+                        Instrument::Ballbar => centre.map(|c| (x - c).norm()),
+                        _ => None,
+                    },
+                    feature: (a.instrument == Instrument::Touch).then_some(1),
                     line: 0,
                 })
             })
             .collect::<Result<Vec<_>, CliError>>()?;
         let comments = vec![format!(
-            "planned by tricept {} for a {:?}: {} measurements, RMS predicted tool-tip sd after touch-off {:.1} um",
+            "planned by tricept {} for a {:?}: {} measurements, RMS predicted tool-tip sd after touch-off {:.1} um, tool axis {:.1} arcsec, redundancy {:.1}",
             env!("CARGO_PKG_VERSION"),
             a.instrument,
             last.k,
-            last.planned_um
+            last.planned_um,
+            last.axis_arcsec,
+            last.redundancy
         )];
         crate::files::written(
             path,
@@ -266,51 +364,83 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
             json!({
                 "instrument": format!("{:?}", a.instrument).to_lowercase(),
                 "candidates": poses.len(),
-                "criterion": "RMS over the evaluation poses of the predicted tool-tip standard deviation after touch-off, um",
+                "criterion": if axis {
+                    "RMS over the evaluation poses of the predicted tool-tip standard deviation after touch-off and of the tool axis' times 100 mm, um"
+                } else {
+                    "RMS over the evaluation poses of the predicted tool-tip standard deviation after touch-off, um"
+                },
                 "prior_only_um": result.prior_only_um,
                 "internal_only_um": result.internal_only_um,
+                "internal_only_axis_arcsec": result.internal_only_axis_arcsec,
+                "min_redundancy": result.min_redundancy,
                 "rows": result.rows.iter().map(|r| json!({
                     "k": r.k, "planned_um": r.planned_um, "planned_raw_um": r.planned_raw_um,
-                    "random_median_um": r.random_median_um,
+                    "random_median_um": r.random_median_um, "axis_arcsec": r.axis_arcsec,
+                    "redundancy": r.redundancy, "checkable": r.checkable,
                 })).collect::<Vec<_>>(),
                 "target_um": a.target_um,
-                "k_for_target": reached,
+                "k_for_target": a.target_um.and(recommended),
+                "recommended_k": recommended,
             })
         );
     } else {
         outln!(
-            "{:?}: {} candidates; criterion: RMS predicted tool-tip sd after touch-off over {} tool poses (um)",
+            "{:?}: {} candidates; criterion: RMS predicted tool-tip sd after touch-off{} over {} tool poses (um)",
             a.instrument,
             poses.len(),
+            if axis { " and tool axis x 100 mm" } else { "" },
             options.eval_poses.len()
         );
         outln!(
-            "prior only {:.1} um; internal campaign ({} poses) alone {:.1} um",
+            "prior only {:.1} um; internal campaign ({} poses) alone {:.1} um, tool axis {:.1} arcsec",
             result.prior_only_um,
             internal_poses,
-            result.internal_only_um
+            result.internal_only_um,
+            result.internal_only_axis_arcsec
         );
         outln!(
-            "{:>4} {:>10} {:>10} {:>14}",
+            "{:>4} {:>10} {:>10} {:>14} {:>12} {:>11}",
             "k",
             "planned",
             "raw",
-            "random median"
+            "random median",
+            "axis arcsec",
+            "redundancy"
         );
         for r in &result.rows {
             outln!(
-                "{:>4} {:>10.1} {:>10.1} {:>14}",
+                "{:>4} {:>10.1} {:>10.1} {:>14} {:>12.1} {:>11}",
                 r.k,
                 r.planned_um,
                 r.planned_raw_um,
-                r.random_median_um.map_or("-".into(), |v| format!("{v:.1}"))
+                r.random_median_um.map_or("-".into(), |v| format!("{v:.1}")),
+                r.axis_arcsec,
+                format!(
+                    "{:.1}{}",
+                    r.redundancy.max(0.0),
+                    if r.checkable { "" } else { " (!)" }
+                )
             );
         }
-        if let Some(t) = a.target_um {
-            match reached {
-                Some(k) => outln!("{t} um is predicted with {k} planned measurements"),
-                None => outln!("{t} um is not predicted with any k asked for"),
+        if result.rows.iter().any(|r| !r.checkable) {
+            outln!(
+                "(!): fewer than {:.0} redundant rows: the fit could not check these measurements (a gross error or a wrong file would go unseen)",
+                result.min_redundancy
+            );
+        }
+        match (a.target_um, recommended) {
+            (Some(t), Some(k)) => outln!(
+                "recommended: {k} planned measurements (the smallest k asked for that predicts {t} um and leaves {:.0} redundant rows)",
+                result.min_redundancy
+            ),
+            (Some(t), None) => {
+                outln!("{t} um is not predicted with enough redundancy by any k asked for")
             }
+            (None, Some(k)) => outln!(
+                "recommended: at least {k} measurements (the smallest k asked for that leaves {:.0} redundant rows; --target-um adds an accuracy target)",
+                result.min_redundancy
+            ),
+            (None, None) => outln!("no k asked for leaves enough redundant rows"),
         }
         outln!(
             "note: a linear-Gaussian prediction of variance only; an unmodelled effect's bias is not in it (docs/hybrid.md)"

@@ -7,8 +7,8 @@ use tricept_ident::GeometricModel;
 use tricept_plant::{Campaign, Plant, PoseOrder};
 
 use crate::args::{
-    MachineArgs, NoiseArgs, ParamArgs, TruthArgs, machine_with_noise, parse_effects, parse_errors,
-    pose_targets,
+    MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs, TruthArgs, machine_with_noise,
+    parse_effects, parse_errors, pose_targets,
 };
 use crate::cli_error::CliError;
 use crate::fusion_cmd::{parse_numbers, positive};
@@ -97,6 +97,30 @@ pub struct SimulateArgs {
     /// Noise of a ballbar reading, um.
     #[arg(long, default_value_t = 1.0, value_name = "UM")]
     pub ballbar_sigma_um: f64,
+    /// Also write touch-offs (CSV) at the planned touches of --touch-poses
+    /// (needs --features-out).
+    #[arg(long, value_name = "FILE.csv")]
+    pub touch_out: Option<PathBuf>,
+    /// The features file of the touch-offs (JSON: the stylus and the
+    /// reference sphere, as a user would write it).
+    #[arg(long, value_name = "FILE.json")]
+    pub features_out: Option<PathBuf>,
+    /// Planned touches (CSV `q1,q2,q3,h1,h2,x,y,z,feature`, as `tricept plan
+    /// --instrument touch --out` writes them).
+    #[arg(long, value_name = "FILE.csv")]
+    pub touch_poses: Option<PathBuf>,
+    /// The reference sphere as it truly is (feature 1), the stylus' nominal
+    /// radius and noise.
+    #[command(flatten)]
+    pub touch: TouchSphereArgs,
+    /// The stylus' true radius minus the nominal one, um.
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        value_name = "UM",
+        allow_hyphen_values = true
+    )]
+    pub touch_stylus_error_um: f64,
     #[command(flatten)]
     pub params: ParamArgs,
     #[command(flatten)]
@@ -338,5 +362,83 @@ fn simulate_external(a: &SimulateArgs, plant: &Plant, comments: &[String]) -> Re
             ));
         }
     }
+    match (&a.touch_out, &a.features_out, &a.touch_poses) {
+        (Some(out), Some(features_out), Some(poses)) => {
+            simulate_touches(a, plant, comments, out, features_out, poses)?
+        }
+        (None, None, None) => {}
+        _ => {
+            return Err(CliError::input(
+                "--touch-out, --features-out and --touch-poses go together",
+            ));
+        }
+    }
     Ok(())
+}
+
+/// Writes simulated touch-offs on the reference sphere at the planned
+/// touches, and the features file a user would write.
+fn simulate_touches(
+    a: &SimulateArgs,
+    plant: &Plant,
+    comments: &[String],
+    out: &std::path::Path,
+    features_out: &std::path::Path,
+    poses: &std::path::Path,
+) -> Result<(), CliError> {
+    let c = parse_numbers("--touch-sphere-mm", &a.touch.touch_sphere_mm, 3)?;
+    let centre = nalgebra::Vector3::new(c[0], c[1], c[2]);
+    let probe = tricept_plant::TouchProbe {
+        stylus_radius_mm: positive("--touch-stylus-radius-mm", a.touch.touch_stylus_radius_mm)?,
+        stylus_radius_error_um: a.touch_stylus_error_um,
+        stylus_radius_sigma_um: positive("--touch-stylus-sigma-um", a.touch.touch_stylus_sigma_um)?,
+        sigma_um: positive("--touch-sigma-um", a.touch.touch_sigma_um)?,
+        features: vec![tricept_plant::TouchFeature::Sphere {
+            id: 1,
+            centre_mm: centre,
+            radius_mm: positive("--touch-sphere-radius-mm", a.touch.touch_sphere_radius_mm)?,
+        }],
+    };
+    let planned = tricept_data::read_external_path::<tricept_data::PlannedPose>(poses)
+        .map_err(|e| CliError::input(e.to_string()))?;
+    let nominal = &plant.nominal;
+    let targets = planned
+        .records
+        .iter()
+        .map(|p| {
+            let at = |e: tricept_kinematics::KinematicsError| {
+                CliError::input(format!("{}: line {}: {e}", planned.source, p.line))
+            };
+            if p.feature.is_some_and(|f| f != 1) {
+                return Err(CliError::input(format!(
+                    "{}: line {}, column `feature`: the simulated probe touches sphere 1 only",
+                    planned.source, p.line
+                )));
+            }
+            let up = nominal.forward(&p.pose.commands_mm).map_err(at)?.up;
+            let tool = nominal.tool_forward(&up, p.pose.head_rad);
+            Ok(tricept_plant::TouchTarget {
+                feature: 1,
+                tip_mm: tool.tip_mm,
+                axis: tool.axis,
+                approach: (centre - tool.tip_mm).normalize(),
+            })
+        })
+        .collect::<Result<Vec<_>, CliError>>()?;
+    let data = probe
+        .measure(plant, &targets, a.seed)
+        .map_err(|e| CliError::input(format!("simulate: {}: {e}", planned.source)))?;
+    let mut c = comments.to_vec();
+    c.push(format!(
+        "touch probe: sphere 1 at (mm) {}, radius {} mm; stylus {} mm ({} um off); {} um per touch",
+        a.touch.touch_sphere_mm,
+        a.touch.touch_sphere_radius_mm,
+        a.touch.touch_stylus_radius_mm,
+        a.touch_stylus_error_um,
+        a.touch.touch_sigma_um
+    ));
+    crate::files::written(out, tricept_data::write_external_path(out, &data, &c))?;
+    let features = serde_json::to_string_pretty(&probe.features_file(0.5))
+        .map_err(|e| CliError::other(e.to_string()))?;
+    crate::files::write_text(features_out, &(features + "\n"))
 }

@@ -794,10 +794,18 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
         ],
     );
     let features = r#"{"stylus": {"radius_mm": 1.0, "radius_sigma_um": 2.0}, "features": [{"id": 1, "kind": "plane"}]}"#;
+    // A tracker's target is always stated (there is no default).
     let fused = |extra: &[&str]| -> Vec<String> {
+        let stated = !extra.contains(&"--tracker") || extra.contains(&"--tracker-target");
+        let target: &[&str] = if stated {
+            &[]
+        } else {
+            &["--tracker-target", "tip"]
+        };
         ["identify", "--data", "good.csv"]
             .iter()
             .chain(extra)
+            .chain(target)
             .map(|s| s.to_string())
             .collect()
     };
@@ -950,7 +958,25 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
             &[],
             vec![],
             2,
-            &["--tracker-target: expected 3 comma-separated numbers"],
+            &["--tracker-target: expected `tip`, `free` or X,Y,Z in mm, got `1,2`"],
+        ),
+        case(
+            "tracker target not stated",
+            &[],
+            vec![],
+            2,
+            &[
+                "--tracker-target is required with a tracker",
+                "`tip`",
+                "`free`",
+            ],
+        ),
+        case(
+            "plan: tracker target not stated",
+            &[],
+            vec![],
+            2,
+            &["--tracker-target is required with a tracker"],
         ),
         case(
             "bad head",
@@ -978,7 +1004,7 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
             &[],
             vec![],
             2,
-            &["--ballbar-pivot-mm 0,0,3000: the machine reaches only 0 ball positions"],
+            &["--ballbar-pivot-mm 0,0,3000: the machine reaches only 0 positions"],
         ),
         case(
             "simulate: tracker output without poses",
@@ -1004,7 +1030,7 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
         fused(&["--tracker", "t6.csv"]),
         fused(&["--tracker", "t7.csv"]),
         fused(&["--tracker", "line-tracker.csv"]),
-        fused(&["--tracker", "still-tracker.csv"]),
+        fused(&["--tracker", "still-tracker.csv", "--tracker-target", "free"]),
         fused(&["--ballbar", "b1.csv"]),
         fused(&["--ballbar", "flat-ballbar.csv"]),
         fused(&["--touch", "touch.csv", "--features", "features.json"]),
@@ -1012,6 +1038,12 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
         fused(&["--touch", "touch.csv", "--features", "bad-features.json"]),
         fused(&["--effects", "gravity"]),
         fused(&["--tracker", "tracker.csv", "--tracker-target", "1,2"]),
+        ["identify", "--data", "good.csv", "--tracker", "tracker.csv"]
+            .map(String::from)
+            .to_vec(),
+        ["plan", "--instrument", "tracker", "--k", "5"]
+            .map(String::from)
+            .to_vec(),
         fused(&["--head", "head15"]),
         fused(&[
             "--tracker",
@@ -1214,6 +1246,8 @@ fn values_sizes_and_files_no_verb_can_use_get_exit_code_2() {
                 "plan",
                 "--instrument",
                 "tracker",
+                "--tracker-target",
+                "tip",
                 "--out",
                 "/nonexistent/dir/p.csv",
             ]),
@@ -1271,7 +1305,15 @@ fn values_sizes_and_files_no_verb_can_use_get_exit_code_2() {
                 2,
                 &["--target-um", "positive"],
             ),
-            a(&["plan", "--instrument", "tracker", "--target-um", "-1"]),
+            a(&[
+                "plan",
+                "--instrument",
+                "tracker",
+                "--tracker-target",
+                "tip",
+                "--target-um",
+                "-1",
+            ]),
         ),
         (
             case(
@@ -1281,7 +1323,15 @@ fn values_sizes_and_files_no_verb_can_use_get_exit_code_2() {
                 2,
                 &["--target-um", "positive"],
             ),
-            a(&["plan", "--instrument", "tracker", "--target-um", "nan"]),
+            a(&[
+                "plan",
+                "--instrument",
+                "tracker",
+                "--tracker-target",
+                "tip",
+                "--target-um",
+                "nan",
+            ]),
         ),
         (
             case(
@@ -1334,6 +1384,8 @@ fn values_sizes_and_files_no_verb_can_use_get_exit_code_2() {
                 "plan",
                 "--instrument",
                 "tracker",
+                "--tracker-target",
+                "tip",
                 "--eval-grid",
                 "1000,1000,1000",
             ]),
@@ -1350,6 +1402,8 @@ fn values_sizes_and_files_no_verb_can_use_get_exit_code_2() {
                 "plan",
                 "--instrument",
                 "tracker",
+                "--tracker-target",
+                "tip",
                 "--candidates",
                 "grid:1000,1000,100",
             ]),

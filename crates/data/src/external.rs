@@ -110,6 +110,8 @@ pub struct PlannedPose {
     pub tip_mm: Option<[f64; 3]>,
     /// The nominal ballbar length there, mm (column `length`).
     pub length_mm: Option<f64>,
+    /// The feature to touch there (column `feature`, touch-offs).
+    pub feature: Option<u32>,
     /// Line in the file (0 if none).
     pub line: u64,
 }
@@ -374,7 +376,7 @@ impl ExternalRow for TouchReading {
 
 impl ExternalRow for PlannedPose {
     const MEASURED: &'static [&'static str] = &[];
-    const OPTIONAL: &'static [&'static str] = &["extension_mm", "x", "y", "z", "length"];
+    const OPTIONAL: &'static [&'static str] = &["extension_mm", "x", "y", "z", "length", "feature"];
 
     fn from_row(pose: ExternalPose, row: &Row<'_>) -> Result<Self, DataError> {
         let any = |_: f64| None;
@@ -395,6 +397,7 @@ impl ExternalRow for PlannedPose {
                 _ => None,
             },
             length_mm: row.optional("length", any)?,
+            feature: row.whole_from_one("feature")?,
             line: row.record.line,
         })
     }
@@ -410,6 +413,7 @@ impl ExternalRow for PlannedPose {
             "y" => self.tip_mm.map(|t| t[1]),
             "z" => self.tip_mm.map(|t| t[2]),
             "length" => self.length_mm,
+            "feature" => self.feature.map(f64::from),
             _ => None,
         }
     }

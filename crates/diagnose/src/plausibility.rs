@@ -16,18 +16,8 @@ use tricept_model::effects::{EffectName, GenericFamily, legendre_p2, legendre_p3
 
 use crate::terms::{CHANNELS, GenericTerm, Term};
 
-/// A physical range with its reason.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Range {
-    /// Smallest plausible value.
-    pub min: f64,
-    /// Largest plausible value.
-    pub max: f64,
-    /// Unit.
-    pub unit: &'static str,
-    /// Why (material, tolerance, definition).
-    pub why: String,
-}
+pub use tricept_model::plausibility::{PlausibilityError, Range};
+use tricept_model::plausibility::{insert_range, round3};
 
 /// The plausibility table: quantity key (`effect.quantity`) to range.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -49,36 +39,11 @@ pub(crate) struct Quantity {
     pub(crate) sd: f64,
 }
 
-/// Why an override file was refused.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[non_exhaustive]
-pub enum PlausibilityError {
-    /// Not a JSON object of `key: [min, max]`.
-    #[error("plausibility overrides: {0}")]
-    Format(String),
-    /// A key that is not in the table.
-    #[error("plausibility overrides: unknown quantity `{key}` (known: {known})")]
-    UnknownKey {
-        /// The key.
-        key: String,
-        /// The keys of the table.
-        known: String,
-    },
-}
-
 impl Default for Plausibility {
     fn default() -> Plausibility {
         let mut ranges = BTreeMap::new();
         let mut add = |key: &str, min: f64, max: f64, unit: &'static str, why: &str| {
-            ranges.insert(
-                key.to_string(),
-                Range {
-                    min,
-                    max,
-                    unit,
-                    why: why.to_string(),
-                },
-            );
+            insert_range(&mut ranges, key, min, max, unit, why)
         };
         add(
             "leg-lead.lead_ppm",
@@ -259,22 +224,7 @@ impl Plausibility {
     /// ```
     pub fn with_overrides(json: &str) -> Result<Plausibility, PlausibilityError> {
         let mut p = Plausibility::default();
-        let v: BTreeMap<String, [f64; 2]> =
-            serde_json::from_str(json).map_err(|e| PlausibilityError::Format(e.to_string()))?;
-        for (key, [min, max]) in v {
-            if !(min.is_finite() && max.is_finite() && min <= max) {
-                return Err(PlausibilityError::Format(format!(
-                    "`{key}`: [{min}, {max}] is not a range"
-                )));
-            }
-            let known = p.ranges.keys().cloned().collect::<Vec<_>>().join(", ");
-            let Some(r) = p.ranges.get_mut(&key) else {
-                return Err(PlausibilityError::UnknownKey { key, known });
-            };
-            r.min = min;
-            r.max = max;
-            r.why = "user override".into();
-        }
+        tricept_model::plausibility::override_ranges(&mut p.ranges, json)?;
         Ok(p)
     }
 
@@ -285,13 +235,12 @@ impl Plausibility {
             let Some(r) = self.ranges.get(&q.key) else {
                 continue;
             };
-            let (lo, hi) = (q.value - 3.0 * q.sd, q.value + 3.0 * q.sd);
-            if hi < r.min || lo > r.max || !q.value.is_finite() {
+            if !r.admits(q.value, q.sd) {
                 return Err(format!(
                     "{} = {} +- {} {} is outside {} to {} {} ({}): the real cause is something else",
                     q.label,
-                    round(q.value),
-                    round(q.sd),
+                    round3(q.value),
+                    round3(q.sd),
                     r.unit,
                     r.min,
                     r.max,
@@ -302,15 +251,6 @@ impl Plausibility {
         }
         Ok(())
     }
-}
-
-/// Three significant digits.
-fn round(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
-    format!("{v:.digits$}")
 }
 
 /// Amplitude `sqrt(a^2 + b^2)` and its standard deviation (delta method).

@@ -265,7 +265,6 @@ fn robust_start(
     data: &Dataset,
     options: &IdentifyOptions,
 ) -> Result<(Vec<bool>, Option<FirstEvaluation>), IdentError> {
-    let n = data.poses.len();
     let k = model.names().len();
     let first = FirstEvaluation::new(model, &vec![0.0; k], &data.poses, &options.sigma)?;
     let nominal: Vec<Option<[f64; 3]>> = first.residuals().iter().map(|r| Some(*r)).collect();
@@ -299,6 +298,13 @@ fn robust_start(
             None => f64::INFINITY,
         })
         .collect();
+    Ok((start_set(&z), Some(first)))
+}
+
+/// The records of the first fit from their robust scores `z`: those within
+/// [`START_Z`], or the half with the smallest scores when fewer are.
+pub(crate) fn start_set(z: &[f64]) -> Vec<bool> {
+    let n = z.len();
     let mut inside: Vec<bool> = z.iter().map(|z| *z <= START_Z).collect();
     let half = n.div_ceil(2);
     if inside.iter().filter(|x| **x).count() < half {
@@ -309,7 +315,7 @@ fn robust_start(
             inside[j] = z[j].is_finite();
         }
     }
-    Ok((inside, Some(first)))
+    inside
 }
 
 /// The statistic `T_j` of every pose at fit `id` made on the poses marked

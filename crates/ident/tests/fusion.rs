@@ -10,7 +10,12 @@
 //! solution); the combination itself is checked against the model's
 //! geometry.
 
-use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion, Vector3};
+mod common;
+
+use common::{
+    head_truth, internal, known_target, spread_poses, table2_plant, tracker, tracker_points,
+};
+use nalgebra::{Rotation3, Vector3};
 use rayon::prelude::*;
 use tricept_data::ExternalPose;
 use tricept_ident::fusion::{
@@ -23,24 +28,7 @@ use tricept_model::effects::EffectName;
 use tricept_model::{HeadParameterSet, ParameterSet};
 use tricept_numerics::stats::chi2_isf;
 use tricept_plant::instruments::commanded;
-use tricept_plant::{
-    Ballbar, Campaign, Effect, Plant, TouchFeature, TouchProbe, TouchTarget, Tracker,
-    random_head_errors,
-};
-
-/// The documented head errors of these tests: `random_head_errors(1.0, 11)`.
-fn head_truth() -> Vec<f64> {
-    random_head_errors(1.0, 11)
-}
-
-/// Table 2's module errors and the documented head errors.
-fn table2_plant() -> Plant {
-    let m = Machine::paper();
-    let set = ParameterSet::paper15();
-    let mut plant = Plant::geometric(m, set.to_errors(&set.table2()));
-    plant.head_errors = head_truth();
-    plant
-}
+use tricept_plant::{Ballbar, Effect, Plant, TouchFeature, TouchProbe, TouchTarget};
 
 /// The truth in the fused model's parameters `[paper15 | effects | head13]`.
 fn truth_of(model: &FusedModel, module: &[f64], effects: &[f64], head: &[f64]) -> Vec<f64> {
@@ -51,65 +39,6 @@ fn truth_of(model: &FusedModel, module: &[f64], effects: &[f64], head: &[f64]) -
     }
     assert_eq!(t.len(), model.len());
     t
-}
-
-/// The tracker of the tests: rotated 0.7 rad about (1, 2, 3), 1.5 m away.
-fn tracker(target_mm: Vector3<f64>) -> Tracker {
-    Tracker {
-        frame: Isometry3::from_parts(
-            Translation3::new(1500.0, -800.0, 200.0),
-            UnitQuaternion::from_axis_angle(
-                &nalgebra::Unit::new_normalize(Vector3::new(1.0, 2.0, 3.0)),
-                0.7,
-            ),
-        ),
-        target_offset_mm: target_mm,
-        sigma_um: 10.0,
-        setup: 1,
-    }
-}
-
-/// The tracker's points of `plant` at `poses` (no extension), target
-/// offset `target`, noise seed `seed`.
-fn tracker_points(
-    plant: &Plant,
-    target: Vector3<f64>,
-    poses: &[ExternalPose],
-    seed: u64,
-) -> tricept_data::TrackerData {
-    let records: Vec<(ExternalPose, f64)> = poses.iter().map(|p| (*p, 0.0)).collect();
-    tracker(target).measure(plant, &records, seed).unwrap()
-}
-
-/// `n` tracker poses: platform points spread over the workspace, head
-/// angles cycling through `h1_deg` x `h2_deg`.
-fn spread_poses(
-    m: &Machine,
-    n: usize,
-    h1_deg: &[f64],
-    h2_deg: &[f64],
-    seed: u64,
-) -> Vec<ExternalPose> {
-    let points = m.workspace.random_poses(n, seed);
-    points
-        .iter()
-        .enumerate()
-        .map(|(j, r)| {
-            let h1 = h1_deg[j % h1_deg.len()];
-            let h2 = h2_deg[(j / h1_deg.len()) % h2_deg.len()];
-            ExternalPose {
-                commands_mm: m.inverse(r).unwrap().legs_mm,
-                head_rad: [h1.to_radians(), h2.to_radians()],
-            }
-        })
-        .collect()
-}
-
-fn internal(plant: &Plant, seed: u64) -> Source {
-    let data = plant
-        .simulate(&Campaign::grid(&plant.nominal, seed))
-        .unwrap();
-    Source::internal(&data, plant.nominal.sensors.logged_sigma())
 }
 
 /// The expected estimate: the truth moved along each reported invisible
@@ -157,14 +86,14 @@ fn assert_recovered(fit: &Fusion, truth: &[f64], what: &str) -> f64 {
 /// Asserts a source's chi-square lies in its two-sided 99.9 % interval.
 fn assert_chi_square_plausible(fit: &Fusion) {
     for s in &fit.sources {
-        let lo = chi2_isf(1.0 - 5e-4, s.dof_share);
-        let hi = chi2_isf(5e-4, s.dof_share);
+        let lo = chi2_isf(1.0 - 5e-4, s.redundancy);
+        let hi = chi2_isf(5e-4, s.redundancy);
         assert!(
             (lo..=hi).contains(&s.chi_square),
             "{}: chi-square {} outside [{lo}, {hi}] (dof {})",
             s.label,
             s.chi_square,
-            s.dof_share
+            s.redundancy
         );
     }
 }
@@ -628,16 +557,6 @@ fn the_machine_scale_is_invisible_inside_and_a_ballbar_of_known_length_or_a_trac
         assert_recovered(fit, &truth, what);
     }
     assert_eq!(named(&fits[2]), None, "{}", fits[2].report.to_text());
-}
-
-fn known_target() -> TrackerOptions {
-    TrackerOptions {
-        sigma_um: 10.0,
-        target: TrackerTarget::Known {
-            offset_mm: [0.0; 3],
-            sigma_um: 5.0,
-        },
-    }
 }
 
 #[test]

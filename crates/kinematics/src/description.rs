@@ -260,8 +260,33 @@ pub struct ExternalSourceRecord {
     pub sha256: String,
     /// Records used.
     pub records: usize,
-    /// Its weighted chi-square per degree of freedom in the fused fit.
-    pub chi2_per_dof: f64,
+    /// Its weighted chi-square per degree of freedom in the fused fit
+    /// (`null` when its rows leave less than one degree of freedom).
+    #[serde(default)]
+    pub chi2_per_dof: Option<f64>,
+    /// Its degrees of freedom in the fused fit (`sum (1 - h_ii)` over its
+    /// rows), and whether they were enough to check the fit.
+    #[serde(default)]
+    pub redundancy: f64,
+    /// Whether its rows could check the fit (`redundancy` at least 6 per
+    /// tracker station, 4 per ballbar setup or touched feature).
+    #[serde(default = "checkable_default")]
+    pub checkable: bool,
+    /// Lines of the file rejected as gross errors.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rejected_lines: Vec<u64>,
+    /// The instrument's fitted nuisance, `{name: {"value", "std_dev"}}`
+    /// (units in the names): each tracker station's frame (`sN.rx_rad`,
+    /// `.ry_rad`, `.rz_rad`: the rotation vector, and `sN.tx_mm` ...: the
+    /// translation, of `y = R x + t` from the machine's base frame into the
+    /// tracker's), its target offset, each ballbar setup's pivot and
+    /// length error, each touched feature and the stylus radius.
+    #[serde(default, skip_serializing_if = "serde_json::Map::is_empty")]
+    pub nuisance: serde_json::Map<String, serde_json::Value>,
+}
+
+fn checkable_default() -> bool {
+    true
 }
 
 fn is_zero3(v: &[f64; 3]) -> bool {

@@ -20,6 +20,8 @@
 //!
 //! - [`ExtendedMachine`]: a calibrated machine's kinematics with the static
 //!   leg effects (lead, compliance) a diagnosis named.
+//! - [`plausibility`]: tables of plausible ranges with overrides, shared by
+//!   the diagnosis and the fused identification.
 //!
 //! All lengths in mm, angles in rad.
 #![cfg_attr(
@@ -34,6 +36,7 @@ mod extended;
 mod head_errors;
 mod jacobian;
 mod params;
+pub mod plausibility;
 mod volumetric;
 
 pub use actual::{actual_machine, errors_between};

@@ -20,8 +20,9 @@
 //!    re-factored (column-scaled) and solved by back substitution; the
 //!    covariance is `(R^T R)^{-1}` in the units of the weighted problem.
 
+use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::Solve;
-use faer::{Mat, MatRef};
+use faer::{Accum, Mat, MatRef, Par};
 
 use crate::linalg::{invert_upper, pivot_order, r_factor, solve_upper, svd_values_and_vectors};
 
@@ -203,6 +204,36 @@ impl ReducedProblem {
     /// assert_eq!((d.rank, d.fixed.len()), (1, 1));
     /// ```
     pub fn decide(&self, tolerance: f64) -> Option<RankDecision> {
+        self.decide_weighted(tolerance, None)
+    }
+
+    /// [`ReducedProblem::decide`] with the choice of the parameters to hold
+    /// (step 3) made on the columns multiplied by `prior_sizes` (each
+    /// parameter's typical size, in its unit) instead of on the unit-norm
+    /// columns: of a set of columns that cannot be told apart, the one
+    /// whose typical size moves the data least is held, so that the held
+    /// combination is the one the prior says matters least. The rank
+    /// (steps 1-2) is decided on the unit-norm columns as before.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_numerics::linalg::TriangularAccumulator;
+    /// use tricept_numerics::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+    /// // b's column is twice a's: one of them is held. Typical sizes 1 and
+    /// // 0.1 make a's effect (1) larger than b's (2 x 0.1): b is held.
+    /// let mut acc = TriangularAccumulator::new(3);
+    /// (1..6).for_each(|i| acc.push_row(&[i as f64, 2.0 * i as f64, 1.0]));
+    /// let p = ReducedProblem { rows: 5, r: acc.finish(), n_nuisance: 0, k: 2 };
+    /// let d = p.decide_weighted(DEFAULT_RANK_TOLERANCE, Some(&[1.0, 0.1])).unwrap();
+    /// assert_eq!(d.fixed, vec![1]);
+    /// let d = p.decide_weighted(DEFAULT_RANK_TOLERANCE, Some(&[0.1, 1.0])).unwrap();
+    /// assert_eq!(d.fixed, vec![0]);
+    /// ```
+    pub fn decide_weighted(
+        &self,
+        tolerance: f64,
+        prior_sizes: Option<&[f64]>,
+    ) -> Option<RankDecision> {
         let k = self.k;
         let block = self.parameter_block();
         let norms: Vec<f64> = (0..k)
@@ -241,7 +272,15 @@ impl ReducedProblem {
             .iter()
             .filter(|s| **s > tolerance * top && **s > 0.0)
             .count();
-        let order = pivot_order(scaled.as_ref());
+        let order = match prior_sizes {
+            Some(sizes) if sizes.len() == k => {
+                let weighted = Mat::from_fn(k, k, |i, j| {
+                    scaled[(i, j)] * column_scale[j] * sizes[j].abs()
+                });
+                pivot_order(weighted.as_ref())
+            }
+            _ => pivot_order(scaled.as_ref()),
+        };
         let mut identifiable: Vec<usize> = order[..rank].to_vec();
         let mut fixed: Vec<usize> = order[rank..].to_vec();
         identifiable.sort_unstable();
@@ -275,29 +314,8 @@ impl ReducedProblem {
     /// ```
     pub fn solve(&self, decision: &RankDecision) -> Solution {
         let nn = self.n_nuisance;
-        let rhs = nn + self.k;
-        let columns: Vec<usize> = (0..nn)
-            .chain(decision.identifiable.iter().map(|j| nn + j))
-            .collect();
+        let (columns, scale, rs) = self.selected(decision);
         let q = columns.len();
-        let scale: Vec<f64> = columns
-            .iter()
-            .map(|&c| {
-                let n = (0..=c)
-                    .map(|i| self.r[(i, c)] * self.r[(i, c)])
-                    .sum::<f64>()
-                    .sqrt();
-                if n > 0.0 { n } else { 1.0 }
-            })
-            .collect();
-        let selected = Mat::from_fn(rhs + 1, q + 1, |i, j| {
-            if j < q {
-                self.r[(i, columns[j])] / scale[j]
-            } else {
-                self.r[(i, rhs)]
-            }
-        });
-        let rs = r_factor(selected.as_ref());
         let tri = rs.as_ref().submatrix(0, 0, q, q);
         let c: Vec<f64> = (0..q).map(|i| rs[(i, q)]).collect();
         let y = solve_upper(tri, &c);
@@ -328,6 +346,127 @@ impl ReducedProblem {
             covariance,
             residual_norm2,
         }
+    }
+}
+
+impl ReducedProblem {
+    /// The estimated columns under `decision` (nuisance, then the
+    /// identifiable parameters, in the problem's column order), their
+    /// scales (unit norm) and the triangular factor of the scaled columns
+    /// with the right-hand side last.
+    fn selected(&self, decision: &RankDecision) -> (Vec<usize>, Vec<f64>, Mat<f64>) {
+        let nn = self.n_nuisance;
+        let rhs = nn + self.k;
+        let columns: Vec<usize> = (0..nn)
+            .chain(decision.identifiable.iter().map(|j| nn + j))
+            .collect();
+        let q = columns.len();
+        let scale: Vec<f64> = columns
+            .iter()
+            .map(|&c| {
+                let n = (0..=c)
+                    .map(|i| self.r[(i, c)] * self.r[(i, c)])
+                    .sum::<f64>()
+                    .sqrt();
+                if n > 0.0 { n } else { 1.0 }
+            })
+            .collect();
+        let selected = Mat::from_fn(rhs + 1, q + 1, |i, j| {
+            if j < q {
+                self.r[(i, columns[j])] / scale[j]
+            } else {
+                self.r[(i, rhs)]
+            }
+        });
+        let rs = r_factor(selected.as_ref());
+        (columns, scale, rs)
+    }
+
+    /// The factor that gives any row's leverage under `decision`: the
+    /// diagonal of the hat matrix `H = X (X^T X)^-1 X^T` over the estimated
+    /// columns, computed as `|R^-T x|^2` on the column-scaled factor (a sum
+    /// of squares: no cancellation, whatever the conditioning).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_numerics::linalg::TriangularAccumulator;
+    /// use tricept_numerics::lsq::{ReducedProblem, DEFAULT_RANK_TOLERANCE};
+    /// // A straight line through 4 points: the leverages sum to the 2 unknowns.
+    /// let rows: Vec<[f64; 3]> = [0.0, 1.0, 2.0, 5.0].iter().map(|&x| [1.0, x, 0.0]).collect();
+    /// let mut acc = TriangularAccumulator::new(3);
+    /// rows.iter().for_each(|r| acc.push_row(r));
+    /// let p = ReducedProblem { rows: 4, r: acc.finish(), n_nuisance: 1, k: 1 };
+    /// let hat = p.hat_factor(&p.decide(DEFAULT_RANK_TOLERANCE).unwrap());
+    /// let h: f64 = rows.iter().map(|r| hat.whiten(r).iter().map(|w| w * w).sum::<f64>()).sum();
+    /// assert!((h - 2.0).abs() < 1e-12);
+    /// ```
+    pub fn hat_factor(&self, decision: &RankDecision) -> HatFactor {
+        let (columns, scale, rs) = self.selected(decision);
+        let q = columns.len();
+        HatFactor {
+            r_inv: invert_upper(rs.as_ref().submatrix(0, 0, q, q)),
+            columns,
+            scale,
+        }
+    }
+}
+
+/// What [`ReducedProblem::hat_factor`] returns: the inverse of the
+/// triangular factor of the estimated, column-scaled columns.
+#[derive(Debug, Clone)]
+pub struct HatFactor {
+    columns: Vec<usize>,
+    scale: Vec<f64>,
+    r_inv: Mat<f64>,
+}
+
+impl HatFactor {
+    /// `w = R^-T x` for a row `x` of the problem (its `n_nuisance + k`
+    /// columns, a right-hand side beyond them ignored): the row's leverage
+    /// is `|w|^2`, the hat matrix' entry of two rows `w_a . w_b`.
+    pub fn whiten(&self, row: &[f64]) -> Vec<f64> {
+        let q = self.columns.len();
+        let x: Vec<f64> = self
+            .columns
+            .iter()
+            .zip(&self.scale)
+            .map(|(&c, s)| row.get(c).copied().unwrap_or(0.0) / s)
+            .collect();
+        (0..q)
+            .map(|a| (0..=a).map(|b| x[b] * self.r_inv[(b, a)]).sum())
+            .collect()
+    }
+
+    /// [`HatFactor::whiten`] of many rows at once (one matrix product):
+    /// `w_i` for each row `x_i` of `rows` (`n x (n_nuisance + k)`, row-major
+    /// slices), as the rows of an `n x q` matrix.
+    pub fn whiten_rows(&self, rows: &[&[f64]]) -> Mat<f64> {
+        let q = self.columns.len();
+        let x = Mat::from_fn(rows.len(), q, |i, j| {
+            rows[i].get(self.columns[j]).copied().unwrap_or(0.0) / self.scale[j]
+        });
+        let mut w = Mat::<f64>::zeros(rows.len(), q);
+        matmul(
+            w.as_mut(),
+            Accum::Replace,
+            x.as_ref(),
+            self.r_inv.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+        w
+    }
+
+    /// The step of the estimated unknowns a row predicts: `x . delta` for
+    /// the solution's `delta` (`[nuisance | parameters]`, held ones zero).
+    pub fn predict(row: &[f64], solution: &Solution) -> f64 {
+        solution
+            .nuisance
+            .iter()
+            .chain(&solution.parameters)
+            .zip(row)
+            .map(|(d, x)| d * x)
+            .sum()
     }
 }
 
@@ -457,6 +596,43 @@ mod tests {
         assert!(s.residual_norm2 < 1e-20);
         assert!((s.nuisance[0] - 2.0).abs() < 1e-12);
         assert_eq!(s.parameters[d.fixed[0]], 0.0);
+    }
+
+    #[test]
+    fn leverages_sum_to_the_unknowns_whichever_parameter_is_held() {
+        let p = problem();
+        let rows: Vec<[f64; 4]> = (0..40)
+            .map(|i| {
+                let x1 = (i as f64 * 0.3).sin();
+                let x2 = (i as f64 * 0.7).cos();
+                [1.0, x1, x2, x1 + x2]
+            })
+            .collect();
+        let leverages = |d: &RankDecision| -> Vec<f64> {
+            let hat = p.hat_factor(d);
+            rows.iter()
+                .map(|r| hat.whiten(r).iter().map(|w| w * w).sum())
+                .collect()
+        };
+        let a = leverages(&p.decide(DEFAULT_RANK_TOLERANCE).unwrap());
+        // One nuisance and two identifiable parameters: trace 3.
+        assert!((a.iter().sum::<f64>() - 3.0).abs() < 1e-10);
+        // The hat matrix projects on the column space: holding another of
+        // the three collinear parameters changes no leverage.
+        for sizes in [[1.0, 1.0, 1e-3], [1e-3, 1.0, 1.0], [1.0, 1e-3, 1.0]] {
+            let d = p
+                .decide_weighted(DEFAULT_RANK_TOLERANCE, Some(&sizes))
+                .unwrap();
+            let b = leverages(&d);
+            assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-10));
+        }
+        let held = |sizes: [f64; 3]| {
+            p.decide_weighted(DEFAULT_RANK_TOLERANCE, Some(&sizes))
+                .unwrap()
+                .fixed
+        };
+        assert_eq!(held([1.0, 1.0, 1e-3]), vec![2]);
+        assert_eq!(held([1e-3, 1.0, 1.0]), vec![0]);
     }
 
     #[test]

@@ -12,7 +12,7 @@ use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_plant::{Campaign, Plant, Tracker, random_head_errors};
 use tricept_study::plan::{
-    PlanProblem, candidate_rows, internal_information, nominal_tracker_data, plan,
+    PlanProblem, candidate_rows, internal_factor, nominal_tracker_data, plan, with_extensions,
 };
 
 fn known_target() -> TrackerOptions {
@@ -29,14 +29,14 @@ fn known_target() -> TrackerOptions {
 fn planned_tracker_points_beat_random_ones_and_predict_the_fit() {
     let m = Machine::paper();
     let model = FusedModel::new(m.clone(), ParameterSet::paper15(), &[], true).unwrap();
-    let f_int = internal_information(&model, &m.workspace.polar_grid(3, 8, 3)).unwrap();
+    let f_int = internal_factor(&model, &m.workspace.polar_grid(3, 8, 3)).unwrap();
     let candidates = head_angle_poses(
         &m,
         &m.workspace.polar_grid(2, 8, 3),
         &[0.0, 60.0, 120.0, 180.0, 240.0, 300.0],
         &[-45.0, -25.0, 25.0, 45.0],
     );
-    let data = nominal_tracker_data(&model, &candidates).unwrap();
+    let data = nominal_tracker_data(&model, &with_extensions(&candidates, &[0.0])).unwrap();
     let rows = candidate_rows(&model, &Source::tracker(&data, &known_target()).unwrap()).unwrap();
     let options = FusionOptions::for_machine(&m);
     let problem = PlanProblem::new(&model, &f_int, &rows, &options.eval_poses).unwrap();
@@ -93,4 +93,19 @@ fn planned_tracker_points_beat_random_ones_and_predict_the_fit() {
         "planned {} um vs fit {fitted} um",
         planned.planned_um
     );
+    // The redundancy the plan predicts is the fit's (taken at the estimate
+    // instead of the nominal machine).
+    let tracker = &fit.sources[1];
+    assert!(
+        (planned.redundancy - tracker.redundancy).abs() < 0.05 * tracker.redundancy,
+        "planned redundancy {} vs fit {}",
+        planned.redundancy,
+        tracker.redundancy
+    );
+    // Five planned points reach 25 um but cannot be checked; the
+    // recommendation is the smallest checkable k that reaches it.
+    let five = &result.rows[0];
+    assert!(five.planned_um < 25.0 && !five.checkable, "{five:?}");
+    let k = result.recommended(Some(25.0), None).unwrap();
+    assert!(k > 5 && result.rows.iter().any(|r| r.k == k && r.checkable));
 }

@@ -17,8 +17,8 @@ use tricept_model::Effector;
 use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Sink, Source, SourceKind, SourceRows, for_each_point, groups, project_rows,
-    sphere_centre,
+    Nuisance, Sink, Source, SourceKind, SourceRows, for_each_point, groups, lines_text,
+    project_rows, sphere_centre,
 };
 
 /// How to read a ballbar file.
@@ -44,7 +44,7 @@ impl Default for BallbarOptions {
     }
 }
 
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct Ballbar {
     readings: Vec<BallbarReading>,
     sigma_mm: Vec<f64>,
@@ -69,7 +69,7 @@ impl Source {
     pub fn ballbar(data: &BallbarData, options: &BallbarOptions) -> Result<Source, IdentError> {
         let (setups, setup_of) = groups(
             &data.source,
-            data.records.iter().map(|r| r.setup),
+            data.records.iter().map(|r| (r.setup, r.line)),
             4,
             |id, n| {
                 format!(
@@ -140,6 +140,16 @@ impl SourceRows for Ballbar {
         }
     }
 
+    fn min_redundancy(&self) -> f64 {
+        4.0 * self.setups.len() as f64
+    }
+
+    fn judged_nuisance(&self, values: &[f64]) -> Vec<(&'static str, usize, f64)> {
+        (0..self.setups.len())
+            .map(|s| ("ballbar.length_error_mm", 4 * s + 3, values[4 * s + 3]))
+            .collect()
+    }
+
     fn pose(&self, record: usize) -> ExternalPose {
         self.readings[record].pose
     }
@@ -153,6 +163,7 @@ impl SourceRows for Ballbar {
         at: &FusedAt<'_>,
         contexts: &[LegContext],
         seeds: &mut [Option<UpJoints>],
+        active: &[bool],
     ) -> Result<Nuisance, IdentError> {
         let mut tips = Vec::with_capacity(self.readings.len());
         for_each_point(at, contexts, seeds, self.records(), |_, x, _| {
@@ -161,14 +172,19 @@ impl SourceRows for Ballbar {
         let mut values = vec![0.0; 4 * self.setups.len()];
         for (s, id) in self.setups.iter().enumerate() {
             let (x, radii): (Vec<Vector3<f64>>, Vec<f64>) = (0..self.readings.len())
-                .filter(|&j| self.setup_of[j] == s)
+                .filter(|&j| self.setup_of[j] == s && active[j])
                 .map(|j| (tips[j], self.readings[j].length_mm))
                 .unzip();
             let c = sphere_centre(&x, &radii).ok_or_else(|| IdentError::Source {
                 file: self.file.clone(),
                 line: None,
                 message: format!(
-                    "the ball positions of setup {id} lie in one plane: the pivot cannot be found"
+                    "the ball positions of setup {id} ({}) lie in one plane: the pivot cannot be found",
+                    lines_text(
+                        (0..self.readings.len())
+                            .filter(|&j| self.setup_of[j] == s && active[j])
+                            .map(|j| self.readings[j].line)
+                    )
                 ),
             })?;
             values[4 * s..4 * s + 3].copy_from_slice(c.as_slice());
@@ -226,5 +242,9 @@ impl SourceRows for Ballbar {
 
     fn nuisance_hint(&self) -> &'static str {
         "spread the ball over the sphere around the pivot (different directions, not one plane)"
+    }
+
+    fn boxed_clone(&self) -> Box<dyn SourceRows> {
+        Box::new(self.clone())
     }
 }

@@ -14,19 +14,32 @@
 //!
 //! With one internal source and no head or effects this is exactly
 //! [`crate::identify`] (bit for bit; tested).
+//!
+//! [`identify_fused`] wraps the fit: the gross-error screen
+//! ([`crate::fusion::ScreenOptions`], `screen.rs`) decides which records
+//! enter it, each fit ends with every source's redundancy (its degrees of
+//! freedom: `sum (1 - h_ii)` over its rows, `h` the hat matrix of the
+//! union), the deleted residual of every record and the verdict; an
+//! implausible or unexplained fit is handed to the likely-cause search
+//! (`causes.rs`).
 
 use faer::Mat;
-use nalgebra::DMatrix;
-use serde_json::{Map, Value, json};
+use nalgebra::{DMatrix, DVector};
+use serde_json::Value;
 use tricept_data::ExternalPose;
 use tricept_kinematics::{Machine, UpJoints};
 use tricept_numerics::linalg::{TriangularAccumulator, r_factor, svd_values_and_vectors};
-use tricept_numerics::lsq::{DEFAULT_RANK_TOLERANCE, RankDecision, ReducedProblem, Solution};
+use tricept_numerics::lsq::{
+    DEFAULT_RANK_TOLERANCE, HatFactor, RankDecision, ReducedProblem, Solution,
+};
 
 use crate::error::IdentError;
 use crate::fusion::model::{FusedModel, LegContext};
-use crate::fusion::report::{FusionReport, build_report};
-use crate::fusion::source::{Nuisance, Sink, Source};
+use crate::fusion::plausibility::FusionPlausibility;
+use crate::fusion::report::build_report;
+use crate::fusion::result::{Fusion, RecordCheck, SourceFit, judge};
+use crate::fusion::screen::ScreenOptions;
+use crate::fusion::source::{KeptRows, Nuisance, Sink, Source};
 use crate::gauss_newton::{Iteration, Run, iterate};
 use crate::report::IdentifiabilityReport;
 
@@ -54,11 +67,25 @@ pub struct FusionOptions {
     /// touch-off, by less than this per standard deviation (per unit
     /// coefficient when invisible) is reported as nearly harmless, um.
     pub harmless_um: f64,
+    /// The gross-error screen of every source's records (`None`: every
+    /// record is fitted).
+    pub screen: Option<ScreenOptions>,
+    /// Plausible ranges of the estimates.
+    pub plausibility: FusionPlausibility,
+    /// A predicted tool-axis uncertainty (RMS over the evaluation poses)
+    /// above this is warned about, arcsec.
+    pub tool_axis_arcsec: f64,
+    /// Whether an implausible or unexplained fit is refitted with the
+    /// usual mistakes undone to name the likely cause.
+    pub likely_causes: bool,
 }
 
 impl FusionOptions {
     /// Defaults: the rank tolerance and weak threshold of
-    /// [`crate::IdentifyOptions`], 30 iterations, 5 um, and the evaluation
+    /// [`crate::IdentifyOptions`], 30 iterations, 5 um, the screen at
+    /// family-wise level 0.001 (at most 10 % of a source's records), the
+    /// default plausibility table, 30 arcsec for the tool axis, the
+    /// likely-cause search, and the evaluation
     /// grid [`evaluation_poses`] with 2 rings of 8 on 3 levels and head
     /// angles `h1` in {0, 90, 180, 270} deg, `h2` in {15, 35} deg (away
     /// from the head singularity at `h2 = 0`, where a calibrated head may
@@ -75,6 +102,10 @@ impl FusionOptions {
                 &[15.0, 35.0],
             ),
             harmless_um: 5.0,
+            screen: Some(ScreenOptions::default()),
+            plausibility: FusionPlausibility::default(),
+            tool_axis_arcsec: 30.0,
+            likely_causes: true,
         }
     }
 }
@@ -127,101 +158,37 @@ pub fn head_angle_poses(
     out
 }
 
-/// A source whose reduced chi-square exceeds this is not explained by the
-/// model and its stated noise (a warning, and [`Fusion::is_trustworthy`]
-/// false): the model misses an effect, or the noise is 1.7 times larger
-/// than stated.
-pub const UNEXPLAINED_REDUCED_CHI_SQUARE: f64 = 3.0;
-
-/// The fit of one source.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct SourceFit {
-    /// Label (prefix of its nuisance names).
-    pub label: String,
-    /// Kind of instrument.
-    pub kind: crate::fusion::SourceKind,
-    /// File the records came from.
-    pub file: String,
-    /// Records.
-    pub records: usize,
-    /// Data rows.
-    pub rows: usize,
-    /// Nuisance parameter names (with the label).
-    pub nuisance_names: Vec<String>,
-    /// Their estimates (rotations as rotation vectors, rad).
-    pub nuisance: Vec<f64>,
-    /// Their standard deviations.
-    pub nuisance_std_dev: Vec<f64>,
-    /// Sum of squared standardised residuals of the data rows.
-    pub chi_square: f64,
-    /// This source's share of the degrees of freedom: its rows less its
-    /// nuisance, less the global rank in proportion to its rows (a guide).
-    pub dof_share: f64,
-    /// `chi_square / dof_share`: about 1 when the model and the stated
-    /// noise explain this source.
-    pub reduced_chi_square: f64,
-    /// RMS residual, um (external sources; `None` for the internal one,
-    /// whose rows mix rad and mm).
-    pub rms_um: Option<f64>,
-    /// Largest standardised residual and the line of its record.
-    pub max_standardised: (f64, u64),
-    /// Fitted geometry beyond the nuisance values (touch-offs: the unit
-    /// normal of each plane, `plane_normals`); `null` when there is none.
-    pub extra: Value,
-}
-
-/// The result of [`identify_fused`].
-#[derive(Debug, Clone)]
-pub struct Fusion {
-    /// Global parameter names `[module | effects | head]`.
-    pub names: Vec<String>,
-    /// Estimates (held parameters at their prior, zero).
-    pub estimate: Vec<f64>,
-    /// Standard deviations (`None` for held parameters).
-    pub std_dev: Vec<Option<f64>>,
-    /// Covariance of the global parameters (zero rows and columns for held
-    /// ones).
-    pub covariance: DMatrix<f64>,
-    /// Each source's fit.
-    pub sources: Vec<SourceFit>,
-    /// What the sources, alone and together, can see.
-    pub report: FusionReport,
-    /// Gauss-Newton iterations.
-    pub iterations: u32,
-    /// Whether the iteration met its tolerance.
-    pub converged: bool,
-    /// Problems a user must read: a source the model does not explain, a
-    /// tool tip that is not calibrated, no convergence.
-    pub warnings: Vec<String>,
-}
-
 /// The fixed parts of a fused problem.
-struct Problem<'a> {
-    model: &'a FusedModel,
-    sources: &'a [Source],
+pub(crate) struct Problem<'a> {
+    pub model: &'a FusedModel,
+    pub sources: &'a [Source],
     contexts: Vec<Vec<LegContext>>,
     /// First union nuisance column of each source.
-    offsets: Vec<usize>,
-    n_nuisance: usize,
+    pub offsets: Vec<usize>,
+    pub n_nuisance: usize,
+    /// Which records of each source are in the fit.
+    pub active: &'a [Vec<bool>],
 }
 
 /// Seeds and carried nuisance of every source.
 #[derive(Clone)]
-struct State {
+pub(crate) struct State {
     seeds: Vec<Vec<Option<UpJoints>>>,
     nuisance: Vec<Nuisance>,
 }
 
 /// One evaluation: the union problem, each source's own, and each source's
-/// standardised residuals.
-struct Evaluation {
-    union: ReducedProblem,
-    parts: Vec<ReducedProblem>,
-    standardised: Vec<Vec<(usize, f64, f64)>>,
+/// standardised residuals (of the records in the fit).
+pub(crate) struct Evaluation {
+    pub union: ReducedProblem,
+    pub parts: Vec<ReducedProblem>,
+    pub standardised: Vec<Vec<(usize, f64, f64)>>,
+    /// Every source's weighted rows (of records outside the fit too).
+    pub kept: Vec<KeptRows>,
 }
 
 impl Problem<'_> {
-    fn nuisance_len(&self, s: usize) -> usize {
+    pub fn nuisance_len(&self, s: usize) -> usize {
         let end = self.offsets.get(s + 1).copied().unwrap_or(self.n_nuisance);
         end - self.offsets[s]
     }
@@ -277,9 +244,11 @@ impl Iteration for Problem<'_> {
         let k = self.model.len();
         let mut parts = Vec::with_capacity(self.sources.len());
         let mut standardised = Vec::with_capacity(self.sources.len());
+        let mut kept = Vec::with_capacity(self.sources.len());
         for (s, source) in self.sources.iter().enumerate() {
             let rows = source.rows();
-            let mut sink = Sink::new(self.nuisance_len(s), k, rows.data_rows());
+            let mut sink =
+                Sink::new(self.nuisance_len(s), k, rows.data_rows()).with_active(&self.active[s]);
             rows.evaluate(
                 &at,
                 &self.contexts[s],
@@ -288,14 +257,16 @@ impl Iteration for Problem<'_> {
                 &mut sink,
             )
             .map_err(|e| in_source(source, e))?;
-            let (part, z) = sink.finish();
+            let (part, z, rows) = sink.finish();
             parts.push(part);
             standardised.push(z);
+            kept.push(rows);
         }
         Ok(Evaluation {
             union: self.merge(&parts),
             parts,
             standardised,
+            kept,
         })
     }
 
@@ -332,7 +303,7 @@ impl Iteration for Problem<'_> {
 }
 
 /// An error of a source's evaluation, named after the source's file.
-fn in_source(source: &Source, e: IdentError) -> IdentError {
+pub(crate) fn in_source(source: &Source, e: IdentError) -> IdentError {
     match e {
         IdentError::Kinematics {
             line, source: k, ..
@@ -346,7 +317,10 @@ fn in_source(source: &Source, e: IdentError) -> IdentError {
 }
 
 /// Fits the parameters of `model` and every source's nuisance to all
-/// sources at once (see the module docs).
+/// sources at once (see the module docs): the gross-error screen of
+/// `options.screen` decides which records enter the fit, the fit is judged
+/// (redundancy, adequacy, plausibility) and an implausible or unexplained
+/// one is searched for its likely cause.
 ///
 /// # Example
 /// ```
@@ -364,6 +338,7 @@ fn in_source(source: &Source, e: IdentError) -> IdentError {
 ///     &FusionOptions::for_machine(&m)).unwrap();
 /// assert_eq!(fit.report.union.rank, 14);
 /// assert!(fit.report.union.fixed.contains(&"tool_length_mm".to_string()));
+/// assert!(fit.sources[0].checkable && fit.rejected.is_empty());
 /// ```
 pub fn identify_fused(
     model: &FusedModel,
@@ -381,17 +356,63 @@ pub fn identify_fused(
             )));
         }
     }
-    let k = model.len();
+    let (active, mut fit) = match &options.screen {
+        Some(screen) => crate::fusion::screen::screened_fit(model, sources, options, screen)?,
+        None => {
+            let active: Vec<Vec<bool>> = sources.iter().map(|s| vec![true; s.records()]).collect();
+            let fit = fit_masked(model, sources, &active, options)?;
+            (active, fit)
+        }
+    };
+    if options.likely_causes && fit.needs_causes() {
+        let causes = crate::fusion::causes::likely_causes(model, sources, &active, options, &fit);
+        fit.add_causes(causes);
+    }
+    Ok(fit)
+}
+
+/// One fit of `model` to the records of `sources` marked in `active`, judged
+/// (redundancy, record checks, verdict, plausibility) but not screened.
+pub(crate) fn fit_masked(
+    model: &FusedModel,
+    sources: &[Source],
+    active: &[Vec<bool>],
+    options: &FusionOptions,
+) -> Result<Fusion, IdentError> {
+    check_counts(model, sources, active)?;
+    let (offsets, n_nuisance) = nuisance_layout(sources);
+    let started = start(model, sources, offsets, n_nuisance, active)?;
+    fit_started(started, options)
+}
+
+/// Each source's first union nuisance column, and their total.
+pub(crate) fn nuisance_layout(sources: &[Source]) -> (Vec<usize>, usize) {
     let mut offsets = Vec::with_capacity(sources.len());
     let mut n_nuisance = 0;
     for s in sources {
         offsets.push(n_nuisance);
         n_nuisance += s.rows().nuisance_names().len();
     }
-    let data_rows: usize = sources.iter().map(|s| s.rows().data_rows()).sum();
+    (offsets, n_nuisance)
+}
+
+/// Refuses fewer rows in the fit than unknowns.
+pub(crate) fn check_counts(
+    model: &FusedModel,
+    sources: &[Source],
+    active: &[Vec<bool>],
+) -> Result<(), IdentError> {
+    let k = model.len();
+    let (_, n_nuisance) = nuisance_layout(sources);
+    let in_fit = |s: usize| active[s].iter().filter(|a| **a).count();
+    let data_rows: usize = sources
+        .iter()
+        .enumerate()
+        .map(|(s, src)| in_fit(s) * src.rows().rows_per_record())
+        .sum();
     let prior_rows: usize = sources.iter().map(|s| s.rows().prior_rows()).sum();
     if data_rows + prior_rows < n_nuisance + k + 1 {
-        let records: usize = sources.iter().map(|s| s.records()).sum();
+        let records: usize = (0..sources.len()).map(in_fit).sum();
         return Err(IdentError::Source {
             file: sources
                 .iter()
@@ -405,22 +426,38 @@ pub fn identify_fused(
             ),
         });
     }
-    let (problem, state, eval) = start(model, sources, offsets.clone(), n_nuisance)?;
+    Ok(())
+}
+
+/// The fit from a problem's start ([`start`]): the rank decision, the
+/// iteration, the judged result.
+pub(crate) fn fit_started(
+    (problem, state, eval): (Problem<'_>, State, Evaluation),
+    options: &FusionOptions,
+) -> Result<Fusion, IdentError> {
+    let (model, sources, active) = (problem.model, problem.sources, problem.active);
+    let k = model.len();
+    let (offsets, n_nuisance) = (problem.offsets.clone(), problem.n_nuisance);
+    let in_fit = |s: usize| active[s].iter().filter(|a| **a).count();
     // The rank decision: on this model, or on its reference (the nominal
-    // machine of a calibrated one) with the same sources.
+    // machine of a calibrated one) with the same sources; which parameter
+    // of an invisible set is held is chosen on the columns scaled by the
+    // parameters' typical sizes (the one whose typical size the data would
+    // see least).
     let reference = match model.rank_reference() {
-        Some(r) => Some(start(r, sources, offsets, n_nuisance)?.2),
+        Some(r) => Some(start(r, sources, offsets, n_nuisance, active)?.2),
         None => None,
     };
     let names = model.names().to_vec();
+    let typical = model.typical_sizes();
     let decision = reference
         .as_ref()
         .unwrap_or(&eval)
         .union
-        .decide(options.rank_tolerance)
+        .decide_weighted(options.rank_tolerance, Some(&typical))
         .ok_or(IdentError::Numerical("SVD did not converge"))?;
     let first = eval.union.solve(&decision);
-    let records: usize = sources.iter().map(|s| s.records()).sum();
+    let records: usize = (0..sources.len()).map(in_fit).sum();
     let union_report = IdentifiabilityReport::new(
         &names,
         &decision,
@@ -451,12 +488,14 @@ pub fn identify_fused(
 }
 
 /// The problem of `model` on `sources`, its starting state (nuisance
-/// initialised from the data at zero errors) and its evaluation there.
-fn start<'a>(
+/// initialised from the records in the fit at zero errors) and its
+/// evaluation there.
+pub(crate) fn start<'a>(
     model: &'a FusedModel,
     sources: &'a [Source],
     offsets: Vec<usize>,
     n_nuisance: usize,
+    active: &'a [Vec<bool>],
 ) -> Result<(Problem<'a>, State, Evaluation), IdentError> {
     let mut contexts = Vec::with_capacity(sources.len());
     for source in sources {
@@ -480,6 +519,7 @@ fn start<'a>(
         contexts,
         offsets,
         n_nuisance,
+        active,
     };
     let p = vec![0.0; model.len()];
     let mut state = State {
@@ -491,7 +531,7 @@ fn start<'a>(
         for (s, source) in sources.iter().enumerate() {
             let nu = source
                 .rows()
-                .initial(&at, &problem.contexts[s], &mut state.seeds[s])
+                .initial(&at, &problem.contexts[s], &mut state.seeds[s], &active[s])
                 .map_err(|e| in_source(source, e))?;
             state.nuisance.push(nu);
         }
@@ -542,6 +582,111 @@ fn check_nuisance(source: &Source, part: &ReducedProblem) -> Result<(), IdentErr
     })
 }
 
+/// The checks of every record of every source at the end of a run: each
+/// record's weighted residual after the last step and its block of the
+/// union's hat matrix ([`RecordCheck`]), and each source's redundancy
+/// `sum (1 - h_ii)` over its data rows in the fit.
+fn record_checks(
+    problem: &Problem<'_>,
+    rows: &[KeptRows],
+    hat: &HatFactor,
+    solution: &Solution,
+) -> (Vec<Vec<RecordCheck>>, Vec<f64>) {
+    let k = problem.model.len();
+    let width = problem.n_nuisance + k;
+    let mut checks = Vec::with_capacity(rows.len());
+    let mut redundancy = Vec::with_capacity(rows.len());
+    for (s, source_rows) in rows.iter().enumerate() {
+        let source = problem.sources[s].rows();
+        let nn = problem.nuisance_len(s);
+        let at = problem.offsets[s];
+        let n = source.records();
+        let mut e: Vec<Vec<f64>> = vec![Vec::new(); n];
+        let mut w: Vec<Vec<Vec<f64>>> = vec![Vec::new(); n];
+        // The data rows in the union's column order, whitened at once.
+        let mut records = Vec::new();
+        let mut union_rows: Vec<Vec<f64>> = Vec::new();
+        for (record, row) in source_rows.iter() {
+            let Some(j) = record else { continue };
+            let mut u = vec![0.0; width];
+            u[at..at + nn].copy_from_slice(&row[..nn]);
+            u[problem.n_nuisance..].copy_from_slice(&row[nn..nn + k]);
+            e[j].push(row[nn + k] - HatFactor::predict(&u, solution));
+            records.push(j);
+            union_rows.push(u);
+        }
+        let slices: Vec<&[f64]> = union_rows.iter().map(|u| u.as_slice()).collect();
+        let whitened = hat.whiten_rows(&slices);
+        for (i, &j) in records.iter().enumerate() {
+            w[j].push((0..whitened.ncols()).map(|c| whitened[(i, c)]).collect());
+        }
+        let mut red = 0.0;
+        let list: Vec<RecordCheck> = (0..n)
+            .map(|j| {
+                let active = problem.active[s][j];
+                let m = e[j].len();
+                let h = DMatrix::from_fn(m, m, |a, b| {
+                    w[j][a].iter().zip(&w[j][b]).map(|(x, y)| x * y).sum()
+                });
+                let leverage = h.trace();
+                if active {
+                    red += m as f64 - leverage;
+                }
+                let sign = if active { -1.0 } else { 1.0 };
+                let quadratic = checked_quadratic(&h, sign, &e[j]);
+                RecordCheck {
+                    line: source.line(j),
+                    active,
+                    rows: m,
+                    leverage,
+                    quadratic: if quadratic.is_finite() {
+                        quadratic.max(0.0)
+                    } else {
+                        f64::INFINITY
+                    },
+                }
+            })
+            .collect();
+        checks.push(list);
+        // A saturated source's leverages are 1 to rounding: never below 0.
+        redundancy.push(red.max(0.0));
+    }
+    (checks, redundancy)
+}
+
+/// `e^T (I + sign H)^-1 e` over the directions the other records check: a
+/// direction with leverage 1 (an eigenvalue of `I - H` near 0) is fitted
+/// exactly whatever it holds and tests nothing. Closed form for one row,
+/// a fixed-size eigen-decomposition for three.
+fn checked_quadratic(h: &DMatrix<f64>, sign: f64, e: &[f64]) -> f64 {
+    const CHECKED: f64 = 1e-6;
+    match e.len() {
+        1 => {
+            let d = 1.0 + sign * h[(0, 0)];
+            if d > CHECKED { e[0] * e[0] / d } else { 0.0 }
+        }
+        3 => {
+            let m =
+                nalgebra::Matrix3::from_fn(|a, b| f64::from(u8::from(a == b)) + sign * h[(a, b)]);
+            let eig = m.symmetric_eigen();
+            let ev = nalgebra::Vector3::new(e[0], e[1], e[2]);
+            (0..3)
+                .filter(|&i| eig.eigenvalues[i] > CHECKED)
+                .map(|i| eig.eigenvectors.column(i).dot(&ev).powi(2) / eig.eigenvalues[i])
+                .sum()
+        }
+        n => {
+            let m: DMatrix<f64> = DMatrix::identity(n, n) + h * sign;
+            let eig = m.symmetric_eigen();
+            let ev = DVector::from_column_slice(e);
+            (0..n)
+                .filter(|&i| eig.eigenvalues[i] > CHECKED)
+                .map(|i| eig.eigenvectors.column(i).dot(&ev).powi(2) / eig.eigenvalues[i])
+                .sum()
+        }
+    }
+}
+
 fn finish(
     problem: &Problem<'_>,
     run: Run<State, Evaluation>,
@@ -573,9 +718,9 @@ fn finish(
         })
         .collect();
     let covariance = DMatrix::from_fn(k, k, |a, b| solution.covariance[(nn + a, nn + b)]);
-    let data_rows: usize = problem.sources.iter().map(|s| s.rows().data_rows()).sum();
+    let hat = eval.union.hat_factor(decision);
+    let (checks, redundancy) = record_checks(problem, &eval.kept, &hat, &solution);
     let mut sources = Vec::with_capacity(problem.sources.len());
-    let mut warnings = Vec::new();
     for (s, source) in problem.sources.iter().enumerate() {
         let rows = source.rows();
         let at = problem.offsets[s];
@@ -588,7 +733,7 @@ fn finish(
             rows.retract(&mut nu, step);
             (rows.report_values(&nu), rows.report_extra(&nu))
         };
-        let nuisance_std_dev = (at..at + n_s)
+        let nuisance_std_dev: Vec<f64> = (at..at + n_s)
             .map(|j| solution.covariance[(j, j)].max(0.0).sqrt())
             .collect();
         // The residuals at the estimate (the final evaluation: the run ends on it),
@@ -597,52 +742,15 @@ fn finish(
         if rows.linear_nuisance() {
             rows.take_off_linear_nuisance(&mut z, step);
         }
-        let chi_square: f64 = z.iter().map(|(_, v, _)| v * v).sum();
-        let n_rows = rows.data_rows();
-        let dof_share =
-            n_rows as f64 - n_s as f64 - decision.rank as f64 * n_rows as f64 / data_rows as f64;
-        let reduced = if dof_share > 0.0 {
-            chi_square / dof_share
-        } else {
-            f64::NAN
-        };
-        let (max_z, max_record) = z.iter().fold((0.0f64, 0usize), |acc, (r, v, _)| {
-            if v.abs() > acc.0 { (v.abs(), *r) } else { acc }
-        });
-        let rms_um = rows.residual_unit_um().map(|unit| {
-            let sum: f64 = z.iter().map(|(_, _, raw)| raw * raw).sum();
-            unit * (sum / z.len().max(1) as f64).sqrt()
-        });
-        if reduced > UNEXPLAINED_REDUCED_CHI_SQUARE {
-            warnings.push(format!(
-                "the model does not explain {} ({}): reduced chi-square {reduced:.1}; run `tricept diagnose` on the internal data and add the effects it names (--effects), or check this instrument's sigma",
-                source.label(),
-                source.file()
-            ));
-        }
-        sources.push(SourceFit {
-            label: source.label().to_string(),
-            kind: source.kind(),
-            file: source.file().to_string(),
-            records: rows.records(),
-            rows: n_rows,
-            nuisance_names: source.nuisance_names(),
-            nuisance,
-            nuisance_std_dev,
-            chi_square,
-            dof_share,
-            reduced_chi_square: reduced,
-            rms_um,
-            max_standardised: (max_z, rows.line(max_record)),
-            extra,
-        });
-    }
-    if !converged {
-        warnings.push(format!(
-            "Gauss-Newton did not converge in {iterations} iterations: the estimate is not trustworthy"
+        sources.push(SourceFit::new(
+            source,
+            &problem.active[s],
+            &z,
+            redundancy[s],
+            (nuisance, nuisance_std_dev, extra),
         ));
     }
-    let report = build_report(
+    let (report, reference_warning) = build_report(
         model,
         problem.sources,
         start_parts,
@@ -652,18 +760,27 @@ fn finish(
         &covariance,
         options,
     )?;
-    warnings.extend(report.warnings());
-    Ok(Fusion {
-        names: model.names().to_vec(),
+    let implausible = judge(
+        model,
+        &estimate,
+        &std_dev,
+        problem.sources,
+        &sources,
+        options,
+    );
+    Ok(Fusion::assemble(
+        model,
         estimate,
         std_dev,
         covariance,
         sources,
         report,
-        iterations,
-        converged,
-        warnings,
-    })
+        (iterations, converged),
+        implausible,
+        checks,
+        reference_warning,
+        options,
+    ))
 }
 
 /// The weighted rows of one source at the nominal machine, with its
@@ -679,6 +796,9 @@ pub struct DesignRows {
     pub records: Vec<DMatrix<f64>>,
     /// The source's prior rows (bar length, target offset, stylus), weighted.
     pub priors: DMatrix<f64>,
+    /// The redundancy its rows need to check a fit
+    /// ([`SourceFit::min_redundancy`]).
+    pub min_redundancy: f64,
 }
 
 /// The rows of `source` at the nominal machine (see [`DesignRows`]).
@@ -700,10 +820,10 @@ pub fn design_rows(model: &FusedModel, source: &Source) -> Result<DesignRows, Id
         .collect::<Result<Vec<_>, _>>()?;
     let mut seeds = vec![None; rows.records()];
     let nu = rows
-        .initial(&at, &contexts, &mut seeds)
+        .initial(&at, &contexts, &mut seeds, &vec![true; rows.records()])
         .map_err(|e| in_source(source, e))?;
     let nn = nu.values.len();
-    let mut sink = Sink::keeping(nn, k, rows.data_rows());
+    let mut sink = Sink::new(nn, k, rows.data_rows());
     rows.evaluate(&at, &contexts, &nu, &mut seeds, &mut sink)
         .map_err(|e| in_source(source, e))?;
     let kept = sink.take_kept();
@@ -723,12 +843,66 @@ pub fn design_rows(model: &FusedModel, source: &Source) -> Result<DesignRows, Id
             .map(|r| DMatrix::from_row_slice(r.len() / width.max(1), width, &r))
             .collect(),
         priors: DMatrix::from_row_slice(priors.len() / width.max(1), width, &priors),
+        min_redundancy: rows.min_redundancy(),
     })
 }
 
 /// The information the `sources` together carry on the global parameters
+/// at the nominal machine, their nuisance projected out, as a square-root
+/// factor: rows whose `F^T F` is the information (every source's parameter
+/// block of its triangular factor, stacked; `rows x k`, in the
+/// parameters' units).
+///
+/// # Example
+/// ```
+/// use tricept_ident::fusion::{FusedModel, Source, information, information_factor};
+/// use tricept_kinematics::Machine;
+/// let m = Machine::paper();
+/// let model = FusedModel::new(m.clone(), tricept_model::ParameterSet::paper15(), &[], true).unwrap();
+/// let poses = m.workspace.polar_grid(3, 8, 3).iter()
+///     .map(|r| tricept_data::MeasuredPose { commands_mm: m.inverse(r).unwrap().legs_mm, ..Default::default() })
+///     .collect();
+/// let data = tricept_data::Dataset { poses, source: "grid".into() };
+/// let sources = [Source::internal(&data, m.sensors.logged_sigma())];
+/// let r = information_factor(&model, &sources).unwrap();
+/// let f = information(&model, &sources).unwrap();
+/// assert!(((r.transpose() * &r) - &f).norm() <= 1e-9 * f.norm());
+/// ```
+pub fn information_factor(
+    model: &FusedModel,
+    sources: &[Source],
+) -> Result<DMatrix<f64>, IdentError> {
+    let k = model.len();
+    let parts = sources
+        .iter()
+        .map(|source| {
+            let d = design_rows(model, source)?;
+            let nn = d.nuisance_names.len();
+            let mut acc = TriangularAccumulator::new(nn + k);
+            for m in d.records.iter().chain(std::iter::once(&d.priors)) {
+                for i in 0..m.nrows() {
+                    let row: Vec<f64> = m.row(i).iter().copied().collect();
+                    acc.push_row(&row);
+                }
+            }
+            Ok((nn, acc.finish()))
+        })
+        .collect::<Result<Vec<_>, IdentError>>()?;
+    let mut factor = DMatrix::zeros(k * parts.len(), k);
+    for (s, (nn, r)) in parts.iter().enumerate() {
+        for i in 0..k {
+            for j in 0..k {
+                factor[(s * k + i, j)] = r[(nn + i, nn + j)];
+            }
+        }
+    }
+    Ok(factor)
+}
+
+/// The information the `sources` together carry on the global parameters
 /// at the nominal machine, their nuisance projected out: `R^T R` of the
-/// union's parameter block (`k x k`, in the parameters' units).
+/// union's parameter block (`k x k`, in the parameters' units;
+/// [`information_factor`] gives `R`).
 ///
 /// # Example
 /// ```
@@ -747,123 +921,6 @@ pub fn design_rows(model: &FusedModel, source: &Source) -> Result<DesignRows, Id
 /// assert!(f[(0, 0)] > 0.0);
 /// ```
 pub fn information(model: &FusedModel, sources: &[Source]) -> Result<DMatrix<f64>, IdentError> {
-    let k = model.len();
-    let parts = sources
-        .iter()
-        .map(|source| {
-            let d = design_rows(model, source)?;
-            let nn = d.nuisance_names.len();
-            let mut acc = TriangularAccumulator::new(nn + k);
-            for m in d.records.iter().chain(std::iter::once(&d.priors)) {
-                for i in 0..m.nrows() {
-                    let row: Vec<f64> = m.row(i).iter().copied().collect();
-                    acc.push_row(&row);
-                }
-            }
-            Ok((nn, acc.finish()))
-        })
-        .collect::<Result<Vec<_>, IdentError>>()?;
-    let mut f = DMatrix::zeros(k, k);
-    for (nn, r) in parts {
-        let block = DMatrix::from_fn(k, k, |i, j| r[(nn + i, nn + j)]);
-        f += block.transpose() * block;
-    }
-    Ok(f)
-}
-
-impl Fusion {
-    /// Whether the fit converged and the model explains every source
-    /// (reduced chi-square at most [`UNEXPLAINED_REDUCED_CHI_SQUARE`]). A
-    /// fit that is not must not be deployed as it stands.
-    pub fn is_trustworthy(&self) -> bool {
-        self.converged
-            && self
-                .sources
-                .iter()
-                .all(|s| s.reduced_chi_square <= UNEXPLAINED_REDUCED_CHI_SQUARE)
-    }
-
-    /// Index of a global parameter by name.
-    pub fn index_of(&self, name: &str) -> Option<usize> {
-        self.names.iter().position(|n| n == name)
-    }
-
-    /// JSON: every global parameter at the top level (as `identify`), with
-    /// `std_dev`, `groups`, `sources`, the identifiability report of the
-    /// union and of each source (`visibility`), `tool_tip`, `warnings`.
-    pub fn to_json(&self, model: &FusedModel) -> Value {
-        let mut m = Map::new();
-        for (n, v) in self.names.iter().zip(&self.estimate) {
-            m.insert(n.clone(), (*v).into());
-        }
-        m.insert(
-            "std_dev".into(),
-            Value::Object(
-                self.names
-                    .iter()
-                    .zip(&self.std_dev)
-                    .map(|(n, s)| (n.clone(), s.map_or(Value::Null, Value::from)))
-                    .collect(),
-            ),
-        );
-        let group = |r: std::ops::Range<usize>| -> Value {
-            self.names[r].iter().cloned().map(Value::from).collect()
-        };
-        m.insert(
-            "groups".into(),
-            json!({"module": group(model.module_range()), "effects": group(model.effect_range()), "head": group(model.head_range())}),
-        );
-        m.insert(
-            "sources".into(),
-            Value::Array(
-                self.sources
-                    .iter()
-                    .map(|s| {
-                        let mut v = serde_json::to_value(s).unwrap_or(Value::Null);
-                        if let Value::Object(o) = &mut v {
-                            o.insert(
-                                "nuisance".into(),
-                                Value::Object(
-                                    s.nuisance_names
-                                        .iter()
-                                        .zip(&s.nuisance)
-                                        .map(|(n, x)| (n.clone(), Value::from(*x)))
-                                        .collect(),
-                                ),
-                            );
-                            o.insert(
-                                "nuisance_std_dev".into(),
-                                Value::Object(
-                                    s.nuisance_names
-                                        .iter()
-                                        .zip(&s.nuisance_std_dev)
-                                        .map(|(n, x)| (n.clone(), Value::from(*x)))
-                                        .collect(),
-                                ),
-                            );
-                            o.remove("nuisance_names");
-                            o.insert(
-                                "max_standardised".into(),
-                                json!({"value": s.max_standardised.0, "line": s.max_standardised.1}),
-                            );
-                        }
-                        v
-                    })
-                    .collect(),
-            ),
-        );
-        if let Value::Object(r) = self.report.union.to_json() {
-            for (key, v) in r {
-                m.insert(key, v);
-            }
-        }
-        m.insert("visibility".into(), self.report.to_json());
-        m.insert("iterations".into(), self.iterations.into());
-        m.insert("converged".into(), self.converged.into());
-        m.insert(
-            "warnings".into(),
-            Value::Array(self.warnings.iter().cloned().map(Value::from).collect()),
-        );
-        Value::Object(m)
-    }
+    let r = information_factor(model, sources)?;
+    Ok(r.transpose() * r)
 }

@@ -16,27 +16,40 @@
 //! - [`FusedModel`]: the global parameters `[module | effects | head]`.
 //! - [`Source`]: one data source; `Source::internal`, `Source::tracker`,
 //!   `Source::ballbar`, `Source::touch`.
-//! - [`identify_fused`] and its result [`Fusion`].
+//! - [`identify_fused`] and its result [`Fusion`]: each source's
+//!   redundancy and whether it can check the fit, the verdict, the records
+//!   the gross-error screen rejected ([`ScreenOptions`]), the estimates
+//!   outside their plausible range ([`FusionPlausibility`]) and the likely
+//!   causes tested by refitting ([`FusionCause`]).
 //!
 //! Lengths in mm, angles in rad, instrument noise in um.
 
 mod ballbar;
+mod causes;
 mod estimate;
 mod model;
+mod plausibility;
 mod report;
+mod result;
+mod screen;
 mod source;
 mod touch;
 mod tracker;
 
 pub use ballbar::BallbarOptions;
+pub use causes::FusionCause;
 pub use estimate::{
-    DesignRows, Fusion, FusionOptions, SourceFit, UNEXPLAINED_REDUCED_CHI_SQUARE, design_rows,
-    evaluation_poses, head_angle_poses, identify_fused, information,
+    DesignRows, FusionOptions, design_rows, evaluation_poses, head_angle_poses, identify_fused,
+    information, information_factor,
 };
 pub use model::{FUSABLE_EFFECTS, FusedModel};
+pub use plausibility::{FusionPlausibility, HEAD_RANGE_TYPICAL_SIZES, Implausible};
 pub use report::{
-    FusionReport, MadeVisible, NamedQuantity, SourceVisibility, TipImpact, ToolTipPrediction,
+    FusionReport, HARMLESS_AXIS_ARCSEC, MadeVisible, NamedQuantity, SourceVisibility, TipImpact,
+    ToolAxisPrediction, ToolTipPrediction,
 };
+pub use result::{Fusion, FusionVerdict, SourceFit};
+pub use screen::{RejectedRecord, ScreenOptions};
 pub use source::{Source, SourceKind};
 pub use touch::TouchOptions;
 pub use tracker::{TrackerOptions, TrackerTarget};

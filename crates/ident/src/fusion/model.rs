@@ -378,6 +378,56 @@ impl FusedModel {
         ))
     }
 
+    /// The Jacobians (`3 x len`) of the spindle points of `effectors` at
+    /// every pose of `poses` for parameters `p`: `[pose][effector]`, with one
+    /// model and one FK per pose (the effectors after the first start from
+    /// its joints). A pose the model cannot reach is an error naming it.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_data::ExternalPose;
+    /// use tricept_ident::fusion::FusedModel;
+    /// use tricept_kinematics::Machine;
+    /// use tricept_model::Effector;
+    /// let model = FusedModel::new(Machine::paper(), tricept_model::ParameterSet::paper15(), &[], true).unwrap();
+    /// let q = Machine::paper().inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0)).unwrap().legs_mm;
+    /// let pose = ExternalPose { commands_mm: q, head_rad: [0.3, 0.2] };
+    /// let p = vec![0.0; model.len()];
+    /// let up = Effector { extension_mm: 100.0, ..Effector::default() };
+    /// let j = model.spindle_jacobians(&p, &[pose], &[Effector::default(), up]).unwrap();
+    /// assert_eq!(j[0][1], model.spindle_point(&p, &pose, &up).unwrap().1);
+    /// ```
+    pub fn spindle_jacobians(
+        &self,
+        p: &[f64],
+        poses: &[ExternalPose],
+        effectors: &[Effector],
+    ) -> Result<Vec<Vec<DMatrix<f64>>>, IdentError> {
+        self.check_len(p)?;
+        let at = self.at(p);
+        let mut jac = vec![0.0; 3 * self.len()];
+        poses
+            .iter()
+            .enumerate()
+            .map(|(i, pose)| {
+                let ctx = self.leg_context(&pose.commands_mm).map_err(kinematics)?;
+                let mut seed = None;
+                effectors
+                    .iter()
+                    .map(|e| {
+                        at.spindle_point(pose, &ctx, e, &mut seed, &mut jac)
+                            .map_err(|source| IdentError::Kinematics {
+                                pose: i,
+                                line: 0,
+                                source,
+                            })?;
+                        Ok(DMatrix::from_row_slice(3, self.len(), &jac))
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
     /// Leg commands and commanded head angles that put the tool tip at
     /// `tip_mm` along `axis` on the machine at parameters `p`: the tool-pose
     /// IK of [`FusedModel::machine_at`], then the leg effects inverted

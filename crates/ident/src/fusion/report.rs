@@ -21,13 +21,17 @@
 //!   the evaluation poses of the tool tip's displacement, raw and after
 //!   touch-off (the mean displacement removed: what locating the part with
 //!   the machine itself makes irrelevant);
-//! - **the tool tip's predicted uncertainty** over the evaluation poses,
-//!   raw and after touch-off, from the covariance of the estimate, and the
-//!   held parameters that move the tip (not calibrated).
+//! - **the tool tip's and the tool axis' predicted uncertainty** over the
+//!   evaluation poses (the tip raw and after touch-off), from the
+//!   covariance of the estimate and, for every parameter held at its prior,
+//!   its invisible combination at the parameter's typical size: the data
+//!   do not calibrate it, so the machine keeps an error of that size along
+//!   it. The held parameters that move the tip or the axis are named.
 
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use serde_json::Value;
+use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_model::Effector;
 use tricept_numerics::lsq::{RankDecision, ReducedProblem};
 
@@ -90,11 +94,16 @@ pub struct TipImpact {
     pub raw_um: f64,
     /// The same after touch-off (mean displacement removed), um.
     pub touch_off_um: f64,
-    /// Whether `touch_off_um` is below the harmless threshold.
+    /// RMS rotation of the tool axis over the evaluation poses, arcsec.
+    pub axis_arcsec: f64,
+    /// Whether `touch_off_um` is below the harmless threshold (harmless to
+    /// the tool tip; `axis_arcsec` says what it does to the tool axis).
     pub harmless: bool,
 }
 
-/// The tool tip's predicted standard deviation over the evaluation poses.
+/// The tool tip's predicted standard deviation over the evaluation poses:
+/// the estimate's covariance plus every held parameter's invisible
+/// combination at its typical size.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ToolTipPrediction {
     /// Number of evaluation poses.
@@ -108,12 +117,43 @@ pub struct ToolTipPrediction {
     pub touch_off_rms_um: f64,
     /// Largest after touch-off, um.
     pub touch_off_max_um: f64,
+    /// The held parameters' share of `raw_rms_um` (their typical sizes
+    /// alone), um.
+    pub held_raw_rms_um: f64,
+    /// The held parameters' share of `touch_off_rms_um`, um.
+    pub held_touch_off_rms_um: f64,
     /// Parameters held at nominal whose invisible combination, at typical
     /// size, moves the tool tip by the harmless threshold or more: the tip
-    /// is not calibrated in those directions, whatever the numbers above
-    /// say.
+    /// is not calibrated in those directions (they are in the numbers
+    /// above at their typical size, not at what this machine has).
     pub held_moving_tip: Vec<String>,
 }
+
+/// The tool axis' predicted standard deviation over the evaluation poses
+/// (the same covariance as [`ToolTipPrediction`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ToolAxisPrediction {
+    /// Number of evaluation poses.
+    pub poses: usize,
+    /// RMS over the poses of the axis direction's standard deviation, arcsec.
+    pub rms_arcsec: f64,
+    /// Largest over the poses, arcsec.
+    pub max_arcsec: f64,
+    /// The held parameters' share of `rms_arcsec`, arcsec.
+    pub held_rms_arcsec: f64,
+    /// Held parameters whose invisible combination, at typical size, turns
+    /// the axis by [`HARMLESS_AXIS_ARCSEC`] or more.
+    pub held_moving_axis: Vec<String>,
+}
+
+/// An invisible combination that turns the tool axis by less than this, at
+/// typical size, is not named as moving it, arcsec.
+pub const HARMLESS_AXIS_ARCSEC: f64 = 5.0;
+
+/// The extension along the tool over which the axis is differentiated, mm
+/// (the axis' Jacobian is exact for any length: the extension runs along
+/// the actual tool axis).
+const AXIS_LEVER_MM: f64 = 100.0;
 
 /// The fused identifiability report (see the module docs).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -133,6 +173,8 @@ pub struct FusionReport {
     pub invisible: Vec<TipImpact>,
     /// The tool tip's predicted uncertainty.
     pub tool_tip: ToolTipPrediction,
+    /// The tool axis' predicted uncertainty.
+    pub tool_axis: ToolAxisPrediction,
 }
 
 /// A reduced problem's rank decision and the covariance of its global
@@ -145,12 +187,13 @@ struct Decided {
 
 fn decide(
     names: &[String],
+    typical: &[f64],
     problem: &ReducedProblem,
     records: usize,
     options: &FusionOptions,
 ) -> Result<Decided, IdentError> {
     let decision = problem
-        .decide(options.rank_tolerance)
+        .decide_weighted(options.rank_tolerance, Some(typical))
         .ok_or(IdentError::Numerical("SVD did not converge"))?;
     let solution = problem.solve(&decision);
     let nn = problem.n_nuisance;
@@ -190,17 +233,37 @@ fn functional_std(decision: &RankDecision, covariance: &DMatrix<f64>, c: &[f64])
     Some((v.transpose() * covariance * &v)[(0, 0)].max(0.0).sqrt())
 }
 
-/// The tool tip's Jacobians over the evaluation poses at `p` (3 x k each).
-fn tip_jacobians(
+/// Per evaluation pose, a `3 x k` Jacobian.
+type PoseJacobians = Vec<DMatrix<f64>>;
+
+/// The tool tip's and the tool axis' Jacobians over the evaluation poses
+/// at `p` (3 x k each; the axis' in rad per unit).
+fn tip_and_axis_jacobians(
     model: &FusedModel,
     p: &[f64],
     options: &FusionOptions,
-) -> Result<Vec<DMatrix<f64>>, IdentError> {
-    options
-        .eval_poses
-        .iter()
-        .map(|pose| Ok(model.spindle_point(p, pose, &Effector::default())?.1))
-        .collect()
+) -> Result<(PoseJacobians, PoseJacobians), IdentError> {
+    let lever = Effector {
+        extension_mm: AXIS_LEVER_MM,
+        ..Effector::default()
+    };
+    let jacobians = model
+        .spindle_jacobians(p, &options.eval_poses, &[Effector::default(), lever])
+        .map_err(|e| match e {
+            IdentError::Kinematics { pose, source, .. } => {
+                IdentError::Invalid(format!("evaluation pose {}: {source}", pose + 1))
+            }
+            e => e,
+        })?;
+    Ok(jacobians
+        .into_iter()
+        .map(|mut g| {
+            let g1 = g.pop().unwrap_or_default();
+            let g0 = g.pop().unwrap_or_default();
+            let axis = (g1 - &g0) / AXIS_LEVER_MM;
+            (g0, axis)
+        })
+        .unzip())
 }
 
 /// `(raw, after touch-off)` RMS over the poses of `G_e v`, in the units of
@@ -218,6 +281,32 @@ fn impact(g: &[DMatrix<f64>], mean: &DMatrix<f64>, v: &[f64]) -> (f64, f64) {
     ((raw / n).sqrt(), (touched / n).sqrt())
 }
 
+/// The Jacobians `G_e` (3 x k each) stacked into one `3E x k` matrix,
+/// each centred on `mean` when given (after touch-off).
+fn stacked(g: &[DMatrix<f64>], mean: Option<&DMatrix<f64>>) -> DMatrix<f64> {
+    let k = g.first().map_or(0, |x| x.ncols());
+    DMatrix::from_fn(3 * g.len(), k, |r, c| {
+        g[r / 3][(r % 3, c)] - mean.map_or(0.0, |m| m[(r % 3, c)])
+    })
+}
+
+/// RMS and largest over the poses of `sqrt(tr(G_e C G_e^T))` for the
+/// stacked Jacobians `g` ([`stacked`]): one matrix product.
+fn spread(g: &DMatrix<f64>, c: &DMatrix<f64>) -> (f64, f64) {
+    let gc = g * c;
+    let poses = g.nrows() / 3;
+    let (mut sum, mut max) = (0.0f64, 0.0f64);
+    for e in 0..poses {
+        let a: f64 = (3 * e..3 * e + 3)
+            .map(|r| gc.row(r).dot(&g.row(r)))
+            .sum::<f64>()
+            .max(0.0);
+        sum += a;
+        max = max.max(a.sqrt());
+    }
+    ((sum / poses.max(1) as f64).sqrt(), max)
+}
+
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn build_report(
     model: &FusedModel,
@@ -228,13 +317,14 @@ pub(crate) fn build_report(
     estimate: &[f64],
     covariance: &DMatrix<f64>,
     options: &FusionOptions,
-) -> Result<FusionReport, IdentError> {
+) -> Result<(FusionReport, Vec<String>), IdentError> {
     let names = model.names();
     let k = names.len();
+    let typical = model.typical_sizes();
     let alone: Vec<Decided> = sources
         .iter()
         .zip(start_parts)
-        .map(|(s, part)| decide(names, part, s.records(), options))
+        .map(|(s, part)| decide(names, &typical, part, s.records(), options))
         .collect::<Result<_, _>>()?;
     let internal = sources
         .iter()
@@ -249,6 +339,7 @@ pub(crate) fn build_report(
             let both = merge(&[&start_parts[i], &start_parts[s]]);
             let d = decide(
                 names,
+                &typical,
                 &both,
                 sources[i].records() + source.records(),
                 options,
@@ -302,9 +393,21 @@ pub(crate) fn build_report(
         })
         .collect();
 
-    let g = tip_jacobians(model, estimate, options)?;
+    // At the estimate; a wild estimate whose machine cannot reach an
+    // evaluation pose is judged at the nominal machine instead (and said so).
+    let mut warnings = Vec::new();
+    let (g, ga) = match tip_and_axis_jacobians(model, estimate, options) {
+        Ok(g) => g,
+        Err(e) => {
+            warnings.push(format!(
+                "the fitted machine cannot reach every evaluation pose ({e}): the estimate is far from the nominal machine; the predictions are taken at the nominal machine"
+            ));
+            tip_and_axis_jacobians(model, &vec![0.0; k], options)?
+        }
+    };
     let n_poses = g.len().max(1) as f64;
     let mean = g.iter().fold(DMatrix::zeros(3, k), |a, b| a + b) / n_poses;
+    let axis_mean = DMatrix::zeros(3, k);
     let harmless = |touch_off_um: f64| touch_off_um < options.harmless_um;
     let mut weak = Vec::new();
     let mut scopes: Vec<(String, &RankDecision, &IdentifiabilityReport)> =
@@ -327,19 +430,20 @@ pub(crate) fn build_report(
             }
             let v: Vec<f64> = d.direction(i).iter().map(|x| x / s).collect();
             let (raw, touched) = impact(&g, &mean, &v);
+            let (axis, _) = impact(&ga, &axis_mean, &v);
             weak.push(TipImpact {
                 scope: scope.clone(),
                 combination: combination(names, &v, s, None),
                 per_std_dev: true,
                 raw_um: 1e3 * raw,
                 touch_off_um: 1e3 * touched,
+                axis_arcsec: axis / RAD_PER_ARCSEC,
                 harmless: harmless(1e3 * touched),
             });
         }
     }
-    let typical = model.typical_sizes();
-    let invisible: Vec<TipImpact> = union_decision
-        .null_space_basis()
+    let null = union_decision.null_space_basis();
+    let invisible: Vec<TipImpact> = null
         .iter()
         .zip(&union_decision.singular_values[union_decision.rank..])
         .map(|(v, s)| {
@@ -349,77 +453,128 @@ pub(crate) fn build_report(
                 .fold(0.0f64, |a, (b, t)| a.max((b / t).abs()));
             let unit: Vec<f64> = v.iter().map(|x| x / largest).collect();
             let (raw, touched) = impact(&g, &mean, &unit);
+            let (axis, _) = impact(&ga, &axis_mean, &unit);
             TipImpact {
                 scope: "union".into(),
                 combination: combination(names, v, *s, None),
                 per_std_dev: false,
                 raw_um: 1e3 * raw,
                 touch_off_um: 1e3 * touched,
+                axis_arcsec: axis / RAD_PER_ARCSEC,
                 harmless: harmless(1e3 * touched),
             }
         })
         .collect();
 
-    let (mut raw2, mut touched2, mut raw_max, mut touched_max) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-    for ge in &g {
-        let a = (ge * covariance * ge.transpose()).trace().max(0.0);
-        let gt = ge - &mean;
-        let b = (&gt * covariance * gt.transpose()).trace().max(0.0);
-        raw2 += a;
-        touched2 += b;
-        raw_max = raw_max.max(a.sqrt());
-        touched_max = touched_max.max(b.sqrt());
+    // The held parameters at their typical sizes: the basic solution holds
+    // each at zero, so the machine keeps its true value along the
+    // parameter's invisible combination (vector f moves held parameter f by
+    // one and the rest so that no source sees it).
+    let mut held_cov = DMatrix::zeros(k, k);
+    for (v, &f) in null.iter().zip(&union_decision.fixed) {
+        let n = DVector::from_column_slice(v) * typical[f];
+        held_cov += &n * n.transpose();
     }
-    // A held parameter leaves the tip uncalibrated when its invisible
-    // combination, at typical size, moves the tip more than is harmless.
-    let held_moving_tip = union_decision
-        .fixed
-        .iter()
-        .zip(&invisible)
-        .filter(|(_, t)| t.raw_um >= options.harmless_um)
-        .map(|(&j, _)| names[j].clone())
-        .collect();
-    Ok(FusionReport {
-        union: union_report,
-        sources: sources
+    let total = covariance + &held_cov;
+    let (raw, touched, axis) = (
+        stacked(&g, None),
+        stacked(&g, Some(&mean)),
+        stacked(&ga, None),
+    );
+    let (raw_rms, raw_max) = spread(&raw, &total);
+    let (touched_rms, touched_max) = spread(&touched, &total);
+    let (held_raw, _) = spread(&raw, &held_cov);
+    let (held_touched, _) = spread(&touched, &held_cov);
+    let (axis_rms, axis_max) = spread(&axis, &total);
+    let (held_axis, _) = spread(&axis, &held_cov);
+    // A held parameter leaves the tip (the axis) uncalibrated when its
+    // invisible combination, at typical size, moves the tip more than is
+    // harmless (turns the axis by HARMLESS_AXIS_ARCSEC or more).
+    let held_moving = |keep: &dyn Fn(&TipImpact) -> bool| -> Vec<String> {
+        union_decision
+            .fixed
             .iter()
-            .zip(alone)
-            .map(|(s, d)| SourceVisibility {
-                label: s.label().to_string(),
-                report: d.report,
-            })
-            .collect(),
-        made_visible,
-        named,
-        weak,
-        invisible,
-        tool_tip: ToolTipPrediction {
-            poses: g.len(),
-            raw_rms_um: 1e3 * (raw2 / n_poses).sqrt(),
-            raw_max_um: 1e3 * raw_max,
-            touch_off_rms_um: 1e3 * (touched2 / n_poses).sqrt(),
-            touch_off_max_um: 1e3 * touched_max,
-            held_moving_tip,
+            .zip(&invisible)
+            .filter(|(_, t)| keep(t))
+            .map(|(&j, _)| names[j].clone())
+            .collect()
+    };
+    let held_moving_tip = held_moving(&|t| t.raw_um >= options.harmless_um);
+    let held_moving_axis = held_moving(&|t| t.axis_arcsec >= HARMLESS_AXIS_ARCSEC);
+    Ok((
+        FusionReport {
+            union: union_report,
+            sources: sources
+                .iter()
+                .zip(alone)
+                .map(|(s, d)| SourceVisibility {
+                    label: s.label().to_string(),
+                    report: d.report,
+                })
+                .collect(),
+            made_visible,
+            named,
+            weak,
+            invisible,
+            tool_tip: ToolTipPrediction {
+                poses: g.len(),
+                raw_rms_um: 1e3 * raw_rms,
+                raw_max_um: 1e3 * raw_max,
+                touch_off_rms_um: 1e3 * touched_rms,
+                touch_off_max_um: 1e3 * touched_max,
+                held_raw_rms_um: 1e3 * held_raw,
+                held_touch_off_rms_um: 1e3 * held_touched,
+                held_moving_tip,
+            },
+            tool_axis: ToolAxisPrediction {
+                poses: ga.len(),
+                rms_arcsec: axis_rms / RAD_PER_ARCSEC,
+                max_arcsec: axis_max / RAD_PER_ARCSEC,
+                held_rms_arcsec: held_axis / RAD_PER_ARCSEC,
+                held_moving_axis,
+            },
         },
-    })
+        warnings,
+    ))
 }
 
 impl FusionReport {
-    /// Warnings a user must read: held parameters that move the tool tip.
-    pub fn warnings(&self) -> Vec<String> {
+    /// Warnings a user must read: held parameters that move the tool tip,
+    /// and a tool axis predicted above `axis_arcsec`.
+    pub fn warnings(&self, axis_arcsec: f64) -> Vec<String> {
+        let mut out = Vec::new();
         let held = &self.tool_tip.held_moving_tip;
-        if held.is_empty() {
-            return Vec::new();
+        if !held.is_empty() {
+            out.push(format!(
+                "the tool tip is not calibrated in every direction: {} held at nominal (no source sees {}); the predicted tool-tip uncertainty includes {} at typical size ({:.1} um raw, {:.1} um after touch-off)",
+                held.join(", "),
+                if held.len() == 1 { "it" } else { "them" },
+                if held.len() == 1 { "it" } else { "them" },
+                self.tool_tip.held_raw_rms_um,
+                self.tool_tip.held_touch_off_rms_um
+            ));
         }
-        vec![format!(
-            "the tool tip is not calibrated in every direction: {} held at nominal (no source sees {}); the predicted tool-tip uncertainty leaves them out",
-            held.join(", "),
-            if held.len() == 1 { "it" } else { "them" }
-        )]
+        let a = &self.tool_axis;
+        if a.rms_arcsec > axis_arcsec {
+            let held = if a.held_moving_axis.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " ({} held at nominal: {:.0} arcsec of it)",
+                    a.held_moving_axis.join(", "),
+                    a.held_rms_arcsec
+                )
+            };
+            out.push(format!(
+                "the tool axis is predicted to {:.0} arcsec rms (max {:.0}), above {axis_arcsec} arcsec{held}: tool-tip data do not calibrate the tool's direction; measure a tracker target at two known extensions along the tool (column `extension_mm`, e.g. 0 and 100 mm: `tricept plan --instrument tracker --extensions 0,100`)",
+                a.rms_arcsec, a.max_arcsec
+            ));
+        }
+        out
     }
 
     /// The report as JSON (`union`, `per_source`, `made_visible`, `named`,
-    /// `weak`, `invisible`, `tool_tip`).
+    /// `weak`, `invisible`, `tool_tip`, `tool_axis`).
     pub fn to_json(&self) -> Value {
         let mut v = serde_json::to_value(self).unwrap_or(Value::Null);
         if let Value::Object(o) = &mut v
@@ -464,11 +619,16 @@ impl FusionReport {
             );
             for t in &self.invisible {
                 s.push_str(&format!(
-                    "  {}   raw {:.1} um, after touch-off {:.1} um{}\n",
+                    "  {}   raw {:.1} um, after touch-off {:.1} um, axis {:.1} arcsec{}\n",
                     t.combination.to_text(),
                     t.raw_um,
                     t.touch_off_um,
-                    if t.harmless { ": harmless" } else { "" }
+                    t.axis_arcsec,
+                    match (t.harmless, t.axis_arcsec >= HARMLESS_AXIS_ARCSEC) {
+                        (true, false) => ": harmless",
+                        (true, true) => ": harmless to the tip, not to the tool axis",
+                        _ => "",
+                    }
                 ));
             }
         }
@@ -476,11 +636,12 @@ impl FusionReport {
             s.push_str("weak combinations, tool-tip impact per standard deviation:\n");
             for t in &self.weak {
                 s.push_str(&format!(
-                    "  [{}] {}\n      raw {:.1} um, after touch-off {:.1} um{}\n",
+                    "  [{}] {}\n      raw {:.1} um, after touch-off {:.1} um, axis {:.1} arcsec{}\n",
                     t.scope,
                     t.combination.to_text(),
                     t.raw_um,
                     t.touch_off_um,
+                    t.axis_arcsec,
                     if t.harmless {
                         ": nearly harmless to the tool tip"
                     } else {
@@ -508,8 +669,19 @@ impl FusionReport {
         }
         let t = &self.tool_tip;
         s.push_str(&format!(
-            "predicted tool tip ({} poses): raw rms {:.1} um (max {:.1}), after touch-off rms {:.1} um (max {:.1})\n",
-            t.poses, t.raw_rms_um, t.raw_max_um, t.touch_off_rms_um, t.touch_off_max_um
+            "predicted tool tip ({} poses): raw rms {:.1} um (max {:.1}), after touch-off rms {:.1} um (max {:.1}); held parameters at typical size: {:.1} um raw, {:.1} um after touch-off\n",
+            t.poses,
+            t.raw_rms_um,
+            t.raw_max_um,
+            t.touch_off_rms_um,
+            t.touch_off_max_um,
+            t.held_raw_rms_um,
+            t.held_touch_off_rms_um
+        ));
+        let a = &self.tool_axis;
+        s.push_str(&format!(
+            "predicted tool axis ({} poses): rms {:.1} arcsec (max {:.1}); held parameters at typical size: {:.1} arcsec\n",
+            a.poses, a.rms_arcsec, a.max_arcsec, a.held_rms_arcsec
         ));
         s
     }

@@ -68,16 +68,43 @@ pub(crate) struct Nuisance {
 
 /// The rows of one source being accumulated: `[nuisance | parameters |
 /// residual]`, each weighted by `1 / sigma`, and the standardised data
-/// residuals by record.
+/// residuals by record. Records outside the fit (set aside by the
+/// gross-error screen) are evaluated but not accumulated.
 pub(crate) struct Sink {
     acc: TriangularAccumulator,
     n_nuisance: usize,
     k: usize,
     row: Vec<f64>,
-    /// `(record, standardised residual, residual)` of every data row.
+    /// `(record, standardised residual, residual)` of every data row in the fit.
     pub standardised: Vec<(usize, f64, f64)>,
-    /// Every weighted row with its record (`None`: a prior), when kept.
-    kept: Option<Vec<(Option<usize>, Vec<f64>)>>,
+    /// Every weighted row, of records outside the fit too, and every prior.
+    kept: KeptRows,
+    /// Which records are in the fit (`None`: all).
+    active: Option<Vec<bool>>,
+}
+
+/// The weighted rows `[nuisance | parameters | residual]` a sink saw, each
+/// with its record (`None`: a prior), stored flat.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct KeptRows {
+    width: usize,
+    values: Vec<f64>,
+    records: Vec<Option<usize>>,
+}
+
+impl KeptRows {
+    fn push(&mut self, record: Option<usize>, row: &[f64]) {
+        self.values.extend_from_slice(row);
+        self.records.push(record);
+    }
+
+    /// Every row with its record.
+    pub fn iter(&self) -> impl Iterator<Item = (Option<usize>, &[f64])> {
+        self.records
+            .iter()
+            .zip(self.values.chunks_exact(self.width.max(1)))
+            .map(|(r, v)| (*r, v))
+    }
 }
 
 impl Sink {
@@ -90,21 +117,25 @@ impl Sink {
             k,
             row: vec![0.0; n_nuisance + k + 1],
             standardised: Vec::with_capacity(rows),
-            kept: None,
+            kept: KeptRows {
+                width: n_nuisance + k + 1,
+                values: Vec::with_capacity(rows * (n_nuisance + k + 1)),
+                records: Vec::with_capacity(rows),
+            },
+            active: None,
         }
     }
 
-    /// A sink that also keeps every weighted row (for planning).
-    pub fn keeping(n_nuisance: usize, k: usize, rows: usize) -> Sink {
-        Sink {
-            kept: Some(Vec::with_capacity(rows)),
-            ..Sink::new(n_nuisance, k, rows)
-        }
+    /// The same sink, accumulating only the records marked in `active`.
+    pub fn with_active(mut self, active: &[bool]) -> Sink {
+        self.active = (!active.iter().all(|a| *a)).then(|| active.to_vec());
+        self
     }
 
-    /// The rows kept by a [`Sink::keeping`] sink.
+    /// Every row the sink saw, with its record (`None`: a prior).
     pub fn take_kept(&mut self) -> Vec<(Option<usize>, Vec<f64>)> {
-        self.kept.take().unwrap_or_default()
+        let kept = std::mem::take(&mut self.kept);
+        kept.iter().map(|(r, v)| (r, v.to_vec())).collect()
     }
 
     /// One data row of `record`: weight `w = 1 / sigma`, the derivatives of
@@ -119,11 +150,16 @@ impl Sink {
             *r = w * v;
         }
         self.row[nn + k] = w * residual;
+        self.kept.push(Some(record), &self.row);
+        if self
+            .active
+            .as_ref()
+            .is_some_and(|a| !a.get(record).copied().unwrap_or(true))
+        {
+            return;
+        }
         self.acc.push_row(&self.row);
         self.standardised.push((record, w * residual, residual));
-        if let Some(kept) = &mut self.kept {
-            kept.push((Some(record), self.row.clone()));
-        }
     }
 
     /// A prior on nuisance parameter `column`: `(prior - value) / sigma`.
@@ -132,13 +168,12 @@ impl Sink {
         self.row[column] = 1.0 / sigma;
         self.row[self.n_nuisance + self.k] = residual / sigma;
         self.acc.push_row(&self.row);
-        if let Some(kept) = &mut self.kept {
-            kept.push((None, self.row.clone()));
-        }
+        self.kept.push(None, &self.row);
     }
 
-    /// The reduced problem of the rows pushed.
-    pub fn finish(self) -> (ReducedProblem, Vec<(usize, f64, f64)>) {
+    /// The reduced problem of the rows pushed, their standardised residuals
+    /// and every row seen.
+    pub fn finish(self) -> (ReducedProblem, Vec<(usize, f64, f64)>, KeptRows) {
         let rows = self.acc.rows();
         (
             ReducedProblem {
@@ -148,6 +183,7 @@ impl Sink {
                 k: self.k,
             },
             self.standardised,
+            self.kept,
         )
     }
 }
@@ -169,6 +205,35 @@ pub(crate) trait SourceRows: Sync + std::fmt::Debug {
     fn prior_rows(&self) -> usize {
         0
     }
+    /// Data rows per record (3 for a point or the UP limb's readings, 1
+    /// for a length or a touch).
+    fn rows_per_record(&self) -> usize {
+        self.data_rows() / self.records().max(1)
+    }
+    /// The redundancy (degrees of freedom) below which the source's rows
+    /// cannot check the fit: 6 per tracker station, 4 per ballbar setup or
+    /// touched feature, 6 for the UP limb's data
+    /// ([`crate::fusion::SourceFit::checkable`]).
+    fn min_redundancy(&self) -> f64;
+    /// The source's nuisance estimates that have a plausible size:
+    /// `(table key, nuisance index, value judged)` for the values reported
+    /// by [`SourceRows::report_values`] (e.g. a target offset's change from
+    /// its stated value).
+    fn judged_nuisance(&self, _values: &[f64]) -> Vec<(&'static str, usize, f64)> {
+        Vec::new()
+    }
+    /// The tracker target's stated offset (tracker sources only).
+    fn tracker_target(&self) -> Option<crate::fusion::TrackerTarget> {
+        None
+    }
+    /// The same records with another statement of the tracker target
+    /// (tracker sources only): what the likely-cause search refits.
+    fn with_tracker_target(
+        &self,
+        _target: crate::fusion::TrackerTarget,
+    ) -> Option<Box<dyn SourceRows>> {
+        None
+    }
     /// Where the machine stood at a record.
     fn pose(&self, record: usize) -> ExternalPose;
     /// The record's line in its file.
@@ -182,13 +247,14 @@ pub(crate) trait SourceRows: Sync + std::fmt::Debug {
     fn linear_nuisance(&self) -> bool {
         false
     }
-    /// Starting values of the nuisance, by closed-form fits to the model's
-    /// predictions at the starting point.
+    /// Starting values of the nuisance, by closed-form fits of the records
+    /// marked `active` to the model's predictions at the starting point.
     fn initial(
         &self,
         at: &FusedAt<'_>,
         contexts: &[LegContext],
         seeds: &mut [Option<UpJoints>],
+        active: &[bool],
     ) -> Result<Nuisance, IdentError>;
     /// The rows at the model `at` and nuisance `nu`.
     fn evaluate(
@@ -214,6 +280,8 @@ pub(crate) trait SourceRows: Sync + std::fmt::Debug {
     }
     /// What the nuisance looks like when it cannot be determined.
     fn nuisance_hint(&self) -> &'static str;
+    /// A copy.
+    fn boxed_clone(&self) -> Box<dyn SourceRows>;
 }
 
 /// One data source of a fused identification.
@@ -232,6 +300,15 @@ pub(crate) trait SourceRows: Sync + std::fmt::Debug {
 pub struct Source {
     label: String,
     rows: Box<dyn SourceRows>,
+}
+
+impl Clone for Source {
+    fn clone(&self) -> Source {
+        Source {
+            label: self.label.clone(),
+            rows: self.rows.boxed_clone(),
+        }
+    }
 }
 
 impl Source {
@@ -291,10 +368,34 @@ impl Source {
     pub(crate) fn rows(&self) -> &dyn SourceRows {
         self.rows.as_ref()
     }
+
+    /// The same tracker records with the target stated as `target` (same
+    /// label); `None` for a source that is not a tracker.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::fusion::{Source, TrackerOptions, TrackerTarget};
+    /// let csv = "q1,q2,q3,h1,h2,x,y,z\n800,800,800,0,0,1,2,3\n810,800,800,0,0,1,5,3\n800,820,800,0,0,4,2,3\n";
+    /// let data = tricept_data::read_external_from(csv.as_bytes(), "t.csv").unwrap();
+    /// let s = Source::tracker(&data, &TrackerOptions::default()).unwrap();
+    /// let t = s.with_tracker_target(TrackerTarget::Known { offset_mm: [0.0; 3], sigma_um: 5.0 }).unwrap();
+    /// assert_eq!((t.label(), t.records()), ("tracker", 3));
+    /// ```
+    pub fn with_tracker_target(&self, target: crate::fusion::TrackerTarget) -> Option<Source> {
+        Some(Source {
+            label: self.label.clone(),
+            rows: self.rows.with_tracker_target(target)?,
+        })
+    }
+
+    /// How the tracker target is stated (`None` for other sources).
+    pub fn tracker_target(&self) -> Option<crate::fusion::TrackerTarget> {
+        self.rows.tracker_target()
+    }
 }
 
 /// The UP limb's readings.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct Internal {
     poses: Vec<MeasuredPose>,
     sigma: [f64; 3],
@@ -326,6 +427,10 @@ impl SourceRows for Internal {
         3 * self.poses.len()
     }
 
+    fn min_redundancy(&self) -> f64 {
+        6.0
+    }
+
     fn pose(&self, record: usize) -> ExternalPose {
         ExternalPose {
             commands_mm: self.poses[record].commands_mm,
@@ -350,6 +455,7 @@ impl SourceRows for Internal {
         _at: &FusedAt<'_>,
         _contexts: &[LegContext],
         _seeds: &mut [Option<UpJoints>],
+        _active: &[bool],
     ) -> Result<Nuisance, IdentError> {
         Ok(Nuisance {
             values: vec![0.0; 3],
@@ -405,6 +511,10 @@ impl SourceRows for Internal {
     fn nuisance_hint(&self) -> &'static str {
         "the poses do not move the UP limb's joints"
     }
+
+    fn boxed_clone(&self) -> Box<dyn SourceRows> {
+        Box::new(self.clone())
+    }
 }
 
 /// The skew-symmetric matrix of `a` (`[a]x b = a x b`).
@@ -426,16 +536,31 @@ pub(crate) fn project_rows(u: &Vector3<f64>, jac: &[f64], k: usize, out: &mut [f
     }
 }
 
-/// Sorted distinct values of `keys` (stations, setups) and each record's
-/// index into them; a group with fewer than `min` records is refused with
-/// `message(id, count)`.
+/// `lines 3, 7, 9` (at most eight, then `...`) for messages about a group
+/// of records.
+pub(crate) fn lines_text(lines: impl Iterator<Item = u64>) -> String {
+    let all: Vec<u64> = lines.collect();
+    let mut shown: Vec<String> = all.iter().take(8).map(|l| l.to_string()).collect();
+    if all.len() > 8 {
+        shown.push("...".into());
+    }
+    format!(
+        "{} {}",
+        if all.len() == 1 { "line" } else { "lines" },
+        shown.join(", ")
+    )
+}
+
+/// Sorted distinct values of `keys` (stations, setups; with each record's
+/// line) and each record's index into them; a group with fewer than `min`
+/// records is refused with `message(id, count)` and the group's lines.
 pub(crate) fn groups(
     file: &str,
-    keys: impl Iterator<Item = u32>,
+    keyed: impl Iterator<Item = (u32, u64)>,
     min: usize,
     message: impl Fn(u32, usize) -> String,
 ) -> Result<(Vec<u32>, Vec<usize>), IdentError> {
-    let keys: Vec<u32> = keys.collect();
+    let (keys, lines): (Vec<u32>, Vec<u64>) = keyed.unzip();
     let mut distinct = keys.clone();
     distinct.sort_unstable();
     distinct.dedup();
@@ -446,10 +571,17 @@ pub(crate) fn groups(
     for (g, id) in distinct.iter().enumerate() {
         let n = index.iter().filter(|&&x| x == g).count();
         if n < min {
+            let at = lines_text(
+                index
+                    .iter()
+                    .zip(&lines)
+                    .filter(|(x, _)| **x == g)
+                    .map(|(_, l)| *l),
+            );
             return Err(IdentError::Source {
                 file: file.to_string(),
                 line: None,
-                message: message(*id, n),
+                message: format!("{} ({at})", message(*id, n)),
             });
         }
     }

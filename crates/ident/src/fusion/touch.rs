@@ -27,7 +27,8 @@ use tricept_model::Effector;
 use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Sink, Source, SourceKind, SourceRows, for_each_point, project_rows, sphere_centre,
+    Nuisance, Sink, Source, SourceKind, SourceRows, for_each_point, lines_text, project_rows,
+    sphere_centre,
 };
 
 /// How to read a touch-off file.
@@ -52,7 +53,7 @@ struct Used {
     column: usize,
 }
 
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct Touch {
     touches: Vec<TouchReading>,
     sigma_mm: Vec<f64>,
@@ -122,8 +123,15 @@ impl Source {
                     file: data.source.clone(),
                     line: None,
                     message: format!(
-                        "{what} {} has {n} touches; it needs at least {needed}",
-                        u.feature.id()
+                        "{what} {} has {n} touches ({}); it needs at least {needed}",
+                        u.feature.id(),
+                        lines_text(
+                            data.records
+                                .iter()
+                                .zip(&feature_of)
+                                .filter(|(_, f)| **f == k)
+                                .map(|(t, _)| t.line)
+                        )
                     ),
                 });
             }
@@ -198,6 +206,18 @@ impl SourceRows for Touch {
         1
     }
 
+    fn min_redundancy(&self) -> f64 {
+        4.0 * self.used.len() as f64
+    }
+
+    fn judged_nuisance(&self, values: &[f64]) -> Vec<(&'static str, usize, f64)> {
+        vec![(
+            "touch.stylus_radius_change_mm",
+            0,
+            values[0] - self.stylus_mm,
+        )]
+    }
+
     fn pose(&self, record: usize) -> ExternalPose {
         self.touches[record].pose
     }
@@ -211,6 +231,7 @@ impl SourceRows for Touch {
         at: &FusedAt<'_>,
         contexts: &[LegContext],
         seeds: &mut [Option<UpJoints>],
+        active: &[bool],
     ) -> Result<Nuisance, IdentError> {
         let mut tips = Vec::with_capacity(self.touches.len());
         let mut axes = Vec::with_capacity(self.touches.len());
@@ -227,15 +248,20 @@ impl SourceRows for Touch {
         nu.values[0] = self.stylus_mm;
         for (k, u) in self.used.iter().enumerate() {
             let x: Vec<Vector3<f64>> = (0..self.touches.len())
-                .filter(|&j| self.feature_of[j] == k)
+                .filter(|&j| self.feature_of[j] == k && active[j])
                 .map(|j| tips[j])
                 .collect();
             let degenerate = |shape: &str| IdentError::Source {
                 file: self.file.clone(),
                 line: None,
                 message: format!(
-                    "the touches of feature {} lie {shape}: it cannot be located",
-                    u.feature.id()
+                    "the touches of feature {} ({}) lie {shape}: it cannot be located",
+                    u.feature.id(),
+                    lines_text(
+                        (0..self.touches.len())
+                            .filter(|&j| self.feature_of[j] == k && active[j])
+                            .map(|j| self.touches[j].line)
+                    )
                 ),
             };
             match u.feature {
@@ -262,7 +288,7 @@ impl SourceRows for Touch {
                     // probe: against the tool axes that touched it.
                     let mut n: Vector3<f64> = eig.eigenvectors.column(order[0]).into();
                     let mean_axis: Vector3<f64> = (0..self.touches.len())
-                        .filter(|&j| self.feature_of[j] == k)
+                        .filter(|&j| self.feature_of[j] == k && active[j])
                         .map(|j| axes[j])
                         .sum();
                     if n.dot(&mean_axis) > 0.0 {
@@ -356,5 +382,9 @@ impl SourceRows for Touch {
 
     fn nuisance_hint(&self) -> &'static str {
         "touch each sphere from directions spread over its surface, and each plane at points spread over it"
+    }
+
+    fn boxed_clone(&self) -> Box<dyn SourceRows> {
+        Box::new(self.clone())
     }
 }

@@ -23,7 +23,7 @@ use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
     Nuisance, Sink, Source, SourceKind, SourceRows, cross_matrix, for_each_point, groups,
-    rotate_row,
+    lines_text, rotate_row,
 };
 
 /// What is known about the tracker target's offset from the tool tip.
@@ -61,7 +61,7 @@ impl Default for TrackerOptions {
     }
 }
 
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct Tracker {
     points: Vec<TrackerPoint>,
     sigma_mm: Vec<f64>,
@@ -81,11 +81,12 @@ impl Source {
     /// let data = tricept_data::read_external_from::<tricept_data::TrackerPoint, _>(csv.as_bytes(), "t.csv").unwrap();
     /// let e = Source::tracker(&data, &TrackerOptions::default()).unwrap_err();
     /// assert!(e.to_string().starts_with("t.csv: station 1 has 2 points"), "{e}");
+    /// assert!(e.to_string().ends_with("(lines 2, 3)"), "{e}");
     /// ```
     pub fn tracker(data: &TrackerData, options: &TrackerOptions) -> Result<Source, IdentError> {
         let (setups, setup_of) = groups(
             &data.source,
-            data.records.iter().map(|p| p.setup),
+            data.records.iter().map(|p| (p.setup, p.line)),
             3,
             |id, n| {
                 format!("station {id} has {n} points; its frame needs at least 3 not on one line")
@@ -192,6 +193,32 @@ impl SourceRows for Tracker {
         }
     }
 
+    fn min_redundancy(&self) -> f64 {
+        6.0 * self.setups.len() as f64
+    }
+
+    fn judged_nuisance(&self, values: &[f64]) -> Vec<(&'static str, usize, f64)> {
+        (0..3)
+            .map(|c| match self.target {
+                TrackerTarget::Free => ("tracker.target_free_mm", c, values[c]),
+                TrackerTarget::Known { offset_mm, .. } => {
+                    ("tracker.target_change_mm", c, values[c] - offset_mm[c])
+                }
+            })
+            .collect()
+    }
+
+    fn tracker_target(&self) -> Option<TrackerTarget> {
+        Some(self.target)
+    }
+
+    fn with_tracker_target(&self, target: TrackerTarget) -> Option<Box<dyn SourceRows>> {
+        Some(Box::new(Tracker {
+            target,
+            ..self.clone()
+        }))
+    }
+
     fn pose(&self, record: usize) -> ExternalPose {
         self.points[record].pose
     }
@@ -205,6 +232,7 @@ impl SourceRows for Tracker {
         at: &FusedAt<'_>,
         contexts: &[LegContext],
         seeds: &mut [Option<UpJoints>],
+        active: &[bool],
     ) -> Result<Nuisance, IdentError> {
         let mut nu = Nuisance {
             values: vec![0.0; 3 + 6 * self.setups.len()],
@@ -220,14 +248,19 @@ impl SourceRows for Tracker {
         })?;
         for (s, id) in self.setups.iter().enumerate() {
             let (x, y): (Vec<Vector3<f64>>, Vec<Vector3<f64>>) = (0..self.points.len())
-                .filter(|&j| self.setup_of[j] == s)
+                .filter(|&j| self.setup_of[j] == s && active[j])
                 .map(|j| (predicted[j], Vector3::from(self.points[j].position_mm)))
                 .unzip();
             let (r, t) = horn(&x, &y).ok_or_else(|| IdentError::Source {
                 file: self.file.clone(),
                 line: None,
                 message: format!(
-                    "the points of station {id} lie on one line: the tracker's frame cannot be found"
+                    "the points of station {id} ({}) lie on one line: the tracker's frame cannot be found",
+                    lines_text(
+                        (0..self.points.len())
+                            .filter(|&j| self.setup_of[j] == s && active[j])
+                            .map(|j| self.points[j].line)
+                    )
                 ),
             })?;
             nu.rotations[s] = r;
@@ -320,5 +353,9 @@ impl SourceRows for Tracker {
 
     fn nuisance_hint(&self) -> &'static str {
         "the target offset and the tracker frame cannot be separated: vary the spindle's orientation (h1, h2 and the platform tilt) between the points"
+    }
+
+    fn boxed_clone(&self) -> Box<dyn SourceRows> {
+        Box::new(self.clone())
     }
 }

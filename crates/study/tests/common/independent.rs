@@ -1,0 +1,336 @@
+//! Machines and measurements the project did not generate: a true Tricept
+//! written from the documented conventions alone (`docs/conventions.md`,
+//! `docs/data-format.md`, the Table 1 machine of
+//! `fixtures/machines/tricept-paper.json` read as plain JSON), never
+//! through the project's kinematics, error model or simulator.
+//!
+//! - The module: base joints `B_i`, platform joints `A_i` (platform frame)
+//!   and leg offsets, each coordinate the paper's frame conventions leave
+//!   free off by N(0, 0.25 mm) (`docs/identifiability.md`: the four others
+//!   are genuine errors the 15-parameter model assumes away; with them the
+//!   internal data are not explained, chi2/dof about 7000); the x-first UP limb `R = Rx(phi) Ry(theta)`, `r = q4 R e_z`;
+//!   leg `i` has length `|r + R A_i - B_i| = q_i + dq_i`; its forward
+//!   kinematics by a Newton iteration of this file's own.
+//! - The head: a general two-axis chain in the platform frame at zero
+//!   angles: each axis a line (its direction tilted, its point shifted in
+//!   all three coordinates, along the axis too), angle zeros (kinematic =
+//!   command + zero), the tool tip off by 0.1-0.5 mm along the tool and a
+//!   few hundredths of a mm across it, the tool direction tilted; the
+//!   point `x` of the spindle goes to `p1 + Rot(k1, h1) (p2 + Rot(k2, h2)
+//!   (x - p2) - p1)`. Sizes scale with the head table's
+//!   (`TYPICAL_HEAD_ERRORS`: 0.3 mrad, 0.1 mm, 0.5 mrad, 0.3 mm, 0.05 mm).
+//! - The sensors: offsets, noise of 0.8 arcsec and 0.5 um per reading,
+//!   the mean of 3.
+//! - A tracker at a random pose 1-3 m from the workspace (any rotation),
+//!   10 um per coordinate; a ballbar, 1 um per reading.
+
+#![allow(dead_code)]
+
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use rand::{RngExt, SeedableRng};
+use rand_distr::{Distribution, StandardNormal};
+use rand_pcg::Pcg64Mcg;
+
+/// Rotation about the unit axis `k` by `angle` (Rodrigues).
+pub fn rot(k: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
+    let kx = Matrix3::new(0.0, -k.z, k.y, k.z, 0.0, -k.x, -k.y, k.x, 0.0);
+    Matrix3::identity() + kx * angle.sin() + kx * kx * (1.0 - angle.cos())
+}
+
+fn rx(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.sin_cos();
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
+}
+
+fn ry(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.sin_cos();
+    Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
+}
+
+fn vec3(v: &serde_json::Value) -> Vector3<f64> {
+    Vector3::new(
+        v[0].as_f64().unwrap(),
+        v[1].as_f64().unwrap(),
+        v[2].as_f64().unwrap(),
+    )
+}
+
+/// The documented Table 1 machine, read as plain JSON.
+fn table1() -> serde_json::Value {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/machines/tricept-paper.json"
+    ))
+    .unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+/// A general two-axis head, platform frame at zero head angles.
+#[derive(Debug, Clone)]
+pub struct TrueHead {
+    pub k1: Vector3<f64>,
+    pub p1: Vector3<f64>,
+    pub k2: Vector3<f64>,
+    pub p2: Vector3<f64>,
+    pub tip: Vector3<f64>,
+    pub direction: Vector3<f64>,
+    /// Kinematic angle = command + zero, rad.
+    pub zeros: [f64; 2],
+}
+
+impl TrueHead {
+    /// Where spindle point `x` (platform frame at zero angles) goes at
+    /// commanded angles `h`.
+    pub fn point(&self, h: [f64; 2], x: &Vector3<f64>) -> Vector3<f64> {
+        let (a, b) = (h[0] + self.zeros[0], h[1] + self.zeros[1]);
+        let second = self.p2 + rot(&self.k2, b) * (x - self.p2);
+        self.p1 + rot(&self.k1, a) * (second - self.p1)
+    }
+
+    /// The spindle's rotation at commanded angles `h`.
+    pub fn rotation(&self, h: [f64; 2]) -> Matrix3<f64> {
+        rot(&self.k1, h[0] + self.zeros[0]) * rot(&self.k2, h[1] + self.zeros[1])
+    }
+}
+
+/// A true machine.
+#[derive(Debug, Clone)]
+pub struct TrueMachine {
+    pub base: [Vector3<f64>; 3],
+    pub platform: [Vector3<f64>; 3],
+    pub leg_offsets_mm: [f64; 3],
+    pub head: TrueHead,
+    /// phi rad, theta rad, s mm.
+    pub sensor_offsets: [f64; 3],
+}
+
+/// A unit vector perpendicular to unit `v`.
+fn perpendicular(v: &Vector3<f64>) -> Vector3<f64> {
+    let t = if v.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    (t - v * v.dot(&t)).normalize()
+}
+
+/// `v` (unit) tilted by N(0, sigma) along two directions across it.
+fn tilted(v: &Vector3<f64>, sigma: f64, rng: &mut Pcg64Mcg) -> Vector3<f64> {
+    let a = perpendicular(v);
+    let b = v.cross(&a);
+    let (x, y): (f64, f64) = (StandardNormal.sample(rng), StandardNormal.sample(rng));
+    (v + a * sigma * x + b * sigma * y).normalize()
+}
+
+/// One standard normal draw.
+pub fn normal(rng: &mut Pcg64Mcg) -> f64 {
+    StandardNormal.sample(rng)
+}
+
+fn normal3(rng: &mut Pcg64Mcg, sigma: f64) -> Vector3<f64> {
+    Vector3::from_fn(|_, _| sigma * normal(rng))
+}
+
+impl TrueMachine {
+    /// The documented machine itself (no errors, no sensor offsets).
+    pub fn documented() -> TrueMachine {
+        let mut m = TrueMachine::random_sized(0.0, 0.0, 0);
+        m.sensor_offsets = [0.0; 3];
+        m.head.tip = vec3(&table1()["head"]["tool_tip_mm"]);
+        m
+    }
+
+    /// A machine: module errors N(0, 0.25 mm); head errors `head_scale`
+    /// times the head table's sizes; seeded.
+    pub fn random(head_scale: f64, seed: u64) -> TrueMachine {
+        TrueMachine::random_sized(0.25, head_scale, seed)
+    }
+
+    fn random_sized(module_mm: f64, head_scale: f64, seed: u64) -> TrueMachine {
+        let d = table1();
+        let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x1dea_0f00);
+        let c = &d["placement"]["circular"];
+        let (b, a) = (
+            c["base_radius_mm"].as_f64().unwrap(),
+            c["platform_radius_mm"].as_f64().unwrap(),
+        );
+        let angles: Vec<f64> = c["joint_angles_deg"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap().to_radians())
+            .collect();
+        let joint = |r: f64, t: f64| Vector3::new(r * t.cos(), r * t.sin(), 0.0);
+        // The paper's frame conventions (docs/identifiability.md): the base
+        // plane through B1 and B2 (dzB1 = dzB2 = 0), B1B2 parallel to y
+        // (dxB2 = dxB1), the platform plane through the A_i (dzA_i = 0); every
+        // other coordinate and each leg is off by N(0, module_mm).
+        let mut base: [Vector3<f64>; 3] = std::array::from_fn(|i| {
+            let mut e = normal3(&mut rng, module_mm);
+            if i < 2 {
+                e.z = 0.0;
+            }
+            joint(b, angles[i]) + e
+        });
+        base[1].x = joint(b, angles[1]).x + (base[0].x - joint(b, angles[0]).x);
+        let platform = std::array::from_fn(|i| {
+            let mut e = normal3(&mut rng, module_mm);
+            e.z = 0.0;
+            joint(a, angles[i]) + e
+        });
+        let leg_offsets_mm = std::array::from_fn(|_| module_mm * normal(&mut rng));
+        let h = &d["head"];
+        let s = head_scale;
+        let k1 = tilted(&vec3(&h["axis1_direction"]).normalize(), 3e-4 * s, &mut rng);
+        let k2 = tilted(&vec3(&h["axis2_direction"]).normalize(), 3e-4 * s, &mut rng);
+        let direction0 = vec3(&h["tool_direction"]).normalize();
+        let direction = tilted(&direction0, 3e-4 * s, &mut rng);
+        let along =
+            (0.1 + 0.4 * rng.random::<f64>()) * if rng.random::<bool>() { 1.0 } else { -1.0 };
+        let across = perpendicular(&direction0);
+        let (e1, e2): (f64, f64) = (
+            StandardNormal.sample(&mut rng),
+            StandardNormal.sample(&mut rng),
+        );
+        let tip = vec3(&h["tool_tip_mm"])
+            + direction0 * along * s
+            + across * 0.05 * s * e1
+            + direction0.cross(&across) * 0.05 * s * e2;
+        let head = TrueHead {
+            k1,
+            p1: vec3(&h["axis1_point_mm"]) + normal3(&mut rng, 0.1 * s),
+            k2,
+            p2: vec3(&h["axis2_point_mm"]) + normal3(&mut rng, 0.1 * s),
+            tip,
+            direction,
+            zeros: std::array::from_fn(|_| 5e-4 * s * normal(&mut rng)),
+        };
+        TrueMachine {
+            base,
+            platform,
+            leg_offsets_mm,
+            head,
+            sensor_offsets: [0.0123, -0.0187, -612.5],
+        }
+    }
+
+    /// The UP limb's joints `(phi, theta, q4)` for leg commands `q` (mm):
+    /// Newton on `|r + R A_i - B_i| = q_i + dq_i`, central differences,
+    /// step halving; panics unless the lengths close to 1e-10 mm.
+    pub fn forward(&self, q: &[f64; 3]) -> [f64; 3] {
+        let residual = |x: &[f64; 3]| -> Vector3<f64> {
+            let r_mat = rx(x[0]) * ry(x[1]);
+            let r = r_mat * Vector3::new(0.0, 0.0, x[2]);
+            Vector3::from_fn(|i, _| {
+                (r + r_mat * self.platform[i] - self.base[i]).norm()
+                    - (q[i] + self.leg_offsets_mm[i])
+            })
+        };
+        let mut x = [0.0, 0.0, (q[0] + q[1] + q[2]) / 3.0];
+        for _ in 0..100 {
+            let f = residual(&x);
+            if f.norm() < 1e-10 {
+                return x;
+            }
+            let mut j = Matrix3::zeros();
+            for c in 0..3 {
+                let h = if c == 2 { 1e-6 } else { 1e-9 };
+                let (mut up, mut down) = (x, x);
+                up[c] += h;
+                down[c] -= h;
+                let d = (residual(&up) - residual(&down)) / (2.0 * h);
+                j.set_column(c, &d);
+            }
+            let step = j.try_inverse().unwrap() * f;
+            let mut t = 1.0;
+            loop {
+                let trial = [x[0] - t * step[0], x[1] - t * step[1], x[2] - t * step[2]];
+                if residual(&trial).norm() < f.norm() || t < 1e-6 {
+                    x = trial;
+                    break;
+                }
+                t *= 0.5;
+            }
+        }
+        panic!("the independent forward kinematics did not close at {q:?}");
+    }
+
+    /// The platform's pose `(r, R)` for leg commands `q`.
+    pub fn platform_pose(&self, q: &[f64; 3]) -> (Vector3<f64>, Matrix3<f64>) {
+        let [phi, theta, q4] = self.forward(q);
+        let r_mat = rx(phi) * ry(theta);
+        (r_mat * Vector3::new(0.0, 0.0, q4), r_mat)
+    }
+
+    /// The spindle point `offset_mm + extension_mm * tool direction` beyond
+    /// the tool tip (spindle frame at zero head angles) in the base frame,
+    /// at commands `q` and commanded head angles `h`.
+    pub fn spindle_point(
+        &self,
+        q: &[f64; 3],
+        h: [f64; 2],
+        extension_mm: f64,
+        offset_mm: &Vector3<f64>,
+    ) -> Vector3<f64> {
+        let (r, r_mat) = self.platform_pose(q);
+        let x = self.head.tip + self.head.direction * extension_mm + offset_mm;
+        r + r_mat * self.head.point(h, &x)
+    }
+
+    /// The tool axis in the base frame.
+    pub fn tool_axis(&self, q: &[f64; 3], h: [f64; 2]) -> Vector3<f64> {
+        let (_, r_mat) = self.platform_pose(q);
+        r_mat * self.head.rotation(h) * self.head.direction
+    }
+
+    /// Logged readings `[phi, theta, s]` at commands `q`: the joints plus
+    /// the sensor offsets plus the mean of 3 readings' noise (0.8 arcsec,
+    /// 0.5 um each).
+    pub fn readings(&self, q: &[f64; 3], rng: &mut Pcg64Mcg) -> [f64; 3] {
+        let j = self.forward(q);
+        let sigma = [
+            0.8 / 206_264.806_247_096_36,
+            0.8 / 206_264.806_247_096_36,
+            0.5e-3,
+        ];
+        std::array::from_fn(|c| {
+            let mean: f64 = (0..3).map(|_| normal(rng)).sum::<f64>() / 3.0;
+            j[c] + self.sensor_offsets[c] + sigma[c] * mean
+        })
+    }
+}
+
+/// A tracker station: `y = R^T (x - c)` in its own coordinates.
+#[derive(Debug, Clone)]
+pub struct TrueTracker {
+    pub rotation: Matrix3<f64>,
+    pub position_mm: Vector3<f64>,
+}
+
+impl TrueTracker {
+    /// A station 1-3 m from the workspace centre (0, 0, 1100) mm, in a
+    /// random direction, turned by a random rotation.
+    pub fn random(seed: u64) -> TrueTracker {
+        let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x7ac4_0001);
+        let dir = normal3(&mut rng, 1.0).normalize();
+        let distance = 1000.0 + 2000.0 * rng.random::<f64>();
+        let q: [f64; 4] = std::array::from_fn(|_| StandardNormal.sample(&mut rng));
+        let rotation =
+            UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]))
+                .to_rotation_matrix()
+                .into_inner();
+        TrueTracker {
+            rotation,
+            position_mm: Vector3::new(0.0, 0.0, 1100.0) + dir * distance,
+        }
+    }
+
+    /// A measurement of `x` (base frame) with 10 um noise per coordinate.
+    pub fn measure(&self, x: &Vector3<f64>, rng: &mut Pcg64Mcg) -> [f64; 3] {
+        let y = self.rotation.transpose() * (x - self.position_mm);
+        std::array::from_fn(|c| {
+            let z: f64 = StandardNormal.sample(rng);
+            y[c] + 0.010 * z
+        })
+    }
+}

@@ -1,0 +1,3 @@
+//! Helpers of the study's tests.
+
+pub mod independent;
