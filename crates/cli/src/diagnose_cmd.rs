@@ -341,6 +341,7 @@ fn write_extended(
             effects,
             n_geometric: g,
             external: Vec::new(),
+            temperature_c: machine_file::mean_temperature_c(dataset),
         },
         deployed.controller,
     )?;

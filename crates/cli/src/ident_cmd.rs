@@ -150,6 +150,8 @@ pub struct Fit {
     /// The platform accuracy the fit predicts, against the machine's
     /// tolerance.
     pub accuracy: PredictedAccuracy,
+    /// Mean logged structure temperature of the data, °C.
+    pub temperature_c: Option<f64>,
 }
 
 impl Fit {
@@ -253,6 +255,7 @@ pub fn fit_from_file(data: &Path, settings: &FitSettings) -> Result<Fit, CliErro
         rejected,
         verdict,
         accuracy,
+        temperature_c: machine_file::mean_temperature_c(&dataset),
     })
 }
 
@@ -341,6 +344,7 @@ fn write_calibrated(path: &Path, data: &Path, fit: &Fit, force: bool) -> Result<
             effects: Map::new(),
             n_geometric: fit.id.names.len(),
             external: Vec::new(),
+            temperature_c: fit.temperature_c,
         },
         None,
     )?;
