@@ -159,6 +159,13 @@ pub struct CandidateResult {
     /// The change of each parameter alone that the check detects with the
     /// stated power at the family-wise level (`None`: not seen).
     pub detectable: Vec<Option<f64>>,
+    /// Each parameter fitted alone: its estimate and standard deviation
+    /// (what a history follows from check to check).
+    pub alone: Vec<Option<(f64, f64)>>,
+    /// The change of each parameter alone beyond which the check flags it
+    /// (its standard deviation alone times the family-wise critical value:
+    /// the band of a history's trend).
+    pub flagged_beyond: Vec<Option<f64>>,
     /// Mean and largest platform error over the evaluation points that the
     /// estimated change causes, um (0 for a sensor).
     pub platform_mean_um: f64,
@@ -585,6 +592,23 @@ fn assess(
             },
         )
         .collect();
+    let alone = idx
+        .iter()
+        .zip(&limits)
+        .map(|(&i, &limit)| {
+            let sd = 1.0 / gram[(i, i)].sqrt();
+            (gram[(i, i)] > 0.0 && sd < limit).then(|| (gram[(i, r)] / gram[(i, i)], sd))
+        })
+        .collect();
+    let critical_1 = chi2_isf(level, 1.0).sqrt();
+    let flagged_beyond = idx
+        .iter()
+        .zip(&limits)
+        .map(|(&i, &limit)| {
+            let sd = 1.0 / gram[(i, i)].sqrt();
+            (gram[(i, i)] > 0.0 && sd < limit).then(|| critical_1 * sd)
+        })
+        .collect();
     let (platform_mean_um, platform_max_um) = if cand.moves_the_platform() {
         impact.of(cand, &estimate, temp_c)
     } else {
@@ -600,6 +624,8 @@ fn assess(
         significant: fit.dof > 0 && test.statistic > test.critical,
         test,
         detectable,
+        alone,
+        flagged_beyond,
         platform_mean_um,
         platform_max_um,
     }

@@ -3,9 +3,10 @@
 //! quantities against their bands.
 //!
 //! Each entry keeps the verdict and, for every leg, the estimated length
-//! change with its standard deviation and its *band*: the change that check
-//! would have flagged on its own (the detectable size at 95 % power and the
-//! family-wise level). A value inside its band is noise; a drift is
+//! change (fitted alone, so that checks compare) with its standard
+//! deviation and its *band*: the change beyond
+//! which that check flags the parameter on its own (its standard deviation
+//! alone times the family-wise critical value). A value inside its band is noise; a drift is
 //! reported once it leaves the band, and its slope (weighted least squares
 //! over the entries, per day) is given with its uncertainty.
 //!
@@ -53,7 +54,7 @@ pub struct Quantity {
     pub value: f64,
     /// Its standard deviation.
     pub std_dev: f64,
-    /// The change this check flags on its own.
+    /// The change beyond which this check flags the quantity on its own.
     pub band: f64,
 }
 
@@ -71,11 +72,10 @@ impl Entry {
             .iter()
             .filter(|c| c.name.starts_with("leg ") || c.kind == crate::CandidateKind::Thermal)
             .filter_map(|c| {
-                let (p, v, sd, d) = (
+                let (p, (v, sd), d) = (
                     c.parameters.first()?,
-                    *c.estimate.first()?,
-                    (*c.std_dev.first()?)?,
-                    (*c.detectable.first()?)?,
+                    (*c.alone.first()?)?,
+                    (*c.flagged_beyond.first()?)?,
                 );
                 let (name, value, unit) = crate::report::shown(p, v);
                 Some(Quantity {
@@ -120,7 +120,7 @@ pub fn read(path: &std::path::Path) -> Result<Vec<Entry>, CheckError> {
         .filter(|(_, l)| !l.trim().is_empty())
         .map(|(i, l)| {
             serde_json::from_str(l).map_err(|e| {
-                CheckError::History(format!(
+                CheckError::HistoryLine(format!(
                     "{file}: line {}: not a check of this history: {e}",
                     i + 1
                 ))

@@ -84,6 +84,9 @@ pub enum CheckError {
         /// The kinematic failure.
         source: tricept_kinematics::KinematicsError,
     },
+    /// The history file holds a line that is not a check.
+    #[error("{0}")]
+    HistoryLine(String),
     /// The history file cannot be read or written.
     #[error("{0}")]
     History(String),
