@@ -606,7 +606,7 @@ fn assess(
         .zip(&limits)
         .map(|(&i, &limit)| {
             let sd = 1.0 / gram[(i, i)].sqrt();
-            (gram[(i, i)] > 0.0 && sd < limit).then(|| critical_1 * sd)
+            (gram[(i, i)] > 0.0 && sd < limit).then_some(critical_1 * sd)
         })
         .collect();
     let (platform_mean_um, platform_max_um) = if cand.moves_the_platform() {
