@@ -363,18 +363,11 @@ pub fn check(
     let t0 = gram[(nz - 1, nz - 1)];
     let dof0 = 3 * data.poses.len() - 3;
     let alpha = options.alpha;
-    let m = candidates.len();
     let consistency = chi_square(t0, dof0, alpha / 2.0);
-    // Bonferroni over every test: a nested candidate tests each of its
-    // leading subsets.
-    let tests: usize = candidates
-        .iter()
-        .map(|c| if c.is_nested() { c.len() } else { 1 })
-        .sum();
-    let level = alpha / (2.0 * tests as f64);
+    let level = family_level(alpha, &candidates);
     let detectable_lambda = required_noncentrality(1.0, level, options.power);
     let impact = Impact::new(machine, &options.points_mm)?;
-    let mut results = Vec::with_capacity(m);
+    let mut results = Vec::with_capacity(candidates.len());
     let mut at = 0;
     for cand in &candidates {
         let idx: Vec<usize> = (at..at + cand.len()).collect();
@@ -464,6 +457,25 @@ impl CandidateResult {
     fn moves_nothing_seen(&self) -> bool {
         self.detectable.iter().all(Option::is_none)
     }
+}
+
+/// The level of each candidate's test: Bonferroni over every test of the
+/// candidates (a nested candidate tests each of its leading subsets) at
+/// half the family-wise `alpha` (the other half is the consistency test's).
+///
+/// # Example
+/// ```
+/// use tricept_check::{Candidate, family_level};
+/// let c = Candidate::all([(700.0, 900.0); 3], None, false);
+/// // 3 legs x 4 nested tests, 6 joints, a common lead, two sensor tests.
+/// assert!((family_level(0.01, &c) - 0.005 / 21.0).abs() < 1e-15);
+/// ```
+pub fn family_level(alpha: f64, candidates: &[Candidate]) -> f64 {
+    let tests: usize = candidates
+        .iter()
+        .map(|c| if c.is_nested() { c.len() } else { 1 })
+        .sum();
+    alpha / (2.0 * tests.max(1) as f64)
 }
 
 /// The test of a statistic at `tail`.
@@ -580,19 +592,9 @@ fn assess(
     estimate.resize(n, 0.0);
     std_dev.resize(n, None);
     let test = chi_square(fit.statistic, fit.dof, level);
-    let detectable = idx
-        .iter()
-        .zip(&limits)
-        .map(
-            |(&i, &limit)| match (gram[(i, i)] > 0.0, detectable_lambda) {
-                (true, Some(l)) if 1.0 / gram[(i, i)].sqrt() < limit => {
-                    Some((l / gram[(i, i)]).sqrt())
-                }
-                _ => None,
-            },
-        )
-        .collect();
-    let alone = idx
+    // Each parameter alone: its estimate and standard deviation where the
+    // campaign sees it, the change it flags and the one it detects.
+    let alone: Vec<Option<(f64, f64)>> = idx
         .iter()
         .zip(&limits)
         .map(|(&i, &limit)| {
@@ -601,13 +603,13 @@ fn assess(
         })
         .collect();
     let critical_1 = chi2_isf(level, 1.0).sqrt();
-    let flagged_beyond = idx
+    let flagged_beyond = alone
         .iter()
-        .zip(&limits)
-        .map(|(&i, &limit)| {
-            let sd = 1.0 / gram[(i, i)].sqrt();
-            (gram[(i, i)] > 0.0 && sd < limit).then_some(critical_1 * sd)
-        })
+        .map(|a| a.map(|(_, sd)| critical_1 * sd))
+        .collect();
+    let detectable = alone
+        .iter()
+        .map(|a| a.zip(detectable_lambda).map(|((_, sd), l)| l.sqrt() * sd))
         .collect();
     let (platform_mean_um, platform_max_um) = if cand.moves_the_platform() {
         impact.of(cand, &estimate, temp_c)
@@ -687,7 +689,7 @@ impl Impact {
 /// Each leg's command range over the workspace (its polar grid of 3 rings
 /// of 8 on 3 levels), mm: the frame of the legs' shape parameters, the same
 /// at every check of a machine.
-fn leg_ranges(machine: &Machine) -> Result<[(f64, f64); 3], CheckError> {
+pub fn leg_ranges(machine: &Machine) -> Result<[(f64, f64); 3], CheckError> {
     let mut ranges = [(f64::INFINITY, f64::NEG_INFINITY); 3];
     for (j, r) in machine.workspace.polar_grid(3, 8, 3).iter().enumerate() {
         let q = machine

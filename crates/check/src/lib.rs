@@ -57,7 +57,7 @@ mod report;
 pub use candidates::{Candidate, CandidateKind};
 pub use check::{
     CandidateResult, CheckOptions, CheckReport, CheckVerdict, ChiSquare, DEFAULT_ALPHA,
-    DEFAULT_POWER, check,
+    DEFAULT_POWER, check, family_level, leg_ranges,
 };
 pub use reference::Reference;
 

@@ -178,6 +178,25 @@ impl Reference {
         self.temperature_c
     }
 
+    /// The directions of the parameter space the calibration determined,
+    /// with their variances (mm^2): the eigenvectors of the covariance whose
+    /// eigenvalue is positive (above 1e-12 of the largest). What a check
+    /// allows the calibrated machine to be off by, direction by direction.
+    pub fn prior_directions(&self) -> Vec<(f64, nalgebra::DVector<f64>)> {
+        let k = self.covariance.nrows();
+        let eigen = self.covariance.clone().symmetric_eigen();
+        let largest = eigen.eigenvalues.iter().copied().fold(0.0, f64::max);
+        (0..k)
+            .filter(|&i| eigen.eigenvalues[i] > 0.0 && eigen.eigenvalues[i] > 1e-12 * largest)
+            .map(|i| {
+                (
+                    eigen.eigenvalues[i],
+                    eigen.eigenvectors.column(i).into_owned(),
+                )
+            })
+            .collect()
+    }
+
     /// The machine's name.
     pub fn name(&self) -> &str {
         &self.name
