@@ -91,7 +91,7 @@ const CALIBRATION_C: f64 = 20.0;
 #[test]
 fn an_unchanged_machine_raises_at_most_one_alarm_in_twenty() {
     let mut alarms = Vec::new();
-    for seed in 0..20 {
+    for seed in 0..100 {
         let (plant, reference) = calibrated(seed);
         let data = check_campaign(&plant, seed, CALIBRATION_C);
         let r = run(&reference, &data);
@@ -114,11 +114,14 @@ fn an_unchanged_machine_raises_at_most_one_alarm_in_twenty() {
             );
         }
     }
+    let first_20 = alarms.iter().filter(|(s, _)| *s < 20).count();
     eprintln!(
-        "TALLY check unchanged (20 poses, offsets re-referenced): {} false alarms in 20 {alarms:?}",
+        "TALLY check unchanged (20 poses, offsets re-referenced): {first_20} false alarms in the first 20 machines, {} in 100 (alpha 0.01) {alarms:?}",
         alarms.len()
     );
-    assert!(alarms.len() <= 1, "{alarms:?}");
+    assert!(first_20 <= 1, "{alarms:?}");
+    // At alpha = 0.01 a fifth alarm in 100 has a probability of 0.3 %.
+    assert!(alarms.len() <= 4, "{alarms:?}");
 }
 
 #[test]
