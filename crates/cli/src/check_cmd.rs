@@ -192,7 +192,7 @@ fn plot_trends(dir: &Path, trends: &[Trend]) -> Result<(), CliError> {
         let x: Vec<f64> = (1..=t.values.len()).map(|i| i as f64).collect();
         let title = format!("{} over the checks ({})", t.name, t.unit);
         let y_label = format!("{} ({})", t.name, t.unit);
-        tricept_plot::curves(
+        let drawn = tricept_plot::curves(
             &path,
             &tricept_plot::Axes {
                 title: &title,
@@ -223,8 +223,8 @@ fn plot_trends(dir: &Path, trends: &[Trend]) -> Result<(), CliError> {
             ],
             &[],
             &[],
-        )
-        .map_err(|e| CliError::other(e.to_string()))?;
+        );
+        crate::files::plotted(&path, drawn)?;
     }
     Ok(())
 }

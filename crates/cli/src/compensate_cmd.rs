@@ -100,7 +100,7 @@ fn machines(a: &CompensateArgs) -> Result<Pair, CliError> {
                 out,
                 warnings: fit.verdict.warnings.clone(),
                 code,
-                why: fit.refusal().unwrap_or("").to_string(),
+                why: fit.reason(),
             })
         }
         None => {
@@ -490,8 +490,9 @@ fn write_map(
             .collect()
     };
     let plot = |name: &str, title: &str, m: &ErrorMap, range| {
-        tricept_plot::heat_map(&dir.join(name), title, &cells(m), spacing, "mm", range)
-            .map_err(|e| CliError::other(e.to_string()))
+        let path = dir.join(name);
+        let drawn = tricept_plot::heat_map(&path, title, &cells(m), spacing, "mm", range);
+        crate::files::plotted(&path, drawn)
     };
     plot(
         "correction.svg",

@@ -175,6 +175,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         Command::Identifiability(a) => {
             machine(&mut r, &a.machine);
             r.input_if_file("--poses", &a.poses);
+            r.inputs("--data", &a.data);
         }
         Command::Identify(a) => {
             machine(&mut r, &a.settings.machine);
@@ -221,6 +222,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         Command::Detectability(a) => {
             machine(&mut r, &a.machine);
             r.input_if_file("--poses", &a.poses);
+            r.inputs("--data", &a.data);
         }
         Command::Compensate(a) => {
             machine(&mut r, &a.settings.machine);
