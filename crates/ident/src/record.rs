@@ -174,12 +174,16 @@ fn differences(file: &Machine, rebuilt: &Machine, c: &CalibrationRecord) -> Vec<
         let equal = (a - b).abs() <= TOLERANCE * (1.0 + b.abs());
         if !equal {
             out.push(format!(
-                "{field} is {a} in the file but {b} from the record{source}"
+                "{field} is {a:.6} in the file but {b:.6} from the record{source}"
             ));
         }
     };
-    let dq = |i: usize| match c.estimates_mm.get(&format!("dq{}", i + 1)) {
-        Some(v) => format!(" (dq{} = {v})", i + 1),
+    let dq = |i: usize| match c
+        .estimates_mm
+        .get(&format!("dq{}", i + 1))
+        .and_then(serde_json::Value::as_f64)
+    {
+        Some(v) => format!(" (dq{} = {v:.6})", i + 1),
         None => String::new(),
     };
     for i in 0..3 {
