@@ -3,8 +3,11 @@
 //! quantities against their bands.
 //!
 //! Each entry keeps the verdict and, for every leg, the estimated length
-//! change (fitted alone, so that checks compare) with its standard
-//! deviation and its *band*: the change beyond
+//! change (fitted alone, so that checks compare; a change of another leg
+//! or a joint moves it too, and the check's verdict says which it was;
+//! fitting the three legs together is no remedy, since their sum is the
+//! weak direction of the calibration and its uncertainty would widen every
+//! band fourfold) with its standard deviation and its *band*: the change beyond
 //! which that check flags the parameter on its own (its standard deviation
 //! alone times the family-wise critical value). A value inside its band is noise; a drift is
 //! reported once it leaves the band, and its slope (weighted least squares
