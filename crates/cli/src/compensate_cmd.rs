@@ -100,7 +100,7 @@ fn machines(a: &CompensateArgs) -> Result<Pair, CliError> {
                 out,
                 warnings: fit.verdict.warnings.clone(),
                 code,
-                why: fit.refusal().unwrap_or("").to_string(),
+                why: fit.reason(),
             })
         }
         None => {
@@ -494,15 +494,9 @@ fn write_map(
     let plot = |name: &str, what: &str, m: &ErrorMap| {
         let z = tricept_plot::plane_z(m.targets_mm.iter().map(|r| r.z));
         let title = format!("{what} |dr| (mm), {z}");
-        tricept_plot::heat_map(
-            &dir.join(name),
-            &title,
-            &cells(m),
-            spacing,
-            "|dr| (mm)",
-            None,
-        )
-        .map_err(|e| CliError::other(e.to_string()))
+        let path = dir.join(name);
+        let drawn = tricept_plot::heat_map(&path, &title, &cells(m), spacing, "|dr| (mm)", None);
+        crate::files::plotted(&path, drawn)
     };
     plot("correction.svg", "Predicted correction", predicted)?;
     if let Some((b, a)) = truth {

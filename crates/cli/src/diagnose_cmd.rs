@@ -71,8 +71,13 @@ pub struct DiagnoseArgs {
 #[derive(Debug, Args)]
 pub struct DetectabilityArgs {
     /// Pose set (as for `identifiability`; positions in mm).
-    #[arg(long, default_value = "grid")]
+    #[arg(long, default_value = "grid", conflicts_with = "data")]
     pub poses: String,
+    /// Assess a logged campaign instead: its commands and their logged
+    /// context (temperatures, times, approach directions) from this
+    /// measured-data file; its readings are not used.
+    #[arg(long, value_name = "FILE.csv")]
+    pub data: Option<PathBuf>,
     /// Visit every pose twice, approaching from both directions.
     #[arg(long)]
     pub both_directions: bool,
@@ -117,7 +122,7 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
         crate::files::create_dir(dir)?;
         for p in &d.plots {
             let path = dir.join(format!("residual-{}.svg", p.effect));
-            tricept_plot::scatter(
+            let drawn = tricept_plot::scatter(
                 &path,
                 &tricept_plot::Axes {
                     title: &format!("{}: {}, before and after", p.effect, p.y_label),
@@ -130,8 +135,8 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
                     ("geometric model".to_string(), p.before.clone()),
                     (format!("with {}", p.effect), p.after.clone()),
                 ],
-            )
-            .map_err(|e| CliError::other(e.to_string()))?;
+            );
+            crate::files::plotted(&path, drawn)?;
         }
     }
     let written = a.write_machine.as_ref().map(|path| {
@@ -341,6 +346,7 @@ fn write_extended(
             effects,
             n_geometric: g,
             external: Vec::new(),
+            temperature_c: machine_file::mean_temperature_c(dataset),
         },
         deployed.controller,
     )?;
@@ -374,23 +380,30 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<u8, CliError> {
         a.temperature_drift,
     );
     let m = machine_with_noise(machine, &a.noise)?;
-    let targets = pose_targets(poses, &m)?;
-    let mut campaign = Campaign::from_targets(&m, targets, 1);
-    if both_directions {
-        campaign.order = PoseOrder::BothDirections;
-    }
-    // The logged context of the campaign (times, temperature with the
-    // stated drift, approach directions), on the nominal machine.
-    let mut plant = Plant::geometric(m.clone(), GeometricErrors::default());
-    if drift_k != 0.0 {
-        plant.effects = vec![Effect::Thermal {
-            drift_k,
-            expansion_ppm_per_k: 0.0,
-        }];
-    }
-    let data = plant
-        .simulate(&campaign)
-        .map_err(|e| CliError::input(format!("--poses {poses}: {e}")))?;
+    let mut campaign = Campaign::from_targets(&m, Vec::new(), 1);
+    let data = match &a.data {
+        // A logged campaign: its poses with their own context.
+        Some(path) => read_data(path, &m)?,
+        None => {
+            campaign.targets_mm = pose_targets(poses, &m)?;
+            if both_directions {
+                campaign.order = PoseOrder::BothDirections;
+            }
+            // The logged context of the campaign (times, temperature with
+            // the stated drift, approach directions), on the nominal
+            // machine.
+            let mut plant = Plant::geometric(m.clone(), GeometricErrors::default());
+            if drift_k != 0.0 {
+                plant.effects = vec![Effect::Thermal {
+                    drift_k,
+                    expansion_ppm_per_k: 0.0,
+                }];
+            }
+            plant
+                .simulate(&campaign)
+                .map_err(|e| CliError::input(format!("--poses {poses}: {e}")))?
+        }
+    };
     let sigma = campaign.noise.logged_sigma();
     let geometric = GeometricModel::new(m.clone(), ParameterSet::paper15());
     let mut rows = Vec::new();
@@ -411,18 +424,26 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<u8, CliError> {
         );
         return Ok(0);
     }
-    outln!(
-        "{} logged poses ({}{}), mean of {} readings, temperature drift {} K",
-        data.poses.len(),
-        poses,
-        if both_directions {
-            ", both approach directions"
-        } else {
-            ""
-        },
-        campaign.noise.readings_per_pose,
-        drift_k
-    );
+    match &a.data {
+        Some(path) => outln!(
+            "{} logged poses of {}, mean of {} readings, with their logged context",
+            data.poses.len(),
+            path.display(),
+            campaign.noise.readings_per_pose
+        ),
+        None => outln!(
+            "{} logged poses ({}{}), mean of {} readings, temperature drift {} K",
+            data.poses.len(),
+            poses,
+            if both_directions {
+                ", both approach directions"
+            } else {
+                ""
+            },
+            campaign.noise.readings_per_pose,
+            drift_k
+        ),
+    }
     outln!(
         "| effect | magnitude | power | detectable from | geometric held-out rms | halved from | largest bias (mm) | advice |"
     );

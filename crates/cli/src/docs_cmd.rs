@@ -17,7 +17,7 @@ pub struct DocsArgs {
 }
 
 /// Every page: name, what it holds, text (Markdown).
-const PAGES: [(&str, &str, &str); 8] = [
+const PAGES: [(&str, &str, &str); 9] = [
     (
         "data-format",
         "the measured-data CSV, the external measurements, the machine JSON, every output file (columns, keys, units)",
@@ -42,6 +42,11 @@ const PAGES: [(&str, &str, &str); 8] = [
         "hybrid",
         "external measurements (tracker, ballbar, touch-offs) fused with the self-calibration; `tricept plan`",
         include_str!("../../../docs/hybrid.md"),
+    ),
+    (
+        "check",
+        "`tricept check`: has the machine changed since its calibration? The test, the candidates, planning a check, measured rates",
+        include_str!("../../../docs/check.md"),
     ),
     (
         "reliability",

@@ -6,7 +6,8 @@
 //! runs before any computation and refuses (exit 2) an output that is an
 //! input, whether by the same name, through a symbolic link or as a hard
 //! link: `identify --data data.csv --write-machine data.csv` would
-//! otherwise replace the measured data by a machine file.
+//! otherwise replace the measured data by a machine file. Every file
+//! written is named on stderr (`wrote PATH`), so that stdout stays data.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -23,10 +24,28 @@ where
 }
 
 /// The outcome of an atomic write of `path` by a library writer
-/// (`tricept_data::write_path`, ...), as the CLI reports it: exit 1 naming
-/// the file, which is as it was before.
+/// (`tricept_data::write_path`, ...), as the CLI reports it: `wrote PATH`
+/// on stderr (stdout stays data), or exit 1 naming the file, which is as it
+/// was before.
 pub fn written(path: &Path, result: std::io::Result<()>) -> Result<(), CliError> {
-    result.map_err(|e| CliError::other(format!("{}: not written: {e}", path.display())))
+    match result {
+        Ok(()) => {
+            errln!("wrote {}", path.display());
+            Ok(())
+        }
+        Err(e) => Err(CliError::other(format!(
+            "{}: not written: {e}",
+            path.display()
+        ))),
+    }
+}
+
+/// The outcome of a figure drawn into `path` (`tricept_plot`, atomic
+/// too): `wrote PATH` on stderr, or exit 1 with the plotter's message.
+pub fn plotted(path: &Path, result: Result<(), tricept_plot::PlotError>) -> Result<(), CliError> {
+    result.map_err(|e| CliError::other(e.to_string()))?;
+    errln!("wrote {}", path.display());
+    Ok(())
 }
 
 /// Writes `text` to `path` atomically (see [`write_with`]).

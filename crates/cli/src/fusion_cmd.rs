@@ -695,6 +695,7 @@ fn write_machine(
             effects: serde_json::Map::new(),
             n_geometric: fit.names.len(),
             external,
+            temperature_c: None,
         },
         None,
     )?;

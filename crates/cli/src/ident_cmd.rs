@@ -25,8 +25,12 @@ use crate::machine_file;
 #[derive(Debug, Args)]
 pub struct IdentifiabilityArgs {
     /// Pose set (see below).
-    #[arg(long, default_value = "grid")]
+    #[arg(long, default_value = "grid", conflicts_with = "data")]
     pub poses: String,
+    /// Assess a logged campaign instead: the commands of this
+    /// measured-data file (its readings are not used).
+    #[arg(long, value_name = "FILE.csv")]
+    pub data: Option<PathBuf>,
     #[command(flatten)]
     pub params: ParamArgs,
     #[command(flatten)]
@@ -90,23 +94,34 @@ pub fn run_identifiability(a: &IdentifiabilityArgs) -> Result<u8, CliError> {
     let (machine, poses) = (&a.machine, a.poses.as_str());
     let m = machine_with_noise(machine, &a.noise)?;
     let set = a.params.set()?;
-    let targets = pose_targets(poses, &m)?;
-    let mut commands = Vec::with_capacity(targets.len());
-    for (i, r) in targets.iter().enumerate() {
-        let ik = m.inverse(r).map_err(|e| {
-            CliError::input(format!(
-                "--poses {poses}: pose {} ({:.3}, {:.3}, {:.3} mm): {e}",
-                i + 1,
-                r.x,
-                r.y,
-                r.z
-            ))
-        })?;
-        commands.push(MeasuredPose {
-            commands_mm: ik.legs_mm,
-            ..Default::default()
-        });
-    }
+    let commands = match &a.data {
+        Some(path) => read_data(path, &m)?.poses,
+        None => {
+            let targets = pose_targets(poses, &m)?;
+            let mut commands = Vec::with_capacity(targets.len());
+            for (i, r) in targets.iter().enumerate() {
+                let ik = m.inverse(r).map_err(|e| {
+                    CliError::input(format!(
+                        "--poses {poses}: pose {} ({:.3}, {:.3}, {:.3} mm): {e}",
+                        i + 1,
+                        r.x,
+                        r.y,
+                        r.z
+                    ))
+                })?;
+                commands.push(MeasuredPose {
+                    commands_mm: ik.legs_mm,
+                    ..Default::default()
+                });
+            }
+            commands
+        }
+    };
+    let (poses, source) = match &a.data {
+        Some(path) => (path.display().to_string(), path.display().to_string()),
+        None => (poses.to_string(), format!("--poses {poses}")),
+    };
+    let poses = poses.as_str();
     let model = GeometricModel::new(m.clone(), set.clone());
     let report = identifiability(
         &model,
@@ -114,7 +129,7 @@ pub fn run_identifiability(a: &IdentifiabilityArgs) -> Result<u8, CliError> {
         &commands,
         &IdentifyOptions::for_machine(&m),
     )
-    .map_err(|e| ident_error(&format!("--poses {poses}"), e))?;
+    .map_err(|e| ident_error(&source, e))?;
     if machine.json {
         let mut v = report.to_json();
         if let Value::Object(o) = &mut v {
@@ -150,6 +165,8 @@ pub struct Fit {
     /// The platform accuracy the fit predicts, against the machine's
     /// tolerance.
     pub accuracy: PredictedAccuracy,
+    /// Mean logged structure temperature of the data, °C.
+    pub temperature_c: Option<f64>,
 }
 
 impl Fit {
@@ -179,6 +196,21 @@ impl Fit {
             Some("the campaign is too small to calibrate the machine")
         } else {
             None
+        }
+    }
+
+    /// The reason of a non-zero exit code in one phrase, with the first
+    /// likely cause when one was found (what stderr says).
+    pub fn reason(&self) -> String {
+        let why = self.refusal().unwrap_or("");
+        match self
+            .verdict
+            .warnings
+            .iter()
+            .find_map(|w| w.strip_prefix("likely cause: "))
+        {
+            Some(cause) => format!("{why}; likely cause: {cause}"),
+            None => why.to_string(),
         }
     }
 
@@ -253,6 +285,7 @@ pub fn fit_from_file(data: &Path, settings: &FitSettings) -> Result<Fit, CliErro
         rejected,
         verdict,
         accuracy,
+        temperature_c: machine_file::mean_temperature_c(&dataset),
     })
 }
 
@@ -323,7 +356,7 @@ fn write_calibrated(path: &Path, data: &Path, fit: &Fit, force: bool) -> Result<
     let forced = machine_file::write_rule(
         &format!("--write-machine {}", path.display()),
         fit.exit_code(),
-        fit.refusal().unwrap_or(""),
+        &fit.reason(),
         force,
     )?;
     let d = machine_file::calibrated_description(
@@ -341,6 +374,7 @@ fn write_calibrated(path: &Path, data: &Path, fit: &Fit, force: bool) -> Result<
             effects: Map::new(),
             n_geometric: fit.id.names.len(),
             external: Vec::new(),
+            temperature_c: fit.temperature_c,
         },
         None,
     )?;
@@ -375,6 +409,19 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
     if a.settings.machine.json {
         let mut v = id.to_json();
         if let Value::Object(o) = &mut v {
+            // One standard deviation per estimate, with its unit: the
+            // estimate's (what `std_dev` holds too, for scripts written
+            // before), not the design's prediction at the starting point,
+            // which `tricept identifiability` reports.
+            let estimates: Map<String, Value> = id
+                .names
+                .iter()
+                .zip(&id.estimate)
+                .map(|(n, v)| (n.clone(), (*v).into()))
+                .collect();
+            let sd = o.get("std_dev").cloned().unwrap_or(Value::Null);
+            o.insert("estimates_mm".into(), Value::Object(estimates));
+            o.insert("std_dev_mm".into(), sd);
             o.insert("rejected".into(), rejected_json(&fit.rejected));
             o.insert("warnings".into(), fit.verdict.warnings.clone().into());
             o.insert(
@@ -392,12 +439,49 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
     if let Some(Err(e)) = written {
         return Err(e);
     }
-    report_exit("identify", code, fit.refusal().unwrap_or(""));
+    report_exit("identify", code, &fit.reason());
     Ok(code)
 }
 
 fn print_identification(fit: &Fit, data: &Path) {
     let id = &fit.id;
+    // What matters first: the verdict, its reason and the likely cause;
+    // the estimates after.
+    let a = &fit.accuracy;
+    outln!(
+        "verdict: {}, {}, {}",
+        if fit.verdict.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        },
+        if fit.verdict.adequate {
+            "adequate (the model explains the data to the sensor noise)"
+        } else {
+            "NOT adequate (the model does not explain the data)"
+        },
+        if a.worthwhile {
+            "worthwhile (it at least halves the platform error)"
+        } else {
+            "NOT worthwhile (the campaign is too small to calibrate)"
+        }
+    );
+    let (causes, others): (Vec<&String>, Vec<&String>) = fit
+        .verdict
+        .warnings
+        .iter()
+        .partition(|w| w.starts_with("likely cause"));
+    for w in causes.iter().chain(&others) {
+        outln!("WARNING: {w}");
+    }
+    outln!(
+        "predicted platform error after calibration: {:.4} mm rms (up to {:.4} mm at one of {} points), against {:.4} mm without calibration ({} mm per parameter)",
+        a.after_rms_mm,
+        a.after_max_mm,
+        a.points,
+        a.before_rms_mm,
+        a.tolerance_mm
+    );
     for r in &fit.rejected {
         let why = match r.residual_sigma {
             Some(z) => format!("a reading {z:.1} noise standard deviations off (gross error)"),
@@ -423,6 +507,11 @@ fn print_identification(fit: &Fit, data: &Path) {
         },
         id.iterations
     );
+    if !(fit.verdict.converged && fit.verdict.adequate && a.worthwhile) {
+        outln!(
+            "(the estimates below are not to be trusted as a calibration: see the verdict above)"
+        );
+    }
     outln!("{:>6} {:>12} {:>10}", "param", "estimate mm", "sd mm");
     for ((n, v), sd) in id.names.iter().zip(&id.estimate).zip(&id.std_dev) {
         match sd {
@@ -430,7 +519,7 @@ fn print_identification(fit: &Fit, data: &Path) {
             None => outln!("{n:>6} {v:>12.5} {:>10}", "held"),
         }
     }
-    let a = RAD_PER_ARCSEC;
+    let arcsec = RAD_PER_ARCSEC;
     outln!(
         "sensor offsets: phi {:.6} rad, theta {:.6} rad, s {:.4} mm",
         id.offsets[0],
@@ -440,8 +529,8 @@ fn print_identification(fit: &Fit, data: &Path) {
     let (z, j) = id.stats.max_standardised;
     outln!(
         "residual rms: phi {:.3} arcsec, theta {:.3} arcsec, s {:.3} um; chi2/dof {:.3} (dof {}, p = {:.2e}); largest {z:.1} sigma at pose {} (line {})",
-        id.stats.rms[0] / a,
-        id.stats.rms[1] / a,
+        id.stats.rms[0] / arcsec,
+        id.stats.rms[1] / arcsec,
         id.stats.rms[2] * 1e3,
         id.stats.reduced_chi_square,
         id.stats.dof,
@@ -450,34 +539,4 @@ fn print_identification(fit: &Fit, data: &Path) {
         id.lines.get(j).copied().unwrap_or(0)
     );
     crate::output::write_text(&id.report.to_text());
-    let a = &fit.accuracy;
-    outln!(
-        "predicted platform error after calibration: {:.4} mm rms (up to {:.4} mm at one of {} points), against {:.4} mm without calibration ({} mm per parameter)",
-        a.after_rms_mm,
-        a.after_max_mm,
-        a.points,
-        a.before_rms_mm,
-        a.tolerance_mm
-    );
-    outln!(
-        "verdict: {}, {}, {}",
-        if fit.verdict.converged {
-            "converged"
-        } else {
-            "NOT converged"
-        },
-        if fit.verdict.adequate {
-            "adequate (the model explains the data to the sensor noise)"
-        } else {
-            "NOT adequate (the model does not explain the data)"
-        },
-        if a.worthwhile {
-            "worthwhile (it at least halves the platform error)"
-        } else {
-            "NOT worthwhile (the campaign is too small to calibrate)"
-        }
-    );
-    for w in &fit.verdict.warnings {
-        outln!("WARNING: {w}");
-    }
 }

@@ -45,6 +45,16 @@ pub struct Provenance<'a> {
     /// External measurement files of a fused fit: the file and its record
     /// (the hash is filled in when written).
     pub external: Vec<(&'a Path, ExternalSourceRecord)>,
+    /// Mean logged structure temperature of the campaign, °C.
+    pub temperature_c: Option<f64>,
+}
+
+/// The mean logged structure temperature of `data`, °C, when every pose
+/// carries one.
+pub fn mean_temperature_c(data: &tricept_data::Dataset) -> Option<f64> {
+    let t: Option<Vec<f64>> = data.poses.iter().map(|p| p.temp_c).collect();
+    t.filter(|t| !t.is_empty())
+        .map(|t| t.iter().sum::<f64>() / t.len() as f64)
 }
 
 /// What the record needs of a fit, whether from the UP limb's data alone
@@ -322,6 +332,7 @@ pub fn calibrated_description(
             .chain(p.warnings)
             .collect(),
         poses_used: id.poses_used,
+        temperature_c: p.temperature_c,
         external_sources: p
             .external
             .iter()

@@ -22,6 +22,7 @@ macro_rules! errln {
 }
 
 mod args;
+mod check_cmd;
 mod cli_error;
 mod compensate_cmd;
 mod diagnose_cmd;
@@ -132,6 +133,13 @@ enum Command {
         after_help = "Without --truth only the correction the identified model predicts is known; with the true errors of simulated data (--truth table2 ...) the before/after error of the actual machine is reported. Exit codes as for identify (0, 3, 4, 2).\n\nExamples:\n  tricept compensate --data data.csv --truth table2 --map out/\n  tricept compensate --data data.csv --targets points.csv > commands.csv\n  tricept compensate --machine calibrated.json --table out/"
     )]
     Compensate(compensate_cmd::CompensateArgs),
+    /// Has the machine changed since its calibration? A short check campaign
+    /// from its own sensors tested against the calibrated machine file.
+    #[command(
+        allow_negative_numbers = true,
+        after_help = "The sensor offsets are re-estimated (a power cycle re-references them); the test allows for the calibration's own uncertainty and the sensors' noise (`tricept docs check`).\n\nExit codes: 0 unchanged; 3 changed (the report names the most likely change, its size and what it does to the platform, or the candidates it cannot tell apart); 2 bad input, including a machine file without a calibration record and a campaign that cannot see a change.\n\nExamples:\n  tricept check --machine calibrated.json --data today.csv\n  tricept check --machine calibrated.json --data today.csv --history checks.jsonl --plot trends/\n  tricept check --machine calibrated.json --data today.csv --json"
+    )]
+    Check(check_cmd::CheckArgs),
     /// Plan a few external measurements (tracker points, ballbar readings,
     /// touch-offs on a reference sphere): which to take so that the tool tip
     /// (and with --extensions the tool axis) is best known after touch-off,
@@ -177,6 +185,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         Command::Identifiability(a) => {
             machine(&mut r, &a.machine);
             r.input_if_file("--poses", &a.poses);
+            r.inputs("--data", &a.data);
         }
         Command::Identify(a) => {
             machine(&mut r, &a.settings.machine);
@@ -227,6 +236,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         Command::Detectability(a) => {
             machine(&mut r, &a.machine);
             r.input_if_file("--poses", &a.poses);
+            r.inputs("--data", &a.data);
         }
         Command::Compensate(a) => {
             machine(&mut r, &a.settings.machine);
@@ -243,6 +253,13 @@ fn file_roles(command: &Command) -> files::FileRoles {
             }
             if let Some(d) = &a.table {
                 r.outputs_in("--table", d, compensate_cmd::TABLE_FILES);
+            }
+        }
+        Command::Check(a) => {
+            machine(&mut r, &a.machine);
+            r.input("--data", &a.data);
+            if let Some(h) = &a.history {
+                r.output("--history", h);
             }
         }
         Command::Plan(a) => {
@@ -275,6 +292,7 @@ fn run(cli: Cli) -> Result<u8, CliError> {
         Command::Compensate(a) => compensate_cmd::run_compensate(&a),
         Command::Plan(a) => plan_cmd::run(&a),
         Command::Docs(a) => docs_cmd::run(&a),
+        Command::Check(a) => check_cmd::run(&a),
     }
 }
 

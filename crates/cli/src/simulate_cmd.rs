@@ -236,8 +236,8 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
                     })
                 );
             } else {
-                outln!(
-                    "wrote {} poses to {} (machine `{}`, true errors `{truth}`, {} effect(s), seed {})",
+                errln!(
+                    "{} poses to {} (machine `{}`, true errors `{truth}`, {} effect(s), seed {})",
                     data.poses.len(),
                     path.display(),
                     m.name,

@@ -1552,6 +1552,20 @@ fn values_sizes_and_files_no_verb_can_use_get_exit_code_2() {
             ),
             a(&["identify", "--data", "ctl.csv"]),
         ),
+        (
+            case(
+                "a tracker file given as measured data",
+                &[],
+                vec![],
+                2,
+                &[
+                    "tracker.csv: line",
+                    "a laser-tracker file",
+                    "give it as --tracker",
+                ],
+            ),
+            a(&["identify", "--data", "tracker.csv"]),
+        ),
         // Calibrated machine files that do not match their record.
         (
             case(

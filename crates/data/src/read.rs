@@ -181,6 +181,29 @@ fn first_duplicate(poses: &[MeasuredPose]) -> Option<(u64, u64)> {
 }
 
 fn locate_columns(header: &Header) -> Result<Columns, DataError> {
+    // An external measurement file given as measured data: say which it
+    // is rather than which column it lacks.
+    let has = |c: &str| header.find(c).is_some();
+    if !has("phi") && has("h1") && has("h2") {
+        let kind = if has("x") && has("y") && has("z") {
+            Some("a laser-tracker file (columns h1, h2, x, y, z): give it as --tracker")
+        } else if has("length") {
+            Some("a ballbar file (columns h1, h2, length): give it as --ballbar")
+        } else if has("feature") {
+            Some("a touch-off file (columns h1, h2, feature): give it as --touch")
+        } else {
+            None
+        };
+        if let Some(kind) = kind {
+            return Err(DataError::Invalid {
+                file: header.file.clone(),
+                message: format!(
+                    "line {}: this is not a measured-data file of the UP limb's readings (q1, q2, q3, phi, theta, s) but {kind}",
+                    header.line
+                ),
+            });
+        }
+    }
     let known: Vec<&str> = REQUIRED_COLUMNS
         .iter()
         .chain(&OPTIONAL_COLUMNS)

@@ -75,7 +75,7 @@ pub enum RecordError {
 ///     effects: Default::default(),
 ///     sensor_offsets: SensorOffsetsDescription { phi_rad: 0.0, theta_rad: 0.0, s_mm: 0.0, std_dev: [0.0; 3] },
 ///     held: vec![], chi2_per_dof: 1.0, dof: 1, converged: true, adequate: true, forced: false,
-///     warnings: vec![], poses_used: 75, rejected_lines: vec![], external_sources: vec![],
+///     warnings: vec![], poses_used: 75, temperature_c: None, rejected_lines: vec![], external_sources: vec![],
 ///     data_file: "d.csv".into(), data_sha256: String::new(), date: String::new(),
 ///     tool_version: String::new(), relative_to: m.name.clone(), relative_to_machine: None,
 ///     nominal,
@@ -174,12 +174,16 @@ fn differences(file: &Machine, rebuilt: &Machine, c: &CalibrationRecord) -> Vec<
         let equal = (a - b).abs() <= TOLERANCE * (1.0 + b.abs());
         if !equal {
             out.push(format!(
-                "{field} is {a} in the file but {b} from the record{source}"
+                "{field} is {a:.6} in the file but {b:.6} from the record{source}"
             ));
         }
     };
-    let dq = |i: usize| match c.estimates_mm.get(&format!("dq{}", i + 1)) {
-        Some(v) => format!(" (dq{} = {v})", i + 1),
+    let dq = |i: usize| match c
+        .estimates_mm
+        .get(&format!("dq{}", i + 1))
+        .and_then(serde_json::Value::as_f64)
+    {
+        Some(v) => format!(" (dq{} = {v:.6})", i + 1),
         None => String::new(),
     };
     for i in 0..3 {

@@ -222,6 +222,10 @@ pub struct CalibrationRecord {
     pub warnings: Vec<String>,
     /// Poses used by the fit.
     pub poses_used: usize,
+    /// Mean logged structure temperature of the campaign, °C (when the
+    /// data carry `temp_c`): the thermal state a later check compares with.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature_c: Option<f64>,
     /// Lines of the data file rejected as gross errors.
     #[serde(default)]
     pub rejected_lines: Vec<u64>,
@@ -1027,6 +1031,7 @@ mod tests {
             tool_version: "0.1.0".into(),
             relative_to: nominal.name.clone(),
             relative_to_machine: None,
+            temperature_c: None,
             nominal: Box::new(nominal.clone()),
         }));
         let again = MachineDescription::from_json(&d.to_json()).unwrap();

@@ -71,6 +71,12 @@ pub fn gamma_p(a: f64, x: f64) -> f64 {
 
 /// `Q(a, x) = 1 - P(a, x)` by Lentz's continued fraction (for `x >= a + 1`).
 fn gamma_q_continued_fraction(a: f64, x: f64) -> f64 {
+    ln_gamma_q_continued_fraction(a, x).exp()
+}
+
+/// `ln Q(a, x)` by Lentz's continued fraction (for `x >= a + 1`): finite
+/// where `Q` itself underflows.
+fn ln_gamma_q_continued_fraction(a: f64, x: f64) -> f64 {
     let tiny = 1e-300;
     let mut b = x + 1.0 - a;
     let mut c = 1.0 / tiny;
@@ -94,7 +100,7 @@ fn gamma_q_continued_fraction(a: f64, x: f64) -> f64 {
             break;
         }
     }
-    (-x + a * x.ln() - ln_gamma(a)).exp() * h
+    -x + a * x.ln() - ln_gamma(a) + h.ln()
 }
 
 /// `P(X > x)` for `X ~ chi-square(k)`.
@@ -113,6 +119,31 @@ pub fn chi2_sf(x: f64, k: f64) -> f64 {
         gamma_q_continued_fraction(k / 2.0, x / 2.0)
     } else {
         1.0 - gamma_p(k / 2.0, x / 2.0)
+    }
+}
+
+/// `ln P(X > x)` for `X ~ chi-square(k)`: finite for any finite `x`, where
+/// [`chi2_sf`] underflows to zero (beyond `x` of about 1400), so that tests
+/// of very strong signals can still be ranked by their p-value.
+///
+/// # Example
+/// ```
+/// use tricept_numerics::stats::{chi2_ln_sf, chi2_sf};
+/// assert!((chi2_ln_sf(10.0, 3.0) - chi2_sf(10.0, 3.0).ln()).abs() < 1e-12);
+/// assert_eq!(chi2_sf(5000.0, 3.0), 0.0);
+/// let l = chi2_ln_sf(5000.0, 3.0);
+/// assert!(l.is_finite() && l < -2400.0);
+/// // With more degrees of freedom the same statistic is less surprising.
+/// assert!(chi2_ln_sf(5000.0, 4.0) > l);
+/// ```
+pub fn chi2_ln_sf(x: f64, k: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if 0.5 * x >= 0.5 * k + 1.0 {
+        ln_gamma_q_continued_fraction(k / 2.0, x / 2.0)
+    } else {
+        (1.0 - gamma_p(k / 2.0, x / 2.0)).ln()
     }
 }
 

@@ -24,6 +24,7 @@
 //! | `leg-periodic` | `um` per leg, `period_mm`, `phase_deg` per leg, `waveform` (`sine` or `sawtooth`) |
 //! | `leg-quadratic` | `um` per leg at `half_width_mm` from `centre_mm` |
 //! | `leg-power` | `um` per leg at `half_width_mm` from `centre_mm`, `exponent` (a shape outside the dictionary for 1.5) |
+//! | `leg-step` | `um` per leg inside the worn segment of commands `from_mm` to `to_mm` (a shape outside the dictionary) |
 //! | `scale-drift` | `um` over the campaign, linear in time |
 //! | `encoder-gain` | `phi_ppm`, `theta_ppm` |
 
@@ -156,6 +157,17 @@ pub enum Effect {
         #[serde(default = "default_half_width_mm")]
         half_width_mm: f64,
     },
+    /// Out of the vocabulary: a worn segment of a leg's ball screw: leg `i`
+    /// is `um_i` longer wherever its command lies from `from_mm` to
+    /// `to_mm`, and as built elsewhere (a step in and out of the segment).
+    LegStep {
+        /// Extra length of each leg inside the segment, um.
+        um: [f64; 3],
+        /// Start of the worn segment, mm of leg command.
+        from_mm: f64,
+        /// End of the worn segment, mm of leg command.
+        to_mm: f64,
+    },
     /// Out of the vocabulary: the scale reading drifts linearly with time,
     /// by `um` from the first to the last pose, whatever the temperature.
     ScaleDrift {
@@ -283,7 +295,7 @@ impl Effect {
             Effect::Compliance { .. } => catalogue(EffectName::Compliance),
             Effect::Outliers { .. } => catalogue(EffectName::Outliers),
             Effect::LegPeriodic { .. } => generic(GenericFamily::LegPeriodic),
-            Effect::LegQuadratic { .. } | Effect::LegPower { .. } => {
+            Effect::LegQuadratic { .. } | Effect::LegPower { .. } | Effect::LegStep { .. } => {
                 generic(GenericFamily::LegPolynomial)
             }
             Effect::ScaleDrift { .. } => generic(GenericFamily::ReadingDrift),
@@ -380,6 +392,13 @@ impl Effect {
                 *centre_mm,
                 *half_width_mm,
             ),
+            Effect::LegStep { um, from_mm, to_mm } => {
+                for i in 0..3 {
+                    if (*from_mm..=*to_mm).contains(&s.commands_mm[i]) {
+                        legs[i] += um[i] * 1e-3;
+                    }
+                }
+            }
             _ => {}
         }
     }

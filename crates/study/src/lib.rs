@@ -28,6 +28,7 @@
 )]
 
 pub mod campaign;
+pub mod check_plan;
 pub mod exact;
 pub mod fast;
 pub mod grades;
@@ -63,6 +64,9 @@ pub enum StudyError {
     /// Kinematics failed.
     #[error(transparent)]
     Kinematics(#[from] tricept_kinematics::KinematicsError),
+    /// A check could not be planned.
+    #[error(transparent)]
+    Check(#[from] tricept_check::CheckError),
     /// An exact trial's Gauss-Newton did not converge.
     #[error("exact trial {trial}: identification did not converge")]
     NotConverged {

@@ -1,0 +1,249 @@
+//! A machine's checks over time: one JSON object per line
+//! (`tricept check --history FILE.jsonl`), and the trend of the key
+//! quantities against their bands.
+//!
+//! Each entry keeps the verdict and, for every leg, the estimated length
+//! change (fitted alone, so that checks compare; a change of another leg
+//! or a joint moves it too, and the check's verdict says which it was;
+//! fitting the three legs together is no remedy, since their sum is the
+//! weak direction of the calibration and its uncertainty would widen every
+//! band fourfold) with its standard deviation and its *band*: the change beyond
+//! which that check flags the parameter on its own (its standard deviation
+//! alone times the family-wise critical value). A value inside its band is noise; a drift is
+//! reported once it leaves the band, and its slope (weighted least squares
+//! over the entries, per day) is given with its uncertainty.
+//!
+//! The file is rewritten whole at every append through
+//! [`tricept_data::write_atomic`], so that a crash never leaves half a
+//! line; a line that does not parse is an error naming it.
+
+use serde::{Deserialize, Serialize};
+
+use crate::{CheckError, CheckReport};
+
+/// One check in the history.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Entry {
+    /// When the check ran, UTC (ISO 8601).
+    pub time: String,
+    /// The same, seconds since 1970-01-01.
+    pub unix_s: f64,
+    /// The machine file checked against.
+    pub machine: String,
+    /// The check campaign's data file.
+    pub data_file: String,
+    /// `unchanged`, `changed` or `changed-unexplained`.
+    pub verdict: String,
+    /// The most likely change, when changed.
+    pub most_likely: Option<String>,
+    /// What the check could not tell apart from it.
+    pub shortlist: Vec<String>,
+    /// The consistency statistic, its degrees of freedom and p-value.
+    pub consistency: (f64, usize, f64),
+    /// The key quantities.
+    pub quantities: Vec<Quantity>,
+}
+
+/// A key quantity of one check.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Quantity {
+    /// `dq1`, ...
+    pub name: String,
+    /// Its unit.
+    pub unit: String,
+    /// The estimate.
+    pub value: f64,
+    /// Its standard deviation.
+    pub std_dev: f64,
+    /// The change beyond which this check flags the quantity on its own.
+    pub band: f64,
+}
+
+impl Entry {
+    /// The entry of `report`, checked at `time` (`unix_s` seconds).
+    pub fn of(
+        report: &CheckReport,
+        time: &str,
+        unix_s: f64,
+        machine: &str,
+        data_file: &str,
+    ) -> Entry {
+        let quantities = report
+            .candidates
+            .iter()
+            .filter(|c| c.name.starts_with("leg ") || c.kind == crate::CandidateKind::Thermal)
+            .filter_map(|c| {
+                let (p, (v, sd), d) = (
+                    c.parameters.first()?,
+                    (*c.alone.first()?)?,
+                    (*c.flagged_beyond.first()?)?,
+                );
+                let (name, value, unit) = crate::report::shown(p, v);
+                Some(Quantity {
+                    name,
+                    unit: unit.to_string(),
+                    value,
+                    std_dev: crate::report::shown(p, sd).1,
+                    band: crate::report::shown(p, d).1,
+                })
+            })
+            .collect();
+        Entry {
+            time: time.to_string(),
+            unix_s,
+            machine: machine.to_string(),
+            data_file: data_file.to_string(),
+            verdict: report.verdict.as_str().to_string(),
+            most_likely: report
+                .most_likely
+                .map(|i| report.candidates[i].name.clone()),
+            shortlist: report.shortlist.clone(),
+            consistency: (
+                report.consistency.statistic,
+                report.consistency.dof,
+                report.consistency.p_value,
+            ),
+            quantities,
+        }
+    }
+}
+
+/// The entries of a history file (none when it does not exist).
+pub fn read(path: &std::path::Path) -> Result<Vec<Entry>, CheckError> {
+    let file = path.display();
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(CheckError::History(format!("{file}: {e}"))),
+    };
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(i, l)| {
+            serde_json::from_str(l).map_err(|e| {
+                CheckError::HistoryLine(format!(
+                    "{file}: line {}: not a check of this history: {e}",
+                    i + 1
+                ))
+            })
+        })
+        .collect()
+}
+
+/// Appends `entry` to the history file `path` (rewritten atomically).
+pub fn append(path: &std::path::Path, entry: &Entry) -> Result<Vec<Entry>, CheckError> {
+    let mut entries = read(path)?;
+    entries.push(entry.clone());
+    let mut text = String::new();
+    for e in &entries {
+        let line = serde_json::to_string(e)
+            .map_err(|e| CheckError::History(format!("{}: {e}", path.display())))?;
+        text.push_str(&line);
+        text.push('\n');
+    }
+    tricept_data::write_atomic(path, |w| w.write_all(text.as_bytes()))
+        .map_err(|e| CheckError::History(format!("{}: not written: {e}", path.display())))?;
+    Ok(entries)
+}
+
+/// The trend of one key quantity over a history.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Trend {
+    /// The quantity.
+    pub name: String,
+    /// Its unit.
+    pub unit: String,
+    /// Days since the first check of each entry.
+    pub days: Vec<f64>,
+    /// The estimates, their standard deviations and bands.
+    pub values: Vec<f64>,
+    /// See `values`.
+    pub std_dev: Vec<f64>,
+    /// See `values`.
+    pub band: Vec<f64>,
+    /// Weighted least-squares slope per day and its standard deviation
+    /// (`None` with fewer than three checks or one day).
+    pub slope_per_day: Option<(f64, f64)>,
+    /// Entries whose value leaves its band.
+    pub outside: Vec<usize>,
+}
+
+/// The trends of the key quantities of `entries` (in time order).
+///
+/// # Example
+/// ```
+/// use tricept_check::history::{Entry, Quantity, trends};
+/// let entry = |day: f64, v: f64| Entry {
+///     time: String::new(), unix_s: day * 86_400.0, machine: "m".into(), data_file: "d".into(),
+///     verdict: "unchanged".into(), most_likely: None, shortlist: vec![], consistency: (50.0, 57, 0.7),
+///     quantities: vec![Quantity { name: "dq1".into(), unit: "um".into(), value: v, std_dev: 1.0, band: 5.0 }],
+/// };
+/// // A leg drifting 1 um a day: inside its band for four days, outside on the sixth.
+/// let t = &trends(&[entry(0.0, 0.0), entry(2.0, 2.0), entry(4.0, 4.0), entry(6.0, 6.0)])[0];
+/// assert_eq!(t.outside, vec![3]);
+/// assert!((t.slope_per_day.unwrap().0 - 1.0).abs() < 1e-9);
+/// ```
+pub fn trends(entries: &[Entry]) -> Vec<Trend> {
+    let t0 = entries.first().map_or(0.0, |e| e.unix_s);
+    let mut names: Vec<(String, String)> = Vec::new();
+    for e in entries {
+        for q in &e.quantities {
+            if !names.iter().any(|(n, _)| *n == q.name) {
+                names.push((q.name.clone(), q.unit.clone()));
+            }
+        }
+    }
+    names
+        .into_iter()
+        .map(|(name, unit)| {
+            let mut t = Trend {
+                name: name.clone(),
+                unit,
+                days: Vec::new(),
+                values: Vec::new(),
+                std_dev: Vec::new(),
+                band: Vec::new(),
+                slope_per_day: None,
+                outside: Vec::new(),
+            };
+            for e in entries {
+                if let Some(q) = e.quantities.iter().find(|q| q.name == name) {
+                    if q.value.abs() > q.band {
+                        t.outside.push(t.values.len());
+                    }
+                    t.days.push((e.unix_s - t0) / 86_400.0);
+                    t.values.push(q.value);
+                    t.std_dev.push(q.std_dev);
+                    t.band.push(q.band);
+                }
+            }
+            t.slope_per_day = slope(&t.days, &t.values, &t.std_dev);
+            t
+        })
+        .collect()
+}
+
+/// Weighted least-squares slope of `y` against `x` with its standard
+/// deviation.
+fn slope(x: &[f64], y: &[f64], sd: &[f64]) -> Option<(f64, f64)> {
+    if x.len() < 3 {
+        return None;
+    }
+    let w: Vec<f64> = sd.iter().map(|s| 1.0 / (s * s).max(1e-300)).collect();
+    let sw: f64 = w.iter().sum();
+    let mx = x.iter().zip(&w).map(|(x, w)| x * w).sum::<f64>() / sw;
+    let my = y.iter().zip(&w).map(|(y, w)| y * w).sum::<f64>() / sw;
+    let sxx: f64 = x.iter().zip(&w).map(|(x, w)| w * (x - mx).powi(2)).sum();
+    if sxx.is_nan() || sxx <= 0.0 || x.last().zip(x.first()).is_some_and(|(b, a)| b - a < 1.0) {
+        return None;
+    }
+    let sxy: f64 = x
+        .iter()
+        .zip(y)
+        .zip(&w)
+        .map(|((x, y), w)| w * (x - mx) * (y - my))
+        .sum();
+    Some((sxy / sxx, (1.0 / sxx).sqrt()))
+}

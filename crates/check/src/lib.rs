@@ -1,0 +1,93 @@
+//! Has the machine changed? A quick check of a calibrated Tricept from its
+//! own sensors.
+//!
+//! Self-calibration needs no external instrument, so a machine can be
+//! checked every day or every shift: a few poses, the UP limb's two
+//! encoders and its scale, tested against what the calibrated machine
+//! predicts, with the calibration's own uncertainty and the sensors'
+//! noise. A crash, a slipped encoder or coupling, a loosened joint, a worn
+//! screw segment or a machine that has not warmed up shows as readings the
+//! calibrated model cannot explain; a re-referenced sensor (a power cycle)
+//! does not, since the offsets are re-estimated at every check.
+//!
+//! - [`Reference`] (`reference.rs`): the calibrated machine with its
+//!   covariance, offsets and temperature, from a machine file's
+//!   `calibration` record;
+//! - [`check`] (`check.rs`): the test, the verdict, the most likely change
+//!   with its size, uncertainty and effect on the platform, the shortlist
+//!   of changes the campaign cannot tell apart;
+//! - [`Candidate`] (`candidates.rs`): what can have changed;
+//! - [`history`] (`history.rs`): checks appended to a JSON-lines file, and
+//!   the trend of the key quantities against their bands;
+//! - `report.rs`: the report as text.
+//!
+//! What a check cannot see: the head (it moves none of the UP limb's
+//! sensors; checking it needs an external measurement), and a change of
+//! all three legs by the same length, which moves the platform along the
+//! scale's axis and reads as a zero jump of the scale (the weak combination
+//! of the self-calibration itself; docs/check.md).
+//!
+//! # Example
+//! ```
+//! use tricept_check::{CheckOptions, Reference, check};
+//! use tricept_kinematics::Machine;
+//! use tricept_model::ParameterSet;
+//! use tricept_plant::{Campaign, Plant};
+//! let m = Machine::paper();
+//! let set = ParameterSet::paper15();
+//! let reference = Reference::new(m.clone(), set.clone(), nalgebra::DMatrix::zeros(15, 15), [0.0; 3], None).unwrap();
+//! let data = Plant::geometric(m.clone(), set.to_errors(&[0.0; 15]))
+//!     .simulate(&Campaign::random(&m, 20, 3))
+//!     .unwrap();
+//! let report = check(&reference, &data, &CheckOptions::for_machine(&m)).unwrap();
+//! assert!(!report.changed);
+//! println!("{}", report.to_text());
+//! ```
+#![cfg_attr(
+    not(test),
+    deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
+)]
+
+mod candidates;
+mod check;
+pub mod history;
+mod reference;
+mod report;
+
+pub use candidates::{Candidate, CandidateKind};
+pub use check::{
+    CandidateResult, CheckOptions, CheckReport, CheckVerdict, ChiSquare, DEFAULT_ALPHA,
+    DEFAULT_POWER, check, family_level, leg_ranges,
+};
+pub use reference::Reference;
+
+/// Why a check could not be made.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum CheckError {
+    /// The machine file cannot serve as a reference.
+    #[error("{0}")]
+    Record(String),
+    /// The check campaign cannot see any change.
+    #[error("the check's poses cannot see a change: {0}")]
+    Blind(String),
+    /// A setting out of range.
+    #[error("{0}")]
+    Invalid(String),
+    /// A pose the calibrated machine cannot solve.
+    #[error("pose {pose}{}: {source}", if *line > 0 { format!(" (line {line})") } else { String::new() })]
+    Kinematics {
+        /// 1-based pose number.
+        pose: usize,
+        /// Line in the data file (0 when there is none).
+        line: u64,
+        /// The kinematic failure.
+        source: tricept_kinematics::KinematicsError,
+    },
+    /// The history file holds a line that is not a check.
+    #[error("{0}")]
+    HistoryLine(String),
+    /// The history file cannot be read or written.
+    #[error("{0}")]
+    History(String),
+}

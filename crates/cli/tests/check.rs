@@ -1,0 +1,229 @@
+//! `tricept check` end to end: a machine calibrated from simulated data,
+//! checked unchanged (exit 0), with a slipped leg hidden in the truth
+//! (exit 3, named), against a file without a record or with a campaign that
+//! sees nothing (exit 2), and its history and trend plots.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn tricept(dir: &Path, args: &[&str]) -> Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_tricept"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(
+        !String::from_utf8_lossy(&out.stderr).contains("panicked"),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn workdir() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tricept-check-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The true errors a simulated file's comment records.
+fn truth_of(csv: &str) -> serde_json::Map<String, serde_json::Value> {
+    let line = csv
+        .lines()
+        .find(|l| l.starts_with("# true errors"))
+        .unwrap();
+    let json = &line[line.find('{').unwrap()..];
+    serde_json::from_str(json).unwrap()
+}
+
+#[test]
+fn a_calibrated_machine_is_checked_from_its_own_sensors() {
+    let dir = workdir();
+    let d = dir.as_path();
+    let ok = |args: &[&str]| {
+        let out = tricept(d, args);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {}", stderr(&out));
+        out
+    };
+    ok(&[
+        "simulate",
+        "--truth",
+        "random:0.25,5",
+        "--poses",
+        "random:80,3",
+        "--out",
+        "cal.csv",
+    ]);
+    ok(&[
+        "identify",
+        "--data",
+        "cal.csv",
+        "--write-machine",
+        "cal.json",
+    ]);
+    // Unchanged: another day, other poses, the sensors re-referenced.
+    ok(&[
+        "simulate",
+        "--truth",
+        "random:0.25,5",
+        "--poses",
+        "random:20,9",
+        "--seed",
+        "4",
+        "--out",
+        "day1.csv",
+    ]);
+    let out = ok(&[
+        "check",
+        "--machine",
+        "cal.json",
+        "--data",
+        "day1.csv",
+        "--history",
+        "h.jsonl",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.lines()
+            .nth(1)
+            .unwrap()
+            .starts_with("verdict: UNCHANGED"),
+        "{text}"
+    );
+    // Leg 2 slipped by 25 um: the truth of the calibration plus the slip.
+    let csv = std::fs::read_to_string(dir.join("cal.csv")).unwrap();
+    let mut truth = truth_of(&csv);
+    let dq2 = truth["dq2"].as_f64().unwrap();
+    truth.insert("dq2".into(), (dq2 + 0.025).into());
+    std::fs::write(
+        dir.join("slipped.json"),
+        serde_json::to_string(&truth).unwrap(),
+    )
+    .unwrap();
+    ok(&[
+        "simulate",
+        "--truth",
+        "slipped.json",
+        "--poses",
+        "random:20,11",
+        "--seed",
+        "5",
+        "--out",
+        "day2.csv",
+    ]);
+    let out = tricept(
+        d,
+        &[
+            "check",
+            "--machine",
+            "cal.json",
+            "--data",
+            "day2.csv",
+            "--history",
+            "h.jsonl",
+            "--json",
+            "--plot",
+            "trends",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("the machine changed since its calibration"),
+        "{}",
+        stderr(&out)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["verdict"], "changed");
+    let best = &v["candidates"][v["most_likely"].as_u64().unwrap() as usize];
+    assert!(
+        v["shortlist"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|s| s == "leg 2"),
+        "{}",
+        v["shortlist"]
+    );
+    if best["name"] == "leg 2" {
+        let (e, sd) = (
+            best["estimate"][0].as_f64().unwrap(),
+            best["std_dev"][0].as_f64().unwrap(),
+        );
+        assert!((e - 0.025).abs() < 5.0 * sd, "{e} +- {sd}");
+    }
+    assert!(best["platform_mean_um"].as_f64().unwrap() > 5.0);
+    assert_eq!(v["history"]["checks"], 2);
+    let lines = std::fs::read_to_string(dir.join("h.jsonl")).unwrap();
+    assert_eq!(lines.lines().count(), 2);
+    for q in ["dq1", "dq2", "dq3"] {
+        assert!(
+            dir.join("trends").join(format!("check-{q}.svg")).exists(),
+            "{q}"
+        );
+    }
+    // No record: nothing to check against.
+    std::fs::write(
+        dir.join("plain.json"),
+        tricept(d, &["machine", "--json"]).stdout,
+    )
+    .unwrap();
+    let out = tricept(
+        d,
+        &["check", "--machine", "plain.json", "--data", "day1.csv"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("holds no `calibration` record"),
+        "{}",
+        stderr(&out)
+    );
+    let out = tricept(d, &["check", "--data", "day1.csv"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--machine CALIBRATED.json is needed"));
+    // Twenty readings at one pose see nothing.
+    let day = std::fs::read_to_string(dir.join("day1.csv")).unwrap();
+    let mut rows = day.lines().filter(|l| !l.starts_with('#'));
+    let header = rows.next().unwrap();
+    let first: Vec<&str> = rows.next().unwrap().split(',').collect();
+    let mut one = format!("{header}\n");
+    for (k, r) in rows.enumerate() {
+        let mut f: Vec<String> = r.split(',').map(str::to_string).collect();
+        f[..3].clone_from_slice(&first[..3].iter().map(|s| s.to_string()).collect::<Vec<_>>());
+        f[5] = format!("{}", f[5].parse::<f64>().unwrap() + 1e-6 * k as f64);
+        one.push_str(&(f.join(",") + "\n"));
+    }
+    std::fs::write(dir.join("one.csv"), one).unwrap();
+    let out = tricept(d, &["check", "--machine", "cal.json", "--data", "one.csv"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("cannot see a change"),
+        "{}",
+        stderr(&out)
+    );
+    // A history line that is not a check is refused, naming the line.
+    std::fs::write(dir.join("bad.jsonl"), "{\"not\": \"a check\"}\n").unwrap();
+    let out = tricept(
+        d,
+        &[
+            "check",
+            "--machine",
+            "cal.json",
+            "--data",
+            "day1.csv",
+            "--history",
+            "bad.jsonl",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("bad.jsonl: line 1"),
+        "{}",
+        stderr(&out)
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

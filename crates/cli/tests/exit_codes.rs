@@ -1,0 +1,162 @@
+//! One exit-code table for every verb (docs/reliability.md): 0 success; 3
+//! a fit that converged but must not be trusted (the model does not explain
+//! the data, the campaign is too small, the machine changed); 4 a fit that
+//! did not converge; 2 bad input; 1 anything else. The same data give the
+//! same code with and without `--write-machine`.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn code(dir: &Path, args: &[&str]) -> i32 {
+    let out = Command::new(env!("CARGO_BIN_EXE_tricept"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    out.status.code().unwrap()
+}
+
+fn fixture(name: &str) -> String {
+    format!("{}/../../fixtures/data/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn workdir() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tricept-exit-codes-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn every_verb_follows_the_one_exit_code_table() {
+    let dir = workdir();
+    let d = dir.as_path();
+    let (good, hidden) = (
+        fixture("table2-grid-seed1.csv"),
+        fixture("diagnose-hidden-effect.csv"),
+    );
+    // phi and theta exchanged: a fit that does not converge.
+    let text = std::fs::read_to_string(&good).unwrap();
+    let swapped: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("q1,") {
+                l.replace("phi,theta", "theta,phi")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(dir.join("swapped.csv"), swapped + "\n").unwrap();
+    std::fs::write(dir.join("points.csv"), "x,y,z\n0,0,750\n").unwrap();
+    assert_eq!(
+        code(
+            d,
+            &["identify", "--data", &good, "--write-machine", "cal.json"]
+        ),
+        0
+    );
+    assert_eq!(
+        code(
+            d,
+            &[
+                "simulate",
+                "--poses",
+                "random:20,4",
+                "--seed",
+                "3",
+                "--out",
+                "today.csv"
+            ]
+        ),
+        0
+    );
+    // (verb and arguments, expected code)
+    let table: Vec<(Vec<&str>, i32)> = vec![
+        (vec!["ik", "0", "0", "750"], 0),
+        (vec!["ik", "0", "0", "5000"], 2),
+        (vec!["fk", "796.5", "796.5", "796.5"], 0),
+        (vec!["fk", "1", "1", "1"], 2),
+        (vec!["tool-ik", "0", "0", "1100", "0", "0", "1"], 0),
+        (vec!["tool-ik", "0", "0", "1100", "0", "0", "0"], 2),
+        (vec!["machine"], 0),
+        (vec!["machine", "--machine", "missing.json"], 2),
+        (vec!["identifiability"], 0),
+        (vec!["identifiability", "--poses", "grid:0,1,1"], 2),
+        (vec!["identify", "--data", &good], 0),
+        (vec!["identify", "--data", &hidden], 3),
+        (vec!["identify", "--data", "swapped.csv"], 4),
+        (vec!["identify", "--data", "missing.csv"], 2),
+        (vec!["simulate", "--poses", "grid:1,4,1"], 0),
+        (vec!["simulate", "--poses", "random:0"], 2),
+        (vec!["diagnose", "--data", &hidden], 0),
+        (vec!["diagnose", "--data", "missing.csv"], 2),
+        (vec!["detectability", "--poses", "grid:1,8,3"], 0),
+        (vec!["detectability", "--data", "missing.csv"], 2),
+        (vec!["compensate", "--data", &good, "--spacing", "50"], 0),
+        (vec!["compensate", "--data", &hidden, "--spacing", "50"], 3),
+        (
+            vec!["compensate", "--data", "swapped.csv", "--spacing", "50"],
+            4,
+        ),
+        (vec!["compensate", "--data", &good, "--spacing", "0.1"], 2),
+        (
+            vec![
+                "plan",
+                "--instrument",
+                "tracker",
+                "--tracker-target",
+                "tip",
+                "--k",
+                "5",
+            ],
+            0,
+        ),
+        (
+            vec![
+                "plan",
+                "--instrument",
+                "tracker",
+                "--tracker-target",
+                "tip",
+                "--k",
+                "0",
+            ],
+            2,
+        ),
+        (
+            vec!["check", "--machine", "cal.json", "--data", "today.csv"],
+            0,
+        ),
+        (vec!["check", "--data", "today.csv"], 2),
+        (vec!["nonsense"], 2),
+    ];
+    let mut failures = Vec::new();
+    for (args, expected) in &table {
+        let got = code(d, args);
+        if got != *expected {
+            failures.push(format!("{args:?}: exit {got}, the table says {expected}"));
+        }
+        // The same data give the same code with --write-machine (the file
+        // is written only at 0, or with --force).
+        if matches!(args[0], "identify" | "diagnose") && *expected != 2 {
+            let _ = std::fs::remove_file(dir.join("written.json"));
+            let mut with = args.clone();
+            with.extend(["--write-machine", "written.json"]);
+            let got = code(d, &with);
+            if got != *expected {
+                failures.push(format!("{with:?}: exit {got}, the table says {expected}"));
+            }
+            if (got == 0) != dir.join("written.json").exists() {
+                failures.push(format!(
+                    "{with:?}: a file written at exit {got}, or none at 0"
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    std::fs::remove_dir_all(&dir).ok();
+}
