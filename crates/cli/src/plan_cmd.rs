@@ -35,6 +35,9 @@ pub enum Instrument {
     Ballbar,
     /// A touch probe in the spindle on a reference sphere.
     Touch,
+    /// A check of the calibrated machine from its own sensors (`tricept
+    /// check`): the fewest poses that detect a stated change.
+    Check,
 }
 
 /// `tricept plan`.
@@ -43,9 +46,19 @@ pub struct PlanArgs {
     /// The instrument.
     #[arg(long, value_enum)]
     pub instrument: Instrument,
-    /// Numbers of measurements to plan for, comma-separated.
-    #[arg(long, default_value = "3,5,8,12,20,30,50", value_delimiter = ',')]
+    /// Numbers of measurements to plan for, comma-separated (default
+    /// 3,5,8,12,20,30,50; for a check, the largest number of poses it may
+    /// take, default 20).
+    #[arg(long, value_delimiter = ',')]
     pub k: Vec<usize>,
+    /// For a check: the change to detect, as the mean platform error it
+    /// causes over the workspace, um (from any single joint or length
+    /// parameter).
+    #[arg(long, default_value_t = 20.0, value_name = "UM")]
+    pub detect_um: f64,
+    /// For a check: the power with which it is detected.
+    #[arg(long, default_value_t = tricept_check::DEFAULT_POWER, value_name = "P")]
+    pub power: f64,
     /// The internal campaign's measured-data file (only its commands are
     /// used); default: the pose set of --poses.
     #[arg(long, value_name = "FILE.csv")]
@@ -172,11 +185,13 @@ pub fn touch_features(
 
 /// `tricept plan`.
 pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
+    let default_k = [3, 5, 8, 12, 20, 30, 50];
+    let k: &[usize] = if a.k.is_empty() { &default_k } else { &a.k };
     let m = machine_with_noise(&a.machine, &a.noise)?;
     let set = a.params.set()?;
     let model = fused_model(&m, &set, &a.effects, Some("head13"))?;
     let options = eval_options(&m, &a.eval_grid, &a.eval_head_angles_deg)?;
-    if a.k.is_empty() || a.k.contains(&0) {
+    if k.contains(&0) {
         return Err(CliError::input("--k: expected positive whole numbers"));
     }
     if let Some(t) = a.target_um
@@ -214,6 +229,7 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
         }
     };
     let (poses, source, centre) = match a.instrument {
+        Instrument::Check => return run_check_plan(a),
         Instrument::Tracker => {
             let target = tracker_target(a.tracker_target.as_deref(), a.tracker_target_sigma_um)?;
             let (h1, h2) = parse_head_angles("--head-angles-deg", &a.head_angles_deg)?;
@@ -308,7 +324,7 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
     if axis {
         problem = problem.with_tool_axis();
     }
-    let result = plan(&problem, &a.k, a.passes, a.random_baseline, a.seed).map_err(study_error)?;
+    let result = plan(&problem, k, a.passes, a.random_baseline, a.seed).map_err(study_error)?;
     let recommended = result.recommended(a.target_um, None);
     if let (Some(path), Some(last)) = (&a.out, result.rows.last()) {
         let p = vec![0.0; model.len()];
@@ -455,4 +471,129 @@ fn study_error(e: tricept_study::StudyError) -> CliError {
         tricept_study::StudyError::Invalid(m) => CliError::input(m),
         e => CliError::other(e.to_string()),
     }
+}
+
+/// `tricept plan --instrument check`: the fewest poses, up to `--k` (default
+/// 20), whose check detects a change of `--detect-um` of platform error in
+/// any single parameter with `--power` (`tricept_study::check_plan`).
+fn run_check_plan(a: &PlanArgs) -> Result<u8, CliError> {
+    let Some(path) = &a.machine.machine else {
+        return Err(CliError::input(
+            "plan --instrument check: --machine CALIBRATED.json is needed (a check is planned for a calibrated machine and its record)",
+        ));
+    };
+    let budget = match a.k.as_slice() {
+        [] => 20,
+        k if k.contains(&0) => {
+            return Err(CliError::input("--k: expected positive whole numbers"));
+        }
+        k => k.iter().copied().max().unwrap_or(20),
+    };
+    if budget > limits::MAX_CANDIDATES {
+        return Err(CliError::input(format!(
+            "--k: {budget} poses; at most {}",
+            limits::MAX_CANDIDATES
+        )));
+    }
+    if !(a.detect_um.is_finite() && a.detect_um > 0.0) {
+        return Err(CliError::input(format!(
+            "--detect-um: the change to detect must be a positive number of um, got {}",
+            a.detect_um
+        )));
+    }
+    if !(a.power > 0.0 && a.power < 1.0) {
+        return Err(CliError::input(format!(
+            "--power: must lie between 0 and 1, got {}",
+            a.power
+        )));
+    }
+    let loaded = crate::args::load_with_noise(&a.machine, &a.noise)?;
+    let reference = tricept_check::Reference::from_description(&loaded.description)
+        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    let p = tricept_study::check_plan::plan_check(
+        &reference,
+        a.detect_um,
+        a.power,
+        tricept_check::DEFAULT_ALPHA,
+        budget,
+    )
+    .map_err(study_error)?;
+    if let Some(out) = &a.out {
+        let m = &loaded.machine;
+        let mut records = Vec::with_capacity(p.targets_mm.len());
+        for r in &p.targets_mm {
+            let q = m
+                .inverse(r)
+                .map_err(|e| CliError::kinematics("plan", &e))?
+                .legs_mm;
+            records.push(format!(
+                "{},{},{},{},{},{}",
+                r.x, r.y, r.z, q[0], q[1], q[2]
+            ));
+        }
+        let text = format!(
+            "# tricept plan --instrument check: {} poses for `{}`; drive the machine to the commands q1,q2,q3 (mm) and log its readings\nx,y,z,q1,q2,q3\n{}\n",
+            p.poses,
+            loaded.description.name,
+            records.join("\n")
+        );
+        crate::files::write_text(out, &text)?;
+    }
+    if a.machine.json {
+        outln!(
+            "{}",
+            json!({
+                "instrument": "check",
+                "detect_um": a.detect_um,
+                "power": a.power,
+                "poses": p.poses,
+                "reached": p.reached,
+                "targets_mm": p.targets_mm.iter().map(|r| [r.x, r.y, r.z]).collect::<Vec<_>>(),
+                "parameters": p.parameters,
+            })
+        );
+    } else {
+        outln!(
+            "check of `{}`: {} poses {} a change of {} um of platform error in any single parameter with power {}{}",
+            loaded.description.name,
+            p.poses,
+            if p.reached { "detect" } else { "do NOT detect" },
+            a.detect_um,
+            a.power,
+            if p.reached {
+                String::new()
+            } else {
+                format!(" (the budget --k {budget} is spent; more poses or a larger --detect-um)")
+            }
+        );
+        outln!(
+            "{:>6} {:>14} {:>18} {:>22} {:>8}",
+            "param",
+            "target um",
+            "detectable um",
+            "as platform error um",
+            "power"
+        );
+        for d in &p.parameters {
+            match (d.detectable_mm, d.detectable_platform_um, d.power) {
+                (Some(det), Some(plat), Some(power)) => outln!(
+                    "{:>6} {:>14.1} {:>18.1} {:>22.1} {:>8.3}",
+                    d.name,
+                    d.target_mm * 1e3,
+                    det * 1e3,
+                    plat,
+                    power
+                ),
+                _ => outln!(
+                    "{:>6} {:>14} {:>18} {:>22} {:>8}",
+                    d.name,
+                    "-",
+                    "not seen",
+                    "-",
+                    "-"
+                ),
+            }
+        }
+    }
+    Ok(0)
 }

@@ -166,6 +166,47 @@ fn a_calibrated_machine_is_checked_from_its_own_sensors() {
             "{q}"
         );
     }
+    // A planned check: its poses, driven and logged, are a check campaign.
+    let out = ok(&[
+        "plan",
+        "--instrument",
+        "check",
+        "--machine",
+        "cal.json",
+        "--k",
+        "30",
+        "--detect-um",
+        "30",
+        "--out",
+        "planned.csv",
+        "--json",
+    ]);
+    let plan: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(plan["reached"], true, "{plan}");
+    let n = plan["poses"].as_u64().unwrap() as usize;
+    assert!((4..=30).contains(&n), "{n}");
+    let dya3 = plan["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "dyA3")
+        .unwrap();
+    assert!(
+        dya3["detectable_mm"].is_null(),
+        "the invisible joint is not seen: {dya3}"
+    );
+    ok(&[
+        "simulate",
+        "--truth",
+        "random:0.25,5",
+        "--poses",
+        "planned.csv",
+        "--seed",
+        "6",
+        "--out",
+        "day3.csv",
+    ]);
+    ok(&["check", "--machine", "cal.json", "--data", "day3.csv"]);
     // No record: nothing to check against.
     std::fs::write(
         dir.join("plain.json"),
