@@ -13,13 +13,16 @@
 //!   and with the analytic Jacobian of any spindle point.
 //! - [`volumetric_errors`]: platform error maps (the paper's Fig. 3).
 //! - [`residual_mu`]: the paper's residual error `mu` (Fig. 4).
-//! - [`effects`]: the effects the geometric model leaves out (leg lead,
-//!   backlash, thermal growth, sensor errors, class-2 errors, compliance),
-//!   their names and their physics, shared by the simulator and the
-//!   diagnosis.
+//! - [`effects`]: the registry of the effects the geometric model leaves
+//!   out (leg lead, backlash, thermal growth, sensor errors, class-2
+//!   errors, compliance; one file and one spec each) and of the generic
+//!   families, their names and their physics, shared by the simulator, the
+//!   diagnosis and the fused identification.
 //!
 //! - [`ExtendedMachine`]: a calibrated machine's kinematics with the static
 //!   leg effects (lead, compliance) a diagnosis named.
+//! - [`plausibility`]: tables of plausible ranges with overrides, shared by
+//!   the diagnosis and the fused identification.
 //!
 //! All lengths in mm, angles in rad.
 #![cfg_attr(
@@ -34,6 +37,7 @@ mod extended;
 mod head_errors;
 mod jacobian;
 mod params;
+pub mod plausibility;
 mod volumetric;
 
 pub use actual::{actual_machine, errors_between};
