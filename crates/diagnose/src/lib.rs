@@ -48,21 +48,21 @@
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
-// Layers, bottom to top (a file imports only from its own layer or those
-// below; `xtask/tests/tidy.rs` checks it):
-// options and errors
+// Layers, bottom to top: a file imports only from its own layer or those
+// below (`xtask/tests/tidy.rs` checks it).
+// Layer 1: options and errors
 mod error;
 mod evidence;
 mod finite;
 mod options;
 mod plausibility;
 mod report;
-// the model
+// Layer 2: the model
 mod model;
 mod terms;
-// the fit core
+// Layer 3: the fit core
 mod fit;
-// dictionary, noise, selection, aliases, gain and residual plots
+// Layer 4: dictionary, noise, selection, aliases, gain and residual plots
 mod alias;
 mod dictionary;
 mod gain;
@@ -70,10 +70,10 @@ mod linear;
 mod noise;
 mod residuals;
 mod select;
-// description and report assembly
+// Layer 5: description and report assembly
 mod assemble;
 mod describe;
-// orchestration: the diagnosis, its deployment, detectability
+// Layer 6: orchestration: the diagnosis, its deployment, detectability
 mod deploy;
 pub mod detect;
 mod run;

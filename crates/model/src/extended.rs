@@ -1,5 +1,5 @@
 //! The machine a controller should run after a diagnosis: the exact
-//! geometry (joints, leg offsets and the class-2 U-joint and tube-twist
+//! geometry (joints, leg offsets and the class-2 U-joint and guide-rail twist
 //! errors of the description) plus the static leg effects the diagnosis
 //! named (ball-screw lead, gravity compliance), with IK and FK that apply
 //! them.

@@ -30,15 +30,21 @@
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
-mod actual;
-pub mod effects;
+// Layers, bottom to top: a file imports only from its own layer or those
+// below (`xtask/tests/tidy.rs` checks it).
+// Layer 1: errors, parameters, plausible ranges
 mod error;
-mod extended;
-mod head_errors;
-mod jacobian;
 mod params;
 pub mod plausibility;
+// Layer 2: the actual machine and the linearisations
+mod actual;
+mod head_errors;
+mod jacobian;
 mod volumetric;
+// Layer 3: the effect registry
+pub mod effects;
+// Layer 4: a calibrated machine's kinematics with its effects
+mod extended;
 
 pub use actual::{actual_machine, errors_between};
 pub use error::ModelError;

@@ -19,9 +19,9 @@ use super::forms::{legendre_p2, legendre_p3};
 /// An effect of the vocabulary.
 #[derive(Debug, Clone, Copy)]
 pub struct EffectSpec {
-    /// The report name (`tube-twist`): the `serde` name of its
+    /// The report name (`leg-lead`): the `serde` name of its
     /// `EffectName` and the prefix of its parameters in a model
-    /// (`tube-twist.twist_arcsec_per_100mm`).
+    /// (`leg-lead.lead1_ppm`).
     pub name: &'static str,
     /// Its physics in one phrase (the vocabulary's table, the CLI help).
     pub physics: &'static str,
