@@ -265,17 +265,23 @@ fn write_extended(
 }
 
 /// The vocabulary for `tricept diagnose --help`, from the registry: each
-/// effect, its physics, its unit and where `--write-machine` puts it.
+/// effect, its physics, its parameters (units in the names) and where
+/// `--write-machine` puts it.
 pub fn vocabulary_help() -> String {
     let lines: Vec<String> = EffectName::ALL
         .iter()
         .map(|e| {
             let s = e.spec();
+            let params = e.parameter_names();
             format!(
-                "  {}: {} ({}); --write-machine: {}",
+                "  {}: {}{}; --write-machine: {}",
                 s.name,
                 s.physics.replace('`', ""),
-                s.quoted_in,
+                if params.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", params.join(", "))
+                },
                 s.deployment.label()
             )
         })

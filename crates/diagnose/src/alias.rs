@@ -137,7 +137,12 @@ fn refinement(g: &GenericTerm, frame: &Frame, data: &Dataset) -> Option<Vec<(usi
                     .collect(),
             )
         }
-        _ => None,
+        GenericFamily::ReadingDrift
+        | GenericFamily::ReadingTemperature
+        | GenericFamily::LegDrift
+        | GenericFamily::EncoderGain
+        | GenericFamily::ScalePolynomial
+        | GenericFamily::ReadingHysteresis => None,
     }
 }
 
