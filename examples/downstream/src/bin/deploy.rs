@@ -3,37 +3,28 @@
 //! on unless the final model explains the data and names no generic term
 //! (whose physics a machine file cannot carry), then deploys the model
 //! (`tricept_diagnose::deploy`: each effect where the registry says it
-//! goes) and prints the calibrated leg commands for a few targets and the
-//! controller parameters of the dynamic effects.
+//! goes) and prints the deployed leg effects, the controller parameters of
+//! the dynamic effects and the calibrated leg commands at the centre of the
+//! workspace.
 //!
 //! ```sh
 //! cargo run -p tricept-example-downstream --bin deploy -- fixtures/data/diagnose-hidden-effect.csv
 //! ```
 
-use std::process::ExitCode;
-
 use nalgebra::Vector3;
 use tricept_diagnose::{CauseKind, DiagnoseOptions, deploy, diagnose};
 use tricept_ident::{ExtendedMachine, Machine, read_path};
 
-fn main() -> ExitCode {
-    let path = std::env::args().nth(1).unwrap_or_else(|| {
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../fixtures/data/diagnose-hidden-effect.csv"
-        )
-        .to_string()
-    });
-    match run(&path) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
-    }
-}
+/// The data file when none is given: a campaign with a hidden compliance.
+const DEFAULT_DATA: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../fixtures/data/diagnose-hidden-effect.csv"
+);
 
-fn run(path: &str) -> Result<(), Box<dyn std::error::Error>> {
+/// Errors end the program with their message and exit code 1.
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let path = std::env::args().nth(1);
+    let path = path.as_deref().unwrap_or(DEFAULT_DATA);
     let data = read_path(path.as_ref())?;
     let nominal = Machine::paper();
     let d = diagnose(&nominal, &data, &DiagnoseOptions::for_machine(&nominal))?;
@@ -50,14 +41,11 @@ fn run(path: &str) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(c) = &deployed.controller {
         println!("controller: {c:?}");
     }
+    println!("leg effects: {:?}", deployed.machine.leg_effects);
     let calibrated = ExtendedMachine::new(deployed.machine);
-    println!("x,y,z,q1,q2,q3");
-    for r in [
-        Vector3::new(0.0, 0.0, 750.0),
-        Vector3::new(200.0, -100.0, 700.0),
-    ] {
-        let q = calibrated.inverse(&r)?.legs_mm;
-        println!("{},{},{},{},{},{}", r.x, r.y, r.z, q[0], q[1], q[2]);
-    }
+    let target = Vector3::new(0.0, 0.0, 750.0);
+    let q = calibrated.inverse(&target)?.legs_mm;
+    let q_nominal = nominal.inverse(&target)?.legs_mm;
+    println!("leg commands at the workspace centre, mm: {q:?} (nominal {q_nominal:?})");
     Ok(())
 }
