@@ -89,7 +89,7 @@ pub struct MachineDescription {
     #[serde(default)]
     pub sensors: SensorDescription,
     /// Masses and stiffness, used by the compliance model of the plant
-    /// simulator and by the `compliance` leg effect.
+    /// simulator and by the gravity compliance of the leg effects.
     #[serde(default)]
     pub loads: LoadsDescription,
     /// Static leg effects a calibration found (ball-screw lead, gravity
