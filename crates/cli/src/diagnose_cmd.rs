@@ -5,13 +5,9 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use serde_json::{Map, json};
 use tricept_diagnose::detect::{advise, realistic, term_detectability};
-use tricept_diagnose::{
-    Candidate, DiagnoseError, DiagnoseOptions, ExtendedModel, Plausibility,
-    REFERENCE_TEMPERATURE_C, diagnose,
-};
-use tricept_ident::{GeometricModel, IdentifyOptions, identify};
-use tricept_kinematics::description::ControllerDescription;
-use tricept_model::effects::CauseName;
+use tricept_diagnose::{DiagnoseError, DiagnoseOptions, Plausibility, deploy, diagnose};
+use tricept_ident::GeometricModel;
+use tricept_model::effects::{CauseName, EffectName};
 use tricept_model::{GeometricErrors, ParameterSet};
 use tricept_plant::{Campaign, Effect, Plant, PoseOrder};
 
@@ -50,11 +46,11 @@ pub struct DiagnoseArgs {
     #[arg(long)]
     pub no_dictionary: bool,
     /// Write the calibrated machine of the final model: the geometric
-    /// estimate with the static effects named (leg-lead, compliance: applied
-    /// by ik, fk, tool-ik and compensate; ujoint-axes, tube-twist: in the
-    /// UP limb's description), the dynamic ones as controller parameters
-    /// (backlash per leg axis in um, thermal expansion in ppm/K from 20 °C),
-    /// and a `calibration` record. Refused when the data are not explained.
+    /// estimate with each named effect where it goes (the list below: the
+    /// static leg effects applied by ik, fk, tool-ik and compensate, the UP
+    /// limb's class-2 errors in its description, the dynamic effects as
+    /// controller parameters), and a `calibration` record. Refused when the
+    /// data are not explained.
     #[arg(long, value_name = "FILE.json")]
     pub write_machine: Option<PathBuf>,
     /// Write the machine even when the data are not explained; the file
@@ -173,86 +169,6 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
     }
 }
 
-/// The deployable model of a diagnosis, refitted on its clean poses for
-/// the record's offsets, covariance and fit quality.
-pub struct Deployed {
-    /// The final model's identification.
-    pub id: tricept_ident::Identification,
-    /// The calibrated machine: geometry, class-2 effects, leg effects.
-    pub machine: tricept_kinematics::Machine,
-    /// The controller parameters of the dynamic effects, when any is named.
-    pub controller: Option<ControllerDescription>,
-}
-
-/// Fits the diagnosis' final model (its named causes on the geometric
-/// model) on the poses it kept, with the rank decision of `rank_reference`
-/// when `nominal` is itself calibrated, and maps every parameter to where
-/// it goes in a machine file.
-pub fn deploy(
-    nominal: &tricept_kinematics::Machine,
-    rank_reference: Option<&tricept_kinematics::Machine>,
-    data: &tricept_data::Dataset,
-    d: &tricept_diagnose::Diagnosis,
-) -> Result<Deployed, CliError> {
-    let flagged = d.outlier_lines();
-    let clean = data.subset(|j| !flagged.contains(&data.poses[j].line));
-    let candidates: Vec<Candidate> = d.model_effects().into_iter().map(Candidate).collect();
-    let mut geometric = GeometricModel::new(nominal.clone(), ParameterSet::paper15());
-    if let Some(reference) = rank_reference {
-        geometric = geometric.with_rank_reference(reference.clone());
-    }
-    let model = ExtendedModel::new(geometric, &candidates);
-    let id = identify(&model, &clean, &IdentifyOptions::for_machine(nominal))
-        .map_err(|e| CliError::other(format!("the diagnosis' final model: {e}")))?;
-    let mut machine = model.machine_at(&id.estimate);
-    let mut controller: Option<ControllerDescription> = None;
-    for (name, value) in id.names.iter().zip(&id.estimate).skip(model.n_geometric()) {
-        let v = *value;
-        let leg = |i: usize| {
-            name.ends_with(&format!("{}_ppm", i + 1)) || name.ends_with(&format!("{}_um", i + 1))
-        };
-        match name.split_once('.') {
-            Some(("leg-lead", _)) => {
-                for i in 0..3 {
-                    if leg(i) {
-                        machine.leg_effects.lead_ppm[i] = v;
-                    }
-                }
-            }
-            Some(("compliance", "compliance_um_per_kn_at_1m")) => {
-                machine.leg_effects.compliance_um_per_kn_at_1m = v;
-            }
-            Some(("backlash", _)) => {
-                let c = controller.get_or_insert_with(ControllerDescription::default);
-                for i in 0..3 {
-                    if leg(i) {
-                        c.backlash_um[i] = v;
-                    }
-                }
-            }
-            Some(("thermal", "expansion_ppm_per_k")) => {
-                let c = controller.get_or_insert_with(ControllerDescription::default);
-                c.thermal_expansion_ppm_per_k = v;
-                c.reference_temperature_c = REFERENCE_TEMPERATURE_C;
-            }
-            // In the machine's UP limb already (model.machine_at), or
-            // sensor-side (they change readings, not where the platform
-            // goes): recorded under `calibration.effects`.
-            Some(("ujoint-axes" | "tube-twist" | "scale-gain" | "encoder-eccentricity", _)) => {}
-            _ => {
-                return Err(CliError::other(format!(
-                    "the diagnosis named a parameter `{name}` that a machine file cannot hold"
-                )));
-            }
-        }
-    }
-    Ok(Deployed {
-        id,
-        machine,
-        controller,
-    })
-}
-
 fn write_extended(
     path: &Path,
     data: &Path,
@@ -316,7 +232,8 @@ fn write_extended(
         &problems.join("; "),
         force,
     )?;
-    let deployed = deploy(&loaded.machine, rank_reference, dataset, d)?;
+    let deployed = deploy(&loaded.machine, rank_reference, dataset, d)
+        .map_err(|e| CliError::other(e.to_string()))?;
     let g = ParameterSet::paper15().len();
     let mut effects = Map::new();
     for ((name, v), sd) in deployed
@@ -351,6 +268,31 @@ fn write_extended(
         deployed.controller,
     )?;
     machine_file::write(path, &description)
+}
+
+/// The vocabulary for `tricept diagnose --help`, from the registry: each
+/// effect, its physics, its parameters (units in the names) and where
+/// `--write-machine` puts it.
+pub fn vocabulary_help() -> String {
+    let lines: Vec<String> = EffectName::ALL
+        .iter()
+        .map(|e| {
+            let s = e.spec();
+            let params = e.parameter_names();
+            format!(
+                "  {}: {}{}; --write-machine: {}",
+                s.name,
+                s.physics.replace('`', ""),
+                if params.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", params.join(", "))
+                },
+                s.deployment.label()
+            )
+        })
+        .collect();
+    format!("Effects of the vocabulary:\n{}", lines.join("\n"))
 }
 
 /// The CLI error of a failed diagnosis: everything the data cause is an

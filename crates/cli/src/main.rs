@@ -111,11 +111,10 @@ enum Command {
     )]
     Simulate(simulate_cmd::SimulateArgs),
     /// Does the geometric model explain the data? If not, which unmodelled
-    /// effect does (leg-lead, backlash, thermal, scale-gain,
-    /// encoder-eccentricity, ujoint-axes, tube-twist, compliance, outliers).
+    /// effect of the vocabulary (listed below) or generic term does.
     #[command(
         allow_negative_numbers = true,
-        after_help = "Examples:\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n  tricept diagnose --data data.csv --json --plots out/\n  tricept diagnose --data fixtures/data/diagnose-noisy.csv --noise-from-data\n  tricept diagnose --data data.csv --write-machine extended.json && tricept ik 0 0 750 --machine extended.json\n\nExit codes: 0 the final model explains the data (verdict adequate or explained), 3 it does not (partially-explained, unexplained: the report says what remains), 2 data that cannot be diagnosed.\nMethod, vocabulary, generic dictionary, plausibility table: `tricept docs diagnosis`"
+        after_help = format!("{}\n\n{}", diagnose_cmd::vocabulary_help(), "Examples:\n  tricept diagnose --data fixtures/data/diagnose-hidden-effect.csv\n  tricept diagnose --data data.csv --json --plots out/\n  tricept diagnose --data fixtures/data/diagnose-noisy.csv --noise-from-data\n  tricept diagnose --data data.csv --write-machine extended.json && tricept ik 0 0 750 --machine extended.json\n\nExit codes: 0 the final model explains the data (verdict adequate or explained), 3 it does not (partially-explained, unexplained: the report says what remains), 2 data that cannot be diagnosed.\nMethod, vocabulary, generic dictionary, plausibility table: `tricept docs diagnosis`")
     )]
     Diagnose(diagnose_cmd::DiagnoseArgs),
     /// For a measurement campaign: how large must each unmodelled effect be

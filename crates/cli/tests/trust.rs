@@ -1147,3 +1147,20 @@ fn a_recalibration_keeps_a_record_the_file_is_checked_against() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("did not converge"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `diagnose --help` names every effect of the registry, with where
+/// `--write-machine` puts it (the list is the registry's, not a copy).
+#[test]
+fn diagnose_help_lists_the_vocabulary_and_its_deployment() {
+    let out = tricept().args(["diagnose", "--help"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let help = String::from_utf8_lossy(&out.stdout);
+    for e in tricept_model::effects::EffectName::ALL {
+        let s = e.spec();
+        let line = help
+            .lines()
+            .find(|l| l.trim_start().starts_with(&format!("{}:", s.name)))
+            .unwrap_or_else(|| panic!("{} is not in the help:\n{help}", s.name));
+        assert!(line.contains(s.deployment.label()), "{line}");
+    }
+}

@@ -30,11 +30,10 @@ use tricept_model::effects::{
 };
 use tricept_numerics::stats::chi2_isf;
 
+use crate::fit::{Fit, term_estimates};
 use crate::linear::{Linearisation, canonical_correlation, nested};
-use crate::model::Candidate;
-use crate::plausibility::quantities;
 use crate::report::{Alias, Estimate, RejectStage, Rejected};
-use crate::select::{Fit, Setup, describe_group, term_estimates};
+use crate::select::Setup;
 use crate::terms::{Frame, GenericTerm, Term};
 
 /// The outcome of the alias analysis.
@@ -63,16 +62,13 @@ struct Alternative {
     params: Vec<String>,
 }
 
-fn lead() -> Candidate {
-    Candidate(EffectName::LegLead)
-}
+const LEAD: Term = Term::Catalogue(EffectName::LegLead);
 
-/// Why two candidates cannot be told apart, and what separates them.
+/// Why two candidates cannot be told apart, and what separates them: a
+/// refinement of a generic term, an alias the registry knows (declared by
+/// either), two causes that follow the campaign's clock, or their
+/// signatures on this campaign.
 fn explain(a: CauseName, c: CauseName, c_label: &str) -> (String, String) {
-    use CauseName::{Catalogue as Cat, Generic as Gen};
-    let pair = |x: CauseName, y: CauseName| (a == x && c == y) || (a == y && c == x);
-    let external_length = "one external length: a laser interferometer or gauge-block measurement of the UP-limb stroke or of one platform displacement fixes the gain; the machine's own sensors never can";
-    let temperature_campaign = "a campaign in which temperature does not follow time: log through warm-up and cool-down, or revisit poses at different temperatures";
     if c_label.ends_with("(higher order)") {
         return (
             format!(
@@ -81,44 +77,15 @@ fn explain(a: CauseName, c: CauseName, c_label: &str) -> (String, String) {
             "a campaign that covers more of each leg's stroke, or more readings per pose".into(),
         );
     }
-    if pair(Cat(EffectName::ScaleGain), Cat(EffectName::LegLead)) {
-        return (
-            "a scale gain g reads exactly like the machine scaled by 1 + g with a lead g on every leg".into(),
-            external_length.into(),
-        );
+    if let Some(known) = a.known_alias(c) {
+        return (known.why.into(), known.separate_by.into());
     }
-    let timelike = |x: CauseName| {
-        matches!(
-            x,
-            Gen(GenericFamily::ReadingDrift)
-                | Gen(GenericFamily::LegDrift)
-                | Gen(GenericFamily::ReadingTemperature)
-                | Cat(EffectName::Thermal)
-        )
-    };
-    if timelike(a) && timelike(c) {
-        if (a == Gen(GenericFamily::ReadingDrift) && c == Gen(GenericFamily::LegDrift))
-            || (a == Gen(GenericFamily::LegDrift) && c == Gen(GenericFamily::ReadingDrift))
-        {
-            return (
-                "a drifting scale and uniformly growing legs move the readings alike".into(),
-                "an external reading of the platform at a repeated pose (dial indicator or touch probe): the machine's own sensors cannot tell a drifting scale from growing legs".into(),
-            );
-        }
+    if a.needs().follows_time() && c.needs().follows_time() {
         return (
             format!(
                 "the logged temperature followed time during the campaign, so a change with temperature and a drift with time ({c_label}) look alike"
             ),
-            temperature_campaign.into(),
-        );
-    }
-    if pair(
-        Cat(EffectName::EncoderEccentricity),
-        Gen(GenericFamily::EncoderGain),
-    ) {
-        return (
-            "over the encoders' small angles (|angle| < 0.6 rad) a gain error and the sine part of an eccentricity are nearly the same curve".into(),
-            "an external angle reference (autocollimator or inclinometer) at about +-30 deg of the U joint".into(),
+            "a campaign in which temperature does not follow time: log through warm-up and cool-down, or revisit poses at different temperatures".into(),
         );
     }
     (
@@ -170,7 +137,12 @@ fn refinement(g: &GenericTerm, frame: &Frame, data: &Dataset) -> Option<Vec<(usi
                     .collect(),
             )
         }
-        _ => None,
+        GenericFamily::ReadingDrift
+        | GenericFamily::ReadingTemperature
+        | GenericFamily::LegDrift
+        | GenericFamily::EncoderGain
+        | GenericFamily::ScalePolynomial
+        | GenericFamily::ReadingHysteresis => None,
     }
 }
 
@@ -189,22 +161,23 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
     let extra: Vec<Term> = setup
         .available
         .iter()
-        .map(|c| Term::Catalogue(*c))
+        .map(|e| Term::Catalogue(*e))
         .filter(|t| !terms.contains(t))
         .collect();
-    let Some(mut lin) = Linearisation::at_fit(fit, clean, &setup.sigma, &extra) else {
+    let Some(mut lin) = Linearisation::at_fit(fit, clean, &setup.fitter.sigma, &extra) else {
         return out;
     };
-    let critical = chi2_isf(setup.options.alpha, 1.0);
+    let critical = chi2_isf(setup.fitter.options.alpha, 1.0);
     let offsets = fit.model.offsets();
     let generic_groups: Vec<GenericTerm> = setup
+        .fitter
         .frame
         .generic_groups()
         .into_iter()
         .filter(|g| g.period_mm.is_none() && g.family != GenericFamily::LegPeriodic)
         .collect();
     for (i, a) in terms.iter().enumerate() {
-        let k = a.params().len();
+        let k = a.param_count();
         let params: Vec<usize> = (offsets[i]..offsets[i] + k).collect();
         lin.set_basis(&params);
         // A's signature: its projected columns times its estimate.
@@ -229,19 +202,19 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
             if let Some(cols) = lin.extra_columns(t) {
                 alternatives.push(Alternative {
                     name: t.name(),
-                    label: describe_group(t),
+                    label: t.label(),
                     term: *t,
                     params: t.params(),
                     columns: cols,
                 });
             }
         }
-        if let Some(cols) = lin.extra_columns(&Term::Catalogue(lead())) {
+        if let Some(cols) = lin.extra_columns(&LEAD) {
             let sum = cols.column(0) + cols.column(1) + cols.column(2);
             alternatives.push(Alternative {
                 name: CauseName::Catalogue(EffectName::LegLead),
                 label: "leg-lead (equal on all legs)".into(),
-                term: Term::Catalogue(lead()),
+                term: LEAD,
                 params: vec!["lead_ppm (every leg)".into()],
                 columns: DMatrix::from_columns(&[sum]),
             });
@@ -252,7 +225,7 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
         if matches!(a, Term::Catalogue(_)) {
             for t in &terms {
                 if let Term::Generic(g) = t
-                    && let Some(cols) = refinement(g, &setup.frame, clean)
+                    && let Some(cols) = refinement(g, &setup.fitter.frame, clean)
                 {
                     let cols = lin.dense(&cols);
                     let k = cols.ncols();
@@ -271,7 +244,7 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
             if terms.iter().any(|u| u.overlaps(&t)) || t.overlaps(a) {
                 continue;
             }
-            let cols = lin.generic_columns(g, &setup.frame, clean);
+            let cols = lin.generic_columns(g, &setup.fitter.frame, clean);
             if cols.is_empty() {
                 continue;
             }
@@ -327,9 +300,12 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
             let plausible = if alt.label.ends_with("(higher order)") {
                 Ok(())
             } else {
-                setup
-                    .plausibility
-                    .check(&quantities(&alt.term, &check_values, &check_cov))
+                setup.plausibility.judge(
+                    alt.term.name(),
+                    &alt.term.judgements(),
+                    &check_values,
+                    &check_cov,
+                )
             };
             match plausible {
                 Ok(()) => {
@@ -343,7 +319,7 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
                     parameters: estimates,
                     reason: format!(
                         "would explain {} as well (unexplained {:.1}), but {reason}",
-                        describe_group(a),
+                        a.label(),
                         lambda
                     ),
                     stage: RejectStage::ImplausibleAlias,
@@ -371,7 +347,7 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
             }
         }
         let mut effects = vec![a.name()];
-        let mut descriptions = vec![describe_group(a)];
+        let mut descriptions = vec![a.label()];
         let mut parameters = Vec::new();
         for (alt, _, est, _) in &members {
             if !effects.contains(&alt.name) || alt.name.is_generic() {
@@ -396,7 +372,7 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
         }
     }
     // Structural: a significant common lead is a scale gain.
-    let lead_term = Term::Catalogue(lead());
+    let lead_term = LEAD;
     if let Some(i) = terms.iter().position(|t| *t == lead_term) {
         let already = out.aliases.iter().any(|al| {
             al.effects
@@ -409,7 +385,7 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
         let mean = v.iter().sum::<f64>() / 3.0;
         let var = cov.iter().sum::<f64>() / 9.0;
         let sd = var.max(0.0).sqrt();
-        let scale_in_model = terms.contains(&Term::Catalogue(Candidate(EffectName::ScaleGain)));
+        let scale_in_model = terms.contains(&Term::Catalogue(EffectName::ScaleGain));
         if !already && !scale_in_model && mean.abs() > 3.0 * sd && offsets.get(i).is_some() {
             let (why, separate_by) = explain(
                 CauseName::Catalogue(EffectName::LegLead),

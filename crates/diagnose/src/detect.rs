@@ -8,7 +8,7 @@
 //! effect of parameter vector `v` the likelihood-ratio statistic is
 //! non-central chi-square with `k` degrees of freedom and non-centrality
 //! `lambda = v^T S_perp^T S_perp v`; detection means power 95 % at the
-//! diagnosis' level (`alpha / 2` divided by the 8 catalogue candidates for
+//! diagnosis' level (`alpha / 2` divided by the vocabulary's 8 candidates for
 //! an effect of the vocabulary, by the dictionary's multiplicity for a
 //! generic term: the same levels as the diagnosis). The held-out residual RMS of the
 //! geometric model is about `sqrt(1 + lambda / m)` noise units over `m`
@@ -27,8 +27,11 @@ use std::sync::Arc;
 
 use tricept_model::effects::{CauseName, GenericFamily};
 
-use crate::dictionary::{Dictionary, DictionaryOptions};
-use crate::model::{Candidate, ExtendedModel};
+use tricept_model::effects::EffectName;
+
+use crate::dictionary::Dictionary;
+use crate::model::ExtendedModel;
+use crate::options::DictionaryOptions;
 use crate::terms::{Frame, GenericTerm, Scope, Term};
 use tricept_numerics::stats::{chi2_power, required_noncentrality};
 
@@ -54,24 +57,17 @@ pub struct Detectability {
     pub bias: Vec<(String, f64)>,
 }
 
-/// Analyses `candidate` with parameters `v` on the poses `poses` (with
-/// their context), noise `sigma`, at family-wise level `alpha`.
+/// Analyses the effect `effect` with parameters `v` on the poses `poses`
+/// (with their context), noise `sigma`, at family-wise level `alpha`.
 pub fn detectability(
     geometric: &GeometricModel,
-    candidate: Candidate,
+    effect: EffectName,
     v: &[f64],
     poses: &[MeasuredPose],
     sigma: [f64; 3],
     alpha: f64,
 ) -> Option<Detectability> {
-    term_detectability(
-        geometric,
-        &Term::Catalogue(candidate),
-        v,
-        poses,
-        sigma,
-        alpha,
-    )
+    term_detectability(geometric, &Term::Catalogue(effect), v, poses, sigma, alpha)
 }
 
 /// [`detectability`] of any term: an effect of the vocabulary or a generic
@@ -142,10 +138,7 @@ pub fn term_detectability(
         .map(|i| (0..ke).map(|j| r_ee[(i, j)] * v[j]).sum())
         .collect();
     // An effect whose data columns are absent or constant has no signature.
-    let available = match term {
-        Term::Catalogue(c) => c.available(&data),
-        Term::Generic(g) => g.available(&frame),
-    };
+    let available = term.available(&frame);
     let lambda: f64 = if available {
         rv.iter().map(|x| x * x).sum()
     } else {
@@ -157,7 +150,7 @@ pub fn term_detectability(
         .max(1) as f64;
     let level = 0.5 * alpha
         / match term {
-            Term::Catalogue(_) => Candidate::ALL.len(),
+            Term::Catalogue(_) => EffectName::terms().count(),
             Term::Generic(_) => dictionary.multiplicity().max(1),
         } as f64;
     let needed = required_noncentrality(dof, level, 0.95)?;
@@ -201,17 +194,13 @@ pub fn term_detectability(
 }
 
 /// Realistic magnitudes of each effect, in the diagnosis'
-/// parameterisation: leg-lead 50 ppm (alternating signs), backlash 5 um,
-/// thermal 11.5 ppm/K (steel; the 2 K drift is in the data), scale-gain
-/// 50 ppm, encoder eccentricity 5 arcsec (sine and cosine phases),
-/// U-joint axes 30 arcsec skew or 20 um offset, tube twist 30 arcsec over the
-/// 290 mm stroke, compliance 10 um of platform deflection; and four
-/// effects outside the vocabulary through their generic terms: a
-/// ball-screw pitch error of 4 um with a 10 mm lead (sine phase on every
-/// leg), a leg curvature of 5 um (Legendre `P2` coefficient on every leg), a
-/// scale drift of 3 um over the campaign, an encoder gain of 200 ppm.
+/// parameterisation: those of the registry for the vocabulary
+/// ([`tricept_model::effects::EffectSpec::realistic`]), and four effects
+/// outside it through their generic terms: a ball-screw pitch error of
+/// 4 um with a 10 mm lead (sine phase on every leg), a leg curvature of
+/// 5 um (Legendre `P2` coefficient on every leg), a scale drift of 3 um
+/// over the campaign, an encoder gain of 200 ppm.
 pub fn realistic(machine: &tricept_kinematics::Machine) -> Vec<(Term, Vec<f64>, &'static str)> {
-    use tricept_model::effects::{EffectName as E, stiffness_for_platform_deflection};
     let generic = |family, scope, period_mm| {
         Term::Generic(GenericTerm {
             family,
@@ -219,35 +208,13 @@ pub fn realistic(machine: &tricept_kinematics::Machine) -> Vec<(Term, Vec<f64>, 
             period_mm,
         })
     };
-    let catalogue = |e| Term::Catalogue(Candidate(e));
-    let mut out: Vec<(Term, Vec<f64>, &'static str)> = vec![
-        (catalogue(E::LegLead), vec![50.0, -50.0, 50.0], "50 ppm"),
-        (catalogue(E::Backlash), vec![5.0, 5.0, 5.0], "5 um"),
-        (catalogue(E::Thermal), vec![11.5], "11.5 ppm/K (steel)"),
-        (catalogue(E::ScaleGain), vec![50.0], "50 ppm"),
-        (
-            catalogue(E::EncoderEccentricity),
-            vec![5.0, 0.0, 5.0, 0.0],
-            "5 arcsec, sine phase",
-        ),
-        (
-            catalogue(E::EncoderEccentricity),
-            vec![0.0, 5.0, 0.0, 5.0],
-            "5 arcsec, cosine phase",
-        ),
-        (catalogue(E::UjointAxes), vec![30.0, 0.0], "30 arcsec skew"),
-        (catalogue(E::UjointAxes), vec![0.0, 20.0], "20 um offset"),
-        (
-            catalogue(E::TubeTwist),
-            vec![30.0 / 2.9],
-            "30 arcsec over the stroke",
-        ),
-        (
-            catalogue(E::Compliance),
-            vec![1000.0 / stiffness_for_platform_deflection(machine, 10.0)],
-            "10 um at the platform",
-        ),
-    ];
+    let mut out: Vec<(Term, Vec<f64>, &'static str)> = EffectName::terms()
+        .flat_map(|e| {
+            (e.spec().realistic)(machine)
+                .into_iter()
+                .map(move |m| (Term::Catalogue(e), m.values, m.label))
+        })
+        .collect();
     out.extend([
         (
             generic(GenericFamily::LegPeriodic, Scope::AllLegs, Some(10.0)),
@@ -276,19 +243,10 @@ pub fn realistic(machine: &tricept_kinematics::Machine) -> Vec<(Term, Vec<f64>, 
 /// One line of campaign advice for an effect analysed on a campaign of
 /// `poses` logged poses with `readings` readings averaged per value.
 pub fn advise(d: &Detectability, poses: usize, readings: u32) -> String {
-    use tricept_model::effects::EffectName;
     if !d.detectable_multiple.is_finite() {
-        return match d.effect {
-            CauseName::Catalogue(EffectName::Backlash) => {
-                "invisible: visit poses from both approach directions (--both-directions)".into()
-            }
-            CauseName::Catalogue(EffectName::Thermal) => {
-                "invisible: log the structure temperature while it changes".into()
-            }
-            CauseName::Generic(GenericFamily::ReadingDrift | GenericFamily::LegDrift) => {
-                "invisible: log the time of every pose".into()
-            }
-            _ => "invisible to these sensors on this pose set".into(),
+        return match d.effect.needs().advice() {
+            Some(advice) => format!("invisible: {advice}"),
+            None => "invisible to these sensors on this pose set".into(),
         };
     }
     let mut parts = Vec::new();

@@ -24,31 +24,8 @@ use tricept_model::effects::GenericFamily;
 
 use crate::evidence::Reference;
 use crate::linear::Linearisation;
+use crate::options::DictionaryOptions;
 use crate::terms::{Frame, GenericTerm, Term};
-
-/// Settings of the generic dictionary.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DictionaryOptions {
-    /// Search the dictionary at all (off: the vocabulary only).
-    pub enabled: bool,
-    /// Shortest and longest period of the ball-screw scan, mm.
-    pub period_range_mm: (f64, f64),
-    /// Grid points per independent frequency of the scan.
-    pub oversampling: f64,
-    /// Best-ranked groups refitted exactly at each selection step.
-    pub refit_top: usize,
-}
-
-impl Default for DictionaryOptions {
-    fn default() -> DictionaryOptions {
-        DictionaryOptions {
-            enabled: true,
-            period_range_mm: (4.0, 50.0),
-            oversampling: 4.0,
-            refit_top: 3,
-        }
-    }
-}
 
 /// A group of the dictionary scored at a fit.
 #[derive(Debug, Clone)]

@@ -5,22 +5,34 @@
 //! unexplained; by how much the causes biased the geometric parameters,
 //! and what the extended model gains.
 //!
-//! - [`diagnose`] (`run.rs`): the pipeline: checks, noise, outlier screen,
-//!   selection, aliases, final adequacy and remainder, report.
-//! - `terms.rs`: the terms of an extended model ([`Term`]: a [`Candidate`]
-//!   of the vocabulary or a [`GenericTerm`]) and the campaign [`Frame`].
-//! - `dictionary.rs`, `linear.rs`: the generic dictionary, its period scan
-//!   and linear screen.
-//! - `select.rs`: one pool of candidates, the evidence rules, swaps,
-//!   admission on the final model, cross-validation.
-//! - `plausibility.rs` ([`Plausibility`]), `alias.rs`, `noise.rs`,
-//!   `evidence.rs`: physical ranges, aliases, pure error, test references.
-//! - `residuals.rs`: residual structure and residual plots.
-//! - [`Diagnosis`] (`report.rs`): the report, as data, JSON and text;
-//!   `finite.rs`: no non-finite number leaves it.
-//! - [`ExtendedModel`] (`model.rs`): the geometric model plus any terms
-//!   ([`tricept_model::effects`]).
-//! - [`detect`]: what a campaign can detect, before it is run.
+//! The crate is layered; a file imports only from its own layer or those
+//! below (checked by `xtask/tests/tidy.rs`), bottom to top:
+//!
+//! 1. **Options and errors**: [`DiagnoseOptions`] and [`DictionaryOptions`]
+//!    (`options.rs`), [`DiagnoseError`] and [`DeployError`] (`error.rs`),
+//!    the plausibility table ([`Plausibility`], `plausibility.rs`), the
+//!    report's types, JSON and text ([`Diagnosis`], `report.rs`; `finite.rs`:
+//!    no non-finite number leaves it), the tests' reference distributions
+//!    (`evidence.rs`).
+//! 2. **The model**: the terms ([`Term`]: an effect of the vocabulary,
+//!    whose spec is in [`tricept_model::effects`], or a [`GenericTerm`]) and
+//!    the campaign [`Frame`] (`terms.rs`); [`ExtendedModel`] (`model.rs`),
+//!    the geometric model plus any terms.
+//! 3. **The fit core** (`fit.rs`): a fitted model, the settings every fit
+//!    shares, cross-validation, residuals, the outlier screen.
+//! 4. **The analyses**: the linearised score of further terms (`linear.rs`),
+//!    the generic dictionary and its period scan (`dictionary.rs`), pure
+//!    error (`noise.rs`), selection from one pool with admission on the
+//!    final model (`select.rs`), aliases (`alias.rs`), the platform's
+//!    displacement between calibrations (`gain.rs`), residual structure and
+//!    plots (`residuals.rs`).
+//! 5. **Description and report assembly**: a named cause in words
+//!    (`describe.rs`), the report from what the pipeline found
+//!    (`assemble.rs`).
+//! 6. **Orchestration**: [`diagnose`] (`run.rs`: checks, noise, outlier
+//!    screen, selection, report), [`deploy`] (`deploy.rs`: the final model
+//!    into a machine file), [`detect`] (what a campaign can detect, before it
+//!    is run).
 //!
 //! # Example
 //! ```no_run
@@ -36,31 +48,48 @@
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
-mod alias;
-pub mod detect;
-mod dictionary;
+// Layers, bottom to top: a file imports only from its own layer or those
+// below (`xtask/tests/tidy.rs` checks it).
+// Layer 1: options and errors
+mod error;
 mod evidence;
 mod finite;
-mod linear;
-mod model;
-mod noise;
+mod options;
 mod plausibility;
 mod report;
-mod residuals;
-mod run;
-mod select;
+// Layer 2: the model
+mod model;
 mod terms;
+// Layer 3: the fit core
+mod fit;
+// Layer 4: dictionary, noise, selection, aliases, gain and residual plots
+mod alias;
+mod dictionary;
+mod gain;
+mod linear;
+mod noise;
+mod residuals;
+mod select;
+// Layer 5: description and report assembly
+mod assemble;
+mod describe;
+// Layer 6: orchestration: the diagnosis, its deployment, detectability
+mod deploy;
+pub mod detect;
+mod run;
 
-pub use dictionary::DictionaryOptions;
+pub use deploy::{Deployed, deploy};
+pub use error::{DeployError, DiagnoseError};
 pub use finite::first_non_finite;
-pub use model::{Candidate, ExtendedModel, MIN_TEMPERATURE_RANGE_K, REFERENCE_TEMPERATURE_C};
+pub use model::ExtendedModel;
 pub use noise::NOISE_CHECK_LEVEL;
+pub use options::{DiagnoseOptions, DictionaryOptions, MIN_PURE_ERROR_DOF};
 pub use plausibility::{Plausibility, PlausibilityError, Range};
 pub use report::{
     Alias, Cause, CauseKind, ChannelRms, Diagnosis, Estimate, Evidence, FinalFit, Gain, NoiseCheck,
     NoiseSource, PureError, RejectStage, Rejected, Remainder, ResidualPlot, Structure, TermScore,
     Tested, Verdict,
 };
-pub use run::{DiagnoseError, DiagnoseOptions, MIN_PURE_ERROR_DOF, diagnose};
-pub use terms::{Frame, GenericTerm, OrderAxis, Scope, Term};
-pub use tricept_model::effects::{CauseName, GenericFamily};
+pub use run::diagnose;
+pub use terms::{Frame, GenericTerm, MIN_TEMPERATURE_RANGE_K, OrderAxis, Scope, Term};
+pub use tricept_model::effects::{CauseName, GenericFamily, REFERENCE_TEMPERATURE_C};

@@ -23,8 +23,10 @@ use tricept_data::Dataset;
 use tricept_ident::ReadingModel;
 use tricept_kinematics::UpJoints;
 
-use crate::select::Fit;
-use crate::terms::{Basis, GenericTerm, Term};
+use tricept_model::effects::Basis;
+
+use crate::fit::Fit;
+use crate::terms::{Frame, GenericTerm, Term};
 
 /// Numerical rank threshold of a term's projected columns: an eigenvalue of
 /// `M` below this share of the largest squared column norm of `G` is a
@@ -174,7 +176,7 @@ impl Linearisation {
         let extra_terms = extra
             .iter()
             .map(|t| {
-                let len = t.params().len();
+                let len = t.param_count();
                 let r = at..at + len;
                 at += len;
                 (*t, r)
@@ -278,7 +280,7 @@ impl Linearisation {
     pub(crate) fn generic_columns(
         &self,
         term: &GenericTerm,
-        frame: &crate::terms::Frame,
+        frame: &Frame,
         data: &Dataset,
     ) -> Vec<(usize, Vec<f64>)> {
         let mut cols: Vec<(usize, Vec<f64>)> = Vec::new();
@@ -291,10 +293,11 @@ impl Linearisation {
             if cols.is_empty() {
                 cols = values
                     .iter()
-                    .map(|(b, _)| (basis_index(*b), vec![0.0; data.poses.len()]))
+                    .map(|(_, b, _)| (basis_index(*b), vec![0.0; data.poses.len()]))
                     .collect();
             }
-            for (k, (_, v)) in values.into_iter().enumerate() {
+            // A generic term has one entry per parameter, in order.
+            for (k, (_, _, v)) in values.into_iter().enumerate() {
                 if let Some(c) = cols.get_mut(k) {
                     c.1[j] = v;
                 }

@@ -2,117 +2,25 @@
 //! that the diagnosis fits for each candidate cause, effects of the
 //! vocabulary and generic terms of the dictionary ([`crate::terms`]) alike.
 //!
-//! Each [`Candidate`] adds the parameters of one effect, with the same
-//! physics as the plant simulator ([`tricept_model::effects`]): leg effects
-//! change the actual leg lengths (their Jacobian columns are
-//! `J1^-1 e_i dq_i/dparam`), reading effects change the readings (direct
-//! columns), class-2 effects change the UP limb's kinematics (columns by
-//! central differences of the exact model). Context-free constant parts
-//! (a leg's mean thermal growth, a constant backlash...) are absorbed by the
+//! Each term adds its parameters with the physics of the registry
+//! ([`tricept_model::effects`], the same as the plant simulator's): leg
+//! terms change the actual leg lengths (their Jacobian columns are
+//! `J1^-1 e_i dq_i/dparam`), reading terms change the readings (direct
+//! columns), both through their `(parameter, Basis, value)` entries;
+//! class-2 effects change the UP limb's kinematics (columns by central
+//! differences of the exact model). Context-free constant parts (a leg's
+//! mean thermal growth, a constant backlash...) are absorbed by the
 //! geometric `dq_i` and the sensor offsets; thermal growth is referred to
-//! the metrology reference temperature of 20 °C.
+//! the metrology reference temperature of 20 °C
+//! ([`tricept_model::effects::REFERENCE_TEMPERATURE_C`]).
 
 use std::sync::Arc;
 
-use crate::terms::{Basis, Frame, Term};
-use tricept_data::{Dataset, MeasuredPose};
+use crate::terms::{Frame, Term, TermKind};
+use tricept_data::MeasuredPose;
 use tricept_ident::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
-use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{KinematicsError, Machine, UpJoints};
-use tricept_model::effects::{
-    CauseName, EffectName, add_tube_twist, add_ujoint_axis_errors, backlash_extra_mm,
-    compliance_extra_mm, gravity_leg_tension_n, leg_lead_extra_mm, scale_gain_error_mm,
-    thermal_extra_mm,
-};
-
-/// An effect the diagnosis can fit (every name of the vocabulary except
-/// `outliers`, which is handled by row screening).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct Candidate(pub EffectName);
-
-/// A logged temperature that varies by less than this over the campaign
-/// (K) carries no usable thermal signature: a logger's own noise (0.02 K in
-/// the plant simulator) spans about 0.1 K over a few hundred readings.
-pub const MIN_TEMPERATURE_RANGE_K: f64 = 0.25;
-
-/// How a parameter enters the model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Kind {
-    Leg,
-    Reading,
-    Kinematic,
-}
-
-impl Candidate {
-    /// Every fittable candidate.
-    pub const ALL: [Candidate; 8] = [
-        Candidate(EffectName::LegLead),
-        Candidate(EffectName::Backlash),
-        Candidate(EffectName::Thermal),
-        Candidate(EffectName::ScaleGain),
-        Candidate(EffectName::EncoderEccentricity),
-        Candidate(EffectName::UjointAxes),
-        Candidate(EffectName::TubeTwist),
-        Candidate(EffectName::Compliance),
-    ];
-
-    /// Parameter names (with their unit in the name).
-    pub fn params(self) -> &'static [&'static str] {
-        self.0.parameter_names()
-    }
-
-    pub(crate) fn kind(self) -> Kind {
-        match self.0 {
-            EffectName::LegLead
-            | EffectName::Backlash
-            | EffectName::Thermal
-            | EffectName::Compliance => Kind::Leg,
-            EffectName::ScaleGain | EffectName::EncoderEccentricity => Kind::Reading,
-            _ => Kind::Kinematic,
-        }
-    }
-
-    /// The data column the effect needs, if any.
-    pub fn needs(self) -> Option<&'static str> {
-        match self.0 {
-            EffectName::Backlash => Some("dir1,dir2,dir3"),
-            EffectName::Thermal => Some("temp_c"),
-            _ => None,
-        }
-    }
-
-    /// Whether `data` has what the effect needs (and, for the context
-    /// columns, some variation in it).
-    pub fn available(self, data: &Dataset) -> bool {
-        match self.0 {
-            EffectName::Backlash => {
-                data.poses.iter().all(|p| p.approach.is_some())
-                    && (0..3).any(|i| {
-                        let dirs: Vec<i8> = data
-                            .poses
-                            .iter()
-                            .filter_map(|p| p.approach.map(|a| a[i]))
-                            .collect();
-                        dirs.contains(&1) && dirs.contains(&-1)
-                    })
-            }
-            EffectName::Thermal => {
-                let t: Vec<f64> = data.poses.iter().filter_map(|p| p.temp_c).collect();
-                t.len() == data.poses.len()
-                    && t.iter().copied().fold(f64::NEG_INFINITY, f64::max)
-                        - t.iter().copied().fold(f64::INFINITY, f64::min)
-                        > MIN_TEMPERATURE_RANGE_K
-            }
-            _ => true,
-        }
-    }
-}
-
-/// The reference temperature of dimensional metrology (ISO 1), °C: the
-/// nominal lengths of the machine are taken to hold at it. (Referring the
-/// thermal growth to the campaign's own mean temperature instead would leave
-/// `alpha (mean - 20 °C) q_i`, a uniform lead error of all legs, unmodelled.)
-pub const REFERENCE_TEMPERATURE_C: f64 = 20.0;
+use tricept_model::effects::{Basis, CauseName, EffectName, Entries, Kind};
 
 /// The geometric model plus the parameters of some terms: effects of the
 /// vocabulary and generic terms of the dictionary.
@@ -123,8 +31,6 @@ pub struct ExtendedModel {
     names: Vec<String>,
     /// The campaign frame of the generic terms.
     frame: Arc<Frame>,
-    /// Reference temperature of the nominal lengths, °C.
-    temp_ref_c: f64,
     /// The same terms on the geometric model's rank reference, when it has
     /// one: the rank decision of a calibrated machine is the nominal's.
     rank_reference: Option<Box<ExtendedModel>>,
@@ -135,15 +41,15 @@ impl ExtendedModel {
     ///
     /// # Example
     /// ```
-    /// use tricept_diagnose::{Candidate, ExtendedModel};
+    /// use tricept_diagnose::ExtendedModel;
     /// use tricept_ident::{GeometricModel, ReadingModel};
     /// use tricept_model::effects::EffectName;
     /// let g = GeometricModel::new(tricept_kinematics::Machine::paper(), tricept_model::ParameterSet::paper15());
-    /// let m = ExtendedModel::new(g, &[Candidate(EffectName::Thermal)]);
+    /// let m = ExtendedModel::new(g, &[EffectName::Thermal]);
     /// assert_eq!(m.names().last().unwrap(), "thermal.expansion_ppm_per_k");
     /// ```
-    pub fn new(geometric: GeometricModel, effects: &[Candidate]) -> ExtendedModel {
-        let terms: Vec<Term> = effects.iter().map(|c| Term::Catalogue(*c)).collect();
+    pub fn new(geometric: GeometricModel, effects: &[EffectName]) -> ExtendedModel {
+        let terms: Vec<Term> = effects.iter().map(|e| Term::Catalogue(*e)).collect();
         ExtendedModel::with_terms(geometric, &terms, Arc::new(Frame::empty()))
     }
 
@@ -196,7 +102,6 @@ impl ExtendedModel {
             terms: terms.to_vec(),
             names,
             frame,
-            temp_ref_c: REFERENCE_TEMPERATURE_C,
             rank_reference,
         }
     }
@@ -212,11 +117,11 @@ impl ExtendedModel {
     }
 
     /// The effects of the vocabulary included.
-    pub fn effects(&self) -> Vec<Candidate> {
+    pub fn effects(&self) -> Vec<EffectName> {
         self.terms
             .iter()
             .filter_map(|t| match t {
-                Term::Catalogue(c) => Some(*c),
+                Term::Catalogue(e) => Some(*e),
                 Term::Generic(_) => None,
             })
             .collect()
@@ -244,7 +149,7 @@ impl ExtendedModel {
             .iter()
             .map(|e| {
                 let here = at;
-                at += e.params().len();
+                at += e.param_count();
                 here
             })
             .collect()
@@ -254,13 +159,11 @@ impl ExtendedModel {
     pub fn machine_at(&self, p: &[f64]) -> Machine {
         let g = self.n_geometric();
         let mut m = self.geometric.machine_at(&p[..g]);
-        for (e, at) in self.terms.iter().zip(self.offsets()) {
-            match e {
-                Term::Catalogue(Candidate(EffectName::UjointAxes)) => {
-                    add_ujoint_axis_errors(&mut m, p[at], p[at + 1])
-                }
-                Term::Catalogue(Candidate(EffectName::TubeTwist)) => add_tube_twist(&mut m, p[at]),
-                _ => {}
+        for (t, at) in self.terms.iter().zip(self.offsets()) {
+            if let Term::Catalogue(e) = t
+                && let Kind::Kinematic(apply) = e.spec().kind
+            {
+                apply(&mut m, &p[at..at + e.parameter_count()]);
             }
         }
         m
@@ -268,7 +171,7 @@ impl ExtendedModel {
 }
 
 fn is_kinematic(t: &Term) -> bool {
-    matches!(t, Term::Catalogue(c) if c.kind() == Kind::Kinematic)
+    t.kind() == TermKind::Kinematic
 }
 
 impl ReadingModel for ExtendedModel {
@@ -282,7 +185,7 @@ impl ReadingModel for ExtendedModel {
             .iter()
             .zip(self.offsets())
             .filter(|(e, _)| is_kinematic(e))
-            .flat_map(|(e, at)| (at..at + e.params().len()).collect::<Vec<_>>())
+            .flat_map(|(e, at)| (at..at + e.param_count()).collect::<Vec<_>>())
             .map(|j| {
                 let h = FD_STEP;
                 let mut plus = p.to_vec();
@@ -324,75 +227,22 @@ struct ExtendedPredictor<'a> {
 
 impl ExtendedPredictor<'_> {
     /// Actual leg lengths at `pose` and their derivatives (per parameter,
-    /// per leg) for the leg effects.
+    /// per leg) for the leg terms.
     fn legs(&self, pose: &MeasuredPose) -> Result<([f64; 3], Vec<Derivative>), KinematicsError> {
         let mut legs = pose.commands_mm;
         let mut derivs = Vec::new();
-        let q = pose.commands_mm;
+        let nominal = self.model.geometric.nominal();
         for (term, at) in self.model.terms.iter().zip(self.model.offsets()) {
-            let e = match term {
-                Term::Catalogue(c) => *c,
-                Term::Generic(g) => {
-                    for (k, (basis, v)) in g
-                        .leg_values(&self.model.frame, pose)
-                        .into_iter()
-                        .enumerate()
-                    {
-                        if let Basis::Leg(i) = basis {
-                            legs[i] += self.p[at + k] * v;
-                            let mut d = [0.0; 3];
-                            d[i] = v;
-                            derivs.push((at + k, d));
-                        }
-                    }
-                    continue;
-                }
-            };
-            match e.0 {
-                EffectName::LegLead => {
-                    for i in 0..3 {
-                        legs[i] += leg_lead_extra_mm(self.p[at + i], q[i]);
-                        let mut d = [0.0; 3];
-                        d[i] = leg_lead_extra_mm(1.0, q[i]);
-                        derivs.push((at + i, d));
-                    }
-                }
-                EffectName::Backlash => {
-                    let dir = pose.approach.unwrap_or([1, 1, 1]);
-                    for i in 0..3 {
-                        legs[i] += backlash_extra_mm(self.p[at + i], dir[i]);
-                        let mut d = [0.0; 3];
-                        d[i] = backlash_extra_mm(1.0, dir[i]);
-                        derivs.push((at + i, d));
-                    }
-                }
-                EffectName::Thermal => {
-                    let dt = pose.temp_c.map_or(0.0, |t| t - self.model.temp_ref_c);
-                    let d: [f64; 3] = std::array::from_fn(|i| thermal_extra_mm(1.0, q[i], dt));
-                    for i in 0..3 {
-                        legs[i] += self.p[at] * d[i];
-                    }
-                    derivs.push((at, d));
-                }
-                EffectName::Compliance => {
-                    let nominal = self.model.geometric.nominal();
-                    let up = nominal.forward(&q)?.up;
-                    let f = gravity_leg_tension_n(nominal, &up);
-                    // compliance c (um/kN at 1 m) = 1000 / stiffness (N/um at 1 m).
-                    let d: [f64; 3] =
-                        std::array::from_fn(|i| compliance_extra_mm(1000.0, f[i], q[i]));
-                    for i in 0..3 {
-                        legs[i] += self.p[at] * d[i];
-                    }
-                    derivs.push((at, d));
-                }
-                _ => {}
-            }
+            let entries = term.leg_entries(&self.model.frame, nominal, pose)?;
+            add(&entries, at, &self.p, &mut legs, &mut derivs, |b| match b {
+                Basis::Leg(i) => Some(i),
+                Basis::Reading(_) => None,
+            });
         }
         Ok((legs, derivs))
     }
 
-    /// Readings from the UP joints, with the reading effects, and the
+    /// Readings from the UP joints, with the reading terms, and the
     /// derivatives of the readings with respect to the reading parameters.
     fn readings(
         &self,
@@ -403,44 +253,39 @@ impl ExtendedPredictor<'_> {
         let mut r = up.to_array();
         let mut derivs = Vec::new();
         for (term, at) in self.model.terms.iter().zip(self.model.offsets()) {
-            let e = match term {
-                Term::Catalogue(c) => *c,
-                Term::Generic(g) => {
-                    for (k, (basis, v)) in g
-                        .reading_values(&self.model.frame, pose, up)
-                        .into_iter()
-                        .enumerate()
-                    {
-                        if let Basis::Reading(c) = basis {
-                            r[c] += p[at + k] * v;
-                            let mut d = [0.0; 3];
-                            d[c] = v;
-                            derivs.push((at + k, d));
-                        }
-                    }
-                    continue;
-                }
-            };
-            match e.0 {
-                EffectName::ScaleGain => {
-                    r[2] += scale_gain_error_mm(p[at], up.q4_mm);
-                    derivs.push((at, [0.0, 0.0, scale_gain_error_mm(1.0, up.q4_mm)]));
-                }
-                EffectName::EncoderEccentricity => {
-                    let a = RAD_PER_ARCSEC;
-                    let (sp, cp) = up.phi_rad.sin_cos();
-                    let (st, ct) = up.theta_rad.sin_cos();
-                    r[0] += a * (p[at] * sp + p[at + 1] * cp);
-                    r[1] += a * (p[at + 2] * st + p[at + 3] * ct);
-                    derivs.push((at, [a * sp, 0.0, 0.0]));
-                    derivs.push((at + 1, [a * cp, 0.0, 0.0]));
-                    derivs.push((at + 2, [0.0, a * st, 0.0]));
-                    derivs.push((at + 3, [0.0, a * ct, 0.0]));
-                }
-                _ => {}
-            }
+            let entries = term.reading_entries(&self.model.frame, pose, up);
+            add(&entries, at, p, &mut r, &mut derivs, |b| match b {
+                Basis::Reading(c) => Some(c),
+                Basis::Leg(_) => None,
+            });
         }
         (r, derivs)
+    }
+}
+
+/// Adds a term's entries (parameters from `at` in `p`) to `values` and
+/// their derivatives to `derivs`, one per parameter; `slot` says which of
+/// the three values a basis is (entries of the other kind are skipped).
+fn add(
+    entries: &Entries,
+    at: usize,
+    p: &[f64],
+    values: &mut [f64; 3],
+    derivs: &mut Vec<Derivative>,
+    slot: impl Fn(Basis) -> Option<usize>,
+) {
+    let first = derivs.len();
+    for &(k, basis, v) in entries {
+        let Some(i) = slot(basis) else { continue };
+        values[i] += p[at + k] * v;
+        match derivs[first..].iter_mut().find(|(j, _)| *j == at + k) {
+            Some((_, d)) => d[i] += v,
+            None => {
+                let mut d = [0.0; 3];
+                d[i] = v;
+                derivs.push((at + k, d));
+            }
+        }
     }
 }
 

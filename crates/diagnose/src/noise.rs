@@ -12,9 +12,11 @@
 //! at [`NOISE_CHECK_LEVEL`] with a Bonferroni factor of 4.
 
 use tricept_data::Dataset;
+use tricept_model::effects::CHANNELS;
 use tricept_numerics::stats::chi2_two_sided;
 
-use crate::report::{ChannelRms, PureError};
+use crate::fit::{Fit, Fitter, residuals_of};
+use crate::report::{ChannelRms, NoiseCheck, NoiseSource, PureError};
 
 /// Level of the check of the stated noise against the data (not a naming
 /// decision, so not the diagnosis' family-wise `alpha`: a 1.5 times worse
@@ -131,6 +133,75 @@ pub(crate) fn check(
         },
         agrees,
     )
+}
+
+/// The noise check against the repeated poses.
+pub(crate) fn noise_check(
+    fitter: &Fitter<'_>,
+    repeated: &Repeats,
+    fit: &Fit,
+    data: &Dataset,
+) -> NoiseCheck {
+    let stated = ChannelRms::from_internal(fitter.options.sigma);
+    let used = if fitter.reference.pure_error_dof.is_some() {
+        NoiseSource::Data
+    } else {
+        NoiseSource::Stated
+    };
+    let res = residuals_of(fit, &data.poses, &fitter.options.sigma);
+    let Some((ss, dof)) = pure_error(repeated, &res) else {
+        return NoiseCheck {
+            stated,
+            used,
+            pure_error: None,
+            agrees: None,
+            note: "no repeated poses: the stated noise cannot be checked (revisit some poses on separate visits to check it)".into(),
+        };
+    };
+    let (pe, agrees) = check(repeated, ss, dof, fitter.options.sigma);
+    let worst = (0..3)
+        .max_by(|&a, &b| (pe.ratio[a].ln().abs()).total_cmp(&pe.ratio[b].ln().abs()))
+        .unwrap_or(0);
+    let mut note = if agrees {
+        format!(
+            "the stated noise agrees with {} repeated poses ({} dof; data/stated {:.2} / {:.2} / {:.2})",
+            pe.groups, pe.dof, pe.ratio[0], pe.ratio[1], pe.ratio[2]
+        )
+    } else {
+        format!(
+            "the data's noise is {:.2}x the stated noise on {} (p = {:.1e}; {} repeated poses, {} dof): chi-square tests against the stated noise are unreliable{}",
+            pe.ratio[worst],
+            CHANNELS[worst],
+            pe.p_value[worst],
+            pe.groups,
+            pe.dof,
+            if used == NoiseSource::Data {
+                ""
+            } else {
+                "; rerun with --noise-from-data"
+            }
+        )
+    };
+    if used == NoiseSource::Data {
+        let s = ChannelRms::from_internal(fitter.sigma);
+        note.push_str(&format!(
+            "; the tests used the data's noise: phi {:.3} arcsec, theta {:.3} arcsec, s {:.3} um (F tests)",
+            s.phi_arcsec, s.theta_arcsec, s.s_um
+        ));
+    }
+    if pe.within_visit > 0 {
+        note.push_str(&format!(
+            "; {} repeats were logged in consecutive rows (within a visit): they miss repositioning and vibration",
+            pe.within_visit
+        ));
+    }
+    NoiseCheck {
+        stated,
+        used,
+        pure_error: Some(pe),
+        agrees: Some(agrees),
+        note,
+    }
 }
 
 #[cfg(test)]

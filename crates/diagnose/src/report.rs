@@ -464,7 +464,7 @@ impl Diagnosis {
             .map(|c| c.effect)
             .chain(self.aliases.iter().map(|a| a.in_model));
         for e in names.filter_map(|n| n.catalogue()) {
-            if e != EffectName::Outliers && !out.contains(&e) {
+            if e.is_term() && !out.contains(&e) {
                 out.push(e);
             }
         }

@@ -6,11 +6,11 @@
 use tricept_data::Dataset;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{Machine, UpJoints};
-use tricept_model::effects::{CauseName, EffectName, GenericFamily};
+use tricept_model::effects::{CauseName, PlotAxes, XAxis, YAxis};
 use tricept_numerics::stats::chi2_sf;
 
+use crate::fit::{Fit, residuals_of};
 use crate::report::{Cause, ResidualPlot, Structure};
-use crate::select::{Fit, residuals_of};
 
 /// Regressors of every pose (name, value per pose).
 fn regressors(nominal: &Machine, data: &Dataset) -> Vec<(String, Vec<f64>)> {
@@ -154,9 +154,65 @@ impl PlotOf {
     }
 }
 
-/// Residual plot of a cause: leg-length residuals (`J1` times the joint
-/// residuals, um) against the leg's regressor for leg effects; reading
-/// residuals against the exposing joint value or time otherwise.
+impl PlotOf {
+    /// The axes of the plot, from the registry.
+    fn axes(&self) -> PlotAxes {
+        match self.effect {
+            CauseName::Catalogue(e) => e.spec().plot,
+            CauseName::Generic(g) => g.plot(self.leg, self.channel),
+        }
+    }
+}
+
+/// What the residual plot of a pose can show.
+struct Point<'a> {
+    pose: &'a tricept_data::MeasuredPose,
+    /// The pose's position in the file.
+    index: usize,
+    /// The nominal UP joints at the commands.
+    up: UpJoints,
+    /// Weighted residuals (noise units).
+    weighted: [f64; 3],
+    /// Joint residuals (rad, rad, mm).
+    joint: [f64; 3],
+    /// Leg-length residuals (`J1` times the joint residuals), mm.
+    legs: nalgebra::Vector3<f64>,
+}
+
+impl Point<'_> {
+    fn x(&self, axis: XAxis, period_mm: Option<f64>) -> Option<f64> {
+        let (p, up) = (self.pose, &self.up);
+        Some(match axis {
+            XAxis::LegCommand(i) => p.commands_mm[i],
+            XAxis::LegCommandModuloPeriod(i) => {
+                p.commands_mm[i].rem_euclid(period_mm.unwrap_or(f64::INFINITY))
+            }
+            XAxis::LegApproach(i) => f64::from(p.approach?[i]) + 0.02 * (p.line % 7) as f64,
+            XAxis::Temperature => p.temp_c?,
+            XAxis::Tilt => up.theta_rad.hypot(up.phi_rad).to_degrees(),
+            XAxis::Extension => up.q4_mm,
+            XAxis::Angle(c) => if c == 0 { up.phi_rad } else { up.theta_rad }.to_degrees(),
+            XAxis::Line => p.line as f64,
+            XAxis::Order => p.time_s.unwrap_or(self.index as f64),
+        })
+    }
+
+    fn y(&self, axis: YAxis) -> f64 {
+        match axis {
+            YAxis::LegResidual(i) => self.legs[i] * 1e3,
+            YAxis::MeanLegResidual => self.legs.sum() / 3.0 * 1e3,
+            YAxis::ScaleResidual => self.joint[2] * 1e3,
+            YAxis::Reading(2) => self.joint[2] * 1e3,
+            YAxis::Reading(c) => self.joint[c] / RAD_PER_ARCSEC,
+            YAxis::LargestResidualSigma => self.weighted.iter().fold(0.0f64, |a, v| a.max(v.abs())),
+        }
+    }
+}
+
+/// Residual plot of a cause (its axes from the registry): leg-length
+/// residuals (`J1` times the joint residuals, um) against the leg's
+/// regressor for leg effects; reading residuals against the exposing joint
+/// value or time otherwise.
 pub(crate) fn residual_plot(
     of: &PlotOf,
     nominal: &Machine,
@@ -165,127 +221,34 @@ pub(crate) fn residual_plot(
     fin: &Fit,
     sigma: &[f64; 3],
 ) -> Option<ResidualPlot> {
-    use CauseName::{Catalogue as C, Generic as G};
-    let (effect, leg, channel, period) = (of.effect, of.leg, of.channel, of.period_mm);
-    let unit = |c: usize| if c == 2 { 1e3 } else { 1.0 / RAD_PER_ARCSEC };
+    let axes = of.axes();
     let series = |f: &Fit| -> Vec<(f64, f64)> {
         let res = residuals_of(f, &data.poses, sigma);
         data.poses
             .iter()
             .enumerate()
             .zip(res)
-            .filter_map(|((j, p), r)| {
-                let r = r?;
-                let joint = [0, 1, 2].map(|c| r[c] * sigma[c]);
-                let fk = nominal.forward(&p.commands_mm).ok()?;
-                let legs = nominal.legs_at(&fk.up).j1() * nalgebra::Vector3::from(joint);
-                let order = p.time_s.unwrap_or(j as f64);
-                let x_y = match effect {
-                    C(EffectName::LegLead) => (p.commands_mm[0], legs[0] * 1e3),
-                    C(EffectName::Backlash) => (
-                        f64::from(p.approach?[0]) + 0.02 * (p.line % 7) as f64,
-                        legs[0] * 1e3,
-                    ),
-                    C(EffectName::Thermal) => (p.temp_c?, legs.sum() / 3.0 * 1e3),
-                    C(EffectName::Compliance) => (
-                        fk.up.theta_rad.hypot(fk.up.phi_rad).to_degrees(),
-                        legs.sum() / 3.0 * 1e3,
-                    ),
-                    C(EffectName::ScaleGain) => (fk.up.q4_mm, joint[2] * 1e3),
-                    C(EffectName::EncoderEccentricity) => {
-                        (fk.up.phi_rad.to_degrees(), joint[0] / RAD_PER_ARCSEC)
-                    }
-                    C(EffectName::UjointAxes) => {
-                        (fk.up.theta_rad.to_degrees(), joint[0] / RAD_PER_ARCSEC)
-                    }
-                    C(EffectName::TubeTwist) => (fk.up.q4_mm, legs[0] * 1e3),
-                    C(EffectName::Outliers) => {
-                        (p.line as f64, r.iter().fold(0.0f64, |a, v| a.max(v.abs())))
-                    }
-                    G(GenericFamily::LegPeriodic) => (
-                        p.commands_mm[leg].rem_euclid(period.unwrap_or(f64::INFINITY)),
-                        legs[leg] * 1e3,
-                    ),
-                    G(GenericFamily::LegPolynomial) => (p.commands_mm[leg], legs[leg] * 1e3),
-                    G(GenericFamily::LegDrift) => (order, legs[leg] * 1e3),
-                    G(GenericFamily::ReadingTemperature) => {
-                        (p.temp_c?, joint[channel] * unit(channel))
-                    }
-                    G(GenericFamily::EncoderGain) => {
-                        let angle = if channel == 0 {
-                            fk.up.phi_rad
-                        } else {
-                            fk.up.theta_rad
-                        };
-                        (angle.to_degrees(), joint[channel] * unit(channel))
-                    }
-                    G(GenericFamily::ScalePolynomial) => (fk.up.q4_mm, joint[2] * 1e3),
-                    G(GenericFamily::ReadingDrift) | G(GenericFamily::ReadingHysteresis) => {
-                        (order, joint[channel] * unit(channel))
-                    }
+            .filter_map(|((index, pose), r)| {
+                let weighted = r?;
+                let joint = [0, 1, 2].map(|c| weighted[c] * sigma[c]);
+                let up = nominal.forward(&pose.commands_mm).ok()?.up;
+                let legs = nominal.legs_at(&up).j1() * nalgebra::Vector3::from(joint);
+                let point = Point {
+                    pose,
+                    index,
+                    up,
+                    weighted,
+                    joint,
+                    legs,
                 };
-                Some(x_y)
+                Some((point.x(axes.x, of.period_mm)?, point.y(axes.y)))
             })
             .collect()
     };
-    let reading = |c: usize| {
-        format!(
-            "{} residual ({})",
-            ["phi", "theta", "s"][c],
-            if c == 2 { "um" } else { "arcsec" }
-        )
-    };
-    let (x_label, y_label): (String, String) = match effect {
-        C(EffectName::LegLead) => (
-            "leg 1 command (mm)".into(),
-            "leg 1 length residual (um)".into(),
-        ),
-        C(EffectName::Backlash) => (
-            "leg 1 approach direction".into(),
-            "leg 1 length residual (um)".into(),
-        ),
-        C(EffectName::Thermal) => (
-            "temperature (°C)".into(),
-            "mean leg length residual (um)".into(),
-        ),
-        C(EffectName::Compliance) => (
-            "tilt of the UP limb (deg)".into(),
-            "mean leg length residual (um)".into(),
-        ),
-        C(EffectName::ScaleGain) => ("q4 (mm)".into(), "scale residual (um)".into()),
-        C(EffectName::EncoderEccentricity) => ("phi (deg)".into(), "phi residual (arcsec)".into()),
-        C(EffectName::UjointAxes) => ("theta (deg)".into(), "phi residual (arcsec)".into()),
-        C(EffectName::TubeTwist) => ("q4 (mm)".into(), "leg 1 length residual (um)".into()),
-        C(EffectName::Outliers) => (
-            "line of the data file".into(),
-            "largest |residual| (sigma)".into(),
-        ),
-        G(GenericFamily::LegPeriodic) => (
-            format!("leg {} command modulo the period (mm)", leg + 1),
-            format!("leg {} length residual (um)", leg + 1),
-        ),
-        G(GenericFamily::LegPolynomial) => (
-            format!("leg {} command (mm)", leg + 1),
-            format!("leg {} length residual (um)", leg + 1),
-        ),
-        G(GenericFamily::LegDrift) => (
-            "time (s) or pose".into(),
-            format!("leg {} length residual (um)", leg + 1),
-        ),
-        G(GenericFamily::ReadingTemperature) => ("temperature (°C)".into(), reading(channel)),
-        G(GenericFamily::EncoderGain) => (
-            format!("{} (deg)", ["phi", "theta", "s"][channel]),
-            reading(channel),
-        ),
-        G(GenericFamily::ScalePolynomial) => ("q4 (mm)".into(), reading(2)),
-        G(GenericFamily::ReadingDrift) | G(GenericFamily::ReadingHysteresis) => {
-            ("time (s) or pose".into(), reading(channel))
-        }
-    };
     Some(ResidualPlot {
-        effect,
-        x_label,
-        y_label,
+        effect: of.effect,
+        x_label: axes.x.label(),
+        y_label: axes.y.label(),
         before: series(geo),
         after: series(fin),
     })

@@ -32,66 +32,36 @@
 //! and the reported gain uses the very same cross-validation, so a named
 //! cause never makes the held-out fit worse.
 
-use std::sync::Arc;
-
-use nalgebra::DMatrix;
 use rayon::prelude::*;
-use tricept_data::{Dataset, MeasuredPose};
-use tricept_ident::{
-    GeometricModel, IdentError, Identification, IdentifyOptions, ReadingModel, identify,
-    residuals_at, screen_gross_errors,
-};
+use tricept_data::Dataset;
+use tricept_model::effects::EffectName;
 
 use crate::dictionary::{At, Dictionary, Scored};
-use crate::evidence::Reference;
+use crate::error::DiagnoseError;
+use crate::fit::{Fit, Fitter, term_estimates};
 use crate::linear::Linearisation;
-use crate::model::{Candidate, ExtendedModel};
-use crate::plausibility::{Plausibility, quantities};
+use crate::plausibility::Plausibility;
 use crate::report::{Estimate, Evidence, RejectStage, Rejected, Tested};
-use crate::run::{DiagnoseError, DiagnoseOptions};
-use crate::terms::{Frame, Term};
+use crate::terms::Term;
 
-/// A model fitted to data.
-#[derive(Clone)]
-pub(crate) struct Fit {
-    pub(crate) model: ExtendedModel,
-    pub(crate) id: Identification,
-}
-
-/// Everything the selection works with, fixed for one diagnosis.
+/// Everything the selection works with, fixed for one diagnosis: the fit
+/// core and the pool (the dictionary, the available effects of the
+/// vocabulary) with its plausibility table.
 pub(crate) struct Setup<'a> {
-    pub(crate) options: &'a DiagnoseOptions,
-    /// Noise of one logged reading used by every fit (stated or estimated).
-    pub(crate) sigma: [f64; 3],
-    pub(crate) reference: Reference,
-    pub(crate) frame: Arc<Frame>,
+    pub(crate) fitter: Fitter<'a>,
     pub(crate) dictionary: Dictionary,
     pub(crate) plausibility: &'a Plausibility,
-    pub(crate) geometric: GeometricModel,
-    /// Catalogue candidates whose data columns are present.
-    pub(crate) available: Vec<Candidate>,
+    /// Effects of the vocabulary whose data columns are present.
+    pub(crate) available: Vec<EffectName>,
 }
 
 impl Setup<'_> {
-    /// The geometric model with the frame and no terms.
-    pub(crate) fn base_model(&self) -> ExtendedModel {
-        ExtendedModel::with_terms(self.geometric.clone(), &[], self.frame.clone())
-    }
-
-    pub(crate) fn model(&self, terms: &[Term]) -> ExtendedModel {
-        ExtendedModel::with_terms(self.geometric.clone(), terms, self.frame.clone())
-    }
-
-    pub(crate) fn identify_options(&self) -> IdentifyOptions {
-        IdentifyOptions::with_sigma(self.sigma)
-    }
-
     /// The family-wise level of each half of the pool.
     pub(crate) fn alpha_share(&self) -> f64 {
         if self.dictionary.is_empty() {
-            self.options.alpha
+            self.fitter.options.alpha
         } else {
-            0.5 * self.options.alpha
+            0.5 * self.fitter.options.alpha
         }
     }
 
@@ -111,7 +81,8 @@ impl Setup<'_> {
                 if g.period_mm.is_some() {
                     self.dictionary.scan_len().max(1)
                 } else {
-                    self.frame
+                    self.fitter
+                        .frame
                         .generic_groups()
                         .iter()
                         .filter(|h| h.family == g.family)
@@ -122,83 +93,20 @@ impl Setup<'_> {
         }
     }
 
-    /// Fits `model` to `data`: a fit that does not converge, or whose
-    /// geometric errors exceed `max_error_mm`, is not a fit.
-    pub(crate) fn fit(&self, model: ExtendedModel, data: &Dataset) -> Result<Fit, FitError> {
-        let id = identify(&model, data, &self.identify_options()).map_err(FitError::Ident)?;
-        let g = model.n_geometric();
-        let largest = id.estimate[..g].iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        if !id.converged
-            || !largest.is_finite()
-            || largest > self.options.max_error_mm
-            || !id.stats.chi_square.is_finite()
-        {
-            return Err(FitError::NotConverged {
-                largest_error_mm: largest,
-                iterations: id.iterations,
-            });
-        }
-        Ok(Fit { model, id })
-    }
-
-    /// K-fold cross-validated RMS of the weighted held-out residuals of
-    /// `model` on `data`, evaluated on the poses `evaluate` accepts;
-    /// `Err(fold)` when a fold cannot be fitted.
-    pub(crate) fn holdout_rms(
-        &self,
-        model: &ExtendedModel,
-        data: &Dataset,
-        evaluate: &(dyn Fn(usize) -> bool + Sync),
-    ) -> Result<f64, usize> {
-        let k = self.options.folds.max(2);
-        let parts: Vec<Result<(f64, usize), usize>> = (0..k)
-            .into_par_iter()
-            .map(|fold| {
-                let train = data.subset(|j| j % k != fold);
-                let f = self.fit(model.clone(), &train).map_err(|_| fold + 1)?;
-                let poses: Vec<MeasuredPose> = data
-                    .poses
-                    .iter()
-                    .enumerate()
-                    .filter(|(j, _)| j % k == fold && evaluate(*j))
-                    .map(|(_, p)| *p)
-                    .collect();
-                let mut sum = 0.0;
-                let mut n = 0;
-                for r in residuals_of(&f, &poses, &self.sigma) {
-                    let r = r.ok_or(fold + 1)?;
-                    sum += r.iter().map(|v| v * v).sum::<f64>();
-                    n += 3;
-                }
-                Ok((sum, n))
-            })
-            .collect();
-        let (mut sum, mut n) = (0.0, 0);
-        for part in parts {
-            let (s, c) = part?;
-            sum += s;
-            n += c;
-        }
-        if n == 0 {
-            return Err(0);
-        }
-        Ok((sum / n as f64).sqrt())
-    }
-
     /// The dictionary screen at `fit` (empty when the fit cannot be
     /// linearised or the dictionary is empty).
     pub(crate) fn screen(&self, fit: &Fit, data: &Dataset) -> Vec<Scored> {
         if self.dictionary.is_empty() {
             return Vec::new();
         }
-        let Some(lin) = Linearisation::at_fit(fit, data, &self.sigma, &[]) else {
+        let Some(lin) = Linearisation::at_fit(fit, data, &self.fitter.sigma, &[]) else {
             return Vec::new();
         };
         let at = At {
             lin: &lin,
-            frame: &self.frame,
+            frame: &self.fitter.frame,
             data,
-            reference: &self.reference,
+            reference: &self.fitter.reference,
             chi_square: fit.id.stats.chi_square,
             dof: fit.id.stats.dof,
         };
@@ -208,7 +116,8 @@ impl Setup<'_> {
     /// Plausibility of `term` in `fit`.
     pub(crate) fn plausible(&self, fit: &Fit, term: &Term) -> Result<(), String> {
         let (values, cov) = term_estimates(fit, term);
-        self.plausibility.check(&quantities(term, &values, &cov))
+        self.plausibility
+            .judge(term.name(), &term.judgements(), &values, &cov)
     }
 
     /// The evidence for `term` from the nested pair `without` / `with`.
@@ -226,10 +135,9 @@ impl Setup<'_> {
             .rank()
             .saturating_sub(without.id.design().rank())
             .max(1);
-        let s2 = self
-            .reference
-            .scale(with.id.stats.chi_square, with.id.stats.dof);
-        let p = self.reference.p_value(delta / s2, k);
+        let reference = &self.fitter.reference;
+        let s2 = reference.scale(with.id.stats.chi_square, with.id.stats.dof);
+        let p = reference.p_value(delta / s2, k);
         let m = self.multiplicity(term);
         let ln_n = (readings as f64).ln();
         Evidence {
@@ -246,89 +154,6 @@ impl Setup<'_> {
             penalised_gain: delta - k as f64 * ln_n - 2.0 * (self.alternatives(term) as f64).ln(),
         }
     }
-}
-
-/// Why a model could not be fitted.
-#[derive(Debug)]
-pub(crate) enum FitError {
-    Ident(IdentError),
-    NotConverged {
-        largest_error_mm: f64,
-        iterations: u32,
-    },
-}
-
-impl From<FitError> for DiagnoseError {
-    fn from(e: FitError) -> DiagnoseError {
-        match e {
-            FitError::Ident(e) => DiagnoseError::Ident(e),
-            FitError::NotConverged {
-                largest_error_mm,
-                iterations,
-            } => DiagnoseError::NotConverged {
-                largest_error_mm,
-                iterations,
-            },
-        }
-    }
-}
-
-/// Values and covariance of `term`'s parameters in `fit`.
-pub(crate) fn term_estimates(fit: &Fit, term: &Term) -> (Vec<f64>, DMatrix<f64>) {
-    let terms = fit.model.terms();
-    let offsets = fit.model.offsets();
-    let Some(i) = terms.iter().position(|t| t == term) else {
-        return (Vec::new(), DMatrix::zeros(0, 0));
-    };
-    let at = offsets[i];
-    let k = term.params().len();
-    let values = fit.id.estimate[at..at + k].to_vec();
-    let cov = fit.id.covariance.view((at, at), (k, k)).into_owned();
-    (values, cov)
-}
-
-/// Weighted residuals of `poses` under a fitted model (offsets applied).
-pub(crate) fn residuals_of(
-    f: &Fit,
-    poses: &[MeasuredPose],
-    sigma: &[f64; 3],
-) -> Vec<Option<[f64; 3]>> {
-    // A fit's estimate always has its model's length.
-    residuals_at(&f.model, &f.id.estimate, &f.id.offsets, poses, sigma)
-        .unwrap_or_else(|_| vec![None; poses.len()])
-}
-
-pub(crate) fn estimates(f: &Fit) -> Vec<Estimate> {
-    f.model
-        .names()
-        .iter()
-        .zip(&f.id.estimate)
-        .zip(&f.id.std_dev)
-        .map(|((n, v), s)| Estimate {
-            name: n.clone(),
-            value: *v,
-            std_dev: *s,
-        })
-        .collect()
-}
-
-/// The outlier screen of `tricept_ident::robust` with the diagnosis'
-/// options; the indices of the flagged poses.
-pub(crate) fn screen_outliers(
-    setup: &Setup<'_>,
-    model: &ExtendedModel,
-    data: &Dataset,
-) -> Result<Vec<usize>, IdentError> {
-    Ok(screen_gross_errors(
-        model,
-        data,
-        &setup.identify_options(),
-        setup.options.alpha,
-        setup.options.max_outlier_share,
-    )?
-    .into_iter()
-    .map(|r| r.pose)
-    .collect())
 }
 
 /// The outcome of the selection on clean data.
@@ -376,7 +201,7 @@ fn reject(
             std_dev: Some(cov[(i, i)].max(0.0).sqrt()),
         })
         .collect();
-    let description = describe_group(term);
+    let description = term.label();
     rejected.retain(|r| !(r.description == description && r.stage == stage));
     rejected.push(Rejected {
         effect: term.name(),
@@ -385,14 +210,6 @@ fn reject(
         reason,
         stage,
     });
-}
-
-/// A short description of a term's group for messages.
-pub(crate) fn describe_group(term: &Term) -> String {
-    match term {
-        Term::Catalogue(c) => c.0.to_string(),
-        Term::Generic(g) => g.label(),
-    }
 }
 
 /// One forward step from `current`: the winning trial and its held-out
@@ -410,7 +227,7 @@ fn forward_step(
     let mut pool: Vec<Term> = setup
         .available
         .iter()
-        .map(|c| Term::Catalogue(*c))
+        .map(|e| Term::Catalogue(*e))
         .filter(|t| !terms.iter().any(|u| u.overlaps(t)))
         .collect();
     let alpha_share = setup.alpha_share();
@@ -419,7 +236,7 @@ fn forward_step(
             .screen(current, clean)
             .into_iter()
             .filter(|s| s.p_adjusted < alpha_share)
-            .take(setup.options.dictionary.refit_top)
+            .take(setup.fitter.options.dictionary.refit_top)
             .map(|s| Term::Generic(s.term)),
     );
     pool.retain(|t| !excluded.iter().any(|e| e.overlaps(t) || e == t));
@@ -429,7 +246,7 @@ fn forward_step(
         .filter_map(|t| {
             let mut with = terms.clone();
             with.push(*t);
-            let fit = setup.fit(setup.model(&with), clean).ok()?;
+            let fit = setup.fitter.fit(setup.fitter.model(&with), clean).ok()?;
             if fit.id.stats.dof == 0 {
                 return None;
             }
@@ -461,9 +278,15 @@ fn forward_step(
             continue;
         }
         if current_rms.is_none() {
-            *current_rms = setup.holdout_rms(&current.model, clean, &|_| true).ok();
+            *current_rms = setup
+                .fitter
+                .holdout_rms(&current.model, clean, &|_| true)
+                .ok();
         }
-        let with = setup.holdout_rms(&t.fit.model, clean, &|_| true).ok();
+        let with = setup
+            .fitter
+            .holdout_rms(&t.fit.model, clean, &|_| true)
+            .ok();
         t.evidence.holdout_rms_without = *current_rms;
         t.evidence.holdout_rms_with = with;
         match (*current_rms, with) {
@@ -489,7 +312,7 @@ fn forward_step(
             .iter()
             .map(|t| Tested {
                 effect: t.term.name(),
-                description: describe_group(&t.term),
+                description: t.term.label(),
                 evidence: t.evidence.clone(),
             })
             .collect();
@@ -515,7 +338,7 @@ fn swaps(setup: &Setup<'_>, clean: &Dataset, mut current: Fit) -> Fit {
                 setup
                     .available
                     .iter()
-                    .map(|c| Term::Catalogue(*c))
+                    .map(|e| Term::Catalogue(*e))
                     .filter(|c| !terms.contains(c))
                     .map(move |c| (slot, c))
             })
@@ -525,7 +348,7 @@ fn swaps(setup: &Setup<'_>, clean: &Dataset, mut current: Fit) -> Fit {
             .filter_map(|&(slot, c)| {
                 let mut with = terms.clone();
                 with[slot] = c;
-                let f = setup.fit(setup.model(&with), clean).ok()?;
+                let f = setup.fitter.fit(setup.fitter.model(&with), clean).ok()?;
                 setup.plausible(&f, &c).ok()?;
                 Some((bic(&f), f))
             })
@@ -556,8 +379,8 @@ fn final_tests(
                 .filter(|(i, _)| *i != slot)
                 .map(|(_, t)| *t)
                 .collect();
-            let model = setup.model(&others);
-            let Ok(without) = setup.fit(model.clone(), clean) else {
+            let model = setup.fitter.model(&others);
+            let Ok(without) = setup.fitter.fit(model.clone(), clean) else {
                 // The model without the cause cannot be fitted: the cause
                 // is needed.
                 let mut ev = setup.evidence(&terms[slot], current, current, readings);
@@ -565,7 +388,7 @@ fn final_tests(
                 return (ev, None, true);
             };
             let mut ev = setup.evidence(&terms[slot], &without, current, readings);
-            let rms_without = setup.holdout_rms(&model, clean, &|_| true).ok();
+            let rms_without = setup.fitter.holdout_rms(&model, clean, &|_| true).ok();
             ev.holdout_rms_without = rms_without;
             ev.holdout_rms_with = Some(current_rms);
             let pass = ev.p_adjusted < setup.alpha_share()
@@ -580,13 +403,14 @@ fn final_tests(
 /// Forward selection, swaps and admission on the final model (see the
 /// module docs).
 pub(crate) fn select(setup: &Setup<'_>, clean: &Dataset) -> Result<Selection, DiagnoseError> {
-    let geo = setup.fit(setup.base_model(), clean)?;
+    let geo = setup.fitter.fit(setup.fitter.base_model(), clean)?;
     if geo.id.stats.dof == 0 {
         return Err(DiagnoseError::Degenerate(
             "as many unknowns as readings: no degree of freedom is left to test the model".into(),
         ));
     }
     let geometric_rms = setup
+        .fitter
         .holdout_rms(&geo.model, clean, &|_| true)
         .map_err(cv_failure)?;
     let mut rejected = Vec::new();
@@ -598,7 +422,7 @@ pub(crate) fn select(setup: &Setup<'_>, clean: &Dataset) -> Result<Selection, Di
     let mut excluded: Vec<Term> = Vec::new();
     loop {
         // Forward steps.
-        while current.model.terms().len() < setup.options.max_causes {
+        while current.model.terms().len() < setup.fitter.options.max_causes {
             let tested = first_step.then_some(&mut first_candidates);
             first_step = false;
             match forward_step(
@@ -633,6 +457,7 @@ pub(crate) fn select(setup: &Setup<'_>, clean: &Dataset) -> Result<Selection, Di
             let rms = match current_rms {
                 Some(r) => r,
                 None => setup
+                    .fitter
                     .holdout_rms(&current.model, clean, &|_| true)
                     .map_err(cv_failure)?,
             };
@@ -668,7 +493,7 @@ pub(crate) fn select(setup: &Setup<'_>, clean: &Dataset) -> Result<Selection, Di
             );
             excluded.push(term);
             let others: Vec<Term> = terms.into_iter().filter(|t| *t != term).collect();
-            current = setup.fit(setup.model(&others), clean)?;
+            current = setup.fitter.fit(setup.fitter.model(&others), clean)?;
             current_rms = if others.is_empty() {
                 Some(geometric_rms)
             } else {

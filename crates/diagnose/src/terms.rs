@@ -1,30 +1,32 @@
 //! The terms an extended model can contain: effects of the vocabulary
-//! ([`Candidate`]) and generic terms of the dictionary ([`GenericTerm`]),
-//! with the campaign [`Frame`] that the generic terms are measured in.
+//! (`Term::Catalogue`, their specs in [`tricept_model::effects`]) and
+//! generic terms of the dictionary ([`GenericTerm`]), with the campaign
+//! [`Frame`] that the generic terms are measured in.
 //!
-//! A generic term is linear in its parameters: each parameter adds, per
-//! unit, a known value to one leg length (a *leg* term, entering like a
-//! catalogue leg effect through `J1^-1 e_i`) or to one reading (a *reading*
-//! term, entering directly). The values are the functional forms of
-//! [`tricept_model::effects`] in coordinates normalised over the campaign
-//! (leg strokes on `[-1, 1]`, time on `[-1/2, 1/2]`, temperature about its
-//! mean), frozen once on the full data set so that every fit, cross-
-//! validation folds included, uses the same coordinates.
+//! Every term linear in its parameters says the same thing at a pose:
+//! per unit of each parameter, what it adds to a leg length (a *leg* term,
+//! entering through `J1^-1 e_i`) or to a reading (a *reading* term,
+//! entering directly): `(parameter, Basis, value)` entries
+//! ([`tricept_model::effects::Entries`]). The generic terms' values are the
+//! functional forms of [`tricept_model::effects`] in coordinates normalised
+//! over the campaign (leg strokes on `[-1, 1]`, time on `[-1/2, 1/2]`,
+//! temperature about its mean), frozen once on the full data set so that
+//! every fit, cross-validation folds included, uses the same coordinates.
 
 use std::collections::BTreeMap;
 
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_kinematics::units::RAD_PER_ARCSEC;
-use tricept_kinematics::{Machine, UpJoints};
+use tricept_kinematics::{KinematicsError, Machine, UpJoints};
 use tricept_model::effects::{
-    CauseName, GenericFamily, encoder_gain_error_rad, legendre_p2, legendre_p3, linear_drift,
-    normalised_coordinate, periodic_extra_mm,
+    Basis, CHANNELS, CauseName, EffectName, Entries, GenericFamily, Judgement, Kind, LegContext,
+    Needs, encoder_gain_error_rad, legendre_p2, legendre_p3, linear_drift, normalised_coordinate,
 };
 
-use crate::model::{Candidate, MIN_TEMPERATURE_RANGE_K};
-
-/// The names of the three reading channels.
-pub const CHANNELS: [&str; 3] = ["phi", "theta", "s"];
+/// A logged temperature that varies by less than this over the campaign
+/// (K) carries no usable thermal signature: a logger's own noise (0.02 K in
+/// the plant simulator) spans about 0.1 K over a few hundred readings.
+pub const MIN_TEMPERATURE_RANGE_K: f64 = 0.25;
 
 /// Which legs or channel a generic term acts on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -49,19 +51,12 @@ pub struct GenericTerm {
     pub period_mm: Option<f64>,
 }
 
-/// Where a unit of a parameter goes: onto a leg length (mm) or a reading
-/// (rad or mm).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Basis {
-    Leg(usize),
-    Reading(usize),
-}
-
 /// A term of an extended model.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Term {
-    /// An effect of the vocabulary.
-    Catalogue(Candidate),
+    /// An effect of the vocabulary (any but `outliers`, which is handled by
+    /// row screening).
+    Catalogue(EffectName),
     /// A generic term.
     Generic(GenericTerm),
 }
@@ -71,16 +66,16 @@ impl Term {
     ///
     /// # Example
     /// ```
-    /// use tricept_diagnose::{Candidate, GenericFamily, GenericTerm, Scope, Term};
+    /// use tricept_diagnose::{GenericFamily, GenericTerm, Scope, Term};
     /// use tricept_model::effects::EffectName;
-    /// let lead = Term::Catalogue(Candidate(EffectName::LegLead));
+    /// let lead = Term::Catalogue(EffectName::LegLead);
     /// let drift = Term::Generic(GenericTerm::new(GenericFamily::ReadingDrift, Scope::Channel(2)));
     /// assert_eq!(lead.name().to_string(), "leg-lead");
     /// assert_eq!(drift.params(), vec!["s_um".to_string()]);
     /// ```
     pub fn name(&self) -> CauseName {
         match self {
-            Term::Catalogue(c) => CauseName::Catalogue(c.0),
+            Term::Catalogue(e) => CauseName::Catalogue(*e),
             Term::Generic(g) => CauseName::Generic(g.family),
         }
     }
@@ -88,8 +83,101 @@ impl Term {
     /// Its parameter names (unit in the name), without the family prefix.
     pub fn params(&self) -> Vec<String> {
         match self {
-            Term::Catalogue(c) => c.params().iter().map(|s| s.to_string()).collect(),
+            Term::Catalogue(e) => e.parameter_names().iter().map(|s| s.to_string()).collect(),
             Term::Generic(g) => g.params(),
+        }
+    }
+
+    /// Its number of parameters.
+    pub fn param_count(&self) -> usize {
+        match self {
+            Term::Catalogue(e) => e.parameter_count(),
+            Term::Generic(g) => g.params().len(),
+        }
+    }
+
+    /// A short label of the term for messages (`leg-lead`,
+    /// `reading-drift:s`).
+    pub fn label(&self) -> String {
+        match self {
+            Term::Catalogue(e) => e.to_string(),
+            Term::Generic(g) => g.label(),
+        }
+    }
+
+    /// What the campaign must log for the term to be seen.
+    pub fn needs(&self) -> Needs {
+        self.name().needs()
+    }
+
+    /// Whether the campaign has what the term needs.
+    pub fn available(&self, frame: &Frame) -> bool {
+        match self {
+            Term::Catalogue(_) => frame.supports(self.needs()),
+            Term::Generic(g) => g.available(frame),
+        }
+    }
+
+    /// The term's judged quantities, resolved for its legs, channel and
+    /// period.
+    pub fn judgements(&self) -> Vec<Judgement> {
+        match self {
+            Term::Catalogue(e) => e.judgements(),
+            Term::Generic(g) => g.family.judgements(&g.legs(), g.channel(), g.period_mm),
+        }
+    }
+
+    /// Whether the term changes leg lengths, readings or the kinematics.
+    pub(crate) fn kind(&self) -> TermKind {
+        match self {
+            Term::Catalogue(e) => match e.spec().kind {
+                Kind::Leg(_) => TermKind::Leg,
+                Kind::Reading(_) => TermKind::Reading,
+                Kind::Kinematic(_) => TermKind::Kinematic,
+                Kind::Rows => TermKind::None,
+            },
+            Term::Generic(g) if g.acts_on_legs() => TermKind::Leg,
+            Term::Generic(_) => TermKind::Reading,
+        }
+    }
+
+    /// Per unit of each parameter, what a leg term adds to the leg lengths
+    /// at `pose` (empty for the others); the nominal machine carries the
+    /// gravity load of a compliance.
+    pub(crate) fn leg_entries(
+        &self,
+        frame: &Frame,
+        nominal: &Machine,
+        pose: &MeasuredPose,
+    ) -> Result<Entries, KinematicsError> {
+        match self {
+            Term::Catalogue(e) => match e.spec().kind {
+                Kind::Leg(entries) => entries(&LegContext {
+                    nominal,
+                    commands_mm: pose.commands_mm,
+                    approach: pose.approach,
+                    temperature_c: pose.temp_c,
+                }),
+                Kind::Reading(_) | Kind::Kinematic(_) | Kind::Rows => Ok(Vec::new()),
+            },
+            Term::Generic(g) => Ok(g.leg_values(frame, pose)),
+        }
+    }
+
+    /// Per unit of each parameter, what a reading term adds to the readings
+    /// with the UP limb at `up` (empty for the others).
+    pub(crate) fn reading_entries(
+        &self,
+        frame: &Frame,
+        pose: &MeasuredPose,
+        up: &UpJoints,
+    ) -> Entries {
+        match self {
+            Term::Catalogue(e) => match e.spec().kind {
+                Kind::Reading(entries) => entries(up),
+                Kind::Leg(_) | Kind::Kinematic(_) | Kind::Rows => Vec::new(),
+            },
+            Term::Generic(g) => g.reading_values(frame, pose, up),
         }
     }
 
@@ -112,6 +200,16 @@ impl Term {
     }
 }
 
+/// How a term's parameters enter the model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum TermKind {
+    Leg,
+    Reading,
+    Kinematic,
+    /// Not a term of a model (outliers).
+    None,
+}
+
 fn leg_label(i: usize) -> usize {
     i + 1
 }
@@ -128,10 +226,7 @@ impl GenericTerm {
 
     /// Whether the term changes leg lengths (else readings).
     pub fn acts_on_legs(&self) -> bool {
-        matches!(
-            self.family,
-            GenericFamily::LegPeriodic | GenericFamily::LegPolynomial | GenericFamily::LegDrift
-        )
+        self.family.spec().acts_on_legs
     }
 
     /// The legs of a leg term.
@@ -200,33 +295,19 @@ impl GenericTerm {
 
     /// Per unit of each parameter (in order), what a leg term adds to a leg
     /// length, mm. Empty for reading terms.
-    pub(crate) fn leg_values(&self, frame: &Frame, pose: &MeasuredPose) -> Vec<(Basis, f64)> {
+    pub(crate) fn leg_values(&self, frame: &Frame, pose: &MeasuredPose) -> Entries {
         let q = pose.commands_mm;
         let mut out = Vec::new();
-        match self.family {
-            GenericFamily::LegPeriodic => {
-                let period = self.period_mm.unwrap_or(f64::INFINITY);
-                for i in self.legs() {
-                    out.push((Basis::Leg(i), periodic_extra_mm(1.0, 0.0, period, q[i])));
-                    out.push((Basis::Leg(i), periodic_extra_mm(0.0, 1.0, period, q[i])));
-                }
+        let mut push = |i: usize, v: f64| out.push((out.len(), Basis::Leg(i), v));
+        for i in self.legs() {
+            if let Some(values) =
+                self.family
+                    .leg_command_entries(q[i], self.period_mm, frame.leg_range_mm[i])
+            {
+                values.into_iter().for_each(|v| push(i, v));
+            } else if self.family == GenericFamily::LegDrift {
+                push(i, linear_drift(1e-3, frame.tau(pose).unwrap_or(0.0)));
             }
-            GenericFamily::LegPolynomial => {
-                for i in self.legs() {
-                    let [lo, hi] = frame.leg_range_mm[i];
-                    let x = normalised_coordinate(q[i], lo, hi);
-                    out.push((Basis::Leg(i), 1e-3 * x));
-                    out.push((Basis::Leg(i), 1e-3 * legendre_p2(x)));
-                    out.push((Basis::Leg(i), 1e-3 * legendre_p3(x)));
-                }
-            }
-            GenericFamily::LegDrift => {
-                let tau = frame.tau(pose).unwrap_or(0.0);
-                for i in self.legs() {
-                    out.push((Basis::Leg(i), linear_drift(1e-3, tau)));
-                }
-            }
-            _ => {}
         }
         out
     }
@@ -238,7 +319,7 @@ impl GenericTerm {
         frame: &Frame,
         pose: &MeasuredPose,
         up: &UpJoints,
-    ) -> Vec<(Basis, f64)> {
+    ) -> Entries {
         let Some(c) = self.channel() else {
             return Vec::new();
         };
@@ -246,40 +327,35 @@ impl GenericTerm {
         let b = Basis::Reading(c);
         match self.family {
             GenericFamily::ReadingDrift => {
-                vec![(b, linear_drift(unit, frame.tau(pose).unwrap_or(0.0)))]
+                vec![(0, b, linear_drift(unit, frame.tau(pose).unwrap_or(0.0)))]
             }
             GenericFamily::ReadingTemperature => {
-                vec![(b, unit * frame.delta_temperature_k(pose).unwrap_or(0.0))]
+                vec![(0, b, unit * frame.delta_temperature_k(pose).unwrap_or(0.0))]
             }
             GenericFamily::ReadingHysteresis => {
                 // A lagging sensor reads half its reversal error short in
                 // the direction it moved.
                 let dir = frame.direction(pose).map_or(0.0, |d| f64::from(d[c]));
-                vec![(b, -0.5 * unit * dir)]
+                vec![(0, b, -0.5 * unit * dir)]
             }
             GenericFamily::EncoderGain => {
                 let angle = if c == 0 { up.phi_rad } else { up.theta_rad };
-                vec![(b, encoder_gain_error_rad(1.0, angle))]
+                vec![(0, b, encoder_gain_error_rad(1.0, angle))]
             }
             GenericFamily::ScalePolynomial => {
                 let [lo, hi] = frame.q4_range_mm;
                 let x = normalised_coordinate(up.q4_mm, lo, hi);
-                vec![(b, 1e-3 * legendre_p2(x)), (b, 1e-3 * legendre_p3(x))]
+                vec![(0, b, 1e-3 * legendre_p2(x)), (1, b, 1e-3 * legendre_p3(x))]
             }
-            _ => Vec::new(),
+            GenericFamily::LegPeriodic | GenericFamily::LegPolynomial | GenericFamily::LegDrift => {
+                Vec::new()
+            }
         }
     }
 
     /// Whether the campaign has what the term needs.
     pub fn available(&self, frame: &Frame) -> bool {
-        match self.family {
-            GenericFamily::ReadingDrift | GenericFamily::LegDrift => frame.order.is_some(),
-            GenericFamily::ReadingTemperature => frame.temperature.is_some(),
-            GenericFamily::ReadingHysteresis => !frame.directions.is_empty(),
-            GenericFamily::LegPolynomial => frame.leg_range_mm.iter().all(|[lo, hi]| hi - lo > 1.0),
-            GenericFamily::ScalePolynomial => frame.q4_range_mm[1] - frame.q4_range_mm[0] > 1.0,
-            _ => true,
-        }
+        frame.supports(self.family.spec().needs)
     }
 
     /// A short label of the group (`leg-polynomial:leg2`, `reading-drift:s`).
@@ -324,6 +400,9 @@ pub struct Frame {
     /// (nominal joints of the commands), by line (empty without distinct
     /// lines).
     pub directions: BTreeMap<u64, [i8; 3]>,
+    /// Whether every pose logs its legs' approach directions and some leg
+    /// is approached from both sides.
+    pub approach_reverses: bool,
 }
 
 impl Frame {
@@ -335,6 +414,7 @@ impl Frame {
             order: None,
             temperature: None,
             directions: BTreeMap::new(),
+            approach_reverses: false,
         }
     }
 
@@ -432,12 +512,35 @@ impl Frame {
                 directions.insert(by_line[k + 1].line, dir);
             }
         }
+        let approach_reverses = poses.iter().all(|p| p.approach.is_some())
+            && (0..3).any(|i| {
+                let dirs: Vec<i8> = poses
+                    .iter()
+                    .filter_map(|p| p.approach.map(|a| a[i]))
+                    .collect();
+                dirs.contains(&1) && dirs.contains(&-1)
+            });
         Frame {
             leg_range_mm,
             q4_range_mm,
             order,
             temperature,
             directions,
+            approach_reverses,
+        }
+    }
+
+    /// Whether the campaign has what a term needs (and, for the context
+    /// columns, some variation in it).
+    pub fn supports(&self, needs: Needs) -> bool {
+        match needs {
+            Needs::Nothing => true,
+            Needs::Temperature => self.temperature.is_some(),
+            Needs::ApproachDirections => self.approach_reverses,
+            Needs::PoseOrder => self.order.is_some(),
+            Needs::SensorDirections => !self.directions.is_empty(),
+            Needs::LegStrokes => self.leg_range_mm.iter().all(|[lo, hi]| hi - lo > 1.0),
+            Needs::ScaleStroke => self.q4_range_mm[1] - self.q4_range_mm[0] > 1.0,
         }
     }
 
@@ -535,6 +638,6 @@ mod tests {
         let v = t.leg_values(&f, &data.poses[0]);
         assert_eq!(v.len(), 6);
         assert_eq!(t.params()[1], "leg1_cos_um");
-        assert!((v[1].1 - 1e-3).abs() < 1e-12); // cos(2 pi 700 / 10) = 1
+        assert!((v[1].2 - 1e-3).abs() < 1e-12); // cos(2 pi 700 / 10) = 1
     }
 }

@@ -17,7 +17,7 @@ mod common;
 
 use common::*;
 use tricept_diagnose::detect::detectability;
-use tricept_diagnose::{Candidate, Diagnosis, Verdict};
+use tricept_diagnose::{Diagnosis, Verdict};
 use tricept_ident::GeometricModel;
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
@@ -180,7 +180,7 @@ fn quadratic_is_named() {
         |s, _| {
             let lambda = detectability(
                 &geometric,
-                Candidate(E::LegLead),
+                E::LegLead,
                 &implied_leads(s),
                 &s.data.poses,
                 s.sigma,

@@ -13,12 +13,14 @@
 //! What is rebuilt: the base and platform joints and the leg offsets (the
 //! module's parameter set on the machine the estimates are relative to),
 //! the head (a fused calibration's `head13` estimates), and the static leg
-//! effects a diagnosis deploys (`leg-lead.leadI_ppm`,
-//! `compliance.compliance_um_per_kn_at_1m`; zero when the record names
-//! none).
+//! effects a diagnosis deploys (every effect the registry deploys into the
+//! machine's leg effects, [`tricept_model::effects::Deployment::LegEffects`],
+//! by its `effect.parameter` names in `calibration.effects`; the base
+//! machine's values for those the record does not name).
 
 use tricept_kinematics::description::CalibrationRecord;
 use tricept_kinematics::{Machine, MachineDescription};
+use tricept_model::effects::{Deployment, EffectName};
 use tricept_model::{HeadParameterSet, ParameterSet, actual_machine};
 
 /// The methods that write calibration records.
@@ -140,13 +142,15 @@ pub fn check_calibration_record(d: &MachineDescription) -> Result<(), RecordErro
         rebuilt.head = head.head_at(&p);
     }
     rebuilt.leg_effects = base.leg_effects;
-    for i in 0..3 {
-        if let Some(v) = effect(c, &format!("leg-lead.lead{}_ppm", i + 1)) {
-            rebuilt.leg_effects.lead_ppm[i] = v;
+    for e in EffectName::ALL {
+        let Deployment::LegEffects(d) = e.spec().deployment else {
+            continue;
+        };
+        for (index, p) in e.spec().parameters.iter().enumerate() {
+            if let Some(v) = effect(c, &format!("{e}.{p}")) {
+                (d.set)(&mut rebuilt.leg_effects, index, v);
+            }
         }
-    }
-    if let Some(v) = effect(c, "compliance.compliance_um_per_kn_at_1m") {
-        rebuilt.leg_effects.compliance_um_per_kn_at_1m = v;
     }
     let fields = differences(&file, &rebuilt, c);
     if fields.is_empty() {

@@ -7,6 +7,11 @@
 
 use thiserror::Error;
 
+/// Largest condition number (of the unit-free `J1`, see
+/// [`crate::FkSolution::condition`]) accepted before a configuration is
+/// declared singular. In the Table 1 workspace it stays below 20.
+pub const SINGULARITY_CONDITION_LIMIT: f64 = 1e6;
+
 /// Why a kinematic computation could not produce a trustworthy answer.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]

@@ -17,7 +17,8 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::error::KinematicsError;
-use crate::machine::{LegGeometry, Machine, SINGULARITY_CONDITION_LIMIT};
+use crate::error::SINGULARITY_CONDITION_LIMIT;
+use crate::machine::{LegGeometry, Machine};
 use crate::up_limb::UpJoints;
 
 /// Result of the forward kinematics.

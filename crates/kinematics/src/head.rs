@@ -335,7 +335,7 @@ impl Machine {
             let Some(chol) = normal.cholesky() else {
                 return Err(KinematicsError::Singular {
                     condition: f64::INFINITY,
-                    limit: crate::SINGULARITY_CONDITION_LIMIT,
+                    limit: crate::error::SINGULARITY_CONDITION_LIMIT,
                 });
             };
             let step = -chol.solve(&(jt * residual));

@@ -37,11 +37,9 @@ mod up_limb;
 mod workspace;
 
 pub use description::{AxisOrder, HeadDescription, MachineDescription, Placement};
-pub use error::{DescriptionError, KinematicsError};
+pub use error::{DescriptionError, KinematicsError, SINGULARITY_CONDITION_LIMIT};
 pub use fk::{FkSeed, FkSolution};
 pub use head::{Head, HeadBranch, ToolIkSolution, ToolPose};
-pub use machine::{
-    IkSolution, LegGeometry, Limits, Machine, SINGULARITY_CONDITION_LIMIT, SensorNoise,
-};
+pub use machine::{IkSolution, LegGeometry, Limits, Machine, SensorNoise};
 pub use up_limb::{UpJoints, UpLimb, UpLimbPose};
 pub use workspace::{MAX_POSES, PoseSet, PoseSetError, Workspace, box_lattice};

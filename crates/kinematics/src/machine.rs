@@ -169,11 +169,6 @@ pub struct Machine {
     pub leg_effects: LegEffectsDescription,
 }
 
-/// Largest condition number (of the unit-free `J1`, see
-/// [`crate::FkSolution::condition`]) accepted before a configuration is
-/// declared singular. In the Table 1 workspace it stays below 20.
-pub const SINGULARITY_CONDITION_LIMIT: f64 = 1e6;
-
 /// Limits are checked with this slack (mm or rad) so that a configuration
 /// exactly on a limit survives the rounding of an IK/FK round trip.
 const LIMIT_SLACK: f64 = 1e-9;
@@ -394,6 +389,20 @@ impl Machine {
             }
         }
         Ok(())
+    }
+}
+
+impl MachineDescription {
+    /// The validated computational form.
+    ///
+    /// # Example
+    /// ```
+    /// let m = tricept_kinematics::MachineDescription::paper().build().unwrap();
+    /// assert!((m.base_joints_mm[2].x - 288.7).abs() < 1e-12);
+    /// ```
+    pub fn build(&self) -> Result<Machine, crate::error::DescriptionError> {
+        self.validate()?;
+        Ok(Machine::from_validated(self))
     }
 }
 

@@ -314,7 +314,7 @@ impl UpLimb {
             let Some(inv) = jac.try_inverse() else {
                 return Err(KinematicsError::Singular {
                     condition: f64::INFINITY,
-                    limit: crate::SINGULARITY_CONDITION_LIMIT,
+                    limit: crate::error::SINGULARITY_CONDITION_LIMIT,
                 });
             };
             let step = -(inv * f);

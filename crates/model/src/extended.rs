@@ -1,13 +1,16 @@
 //! The machine a controller should run after a diagnosis: the exact
-//! geometry (joints, leg offsets and the class-2 U-joint and tube-twist
+//! geometry (joints, leg offsets and the class-2 U-joint and guide-rail twist
 //! errors of the description) plus the static leg effects the diagnosis
 //! named (ball-screw lead, gravity compliance), with IK and FK that apply
 //! them.
 //!
-//! For leg command `q_i` the actual leg length is
-//! `q_i + dq_i + lead_i 1e-6 q_i + c F_i q_i 1e-9` (mm), the physics of
-//! [`crate::effects`]: `lead_i` in ppm, `c` the compliance of a 1 m leg in
-//! um/kN, `F_i` the gravity tension of leg `i` in N at the pose reached.
+//! For leg command `q_i` the actual leg length is `q_i + dq_i + r_i q_i`
+//! (mm), where `r_i` sums the rates of every effect the registry deploys
+//! into the machine's leg effects
+//! ([`crate::effects::static_leg_extra_per_mm`]): today
+//! `lead_i 1e-6 + c F_i 1e-9`, `lead_i` in ppm, `c` the compliance of a 1 m
+//! leg in um/kN, `F_i` the gravity tension of leg `i` in N at the pose
+//! reached.
 //! The diagnosis and the plant simulator evaluate `F` on the nominal machine
 //! at the commands; here it is evaluated on this machine at the pose it
 //! reaches. The two differ by the geometric errors (tenths of a mm), which
@@ -25,8 +28,8 @@ use tricept_kinematics::{
 };
 
 #[cfg(test)]
-use crate::effects::{compliance_extra_mm, gravity_leg_tension_n};
-use crate::effects::{leg_lead_extra_mm, static_leg_extra_per_mm};
+use crate::effects::{compliance_extra_mm, gravity_leg_tension_n, leg_lead_extra_mm};
+use crate::effects::{pose_free_leg_extra_per_mm, static_leg_extra_per_mm};
 
 /// A [`Machine`] whose kinematics include its static leg effects
 /// ([`Machine::leg_effects`]). With no effects it is the machine itself,
@@ -135,8 +138,8 @@ impl ExtendedMachine {
         if !self.has_leg_effects() {
             return self.machine.forward(commands_mm);
         }
-        // The lead part needs no pose: start from it.
-        let first = self.machine.forward(&self.with_lead(commands_mm))?;
+        // Start from the part of the effects that needs no pose.
+        let first = self.machine.forward(&self.with_pose_free(commands_mm))?;
         self.refine(commands_mm, first)
     }
 
@@ -151,15 +154,15 @@ impl ExtendedMachine {
         }
         let first = self
             .machine
-            .forward_from(&self.with_lead(commands_mm), seed)?;
+            .forward_from(&self.with_pose_free(commands_mm), seed)?;
         self.refine(commands_mm, first)
     }
 
-    /// The commands plus their lead errors (the part of the effects that
-    /// does not depend on the pose).
-    fn with_lead(&self, commands_mm: &[f64; 3]) -> [f64; 3] {
-        let lead = self.machine.leg_effects.lead_ppm;
-        std::array::from_fn(|i| commands_mm[i] + leg_lead_extra_mm(lead[i], commands_mm[i]))
+    /// The commands plus the part of the effects that does not depend on
+    /// the pose (the lead errors).
+    fn with_pose_free(&self, commands_mm: &[f64; 3]) -> [f64; 3] {
+        let rate = pose_free_leg_extra_per_mm(&self.machine);
+        std::array::from_fn(|i| commands_mm[i] + rate[i] * commands_mm[i])
     }
 
     fn refine(
@@ -169,8 +172,8 @@ impl ExtendedMachine {
     ) -> Result<FkSolution, KinematicsError> {
         let mut sol = first;
         let mut iterations = sol.iterations;
-        let with_lead = self.with_lead(commands_mm);
-        let mut extra: [f64; 3] = std::array::from_fn(|i| with_lead[i] - commands_mm[i]);
+        let start = self.with_pose_free(commands_mm);
+        let mut extra: [f64; 3] = std::array::from_fn(|i| start[i] - commands_mm[i]);
         for _ in 0..MAX_PASSES {
             let next = self.leg_extra_mm(commands_mm, &sol.up);
             let change = (0..3)

@@ -13,10 +13,11 @@
 //!   and with the analytic Jacobian of any spindle point.
 //! - [`volumetric_errors`]: platform error maps (the paper's Fig. 3).
 //! - [`residual_mu`]: the paper's residual error `mu` (Fig. 4).
-//! - [`effects`]: the effects the geometric model leaves out (leg lead,
-//!   backlash, thermal growth, sensor errors, class-2 errors, compliance),
-//!   their names and their physics, shared by the simulator and the
-//!   diagnosis.
+//! - [`effects`]: the registry of the effects the geometric model leaves
+//!   out (leg lead, backlash, thermal growth, sensor errors, class-2
+//!   errors, compliance; one file and one spec each) and of the generic
+//!   families, their names and their physics, shared by the simulator, the
+//!   diagnosis and the fused identification.
 //!
 //! - [`ExtendedMachine`]: a calibrated machine's kinematics with the static
 //!   leg effects (lead, compliance) a diagnosis named.
@@ -29,15 +30,21 @@
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
-mod actual;
-pub mod effects;
+// Layers, bottom to top: a file imports only from its own layer or those
+// below (`xtask/tests/tidy.rs` checks it).
+// Layer 1: errors, parameters, plausible ranges
 mod error;
-mod extended;
-mod head_errors;
-mod jacobian;
 mod params;
 pub mod plausibility;
+// Layer 2: the actual machine and the linearisations
+mod actual;
+mod head_errors;
+mod jacobian;
 mod volumetric;
+// Layer 3: the effect registry
+pub mod effects;
+// Layer 4: a calibrated machine's kinematics with its effects
+mod extended;
 
 pub use actual::{actual_machine, errors_between};
 pub use error::ModelError;

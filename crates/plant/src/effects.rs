@@ -1,7 +1,10 @@
 //! How the effects of the vocabulary ([`tricept_model::effects`]) are put
-//! into a simulated machine: each [`Effect`] carries its magnitude, and the
-//! plant applies its physics to the legs, the readings, the machine's
-//! kinematics or the logged rows.
+//! into a simulated machine: each [`Effect`] carries its magnitude (in the
+//! units a machine builder quotes, not the diagnosis' parameters), maps to
+//! its name in the registry in one place ([`Effect::name`]), and the plant
+//! applies its physics to the legs, the readings, the machine's kinematics
+//! or the logged rows. Every stage matches every effect: a new one is
+//! flagged by the compiler wherever it must act.
 //!
 //! | name | magnitude |
 //! |---|---|
@@ -311,7 +314,19 @@ impl Effect {
                 offset_um,
             } => add_ujoint_axis_errors(m, *skew_arcsec, *offset_um),
             Effect::TubeTwist { arcsec_per_100mm } => add_tube_twist(m, *arcsec_per_100mm),
-            _ => {}
+            Effect::LegLead { .. }
+            | Effect::Backlash { .. }
+            | Effect::Thermal { .. }
+            | Effect::ScaleGain { .. }
+            | Effect::EncoderEccentricity { .. }
+            | Effect::Compliance { .. }
+            | Effect::LegPeriodic { .. }
+            | Effect::LegQuadratic { .. }
+            | Effect::LegPower { .. }
+            | Effect::LegStep { .. }
+            | Effect::ScaleDrift { .. }
+            | Effect::EncoderGain { .. }
+            | Effect::Outliers { .. } => {}
         }
     }
 
@@ -319,7 +334,20 @@ impl Effect {
     pub(crate) fn temperature_drift_k(&self, fraction: f64) -> f64 {
         match self {
             Effect::Thermal { drift_k, .. } => drift_k * fraction,
-            _ => 0.0,
+            Effect::LegLead { .. }
+            | Effect::Backlash { .. }
+            | Effect::ScaleGain { .. }
+            | Effect::EncoderEccentricity { .. }
+            | Effect::UjointAxes { .. }
+            | Effect::TubeTwist { .. }
+            | Effect::Compliance { .. }
+            | Effect::LegPeriodic { .. }
+            | Effect::LegQuadratic { .. }
+            | Effect::LegPower { .. }
+            | Effect::LegStep { .. }
+            | Effect::ScaleDrift { .. }
+            | Effect::EncoderGain { .. }
+            | Effect::Outliers { .. } => 0.0,
         }
     }
 
@@ -399,7 +427,13 @@ impl Effect {
                     }
                 }
             }
-            _ => {}
+            Effect::ScaleGain { .. }
+            | Effect::EncoderEccentricity { .. }
+            | Effect::UjointAxes { .. }
+            | Effect::TubeTwist { .. }
+            | Effect::ScaleDrift { .. }
+            | Effect::EncoderGain { .. }
+            | Effect::Outliers { .. } => {}
         }
     }
 
@@ -422,7 +456,17 @@ impl Effect {
                 r[0] += eccentricity_error_rad(*phi_arcsec, *phi_phase_deg, up.phi_rad);
                 r[1] += eccentricity_error_rad(*theta_arcsec, *theta_phase_deg, up.theta_rad);
             }
-            _ => {}
+            Effect::LegLead { .. }
+            | Effect::Backlash { .. }
+            | Effect::Thermal { .. }
+            | Effect::UjointAxes { .. }
+            | Effect::TubeTwist { .. }
+            | Effect::Compliance { .. }
+            | Effect::LegPeriodic { .. }
+            | Effect::LegQuadratic { .. }
+            | Effect::LegPower { .. }
+            | Effect::LegStep { .. }
+            | Effect::Outliers { .. } => {}
         }
     }
 

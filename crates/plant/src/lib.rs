@@ -27,13 +27,13 @@
 
 pub mod campaign;
 pub mod effects;
+mod error;
 pub mod instruments;
 
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 use rand_pcg::Pcg64Mcg;
-use thiserror::Error;
 use tricept_data::{Dataset, MeasuredPose, Readings};
 use tricept_kinematics::{KinematicsError, Machine, UpJoints};
 use tricept_model::{
@@ -42,28 +42,9 @@ use tricept_model::{
 
 pub use campaign::{Campaign, PoseOrder};
 pub use effects::Effect;
+pub use error::PlantError;
 pub use instruments::{Ballbar, TouchFeature, TouchProbe, TouchTarget, Tracker};
 pub use tricept_model::effects::EffectName;
-
-/// Why a simulation failed.
-#[derive(Debug, Clone, PartialEq, Error)]
-#[non_exhaustive]
-pub enum PlantError {
-    /// A target pose the nominal machine cannot reach, or an actual machine
-    /// that cannot assemble at the commands.
-    #[error("pose {} ({target_mm:?} mm): {source}", index + 1)]
-    Kinematics {
-        /// Index of the target in the campaign (0-based; shown 1-based).
-        index: usize,
-        /// The target, mm.
-        target_mm: [f64; 3],
-        /// The kinematic failure.
-        source: KinematicsError,
-    },
-    /// An inconsistent configuration.
-    #[error("invalid plant configuration: {0}")]
-    Invalid(String),
-}
 
 /// The simulated machine: nominal model, geometric errors and effects.
 #[derive(Debug, Clone)]

@@ -1,0 +1,80 @@
+//! `backlash`: lost motion of each actuated leg; the leg stops `b_i / 2`
+//! short of the command in the direction it came from (`b_i` in um).
+
+use tricept_kinematics::KinematicsError;
+use tricept_kinematics::description::ControllerDescription;
+
+use super::spec::{
+    Basis, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, Magnitude, Measure, Needs,
+    Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
+};
+
+pub(super) const SPEC: EffectSpec = EffectSpec {
+    name: "backlash",
+    physics: "lost motion: the leg stops `b_i/2` short of the command in the direction it came from",
+    quoted_in: "um per leg",
+    parameters: &[
+        Parameter {
+            name: "backlash1_um",
+            unit: "um",
+            typical: 5.0,
+        },
+        Parameter {
+            name: "backlash2_um",
+            unit: "um",
+            typical: 5.0,
+        },
+        Parameter {
+            name: "backlash3_um",
+            unit: "um",
+            typical: 5.0,
+        },
+    ],
+    kind: Kind::Leg(entries),
+    needs: Needs::ApproachDirections,
+    deployment: Deployment::Controller(set),
+    plausible: &[Judged {
+        range: PlausibleRange {
+            quantity: "backlash_um",
+            min: 0.0,
+            max: 50.0,
+            unit: "um",
+            why: "lost motion is positive: the nut lags",
+        },
+        of: &[
+            (Measure::Parameter(0), ""),
+            (Measure::Parameter(1), ""),
+            (Measure::Parameter(2), ""),
+        ],
+    }],
+    description: "lost motion of the legs",
+    plot: PlotAxes {
+        x: XAxis::LegApproach(0),
+        y: YAxis::LegResidual(0),
+    },
+    realistic: |_| {
+        vec![Magnitude {
+            values: vec![5.0, 5.0, 5.0],
+            label: "5 um",
+        }]
+    },
+    aliases: &[],
+};
+
+/// Without logged directions every leg counts as extending.
+fn entries(at: &LegContext<'_>) -> Result<Entries, KinematicsError> {
+    let dir = at.approach.unwrap_or([1, 1, 1]);
+    Ok((0..3)
+        .map(|i| (i, Basis::Leg(i), backlash_extra_mm(1.0, dir[i])))
+        .collect())
+}
+
+fn set(c: &mut ControllerDescription, index: usize, value: f64) {
+    c.backlash_um[index] = value;
+}
+
+/// Extra leg length from backlash `um` approached in direction `dir`, mm:
+/// the nut lags, so an extending leg stops short and a retracting one long.
+pub fn backlash_extra_mm(um: f64, dir: i8) -> f64 {
+    -f64::from(dir) * 0.5 * um * 1e-3
+}

@@ -1,0 +1,95 @@
+//! `encoder-eccentricity`: a once-per-revolution error `A sin(angle + psi)`
+//! of each U-joint encoder, fitted as its sine and cosine parts (arcsec).
+
+use tricept_kinematics::UpJoints;
+use tricept_kinematics::units::RAD_PER_ARCSEC;
+
+use super::spec::{
+    Basis, Deployment, EffectSpec, Entries, Judged, Kind, KnownAlias, Magnitude, Measure, Needs,
+    Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
+};
+
+const ARCSEC: Parameter = Parameter {
+    name: "",
+    unit: "arcsec",
+    typical: 5.0,
+};
+
+pub(super) const SPEC: EffectSpec = EffectSpec {
+    name: "encoder-eccentricity",
+    physics: "once-per-revolution error `A sin(angle + psi)` of each encoder",
+    quoted_in: "arcsec",
+    parameters: &[
+        Parameter {
+            name: "phi_sin_arcsec",
+            ..ARCSEC
+        },
+        Parameter {
+            name: "phi_cos_arcsec",
+            ..ARCSEC
+        },
+        Parameter {
+            name: "theta_sin_arcsec",
+            ..ARCSEC
+        },
+        Parameter {
+            name: "theta_cos_arcsec",
+            ..ARCSEC
+        },
+    ],
+    kind: Kind::Reading(entries),
+    needs: Needs::Nothing,
+    deployment: Deployment::Sensor,
+    plausible: &[Judged {
+        range: PlausibleRange {
+            quantity: "amplitude_arcsec",
+            min: 0.0,
+            max: 60.0,
+            unit: "arcsec",
+            why: "10 um of eccentricity on a 35-50 mm graduation radius",
+        },
+        of: &[
+            (Measure::Amplitude(0, 1), "eccentricity of the phi encoder"),
+            (Measure::Amplitude(2, 3), "eccentricity of the theta encoder"),
+        ],
+    }],
+    description: "once-per-revolution errors of the encoders",
+    plot: PlotAxes {
+        x: XAxis::Angle(0),
+        y: YAxis::Reading(0),
+    },
+    realistic: |_| {
+        vec![
+            Magnitude {
+                values: vec![5.0, 0.0, 5.0, 0.0],
+                label: "5 arcsec, sine phase",
+            },
+            Magnitude {
+                values: vec![0.0, 5.0, 0.0, 5.0],
+                label: "5 arcsec, cosine phase",
+            },
+        ]
+    },
+    aliases: &[KnownAlias {
+        with: "encoder-gain",
+        why: "over the encoders' small angles (|angle| < 0.6 rad) a gain error and the sine part of an eccentricity are nearly the same curve",
+        separate_by: "an external angle reference (autocollimator or inclinometer) at about +-30 deg of the U joint",
+    }],
+};
+
+fn entries(up: &UpJoints) -> Entries {
+    let a = RAD_PER_ARCSEC;
+    let (sp, cp) = up.phi_rad.sin_cos();
+    let (st, ct) = up.theta_rad.sin_cos();
+    vec![
+        (0, Basis::Reading(0), a * sp),
+        (1, Basis::Reading(0), a * cp),
+        (2, Basis::Reading(1), a * st),
+        (3, Basis::Reading(1), a * ct),
+    ]
+}
+
+/// Once-per-revolution encoder error at `angle_rad`, rad.
+pub fn eccentricity_error_rad(amplitude_arcsec: f64, phase_deg: f64, angle_rad: f64) -> f64 {
+    amplitude_arcsec * RAD_PER_ARCSEC * (angle_rad + phase_deg.to_radians()).sin()
+}

@@ -1,0 +1,58 @@
+//! `scale-gain`: the UP limb's linear scale reads `(1 + g) q4` (`g` in
+//! ppm).
+
+use tricept_kinematics::UpJoints;
+
+use super::spec::{
+    Basis, Deployment, EffectSpec, Entries, Judged, Kind, KnownAlias, Magnitude, Measure, Needs,
+    Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
+};
+
+pub(super) const SPEC: EffectSpec = EffectSpec {
+    name: "scale-gain",
+    physics: "the linear scale reads `(1 + g) q4`",
+    quoted_in: "ppm",
+    parameters: &[Parameter {
+        name: "scale_gain_ppm",
+        unit: "ppm",
+        typical: 100.0,
+    }],
+    kind: Kind::Reading(entries),
+    needs: Needs::Nothing,
+    deployment: Deployment::Sensor,
+    plausible: &[Judged {
+        range: PlausibleRange {
+            quantity: "scale_gain_ppm",
+            min: -300.0,
+            max: 300.0,
+            unit: "ppm",
+            why: "glass scales and their mounting",
+        },
+        of: &[(Measure::Parameter(0), "")],
+    }],
+    description: "gain error of the linear scale",
+    plot: PlotAxes {
+        x: XAxis::Extension,
+        y: YAxis::ScaleResidual,
+    },
+    realistic: |_| {
+        vec![Magnitude {
+            values: vec![50.0],
+            label: "50 ppm",
+        }]
+    },
+    aliases: &[KnownAlias {
+        with: "leg-lead",
+        why: "a scale gain g reads exactly like the machine scaled by 1 + g with a lead g on every leg",
+        separate_by: "one external length: a laser interferometer or gauge-block measurement of the UP-limb stroke or of one platform displacement fixes the gain; the machine's own sensors never can",
+    }],
+};
+
+fn entries(up: &UpJoints) -> Entries {
+    vec![(0, Basis::Reading(2), scale_gain_error_mm(1.0, up.q4_mm))]
+}
+
+/// Reading error of a scale with gain error `ppm` at extension `q4_mm`, mm.
+pub fn scale_gain_error_mm(ppm: f64, q4_mm: f64) -> f64 {
+    ppm * 1e-6 * q4_mm
+}

@@ -1,0 +1,72 @@
+//! `tube-twist`: twisted guide rails of the UP limb turn the platform about
+//! the limb axis as it extends, a class-2 error of its kinematics.
+
+use tricept_kinematics::Machine;
+use tricept_kinematics::units::RAD_PER_ARCSEC;
+
+use super::spec::{
+    Deployment, EffectSpec, Judged, Kind, Magnitude, Measure, Needs, Parameter, PlausibleRange,
+    PlotAxes, XAxis, YAxis,
+};
+
+pub(super) const SPEC: EffectSpec = EffectSpec {
+    name: "tube-twist",
+    physics: "twisted guide rails turn the platform about the limb axis as it extends",
+    quoted_in: "arcsec per 100 mm",
+    parameters: &[Parameter {
+        name: "twist_arcsec_per_100mm",
+        unit: "arcsec per 100 mm",
+        typical: 10.0,
+    }],
+    kind: Kind::Kinematic(apply),
+    needs: Needs::Nothing,
+    deployment: Deployment::UpLimb,
+    plausible: &[Judged {
+        range: PlausibleRange {
+            quantity: "twist_arcsec_per_100mm",
+            min: -50.0,
+            max: 50.0,
+            unit: "arcsec per 100 mm",
+            why: "guide-rail twist tolerances (150 arcsec over the stroke)",
+        },
+        of: &[(Measure::Parameter(0), "")],
+    }],
+    description: "the platform twists about the UP limb as it extends",
+    plot: PlotAxes {
+        x: XAxis::Extension,
+        y: YAxis::LegResidual(0),
+    },
+    realistic: |_| {
+        vec![Magnitude {
+            values: vec![30.0 / 2.9],
+            label: "30 arcsec over the stroke",
+        }]
+    },
+    aliases: &[],
+};
+
+fn apply(machine: &mut Machine, p: &[f64]) {
+    add_tube_twist(machine, p[0]);
+}
+
+/// Adds a twist of the UP limb's guide rails to `machine` (class 2): the
+/// platform turns about the limb axis by `arcsec_per_100mm` per 100 mm of
+/// extension from [`twist_reference_mm`].
+///
+/// # Example
+/// ```
+/// use tricept_kinematics::Machine;
+/// let mut m = Machine::paper();
+/// tricept_model::effects::add_tube_twist(&mut m, 30.0);
+/// assert_eq!(m.up_limb.twist_reference_mm, 750.0);
+/// ```
+pub fn add_tube_twist(machine: &mut Machine, arcsec_per_100mm: f64) {
+    machine.up_limb.twist_rad_per_mm += arcsec_per_100mm * RAD_PER_ARCSEC / 100.0;
+    machine.up_limb.twist_reference_mm = twist_reference_mm(machine);
+}
+
+/// Extension at which the tube twist is zero: the UP limb length at the
+/// workspace's middle plane on the axis.
+pub fn twist_reference_mm(machine: &Machine) -> f64 {
+    machine.workspace.mid_plane_z_mm()
+}

@@ -1,0 +1,671 @@
+//! Tidy checks of the workspace's structure, in the spirit of
+//! rust-analyzer's tidy tests: the import graph between the files of every
+//! crate (`crates/*/src`, `xtask/src`, `examples/*/src`, `fuzz/src`).
+//!
+//! - **Layers.** A crate root may declare layers: `// Layer N: job` comment
+//!   lines in `lib.rs`, each followed by the `mod` declarations of its
+//!   layer, bottom (1) to top. A file imports only from its own layer or
+//!   those below: any `crate::` (or `super::`, or child) path that runs
+//!   upward fails, and every module must be in a layer.
+//! - **No circles.** No two files of a crate import each other, directly
+//!   or through others, except the pairs listed in [`ALLOWED_CIRCLES`].
+//!
+//! An edge is a path in a file's code outside its tests (`#[cfg(test)]`
+//! items) that resolves to another file's module; a path to an item that a
+//! module re-exports from a child (`pub use child::Item`) resolves to the
+//! child. A module's re-export of its own children is its facade, not a
+//! dependency. Paths that macros build are not seen.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// Circles that may stay: `(crate directory, files)`, with why.
+const ALLOWED_CIRCLES: &[(&str, &[&str])] = &[
+    // One type's impl split over two files: the 2-DOF head's methods of
+    // `Machine` live beside the head.
+    ("crates/kinematics", &["head", "machine"]),
+    // Phase 2 of issue 19 (after issue 18): `merge` and `FusionOptions`
+    // move out of `estimate.rs`, and `IdentifyArgs` stops flattening
+    // `fusion_cmd::ExternalArgs` while `fusion_cmd::run` takes it.
+    ("crates/ident", &["fusion::estimate", "fusion::report"]),
+    ("crates/cli", &["fusion_cmd", "ident_cmd"]),
+];
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default()
+}
+
+/// The source directories checked, relative to the workspace.
+fn source_dirs(root: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for parent in ["crates", "examples"] {
+        let Ok(entries) = std::fs::read_dir(root.join(parent)) else {
+            continue;
+        };
+        let mut dirs: Vec<PathBuf> = entries
+            .filter_map(|e| e.ok().map(|e| e.path().join("src")))
+            .filter(|p| p.is_dir())
+            .collect();
+        dirs.sort();
+        out.extend(dirs);
+    }
+    out.push(root.join("xtask/src"));
+    out.push(root.join("fuzz/src"));
+    out.into_iter().filter(|p| p.is_dir()).collect()
+}
+
+/// A module: its path below the crate root (`["fusion", "estimate"]`).
+type Module = Vec<String>;
+
+fn label(m: &Module) -> String {
+    if m.is_empty() {
+        "(root)".into()
+    } else {
+        m.join("::")
+    }
+}
+
+/// Every `.rs` file of `src` with its module path.
+fn modules(src: &Path) -> BTreeMap<Module, PathBuf> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            return;
+        };
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                out.push(p);
+            }
+        }
+    }
+    let mut files = Vec::new();
+    walk(src, &mut files);
+    let mut out = BTreeMap::new();
+    for f in files {
+        let Ok(rel) = f.strip_prefix(src) else {
+            continue;
+        };
+        let mut parts: Module = rel
+            .iter()
+            .map(|s| s.to_string_lossy().trim_end_matches(".rs").to_string())
+            .collect();
+        if parts.last().is_some_and(|l| l == "mod") {
+            parts.pop();
+        }
+        if parts.len() == 1 && (parts[0] == "lib" || parts[0] == "main") {
+            parts.clear();
+        }
+        out.insert(parts, f);
+    }
+    out
+}
+
+/// The code of a file without comments, string and character literals
+/// (each replaced by a space, so that nothing inside them reads as a
+/// path).
+fn strip(text: &str) -> String {
+    let c: Vec<char> = text.chars().collect();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < c.len() {
+        let next = c.get(i + 1).copied();
+        if c[i] == '/' && next == Some('/') {
+            while i < c.len() && c[i] != '\n' {
+                i += 1;
+            }
+        } else if c[i] == '/' && next == Some('*') {
+            let mut depth = 0;
+            while i < c.len() {
+                if c[i] == '/' && c.get(i + 1) == Some(&'*') {
+                    depth += 1;
+                    i += 2;
+                } else if c[i] == '*' && c.get(i + 1) == Some(&'/') {
+                    depth -= 1;
+                    i += 2;
+                    if depth == 0 {
+                        break;
+                    }
+                } else {
+                    i += 1;
+                }
+            }
+            out.push(' ');
+        } else if c[i] == 'r' && (next == Some('#') || next == Some('"')) && !ident_before(&c, i) {
+            // A raw string: r"..." or r#"..."#.
+            let mut j = i + 1;
+            let mut hashes = 0;
+            while c.get(j) == Some(&'#') {
+                hashes += 1;
+                j += 1;
+            }
+            if c.get(j) != Some(&'"') {
+                out.push(c[i]);
+                i += 1;
+                continue;
+            }
+            j += 1;
+            while j < c.len() {
+                if c[j] == '"' && (0..hashes).all(|h| c.get(j + 1 + h) == Some(&'#')) {
+                    j += 1 + hashes;
+                    break;
+                }
+                j += 1;
+            }
+            i = j;
+            out.push(' ');
+        } else if c[i] == '"' {
+            i += 1;
+            while i < c.len() && c[i] != '"' {
+                if c[i] == '\\' {
+                    i += 1;
+                }
+                i += 1;
+            }
+            i += 1;
+            out.push(' ');
+        } else if c[i] == '\'' {
+            // A character literal ('x', '\n', '\u{..}') or a lifetime.
+            if next == Some('\\') {
+                let mut j = i + 2;
+                while j < c.len() && c[j] != '\'' {
+                    j += 1;
+                }
+                i = j + 1;
+                out.push(' ');
+            } else if c.get(i + 2) == Some(&'\'') {
+                i += 3;
+                out.push(' ');
+            } else {
+                out.push(c[i]);
+                i += 1;
+            }
+        } else {
+            out.push(c[i]);
+            i += 1;
+        }
+    }
+    out
+}
+
+fn ident_before(c: &[char], i: usize) -> bool {
+    i > 0 && (c[i - 1].is_alphanumeric() || c[i - 1] == '_')
+}
+
+/// The code without the items under `#[cfg(test)]` (a test module, a
+/// test-only `use`).
+fn without_tests(code: &str) -> String {
+    let mut out = String::new();
+    let mut rest = code;
+    while let Some(at) = rest.find("#[cfg(test)]") {
+        out.push_str(&rest[..at]);
+        let after = &rest[at + "#[cfg(test)]".len()..];
+        // The item ends at its first `;` outside braces, or its closing
+        // brace.
+        let mut depth = 0usize;
+        let mut end = after.len();
+        for (k, ch) in after.char_indices() {
+            match ch {
+                '{' => depth += 1,
+                '}' => {
+                    depth = depth.saturating_sub(1);
+                    if depth == 0 {
+                        end = k + 1;
+                        break;
+                    }
+                }
+                ';' if depth == 0 => {
+                    end = k + 1;
+                    break;
+                }
+                _ => {}
+            }
+        }
+        rest = &after[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// A path found in a file: whether it is a re-export (`pub use`), and
+/// whether the file's own code uses the name it re-exports.
+struct Found {
+    path: Vec<String>,
+    reexport: bool,
+    used: bool,
+}
+
+/// Splits a use tree (`crate::{a::B, c::*}`) into its paths.
+fn expand(tree: &str) -> Vec<Vec<String>> {
+    let tree = tree.trim();
+    if let Some(inner) = tree.strip_prefix('{') {
+        let inner = inner.strip_suffix('}').unwrap_or(inner);
+        let mut parts = Vec::new();
+        let (mut depth, mut start) = (0usize, 0usize);
+        for (k, ch) in inner.char_indices() {
+            match ch {
+                '{' => depth += 1,
+                '}' => depth = depth.saturating_sub(1),
+                ',' if depth == 0 => {
+                    parts.push(&inner[start..k]);
+                    start = k + 1;
+                }
+                _ => {}
+            }
+        }
+        parts.push(&inner[start..]);
+        return parts
+            .into_iter()
+            .filter(|p| !p.trim().is_empty())
+            .flat_map(expand)
+            .collect();
+    }
+    match tree.find("::") {
+        Some(k) => {
+            let head = tree[..k].trim().to_string();
+            expand(&tree[k + 2..])
+                .into_iter()
+                .map(|mut t| {
+                    t.insert(0, head.clone());
+                    t
+                })
+                .collect()
+        }
+        None => {
+            let name = tree.split(" as ").next().unwrap_or("").trim().to_string();
+            vec![vec![name]]
+        }
+    }
+}
+
+fn is_ident(ch: char) -> bool {
+    ch.is_alphanumeric() || ch == '_'
+}
+
+/// Every `use` path and every `a::b` path in the code. A re-export whose
+/// name the module's own code uses is a dependency too.
+fn paths(code: &str) -> Vec<Found> {
+    let mut out = Vec::new();
+    let mut rest = String::new();
+    // Use statements first (blanked out of the code scanned for inline
+    // paths).
+    let mut i = 0;
+    while let Some(ch) = code[i..].chars().next() {
+        let at_word = !code[..i].chars().next_back().is_some_and(is_ident);
+        if at_word && code[i..].starts_with("use ") {
+            let end = code[i..].find(';').map_or(code.len(), |e| i + e);
+            let before = code[..i].trim_end();
+            let reexport = before.ends_with("pub") || before.ends_with(')');
+            for path in expand(&code[i + 4..end]) {
+                out.push(Found {
+                    path,
+                    reexport,
+                    used: !reexport,
+                });
+            }
+            rest.push(' ');
+            i = (end + 1).min(code.len());
+        } else {
+            rest.push(ch);
+            i += ch.len_utf8();
+        }
+    }
+    // Inline paths: runs of `ident::ident::...`; and the words of the code.
+    let mut words = BTreeSet::new();
+    let chars: Vec<char> = rest.chars().collect();
+    let mut k = 0;
+    while k < chars.len() {
+        if is_ident(chars[k]) && (k == 0 || !(is_ident(chars[k - 1]) || chars[k - 1] == ':')) {
+            let mut segments = Vec::new();
+            let mut j = k;
+            loop {
+                let start = j;
+                while j < chars.len() && is_ident(chars[j]) {
+                    j += 1;
+                }
+                segments.push(chars[start..j].iter().collect::<String>());
+                if chars.get(j) == Some(&':') && chars.get(j + 1) == Some(&':') {
+                    j += 2;
+                    if chars.get(j).is_some_and(|c| is_ident(*c)) {
+                        continue;
+                    }
+                }
+                break;
+            }
+            if segments.len() > 1 {
+                out.push(Found {
+                    path: segments,
+                    reexport: false,
+                    used: true,
+                });
+            } else {
+                words.insert(segments.remove(0));
+            }
+            k = j.max(k + 1);
+        } else {
+            k += 1;
+        }
+    }
+    for f in out.iter_mut().filter(|f| f.reexport) {
+        f.used = f.path.last().is_some_and(|name| words.contains(name));
+    }
+    out
+}
+
+/// A crate's files, what each re-exports from its children, and the
+/// edges between them.
+struct Graph {
+    modules: BTreeMap<Module, PathBuf>,
+    edges: BTreeMap<Module, BTreeSet<Module>>,
+}
+
+fn graph(src: &Path) -> Graph {
+    let modules = modules(src);
+    let mut found: BTreeMap<Module, Vec<Found>> = BTreeMap::new();
+    for (m, file) in &modules {
+        let text = std::fs::read_to_string(file).unwrap_or_default();
+        found.insert(m.clone(), paths(&without_tests(&strip(&text))));
+    }
+    // Items each module re-exports from a child: name -> child.
+    let mut reexports: BTreeMap<Module, BTreeMap<String, Module>> = BTreeMap::new();
+    for (m, list) in &found {
+        for f in list.iter().filter(|f| f.reexport) {
+            let mut target = m.clone();
+            let mut p = f.path.as_slice();
+            if p.first().is_some_and(|s| s == "self") {
+                p = &p[1..];
+            }
+            let mut child = target.clone();
+            child.extend(p.first().cloned());
+            if p.len() < 2 || !modules.contains_key(&child) {
+                continue;
+            }
+            target = child;
+            if let Some(name) = p.last() {
+                reexports
+                    .entry(m.clone())
+                    .or_default()
+                    .insert(name.clone(), target);
+            }
+        }
+    }
+    let resolve = |from: &Module, path: &[String]| -> Option<Module> {
+        let mut at: Module;
+        let mut p = path;
+        match p.first().map(String::as_str) {
+            Some("crate") => {
+                at = Vec::new();
+                p = &p[1..];
+            }
+            Some("super") => {
+                at = from.clone();
+                while p.first().is_some_and(|s| s == "super") {
+                    at.pop()?;
+                    p = &p[1..];
+                }
+            }
+            Some("self") => {
+                at = from.clone();
+                p = &p[1..];
+            }
+            Some(first) => {
+                // A path relative to the module: a child module's only.
+                let mut child = from.clone();
+                child.push(first.to_string());
+                if !modules.contains_key(&child) {
+                    return None;
+                }
+                at = from.clone();
+            }
+            None => return None,
+        }
+        for s in p {
+            let mut child = at.clone();
+            child.push(s.clone());
+            if modules.contains_key(&child) {
+                at = child;
+                continue;
+            }
+            // An item: through the module's re-exports to its file.
+            while let Some(target) = reexports.get(&at).and_then(|r| r.get(s)) {
+                if *target == at {
+                    break;
+                }
+                at = target.clone();
+            }
+            break;
+        }
+        Some(at)
+    };
+    let mut edges: BTreeMap<Module, BTreeSet<Module>> = BTreeMap::new();
+    for (m, list) in &found {
+        for f in list {
+            let Some(target) = resolve(m, &f.path) else {
+                continue;
+            };
+            // A facade re-exporting its own children.
+            let own_child = target.len() > m.len() && target.starts_with(m);
+            if target == *m || (f.reexport && !f.used && own_child) {
+                continue;
+            }
+            edges.entry(m.clone()).or_default().insert(target);
+        }
+    }
+    Graph { modules, edges }
+}
+
+/// Strongly connected components with more than one module.
+fn circles(g: &Graph) -> Vec<BTreeSet<Module>> {
+    struct State<'a> {
+        g: &'a Graph,
+        index: BTreeMap<Module, usize>,
+        low: BTreeMap<Module, usize>,
+        stack: Vec<Module>,
+        on: BTreeSet<Module>,
+        out: Vec<BTreeSet<Module>>,
+    }
+    fn visit(s: &mut State<'_>, v: &Module) {
+        let i = s.index.len();
+        s.index.insert(v.clone(), i);
+        s.low.insert(v.clone(), i);
+        s.stack.push(v.clone());
+        s.on.insert(v.clone());
+        let next: Vec<Module> = s.g.edges.get(v).into_iter().flatten().cloned().collect();
+        for w in next {
+            if !s.index.contains_key(&w) {
+                visit(s, &w);
+                let lw = s.low[&w];
+                let lv = s.low.get_mut(v).map_or(0, |x| {
+                    *x = (*x).min(lw);
+                    *x
+                });
+                let _ = lv;
+            } else if s.on.contains(&w) {
+                let iw = s.index[&w];
+                if let Some(x) = s.low.get_mut(v) {
+                    *x = (*x).min(iw);
+                }
+            }
+        }
+        if s.low[v] == s.index[v] {
+            let mut comp = BTreeSet::new();
+            while let Some(w) = s.stack.pop() {
+                s.on.remove(&w);
+                let done = w == *v;
+                comp.insert(w);
+                if done {
+                    break;
+                }
+            }
+            if comp.len() > 1 {
+                s.out.push(comp);
+            }
+        }
+    }
+    let mut s = State {
+        g,
+        index: BTreeMap::new(),
+        low: BTreeMap::new(),
+        stack: Vec::new(),
+        on: BTreeSet::new(),
+        out: Vec::new(),
+    };
+    for v in g.modules.keys() {
+        if !s.index.contains_key(v) {
+            visit(&mut s, v);
+        }
+    }
+    s.out
+}
+
+/// The layers a crate root declares: top-level module -> (layer, job).
+fn layers(root_file: &Path) -> BTreeMap<String, (usize, String)> {
+    let text = std::fs::read_to_string(root_file).unwrap_or_default();
+    let mut out = BTreeMap::new();
+    let mut current: Option<(usize, String)> = None;
+    for line in text.lines() {
+        let line = line.trim();
+        if let Some(rest) = line.strip_prefix("// Layer ") {
+            let (n, job) = rest.split_once(':').unwrap_or((rest, ""));
+            current = n.trim().parse().ok().map(|n| (n, job.trim().to_string()));
+            continue;
+        }
+        let decl = line
+            .strip_prefix("pub mod ")
+            .or_else(|| line.strip_prefix("pub(crate) mod "))
+            .or_else(|| line.strip_prefix("mod "));
+        if let (Some(name), Some(layer)) = (decl.and_then(|d| d.strip_suffix(';')), &current) {
+            out.insert(name.trim().to_string(), layer.clone());
+        }
+    }
+    out
+}
+
+fn relative(root: &Path, p: &Path) -> String {
+    p.strip_prefix(root).unwrap_or(p).display().to_string()
+}
+
+#[test]
+fn no_import_runs_up_a_crate_s_layers() {
+    let root = workspace();
+    let mut problems = Vec::new();
+    let mut layered = 0;
+    for src in source_dirs(&root) {
+        let declared = layers(&src.join("lib.rs"));
+        if declared.is_empty() {
+            continue;
+        }
+        layered += 1;
+        let g = graph(&src);
+        let layer_of = |m: &Module| m.first().and_then(|top| declared.get(top));
+        for m in g.modules.keys().filter(|m| !m.is_empty()) {
+            if layer_of(m).is_none() {
+                problems.push(format!(
+                    "{}: module `{}` is in no layer of its crate's lib.rs",
+                    relative(&root, &src),
+                    label(m)
+                ));
+            }
+        }
+        for (from, targets) in &g.edges {
+            let Some((lf, jf)) = layer_of(from) else {
+                continue;
+            };
+            for to in targets {
+                // The crate root is the top: its items are not below anyone.
+                let upward = match layer_of(to) {
+                    Some((lt, jt)) if lt > lf => Some(format!("layer {lt}, {jt}")),
+                    Some(_) => None,
+                    None => Some("the crate root".to_string()),
+                };
+                if let Some(up) = upward {
+                    problems.push(format!(
+                        "{}: `{}` (layer {lf}, {jf}) imports `{}` ({up}): upward",
+                        relative(&root, &src),
+                        label(from),
+                        label(to)
+                    ));
+                }
+            }
+        }
+    }
+    assert!(layered >= 2, "the layered crates were not found");
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+#[test]
+fn no_import_circles_between_files() {
+    let root = workspace();
+    let mut problems = Vec::new();
+    let mut allowed_seen = BTreeSet::new();
+    for src in source_dirs(&root) {
+        let g = graph(&src);
+        let krate = relative(&root, src.parent().unwrap_or(&src));
+        for circle in circles(&g) {
+            let names: BTreeSet<String> = circle.iter().map(label).collect();
+            let allowed = ALLOWED_CIRCLES.iter().position(|(c, files)| {
+                *c == krate && files.iter().map(|f| f.to_string()).collect::<BTreeSet<_>>() == names
+            });
+            if let Some(i) = allowed {
+                allowed_seen.insert(i);
+                continue;
+            }
+            let edges: Vec<String> = circle
+                .iter()
+                .flat_map(|a| {
+                    g.edges
+                        .get(a)
+                        .into_iter()
+                        .flatten()
+                        .filter(|b| circle.contains(*b))
+                        .map(move |b| format!("{} -> {}", label(a), label(b)))
+                })
+                .collect();
+            problems.push(format!("{krate}: import circle: {}", edges.join(", ")));
+        }
+    }
+    // An allowed circle that is gone leaves the list.
+    for (i, (krate, files)) in ALLOWED_CIRCLES.iter().enumerate() {
+        if !allowed_seen.contains(&i) {
+            problems.push(format!(
+                "{krate}: the allowed circle {files:?} is gone: remove it from ALLOWED_CIRCLES"
+            ));
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// The parser itself: paths in use trees, inline paths, strings and
+/// comments ignored, tests cut.
+#[test]
+fn the_parser_reads_paths() {
+    let code = r#"
+use crate::{a::B, c::{d::E, F as G}};
+pub use child::Thing;
+// use crate::commented::Out;
+fn f() { let s = "crate::in_string::X"; crate::inline::call(); 'a'; }
+#[cfg(test)]
+mod tests { use crate::only_tests::T; }
+"#;
+    let found: Vec<(String, bool)> = paths(&without_tests(&strip(code)))
+        .into_iter()
+        .map(|f| (f.path.join("::"), f.reexport))
+        .collect();
+    let want = [
+        ("crate::a::B", false),
+        ("crate::c::d::E", false),
+        ("crate::c::F", false),
+        ("child::Thing", true),
+        ("crate::inline::call", false),
+    ];
+    for (p, r) in want {
+        assert!(found.contains(&(p.to_string(), r)), "{p}: {found:?}");
+    }
+    assert!(!found.iter().any(|(p, _)| p.contains("commented")
+        || p.contains("in_string")
+        || p.contains("only_tests")));
+}
