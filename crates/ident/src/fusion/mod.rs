@@ -42,7 +42,7 @@ pub use estimate::{
     DesignRows, FusionOptions, design_rows, evaluation_poses, head_angle_poses, identify_fused,
     information, information_factor,
 };
-pub use model::{FUSABLE_EFFECTS, FusedModel};
+pub use model::{FusedModel, fusable_effects};
 pub use plausibility::{FusionPlausibility, HEAD_RANGE_TYPICAL_SIZES, Implausible};
 pub use report::{
     FusionReport, HARMLESS_AXIS_ARCSEC, MadeVisible, NamedQuantity, SourceVisibility, TipImpact,
