@@ -25,7 +25,8 @@
 
 use serde::Serialize;
 
-use crate::fusion::estimate::{FusionOptions, fit_masked};
+use crate::fusion::estimate::fit_masked;
+use crate::fusion::options::FusionOptions;
 use crate::fusion::model::FusedModel;
 use crate::fusion::result::Fusion;
 use crate::fusion::source::{Source, SourceKind};

@@ -27,7 +27,9 @@
 mod ballbar;
 mod causes;
 mod estimate;
+mod design;
 mod model;
+mod options;
 mod plausibility;
 mod report;
 mod result;
@@ -38,10 +40,9 @@ mod tracker;
 
 pub use ballbar::BallbarOptions;
 pub use causes::FusionCause;
-pub use estimate::{
-    DesignRows, FusionOptions, design_rows, evaluation_poses, head_angle_poses, identify_fused,
-    information, information_factor,
-};
+pub use design::{DesignRows, design_rows, information, information_factor};
+pub use estimate::identify_fused;
+pub use options::{FusionOptions, ScreenOptions, evaluation_poses, head_angle_poses};
 pub use model::{FusedModel, fusable_effects};
 pub use plausibility::{FusionPlausibility, HEAD_RANGE_TYPICAL_SIZES, Implausible};
 pub use report::{
@@ -49,7 +50,7 @@ pub use report::{
     ToolAxisPrediction, ToolTipPrediction,
 };
 pub use result::{Fusion, FusionVerdict, SourceFit};
-pub use screen::{RejectedRecord, ScreenOptions};
+pub use screen::RejectedRecord;
 pub use source::{Source, SourceKind};
 pub use touch::TouchOptions;
 pub use tracker::{TrackerOptions, TrackerTarget};

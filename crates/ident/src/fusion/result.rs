@@ -11,7 +11,7 @@ use serde_json::{Map, Value, json};
 use tricept_numerics::stats::chi2_sf;
 
 use crate::fusion::causes::FusionCause;
-use crate::fusion::estimate::FusionOptions;
+use crate::fusion::options::FusionOptions;
 use crate::fusion::model::FusedModel;
 use crate::fusion::plausibility::{FusionPlausibility, Implausible};
 use crate::fusion::report::FusionReport;

@@ -30,31 +30,13 @@ use tricept_numerics::stats::{chi2_isf, quantile};
 
 use crate::error::IdentError;
 use crate::fusion::estimate::{
-    Evaluation, FusionOptions, check_counts, fit_masked, fit_started, nuisance_layout, start,
+    Evaluation, check_counts, fit_masked, fit_started, nuisance_layout, start,
 };
+use crate::fusion::options::{FusionOptions, ScreenOptions};
 use crate::fusion::model::FusedModel;
 use crate::fusion::result::{Fusion, RecordCheck, SourceFit};
 use crate::fusion::source::Source;
 use crate::robust::start_set;
-
-/// Settings of the gross-error screen.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ScreenOptions {
-    /// Family-wise level of the test per source.
-    pub alpha: f64,
-    /// Largest share of a source's records that may be rejected.
-    pub max_share: f64,
-}
-
-impl Default for ScreenOptions {
-    /// Level 0.001, at most 10 % of the records (as `identify`).
-    fn default() -> Self {
-        ScreenOptions {
-            alpha: 1e-3,
-            max_share: 0.1,
-        }
-    }
-}
 
 /// A record the screen rejected.
 #[derive(Debug, Clone, PartialEq, Serialize)]
