@@ -83,6 +83,7 @@ const fn range(
         max,
         unit,
         why,
+        if_negated: "",
     }
 }
 
