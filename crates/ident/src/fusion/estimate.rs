@@ -15,13 +15,11 @@
 //! With one internal source and no head or effects this is exactly
 //! [`crate::identify`] (bit for bit; tested).
 //!
-//! [`identify_fused`] wraps the fit: the gross-error screen
-//! ([`crate::fusion::ScreenOptions`], `screen.rs`) decides which records
-//! enter it, each fit ends with every source's redundancy (its degrees of
-//! freedom: `sum (1 - h_ii)` over its rows, `h` the hat matrix of the
-//! union), the deleted residual of every record and the verdict; an
-//! implausible or unexplained fit is handed to the likely-cause search
-//! (`causes.rs`).
+//! Each fit ends with every source's redundancy (its degrees of freedom:
+//! `sum (1 - h_ii)` over its rows, `h` the hat matrix of the union), the
+//! deleted residual of every record and the verdict
+//! ([`crate::fusion::identify_fused`] wraps it in the screen and the
+//! likely-cause search).
 
 use faer::Mat;
 use nalgebra::{DMatrix, DVector};
@@ -32,9 +30,9 @@ use tricept_numerics::lsq::{HatFactor, RankDecision, ReducedProblem, Solution};
 
 use crate::error::IdentError;
 use crate::fusion::model::{FusedModel, LegContext};
+use crate::fusion::options::FusionOptions;
 use crate::fusion::report::build_report;
 use crate::fusion::result::{Fusion, RecordCheck, SourceFit, judge};
-use crate::fusion::options::FusionOptions;
 use crate::fusion::source::{KeptRows, Nuisance, Sink, Source};
 use crate::gauss_newton::{Iteration, Run, iterate};
 use crate::report::IdentifiabilityReport;
@@ -162,61 +160,6 @@ pub(crate) fn in_source(source: &Source, e: IdentError) -> IdentError {
         },
         e => e,
     }
-}
-
-/// Fits the parameters of `model` and every source's nuisance to all
-/// sources at once (see the module docs): the gross-error screen of
-/// `options.screen` decides which records enter the fit, the fit is judged
-/// (redundancy, adequacy, plausibility) and an implausible or unexplained
-/// one is searched for its likely cause.
-///
-/// # Example
-/// ```
-/// use tricept_ident::fusion::{FusedModel, FusionOptions, Source, identify_fused};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let m = Machine::paper();
-/// let set = ParameterSet::paper15();
-/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
-///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
-///     .unwrap();
-/// // The internal data alone, head in the model: the head is invisible.
-/// let model = FusedModel::new(m.clone(), set, &[], true).unwrap();
-/// let fit = identify_fused(&model, &[Source::internal(&data, m.sensors.logged_sigma())],
-///     &FusionOptions::for_machine(&m)).unwrap();
-/// assert_eq!(fit.report.union.rank, 14);
-/// assert!(fit.report.union.fixed.contains(&"tool_length_mm".to_string()));
-/// assert!(fit.sources[0].checkable && fit.rejected.is_empty());
-/// ```
-pub fn identify_fused(
-    model: &FusedModel,
-    sources: &[Source],
-    options: &FusionOptions,
-) -> Result<Fusion, IdentError> {
-    if sources.is_empty() {
-        return Err(IdentError::Invalid("no data source".into()));
-    }
-    for (s, a) in sources.iter().enumerate() {
-        if sources[..s].iter().any(|b| b.label() == a.label()) {
-            return Err(IdentError::Invalid(format!(
-                "two sources are labelled `{}`: label them apart (Source::with_label)",
-                a.label()
-            )));
-        }
-    }
-    let (active, mut fit) = match &options.screen {
-        Some(screen) => crate::fusion::screen::screened_fit(model, sources, options, screen)?,
-        None => {
-            let active: Vec<Vec<bool>> = sources.iter().map(|s| vec![true; s.records()]).collect();
-            let fit = fit_masked(model, sources, &active, options)?;
-            (active, fit)
-        }
-    };
-    if options.likely_causes && fit.needs_causes() {
-        let causes = crate::fusion::causes::likely_causes(model, sources, &active, options, &fit);
-        fit.add_causes(causes);
-    }
-    Ok(fit)
 }
 
 /// One fit of `model` to the records of `sources` marked in `active`, judged

@@ -18,10 +18,10 @@
 use std::collections::BTreeMap;
 
 use serde::Serialize;
+use tricept_model::effects::Measure;
 use tricept_model::plausibility::{
     PlausibilityError, Range, insert_range, override_ranges, round3,
 };
-use tricept_model::effects::Measure;
 use tricept_model::{HEAD13_NAMES, TYPICAL_HEAD_ERRORS};
 
 use crate::fusion::model::{FusedModel, fusable_effects};

@@ -36,8 +36,8 @@ use tricept_model::Effector;
 use tricept_numerics::lsq::{RankDecision, ReducedProblem};
 
 use crate::error::IdentError;
-use crate::fusion::options::FusionOptions;
 use crate::fusion::model::FusedModel;
+use crate::fusion::options::FusionOptions;
 use crate::fusion::source::{Source, SourceKind};
 use crate::report::{Combination, IdentifiabilityReport, NamedValues, combination};
 
