@@ -24,9 +24,6 @@ const ALLOWED_CIRCLES: &[(&str, &[&str])] = &[
     // One type's impl split over two files: the 2-DOF head's methods of
     // `Machine` live beside the head.
     ("crates/kinematics", &["head", "machine"]),
-    // Until `IdentifyArgs` stops flattening `fusion_cmd::ExternalArgs`
-    // while `fusion_cmd::run` takes it.
-    ("crates/cli", &["fusion_cmd", "ident_cmd"]),
 ];
 
 fn workspace() -> PathBuf {
