@@ -41,8 +41,8 @@ use serde_json::{Value, json};
 use tricept_data::{ExternalData, ExternalPose};
 use tricept_diagnose::{DiagnoseOptions, diagnose};
 use tricept_ident::fusion::{
-    BallbarOptions, FusedModel, FusionOptions, Source, TouchOptions,
-    TrackerOptions, TrackerTarget, head_angle_poses, identify_fused,
+    BallbarOptions, FusedModel, FusionOptions, Source, TouchOptions, TrackerOptions, TrackerTarget,
+    head_angle_poses, identify_fused,
 };
 use tricept_kinematics::{HeadBranch, Machine};
 use tricept_model::effects::{EffectName, stiffness_for_platform_deflection};

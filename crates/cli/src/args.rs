@@ -504,8 +504,9 @@ pub struct ExternalArgs {
     #[arg(long, value_name = "head13|none")]
     pub head: Option<String>,
     /// Effects to fit with the geometry (names from `tricept diagnose`):
-    /// any of leg-lead, scale-gain, compliance, comma-separated.
-    #[arg(long, value_name = "NAMES", value_delimiter = ',')]
+    /// any of the registry's fusable effects, comma-separated (the help
+    /// lists them).
+    #[arg(long, value_name = "NAMES", value_delimiter = ',', help = effects_help())]
     pub effects: Vec<String>,
     /// Evaluation grid of the predicted tool tip: platform points of
     /// `polar_grid(RINGS, PER_RING, LEVELS)`.
@@ -522,6 +523,18 @@ pub struct ExternalArgs {
     /// Warn when the predicted tool-axis uncertainty exceeds this, arcsec.
     #[arg(long, default_value_t = 30.0, value_name = "ARCSEC")]
     pub tool_axis_warn_arcsec: f64,
+}
+
+/// The help of `--effects`: the effects the fused model can carry, from
+/// the registry.
+fn effects_help() -> String {
+    let names: Vec<&str> = tricept_ident::fusion::fusable_effects()
+        .map(|e| e.as_str())
+        .collect();
+    format!(
+        "Effects to fit with the geometry (names from `tricept diagnose`): any of {}, comma-separated",
+        names.join(", ")
+    )
 }
 
 impl ExternalArgs {
