@@ -34,17 +34,7 @@ pub fn design_rows(model: &FusedModel, source: &Source) -> Result<DesignRows, Id
     let p = vec![0.0; k];
     let at = model.at(&p);
     let rows = source.rows();
-    let contexts = (0..rows.records())
-        .map(|j| {
-            model
-                .leg_context(&rows.pose(j).commands_mm)
-                .map_err(|e| IdentError::Source {
-                    file: source.file().to_string(),
-                    line: Some(rows.line(j)),
-                    message: format!("the commands of this record cannot be reached: {e}"),
-                })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let contexts = source.leg_contexts(model)?;
     let mut seeds = vec![None; rows.records()];
     let nu = rows
         .initial(&at, &contexts, &mut seeds, &vec![true; rows.records()])

@@ -288,22 +288,10 @@ pub(crate) fn start<'a>(
     n_nuisance: usize,
     active: &'a [Vec<bool>],
 ) -> Result<(Problem<'a>, State, Evaluation), IdentError> {
-    let mut contexts = Vec::with_capacity(sources.len());
-    for source in sources {
-        let rows = source.rows();
-        let ctx = (0..rows.records())
-            .map(|j| {
-                model
-                    .leg_context(&rows.pose(j).commands_mm)
-                    .map_err(|e| IdentError::Source {
-                        file: source.file().to_string(),
-                        line: Some(rows.line(j)),
-                        message: format!("the commands of this record cannot be reached: {e}"),
-                    })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        contexts.push(ctx);
-    }
+    let contexts = sources
+        .iter()
+        .map(|source| source.leg_contexts(model))
+        .collect::<Result<Vec<_>, _>>()?;
     let problem = Problem {
         model,
         sources,

@@ -24,7 +24,7 @@ use tricept_numerics::linalg::TriangularAccumulator;
 use tricept_numerics::lsq::ReducedProblem;
 
 use crate::error::IdentError;
-use crate::fusion::model::{FusedAt, LegContext, SpindlePoint};
+use crate::fusion::model::{FusedAt, FusedModel, LegContext, SpindlePoint};
 
 /// What kind of instrument a source is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -372,6 +372,24 @@ impl Source {
 
     pub(crate) fn rows(&self) -> &dyn SourceRows {
         self.rows.as_ref()
+    }
+
+    /// The leg effects' context of every record at its commands
+    /// ([`FusedModel`]'s nominal machine); a record whose commands cannot
+    /// be reached is an error naming its line.
+    pub(crate) fn leg_contexts(&self, model: &FusedModel) -> Result<Vec<LegContext>, IdentError> {
+        let rows = self.rows();
+        (0..rows.records())
+            .map(|j| {
+                model
+                    .leg_context(&rows.pose(j).commands_mm)
+                    .map_err(|e| IdentError::Source {
+                        file: self.file().to_string(),
+                        line: Some(rows.line(j)),
+                        message: format!("the commands of this record cannot be reached: {e}"),
+                    })
+            })
+            .collect()
     }
 
     /// The same tracker records with the target stated as `target` (same

@@ -1,12 +1,13 @@
-//! External instruments that measure the simulated machine from outside:
-//! a laser tracker (or CMM) on a target in the spindle, a ballbar from the
+//! External instruments that measure the simulated machine from outside: a
+//! laser tracker (or CMM) on a target in the spindle, a ballbar from the
 //! tool-tip ball to a pivot on the table, and a touch probe on reference
 //! spheres and planes. Each measures the exact spindle point of the actual
-//! machine ([`Plant::spindle_point`]), adds its own noise from its own
-//! seeded generator (PCG-64 MCG, the seed mixed with a tag per instrument)
-//! and writes the external-measurement records of `tricept-data`. One file
-//! per instrument (`tracker.rs`, `ballbar.rs`, `touch.rs`), as in
-//! `tricept-data`'s `external/` and `tricept-ident`'s `fusion/`.
+//! machine ([`Plant::spindle_point`](crate::Plant::spindle_point)), adds
+//! its own noise from its own seeded generator (PCG-64 MCG, the seed mixed
+//! with a tag per instrument) and writes the external-measurement records
+//! of `tricept-data`. One file per instrument (`tracker.rs`, `ballbar.rs`,
+//! `touch.rs`), as in `tricept-data`'s `external/` and `tricept-ident`'s
+//! `fusion/`.
 
 use nalgebra::Vector3;
 use tricept_data::ExternalPose;
