@@ -41,8 +41,8 @@ use serde_json::{Value, json};
 use tricept_data::{ExternalData, ExternalPose};
 use tricept_diagnose::{DiagnoseOptions, diagnose};
 use tricept_ident::fusion::{
-    BallbarOptions, FUSABLE_EFFECTS, FusedModel, FusionOptions, Source, TouchOptions,
-    TrackerOptions, TrackerTarget, head_angle_poses, identify_fused,
+    BallbarOptions, FusedModel, FusionOptions, Source, TouchOptions, TrackerOptions, TrackerTarget,
+    head_angle_poses, identify_fused,
 };
 use tricept_kinematics::{HeadBranch, Machine};
 use tricept_model::effects::{EffectName, stiffness_for_platform_deflection};
@@ -526,7 +526,7 @@ fn run_machine(
         .map(|d| {
             d.model_effects()
                 .into_iter()
-                .filter(|e| FUSABLE_EFFECTS.contains(e))
+                .filter(|e| e.spec().fused)
                 .collect()
         })
         .unwrap_or_default();

@@ -24,11 +24,6 @@ const ALLOWED_CIRCLES: &[(&str, &[&str])] = &[
     // One type's impl split over two files: the 2-DOF head's methods of
     // `Machine` live beside the head.
     ("crates/kinematics", &["head", "machine"]),
-    // Phase 2 of issue 19 (after issue 18): `merge` and `FusionOptions`
-    // move out of `estimate.rs`, and `IdentifyArgs` stops flattening
-    // `fusion_cmd::ExternalArgs` while `fusion_cmd::run` takes it.
-    ("crates/ident", &["fusion::estimate", "fusion::report"]),
-    ("crates/cli", &["fusion_cmd", "ident_cmd"]),
 ];
 
 fn workspace() -> PathBuf {

@@ -1,6 +1,8 @@
 //! Arguments and loaders shared by several verbs: the machine and its
 //! sensor noise, the parameter set, pose sets, measured data, true errors
-//! and effects of simulated machines, progress display.
+//! and effects of simulated machines, the settings of `identify` (its fit,
+//! its external measurements and head) that `compensate` and the fused
+//! path share, number lists, progress display.
 
 use std::path::{Path, PathBuf};
 
@@ -15,6 +17,7 @@ use tricept_model::ParameterSet;
 use tricept_plant::Effect;
 
 use crate::cli_error::CliError;
+use crate::limits;
 
 /// Options shared by every verb that works on a machine.
 #[derive(Debug, Args, Clone)]
@@ -417,4 +420,181 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, CliError> {
         }
     }
     Ok(out)
+}
+
+/// The fit settings of `identify` and `compensate`.
+#[derive(Debug, Args)]
+pub struct FitSettings {
+    #[command(flatten)]
+    pub fit: FitArgs,
+    #[command(flatten)]
+    pub params: ParamArgs,
+    #[command(flatten)]
+    pub noise: NoiseArgs,
+    #[command(flatten)]
+    pub machine: MachineArgs,
+}
+
+/// `tricept identify`.
+#[derive(Debug, Args)]
+pub struct IdentifyArgs {
+    /// Measured-data CSV (see docs/data-format.md).
+    #[arg(long, value_name = "FILE.csv")]
+    pub data: PathBuf,
+    #[command(flatten)]
+    pub settings: FitSettings,
+    /// Also write the calibrated machine as a description file (loadable
+    /// by every --machine), with a `calibration` record of the estimates,
+    /// their uncertainties and the fit's quality. Refused when the fit did
+    /// not converge or the data cannot come from the machine.
+    #[arg(long, value_name = "FILE.json")]
+    pub write_machine: Option<PathBuf>,
+    /// Write the machine even when the fit is not to be trusted; the file
+    /// says so (`calibration.forced`, its name).
+    #[arg(long, requires = "write_machine")]
+    pub force: bool,
+    /// External measurements and the head (the fused identification).
+    #[command(flatten)]
+    pub external: ExternalArgs,
+}
+
+/// External measurements and the head (options of `tricept identify`).
+#[derive(Debug, Args, Clone, Default)]
+pub struct ExternalArgs {
+    /// Laser-tracker or CMM points (CSV `q1,q2,q3,h1,h2,x,y,z`); repeatable.
+    #[arg(long, value_name = "FILE.csv")]
+    pub tracker: Vec<PathBuf>,
+    /// Standard deviation of a tracker coordinate for rows without `sigma_um`, um.
+    #[arg(long, default_value_t = 10.0, value_name = "UM")]
+    pub tracker_sigma_um: f64,
+    /// Where the tracker's target sits (required with --tracker; no
+    /// default): `tip` (in a nest at the tool tip), `X,Y,Z` (a known offset
+    /// from the tip, mm, spindle frame at zero head angles) or `free`
+    /// (unknown: the tool tip is then not calibrated).
+    #[arg(long, value_name = "tip|X,Y,Z|free", allow_hyphen_values = true)]
+    pub tracker_target: Option<String>,
+    /// Standard deviation of a known target offset, um.
+    #[arg(long, default_value_t = 5.0, value_name = "UM")]
+    pub tracker_target_sigma_um: f64,
+    /// Ballbar readings (CSV `q1,q2,q3,h1,h2,length`); repeatable.
+    #[arg(long, value_name = "FILE.csv")]
+    pub ballbar: Vec<PathBuf>,
+    /// Standard deviation of a ballbar reading for rows without `sigma_um`, um.
+    #[arg(long, default_value_t = 1.0, value_name = "UM")]
+    pub ballbar_sigma_um: f64,
+    /// Standard deviation of the bar's length (its certificate), um, or
+    /// `free` (the machine's scale then stays invisible to the ballbar).
+    #[arg(long, default_value = "1", value_name = "UM|free")]
+    pub ballbar_length_sigma_um: String,
+    /// Offset of the spindle ball from the tool tip, mm (spindle frame at
+    /// zero head angles).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub ballbar_ball_mm: Option<String>,
+    /// Touch-offs (CSV `q1,q2,q3,h1,h2,feature`); repeatable; needs --features.
+    #[arg(long, value_name = "FILE.csv")]
+    pub touch: Vec<PathBuf>,
+    /// The features file of the touch-offs (JSON: stylus, spheres, planes).
+    #[arg(long, value_name = "FILE.json")]
+    pub features: Option<PathBuf>,
+    /// Standard deviation of a touch for rows without `sigma_um`, um.
+    #[arg(long, default_value_t = 1.5, value_name = "UM")]
+    pub touch_sigma_um: f64,
+    /// The head's parameters: `head13` (default with external data) or
+    /// `none` (the head held nominal).
+    #[arg(long, value_name = "head13|none")]
+    pub head: Option<String>,
+    /// Effects to fit with the geometry (names from `tricept diagnose`):
+    /// any of the registry's fusable effects, comma-separated (the help
+    /// lists them).
+    #[arg(long, value_name = "NAMES", value_delimiter = ',', help = effects_help())]
+    pub effects: Vec<String>,
+    /// Evaluation grid of the predicted tool tip: platform points of
+    /// `polar_grid(RINGS, PER_RING, LEVELS)`.
+    #[arg(long, default_value = "2,8,3", value_name = "RINGS,PER_RING,LEVELS")]
+    pub eval_grid: String,
+    /// Head angles of the evaluation grid, deg: `H1,H1,...:H2,H2,...`.
+    #[arg(long, default_value = "0,90,180,270:15,35", value_name = "H1S:H2S")]
+    pub eval_head_angles_deg: String,
+    /// Override plausible ranges of the head, tool and instrument
+    /// estimates: a JSON object `{"tool_length_mm": [-5, 5]}` (keys and
+    /// defaults in docs/hybrid.md).
+    #[arg(long, value_name = "FILE.json")]
+    pub plausibility: Option<PathBuf>,
+    /// Warn when the predicted tool-axis uncertainty exceeds this, arcsec.
+    #[arg(long, default_value_t = 30.0, value_name = "ARCSEC")]
+    pub tool_axis_warn_arcsec: f64,
+}
+
+/// The help of `--effects`: the effects the fused model can carry, from
+/// the registry.
+fn effects_help() -> String {
+    let names: Vec<&str> = tricept_ident::fusion::fusable_effects()
+        .map(|e| e.as_str())
+        .collect();
+    format!(
+        "Effects to fit with the geometry (names from `tricept diagnose`): any of {}, comma-separated",
+        names.join(", ")
+    )
+}
+
+impl ExternalArgs {
+    /// Whether the fused path is asked for.
+    pub fn any(&self) -> bool {
+        !self.tracker.is_empty()
+            || !self.ballbar.is_empty()
+            || !self.touch.is_empty()
+            || self.head.is_some()
+            || !self.effects.is_empty()
+    }
+}
+
+/// `X,Y,Z` (or any count) as numbers.
+pub fn parse_numbers(flag: &str, text: &str, count: usize) -> Result<Vec<f64>, CliError> {
+    let values: Result<Vec<f64>, _> = text.split(',').map(|t| t.trim().parse::<f64>()).collect();
+    match values {
+        Ok(v) if v.len() == count && v.iter().all(|x| x.is_finite()) => {
+            if let Some(x) = v.iter().find(|x| x.abs() > limits::MAX_COORDINATE) {
+                return Err(CliError::input(format!(
+                    "{flag}: {x} is beyond ±{} (mm, deg or rad): not a value for this machine",
+                    limits::MAX_COORDINATE
+                )));
+            }
+            Ok(v)
+        }
+        _ => Err(CliError::input(format!(
+            "{flag}: expected {count} comma-separated numbers, got `{text}`"
+        ))),
+    }
+}
+
+/// A list of angles in degrees, `a,b,c`.
+fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>, CliError> {
+    let n = text.split(',').count();
+    if n > limits::MAX_HEAD_ANGLES {
+        return Err(CliError::input(format!(
+            "{flag}: {n} angles; at most {} per head axis",
+            limits::MAX_HEAD_ANGLES
+        )));
+    }
+    parse_numbers(flag, text, n)
+}
+
+/// `H1S:H2S` lists of degrees.
+pub fn parse_head_angles(flag: &str, text: &str) -> Result<(Vec<f64>, Vec<f64>), CliError> {
+    let Some((a, b)) = text.split_once(':') else {
+        return Err(CliError::input(format!(
+            "{flag}: expected `H1,H1,...:H2,H2,...` in degrees, got `{text}`"
+        )));
+    };
+    Ok((parse_list(flag, a)?, parse_list(flag, b)?))
+}
+
+pub fn positive(flag: &str, v: f64) -> Result<f64, CliError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(CliError::input(format!(
+            "{flag}: must be a positive number, got {v}"
+        )))
+    }
 }

@@ -6,7 +6,6 @@
 
 use std::path::{Path, PathBuf};
 
-use clap::Args;
 use serde_json::{Value, json};
 use tricept_data::{
     BallbarReading, ExternalData, ExternalRecord, Features, TouchReading, TrackerPoint,
@@ -19,143 +18,17 @@ use tricept_ident::fusion::{
 use tricept_kinematics::description::ExternalSourceRecord;
 use tricept_model::effects::EffectName;
 
-use crate::args::{check_commands, load_with_noise, read_data};
+use crate::args::{
+    IdentifyArgs, check_commands, load_with_noise, parse_head_angles, parse_numbers, positive,
+    read_data,
+};
 use crate::cli_error::{CliError, EXIT_NOT_CONVERGED};
-use crate::ident_cmd::IdentifyArgs;
 use crate::limits;
 use crate::machine_file;
 
 /// Exit code of a fit that converged but that the user must not trust as
 /// it stands: a source the model does not explain (`identify`'s 3).
 pub const EXIT_UNTRUSTED: u8 = crate::cli_error::EXIT_INADEQUATE;
-
-/// External measurements and the head (options of `tricept identify`).
-#[derive(Debug, Args, Clone, Default)]
-pub struct ExternalArgs {
-    /// Laser-tracker or CMM points (CSV `q1,q2,q3,h1,h2,x,y,z`); repeatable.
-    #[arg(long, value_name = "FILE.csv")]
-    pub tracker: Vec<PathBuf>,
-    /// Standard deviation of a tracker coordinate for rows without `sigma_um`, um.
-    #[arg(long, default_value_t = 10.0, value_name = "UM")]
-    pub tracker_sigma_um: f64,
-    /// Where the tracker's target sits (required with --tracker; no
-    /// default): `tip` (in a nest at the tool tip), `X,Y,Z` (a known offset
-    /// from the tip, mm, spindle frame at zero head angles) or `free`
-    /// (unknown: the tool tip is then not calibrated).
-    #[arg(long, value_name = "tip|X,Y,Z|free", allow_hyphen_values = true)]
-    pub tracker_target: Option<String>,
-    /// Standard deviation of a known target offset, um.
-    #[arg(long, default_value_t = 5.0, value_name = "UM")]
-    pub tracker_target_sigma_um: f64,
-    /// Ballbar readings (CSV `q1,q2,q3,h1,h2,length`); repeatable.
-    #[arg(long, value_name = "FILE.csv")]
-    pub ballbar: Vec<PathBuf>,
-    /// Standard deviation of a ballbar reading for rows without `sigma_um`, um.
-    #[arg(long, default_value_t = 1.0, value_name = "UM")]
-    pub ballbar_sigma_um: f64,
-    /// Standard deviation of the bar's length (its certificate), um, or
-    /// `free` (the machine's scale then stays invisible to the ballbar).
-    #[arg(long, default_value = "1", value_name = "UM|free")]
-    pub ballbar_length_sigma_um: String,
-    /// Offset of the spindle ball from the tool tip, mm (spindle frame at
-    /// zero head angles).
-    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    pub ballbar_ball_mm: Option<String>,
-    /// Touch-offs (CSV `q1,q2,q3,h1,h2,feature`); repeatable; needs --features.
-    #[arg(long, value_name = "FILE.csv")]
-    pub touch: Vec<PathBuf>,
-    /// The features file of the touch-offs (JSON: stylus, spheres, planes).
-    #[arg(long, value_name = "FILE.json")]
-    pub features: Option<PathBuf>,
-    /// Standard deviation of a touch for rows without `sigma_um`, um.
-    #[arg(long, default_value_t = 1.5, value_name = "UM")]
-    pub touch_sigma_um: f64,
-    /// The head's parameters: `head13` (default with external data) or
-    /// `none` (the head held nominal).
-    #[arg(long, value_name = "head13|none")]
-    pub head: Option<String>,
-    /// Effects to fit with the geometry (names from `tricept diagnose`):
-    /// any of leg-lead, scale-gain, compliance, comma-separated.
-    #[arg(long, value_name = "NAMES", value_delimiter = ',')]
-    pub effects: Vec<String>,
-    /// Evaluation grid of the predicted tool tip: platform points of
-    /// `polar_grid(RINGS, PER_RING, LEVELS)`.
-    #[arg(long, default_value = "2,8,3", value_name = "RINGS,PER_RING,LEVELS")]
-    pub eval_grid: String,
-    /// Head angles of the evaluation grid, deg: `H1,H1,...:H2,H2,...`.
-    #[arg(long, default_value = "0,90,180,270:15,35", value_name = "H1S:H2S")]
-    pub eval_head_angles_deg: String,
-    /// Override plausible ranges of the head, tool and instrument
-    /// estimates: a JSON object `{"tool_length_mm": [-5, 5]}` (keys and
-    /// defaults in docs/hybrid.md).
-    #[arg(long, value_name = "FILE.json")]
-    pub plausibility: Option<PathBuf>,
-    /// Warn when the predicted tool-axis uncertainty exceeds this, arcsec.
-    #[arg(long, default_value_t = 30.0, value_name = "ARCSEC")]
-    pub tool_axis_warn_arcsec: f64,
-}
-
-impl ExternalArgs {
-    /// Whether the fused path is asked for.
-    pub fn any(&self) -> bool {
-        !self.tracker.is_empty()
-            || !self.ballbar.is_empty()
-            || !self.touch.is_empty()
-            || self.head.is_some()
-            || !self.effects.is_empty()
-    }
-}
-
-/// `X,Y,Z` (or any count) as numbers.
-pub fn parse_numbers(flag: &str, text: &str, count: usize) -> Result<Vec<f64>, CliError> {
-    let values: Result<Vec<f64>, _> = text.split(',').map(|t| t.trim().parse::<f64>()).collect();
-    match values {
-        Ok(v) if v.len() == count && v.iter().all(|x| x.is_finite()) => {
-            if let Some(x) = v.iter().find(|x| x.abs() > limits::MAX_COORDINATE) {
-                return Err(CliError::input(format!(
-                    "{flag}: {x} is beyond ±{} (mm, deg or rad): not a value for this machine",
-                    limits::MAX_COORDINATE
-                )));
-            }
-            Ok(v)
-        }
-        _ => Err(CliError::input(format!(
-            "{flag}: expected {count} comma-separated numbers, got `{text}`"
-        ))),
-    }
-}
-
-/// A list of angles in degrees, `a,b,c`.
-fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>, CliError> {
-    let n = text.split(',').count();
-    if n > limits::MAX_HEAD_ANGLES {
-        return Err(CliError::input(format!(
-            "{flag}: {n} angles; at most {} per head axis",
-            limits::MAX_HEAD_ANGLES
-        )));
-    }
-    parse_numbers(flag, text, n)
-}
-
-/// `H1S:H2S` lists of degrees.
-pub fn parse_head_angles(flag: &str, text: &str) -> Result<(Vec<f64>, Vec<f64>), CliError> {
-    let Some((a, b)) = text.split_once(':') else {
-        return Err(CliError::input(format!(
-            "{flag}: expected `H1,H1,...:H2,H2,...` in degrees, got `{text}`"
-        )));
-    };
-    Ok((parse_list(flag, a)?, parse_list(flag, b)?))
-}
-
-pub fn positive(flag: &str, v: f64) -> Result<f64, CliError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(CliError::input(format!(
-            "{flag}: must be a positive number, got {v}"
-        )))
-    }
-}
 
 /// The effects named by `--effects`.
 pub fn parse_effect_names(names: &[String]) -> Result<Vec<EffectName>, CliError> {

@@ -14,8 +14,11 @@ use tricept_kinematics::Machine;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_model::ParameterSet;
 
+// The settings live in `args.rs`, below this verb and the fused path it
+// hands external measurements to (`fusion_cmd.rs`).
+pub use crate::args::{FitSettings, IdentifyArgs};
 use crate::args::{
-    FitArgs, LoadedMachine, MachineArgs, NoiseArgs, ParamArgs, load_with_noise, machine_with_noise,
+    LoadedMachine, MachineArgs, NoiseArgs, ParamArgs, load_with_noise, machine_with_noise,
     pose_targets, read_data, spinner,
 };
 use crate::cli_error::{CliError, EXIT_INADEQUATE, EXIT_NOT_CONVERGED};
@@ -37,42 +40,6 @@ pub struct IdentifiabilityArgs {
     pub noise: NoiseArgs,
     #[command(flatten)]
     pub machine: MachineArgs,
-}
-
-/// The fit settings of `identify` and `compensate`.
-#[derive(Debug, Args)]
-pub struct FitSettings {
-    #[command(flatten)]
-    pub fit: FitArgs,
-    #[command(flatten)]
-    pub params: ParamArgs,
-    #[command(flatten)]
-    pub noise: NoiseArgs,
-    #[command(flatten)]
-    pub machine: MachineArgs,
-}
-
-/// `tricept identify`.
-#[derive(Debug, Args)]
-pub struct IdentifyArgs {
-    /// Measured-data CSV (see docs/data-format.md).
-    #[arg(long, value_name = "FILE.csv")]
-    pub data: PathBuf,
-    #[command(flatten)]
-    pub settings: FitSettings,
-    /// Also write the calibrated machine as a description file (loadable
-    /// by every --machine), with a `calibration` record of the estimates,
-    /// their uncertainties and the fit's quality. Refused when the fit did
-    /// not converge or the data cannot come from the machine.
-    #[arg(long, value_name = "FILE.json")]
-    pub write_machine: Option<PathBuf>,
-    /// Write the machine even when the fit is not to be trusted; the file
-    /// says so (`calibration.forced`, its name).
-    #[arg(long, requires = "write_machine")]
-    pub force: bool,
-    /// External measurements and the head (the fused identification).
-    #[command(flatten)]
-    pub external: crate::fusion_cmd::ExternalArgs,
 }
 
 fn ident_error(source: &str, e: IdentError) -> CliError {

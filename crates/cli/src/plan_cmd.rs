@@ -19,11 +19,9 @@ use tricept_study::plan::{
 use crate::args::{
     MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs, machine_with_noise, pose_targets, read_data,
 };
+use crate::args::{parse_head_angles, parse_numbers, positive};
 use crate::cli_error::CliError;
-use crate::fusion_cmd::{
-    eval_options, fused_model, fusion_error, parse_head_angles, parse_numbers, positive,
-    tracker_target,
-};
+use crate::fusion_cmd::{eval_options, fused_model, fusion_error, tracker_target};
 use crate::limits;
 
 /// The instrument to plan for.

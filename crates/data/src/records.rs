@@ -1,6 +1,6 @@
 //! The line and record machinery shared by every CSV reader of the crate
 //! (measured data in `read.rs`, target lists in `targets.rs`, external
-//! measurements in `external.rs`), so that all
+//! measurements in `external/`), so that all
 //! read the same format the same way and report problems with the same
 //! messages.
 //!

@@ -26,43 +26,15 @@
 use nalgebra::DMatrix;
 use serde_json::{Map, Value};
 use tricept_data::{Dataset, MeasuredPose};
-use tricept_kinematics::{Machine, UpJoints};
+use tricept_kinematics::UpJoints;
 
 use crate::error::IdentError;
+use crate::evaluate::{Evaluation, evaluate};
 use crate::gauss_newton::{Iteration, Run, iterate};
-use crate::model::{PosePredictor, ReadingModel};
+use crate::model::ReadingModel;
+use crate::options::IdentifyOptions;
 use crate::report::{IdentifiabilityReport, NamedValues};
-use rayon::prelude::*;
-use tricept_numerics::linalg::TriangularAccumulator;
-use tricept_numerics::lsq::{DEFAULT_RANK_TOLERANCE, RankDecision, ReducedProblem};
-
-/// Settings of [`identify`]: the noise model and the solver's tolerances,
-/// the same for every data set they are used on.
-///
-/// # Example
-/// ```
-/// use tricept_ident::IdentifyOptions;
-/// use tricept_kinematics::{Machine, units::arcsec_to_rad};
-/// let mut o = IdentifyOptions::for_machine(&Machine::paper());
-/// // The paper's sensors: 0.8 arcsec and 0.5 um per reading, mean of 3.
-/// assert!((o.sigma[0] - arcsec_to_rad(0.8) / 3f64.sqrt()).abs() < 1e-15);
-/// o.sigma[0] = arcsec_to_rad(2.0); // a 2 arcsec encoder, one reading
-/// ```
-#[derive(Debug, Clone, PartialEq)]
-pub struct IdentifyOptions {
-    /// Standard deviation of one *logged* reading `[phi, theta, s]`
-    /// (rad, rad, mm).
-    pub sigma: [f64; 3],
-    /// Relative singular-value tolerance of the rank decision.
-    pub rank_tolerance: f64,
-    /// `s_i / s_1` below which an identifiable direction is reported weak.
-    pub weak_threshold: f64,
-    /// Gauss-Newton iteration limit. With 0 the estimate is the one linear
-    /// solve at the starting point (the linearised estimator) and the
-    /// residual statistics are those of the starting point; otherwise they
-    /// are those of the estimate.
-    pub max_iterations: u32,
-}
+use tricept_numerics::lsq::{RankDecision, ReducedProblem};
 
 /// What a caller knows about one data set before identifying it: where to
 /// start, per-pose weights and FK seeds, and a rank decision taken earlier
@@ -215,42 +187,6 @@ impl Design {
     }
 }
 
-impl IdentifyOptions {
-    /// Defaults with the logged noise of `machine`'s sensors.
-    ///
-    /// # Example
-    /// ```
-    /// use tricept_ident::IdentifyOptions;
-    /// let m = tricept_kinematics::Machine::paper();
-    /// let o = IdentifyOptions::for_machine(&m);
-    /// assert_eq!(o.sigma, m.sensors.logged_sigma());
-    /// ```
-    pub fn for_machine(machine: &Machine) -> IdentifyOptions {
-        IdentifyOptions::with_sigma(machine.sensors.logged_sigma())
-    }
-
-    /// Defaults with the given standard deviations of one logged reading
-    /// (`phi` rad, `theta` rad, `s` mm): the stated rank tolerance, weak
-    /// threshold 1e-2, at most 30 iterations.
-    ///
-    /// # Example
-    /// ```
-    /// use tricept_ident::IdentifyOptions;
-    /// use tricept_kinematics::units::arcsec_to_rad;
-    /// // A 2 arcsec encoder and a 0.5 um scale, one reading per pose.
-    /// let o = IdentifyOptions::with_sigma([arcsec_to_rad(2.0), arcsec_to_rad(2.0), 0.5e-3]);
-    /// assert_eq!(o.max_iterations, 30);
-    /// ```
-    pub fn with_sigma(sigma: [f64; 3]) -> IdentifyOptions {
-        IdentifyOptions {
-            sigma,
-            rank_tolerance: DEFAULT_RANK_TOLERANCE,
-            weak_threshold: 1e-2,
-            max_iterations: 30,
-        }
-    }
-}
-
 /// Residual statistics of a fit.
 ///
 /// # Example
@@ -334,158 +270,6 @@ pub struct Identification {
     /// Covariance of `[offsets | parameters]` (`3 + k` square), for the
     /// gross-error screen's hat matrix.
     pub(crate) full_covariance: faer::Mat<f64>,
-}
-
-/// One evaluation of the model at fixed parameters over all poses.
-struct Evaluation {
-    /// The reduced weighted problem `[offsets | parameters | y - g(p)]`.
-    problem: ReducedProblem,
-    /// `y - g(p)` per pose (rad, rad, mm).
-    residuals: Vec<[f64; 3]>,
-}
-
-/// Poses per block of an evaluation: each block is predicted and reduced
-/// to its triangular factor on its own, the blocks in parallel, and the
-/// factors are merged in block order, so the result does not depend on
-/// the number of threads. Up to one block the evaluation is sequential.
-pub(crate) const EVALUATION_BLOCK: usize = 4096;
-
-/// Evaluates `model` at `p` on `poses`: predictions, Jacobians and the
-/// reduced weighted problem. `seeds` carries FK starting points between
-/// calls; `seeds` and `pose_weights` have one entry per pose (checked by
-/// the callers).
-fn evaluate(
-    model: &dyn ReadingModel,
-    p: &[f64],
-    poses: &[MeasuredPose],
-    sigma: &[f64; 3],
-    pose_weights: Option<&[f64]>,
-    seeds: &mut [Option<UpJoints>],
-) -> Result<Evaluation, IdentError> {
-    let k = model.names().len();
-    let predictor = model.at(p);
-    let block = |first: usize, poses: &[MeasuredPose], seeds: &mut [Option<UpJoints>]| {
-        evaluate_block(&*predictor, k, first, poses, sigma, pose_weights, seeds)
-    };
-    let blocks: Vec<Result<Block, IdentError>> = if poses.len() <= EVALUATION_BLOCK {
-        vec![block(0, poses, seeds)]
-    } else {
-        poses
-            .par_chunks(EVALUATION_BLOCK)
-            .zip(seeds.par_chunks_mut(EVALUATION_BLOCK))
-            .enumerate()
-            .map(|(b, (poses, seeds))| block(b * EVALUATION_BLOCK, poses, seeds))
-            .collect()
-    };
-    let mut residuals = Vec::with_capacity(poses.len());
-    let mut factors = Vec::with_capacity(blocks.len());
-    let mut rows = 0;
-    for b in blocks {
-        let b = b?;
-        rows += b.rows;
-        residuals.extend(b.residuals);
-        factors.push(b.r);
-    }
-    let r = match factors.pop() {
-        Some(r) if factors.is_empty() => r,
-        last => {
-            let n = 3 + k + 1;
-            let mut acc = TriangularAccumulator::with_rows_hint(n, n * (factors.len() + 1));
-            let mut row = vec![0.0; n];
-            for f in factors.iter().chain(&last) {
-                for i in 0..f.nrows() {
-                    row.iter_mut().enumerate().for_each(|(j, v)| *v = f[(i, j)]);
-                    acc.push_row(&row);
-                }
-            }
-            acc.finish()
-        }
-    };
-    Ok(Evaluation {
-        problem: ReducedProblem {
-            rows,
-            r,
-            n_nuisance: 3,
-            k,
-        },
-        residuals,
-    })
-}
-
-/// `f(first, block)` over the poses a block of [`EVALUATION_BLOCK`] at a
-/// time (in parallel beyond one block), the results in pose order; the
-/// first error in pose order is the one returned.
-pub(crate) fn map_blocks<T: Send>(
-    poses: &[MeasuredPose],
-    f: impl Fn(usize, &[MeasuredPose]) -> Result<Vec<T>, IdentError> + Sync,
-) -> Result<Vec<T>, IdentError> {
-    if poses.len() <= EVALUATION_BLOCK {
-        return f(0, poses);
-    }
-    let blocks: Vec<Result<Vec<T>, IdentError>> = poses
-        .par_chunks(EVALUATION_BLOCK)
-        .enumerate()
-        .map(|(b, block)| f(b * EVALUATION_BLOCK, block))
-        .collect();
-    let mut out = Vec::with_capacity(poses.len());
-    for b in blocks {
-        out.extend(b?);
-    }
-    Ok(out)
-}
-
-/// One block of an evaluation: its triangular factor, rows and residuals.
-struct Block {
-    r: faer::Mat<f64>,
-    rows: usize,
-    residuals: Vec<[f64; 3]>,
-}
-
-/// The poses `first..first + poses.len()` of an evaluation.
-fn evaluate_block(
-    predictor: &dyn PosePredictor,
-    k: usize,
-    first: usize,
-    poses: &[MeasuredPose],
-    sigma: &[f64; 3],
-    pose_weights: Option<&[f64]>,
-    seeds: &mut [Option<UpJoints>],
-) -> Result<Block, IdentError> {
-    let mut acc = TriangularAccumulator::with_rows_hint(3 + k + 1, 3 * poses.len());
-    let mut jac = vec![0.0; 3 * k];
-    let mut row = vec![0.0; 3 + k + 1];
-    let mut residuals = Vec::with_capacity(poses.len());
-    for ((i, pose), seed) in poses.iter().enumerate().zip(seeds.iter_mut()) {
-        let j = first + i;
-        let g =
-            predictor
-                .predict(pose, seed, &mut jac)
-                .map_err(|source| IdentError::Kinematics {
-                    pose: j,
-                    line: pose.line,
-                    source,
-                })?;
-        let y = pose.readings.to_array();
-        let w_pose = pose_weights.and_then(|w| w.get(j)).copied().unwrap_or(1.0);
-        let mut res = [0.0; 3];
-        for c in 0..3 {
-            res[c] = y[c] - g[c];
-            let w = w_pose / sigma[c];
-            row.iter_mut().for_each(|v| *v = 0.0);
-            row[c] = w;
-            for t in 0..k {
-                row[3 + t] = w * jac[c * k + t];
-            }
-            row[3 + k] = w * res[c];
-            acc.push_row(&row);
-        }
-        residuals.push(res);
-    }
-    Ok(Block {
-        rows: acc.rows(),
-        r: acc.finish(),
-        residuals,
-    })
 }
 
 /// Checks that there are enough readings, and enough distinct poses, for

@@ -67,10 +67,12 @@
 mod accuracy;
 mod compensate;
 mod error;
+mod evaluate;
 pub mod fusion;
 mod gauss_newton;
 mod identify;
 mod model;
+mod options;
 mod record;
 mod report;
 mod robust;
@@ -82,10 +84,10 @@ pub use accuracy::{AccuracyModel, DEFAULT_TOLERANCE_MM, PredictedAccuracy, WORTH
 pub use compensate::{Compensation, compensation, corrected_commands};
 pub use error::IdentError;
 pub use identify::{
-    Design, Identification, IdentifyOptions, ResidualStats, Start, design, identifiability,
-    identify, identify_from,
+    Design, Identification, ResidualStats, Start, design, identifiability, identify, identify_from,
 };
 pub use model::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
+pub use options::IdentifyOptions;
 pub use record::{RECORD_METHODS, RecordError, check_calibration_record};
 pub use report::{Combination, CorrelatedPair, IdentifiabilityReport, NamedValues, Observability};
 pub use robust::{Rejection, identify_robust, residuals_at, screen_gross_errors};

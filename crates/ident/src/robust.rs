@@ -39,10 +39,10 @@ use tricept_kinematics::UpJoints;
 use tricept_numerics::stats::chi2_isf;
 
 use crate::error::IdentError;
-use crate::identify::{
-    FirstEvaluation, Identification, IdentifyOptions, Start, fit, identify, map_blocks,
-};
+use crate::evaluate::map_blocks;
+use crate::identify::{FirstEvaluation, Identification, Start, fit, identify};
 use crate::model::ReadingModel;
+use crate::options::IdentifyOptions;
 
 /// Largest robust z-score (residual at the nominal machine, in units of
 /// the larger of the sensor noise and 1.4826 MAD) of a pose in the first

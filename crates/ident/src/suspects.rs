@@ -15,8 +15,9 @@ use tricept_data::{Dataset, Readings};
 use tricept_kinematics::{AxisOrder, Machine};
 use tricept_model::ParameterSet;
 
-use crate::identify::{IdentifyOptions, identify};
+use crate::identify::identify;
 use crate::model::GeometricModel;
+use crate::options::IdentifyOptions;
 use crate::verdict::INCONSISTENT_CHI2_PER_DOF;
 
 /// Largest number of poses each trial identification uses.

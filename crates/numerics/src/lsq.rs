@@ -127,6 +127,58 @@ pub struct Solution {
 }
 
 impl ReducedProblem {
+    /// The union of reduced problems over the same `k` parameters: their
+    /// factors stacked with every nuisance block first (in the order of
+    /// `parts`), then the parameters and the right-hand side, and factored
+    /// again. Each part keeps its own nuisance columns; the rows add up.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_numerics::linalg::TriangularAccumulator;
+    /// use tricept_numerics::lsq::ReducedProblem;
+    /// // Two sources of y = 2 x, each with an offset of its own.
+    /// let part = |offset: f64| {
+    ///     let mut acc = TriangularAccumulator::new(3);
+    ///     for x in [0.0, 1.0, 2.0] {
+    ///         acc.push_row(&[1.0, x, offset + 2.0 * x]);
+    ///     }
+    ///     ReducedProblem { r: acc.finish(), n_nuisance: 1, k: 1, rows: 3 }
+    /// };
+    /// let (a, b) = (part(1.0), part(-3.0));
+    /// let union = ReducedProblem::merge(&[&a, &b]);
+    /// assert_eq!((union.n_nuisance, union.k, union.rows), (2, 1, 6));
+    /// assert_eq!((union.r.nrows(), union.r.ncols()), (4, 4));
+    /// ```
+    pub fn merge(parts: &[&ReducedProblem]) -> ReducedProblem {
+        let k = parts.first().map_or(0, |p| p.k);
+        let n_nuisance: usize = parts.iter().map(|p| p.n_nuisance).sum();
+        let width = n_nuisance + k + 1;
+        let height: usize = parts.iter().map(|p| p.r.nrows()).sum();
+        let mut stacked = Mat::<f64>::zeros(height, width);
+        let (mut row, mut offset) = (0, 0);
+        for part in parts {
+            let nn = part.n_nuisance;
+            for i in 0..part.r.nrows() {
+                for j in 0..part.r.ncols() {
+                    let col = if j < nn {
+                        offset + j
+                    } else {
+                        n_nuisance + (j - nn)
+                    };
+                    stacked[(row + i, col)] = part.r[(i, j)];
+                }
+            }
+            row += part.r.nrows();
+            offset += nn;
+        }
+        ReducedProblem {
+            r: r_factor(stacked.as_ref()),
+            n_nuisance,
+            k,
+            rows: parts.iter().map(|p| p.rows).sum(),
+        }
+    }
+
     /// The parameter block `R_pp` (`k x k`).
     ///
     /// # Example

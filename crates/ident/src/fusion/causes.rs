@@ -23,26 +23,11 @@
 //! Each trial is a plain fit of the records the screen kept (no screen, no
 //! further search).
 
-use serde::Serialize;
-
-use crate::fusion::estimate::{FusionOptions, fit_masked};
+use crate::fusion::estimate::fit_masked;
 use crate::fusion::model::FusedModel;
-use crate::fusion::result::Fusion;
-use crate::fusion::source::{Source, SourceKind};
-use crate::fusion::tracker::TrackerTarget;
-
-/// A mistake whose undoing makes the data fit.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct FusionCause {
-    /// The source it concerns (label).
-    pub source: String,
-    /// Which mistake: `target-sign`, `target-mode` or `another-machine`.
-    pub mistake: &'static str,
-    /// What it is and what the refit gave, in words.
-    pub description: String,
-    /// The source's reduced chi-square with the mistake undone.
-    pub chi2_per_dof: f64,
-}
+use crate::fusion::options::FusionOptions;
+use crate::fusion::result::{Fusion, FusionCause};
+use crate::fusion::source::{Source, SourceKind, TrackerTarget};
 
 /// Whether source `s` of the trial fit `f` is explained, checkable and the
 /// fit converged and plausible.

@@ -15,148 +15,27 @@
 //! With one internal source and no head or effects this is exactly
 //! [`crate::identify`] (bit for bit; tested).
 //!
-//! [`identify_fused`] wraps the fit: the gross-error screen
-//! ([`crate::fusion::ScreenOptions`], `screen.rs`) decides which records
-//! enter it, each fit ends with every source's redundancy (its degrees of
-//! freedom: `sum (1 - h_ii)` over its rows, `h` the hat matrix of the
-//! union), the deleted residual of every record and the verdict; an
-//! implausible or unexplained fit is handed to the likely-cause search
-//! (`causes.rs`).
+//! Each fit ends with every source's redundancy (its degrees of freedom:
+//! `sum (1 - h_ii)` over its rows, `h` the hat matrix of the union), the
+//! deleted residual of every record and the verdict
+//! ([`crate::fusion::identify_fused`] wraps it in the screen and the
+//! likely-cause search).
 
 use faer::Mat;
 use nalgebra::{DMatrix, DVector};
 use serde_json::Value;
-use tricept_data::ExternalPose;
-use tricept_kinematics::{Machine, UpJoints};
-use tricept_numerics::linalg::{TriangularAccumulator, r_factor, svd_values_and_vectors};
-use tricept_numerics::lsq::{
-    DEFAULT_RANK_TOLERANCE, HatFactor, RankDecision, ReducedProblem, Solution,
-};
+use tricept_kinematics::UpJoints;
+use tricept_numerics::linalg::svd_values_and_vectors;
+use tricept_numerics::lsq::{HatFactor, RankDecision, ReducedProblem, Solution};
 
 use crate::error::IdentError;
 use crate::fusion::model::{FusedModel, LegContext};
-use crate::fusion::plausibility::FusionPlausibility;
+use crate::fusion::options::FusionOptions;
 use crate::fusion::report::build_report;
 use crate::fusion::result::{Fusion, RecordCheck, SourceFit, judge};
-use crate::fusion::screen::ScreenOptions;
 use crate::fusion::source::{KeptRows, Nuisance, Sink, Source};
 use crate::gauss_newton::{Iteration, Run, iterate};
 use crate::report::IdentifiabilityReport;
-
-/// Settings of [`identify_fused`].
-///
-/// # Example
-/// ```
-/// use tricept_ident::fusion::FusionOptions;
-/// let o = FusionOptions::for_machine(&tricept_kinematics::Machine::paper());
-/// // 51 platform points x 4 x 2 head angle pairs.
-/// assert_eq!(o.eval_poses.len(), 408);
-/// ```
-#[derive(Debug, Clone, PartialEq)]
-pub struct FusionOptions {
-    /// Relative singular-value tolerance of the rank decision.
-    pub rank_tolerance: f64,
-    /// `s_i / s_1` below which an identifiable direction is reported weak.
-    pub weak_threshold: f64,
-    /// Gauss-Newton iteration limit.
-    pub max_iterations: u32,
-    /// Tool poses over which the tool tip's predicted uncertainty and the
-    /// tip impact of weak combinations are reported.
-    pub eval_poses: Vec<ExternalPose>,
-    /// A weak or invisible combination that moves the tool tip, after
-    /// touch-off, by less than this per standard deviation (per unit
-    /// coefficient when invisible) is reported as nearly harmless, um.
-    pub harmless_um: f64,
-    /// The gross-error screen of every source's records (`None`: every
-    /// record is fitted).
-    pub screen: Option<ScreenOptions>,
-    /// Plausible ranges of the estimates.
-    pub plausibility: FusionPlausibility,
-    /// A predicted tool-axis uncertainty (RMS over the evaluation poses)
-    /// above this is warned about, arcsec.
-    pub tool_axis_arcsec: f64,
-    /// Whether an implausible or unexplained fit is refitted with the
-    /// usual mistakes undone to name the likely cause.
-    pub likely_causes: bool,
-}
-
-impl FusionOptions {
-    /// Defaults: the rank tolerance and weak threshold of
-    /// [`crate::IdentifyOptions`], 30 iterations, 5 um, the screen at
-    /// family-wise level 0.001 (at most 10 % of a source's records), the
-    /// default plausibility table, 30 arcsec for the tool axis, the
-    /// likely-cause search, and the evaluation
-    /// grid [`evaluation_poses`] with 2 rings of 8 on 3 levels and head
-    /// angles `h1` in {0, 90, 180, 270} deg, `h2` in {15, 35} deg (away
-    /// from the head singularity at `h2 = 0`, where a calibrated head may
-    /// not point exactly along its first axis).
-    pub fn for_machine(machine: &Machine) -> FusionOptions {
-        FusionOptions {
-            rank_tolerance: DEFAULT_RANK_TOLERANCE,
-            weak_threshold: 1e-2,
-            max_iterations: 30,
-            eval_poses: evaluation_poses(
-                machine,
-                (2, 8, 3),
-                &[0.0, 90.0, 180.0, 270.0],
-                &[15.0, 35.0],
-            ),
-            harmless_um: 5.0,
-            screen: Some(ScreenOptions::default()),
-            plausibility: FusionPlausibility::default(),
-            tool_axis_arcsec: 30.0,
-            likely_causes: true,
-        }
-    }
-}
-
-/// Tool poses for evaluation: the platform points of the workspace's
-/// `polar_grid(rings, per_ring, levels)` with every pair of head angles from
-/// `h1_deg` x `h2_deg` ([`head_angle_poses`]).
-pub fn evaluation_poses(
-    machine: &Machine,
-    (rings, per_ring, levels): (usize, usize, usize),
-    h1_deg: &[f64],
-    h2_deg: &[f64],
-) -> Vec<ExternalPose> {
-    let points = machine.workspace.polar_grid(rings, per_ring, levels);
-    head_angle_poses(machine, &points, h1_deg, h2_deg)
-}
-
-/// Each platform point (commanded by the nominal IK) with each pair of head
-/// angles from `h1_deg` x `h2_deg` (degrees): evaluation poses, tracker
-/// candidates. Points the IK cannot reach are left out.
-///
-/// # Example
-/// ```
-/// use tricept_ident::fusion::head_angle_poses;
-/// let m = tricept_kinematics::Machine::paper();
-/// let poses = head_angle_poses(&m, &[nalgebra::Vector3::new(0.0, 0.0, 750.0)], &[0.0, 90.0], &[30.0]);
-/// assert_eq!(poses.len(), 2);
-/// assert!((poses[1].head_rad[0] - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
-/// ```
-pub fn head_angle_poses(
-    machine: &Machine,
-    platform_mm: &[nalgebra::Vector3<f64>],
-    h1_deg: &[f64],
-    h2_deg: &[f64],
-) -> Vec<ExternalPose> {
-    let mut out = Vec::new();
-    for r in platform_mm {
-        let Ok(ik) = machine.inverse(r) else {
-            continue;
-        };
-        for h1 in h1_deg {
-            for h2 in h2_deg {
-                out.push(ExternalPose {
-                    commands_mm: ik.legs_mm,
-                    head_rad: [h1.to_radians(), h2.to_radians()],
-                });
-            }
-        }
-    }
-    out
-}
 
 /// The fixed parts of a fused problem.
 pub(crate) struct Problem<'a> {
@@ -198,40 +77,7 @@ impl Problem<'_> {
         if parts.len() == 1 {
             return parts[0].clone();
         }
-        merge(&parts.iter().collect::<Vec<_>>())
-    }
-}
-
-/// The union of reduced problems over the same global parameters: their
-/// factors stacked with every nuisance block first (in order) and factored
-/// again.
-pub(crate) fn merge(parts: &[&ReducedProblem]) -> ReducedProblem {
-    let k = parts.first().map_or(0, |p| p.k);
-    let n_nuisance: usize = parts.iter().map(|p| p.n_nuisance).sum();
-    let width = n_nuisance + k + 1;
-    let height: usize = parts.iter().map(|p| p.r.nrows()).sum();
-    let mut stacked = Mat::<f64>::zeros(height, width);
-    let (mut row, mut offset) = (0, 0);
-    for part in parts {
-        let nn = part.n_nuisance;
-        for i in 0..part.r.nrows() {
-            for j in 0..part.r.ncols() {
-                let col = if j < nn {
-                    offset + j
-                } else {
-                    n_nuisance + (j - nn)
-                };
-                stacked[(row + i, col)] = part.r[(i, j)];
-            }
-        }
-        row += part.r.nrows();
-        offset += nn;
-    }
-    ReducedProblem {
-        r: r_factor(stacked.as_ref()),
-        n_nuisance,
-        k,
-        rows: parts.iter().map(|p| p.rows).sum(),
+        ReducedProblem::merge(&parts.iter().collect::<Vec<_>>())
     }
 }
 
@@ -314,61 +160,6 @@ pub(crate) fn in_source(source: &Source, e: IdentError) -> IdentError {
         },
         e => e,
     }
-}
-
-/// Fits the parameters of `model` and every source's nuisance to all
-/// sources at once (see the module docs): the gross-error screen of
-/// `options.screen` decides which records enter the fit, the fit is judged
-/// (redundancy, adequacy, plausibility) and an implausible or unexplained
-/// one is searched for its likely cause.
-///
-/// # Example
-/// ```
-/// use tricept_ident::fusion::{FusedModel, FusionOptions, Source, identify_fused};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let m = Machine::paper();
-/// let set = ParameterSet::paper15();
-/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
-///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
-///     .unwrap();
-/// // The internal data alone, head in the model: the head is invisible.
-/// let model = FusedModel::new(m.clone(), set, &[], true).unwrap();
-/// let fit = identify_fused(&model, &[Source::internal(&data, m.sensors.logged_sigma())],
-///     &FusionOptions::for_machine(&m)).unwrap();
-/// assert_eq!(fit.report.union.rank, 14);
-/// assert!(fit.report.union.fixed.contains(&"tool_length_mm".to_string()));
-/// assert!(fit.sources[0].checkable && fit.rejected.is_empty());
-/// ```
-pub fn identify_fused(
-    model: &FusedModel,
-    sources: &[Source],
-    options: &FusionOptions,
-) -> Result<Fusion, IdentError> {
-    if sources.is_empty() {
-        return Err(IdentError::Invalid("no data source".into()));
-    }
-    for (s, a) in sources.iter().enumerate() {
-        if sources[..s].iter().any(|b| b.label() == a.label()) {
-            return Err(IdentError::Invalid(format!(
-                "two sources are labelled `{}`: label them apart (Source::with_label)",
-                a.label()
-            )));
-        }
-    }
-    let (active, mut fit) = match &options.screen {
-        Some(screen) => crate::fusion::screen::screened_fit(model, sources, options, screen)?,
-        None => {
-            let active: Vec<Vec<bool>> = sources.iter().map(|s| vec![true; s.records()]).collect();
-            let fit = fit_masked(model, sources, &active, options)?;
-            (active, fit)
-        }
-    };
-    if options.likely_causes && fit.needs_causes() {
-        let causes = crate::fusion::causes::likely_causes(model, sources, &active, options, &fit);
-        fit.add_causes(causes);
-    }
-    Ok(fit)
 }
 
 /// One fit of `model` to the records of `sources` marked in `active`, judged
@@ -497,22 +288,10 @@ pub(crate) fn start<'a>(
     n_nuisance: usize,
     active: &'a [Vec<bool>],
 ) -> Result<(Problem<'a>, State, Evaluation), IdentError> {
-    let mut contexts = Vec::with_capacity(sources.len());
-    for source in sources {
-        let rows = source.rows();
-        let ctx = (0..rows.records())
-            .map(|j| {
-                model
-                    .leg_context(&rows.pose(j).commands_mm)
-                    .map_err(|e| IdentError::Source {
-                        file: source.file().to_string(),
-                        line: Some(rows.line(j)),
-                        message: format!("the commands of this record cannot be reached: {e}"),
-                    })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        contexts.push(ctx);
-    }
+    let contexts = sources
+        .iter()
+        .map(|source| source.leg_contexts(model))
+        .collect::<Result<Vec<_>, _>>()?;
     let problem = Problem {
         model,
         sources,
@@ -781,146 +560,4 @@ fn finish(
         reference_warning,
         options,
     ))
-}
-
-/// The weighted rows of one source at the nominal machine, with its
-/// nuisance at its starting values: what planning scores candidate
-/// measurements with (the rows' Jacobians do not depend on the measured
-/// values, only on where the machine stood).
-#[derive(Debug, Clone, PartialEq)]
-pub struct DesignRows {
-    /// The source's nuisance parameter names (with its label).
-    pub nuisance_names: Vec<String>,
-    /// Per record, its rows `[nuisance | global parameters]`, each weighted
-    /// by `1 / sigma` (`rows per record x (nuisance + parameters)`).
-    pub records: Vec<DMatrix<f64>>,
-    /// The source's prior rows (bar length, target offset, stylus), weighted.
-    pub priors: DMatrix<f64>,
-    /// The redundancy its rows need to check a fit
-    /// ([`SourceFit::min_redundancy`]).
-    pub min_redundancy: f64,
-}
-
-/// The rows of `source` at the nominal machine (see [`DesignRows`]).
-pub fn design_rows(model: &FusedModel, source: &Source) -> Result<DesignRows, IdentError> {
-    let k = model.len();
-    let p = vec![0.0; k];
-    let at = model.at(&p);
-    let rows = source.rows();
-    let contexts = (0..rows.records())
-        .map(|j| {
-            model
-                .leg_context(&rows.pose(j).commands_mm)
-                .map_err(|e| IdentError::Source {
-                    file: source.file().to_string(),
-                    line: Some(rows.line(j)),
-                    message: format!("the commands of this record cannot be reached: {e}"),
-                })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut seeds = vec![None; rows.records()];
-    let nu = rows
-        .initial(&at, &contexts, &mut seeds, &vec![true; rows.records()])
-        .map_err(|e| in_source(source, e))?;
-    let nn = nu.values.len();
-    let mut sink = Sink::new(nn, k, rows.data_rows());
-    rows.evaluate(&at, &contexts, &nu, &mut seeds, &mut sink)
-        .map_err(|e| in_source(source, e))?;
-    let kept = sink.take_kept();
-    let width = nn + k;
-    let mut records: Vec<Vec<f64>> = vec![Vec::new(); rows.records()];
-    let mut priors = Vec::new();
-    for (record, row) in kept {
-        match record {
-            Some(j) => records[j].extend_from_slice(&row[..width]),
-            None => priors.extend_from_slice(&row[..width]),
-        }
-    }
-    Ok(DesignRows {
-        nuisance_names: source.nuisance_names(),
-        records: records
-            .into_iter()
-            .map(|r| DMatrix::from_row_slice(r.len() / width.max(1), width, &r))
-            .collect(),
-        priors: DMatrix::from_row_slice(priors.len() / width.max(1), width, &priors),
-        min_redundancy: rows.min_redundancy(),
-    })
-}
-
-/// The information the `sources` together carry on the global parameters
-/// at the nominal machine, their nuisance projected out, as a square-root
-/// factor: rows whose `F^T F` is the information (every source's parameter
-/// block of its triangular factor, stacked; `rows x k`, in the
-/// parameters' units).
-///
-/// # Example
-/// ```
-/// use tricept_ident::fusion::{FusedModel, Source, information, information_factor};
-/// use tricept_kinematics::Machine;
-/// let m = Machine::paper();
-/// let model = FusedModel::new(m.clone(), tricept_model::ParameterSet::paper15(), &[], true).unwrap();
-/// let poses = m.workspace.polar_grid(3, 8, 3).iter()
-///     .map(|r| tricept_data::MeasuredPose { commands_mm: m.inverse(r).unwrap().legs_mm, ..Default::default() })
-///     .collect();
-/// let data = tricept_data::Dataset { poses, source: "grid".into() };
-/// let sources = [Source::internal(&data, m.sensors.logged_sigma())];
-/// let r = information_factor(&model, &sources).unwrap();
-/// let f = information(&model, &sources).unwrap();
-/// assert!(((r.transpose() * &r) - &f).norm() <= 1e-9 * f.norm());
-/// ```
-pub fn information_factor(
-    model: &FusedModel,
-    sources: &[Source],
-) -> Result<DMatrix<f64>, IdentError> {
-    let k = model.len();
-    let parts = sources
-        .iter()
-        .map(|source| {
-            let d = design_rows(model, source)?;
-            let nn = d.nuisance_names.len();
-            let mut acc = TriangularAccumulator::new(nn + k);
-            for m in d.records.iter().chain(std::iter::once(&d.priors)) {
-                for i in 0..m.nrows() {
-                    let row: Vec<f64> = m.row(i).iter().copied().collect();
-                    acc.push_row(&row);
-                }
-            }
-            Ok((nn, acc.finish()))
-        })
-        .collect::<Result<Vec<_>, IdentError>>()?;
-    let mut factor = DMatrix::zeros(k * parts.len(), k);
-    for (s, (nn, r)) in parts.iter().enumerate() {
-        for i in 0..k {
-            for j in 0..k {
-                factor[(s * k + i, j)] = r[(nn + i, nn + j)];
-            }
-        }
-    }
-    Ok(factor)
-}
-
-/// The information the `sources` together carry on the global parameters
-/// at the nominal machine, their nuisance projected out: `R^T R` of the
-/// union's parameter block (`k x k`, in the parameters' units;
-/// [`information_factor`] gives `R`).
-///
-/// # Example
-/// ```
-/// use tricept_ident::fusion::{FusedModel, Source, information};
-/// use tricept_kinematics::Machine;
-/// let m = Machine::paper();
-/// let model = FusedModel::new(m.clone(), tricept_model::ParameterSet::paper15(), &[], true).unwrap();
-/// let poses = m.workspace.polar_grid(3, 8, 3).iter()
-///     .map(|r| tricept_data::MeasuredPose { commands_mm: m.inverse(r).unwrap().legs_mm, ..Default::default() })
-///     .collect();
-/// let data = tricept_data::Dataset { poses, source: "grid".into() };
-/// let f = information(&model, &[Source::internal(&data, m.sensors.logged_sigma())]).unwrap();
-/// // The UP limb's readings carry nothing on the head.
-/// let head = model.index_of("tool_length_mm").unwrap();
-/// assert_eq!(f[(head, head)], 0.0);
-/// assert!(f[(0, 0)] > 0.0);
-/// ```
-pub fn information(model: &FusedModel, sources: &[Source]) -> Result<DMatrix<f64>, IdentError> {
-    let r = information_factor(model, sources)?;
-    Ok(r.transpose() * r)
 }

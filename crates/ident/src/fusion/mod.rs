@@ -26,8 +26,12 @@
 
 mod ballbar;
 mod causes;
+mod design;
 mod estimate;
+mod identify;
+mod internal;
 mod model;
+mod options;
 mod plausibility;
 mod report;
 mod result;
@@ -37,19 +41,16 @@ mod touch;
 mod tracker;
 
 pub use ballbar::BallbarOptions;
-pub use causes::FusionCause;
-pub use estimate::{
-    DesignRows, FusionOptions, design_rows, evaluation_poses, head_angle_poses, identify_fused,
-    information, information_factor,
-};
-pub use model::{FUSABLE_EFFECTS, FusedModel};
+pub use design::{DesignRows, design_rows, information, information_factor};
+pub use identify::identify_fused;
+pub use model::{FusedModel, fusable_effects};
+pub use options::{FusionOptions, ScreenOptions, evaluation_poses, head_angle_poses};
 pub use plausibility::{FusionPlausibility, HEAD_RANGE_TYPICAL_SIZES, Implausible};
 pub use report::{
     FusionReport, HARMLESS_AXIS_ARCSEC, MadeVisible, NamedQuantity, SourceVisibility, TipImpact,
     ToolAxisPrediction, ToolTipPrediction,
 };
-pub use result::{Fusion, FusionVerdict, SourceFit};
-pub use screen::{RejectedRecord, ScreenOptions};
-pub use source::{Source, SourceKind};
+pub use result::{Fusion, FusionCause, FusionVerdict, RejectedRecord, SourceFit};
+pub use source::{Source, SourceKind, TrackerTarget};
 pub use touch::TouchOptions;
-pub use tracker::{TrackerOptions, TrackerTarget};
+pub use tracker::TrackerOptions;

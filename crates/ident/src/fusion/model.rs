@@ -4,9 +4,11 @@
 //!
 //! Parameters are ordered `[module | effects | head]`. The module is a
 //! [`ParameterSet`] (`paper15`, `full21`); effects are the parameters of
-//! `leg-lead` (ppm per leg), `scale-gain` (ppm) and `compliance` (um/kN at
-//! 1 m), with the physics of [`tricept_model::effects`] that the plant
-//! simulator and the diagnosis use; the head is
+//! the registry's effects that say they can be fused
+//! ([`EffectSpec::fused`](tricept_model::effects::EffectSpec): a leg or
+//! reading term linear in its parameters), with the columns their specs
+//! give, the physics of [`tricept_model::effects`] that the plant simulator
+//! and the diagnosis use; the head is
 //! [`HeadParameterSet::head13`]. A reading or a spindle point is computed
 //! on the exact model: FK of the actual module at the actual leg lengths
 //! (commands plus `dq` plus the leg effects), then the actual head at the
@@ -20,9 +22,7 @@ use std::ops::Range;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use tricept_data::ExternalPose;
 use tricept_kinematics::{HeadBranch, KinematicsError, Machine, UpJoints};
-use tricept_model::effects::{
-    EffectName, compliance_extra_mm, gravity_leg_tension_n, leg_lead_extra_mm, scale_gain_error_mm,
-};
+use tricept_model::effects::{Basis, EffectName, Kind, LegContext as EffectContext};
 use tricept_model::{
     Effector, HeadAt, HeadParameterSet, N_FULL, ParameterSet, actual_machine, point_error_jacobian,
 };
@@ -30,14 +30,20 @@ use tricept_model::{
 use crate::error::IdentError;
 use crate::model::{GeometricPredictor, solve_pose};
 
-/// The effects the fused model can carry: those whose physics changes the
-/// legs or the scale reading with no context column (`leg-lead`,
-/// `scale-gain`, `compliance`).
-pub const FUSABLE_EFFECTS: [EffectName; 3] = [
-    EffectName::LegLead,
-    EffectName::ScaleGain,
-    EffectName::Compliance,
-];
+/// The effects the fused model can carry, in registry order: those whose
+/// spec says so ([`EffectSpec::fused`](tricept_model::effects::EffectSpec)),
+/// leg or reading terms linear in their parameters that need no context
+/// column.
+///
+/// # Example
+/// ```
+/// use tricept_ident::fusion::fusable_effects;
+/// let names: Vec<&str> = fusable_effects().map(|e| e.as_str()).collect();
+/// assert_eq!(names, ["leg-lead", "scale-gain", "compliance"]);
+/// ```
+pub fn fusable_effects() -> impl Iterator<Item = EffectName> {
+    EffectName::ALL.into_iter().filter(|e| e.spec().fused)
+}
 
 /// Module errors, effects and head errors of one machine, as one parameter
 /// vector.
@@ -63,19 +69,18 @@ pub struct FusedModel {
 }
 
 /// What the leg effects need at one record, computed once from the
-/// commands on the nominal machine: the extra leg length per unit of each
-/// effect parameter.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+/// commands on the nominal machine: the extra leg lengths per unit of each
+/// leg-effect parameter (the entries of its spec).
+#[derive(Debug, Clone, PartialEq, Default)]
 pub(crate) struct LegContext {
-    /// Extra length per ppm of lead, mm.
-    lead_mm_per_ppm: [f64; 3],
-    /// Extra length per um/kN at 1 m of compliance, mm.
-    compliance_mm_per_unit: [f64; 3],
+    /// `(global column, d(leg lengths)/d(parameter), mm per unit)`, the
+    /// effects in registry order.
+    columns: Vec<(usize, Vector3<f64>)>,
 }
 
 impl FusedModel {
     /// The model of `nominal` with the module errors of `module`, the
-    /// parameters of `effects` (each of [`FUSABLE_EFFECTS`], at most once)
+    /// parameters of `effects` (each of [`fusable_effects`], at most once)
     /// and, if `head`, the 13 head errors.
     pub fn new(
         nominal: Machine,
@@ -86,9 +91,11 @@ impl FusedModel {
         let mut names = module.names().to_vec();
         let mut seen: Vec<EffectName> = Vec::new();
         for e in effects {
-            if !FUSABLE_EFFECTS.contains(e) {
+            if !e.spec().fused {
+                let can: Vec<&str> = fusable_effects().map(|e| e.as_str()).collect();
                 return Err(IdentError::Invalid(format!(
-                    "the fused model cannot carry `{e}` (it can: leg-lead, scale-gain, compliance)"
+                    "the fused model cannot carry `{e}` (it can: {})",
+                    can.join(", ")
                 )));
             }
             if seen.contains(e) {
@@ -284,8 +291,9 @@ impl FusedModel {
 
     /// Typical sizes of the parameters as a machine is built, in their
     /// units: 0.3 mm for every module parameter (class-1 errors of a few
-    /// tenths of a mm), 100 ppm for a lead or a scale gain, 30 um/kN at 1 m
-    /// for the compliance (a 12 um sag on the default machine), and
+    /// tenths of a mm), each effect parameter's typical size in the
+    /// registry (100 ppm for a lead or a scale gain, 30 um/kN at 1 m for the
+    /// compliance: a 12 um sag on the default machine), and
     /// [`tricept_model::TYPICAL_HEAD_ERRORS`] for the head. They size the
     /// report's invisible combinations and the priors of planning.
     ///
@@ -299,11 +307,7 @@ impl FusedModel {
     pub fn typical_sizes(&self) -> Vec<f64> {
         let mut t = vec![0.3; self.module.len()];
         for e in &self.effects {
-            let size = match e {
-                EffectName::Compliance => 30.0,
-                _ => 100.0,
-            };
-            t.extend(std::iter::repeat_n(size, e.parameter_names().len()));
+            t.extend(e.spec().parameters.iter().map(|p| p.typical));
         }
         if self.head.is_some() {
             t.extend_from_slice(&tricept_model::TYPICAL_HEAD_ERRORS);
@@ -311,19 +315,53 @@ impl FusedModel {
         t
     }
 
-    /// The leg effects' context at leg commands `q` (nominal FK for the
-    /// gravity load).
+    /// The effect whose parameter sits at column `j`, and the parameter's
+    /// index in its spec.
+    pub(crate) fn effect_parameter(&self, j: usize) -> Option<(EffectName, usize)> {
+        let mut at = self.module.len();
+        for e in &self.effects {
+            let n = e.parameter_count();
+            if (at..at + n).contains(&j) {
+                return Some((*e, j - at));
+            }
+            at += n;
+        }
+        None
+    }
+
+    /// The carried effects in registry order, each with the column of its
+    /// first parameter.
+    fn effect_columns(&self) -> impl Iterator<Item = (EffectName, usize)> + '_ {
+        EffectName::ALL
+            .into_iter()
+            .filter_map(|e| self.effect_column(e).map(|at| (e, at)))
+    }
+
+    /// The leg effects' context at leg commands `q`: their specs' entries
+    /// on the nominal machine at the commands (a compliance evaluates the
+    /// gravity load there).
     pub(crate) fn leg_context(&self, q: &[f64; 3]) -> Result<LegContext, KinematicsError> {
         let mut ctx = LegContext::default();
-        if self.effects.contains(&EffectName::LegLead) {
-            ctx.lead_mm_per_ppm = std::array::from_fn(|i| leg_lead_extra_mm(1.0, q[i]));
-        }
-        if self.effects.contains(&EffectName::Compliance) {
-            let up = self.nominal.forward(q)?.up;
-            let f = gravity_leg_tension_n(&self.nominal, &up);
-            // Compliance c (um/kN at 1 m) = 1000 / stiffness (N/um at 1 m).
-            ctx.compliance_mm_per_unit =
-                std::array::from_fn(|i| compliance_extra_mm(1000.0, f[i], q[i]));
+        let at = EffectContext {
+            nominal: &self.nominal,
+            commands_mm: *q,
+            approach: None,
+            temperature_c: None,
+        };
+        for (e, column) in self.effect_columns() {
+            let Kind::Leg(entries) = e.spec().kind else {
+                continue;
+            };
+            let entries = entries(&at)?;
+            for j in 0..e.parameter_count() {
+                let mut d = Vector3::zeros();
+                for (_, basis, value) in entries.iter().filter(|(p, _, _)| *p == j) {
+                    if let Basis::Leg(i) = basis {
+                        d[*i] += value;
+                    }
+                }
+                ctx.columns.push((column + j, d));
+            }
         }
         Ok(ctx)
     }
@@ -532,33 +570,14 @@ impl FusedAt<'_> {
     /// (the geometric `dq` is part of the machine).
     pub fn legs(&self, q: &[f64; 3], ctx: &LegContext) -> [f64; 3] {
         let mut legs = *q;
-        if let Some(at) = self.model.effect_column(EffectName::LegLead) {
-            for i in 0..3 {
-                legs[i] += self.p[at + i] * ctx.lead_mm_per_ppm[i];
-            }
-        }
-        if let Some(at) = self.model.effect_column(EffectName::Compliance) {
-            for i in 0..3 {
-                legs[i] += self.p[at] * ctx.compliance_mm_per_unit[i];
+        for (j, d) in &ctx.columns {
+            for (i, leg) in legs.iter_mut().enumerate() {
+                if d[i] != 0.0 {
+                    *leg += self.p[*j] * d[i];
+                }
             }
         }
         legs
-    }
-
-    /// `(column, d(leg lengths)/d(parameter))` of the leg effects.
-    fn leg_columns(&self, ctx: &LegContext) -> Vec<(usize, Vector3<f64>)> {
-        let mut out = Vec::new();
-        if let Some(at) = self.model.effect_column(EffectName::LegLead) {
-            for i in 0..3 {
-                let mut d = Vector3::zeros();
-                d[i] = ctx.lead_mm_per_ppm[i];
-                out.push((at + i, d));
-            }
-        }
-        if let Some(at) = self.model.effect_column(EffectName::Compliance) {
-            out.push((at, Vector3::from(ctx.compliance_mm_per_unit)));
-        }
-        out
     }
 
     /// The UP limb's readings without offsets at commands `q` (rad, rad,
@@ -579,19 +598,25 @@ impl FusedAt<'_> {
         let (up, geometry) = self.geometric.solve(&legs, seed, jacobian, k)?;
         let mut r = up.to_array();
         if has_effects {
-            let columns = self.leg_columns(ctx);
-            if !columns.is_empty() {
+            if !ctx.columns.is_empty() {
                 let j1_inv = invert(&geometry.j1())?;
-                for (j, d) in columns {
+                for (j, d) in &ctx.columns {
                     let v = j1_inv * d;
                     for c in 0..3 {
                         jacobian[c * k + j] = v[c];
                     }
                 }
             }
-            if let Some(at) = self.model.effect_column(EffectName::ScaleGain) {
-                r[2] += scale_gain_error_mm(self.p[at], up.q4_mm);
-                jacobian[2 * k + at] = scale_gain_error_mm(1.0, up.q4_mm);
+            for (e, at) in self.model.effect_columns() {
+                let Kind::Reading(entries) = e.spec().kind else {
+                    continue;
+                };
+                for (j, basis, value) in entries(&up) {
+                    if let Basis::Reading(c) = basis {
+                        r[c] += self.p[at + j] * value;
+                        jacobian[c * k + at + j] += value;
+                    }
+                }
             }
         }
         Ok(r)
@@ -646,10 +671,9 @@ impl FusedAt<'_> {
         for c in 0..3 {
             jacobian[c * k..c * k + km].copy_from_slice(&block[c * km..(c + 1) * km]);
         }
-        let columns = self.leg_columns(ctx);
-        if !columns.is_empty() {
+        if !ctx.columns.is_empty() {
             let dx = limb.point_jacobian(&x) * invert(&geometry.j1())?;
-            for (j, d) in columns {
+            for (j, d) in &ctx.columns {
                 let v = dx * d;
                 for c in 0..3 {
                     jacobian[c * k + j] = v[c];

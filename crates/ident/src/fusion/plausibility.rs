@@ -18,12 +18,13 @@
 use std::collections::BTreeMap;
 
 use serde::Serialize;
+use tricept_model::effects::Measure;
 use tricept_model::plausibility::{
     PlausibilityError, Range, insert_range, override_ranges, round3,
 };
 use tricept_model::{HEAD13_NAMES, TYPICAL_HEAD_ERRORS};
 
-use crate::fusion::model::FusedModel;
+use crate::fusion::model::{FusedModel, fusable_effects};
 
 /// The plausibility table of a fused fit: quantity key to range.
 ///
@@ -77,27 +78,18 @@ impl Default for FusionPlausibility {
                 ),
             );
         }
-        add(
-            "leg-lead.lead_ppm",
-            -300.0,
-            300.0,
-            "ppm",
-            "ball-screw lead deviations are tens of ppm".into(),
-        );
-        add(
-            "scale-gain.scale_gain_ppm",
-            -300.0,
-            300.0,
-            "ppm",
-            "glass scales and their mounting".into(),
-        );
-        add(
-            "compliance.compliance_um_per_kn_at_1m",
-            0.0,
-            200.0,
-            "um/kN at 1 m",
-            "tension stretches the legs; 5 N/um is a very soft leg".into(),
-        );
+        for e in fusable_effects() {
+            for j in e.spec().plausible {
+                let r = &j.range;
+                add(
+                    &format!("{e}.{}", r.quantity),
+                    r.min,
+                    r.max,
+                    r.unit,
+                    r.why.into(),
+                );
+            }
+        }
         add(
             "tracker.target_change_mm",
             -0.5,
@@ -145,9 +137,14 @@ impl FusionPlausibility {
         let name = &model.names()[j];
         if model.module_range().contains(&j) {
             "module_mm".into()
-        } else if name.starts_with("leg-lead.lead") {
-            // lead1_ppm, lead2_ppm, lead3_ppm share one range.
-            "leg-lead.lead_ppm".into()
+        } else if let Some((e, i)) = model.effect_parameter(j) {
+            // The range that judges the parameter itself (lead1_ppm,
+            // lead2_ppm and lead3_ppm share one).
+            e.spec()
+                .plausible
+                .iter()
+                .find(|r| r.of.iter().any(|(m, _)| *m == Measure::Parameter(i)))
+                .map_or_else(|| name.clone(), |r| format!("{e}.{}", r.range.quantity))
         } else {
             name.clone()
         }

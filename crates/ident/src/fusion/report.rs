@@ -36,8 +36,8 @@ use tricept_model::Effector;
 use tricept_numerics::lsq::{RankDecision, ReducedProblem};
 
 use crate::error::IdentError;
-use crate::fusion::estimate::{FusionOptions, merge};
 use crate::fusion::model::FusedModel;
+use crate::fusion::options::FusionOptions;
 use crate::fusion::source::{Source, SourceKind};
 use crate::report::{Combination, IdentifiabilityReport, NamedValues, combination};
 
@@ -336,7 +336,7 @@ pub(crate) fn build_report(
             if s == i {
                 continue;
             }
-            let both = merge(&[&start_parts[i], &start_parts[s]]);
+            let both = ReducedProblem::merge(&[&start_parts[i], &start_parts[s]]);
             let d = decide(
                 names,
                 &typical,

@@ -10,12 +10,10 @@ use serde::Serialize;
 use serde_json::{Map, Value, json};
 use tricept_numerics::stats::chi2_sf;
 
-use crate::fusion::causes::FusionCause;
-use crate::fusion::estimate::FusionOptions;
 use crate::fusion::model::FusedModel;
+use crate::fusion::options::FusionOptions;
 use crate::fusion::plausibility::{FusionPlausibility, Implausible};
 use crate::fusion::report::FusionReport;
-use crate::fusion::screen::RejectedRecord;
 use crate::fusion::source::{Source, SourceKind};
 use crate::verdict::{ADEQUACY_ALPHA, INCONSISTENT_CHI2_PER_DOF};
 
@@ -536,5 +534,44 @@ fn plural(kind: SourceKind, n: usize) -> &'static str {
         (SourceKind::Ballbar, false) => "readings",
         (SourceKind::Touch, true) => "touch",
         (SourceKind::Touch, false) => "touches",
+    }
+}
+
+/// A mistake whose undoing makes the data fit.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FusionCause {
+    /// The source it concerns (label).
+    pub source: String,
+    /// Which mistake: `target-sign`, `target-mode` or `another-machine`.
+    pub mistake: &'static str,
+    /// What it is and what the refit gave, in words.
+    pub description: String,
+    /// The source's reduced chi-square with the mistake undone.
+    pub chi2_per_dof: f64,
+}
+
+/// A record the screen rejected.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RejectedRecord {
+    /// The source's label.
+    pub label: String,
+    /// Its file.
+    pub file: String,
+    /// The record's line in the file.
+    pub line: u64,
+    /// Index of the record in the source (0-based).
+    pub record: usize,
+    /// Its prediction residual from the fit without it, in noise standard
+    /// deviations (`sqrt(T_j)`, see the module docs).
+    pub residual_sigma: f64,
+}
+
+impl RejectedRecord {
+    /// One sentence.
+    pub fn to_text(&self) -> String {
+        format!(
+            "rejected {} line {} ({}): {:.1} noise standard deviations from the fit of the other records (a gross error); the fit is without it",
+            self.file, self.line, self.label, self.residual_sigma
+        )
     }
 }

@@ -25,62 +25,17 @@
 //! setup problem, not gross errors). Rejected records are reported by file
 //! and line, and the fit is redone without them.
 
-use serde::Serialize;
 use tricept_numerics::stats::{chi2_isf, quantile};
 
 use crate::error::IdentError;
 use crate::fusion::estimate::{
-    Evaluation, FusionOptions, check_counts, fit_masked, fit_started, nuisance_layout, start,
+    Evaluation, check_counts, fit_masked, fit_started, nuisance_layout, start,
 };
 use crate::fusion::model::FusedModel;
-use crate::fusion::result::{Fusion, RecordCheck, SourceFit};
+use crate::fusion::options::{FusionOptions, ScreenOptions};
+use crate::fusion::result::{Fusion, RecordCheck, RejectedRecord, SourceFit};
 use crate::fusion::source::Source;
 use crate::robust::start_set;
-
-/// Settings of the gross-error screen.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ScreenOptions {
-    /// Family-wise level of the test per source.
-    pub alpha: f64,
-    /// Largest share of a source's records that may be rejected.
-    pub max_share: f64,
-}
-
-impl Default for ScreenOptions {
-    /// Level 0.001, at most 10 % of the records (as `identify`).
-    fn default() -> Self {
-        ScreenOptions {
-            alpha: 1e-3,
-            max_share: 0.1,
-        }
-    }
-}
-
-/// A record the screen rejected.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct RejectedRecord {
-    /// The source's label.
-    pub label: String,
-    /// Its file.
-    pub file: String,
-    /// The record's line in the file.
-    pub line: u64,
-    /// Index of the record in the source (0-based).
-    pub record: usize,
-    /// Its prediction residual from the fit without it, in noise standard
-    /// deviations (`sqrt(T_j)`, see the module docs).
-    pub residual_sigma: f64,
-}
-
-impl RejectedRecord {
-    /// One sentence.
-    pub fn to_text(&self) -> String {
-        format!(
-            "rejected {} line {} ({}): {:.1} noise standard deviations from the fit of the other records (a gross error); the fit is without it",
-            self.file, self.line, self.label, self.residual_sigma
-        )
-    }
-}
 
 /// `T_j` of one record (see the module docs) in a source whose fit is `fit`.
 fn statistic(check: &RecordCheck, fit: &SourceFit) -> f64 {

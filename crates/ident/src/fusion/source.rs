@@ -18,13 +18,13 @@
 //! [`crate::identify`] does.
 
 use nalgebra::{Matrix3, Vector3};
-use tricept_data::{Dataset, ExternalPose, MeasuredPose};
+use tricept_data::ExternalPose;
 use tricept_kinematics::UpJoints;
 use tricept_numerics::linalg::TriangularAccumulator;
 use tricept_numerics::lsq::ReducedProblem;
 
 use crate::error::IdentError;
-use crate::fusion::model::{FusedAt, LegContext, SpindlePoint};
+use crate::fusion::model::{FusedAt, FusedModel, LegContext, SpindlePoint};
 
 /// What kind of instrument a source is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -223,15 +223,12 @@ pub(crate) trait SourceRows: Sync + std::fmt::Debug {
         Vec::new()
     }
     /// The tracker target's stated offset (tracker sources only).
-    fn tracker_target(&self) -> Option<crate::fusion::TrackerTarget> {
+    fn tracker_target(&self) -> Option<TrackerTarget> {
         None
     }
     /// The same records with another statement of the tracker target
     /// (tracker sources only): what the likely-cause search refits.
-    fn with_tracker_target(
-        &self,
-        _target: crate::fusion::TrackerTarget,
-    ) -> Option<Box<dyn SourceRows>> {
+    fn with_tracker_target(&self, _target: TrackerTarget) -> Option<Box<dyn SourceRows>> {
         None
     }
     /// Where the machine stood at a record.
@@ -284,6 +281,24 @@ pub(crate) trait SourceRows: Sync + std::fmt::Debug {
     fn boxed_clone(&self) -> Box<dyn SourceRows>;
 }
 
+/// What is known about the tracker target's offset from the tool tip (a
+/// statement the likely-cause search restates, so every source can be
+/// asked for it: [`Source::tracker_target`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TrackerTarget {
+    /// Unknown (the default): the target offset is a free nuisance, and the
+    /// tool tip is not calibrated by this source.
+    Free,
+    /// Known to `sigma_um` (a target in a presetter-measured nest at the tool
+    /// tip: offset zero).
+    Known {
+        /// The offset, mm, spindle frame at zero head angles.
+        offset_mm: [f64; 3],
+        /// Its standard deviation per coordinate, um.
+        sigma_um: f64,
+    },
+}
+
 /// One data source of a fused identification.
 ///
 /// # Example
@@ -317,16 +332,6 @@ impl Source {
             label: rows.kind().as_str().to_string(),
             rows,
         }
-    }
-
-    /// The UP limb's readings, with the standard deviation of one logged
-    /// reading `[phi, theta, s]` (rad, rad, mm).
-    pub fn internal(data: &Dataset, sigma: [f64; 3]) -> Source {
-        Source::new(Box::new(Internal {
-            poses: data.poses.clone(),
-            sigma,
-            file: data.source.clone(),
-        }))
     }
 
     /// The same source under another label (the prefix of its nuisance
@@ -369,6 +374,24 @@ impl Source {
         self.rows.as_ref()
     }
 
+    /// The leg effects' context of every record at its commands
+    /// ([`FusedModel`]'s nominal machine); a record whose commands cannot
+    /// be reached is an error naming its line.
+    pub(crate) fn leg_contexts(&self, model: &FusedModel) -> Result<Vec<LegContext>, IdentError> {
+        let rows = self.rows();
+        (0..rows.records())
+            .map(|j| {
+                model
+                    .leg_context(&rows.pose(j).commands_mm)
+                    .map_err(|e| IdentError::Source {
+                        file: self.file().to_string(),
+                        line: Some(rows.line(j)),
+                        message: format!("the commands of this record cannot be reached: {e}"),
+                    })
+            })
+            .collect()
+    }
+
     /// The same tracker records with the target stated as `target` (same
     /// label); `None` for a source that is not a tracker.
     ///
@@ -381,7 +404,7 @@ impl Source {
     /// let t = s.with_tracker_target(TrackerTarget::Known { offset_mm: [0.0; 3], sigma_um: 5.0 }).unwrap();
     /// assert_eq!((t.label(), t.records()), ("tracker", 3));
     /// ```
-    pub fn with_tracker_target(&self, target: crate::fusion::TrackerTarget) -> Option<Source> {
+    pub fn with_tracker_target(&self, target: TrackerTarget) -> Option<Source> {
         Some(Source {
             label: self.label.clone(),
             rows: self.rows.with_tracker_target(target)?,
@@ -389,131 +412,8 @@ impl Source {
     }
 
     /// How the tracker target is stated (`None` for other sources).
-    pub fn tracker_target(&self) -> Option<crate::fusion::TrackerTarget> {
+    pub fn tracker_target(&self) -> Option<TrackerTarget> {
         self.rows.tracker_target()
-    }
-}
-
-/// The UP limb's readings.
-#[derive(Debug, Clone)]
-struct Internal {
-    poses: Vec<MeasuredPose>,
-    sigma: [f64; 3],
-    file: String,
-}
-
-impl SourceRows for Internal {
-    fn kind(&self) -> SourceKind {
-        SourceKind::Internal
-    }
-
-    fn file(&self) -> &str {
-        &self.file
-    }
-
-    fn nuisance_names(&self) -> Vec<String> {
-        vec![
-            "phi_offset_rad".into(),
-            "theta_offset_rad".into(),
-            "s_offset_mm".into(),
-        ]
-    }
-
-    fn records(&self) -> usize {
-        self.poses.len()
-    }
-
-    fn data_rows(&self) -> usize {
-        3 * self.poses.len()
-    }
-
-    fn min_redundancy(&self) -> f64 {
-        6.0
-    }
-
-    fn pose(&self, record: usize) -> ExternalPose {
-        ExternalPose {
-            commands_mm: self.poses[record].commands_mm,
-            head_rad: [0.0, 0.0],
-        }
-    }
-
-    fn line(&self, record: usize) -> u64 {
-        self.poses[record].line
-    }
-
-    fn residual_unit_um(&self) -> Option<f64> {
-        None
-    }
-
-    fn linear_nuisance(&self) -> bool {
-        true
-    }
-
-    fn initial(
-        &self,
-        _at: &FusedAt<'_>,
-        _contexts: &[LegContext],
-        _seeds: &mut [Option<UpJoints>],
-        _active: &[bool],
-    ) -> Result<Nuisance, IdentError> {
-        Ok(Nuisance {
-            values: vec![0.0; 3],
-            ..Nuisance::default()
-        })
-    }
-
-    fn evaluate(
-        &self,
-        at: &FusedAt<'_>,
-        contexts: &[LegContext],
-        _nu: &Nuisance,
-        seeds: &mut [Option<UpJoints>],
-        sink: &mut Sink,
-    ) -> Result<(), IdentError> {
-        let k = at.len();
-        let mut jac = vec![0.0; 3 * k];
-        let mut unit = [0.0; 3];
-        for (j, ((pose, seed), ctx)) in self.poses.iter().zip(seeds).zip(contexts).enumerate() {
-            let g = at
-                .readings(&pose.commands_mm, ctx, seed, &mut jac)
-                .map_err(|source| IdentError::Kinematics {
-                    pose: j,
-                    line: pose.line,
-                    source,
-                })?;
-            let y = pose.readings.to_array();
-            for c in 0..3 {
-                unit.iter_mut().for_each(|v| *v = 0.0);
-                unit[c] = 1.0;
-                sink.data(
-                    j,
-                    1.0 / self.sigma[c],
-                    &unit,
-                    &jac[c * k..(c + 1) * k],
-                    y[c] - g[c],
-                );
-            }
-        }
-        Ok(())
-    }
-
-    fn retract(&self, _nu: &mut Nuisance, _step: &[f64]) {}
-
-    fn take_off_linear_nuisance(&self, rows: &mut [(usize, f64, f64)], offsets: &[f64]) {
-        for (i, (_, z, raw)) in rows.iter_mut().enumerate() {
-            let c = i % 3;
-            *raw -= offsets[c];
-            *z = *raw / self.sigma[c];
-        }
-    }
-
-    fn nuisance_hint(&self) -> &'static str {
-        "the poses do not move the UP limb's joints"
-    }
-
-    fn boxed_clone(&self) -> Box<dyn SourceRows> {
-        Box::new(self.clone())
     }
 }
 

@@ -22,25 +22,9 @@ use tricept_model::Effector;
 use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Sink, Source, SourceKind, SourceRows, cross_matrix, for_each_point, groups,
-    lines_text, rotate_row,
+    Nuisance, Sink, Source, SourceKind, SourceRows, TrackerTarget, cross_matrix, for_each_point,
+    groups, lines_text, rotate_row,
 };
-
-/// What is known about the tracker target's offset from the tool tip.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum TrackerTarget {
-    /// Unknown (the default): the target offset is a free nuisance, and the
-    /// tool tip is not calibrated by this source.
-    Free,
-    /// Known to `sigma_um` (a target in a presetter-measured nest at the tool
-    /// tip: offset zero).
-    Known {
-        /// The offset, mm, spindle frame at zero head angles.
-        offset_mm: [f64; 3],
-        /// Its standard deviation per coordinate, um.
-        sigma_um: f64,
-    },
-}
 
 /// How to read a tracker file.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -33,6 +33,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     kind: Kind::Leg(entries),
     needs: Needs::ApproachDirections,
     deployment: Deployment::Controller(set),
+    fused: false,
     plausible: &[Judged {
         range: PlausibleRange {
             quantity: "backlash_um",

@@ -23,6 +23,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     kind: Kind::Leg(entries),
     needs: Needs::Nothing,
     deployment: Deployment::LegEffects(LegDeployment { set, rate }),
+    fused: true,
     plausible: &[Judged {
         range: PlausibleRange {
             quantity: "compliance_um_per_kn_at_1m",

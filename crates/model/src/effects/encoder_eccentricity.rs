@@ -40,6 +40,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     kind: Kind::Reading(entries),
     needs: Needs::Nothing,
     deployment: Deployment::Sensor,
+    fused: false,
     plausible: &[Judged {
         range: PlausibleRange {
             quantity: "amplitude_arcsec",

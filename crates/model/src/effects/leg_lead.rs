@@ -33,6 +33,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     kind: Kind::Leg(entries),
     needs: Needs::Nothing,
     deployment: Deployment::LegEffects(LegDeployment { set, rate }),
+    fused: true,
     plausible: &[Judged {
         range: PlausibleRange {
             quantity: "lead_ppm",

@@ -436,6 +436,10 @@ mod tests {
                     "{e} and {other} both declare their alias"
                 );
             }
+            if s.fused {
+                assert!(matches!(s.kind, Kind::Leg(_) | Kind::Reading(_)), "{e}");
+                assert_eq!(s.needs, Needs::Nothing, "{e}");
+            }
             for case in (s.realistic)(&m) {
                 assert_eq!(case.values.len(), k, "{e}");
             }

@@ -11,6 +11,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     kind: Kind::Rows,
     needs: Needs::Nothing,
     deployment: Deployment::SetAside,
+    fused: false,
     plausible: &[],
     description: "gross reading errors",
     plot: PlotAxes {

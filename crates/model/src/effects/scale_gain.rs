@@ -20,6 +20,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     kind: Kind::Reading(entries),
     needs: Needs::Nothing,
     deployment: Deployment::Sensor,
+    fused: true,
     plausible: &[Judged {
         range: PlausibleRange {
             quantity: "scale_gain_ppm",

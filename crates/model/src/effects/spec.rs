@@ -35,6 +35,12 @@ pub struct EffectSpec {
     pub needs: Needs,
     /// Where a fitted value goes in a calibrated machine file.
     pub deployment: Deployment,
+    /// Whether the fused identification with external measurements
+    /// (`tricept_ident::fusion`) can carry it: a [`Kind::Leg`] or
+    /// [`Kind::Reading`] term that needs no logged context
+    /// ([`Needs::Nothing`]), whose entries the fused model takes as its
+    /// columns (a test of the registry checks that).
+    pub fused: bool,
     /// Its physical ranges (the diagnosis' plausibility table).
     pub plausible: &'static [Judged],
     /// What a named cause is, in words a machine builder can act on (the

@@ -27,6 +27,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     kind: Kind::Leg(entries),
     needs: Needs::Temperature,
     deployment: Deployment::Controller(set),
+    fused: false,
     plausible: &[Judged {
         range: PlausibleRange {
             quantity: "expansion_ppm_per_k",

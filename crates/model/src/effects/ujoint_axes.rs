@@ -28,6 +28,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     kind: Kind::Kinematic(apply),
     needs: Needs::Nothing,
     deployment: Deployment::UpLimb,
+    fused: false,
     plausible: &[
         Judged {
             range: PlausibleRange {

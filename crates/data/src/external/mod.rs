@@ -30,10 +30,18 @@
 use std::io::{Read, Write};
 use std::path::Path;
 
-use serde::{Deserialize, Serialize};
-
 use crate::records::{Header, Record, Records, open};
 use crate::{DataError, MAX_LENGTH_MM};
+
+mod ballbar;
+mod planned;
+mod touch;
+mod tracker;
+
+pub use ballbar::{BallbarData, BallbarReading};
+pub use planned::{PlannedPose, PlannedPoses};
+pub use touch::{Feature, Features, Stylus, TouchData, TouchReading};
+pub use tracker::{TrackerData, TrackerPoint};
 
 /// Where the machine stood when an instrument measured.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -42,78 +50,6 @@ pub struct ExternalPose {
     pub commands_mm: [f64; 3],
     /// Commanded head angles `[h1, h2]`, rad.
     pub head_rad: [f64; 2],
-}
-
-/// One point measured by a laser tracker or a CMM.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct TrackerPoint {
-    /// Where the machine stood.
-    pub pose: ExternalPose,
-    /// The measured point in the instrument's frame, mm.
-    pub position_mm: [f64; 3],
-    /// Standard deviation of each coordinate, um (`None`: the default).
-    pub sigma_um: Option<f64>,
-    /// Known extension of the target along the tool axis beyond the tool
-    /// tip, mm (0 when the column is absent).
-    pub extension_mm: f64,
-    /// Instrument station, from 1.
-    pub setup: u32,
-    /// Structure temperature, °C.
-    pub temp_c: Option<f64>,
-    /// Line in the file (0 if none).
-    pub line: u64,
-}
-
-/// One reading of a ballbar between the tool-tip ball and a pivot on the table.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct BallbarReading {
-    /// Where the machine stood.
-    pub pose: ExternalPose,
-    /// The bar's reading: the ball-to-pivot distance, mm.
-    pub length_mm: f64,
-    /// Standard deviation of the reading, um (`None`: the default).
-    pub sigma_um: Option<f64>,
-    /// Pivot mounting, from 1.
-    pub setup: u32,
-    /// Structure temperature, °C.
-    pub temp_c: Option<f64>,
-    /// Line in the file (0 if none).
-    pub line: u64,
-}
-
-/// One touch of a probe in the spindle on a feature of the features file.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct TouchReading {
-    /// Where the machine stood when the probe triggered (latched values).
-    pub pose: ExternalPose,
-    /// Id of the feature touched.
-    pub feature: u32,
-    /// Standard deviation of the touch along the surface normal, um
-    /// (`None`: the default).
-    pub sigma_um: Option<f64>,
-    /// Structure temperature, °C.
-    pub temp_c: Option<f64>,
-    /// Line in the file (0 if none).
-    pub line: u64,
-}
-
-/// A pose to measure at (what `tricept plan` writes and `tricept simulate`
-/// reads): the commands and, for information, the nominal tool tip and
-/// ballbar length there.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct PlannedPose {
-    /// Where the machine is to stand.
-    pub pose: ExternalPose,
-    /// Known extension of a tracker target along the tool, mm.
-    pub extension_mm: f64,
-    /// The nominal tool tip there, mm (columns `x,y,z`).
-    pub tip_mm: Option<[f64; 3]>,
-    /// The nominal ballbar length there, mm (column `length`).
-    pub length_mm: Option<f64>,
-    /// The feature to touch there (column `feature`, touch-offs).
-    pub feature: Option<u32>,
-    /// Line in the file (0 if none).
-    pub line: u64,
 }
 
 /// The records of one external-measurement file and where they came from.
@@ -125,22 +61,11 @@ pub struct ExternalData<T> {
     pub source: String,
 }
 
-/// Points of a laser tracker or CMM.
-pub type TrackerData = ExternalData<TrackerPoint>;
-/// Readings of a ballbar.
-pub type BallbarData = ExternalData<BallbarReading>;
-/// Touches of a probe.
-pub type TouchData = ExternalData<TouchReading>;
-/// Poses to measure at.
-pub type PlannedPoses = ExternalData<PlannedPose>;
-
 /// The pose columns every external file starts with.
 const POSE_COLUMNS: [&str; 5] = ["q1", "q2", "q3", "h1", "h2"];
 
 /// Largest head angle accepted as radians.
 const MAX_HEAD_ANGLE_RAD: f64 = std::f64::consts::TAU;
-/// Plausible ballbar lengths, mm.
-const BALLBAR_LENGTH_MM: (f64, f64) = (10.0, 2000.0);
 /// Plausible structure temperatures, °C.
 const TEMP_RANGE_C: (f64, f64) = (-60.0, 200.0);
 /// Largest extension along the tool accepted, mm.
@@ -257,165 +182,6 @@ impl Row<'_> {
 
     fn bad(&self, idx: usize, reason: &str) -> DataError {
         self.header.bad_value(self.record, idx, reason)
-    }
-}
-
-impl ExternalRow for TrackerPoint {
-    const MEASURED: &'static [&'static str] = &["x", "y", "z"];
-    const OPTIONAL: &'static [&'static str] = &["sigma_um", "extension_mm", "setup", "temp_c"];
-
-    fn from_row(pose: ExternalPose, row: &Row<'_>) -> Result<Self, DataError> {
-        Ok(TrackerPoint {
-            pose,
-            position_mm: [
-                row.measured_mm(0)?,
-                row.measured_mm(1)?,
-                row.measured_mm(2)?,
-            ],
-            sigma_um: row.sigma_um()?,
-            extension_mm: row
-                .optional("extension_mm", |v| {
-                    (v.abs() > MAX_EXTENSION_MM).then_some("an extension beyond ±1000 mm (mm?)")
-                })?
-                .unwrap_or(0.0),
-            setup: row.whole_from_one("setup")?.unwrap_or(1),
-            temp_c: row.temp_c()?,
-            line: row.record.line,
-        })
-    }
-
-    fn pose(&self) -> &ExternalPose {
-        &self.pose
-    }
-
-    fn value(&self, column: &str) -> Option<f64> {
-        match column {
-            "x" => Some(self.position_mm[0]),
-            "y" => Some(self.position_mm[1]),
-            "z" => Some(self.position_mm[2]),
-            "sigma_um" => self.sigma_um,
-            "extension_mm" => (self.extension_mm != 0.0).then_some(self.extension_mm),
-            "setup" => (self.setup != 1).then_some(f64::from(self.setup)),
-            "temp_c" => self.temp_c,
-            _ => None,
-        }
-    }
-}
-
-impl ExternalRow for BallbarReading {
-    const MEASURED: &'static [&'static str] = &["length"];
-    const OPTIONAL: &'static [&'static str] = &["sigma_um", "setup", "temp_c"];
-
-    fn from_row(pose: ExternalPose, row: &Row<'_>) -> Result<Self, DataError> {
-        let length_mm = row.measured(0)?;
-        if !(BALLBAR_LENGTH_MM.0..=BALLBAR_LENGTH_MM.1).contains(&length_mm) {
-            return Err(row.bad(
-                row.measured_column(0),
-                "a ballbar length must be 10-2000 mm (um or m?)",
-            ));
-        }
-        Ok(BallbarReading {
-            pose,
-            length_mm,
-            sigma_um: row.sigma_um()?,
-            setup: row.whole_from_one("setup")?.unwrap_or(1),
-            temp_c: row.temp_c()?,
-            line: row.record.line,
-        })
-    }
-
-    fn pose(&self) -> &ExternalPose {
-        &self.pose
-    }
-
-    fn value(&self, column: &str) -> Option<f64> {
-        match column {
-            "length" => Some(self.length_mm),
-            "sigma_um" => self.sigma_um,
-            "setup" => (self.setup != 1).then_some(f64::from(self.setup)),
-            "temp_c" => self.temp_c,
-            _ => None,
-        }
-    }
-}
-
-impl ExternalRow for TouchReading {
-    const MEASURED: &'static [&'static str] = &["feature"];
-    const OPTIONAL: &'static [&'static str] = &["sigma_um", "temp_c"];
-
-    fn from_row(pose: ExternalPose, row: &Row<'_>) -> Result<Self, DataError> {
-        let f = row.measured(0)?;
-        if f < 1.0 || f.fract() != 0.0 || f > f64::from(u32::MAX) {
-            return Err(row.bad(
-                row.measured_column(0),
-                "a feature id must be a whole number from 1",
-            ));
-        }
-        Ok(TouchReading {
-            pose,
-            feature: f as u32,
-            sigma_um: row.sigma_um()?,
-            temp_c: row.temp_c()?,
-            line: row.record.line,
-        })
-    }
-
-    fn pose(&self) -> &ExternalPose {
-        &self.pose
-    }
-
-    fn value(&self, column: &str) -> Option<f64> {
-        match column {
-            "feature" => Some(f64::from(self.feature)),
-            "sigma_um" => self.sigma_um,
-            "temp_c" => self.temp_c,
-            _ => None,
-        }
-    }
-}
-
-impl ExternalRow for PlannedPose {
-    const MEASURED: &'static [&'static str] = &[];
-    const OPTIONAL: &'static [&'static str] = &["extension_mm", "x", "y", "z", "length", "feature"];
-
-    fn from_row(pose: ExternalPose, row: &Row<'_>) -> Result<Self, DataError> {
-        let any = |_: f64| None;
-        let tip = [
-            row.optional("x", any)?,
-            row.optional("y", any)?,
-            row.optional("z", any)?,
-        ];
-        Ok(PlannedPose {
-            pose,
-            extension_mm: row
-                .optional("extension_mm", |v| {
-                    (v.abs() > MAX_EXTENSION_MM).then_some("an extension beyond ±1000 mm (mm?)")
-                })?
-                .unwrap_or(0.0),
-            tip_mm: match tip {
-                [Some(x), Some(y), Some(z)] => Some([x, y, z]),
-                _ => None,
-            },
-            length_mm: row.optional("length", any)?,
-            feature: row.whole_from_one("feature")?,
-            line: row.record.line,
-        })
-    }
-
-    fn pose(&self) -> &ExternalPose {
-        &self.pose
-    }
-
-    fn value(&self, column: &str) -> Option<f64> {
-        match column {
-            "extension_mm" => (self.extension_mm != 0.0).then_some(self.extension_mm),
-            "x" => self.tip_mm.map(|t| t[0]),
-            "y" => self.tip_mm.map(|t| t[1]),
-            "z" => self.tip_mm.map(|t| t[2]),
-            "length" => self.length_mm,
-            "feature" => self.feature.map(f64::from),
-            _ => None,
-        }
     }
 }
 
@@ -630,158 +396,6 @@ pub fn write_external_path<T: ExternalRecord>(
     comments: &[String],
 ) -> std::io::Result<()> {
     crate::write_atomic(path, |w| write_rows(w, data, comments))
-}
-
-/// The probe's stylus.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Stylus {
-    /// Effective radius of the stylus ball (pre-travel included), mm.
-    pub radius_mm: f64,
-    /// Standard deviation of that radius (calibration certificate), um.
-    pub radius_sigma_um: f64,
-}
-
-/// A reference feature on the table or the part, touched by the probe.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
-pub enum Feature {
-    /// A reference sphere of known radius; its centre is unknown.
-    Sphere {
-        /// Id used by the touch file's `feature` column.
-        id: u32,
-        /// Radius, mm.
-        radius_mm: f64,
-        /// Standard deviation of the radius, um.
-        #[serde(default)]
-        radius_sigma_um: f64,
-    },
-    /// A plane; its position and orientation are unknown.
-    Plane {
-        /// Id used by the touch file's `feature` column.
-        id: u32,
-    },
-}
-
-impl Feature {
-    /// The feature's id.
-    pub fn id(&self) -> u32 {
-        match self {
-            Feature::Sphere { id, .. } | Feature::Plane { id } => *id,
-        }
-    }
-}
-
-/// The features file of a touch-off campaign (JSON).
-///
-/// # Example
-/// ```
-/// let json = r#"{"stylus": {"radius_mm": 1.0, "radius_sigma_um": 2.0},
-///   "features": [{"id": 1, "kind": "sphere", "radius_mm": 12.7, "radius_sigma_um": 0.5},
-///                {"id": 2, "kind": "plane"}]}"#;
-/// let f = tricept_data::Features::from_json(json, "features.json").unwrap();
-/// assert_eq!(f.features.len(), 2);
-/// let e = tricept_data::Features::from_json(r#"{"stylus": {"radius_mm": 1.0, "radius_sigma_um": 2.0},
-///   "features": [{"id": 1, "kind": "cube"}]}"#, "f.json").unwrap_err();
-/// assert!(e.to_string().starts_with("f.json: line 2, column"), "{e}");
-/// ```
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Features {
-    /// The stylus.
-    pub stylus: Stylus,
-    /// The features, with distinct ids.
-    pub features: Vec<Feature>,
-}
-
-/// The largest stylus ball radius a features file may state, mm.
-pub const MAX_STYLUS_RADIUS_MM: f64 = 50.0;
-/// The largest sphere radius a features file may state, mm.
-pub const MAX_SPHERE_RADIUS_MM: f64 = 1000.0;
-
-impl Features {
-    /// Parses and checks a features file's text; `file` names it in errors.
-    pub fn from_json(text: &str, file: &str) -> Result<Features, DataError> {
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        let f: Features = serde_json::from_str(text).map_err(|e| DataError::Json {
-            file: file.into(),
-            line: e.line() as u64,
-            column: e.column() as u64,
-            message: strip_position(&e.to_string()),
-        })?;
-        let invalid = |message: String| DataError::Invalid {
-            file: file.into(),
-            message,
-        };
-        let s = f.stylus;
-        if !(s.radius_mm.is_finite() && (0.0..=MAX_STYLUS_RADIUS_MM).contains(&s.radius_mm)) {
-            return Err(invalid(format!(
-                "stylus.radius_mm must be a number of mm from 0 to {MAX_STYLUS_RADIUS_MM}, got {}",
-                s.radius_mm
-            )));
-        }
-        if !(s.radius_sigma_um.is_finite() && s.radius_sigma_um > 0.0) {
-            return Err(invalid(format!(
-                "stylus.radius_sigma_um must be positive, got {}",
-                s.radius_sigma_um
-            )));
-        }
-        for (k, feature) in f.features.iter().enumerate() {
-            if f.features[..k].iter().any(|g| g.id() == feature.id()) {
-                return Err(invalid(format!(
-                    "feature id {} appears twice",
-                    feature.id()
-                )));
-            }
-            if let Feature::Sphere {
-                radius_mm,
-                radius_sigma_um,
-                id,
-            } = feature
-            {
-                if !(radius_mm.is_finite()
-                    && *radius_mm > 0.0
-                    && *radius_mm <= MAX_SPHERE_RADIUS_MM)
-                {
-                    return Err(invalid(format!(
-                        "feature {id}: radius_mm must be positive and at most {MAX_SPHERE_RADIUS_MM} mm, got {radius_mm}"
-                    )));
-                }
-                if !(radius_sigma_um.is_finite() && *radius_sigma_um >= 0.0) {
-                    return Err(invalid(format!(
-                        "feature {id}: radius_sigma_um must be non-negative, got {radius_sigma_um}"
-                    )));
-                }
-            }
-        }
-        if f.features.is_empty() {
-            return Err(invalid("no features".into()));
-        }
-        Ok(f)
-    }
-
-    /// Reads and checks a features file.
-    pub fn from_path(path: &Path) -> Result<Features, DataError> {
-        let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| DataError::Io {
-            file: file.clone(),
-            source,
-        })?;
-        Features::from_json(&text, &file)
-    }
-
-    /// The feature with id `id`.
-    pub fn get(&self, id: u32) -> Option<&Feature> {
-        self.features.iter().find(|f| f.id() == id)
-    }
-}
-
-/// serde_json appends " at line L column C"; the message states it up front.
-fn strip_position(s: &str) -> String {
-    match s.rfind(" at line ") {
-        Some(i) => s[..i].to_string(),
-        None => s.to_string(),
-    }
 }
 
 #[cfg(test)]
