@@ -1,13 +1,13 @@
 //! `tricept effects [EFFECT]`: every effect the simulator can hide in a
 //! machine (`simulate --truth-effect`), with its keys, their units and a
-//! typical example ([`tricept_plant::catalogue`]), and whether the
+//! typical example ([`tricept_plant::effects::typical_effects`], [`tricept_plant::Effect::keys`]), and whether the
 //! diagnosis names it (in its vocabulary) or describes it through a generic
 //! family.
 
 use clap::Args;
 use serde_json::{Value, json};
 use tricept_plant::Effect;
-use tricept_plant::catalogue::typical_effects;
+use tricept_plant::effects::typical_effects;
 
 use crate::cli_error::CliError;
 

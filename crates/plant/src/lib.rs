@@ -26,7 +26,6 @@
 )]
 
 pub mod campaign;
-pub mod catalogue;
 pub mod effects;
 mod error;
 pub mod instruments;
