@@ -38,7 +38,7 @@ pub use geometry::{
 };
 pub use record::{
     ControllerDescription, CorrelationsDescription, ExternalSourceRecord, HeldParameter,
-    LegEffectsDescription, SensorOffsetsDescription,
+    Interpolation, LegEffectsDescription, LegTableDescription, SensorOffsetsDescription,
 };
 
 /// The JSON text of the paper's Table 1 machine, embedded at compile time.
