@@ -299,10 +299,10 @@ mod tests {
         use tricept_kinematics::description::LegTableDescription;
         let mut m = with_effects();
         // A 4 um pitch error of period 10 mm on leg 2, tabulated every
-        // 0.5 mm over 600-1000 mm.
+        // 0.5 mm over the whole stroke, 450-1250 mm.
         let pitch = |q: f64| 4.0 * (std::f64::consts::TAU * q / 10.0).sin();
-        let values: Vec<f64> = (0..=800).map(|k| pitch(600.0 + 0.5 * k as f64)).collect();
-        m.leg_effects.tables = vec![LegTableDescription::new(2, 600.0, 0.5, values)];
+        let values: Vec<f64> = (0..=1600).map(|k| pitch(450.0 + 0.5 * k as f64)).collect();
+        m.leg_effects.tables = vec![LegTableDescription::new(2, 450.0, 0.5, values)];
         let x = ExtendedMachine::new(m.clone());
         for r in m.workspace.random_poses(100, 7) {
             let ik = x.inverse(&r).unwrap();
@@ -319,8 +319,8 @@ mod tests {
                 + m.leg_effects.tables[0].extra_mm(q);
             assert!((actual - geometric).abs() < 1e-9);
             // The table is the pitch error to its interpolation error
-            // (A (pi/10)^2 / 2 = 0.2 um at 20 points per period).
-            assert!((m.leg_effects.tables[0].extra_mm(q) * 1e3 - pitch(q)).abs() < 0.2);
+            // (h^2 / 8 A (2 pi / P)^2 = 0.05 um at 20 points per period).
+            assert!((m.leg_effects.tables[0].extra_mm(q) * 1e3 - pitch(q)).abs() < 0.05);
         }
     }
 

@@ -36,6 +36,7 @@ pub use geometry::{
     LoadsDescription, MAX_HEAD_ANGLE_OFFSET_RAD, Placement, SensorDescription, UpLimbDescription,
     WorkspaceDescription,
 };
+pub use validate::{MAX_TABLE_EXTRA_UM, MAX_TABLE_POINTS, MAX_TABLE_SLOPE_UM_PER_MM};
 pub use record::{
     ControllerDescription, CorrelationsDescription, ExternalSourceRecord, HeldParameter,
     Interpolation, LegEffectsDescription, LegTableDescription, SensorOffsetsDescription,
@@ -132,6 +133,15 @@ pub struct CalibrationRecord {
     pub effects: serde_json::Map<String, serde_json::Value>,
     /// Sensor zero offsets.
     pub sensor_offsets: SensorOffsetsDescription,
+    /// What the file applies, one line per deployed part (a diagnosis':
+    /// leg effects, compensation tables, the UP limb, controller
+    /// parameters), and where it goes.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub applies: Vec<String>,
+    /// What the file only records and does not apply: sensor corrections,
+    /// time terms, terms seen but not worth deploying.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub records: Vec<String>,
     /// Parameters held at their prior, with the reason.
     pub held: Vec<HeldParameter>,
     /// Weighted chi-square per degree of freedom of the fit (1 when the
@@ -338,6 +348,8 @@ mod tests {
             correlations: CorrelationsDescription::default(),
             effects: serde_json::Map::new(),
             sensor_offsets: SensorOffsetsDescription::default(),
+            applies: Vec::new(),
+            records: Vec::new(),
             held: vec![HeldParameter {
                 name: "dyA3".into(),
                 reason: "unidentifiable".into(),
