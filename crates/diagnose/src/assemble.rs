@@ -174,8 +174,9 @@ pub(crate) fn report(
             volumetric_max_mm: volumetric.map(|v| v.1),
             volumetric_touched_mean_mm: volumetric.map(|v| v.2),
             volumetric_note,
-            improvement_mm: gained.map(|g| g.0),
-            improvement_sd_mm: gained.map(|g| g.1),
+            improvement_mm: gained.map(|g| g.mean_mm),
+            improvement_sd_mm: gained.map(|g| g.sd_mm),
+            difference_sd_mm: gained.map(|g| g.difference_sd_mm),
         },
         model_terms,
         geometric_only,
@@ -219,7 +220,9 @@ pub(crate) fn report(
 /// final model against the final model without it, [`improvement`]) and
 /// whether it is deployed: a controller parameter always, any other term
 /// when its improvement exceeds [`SIGNIFICANT_IMPROVEMENT_SD`] standard
-/// deviations, or when the model without it cannot be fitted. With the
+/// deviations (against the truth: the deployed model's own platform
+/// uncertainty with the move's), or when the model without it cannot be
+/// fitted. With the
 /// model of the deployed terms refitted when some are left out.
 fn deployable(
     nominal: &Machine,
@@ -245,7 +248,7 @@ fn deployable(
             };
             let deployed = match gained {
                 None => true,
-                Some(Some((i, sd))) => i > SIGNIFICANT_IMPROVEMENT_SD * sd,
+                Some(Some(g)) => g.mean_mm > SIGNIFICANT_IMPROVEMENT_SD * g.sd_mm,
                 // The plane cannot be reached: nothing says it does not pay.
                 Some(None) => true,
             };
@@ -265,8 +268,9 @@ fn deployable(
                 channel,
                 period_mm,
                 deployed,
-                improvement_mm: g.map(|g| g.0),
-                improvement_sd_mm: g.map(|g| g.1),
+                improvement_mm: g.map(|g| g.mean_mm),
+                improvement_sd_mm: g.map(|g| g.sd_mm),
+                difference_sd_mm: g.map(|g| g.difference_sd_mm),
             }
         })
         .collect();

@@ -147,10 +147,7 @@ pub fn deploy(
     }
     let tables = leg_tables(&model, &id.estimate, &frame, nominal, &machine)?;
     for t in &tables {
-        applied.push(format!(
-            "leg {} compensation table: {}",
-            t.leg, t.source
-        ));
+        applied.push(format!("leg {} compensation table: {}", t.leg, t.source));
     }
     for t in tables {
         machine.leg_effects.tables.retain(|old| old.leg != t.leg);
@@ -252,7 +249,9 @@ fn leg_tables(
             for (g, at) in &on_leg {
                 for (k, basis, v) in Term::Generic(**g)
                     .leg_entries(frame, nominal, &pose)
-                    .map_err(|e| DeployError::NotDeployable(format!("leg {} table: {e}", leg + 1)))?
+                    .map_err(|e| {
+                        DeployError::NotDeployable(format!("leg {} table: {e}", leg + 1))
+                    })?
                 {
                     if basis == Basis::Leg(leg) {
                         mm += p.get(at + k).copied().unwrap_or(0.0) * v;

@@ -82,20 +82,21 @@ pub(crate) fn volumetric_difference(
 /// put its predicted platform on the target; the terms at the campaign's
 /// middle context). The platform is then predicted by `better`: `base`'s
 /// commands miss by `D_k`, `better`'s by nothing, so the improvement is
-/// `mean_k |D_k|`. Its standard deviation is the root mean square over the
-/// plane of the platform uncertainty `tr(J_k C J_k^T)` (`J_k` the
+/// `mean_k |D_k|`. Its standard deviations are root mean squares over the
+/// plane of platform uncertainties `tr(J_k C J_k^T)` (`J_k` the
 /// platform's derivatives with respect to `better`'s parameters, by
-/// central differences) for `C` the sum of `better`'s covariance (what
-/// the deployed model itself does not know, its weak directions included)
-/// and the covariance of the difference of the two fits, `C_better - C_base`
-/// (Hausman; its negative eigenvalues, rounding, set to zero).
-/// `None` when no target can be commanded.
+/// central differences): for `C` the covariance of the difference of the
+/// two fits, `C_better - C_base` (Hausman; its negative eigenvalues,
+/// rounding, set to zero), the uncertainty of the move itself; and in
+/// quadrature with it, for `C` `better`'s covariance, what the deployed
+/// model itself does not know (its weak directions included), which the
+/// true improvement also carries. `None` when no target can be commanded.
 pub(crate) fn improvement(
     nominal: &Machine,
     base: &Fit,
     better: &Fit,
     options: &DiagnoseOptions,
-) -> Option<(f64, f64)> {
+) -> Option<Improvement> {
     let targets = nominal
         .workspace
         .disc_grid(nominal.workspace.mid_plane_z_mm(), options.plane_spacing_mm);
@@ -131,7 +132,6 @@ pub(crate) fn improvement(
         return None;
     }
     let difference = difference_covariance(base, better);
-    let total = c + difference;
     let mut jac: Vec<DMatrix<f64>> = vec![DMatrix::zeros(3, k); sampled.len()];
     for j in 0..k {
         let h = c[(j, j)].sqrt();
@@ -151,12 +151,35 @@ pub(crate) fn improvement(
             }
         }
     }
-    let variance = jac
-        .iter()
-        .map(|jk| (jk * &total * jk.transpose()).trace())
-        .sum::<f64>()
-        / sampled.len() as f64;
-    Some((mean, variance.max(0.0).sqrt()))
+    let sd = |cov: &DMatrix<f64>| {
+        let variance = jac
+            .iter()
+            .map(|jk| (jk * cov * jk.transpose()).trace())
+            .sum::<f64>()
+            / sampled.len() as f64;
+        variance.max(0.0).sqrt()
+    };
+    let own = sd(c);
+    let moved = sd(&difference);
+    Some(Improvement {
+        mean_mm: mean,
+        sd_mm: own.hypot(moved),
+        difference_sd_mm: moved,
+    })
+}
+
+/// A predicted improvement ([`improvement`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Improvement {
+    /// Mean platform error on the middle plane of the base fit's commands
+    /// under the better model, mm.
+    pub(crate) mean_mm: f64,
+    /// Its standard deviation against the truth: the better model's own
+    /// platform uncertainty and the difference's, in quadrature, mm.
+    pub(crate) sd_mm: f64,
+    /// The standard deviation of the difference between the two fits
+    /// alone, mm: what the significance of a move is judged against.
+    pub(crate) difference_sd_mm: f64,
 }
 
 /// The commands of `fit` (its machine `machine`) for target `r`: the

@@ -293,11 +293,17 @@ pub struct Gain {
     /// both measured against the deployed model, mm; `null` when the plane
     /// cannot be reached.
     pub improvement_mm: Option<f64>,
-    /// Its standard deviation, mm: the root mean square over the plane of
-    /// the platform uncertainty of the deployed model (its covariance, the
-    /// geometry's weak directions included) and of its difference from the
-    /// geometric-only fit (the difference of the two covariances).
+    /// Its standard deviation against the truth, mm: the root mean square
+    /// over the plane of the platform uncertainty of the deployed model
+    /// (its covariance, the geometry's weak directions included) and of its
+    /// difference from the geometric-only fit (the difference of the two
+    /// covariances), in quadrature.
     pub improvement_sd_mm: Option<f64>,
+    /// The standard deviation of the difference alone, mm: how far the
+    /// deployed model would move the platform from the geometric-only one
+    /// by noise (Hausman's covariance; it ignores that the geometric-only
+    /// fit is biased, so it is reported, not used by the rule).
+    pub difference_sd_mm: Option<f64>,
 }
 
 /// A term of the final model, and whether the deployed machine carries it.
@@ -322,12 +328,14 @@ pub struct ModelTerm {
     /// without this term minus that of the final model, mm (`null` for a
     /// controller parameter).
     pub improvement_mm: Option<f64>,
-    /// Its standard deviation ([`Gain::improvement_sd_mm`]), mm.
+    /// Its standard deviation against the truth ([`Gain::improvement_sd_mm`]), mm.
     pub improvement_sd_mm: Option<f64>,
+    /// The standard deviation of the move alone ([`Gain::difference_sd_mm`]), mm.
+    pub difference_sd_mm: Option<f64>,
 }
 
-/// How many standard deviations an improvement must exceed for its term to
-/// be deployed.
+/// How many standard deviations ([`ModelTerm::improvement_sd_mm`]) a
+/// term's improvement must exceed for the term to be deployed.
 pub const SIGNIFICANT_IMPROVEMENT_SD: f64 = 2.0;
 
 /// A residual plot: weighted residuals of a channel (or implied leg-length
@@ -653,8 +661,10 @@ impl Diagnosis {
             );
         }
         for t in &self.model_terms {
-            let numbers = match (t.improvement_mm, t.improvement_sd_mm) {
-                (Some(i), Some(sd)) => format!(": improvement {i:.4} +- {sd:.4} mm"),
+            let numbers = match (t.improvement_mm, t.improvement_sd_mm, t.difference_sd_mm) {
+                (Some(i), Some(sd), Some(moved)) => {
+                    format!(": improvement {i:.4} +- {sd:.4} mm (the move's own sd {moved:.4} mm)")
+                }
                 _ => String::new(),
             };
             if t.deployed {

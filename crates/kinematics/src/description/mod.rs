@@ -36,11 +36,11 @@ pub use geometry::{
     LoadsDescription, MAX_HEAD_ANGLE_OFFSET_RAD, Placement, SensorDescription, UpLimbDescription,
     WorkspaceDescription,
 };
-pub use validate::{MAX_TABLE_EXTRA_UM, MAX_TABLE_POINTS, MAX_TABLE_SLOPE_UM_PER_MM};
 pub use record::{
     ControllerDescription, CorrelationsDescription, ExternalSourceRecord, HeldParameter,
     Interpolation, LegEffectsDescription, LegTableDescription, SensorOffsetsDescription,
 };
+pub use validate::{MAX_TABLE_EXTRA_UM, MAX_TABLE_POINTS, MAX_TABLE_SLOPE_UM_PER_MM};
 
 /// The JSON text of the paper's Table 1 machine, embedded at compile time.
 pub const PAPER_MACHINE_JSON: &str = include_str!(concat!(
