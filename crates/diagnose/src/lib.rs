@@ -91,5 +91,7 @@ pub use report::{
     SIGNIFICANT_IMPROVEMENT_SD, Structure, TermScore, Tested, Verdict,
 };
 pub use run::diagnose;
-pub use terms::{Frame, GenericTerm, MIN_TEMPERATURE_RANGE_K, OrderAxis, Scope, Term};
+pub use terms::{
+    Frame, GenericTerm, MIN_TEMPERATURE_RANGE_K, OrderAxis, Scope, TEMPERATURE_FOLLOWS_TIME, Term,
+};
 pub use tricept_model::effects::{CauseName, GenericFamily, REFERENCE_TEMPERATURE_C};
