@@ -359,7 +359,7 @@ mod tests {
                 "tables[0].extra_length_um[1]",
             ),
             (
-                vec![table(1, 600.0, 0.1, vec![0.0, 10.0])],
+                vec![table(1, 600.0, 0.1, vec![0.0, 30.0])],
                 "tables[0].extra_length_um[1]",
             ),
         ] {

@@ -345,9 +345,11 @@ pub const MAX_TABLE_POINTS: usize = 100_000;
 pub const MAX_TABLE_EXTRA_UM: f64 = 1000.0;
 
 /// The steepest a compensation table may be between neighbouring points,
-/// um of extra length per mm of command: 50 um/mm (5 %) is far beyond any
-/// screw's pitch error and keeps the corrected command unique.
-pub const MAX_TABLE_SLOPE_UM_PER_MM: f64 = 50.0;
+/// um of extra length per mm of command: 200 um/mm (20 %) holds the
+/// steepest pitch error a diagnosis finds plausible (25 um at a 1 mm
+/// period, 157 um/mm) and keeps the corrected command unique (IK's passes
+/// contract by the slope).
+pub const MAX_TABLE_SLOPE_UM_PER_MM: f64 = 200.0;
 
 impl MachineDescription {
     /// The checks of the per-leg compensation tables: a leg 1-3 at most
