@@ -760,7 +760,7 @@ fn validate(data: &Dataset, options: &CheckOptions) -> Result<(), CheckError> {
 
 impl CheckReport {
     /// The smallest change of any leg or joint parameter this campaign
-    /// detects, mm (the campaign is blind above [`BLIND_LIMIT_MM`]).
+    /// detects, mm (the campaign is blind above `BLIND_LIMIT_MM`).
     pub fn smallest_detectable_mm(&self) -> Option<f64> {
         self.candidates
             .iter()
