@@ -3,7 +3,10 @@
 //! 2 K temperature drift): the whole `diagnose` (outlier screen, selection
 //! from the vocabulary and the generic dictionary with its period scan,
 //! cross-validation, admission on the final model, aliases, final
-//! adequacy). Target: 200 poses in under 2 s.
+//! adequacy). Target: 200 poses in under 2 s. `diagnose_large`: a
+//! continuous log of 100 000 poses, against `identify_large` of
+//! `benches/identification.rs` on the same size (target: at most 10 times
+//! its time).
 
 use std::hint::black_box;
 
@@ -75,5 +78,17 @@ fn diagnosis(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, diagnosis);
+fn large(c: &mut Criterion) {
+    let m = Machine::paper();
+    let options = DiagnoseOptions::for_machine(&m);
+    let d = data(100_000, 5, Vec::new());
+    let mut group = c.benchmark_group("diagnose_large");
+    group.sample_size(10);
+    group.bench_function("100000_poses_clean", |b| {
+        b.iter(|| black_box(diagnose(&m, black_box(&d), &options).unwrap()))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, diagnosis, large);
 criterion_main!(benches);

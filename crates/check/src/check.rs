@@ -50,7 +50,8 @@ use tricept_numerics::linalg::{TriangularAccumulator, invert_upper, solve_upper}
 use tricept_numerics::stats::{chi2_isf, chi2_ln_sf, chi2_sf, required_noncentrality};
 
 use crate::candidates::{Candidate, CandidateKind, MAX_PARAMETERS, PoseTerms};
-use crate::{CheckError, Reference};
+use crate::error::CheckError;
+use crate::reference::Reference;
 
 /// The default family-wise false-alarm probability.
 pub const DEFAULT_ALPHA: f64 = 0.01;
@@ -760,7 +761,7 @@ fn validate(data: &Dataset, options: &CheckOptions) -> Result<(), CheckError> {
 
 impl CheckReport {
     /// The smallest change of any leg or joint parameter this campaign
-    /// detects, mm (the campaign is blind above `BLIND_LIMIT_MM`).
+    /// detects, mm (the campaign is blind above 1 mm).
     pub fn smallest_detectable_mm(&self) -> Option<f64> {
         self.candidates
             .iter()

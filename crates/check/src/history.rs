@@ -19,7 +19,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::{CheckError, CheckReport};
+use crate::check::CheckReport;
+use crate::error::CheckError;
 
 /// One check in the history.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -73,7 +74,9 @@ impl Entry {
         let quantities = report
             .candidates
             .iter()
-            .filter(|c| c.name.starts_with("leg ") || c.kind == crate::CandidateKind::Thermal)
+            .filter(|c| {
+                c.name.starts_with("leg ") || c.kind == crate::candidates::CandidateKind::Thermal
+            })
             .filter_map(|c| {
                 let (p, (v, sd), d) = (
                     c.parameters.first()?,

@@ -50,6 +50,7 @@
 
 mod candidates;
 mod check;
+mod error;
 pub mod history;
 mod reference;
 mod report;
@@ -59,35 +60,5 @@ pub use check::{
     CandidateResult, CheckOptions, CheckReport, CheckVerdict, ChiSquare, DEFAULT_ALPHA,
     DEFAULT_POWER, check, family_level, leg_ranges,
 };
+pub use error::CheckError;
 pub use reference::Reference;
-
-/// Why a check could not be made.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum CheckError {
-    /// The machine file cannot serve as a reference.
-    #[error("{0}")]
-    Record(String),
-    /// The check campaign cannot see any change.
-    #[error("the check's poses cannot see a change: {0}")]
-    Blind(String),
-    /// A setting out of range.
-    #[error("{0}")]
-    Invalid(String),
-    /// A pose the calibrated machine cannot solve.
-    #[error("pose {pose}{}: {source}", if *line > 0 { format!(" (line {line})") } else { String::new() })]
-    Kinematics {
-        /// 1-based pose number.
-        pose: usize,
-        /// Line in the data file (0 when there is none).
-        line: u64,
-        /// The kinematic failure.
-        source: tricept_kinematics::KinematicsError,
-    },
-    /// The history file holds a line that is not a check.
-    #[error("{0}")]
-    HistoryLine(String),
-    /// The history file cannot be read or written.
-    #[error("{0}")]
-    History(String),
-}

@@ -7,7 +7,7 @@ use tricept_ident::GeometricModel;
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
-use crate::CheckError;
+use crate::error::CheckError;
 
 /// The calibrated machine a check campaign is compared with.
 ///

@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 
-use crate::{CandidateResult, CheckReport, CheckVerdict};
+use crate::check::{CandidateResult, CheckReport, CheckVerdict};
 
 /// A parameter's value in the unit a person reads: um for a length
 /// (parameters ending in `_mm`), the parameter's own unit otherwise.

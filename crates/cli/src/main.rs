@@ -27,6 +27,7 @@ mod cli_error;
 mod compensate_cmd;
 mod diagnose_cmd;
 mod docs_cmd;
+mod effects_cmd;
 mod files;
 mod fusion_cmd;
 mod ident_cmd;
@@ -107,7 +108,7 @@ enum Command {
     /// default) with sensor noise, offsets and optional unmodelled effects.
     #[command(
         allow_negative_numbers = true,
-        after_help = "True errors (--truth): table2, zero, random:MAG_MM[,SEED], or a JSON file {name: mm}.\nEffects (--truth-effect, repeatable): a JSON object or @FILE, e.g. '{\"effect\":\"leg-lead\",\"ppm\":[50,-30,40]}' (see `tricept docs diagnosis` for every effect and its units).\n\nExamples:\n  tricept simulate --out data.csv\n  tricept simulate --truth random:1.0,3 --poses random:100,2 --seed 9 --out data.csv\n  tricept simulate --truth-effect '{\"effect\":\"backlash\",\"um\":[6,5,8]}' --both-directions --out data.csv\n  tricept simulate --head-errors random:1,3 --out data.csv --tracker-out t.csv --tracker-poses points.csv\n  tricept simulate --out data.csv --touch-out touch.csv --features-out features.json --touch-poses touches.csv"
+        after_help = "True errors (--truth): table2, zero, random:MAG_MM[,SEED], or a JSON file {name: mm}.\nEffects (--truth-effect, repeatable): a JSON object or @FILE, e.g. '{\"effect\":\"leg-lead\",\"ppm\":[50,-30,40]}' (`tricept effects` lists every effect with its keys, units and a typical example).\n\nExamples:\n  tricept simulate --out data.csv\n  tricept simulate --truth random:1.0,3 --poses random:100,2 --seed 9 --out data.csv\n  tricept simulate --truth-effect '{\"effect\":\"backlash\",\"um\":[6,5,8]}' --both-directions --out data.csv\n  tricept simulate --head-errors random:1,3 --out data.csv --tracker-out t.csv --tracker-poses points.csv\n  tricept simulate --out data.csv --touch-out touch.csv --features-out features.json --touch-poses touches.csv"
     )]
     Simulate(simulate_cmd::SimulateArgs),
     /// Does the geometric model explain the data? If not, which unmodelled
@@ -155,6 +156,13 @@ enum Command {
         after_help = "Examples:\n  tricept docs\n  tricept docs data-format | less\n  tricept docs docs/diagnosis.md"
     )]
     Docs(docs_cmd::DocsArgs),
+    /// The effects the simulator can hide in a machine (`simulate
+    /// --truth-effect`): each one's keys, units and a typical example, and
+    /// whether the diagnosis names it or describes it generically.
+    #[command(
+        after_help = "The keys are the simulator's inputs, in the units a machine builder quotes; the diagnosis fits its own parameters (`tricept docs diagnosis`).\n\nExamples:\n  tricept effects\n  tricept effects compliance\n  tricept effects --json | head -1"
+    )]
+    Effects(effects_cmd::EffectsArgs),
 }
 
 /// The files a verb reads and writes, by flag (checked before it runs:
@@ -180,7 +188,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
             r.inputs("--input", &a.input.input);
         }
         Command::Machine(a) => machine(&mut r, &a.machine),
-        Command::Docs(_) => {}
+        Command::Docs(_) | Command::Effects(_) => {}
         Command::Identifiability(a) => {
             machine(&mut r, &a.machine);
             r.input_if_file("--poses", &a.poses);
@@ -291,6 +299,7 @@ fn run(cli: Cli) -> Result<u8, CliError> {
         Command::Compensate(a) => compensate_cmd::run_compensate(&a),
         Command::Plan(a) => plan_cmd::run(&a),
         Command::Docs(a) => docs_cmd::run(&a),
+        Command::Effects(a) => effects_cmd::run(&a),
         Command::Check(a) => check_cmd::run(&a),
     }
 }

@@ -88,3 +88,61 @@ fn every_page_a_help_text_names_is_there() {
     let (code, _) = tricept(&["docs", "no-such-page"]);
     assert_eq!(code, 2);
 }
+
+/// `tricept effects` lists every simulated effect with keys that
+/// `simulate --truth-effect` takes as they are (and no others), and
+/// docs/diagnosis.md's table holds every one of them.
+#[test]
+fn every_simulated_effect_is_listed_simulated_and_documented() {
+    let (code, listing) = tricept(&["effects", "--json"]);
+    assert_eq!(code, 0);
+    let page = std::fs::read_to_string(format!("{DOCS}/diagnosis.md")).unwrap();
+    let table = page
+        .split("## The simulator's effects")
+        .nth(1)
+        .and_then(|rest| rest.split("\n## ").next())
+        .expect("docs/diagnosis.md has a section on the simulator's effects");
+    let dir = std::env::temp_dir().join(format!("tricept-effects-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("data.csv");
+    let out = out.to_str().unwrap();
+    let mut effects = 0;
+    for line in listing.lines() {
+        let entry: serde_json::Value = serde_json::from_str(line).unwrap();
+        let name = entry["effect"].as_str().unwrap();
+        let example = entry["example"].to_string();
+        assert!(
+            table.contains(&format!("`{example}`")),
+            "{name}: its example is not in docs/diagnosis.md"
+        );
+        for key in entry["keys"].as_array().unwrap() {
+            let key = key["key"].as_str().unwrap();
+            assert!(
+                table.contains(&format!("`{key}`")),
+                "{name}.{key} undocumented"
+            );
+        }
+        let simulate = |effect: &str| {
+            tricept(&[
+                "simulate",
+                "--poses",
+                "random:12,1",
+                "--truth-effect",
+                effect,
+                "--out",
+                out,
+            ])
+            .0
+        };
+        assert_eq!(simulate(&example), 0, "simulate --truth-effect '{example}'");
+        // A key the listing does not give is refused.
+        let mut extra = entry["example"].clone();
+        extra["not_a_key"] = serde_json::json!(1.0);
+        assert_eq!(simulate(&extra.to_string()), 2, "{name} with an extra key");
+        effects += 1;
+    }
+    assert_eq!(effects, 15, "{listing}");
+    let (code, _) = tricept(&["effects", "no-such-effect"]);
+    assert_eq!(code, 2);
+    std::fs::remove_dir_all(&dir).ok();
+}

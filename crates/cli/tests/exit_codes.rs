@@ -83,6 +83,8 @@ fn every_verb_follows_the_one_exit_code_table() {
         (vec!["tool-ik", "0", "0", "1100", "0", "0", "1"], 0),
         (vec!["tool-ik", "0", "0", "1100", "0", "0", "0"], 2),
         (vec!["machine"], 0),
+        (vec!["effects"], 0),
+        (vec!["effects", "nope"], 2),
         (vec!["machine", "--machine", "missing.json"], 2),
         (vec!["identifiability"], 0),
         (vec!["identifiability", "--poses", "grid:0,1,1"], 2),

@@ -1218,3 +1218,50 @@ fn diagnose_help_lists_the_vocabulary_and_its_deployment() {
         assert!(line.contains(s.deployment.label()), "{line}");
     }
 }
+
+/// Backlash logged with the `dir` columns' sign convention flipped fits as
+/// a negative lost motion on every leg: the diagnosis rejects it as
+/// implausible and names the convention as the likely cause (it cannot say
+/// "the real cause is something else" about data whose only fault is a sign).
+#[test]
+fn backlash_with_a_flipped_dir_convention_names_the_convention() {
+    let dir = workdir("dir-sign");
+    let data = dir.join("backlash.csv");
+    let out = run(&[
+        "simulate",
+        "--truth-effect",
+        r#"{"effect":"backlash","um":[6,5,8]}"#,
+        "--both-directions",
+        "--poses",
+        "random:80,2",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let as_logged = run(&["diagnose", "--data", data.to_str().unwrap()]);
+    assert_eq!(as_logged.status.code(), Some(0), "{}", text(&as_logged));
+    let flipped = dir.join("flipped.csv");
+    rewrite(
+        &std::fs::read_to_string(&data).unwrap(),
+        &flipped,
+        |_| {},
+        |_, names, r| {
+            for c in ["dir1", "dir2", "dir3"] {
+                let i = col(names, c);
+                r[i] = (-r[i].parse::<i32>().unwrap()).to_string();
+            }
+        },
+    );
+    let out = run(&["diagnose", "--data", flipped.to_str().unwrap()]);
+    let report = text(&out);
+    assert_eq!(out.status.code(), Some(3), "{report}");
+    let rejected = report
+        .lines()
+        .find(|l| l.starts_with("rejected: backlash"))
+        .unwrap_or_else(|| panic!("no rejected backlash line:\n{report}"));
+    assert!(
+        rejected.contains("likely cause") && rejected.contains("`dir`"),
+        "{rejected}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

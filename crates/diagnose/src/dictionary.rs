@@ -75,7 +75,7 @@ impl At<'_> {
 pub(crate) struct Dictionary {
     /// Groups without a period, and `leg-periodic` (once) when scanned.
     groups: Vec<GenericTerm>,
-    /// Scan frequencies, 1/mm.
+    /// Scan frequencies, 1/mm: `f_min + k step`.
     frequencies: Vec<f64>,
     /// Grid step, 1/mm.
     step: f64,
@@ -102,12 +102,11 @@ impl Dictionary {
         // A period needs at least two cycles over the stroke to be told from
         // a polynomial.
         if stroke > 2.0 * p_min && p_max > p_min && p_min > 0.0 {
-            let f_max = 1.0 / p_min;
-            let mut f = (1.0 / p_max).max(2.0 / stroke);
-            while f <= f_max {
-                frequencies.push(f);
-                f += step;
-            }
+            let (f_min, f_max) = ((1.0 / p_max).max(2.0 / stroke), 1.0 / p_min);
+            frequencies = (0..)
+                .map(|k| f_min + f64::from(k) * step)
+                .take_while(|&f| f <= f_max)
+                .collect();
         }
         let groups = frame
             .generic_groups()
@@ -213,12 +212,20 @@ impl Dictionary {
         };
         let score = |f: f64| at.score(&with(f));
         let near_admitted = |f: f64| admitted.iter().any(|a| (f - a).abs() <= 2.0 * self.step);
+        let commands: Vec<[f64; 3]> = at.data.poses.iter().map(|p| p.commands_mm).collect();
+        let f0 = self.frequencies.first().copied()?;
+        let scores = at.lin.periodic_scan(
+            &commands,
+            &group.legs(),
+            f0,
+            self.step,
+            self.frequencies.len(),
+        );
         let mut best: Option<(f64, f64)> = None;
-        for &f in &self.frequencies {
+        for (&f, &(s, k)) in self.frequencies.iter().zip(&scores) {
             if near_admitted(f) {
                 continue;
             }
-            let (s, k) = score(f);
             if k > 0 && best.is_none_or(|b| s > b.1) {
                 best = Some((f, s));
             }

@@ -33,6 +33,38 @@ use crate::terms::{Frame, GenericTerm, Term};
 /// direction the fitted model already absorbs.
 const ABSORBED: f64 = 1e-10;
 
+/// Poses per block of [`Linearisation::periodic_scan`].
+const SCAN_BLOCK: usize = 256;
+
+/// Frequencies between exact evaluations of the scan's sines and cosines
+/// (in between, a rotation: its rounding grows by about one unit in the
+/// last place per frequency).
+const SCAN_RESEED: usize = 32;
+
+/// Blocks of the scan summed at a time.
+const SCAN_PARALLEL_BLOCKS: usize = 16;
+
+/// The products of one frequency of the scan, accumulated over poses:
+/// `Q^T G` (`p x k`, column-major), the upper triangle of `G^T G` (row-major)
+/// and `G^T t`.
+struct PeriodicSums {
+    qtg: Vec<f64>,
+    gtg: Vec<f64>,
+    gtt: Vec<f64>,
+}
+
+impl PeriodicSums {
+    fn add(&mut self, other: &PeriodicSums) {
+        for (a, b) in [
+            (&mut self.qtg, &other.qtg),
+            (&mut self.gtg, &other.gtg),
+            (&mut self.gtt, &other.gtt),
+        ] {
+            a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
+        }
+    }
+}
+
 /// How much a term explains of a target.
 #[derive(Debug, Clone)]
 pub(crate) struct Score {
@@ -182,14 +214,7 @@ impl Linearisation {
                 (*t, r)
             })
             .collect();
-        let gram = directions
-            .iter()
-            .map(|d| {
-                std::array::from_fn(|a| {
-                    std::array::from_fn(|b| (0..3).map(|c| d[a][c] * d[b][c]).sum())
-                })
-            })
-            .collect();
+        let gram = grams(&directions);
         let mut lin = Linearisation {
             q: DMatrix::zeros(0, 0),
             x,
@@ -334,6 +359,143 @@ impl Linearisation {
         score_from(&qtg, &gtg, &gtt, &self.qtt)
     }
 
+    /// The scores of the leg-periodic term on `legs` (its columns
+    /// `1e-3 sin(2 pi f q_i)`, `1e-3 cos(2 pi f q_i)` per leg, as
+    /// [`GenericTerm::leg_values`] gives them) at every frequency
+    /// `f0 + k step`, `k < count` (1/mm): `(explained, rank)` per frequency,
+    /// equal to [`Linearisation::score_columns`] of those columns up to
+    /// rounding.
+    ///
+    /// One pass over the poses for the whole grid: the poses go in blocks
+    /// of [`SCAN_BLOCK`], whose projected directions stay in cache while
+    /// every frequency accumulates its products, and the sines and cosines
+    /// of consecutive frequencies follow by rotation (re-seeded exactly
+    /// every [`SCAN_RESEED`] frequencies), so a frequency costs about
+    /// `2 L p + 2 L (2 L + 1)` multiply-adds per pose for `L` legs and `p`
+    /// fitted columns instead of a fresh evaluation of the term. Blocks run
+    /// in parallel and are summed in their order: the same bits at any
+    /// thread count.
+    pub(crate) fn periodic_scan(
+        &self,
+        commands_mm: &[[f64; 3]],
+        legs: &[usize],
+        f0: f64,
+        step: f64,
+        count: usize,
+    ) -> Vec<(f64, usize)> {
+        use rayon::prelude::*;
+        let p = self.q.ncols();
+        let k = 2 * legs.len();
+        let n = self.poses().min(commands_mm.len());
+        let zero = || PeriodicSums {
+            qtg: vec![0.0; p * k],
+            gtg: vec![0.0; k * k],
+            gtt: vec![0.0; k],
+        };
+        let nl = legs.len();
+        let block_sums = |start: usize| -> Vec<PeriodicSums> {
+            let end = (start + SCAN_BLOCK).min(n);
+            let len = end - start;
+            let mut sums: Vec<PeriodicSums> = (0..count).map(|_| zero()).collect();
+            // Per leg, over the block's poses: the projected directions
+            // (`p x len`, column-major), the target products, the rotation
+            // by one grid step and the current sine and cosine; per pair of
+            // legs, their directions' inner products.
+            let projected: Vec<&[f64]> = legs
+                .iter()
+                .map(|&i| &self.projected[i].as_slice()[start * p..end * p])
+                .collect();
+            let products: Vec<Vec<f64>> = legs
+                .iter()
+                .map(|&i| (start..end).map(|j| self.target_products[j][i]).collect())
+                .collect();
+            let gram: Vec<Vec<f64>> = (0..nl * nl)
+                .map(|ab| {
+                    let (la, lb) = (legs[ab / nl], legs[ab % nl]);
+                    (start..end).map(|j| self.gram[j][la][lb]).collect()
+                })
+                .collect();
+            let angle = |f: f64, i: usize, j: usize| std::f64::consts::TAU * f * commands_mm[j][i];
+            let rotation: Vec<Vec<(f64, f64)>> = legs
+                .iter()
+                .map(|&i| (start..end).map(|j| angle(step, i, j).sin_cos()).collect())
+                .collect();
+            // values[2 l] the sines of leg l, values[2 l + 1] its cosines.
+            let mut values = vec![vec![0.0; len]; 2 * nl];
+            for (f, acc) in sums.iter_mut().enumerate() {
+                let frequency = f0 + f as f64 * step;
+                for (l, &i) in legs.iter().enumerate() {
+                    let (sines, rest) = values[2 * l..].split_at_mut(1);
+                    let (sines, cosines) = (&mut sines[0], &mut rest[0]);
+                    if f % SCAN_RESEED == 0 {
+                        for (t, j) in (start..end).enumerate() {
+                            (sines[t], cosines[t]) = angle(frequency, i, j).sin_cos();
+                        }
+                    } else {
+                        for ((s, c), &(ws, wc)) in
+                            sines.iter_mut().zip(cosines.iter_mut()).zip(&rotation[l])
+                        {
+                            (*s, *c) = (*s * wc + *c * ws, *c * wc - *s * ws);
+                        }
+                    }
+                    // Q^T G for the leg's two columns: one pass over its
+                    // projected directions.
+                    let (qs, qc) = acc.qtg[2 * l * p..(2 * l + 2) * p].split_at_mut(p);
+                    for (t, column) in projected[l].chunks_exact(p).enumerate() {
+                        let (s, c) = (sines[t], cosines[t]);
+                        for ((a, b), &x) in qs.iter_mut().zip(qc.iter_mut()).zip(column) {
+                            *a += x * s;
+                            *b += x * c;
+                        }
+                    }
+                }
+                for a in 0..2 * nl {
+                    let va = &values[a];
+                    acc.gtt[a] += dot(va, &products[a / 2]);
+                    for b in a..2 * nl {
+                        let g = &gram[(a / 2) * nl + b / 2];
+                        acc.gtg[a * k + b] += va
+                            .iter()
+                            .zip(&values[b])
+                            .zip(g)
+                            .map(|((x, y), g)| x * y * g)
+                            .sum::<f64>();
+                    }
+                }
+            }
+            sums
+        };
+        let starts: Vec<usize> = (0..n).step_by(SCAN_BLOCK).collect();
+        let mut total: Vec<PeriodicSums> = (0..count).map(|_| zero()).collect();
+        // A bounded number of blocks at a time (their sums are
+        // `count x (p + k + 1) k` numbers each), added in block order.
+        for group in starts.chunks(SCAN_PARALLEL_BLOCKS) {
+            let partial: Vec<Vec<PeriodicSums>> =
+                group.par_iter().map(|&start| block_sums(start)).collect();
+            for block in partial {
+                for (t, b) in total.iter_mut().zip(block) {
+                    t.add(&b);
+                }
+            }
+        }
+        total
+            .into_iter()
+            .map(|t| {
+                // The columns are `1e-3` sin and cos (mm per um).
+                let qtg = DMatrix::from_column_slice(p, k, &t.qtg) * 1e-3;
+                let mut gtg = DMatrix::from_row_slice(k, k, &t.gtg) * 1e-6;
+                for a in 0..k {
+                    for b in 0..a {
+                        gtg[(a, b)] = gtg[(b, a)];
+                    }
+                }
+                let gtt = DVector::from_vec(t.gtt) * 1e-3;
+                let s = score_from(&qtg, &gtg, &gtt, &self.qtt);
+                (s.explained, s.rank)
+            })
+            .collect()
+    }
+
     /// Dense weighted columns (`3n x k`) of per-pose values.
     pub(crate) fn dense(&self, cols: &[(usize, Vec<f64>)]) -> DMatrix<f64> {
         let n = self.poses();
@@ -363,6 +525,23 @@ impl Linearisation {
             .find(|(t, _)| t == term)
             .map(|(_, r)| self.extra.columns(r.start, r.len()).into_owned())
     }
+}
+
+/// Per pose, the Gram matrix of its six directions.
+fn grams(directions: &[[[f64; 3]; 6]]) -> Vec<[[f64; 6]; 6]> {
+    directions
+        .iter()
+        .map(|d| {
+            std::array::from_fn(|a| {
+                std::array::from_fn(|b| (0..3).map(|c| d[a][c] * d[b][c]).sum())
+            })
+        })
+        .collect()
+}
+
+/// `a . b`.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// An orthonormal basis of the column space of `a` (thin QR; `a` has full
@@ -415,6 +594,114 @@ pub(crate) fn canonical_correlation(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::{RngExt, SeedableRng};
+    use tricept_model::effects::periodic_extra_mm;
+
+    /// A linearisation of `n` random poses: random fitted columns,
+    /// directions and target, and leg commands over 600-1000 mm.
+    fn synthetic(n: usize, seed: u64) -> (Linearisation, Vec<[f64; 3]>) {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
+        let mut normal = || rng.random_range(-1.0..1.0);
+        let x = DMatrix::from_fn(3 * n, 7, |_, _| normal());
+        let target = DVector::from_fn(3 * n, |_, _| normal());
+        let directions: Vec<[[f64; 3]; 6]> = (0..n)
+            .map(|_| {
+                std::array::from_fn(|b| {
+                    std::array::from_fn(|c| if b < 3 || b - 3 == c { normal() } else { 0.0 })
+                })
+            })
+            .collect();
+        let commands: Vec<[f64; 3]> = (0..n)
+            .map(|_| std::array::from_fn(|_| 800.0 + 200.0 * normal()))
+            .collect();
+        let mut lin = Linearisation {
+            q: DMatrix::zeros(0, 0),
+            x_params: (0..4).collect(),
+            x,
+            target: target.clone(),
+            ups: Vec::new(),
+            gram: grams(&directions),
+            directions,
+            projected: Vec::new(),
+            target_products: Vec::new(),
+            qtt: DVector::zeros(0),
+            extra: DMatrix::zeros(3 * n, 0),
+            extra_terms: Vec::new(),
+        };
+        lin.set_basis(&[]);
+        // A target with a periodic part on leg 2 (period 10 mm), so that
+        // the scores range from noise to signal.
+        let signal = lin.dense(&[(
+            1,
+            (0..n)
+                .map(|j| 3.0 * periodic_extra_mm(1000.0, 300.0, 10.0, commands[j][1]))
+                .collect(),
+        )]);
+        lin.set_target(target + signal.column(0));
+        (lin, commands)
+    }
+
+    #[test]
+    fn the_periodic_scan_equals_scoring_each_period() {
+        // 700 poses: several blocks, the last one partial.
+        let (lin, commands) = synthetic(700, 5);
+        let (f0, step, count) = (1.0 / 50.0, 1.0 / 1600.0, 140);
+        for legs in [vec![0, 1, 2], vec![1]] {
+            let scan = lin.periodic_scan(&commands, &legs, f0, step, count);
+            assert_eq!(scan.len(), count);
+            let mut best = (0, f64::MIN);
+            for (k, &(explained, rank)) in scan.iter().enumerate() {
+                let period = 1.0 / (f0 + k as f64 * step);
+                let cols: Vec<(usize, Vec<f64>)> = legs
+                    .iter()
+                    .flat_map(|&i| {
+                        let at = |a: f64, b: f64| -> Vec<f64> {
+                            commands
+                                .iter()
+                                .map(|q| periodic_extra_mm(a, b, period, q[i]))
+                                .collect()
+                        };
+                        [(i, at(1.0, 0.0)), (i, at(0.0, 1.0))]
+                    })
+                    .collect();
+                let direct = lin.score_columns(&cols);
+                assert_eq!(rank, direct.rank, "frequency {k}");
+                let tolerance = 1e-9 * direct.explained.max(1.0);
+                assert!(
+                    (explained - direct.explained).abs() <= tolerance,
+                    "frequency {k}: scan {explained} against {}",
+                    direct.explained
+                );
+                if explained > best.1 {
+                    best = (k, explained);
+                }
+            }
+            // The hidden 10 mm period on leg 2 is grid frequency 128.
+            assert_eq!(best.0, 128, "{legs:?}");
+        }
+    }
+
+    #[test]
+    fn the_periodic_scan_has_the_same_bits_at_any_thread_count() {
+        let (lin, commands) = synthetic(3000, 8);
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| lin.periodic_scan(&commands, &[0, 1, 2], 0.02, 1.0 / 1600.0, 40))
+        };
+        let one = run(1);
+        for threads in [2, 3] {
+            let other = run(threads);
+            assert!(
+                one.iter()
+                    .zip(&other)
+                    .all(|(a, b)| a.0.to_bits() == b.0.to_bits() && a.1 == b.1),
+                "{threads} threads"
+            );
+        }
+    }
 
     #[test]
     fn score_is_the_explained_sum_of_squares() {

@@ -86,19 +86,32 @@ impl Plausibility {
         values: &[f64],
         cov: &DMatrix<f64>,
     ) -> Result<(), String> {
+        let range_of = |j: &Judgement| {
+            self.ranges
+                .get(&key(cause, j))
+                .cloned()
+                .unwrap_or_else(|| j.range.to_range())
+        };
         for j in judgements {
-            let own;
-            let r = match self.ranges.get(&key(cause, j)) {
-                Some(r) => r,
-                None => {
-                    own = j.range.to_range();
-                    &own
-                }
-            };
+            let r = range_of(j);
             let (value, sd) = j.measure.evaluate(values, cov);
             if !r.admits(value, sd) {
+                // A sign convention flips every quantity its hint covers.
+                let hint = j.range.if_negated;
+                let negated_plausible = judgements
+                    .iter()
+                    .filter(|k| k.range.if_negated == hint)
+                    .all(|k| {
+                        let (v, sd) = k.measure.evaluate(values, cov);
+                        range_of(k).admits(-v, sd)
+                    });
+                let cause = if !hint.is_empty() && negated_plausible {
+                    format!("; likely cause: {hint}")
+                } else {
+                    ": the real cause is something else".to_string()
+                };
                 return Err(format!(
-                    "{} = {} +- {} {} is outside {} to {} {} ({}): the real cause is something else",
+                    "{} = {} +- {} {} is outside {} to {} {} ({}){cause}",
                     j.label,
                     round3(value),
                     round3(sd),
@@ -136,8 +149,16 @@ mod tests {
         assert!(judge(&p, EffectName::EncoderEccentricity, &v, 5.0).is_err());
         // A -199 um U-joint offset.
         assert!(judge(&p, EffectName::UjointAxes, &[0.0, -199.0], 10.0).is_err());
-        // Negative backlash, far from zero.
-        assert!(judge(&p, EffectName::Backlash, &[5.0, -8.0, 5.0], 1.0).is_err());
+        // Negative backlash, far from zero, on one leg: no sign convention
+        // explains it.
+        let one = judge(&p, EffectName::Backlash, &[5.0, -8.0, 5.0], 1.0).unwrap_err();
+        assert!(one.contains("the real cause is something else"), "{one}");
+        // On every leg: the `dir` columns' sign convention is flipped.
+        let all = judge(&p, EffectName::Backlash, &[-6.0, -5.0, -8.0], 1.0).unwrap_err();
+        assert!(
+            all.contains("likely cause") && all.contains("`dir`"),
+            "{all}"
+        );
     }
 
     /// The keys are the `--plausibility` contract (docs/diagnosis.md).

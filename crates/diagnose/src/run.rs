@@ -100,6 +100,7 @@ pub fn diagnose(
         dictionary,
         plausibility: &options.plausibility,
         available,
+        last_screen: Default::default(),
     };
     if options.noise_from_data {
         let dof = repeated.dof();

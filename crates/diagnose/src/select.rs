@@ -53,6 +53,35 @@ pub(crate) struct Setup<'a> {
     pub(crate) plausibility: &'a Plausibility,
     /// Effects of the vocabulary whose data columns are present.
     pub(crate) available: Vec<EffectName>,
+    /// The last dictionary screen with the point it was made at: the
+    /// selection's last step and the report's remainder screen the same fit.
+    pub(crate) last_screen: std::sync::Mutex<Option<(ScreenPoint, Vec<Scored>)>>,
+}
+
+/// Everything a dictionary screen depends on besides the fixed setup: the
+/// fit (its model's terms, estimate and chi-square), the test reference and
+/// the poses.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct ScreenPoint {
+    terms: Vec<Term>,
+    estimate_bits: Vec<u64>,
+    chi_square_bits: u64,
+    dof: usize,
+    reference: crate::evidence::Reference,
+    lines: Vec<u64>,
+}
+
+impl ScreenPoint {
+    fn of(setup: &Setup<'_>, fit: &Fit, data: &Dataset) -> ScreenPoint {
+        ScreenPoint {
+            terms: fit.model.terms().to_vec(),
+            estimate_bits: fit.id.estimate.iter().map(|v| v.to_bits()).collect(),
+            chi_square_bits: fit.id.stats.chi_square.to_bits(),
+            dof: fit.id.stats.dof,
+            reference: setup.fitter.reference,
+            lines: data.poses.iter().map(|p| p.line).collect(),
+        }
+    }
 }
 
 impl Setup<'_> {
@@ -99,6 +128,13 @@ impl Setup<'_> {
         if self.dictionary.is_empty() {
             return Vec::new();
         }
+        let point = ScreenPoint::of(self, fit, data);
+        if let Ok(last) = self.last_screen.lock()
+            && let Some((at, scored)) = last.as_ref()
+            && *at == point
+        {
+            return scored.clone();
+        }
         let Some(lin) = Linearisation::at_fit(fit, data, &self.fitter.sigma, &[]) else {
             return Vec::new();
         };
@@ -110,7 +146,11 @@ impl Setup<'_> {
             chi_square: fit.id.stats.chi_square,
             dof: fit.id.stats.dof,
         };
-        self.dictionary.screen(&at, fit.model.terms())
+        let scored = self.dictionary.screen(&at, fit.model.terms());
+        if let Ok(mut last) = self.last_screen.lock() {
+            *last = Some((point, scored.clone()));
+        }
+        scored
     }
 
     /// Plausibility of `term` in `fit`.

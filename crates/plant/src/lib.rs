@@ -26,6 +26,7 @@
 )]
 
 pub mod campaign;
+pub mod catalogue;
 pub mod effects;
 mod error;
 pub mod instruments;

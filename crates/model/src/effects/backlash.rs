@@ -40,6 +40,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
             max: 50.0,
             unit: "um",
             why: "lost motion is positive: the nut lags",
+            if_negated: "a backlash of the opposite sign is what the approach directions' sign convention flipped gives: `dir` must be +1 when the leg last extended (its command grew) and -1 when it retracted (docs/data-format.md)",
         },
         of: &[
             (Measure::Parameter(0), ""),

@@ -30,6 +30,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
             max: 200.0,
             unit: "um/kN at 1 m",
             why: "tension stretches the legs; 5 N/um is a very soft leg",
+            if_negated: "",
         },
         of: &[(Measure::Parameter(0), "")],
     }],

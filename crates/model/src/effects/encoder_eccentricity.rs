@@ -47,6 +47,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
             max: 60.0,
             unit: "arcsec",
             why: "10 um of eccentricity on a 35-50 mm graduation radius",
+            if_negated: "",
         },
         of: &[
             (Measure::Amplitude(0, 1), "eccentricity of the phi encoder"),

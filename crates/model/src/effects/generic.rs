@@ -85,6 +85,7 @@ const fn range(
         max,
         unit,
         why,
+        if_negated: "",
     }
 }
 

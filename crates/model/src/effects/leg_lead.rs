@@ -40,6 +40,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
             max: 300.0,
             unit: "ppm",
             why: "ball-screw lead deviations are tens of ppm",
+            if_negated: "",
         },
         of: &[
             (Measure::Parameter(0), ""),

@@ -27,6 +27,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
             max: 300.0,
             unit: "ppm",
             why: "glass scales and their mounting",
+            if_negated: "",
         },
         of: &[(Measure::Parameter(0), "")],
     }],

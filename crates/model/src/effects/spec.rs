@@ -264,6 +264,10 @@ pub struct PlausibleRange {
     pub unit: &'static str,
     /// Why (material, tolerance, definition).
     pub why: &'static str,
+    /// What a value outside the range whose negation lies inside it most
+    /// likely means, when a sign convention of the data can flip it (empty:
+    /// nothing is known, and the real cause is something else).
+    pub if_negated: &'static str,
 }
 
 impl PlausibleRange {

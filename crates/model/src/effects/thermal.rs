@@ -34,6 +34,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
             max: 16.0,
             unit: "ppm/K",
             why: "steel or cast-iron legs",
+            if_negated: "",
         },
         of: &[(Measure::Parameter(0), "")],
     }],

@@ -28,6 +28,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
             max: 50.0,
             unit: "arcsec per 100 mm",
             why: "guide-rail twist tolerances (150 arcsec over the stroke)",
+            if_negated: "",
         },
         of: &[(Measure::Parameter(0), "")],
     }],
