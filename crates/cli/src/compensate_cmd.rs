@@ -22,8 +22,9 @@ pub const TABLE_ERROR_LIMIT_UM: f64 = 1.0;
 
 /// The files `--map DIR` writes into DIR.
 pub const MAP_FILES: &[&str] = &["map.csv", "correction.svg", "before.svg", "after.svg"];
-/// The files `--table DIR` writes into DIR.
-pub const TABLE_FILES: &[&str] = &["table.csv"];
+/// The files `--table DIR` writes into DIR (the second only for a machine
+/// with per-leg compensation tables).
+pub const TABLE_FILES: &[&str] = &["table.csv", "leg-tables.csv"];
 
 /// `tricept compensate`.
 #[derive(Debug, Args)]
@@ -55,7 +56,11 @@ pub struct CompensateArgs {
     pub map: Option<PathBuf>,
     /// Write the compensation table DIR/table.csv: leg-command corrections
     /// (mm) on a regular grid over the workspace, for trilinear lookup (see
-    /// docs/data-format.md), with its measured interpolation error.
+    /// docs/data-format.md), with its measured interpolation error; and for
+    /// a machine file with per-leg compensation tables (a pitch error, a
+    /// curved or worn screw: `diagnose --write-machine`), those tables as
+    /// DIR/leg-tables.csv (leg command to extra length, linear), which the
+    /// controller applies on each leg axis after table.csv.
     #[arg(long, value_name = "DIR")]
     pub table: Option<PathBuf>,
     /// Grid spacing of the table, mm (default: the coarsest of 100, 50,
@@ -231,6 +236,17 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
         out.insert("map".into(), dir.display().to_string().into());
     }
     if let Some(dir) = &a.table {
+        // The per-leg compensation tables are exported as they are (the
+        // controller's pitch-error compensation on each leg axis); the
+        // workspace table carries the rest, which is smooth.
+        let leg_tables = calibrated.machine().leg_effects.tables.clone();
+        let calibrated = if leg_tables.is_empty() {
+            calibrated.clone()
+        } else {
+            let mut m = calibrated.machine().clone();
+            m.leg_effects.tables.clear();
+            ExtendedMachine::new(m)
+        };
         let (table, error_um) = match a.table_spacing {
             Some(h) => {
                 let t = CompensationTable::build(&nominal, &calibrated, w, h)
@@ -253,15 +269,18 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
         }
         let path = dir.join(TABLE_FILES[0]);
         write_table(&path, &table, error_um, &nominal, &calibrated)?;
-        out.insert(
-            "table".into(),
-            json!({
-                "file": path.display().to_string(),
-                "spacing_mm": table.spacing_mm,
-                "counts": table.counts,
-                "interpolation_error_um": error_um,
-            }),
-        );
+        let mut entry = json!({
+            "file": path.display().to_string(),
+            "spacing_mm": table.spacing_mm,
+            "counts": table.counts,
+            "interpolation_error_um": error_um,
+        });
+        if !leg_tables.is_empty() {
+            let legs = dir.join(TABLE_FILES[1]);
+            write_leg_tables(&legs, &leg_tables, calibrated.machine())?;
+            entry["leg_tables"] = legs.display().to_string().into();
+        }
+        out.insert("table".into(), entry);
     }
     out.insert("warnings".into(), warnings.clone().into());
     let targets = match &a.targets {
@@ -557,6 +576,45 @@ fn write_table(
                     );
                 }
             }
+        }
+    }
+    crate::files::write_text(path, &s)
+}
+
+/// Writes the per-leg compensation tables of `machine` as CSV: one row per
+/// point (`leg,command_mm,extra_length_um`), each table's range, spacing,
+/// interpolation and source in the header.
+fn write_leg_tables(
+    path: &Path,
+    tables: &[tricept_kinematics::description::LegTableDescription],
+    machine: &tricept_kinematics::Machine,
+) -> Result<(), CliError> {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# tricept {} per-leg compensation tables of {}: the extra length of each leg (um) at equally spaced leg commands (mm)",
+        env!("CARGO_PKG_VERSION"),
+        machine.name
+    );
+    let _ = writeln!(
+        s,
+        "# interpolation: linear between the points, the end values beyond them; applied on each leg axis after table.csv: the command q with q + extra(q) = the table's command (to first order q = command - extra(command), the form of a CNC controller's pitch-error compensation)"
+    );
+    for t in tables {
+        let _ = writeln!(
+            s,
+            "# leg {}: from {} mm every {} mm, {} points; {}",
+            t.leg,
+            t.start_mm,
+            t.step_mm,
+            t.extra_length_um.len(),
+            t.source
+        );
+    }
+    let _ = writeln!(s, "leg,command_mm,extra_length_um");
+    for t in tables {
+        for (k, v) in t.extra_length_um.iter().enumerate() {
+            let _ = writeln!(s, "{},{},{v}", t.leg, t.start_mm + t.step_mm * k as f64);
         }
     }
     crate::files::write_text(path, &s)

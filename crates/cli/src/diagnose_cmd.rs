@@ -7,7 +7,7 @@ use serde_json::{Map, json};
 use tricept_diagnose::detect::{advise, realistic, term_detectability};
 use tricept_diagnose::{DiagnoseError, DiagnoseOptions, Plausibility, deploy, diagnose};
 use tricept_ident::GeometricModel;
-use tricept_model::effects::{CauseName, EffectName};
+use tricept_model::effects::EffectName;
 use tricept_model::{GeometricErrors, ParameterSet};
 use tricept_plant::{Campaign, Effect, Plant, PoseOrder};
 
@@ -45,12 +45,17 @@ pub struct DiagnoseArgs {
     /// reported as unexplained).
     #[arg(long)]
     pub no_dictionary: bool,
-    /// Write the calibrated machine of the final model: the geometric
-    /// estimate with each named effect where it goes (the list below: the
-    /// static leg effects applied by ik, fk, tool-ik and compensate, the UP
-    /// limb's class-2 errors in its description, the dynamic effects as
-    /// controller parameters), and a `calibration` record. Refused when the
-    /// data are not explained.
+    /// Write the calibrated machine of the final model: the geometry
+    /// de-biased by every deployed cause, each named effect where it goes
+    /// (the list below: the static leg effects applied by ik, fk, tool-ik
+    /// and compensate, the UP limb's class-2 errors in its description, the
+    /// dynamic effects as controller parameters), the generic leg errors
+    /// that are functions of the leg command as per-leg compensation
+    /// tables (leg_effects.tables, applied by ik, fk, tool-ik and
+    /// compensate), sensor corrections and time terms recorded only, and a
+    /// `calibration` record saying what it applies and what it records.
+    /// A cause whose improvement is not above 2 sd is not deployed.
+    /// Refused when the data are not explained (exit 3).
     #[arg(long, value_name = "FILE.json")]
     pub write_machine: Option<PathBuf>,
     /// Write the machine even when the data are not explained; the file
@@ -178,26 +183,15 @@ fn write_extended(
     d: &tricept_diagnose::Diagnosis,
     force: bool,
 ) -> Result<(), CliError> {
-    // What a machine file cannot hold: a misfit the final model leaves, or
-    // a generic term of the dictionary (its physics is not in the
-    // kinematics; the report says what to look for).
+    // What a machine file cannot hold: a misfit the final model leaves
+    // (every named cause is deployed, or recorded, or reported as not
+    // worth deploying).
     let mut problems = Vec::new();
     if !d.final_adequate {
         problems.push(match &d.unexplained {
             Some(u) => u.clone(),
             None => "the final model does not explain the data (a remainder is reported)".into(),
         });
-    }
-    for c in d
-        .causes
-        .iter()
-        .filter(|c| matches!(c.effect, CauseName::Generic(_)))
-    {
-        problems.push(format!(
-            "the generic term `{}` ({}) is not part of the written model",
-            c.effect.as_str(),
-            c.description
-        ));
     }
     // An alias is deployed with the member the final model carries; the
     // file's warnings name the alternatives and what would separate them
@@ -246,9 +240,18 @@ fn write_extended(
     {
         effects.insert(name.clone(), json!({"value": v, "std_dev": sd}));
     }
+    // The period of each periodic term, beside its amplitudes.
+    for t in &d.model_terms {
+        if let (true, Some(p)) = (t.deployed, t.period_mm) {
+            effects.insert(
+                format!("{}.period_mm", t.effect),
+                json!({"value": p, "std_dev": serde_json::Value::Null}),
+            );
+        }
+    }
     let rejected_lines = d.outlier_lines();
     let warnings = problems.into_iter().chain(notes).collect();
-    let description = machine_file::calibrated_description(
+    let mut description = machine_file::calibrated_description(
         loaded,
         &deployed.machine,
         &machine_file::FitRecord::of_identification(&deployed.id),
@@ -267,6 +270,10 @@ fn write_extended(
         },
         deployed.controller,
     )?;
+    if let Some(c) = description.calibration.as_mut() {
+        c.applies = deployed.applied;
+        c.records = deployed.recorded;
+    }
     machine_file::write(path, &description)
 }
 

@@ -311,6 +311,8 @@ pub fn calibrated_description(
             s_mm: id.offsets[2],
             std_dev: id.offsets_std_dev,
         },
+        applies: Vec::new(),
+        records: Vec::new(),
         held: held(
             id,
             &reference,

@@ -897,11 +897,12 @@ fn the_dynamic_effects_are_exported_as_controller_parameters() {
 }
 
 #[test]
-fn diagnose_says_in_its_exit_code_and_its_machine_file_what_it_cannot_deploy() {
+fn diagnose_says_in_its_exit_code_and_its_machine_file_what_it_deploys() {
     let dir = workdir("diagnose-deploy");
     let file = |name: &str| dir.join(name).to_str().unwrap().to_string();
-    // Explained by a generic term: exit 0, but a machine file cannot hold
-    // a pitch error, so --write-machine refuses (3) unless forced.
+    // Explained by a generic term: exit 0 with or without the file, and
+    // the pitch error is in it as a compensation table per leg, applied by
+    // ik and exported by compensate --table.
     let pitch = fixture("data/diagnose-pitch.csv");
     let out = run(&[
         "diagnose",
@@ -910,27 +911,80 @@ fn diagnose_says_in_its_exit_code_and_its_machine_file_what_it_cannot_deploy() {
         "--write-machine",
         &file("p.json"),
     ]);
-    assert_eq!(out.status.code(), Some(3), "{}", text(&out));
-    assert!(text(&out).contains("leg-periodic"), "{}", text(&out));
-    assert!(!dir.join("p.json").exists());
-    let out = run(&[
-        "diagnose",
-        "--data",
-        &pitch,
-        "--write-machine",
-        &file("p.json"),
-        "--force",
-    ]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out));
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("p.json")).unwrap()).unwrap();
-    assert_eq!(m["calibration"]["forced"], true);
-    assert_eq!(m["calibration"]["adequate"], false);
+    assert_eq!(m["calibration"]["forced"], false);
+    assert_eq!(m["calibration"]["adequate"], true);
+    let tables = m["leg_effects"]["tables"].as_array().unwrap();
+    assert_eq!(tables.len(), 3, "{m}");
+    for t in tables {
+        assert_eq!(t["interpolation"], "linear");
+        // At least 20 points per 10 mm period.
+        assert!(t["step_mm"].as_f64().unwrap() <= 0.5, "{t}");
+        let v: Vec<f64> = t["extra_length_um"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        // The fixture's pitch error: 4 um on each leg.
+        let amplitude = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        assert!((2.0..8.0).contains(&amplitude), "{amplitude}");
+    }
+    let applies = m["calibration"]["applies"].to_string();
+    assert!(applies.contains("compensation table"), "{applies}");
+    // ik applies the tables: the file without them commands otherwise.
+    let ik = |machine: &str| {
+        let v = json(&run(&[
+            "ik",
+            "10",
+            "20",
+            "760",
+            "--machine",
+            machine,
+            "--json",
+        ]));
+        [v["q1"].clone(), v["q2"].clone(), v["q3"].clone()]
+    };
+    let mut plain = m.clone();
+    plain["leg_effects"]
+        .as_object_mut()
+        .unwrap()
+        .remove("tables");
+    std::fs::write(dir.join("plain.json"), plain.to_string()).unwrap();
+    let (with, without) = (ik(&file("p.json")), ik(&file("plain.json")));
+    let moved = (0..3)
+        .map(|i| (with[i].as_f64().unwrap() - without[i].as_f64().unwrap()).abs())
+        .fold(0.0, f64::max);
+    assert!(moved > 1e-4 && moved < 0.01, "{moved} mm");
+    // compensate --table exports them.
+    let out = run(&[
+        "compensate",
+        "--machine",
+        &file("p.json"),
+        "--table",
+        &file("table"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let legs = std::fs::read_to_string(dir.join("table").join("leg-tables.csv")).unwrap();
+    assert!(legs.contains("leg,command_mm,extra_length_um"), "{legs}");
+    assert!(legs.contains("linear"), "{legs}");
+    // A table that is not a table: exit 2, naming the file and the field.
+    let mut bad = m.clone();
+    bad["leg_effects"]["tables"][1]["step_mm"] = (-0.5).into();
+    std::fs::write(dir.join("bad.json"), bad.to_string()).unwrap();
+    let out = run(&["ik", "0", "0", "750", "--machine", &file("bad.json")]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
     assert!(
-        m["calibration"]["warnings"]
-            .to_string()
-            .contains("leg-periodic")
+        err.contains("bad.json") && err.contains("leg_effects.tables[1].step_mm"),
+        "{err}"
     );
+    // A file written before the tables loads as it did.
+    std::fs::write(dir.join("old.json"), plain.to_string()).unwrap();
+    let out = run(&["fk", "800", "800", "800", "--machine", &file("old.json")]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
     // Worse noise than stated and nothing to name: the verdict in the exit
     // code.
     let noisy = fixture("data/diagnose-noisy.csv");

@@ -26,7 +26,8 @@
 use nalgebra::{DMatrix, DVector};
 use tricept_data::Dataset;
 use tricept_model::effects::{
-    CauseName, EffectName, GenericFamily, legendre_p4, normalised_coordinate, periodic_extra_mm,
+    CauseName, EffectName, GenericFamily, Needs, legendre_p4, normalised_coordinate,
+    periodic_extra_mm,
 };
 use tricept_numerics::stats::chi2_isf;
 
@@ -369,6 +370,68 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
         match a {
             Term::Catalogue(_) => out.unnamed.push(*a),
             Term::Generic(_) => out.alternatives.push((*a, descriptions[1..].to_vec())),
+        }
+    }
+    // Structural: when the logged temperature follows the campaign's time,
+    // the model's temperature terms and time terms are one alias set, kept
+    // under the temperature term; no time term is named beside it.
+    let frame = &setup.fitter.frame;
+    let follows = |t: &Term, needs: Needs| t.needs() == needs;
+    let thermal: Vec<Term> = terms
+        .iter()
+        .copied()
+        .filter(|t| follows(t, Needs::Temperature))
+        .collect();
+    let timed: Vec<Term> = terms
+        .iter()
+        .copied()
+        .filter(|t| follows(t, Needs::PoseOrder))
+        .collect();
+    if frame.temperature_follows_time()
+        && let (Some(first), false) = (thermal.first(), timed.is_empty())
+    {
+        let r = frame.temperature_time_r.unwrap_or(1.0);
+        let members: Vec<Term> = thermal.iter().chain(&timed).copied().collect();
+        let mut effects = Vec::new();
+        for t in &members {
+            if !effects.contains(&t.name()) {
+                effects.push(t.name());
+            }
+        }
+        let (_, separate_by) = explain(first.name(), timed[0].name(), &timed[0].label());
+        out.aliases
+            .retain(|a| !members.iter().any(|t| a.in_model == t.name()));
+        out.aliases.push(Alias {
+            effects,
+            descriptions: members.iter().map(Term::label).collect(),
+            why: format!(
+                "the logged temperature followed the campaign's time (r = {r:+.3}): a change with temperature and a drift with time read alike, so none of these is independent of the other"
+            ),
+            separate_by,
+            exact: false,
+            lambda_unexplained: 0.0,
+            in_model: first.name(),
+            parameters: members
+                .iter()
+                .flat_map(|t| {
+                    let (v, cov) = term_estimates(fit, t);
+                    let label = t.name();
+                    t.params()
+                        .into_iter()
+                        .enumerate()
+                        .map(move |(j, n)| Estimate {
+                            name: format!("{label}.{n}"),
+                            value: v[j],
+                            std_dev: Some(cov[(j, j)].max(0.0).sqrt()),
+                        })
+                        .collect::<Vec<_>>()
+                })
+                .collect(),
+        });
+        for t in &timed {
+            if !out.unnamed.contains(t) {
+                out.unnamed.push(*t);
+            }
         }
     }
     // Structural: a significant common lead is a scale gain.

@@ -6,7 +6,7 @@
 
 use tricept_data::Dataset;
 use tricept_kinematics::Machine;
-use tricept_model::effects::{CHANNELS, CauseName, EffectName, GenericFamily};
+use tricept_model::effects::{CHANNELS, CauseName, Deployment, EffectName, GenericFamily};
 use tricept_numerics::stats::chi2_sf;
 
 use crate::alias::{Aliases, analyse};
@@ -14,11 +14,11 @@ use crate::describe::describe;
 use crate::dictionary::Scored;
 use crate::error::DiagnoseError;
 use crate::fit::{Fit, estimates, residuals_of};
-use crate::gain::volumetric_difference;
+use crate::gain::{improvement, volumetric_difference};
 use crate::noise::{Repeats, noise_check};
 use crate::report::{
-    Alias, Cause, CauseKind, ChannelRms, Diagnosis, Estimate, Evidence, FinalFit, Gain, Remainder,
-    TermScore, Verdict,
+    Alias, Cause, CauseKind, ChannelRms, Diagnosis, Estimate, Evidence, FinalFit, Gain, ModelTerm,
+    Remainder, SIGNIFICANT_IMPROVEMENT_SD, TermScore, Verdict,
 };
 use crate::residuals::{PlotOf, residual_plot, structure};
 use crate::select::{Selection, Setup};
@@ -133,6 +133,16 @@ pub(crate) fn report(
     let (volumetric, volumetric_note) =
         volumetric_difference(nominal, &geo, &current, fitter.options);
 
+    // What is worth deploying, and the deployed model's improvement over
+    // the geometric-only fit.
+    let (model_terms, deployed_fit) = deployable(nominal, setup, &clean, &current);
+    let gained = improvement(
+        nominal,
+        &geo,
+        deployed_fit.as_ref().unwrap_or(&current),
+        fitter.options,
+    );
+
     let noise = noise_check(fitter, repeated, &current, data);
     let mut d = Diagnosis {
         adequate,
@@ -164,7 +174,11 @@ pub(crate) fn report(
             volumetric_max_mm: volumetric.map(|v| v.1),
             volumetric_touched_mean_mm: volumetric.map(|v| v.2),
             volumetric_note,
+            improvement_mm: gained.map(|g| g.mean_mm),
+            improvement_sd_mm: gained.map(|g| g.sd_mm),
+            difference_sd_mm: gained.map(|g| g.difference_sd_mm),
         },
+        model_terms,
         geometric_only,
         extended: final_estimates,
         geometric_bias,
@@ -200,6 +214,83 @@ pub(crate) fn report(
         .filter_map(|p| residual_plot(p, nominal, &clean, &geo, &current, &fitter.sigma))
         .collect();
     Ok(d)
+}
+
+/// Every term of the final model `current` with its improvement (the
+/// final model against the final model without it, [`improvement`]) and
+/// whether it is deployed: a controller parameter always, any other term
+/// when its improvement exceeds [`SIGNIFICANT_IMPROVEMENT_SD`] standard
+/// deviations (against the truth: the deployed model's own platform
+/// uncertainty with the move's), or when the model without it cannot be
+/// fitted. With the
+/// model of the deployed terms refitted when some are left out.
+fn deployable(
+    nominal: &Machine,
+    setup: &Setup<'_>,
+    clean: &Dataset,
+    current: &Fit,
+) -> (Vec<ModelTerm>, Option<Fit>) {
+    let fitter = &setup.fitter;
+    let terms = current.model.terms();
+    let mut out: Vec<ModelTerm> = terms
+        .iter()
+        .map(|t| {
+            let controller = matches!(t, Term::Catalogue(e)
+                if matches!(e.spec().deployment, Deployment::Controller(_)));
+            let gained = if controller {
+                None
+            } else {
+                let others: Vec<Term> = terms.iter().copied().filter(|u| u != t).collect();
+                fitter
+                    .fit(fitter.model(&others), clean)
+                    .ok()
+                    .map(|without| improvement(nominal, &without, current, fitter.options))
+            };
+            let deployed = match gained {
+                None => true,
+                Some(Some(g)) => g.mean_mm > SIGNIFICANT_IMPROVEMENT_SD * g.sd_mm,
+                // The plane cannot be reached: nothing says it does not pay.
+                Some(None) => true,
+            };
+            let g = gained.flatten();
+            let (legs, channel, period_mm) = match t {
+                Term::Generic(g) => (
+                    g.legs().iter().map(|i| *i as u8 + 1).collect(),
+                    g.channel().map(|c| c as u8),
+                    g.period_mm,
+                ),
+                Term::Catalogue(_) => (Vec::new(), None, None),
+            };
+            ModelTerm {
+                effect: t.name(),
+                description: t.label(),
+                legs,
+                channel,
+                period_mm,
+                deployed,
+                improvement_mm: g.map(|g| g.mean_mm),
+                improvement_sd_mm: g.map(|g| g.sd_mm),
+                difference_sd_mm: g.map(|g| g.difference_sd_mm),
+            }
+        })
+        .collect();
+    if out.iter().all(|t| t.deployed) {
+        return (out, None);
+    }
+    let kept: Vec<Term> = terms
+        .iter()
+        .zip(&out)
+        .filter(|(_, m)| m.deployed)
+        .map(|(t, _)| *t)
+        .collect();
+    match fitter.fit(fitter.model(&kept), clean) {
+        Ok(fit) => (out, Some(fit)),
+        Err(_) => {
+            // The model of the deployed terms cannot be fitted: deploy all.
+            out.iter_mut().for_each(|t| t.deployed = true);
+            (out, None)
+        }
+    }
 }
 
 /// The `outliers` cause: the flagged poses of `data`, their largest

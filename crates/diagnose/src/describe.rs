@@ -131,6 +131,8 @@ pub(crate) fn describe(
                         .any(|a| a.starts_with("reading-temperature") || a == "thermal")
                     {
                         "with time or with temperature (they followed each other during the campaign)"
+                    } else if frame.temperature_follows_time() {
+                        "with time or with the logged temperature, which followed time during the campaign"
                     } else if frame.temperature.is_some() {
                         "independent of temperature"
                     } else {

@@ -86,10 +86,12 @@ pub use noise::NOISE_CHECK_LEVEL;
 pub use options::{DiagnoseOptions, DictionaryOptions, MIN_PURE_ERROR_DOF};
 pub use plausibility::{Plausibility, PlausibilityError, Range};
 pub use report::{
-    Alias, Cause, CauseKind, ChannelRms, Diagnosis, Estimate, Evidence, FinalFit, Gain, NoiseCheck,
-    NoiseSource, PureError, RejectStage, Rejected, Remainder, ResidualPlot, Structure, TermScore,
-    Tested, Verdict,
+    Alias, Cause, CauseKind, ChannelRms, Diagnosis, Estimate, Evidence, FinalFit, Gain, ModelTerm,
+    NoiseCheck, NoiseSource, PureError, RejectStage, Rejected, Remainder, ResidualPlot,
+    SIGNIFICANT_IMPROVEMENT_SD, Structure, TermScore, Tested, Verdict,
 };
 pub use run::diagnose;
-pub use terms::{Frame, GenericTerm, MIN_TEMPERATURE_RANGE_K, OrderAxis, Scope, Term};
+pub use terms::{
+    Frame, GenericTerm, MIN_TEMPERATURE_RANGE_K, OrderAxis, Scope, TEMPERATURE_FOLLOWS_TIME, Term,
+};
 pub use tricept_model::effects::{CauseName, GenericFamily, REFERENCE_TEMPERATURE_C};

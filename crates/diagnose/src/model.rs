@@ -170,6 +170,28 @@ impl ExtendedModel {
     }
 }
 
+impl ExtendedModel {
+    /// The extra length of each leg (mm) the leg terms add at parameters
+    /// `p` for `pose` (its commands and logged context; a context the pose
+    /// does not log contributes nothing: the campaign's middle).
+    pub(crate) fn leg_extra_mm(
+        &self,
+        p: &[f64],
+        pose: &MeasuredPose,
+    ) -> Result<[f64; 3], KinematicsError> {
+        let mut legs = [0.0; 3];
+        let nominal = self.geometric.nominal();
+        for (term, at) in self.terms.iter().zip(self.offsets()) {
+            for (k, basis, v) in term.leg_entries(&self.frame, nominal, pose)? {
+                if let (Basis::Leg(i), Some(value)) = (basis, p.get(at + k)) {
+                    legs[i] += value * v;
+                }
+            }
+        }
+        Ok(legs)
+    }
+}
+
 fn is_kinematic(t: &Term) -> bool {
     t.kind() == TermKind::Kinematic
 }

@@ -287,7 +287,56 @@ pub struct Gain {
     pub volumetric_touched_mean_mm: Option<f64>,
     /// Why the displacement is missing or partial.
     pub volumetric_note: Option<String>,
+    /// The predicted true improvement of deploying: the mean platform
+    /// error on the middle plane of the geometric-only fit minus that of
+    /// the deployed final model (the terms worth deploying, [`ModelTerm`]),
+    /// both measured against the deployed model, mm; `null` when the plane
+    /// cannot be reached.
+    pub improvement_mm: Option<f64>,
+    /// Its standard deviation against the truth, mm: the root mean square
+    /// over the plane of the platform uncertainty of the deployed model
+    /// (its covariance, the geometry's weak directions included) and of its
+    /// difference from the geometric-only fit (the difference of the two
+    /// covariances), in quadrature.
+    pub improvement_sd_mm: Option<f64>,
+    /// The standard deviation of the difference alone, mm: how far the
+    /// deployed model would move the platform from the geometric-only one
+    /// by noise (Hausman's covariance; it ignores that the geometric-only
+    /// fit is biased, so it is reported, not used by the rule).
+    pub difference_sd_mm: Option<f64>,
 }
+
+/// A term of the final model, and whether the deployed machine carries it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ModelTerm {
+    /// The effect or family.
+    pub effect: CauseName,
+    /// The group (`leg-periodic:legs@10.000mm`, `leg-lead`).
+    pub description: String,
+    /// The legs of a generic leg term (1-3).
+    pub legs: Vec<u8>,
+    /// The reading channel of a generic reading term (0 `phi`, 1 `theta`,
+    /// 2 `s`).
+    pub channel: Option<u8>,
+    /// The period of a periodic term, mm.
+    pub period_mm: Option<f64>,
+    /// Whether it is deployed: its improvement is significant, or it is a
+    /// controller parameter (backlash, thermal expansion: its gain is at
+    /// the approach directions and temperatures the controller knows).
+    pub deployed: bool,
+    /// The mean platform error on the middle plane of the final model
+    /// without this term minus that of the final model, mm (`null` for a
+    /// controller parameter).
+    pub improvement_mm: Option<f64>,
+    /// Its standard deviation against the truth ([`Gain::improvement_sd_mm`]), mm.
+    pub improvement_sd_mm: Option<f64>,
+    /// The standard deviation of the move alone ([`Gain::difference_sd_mm`]), mm.
+    pub difference_sd_mm: Option<f64>,
+}
+
+/// How many standard deviations ([`ModelTerm::improvement_sd_mm`]) a
+/// term's improvement must exceed for the term to be deployed.
+pub const SIGNIFICANT_IMPROVEMENT_SD: f64 = 2.0;
 
 /// A residual plot: weighted residuals of a channel (or implied leg-length
 /// residuals) against the regressor that exposes a cause.
@@ -352,6 +401,9 @@ pub struct Diagnosis {
     pub limitations: Vec<String>,
     /// Gain of the final model.
     pub gain: Gain,
+    /// The terms of the final model, each deployed or "seen, not worth
+    /// deploying", with its improvement.
+    pub model_terms: Vec<ModelTerm>,
     /// Geometric parameters of the geometric-only fit.
     #[serde(serialize_with = "estimates_by_name")]
     pub geometric_only: Vec<Estimate>,
@@ -601,6 +653,29 @@ impl Diagnosis {
                 .as_ref()
                 .map_or(String::new(), |n| format!(" ({n})"))
         );
+        if let (Some(i), Some(sd)) = (g.improvement_mm, g.improvement_sd_mm) {
+            w!(
+                "predicted improvement of the deployed model over the geometric-only one: {:.4} +- {:.4} mm mean platform error on the middle plane",
+                i,
+                sd
+            );
+        }
+        for t in &self.model_terms {
+            let numbers = match (t.improvement_mm, t.improvement_sd_mm, t.difference_sd_mm) {
+                (Some(i), Some(sd), Some(moved)) => {
+                    format!(": improvement {i:.4} +- {sd:.4} mm (the move's own sd {moved:.4} mm)")
+                }
+                _ => String::new(),
+            };
+            if t.deployed {
+                w!("deployed: {}{numbers}", t.description);
+            } else {
+                w!(
+                    "seen, not worth deploying: {}{numbers} (not above {SIGNIFICANT_IMPROVEMENT_SD} sd)",
+                    t.description
+                );
+            }
+        }
         out
     }
 }

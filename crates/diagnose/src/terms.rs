@@ -403,7 +403,16 @@ pub struct Frame {
     /// Whether every pose logs its legs' approach directions and some leg
     /// is approached from both sides.
     pub approach_reverses: bool,
+    /// The correlation of the logged temperature with the time axis, when
+    /// both vary ([`Frame::order`] and [`Frame::temperature`]): beyond
+    /// [`TEMPERATURE_FOLLOWS_TIME`] a change with temperature and a drift
+    /// with time cannot be told apart.
+    pub temperature_time_r: Option<f64>,
 }
+
+/// The correlation (absolute) of the logged temperature with the campaign's
+/// time beyond which temperature terms and time terms form one alias set.
+pub const TEMPERATURE_FOLLOWS_TIME: f64 = 0.95;
 
 impl Frame {
     /// A frame with no campaign: every generic term is zero in it.
@@ -415,6 +424,7 @@ impl Frame {
             temperature: None,
             directions: BTreeMap::new(),
             approach_reverses: false,
+            temperature_time_r: None,
         }
     }
 
@@ -520,14 +530,50 @@ impl Frame {
                     .collect();
                 dirs.contains(&1) && dirs.contains(&-1)
             });
-        Frame {
+        let mut frame = Frame {
             leg_range_mm,
             q4_range_mm,
             order,
             temperature,
             directions,
             approach_reverses,
+            temperature_time_r: None,
+        };
+        frame.temperature_time_r = frame.correlation_of_temperature_with_time(poses);
+        frame
+    }
+
+    /// Pearson's correlation of the logged temperature with [`Frame::tau`]
+    /// over `poses`, when both vary.
+    fn correlation_of_temperature_with_time(&self, poses: &[MeasuredPose]) -> Option<f64> {
+        self.temperature?;
+        let pairs: Vec<(f64, f64)> = poses
+            .iter()
+            .filter_map(|p| Some((self.tau(p)?, p.temp_c?)))
+            .collect();
+        let n = pairs.len() as f64;
+        if pairs.len() < 3 {
+            return None;
         }
+        let (mx, my) = pairs
+            .iter()
+            .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+        let (sxy, sxx, syy) = pairs.iter().fold((0.0, 0.0, 0.0), |(a, b, c), (x, y)| {
+            (
+                a + (x - mx) * (y - my),
+                b + (x - mx).powi(2),
+                c + (y - my).powi(2),
+            )
+        });
+        let r = sxy / (sxx * syy).sqrt();
+        r.is_finite().then_some(r)
+    }
+
+    /// Whether the logged temperature follows the campaign's time (|r|
+    /// beyond [`TEMPERATURE_FOLLOWS_TIME`]).
+    pub fn temperature_follows_time(&self) -> bool {
+        self.temperature_time_r
+            .is_some_and(|r| r.abs() > TEMPERATURE_FOLLOWS_TIME)
     }
 
     /// Whether the campaign has what a term needs (and, for the context

@@ -349,7 +349,8 @@ impl PosePredictor for GeometricPredictor<'_> {
             let mut probe = *seed;
             let up = solve_pose(&self.machine, &pose.commands_mm, &mut probe)?;
             let rate = static_leg_extra_per_mm(&self.machine, &up);
-            std::array::from_fn(|i| pose.commands_mm[i] * (1.0 + rate[i]))
+            let table = self.machine.leg_effects.table_extra_mm(&pose.commands_mm);
+            std::array::from_fn(|i| pose.commands_mm[i] * (1.0 + rate[i]) + table[i])
         };
         let (up, _) = self.solve(&legs, seed, jacobian, k)?;
         Ok(up.to_array())

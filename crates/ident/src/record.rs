@@ -76,7 +76,7 @@ pub enum RecordError {
 ///     correlations: CorrelationsDescription { names: vec![], matrix: vec![] },
 ///     effects: Default::default(),
 ///     sensor_offsets: SensorOffsetsDescription { phi_rad: 0.0, theta_rad: 0.0, s_mm: 0.0, std_dev: [0.0; 3] },
-///     held: vec![], chi2_per_dof: 1.0, dof: 1, converged: true, adequate: true, forced: false,
+///     applies: vec![], records: vec![], held: vec![], chi2_per_dof: 1.0, dof: 1, converged: true, adequate: true, forced: false,
 ///     warnings: vec![], poses_used: 75, temperature_c: None, rejected_lines: vec![], external_sources: vec![],
 ///     data_file: "d.csv".into(), data_sha256: String::new(), date: String::new(),
 ///     tool_version: String::new(), relative_to: m.name.clone(), relative_to_machine: None,

@@ -197,7 +197,7 @@ impl Machine {
             head: Head::from_description(&d.head),
             sensors: SensorNoise::from_description(&d.sensors),
             loads: d.loads.clone(),
-            leg_effects: d.leg_effects,
+            leg_effects: d.leg_effects.clone(),
         }
     }
 
@@ -261,7 +261,7 @@ impl Machine {
                 readings_per_pose: self.sensors.readings_per_pose,
             },
             loads: self.loads.clone(),
-            leg_effects: self.leg_effects,
+            leg_effects: self.leg_effects.clone(),
             controller: None,
             calibration: None,
         }

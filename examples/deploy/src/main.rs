@@ -1,17 +1,17 @@
 //! A downstream program that diagnoses measured data and deploys what the
 //! diagnosis found, with `tricept-diagnose` as a library: it refuses to go
-//! on unless the final model explains the data and names no generic term
-//! (whose physics a machine file cannot carry), then deploys the model
-//! (`tricept_diagnose::deploy`: each effect where the registry says it
-//! goes) and prints the deployed leg effects, the controller parameters of
-//! the dynamic effects and the calibrated leg commands at the centre of the
-//! workspace.
+//! on unless the final model explains the data, then deploys the model
+//! (`tricept_diagnose::deploy`: each term worth deploying where the
+//! registry says it goes, a generic leg error as per-leg compensation
+//! tables) and prints what it applies and what it only records, the
+//! controller parameters of the dynamic effects and the calibrated leg
+//! commands at the centre of the workspace.
 //!
 //! ```sh
 //! cargo run -p tricept-example-deploy -- fixtures/data/diagnose-hidden-effect.csv
 //! ```
 
-use tricept_diagnose::{CauseKind, DiagnoseOptions, deploy, diagnose};
+use tricept_diagnose::{DiagnoseOptions, deploy, diagnose};
 use tricept_ident::nalgebra::Vector3;
 use tricept_ident::{ExtendedMachine, Machine, read_path};
 
@@ -34,14 +34,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if !d.final_adequate {
         return Err("the final model does not explain the data (see the report)".into());
     }
-    if d.causes.iter().any(|c| c.kind == CauseKind::Generic) {
-        return Err("a generic term is named: its physics is not in a machine file".into());
-    }
     let deployed = deploy(&nominal, None, &data, &d)?;
+    for line in &deployed.applied {
+        println!("applies: {line}");
+    }
+    for line in &deployed.recorded {
+        println!("records: {line}");
+    }
     if let Some(c) = &deployed.controller {
         println!("controller: {c:?}");
     }
-    println!("leg effects: {:?}", deployed.machine.leg_effects);
+    let e = &deployed.machine.leg_effects;
+    println!(
+        "leg effects: lead {:?} ppm, compliance {} um/kN at 1 m, {} compensation tables",
+        e.lead_ppm,
+        e.compliance_um_per_kn_at_1m,
+        e.tables.len()
+    );
     let calibrated = ExtendedMachine::new(deployed.machine);
     let target = Vector3::new(0.0, 0.0, 750.0);
     let q = calibrated.inverse(&target)?.legs_mm;

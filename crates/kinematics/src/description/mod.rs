@@ -38,8 +38,9 @@ pub use geometry::{
 };
 pub use record::{
     ControllerDescription, CorrelationsDescription, ExternalSourceRecord, HeldParameter,
-    LegEffectsDescription, SensorOffsetsDescription,
+    Interpolation, LegEffectsDescription, LegTableDescription, SensorOffsetsDescription,
 };
+pub use validate::{MAX_TABLE_EXTRA_UM, MAX_TABLE_POINTS, MAX_TABLE_SLOPE_UM_PER_MM};
 
 /// The JSON text of the paper's Table 1 machine, embedded at compile time.
 pub const PAPER_MACHINE_JSON: &str = include_str!(concat!(
@@ -132,6 +133,15 @@ pub struct CalibrationRecord {
     pub effects: serde_json::Map<String, serde_json::Value>,
     /// Sensor zero offsets.
     pub sensor_offsets: SensorOffsetsDescription,
+    /// What the file applies, one line per deployed part (a diagnosis':
+    /// leg effects, compensation tables, the UP limb, controller
+    /// parameters), and where it goes.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub applies: Vec<String>,
+    /// What the file only records and does not apply: sensor corrections,
+    /// time terms, terms seen but not worth deploying.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub records: Vec<String>,
     /// Parameters held at their prior, with the reason.
     pub held: Vec<HeldParameter>,
     /// Weighted chi-square per degree of freedom of the fit (1 when the
@@ -301,6 +311,72 @@ mod tests {
     }
 
     #[test]
+    fn compensation_tables_are_checked_on_load_by_field() {
+        let table = |leg: u8, start: f64, step: f64, values: Vec<f64>| {
+            serde_json::json!({"leg": leg, "start_mm": start, "step_mm": step,
+                "extra_length_um": values, "interpolation": "linear"})
+        };
+        let with = |tables: Vec<serde_json::Value>| {
+            let mut v: serde_json::Value = serde_json::from_str(PAPER_MACHINE_JSON).unwrap();
+            v["leg_effects"] = serde_json::json!({ "tables": tables });
+            MachineDescription::from_json(&v.to_string())
+        };
+        // A good table loads, and is read linearly.
+        let d = with(vec![table(1, 600.0, 1.0, vec![0.0, 2.0, 4.0])]).unwrap();
+        let m = d.build().unwrap();
+        assert_eq!(m.leg_effects.table_extra_mm(&[601.5, 0.0, 0.0])[0], 0.003);
+        for (tables, field) in [
+            (vec![table(4, 600.0, 1.0, vec![0.0, 1.0])], "tables[0].leg"),
+            (
+                vec![
+                    table(2, 600.0, 1.0, vec![0.0, 1.0]),
+                    table(2, 700.0, 1.0, vec![0.0, 1.0]),
+                ],
+                "tables[1].leg",
+            ),
+            (
+                vec![table(1, 600.0, 1.0, vec![0.0])],
+                "tables[0].extra_length_um",
+            ),
+            (
+                vec![table(1, 600.0, -1.0, vec![0.0, 1.0])],
+                "tables[0].step_mm",
+            ),
+            (
+                vec![table(1, 600.0, 0.0, vec![0.0, 1.0])],
+                "tables[0].step_mm",
+            ),
+            (
+                vec![table(1, 100.0, 1.0, vec![0.0, 1.0])],
+                "tables[0].start_mm",
+            ),
+            (
+                vec![table(1, 1249.5, 1.0, vec![0.0, 1.0])],
+                "tables[0].start_mm",
+            ),
+            (
+                vec![table(1, 600.0, 1.0, vec![0.0, 2000.0])],
+                "tables[0].extra_length_um[1]",
+            ),
+            (
+                vec![table(1, 600.0, 0.1, vec![0.0, 30.0])],
+                "tables[0].extra_length_um[1]",
+            ),
+        ] {
+            let e = with(tables).unwrap_err();
+            assert!(
+                e.to_string().contains(&format!("leg_effects.{field}")),
+                "{field}: {e}"
+            );
+        }
+        // Not a number at all: the parser says where.
+        let mut v: serde_json::Value = serde_json::from_str(PAPER_MACHINE_JSON).unwrap();
+        v["leg_effects"] = serde_json::json!({"tables": [{"leg": 1, "start_mm": 600.0,
+            "step_mm": 1.0, "extra_length_um": [0.0, "x"]}]});
+        assert!(MachineDescription::from_json(&v.to_string()).is_err());
+    }
+
+    #[test]
     fn rejects_sizes_no_machine_has() {
         for (key, value) in [
             ("/placement/circular/base_radius_mm", 1e200),
@@ -338,6 +414,8 @@ mod tests {
             correlations: CorrelationsDescription::default(),
             effects: serde_json::Map::new(),
             sensor_offsets: SensorOffsetsDescription::default(),
+            applies: Vec::new(),
+            records: Vec::new(),
             held: vec![HeldParameter {
                 name: "dyA3".into(),
                 reason: "unidentifiable".into(),

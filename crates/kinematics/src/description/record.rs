@@ -8,9 +8,11 @@ use serde::{Deserialize, Serialize};
 use super::geometry::is_zero3;
 
 /// Static effects of the actuated legs: the actual length of leg `i` for
-/// command `q_i` is `q_i + dq_i + lead_i 1e-6 q_i + c F_i q_i 1e-9` (mm),
-/// with `F_i` the gravity tension of the leg (N) at the pose and `c` the
-/// compliance of a 1 m leg (um/kN; stiffness scales as 1/length).
+/// command `q_i` is `q_i + dq_i + lead_i 1e-6 q_i + c F_i q_i 1e-9 +
+/// T_i(q_i)` (mm), with `F_i` the gravity tension of the leg (N) at the
+/// pose, `c` the compliance of a 1 m leg (um/kN; stiffness scales as
+/// 1/length) and `T_i` leg `i`'s compensation table, when it has one
+/// ([`LegTableDescription`]).
 ///
 /// # Example
 /// ```
@@ -19,7 +21,7 @@ use super::geometry::is_zero3;
 /// assert!(!e.is_zero());
 /// assert!(LegEffectsDescription::default().is_zero());
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
 pub struct LegEffectsDescription {
     /// Ball-screw lead error of each leg, ppm of the command.
@@ -27,12 +29,134 @@ pub struct LegEffectsDescription {
     /// Axial compliance of a leg of 1 m under its gravity tension, um/kN
     /// (1000 / stiffness in N/um).
     pub compliance_um_per_kn_at_1m: f64,
+    /// Per-leg compensation tables (at most one per leg): the leg errors
+    /// that are functions of the leg command (ball-screw pitch error, a
+    /// curved or worn screw), the form a CNC controller's pitch-error
+    /// compensation takes. Absent in files written before them.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub tables: Vec<LegTableDescription>,
 }
 
 impl LegEffectsDescription {
     /// No effect at all (what a nominal machine has).
     pub fn is_zero(&self) -> bool {
-        is_zero3(&self.lead_ppm) && self.compliance_um_per_kn_at_1m == 0.0
+        is_zero3(&self.lead_ppm) && self.compliance_um_per_kn_at_1m == 0.0 && self.tables.is_empty()
+    }
+
+    /// The extra length of each leg (mm) from its compensation table at
+    /// the commands `commands_mm` (zero for a leg without one).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_kinematics::description::{LegEffectsDescription, LegTableDescription};
+    /// let e = LegEffectsDescription {
+    ///     tables: vec![LegTableDescription::new(2, 600.0, 10.0, vec![0.0, 4.0, 2.0])],
+    ///     ..Default::default()
+    /// };
+    /// let x = e.table_extra_mm(&[605.0, 605.0, 1000.0]);
+    /// assert_eq!(x[0], 0.0);
+    /// assert!((x[1] - 0.002).abs() < 1e-15); // halfway between 0 and 4 um
+    /// ```
+    pub fn table_extra_mm(&self, commands_mm: &[f64; 3]) -> [f64; 3] {
+        let mut out = [0.0; 3];
+        for t in &self.tables {
+            if let Some(i) = t.leg_index() {
+                out[i] += t.extra_mm(commands_mm[i]);
+            }
+        }
+        out
+    }
+}
+
+/// How a compensation table is read between its points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Interpolation {
+    /// Straight lines between neighbouring points; beyond the first or the
+    /// last point the end value holds.
+    #[default]
+    Linear,
+}
+
+/// A leg's compensation table: the extra length of the leg (um) at leg
+/// commands `start_mm + k step_mm`, `k = 0 .. n-1`, equally spaced over
+/// the stroke the calibration measured, read by linear interpolation
+/// ([`Interpolation::Linear`]; the end values hold beyond the table). A
+/// leg whose table reads `+3 um` at a command is 3 um longer there than
+/// the geometry says: `ik` commands it 3 um shorter.
+///
+/// # Example
+/// ```
+/// use tricept_kinematics::description::LegTableDescription;
+/// let t = LegTableDescription::new(1, 700.0, 5.0, vec![1.0, -1.0]);
+/// assert!((t.extra_mm(702.5) - 0.0).abs() < 1e-15);
+/// assert_eq!(t.extra_mm(600.0), 0.001); // the first value holds before the table
+/// assert_eq!(t.end_mm(), 705.0);
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LegTableDescription {
+    /// The leg, 1 to 3.
+    pub leg: u8,
+    /// The leg command of the first point, mm.
+    pub start_mm: f64,
+    /// The spacing of the points, mm (positive: the commands increase).
+    pub step_mm: f64,
+    /// The leg's extra length at each point, um.
+    pub extra_length_um: Vec<f64>,
+    /// How values between the points are read.
+    #[serde(default)]
+    pub interpolation: Interpolation,
+    /// What the table carries (the diagnosis' terms), for people.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub source: String,
+}
+
+impl LegTableDescription {
+    /// A linear table of leg `leg` (1-3) without a source note.
+    pub fn new(leg: u8, start_mm: f64, step_mm: f64, extra_length_um: Vec<f64>) -> Self {
+        LegTableDescription {
+            leg,
+            start_mm,
+            step_mm,
+            extra_length_um,
+            interpolation: Interpolation::Linear,
+            source: String::new(),
+        }
+    }
+
+    /// The leg's index, 0 to 2 (`None` for a leg number outside 1-3, which
+    /// validation refuses).
+    pub fn leg_index(&self) -> Option<usize> {
+        (1..=3)
+            .contains(&self.leg)
+            .then(|| usize::from(self.leg) - 1)
+    }
+
+    /// The command of the last point, mm.
+    pub fn end_mm(&self) -> f64 {
+        self.start_mm + self.step_mm * self.extra_length_um.len().saturating_sub(1) as f64
+    }
+
+    /// The extra length (mm) at command `command_mm`: linear between the
+    /// points, the end values beyond them, zero for an empty table.
+    pub fn extra_mm(&self, command_mm: f64) -> f64 {
+        let v = &self.extra_length_um;
+        let Some(last) = v.len().checked_sub(1) else {
+            return 0.0;
+        };
+        let x = ((command_mm - self.start_mm) / self.step_mm).clamp(0.0, last as f64);
+        if !x.is_finite() {
+            return 0.0;
+        }
+        let k = (x.floor() as usize).min(last.saturating_sub(1));
+        let f = x - k as f64;
+        let um = if last == 0 {
+            v[0]
+        } else {
+            v[k] + f * (v[k + 1] - v[k])
+        };
+        um * 1e-3
     }
 }
 

@@ -120,6 +120,7 @@ impl MachineDescription {
                 ),
             ));
         }
+        self.validate_leg_tables()?;
         if let Some(c) = &self.controller {
             finite("controller.backlash_um", &c.backlash_um)?;
             finite(
@@ -334,4 +335,97 @@ fn check_triangle(
         return Err(format!("{what} are collinear"));
     }
     Ok(())
+}
+
+/// The most points a compensation table may hold per leg.
+pub const MAX_TABLE_POINTS: usize = 100_000;
+
+/// The largest extra length a compensation table may hold, um: 1 mm, far
+/// beyond any screw error (a larger value is a unit mistake).
+pub const MAX_TABLE_EXTRA_UM: f64 = 1000.0;
+
+/// The steepest a compensation table may be between neighbouring points,
+/// um of extra length per mm of command: 200 um/mm (20 %) holds the
+/// steepest pitch error a diagnosis finds plausible (25 um at a 1 mm
+/// period, 157 um/mm) and keeps the corrected command unique (IK's passes
+/// contract by the slope).
+pub const MAX_TABLE_SLOPE_UM_PER_MM: f64 = 200.0;
+
+impl MachineDescription {
+    /// The checks of the per-leg compensation tables: a leg 1-3 at most
+    /// once, 2 to [`MAX_TABLE_POINTS`] points, a positive finite spacing
+    /// (the commands increase), a start and end within the legs' stroke,
+    /// finite values within [`MAX_TABLE_EXTRA_UM`] and slopes within
+    /// [`MAX_TABLE_SLOPE_UM_PER_MM`].
+    fn validate_leg_tables(&self) -> Result<(), DescriptionError> {
+        let mut seen = [false; 3];
+        for (k, t) in self.leg_effects.tables.iter().enumerate() {
+            let key = |field: &str| format!("leg_effects.tables[{k}].{field}");
+            let invalid = |field: &str, reason: String| DescriptionError::Invalid {
+                key: key(field),
+                reason,
+            };
+            let Some(i) = t.leg_index() else {
+                return Err(invalid("leg", format!("must be 1, 2 or 3, got {}", t.leg)));
+            };
+            if std::mem::replace(&mut seen[i], true) {
+                return Err(invalid(
+                    "leg",
+                    format!("leg {} has a second table (one per leg)", t.leg),
+                ));
+            }
+            let n = t.extra_length_um.len();
+            if !(2..=MAX_TABLE_POINTS).contains(&n) {
+                return Err(invalid(
+                    "extra_length_um",
+                    format!("must hold 2 to {MAX_TABLE_POINTS} points, got {n}"),
+                ));
+            }
+            if !(t.step_mm.is_finite() && t.step_mm > 0.0) {
+                return Err(invalid(
+                    "step_mm",
+                    format!(
+                        "must be a positive number of mm (the commands increase along the table), got {}",
+                        t.step_mm
+                    ),
+                ));
+            }
+            let [lo, hi] = self.limits.leg_stroke_mm;
+            if !(t.start_mm.is_finite() && t.start_mm >= lo && t.end_mm() <= hi) {
+                return Err(invalid(
+                    "start_mm",
+                    format!(
+                        "the table covers {} to {} mm, outside the legs' stroke {lo} to {hi} mm (limits.leg_stroke_mm)",
+                        t.start_mm,
+                        t.end_mm()
+                    ),
+                ));
+            }
+            if let Some((j, v)) = t
+                .extra_length_um
+                .iter()
+                .enumerate()
+                .find(|(_, v)| !(v.is_finite() && v.abs() <= MAX_TABLE_EXTRA_UM))
+            {
+                return Err(invalid(
+                    &format!("extra_length_um[{j}]"),
+                    format!("{v} um is not a leg error (finite, within {MAX_TABLE_EXTRA_UM} um)"),
+                ));
+            }
+            if let Some(j) = (1..n).find(|&j| {
+                (t.extra_length_um[j] - t.extra_length_um[j - 1]).abs() / t.step_mm
+                    > MAX_TABLE_SLOPE_UM_PER_MM
+            }) {
+                return Err(invalid(
+                    &format!("extra_length_um[{j}]"),
+                    format!(
+                        "changes by {} um over {} mm from the point before: steeper than {MAX_TABLE_SLOPE_UM_PER_MM} um/mm",
+                        t.extra_length_um[j] - t.extra_length_um[j - 1],
+                        t.step_mm
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
 }

@@ -46,7 +46,7 @@ impl EffectName {
                 value,
             ),
             Deployment::UpLimb | Deployment::Sensor => {}
-            Deployment::SetAside | Deployment::ReportOnly => return false,
+            Deployment::SetAside | Deployment::LegTable | Deployment::Recorded => return false,
         }
         true
     }

@@ -15,10 +15,12 @@
 //! | `reading-hysteresis` | reading offset by `h/2` in the direction the sensor moved | sensor reversal error |
 //!
 //! Each family's [`GenericSpec`] says what it acts on, what the campaign
-//! must log, its physical ranges and known aliases, and where it would be
-//! deployed. The leg families that are functions of the leg command alone
-//! ([`GenericFamily::leg_command_entries`]: periodic and polynomial) are
-//! what a per-leg compensation table could carry.
+//! must log, its physical ranges and known aliases, and where it is
+//! deployed: the leg families that are functions of the leg command alone
+//! ([`GenericFamily::leg_command_entries`]: periodic and polynomial) as
+//! per-leg compensation tables, the reading families as sensor
+//! corrections (recorded, they do not move the platform), the legs'
+//! drift over time recorded with the campaign's middle, not applied.
 
 use serde::{Deserialize, Serialize};
 
@@ -66,7 +68,7 @@ pub struct GenericSpec {
     pub ranges: &'static [(Option<usize>, PlausibleRange)],
     /// Causes it is known to be confused with.
     pub aliases: &'static [KnownAlias],
-    /// Where a fitted term would go in a machine file.
+    /// Where a fitted term goes in a machine file.
     pub deployment: Deployment,
 }
 
@@ -118,7 +120,13 @@ impl GenericFamily {
                 needs,
                 ranges,
                 aliases: &[],
-                deployment: Deployment::ReportOnly,
+                deployment: if !acts_on_legs {
+                    Deployment::Sensor
+                } else if matches!(needs, Needs::PoseOrder) {
+                    Deployment::Recorded
+                } else {
+                    Deployment::LegTable
+                },
             }
         }
         const LEG_PERIODIC: GenericSpec = spec(

@@ -214,10 +214,15 @@ pub enum Deployment {
     Sensor,
     /// Rows set aside, not a parameter of a machine.
     SetAside,
-    /// Not part of a machine file: the report says what to look for. (The
-    /// generic terms of the dictionary today; a per-leg compensation table
-    /// or a sensor correction would be their deployment.)
-    ReportOnly,
+    /// A leg error that is a function of the leg command (the generic
+    /// periodic and polynomial leg terms): tabulated per leg in the
+    /// machine's compensation tables (`leg_effects.tables`), applied by
+    /// `ik`, `fk`, `tool-ik` and `compensate`.
+    LegTable,
+    /// A time term (legs drifting over the campaign): recorded under
+    /// `calibration.effects` with the state it describes (the geometry is
+    /// the machine's at the campaign's middle), not applied.
+    Recorded,
 }
 
 impl Deployment {
@@ -231,7 +236,12 @@ impl Deployment {
             Deployment::UpLimb => "the UP limb's description",
             Deployment::Sensor => "sensor side: recorded under calibration.effects",
             Deployment::SetAside => "set aside (not written)",
-            Deployment::ReportOnly => "reported only (not part of a machine file)",
+            Deployment::LegTable => {
+                "per-leg compensation tables (leg_effects.tables, applied by ik, fk, tool-ik and compensate)"
+            }
+            Deployment::Recorded => {
+                "a time term: recorded under calibration.effects with the campaign's middle, not applied"
+            }
         }
     }
 }
