@@ -12,9 +12,10 @@ use serde_json::{Map, Value, json};
 use tricept_ident::{CompensationTable, ExtendedMachine};
 use tricept_model::{ErrorMap, MapStats};
 
+use crate::args::FitSettings;
 use crate::args::{TruthArgs, load, parse_effects, parse_errors};
 use crate::cli_error::{CliError, EXIT_INADEQUATE, EXIT_NOT_CONVERGED};
-use crate::ident_cmd::{FitSettings, fit_from_file, rejected_json, report_exit};
+use crate::ident_cmd::{fit_from_file, rejected_json, report_exit};
 use crate::machine_file;
 
 /// The largest interpolation error (um) the default table spacing allows.

@@ -16,7 +16,7 @@ use tricept_model::ParameterSet;
 
 // The settings live in `args.rs`, below this verb and the fused path it
 // hands external measurements to (`fusion_cmd.rs`).
-pub use crate::args::{FitSettings, IdentifyArgs};
+use crate::args::{FitSettings, IdentifyArgs};
 use crate::args::{
     LoadedMachine, MachineArgs, NoiseArgs, ParamArgs, load_with_noise, machine_with_noise,
     pose_targets, read_data, spinner,
