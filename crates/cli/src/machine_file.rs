@@ -346,6 +346,7 @@ pub fn calibrated_description(
             })
             .collect::<Result<_, CliError>>()?,
         rejected_lines: p.rejected_lines,
+        leg_tables_digest: d.leg_effects.tables_digest(),
         data_file: data_name,
         data_sha256: sha256_file(p.data_file)?,
         date,

@@ -947,11 +947,21 @@ fn diagnose_says_in_its_exit_code_and_its_machine_file_what_it_deploys() {
         ]));
         [v["q1"].clone(), v["q2"].clone(), v["q3"].clone()]
     };
+    // (Without the tables and without the record's digest of them: a file
+    // as written before tables existed.)
     let mut plain = m.clone();
     plain["leg_effects"]
         .as_object_mut()
         .unwrap()
         .remove("tables");
+    assert!(
+        plain["calibration"]
+            .as_object_mut()
+            .unwrap()
+            .remove("leg_tables_digest")
+            .is_some(),
+        "the record keeps a digest of the tables"
+    );
     std::fs::write(dir.join("plain.json"), plain.to_string()).unwrap();
     let (with, without) = (ik(&file("p.json")), ik(&file("plain.json")));
     let moved = (0..3)
@@ -981,6 +991,28 @@ fn diagnose_says_in_its_exit_code_and_its_machine_file_what_it_deploys() {
         err.contains("bad.json") && err.contains("leg_effects.tables[1].step_mm"),
         "{err}"
     );
+    // A table edited after the calibration, or removed while the record
+    // still has it: the file does not match its record (exit 2).
+    let mut edited = m.clone();
+    let value = edited["leg_effects"]["tables"][0]["extra_length_um"][5]
+        .as_f64()
+        .unwrap();
+    edited["leg_effects"]["tables"][0]["extra_length_um"][5] = (value + 1.0).into();
+    let mut removed = m.clone();
+    removed["leg_effects"]
+        .as_object_mut()
+        .unwrap()
+        .remove("tables");
+    for (name, d) in [("edited.json", edited), ("removed.json", removed)] {
+        std::fs::write(dir.join(name), d.to_string()).unwrap();
+        let out = run(&["ik", "0", "0", "750", "--machine", &file(name)]);
+        assert_eq!(out.status.code(), Some(2), "{name}: {}", text(&out));
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(
+            err.contains(name) && err.contains("leg_effects.tables differ"),
+            "{err}"
+        );
+    }
     // A file written before the tables loads as it did.
     std::fs::write(dir.join("old.json"), plain.to_string()).unwrap();
     let out = run(&["fk", "800", "800", "800", "--machine", &file("old.json")]);

@@ -77,7 +77,7 @@ pub enum RecordError {
 ///     effects: Default::default(),
 ///     sensor_offsets: SensorOffsetsDescription { phi_rad: 0.0, theta_rad: 0.0, s_mm: 0.0, std_dev: [0.0; 3] },
 ///     applies: vec![], records: vec![], held: vec![], chi2_per_dof: 1.0, dof: 1, converged: true, adequate: true, forced: false,
-///     warnings: vec![], poses_used: 75, temperature_c: None, rejected_lines: vec![], external_sources: vec![],
+///     warnings: vec![], poses_used: 75, temperature_c: None, rejected_lines: vec![], leg_tables_digest: None, external_sources: vec![],
 ///     data_file: "d.csv".into(), data_sha256: String::new(), date: String::new(),
 ///     tool_version: String::new(), relative_to: m.name.clone(), relative_to_machine: None,
 ///     nominal,
@@ -152,7 +152,22 @@ pub fn check_calibration_record(d: &MachineDescription) -> Result<(), RecordErro
             }
         }
     }
-    let fields = differences(&file, &rebuilt, c);
+    let mut fields = differences(&file, &rebuilt, c);
+    // The compensation tables are checked against the digest the record
+    // kept of them (a record without one: the base machine's tables).
+    let recorded = match &c.leg_tables_digest {
+        Some(digest) => Some(digest.clone()),
+        None => base_description(c).leg_effects.tables_digest(),
+    };
+    let in_file = d.leg_effects.tables_digest();
+    if in_file != recorded {
+        let shown = |x: &Option<String>| x.clone().unwrap_or_else(|| "no tables".into());
+        fields.push(format!(
+            "leg_effects.tables differ from the tables the record was written with (digest {} in the file, {} in the record)",
+            shown(&in_file),
+            shown(&recorded)
+        ));
+    }
     if fields.is_empty() {
         Ok(())
     } else {
@@ -160,6 +175,14 @@ pub fn check_calibration_record(d: &MachineDescription) -> Result<(), RecordErro
             base: base_field,
             fields,
         })
+    }
+}
+
+/// The description the record's estimates are relative to.
+fn base_description(c: &CalibrationRecord) -> &MachineDescription {
+    match &c.relative_to_machine {
+        Some(b) => b,
+        None => &c.nominal,
     }
 }
 

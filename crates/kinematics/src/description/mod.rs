@@ -168,6 +168,11 @@ pub struct CalibrationRecord {
     /// Lines of the data file rejected as gross errors.
     #[serde(default)]
     pub rejected_lines: Vec<u64>,
+    /// [`LegEffectsDescription::tables_digest`] of the file's compensation
+    /// tables as written (absent: the file has none, or it was written
+    /// before tables existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub leg_tables_digest: Option<String>,
     /// External measurements fused with the UP limb's data (tracker,
     /// ballbar, touch-off files), when there were any.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -428,6 +433,7 @@ mod tests {
             warnings: Vec::new(),
             poses_used: 75,
             rejected_lines: Vec::new(),
+            leg_tables_digest: None,
             external_sources: Vec::new(),
             data_file: "data.csv".into(),
             data_sha256: "0".repeat(64),

@@ -66,6 +66,56 @@ impl LegEffectsDescription {
         }
         out
     }
+
+    /// A digest of the tables as written (64-bit FNV-1a over every field
+    /// that is applied: leg, start and step to 1e-9 mm, the values to
+    /// 1e-6 um, the interpolation), in hex; `None` without tables. A calibration record
+    /// keeps it, so that a table edited after the calibration is seen when
+    /// the file is loaded.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_kinematics::description::{LegEffectsDescription, LegTableDescription};
+    /// let mut e = LegEffectsDescription {
+    ///     tables: vec![LegTableDescription::new(1, 600.0, 10.0, vec![0.0, 4.0, 2.0])],
+    ///     ..Default::default()
+    /// };
+    /// let written = e.tables_digest();
+    /// assert!(written.is_some());
+    /// e.tables[0].extra_length_um[1] = 4.5;
+    /// assert_ne!(e.tables_digest(), written);
+    /// assert_eq!(LegEffectsDescription::default().tables_digest(), None);
+    /// ```
+    pub fn tables_digest(&self) -> Option<String> {
+        if self.tables.is_empty() {
+            return None;
+        }
+        const OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+        const PRIME: u64 = 0x0000_0100_0000_01b3;
+        let mut hash = OFFSET;
+        let mut eat = |word: u64| {
+            for byte in word.to_le_bytes() {
+                hash = (hash ^ u64::from(byte)).wrapping_mul(PRIME);
+            }
+        };
+        // Quantised (1e-9 mm, 1e-6 um: far below any machine's resolution)
+        // so that a JSON round trip, whose parser may move a number by one
+        // unit in its last place, keeps the digest.
+        let quantised = |x: f64, unit: f64| (x / unit).round() as i64 as u64;
+        for t in &self.tables {
+            eat(u64::from(t.leg));
+            eat(quantised(t.start_mm, 1e-9));
+            eat(quantised(t.step_mm, 1e-9));
+            eat(t.extra_length_um.len() as u64);
+            t.extra_length_um
+                .iter()
+                .for_each(|&v| eat(quantised(v, 1e-6)));
+            eat(match t.interpolation {
+                Interpolation::Linear => 0,
+            });
+        }
+        Some(format!("{hash:016x}"))
+    }
 }
 
 /// How a compensation table is read between its points.
