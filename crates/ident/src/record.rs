@@ -110,11 +110,12 @@ pub fn check_calibration_record(d: &MachineDescription) -> Result<(), RecordErro
             c.parameter_set
         ))
     })?;
-    let (base_field, base) = match &c.relative_to_machine {
-        Some(b) => ("relative_to_machine", b.as_ref()),
-        None => ("nominal", c.nominal.as_ref()),
+    let base_field = if c.relative_to_machine.is_some() {
+        "relative_to_machine"
+    } else {
+        "nominal"
     };
-    let base = base
+    let base = base_description(c)
         .build()
         .map_err(|e| unreadable(format!("`calibration.{base_field}`: {e}")))?;
     let file = d

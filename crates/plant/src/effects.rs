@@ -564,6 +564,18 @@ impl Effect {
     /// assert_eq!(keys[0].unit, "N/um");
     /// ```
     pub fn keys(&self) -> &'static [EffectKey] {
+        // The keys of the two curved-leg shapes.
+        const UM_AT_HALF_WIDTH: EffectKey = key!(
+            "um",
+            "um",
+            "error of each leg [3] at half_width_mm from the centre"
+        );
+        const CENTRE: EffectKey = key!("centre_mm", "mm", "leg length of zero error (default 845)");
+        const HALF_WIDTH: EffectKey = key!(
+            "half_width_mm",
+            "mm",
+            "distance from the centre at which the error is `um` (default 250)"
+        );
         match self {
             Effect::LegLead { .. } => &[key!(
                 "ppm",
@@ -626,36 +638,16 @@ impl Effect {
                     "`sine` (default) or `sawtooth` (outside the dictionary)"
                 ),
             ],
-            Effect::LegQuadratic { .. } => &[
-                key!(
-                    "um",
-                    "um",
-                    "error of each leg [3] at half_width_mm from the centre"
-                ),
-                key!("centre_mm", "mm", "leg length of zero error (default 845)"),
-                key!(
-                    "half_width_mm",
-                    "mm",
-                    "distance from the centre at which the error is `um` (default 250)"
-                ),
-            ],
+            Effect::LegQuadratic { .. } => &[UM_AT_HALF_WIDTH, CENTRE, HALF_WIDTH],
             Effect::LegPower { .. } => &[
-                key!(
-                    "um",
-                    "um",
-                    "error of each leg [3] at half_width_mm from the centre"
-                ),
+                UM_AT_HALF_WIDTH,
                 key!(
                     "exponent",
                     "-",
                     "exponent of |x| (outside the dictionary unless 2)"
                 ),
-                key!("centre_mm", "mm", "leg length of zero error (default 845)"),
-                key!(
-                    "half_width_mm",
-                    "mm",
-                    "distance from the centre at which the error is `um` (default 250)"
-                ),
+                CENTRE,
+                HALF_WIDTH,
             ],
             Effect::LegStep { .. } => &[
                 key!(
