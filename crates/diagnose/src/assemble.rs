@@ -13,7 +13,7 @@ use crate::alias::{Aliases, analyse};
 use crate::describe::describe;
 use crate::dictionary::Scored;
 use crate::error::DiagnoseError;
-use crate::fit::{Fit, estimates, residuals_of};
+use crate::fit::{Fit, estimates, residuals_of, without};
 use crate::gain::{improvement, volumetric_difference};
 use crate::noise::{Repeats, noise_check};
 use crate::report::{
@@ -44,8 +44,8 @@ pub(crate) fn report(
     let fitter = &setup.fitter;
     let Outcome { flagged, selection } = outcome;
     let outliers = !flagged.is_empty();
-    let is_clean = |j: usize| !flagged.contains(&j);
-    let clean = data.subset(is_clean);
+    let is_clean = without(data.poses.len(), &flagged);
+    let clean = data.subset(&is_clean);
     let Selection {
         terms,
         evidences,

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_ident::{
     GeometricModel, IdentError, Identification, IdentifyOptions, ReadingModel, identify,
-    residuals_at, screen_gross_errors,
+    residuals_at, screen_gross_errors, screen_gross_errors_with_fit,
 };
 
 use tricept_model::effects::Needs;
@@ -58,6 +58,13 @@ impl Fitter<'_> {
     /// geometric errors exceed `max_error_mm`, is not a fit.
     pub(crate) fn fit(&self, model: ExtendedModel, data: &Dataset) -> Result<Fit, FitError> {
         let id = identify(&model, data, &self.identify_options()).map_err(FitError::Ident)?;
+        self.checked(model, id)
+    }
+
+    /// `id`, an identification of `model`, as a fit: one that did not
+    /// converge, or whose geometric errors exceed `max_error_mm`, is not a
+    /// fit.
+    fn checked(&self, model: ExtendedModel, id: Identification) -> Result<Fit, FitError> {
         let g = model.n_geometric();
         let largest = id.estimate[..g].iter().fold(0.0f64, |a, v| a.max(v.abs()));
         if !id.converged
@@ -173,6 +180,25 @@ impl Fitter<'_> {
         .map(|r| r.pose)
         .collect())
     }
+
+    /// [`Fitter::screen_outliers`] with the screen's fit of `model` to the
+    /// poses it keeps, when it made one: the same as [`Fitter::fit`] on
+    /// them (or its error), which the selection need not repeat.
+    pub(crate) fn screen_outliers_with_fit(
+        &self,
+        model: &ExtendedModel,
+        data: &Dataset,
+    ) -> Result<(Vec<usize>, Option<Result<Fit, FitError>>), IdentError> {
+        let (rejected, id) = screen_gross_errors_with_fit(
+            model,
+            data,
+            &self.identify_options(),
+            self.options.alpha,
+            self.options.max_outlier_share,
+        )?;
+        let flagged = rejected.into_iter().map(|r| r.pose).collect();
+        Ok((flagged, id.map(|id| self.checked(model.clone(), id))))
+    }
 }
 
 /// Why a model could not be fitted.
@@ -198,6 +224,17 @@ impl From<FitError> for DiagnoseError {
             },
         }
     }
+}
+
+/// Whether pose `j` of `n` is not among `flagged`.
+pub(crate) fn without(n: usize, flagged: &[usize]) -> impl Fn(usize) -> bool + use<> {
+    let mut keep = vec![true; n];
+    for &j in flagged {
+        if let Some(k) = keep.get_mut(j) {
+            *k = false;
+        }
+    }
+    move |j| keep.get(j).copied().unwrap_or(false)
 }
 
 /// Values and covariance of `term`'s parameters in `fit`.

@@ -33,7 +33,7 @@ use crate::dictionary::Dictionary;
 use crate::error::DiagnoseError;
 use crate::evidence::Reference;
 use crate::finite::first_non_finite;
-use crate::fit::{Fitter, residuals_of};
+use crate::fit::{Fitter, residuals_of, without};
 use crate::noise::{pure_error, repeats};
 use crate::options::{DiagnoseOptions, MIN_PURE_ERROR_DOF};
 use crate::report::Diagnosis;
@@ -197,13 +197,22 @@ fn numbered(data: &Dataset, limitations: &mut Vec<String>) -> Dataset {
 fn run(setup: &Setup<'_>, data: &Dataset) -> Result<Outcome, DiagnoseError> {
     let fitter = &setup.fitter;
     let base = fitter.base_model();
-    let mut flagged = fitter.screen_outliers(&base, data)?;
+    // The screen's fit of the geometric model to the poses it keeps is the
+    // selection's geometric fit on the first round.
+    let (geometric_flagged, mut geo) = fitter.screen_outliers_with_fit(&base, data)?;
+    let mut flagged = geometric_flagged.clone();
     let mut rounds = 0;
     loop {
         rounds += 1;
-        let clean = data.subset(|j| !flagged.contains(&j));
-        let selection = select(setup, &clean)?;
-        let again = fitter.screen_outliers(&selection.current.model, data)?;
+        let clean = data.subset(without(data.poses.len(), &flagged));
+        let selection = select(setup, &clean, geo.take())?;
+        // A selection that named nothing ends on the geometric model, whose
+        // screen of these data is the first one.
+        let again = if selection.current.model.terms().is_empty() {
+            geometric_flagged.clone()
+        } else {
+            fitter.screen_outliers(&selection.current.model, data)?
+        };
         if again == flagged || rounds == 3 {
             return Ok(Outcome { flagged, selection });
         }

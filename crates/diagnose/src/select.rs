@@ -38,7 +38,7 @@ use tricept_model::effects::EffectName;
 
 use crate::dictionary::{At, Dictionary, Scored};
 use crate::error::DiagnoseError;
-use crate::fit::{Fit, Fitter, term_estimates};
+use crate::fit::{Fit, FitError, Fitter, term_estimates};
 use crate::linear::Linearisation;
 use crate::plausibility::Plausibility;
 use crate::report::{Estimate, Evidence, RejectStage, Rejected, Tested};
@@ -442,8 +442,17 @@ fn final_tests(
 
 /// Forward selection, swaps and admission on the final model (see the
 /// module docs).
-pub(crate) fn select(setup: &Setup<'_>, clean: &Dataset) -> Result<Selection, DiagnoseError> {
-    let geo = setup.fitter.fit(setup.fitter.base_model(), clean)?;
+/// `geo` is the geometric model's fit to `clean` when the caller has made
+/// it already.
+pub(crate) fn select(
+    setup: &Setup<'_>,
+    clean: &Dataset,
+    geo: Option<Result<Fit, FitError>>,
+) -> Result<Selection, DiagnoseError> {
+    let geo = match geo {
+        Some(fit) => fit?,
+        None => setup.fitter.fit(setup.fitter.base_model(), clean)?,
+    };
     if geo.id.stats.dof == 0 {
         return Err(DiagnoseError::Degenerate(
             "as many unknowns as readings: no degree of freedom is left to test the model".into(),

@@ -90,7 +90,9 @@ pub use model::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel,
 pub use options::IdentifyOptions;
 pub use record::{RECORD_METHODS, RecordError, check_calibration_record};
 pub use report::{Combination, CorrelatedPair, IdentifiabilityReport, NamedValues, Observability};
-pub use robust::{Rejection, identify_robust, residuals_at, screen_gross_errors};
+pub use robust::{
+    Rejection, identify_robust, residuals_at, screen_gross_errors, screen_gross_errors_with_fit,
+};
 pub use suspects::{LikelyCause, likely_causes};
 pub use table::{CompensationTable, MAX_TABLE_NODES, SPACING_LADDER_MM};
 pub use verdict::{

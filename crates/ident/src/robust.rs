@@ -165,6 +165,38 @@ pub fn screen_gross_errors(
     Ok(screen(model, data, options, alpha, max_share)?.0)
 }
 
+/// [`screen_gross_errors`] with the screen's last fit when it was made on
+/// exactly the poses kept: the same [`Identification`] as [`identify`] on
+/// them, bit for bit, which a caller need not repeat. `None` when the
+/// share cap cleared the rejections (the last fit was of fewer poses).
+///
+/// # Example
+/// ```
+/// use tricept_ident::{GeometricModel, IdentifyOptions, identify, screen_gross_errors_with_fit};
+/// use tricept_kinematics::Machine;
+/// use tricept_model::ParameterSet;
+/// let m = Machine::paper();
+/// let set = ParameterSet::paper15();
+/// let model = GeometricModel::new(m.clone(), set.clone());
+/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
+///     .unwrap();
+/// let options = IdentifyOptions::for_machine(&m);
+/// let (rejected, fit) = screen_gross_errors_with_fit(&model, &data, &options, 1e-3, 0.1).unwrap();
+/// assert!(rejected.is_empty());
+/// let direct = identify(&model, &data, &options).unwrap();
+/// assert_eq!(fit.unwrap().estimate, direct.estimate);
+/// ```
+pub fn screen_gross_errors_with_fit(
+    model: &dyn ReadingModel,
+    data: &Dataset,
+    options: &IdentifyOptions,
+    alpha: f64,
+    max_share: f64,
+) -> Result<(Vec<Rejection>, Option<Identification>), IdentError> {
+    screen(model, data, options, alpha, max_share)
+}
+
 /// [`screen_gross_errors`], with the screen's last fit when it was made on
 /// exactly the poses kept (the identification [`identify_robust`] would
 /// otherwise repeat).
