@@ -188,7 +188,7 @@ impl Fitter<'_> {
         &self,
         model: &ExtendedModel,
         data: &Dataset,
-    ) -> Result<(Vec<usize>, Option<Result<Fit, FitError>>), IdentError> {
+    ) -> Result<(Vec<usize>, Option<FitResult>), IdentError> {
         let (rejected, id) = screen_gross_errors_with_fit(
             model,
             data,
@@ -200,6 +200,9 @@ impl Fitter<'_> {
         Ok((flagged, id.map(|id| self.checked(model.clone(), id))))
     }
 }
+
+/// A fit, or why the model could not be fitted.
+pub(crate) type FitResult = Result<Fit, FitError>;
 
 /// Why a model could not be fitted.
 #[derive(Debug)]

@@ -2,26 +2,36 @@
 //! still explain, without refitting.
 //!
 //! With `X` the weighted design of the fit (the three sensor offsets and
-//! the identifiable parameters, `3n` rows in noise units), `Q` an
-//! orthonormal basis of it and `t` a target (the weighted residuals, or a
-//! fitted term's signature), the columns `G` of a candidate term explain
+//! the identifiable parameters, `3n` rows in noise units), `X = Q R` its
+//! thin QR and `t` a target (the weighted residuals, or a fitted term's
+//! signature), the columns `G` of a candidate term explain
 //!
 //! ```text
 //! S(G) = v^T M^+ v,   M = G^T G - (Q^T G)^T (Q^T G),   v = G^T t - (Q^T G)^T (Q^T t)
 //! ```
 //!
 //! of `|t|^2`: the Rao score statistic, the linearised drop of chi-square
-//! (its degrees of freedom the numerical rank of `M`). Generic terms are
-//! combinations of six per-pose directions (the three legs through
-//! `W J1^-1 e_i`, the three readings through `e_c / sigma_c`) times scalar
-//! functions of the pose, so every product above reduces to sums over poses
-//! of precomputed 3-vectors: a period of the ball-screw scan costs a few
-//! hundred flops per pose.
+//! (its degrees of freedom the numerical rank of `M`). `Q` is never formed:
+//! `Q^T G = R^-T (X^T G)`, with `R` folded from the design's rows a block
+//! at a time (TSQR) and `X^T G` a sum over poses. What is kept per pose is
+//! the design's three rows (`3 p` numbers), the six weighted directions and
+//! the target; every product above is accumulated over blocks of poses,
+//! in parallel and summed in block order (the same bits at any thread
+//! count). Generic terms are combinations of six per-pose directions (the
+//! three legs through `W J1^-1 e_i`, the three readings through
+//! `e_c / sigma_c`) times scalar functions of the pose, so every product
+//! reduces to sums over poses of the directions' projections `X_j^T d`,
+//! computed for a block of poses at a time ([`Linearisation::projections`]):
+//! a period of the ball-screw scan costs a few hundred flops per pose.
+
+use std::ops::Range;
 
 use nalgebra::{DMatrix, DVector, Matrix3};
+use rayon::prelude::*;
 use tricept_data::Dataset;
 use tricept_ident::ReadingModel;
 use tricept_kinematics::UpJoints;
+use tricept_numerics::linalg::TriangularAccumulator;
 
 use tricept_model::effects::Basis;
 
@@ -33,8 +43,11 @@ use crate::terms::{Frame, GenericTerm, Term};
 /// direction the fitted model already absorbs.
 const ABSORBED: f64 = 1e-10;
 
-/// Poses per block of [`Linearisation::periodic_scan`].
-const SCAN_BLOCK: usize = 256;
+/// Poses per block of the sums over poses (and of the period scan).
+const BLOCK: usize = 256;
+
+/// Poses per block of the linearisation's evaluation and of its `R`.
+const EVALUATION_BLOCK: usize = 4096;
 
 /// Frequencies between exact evaluations of the scan's sines and cosines
 /// (in between, a rotation: its rounding grows by about one unit in the
@@ -44,25 +57,43 @@ const SCAN_RESEED: usize = 32;
 /// Blocks of the scan summed at a time.
 const SCAN_PARALLEL_BLOCKS: usize = 16;
 
-/// The products of one frequency of the scan, accumulated over poses:
-/// `Q^T G` (`p x k`, column-major), the upper triangle of `G^T G` (row-major)
-/// and `G^T t`.
-struct PeriodicSums {
-    qtg: Vec<f64>,
+/// Sums over poses of the products a score needs, for `k` columns and `p`
+/// basis columns: `X^T G` (`p x k`, column-major), the upper triangle of
+/// `G^T G` (row-major) and `G^T t`.
+struct Sums {
+    xtg: Vec<f64>,
     gtg: Vec<f64>,
     gtt: Vec<f64>,
 }
 
-impl PeriodicSums {
-    fn add(&mut self, other: &PeriodicSums) {
+impl Sums {
+    fn zero(p: usize, k: usize) -> Sums {
+        Sums {
+            xtg: vec![0.0; p * k],
+            gtg: vec![0.0; k * k],
+            gtt: vec![0.0; k],
+        }
+    }
+
+    fn add(&mut self, other: &Sums) {
         for (a, b) in [
-            (&mut self.qtg, &other.qtg),
+            (&mut self.xtg, &other.xtg),
             (&mut self.gtg, &other.gtg),
             (&mut self.gtt, &other.gtt),
         ] {
             a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
         }
     }
+}
+
+/// The projections of the six directions of a block of poses on the
+/// basis columns: `of[b]` holds `X_j^T d_jb`, `p x len` with the poses of a
+/// basis column contiguous (empty for a direction not asked for).
+pub(crate) struct Projections {
+    /// Poses in the block.
+    pub(crate) len: usize,
+    /// Per direction, `p x len`, row-major.
+    pub(crate) of: [Vec<f64>; 6],
 }
 
 /// How much a term explains of a target.
@@ -78,6 +109,17 @@ pub(crate) struct Score {
     pub(crate) covariance: DMatrix<f64>,
 }
 
+impl Score {
+    fn none(k: usize) -> Score {
+        Score {
+            explained: 0.0,
+            rank: 0,
+            coefficients: DVector::zeros(k),
+            covariance: DMatrix::zeros(k, k),
+        }
+    }
+}
+
 /// The score from the three products (see the module docs).
 pub(crate) fn score_from(
     qtg: &DMatrix<f64>,
@@ -89,12 +131,7 @@ pub(crate) fn score_from(
     let m = gtg - qtg.transpose() * qtg;
     let v = gtt - qtg.transpose() * qtt;
     let scale = (0..k).map(|i| gtg[(i, i)]).fold(0.0, f64::max);
-    let mut out = Score {
-        explained: 0.0,
-        rank: 0,
-        coefficients: DVector::zeros(k),
-        covariance: DMatrix::zeros(k, k),
-    };
+    let mut out = Score::none(k);
     if !(scale > 0.0 && scale.is_finite()) {
         return out;
     }
@@ -116,24 +153,23 @@ pub(crate) fn score_from(
 /// The linearisation of a fit on its poses.
 #[derive(Debug, Clone)]
 pub(crate) struct Linearisation {
-    /// Weighted design `[offsets | identifiable parameters]`, `3n x p`.
-    pub(crate) x: DMatrix<f64>,
-    /// Model parameter index of each column of `x` after the three offsets.
+    /// Weighted design `[offsets | identifiable parameters]`, `3n x width`,
+    /// row after row (a pose's three rows together).
+    rows: Vec<f64>,
+    /// Columns of the design.
+    width: usize,
+    /// Model parameter index of each design column after the three offsets.
     pub(crate) x_params: Vec<usize>,
-    /// Orthonormal basis of the columns of `x` kept (all, or all but a term's).
-    q: DMatrix<f64>,
+    /// The design columns of the fitted model (all, or all but a term's).
+    basis: Vec<usize>,
+    /// `R` of the basis columns (`X_B = Q R`, upper triangular).
+    r: DMatrix<f64>,
     /// The target: weighted residuals of the fit unless replaced.
     pub(crate) target: DVector<f64>,
     /// Solved UP joints of every pose at the estimate.
     pub(crate) ups: Vec<UpJoints>,
     /// Per pose, the six weighted directions: legs 1-3, readings phi, theta, s.
     directions: Vec<[[f64; 3]; 6]>,
-    /// Per direction, `Q_j^T d_j` for every pose (`p x n`).
-    projected: Vec<DMatrix<f64>>,
-    /// Per pose, the Gram matrix of the six directions.
-    gram: Vec<[[f64; 6]; 6]>,
-    /// Per pose, the directions' products with the target.
-    target_products: Vec<[f64; 6]>,
     /// `Q^T t`.
     qtt: DVector<f64>,
     /// Weighted columns of extra terms at zero (`3n x m`).
@@ -147,6 +183,16 @@ fn basis_index(b: Basis) -> usize {
         Basis::Leg(i) => i,
         Basis::Reading(c) => 3 + c,
     }
+}
+
+/// One pose of the linearisation: its design rows, extra columns, target,
+/// UP joints and directions.
+struct PoseRows {
+    rows: Vec<f64>,
+    extra: Vec<f64>,
+    target: [f64; 3],
+    up: UpJoints,
+    directions: [[f64; 3]; 6],
 }
 
 impl Linearisation {
@@ -170,39 +216,72 @@ impl Linearisation {
         let machine = model.machine_at(&p);
         let identifiable = fit.id.design().identifiable().to_vec();
         let n = data.poses.len();
-        let cols = 3 + identifiable.len();
-        let mut x = DMatrix::zeros(3 * n, cols);
-        let mut ext = DMatrix::zeros(3 * n, kf - k);
+        let width = 3 + identifiable.len();
+        let m = kf - k;
+        let offsets = fit.id.offsets;
+        // Every pose on its own: blocks in parallel, in pose order.
+        let blocks: Vec<Option<Vec<PoseRows>>> = data
+            .poses
+            .par_chunks(EVALUATION_BLOCK)
+            .map(|poses| {
+                let mut jac = vec![0.0; 3 * kf];
+                poses
+                    .iter()
+                    .map(|pose| {
+                        let mut seed = None;
+                        let g = predictor.predict(pose, &mut seed, &mut jac).ok()?;
+                        let up = seed?;
+                        let legs = machine.legs_at(&up);
+                        let j1_inv: Matrix3<f64> = legs.j1().try_inverse()?;
+                        let y = pose.readings.to_array();
+                        let mut out = PoseRows {
+                            rows: vec![0.0; 3 * width],
+                            extra: vec![0.0; 3 * m],
+                            target: [0.0; 3],
+                            up,
+                            directions: [[0.0; 3]; 6],
+                        };
+                        for c in 0..3 {
+                            let w = 1.0 / sigma[c];
+                            let row = &mut out.rows[c * width..(c + 1) * width];
+                            row[c] = w;
+                            for (t, &gi) in identifiable.iter().enumerate() {
+                                row[3 + t] = w * jac[c * kf + gi];
+                            }
+                            for e in 0..m {
+                                out.extra[c * m + e] = w * jac[c * kf + k + e];
+                            }
+                            out.target[c] = w * (y[c] - g[c] - offsets[c]);
+                            for i in 0..3 {
+                                out.directions[i][c] = w * j1_inv[(c, i)];
+                            }
+                            out.directions[3 + c][c] = w;
+                        }
+                        Some(out)
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut rows = Vec::with_capacity(3 * n * width);
+        let mut ext = DMatrix::zeros(3 * n, m);
         let mut target = DVector::zeros(3 * n);
         let mut ups = Vec::with_capacity(n);
         let mut directions = Vec::with_capacity(n);
-        let mut jac = vec![0.0; 3 * kf];
-        for (j, pose) in data.poses.iter().enumerate() {
-            let mut seed = None;
-            let g = predictor.predict(pose, &mut seed, &mut jac).ok()?;
-            let up = seed?;
-            let legs = machine.legs_at(&up);
-            let j1_inv: Matrix3<f64> = legs.j1().try_inverse()?;
-            let y = pose.readings.to_array();
-            let mut dirs = [[0.0; 3]; 6];
+        for pose in blocks.into_iter().flat_map(|b| b.into_iter().flatten()) {
+            let j = ups.len();
             for c in 0..3 {
-                let w = 1.0 / sigma[c];
-                let row = 3 * j + c;
-                x[(row, c)] = w;
-                for (t, &gi) in identifiable.iter().enumerate() {
-                    x[(row, 3 + t)] = w * jac[c * kf + gi];
+                target[3 * j + c] = pose.target[c];
+                for e in 0..m {
+                    ext[(3 * j + c, e)] = pose.extra[c * m + e];
                 }
-                for e in 0..kf - k {
-                    ext[(row, e)] = w * jac[c * kf + k + e];
-                }
-                target[row] = w * (y[c] - g[c] - fit.id.offsets[c]);
-                for i in 0..3 {
-                    dirs[i][c] = w * j1_inv[(c, i)];
-                }
-                dirs[3 + c][c] = w;
             }
-            ups.push(up);
-            directions.push(dirs);
+            rows.extend_from_slice(&pose.rows);
+            ups.push(pose.up);
+            directions.push(pose.directions);
+        }
+        if ups.len() != n {
+            // A pose the model cannot solve at the estimate.
+            return None;
         }
         let mut at = 0;
         let extra_terms = extra
@@ -214,24 +293,20 @@ impl Linearisation {
                 (*t, r)
             })
             .collect();
-        let gram = grams(&directions);
         let mut lin = Linearisation {
-            q: DMatrix::zeros(0, 0),
-            x,
+            rows,
+            width,
             x_params: identifiable,
+            basis: Vec::new(),
+            r: DMatrix::zeros(0, 0),
             target,
             ups,
             directions,
-            projected: Vec::new(),
-            gram,
-            target_products: Vec::new(),
             qtt: DVector::zeros(0),
             extra: ext,
             extra_terms,
         };
         lin.set_basis(&[]);
-        let t = lin.target.clone();
-        lin.set_target(t);
         Some(lin)
     }
 
@@ -240,64 +315,183 @@ impl Linearisation {
         self.directions.len()
     }
 
-    /// Uses the columns of `x` except those of the model parameters `drop`
-    /// as the fitted model.
+    /// Design row `i` (of `3n`).
+    fn row(&self, i: usize) -> &[f64] {
+        &self.rows[i * self.width..(i + 1) * self.width]
+    }
+
+    /// Uses the columns of the design except those of the model parameters
+    /// `drop` as the fitted model.
     pub(crate) fn set_basis(&mut self, drop: &[usize]) {
-        let keep: Vec<usize> = (0..self.x.ncols())
+        self.basis = (0..self.width)
             .filter(|&c| c < 3 || !drop.contains(&self.x_params[c - 3]))
             .collect();
-        let xk = self.x.select_columns(&keep);
-        self.q = orthonormal_basis(&xk);
-        let p = self.q.ncols();
-        let n = self.poses();
-        self.projected = (0..6)
-            .map(|b| {
-                let mut m = DMatrix::zeros(p, n);
-                for j in 0..n {
-                    for c in 0..3 {
-                        let d = self.directions[j][b][c];
-                        if d != 0.0 {
-                            for r in 0..p {
-                                m[(r, j)] += self.q[(3 * j + c, r)] * d;
-                            }
-                        }
+        let p = self.basis.len();
+        let rows = 3 * self.poses();
+        // TSQR over blocks of rows in parallel, merged in block order.
+        let factors: Vec<faer::Mat<f64>> = (0..rows)
+            .step_by(3 * EVALUATION_BLOCK)
+            .collect::<Vec<_>>()
+            .par_iter()
+            .map(|&first| {
+                let end = (first + 3 * EVALUATION_BLOCK).min(rows);
+                let mut acc = TriangularAccumulator::with_rows_hint(p, end - first);
+                let mut gathered = vec![0.0; p];
+                for i in first..end {
+                    let row = self.row(i);
+                    for (g, &c) in gathered.iter_mut().zip(&self.basis) {
+                        *g = row[c];
                     }
+                    acc.push_row(&gathered);
                 }
-                m
+                acc.finish()
             })
             .collect();
+        let r = match factors.as_slice() {
+            [one] => one.clone(),
+            _ => {
+                let mut acc = TriangularAccumulator::with_rows_hint(p, p * factors.len());
+                let mut row = vec![0.0; p];
+                for f in &factors {
+                    for i in 0..f.nrows() {
+                        row.iter_mut().enumerate().for_each(|(j, v)| *v = f[(i, j)]);
+                        acc.push_row(&row);
+                    }
+                }
+                acc.finish()
+            }
+        };
+        self.r = DMatrix::from_fn(p, p, |i, j| if i <= j { r[(i, j)] } else { 0.0 });
         let t = self.target.clone();
         self.set_target(t);
     }
 
     /// Replaces the target.
     pub(crate) fn set_target(&mut self, target: DVector<f64>) {
-        self.qtt = self.q.transpose() * &target;
-        self.target_products = self
-            .directions
-            .iter()
-            .enumerate()
-            .map(|(j, d)| {
-                std::array::from_fn(|b| (0..3).map(|c| d[b][c] * target[3 * j + c]).sum())
-            })
-            .collect();
+        let g = DMatrix::from_column_slice(target.len(), 1, target.as_slice());
+        let q = self.qt(&self.xt_dense(&g));
+        self.qtt = q.column(0).into_owned();
         self.target = target;
     }
 
-    /// Columns of `x` for the model parameters `params`, projected onto the
-    /// complement of the current basis (the part the rest cannot absorb).
+    /// `Q^T G` from `X_B^T G` (`R^-T` applied; zero when `R` is singular).
+    fn qt(&self, xtg: &DMatrix<f64>) -> DMatrix<f64> {
+        self.r
+            .tr_solve_upper_triangular(xtg)
+            .unwrap_or_else(|| DMatrix::zeros(xtg.nrows(), xtg.ncols()))
+    }
+
+    /// `X_B^T g` of dense columns (`3n x k`), summed over blocks of rows in
+    /// block order.
+    fn xt_dense(&self, g: &DMatrix<f64>) -> DMatrix<f64> {
+        let p = self.basis.len();
+        let k = g.ncols();
+        let rows = g.nrows().min(3 * self.poses());
+        let starts: Vec<usize> = (0..rows).step_by(3 * BLOCK).collect();
+        let partial: Vec<Vec<f64>> = starts
+            .par_iter()
+            .map(|&first| {
+                let mut sum = vec![0.0; p * k];
+                for i in first..(first + 3 * BLOCK).min(rows) {
+                    let row = self.row(i);
+                    for a in 0..k {
+                        let v = g[(i, a)];
+                        if v != 0.0 {
+                            let out = &mut sum[a * p..(a + 1) * p];
+                            for (o, &c) in out.iter_mut().zip(&self.basis) {
+                                *o += row[c] * v;
+                            }
+                        }
+                    }
+                }
+                sum
+            })
+            .collect();
+        let mut total = vec![0.0; p * k];
+        for part in partial {
+            total.iter_mut().zip(&part).for_each(|(t, v)| *t += v);
+        }
+        DMatrix::from_vec(p, k, total)
+    }
+
+    /// `X_B y` for a `p x k` coefficient matrix (`3n x k`).
+    fn x_times(&self, y: &DMatrix<f64>) -> DMatrix<f64> {
+        let rows = 3 * self.poses();
+        DMatrix::from_fn(rows, y.ncols(), |i, a| {
+            let row = self.row(i);
+            self.basis
+                .iter()
+                .enumerate()
+                .map(|(r, &c)| row[c] * y[(r, a)])
+                .sum()
+        })
+    }
+
+    /// Columns of the design for the model parameters `params`, projected
+    /// onto the complement of the current basis (the part the rest cannot
+    /// absorb).
     pub(crate) fn projected_columns(&self, params: &[usize]) -> DMatrix<f64> {
         let cols: Vec<usize> = (0..self.x_params.len())
             .filter(|&c| params.contains(&self.x_params[c]))
             .map(|c| c + 3)
             .collect();
-        let g = self.x.select_columns(&cols);
-        &g - &self.q * (self.q.transpose() * &g)
+        let g = DMatrix::from_fn(3 * self.poses(), cols.len(), |i, a| self.row(i)[cols[a]]);
+        self.project(&g)
     }
 
     /// Projects dense columns onto the complement of the basis.
     pub(crate) fn project(&self, g: &DMatrix<f64>) -> DMatrix<f64> {
-        g - &self.q * (self.q.transpose() * g)
+        let qtg = self.qt(&self.xt_dense(g));
+        let y = self
+            .r
+            .solve_upper_triangular(&qtg)
+            .unwrap_or_else(|| DMatrix::zeros(qtg.nrows(), qtg.ncols()));
+        g - self.x_times(&y)
+    }
+
+    /// The projections `X_j^T d_jb` of the directions `wanted` for the
+    /// poses `range` (see [`Projections`]).
+    pub(crate) fn projections(&self, range: Range<usize>, wanted: &[bool; 6]) -> Projections {
+        let p = self.basis.len();
+        let len = range.len();
+        let mut of: [Vec<f64>; 6] = std::array::from_fn(|b| {
+            if wanted[b] {
+                vec![0.0; p * len]
+            } else {
+                Vec::new()
+            }
+        });
+        for (t, j) in range.enumerate() {
+            let d = &self.directions[j];
+            for c in 0..3 {
+                let row = self.row(3 * j + c);
+                for b in 0..6 {
+                    let w = d[b][c];
+                    if !wanted[b] || w == 0.0 {
+                        continue;
+                    }
+                    let out = &mut of[b];
+                    for (r, &col) in self.basis.iter().enumerate() {
+                        out[r * len + t] += row[col] * w;
+                    }
+                }
+            }
+        }
+        Projections { len, of }
+    }
+
+    /// `d_ja . d_jb` at pose `j`.
+    fn gram(&self, j: usize, a: usize, b: usize) -> f64 {
+        let d = &self.directions[j];
+        dot3(&d[a], &d[b])
+    }
+
+    /// `d_jb . t_j` at pose `j`.
+    fn target_product(&self, j: usize, b: usize) -> f64 {
+        let t = &self.target.as_slice()[3 * j..3 * j + 3];
+        self.directions[j][b][0] * t[0]
+            + self.directions[j][b][1] * t[1]
+            + self.directions[j][b][2] * t[2]
     }
 
     /// Per-pose values of every parameter of a generic term, with its
@@ -334,28 +528,58 @@ impl Linearisation {
     /// The score of columns given as (direction, per-pose value).
     pub(crate) fn score_columns(&self, cols: &[(usize, Vec<f64>)]) -> Score {
         let k = cols.len();
-        let p = self.q.ncols();
-        let mut qtg = DMatrix::zeros(p, k);
-        let mut gtg = DMatrix::zeros(k, k);
-        let mut gtt = DVector::zeros(k);
-        for (a, (ba, fa)) in cols.iter().enumerate() {
-            qtg.set_column(a, &(&self.projected[*ba] * DVector::from_column_slice(fa)));
-            gtt[a] = fa
-                .iter()
-                .zip(&self.target_products)
-                .map(|(f, t)| f * t[*ba])
-                .sum();
-            for (b, (bb, fb)) in cols.iter().enumerate().skip(a) {
-                let v: f64 = fa
-                    .iter()
-                    .zip(fb)
-                    .zip(&self.gram)
-                    .map(|((x, y), g)| x * y * g[*ba][*bb])
-                    .sum();
-                gtg[(a, b)] = v;
-                gtg[(b, a)] = v;
+        let p = self.basis.len();
+        let n = self
+            .poses()
+            .min(cols.iter().map(|c| c.1.len()).min().unwrap_or(0));
+        let mut wanted = [false; 6];
+        cols.iter().for_each(|(b, _)| wanted[*b] = true);
+        let starts: Vec<usize> = (0..n).step_by(BLOCK).collect();
+        let partial: Vec<Sums> = starts
+            .par_iter()
+            .map(|&start| {
+                let range = start..(start + BLOCK).min(n);
+                let proj = self.projections(range.clone(), &wanted);
+                let len = proj.len;
+                let mut sums = Sums::zero(p, k);
+                for (a, (ba, fa)) in cols.iter().enumerate() {
+                    let fa = &fa[range.clone()];
+                    let of = &proj.of[*ba];
+                    for r in 0..p {
+                        sums.xtg[a * p + r] = dot(&of[r * len..(r + 1) * len], fa);
+                    }
+                    for (t, j) in range.clone().enumerate() {
+                        sums.gtt[a] += fa[t] * self.target_product(j, *ba);
+                    }
+                    for (b, (bb, fb)) in cols.iter().enumerate().skip(a) {
+                        let fb = &fb[range.clone()];
+                        sums.gtg[a * k + b] = range
+                            .clone()
+                            .enumerate()
+                            .map(|(t, j)| fa[t] * fb[t] * self.gram(j, *ba, *bb))
+                            .sum();
+                    }
+                }
+                sums
+            })
+            .collect();
+        let mut total = Sums::zero(p, k);
+        partial.iter().for_each(|s| total.add(s));
+        self.score_of(total, 1.0)
+    }
+
+    /// The score from sums over poses of columns scaled by `scale`.
+    fn score_of(&self, sums: Sums, scale: f64) -> Score {
+        let p = self.basis.len();
+        let k = sums.gtt.len();
+        let qtg = self.qt(&(DMatrix::from_vec(p, k, sums.xtg) * scale));
+        let mut gtg = DMatrix::from_row_slice(k, k, &sums.gtg) * (scale * scale);
+        for a in 0..k {
+            for b in 0..a {
+                gtg[(a, b)] = gtg[(b, a)];
             }
         }
+        let gtt = DVector::from_vec(sums.gtt) * scale;
         score_from(&qtg, &gtg, &gtt, &self.qtt)
     }
 
@@ -367,10 +591,10 @@ impl Linearisation {
     /// rounding.
     ///
     /// One pass over the poses for the whole grid: the poses go in blocks
-    /// of [`SCAN_BLOCK`], whose projected directions stay in cache while
-    /// every frequency accumulates its products, and the sines and cosines
-    /// of consecutive frequencies follow by rotation (re-seeded exactly
-    /// every [`SCAN_RESEED`] frequencies), so a frequency costs about
+    /// of [`BLOCK`], whose projected directions stay in cache while every
+    /// frequency accumulates its products, and the sines and cosines of
+    /// consecutive frequencies follow by rotation (re-seeded exactly every
+    /// [`SCAN_RESEED`] frequencies), so a frequency costs about
     /// `2 L p + 2 L (2 L + 1)` multiply-adds per pose for `L` legs and `p`
     /// fitted columns instead of a fresh evaluation of the term. Blocks run
     /// in parallel and are summed in their order: the same bits at any
@@ -383,36 +607,30 @@ impl Linearisation {
         step: f64,
         count: usize,
     ) -> Vec<(f64, usize)> {
-        use rayon::prelude::*;
-        let p = self.q.ncols();
+        let p = self.basis.len();
         let k = 2 * legs.len();
         let n = self.poses().min(commands_mm.len());
-        let zero = || PeriodicSums {
-            qtg: vec![0.0; p * k],
-            gtg: vec![0.0; k * k],
-            gtt: vec![0.0; k],
-        };
         let nl = legs.len();
-        let block_sums = |start: usize| -> Vec<PeriodicSums> {
-            let end = (start + SCAN_BLOCK).min(n);
+        let mut wanted = [false; 6];
+        legs.iter().for_each(|&i| wanted[i] = true);
+        let block_sums = |start: usize| -> Vec<Sums> {
+            let end = (start + BLOCK).min(n);
             let len = end - start;
-            let mut sums: Vec<PeriodicSums> = (0..count).map(|_| zero()).collect();
-            // Per leg, over the block's poses: the projected directions
-            // (`p x len`, column-major), the target products, the rotation
-            // by one grid step and the current sine and cosine; per pair of
-            // legs, their directions' inner products.
-            let projected: Vec<&[f64]> = legs
-                .iter()
-                .map(|&i| &self.projected[i].as_slice()[start * p..end * p])
-                .collect();
+            let mut sums: Vec<Sums> = (0..count).map(|_| Sums::zero(p, k)).collect();
+            // Per leg, over the block's poses: the projected directions,
+            // the target products, the rotation by one grid step and the
+            // current sine and cosine; per pair of legs, their directions'
+            // inner products.
+            let projections = self.projections(start..end, &wanted);
+            let projected: Vec<&[f64]> = legs.iter().map(|&i| &projections.of[i][..]).collect();
             let products: Vec<Vec<f64>> = legs
                 .iter()
-                .map(|&i| (start..end).map(|j| self.target_products[j][i]).collect())
+                .map(|&i| (start..end).map(|j| self.target_product(j, i)).collect())
                 .collect();
             let gram: Vec<Vec<f64>> = (0..nl * nl)
                 .map(|ab| {
                     let (la, lb) = (legs[ab / nl], legs[ab % nl]);
-                    (start..end).map(|j| self.gram[j][la][lb]).collect()
+                    (start..end).map(|j| self.gram(j, la, lb)).collect()
                 })
                 .collect();
             let angle = |f: f64, i: usize, j: usize| std::f64::consts::TAU * f * commands_mm[j][i];
@@ -438,15 +656,11 @@ impl Linearisation {
                             (*s, *c) = (*s * wc + *c * ws, *c * wc - *s * ws);
                         }
                     }
-                    // Q^T G for the leg's two columns: one pass over its
-                    // projected directions.
-                    let (qs, qc) = acc.qtg[2 * l * p..(2 * l + 2) * p].split_at_mut(p);
-                    for (t, column) in projected[l].chunks_exact(p).enumerate() {
-                        let (s, c) = (sines[t], cosines[t]);
-                        for ((a, b), &x) in qs.iter_mut().zip(qc.iter_mut()).zip(column) {
-                            *a += x * s;
-                            *b += x * c;
-                        }
+                    // X^T G for the leg's two columns: a pair of dot
+                    // products per basis column.
+                    let (qs, qc) = acc.xtg[2 * l * p..(2 * l + 2) * p].split_at_mut(p);
+                    for (r, x) in projected[l].chunks_exact(len).enumerate() {
+                        (qs[r], qc[r]) = dot2(x, sines, cosines);
                     }
                 }
                 for a in 0..2 * nl {
@@ -465,12 +679,12 @@ impl Linearisation {
             }
             sums
         };
-        let starts: Vec<usize> = (0..n).step_by(SCAN_BLOCK).collect();
-        let mut total: Vec<PeriodicSums> = (0..count).map(|_| zero()).collect();
+        let starts: Vec<usize> = (0..n).step_by(BLOCK).collect();
+        let mut total: Vec<Sums> = (0..count).map(|_| Sums::zero(p, k)).collect();
         // A bounded number of blocks at a time (their sums are
         // `count x (p + k + 1) k` numbers each), added in block order.
         for group in starts.chunks(SCAN_PARALLEL_BLOCKS) {
-            let partial: Vec<Vec<PeriodicSums>> =
+            let partial: Vec<Vec<Sums>> =
                 group.par_iter().map(|&start| block_sums(start)).collect();
             for block in partial {
                 for (t, b) in total.iter_mut().zip(block) {
@@ -482,15 +696,7 @@ impl Linearisation {
             .into_iter()
             .map(|t| {
                 // The columns are `1e-3` sin and cos (mm per um).
-                let qtg = DMatrix::from_column_slice(p, k, &t.qtg) * 1e-3;
-                let mut gtg = DMatrix::from_row_slice(k, k, &t.gtg) * 1e-6;
-                for a in 0..k {
-                    for b in 0..a {
-                        gtg[(a, b)] = gtg[(b, a)];
-                    }
-                }
-                let gtt = DVector::from_vec(t.gtt) * 1e-3;
-                let s = score_from(&qtg, &gtg, &gtt, &self.qtt);
+                let s = self.score_of(t, 1e-3);
                 (s.explained, s.rank)
             })
             .collect()
@@ -512,7 +718,7 @@ impl Linearisation {
 
     /// The score of dense weighted columns.
     pub(crate) fn score_dense(&self, g: &DMatrix<f64>) -> Score {
-        let qtg = self.q.transpose() * g;
+        let qtg = self.qt(&self.xt_dense(g));
         let gtg = g.transpose() * g;
         let gtt = g.transpose() * &self.target;
         score_from(&qtg, &gtg, &gtt, &self.qtt)
@@ -527,30 +733,53 @@ impl Linearisation {
     }
 }
 
-/// Per pose, the Gram matrix of its six directions.
-fn grams(directions: &[[[f64; 3]; 6]]) -> Vec<[[f64; 6]; 6]> {
-    directions
-        .iter()
-        .map(|d| {
-            std::array::from_fn(|a| {
-                std::array::from_fn(|b| (0..3).map(|c| d[a][c] * d[b][c]).sum())
-            })
-        })
-        .collect()
+/// `a . b` of 3-vectors.
+fn dot3(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// `a . b`.
+/// `a . b`, in four interleaved partial sums.
 fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+    let mut s = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in ca.zip(cb) {
+        for l in 0..4 {
+            s[l] += x[l] * y[l];
+        }
+    }
+    (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
-/// An orthonormal basis of the column space of `a` (thin QR; `a` has full
-/// column rank by construction: identifiable columns only).
-pub(crate) fn orthonormal_basis(a: &DMatrix<f64>) -> DMatrix<f64> {
-    if a.ncols() == 0 {
-        return DMatrix::zeros(a.nrows(), 0);
+/// `(x . s, x . c)`, in four interleaved partial sums each.
+fn dot2(x: &[f64], s: &[f64], c: &[f64]) -> (f64, f64) {
+    let (mut a, mut b) = ([0.0; 4], [0.0; 4]);
+    let (cx, cs, cc) = (x.chunks_exact(4), s.chunks_exact(4), c.chunks_exact(4));
+    let (mut ta, mut tb) = (0.0, 0.0);
+    for ((x, s), c) in cx
+        .remainder()
+        .iter()
+        .zip(cs.remainder())
+        .zip(cc.remainder())
+    {
+        ta += x * s;
+        tb += x * c;
     }
-    a.clone().qr().q()
+    for ((x, s), c) in cx.zip(cs).zip(cc) {
+        for l in 0..4 {
+            a[l] += x[l] * s[l];
+            b[l] += x[l] * c[l];
+        }
+    }
+    (
+        (a[0] + a[1]) + (a[2] + a[3]) + ta,
+        (b[0] + b[1]) + (b[2] + b[3]) + tb,
+    )
 }
 
 /// Whether the column space of `a` lies inside that of `b` (every
@@ -597,12 +826,18 @@ mod tests {
     use rand::{RngExt, SeedableRng};
     use tricept_model::effects::periodic_extra_mm;
 
+    /// An orthonormal basis of the column space of `a` (thin QR).
+    fn orthonormal_basis(a: &DMatrix<f64>) -> DMatrix<f64> {
+        a.clone().qr().q()
+    }
+
     /// A linearisation of `n` random poses: random fitted columns,
     /// directions and target, and leg commands over 600-1000 mm.
     fn synthetic(n: usize, seed: u64) -> (Linearisation, Vec<[f64; 3]>) {
         let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
         let mut normal = || rng.random_range(-1.0..1.0);
-        let x = DMatrix::from_fn(3 * n, 7, |_, _| normal());
+        let width = 7;
+        let rows: Vec<f64> = (0..3 * n * width).map(|_| normal()).collect();
         let target = DVector::from_fn(3 * n, |_, _| normal());
         let directions: Vec<[[f64; 3]; 6]> = (0..n)
             .map(|_| {
@@ -615,15 +850,14 @@ mod tests {
             .map(|_| std::array::from_fn(|_| 800.0 + 200.0 * normal()))
             .collect();
         let mut lin = Linearisation {
-            q: DMatrix::zeros(0, 0),
+            rows,
+            width,
             x_params: (0..4).collect(),
-            x,
+            basis: Vec::new(),
+            r: DMatrix::zeros(0, 0),
             target: target.clone(),
             ups: Vec::new(),
-            gram: grams(&directions),
             directions,
-            projected: Vec::new(),
-            target_products: Vec::new(),
             qtt: DVector::zeros(0),
             extra: DMatrix::zeros(3 * n, 0),
             extra_terms: Vec::new(),
@@ -678,6 +912,70 @@ mod tests {
             }
             // The hidden 10 mm period on leg 2 is grid frequency 128.
             assert_eq!(best.0, 128, "{legs:?}");
+        }
+    }
+
+    #[test]
+    fn scores_without_q_equal_those_with_an_explicit_q() {
+        let (mut lin, commands) = synthetic(900, 11);
+        // Columns of very different sizes, as offsets (rad) and parameters
+        // (mm) are in noise units.
+        let width = lin.width;
+        for (i, v) in lin.rows.iter_mut().enumerate() {
+            *v *= 10f64.powi((i % width) as i32 - 2);
+        }
+        let n = lin.poses();
+        let x = DMatrix::from_fn(3 * n, width, |i, c| lin.row(i)[c]);
+        let cols: Vec<(usize, Vec<f64>)> = [(0, 0.0), (0, 1.0), (2, 0.0), (4, 0.0)]
+            .iter()
+            .map(|&(b, phase)| {
+                let leg = if b < 3 { b } else { 1 };
+                let values = commands
+                    .iter()
+                    .map(|q| periodic_extra_mm(1.0 - phase, phase, 37.0, q[leg]))
+                    .collect();
+                (b, values)
+            })
+            .collect();
+        for drop in [vec![], vec![1]] {
+            lin.set_basis(&drop);
+            let keep: Vec<usize> = (0..width)
+                .filter(|&c| c < 3 || !drop.contains(&(c - 3)))
+                .collect();
+            let q = orthonormal_basis(&x.select_columns(&keep));
+            let g = lin.dense(&cols);
+            let t = &lin.target;
+            let explicit = score_from(
+                &(q.transpose() * &g),
+                &(g.transpose() * &g),
+                &(g.transpose() * t),
+                &(q.transpose() * t),
+            );
+            for s in [lin.score_columns(&cols), lin.score_dense(&g)] {
+                assert_eq!(s.rank, explicit.rank, "{drop:?}");
+                let tolerance = 1e-9 * explicit.explained.max(1.0);
+                assert!(
+                    (s.explained - explicit.explained).abs() <= tolerance,
+                    "{drop:?}: {} against {}",
+                    s.explained,
+                    explicit.explained
+                );
+                let dc = (&s.coefficients - &explicit.coefficients).norm();
+                assert!(dc <= 1e-9 * explicit.coefficients.norm(), "{drop:?}: {dc}");
+            }
+            let projected = &g - &q * (q.transpose() * &g);
+            let dp = (lin.project(&g) - &projected).norm();
+            assert!(dp <= 1e-9 * g.norm(), "{drop:?}: {dp}");
+            // A design column projects to nothing once in the basis, and to
+            // its own residual when dropped.
+            let own = lin.projected_columns(&[1]);
+            let column = x.column(4).into_owned();
+            let expected = if drop.is_empty() {
+                DVector::zeros(3 * n)
+            } else {
+                &column - &q * (q.transpose() * &column)
+            };
+            assert!((own.column(0) - expected).norm() <= 1e-9 * column.norm());
         }
     }
 

@@ -38,7 +38,7 @@ use tricept_model::effects::EffectName;
 
 use crate::dictionary::{At, Dictionary, Scored};
 use crate::error::DiagnoseError;
-use crate::fit::{Fit, FitError, Fitter, term_estimates};
+use crate::fit::{Fit, FitResult, Fitter, term_estimates};
 use crate::linear::Linearisation;
 use crate::plausibility::Plausibility;
 use crate::report::{Estimate, Evidence, RejectStage, Rejected, Tested};
@@ -447,7 +447,7 @@ fn final_tests(
 pub(crate) fn select(
     setup: &Setup<'_>,
     clean: &Dataset,
-    geo: Option<Result<Fit, FitError>>,
+    geo: Option<FitResult>,
 ) -> Result<Selection, DiagnoseError> {
     let geo = match geo {
         Some(fit) => fit?,
