@@ -185,14 +185,44 @@ fn basis_index(b: Basis) -> usize {
     }
 }
 
-/// One pose of the linearisation: its design rows, extra columns, target,
-/// UP joints and directions.
-struct PoseRows {
-    rows: Vec<f64>,
+/// One block of poses of the linearisation: their targets, UP joints,
+/// directions, the extra columns when they are kept, and else the sums
+/// the extra terms' scores need.
+struct Block {
+    target: Vec<f64>,
+    ups: Vec<UpJoints>,
+    directions: Vec<[[f64; 3]; 6]>,
     extra: Vec<f64>,
-    target: [f64; 3],
-    up: UpJoints,
-    directions: [[f64; 3]; 6],
+    sums: ExtraSums,
+}
+
+/// Sums over poses for the scores of `m` extra columns `E` against the
+/// design's `width` columns: `X^T E` (`width x m`, column-major), `E^T E`
+/// and `E^T t`.
+struct ExtraSums {
+    xte: Vec<f64>,
+    ete: Vec<f64>,
+    ett: Vec<f64>,
+}
+
+impl ExtraSums {
+    fn zero(width: usize, m: usize) -> ExtraSums {
+        ExtraSums {
+            xte: vec![0.0; width * m],
+            ete: vec![0.0; m * m],
+            ett: vec![0.0; m],
+        }
+    }
+
+    fn add(&mut self, other: &ExtraSums) {
+        for (a, b) in [
+            (&mut self.xte, &other.xte),
+            (&mut self.ete, &other.ete),
+            (&mut self.ett, &other.ett),
+        ] {
+            a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
+        }
+    }
 }
 
 impl Linearisation {
@@ -205,6 +235,44 @@ impl Linearisation {
         sigma: &[f64; 3],
         extra: &[Term],
     ) -> Option<Linearisation> {
+        Self::build(fit, data, sigma, extra, true).map(|(lin, _)| lin)
+    }
+
+    /// [`Linearisation::at_fit`] without keeping the extra terms' columns:
+    /// each extra term's score against the fit's residuals instead (the
+    /// linearised drop of chi-square of adding it), from sums over poses.
+    pub(crate) fn scoring(
+        fit: &Fit,
+        data: &Dataset,
+        sigma: &[f64; 3],
+        extra: &[Term],
+    ) -> Option<(Linearisation, Vec<(Term, Score)>)> {
+        let (lin, sums) = Self::build(fit, data, sigma, extra, false)?;
+        let m = sums.ett.len();
+        let width = lin.width;
+        let scores = lin
+            .extra_terms
+            .iter()
+            .map(|(t, r)| {
+                let k = r.len();
+                // The basis is every design column here.
+                let xtg = DMatrix::from_fn(width, k, |i, a| sums.xte[(r.start + a) * width + i]);
+                let gtg = DMatrix::from_fn(k, k, |a, b| sums.ete[(r.start + a) * m + r.start + b]);
+                let gtt = DVector::from_fn(k, |a, _| sums.ett[r.start + a]);
+                (*t, score_from(&lin.qt(&xtg), &gtg, &gtt, &lin.qtt))
+            })
+            .collect();
+        Some((lin, scores))
+    }
+
+    /// The linearisation with the extra columns kept (`dense`) or summed.
+    fn build(
+        fit: &Fit,
+        data: &Dataset,
+        sigma: &[f64; 3],
+        extra: &[Term],
+        dense: bool,
+    ) -> Option<(Linearisation, ExtraSums)> {
         let mut terms = fit.model.terms().to_vec();
         terms.extend_from_slice(extra);
         let model = fit.model.with(&terms);
@@ -219,70 +287,95 @@ impl Linearisation {
         let width = 3 + identifiable.len();
         let m = kf - k;
         let offsets = fit.id.offsets;
-        // Every pose on its own: blocks in parallel, in pose order.
-        let blocks: Vec<Option<Vec<PoseRows>>> = data
+        let mut rows = vec![0.0; 3 * n * width];
+        // Blocks of poses in parallel, each writing its design rows in
+        // place; the rest is joined (and summed) in block order.
+        let blocks: Vec<Option<Block>> = data
             .poses
             .par_chunks(EVALUATION_BLOCK)
-            .map(|poses| {
+            .zip(rows.par_chunks_mut(3 * EVALUATION_BLOCK * width))
+            .map(|(poses, rows)| {
+                let len = poses.len();
+                let mut block = Block {
+                    target: Vec::with_capacity(3 * len),
+                    ups: Vec::with_capacity(len),
+                    directions: Vec::with_capacity(len),
+                    extra: Vec::with_capacity(if dense { 3 * len * m } else { 0 }),
+                    sums: ExtraSums::zero(width, if dense { 0 } else { m }),
+                };
                 let mut jac = vec![0.0; 3 * kf];
-                poses
-                    .iter()
-                    .map(|pose| {
-                        let mut seed = None;
-                        let g = predictor.predict(pose, &mut seed, &mut jac).ok()?;
-                        let up = seed?;
-                        let legs = machine.legs_at(&up);
-                        let j1_inv: Matrix3<f64> = legs.j1().try_inverse()?;
-                        let y = pose.readings.to_array();
-                        let mut out = PoseRows {
-                            rows: vec![0.0; 3 * width],
-                            extra: vec![0.0; 3 * m],
-                            target: [0.0; 3],
-                            up,
-                            directions: [[0.0; 3]; 6],
-                        };
-                        for c in 0..3 {
-                            let w = 1.0 / sigma[c];
-                            let row = &mut out.rows[c * width..(c + 1) * width];
-                            row[c] = w;
-                            for (t, &gi) in identifiable.iter().enumerate() {
-                                row[3 + t] = w * jac[c * kf + gi];
-                            }
-                            for e in 0..m {
-                                out.extra[c * m + e] = w * jac[c * kf + k + e];
-                            }
-                            out.target[c] = w * (y[c] - g[c] - offsets[c]);
-                            for i in 0..3 {
-                                out.directions[i][c] = w * j1_inv[(c, i)];
-                            }
-                            out.directions[3 + c][c] = w;
+                let mut e = vec![0.0; m];
+                for (t, pose) in poses.iter().enumerate() {
+                    let mut seed = None;
+                    let g = predictor.predict(pose, &mut seed, &mut jac).ok()?;
+                    let up = seed?;
+                    let legs = machine.legs_at(&up);
+                    let j1_inv: Matrix3<f64> = legs.j1().try_inverse()?;
+                    let y = pose.readings.to_array();
+                    let mut directions = [[0.0; 3]; 6];
+                    for c in 0..3 {
+                        let w = 1.0 / sigma[c];
+                        let row = &mut rows[(3 * t + c) * width..(3 * t + c + 1) * width];
+                        row[c] = w;
+                        for (t, &gi) in identifiable.iter().enumerate() {
+                            row[3 + t] = w * jac[c * kf + gi];
                         }
-                        Some(out)
-                    })
-                    .collect()
+                        let target = w * (y[c] - g[c] - offsets[c]);
+                        for (i, e) in e.iter_mut().enumerate() {
+                            *e = w * jac[c * kf + k + i];
+                        }
+                        if dense {
+                            block.extra.extend_from_slice(&e);
+                        } else {
+                            let sums = &mut block.sums;
+                            for (i, &ei) in e.iter().enumerate() {
+                                if ei == 0.0 {
+                                    continue;
+                                }
+                                let xte = &mut sums.xte[i * width..(i + 1) * width];
+                                xte.iter_mut()
+                                    .zip(row.iter())
+                                    .for_each(|(s, x)| *s += x * ei);
+                                let ete = &mut sums.ete[i * m..(i + 1) * m];
+                                ete.iter_mut().zip(&e).for_each(|(s, el)| *s += ei * el);
+                                sums.ett[i] += ei * target;
+                            }
+                        }
+                        block.target.push(target);
+                        for i in 0..3 {
+                            directions[i][c] = w * j1_inv[(c, i)];
+                        }
+                        directions[3 + c][c] = w;
+                    }
+                    block.ups.push(up);
+                    block.directions.push(directions);
+                }
+                Some(block)
             })
             .collect();
-        let mut rows = Vec::with_capacity(3 * n * width);
-        let mut ext = DMatrix::zeros(3 * n, m);
-        let mut target = DVector::zeros(3 * n);
+        let mut target = Vec::with_capacity(3 * n);
         let mut ups = Vec::with_capacity(n);
         let mut directions = Vec::with_capacity(n);
-        for pose in blocks.into_iter().flat_map(|b| b.into_iter().flatten()) {
-            let j = ups.len();
-            for c in 0..3 {
-                target[3 * j + c] = pose.target[c];
-                for e in 0..m {
-                    ext[(3 * j + c, e)] = pose.extra[c * m + e];
-                }
-            }
-            rows.extend_from_slice(&pose.rows);
-            ups.push(pose.up);
-            directions.push(pose.directions);
-        }
-        if ups.len() != n {
+        let mut sums = ExtraSums::zero(width, if dense { 0 } else { m });
+        let mut ext = DMatrix::zeros(if dense { 3 * n } else { 0 }, m);
+        for block in blocks {
             // A pose the model cannot solve at the estimate.
-            return None;
+            let block = block?;
+            if dense {
+                let first = target.len();
+                for (i, row) in block.extra.chunks_exact(m.max(1)).enumerate() {
+                    for (e, v) in row.iter().enumerate() {
+                        ext[(first + i, e)] = *v;
+                    }
+                }
+            } else {
+                sums.add(&block.sums);
+            }
+            target.extend(block.target);
+            ups.extend(block.ups);
+            directions.extend(block.directions);
         }
+        let target = DVector::from_vec(target);
         let mut at = 0;
         let extra_terms = extra
             .iter()
@@ -307,7 +400,7 @@ impl Linearisation {
             extra_terms,
         };
         lin.set_basis(&[]);
-        Some(lin)
+        Some((lin, sums))
     }
 
     /// Number of poses.

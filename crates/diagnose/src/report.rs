@@ -450,6 +450,12 @@ pub struct Tested {
     pub description: String,
     /// Its evidence.
     pub evidence: Evidence,
+    /// Whether it was refitted exactly, its evidence the likelihood-ratio
+    /// test of the two fits; `false`: judged by the score test at the
+    /// current fit, its `delta_chi_square` the linearised drop of
+    /// chi-square (a catalogue effect that could not be admissible even at
+    /// twice its score is not refitted).
+    pub refitted: bool,
 }
 
 /// Serialises estimates as `{name: {"value": v, "std_dev": s}}`.

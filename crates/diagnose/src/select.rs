@@ -1,10 +1,14 @@
 //! Selection of causes from one pool: the effects of the vocabulary and
 //! the generic dictionary.
 //!
-//! **Forward steps.** Every available catalogue effect not yet in the model
-//! is refitted exactly; the dictionary is screened linearly at the current
-//! fit and its best `refit_top` groups are refitted exactly too. A refitted
-//! candidate `c` is admissible when
+//! **Forward steps.** The available catalogue effects not yet in the
+//! model and the dictionary are screened linearly at the current fit (the
+//! score test: the linearised drop of chi-square, [`crate::linear`]). The
+//! dictionary's best `refit_top` significant groups are refitted exactly,
+//! and so is every catalogue effect that could be admissible at
+//! [`SCORE_MARGIN`] times its score; the others keep their score test as
+//! their evidence (`refitted: false` among the first step's candidates). A
+//! refitted candidate `c` is admissible when
 //! 1. the likelihood-ratio test passes: its drop of chi-square, divided by
 //!    the residual variance of the larger model (never below the noise), is
 //!    significant at `alpha / 2` divided by the number of catalogue
@@ -53,9 +57,28 @@ pub(crate) struct Setup<'a> {
     pub(crate) plausibility: &'a Plausibility,
     /// Effects of the vocabulary whose data columns are present.
     pub(crate) available: Vec<EffectName>,
-    /// The last dictionary screen with the point it was made at: the
+    /// The last linear screen with the point it was made at: the
     /// selection's last step and the report's remainder screen the same fit.
-    pub(crate) last_screen: std::sync::Mutex<Option<(ScreenPoint, Vec<Scored>)>>,
+    pub(crate) last_screen: std::sync::Mutex<Option<(ScreenPoint, Screen)>>,
+}
+
+/// A catalogue effect is refitted exactly when it could be admissible (its
+/// likelihood-ratio test and penalised gain passed) with a drop of
+/// chi-square this many times its linearised drop at the current fit: the
+/// two agree to second order in the effect, so a candidate that fails even
+/// at twice its score fails when refitted.
+pub(crate) const SCORE_MARGIN: f64 = 2.0;
+
+/// The linear screen at a fit: the dictionary's groups scored, and the
+/// score of each catalogue effect not in the fit's model.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Screen {
+    /// The dictionary's groups, best first.
+    pub(crate) dictionary: Vec<Scored>,
+    /// Each catalogue effect with its linearised drop of chi-square and
+    /// its rank (empty when the fit cannot be linearised with their
+    /// columns).
+    pub(crate) catalogue: Vec<(Term, f64, usize)>,
 }
 
 /// Everything a dictionary screen depends on besides the fixed setup: the
@@ -128,15 +151,43 @@ impl Setup<'_> {
         if self.dictionary.is_empty() {
             return Vec::new();
         }
+        self.linear_screen(fit, data).dictionary
+    }
+
+    /// The linear screen at `fit`: the dictionary, and the catalogue
+    /// effects not in its model (one linearisation for both; the last one
+    /// is kept with its point).
+    pub(crate) fn linear_screen(&self, fit: &Fit, data: &Dataset) -> Screen {
+        let catalogue: Vec<Term> = self
+            .available
+            .iter()
+            .map(|e| Term::Catalogue(*e))
+            .filter(|t| !fit.model.terms().iter().any(|u| u.overlaps(t)))
+            .collect();
+        if self.dictionary.is_empty() && catalogue.is_empty() {
+            return Screen::default();
+        }
         let point = ScreenPoint::of(self, fit, data);
         if let Ok(last) = self.last_screen.lock()
-            && let Some((at, scored)) = last.as_ref()
+            && let Some((at, screen)) = last.as_ref()
             && *at == point
         {
-            return scored.clone();
+            return screen.clone();
         }
-        let Some(lin) = Linearisation::at_fit(fit, data, &self.fitter.sigma, &[]) else {
-            return Vec::new();
+        let sigma = &self.fitter.sigma;
+        let linearised = match Linearisation::scoring(fit, data, sigma, &catalogue) {
+            Some((lin, scores)) => Some((
+                lin,
+                scores
+                    .into_iter()
+                    .map(|(t, s)| (t, s.explained, s.rank))
+                    .collect(),
+            )),
+            // The catalogue's columns cannot be had: the dictionary alone.
+            None => Linearisation::scoring(fit, data, sigma, &[]).map(|(lin, _)| (lin, Vec::new())),
+        };
+        let Some((lin, catalogue)) = linearised else {
+            return Screen::default();
         };
         let at = At {
             lin: &lin,
@@ -146,11 +197,18 @@ impl Setup<'_> {
             chi_square: fit.id.stats.chi_square,
             dof: fit.id.stats.dof,
         };
-        let scored = self.dictionary.screen(&at, fit.model.terms());
+        let screen = Screen {
+            dictionary: if self.dictionary.is_empty() {
+                Vec::new()
+            } else {
+                self.dictionary.screen(&at, fit.model.terms())
+            },
+            catalogue,
+        };
         if let Ok(mut last) = self.last_screen.lock() {
-            *last = Some((point, scored.clone()));
+            *last = Some((point, screen.clone()));
         }
-        scored
+        screen
     }
 
     /// Plausibility of `term` in `fit`.
@@ -175,8 +233,43 @@ impl Setup<'_> {
             .rank()
             .saturating_sub(without.id.design().rank())
             .max(1);
+        self.evidence_of(
+            term,
+            delta,
+            k,
+            (with.id.stats.chi_square, with.id.stats.dof),
+            readings,
+        )
+    }
+
+    /// The score test of adding `term` to `current`: the evidence of its
+    /// linearised drop of chi-square `explained` for `rank` parameters.
+    fn score_evidence(
+        &self,
+        term: &Term,
+        current: &Fit,
+        explained: f64,
+        rank: usize,
+        readings: usize,
+    ) -> Evidence {
+        let k = rank.max(1);
+        let stats = &current.id.stats;
+        let with = (stats.chi_square - explained, stats.dof.saturating_sub(k));
+        self.evidence_of(term, explained, k, with, readings)
+    }
+
+    /// The evidence of a drop of chi-square `delta` for `k` parameters, the
+    /// larger model leaving `(chi-square, dof)` `with`.
+    fn evidence_of(
+        &self,
+        term: &Term,
+        delta: f64,
+        k: usize,
+        with: (f64, usize),
+        readings: usize,
+    ) -> Evidence {
         let reference = &self.fitter.reference;
-        let s2 = reference.scale(with.id.stats.chi_square, with.id.stats.dof);
+        let s2 = reference.scale(with.0, with.1);
         let p = reference.p_value(delta / s2, k);
         let m = self.multiplicity(term);
         let ln_n = (readings as f64).ln();
@@ -271,16 +364,32 @@ fn forward_step(
         .filter(|t| !terms.iter().any(|u| u.overlaps(t)))
         .collect();
     let alpha_share = setup.alpha_share();
+    let screen = setup.linear_screen(current, clean);
     pool.extend(
-        setup
-            .screen(current, clean)
-            .into_iter()
+        screen
+            .dictionary
+            .iter()
             .filter(|s| s.p_adjusted < alpha_share)
             .take(setup.fitter.options.dictionary.refit_top)
             .map(|s| Term::Generic(s.term)),
     );
     pool.retain(|t| !excluded.iter().any(|e| e.overlaps(t) || e == t));
     let readings = 3 * clean.poses.len();
+    // The score test: a catalogue effect that could not be admissible even
+    // at SCORE_MARGIN times its linearised drop is not refitted.
+    let admissible = |e: &Evidence| e.p_adjusted < alpha_share && e.penalised_gain > 0.0;
+    let mut judged: Vec<(Term, Evidence)> = Vec::new();
+    pool.retain(|t| {
+        let Some(&(_, explained, rank)) = screen.catalogue.iter().find(|(c, _, _)| c == t) else {
+            return true;
+        };
+        let at = |x: f64| setup.score_evidence(t, current, x, rank, readings);
+        if admissible(&at(SCORE_MARGIN * explained)) {
+            return true;
+        }
+        judged.push((*t, at(explained)));
+        false
+    });
     let mut trials: Vec<Trial> = pool
         .par_iter()
         .filter_map(|t| {
@@ -348,14 +457,24 @@ fn forward_step(
         }
     }
     if let Some(tested) = tested {
-        *tested = trials
-            .iter()
-            .map(|t| Tested {
-                effect: t.term.name(),
-                description: t.term.label(),
-                evidence: t.evidence.clone(),
+        let refitted = trials.iter().map(|t| (t.term, &t.evidence, true));
+        let scored = judged.iter().map(|(t, e)| (*t, e, false));
+        *tested = refitted
+            .chain(scored)
+            .map(|(t, evidence, refitted)| Tested {
+                effect: t.name(),
+                description: t.label(),
+                evidence: evidence.clone(),
+                refitted,
             })
             .collect();
+        // Strongest first; among equals the catalogue.
+        tested.sort_by(|a, b| {
+            b.evidence
+                .penalised_gain
+                .total_cmp(&a.evidence.penalised_gain)
+                .then(a.effect.is_generic().cmp(&b.effect.is_generic()))
+        });
     }
     let (term, rms) = winner?;
     let index = trials.iter().position(|t| t.term == term)?;
