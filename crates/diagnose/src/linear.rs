@@ -90,8 +90,6 @@ impl Sums {
 /// basis columns: `of[b]` holds `X_j^T d_jb`, `p x len` with the poses of a
 /// basis column contiguous (empty for a direction not asked for).
 pub(crate) struct Projections {
-    /// Poses in the block.
-    pub(crate) len: usize,
     /// Per direction, `p x len`, row-major.
     pub(crate) of: [Vec<f64>; 6],
 }
@@ -554,23 +552,24 @@ impl Linearisation {
                 Vec::new()
             }
         });
+        let mut row = vec![0.0; p];
         for (t, j) in range.enumerate() {
             let d = &self.directions[j];
             for c in 0..3 {
-                let row = self.row(3 * j + c);
+                self.basis_row(3 * j + c, &mut row);
                 for b in 0..6 {
                     let w = d[b][c];
                     if !wanted[b] || w == 0.0 {
                         continue;
                     }
-                    let out = &mut of[b];
-                    for (r, &col) in self.basis.iter().enumerate() {
-                        out[r * len + t] += row[col] * w;
+                    let out = &mut of[b][t..];
+                    for (o, x) in out.iter_mut().step_by(len).zip(&row) {
+                        *o += x * w;
                     }
                 }
             }
         }
-        Projections { len, of }
+        Projections { of }
     }
 
     /// `d_ja . d_jb` at pose `j`.
@@ -625,32 +624,34 @@ impl Linearisation {
         let n = self
             .poses()
             .min(cols.iter().map(|c| c.1.len()).min().unwrap_or(0));
-        let mut wanted = [false; 6];
-        cols.iter().for_each(|(b, _)| wanted[*b] = true);
         let starts: Vec<usize> = (0..n).step_by(BLOCK).collect();
         let partial: Vec<Sums> = starts
             .par_iter()
             .map(|&start| {
-                let range = start..(start + BLOCK).min(n);
-                let proj = self.projections(range.clone(), &wanted);
-                let len = proj.len;
                 let mut sums = Sums::zero(p, k);
-                for (a, (ba, fa)) in cols.iter().enumerate() {
-                    let fa = &fa[range.clone()];
-                    let of = &proj.of[*ba];
-                    for r in 0..p {
-                        sums.xtg[a * p + r] = dot(&of[r * len..(r + 1) * len], fa);
+                // The columns' 3-vectors at one pose, and a design row on
+                // the basis.
+                let mut g = vec![[0.0; 3]; k];
+                let mut row = vec![0.0; p];
+                for j in start..(start + BLOCK).min(n) {
+                    let d = &self.directions[j];
+                    let t = &self.target.as_slice()[3 * j..3 * j + 3];
+                    for (a, (b, f)) in cols.iter().enumerate() {
+                        g[a] = d[*b].map(|v| v * f[j]);
+                        sums.gtt[a] += g[a][0] * t[0] + g[a][1] * t[1] + g[a][2] * t[2];
+                        for b in 0..=a {
+                            sums.gtg[b * k + a] += dot3(&g[a], &g[b]);
+                        }
                     }
-                    for (t, j) in range.clone().enumerate() {
-                        sums.gtt[a] += fa[t] * self.target_product(j, *ba);
-                    }
-                    for (b, (bb, fb)) in cols.iter().enumerate().skip(a) {
-                        let fb = &fb[range.clone()];
-                        sums.gtg[a * k + b] = range
-                            .clone()
-                            .enumerate()
-                            .map(|(t, j)| fa[t] * fb[t] * self.gram(j, *ba, *bb))
-                            .sum();
+                    for c in 0..3 {
+                        self.basis_row(3 * j + c, &mut row);
+                        for (a, ga) in g.iter().enumerate() {
+                            let v = ga[c];
+                            if v != 0.0 {
+                                let out = &mut sums.xtg[a * p..(a + 1) * p];
+                                out.iter_mut().zip(&row).for_each(|(o, x)| *o += x * v);
+                            }
+                        }
                     }
                 }
                 sums
@@ -659,6 +660,18 @@ impl Linearisation {
         let mut total = Sums::zero(p, k);
         partial.iter().for_each(|s| total.add(s));
         self.score_of(total, 1.0)
+    }
+
+    /// Design row `i` on the basis columns, into `out`.
+    fn basis_row(&self, i: usize, out: &mut [f64]) {
+        let row = self.row(i);
+        if self.basis.len() == self.width {
+            out.copy_from_slice(row);
+        } else {
+            for (o, &c) in out.iter_mut().zip(&self.basis) {
+                *o = row[c];
+            }
+        }
     }
 
     /// The score from sums over poses of columns scaled by `scale`.
