@@ -210,13 +210,14 @@ impl Dictionary {
             period_mm: Some(1.0 / f),
             ..*group
         };
-        let score = |f: f64| at.score(&with(f));
         let near_admitted = |f: f64| admitted.iter().any(|a| (f - a).abs() <= 2.0 * self.step);
         let commands: Vec<[f64; 3]> = at.data.poses.iter().map(|p| p.commands_mm).collect();
+        let legs = group.legs();
+        let score = |f: f64| at.lin.periodic_score(&commands, &legs, f);
         let f0 = self.frequencies.first().copied()?;
         let scores = at.lin.periodic_scan(
             &commands,
-            &group.legs(),
+            &legs,
             f0,
             self.step,
             self.frequencies.len(),

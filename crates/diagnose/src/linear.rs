@@ -740,10 +740,13 @@ impl Linearisation {
                 })
                 .collect();
             let angle = |f: f64, i: usize, j: usize| std::f64::consts::TAU * f * commands_mm[j][i];
-            let rotation: Vec<Vec<(f64, f64)>> = legs
-                .iter()
-                .map(|&i| (start..end).map(|j| angle(step, i, j).sin_cos()).collect())
-                .collect();
+            let rotation: Vec<Vec<(f64, f64)>> = if count > 1 {
+                legs.iter()
+                    .map(|&i| (start..end).map(|j| angle(step, i, j).sin_cos()).collect())
+                    .collect()
+            } else {
+                vec![Vec::new(); nl]
+            };
             // values[2 l] the sines of leg l, values[2 l + 1] its cosines.
             let mut values = vec![vec![0.0; len]; 2 * nl];
             for (f, acc) in sums.iter_mut().enumerate() {
@@ -765,8 +768,16 @@ impl Linearisation {
                     // X^T G for the leg's two columns: a pair of dot
                     // products per basis column.
                     let (qs, qc) = acc.xtg[2 * l * p..(2 * l + 2) * p].split_at_mut(p);
-                    for (r, x) in projected[l].chunks_exact(len).enumerate() {
-                        (qs[r], qc[r]) = dot2(x, sines, cosines);
+                    let rows = projected[l];
+                    for r in (0..p).step_by(2) {
+                        let x = &rows[r * len..(r + 1) * len];
+                        if r + 1 < p {
+                            let y = &rows[(r + 1) * len..(r + 2) * len];
+                            let ([sx, cx], [sy, cy]) = dot2x2(x, y, sines, cosines);
+                            (qs[r], qc[r], qs[r + 1], qc[r + 1]) = (sx, cx, sy, cy);
+                        } else {
+                            (qs[r], qc[r]) = dot2(x, sines, cosines);
+                        }
                     }
                 }
                 for a in 0..2 * nl {
@@ -808,6 +819,20 @@ impl Linearisation {
             .collect()
     }
 
+    /// The score of the leg-periodic term on `legs` at frequency `f`
+    /// (1/mm): [`Linearisation::periodic_scan`] of that one frequency.
+    pub(crate) fn periodic_score(
+        &self,
+        commands_mm: &[[f64; 3]],
+        legs: &[usize],
+        f: f64,
+    ) -> (f64, usize) {
+        self.periodic_scan(commands_mm, legs, f, 0.0, 1)
+            .first()
+            .copied()
+            .unwrap_or((0.0, 0))
+    }
+
     /// Dense weighted columns (`3n x k`) of per-pose values.
     pub(crate) fn dense(&self, cols: &[(usize, Vec<f64>)]) -> DMatrix<f64> {
         let n = self.poses();
@@ -837,6 +862,35 @@ impl Linearisation {
             .find(|(t, _)| t == term)
             .map(|(_, r)| self.extra.columns(r.start, r.len()).into_owned())
     }
+}
+
+/// `([x . s, x . c], [y . s, y . c])`, each as [`dot2`] computes it.
+fn dot2x2(x: &[f64], y: &[f64], s: &[f64], c: &[f64]) -> ([f64; 2], [f64; 2]) {
+    let mut acc = [[0.0; 4]; 4];
+    let (cx, cy, cs, cc) = (
+        x.chunks_exact(4),
+        y.chunks_exact(4),
+        s.chunks_exact(4),
+        c.chunks_exact(4),
+    );
+    for (((x, y), s), c) in cx.zip(cy).zip(cs).zip(cc) {
+        for l in 0..4 {
+            acc[0][l] += x[l] * s[l];
+            acc[1][l] += x[l] * c[l];
+            acc[2][l] += y[l] * s[l];
+            acc[3][l] += y[l] * c[l];
+        }
+    }
+    let whole = x.len() / 4 * 4;
+    let mut tail = [0.0; 4];
+    for t in whole..x.len().min(y.len()).min(s.len()).min(c.len()) {
+        tail[0] += x[t] * s[t];
+        tail[1] += x[t] * c[t];
+        tail[2] += y[t] * s[t];
+        tail[3] += y[t] * c[t];
+    }
+    let sum = |i: usize| (acc[i][0] + acc[i][1]) + (acc[i][2] + acc[i][3]) + tail[i];
+    ([sum(0), sum(1)], [sum(2), sum(3)])
 }
 
 /// `a . b` of 3-vectors.
@@ -1104,6 +1158,19 @@ mod tests {
                     .all(|(a, b)| a.0.to_bits() == b.0.to_bits() && a.1 == b.1),
                 "{threads} threads"
             );
+        }
+    }
+
+    #[test]
+    fn paired_dot_products_are_those_of_each_row() {
+        for len in [0, 3, 4, 9, 256] {
+            let v = |k: f64| -> Vec<f64> { (0..len).map(|i| (i as f64 * k).sin()).collect() };
+            let (x, y, s, c) = (v(0.3), v(1.7), v(2.9), v(0.11));
+            let (a, b) = dot2x2(&x, &y, &s, &c);
+            let (xs, xc) = dot2(&x, &s, &c);
+            let (ys, yc) = dot2(&y, &s, &c);
+            assert_eq!([a, b].map(|p| p.map(f64::to_bits)), [[xs, xc], [ys, yc]].map(|p| p.map(f64::to_bits)));
+            assert!((xs - dot(&x, &s)).abs() <= 1e-12 * len as f64);
         }
     }
 
