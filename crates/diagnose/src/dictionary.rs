@@ -215,13 +215,9 @@ impl Dictionary {
         let legs = group.legs();
         let score = |f: f64| at.lin.periodic_score(&commands, &legs, f);
         let f0 = self.frequencies.first().copied()?;
-        let scores = at.lin.periodic_scan(
-            &commands,
-            &legs,
-            f0,
-            self.step,
-            self.frequencies.len(),
-        );
+        let scores = at
+            .lin
+            .periodic_scan(&commands, &legs, f0, self.step, self.frequencies.len());
         let mut best: Option<(f64, f64)> = None;
         for (&f, &(s, k)) in self.frequencies.iter().zip(&scores) {
             if near_admitted(f) {

@@ -552,20 +552,30 @@ impl Linearisation {
                 Vec::new()
             }
         });
+        // A tile of poses at a time, pose-major, then copied into rows.
+        const TILE: usize = 8;
         let mut row = vec![0.0; p];
-        for (t, j) in range.enumerate() {
-            let d = &self.directions[j];
-            for c in 0..3 {
-                self.basis_row(3 * j + c, &mut row);
-                for b in 0..6 {
-                    let w = d[b][c];
-                    if !wanted[b] || w == 0.0 {
-                        continue;
+        let mut tile = vec![[0.0; TILE]; p];
+        let first = range.start;
+        for t0 in (0..len).step_by(TILE) {
+            let width = TILE.min(len - t0);
+            for b in (0..6).filter(|&b| wanted[b]) {
+                tile.iter_mut().for_each(|v| *v = [0.0; TILE]);
+                for tt in 0..width {
+                    let j = first + t0 + tt;
+                    for c in 0..3 {
+                        let w = self.directions[j][b][c];
+                        if w == 0.0 {
+                            continue;
+                        }
+                        self.basis_row(3 * j + c, &mut row);
+                        for (v, x) in tile.iter_mut().zip(&row) {
+                            v[tt] += x * w;
+                        }
                     }
-                    let out = &mut of[b][t..];
-                    for (o, x) in out.iter_mut().step_by(len).zip(&row) {
-                        *o += x * w;
-                    }
+                }
+                for (r, v) in tile.iter().enumerate() {
+                    of[b][r * len + t0..r * len + t0 + width].copy_from_slice(&v[..width]);
                 }
             }
         }
@@ -785,12 +795,7 @@ impl Linearisation {
                     acc.gtt[a] += dot(va, &products[a / 2]);
                     for b in a..2 * nl {
                         let g = &gram[(a / 2) * nl + b / 2];
-                        acc.gtg[a * k + b] += va
-                            .iter()
-                            .zip(&values[b])
-                            .zip(g)
-                            .map(|((x, y), g)| x * y * g)
-                            .sum::<f64>();
+                        acc.gtg[a * k + b] += triple(va, &values[b], g);
                     }
                 }
             }
@@ -862,6 +867,25 @@ impl Linearisation {
             .find(|(t, _)| t == term)
             .map(|(_, r)| self.extra.columns(r.start, r.len()).into_owned())
     }
+}
+
+/// `sum x_t y_t w_t`, in four interleaved partial sums.
+fn triple(x: &[f64], y: &[f64], w: &[f64]) -> f64 {
+    let mut s = [0.0; 4];
+    let (cx, cy, cw) = (x.chunks_exact(4), y.chunks_exact(4), w.chunks_exact(4));
+    let tail: f64 = cx
+        .remainder()
+        .iter()
+        .zip(cy.remainder())
+        .zip(cw.remainder())
+        .map(|((x, y), w)| x * y * w)
+        .sum();
+    for ((x, y), w) in cx.zip(cy).zip(cw) {
+        for l in 0..4 {
+            s[l] += x[l] * y[l] * w[l];
+        }
+    }
+    (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
 /// `([x . s, x . c], [y . s, y . c])`, each as [`dot2`] computes it.
@@ -1169,7 +1193,10 @@ mod tests {
             let (a, b) = dot2x2(&x, &y, &s, &c);
             let (xs, xc) = dot2(&x, &s, &c);
             let (ys, yc) = dot2(&y, &s, &c);
-            assert_eq!([a, b].map(|p| p.map(f64::to_bits)), [[xs, xc], [ys, yc]].map(|p| p.map(f64::to_bits)));
+            assert_eq!(
+                [a, b].map(|p| p.map(f64::to_bits)),
+                [[xs, xc], [ys, yc]].map(|p| p.map(f64::to_bits))
+            );
             assert!((xs - dot(&x, &s)).abs() <= 1e-12 * len as f64);
         }
     }
