@@ -554,7 +554,7 @@ impl Linearisation {
         });
         // A tile of poses at a time, pose-major, then copied into rows.
         const TILE: usize = 8;
-        let mut row = vec![0.0; p];
+        let mut buffer = vec![0.0; p];
         let mut tile = vec![[0.0; TILE]; p];
         let first = range.start;
         for t0 in (0..len).step_by(TILE) {
@@ -568,8 +568,8 @@ impl Linearisation {
                         if w == 0.0 {
                             continue;
                         }
-                        self.basis_row(3 * j + c, &mut row);
-                        for (v, x) in tile.iter_mut().zip(&row) {
+                        let row = self.basis_row(3 * j + c, &mut buffer);
+                        for (v, x) in tile.iter_mut().zip(row) {
                             v[tt] += x * w;
                         }
                     }
@@ -629,37 +629,56 @@ impl Linearisation {
 
     /// The score of columns given as (direction, per-pose value).
     pub(crate) fn score_columns(&self, cols: &[(usize, Vec<f64>)]) -> Score {
-        let k = cols.len();
-        let p = self.basis.len();
         let n = self
             .poses()
             .min(cols.iter().map(|c| c.1.len()).min().unwrap_or(0));
+        let directions: Vec<usize> = cols.iter().map(|c| c.0).collect();
+        let values = |j: usize, out: &mut [f64]| {
+            for (o, (_, f)) in out.iter_mut().zip(cols) {
+                *o = f[j];
+            }
+        };
+        self.score_of(self.sums(n, &directions, &values), 1.0)
+    }
+
+    /// The sums over the first `n` poses of `k` columns: column `a` at
+    /// pose `j` is direction `directions[a]` times `values(j)[a]`. Blocks
+    /// of poses in parallel, summed in block order.
+    fn sums(
+        &self,
+        n: usize,
+        directions: &[usize],
+        values: &(dyn Fn(usize, &mut [f64]) + Sync),
+    ) -> Sums {
+        let k = directions.len();
+        let p = self.basis.len();
         let starts: Vec<usize> = (0..n).step_by(BLOCK).collect();
         let partial: Vec<Sums> = starts
             .par_iter()
             .map(|&start| {
                 let mut sums = Sums::zero(p, k);
-                // The columns' 3-vectors at one pose, and a design row on
-                // the basis.
+                // The columns' values and 3-vectors at one pose.
+                let mut v = vec![0.0; k];
                 let mut g = vec![[0.0; 3]; k];
-                let mut row = vec![0.0; p];
+                let mut buffer = vec![0.0; p];
                 for j in start..(start + BLOCK).min(n) {
+                    values(j, &mut v);
                     let d = &self.directions[j];
                     let t = &self.target.as_slice()[3 * j..3 * j + 3];
-                    for (a, (b, f)) in cols.iter().enumerate() {
-                        g[a] = d[*b].map(|v| v * f[j]);
+                    for a in 0..k {
+                        g[a] = d[directions[a]].map(|x| x * v[a]);
                         sums.gtt[a] += g[a][0] * t[0] + g[a][1] * t[1] + g[a][2] * t[2];
                         for b in 0..=a {
                             sums.gtg[b * k + a] += dot3(&g[a], &g[b]);
                         }
                     }
                     for c in 0..3 {
-                        self.basis_row(3 * j + c, &mut row);
+                        let row = self.basis_row(3 * j + c, &mut buffer);
                         for (a, ga) in g.iter().enumerate() {
-                            let v = ga[c];
-                            if v != 0.0 {
+                            let w = ga[c];
+                            if w != 0.0 {
                                 let out = &mut sums.xtg[a * p..(a + 1) * p];
-                                out.iter_mut().zip(&row).for_each(|(o, x)| *o += x * v);
+                                out.iter_mut().zip(row).for_each(|(o, x)| *o += x * w);
                             }
                         }
                     }
@@ -669,19 +688,20 @@ impl Linearisation {
             .collect();
         let mut total = Sums::zero(p, k);
         partial.iter().for_each(|s| total.add(s));
-        self.score_of(total, 1.0)
+        total
     }
 
-    /// Design row `i` on the basis columns, into `out`.
-    fn basis_row(&self, i: usize, out: &mut [f64]) {
+    /// Design row `i` on the basis columns (gathered into `buffer` when the
+    /// basis leaves some out).
+    fn basis_row<'s>(&'s self, i: usize, buffer: &'s mut [f64]) -> &'s [f64] {
         let row = self.row(i);
         if self.basis.len() == self.width {
-            out.copy_from_slice(row);
-        } else {
-            for (o, &c) in out.iter_mut().zip(&self.basis) {
-                *o = row[c];
-            }
+            return row;
         }
+        for (o, &c) in buffer.iter_mut().zip(&self.basis) {
+            *o = row[c];
+        }
+        buffer
     }
 
     /// The score from sums over poses of columns scaled by `scale`.
@@ -825,17 +845,25 @@ impl Linearisation {
     }
 
     /// The score of the leg-periodic term on `legs` at frequency `f`
-    /// (1/mm): [`Linearisation::periodic_scan`] of that one frequency.
+    /// (1/mm), as [`Linearisation::periodic_scan`] scores a frequency of
+    /// its grid, up to rounding: its columns evaluated pose by pose.
     pub(crate) fn periodic_score(
         &self,
         commands_mm: &[[f64; 3]],
         legs: &[usize],
         f: f64,
     ) -> (f64, usize) {
-        self.periodic_scan(commands_mm, legs, f, 0.0, 1)
-            .first()
-            .copied()
-            .unwrap_or((0.0, 0))
+        let n = self.poses().min(commands_mm.len());
+        let directions: Vec<usize> = legs.iter().flat_map(|&i| [i, i]).collect();
+        let values = |j: usize, out: &mut [f64]| {
+            for (l, &i) in legs.iter().enumerate() {
+                (out[2 * l], out[2 * l + 1]) =
+                    (std::f64::consts::TAU * f * commands_mm[j][i]).sin_cos();
+            }
+        };
+        // The columns are `1e-3` sin and cos (mm per um).
+        let s = self.score_of(self.sums(n, &directions, &values), 1e-3);
+        (s.explained, s.rank)
     }
 
     /// Dense weighted columns (`3n x k`) of per-pose values.
@@ -1084,6 +1112,13 @@ mod tests {
                     .collect();
                 let direct = lin.score_columns(&cols);
                 assert_eq!(rank, direct.rank, "frequency {k}");
+                let (one, one_rank) = lin.periodic_score(&commands, &legs, f0 + k as f64 * step);
+                assert_eq!(one_rank, direct.rank, "frequency {k}");
+                assert!(
+                    (one - direct.explained).abs() <= 1e-9 * direct.explained.max(1.0),
+                    "frequency {k}: one frequency {one} against {}",
+                    direct.explained
+                );
                 let tolerance = 1e-9 * direct.explained.max(1.0);
                 assert!(
                     (explained - direct.explained).abs() <= tolerance,
