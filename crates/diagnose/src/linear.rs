@@ -751,8 +751,7 @@ impl Linearisation {
         legs.iter().for_each(|&i| wanted[i] = true);
         let block_sums = |start: usize| -> Vec<Sums> {
             let end = (start + BLOCK).min(n);
-            let len = end - start;
-            let mut sums: Vec<Sums> = (0..count).map(|_| Sums::zero(p, k)).collect();
+            let sums: Vec<Sums> = (0..count).map(|_| Sums::zero(p, k)).collect();
             // Per leg, over the block's poses: the projected directions,
             // the target products, the rotation by one grid step and the
             // current sine and cosine; per pair of legs, their directions'
@@ -777,49 +776,19 @@ impl Linearisation {
             } else {
                 vec![Vec::new(); nl]
             };
-            // values[2 l] the sines of leg l, values[2 l + 1] its cosines.
-            let mut values = vec![vec![0.0; len]; 2 * nl];
-            for (f, acc) in sums.iter_mut().enumerate() {
-                let frequency = f0 + f as f64 * step;
-                for (l, &i) in legs.iter().enumerate() {
-                    let (sines, rest) = values[2 * l..].split_at_mut(1);
-                    let (sines, cosines) = (&mut sines[0], &mut rest[0]);
-                    if f % SCAN_RESEED == 0 {
-                        for (t, j) in (start..end).enumerate() {
-                            (sines[t], cosines[t]) = angle(frequency, i, j).sin_cos();
-                        }
-                    } else {
-                        for ((s, c), &(ws, wc)) in
-                            sines.iter_mut().zip(cosines.iter_mut()).zip(&rotation[l])
-                        {
-                            (*s, *c) = (*s * wc + *c * ws, *c * wc - *s * ws);
-                        }
-                    }
-                    // X^T G for the leg's two columns: a pair of dot
-                    // products per basis column.
-                    let (qs, qc) = acc.xtg[2 * l * p..(2 * l + 2) * p].split_at_mut(p);
-                    let rows = projected[l];
-                    for r in (0..p).step_by(2) {
-                        let x = &rows[r * len..(r + 1) * len];
-                        if r + 1 < p {
-                            let y = &rows[(r + 1) * len..(r + 2) * len];
-                            let ([sx, cx], [sy, cy]) = dot2x2(x, y, sines, cosines);
-                            (qs[r], qc[r], qs[r + 1], qc[r + 1]) = (sx, cx, sy, cy);
-                        } else {
-                            (qs[r], qc[r]) = dot2(x, sines, cosines);
-                        }
-                    }
-                }
-                for a in 0..2 * nl {
-                    let va = &values[a];
-                    acc.gtt[a] += dot(va, &products[a / 2]);
-                    for b in a..2 * nl {
-                        let g = &gram[(a / 2) * nl + b / 2];
-                        acc.gtg[a * k + b] += triple(va, &values[b], g);
-                    }
-                }
-            }
-            sums
+            pulp::Arch::new().dispatch(ScanBlock {
+                commands_mm,
+                legs,
+                poses: start..end,
+                f0,
+                step,
+                p,
+                projected,
+                products,
+                gram,
+                rotation,
+                sums,
+            })
         };
         let starts: Vec<usize> = (0..n).step_by(BLOCK).collect();
         let mut total: Vec<Sums> = (0..count).map(|_| Sums::zero(p, k)).collect();
@@ -897,101 +866,197 @@ impl Linearisation {
     }
 }
 
-/// `sum x_t y_t w_t`, in four interleaved partial sums.
-fn triple(x: &[f64], y: &[f64], w: &[f64]) -> f64 {
-    let mut s = [0.0; 4];
-    let (cx, cy, cw) = (x.chunks_exact(4), y.chunks_exact(4), w.chunks_exact(4));
-    let tail: f64 = cx
-        .remainder()
-        .iter()
-        .zip(cy.remainder())
-        .zip(cw.remainder())
-        .map(|((x, y), w)| x * y * w)
-        .sum();
-    for ((x, y), w) in cx.zip(cy).zip(cw) {
-        for l in 0..4 {
-            s[l] += x[l] * y[l] * w[l];
-        }
+/// The frequency loop of one block of [`Linearisation::periodic_scan`],
+/// run with the widest vector instructions the CPU has
+/// ([`pulp::Arch::dispatch`]). The code is scalar: each product's four
+/// interleaved partial sums are the same at any vector width and nothing
+/// is fused into a multiply-add, so the bits do not depend on the CPU.
+struct ScanBlock<'a> {
+    commands_mm: &'a [[f64; 3]],
+    legs: &'a [usize],
+    poses: Range<usize>,
+    f0: f64,
+    step: f64,
+    /// Basis columns.
+    p: usize,
+    /// Per leg, the projected directions (`p x len`, row-major).
+    projected: Vec<&'a [f64]>,
+    /// Per leg, the directions' products with the target.
+    products: Vec<Vec<f64>>,
+    /// Per pair of legs, their directions' inner products.
+    gram: Vec<Vec<f64>>,
+    /// Per leg, the rotation by one grid step.
+    rotation: Vec<Vec<(f64, f64)>>,
+    /// Per frequency, the block's sums.
+    sums: Vec<Sums>,
+}
+
+impl pulp::WithSimd for ScanBlock<'_> {
+    type Output = Vec<Sums>;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) -> Vec<Sums> {
+        self.run(simd)
     }
+}
+
+impl ScanBlock<'_> {
+    #[inline(always)]
+    fn run<S: pulp::Simd>(self, simd: S) -> Vec<Sums> {
+        let ScanBlock {
+            commands_mm,
+            legs,
+            poses,
+            f0,
+            step,
+            p,
+            projected,
+            products,
+            gram,
+            rotation,
+            mut sums,
+        } = self;
+        let len = poses.len();
+        let nl = legs.len();
+        let k = 2 * nl;
+        let angle = |f: f64, i: usize, j: usize| std::f64::consts::TAU * f * commands_mm[j][i];
+        // values[2 l] the sines of leg l, values[2 l + 1] its cosines.
+        let mut values = vec![vec![0.0; len]; 2 * nl];
+        for (f, acc) in sums.iter_mut().enumerate() {
+            let frequency = f0 + f as f64 * step;
+            for (l, &i) in legs.iter().enumerate() {
+                let (sines, rest) = values[2 * l..].split_at_mut(1);
+                let (sines, cosines) = (&mut sines[0], &mut rest[0]);
+                if f % SCAN_RESEED == 0 {
+                    for (t, j) in poses.clone().enumerate() {
+                        (sines[t], cosines[t]) = angle(frequency, i, j).sin_cos();
+                    }
+                } else {
+                    for ((s, c), &(ws, wc)) in
+                        sines.iter_mut().zip(cosines.iter_mut()).zip(&rotation[l])
+                    {
+                        (*s, *c) = (*s * wc + *c * ws, *c * wc - *s * ws);
+                    }
+                }
+                // X^T G for the leg's two columns: a pair of dot products
+                // per basis column, two columns at a time.
+                let (qs, qc) = acc.xtg[2 * l * p..(2 * l + 2) * p].split_at_mut(p);
+                let rows = projected[l];
+                for r in (0..p).step_by(2) {
+                    let x = &rows[r * len..(r + 1) * len];
+                    if r + 1 < p {
+                        let y = &rows[(r + 1) * len..(r + 2) * len];
+                        let [sx, cx, sy, cy] = sums4(
+                            simd,
+                            [x, y, sines, cosines],
+                            |[x, y, s, c]| {
+                                [(x, s), (x, c), (y, s), (y, c)].map(|(a, b)| simd.mul_f64s(*a, *b))
+                            },
+                            |[x, y, s, c]| [x * s, x * c, y * s, y * c],
+                        );
+                        (qs[r], qc[r], qs[r + 1], qc[r + 1]) = (sx, cx, sy, cy);
+                    } else {
+                        let [sx, cx] = sums4(
+                            simd,
+                            [x, sines, cosines],
+                            |[x, s, c]| [simd.mul_f64s(*x, *s), simd.mul_f64s(*x, *c)],
+                            |[x, s, c]| [x * s, x * c],
+                        );
+                        (qs[r], qc[r]) = (sx, cx);
+                    }
+                }
+            }
+            for a in 0..k {
+                let va = &values[a];
+                let [t] = sums4(
+                    simd,
+                    [va, &products[a / 2]],
+                    |[x, y]| [simd.mul_f64s(*x, *y)],
+                    |[x, y]| [x * y],
+                );
+                acc.gtt[a] += t;
+                for b in a..k {
+                    let g = &gram[(a / 2) * nl + b / 2];
+                    let [w] = sums4(
+                        simd,
+                        [va, &values[b], g],
+                        |[x, y, w]| [simd.mul_f64s(simd.mul_f64s(*x, *y), *w)],
+                        |[x, y, w]| [x * y * w],
+                    );
+                    acc.gtg[a * k + b] += w;
+                }
+            }
+        }
+        sums
+    }
+}
+
+/// The four lanes of a four-wide vector.
+#[inline(always)]
+fn lanes<S: pulp::Simd>(v: S::f64s) -> [f64; 4] {
+    let mut out = [0.0; 4];
+    if let Some(o) = S::as_mut_simd_f64s(&mut out).0.first_mut() {
+        *o = v;
+    }
+    out
+}
+
+/// `(s0 + s1) + (s2 + s3) + tail` of four partial sums.
+#[inline(always)]
+fn combine(s: [f64; 4], tail: f64) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
-/// `([x . s, x . c], [y . s, y . c])`, each as [`dot2`] computes it.
-fn dot2x2(x: &[f64], y: &[f64], s: &[f64], c: &[f64]) -> ([f64; 2], [f64; 2]) {
-    let mut acc = [[0.0; 4]; 4];
-    let (cx, cy, cs, cc) = (
-        x.chunks_exact(4),
-        y.chunks_exact(4),
-        s.chunks_exact(4),
-        c.chunks_exact(4),
-    );
-    for (((x, y), s), c) in cx.zip(cy).zip(cs).zip(cc) {
-        for l in 0..4 {
-            acc[0][l] += x[l] * s[l];
-            acc[1][l] += x[l] * c[l];
-            acc[2][l] += y[l] * s[l];
-            acc[3][l] += y[l] * c[l];
+/// `n` products of slices, summed as the scalar kernels below do (element
+/// `t` into partial sum `t mod 4`, the tail after the last whole four in
+/// order, then [`combine`]) with four-wide vectors when `S` has four lanes
+/// and with the scalar kernel otherwise: the same bits either way (no
+/// fused multiply-add).
+#[inline(always)]
+fn sums4<S: pulp::Simd, const N: usize, const M: usize>(
+    simd: S,
+    x: [&[f64]; M],
+    vector: impl Fn(&[S::f64s; M]) -> [S::f64s; N],
+    scalar: impl Fn(&[f64; M]) -> [f64; N],
+) -> [f64; N] {
+    let len = x.iter().map(|v| v.len()).min().unwrap_or(0);
+    let whole = len / 4 * 4;
+    let mut partial = [[0.0; 4]; N];
+    if S::F64_LANES == 4 {
+        let heads = x.map(|v| S::as_simd_f64s(&v[..whole]).0);
+        let mut acc = [simd.splat_f64s(0.0); N];
+        for i in 0..whole / 4 {
+            let t = vector(&std::array::from_fn(|m| heads[m][i]));
+            for q in 0..N {
+                acc[q] = simd.add_f64s(acc[q], t[q]);
+            }
+        }
+        for q in 0..N {
+            partial[q] = lanes::<S>(acc[q]);
+        }
+    } else {
+        for i in (0..whole).step_by(4) {
+            for l in 0..4 {
+                let t = scalar(&std::array::from_fn(|m| x[m][i + l]));
+                for q in 0..N {
+                    partial[q][l] += t[q];
+                }
+            }
         }
     }
-    let whole = x.len() / 4 * 4;
-    let mut tail = [0.0; 4];
-    for t in whole..x.len().min(y.len()).min(s.len()).min(c.len()) {
-        tail[0] += x[t] * s[t];
-        tail[1] += x[t] * c[t];
-        tail[2] += y[t] * s[t];
-        tail[3] += y[t] * c[t];
+    let mut tail = [0.0; N];
+    for i in whole..len {
+        let t = scalar(&std::array::from_fn(|m| x[m][i]));
+        for q in 0..N {
+            tail[q] += t[q];
+        }
     }
-    let sum = |i: usize| (acc[i][0] + acc[i][1]) + (acc[i][2] + acc[i][3]) + tail[i];
-    ([sum(0), sum(1)], [sum(2), sum(3)])
+    std::array::from_fn(|q| combine(partial[q], tail[q]))
 }
 
 /// `a . b` of 3-vectors.
 fn dot3(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// `a . b`, in four interleaved partial sums.
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut s = [0.0; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = ca
-        .remainder()
-        .iter()
-        .zip(cb.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in ca.zip(cb) {
-        for l in 0..4 {
-            s[l] += x[l] * y[l];
-        }
-    }
-    (s[0] + s[1]) + (s[2] + s[3]) + tail
-}
-
-/// `(x . s, x . c)`, in four interleaved partial sums each.
-fn dot2(x: &[f64], s: &[f64], c: &[f64]) -> (f64, f64) {
-    let (mut a, mut b) = ([0.0; 4], [0.0; 4]);
-    let (cx, cs, cc) = (x.chunks_exact(4), s.chunks_exact(4), c.chunks_exact(4));
-    let (mut ta, mut tb) = (0.0, 0.0);
-    for ((x, s), c) in cx
-        .remainder()
-        .iter()
-        .zip(cs.remainder())
-        .zip(cc.remainder())
-    {
-        ta += x * s;
-        tb += x * c;
-    }
-    for ((x, s), c) in cx.zip(cs).zip(cc) {
-        for l in 0..4 {
-            a[l] += x[l] * s[l];
-            b[l] += x[l] * c[l];
-        }
-    }
-    (
-        (a[0] + a[1]) + (a[2] + a[3]) + ta,
-        (b[0] + b[1]) + (b[2] + b[3]) + tb,
-    )
 }
 
 /// Whether the column space of `a` lies inside that of `b` (every
@@ -1221,18 +1286,34 @@ mod tests {
     }
 
     #[test]
-    fn paired_dot_products_are_those_of_each_row() {
-        for len in [0, 3, 4, 9, 256] {
+    fn vector_sums_have_the_bits_of_the_scalar_ones() {
+        fn sums<S: pulp::Simd>(simd: S, x: &[f64], y: &[f64], w: &[f64]) -> [f64; 2] {
+            sums4(
+                simd,
+                [x, y, w],
+                |[x, y, w]| {
+                    [
+                        simd.mul_f64s(*x, *y),
+                        simd.mul_f64s(simd.mul_f64s(*x, *y), *w),
+                    ]
+                },
+                |[x, y, w]| [x * y, x * y * w],
+            )
+        }
+        for len in [0, 3, 4, 9, 256, 1001] {
             let v = |k: f64| -> Vec<f64> { (0..len).map(|i| (i as f64 * k).sin()).collect() };
-            let (x, y, s, c) = (v(0.3), v(1.7), v(2.9), v(0.11));
-            let (a, b) = dot2x2(&x, &y, &s, &c);
-            let (xs, xc) = dot2(&x, &s, &c);
-            let (ys, yc) = dot2(&y, &s, &c);
-            assert_eq!(
-                [a, b].map(|p| p.map(f64::to_bits)),
-                [[xs, xc], [ys, yc]].map(|p| p.map(f64::to_bits))
+            let (x, y, w) = (v(0.3), v(1.7), v(2.9));
+            let scalar = sums(pulp::Scalar::new(), &x, &y, &w);
+            let naive: f64 = x.iter().zip(&y).map(|(a, b)| a * b).sum();
+            assert!(
+                (scalar[0] - naive).abs() <= 1e-12 * (len as f64 + 1.0),
+                "{len}"
             );
-            assert!((xs - dot(&x, &s)).abs() <= 1e-12 * len as f64);
+            #[cfg(target_arch = "x86_64")]
+            if let Some(simd) = pulp::x86::V3::try_new() {
+                let vector = sums(simd, &x, &y, &w);
+                assert_eq!(vector.map(f64::to_bits), scalar.map(f64::to_bits), "{len}");
+            }
         }
     }
 
