@@ -656,34 +656,12 @@ impl Linearisation {
         let partial: Vec<Sums> = starts
             .par_iter()
             .map(|&start| {
-                let mut sums = Sums::zero(p, k);
-                // The columns' values and 3-vectors at one pose.
-                let mut v = vec![0.0; k];
-                let mut g = vec![[0.0; 3]; k];
-                let mut buffer = vec![0.0; p];
-                for j in start..(start + BLOCK).min(n) {
-                    values(j, &mut v);
-                    let d = &self.directions[j];
-                    let t = &self.target.as_slice()[3 * j..3 * j + 3];
-                    for a in 0..k {
-                        g[a] = d[directions[a]].map(|x| x * v[a]);
-                        sums.gtt[a] += g[a][0] * t[0] + g[a][1] * t[1] + g[a][2] * t[2];
-                        for b in 0..=a {
-                            sums.gtg[b * k + a] += dot3(&g[a], &g[b]);
-                        }
-                    }
-                    for c in 0..3 {
-                        let row = self.basis_row(3 * j + c, &mut buffer);
-                        for (a, ga) in g.iter().enumerate() {
-                            let w = ga[c];
-                            if w != 0.0 {
-                                let out = &mut sums.xtg[a * p..(a + 1) * p];
-                                out.iter_mut().zip(row).for_each(|(o, x)| *o += x * w);
-                            }
-                        }
-                    }
-                }
-                sums
+                pulp::Arch::new().dispatch(SumsBlock {
+                    lin: self,
+                    poses: start..(start + BLOCK).min(n),
+                    directions,
+                    values,
+                })
             })
             .collect();
         let mut total = Sums::zero(p, k);
@@ -863,6 +841,74 @@ impl Linearisation {
             .iter()
             .find(|(t, _)| t == term)
             .map(|(_, r)| self.extra.columns(r.start, r.len()).into_owned())
+    }
+}
+
+/// One block of poses of [`Linearisation::sums`] (with the widest vector
+/// instructions the CPU has; the products are element by element, the
+/// same bits at any width).
+struct SumsBlock<'a> {
+    lin: &'a Linearisation,
+    poses: Range<usize>,
+    directions: &'a [usize],
+    values: &'a (dyn Fn(usize, &mut [f64]) + Sync),
+}
+
+impl pulp::WithSimd for SumsBlock<'_> {
+    type Output = Sums;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) -> Sums {
+        let SumsBlock {
+            lin,
+            poses,
+            directions,
+            values,
+        } = self;
+        let k = directions.len();
+        let p = lin.basis.len();
+        let mut sums = Sums::zero(p, k);
+        // The columns' values and 3-vectors at one pose.
+        let mut v = vec![0.0; k];
+        let mut g = vec![[0.0; 3]; k];
+        let mut buffer = vec![0.0; p];
+        for j in poses {
+            values(j, &mut v);
+            let d = &lin.directions[j];
+            let t = &lin.target.as_slice()[3 * j..3 * j + 3];
+            for a in 0..k {
+                g[a] = d[directions[a]].map(|x| x * v[a]);
+                sums.gtt[a] += g[a][0] * t[0] + g[a][1] * t[1] + g[a][2] * t[2];
+                for b in 0..=a {
+                    sums.gtg[b * k + a] += dot3(&g[a], &g[b]);
+                }
+            }
+            for c in 0..3 {
+                let row = lin.basis_row(3 * j + c, &mut buffer);
+                for (a, ga) in g.iter().enumerate() {
+                    let w = ga[c];
+                    if w != 0.0 {
+                        axpy(simd, &mut sums.xtg[a * p..(a + 1) * p], row, w);
+                    }
+                }
+            }
+        }
+        sums
+    }
+}
+
+/// `out += w x`, element by element.
+#[inline(always)]
+fn axpy<S: pulp::Simd>(simd: S, out: &mut [f64], x: &[f64], w: f64) {
+    let len = out.len().min(x.len());
+    let (oh, ot) = S::as_mut_simd_f64s(&mut out[..len]);
+    let (xh, xt) = S::as_simd_f64s(&x[..len]);
+    let wv = simd.splat_f64s(w);
+    for (o, x) in oh.iter_mut().zip(xh) {
+        *o = simd.add_f64s(*o, simd.mul_f64s(*x, wv));
+    }
+    for (o, x) in ot.iter_mut().zip(xt) {
+        *o += x * w;
     }
 }
 
