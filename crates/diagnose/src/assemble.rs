@@ -13,7 +13,7 @@ use crate::alias::{Aliases, analyse};
 use crate::describe::describe;
 use crate::dictionary::Scored;
 use crate::error::DiagnoseError;
-use crate::fit::{Fit, estimates, residuals_of, without};
+use crate::fit::{Fit, clean_poses, estimates, residuals_of, without};
 use crate::gain::{improvement, volumetric_difference};
 use crate::noise::{Repeats, noise_check};
 use crate::report::{
@@ -45,7 +45,7 @@ pub(crate) fn report(
     let Outcome { flagged, selection } = outcome;
     let outliers = !flagged.is_empty();
     let is_clean = without(data.poses.len(), &flagged);
-    let clean = data.subset(&is_clean);
+    let clean = clean_poses(data, &flagged);
     let Selection {
         terms,
         evidences,

@@ -229,6 +229,18 @@ impl From<FitError> for DiagnoseError {
     }
 }
 
+/// `data` without the poses `flagged` (`data` itself when none is).
+pub(crate) fn clean_poses<'d>(
+    data: &'d Dataset,
+    flagged: &[usize],
+) -> std::borrow::Cow<'d, Dataset> {
+    if flagged.is_empty() {
+        std::borrow::Cow::Borrowed(data)
+    } else {
+        std::borrow::Cow::Owned(data.subset(without(data.poses.len(), flagged)))
+    }
+}
+
 /// Whether pose `j` of `n` is not among `flagged`.
 pub(crate) fn without(n: usize, flagged: &[usize]) -> impl Fn(usize) -> bool + use<> {
     let mut keep = vec![true; n];

@@ -14,8 +14,8 @@
 //! (its degrees of freedom the numerical rank of `M`). `Q` is never formed:
 //! `Q^T G = R^-T (X^T G)`, with `R` folded from the design's rows a block
 //! at a time (TSQR) and `X^T G` a sum over poses. What is kept per pose is
-//! the design's three rows (`3 p` numbers), the six weighted directions and
-//! the target; every product above is accumulated over blocks of poses,
+//! the design's three rows (`3 p` numbers), the three legs' weighted
+//! directions and the target; every product above is accumulated over blocks of poses,
 //! in parallel and summed in block order (the same bits at any thread
 //! count). Generic terms are combinations of six per-pose directions (the
 //! three legs through `W J1^-1 e_i`, the three readings through
@@ -166,8 +166,11 @@ pub(crate) struct Linearisation {
     pub(crate) target: DVector<f64>,
     /// Solved UP joints of every pose at the estimate.
     pub(crate) ups: Vec<UpJoints>,
-    /// Per pose, the six weighted directions: legs 1-3, readings phi, theta, s.
-    directions: Vec<[[f64; 3]; 6]>,
+    /// Per pose, the weighted directions of the three legs (`W J1^-1 e_i`);
+    /// those of the readings are `e_c / sigma_c` ([`Linearisation::direction`]).
+    directions: Vec<[[f64; 3]; 3]>,
+    /// `1 / sigma_c` of the three readings.
+    weights: [f64; 3],
     /// `Q^T t`.
     qtt: DVector<f64>,
     /// Weighted columns of extra terms at zero (`3n x m`).
@@ -189,7 +192,7 @@ fn basis_index(b: Basis) -> usize {
 struct Block {
     target: Vec<f64>,
     ups: Vec<UpJoints>,
-    directions: Vec<[[f64; 3]; 6]>,
+    directions: Vec<[[f64; 3]; 3]>,
     extra: Vec<f64>,
     sums: ExtraSums,
 }
@@ -310,7 +313,7 @@ impl Linearisation {
                     let legs = machine.legs_at(&up);
                     let j1_inv: Matrix3<f64> = legs.j1().try_inverse()?;
                     let y = pose.readings.to_array();
-                    let mut directions = [[0.0; 3]; 6];
+                    let mut directions = [[0.0; 3]; 3];
                     for c in 0..3 {
                         let w = 1.0 / sigma[c];
                         let row = &mut rows[(3 * t + c) * width..(3 * t + c + 1) * width];
@@ -343,7 +346,6 @@ impl Linearisation {
                         for i in 0..3 {
                             directions[i][c] = w * j1_inv[(c, i)];
                         }
-                        directions[3 + c][c] = w;
                     }
                     block.ups.push(up);
                     block.directions.push(directions);
@@ -393,6 +395,7 @@ impl Linearisation {
             target,
             ups,
             directions,
+            weights: sigma.map(|s| 1.0 / s),
             qtt: DVector::zeros(0),
             extra: ext,
             extra_terms,
@@ -404,6 +407,20 @@ impl Linearisation {
     /// Number of poses.
     pub(crate) fn poses(&self) -> usize {
         self.directions.len()
+    }
+
+    /// Weighted direction `b` at pose `j`: legs 1-3, readings phi, theta, s.
+    #[inline]
+    fn direction(&self, j: usize, b: usize) -> [f64; 3] {
+        match self.directions[j].get(b) {
+            Some(d) => *d,
+            None => {
+                let mut d = [0.0; 3];
+                let c = (b - 3).min(2);
+                d[c] = self.weights[c];
+                d
+            }
+        }
     }
 
     /// Design row `i` (of `3n`).
@@ -564,7 +581,7 @@ impl Linearisation {
                 for tt in 0..width {
                     let j = first + t0 + tt;
                     for c in 0..3 {
-                        let w = self.directions[j][b][c];
+                        let w = self.direction(j, b)[c];
                         if w == 0.0 {
                             continue;
                         }
@@ -584,16 +601,14 @@ impl Linearisation {
 
     /// `d_ja . d_jb` at pose `j`.
     fn gram(&self, j: usize, a: usize, b: usize) -> f64 {
-        let d = &self.directions[j];
-        dot3(&d[a], &d[b])
+        dot3(&self.direction(j, a), &self.direction(j, b))
     }
 
     /// `d_jb . t_j` at pose `j`.
     fn target_product(&self, j: usize, b: usize) -> f64 {
         let t = &self.target.as_slice()[3 * j..3 * j + 3];
-        self.directions[j][b][0] * t[0]
-            + self.directions[j][b][1] * t[1]
-            + self.directions[j][b][2] * t[2]
+        let d = self.direction(j, b);
+        d[0] * t[0] + d[1] * t[1] + d[2] * t[2]
     }
 
     /// Per-pose values of every parameter of a generic term, with its
@@ -820,7 +835,7 @@ impl Linearisation {
         for (a, (b, f)) in cols.iter().enumerate() {
             for j in 0..n {
                 for c in 0..3 {
-                    g[(3 * j + c, a)] = f[j] * self.directions[j][*b][c];
+                    g[(3 * j + c, a)] = f[j] * self.direction(j, *b)[c];
                 }
             }
         }
@@ -874,10 +889,9 @@ impl pulp::WithSimd for SumsBlock<'_> {
         let mut buffer = vec![0.0; p];
         for j in poses {
             values(j, &mut v);
-            let d = &lin.directions[j];
             let t = &lin.target.as_slice()[3 * j..3 * j + 3];
             for a in 0..k {
-                g[a] = d[directions[a]].map(|x| x * v[a]);
+                g[a] = lin.direction(j, directions[a]).map(|x| x * v[a]);
                 sums.gtt[a] += g[a][0] * t[0] + g[a][1] * t[1] + g[a][2] * t[2];
                 for b in 0..=a {
                     sums.gtg[b * k + a] += dot3(&g[a], &g[b]);
@@ -1162,13 +1176,10 @@ mod tests {
         let width = 7;
         let rows: Vec<f64> = (0..3 * n * width).map(|_| normal()).collect();
         let target = DVector::from_fn(3 * n, |_, _| normal());
-        let directions: Vec<[[f64; 3]; 6]> = (0..n)
-            .map(|_| {
-                std::array::from_fn(|b| {
-                    std::array::from_fn(|c| if b < 3 || b - 3 == c { normal() } else { 0.0 })
-                })
-            })
+        let directions: Vec<[[f64; 3]; 3]> = (0..n)
+            .map(|_| std::array::from_fn(|_| std::array::from_fn(|_| normal())))
             .collect();
+        let weights = [2.0 + normal(), 0.5, 3.0];
         let commands: Vec<[f64; 3]> = (0..n)
             .map(|_| std::array::from_fn(|_| 800.0 + 200.0 * normal()))
             .collect();
@@ -1181,6 +1192,7 @@ mod tests {
             target: target.clone(),
             ups: Vec::new(),
             directions,
+            weights,
             qtt: DVector::zeros(0),
             extra: DMatrix::zeros(3 * n, 0),
             extra_terms: Vec::new(),

@@ -20,6 +20,7 @@
 //!    explained* and the remainder is reported.
 //! 7. **Report**, with a last check that every number in it is finite.
 
+use std::borrow::Cow;
 use std::sync::Arc;
 
 use tricept_data::Dataset;
@@ -33,7 +34,7 @@ use crate::dictionary::Dictionary;
 use crate::error::DiagnoseError;
 use crate::evidence::Reference;
 use crate::finite::first_non_finite;
-use crate::fit::{Fitter, residuals_of, without};
+use crate::fit::{Fitter, clean_poses, residuals_of};
 use crate::noise::{pure_error, repeats};
 use crate::options::{DiagnoseOptions, MIN_PURE_ERROR_DOF};
 use crate::report::Diagnosis;
@@ -177,12 +178,12 @@ fn check_values(data: &Dataset) -> Result<(), DiagnoseError> {
 
 /// The data with distinct line numbers (numbered from 1 in pose order
 /// when they are not).
-fn numbered(data: &Dataset, limitations: &mut Vec<String>) -> Dataset {
+fn numbered<'d>(data: &'d Dataset, limitations: &mut Vec<String>) -> Cow<'d, Dataset> {
     let mut lines: Vec<u64> = data.poses.iter().map(|p| p.line).collect();
     lines.sort_unstable();
     lines.dedup();
     if lines.len() == data.poses.len() {
-        return data.clone();
+        return Cow::Borrowed(data);
     }
     limitations.push(
         "the poses carry no distinct line numbers: rows are numbered from 1 in pose order".into(),
@@ -191,7 +192,7 @@ fn numbered(data: &Dataset, limitations: &mut Vec<String>) -> Dataset {
     for (j, p) in d.poses.iter_mut().enumerate() {
         p.line = j as u64 + 1;
     }
-    d
+    Cow::Owned(d)
 }
 
 fn run(setup: &Setup<'_>, data: &Dataset) -> Result<Outcome, DiagnoseError> {
@@ -204,7 +205,7 @@ fn run(setup: &Setup<'_>, data: &Dataset) -> Result<Outcome, DiagnoseError> {
     let mut rounds = 0;
     loop {
         rounds += 1;
-        let clean = data.subset(without(data.poses.len(), &flagged));
+        let clean = clean_poses(data, &flagged);
         let selection = select(setup, &clean, geo.take())?;
         // A selection that named nothing ends on the geometric model, whose
         // screen of these data is the first one.
