@@ -4,14 +4,14 @@
 //! from the vocabulary and the generic dictionary with its period scan,
 //! cross-validation, admission on the final model, aliases, final
 //! adequacy). Target: 200 poses in under 2 s. `diagnose_large`: a
-//! continuous log of 100 000 poses, against `identify_large` of
-//! `benches/identification.rs` on the same size (target: at most 10 times
-//! its time).
+//! continuous log of 100 000 poses, and `identify`'s fit of the same poses
+//! in the same run (target: the diagnosis in at most 10 times its time).
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use tricept_diagnose::{DiagnoseOptions, diagnose};
+use tricept_ident::{GeometricModel, IdentifyOptions, identify_robust};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_plant::effects::{Effect, Waveform};
@@ -82,10 +82,16 @@ fn large(c: &mut Criterion) {
     let m = Machine::paper();
     let options = DiagnoseOptions::for_machine(&m);
     let d = data(100_000, 5, Vec::new());
+    let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+    let identify_options = IdentifyOptions::for_machine(&m);
     let mut group = c.benchmark_group("diagnose_large");
     group.sample_size(10);
     group.bench_function("100000_poses_clean", |b| {
         b.iter(|| black_box(diagnose(&m, black_box(&d), &options).unwrap()))
+    });
+    // `identify`'s fit (its gross-error screen included) of the same poses.
+    group.bench_function("100000_poses_identify", |b| {
+        b.iter(|| black_box(identify_robust(&model, black_box(&d), &identify_options).unwrap()))
     });
     group.finish();
 }
