@@ -9,7 +9,9 @@
 //! comments skipped (they still count, so line numbers are exact and
 //! 1-based), each remaining line checked to be UTF-8 and split on commas
 //! (the format has no quoting: every field is a number or a column name),
-//! fields trimmed. [`Header`] takes the first record as the column names,
+//! fields trimmed; `Records::next_lines` hands over batches of lines unparsed,
+//! for a reader that turns them into records in parallel (`read.rs`).
+//! [`Header`] takes the first record as the column names,
 //! locates the columns a reader needs, checks that each row has as many
 //! fields, and parses fields as finite numbers. Files written with `;` as
 //! separator or with decimal commas are recognised and reported as such.
