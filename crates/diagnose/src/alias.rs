@@ -97,7 +97,7 @@ fn explain(a: CauseName, c: CauseName, c_label: &str) -> (String, String) {
 
 /// Per-pose columns (direction, value) of the refinement of a generic
 /// leg term: the quartic Legendre part of a polynomial, the second
-/// harmonic of a periodic term.
+/// harmonic of a periodic term (none for a step).
 fn refinement(g: &GenericTerm, frame: &Frame, data: &Dataset) -> Option<Vec<(usize, Vec<f64>)>> {
     let legs = g.legs();
     let poses = &data.poses;
@@ -138,7 +138,8 @@ fn refinement(g: &GenericTerm, frame: &Frame, data: &Dataset) -> Option<Vec<(usi
                     .collect(),
             )
         }
-        GenericFamily::ReadingDrift
+        GenericFamily::LegStep
+        | GenericFamily::ReadingDrift
         | GenericFamily::ReadingTemperature
         | GenericFamily::LegDrift
         | GenericFamily::EncoderGain
@@ -175,7 +176,7 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
         .frame
         .generic_groups()
         .into_iter()
-        .filter(|g| g.period_mm.is_none() && g.family != GenericFamily::LegPeriodic)
+        .filter(|g| g.period_mm.is_none() && g.is_scanned())
         .collect();
     for (i, a) in terms.iter().enumerate() {
         let k = a.param_count();
