@@ -29,7 +29,11 @@
 //! neither moves. Each edge's standard deviation is the half-width of its
 //! profile-likelihood interval (the edge positions whose score is within
 //! `s2` of the best, the other edge fixed); an edge at the end of the
-//! stroke has none (the campaign cannot place it).
+//! stroke has none (the campaign cannot place it). On a leg that a leg
+//! polynomial of the model covers, a step is screened by what it explains
+//! beyond the polynomial's next order (its quartic part): a step that only
+//! mops up what the polynomial leaves of a curved leg is not a worn
+//! segment.
 //!
 //! **Screen.** Each group's score `S` (the linearised drop of chi-square,
 //! [`crate::linear`]) is tested against chi-square with its rank as degrees
@@ -88,6 +92,41 @@ impl At<'_> {
             .lin
             .score_columns(&self.lin.generic_columns(term, self.frame, self.data));
         (s.explained, s.rank)
+    }
+
+    /// What a step `term` of score `explained` and rank `rank` explains
+    /// beyond the next order of the smooth leg terms of the model on its
+    /// leg (the quartic part of a leg polynomial): a step that only mops up
+    /// what a polynomial leaves of a curved leg is not a worn segment.
+    /// `None` when nothing is left.
+    fn beyond_smooth(
+        &self,
+        term: &GenericTerm,
+        explained: f64,
+        rank: usize,
+        model_terms: &[Term],
+    ) -> Option<(f64, usize)> {
+        let legs = term.legs();
+        let smooth: Vec<(usize, Vec<f64>)> = model_terms
+            .iter()
+            .filter_map(|t| match t {
+                Term::Generic(g) if g.family == GenericFamily::LegPolynomial => {
+                    g.refinement(self.frame, self.data)
+                }
+                _ => None,
+            })
+            .flatten()
+            .filter(|(direction, _)| legs.contains(direction))
+            .collect();
+        if smooth.is_empty() {
+            return Some((explained, rank));
+        }
+        let alone = self.lin.score_columns(&smooth);
+        let mut both = smooth;
+        both.extend(self.lin.generic_columns(term, self.frame, self.data));
+        let with = self.lin.score_columns(&both);
+        let rank = with.rank.saturating_sub(alone.rank);
+        (rank > 0).then(|| ((with.explained - alone.explained).max(0.0), rank))
     }
 
     /// The residual variance factor a term of score `explained` and rank
@@ -230,7 +269,10 @@ impl Dictionary {
                 continue;
             }
             if g.family == GenericFamily::LegStep {
-                if let Some((explained, rank, term, edges_sd_mm)) = self.step_scan(at, g) {
+                if let Some((explained, rank, term, edges_sd_mm)) = self.step_scan(at, g)
+                    && let Some((explained, rank)) =
+                        at.beyond_smooth(&term, explained, rank, model_terms)
+                {
                     out.push(Scored {
                         term,
                         explained,

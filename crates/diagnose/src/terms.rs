@@ -20,7 +20,8 @@ use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{KinematicsError, Machine, UpJoints};
 use tricept_model::effects::{
     Basis, CHANNELS, CauseName, EffectName, Entries, GenericFamily, Judgement, Kind, LegContext,
-    Needs, encoder_gain_error_rad, legendre_p2, legendre_p3, linear_drift, normalised_coordinate,
+    Needs, encoder_gain_error_rad, legendre_p2, legendre_p3, legendre_p4, linear_drift,
+    normalised_coordinate, periodic_extra_mm,
 };
 
 /// A logged temperature that varies by less than this over the campaign
@@ -379,6 +380,64 @@ impl GenericTerm {
     /// Whether the campaign has what the term needs.
     pub fn available(&self, frame: &Frame) -> bool {
         frame.supports(self.family.spec().needs)
+    }
+
+    /// Per-pose columns (direction, value) of the refinement of a generic
+    /// leg term: the quartic Legendre part of a polynomial, the second
+    /// harmonic of a periodic term (none for a step).
+    pub(crate) fn refinement(
+        &self,
+        frame: &Frame,
+        data: &Dataset,
+    ) -> Option<Vec<(usize, Vec<f64>)>> {
+        let g = self;
+        let legs = g.legs();
+        let poses = &data.poses;
+        match g.family {
+            GenericFamily::LegPolynomial => Some(
+                legs.iter()
+                    .flat_map(|&i| {
+                        let [lo, hi] = frame.leg_range_mm[i];
+                        let x: Vec<f64> = poses
+                            .iter()
+                            .map(|p| normalised_coordinate(p.commands_mm[i], lo, hi))
+                            .collect();
+                        [(i, x.iter().map(|x| 1e-3 * legendre_p4(*x)).collect())]
+                    })
+                    .collect(),
+            ),
+            GenericFamily::LegPeriodic => {
+                let half = g.period_mm? / 2.0;
+                Some(
+                    legs.iter()
+                        .flat_map(|&i| {
+                            let q: Vec<f64> = poses.iter().map(|p| p.commands_mm[i]).collect();
+                            [
+                                (
+                                    i,
+                                    q.iter()
+                                        .map(|q| periodic_extra_mm(1.0, 0.0, half, *q))
+                                        .collect(),
+                                ),
+                                (
+                                    i,
+                                    q.iter()
+                                        .map(|q| periodic_extra_mm(0.0, 1.0, half, *q))
+                                        .collect(),
+                                ),
+                            ]
+                        })
+                        .collect(),
+                )
+            }
+            GenericFamily::LegStep
+            | GenericFamily::ReadingDrift
+            | GenericFamily::ReadingTemperature
+            | GenericFamily::LegDrift
+            | GenericFamily::EncoderGain
+            | GenericFamily::ScalePolynomial
+            | GenericFamily::ReadingHysteresis => None,
+        }
     }
 
     /// A short label of the group (`leg-polynomial:leg2`, `reading-drift:s`,
