@@ -764,6 +764,18 @@ mod tests {
         (lin, commands)
     }
 
+    /// A scan's `(explained, rank)` equals the direct score to rounding.
+    fn assert_same_score(scan: (f64, usize), direct: &Score, what: &str) {
+        assert_eq!(scan.1, direct.rank, "{what}");
+        let tolerance = 1e-9 * direct.explained.max(1.0);
+        assert!(
+            (scan.0 - direct.explained).abs() <= tolerance,
+            "{what}: scan {} against {}",
+            scan.0,
+            direct.explained
+        );
+    }
+
     #[test]
     fn the_periodic_scan_equals_scoring_each_period() {
         // 700 poses: several blocks, the last one partial.
@@ -788,13 +800,7 @@ mod tests {
                     })
                     .collect();
                 let direct = lin.score_columns(&cols);
-                assert_eq!(rank, direct.rank, "frequency {k}");
-                let tolerance = 1e-9 * direct.explained.max(1.0);
-                assert!(
-                    (explained - direct.explained).abs() <= tolerance,
-                    "frequency {k}: scan {explained} against {}",
-                    direct.explained
-                );
+                assert_same_score((explained, rank), &direct, &format!("frequency {k}"));
                 if explained > best.1 {
                     best = (k, explained);
                 }
@@ -806,8 +812,7 @@ mod tests {
 
     #[test]
     fn the_step_scan_equals_scoring_each_segment() {
-        // 700 poses over 600-1000 mm; cuts every 25 mm and one beyond the
-        // last command of leg 3.
+        // 700 poses over 600-1000 mm; cuts every 25 mm over that range.
         let (lin, commands) = synthetic(700, 11);
         let cuts: Vec<f64> = (0..=16).map(|k| 600.0 + 25.0 * f64::from(k)).collect();
         for leg in 0..3 {
@@ -823,12 +828,10 @@ mod tests {
                     let expected_inside = column.iter().filter(|v| **v != 0.0).count();
                     assert_eq!(inside, expected_inside, "leg {leg} cuts {u}-{v}");
                     let direct = lin.score_columns(&[(leg, column)]);
-                    assert_eq!(rank, direct.rank, "leg {leg} cuts {u}-{v}");
-                    let tolerance = 1e-9 * direct.explained.max(1.0);
-                    assert!(
-                        (explained - direct.explained).abs() <= tolerance,
-                        "leg {leg} cuts {u}-{v}: scan {explained} against {}",
-                        direct.explained
+                    assert_same_score(
+                        (explained, rank),
+                        &direct,
+                        &format!("leg {leg} cuts {u}-{v}"),
                     );
                 }
             }

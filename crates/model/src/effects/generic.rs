@@ -382,26 +382,17 @@ impl GenericFamily {
                     )
                 })
                 .collect(),
-            G::LegStep => legs
+            // One judged parameter per leg: a step's height, a drift.
+            G::LegStep | G::LegDrift => legs
                 .iter()
                 .enumerate()
                 .map(|(k, leg)| {
-                    judged(
-                        first,
-                        Measure::Parameter(k),
-                        format!("step of leg {} over its segment", leg + 1),
-                    )
-                })
-                .collect(),
-            G::LegDrift => legs
-                .iter()
-                .enumerate()
-                .map(|(k, leg)| {
-                    judged(
-                        first,
-                        Measure::Parameter(k),
-                        format!("drift of leg {} over the campaign", leg + 1),
-                    )
+                    let label = if self == G::LegStep {
+                        format!("step of leg {} over its segment", leg + 1)
+                    } else {
+                        format!("drift of leg {} over the campaign", leg + 1)
+                    };
+                    judged(first, Measure::Parameter(k), label)
                 })
                 .collect(),
             G::ScalePolynomial => vec![judged(
