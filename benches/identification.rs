@@ -53,6 +53,14 @@ fn large(c: &mut Criterion) {
                 )
             })
         });
+        // The other part of `tricept identify` on a log: reading and
+        // checking the CSV (parsed in parallel batches).
+        let mut csv = Vec::new();
+        tricept_data::write_to(&mut csv, &data, &[]).unwrap();
+        group.throughput(criterion::Throughput::Bytes(csv.len() as u64));
+        group.bench_function(format!("{n}_rows_read"), |b| {
+            b.iter(|| black_box(tricept_data::read_from(black_box(&csv[..]), "bench.csv").unwrap()))
+        });
     }
     group.finish();
 }

@@ -240,13 +240,27 @@ fn write_extended(
     {
         effects.insert(name.clone(), json!({"value": v, "std_dev": sd}));
     }
-    // The period of each periodic term, beside its amplitudes.
+    // The period of each periodic term, beside its amplitudes, and the
+    // edges of each step beside its height.
     for t in &d.model_terms {
         if let (true, Some(p)) = (t.deployed, t.period_mm) {
             effects.insert(
                 format!("{}.period_mm", t.effect),
                 json!({"value": p, "std_dev": serde_json::Value::Null}),
             );
+        }
+        if let (true, Some(edges), [leg]) = (t.deployed, t.edges_mm, t.legs.as_slice()) {
+            for (side, value) in ["from", "to"].into_iter().zip(edges) {
+                let name = format!("{}.leg{leg}_{side}_mm", t.effect);
+                // Its profile-likelihood half-width, when the report has it.
+                let sd = d
+                    .causes
+                    .iter()
+                    .flat_map(|c| &c.parameters)
+                    .find(|p| p.name == name && p.value == value)
+                    .and_then(|p| p.std_dev);
+                effects.insert(name, json!({"value": value, "std_dev": sd}));
+            }
         }
     }
     let rejected_lines = d.outlier_lines();

@@ -8,7 +8,9 @@
 use std::io::Read;
 use std::path::Path;
 
-use crate::records::{Header, Record, Records, open};
+use rayon::prelude::*;
+
+use crate::records::{Header, LineBatch, Record, Records, open, record_of};
 use crate::{DataError, Dataset, MeasuredPose, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Readings};
 
 /// Largest span of an encoder column accepted as radians: a U joint of a
@@ -18,6 +20,12 @@ pub const MAX_ANGLE_SPAN_RAD: f64 = 1.75;
 /// The largest length (a leg command, a scale reading, a tracker
 /// coordinate), mm: 100 m, beyond any machine the format describes.
 pub const MAX_LENGTH_MM: f64 = 1e5;
+
+/// Lines read and parsed together (in parallel) by [`read_with_progress`].
+const BATCH_LINES: usize = 16_384;
+
+/// Rows between two calls of [`read_with_progress`]'s `progress`.
+const PROGRESS_ROWS: usize = 65_536;
 
 /// Plausible structure temperatures, °C.
 const TEMP_RANGE_C: (f64, f64) = (-60.0, 200.0);
@@ -99,13 +107,38 @@ pub fn read_with_progress<R: Read>(
     let header = Header::read(&mut records, &REQUIRED_COLUMNS.join(","))?;
     let columns = locate_columns(&header)?;
 
+    // Lines are read in batches and parsed in parallel; every batch's rows
+    // are appended in file order, and its first error (in file order) is
+    // the one reported, as a line-by-line reader would.
     let mut poses = Vec::new();
-    for record in records {
-        let record = record?;
-        header.check(&record)?;
-        poses.push(parse_row(&record, &columns, &header)?);
-        if poses.len() % 65_536 == 0 {
-            progress(poses.len() as u64);
+    let mut batch = LineBatch::default();
+    loop {
+        let read = records.next_lines(BATCH_LINES, &mut batch);
+        let parsed: Vec<Result<Option<MeasuredPose>, DataError>> = batch
+            .spans()
+            .par_iter()
+            .map(
+                |(line, range)| match record_of(file, *line, batch.bytes(range))? {
+                    None => Ok(None),
+                    Some(record) => {
+                        header.check(&record)?;
+                        parse_row(&record, &columns, &header).map(Some)
+                    }
+                },
+            )
+            .collect();
+        let before = poses.len();
+        for pose in parsed {
+            if let Some(pose) = pose? {
+                poses.push(pose);
+            }
+        }
+        read?;
+        for reached in (before / PROGRESS_ROWS + 1)..=(poses.len() / PROGRESS_ROWS) {
+            progress((reached * PROGRESS_ROWS) as u64);
+        }
+        if batch.spans().len() < BATCH_LINES {
+            break;
         }
     }
     if poses.is_empty() {
@@ -366,6 +399,65 @@ mod tests {
     fn assert_error_starts(text: &str, start: &str) {
         let e = error(text);
         assert!(e.starts_with(start), "{e}");
+    }
+
+    /// Rows are parsed in parallel batches ([`BATCH_LINES`]); the error
+    /// reported is still the first in the file, within a batch, across
+    /// batches and before an overlong line, and rows keep their order.
+    #[test]
+    fn batches_report_the_first_error_in_the_file_and_keep_row_order() {
+        let rows = |n: usize, comment_every: usize| {
+            let mut csv = String::from("q1,q2,q3,phi,theta,s\n");
+            for k in 0..n {
+                if comment_every > 0 && k % comment_every == 0 {
+                    csv.push_str("# a comment\n");
+                }
+                csv.push_str(&format!(
+                    "{},800,800,0.01,0.02,5\n",
+                    700.0 + k as f64 * 1e-3
+                ));
+            }
+            csv
+        };
+        let n = 3 * BATCH_LINES + 17;
+        let data = read(&rows(n, 1000)).unwrap();
+        assert_eq!(data.poses.len(), n);
+        for (k, p) in data.poses.iter().enumerate() {
+            assert_eq!(p.commands_mm[0], 700.0 + k as f64 * 1e-3);
+        }
+        // Line numbers count the header and the comments.
+        assert_eq!(data.poses[0].line, 3);
+        assert_eq!(data.poses[n - 1].line, (n + 1 + n.div_ceil(1000)) as u64);
+
+        let spoil = |csv: &str, lines: &[usize], with: &str| -> String {
+            csv.lines()
+                .enumerate()
+                .map(|(i, l)| if lines.contains(&(i + 1)) { with } else { l })
+                .collect::<Vec<_>>()
+                .join("\n")
+        };
+        let clean = rows(n, 0);
+        // Two bad rows in one batch, and one in a later batch.
+        let two = spoil(
+            &clean,
+            &[2 * BATCH_LINES + 5, BATCH_LINES + 9, BATCH_LINES + 3],
+            "1,2,x,0,0,0",
+        );
+        assert!(error(&two).starts_with(&format!("t.csv: line {}, column `q3`", BATCH_LINES + 3)));
+        // A bad row before an overlong line in the same batch.
+        let long = "9".repeat(crate::MAX_LINE_BYTES + 10);
+        let both = spoil(
+            &spoil(&clean, &[BATCH_LINES + 100], &long),
+            &[BATCH_LINES + 50],
+            "1,2,3,0,0",
+        );
+        assert!(
+            error(&both).starts_with(&format!("t.csv: line {}:", BATCH_LINES + 50)),
+            "{}",
+            error(&both)
+        );
+        let only_long = spoil(&clean, &[BATCH_LINES + 100], &long);
+        assert!(error(&only_long).contains("longer than"));
     }
 
     #[test]

@@ -9,7 +9,9 @@
 //! comments skipped (they still count, so line numbers are exact and
 //! 1-based), each remaining line checked to be UTF-8 and split on commas
 //! (the format has no quoting: every field is a number or a column name),
-//! fields trimmed. [`Header`] takes the first record as the column names,
+//! fields trimmed; `Records::next_lines` hands over batches of lines unparsed,
+//! for a reader that turns them into records in parallel (`read.rs`).
+//! [`Header`] takes the first record as the column names,
 //! locates the columns a reader needs, checks that each row has as many
 //! fields, and parses fields as finite numbers. Files written with `;` as
 //! separator or with decimal commas are recognised and reported as such.
@@ -92,55 +94,108 @@ impl<'f, R: Read> Records<'f, R> {
         }
     }
 
-    fn next_record(&mut self) -> Result<Option<Record>, DataError> {
-        loop {
-            self.buf.clear();
-            let n = (&mut self.reader)
-                .take(MAX_LINE_BYTES as u64 + 1)
-                .read_until(b'\n', &mut self.buf)
-                .map_err(|source| DataError::Io {
-                    file: self.file.to_string(),
-                    source,
-                })?;
-            if n == 0 {
-                return Ok(None);
-            }
-            self.line += 1;
-            let not_text = |line, message: String| DataError::NotText {
+    /// Reads the next line into `self.buf` (line end included) and counts
+    /// it; `false` at the end of the source.
+    fn read_line(&mut self) -> Result<bool, DataError> {
+        self.buf.clear();
+        let n = (&mut self.reader)
+            .take(MAX_LINE_BYTES as u64 + 1)
+            .read_until(b'\n', &mut self.buf)
+            .map_err(|source| DataError::Io {
                 file: self.file.to_string(),
-                line,
-                message,
-            };
-            if self.buf.len() > MAX_LINE_BYTES {
-                return Err(not_text(
-                    self.line,
-                    format!(
-                        "a line longer than {MAX_LINE_BYTES} bytes: not a data file of numbers"
-                    ),
-                ));
-            }
-            let mut bytes = self.buf.as_slice();
-            if self.line == 1 {
-                bytes = bytes.strip_prefix(BYTE_ORDER_MARK).unwrap_or(bytes);
-            }
-            let trimmed = bytes.trim_ascii();
-            if trimmed.contains(&b'\r') {
-                return Err(not_text(
-                    self.line,
-                    "carriage returns (\\r) inside the line: the file has old Mac line ends; save it with \\n (or \\r\\n) line ends".into(),
-                ));
-            }
-            if trimmed.is_empty() || trimmed.starts_with(b"#") {
-                continue;
-            }
-            let text = std::str::from_utf8(trimmed)
-                .map_err(|_| not_text(self.line, "not valid UTF-8 text".into()))?;
-            return Ok(Some(Record {
-                line: self.line,
-                fields: text.split(',').map(|f| f.trim().to_string()).collect(),
-            }));
+                source,
+            })?;
+        if n == 0 {
+            return Ok(false);
         }
+        self.line += 1;
+        if self.buf.len() > MAX_LINE_BYTES {
+            return Err(DataError::NotText {
+                file: self.file.to_string(),
+                line: self.line,
+                message: format!(
+                    "a line longer than {MAX_LINE_BYTES} bytes: not a data file of numbers"
+                ),
+            });
+        }
+        Ok(true)
     }
+
+    fn next_record(&mut self) -> Result<Option<Record>, DataError> {
+        while self.read_line()? {
+            if let Some(record) = record_of(self.file, self.line, &self.buf)? {
+                return Ok(Some(record));
+            }
+        }
+        Ok(None)
+    }
+
+    /// Reads up to `max_lines` further lines into `batch` (cleared first),
+    /// unparsed, so that a reader can turn them into records in parallel
+    /// ([`record_of`]). An error (unreadable source, an overlong line) is
+    /// returned with the lines read before it kept in `batch`: they come
+    /// first in the file, and so do their errors.
+    pub fn next_lines(&mut self, max_lines: usize, batch: &mut LineBatch) -> Result<(), DataError> {
+        batch.bytes.clear();
+        batch.lines.clear();
+        while batch.lines.len() < max_lines && self.read_line()? {
+            let start = batch.bytes.len();
+            batch.bytes.extend_from_slice(&self.buf);
+            batch.lines.push((self.line, start..batch.bytes.len()));
+        }
+        Ok(())
+    }
+}
+
+/// Lines read by [`Records::next_lines`]: their bytes end to end, and each
+/// line's number and byte range.
+#[derive(Debug, Default)]
+pub(crate) struct LineBatch {
+    bytes: Vec<u8>,
+    lines: Vec<(u64, std::ops::Range<usize>)>,
+}
+
+impl LineBatch {
+    /// The lines as a slice of `(line number, byte range)` (for a parallel
+    /// iterator), with [`LineBatch::bytes`] to resolve them.
+    pub fn spans(&self) -> &[(u64, std::ops::Range<usize>)] {
+        &self.lines
+    }
+
+    /// The bytes of line `range` of [`LineBatch::spans`].
+    pub fn bytes(&self, range: &std::ops::Range<usize>) -> &[u8] {
+        &self.bytes[range.clone()]
+    }
+}
+
+/// The record of line `line` of `file` (its bytes as read, line end
+/// included): `None` for a blank line or a `#` comment; an error for text
+/// that is not this format's.
+pub(crate) fn record_of(file: &str, line: u64, bytes: &[u8]) -> Result<Option<Record>, DataError> {
+    let not_text = |message: String| DataError::NotText {
+        file: file.to_string(),
+        line,
+        message,
+    };
+    let bytes = if line == 1 {
+        bytes.strip_prefix(BYTE_ORDER_MARK).unwrap_or(bytes)
+    } else {
+        bytes
+    };
+    let trimmed = bytes.trim_ascii();
+    if trimmed.contains(&b'\r') {
+        return Err(not_text(
+            "carriage returns (\\r) inside the line: the file has old Mac line ends; save it with \\n (or \\r\\n) line ends".into(),
+        ));
+    }
+    if trimmed.is_empty() || trimmed.starts_with(b"#") {
+        return Ok(None);
+    }
+    let text = std::str::from_utf8(trimmed).map_err(|_| not_text("not valid UTF-8 text".into()))?;
+    Ok(Some(Record {
+        line,
+        fields: text.split(',').map(|f| f.trim().to_string()).collect(),
+    }))
 }
 
 impl<R: Read> Iterator for Records<'_, R> {

@@ -25,17 +25,14 @@
 
 use nalgebra::{DMatrix, DVector};
 use tricept_data::Dataset;
-use tricept_model::effects::{
-    CauseName, EffectName, GenericFamily, Needs, legendre_p4, normalised_coordinate,
-    periodic_extra_mm,
-};
+use tricept_model::effects::{CauseName, EffectName, Needs};
 use tricept_numerics::stats::chi2_isf;
 
 use crate::fit::{Fit, term_estimates};
 use crate::linear::{Linearisation, canonical_correlation, nested};
 use crate::report::{Alias, Estimate, RejectStage, Rejected};
 use crate::select::Setup;
-use crate::terms::{Frame, GenericTerm, Term};
+use crate::terms::{GenericTerm, Term};
 
 /// The outcome of the alias analysis.
 pub(crate) struct Aliases {
@@ -95,58 +92,6 @@ fn explain(a: CauseName, c: CauseName, c_label: &str) -> (String, String) {
     )
 }
 
-/// Per-pose columns (direction, value) of the refinement of a generic
-/// leg term: the quartic Legendre part of a polynomial, the second
-/// harmonic of a periodic term.
-fn refinement(g: &GenericTerm, frame: &Frame, data: &Dataset) -> Option<Vec<(usize, Vec<f64>)>> {
-    let legs = g.legs();
-    let poses = &data.poses;
-    match g.family {
-        GenericFamily::LegPolynomial => Some(
-            legs.iter()
-                .flat_map(|&i| {
-                    let [lo, hi] = frame.leg_range_mm[i];
-                    let x: Vec<f64> = poses
-                        .iter()
-                        .map(|p| normalised_coordinate(p.commands_mm[i], lo, hi))
-                        .collect();
-                    [(i, x.iter().map(|x| 1e-3 * legendre_p4(*x)).collect())]
-                })
-                .collect(),
-        ),
-        GenericFamily::LegPeriodic => {
-            let half = g.period_mm? / 2.0;
-            Some(
-                legs.iter()
-                    .flat_map(|&i| {
-                        let q: Vec<f64> = poses.iter().map(|p| p.commands_mm[i]).collect();
-                        [
-                            (
-                                i,
-                                q.iter()
-                                    .map(|q| periodic_extra_mm(1.0, 0.0, half, *q))
-                                    .collect(),
-                            ),
-                            (
-                                i,
-                                q.iter()
-                                    .map(|q| periodic_extra_mm(0.0, 1.0, half, *q))
-                                    .collect(),
-                            ),
-                        ]
-                    })
-                    .collect(),
-            )
-        }
-        GenericFamily::ReadingDrift
-        | GenericFamily::ReadingTemperature
-        | GenericFamily::LegDrift
-        | GenericFamily::EncoderGain
-        | GenericFamily::ScalePolynomial
-        | GenericFamily::ReadingHysteresis => None,
-    }
-}
-
 /// The alias analysis of the final model `fit` on `clean`.
 pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases {
     let mut out = Aliases {
@@ -175,7 +120,7 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
         .frame
         .generic_groups()
         .into_iter()
-        .filter(|g| g.period_mm.is_none() && g.family != GenericFamily::LegPeriodic)
+        .filter(|g| g.period_mm.is_none() && g.is_scanned())
         .collect();
     for (i, a) in terms.iter().enumerate() {
         let k = a.param_count();
@@ -226,7 +171,7 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
         if matches!(a, Term::Catalogue(_)) {
             for t in &terms {
                 if let Term::Generic(g) = t
-                    && let Some(cols) = refinement(g, &setup.fitter.frame, clean)
+                    && let Some(cols) = g.refinement(&setup.fitter.frame, clean)
                 {
                     let cols = lin.dense(&cols);
                     let k = cols.ncols();

@@ -253,13 +253,14 @@ fn deployable(
                 Some(None) => true,
             };
             let g = gained.flatten();
-            let (legs, channel, period_mm) = match t {
+            let (legs, channel, period_mm, edges_mm) = match t {
                 Term::Generic(g) => (
                     g.legs().iter().map(|i| *i as u8 + 1).collect(),
                     g.channel().map(|c| c as u8),
                     g.period_mm,
+                    g.edges_mm,
                 ),
-                Term::Catalogue(_) => (Vec::new(), None, None),
+                Term::Catalogue(_) => (Vec::new(), None, None, None),
             };
             ModelTerm {
                 effect: t.name(),
@@ -267,6 +268,7 @@ fn deployable(
                 legs,
                 channel,
                 period_mm,
+                edges_mm,
                 deployed,
                 improvement_mm: g.map(|g| g.mean_mm),
                 improvement_sd_mm: g.map(|g| g.sd_mm),
@@ -377,25 +379,39 @@ fn term_causes(
         }
         let k = term.param_count();
         let mut parameters = final_estimates[*at..*at + k].to_vec();
-        let mut period_sd = None;
+        let (mut period_sd, mut edges_sd) = (None, [None, None]);
         if let Term::Generic(g) = term
-            && let Some(p) = g.period_mm
+            && (g.period_mm.is_some() || g.edges_mm.is_some())
         {
-            period_sd = period_uncertainty(setup, clean, current, term);
-            let prefix = final_estimates[*at]
-                .name
-                .split('.')
-                .next()
-                .unwrap_or("leg-periodic")
-                .to_string();
-            parameters.insert(
-                0,
-                Estimate {
-                    name: format!("{prefix}.period_mm"),
-                    value: p,
-                    std_dev: period_sd,
-                },
-            );
+            let rescanned = scan_uncertainty(setup, clean, current, term);
+            let prefix = g.family.as_str();
+            if let Some(p) = g.period_mm {
+                period_sd = rescanned.as_ref().and_then(|s| s.period_sd_mm);
+                parameters.insert(
+                    0,
+                    Estimate {
+                        name: format!("{prefix}.period_mm"),
+                        value: p,
+                        std_dev: period_sd,
+                    },
+                );
+            }
+            if let (Some(edges), Some(leg)) = (g.edges_mm, g.legs().first()) {
+                edges_sd = rescanned
+                    .as_ref()
+                    .and_then(|s| s.edges_sd_mm)
+                    .unwrap_or([None, None]);
+                for (k, side) in ["from", "to"].iter().enumerate().rev() {
+                    parameters.insert(
+                        0,
+                        Estimate {
+                            name: format!("{prefix}.leg{}_{side}_mm", leg + 1),
+                            value: edges[k],
+                            std_dev: edges_sd[k],
+                        },
+                    );
+                }
+            }
         }
         let alts = named
             .alternatives
@@ -417,7 +433,14 @@ fn term_causes(
             } else {
                 CauseKind::Catalogue
             },
-            description: describe(term, current, &setup.fitter.frame, period_sd, &alts),
+            description: describe(
+                term,
+                current,
+                &setup.fitter.frame,
+                period_sd,
+                edges_sd,
+                &alts,
+            ),
             plausible: setup.plausible(current, term).is_ok(),
             parameters,
             evidence: ev.clone(),
@@ -429,9 +452,11 @@ fn term_causes(
     causes
 }
 
-/// The period's standard deviation of a periodic term of `fit`: the scan's
-/// curvature at the final model without the term.
-fn period_uncertainty(setup: &Setup<'_>, clean: &Dataset, fit: &Fit, term: &Term) -> Option<f64> {
+/// The scan of a scanned term of `fit` (a periodic term, a step) at the
+/// final model without the term, for the uncertainty of its nonlinear
+/// parameters: the period's from the scan's curvature, the edges' from
+/// their profile likelihood.
+fn scan_uncertainty(setup: &Setup<'_>, clean: &Dataset, fit: &Fit, term: &Term) -> Option<Scored> {
     let others: Vec<Term> = fit
         .model
         .terms()
@@ -442,17 +467,20 @@ fn period_uncertainty(setup: &Setup<'_>, clean: &Dataset, fit: &Fit, term: &Term
     let fitter = &setup.fitter;
     let without = fitter.fit(fitter.model(&others), clean).ok()?;
     let Term::Generic(g) = term else { return None };
-    let target = g.period_mm?;
-    setup
-        .screen(&without, clean)
-        .into_iter()
-        .filter(|s| s.term.family == GenericFamily::LegPeriodic)
-        .filter_map(|s| {
-            let p = s.term.period_mm?;
-            ((p - target).abs() < 0.02 * target).then_some(s.period_sd_mm)
-        })
-        .next()
-        .flatten()
+    let mut screened = setup.screen(&without, clean).into_iter();
+    match (g.period_mm, g.edges_mm) {
+        (Some(target), _) => screened
+            .filter(|s| s.term.family == GenericFamily::LegPeriodic)
+            .find(|s| {
+                s.term
+                    .period_mm
+                    .is_some_and(|p| (p - target).abs() < 0.02 * target)
+            }),
+        (None, Some(_)) => {
+            screened.find(|s| s.term.family == GenericFamily::LegStep && s.term.scope == g.scope)
+        }
+        (None, None) => None,
+    }
 }
 
 /// What the final model leaves: its fit, the strongest residual structure

@@ -7,7 +7,7 @@
 //! [`tricept_model::effects::GenericSpec::deployment`]): the machine's
 //! leg effects, its UP limb, the controller parameters, the per-leg
 //! compensation tables of the leg errors that are functions of the leg
-//! command (a ball-screw pitch error, a curved or worn screw), or, for
+//! command (a ball-screw pitch error, a curved screw, a worn segment), or, for
 //! sensor-side and time terms, only the calibration record.
 
 use std::sync::Arc;
@@ -16,7 +16,7 @@ use tricept_data::{Dataset, MeasuredPose};
 use tricept_ident::{GeometricModel, Identification, IdentifyOptions, identify};
 use tricept_kinematics::Machine;
 use tricept_kinematics::description::{
-    ControllerDescription, LegTableDescription, MAX_TABLE_POINTS,
+    ControllerDescription, LegTableDescription, MAX_TABLE_POINTS, MAX_TABLE_SLOPE_UM_PER_MM,
 };
 use tricept_model::ParameterSet;
 use tricept_model::effects::{Basis, CHANNELS, CauseName, Deployment, GenericFamily};
@@ -178,6 +178,7 @@ fn term_of(t: &ModelTerm) -> Option<Term> {
                 family,
                 scope,
                 period_mm: t.period_mm,
+                edges_mm: t.edges_mm,
             }))
         }
     }
@@ -191,6 +192,16 @@ const POINTS_PER_PERIOD: f64 = 24.0;
 /// Points of a table without a periodic term (a polynomial over the
 /// stroke).
 const POINTS_OVER_STROKE: f64 = 200.0;
+
+/// The finest spacing of a table with a step, mm: linear interpolation
+/// ramps a step over the one spacing that holds its edge and is exact
+/// elsewhere; finer than the edge is known (about a millimetre at 80
+/// poses over a 400 mm stroke) helps nothing.
+const STEP_SPACING_MM: f64 = 0.05;
+
+/// The share of [`MAX_TABLE_SLOPE_UM_PER_MM`] a step's ramp may take (the
+/// rest is left to the table's other terms).
+const STEP_SLOPE_SHARE: f64 = 0.5;
 
 /// The compensation table of each leg that a generic leg term of the
 /// model (at parameters `p`) acts on: its extra length at equally spaced
@@ -229,7 +240,27 @@ fn leg_tables(
             .iter()
             .filter_map(|(g, _)| g.period_mm)
             .fold(f64::INFINITY, f64::min);
-        let step = (finest / POINTS_PER_PERIOD).min(stroke / POINTS_OVER_STROKE);
+        // A step's ramp: one spacing, no steeper than its share of the
+        // slope a table may have.
+        let edges: Vec<(f64, f64)> = on_leg
+            .iter()
+            .filter_map(|(g, at)| {
+                let [a, b] = g.edges_mm?;
+                let um = p.get(*at).copied().unwrap_or(0.0);
+                Some([(a, um), (b, um)])
+            })
+            .flatten()
+            .filter(|(e, _)| *e > lo && *e < hi)
+            .collect();
+        let ramp = edges
+            .iter()
+            .map(|(_, um)| {
+                STEP_SPACING_MM.max(um.abs() / (STEP_SLOPE_SHARE * MAX_TABLE_SLOPE_UM_PER_MM))
+            })
+            .fold(f64::INFINITY, f64::min);
+        let step = (finest / POINTS_PER_PERIOD)
+            .min(stroke / POINTS_OVER_STROKE)
+            .min(ramp);
         let points = (stroke / step).ceil() + 1.0;
         if !(stroke > 0.0 && points.is_finite() && points <= MAX_TABLE_POINTS as f64) {
             return Err(DeployError::NotDeployable(format!(
@@ -264,18 +295,41 @@ fn leg_tables(
             .map(|k| extra_um(lo + step * k as f64))
             .collect::<Result<Vec<f64>, _>>()?;
         let mut table = LegTableDescription::new(leg as u8 + 1, lo, step, values);
-        // The interpolation error, measured at the midpoints.
+        // The interpolation error, measured at the midpoints away from a
+        // step's edges, and on both sides of each edge (where it is
+        // largest: the table ramps over the spacing that holds the edge).
+        let error = |q: f64| -> Result<f64, DeployError> {
+            Ok((table.extra_mm(q) * 1e3 - extra_um(q)?).abs())
+        };
         let mut worst: f64 = 0.0;
         for k in 0..points - 1 {
-            let q = lo + step * (k as f64 + 0.5);
-            worst = worst.max((table.extra_mm(q) * 1e3 - extra_um(q)?).abs());
+            let (from, to) = (lo + step * k as f64, lo + step * (k + 1) as f64);
+            if edges.iter().any(|(e, _)| (from..=to).contains(e)) {
+                continue;
+            }
+            worst = worst.max(error(0.5 * (from + to))?);
+        }
+        let mut at_edges: f64 = 0.0;
+        for (e, _) in &edges {
+            for q in [e - 1e-6 * step, e + 1e-6 * step] {
+                at_edges = at_edges.max(error(q)?);
+            }
         }
         let names: Vec<String> = on_leg.iter().map(|(g, _)| g.label()).collect();
         let periodic = on_leg
             .iter()
             .any(|(g, _)| g.family == GenericFamily::LegPeriodic);
+        let edge_note = if edges.is_empty() {
+            String::new()
+        } else {
+            let at: Vec<String> = edges.iter().map(|(e, _)| format!("{e:.3}")).collect();
+            format!(
+                "; at a step's edge ({} mm), within the {step:.4} mm spacing that holds it, up to {at_edges:.3} um",
+                at.join(", ")
+            )
+        };
         table.source = format!(
-            "{} on {points} points every {step:.4} mm over the campaign's stroke {lo:.3} to {hi:.3} mm, linear interpolation (largest interpolation error {worst:.3} um), the end values beyond{}",
+            "{} on {points} points every {step:.4} mm over the campaign's stroke {lo:.3} to {hi:.3} mm, linear interpolation (largest interpolation error {worst:.3} um{edge_note}), the end values beyond{}",
             names.join(" + "),
             if periodic {
                 " (a periodic error is known only where the campaign measured it)"

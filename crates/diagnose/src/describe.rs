@@ -1,7 +1,8 @@
 //! A named cause in words a machine builder can act on: an effect of the
 //! vocabulary by its spec's description and estimates
 //! ([`tricept_model::effects::EffectSpec::description`]); a generic term by
-//! what its fitted form reads as (a screw lead, a curved leg, a drift),
+//! what its fitted form reads as (a screw lead, a curved leg, a worn
+//! segment, a drift),
 //! with the alternatives this campaign cannot tell from it.
 
 use tricept_model::effects::{CHANNELS, GenericFamily, legendre_p2, legendre_p3};
@@ -20,6 +21,7 @@ pub(crate) fn describe(
     fit: &Fit,
     frame: &Frame,
     period_sd: Option<f64>,
+    edges_sd: [Option<f64>; 2],
     alternatives: &[String],
 ) -> String {
     let (v, cov) = term_estimates(fit, term);
@@ -113,6 +115,32 @@ pub(crate) fn describe(
                     format!(
                         "length error curved along the stroke ({}): ball-screw travel variation (and mean travel deviation) or a bent guide?",
                         parts.join("; ")
+                    )
+                }
+                GenericFamily::LegStep => {
+                    let [a, b] = g.edges_mm.unwrap_or([f64::NAN; 2]);
+                    let [lo, hi] = legs
+                        .first()
+                        .map_or([f64::NAN; 2], |&i| frame.leg_range_mm[i]);
+                    let edge = |x: f64, sd: Option<f64>, end: &str| match sd {
+                        Some(sd) => format!("{x:.1} +- {sd:.1} mm"),
+                        None => format!("{x:.1} mm ({end})"),
+                    };
+                    let reads_as = match (a <= lo, b >= hi) {
+                        (false, false) => "a worn screw segment (a step at each edge)?".to_string(),
+                        (true, _) => format!(
+                            "a step of the screw at {b:.1} mm (a worn segment reaching beyond the campaign's stroke)?"
+                        ),
+                        (false, true) => format!(
+                            "a step of the screw at {a:.1} mm (a worn segment reaching beyond the campaign's stroke)?"
+                        ),
+                    };
+                    format!(
+                        "{}: length error of {} um while the command is from {} to {}: {reads_as}",
+                        legs_list(&legs),
+                        pm(0),
+                        edge(a, edges_sd[0], "the campaign's smallest command"),
+                        edge(b, edges_sd[1], "the campaign's largest command"),
                     )
                 }
                 GenericFamily::LegDrift => {

@@ -206,6 +206,7 @@ pub fn realistic(machine: &tricept_kinematics::Machine) -> Vec<(Term, Vec<f64>, 
             family,
             scope,
             period_mm,
+            edges_mm: None,
         })
     };
     let mut out: Vec<(Term, Vec<f64>, &'static str)> = EffectName::terms()

@@ -1,6 +1,7 @@
 //! The generic dictionary: every group of generic terms the campaign
 //! supports ([`crate::terms::Frame::generic_groups`]), the ball-screw
-//! period scan, and the linear screen that ranks them at the current fit.
+//! period scan, the worn-segment (step) scan, and the linear screen that
+//! ranks them at the current fit.
 //!
 //! **Period scan.** Periods from `period_range_mm` (default 4 to 50 mm:
 //! standard screw leads; above about a fifth of the stroke a sinusoid looks
@@ -12,6 +13,27 @@
 //! refined by golden-section search of the score within one grid step;
 //! its standard deviation follows from the curvature of the score,
 //! `sd(f) = sqrt(2 s2 / -S''(f))`.
+//!
+//! **Step scan.** The edges `a < b` of a leg's step (the leg longer by `h`
+//! while its command is inside `[a, b]`) on a grid of `step_cells + 1`
+//! cuts equally spaced over the leg's stroke in the campaign (its first
+//! and last command included: an edge there is a single step at the other
+//! edge): every pair but the whole stroke (which a leg offset absorbs), so
+//! `K (K + 1) / 2 - 1` pairs for `K` cells, each counted in the
+//! multiplicity. A pair with fewer than [`MIN_STEP_POSES`] poses inside
+//! or outside is not scored (a step carried by a few poses is a gross
+//! error, for the outlier screen). The best pair is refined within one
+//! cell of each edge over every distinct segment of the poses (the score
+//! changes only where an edge crosses a pose's command: the edges are put
+//! midway between neighbouring commands), one edge at a time until
+//! neither moves. Each edge's standard deviation is the half-width of its
+//! profile-likelihood interval (the edge positions whose score is within
+//! `s2` of the best, the other edge fixed); an edge at the end of the
+//! stroke has none (the campaign cannot place it). On a leg that a leg
+//! polynomial of the model covers, a step is screened by what it explains
+//! beyond the polynomial's next order (its quartic part): a step that only
+//! mops up what the polynomial leaves of a curved leg is not a worn
+//! segment.
 //!
 //! **Screen.** Each group's score `S` (the linearised drop of chi-square,
 //! [`crate::linear`]) is tested against chi-square with its rank as degrees
@@ -25,7 +47,14 @@ use tricept_model::effects::GenericFamily;
 use crate::evidence::Reference;
 use crate::linear::Linearisation;
 use crate::options::DictionaryOptions;
-use crate::terms::{Frame, GenericTerm, Term};
+use crate::terms::{Frame, GenericTerm, Scope, Term};
+
+/// The fewest poses a scanned step may hold inside its segment, and leave
+/// outside it.
+pub(crate) const MIN_STEP_POSES: usize = 3;
+
+/// Rounds of the step refinement (one edge, then the other) at most.
+const STEP_ROUNDS: usize = 10;
 
 /// A group of the dictionary scored at a fit.
 #[derive(Debug, Clone)]
@@ -40,6 +69,9 @@ pub(crate) struct Scored {
     pub(crate) p_adjusted: f64,
     /// Standard deviation of the period, mm.
     pub(crate) period_sd_mm: Option<f64>,
+    /// Standard deviation of each edge of a step, mm (`None` for an edge
+    /// at the end of the campaign's stroke).
+    pub(crate) edges_sd_mm: Option<[Option<f64>; 2]>,
 }
 
 /// A fit the dictionary is screened at: its linearisation, the campaign
@@ -62,6 +94,41 @@ impl At<'_> {
         (s.explained, s.rank)
     }
 
+    /// What a step `term` of score `explained` and rank `rank` explains
+    /// beyond the next order of the smooth leg terms of the model on its
+    /// leg (the quartic part of a leg polynomial): a step that only mops up
+    /// what a polynomial leaves of a curved leg is not a worn segment.
+    /// `None` when nothing is left.
+    fn beyond_smooth(
+        &self,
+        term: &GenericTerm,
+        explained: f64,
+        rank: usize,
+        model_terms: &[Term],
+    ) -> Option<(f64, usize)> {
+        let legs = term.legs();
+        let smooth: Vec<(usize, Vec<f64>)> = model_terms
+            .iter()
+            .filter_map(|t| match t {
+                Term::Generic(g) if g.family == GenericFamily::LegPolynomial => {
+                    g.refinement(self.frame, self.data)
+                }
+                _ => None,
+            })
+            .flatten()
+            .filter(|(direction, _)| legs.contains(direction))
+            .collect();
+        if smooth.is_empty() {
+            return Some((explained, rank));
+        }
+        let alone = self.lin.score_columns(&smooth);
+        let mut both = smooth;
+        both.extend(self.lin.generic_columns(term, self.frame, self.data));
+        let with = self.lin.score_columns(&both);
+        let rank = with.rank.saturating_sub(alone.rank);
+        (rank > 0).then(|| ((with.explained - alone.explained).max(0.0), rank))
+    }
+
     /// The residual variance factor a term of score `explained` and rank
     /// `rank` would leave.
     fn scale(&self, explained: f64, rank: usize) -> f64 {
@@ -79,6 +146,8 @@ pub(crate) struct Dictionary {
     frequencies: Vec<f64>,
     /// Grid step, 1/mm.
     step: f64,
+    /// Cells of the step scan's grid over each leg's stroke (0: no scan).
+    step_cells: usize,
 }
 
 impl Dictionary {
@@ -89,6 +158,7 @@ impl Dictionary {
                 groups: Vec::new(),
                 frequencies: Vec::new(),
                 step: 0.0,
+                step_cells: 0,
             };
         }
         let stroke = frame
@@ -108,35 +178,54 @@ impl Dictionary {
                 .take_while(|&f| f <= f_max)
                 .collect();
         }
+        let step_cells = options.step_cells;
         let groups = frame
             .generic_groups()
             .into_iter()
             .filter(|g| g.family != GenericFamily::LegPeriodic || !frequencies.is_empty())
+            .filter(|g| g.family != GenericFamily::LegStep || step_cells > 0)
             .collect();
         Dictionary {
             groups,
             frequencies,
             step,
+            step_cells,
         }
     }
 
-    /// Number of tests the dictionary makes (every scan period counts).
-    pub(crate) fn multiplicity(&self) -> usize {
-        self.groups
-            .iter()
-            .map(|g| {
-                if g.family == GenericFamily::LegPeriodic {
-                    self.frequencies.len()
-                } else {
-                    1
-                }
-            })
-            .sum()
+    /// Pairs of edges of one leg's step scan: every pair of the grid's
+    /// cuts but the whole stroke.
+    fn step_pairs(&self) -> usize {
+        let k = self.step_cells;
+        (k * (k + 1) / 2).saturating_sub(1)
     }
 
-    /// Number of scan periods.
-    pub(crate) fn scan_len(&self) -> usize {
-        self.frequencies.len()
+    /// Tests of one group: the scan's grid points for a scanned family.
+    fn tests(&self, family: GenericFamily) -> usize {
+        match family {
+            GenericFamily::LegPeriodic => self.frequencies.len(),
+            GenericFamily::LegStep => self.step_pairs(),
+            _ => 1,
+        }
+    }
+
+    /// Number of tests the dictionary makes (every scan period and every
+    /// pair of a step's edges counts).
+    pub(crate) fn multiplicity(&self) -> usize {
+        self.groups.iter().map(|g| self.tests(g.family)).sum()
+    }
+
+    /// The alternatives of a scanned family for the penalised gain: every
+    /// grid point of its scan over all its groups (`None` for a family
+    /// without a scan).
+    pub(crate) fn scan_alternatives(&self, family: GenericFamily) -> Option<usize> {
+        matches!(family, GenericFamily::LegPeriodic | GenericFamily::LegStep).then(|| {
+            self.groups
+                .iter()
+                .filter(|g| g.family == family)
+                .map(|g| self.tests(g.family))
+                .sum()
+        })
     }
 
     /// Whether the dictionary is empty.
@@ -174,6 +263,23 @@ impl Dictionary {
                         rank,
                         p_adjusted: test(explained, rank),
                         period_sd_mm,
+                        edges_sd_mm: None,
+                    });
+                }
+                continue;
+            }
+            if g.family == GenericFamily::LegStep {
+                if let Some((explained, rank, term, edges_sd_mm)) = self.step_scan(at, g)
+                    && let Some((explained, rank)) =
+                        at.beyond_smooth(&term, explained, rank, model_terms)
+                {
+                    out.push(Scored {
+                        term,
+                        explained,
+                        rank,
+                        p_adjusted: test(explained, rank),
+                        period_sd_mm: None,
+                        edges_sd_mm: Some(edges_sd_mm),
                     });
                 }
                 continue;
@@ -188,6 +294,7 @@ impl Dictionary {
                 rank,
                 p_adjusted: test(explained, rank),
                 period_sd_mm: None,
+                edges_sd_mm: None,
             });
         }
         out.sort_by(|a, b| {
@@ -256,5 +363,140 @@ impl Dictionary {
         let curvature = (score(f + h).0 - 2.0 * s + score(f - h).0) / (h * h);
         let sd_f = (curvature < 0.0).then(|| (2.0 * at.scale(s, k) / -curvature).sqrt());
         Some((s, k, with(f), sd_f.map(|sd| sd / (f * f))))
+    }
+
+    /// The best step of the scan on `group`'s leg, refined: (score, rank,
+    /// term with its edges, sd of each edge).
+    fn step_scan(
+        &self,
+        at: &At<'_>,
+        group: &GenericTerm,
+    ) -> Option<(f64, usize, GenericTerm, [Option<f64>; 2])> {
+        let Scope::Leg(leg) = group.scope else {
+            return None;
+        };
+        let leg = usize::from(leg);
+        let [lo, hi] = at.frame.leg_range_mm[leg];
+        let cells = self.step_cells;
+        if hi <= lo || cells == 0 {
+            return None;
+        }
+        let commands: Vec<[f64; 3]> = at.data.poses.iter().map(|p| p.commands_mm).collect();
+        let n = commands.len();
+        let counts_ok = |inside: usize| inside >= MIN_STEP_POSES && n - inside >= MIN_STEP_POSES;
+        // The grid.
+        let grid: Vec<f64> = (0..=cells)
+            .map(|k| {
+                if k == cells {
+                    hi
+                } else {
+                    lo + (hi - lo) * k as f64 / cells as f64
+                }
+            })
+            .collect();
+        let prefix = at.lin.step_prefix(&commands, leg, &grid);
+        let mut best: Option<(usize, usize, f64)> = None;
+        for u in 0..cells {
+            for v in u + 1..=cells {
+                if (u, v) == (0, cells) {
+                    continue;
+                }
+                let (s, k, inside) = at.lin.step_score(&prefix, u, v);
+                if k > 0 && counts_ok(inside) && best.is_none_or(|b| s > b.2) {
+                    best = Some((u, v, s));
+                }
+            }
+        }
+        let (u, v, _) = best?;
+        // The candidate edges within one cell of each: midway between
+        // neighbouring commands, and the end of the stroke when the window
+        // reaches it; each with the gap of commands it stands for.
+        let mut sorted: Vec<f64> = commands.iter().map(|q| q[leg]).collect();
+        sorted.sort_by(f64::total_cmp);
+        sorted.dedup();
+        let window = |k: usize| (grid[k.saturating_sub(1)], grid[(k + 1).min(cells)]);
+        let candidates = |(from, to): (f64, f64)| -> Vec<(f64, [f64; 2])> {
+            let mut out: Vec<(f64, [f64; 2])> = Vec::new();
+            if from <= lo {
+                out.push((lo, [f64::NEG_INFINITY, lo]));
+            }
+            out.extend(
+                sorted
+                    .windows(2)
+                    .map(|w| (0.5 * (w[0] + w[1]), [w[0], w[1]]))
+                    .filter(|(m, _)| (from..=to).contains(m)),
+            );
+            if to >= hi {
+                out.push((hi, [hi, f64::INFINITY]));
+            }
+            out
+        };
+        let (lower, upper) = (candidates(window(u)), candidates(window(v)));
+        let mut cuts: Vec<f64> = lower.iter().chain(&upper).map(|c| c.0).collect();
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
+        let index = |x: f64| cuts.partition_point(|c| *c < x);
+        let prefix = at.lin.step_prefix(&commands, leg, &cuts);
+        let score = |a: usize, b: usize| -> Option<f64> {
+            let (s, k, inside) = at.lin.step_score(&prefix, a, b);
+            (a < b && k > 0 && counts_ok(inside)).then_some(s)
+        };
+        // Start from the candidates nearest the grid's edges.
+        let nearest = |list: &[(f64, [f64; 2])], x: f64| {
+            list.iter()
+                .min_by(|p, q| (p.0 - x).abs().total_cmp(&(q.0 - x).abs()))
+                .map(|c| index(c.0))
+        };
+        let (mut a, mut b) = (nearest(&lower, grid[u])?, nearest(&upper, grid[v])?);
+        let mut s_best = score(a, b).unwrap_or(f64::NEG_INFINITY);
+        for _ in 0..STEP_ROUNDS {
+            let before = (a, b);
+            for (list, lower_edge) in [(&lower, true), (&upper, false)] {
+                for c in list.iter() {
+                    let i = index(c.0);
+                    let (x, y) = if lower_edge { (i, b) } else { (a, i) };
+                    if let Some(s) = score(x, y)
+                        && s > s_best
+                    {
+                        s_best = s;
+                        (a, b) = (x, y);
+                    }
+                }
+            }
+            if (a, b) == before {
+                break;
+            }
+        }
+        let term = GenericTerm {
+            edges_mm: Some([cuts[a], cuts[b]]),
+            ..*group
+        };
+        let (s, k) = at.score(&term);
+        if k == 0 {
+            return None;
+        }
+        // Each edge's profile-likelihood interval: the candidates within
+        // s2 of the best, the other edge fixed.
+        let s2 = at.scale(s, k);
+        let interval = |list: &[(f64, [f64; 2])], lower_edge: bool| -> Option<f64> {
+            let admitted: Vec<[f64; 2]> = list
+                .iter()
+                .filter(|c| {
+                    let i = index(c.0);
+                    let (x, y) = if lower_edge { (i, b) } else { (a, i) };
+                    score(x, y).is_some_and(|v| v >= s_best - s2)
+                })
+                .map(|c| c.1)
+                .collect();
+            let from = admitted.iter().map(|g| g[0]).fold(f64::INFINITY, f64::min);
+            let to = admitted
+                .iter()
+                .map(|g| g[1])
+                .fold(f64::NEG_INFINITY, f64::max);
+            let half = 0.5 * (to - from);
+            half.is_finite().then_some(half)
+        };
+        let sd = [interval(&lower, true), interval(&upper, false)];
+        Some((s, k, term, sd))
     }
 }

@@ -94,6 +94,55 @@ pub(crate) struct Projections {
     pub(crate) of: [Vec<f64>; 6],
 }
 
+/// The products of a step column (`1e-3` times one leg's direction) over
+/// the poses whose command lies between two cuts of the step scan:
+/// `X^T g` (before the `1e-3`; `Q^T g` is `R^-T` of it), `g^T g` (before
+/// `1e-6`), `g^T t` (before `1e-3`), and the number of poses.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct StepSums {
+    xtg: Vec<f64>,
+    gtg: f64,
+    gtt: f64,
+    /// Poses summed.
+    pub(crate) poses: usize,
+}
+
+impl StepSums {
+    fn zero(p: usize) -> StepSums {
+        StepSums {
+            xtg: vec![0.0; p],
+            gtg: 0.0,
+            gtt: 0.0,
+            poses: 0,
+        }
+    }
+
+    /// `self - other`: the poses of `self` not in `other` (prefix sums).
+    fn minus(&self, other: &StepSums) -> StepSums {
+        StepSums {
+            xtg: self
+                .xtg
+                .iter()
+                .zip(&other.xtg)
+                .map(|(a, b)| a - b)
+                .collect(),
+            gtg: self.gtg - other.gtg,
+            gtt: self.gtt - other.gtt,
+            poses: self.poses - other.poses,
+        }
+    }
+
+    fn add(&mut self, other: &StepSums) {
+        self.xtg
+            .iter_mut()
+            .zip(&other.xtg)
+            .for_each(|(a, b)| *a += b);
+        self.gtg += other.gtg;
+        self.gtt += other.gtt;
+        self.poses += other.poses;
+    }
+}
+
 /// How much a term explains of a target.
 #[derive(Debug, Clone)]
 pub(crate) struct Score {
@@ -828,6 +877,86 @@ impl Linearisation {
         (s.explained, s.rank)
     }
 
+    /// The prefix sums of the step scan of leg `leg` over the `cuts` of its
+    /// command (increasing): element `k` sums the step column over the
+    /// poses with `cuts[0] <= q < cuts[k]` (the last cut included), so that
+    /// the indicator of `[cuts[u], cuts[v]]` has the products
+    /// `prefix[v] - prefix[u]` ([`Linearisation::step_score`]). Poses
+    /// outside the cuts are in no bin.
+    ///
+    /// One pass over the poses: each adds its `p + 2` numbers (its design
+    /// rows times the leg's direction) to the bin of its command, in pose
+    /// order, and the bins are summed in their
+    /// order, so that a scan of `K` cuts costs `O(n p + K p)` and has the
+    /// same bits at any thread count (it runs on one).
+    pub(crate) fn step_prefix(
+        &self,
+        commands_mm: &[[f64; 3]],
+        leg: usize,
+        cuts: &[f64],
+    ) -> Vec<StepSums> {
+        let p = self.basis.len();
+        let n = self.poses().min(commands_mm.len());
+        let mut bins = vec![StepSums::zero(p); cuts.len().saturating_sub(1)];
+        let (Some(&first), Some(&last)) = (cuts.first(), cuts.last()) else {
+            return vec![StepSums::zero(p)];
+        };
+        let mut buffer = vec![0.0; p];
+        for j in 0..n {
+            let q = commands_mm[j][leg];
+            if !(first..=last).contains(&q) || bins.is_empty() {
+                continue;
+            }
+            let k = (cuts.partition_point(|c| *c <= q) - 1).min(bins.len() - 1);
+            let bin = &mut bins[k];
+            // X_j^T d_j,leg.
+            let d = self.direction(j, leg);
+            for c in 0..3 {
+                let row = self.basis_row(3 * j + c, &mut buffer);
+                bin.xtg
+                    .iter_mut()
+                    .zip(row)
+                    .for_each(|(a, x)| *a += x * d[c]);
+            }
+            bin.gtg += self.gram(j, leg, leg);
+            bin.gtt += self.target_product(j, leg);
+            bin.poses += 1;
+        }
+        let mut prefix = Vec::with_capacity(bins.len() + 1);
+        let mut running = StepSums::zero(p);
+        prefix.push(running.clone());
+        for b in &bins {
+            running.add(b);
+            prefix.push(running.clone());
+        }
+        prefix
+    }
+
+    /// The score `(explained, rank)` of the step column over the poses
+    /// between cuts `u < v` of `prefix` ([`Linearisation::step_prefix`]),
+    /// and the number of those poses: equal to
+    /// [`Linearisation::score_columns`] of the term's column up to
+    /// rounding.
+    pub(crate) fn step_score(
+        &self,
+        prefix: &[StepSums],
+        u: usize,
+        v: usize,
+    ) -> (f64, usize, usize) {
+        let (Some(a), Some(b)) = (prefix.get(u), prefix.get(v)) else {
+            return (0.0, 0, 0);
+        };
+        if u >= v {
+            return (0.0, 0, 0);
+        }
+        let s = b.minus(a);
+        let qtg = self.qt(&DMatrix::from_column_slice(s.xtg.len(), 1, &s.xtg)) * 1e-3;
+        let gtg = DMatrix::from_element(1, 1, s.gtg * 1e-6);
+        let gtt = DVector::from_element(1, s.gtt * 1e-3);
+        let score = score_from(&qtg, &gtg, &gtt, &self.qtt);
+        (score.explained, score.rank, s.poses)
+    }
+
     /// Dense weighted columns (`3n x k`) of per-pose values.
     pub(crate) fn dense(&self, cols: &[(usize, Vec<f64>)]) -> DMatrix<f64> {
         let n = self.poses();
@@ -1161,7 +1290,7 @@ pub(crate) fn canonical_correlation(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
 mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
-    use tricept_model::effects::periodic_extra_mm;
+    use tricept_model::effects::{periodic_extra_mm, segment_extra_mm};
 
     /// An orthonormal basis of the column space of `a` (thin QR).
     fn orthonormal_basis(a: &DMatrix<f64>) -> DMatrix<f64> {
@@ -1210,6 +1339,18 @@ mod tests {
         (lin, commands)
     }
 
+    /// A scan's `(explained, rank)` equals the direct score to rounding.
+    fn assert_same_score(scan: (f64, usize), direct: &Score, what: &str) {
+        assert_eq!(scan.1, direct.rank, "{what}");
+        let tolerance = 1e-9 * direct.explained.max(1.0);
+        assert!(
+            (scan.0 - direct.explained).abs() <= tolerance,
+            "{what}: scan {} against {}",
+            scan.0,
+            direct.explained
+        );
+    }
+
     #[test]
     fn the_periodic_scan_equals_scoring_each_period() {
         // 700 poses: several blocks, the last one partial.
@@ -1234,20 +1375,9 @@ mod tests {
                     })
                     .collect();
                 let direct = lin.score_columns(&cols);
-                assert_eq!(rank, direct.rank, "frequency {k}");
-                let (one, one_rank) = lin.periodic_score(&commands, &legs, f0 + k as f64 * step);
-                assert_eq!(one_rank, direct.rank, "frequency {k}");
-                assert!(
-                    (one - direct.explained).abs() <= 1e-9 * direct.explained.max(1.0),
-                    "frequency {k}: one frequency {one} against {}",
-                    direct.explained
-                );
-                let tolerance = 1e-9 * direct.explained.max(1.0);
-                assert!(
-                    (explained - direct.explained).abs() <= tolerance,
-                    "frequency {k}: scan {explained} against {}",
-                    direct.explained
-                );
+                assert_same_score((explained, rank), &direct, &format!("frequency {k}"));
+                let one = lin.periodic_score(&commands, &legs, f0 + k as f64 * step);
+                assert_same_score(one, &direct, &format!("frequency {k} alone"));
                 if explained > best.1 {
                     best = (k, explained);
                 }
@@ -1318,6 +1448,37 @@ mod tests {
                 &column - &q * (q.transpose() * &column)
             };
             assert!((own.column(0) - expected).norm() <= 1e-9 * column.norm());
+        }
+    }
+
+    #[test]
+    fn the_step_scan_equals_scoring_each_segment() {
+        // 700 poses over 600-1000 mm; cuts every 25 mm over that range.
+        let (lin, commands) = synthetic(700, 11);
+        let cuts: Vec<f64> = (0..=16).map(|k| 600.0 + 25.0 * f64::from(k)).collect();
+        for leg in 0..3 {
+            let prefix = lin.step_prefix(&commands, leg, &cuts);
+            assert_eq!(prefix.len(), cuts.len());
+            for u in 0..cuts.len() {
+                for v in u + 1..cuts.len() {
+                    let (explained, rank, inside) = lin.step_score(&prefix, u, v);
+                    let column: Vec<f64> = commands
+                        .iter()
+                        .map(|q| segment_extra_mm(1.0, cuts[u], cuts[v], q[leg]))
+                        .collect();
+                    let expected_inside = column.iter().filter(|v| **v != 0.0).count();
+                    assert_eq!(inside, expected_inside, "leg {leg} cuts {u}-{v}");
+                    let direct = lin.score_columns(&[(leg, column)]);
+                    assert_same_score(
+                        (explained, rank),
+                        &direct,
+                        &format!("leg {leg} cuts {u}-{v}"),
+                    );
+                }
+            }
+            // A segment the wrong way round, or of one cut, is empty.
+            assert_eq!(lin.step_score(&prefix, 5, 3), (0.0, 0, 0));
+            assert_eq!(lin.step_score(&prefix, 4, 4), (0.0, 0, 0));
         }
     }
 

@@ -66,11 +66,18 @@ impl ExtendedModel {
     ///     family: GenericFamily::LegPeriodic,
     ///     scope: Scope::AllLegs,
     ///     period_mm: Some(10.0),
+    ///     edges_mm: None,
+    /// });
+    /// // A worn segment of leg 2's screw from 750 to 900 mm of command.
+    /// let step = Term::Generic(GenericTerm {
+    ///     edges_mm: Some([750.0, 900.0]),
+    ///     ..GenericTerm::new(GenericFamily::LegStep, Scope::Leg(1))
     /// });
     /// let g = GeometricModel::new(m.clone(), tricept_model::ParameterSet::paper15());
-    /// let model = ExtendedModel::with_terms(g, &[pitch], Arc::new(Frame::of(&m, &data)));
-    /// assert_eq!(model.names().len(), 15 + 6);
+    /// let model = ExtendedModel::with_terms(g, &[pitch, step], Arc::new(Frame::of(&m, &data)));
+    /// assert_eq!(model.names().len(), 15 + 6 + 1);
     /// assert_eq!(model.names()[15], "leg-periodic.leg1_sin_um");
+    /// assert_eq!(model.names()[21], "leg-step.leg2_um");
     /// ```
     pub fn with_terms(
         geometric: GeometricModel,

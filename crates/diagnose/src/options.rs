@@ -72,6 +72,10 @@ pub struct DictionaryOptions {
     pub period_range_mm: (f64, f64),
     /// Grid points per independent frequency of the scan.
     pub oversampling: f64,
+    /// Cells of the step scan's grid over each leg's stroke (its
+    /// `K (K + 1) / 2 - 1` pairs of edges each count in the multiplicity;
+    /// 0: no step scan).
+    pub step_cells: usize,
     /// Best-ranked groups refitted exactly at each selection step.
     pub refit_top: usize,
 }
@@ -82,6 +86,7 @@ impl Default for DictionaryOptions {
             enabled: true,
             period_range_mm: (4.0, 50.0),
             oversampling: 4.0,
+            step_cells: 16,
             refit_top: 3,
         }
     }

@@ -178,6 +178,7 @@ mod tests {
             "leg-periodic.amplitude_um",
             "leg-periodic.period_mm",
             "leg-polynomial.peak_to_valley_um",
+            "leg-step.step_um",
             "reading-drift.phi_arcsec",
             "reading-drift.theta_arcsec",
             "reading-drift.s_um",

@@ -320,6 +320,8 @@ pub struct ModelTerm {
     pub channel: Option<u8>,
     /// The period of a periodic term, mm.
     pub period_mm: Option<f64>,
+    /// The edges of a step, leg command `[from, to]`, mm.
+    pub edges_mm: Option<[f64; 2]>,
     /// Whether it is deployed: its improvement is significant, or it is a
     /// controller parameter (backlash, thermal expansion: its gain is at
     /// the approach directions and temperatures the controller knows).

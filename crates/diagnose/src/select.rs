@@ -13,10 +13,11 @@
 //!    the residual variance of the larger model (never below the noise), is
 //!    significant at `alpha / 2` divided by the number of catalogue
 //!    candidates (catalogue) or by the dictionary's multiplicity (generic:
-//!    every scan period counts);
+//!    every scan period and every pair of a step's edges counts);
 //! 2. its penalised gain is positive:
 //!    `G = X - k ln(3n) - 2 ln m_c`, the BIC plus an extended-BIC term
-//!    for the `m_c` alternatives of its family (1 for a catalogue effect);
+//!    for the `m_c` alternatives of its family (1 for a catalogue effect,
+//!    every grid point of the scan for a scanned family);
 //! 3. its parameters are physically plausible ([`crate::plausibility`]);
 //!    otherwise it is recorded as rejected with the reason;
 //! 4. the 5-fold cross-validated held-out RMS improves.
@@ -130,8 +131,8 @@ impl Setup<'_> {
         match term {
             Term::Catalogue(_) => 1,
             Term::Generic(g) => {
-                if g.period_mm.is_some() {
-                    self.dictionary.scan_len().max(1)
+                if let Some(m) = self.dictionary.scan_alternatives(g.family) {
+                    m.max(1)
                 } else {
                     self.fitter
                         .frame

@@ -20,7 +20,8 @@ use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{KinematicsError, Machine, UpJoints};
 use tricept_model::effects::{
     Basis, CHANNELS, CauseName, EffectName, Entries, GenericFamily, Judgement, Kind, LegContext,
-    Needs, encoder_gain_error_rad, legendre_p2, legendre_p3, linear_drift, normalised_coordinate,
+    Needs, encoder_gain_error_rad, legendre_p2, legendre_p3, legendre_p4, linear_drift,
+    normalised_coordinate, periodic_extra_mm,
 };
 
 /// A logged temperature that varies by less than this over the campaign
@@ -39,8 +40,9 @@ pub enum Scope {
     Channel(u8),
 }
 
-/// A generic term of the dictionary: a family, its scope and, for
-/// `leg-periodic`, the period.
+/// A generic term of the dictionary: a family, its scope and its
+/// nonlinear parameters, found by a scan: the period of a `leg-periodic`
+/// term, the edges of a `leg-step` term.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GenericTerm {
     /// The family.
@@ -49,6 +51,9 @@ pub struct GenericTerm {
     pub scope: Scope,
     /// Period of a `leg-periodic` term, mm.
     pub period_mm: Option<f64>,
+    /// Edges of a `leg-step` term, leg command `[a, b]` (mm): the leg is
+    /// longer by the step while its command is inside, both included.
+    pub edges_mm: Option<[f64; 2]>,
 }
 
 /// A term of an extended model.
@@ -221,6 +226,17 @@ impl GenericTerm {
             family,
             scope,
             period_mm: None,
+            edges_mm: None,
+        }
+    }
+
+    /// Whether the term has the nonlinear parameters its family scans for
+    /// (a period, edges); a group of the dictionary has none until scanned.
+    pub fn is_scanned(&self) -> bool {
+        match self.family {
+            GenericFamily::LegPeriodic => self.period_mm.is_some(),
+            GenericFamily::LegStep => self.edges_mm.is_some(),
+            _ => true,
         }
     }
 
@@ -274,6 +290,11 @@ impl GenericTerm {
                     ]
                 })
                 .collect(),
+            GenericFamily::LegStep => self
+                .legs()
+                .into_iter()
+                .map(|i| format!("leg{}_um", leg_label(i)))
+                .collect(),
             GenericFamily::LegDrift => self
                 .legs()
                 .into_iter()
@@ -300,10 +321,12 @@ impl GenericTerm {
         let mut out = Vec::new();
         let mut push = |i: usize, v: f64| out.push((out.len(), Basis::Leg(i), v));
         for i in self.legs() {
-            if let Some(values) =
-                self.family
-                    .leg_command_entries(q[i], self.period_mm, frame.leg_range_mm[i])
-            {
+            if let Some(values) = self.family.leg_command_entries(
+                q[i],
+                self.period_mm,
+                self.edges_mm,
+                frame.leg_range_mm[i],
+            ) {
                 values.into_iter().for_each(|v| push(i, v));
             } else if self.family == GenericFamily::LegDrift {
                 push(i, linear_drift(1e-3, frame.tau(pose).unwrap_or(0.0)));
@@ -347,9 +370,10 @@ impl GenericTerm {
                 let x = normalised_coordinate(up.q4_mm, lo, hi);
                 vec![(0, b, 1e-3 * legendre_p2(x)), (1, b, 1e-3 * legendre_p3(x))]
             }
-            GenericFamily::LegPeriodic | GenericFamily::LegPolynomial | GenericFamily::LegDrift => {
-                Vec::new()
-            }
+            GenericFamily::LegPeriodic
+            | GenericFamily::LegPolynomial
+            | GenericFamily::LegStep
+            | GenericFamily::LegDrift => Vec::new(),
         }
     }
 
@@ -358,16 +382,76 @@ impl GenericTerm {
         frame.supports(self.family.spec().needs)
     }
 
-    /// A short label of the group (`leg-polynomial:leg2`, `reading-drift:s`).
+    /// Per-pose columns (direction, value) of the refinement of a generic
+    /// leg term: the quartic Legendre part of a polynomial, the second
+    /// harmonic of a periodic term (none for a step).
+    pub(crate) fn refinement(
+        &self,
+        frame: &Frame,
+        data: &Dataset,
+    ) -> Option<Vec<(usize, Vec<f64>)>> {
+        let g = self;
+        let legs = g.legs();
+        let poses = &data.poses;
+        match g.family {
+            GenericFamily::LegPolynomial => Some(
+                legs.iter()
+                    .flat_map(|&i| {
+                        let [lo, hi] = frame.leg_range_mm[i];
+                        let x: Vec<f64> = poses
+                            .iter()
+                            .map(|p| normalised_coordinate(p.commands_mm[i], lo, hi))
+                            .collect();
+                        [(i, x.iter().map(|x| 1e-3 * legendre_p4(*x)).collect())]
+                    })
+                    .collect(),
+            ),
+            GenericFamily::LegPeriodic => {
+                let half = g.period_mm? / 2.0;
+                Some(
+                    legs.iter()
+                        .flat_map(|&i| {
+                            let q: Vec<f64> = poses.iter().map(|p| p.commands_mm[i]).collect();
+                            [
+                                (
+                                    i,
+                                    q.iter()
+                                        .map(|q| periodic_extra_mm(1.0, 0.0, half, *q))
+                                        .collect(),
+                                ),
+                                (
+                                    i,
+                                    q.iter()
+                                        .map(|q| periodic_extra_mm(0.0, 1.0, half, *q))
+                                        .collect(),
+                                ),
+                            ]
+                        })
+                        .collect(),
+                )
+            }
+            GenericFamily::LegStep
+            | GenericFamily::ReadingDrift
+            | GenericFamily::ReadingTemperature
+            | GenericFamily::LegDrift
+            | GenericFamily::EncoderGain
+            | GenericFamily::ScalePolynomial
+            | GenericFamily::ReadingHysteresis => None,
+        }
+    }
+
+    /// A short label of the group (`leg-polynomial:leg2`, `reading-drift:s`,
+    /// `leg-periodic:legs@10.001mm`, `leg-step:leg1@718.4-958.0mm`).
     pub fn label(&self) -> String {
         let scope = match self.scope {
             Scope::Leg(i) => format!("leg{}", i + 1),
             Scope::AllLegs => "legs".into(),
             Scope::Channel(c) => CHANNELS[usize::from(c)].into(),
         };
-        match self.period_mm {
-            Some(p) => format!("{}:{scope}@{p:.3}mm", self.family),
-            None => format!("{}:{scope}", self.family),
+        match (self.period_mm, self.edges_mm) {
+            (Some(p), _) => format!("{}:{scope}@{p:.3}mm", self.family),
+            (None, Some([a, b])) => format!("{}:{scope}@{a:.1}-{b:.1}mm", self.family),
+            (None, None) => format!("{}:{scope}", self.family),
         }
     }
 }
@@ -626,6 +710,9 @@ impl Frame {
             out.push(GenericTerm::new(G::LegPolynomial, Scope::Leg(i)));
         }
         out.push(GenericTerm::new(G::LegPolynomial, Scope::AllLegs));
+        for i in 0..3 {
+            out.push(GenericTerm::new(G::LegStep, Scope::Leg(i)));
+        }
         for c in 0..3 {
             out.push(GenericTerm::new(G::ReadingDrift, Scope::Channel(c)));
             out.push(GenericTerm::new(G::ReadingTemperature, Scope::Channel(c)));
@@ -680,6 +767,7 @@ mod tests {
             family: GenericFamily::LegPeriodic,
             scope: Scope::AllLegs,
             period_mm: Some(10.0),
+            edges_mm: None,
         };
         let v = t.leg_values(&f, &data.poses[0]);
         assert_eq!(v.len(), 6);

@@ -300,10 +300,7 @@ fn robust_start(
     let k = model.names().len();
     let first = FirstEvaluation::new(model, &vec![0.0; k], &data.poses, &options.sigma)?;
     let nominal: Vec<Option<[f64; 3]>> = first.residuals().iter().map(|r| Some(*r)).collect();
-    let median = |mut v: Vec<f64>| -> f64 {
-        v.sort_by(f64::total_cmp);
-        tricept_numerics::stats::quantile(&v, 0.5)
-    };
+    let median = |mut v: Vec<f64>| -> f64 { tricept_numerics::stats::median(&mut v) };
     let centre: [f64; 3] =
         std::array::from_fn(|c| median(nominal.iter().flatten().map(|r| r[c]).collect()));
     let scale: [f64; 3] = std::array::from_fn(|c| {

@@ -32,7 +32,7 @@
 //! | `leg-periodic` | `um` per leg, `period_mm`, `phase_deg` per leg, `waveform` (`sine` or `sawtooth`) |
 //! | `leg-quadratic` | `um` per leg at `half_width_mm` from `centre_mm` |
 //! | `leg-power` | `um` per leg at `half_width_mm` from `centre_mm`, `exponent` (a shape outside the dictionary for 1.5) |
-//! | `leg-step` | `um` per leg inside the worn segment of commands `from_mm` to `to_mm` (a shape outside the dictionary) |
+//! | `leg-step` | `um` per leg inside the worn segment of commands `from_mm` to `to_mm` |
 //! | `scale-drift` | `um` over the campaign, linear in time |
 //! | `encoder-gain` | `phi_ppm`, `theta_ppm` |
 
@@ -45,7 +45,7 @@ use tricept_model::effects::{
     CauseName, EffectName, GenericFamily, add_tube_twist, add_ujoint_axis_errors,
     backlash_extra_mm, compliance_extra_mm, eccentricity_error_rad, encoder_gain_error_rad,
     gravity_leg_tension_n, leg_lead_extra_mm, linear_drift, normalised_coordinate,
-    periodic_extra_mm, scale_gain_error_mm, thermal_extra_mm,
+    periodic_extra_mm, scale_gain_error_mm, segment_extra_mm, thermal_extra_mm,
 };
 
 /// Shape of a periodic leg-length error.
@@ -303,9 +303,10 @@ impl Effect {
             Effect::Compliance { .. } => catalogue(EffectName::Compliance),
             Effect::Outliers { .. } => catalogue(EffectName::Outliers),
             Effect::LegPeriodic { .. } => generic(GenericFamily::LegPeriodic),
-            Effect::LegQuadratic { .. } | Effect::LegPower { .. } | Effect::LegStep { .. } => {
+            Effect::LegQuadratic { .. } | Effect::LegPower { .. } => {
                 generic(GenericFamily::LegPolynomial)
             }
+            Effect::LegStep { .. } => generic(GenericFamily::LegStep),
             Effect::ScaleDrift { .. } => generic(GenericFamily::ReadingDrift),
             Effect::EncoderGain { .. } => generic(GenericFamily::EncoderGain),
         }
@@ -427,9 +428,7 @@ impl Effect {
             ),
             Effect::LegStep { um, from_mm, to_mm } => {
                 for i in 0..3 {
-                    if (*from_mm..=*to_mm).contains(&s.commands_mm[i]) {
-                        legs[i] += um[i] * 1e-3;
-                    }
+                    legs[i] += segment_extra_mm(um[i], *from_mm, *to_mm, s.commands_mm[i]);
                 }
             }
             Effect::ScaleGain { .. }

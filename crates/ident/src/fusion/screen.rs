@@ -25,7 +25,7 @@
 //! setup problem, not gross errors). Rejected records are reported by file
 //! and line, and the fit is redone without them.
 
-use tricept_numerics::stats::{chi2_isf, quantile};
+use tricept_numerics::stats::chi2_isf;
 
 use crate::error::IdentError;
 use crate::fusion::estimate::{
@@ -65,10 +65,7 @@ fn robust_start(sources: &[Source], eval: &Evaluation) -> Vec<Vec<bool>> {
         .map(|(source, z)| {
             let n = source.records();
             let m = source.rows().rows_per_record().max(1);
-            let median = |mut v: Vec<f64>| -> f64 {
-                v.sort_by(f64::total_cmp);
-                quantile(&v, 0.5)
-            };
+            let median = |mut v: Vec<f64>| -> f64 { tricept_numerics::stats::median(&mut v) };
             let channel = |c: usize| -> Vec<(usize, f64)> {
                 z.iter()
                     .enumerate()

@@ -1,6 +1,7 @@
 //! The functional forms of the generic families and of the simulator's
 //! effects outside the vocabulary: periodic and Legendre shapes over a
-//! normalised stroke, encoder gains, linear drifts.
+//! normalised stroke, a worn segment of the stroke, encoder gains, linear
+//! drifts.
 
 /// Extra leg length (mm) of a periodic error of period `period_mm` in the
 /// leg length `command_mm`, with sine and cosine amplitudes in um (a
@@ -16,6 +17,25 @@
 pub fn periodic_extra_mm(sin_um: f64, cos_um: f64, period_mm: f64, command_mm: f64) -> f64 {
     let (s, c) = (std::f64::consts::TAU * command_mm / period_mm).sin_cos();
     (sin_um * s + cos_um * c) * 1e-3
+}
+
+/// Extra leg length (mm) of a worn segment: `um` inside the commands
+/// `from_mm` to `to_mm` (both included), nothing outside (a step in and a
+/// step out of the segment).
+///
+/// # Example
+/// ```
+/// use tricept_model::effects::segment_extra_mm;
+/// assert_eq!(segment_extra_mm(3.0, 720.0, 960.0, 800.0), 0.003);
+/// assert_eq!(segment_extra_mm(3.0, 720.0, 960.0, 960.0), 0.003);
+/// assert_eq!(segment_extra_mm(3.0, 720.0, 960.0, 961.0), 0.0);
+/// ```
+pub fn segment_extra_mm(um: f64, from_mm: f64, to_mm: f64, command_mm: f64) -> f64 {
+    if (from_mm..=to_mm).contains(&command_mm) {
+        um * 1e-3
+    } else {
+        0.0
+    }
 }
 
 /// `x` in `[lo, hi]` mapped linearly onto `[-1, 1]` (`0` when the range is

@@ -7,6 +7,7 @@
 //! |---|---|---|
 //! | `leg-periodic` | `a_i sin(2 pi q_i / P) + b_i cos(2 pi q_i / P)` per leg | ball-screw pitch error (period = lead) |
 //! | `leg-polynomial` | `c1_i x_i + c2_i P2(x_i) + c3_i P3(x_i)`, `x_i` the leg's stroke over the campaign on `[-1, 1]` | mean travel deviation and travel variation of a screw, a bent guide |
+//! | `leg-step` | `h_i` while leg `i`'s command is inside `[a, b]` (edges scanned; an edge at the end of the campaign's stroke: a single step) | a worn screw segment, a step of the drive |
 //! | `reading-drift` | reading drifts linearly with time (or pose order) | sensor or mounting drift |
 //! | `reading-temperature` | reading changes with the logged temperature | thermal drift of the sensor path |
 //! | `leg-drift` | leg lengths drift linearly with time | creep, drive warm-up |
@@ -17,14 +18,16 @@
 //! Each family's [`GenericSpec`] says what it acts on, what the campaign
 //! must log, its physical ranges and known aliases, and where it is
 //! deployed: the leg families that are functions of the leg command alone
-//! ([`GenericFamily::leg_command_entries`]: periodic and polynomial) as
+//! ([`GenericFamily::leg_command_entries`]: periodic, polynomial, step) as
 //! per-leg compensation tables, the reading families as sensor
 //! corrections (recorded, they do not move the platform), the legs'
 //! drift over time recorded with the campaign's middle, not applied.
 
 use serde::{Deserialize, Serialize};
 
-use super::forms::{legendre_p2, legendre_p3, normalised_coordinate, periodic_extra_mm};
+use super::forms::{
+    legendre_p2, legendre_p3, normalised_coordinate, periodic_extra_mm, segment_extra_mm,
+};
 use super::spec::{
     CHANNELS, Deployment, Judgement, KnownAlias, Measure, Needs, PlausibleRange, PlotAxes, XAxis,
     YAxis,
@@ -40,6 +43,9 @@ pub enum GenericFamily {
     LegPeriodic,
     /// Leg-length error quadratic and cubic in the leg length.
     LegPolynomial,
+    /// Leg-length error constant over a segment of the leg's commands (a
+    /// worn screw segment).
+    LegStep,
     /// A reading drifting with time.
     ReadingDrift,
     /// A reading changing with temperature.
@@ -94,9 +100,10 @@ const MOUNT: &str = "thermal bending of a sensor mount";
 
 impl GenericFamily {
     /// Every family, in the order of the table.
-    pub const ALL: [GenericFamily; 8] = [
+    pub const ALL: [GenericFamily; 9] = [
         GenericFamily::LegPeriodic,
         GenericFamily::LegPolynomial,
+        GenericFamily::LegStep,
         GenericFamily::ReadingDrift,
         GenericFamily::ReadingTemperature,
         GenericFamily::LegDrift,
@@ -159,6 +166,21 @@ impl GenericFamily {
                     50.0,
                     "um",
                     "travel variation of transport-grade screws",
+                ),
+            )],
+        );
+        const LEG_STEP: GenericSpec = spec(
+            "leg-step",
+            true,
+            Needs::LegStrokes,
+            &[(
+                None,
+                range(
+                    "step_um",
+                    -25.0,
+                    25.0,
+                    "um",
+                    "a worn or damaged screw segment (beyond: a crash or a slipped coupling, not wear)",
                 ),
             )],
         );
@@ -277,6 +299,7 @@ impl GenericFamily {
         match self {
             G::LegPeriodic => &LEG_PERIODIC,
             G::LegPolynomial => &LEG_POLYNOMIAL,
+            G::LegStep => &LEG_STEP,
             G::ReadingDrift => &READING_DRIFT,
             G::ReadingTemperature => &READING_TEMPERATURE,
             G::LegDrift => &LEG_DRIFT,
@@ -301,7 +324,7 @@ impl GenericFamily {
     /// The judged quantities of a term of this family on `legs` (0-2) or
     /// `channel`, with `period_mm` for a periodic term: the parameters are
     /// those of the term in order (per leg: sine and cosine of a periodic
-    /// term, `P1`, `P2`, `P3` of a polynomial, one drift).
+    /// term, `P1`, `P2`, `P3` of a polynomial, one step, one drift).
     ///
     /// # Example
     /// ```
@@ -359,15 +382,17 @@ impl GenericFamily {
                     )
                 })
                 .collect(),
-            G::LegDrift => legs
+            // One judged parameter per leg: a step's height, a drift.
+            G::LegStep | G::LegDrift => legs
                 .iter()
                 .enumerate()
                 .map(|(k, leg)| {
-                    judged(
-                        first,
-                        Measure::Parameter(k),
-                        format!("drift of leg {} over the campaign", leg + 1),
-                    )
+                    let label = if self == G::LegStep {
+                        format!("step of leg {} over its segment", leg + 1)
+                    } else {
+                        format!("drift of leg {} over the campaign", leg + 1)
+                    };
+                    judged(first, Measure::Parameter(k), label)
                 })
                 .collect(),
             G::ScalePolynomial => vec![judged(
@@ -400,7 +425,7 @@ impl GenericFamily {
         use GenericFamily as G;
         let (x, y) = match self {
             G::LegPeriodic => (XAxis::LegCommandModuloPeriod(leg), YAxis::LegResidual(leg)),
-            G::LegPolynomial => (XAxis::LegCommand(leg), YAxis::LegResidual(leg)),
+            G::LegPolynomial | G::LegStep => (XAxis::LegCommand(leg), YAxis::LegResidual(leg)),
             G::LegDrift => (XAxis::Order, YAxis::LegResidual(leg)),
             G::ReadingTemperature => (XAxis::Temperature, YAxis::Reading(channel)),
             G::EncoderGain => (XAxis::Angle(channel), YAxis::Reading(channel)),
@@ -414,20 +439,24 @@ impl GenericFamily {
     /// (in order), the length it adds (mm) at leg command `command_mm`,
     /// for the families that are functions of the leg command alone: a
     /// periodic term of period `period_mm`, a polynomial over the stroke
-    /// `stroke_mm` (`[lo, hi]`, normalised onto `[-1, 1]`). `None` for the
-    /// other families (a drift depends on time).
+    /// `stroke_mm` (`[lo, hi]`, normalised onto `[-1, 1]`), a step over the
+    /// segment `edges_mm` (`[a, b]`, both included; zero without edges).
+    /// `None` for the other families (a drift depends on time).
     ///
     /// # Example
     /// ```
     /// use tricept_model::effects::GenericFamily;
-    /// let v = GenericFamily::LegPeriodic.leg_command_entries(700.0, Some(10.0), [600.0, 900.0]).unwrap();
+    /// let v = GenericFamily::LegPeriodic.leg_command_entries(700.0, Some(10.0), None, [600.0, 900.0]).unwrap();
     /// assert!((v[1] - 1e-3).abs() < 1e-12); // cos(2 pi 700 / 10) = 1, per um
-    /// assert!(GenericFamily::LegDrift.leg_command_entries(700.0, None, [600.0, 900.0]).is_none());
+    /// let step = |q| GenericFamily::LegStep.leg_command_entries(q, None, Some([720.0, 960.0]), [600.0, 1000.0]).unwrap();
+    /// assert_eq!((step(700.0)[0], step(800.0)[0]), (0.0, 1e-3));
+    /// assert!(GenericFamily::LegDrift.leg_command_entries(700.0, None, None, [600.0, 900.0]).is_none());
     /// ```
     pub fn leg_command_entries(
         self,
         command_mm: f64,
         period_mm: Option<f64>,
+        edges_mm: Option<[f64; 2]>,
         stroke_mm: [f64; 2],
     ) -> Option<Vec<f64>> {
         use GenericFamily as G;
@@ -443,6 +472,11 @@ impl GenericFamily {
                 let [lo, hi] = stroke_mm;
                 let x = normalised_coordinate(command_mm, lo, hi);
                 Some(vec![1e-3 * x, 1e-3 * legendre_p2(x), 1e-3 * legendre_p3(x)])
+            }
+            G::LegStep => {
+                Some(vec![edges_mm.map_or(0.0, |[a, b]| {
+                    segment_extra_mm(1.0, a, b, command_mm)
+                })])
             }
             G::LegDrift
             | G::ReadingDrift

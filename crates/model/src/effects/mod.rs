@@ -58,7 +58,7 @@ mod spec;
 pub use deployment::{pose_free_leg_extra_per_mm, static_leg_extra_per_mm};
 pub use forms::{
     encoder_gain_error_rad, legendre_p2, legendre_p3, legendre_p4, linear_drift,
-    normalised_coordinate, periodic_extra_mm,
+    normalised_coordinate, periodic_extra_mm, segment_extra_mm,
 };
 pub use generic::{GenericFamily, GenericSpec};
 pub use spec::{
