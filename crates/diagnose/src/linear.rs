@@ -96,11 +96,11 @@ pub(crate) struct Projections {
 
 /// The products of a step column (`1e-3` times one leg's direction) over
 /// the poses whose command lies between two cuts of the step scan:
-/// `X^T g` (before the `1e-3`; `Q^T g` is `R^-T` of it), `g^T g` (before
-/// `1e-6`), `g^T t` (before `1e-3`), and the number of poses.
+/// `Q^T g` (before the `1e-3`), `g^T g` (before `1e-6`), `g^T t` (before
+/// `1e-3`), and the number of poses.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct StepSums {
-    xtg: Vec<f64>,
+    qtg: Vec<f64>,
     gtg: f64,
     gtt: f64,
     /// Poses summed.
@@ -110,7 +110,7 @@ pub(crate) struct StepSums {
 impl StepSums {
     fn zero(p: usize) -> StepSums {
         StepSums {
-            xtg: vec![0.0; p],
+            qtg: vec![0.0; p],
             gtg: 0.0,
             gtt: 0.0,
             poses: 0,
@@ -120,10 +120,10 @@ impl StepSums {
     /// `self - other`: the poses of `self` not in `other` (prefix sums).
     fn minus(&self, other: &StepSums) -> StepSums {
         StepSums {
-            xtg: self
-                .xtg
+            qtg: self
+                .qtg
                 .iter()
-                .zip(&other.xtg)
+                .zip(&other.qtg)
                 .map(|(a, b)| a - b)
                 .collect(),
             gtg: self.gtg - other.gtg,
@@ -133,9 +133,9 @@ impl StepSums {
     }
 
     fn add(&mut self, other: &StepSums) {
-        self.xtg
+        self.qtg
             .iter_mut()
-            .zip(&other.xtg)
+            .zip(&other.qtg)
             .for_each(|(a, b)| *a += b);
         self.gtg += other.gtg;
         self.gtt += other.gtt;
@@ -886,9 +886,9 @@ impl Linearisation {
     ///
     /// One pass over the poses: each adds its `p + 2` numbers (its design
     /// rows times the leg's direction) to the bin of its command, in pose
-    /// order, and the bins are summed in their
-    /// order, so that a scan of `K` cuts costs `O(n p + K p)` and has the
-    /// same bits at any thread count (it runs on one).
+    /// order, the bins are summed in their order and each prefix is taken
+    /// to `Q^T g` once, so that a scan of `K` cuts costs `O(n p + K p^2)`
+    /// and has the same bits at any thread count (it runs on one).
     pub(crate) fn step_prefix(
         &self,
         commands_mm: &[[f64; 3]],
@@ -913,7 +913,7 @@ impl Linearisation {
             let d = self.direction(j, leg);
             for c in 0..3 {
                 let row = self.basis_row(3 * j + c, &mut buffer);
-                bin.xtg
+                bin.qtg
                     .iter_mut()
                     .zip(row)
                     .for_each(|(a, x)| *a += x * d[c]);
@@ -928,6 +928,12 @@ impl Linearisation {
         for b in &bins {
             running.add(b);
             prefix.push(running.clone());
+        }
+        // Each prefix's X^T g into Q^T g once (R^-T is linear: the
+        // differences follow).
+        for s in &mut prefix {
+            let x = DMatrix::from_column_slice(p, 1, &s.qtg);
+            s.qtg = self.qt(&x).as_slice().to_vec();
         }
         prefix
     }
@@ -950,7 +956,7 @@ impl Linearisation {
             return (0.0, 0, 0);
         }
         let s = b.minus(a);
-        let qtg = self.qt(&DMatrix::from_column_slice(s.xtg.len(), 1, &s.xtg)) * 1e-3;
+        let qtg = DMatrix::from_column_slice(s.qtg.len(), 1, &s.qtg) * 1e-3;
         let gtg = DMatrix::from_element(1, 1, s.gtg * 1e-6);
         let gtt = DVector::from_element(1, s.gtt * 1e-3);
         let score = score_from(&qtg, &gtg, &gtt, &self.qtt);

@@ -148,7 +148,12 @@ pub(crate) fn noise_check(
     } else {
         NoiseSource::Stated
     };
-    let res = residuals_of(fit, &data.poses, &fitter.options.sigma);
+    // Without repeats there is no pure error: no residuals needed.
+    let res = if repeated.groups.is_empty() {
+        Vec::new()
+    } else {
+        residuals_of(fit, &data.poses, &fitter.options.sigma)
+    };
     let Some((ss, dof)) = pure_error(repeated, &res) else {
         return NoiseCheck {
             stated,
