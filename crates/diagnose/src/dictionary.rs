@@ -88,9 +88,7 @@ pub(crate) struct At<'a> {
 impl At<'_> {
     /// Score and rank of a term's columns.
     fn score(&self, term: &GenericTerm) -> (f64, usize) {
-        let s = self
-            .lin
-            .score_columns(&self.lin.generic_columns(term, self.frame, self.data));
+        let s = self.lin.score_generic(term, self.frame, self.data);
         (s.explained, s.rank)
     }
 

@@ -691,6 +691,34 @@ impl Linearisation {
         cols
     }
 
+    /// The score of a generic term's columns ([`Linearisation::generic_columns`]),
+    /// evaluated pose by pose within the sums (no column is kept).
+    pub(crate) fn score_generic(&self, term: &GenericTerm, frame: &Frame, data: &Dataset) -> Score {
+        let n = self.poses().min(data.poses.len());
+        let values_at = |j: usize| {
+            if term.acts_on_legs() {
+                term.leg_values(frame, &data.poses[j])
+            } else {
+                term.reading_values(frame, &data.poses[j], &self.ups[j])
+            }
+        };
+        // The directions of the first pose's entries, one per parameter.
+        let directions: Vec<usize> = match n {
+            0 => Vec::new(),
+            _ => values_at(0)
+                .iter()
+                .map(|(_, b, _)| basis_index(*b))
+                .collect(),
+        };
+        let values = |j: usize, out: &mut [f64]| {
+            out.iter_mut().for_each(|o| *o = 0.0);
+            for (o, (_, _, v)) in out.iter_mut().zip(values_at(j)) {
+                *o = v;
+            }
+        };
+        self.score_of(self.sums(n, &directions, &values), 1.0)
+    }
+
     /// The score of columns given as (direction, per-pose value).
     pub(crate) fn score_columns(&self, cols: &[(usize, Vec<f64>)]) -> Score {
         let n = self
