@@ -243,36 +243,8 @@ struct Block {
     ups: Vec<UpJoints>,
     directions: Vec<[[f64; 3]; 3]>,
     extra: Vec<f64>,
-    sums: ExtraSums,
-}
-
-/// Sums over poses for the scores of `m` extra columns `E` against the
-/// design's `width` columns: `X^T E` (`width x m`, column-major), `E^T E`
-/// and `E^T t`.
-struct ExtraSums {
-    xte: Vec<f64>,
-    ete: Vec<f64>,
-    ett: Vec<f64>,
-}
-
-impl ExtraSums {
-    fn zero(width: usize, m: usize) -> ExtraSums {
-        ExtraSums {
-            xte: vec![0.0; width * m],
-            ete: vec![0.0; m * m],
-            ett: vec![0.0; m],
-        }
-    }
-
-    fn add(&mut self, other: &ExtraSums) {
-        for (a, b) in [
-            (&mut self.xte, &other.xte),
-            (&mut self.ete, &other.ete),
-            (&mut self.ett, &other.ett),
-        ] {
-            a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
-        }
-    }
+    /// `X^T E`, `E^T E` (every entry) and `E^T t` of the extra columns.
+    sums: Sums,
 }
 
 impl Linearisation {
@@ -298,7 +270,7 @@ impl Linearisation {
         extra: &[Term],
     ) -> Option<(Linearisation, Vec<(Term, Score)>)> {
         let (lin, sums) = Self::build(fit, data, sigma, extra, false)?;
-        let m = sums.ett.len();
+        let m = sums.gtt.len();
         let width = lin.width;
         let scores = lin
             .extra_terms
@@ -306,9 +278,9 @@ impl Linearisation {
             .map(|(t, r)| {
                 let k = r.len();
                 // The basis is every design column here.
-                let xtg = DMatrix::from_fn(width, k, |i, a| sums.xte[(r.start + a) * width + i]);
-                let gtg = DMatrix::from_fn(k, k, |a, b| sums.ete[(r.start + a) * m + r.start + b]);
-                let gtt = DVector::from_fn(k, |a, _| sums.ett[r.start + a]);
+                let xtg = DMatrix::from_fn(width, k, |i, a| sums.xtg[(r.start + a) * width + i]);
+                let gtg = DMatrix::from_fn(k, k, |a, b| sums.gtg[(r.start + a) * m + r.start + b]);
+                let gtt = DVector::from_fn(k, |a, _| sums.gtt[r.start + a]);
                 (*t, score_from(&lin.qt(&xtg), &gtg, &gtt, &lin.qtt))
             })
             .collect();
@@ -322,7 +294,7 @@ impl Linearisation {
         sigma: &[f64; 3],
         extra: &[Term],
         dense: bool,
-    ) -> Option<(Linearisation, ExtraSums)> {
+    ) -> Option<(Linearisation, Sums)> {
         let mut terms = fit.model.terms().to_vec();
         terms.extend_from_slice(extra);
         let model = fit.model.with(&terms);
@@ -351,7 +323,7 @@ impl Linearisation {
                     ups: Vec::with_capacity(len),
                     directions: Vec::with_capacity(len),
                     extra: Vec::with_capacity(if dense { 3 * len * m } else { 0 }),
-                    sums: ExtraSums::zero(width, if dense { 0 } else { m }),
+                    sums: Sums::zero(width, if dense { 0 } else { m }),
                 };
                 let mut jac = vec![0.0; 3 * kf];
                 let mut e = vec![0.0; m];
@@ -382,13 +354,13 @@ impl Linearisation {
                                 if ei == 0.0 {
                                     continue;
                                 }
-                                let xte = &mut sums.xte[i * width..(i + 1) * width];
+                                let xte = &mut sums.xtg[i * width..(i + 1) * width];
                                 xte.iter_mut()
                                     .zip(row.iter())
                                     .for_each(|(s, x)| *s += x * ei);
-                                let ete = &mut sums.ete[i * m..(i + 1) * m];
+                                let ete = &mut sums.gtg[i * m..(i + 1) * m];
                                 ete.iter_mut().zip(&e).for_each(|(s, el)| *s += ei * el);
-                                sums.ett[i] += ei * target;
+                                sums.gtt[i] += ei * target;
                             }
                         }
                         block.target.push(target);
@@ -405,7 +377,7 @@ impl Linearisation {
         let mut target = Vec::with_capacity(3 * n);
         let mut ups = Vec::with_capacity(n);
         let mut directions = Vec::with_capacity(n);
-        let mut sums = ExtraSums::zero(width, if dense { 0 } else { m });
+        let mut sums = Sums::zero(width, if dense { 0 } else { m });
         let mut ext = DMatrix::zeros(if dense { 3 * n } else { 0 }, m);
         for block in blocks {
             // A pose the model cannot solve at the estimate.
@@ -1126,19 +1098,9 @@ impl pulp::WithSimd for ScanBlock<'_> {
 impl ScanBlock<'_> {
     #[inline(always)]
     fn run<S: pulp::Simd>(self, simd: S) -> Vec<Sums> {
-        let ScanBlock {
-            commands_mm,
-            legs,
-            poses,
-            f0,
-            step,
-            p,
-            projected,
-            products,
-            gram,
-            rotation,
-            mut sums,
-        } = self;
+        let (commands_mm, legs, poses, p) = (self.commands_mm, self.legs, &self.poses, self.p);
+        let (projected, products, gram) = (&self.projected, &self.products, &self.gram);
+        let mut sums = self.sums;
         let len = poses.len();
         let nl = legs.len();
         let k = 2 * nl;
@@ -1146,7 +1108,7 @@ impl ScanBlock<'_> {
         // values[2 l] the sines of leg l, values[2 l + 1] its cosines.
         let mut values = vec![vec![0.0; len]; 2 * nl];
         for (f, acc) in sums.iter_mut().enumerate() {
-            let frequency = f0 + f as f64 * step;
+            let frequency = self.f0 + f as f64 * self.step;
             for (l, &i) in legs.iter().enumerate() {
                 let (sines, rest) = values[2 * l..].split_at_mut(1);
                 let (sines, cosines) = (&mut sines[0], &mut rest[0]);
@@ -1155,8 +1117,10 @@ impl ScanBlock<'_> {
                         (sines[t], cosines[t]) = angle(frequency, i, j).sin_cos();
                     }
                 } else {
-                    for ((s, c), &(ws, wc)) in
-                        sines.iter_mut().zip(cosines.iter_mut()).zip(&rotation[l])
+                    for ((s, c), &(ws, wc)) in sines
+                        .iter_mut()
+                        .zip(cosines.iter_mut())
+                        .zip(&self.rotation[l])
                     {
                         (*s, *c) = (*s * wc + *c * ws, *c * wc - *s * ws);
                     }

@@ -162,7 +162,7 @@ pub fn screen_gross_errors(
     alpha: f64,
     max_share: f64,
 ) -> Result<Vec<Rejection>, IdentError> {
-    Ok(screen(model, data, options, alpha, max_share)?.0)
+    Ok(screen_gross_errors_with_fit(model, data, options, alpha, max_share)?.0)
 }
 
 /// [`screen_gross_errors`] with the screen's last fit when it was made on
@@ -188,19 +188,6 @@ pub fn screen_gross_errors(
 /// assert_eq!(fit.unwrap().estimate, direct.estimate);
 /// ```
 pub fn screen_gross_errors_with_fit(
-    model: &dyn ReadingModel,
-    data: &Dataset,
-    options: &IdentifyOptions,
-    alpha: f64,
-    max_share: f64,
-) -> Result<(Vec<Rejection>, Option<Identification>), IdentError> {
-    screen(model, data, options, alpha, max_share)
-}
-
-/// [`screen_gross_errors`], with the screen's last fit when it was made on
-/// exactly the poses kept (the identification [`identify_robust`] would
-/// otherwise repeat).
-fn screen(
     model: &dyn ReadingModel,
     data: &Dataset,
     options: &IdentifyOptions,
@@ -465,7 +452,7 @@ pub fn identify_robust(
     data: &Dataset,
     options: &IdentifyOptions,
 ) -> Result<(Identification, Vec<Rejection>), IdentError> {
-    let (rejected, fit) = screen(model, data, options, 1e-3, 0.1)?;
+    let (rejected, fit) = screen_gross_errors_with_fit(model, data, options, 1e-3, 0.1)?;
     let id = match fit {
         Some(id) => id,
         None => identify(model, &kept(data, &rejected), options)?,
