@@ -10,7 +10,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use tricept_ident::{GeometricModel, IdentifyOptions, identify};
+use tricept_engine::{GeometricModel, IdentifyOptions, identify};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_plant::{Campaign, Plant};
@@ -49,7 +49,7 @@ fn large(c: &mut Criterion) {
         group.bench_function(format!("{n}_poses_robust"), |b| {
             b.iter(|| {
                 black_box(
-                    tricept_ident::identify_robust(&model, black_box(&data), &options).unwrap(),
+                    tricept_engine::identify_robust(&model, black_box(&data), &options).unwrap(),
                 )
             })
         });
@@ -66,7 +66,7 @@ fn large(c: &mut Criterion) {
 }
 
 fn fused(c: &mut Criterion) {
-    use tricept_ident::fusion::{
+    use tricept_engine::fusion::{
         FusedModel, FusionOptions, Source, TrackerOptions, TrackerTarget, identify_fused,
     };
     let m = Machine::paper();

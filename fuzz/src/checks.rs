@@ -1,13 +1,13 @@
 //! The properties the fuzz targets check, one function per target.
 //!
 //! Shared by the libFuzzer targets in `fuzz_targets/` and by the ordinary
-//! regression test `crates/ident/tests/fuzz_regressions.rs`, which replays
+//! regression test `crates/engine/tests/fuzz_regressions.rs`, which replays
 //! every file under `fuzz/seeds/` and `fuzz/regressions/` on each
 //! `cargo test`. A crash input found by `cargo fuzz` is committed to
 //! `fuzz/regressions/<target>/` once the bug is fixed.
 
 use nalgebra::Vector3;
-use tricept_ident::{GeometricModel, IdentifyOptions, identify_robust};
+use tricept_engine::{GeometricModel, IdentifyOptions, identify_robust};
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 

@@ -250,18 +250,18 @@ fn one_seed(
     targets: &[Vector3<f64>],
     plane: &[Vector3<f64>],
     seed: u64,
-) -> Result<(SeedResult, tricept_ident::Compensation), String> {
+) -> Result<(SeedResult, tricept_engine::Compensation), String> {
     let campaign = tricept_plant::Campaign::from_targets(nominal, targets.to_vec(), seed);
     let data = plant.simulate(&campaign).map_err(|e| e.to_string())?;
-    let model = tricept_ident::GeometricModel::new(nominal.clone(), ParameterSet::paper15());
-    let id = tricept_ident::identify(
+    let model = tricept_engine::GeometricModel::new(nominal.clone(), ParameterSet::paper15());
+    let id = tricept_engine::identify(
         &model,
         &data,
-        &tricept_ident::IdentifyOptions::for_machine(nominal),
+        &tricept_engine::IdentifyOptions::for_machine(nominal),
     )
     .map_err(|e| e.to_string())?;
     let identified = model.machine_at(&id.estimate);
-    let c = tricept_ident::compensation(nominal, &identified, &plant.actual_machine(), plane)
+    let c = tricept_engine::compensation(nominal, &identified, &plant.actual_machine(), plane)
         .map_err(|e| e.to_string())?;
     let residual = c.after.without_mean_translation().stats();
     Ok((
@@ -396,11 +396,11 @@ fn predicted_translation_sd(
     let k = set.len();
     let campaign = tricept_plant::Campaign::from_targets(nominal, targets.to_vec(), 1);
     let data = plant.simulate(&campaign).map_err(|e| e.to_string())?;
-    let model = tricept_ident::GeometricModel::new(nominal.clone(), set.clone());
-    let id = tricept_ident::identify(
+    let model = tricept_engine::GeometricModel::new(nominal.clone(), set.clone());
+    let id = tricept_engine::identify(
         &model,
         &data,
-        &tricept_ident::IdentifyOptions::for_machine(nominal),
+        &tricept_engine::IdentifyOptions::for_machine(nominal),
     )
     .map_err(|e| e.to_string())?;
     let mut c = vec![0.0; k];

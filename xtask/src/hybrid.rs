@@ -40,7 +40,7 @@ use rayon::prelude::*;
 use serde_json::{Value, json};
 use tricept_data::{ExternalData, ExternalPose};
 use tricept_diagnose::{DiagnoseOptions, diagnose};
-use tricept_ident::fusion::{
+use tricept_engine::fusion::{
     BallbarOptions, FusedModel, FusionOptions, Source, TouchOptions, TrackerOptions, TrackerTarget,
     head_angle_poses, identify_fused,
 };
@@ -237,7 +237,7 @@ fn plant(m: &Machine, scenario: Scenario, seed: u64, head_scale: f64) -> Plant {
 fn tip_error(
     plant: &Plant,
     model: &FusedModel,
-    fit: &tricept_ident::fusion::Fusion,
+    fit: &tricept_engine::fusion::Fusion,
     eval: &[ExternalPose],
 ) -> Option<TipError> {
     let nominal = &plant.nominal;
@@ -538,10 +538,10 @@ fn run_machine(
             .collect::<Option<_>>()
             .ok_or("instrument data unusable")?;
         let f = identify_fused(model, &sources, &options).map_err(|e| match e {
-            tricept_ident::IdentError::Source { message, .. } if message.starts_with("too few") => {
+            tricept_engine::IdentError::Source { message, .. } if message.starts_with("too few") => {
                 "too few measurements for the unknowns"
             }
-            tricept_ident::IdentError::NuisanceUnidentifiable { .. } => {
+            tricept_engine::IdentError::NuisanceUnidentifiable { .. } => {
                 "the instrument's nuisance is undetermined"
             }
             _ => "identification failed",

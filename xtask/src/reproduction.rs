@@ -29,7 +29,7 @@ use std::path::PathBuf;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde_json::{Value, json};
-use tricept_ident::{GeometricModel, IdentifyOptions, design};
+use tricept_engine::{GeometricModel, IdentifyOptions, design};
 use tricept_kinematics::{AxisOrder, Machine, MachineDescription, Placement};
 use tricept_model::{MapStats, ParameterSet, residual_mu};
 use tricept_numerics::stats::quantile;
@@ -220,7 +220,7 @@ fn placed_machine(angles_deg: [f64; 3], order: AxisOrder) -> Result<Machine, Str
 
 /// Whether a combination is one parameter alone (every other coefficient
 /// below 1e-6 of the largest, which is 1).
-fn single_term(c: &tricept_ident::Combination) -> Option<String> {
+fn single_term(c: &tricept_engine::Combination) -> Option<String> {
     let others = c.terms.iter().skip(1).all(|(_, v)| v.abs() < 1e-6);
     (others && !c.terms.is_empty()).then(|| c.terms[0].0.clone())
 }
@@ -264,7 +264,7 @@ fn invisible() -> Result<Value, String> {
                 .map_err(|e| e.to_string())?;
             for set in [ParameterSet::paper15(), ParameterSet::full21()] {
                 let model = GeometricModel::new(m.clone(), set.clone());
-                let report = tricept_ident::identifiability(
+                let report = tricept_engine::identifiability(
                     &model,
                     &vec![0.0; set.len()],
                     &poses,
@@ -523,7 +523,7 @@ fn fig3b(a: &ReproductionArgs) -> Result<Value, String> {
                             solve.estimate(&lin, k, &y).map_err(s)?
                         }
                         Estimator::Ours => {
-                            tricept_ident::identify(&model, &data, &options)
+                            tricept_engine::identify(&model, &data, &options)
                                 .map_err(|e| e.to_string())?
                                 .estimate
                         }
@@ -744,7 +744,7 @@ fn argmin(v: &[f64], key: impl Fn(f64) -> f64) -> usize {
 /// `b^T C^-1 b` over the identifiable parameters `ident`, `C` the fit's
 /// covariance.
 fn mahalanobis2(
-    id: &tricept_ident::Identification,
+    id: &tricept_engine::Identification,
     ident: &[usize],
     b: &[f64],
 ) -> Result<f64, String> {
@@ -769,7 +769,7 @@ fn mahalanobis2(
 /// identifiable parameters: 14 on average for an unbiased fit, `14 +
 /// b^T C^-1 b` with the bias `b`.
 fn held(a: &ReproductionArgs) -> Result<Value, String> {
-    use tricept_ident::{Start, identify, identify_from};
+    use tricept_engine::{Start, identify, identify_from};
     use tricept_plant::{Campaign, Plant};
     println!(
         "## What holding dyA3 at zero biases (`cargo xtask reproduction --only held`)\n\nTable 2 on the x-first machine (dyA3 = 0.2 mm), paper noise. Bias: noise-free exact readings fitted with dyA3 held at zero, minus the truth, in standard deviations of that campaign; `check`: the largest |error| / sd with dyA3 held at its true value. d^2: mean Mahalanobis distance from the truth of {} noisy campaigns per size (14 identifiable parameters), with dyA3 at zero and at the truth, the bias's own b^T C^-1 b, and the fits' mean chi-square per degree of freedom.\n",
@@ -832,7 +832,7 @@ fn held(a: &ReproductionArgs) -> Result<Value, String> {
         clean.noise.length_mm = 0.0;
         let (zero, truth_held) = fits(&clean)?;
         let ident = zero.design().identifiable().to_vec();
-        let sd = |id: &tricept_ident::Identification, j: usize| id.std_dev[j].unwrap_or(f64::NAN);
+        let sd = |id: &tricept_engine::Identification, j: usize| id.std_dev[j].unwrap_or(f64::NAN);
         let bias: Vec<f64> = (0..set.len())
             .map(|j| zero.estimate[j] - truth[j])
             .collect();
@@ -846,7 +846,7 @@ fn held(a: &ReproductionArgs) -> Result<Value, String> {
             .into_par_iter()
             .map(|seed| {
                 let (z, t) = fits(&campaign(size, seed))?;
-                let e = |id: &tricept_ident::Identification| -> Vec<f64> {
+                let e = |id: &tricept_engine::Identification| -> Vec<f64> {
                     (0..set.len()).map(|j| id.estimate[j] - truth[j]).collect()
                 };
                 Ok((

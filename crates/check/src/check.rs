@@ -43,7 +43,7 @@
 use nalgebra::{DMatrix, DVector, Vector3};
 use serde::Serialize;
 use tricept_data::Dataset;
-use tricept_ident::ReadingModel;
+use tricept_engine::ReadingModel;
 use tricept_kinematics::{Machine, UpJoints};
 use tricept_model::{error_jacobian_at, position_error_jacobian};
 use tricept_numerics::linalg::{TriangularAccumulator, invert_upper, solve_upper};

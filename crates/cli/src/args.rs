@@ -118,7 +118,7 @@ pub struct FitArgs {
     /// machine has without calibration. A campaign whose predicted platform
     /// accuracy is not at most half of what this tolerance gives is
     /// refused (exit 3; docs/reliability.md).
-    #[arg(long, default_value_t = tricept_ident::DEFAULT_TOLERANCE_MM, value_name = "MM")]
+    #[arg(long, default_value_t = tricept_engine::DEFAULT_TOLERANCE_MM, value_name = "MM")]
     pub tolerance_mm: f64,
 }
 
@@ -190,7 +190,7 @@ pub fn load(args: &MachineArgs) -> Result<LoadedMachine, CliError> {
             w.radius_mm, w.z_min_mm, w.z_max_mm, r.x, r.y, r.z
         )));
     }
-    tricept_ident::check_calibration_record(&description)
+    tricept_engine::check_calibration_record(&description)
         .map_err(|e| CliError::input(format!("{source}: {e}")))?;
     if let Some(c) = &description.calibration {
         if c.forced {
@@ -528,7 +528,7 @@ pub struct ExternalArgs {
 /// The help of `--effects`: the effects the fused model can carry, from
 /// the registry.
 fn effects_help() -> String {
-    let names: Vec<&str> = tricept_ident::fusion::fusable_effects()
+    let names: Vec<&str> = tricept_engine::fusion::fusable_effects()
         .map(|e| e.as_str())
         .collect();
     format!(

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use nalgebra::Vector3;
 use serde_json::{Map, Value, json};
-use tricept_ident::{CompensationTable, ExtendedMachine};
+use tricept_engine::{CompensationTable, ExtendedMachine};
 use tricept_model::{ErrorMap, MapStats};
 
 use crate::args::FitSettings;

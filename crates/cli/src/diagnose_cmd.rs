@@ -6,7 +6,7 @@ use clap::Args;
 use serde_json::{Map, json};
 use tricept_diagnose::detect::{advise, realistic, term_detectability};
 use tricept_diagnose::{DiagnoseError, DiagnoseOptions, Plausibility, deploy, diagnose};
-use tricept_ident::GeometricModel;
+use tricept_engine::GeometricModel;
 use tricept_model::effects::EffectName;
 use tricept_model::{GeometricErrors, ParameterSet};
 use tricept_plant::{Campaign, Effect, Plant, PoseOrder};
@@ -320,14 +320,14 @@ pub fn vocabulary_help() -> String {
 /// input error (exit 2), naming the file.
 fn diagnose_error(source: &str, e: DiagnoseError) -> CliError {
     match e {
-        DiagnoseError::Ident(tricept_ident::IdentError::Kinematics {
+        DiagnoseError::Ident(tricept_engine::IdentError::Kinematics {
             line, source: k, ..
         }) => CliError::input(format!(
             "{source}: line {line}: the commands of this pose cannot be reached: {k}"
         )),
         DiagnoseError::Ident(
-            tricept_ident::IdentError::TooFewPoses { .. }
-            | tricept_ident::IdentError::TooFewDistinctPoses { .. },
+            tricept_engine::IdentError::TooFewPoses { .. }
+            | tricept_engine::IdentError::TooFewDistinctPoses { .. },
         ) => CliError::input(format!("{source}: {e}")),
         DiagnoseError::Ident(e) => CliError::other(format!("{source}: {e}")),
         e => CliError::input(format!("{source}: {e}")),

@@ -1,6 +1,6 @@
 //! `tricept identify` with external measurements: the fused identification
 //! of the module, the head and every instrument's nuisance
-//! (`tricept_ident::fusion`). `identify` dispatches here when a tracker,
+//! (`tricept_engine::fusion`). `identify` dispatches here when a tracker,
 //! ballbar or touch file, a head option or an effect is given; without them
 //! it runs the internal-only path unchanged.
 
@@ -10,8 +10,8 @@ use serde_json::{Value, json};
 use tricept_data::{
     BallbarReading, ExternalData, ExternalRecord, Features, TouchReading, TrackerPoint,
 };
-use tricept_ident::IdentError;
-use tricept_ident::fusion::{
+use tricept_engine::IdentError;
+use tricept_engine::fusion::{
     BallbarOptions, FusedModel, Fusion, FusionOptions, FusionPlausibility, Source, SourceKind,
     TouchOptions, TrackerOptions, TrackerTarget, evaluation_poses, identify_fused,
 };

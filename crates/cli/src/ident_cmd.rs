@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use serde_json::{Map, Value, json};
 use tricept_data::MeasuredPose;
-use tricept_ident::{
+use tricept_engine::{
     AccuracyModel, GeometricModel, IdentError, Identification, IdentifyOptions, PredictedAccuracy,
     Rejection, Verdict, identifiability, identify, identify_robust, likely_causes,
 };

@@ -8,8 +8,8 @@ use std::path::Path;
 use nalgebra::DMatrix;
 use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
-use tricept_ident::fusion::{Fusion, SourceKind};
-use tricept_ident::{IdentifiabilityReport, Identification};
+use tricept_engine::fusion::{Fusion, SourceKind};
+use tricept_engine::{IdentifiabilityReport, Identification};
 use tricept_kinematics::description::{
     CalibrationRecord, CorrelationsDescription, ExternalSourceRecord, HeldParameter,
     SensorOffsetsDescription,

@@ -10,7 +10,7 @@ use clap::{Args, ValueEnum};
 use nalgebra::Vector3;
 use serde_json::json;
 use tricept_data::{ExternalData, PlannedPose};
-use tricept_ident::fusion::{Source, TrackerOptions, head_angle_poses, information_factor};
+use tricept_engine::fusion::{Source, TrackerOptions, head_angle_poses, information_factor};
 use tricept_study::plan::{
     PlanProblem, candidate_rows, internal_factor, nominal_ballbar_data, nominal_touch_data,
     nominal_tracker_data, plan, sphere_candidates, with_extensions,
@@ -294,13 +294,13 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
                     a.touch.touch_stylus_radius_mm,
                     positive("--touch-stylus-sigma-um", a.touch.touch_stylus_sigma_um)?,
                 );
-                let options = tricept_ident::fusion::TouchOptions {
+                let options = tricept_engine::fusion::TouchOptions {
                     sigma_um: instrument_sigma(a, a.touch.touch_sigma_um, "--touch-sigma-um")?,
                 };
                 Source::touch(&data, &features, &options).map_err(fusion_error)?
             } else {
                 let data = nominal_ballbar_data(&model, &poses, &centre).map_err(study_error)?;
-                let options = tricept_ident::fusion::BallbarOptions {
+                let options = tricept_engine::fusion::BallbarOptions {
                     sigma_um: instrument_sigma(a, a.ballbar_sigma_um, "--ballbar-sigma-um")?,
                     ..Default::default()
                 };

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_ident::GeometricModel;
+use tricept_engine::GeometricModel;
 use tricept_plant::{Campaign, Plant, PoseOrder};
 
 use crate::args::{

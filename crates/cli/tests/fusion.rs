@@ -9,7 +9,7 @@ use std::process::Command;
 
 use nalgebra::Vector3;
 use tricept_data::ExternalPose;
-use tricept_ident::fusion::FusedModel;
+use tricept_engine::fusion::FusedModel;
 use tricept_kinematics::Machine;
 use tricept_model::{Effector, ParameterSet};
 

@@ -13,7 +13,7 @@
 use std::sync::Arc;
 
 use tricept_data::{Dataset, MeasuredPose};
-use tricept_ident::{GeometricModel, Identification, IdentifyOptions, identify};
+use tricept_engine::{GeometricModel, Identification, IdentifyOptions, identify};
 use tricept_kinematics::Machine;
 use tricept_kinematics::description::{
     ControllerDescription, LegTableDescription, MAX_TABLE_POINTS, MAX_TABLE_SLOPE_UM_PER_MM,

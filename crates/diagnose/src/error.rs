@@ -1,6 +1,6 @@
 //! Why a diagnosis, or the deployment of its model, could not be made.
 
-use tricept_ident::IdentError;
+use tricept_engine::IdentError;
 
 /// Why a diagnosis could not be made.
 #[derive(Debug, thiserror::Error)]

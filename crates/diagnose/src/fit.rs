@@ -9,7 +9,7 @@ use std::sync::Arc;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use tricept_data::{Dataset, MeasuredPose};
-use tricept_ident::{
+use tricept_engine::{
     GeometricModel, IdentError, Identification, IdentifyOptions, ReadingModel, identify,
     residuals_at, screen_gross_errors, screen_gross_errors_with_fit,
 };
@@ -162,7 +162,7 @@ impl Fitter<'_> {
         chi2
     }
 
-    /// The outlier screen of `tricept_ident::robust` with the diagnosis'
+    /// The outlier screen of `tricept_engine::robust` with the diagnosis'
     /// options; the indices of the flagged poses.
     pub(crate) fn screen_outliers(
         &self,

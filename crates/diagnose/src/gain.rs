@@ -6,7 +6,7 @@
 
 use nalgebra::{DMatrix, Vector3};
 use tricept_data::MeasuredPose;
-use tricept_ident::ReadingModel;
+use tricept_engine::ReadingModel;
 use tricept_kinematics::{Machine, UpJoints};
 
 use crate::fit::Fit;

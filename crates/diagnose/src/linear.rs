@@ -29,7 +29,7 @@ use std::ops::Range;
 use nalgebra::{DMatrix, DVector, Matrix3};
 use rayon::prelude::*;
 use tricept_data::Dataset;
-use tricept_ident::ReadingModel;
+use tricept_engine::ReadingModel;
 use tricept_kinematics::UpJoints;
 use tricept_numerics::linalg::TriangularAccumulator;
 

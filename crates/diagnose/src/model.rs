@@ -18,7 +18,7 @@ use std::sync::Arc;
 
 use crate::terms::{Frame, Term, TermKind};
 use tricept_data::MeasuredPose;
-use tricept_ident::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
+use tricept_engine::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
 use tricept_kinematics::{KinematicsError, Machine, UpJoints};
 use tricept_model::effects::{Basis, CauseName, EffectName, Entries, Kind};
 
@@ -42,7 +42,7 @@ impl ExtendedModel {
     /// # Example
     /// ```
     /// use tricept_diagnose::ExtendedModel;
-    /// use tricept_ident::{GeometricModel, ReadingModel};
+    /// use tricept_engine::{GeometricModel, ReadingModel};
     /// use tricept_model::effects::EffectName;
     /// let g = GeometricModel::new(tricept_kinematics::Machine::paper(), tricept_model::ParameterSet::paper15());
     /// let m = ExtendedModel::new(g, &[EffectName::Thermal]);
@@ -59,7 +59,7 @@ impl ExtendedModel {
     /// ```
     /// use std::sync::Arc;
     /// use tricept_diagnose::{ExtendedModel, Frame, GenericFamily, GenericTerm, Scope, Term};
-    /// use tricept_ident::{GeometricModel, ReadingModel};
+    /// use tricept_engine::{GeometricModel, ReadingModel};
     /// let m = tricept_kinematics::Machine::paper();
     /// let data = tricept_data::read_path("../../fixtures/data/diagnose-pitch.csv".as_ref()).unwrap();
     /// let pitch = Term::Generic(GenericTerm {

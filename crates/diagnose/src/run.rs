@@ -5,7 +5,7 @@
 //!    distinct line numbers are numbered from 1 in pose order.
 //! 2. **Noise.** Repeated poses give the pure error ([`crate::noise`]); with
 //!    `noise_from_data` the tests use the data's noise and F distributions.
-//! 3. **Outliers.** The outlier screen of `tricept_ident::robust`; flagged
+//! 3. **Outliers.** The outlier screen of `tricept_engine::robust`; flagged
 //!    poses make the cause `outliers`, and the rest of the analysis uses
 //!    the clean poses. The screen is repeated with the selected causes, so
 //!    that a misfit they explain is not taken for gross errors.
@@ -24,7 +24,7 @@ use std::borrow::Cow;
 use std::sync::Arc;
 
 use tricept_data::Dataset;
-use tricept_ident::GeometricModel;
+use tricept_engine::GeometricModel;
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_model::effects::EffectName;

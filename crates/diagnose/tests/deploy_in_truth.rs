@@ -16,7 +16,7 @@ use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 use tricept_data::Dataset;
 use tricept_diagnose::{Diagnosis, deploy, diagnose};
-use tricept_ident::{GeometricModel, IdentifyOptions, identify};
+use tricept_engine::{GeometricModel, IdentifyOptions, identify};
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::effects::{CauseName, EffectName};
 use tricept_model::{ExtendedMachine, ParameterSet};

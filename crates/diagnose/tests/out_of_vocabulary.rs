@@ -18,7 +18,7 @@ mod common;
 use common::*;
 use tricept_diagnose::detect::detectability;
 use tricept_diagnose::{Diagnosis, Verdict};
-use tricept_ident::GeometricModel;
+use tricept_engine::GeometricModel;
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_model::effects::{CauseName, EffectName as E, GenericFamily as G};

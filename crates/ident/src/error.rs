@@ -1,91 +1,282 @@
-//! Typed errors of the identification crate.
+//! The door's one error type and the one mapping from a library error's
+//! kind to the process exit code, for every verb.
+//!
+//! Every error of the crates behind the door is [`Classify`]: its kind
+//! says whether the user's input is at fault ([`ErrorKind::Input`], exit
+//! code 2) or not ([`ErrorKind::Other`], exit code 1). The mapping lives
+//! here alone, so the same library error exits with the same code from
+//! every verb that can meet it.
 
-use thiserror::Error;
-use tricept_kinematics::KinematicsError;
+use std::fmt;
 
-/// Why an identification could not produce a trustworthy answer.
+use tricept_check::CheckError;
+use tricept_data::DataError;
+use tricept_diagnose::{DeployError, DiagnoseError};
+use tricept_engine::{IdentError, RecordError};
+use tricept_kinematics::{DescriptionError, KinematicsError};
+use tricept_model::ModelError;
+use tricept_plant::PlantError;
+use tricept_study::StudyError;
+
+/// Exit code of a result that can be trusted.
+pub const EXIT_OK: u8 = 0;
+/// Exit code of anything that is not the input's fault.
+pub const EXIT_OTHER: u8 = 1;
+/// Exit code of bad input: a file, a flag, a request.
+pub const EXIT_INPUT: u8 = 2;
+/// Exit code of a fit that converged but whose model does not explain the
+/// data, or of a campaign too small to calibrate.
+pub const EXIT_INADEQUATE: u8 = 3;
+/// Exit code of a fit that did not converge.
+pub const EXIT_NOT_CONVERGED: u8 = 4;
+
+/// Whose fault a failure is, which decides the exit code.
 ///
 /// # Example
 /// ```
-/// use tricept_ident::{GeometricModel, IdentifyOptions};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let m = Machine::paper();
-/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-/// let e = tricept_ident::identify(&model, &tricept_data::Dataset::default(), &IdentifyOptions::for_machine(&m))
-///     .unwrap_err();
-/// assert!(matches!(e, tricept_ident::IdentError::TooFewPoses { poses: 0, .. }));
+/// use tricept_ident::{ErrorKind, EXIT_INPUT};
+/// assert_eq!(ErrorKind::Input.exit_code(), EXIT_INPUT);
 /// ```
-#[derive(Debug, Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
-pub enum IdentError {
-    /// Fewer readings than unknowns (plus one for a residual).
-    #[error(
-        "too few poses: {poses} poses give {readings} readings for {unknowns} unknowns (parameters + 3 sensor offsets); at least {needed} poses are needed"
-    )]
-    TooFewPoses {
-        /// Poses given.
-        poses: usize,
-        /// Readings (3 per pose).
-        readings: usize,
-        /// Unknowns.
-        unknowns: usize,
-        /// Minimum number of poses.
-        needed: usize,
-    },
-    /// Enough rows, but too few distinct poses: rows repeating the same
-    /// commands average the noise and add no geometry.
-    #[error(
-        "too few distinct poses: the {poses} rows hold {distinct} distinct leg commands, and {unknowns} unknowns (parameters + 3 sensor offsets) need at least {needed} distinct poses"
-    )]
-    TooFewDistinctPoses {
-        /// Rows given.
-        poses: usize,
-        /// Distinct command triples among them (counted up to `needed`).
-        distinct: usize,
-        /// Unknowns.
-        unknowns: usize,
-        /// Minimum number of distinct poses.
-        needed: usize,
-    },
-    /// A pose the model cannot solve (commands out of reach, no assembly...).
-    #[error("pose {} (line {line}): {source}", pose + 1)]
-    Kinematics {
-        /// Index of the pose (0-based; shown 1-based).
-        pose: usize,
-        /// Line of the pose in its file (0 if none).
-        line: u64,
-        /// The kinematic failure.
-        source: KinematicsError,
-    },
-    /// A numerical failure of the linear algebra.
-    #[error("numerical failure: {0}")]
-    Numerical(&'static str),
-    /// Inconsistent arguments.
-    #[error("{0}")]
-    Invalid(String),
-    /// External data that cannot be used as given (too few records, a
-    /// degenerate geometry), naming the source and, where one record is at
-    /// fault, its line.
-    #[error("{file}{}: {message}", line.map(|l| format!(": line {l}")).unwrap_or_default())]
-    Source {
-        /// The source's file or label.
-        file: String,
-        /// The line at fault, if one is.
-        line: Option<u64>,
-        /// What is wrong and what to do.
-        message: String,
-    },
-    /// A source's own nuisance parameters (an instrument's frame, a pivot,
-    /// a target offset) cannot be told apart from its data: the estimate
-    /// would divide by rounding noise.
-    #[error("{file}: {combination} cannot be determined from its data: {hint}")]
-    NuisanceUnidentifiable {
-        /// The source's file or label.
-        file: String,
-        /// The invisible combination of its nuisance parameters.
-        combination: String,
-        /// What to measure differently.
-        hint: String,
-    },
+pub enum ErrorKind {
+    /// The input is at fault: a file, a flag, data that cannot be used
+    /// (exit code 2).
+    Input,
+    /// Anything else: a numerical failure, an I/O failure of an output
+    /// (exit code 1).
+    Other,
+}
+
+impl ErrorKind {
+    /// The process exit code of a failure of this kind.
+    pub fn exit_code(self) -> u8 {
+        match self {
+            ErrorKind::Input => EXIT_INPUT,
+            ErrorKind::Other => EXIT_OTHER,
+        }
+    }
+}
+
+/// A library error that knows whose fault it is.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{Classify, ErrorKind, IdentError};
+/// let e = IdentError::Invalid("alpha must lie in (0, 0.5)".into());
+/// assert_eq!(e.kind(), ErrorKind::Input);
+/// ```
+pub trait Classify {
+    /// Whose fault this error is.
+    fn kind(&self) -> ErrorKind;
+}
+
+/// A failure of a workflow: a one-line message (naming the file, line and
+/// column where there is one) and its [`ErrorKind`].
+///
+/// # Example
+/// ```
+/// use tricept_ident::{Error, EXIT_INPUT};
+/// let e = Error::input("--alpha: must lie between 0 and 0.5, got 2").in_file("check");
+/// assert_eq!(e.exit_code(), EXIT_INPUT);
+/// assert_eq!(e.to_string(), "check: --alpha: must lie between 0 and 0.5, got 2");
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Error {
+    kind: ErrorKind,
+    message: String,
+}
+
+impl Error {
+    /// An error of the user's input (exit code 2).
+    pub fn input(message: impl Into<String>) -> Error {
+        Error {
+            kind: ErrorKind::Input,
+            message: message.into(),
+        }
+    }
+
+    /// Any other error (exit code 1).
+    pub fn other(message: impl Into<String>) -> Error {
+        Error {
+            kind: ErrorKind::Other,
+            message: message.into(),
+        }
+    }
+
+    /// A library error with its kind and its message.
+    pub fn from_library(e: &(impl Classify + fmt::Display)) -> Error {
+        Error {
+            kind: e.kind(),
+            message: e.to_string(),
+        }
+    }
+
+    /// The same error with `context: ` before its message (a file, a flag).
+    #[must_use]
+    pub fn in_file(self, context: impl fmt::Display) -> Error {
+        Error {
+            kind: self.kind,
+            message: format!("{context}: {}", self.message),
+        }
+    }
+
+    /// Whose fault it is.
+    pub fn kind(&self) -> ErrorKind {
+        self.kind
+    }
+
+    /// The process exit code: 2 for input, 1 for anything else.
+    pub fn exit_code(&self) -> u8 {
+        self.kind.exit_code()
+    }
+
+    /// The one-line message.
+    pub fn message(&self) -> &str {
+        &self.message
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for Error {}
+
+impl<E: Classify + fmt::Display> From<E> for Error {
+    fn from(e: E) -> Error {
+        Error::from_library(&e)
+    }
+}
+
+impl Classify for DataError {
+    fn kind(&self) -> ErrorKind {
+        ErrorKind::Input
+    }
+}
+
+impl Classify for DescriptionError {
+    fn kind(&self) -> ErrorKind {
+        ErrorKind::Input
+    }
+}
+
+impl Classify for RecordError {
+    fn kind(&self) -> ErrorKind {
+        ErrorKind::Input
+    }
+}
+
+impl Classify for KinematicsError {
+    /// Unreachable or non-finite inputs are the user's; solver failures
+    /// are not.
+    fn kind(&self) -> ErrorKind {
+        match self {
+            KinematicsError::NotFinite { .. }
+            | KinematicsError::OutOfReach { .. }
+            | KinematicsError::OutOfStroke { .. }
+            | KinematicsError::NoAssembly { .. }
+            | KinematicsError::Singular { .. } => ErrorKind::Input,
+            _ => ErrorKind::Other,
+        }
+    }
+}
+
+impl Classify for IdentError {
+    /// Data too small to calibrate, unreachable poses, inconsistent
+    /// options and unusable external sources are the input's fault; a
+    /// numerical failure is not.
+    fn kind(&self) -> ErrorKind {
+        match self {
+            IdentError::TooFewPoses { .. }
+            | IdentError::TooFewDistinctPoses { .. }
+            | IdentError::Kinematics { .. }
+            | IdentError::Invalid(_)
+            | IdentError::Source { .. }
+            | IdentError::NuisanceUnidentifiable { .. } => ErrorKind::Input,
+            _ => ErrorKind::Other,
+        }
+    }
+}
+
+impl Classify for DiagnoseError {
+    /// What the data cause is the input's fault; an identification error
+    /// keeps its own kind.
+    fn kind(&self) -> ErrorKind {
+        match self {
+            DiagnoseError::Ident(e) => e.kind(),
+            _ => ErrorKind::Input,
+        }
+    }
+}
+
+impl Classify for DeployError {
+    fn kind(&self) -> ErrorKind {
+        match self {
+            DeployError::Refit(e) => e.kind(),
+            _ => ErrorKind::Input,
+        }
+    }
+}
+
+impl Classify for CheckError {
+    fn kind(&self) -> ErrorKind {
+        match self {
+            CheckError::Record(_)
+            | CheckError::Blind(_)
+            | CheckError::Invalid(_)
+            | CheckError::HistoryLine(_)
+            | CheckError::Kinematics { .. } => ErrorKind::Input,
+            _ => ErrorKind::Other,
+        }
+    }
+}
+
+impl Classify for ModelError {
+    fn kind(&self) -> ErrorKind {
+        match self {
+            ModelError::Kinematics(e) => e.kind(),
+            _ => ErrorKind::Input,
+        }
+    }
+}
+
+impl Classify for PlantError {
+    fn kind(&self) -> ErrorKind {
+        ErrorKind::Input
+    }
+}
+
+impl Classify for StudyError {
+    fn kind(&self) -> ErrorKind {
+        match self {
+            StudyError::Ident(e) => e.kind(),
+            StudyError::Kinematics(e) => e.kind(),
+            StudyError::Model(e) => e.kind(),
+            StudyError::Check(e) => e.kind(),
+            StudyError::Invalid(_) => ErrorKind::Input,
+            _ => ErrorKind::Other,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_same_library_error_has_one_exit_code_wherever_it_is_wrapped() {
+        let direct = IdentError::Invalid("x".into());
+        let via_diagnose = DiagnoseError::Ident(IdentError::Invalid("x".into()));
+        let via_study = StudyError::Ident(IdentError::Invalid("x".into()));
+        assert_eq!(Error::from(direct).exit_code(), EXIT_INPUT);
+        assert_eq!(Error::from(via_diagnose).exit_code(), EXIT_INPUT);
+        assert_eq!(Error::from(via_study).exit_code(), EXIT_INPUT);
+        let numerical = IdentError::Numerical("rank");
+        assert_eq!(Error::from(numerical).exit_code(), EXIT_OTHER);
+        let wrapped = StudyError::Ident(IdentError::Numerical("rank"));
+        assert_eq!(Error::from(wrapped).exit_code(), EXIT_OTHER);
+    }
 }

@@ -3,7 +3,7 @@
 //! ranges from a JSON object `{"key": [min, max]}`. The diagnosis judges
 //! its fitted effects by one (`tricept-diagnose`, `--plausibility`), the
 //! fused identification its head, tool and instrument estimates by
-//! another (`tricept_ident::fusion`, `identify --plausibility`).
+//! another (`tricept_engine::fusion`, `identify --plausibility`).
 //!
 //! A quantity is implausible when its 3-sigma interval misses the range
 //! ([`Range::admits`]): an estimate that only its noise makes implausible

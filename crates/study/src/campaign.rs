@@ -1,6 +1,6 @@
 //! How many self-calibration poses, and which, make a campaign worth
 //! deploying: the advice of a refused campaign
-//! ([`tricept_ident::PredictedAccuracy`]).
+//! ([`tricept_engine::PredictedAccuracy`]).
 //!
 //! For a pose count `n` on a ladder of sizes, the `n` poses are chosen from
 //! the candidate grid of the workspace ([`crate::optimise::candidate_grid`])
@@ -14,7 +14,7 @@
 
 use nalgebra::{DMatrix, Vector3};
 use serde::Serialize;
-use tricept_ident::{AccuracyModel, GeometricModel, IdentifyOptions, PredictedAccuracy};
+use tricept_engine::{AccuracyModel, GeometricModel, IdentifyOptions, PredictedAccuracy};
 use tricept_kinematics::{Machine, PoseSet};
 use tricept_model::ParameterSet;
 
@@ -53,7 +53,7 @@ fn columns(machine: &Machine, set: &ParameterSet) -> Result<(Vec<usize>, Vec<usi
         })
         .collect::<Result<_, StudyError>>()?;
     let model = GeometricModel::new(machine.clone(), set.clone());
-    let d = tricept_ident::design(
+    let d = tricept_engine::design(
         &model,
         &vec![0.0; set.len()],
         &poses,

@@ -8,7 +8,7 @@ use thiserror::Error;
 pub enum StudyError {
     /// Identification failed.
     #[error(transparent)]
-    Ident(#[from] tricept_ident::IdentError),
+    Ident(#[from] tricept_engine::IdentError),
     /// The plant simulator failed.
     #[error(transparent)]
     Plant(#[from] tricept_plant::PlantError),

@@ -1,7 +1,7 @@
 //! The exact Monte Carlo path: every trial's readings are the exact model's
 //! noise-free readings plus fresh noise (each logged value the mean of
 //! `readings_per_pose` Gaussian draws, as on the machine), identified by the
-//! full nonlinear Gauss-Newton of `tricept-ident`, and compensated on the
+//! full nonlinear Gauss-Newton of `tricept-engine`, and compensated on the
 //! exact model.
 //!
 //! Gauss-Newton starts at the noise-free estimate `p*` and the FK at the
@@ -12,7 +12,7 @@
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use tricept_data::Dataset;
-use tricept_ident::{Identification, Start, identify_from};
+use tricept_engine::{Identification, Start, identify_from};
 use tricept_model::{residual_mu, volumetric_errors};
 
 use crate::fast::{GradeModel, model_of, options_for, start_for};

@@ -21,7 +21,7 @@
 
 use faer::Mat;
 use rayon::prelude::*;
-use tricept_ident::{
+use tricept_engine::{
     Design, GeometricModel, IdentifyOptions, ReadingModel, Start, design, identify_from,
 };
 use tricept_kinematics::UpJoints;

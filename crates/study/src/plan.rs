@@ -40,7 +40,7 @@
 //! check: [`PlanProblem::redundancy`] is the degrees of freedom the
 //! selection's rows keep in the (prior-free) fused fit with the internal
 //! campaign, `sum (1 - h_ii)` over them, as
-//! [`tricept_ident::fusion::SourceFit::redundancy`]; a selection below the
+//! [`tricept_engine::fusion::SourceFit::redundancy`]; a selection below the
 //! source's [`DesignRows::min_redundancy`] (6 per tracker station, 4 per
 //! ballbar setup or touched sphere) fits whatever its rows hold.
 //!
@@ -57,7 +57,7 @@ use tricept_data::{
     BallbarData, BallbarReading, ExternalData, ExternalPose, TouchData, TouchReading, TrackerData,
     TrackerPoint,
 };
-use tricept_ident::fusion::{DesignRows, FusedModel, Source, design_rows, information_factor};
+use tricept_engine::fusion::{DesignRows, FusedModel, Source, design_rows, information_factor};
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{HeadBranch, Machine};
 use tricept_model::Effector;
@@ -104,7 +104,7 @@ pub struct PlanProblem {
 impl PlanProblem {
     /// The problem for `model` with the internal campaign's information
     /// factor `internal` (`r x k` with information `R^T R`,
-    /// [`tricept_ident::fusion::information_factor`], [`internal_factor`];
+    /// [`tricept_engine::fusion::information_factor`], [`internal_factor`];
     /// zero rows for none), candidate measurements `candidates` (one
     /// instrument's [`DesignRows`]) and the tool poses `eval` the criterion
     /// averages over.
@@ -661,7 +661,7 @@ pub fn nominal_touch_data(poses: &[ExternalPose], feature: u32) -> Result<TouchD
 /// [`design_rows`] with the study's error type.
 pub fn candidate_rows(
     model: &FusedModel,
-    source: &tricept_ident::fusion::Source,
+    source: &tricept_engine::fusion::Source,
 ) -> Result<DesignRows, StudyError> {
     Ok(design_rows(model, source)?)
 }

@@ -3,7 +3,7 @@
 //! the identifiability report's rank and unidentifiable combinations, and
 //! the exact model's readings.
 
-use tricept_ident::{GeometricModel, IdentifyOptions, identifiability};
+use tricept_engine::{GeometricModel, IdentifyOptions, identifiability};
 use tricept_kinematics::{AxisOrder, Machine, MachineDescription, Placement};
 use tricept_model::ParameterSet;
 use tricept_plant::{Campaign, Plant};

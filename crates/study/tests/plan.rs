@@ -4,7 +4,7 @@
 //! fused identification run on data simulated at the planned poses.
 
 use nalgebra::{Isometry3, Vector3};
-use tricept_ident::fusion::{
+use tricept_engine::fusion::{
     FusedModel, FusionOptions, Source, TrackerOptions, TrackerTarget, head_angle_poses,
     identify_fused,
 };

@@ -19,7 +19,7 @@ use rayon::prelude::*;
 use tricept_data::{
     BallbarReading, Dataset, ExternalData, ExternalPose, MeasuredPose, Readings, TrackerPoint,
 };
-use tricept_ident::fusion::{
+use tricept_engine::fusion::{
     BallbarOptions, FusedModel, Fusion, FusionOptions, Source, TrackerOptions, TrackerTarget,
     head_angle_poses, identify_fused,
 };

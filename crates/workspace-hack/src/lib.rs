@@ -11,7 +11,7 @@
 //!
 //! This crate has no code. Its `Cargo.toml` depends on those crates with the
 //! union of the features the workspace's targets turn on, and
-//! `tricept-ident` (which every binary and the downstream example build on)
+//! `tricept-engine` (which every binary and the downstream example build on)
 //! depends on it, so every build resolves the same features. This is the
 //! pattern of `cargo hakari`'s workspace-hack crates, kept by hand: `cargo
 //! xtask one-build`, run by `.ci/run` after the tests, builds each README

@@ -36,7 +36,7 @@ pub struct EffectSpec {
     /// Where a fitted value goes in a calibrated machine file.
     pub deployment: Deployment,
     /// Whether the fused identification with external measurements
-    /// (`tricept_ident::fusion`) can carry it: a [`Kind::Leg`] or
+    /// (`tricept_engine::fusion`) can carry it: a [`Kind::Leg`] or
     /// [`Kind::Reading`] term that needs no logged context
     /// ([`Needs::Nothing`]), whose entries the fused model takes as its
     /// columns (a test of the registry checks that).

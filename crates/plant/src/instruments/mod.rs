@@ -6,7 +6,7 @@
 //! its own noise from its own seeded generator (PCG-64 MCG, the seed mixed
 //! with a tag per instrument) and writes the external-measurement records
 //! of `tricept-data`. One file per instrument (`tracker.rs`, `ballbar.rs`,
-//! `touch.rs`), as in `tricept-data`'s `external/` and `tricept-ident`'s
+//! `touch.rs`), as in `tricept-data`'s `external/` and `tricept-engine`'s
 //! `fusion/`.
 
 use nalgebra::Vector3;
