@@ -56,9 +56,9 @@ pub fn run(a: &CheckArgs) -> Result<u8, CliError> {
         ));
     };
     let loaded = load_with_noise(&a.machine, &a.noise)?;
-    let reference = Reference::from_description(&loaded.description)
+    let reference = Reference::from_description(loaded.description())
         .map_err(|e| CliError::input(format!("{}: {}", machine_path.display(), e)))?;
-    let data = read_data(&a.data, &loaded.machine)?;
+    let data = read_data(&a.data, loaded.machine())?;
     if !(a.alpha > 0.0 && a.alpha < 0.5) {
         return Err(CliError::input(format!(
             "--alpha: the false-alarm probability must lie between 0 and 0.5, got {}",
@@ -69,7 +69,7 @@ pub fn run(a: &CheckArgs) -> Result<u8, CliError> {
         // A history that cannot be read is refused before the check runs.
         tricept_check::history::read(h).map_err(check_error)?;
     }
-    let mut options = CheckOptions::for_machine(&loaded.machine);
+    let mut options = CheckOptions::for_machine(loaded.machine());
     options.alpha = a.alpha;
     let report = check(&reference, &data, &options).map_err(|e| match e {
         CheckError::Blind(_) => CliError::input(format!("{}: {e}", a.data.display())),

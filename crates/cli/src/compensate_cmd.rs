@@ -13,10 +13,11 @@ use tricept_engine::{CompensationTable, ExtendedMachine};
 use tricept_model::{ErrorMap, MapStats};
 
 use crate::args::FitSettings;
-use crate::args::{TruthArgs, load, parse_effects, parse_errors};
+use crate::args::{TruthArgs, load, parse_errors};
 use crate::cli_error::{CliError, EXIT_INADEQUATE, EXIT_NOT_CONVERGED};
 use crate::ident_cmd::{fit_from_file, rejected_json, report_exit};
 use crate::machine_file;
+use tricept_ident::parse_effects;
 
 /// The largest interpolation error (um) the default table spacing allows.
 pub const TABLE_ERROR_LIMIT_UM: f64 = 1.0;
@@ -101,7 +102,7 @@ fn machines(a: &CompensateArgs) -> Result<Pair, CliError> {
             out.insert("adequate".into(), fit.verdict.adequate.into());
             out.insert("rejected".into(), rejected_json(&fit.rejected));
             Ok(Pair {
-                nominal: ExtendedMachine::new(fit.loaded.machine.clone()),
+                nominal: ExtendedMachine::new(fit.loaded.machine().clone()),
                 calibrated: ExtendedMachine::new(fit.identified()),
                 out,
                 warnings: fit.verdict.warnings.clone(),
@@ -111,16 +112,16 @@ fn machines(a: &CompensateArgs) -> Result<Pair, CliError> {
         }
         None => {
             let loaded = load(&a.settings.machine)?;
-            let Some(c) = &loaded.description.calibration else {
+            let Some(c) = &loaded.description().calibration else {
                 return Err(CliError::input(format!(
                     "compensate: give --data FILE.csv to identify from, or a calibrated machine file as --machine ({} holds no `calibration` record)",
-                    loaded.source
+                    loaded.source()
                 )));
             };
             let nominal = c
                 .nominal
                 .build()
-                .map_err(|e| CliError::description(&loaded.source, &e))?;
+                .map_err(|e| tricept_ident::description_error(loaded.source(), &e))?;
             let (code, why) = if !c.converged {
                 (EXIT_NOT_CONVERGED, "its calibration did not converge")
             } else if c.forced || !c.adequate {
@@ -132,17 +133,17 @@ fn machines(a: &CompensateArgs) -> Result<Pair, CliError> {
                 (0, "")
             };
             machine_file::write_rule(
-                &format!("compensate --machine {}", loaded.source),
+                &format!("compensate --machine {}", loaded.source()),
                 code,
                 why,
                 a.force,
             )?;
-            out.insert("machine".into(), loaded.description.name.clone().into());
+            out.insert("machine".into(), loaded.description().name.clone().into());
             out.insert("converged".into(), c.converged.into());
             out.insert("adequate".into(), c.adequate.into());
             Ok(Pair {
                 nominal: ExtendedMachine::new(nominal),
-                calibrated: ExtendedMachine::new(loaded.machine),
+                calibrated: ExtendedMachine::new(loaded.machine().clone()),
                 out,
                 warnings: Vec::new(),
                 code,
@@ -192,11 +193,11 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
         )));
     }
     let points = std::f64::consts::PI * (w.radius_mm / a.spacing + 1.0).powi(2);
-    if points > crate::limits::MAX_MAP_POINTS as f64 {
+    if points > tricept_ident::limits::MAX_MAP_POINTS as f64 {
         return Err(CliError::input(format!(
             "--spacing {} mm: about {points:.0} map points, more than {}; a coarser spacing is needed",
             a.spacing,
-            crate::limits::MAX_MAP_POINTS
+            tricept_ident::limits::MAX_MAP_POINTS
         )));
     }
     let grid = w.disc_grid(z, a.spacing);

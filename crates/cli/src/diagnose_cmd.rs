@@ -12,11 +12,11 @@ use tricept_model::{GeometricErrors, ParameterSet};
 use tricept_plant::{Campaign, Effect, Plant, PoseOrder};
 
 use crate::args::{
-    LoadedMachine, MachineArgs, NoiseArgs, load_with_noise, machine_with_noise, pose_targets,
-    read_data,
+    MachineArgs, NoiseArgs, load_with_noise, machine_with_noise, pose_targets, read_data,
 };
 use crate::cli_error::CliError;
 use crate::machine_file;
+use tricept_ident::LoadedMachine;
 
 /// `tricept diagnose`.
 #[derive(Debug, Args)]
@@ -96,7 +96,7 @@ pub struct DetectabilityArgs {
 pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
     let (machine, data) = (&a.machine, a.data.as_path());
     let loaded = load_with_noise(machine, &a.noise)?;
-    let m = loaded.machine.clone();
+    let m = loaded.machine().clone();
     let dataset = read_data(data, &m)?;
     let source = data.display().to_string();
     let mut options = DiagnoseOptions::for_machine(&m);
@@ -226,7 +226,7 @@ fn write_extended(
         &problems.join("; "),
         force,
     )?;
-    let deployed = deploy(&loaded.machine, rank_reference, dataset, d)
+    let deployed = deploy(loaded.machine(), rank_reference, dataset, d)
         .map_err(|e| CliError::other(e.to_string()))?;
     let g = ParameterSet::paper15().len();
     let mut effects = Map::new();

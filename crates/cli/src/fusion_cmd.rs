@@ -18,13 +18,11 @@ use tricept_engine::fusion::{
 use tricept_kinematics::description::ExternalSourceRecord;
 use tricept_model::effects::EffectName;
 
-use crate::args::{
-    IdentifyArgs, check_commands, load_with_noise, parse_head_angles, parse_numbers, positive,
-    read_data,
-};
+use crate::args::{IdentifyArgs, load_with_noise, parse_head_angles, read_data};
 use crate::cli_error::{CliError, EXIT_NOT_CONVERGED};
-use crate::limits;
 use crate::machine_file;
+use tricept_ident::limits;
+use tricept_ident::{check_commands, parse_numbers, positive};
 
 /// Exit code of a fit that converged but that the user must not trust as
 /// it stands: a source the model does not explain (`identify`'s 3).
@@ -255,7 +253,7 @@ pub fn eval_options(
 /// `tricept identify` with external data.
 pub fn run(a: &IdentifyArgs) -> Result<u8, CliError> {
     let loaded = load_with_noise(&a.settings.machine, &a.settings.noise)?;
-    let machine = loaded.machine.clone();
+    let machine = loaded.machine().clone();
     let set = a.settings.params.set()?;
     let x = &a.external;
     if x.tracker.is_empty() && x.tracker_target.is_some() {
@@ -311,7 +309,7 @@ pub fn run(a: &IdentifyArgs) -> Result<u8, CliError> {
     if a.settings.machine.json {
         let mut v = fit.to_json(&model);
         if let Value::Object(o) = &mut v {
-            o.insert("machine".into(), loaded.description.name.clone().into());
+            o.insert("machine".into(), loaded.description().name.clone().into());
             o.insert("data_file".into(), a.data.display().to_string().into());
             if let Some(d) = &deployed {
                 o.insert("deployed".into(), d.clone());
@@ -325,14 +323,14 @@ pub fn run(a: &IdentifyArgs) -> Result<u8, CliError> {
         errln!("warning: {w}");
     }
     if let Some(path) = refused {
-        return Err(CliError {
-            code,
-            message: format!(
+        return Err(CliError::new(
+            tricept_ident::ErrorKind::of_exit_code(code),
+            format!(
                 "--write-machine {}: not written: {}; --force writes it anyway, marked as forced",
                 path.display(),
                 refusal_reason(&fit)
             ),
-        });
+        ));
     }
     match code {
         EXIT_NOT_CONVERGED => {

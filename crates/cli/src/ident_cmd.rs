@@ -18,11 +18,12 @@ use tricept_model::ParameterSet;
 // hands external measurements to (`fusion_cmd.rs`).
 use crate::args::{FitSettings, IdentifyArgs};
 use crate::args::{
-    LoadedMachine, MachineArgs, NoiseArgs, ParamArgs, load_with_noise, machine_with_noise,
-    pose_targets, read_data, spinner,
+    MachineArgs, NoiseArgs, ParamArgs, load_with_noise, machine_with_noise, pose_targets,
+    read_data, spinner,
 };
 use crate::cli_error::{CliError, EXIT_INADEQUATE, EXIT_NOT_CONVERGED};
 use crate::machine_file;
+use tricept_ident::LoadedMachine;
 
 /// `tricept identifiability`.
 #[derive(Debug, Args)]
@@ -198,7 +199,7 @@ pub fn fit_from_file(data: &Path, settings: &FitSettings) -> Result<Fit, CliErro
         )));
     }
     let loaded = load_with_noise(&settings.machine, &settings.noise)?;
-    let m = loaded.machine.clone();
+    let m = loaded.machine().clone();
     let set = settings.params.set()?;
     let dataset = read_data(data, &m)?;
     let mut model = GeometricModel::new(m.clone(), set.clone());
@@ -396,7 +397,10 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
                 serde_json::to_value(fit.accuracy).unwrap_or(Value::Null),
             );
             o.insert("worthwhile".into(), fit.accuracy.worthwhile.into());
-            o.insert("machine".into(), fit.loaded.description.name.clone().into());
+            o.insert(
+                "machine".into(),
+                fit.loaded.description().name.clone().into(),
+            );
             o.insert("data_file".into(), data.display().to_string().into());
         }
         outln!("{v}");
@@ -465,7 +469,7 @@ fn print_identification(fit: &Fit, data: &Path) {
         "{} poses of {} against `{}`, parameter set {}: {} in {} Gauss-Newton iterations",
         id.residuals.len(),
         data.display(),
-        fit.loaded.description.name,
+        fit.loaded.description().name,
         fit.model.parameter_set().label(),
         if id.converged {
             "converged"

@@ -102,7 +102,7 @@ fn kinematics(
     input: &InputArgs,
     machine: &MachineArgs,
 ) -> Result<u8, CliError> {
-    let m = ExtendedMachine::new(load(machine)?.machine);
+    let m = ExtendedMachine::new(load(machine)?.machine().clone());
     if let Some(path) = &input.input {
         if point.iter().any(Option::is_some) {
             return Err(CliError::input(format!(
@@ -121,7 +121,7 @@ fn kinematics(
     let values: Vec<f64> = point.iter().map(|v| v.unwrap_or(f64::NAN)).collect();
     let cells = verb
         .solve(&m, &values)
-        .map_err(|e| CliError::kinematics(verb.name(), &e))?;
+        .map_err(|e| CliError::with_context(verb.name(), &e))?;
     let fields: Vec<Field> = verb
         .keys()
         .iter()
@@ -153,8 +153,8 @@ fn run_batch(verb: Verb, m: &ExtendedMachine, path: &std::path::Path) -> Result<
     match result {
         Ok(_) => Ok(0),
         Err(BatchError::Input(message)) => Err(CliError::input(message)),
-        Err(BatchError::Point { line, source }) => Err(CliError::kinematics(
-            &format!("{} --input {file}: line {line}", verb.name()),
+        Err(BatchError::Point { line, source }) => Err(CliError::with_context(
+            format!("{} --input {file}: line {line}", verb.name()),
             &source,
         )),
         Err(BatchError::Output(message)) => Err(CliError::other(format!("stdout: {message}"))),
@@ -186,10 +186,10 @@ pub fn tool_ik(a: &ToolIkArgs) -> Result<u8, CliError> {
 pub fn print_machine(a: &MachineVerbArgs) -> Result<u8, CliError> {
     let loaded = load(&a.machine)?;
     if a.machine.json {
-        outln!("{}", loaded.description.to_json());
+        outln!("{}", loaded.description().to_json());
         return Ok(0);
     }
-    summary(&loaded.description, &loaded.machine, &loaded.source);
+    summary(loaded.description(), loaded.machine(), loaded.source());
     Ok(0)
 }
 

@@ -16,8 +16,8 @@ use tricept_kinematics::description::{
 };
 use tricept_kinematics::{Machine, MachineDescription};
 
-use crate::args::LoadedMachine;
 use crate::cli_error::CliError;
+use tricept_ident::LoadedMachine;
 
 /// What the record says beyond the fit itself.
 pub struct Provenance<'a> {
@@ -138,12 +138,10 @@ pub fn write_rule(
             errln!("warning: {what}: written with --force although {why}");
             Ok(Some(why.to_string()))
         }
-        (_, false) => Err(CliError {
-            code,
-            message: format!(
-                "{what}: not written: {why}; --force writes it anyway, marked as forced"
-            ),
-        }),
+        (_, false) => Err(CliError::new(
+            tricept_ident::ErrorKind::of_exit_code(code),
+            format!("{what}: not written: {why}; --force writes it anyway, marked as forced"),
+        )),
     }
 }
 
@@ -268,7 +266,7 @@ pub fn calibrated_description(
     let date = utc_now();
     let data_name = p.data_file.display().to_string();
     let mut d = identified.to_description();
-    d.controller = controller.or(base.description.controller);
+    d.controller = controller.or(base.description().controller);
     let status = match (&p.forced, p.adequate) {
         (Some(why), _) => format!(" (FORCED: {why})"),
         (None, false) => " (the model does not explain the data)".to_string(),
@@ -285,7 +283,7 @@ pub fn calibrated_description(
         env!("CARGO_PKG_VERSION"),
         p.method,
         data_name,
-        base.description.name
+        base.description().name
     ));
     let n = p.n_geometric.min(id.names.len());
     let mut estimates = Map::new();
@@ -351,9 +349,9 @@ pub fn calibrated_description(
         data_sha256: sha256_file(p.data_file)?,
         date,
         tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        relative_to: base.description.name.clone(),
-        relative_to_machine: base.description.calibration.as_ref().map(|_| {
-            let mut b = base.description.clone();
+        relative_to: base.description().name.clone(),
+        relative_to_machine: base.description().calibration.as_ref().map(|_| {
+            let mut b = base.description().clone();
             b.calibration = None;
             Box::new(b)
         }),

@@ -32,7 +32,6 @@ mod files;
 mod fusion_cmd;
 mod ident_cmd;
 mod kinematics_cmd;
-mod limits;
 mod machine_file;
 mod output;
 mod plan_cmd;
@@ -317,8 +316,8 @@ fn main() -> ExitCode {
     let code = match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            errln!("error: {}", e.message);
-            e.code
+            errln!("error: {}", e.message());
+            e.exit_code()
         }
     };
     // Output that did not reach stdout (a full disk, an I/O error; not a

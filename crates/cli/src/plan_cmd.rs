@@ -16,13 +16,14 @@ use tricept_study::plan::{
     nominal_tracker_data, plan, sphere_candidates, with_extensions,
 };
 
+use crate::args::parse_head_angles;
 use crate::args::{
     MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs, machine_with_noise, pose_targets, read_data,
 };
-use crate::args::{parse_head_angles, parse_numbers, positive};
 use crate::cli_error::CliError;
 use crate::fusion_cmd::{eval_options, fused_model, fusion_error, tracker_target};
-use crate::limits;
+use tricept_ident::limits;
+use tricept_ident::{parse_numbers, positive};
 
 /// The instrument to plan for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -506,7 +507,7 @@ fn run_check_plan(a: &PlanArgs) -> Result<u8, CliError> {
         )));
     }
     let loaded = crate::args::load_with_noise(&a.machine, &a.noise)?;
-    let reference = tricept_check::Reference::from_description(&loaded.description)
+    let reference = tricept_check::Reference::from_description(loaded.description())
         .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
     let p = tricept_study::check_plan::plan_check(
         &reference,
@@ -517,12 +518,12 @@ fn run_check_plan(a: &PlanArgs) -> Result<u8, CliError> {
     )
     .map_err(study_error)?;
     if let Some(out) = &a.out {
-        let m = &loaded.machine;
+        let m = loaded.machine();
         let mut records = Vec::with_capacity(p.targets_mm.len());
         for r in &p.targets_mm {
             let q = m
                 .inverse(r)
-                .map_err(|e| CliError::kinematics("plan", &e))?
+                .map_err(|e| CliError::with_context("plan", &e))?
                 .legs_mm;
             records.push(format!(
                 "{},{},{},{},{},{}",
@@ -532,7 +533,7 @@ fn run_check_plan(a: &PlanArgs) -> Result<u8, CliError> {
         let text = format!(
             "# tricept plan --instrument check: {} poses for `{}`; drive the machine to the commands q1,q2,q3 (mm) and log its readings\nx,y,z,q1,q2,q3\n{}\n",
             p.poses,
-            loaded.description.name,
+            loaded.description().name,
             records.join("\n")
         );
         crate::files::write_text(out, &text)?;
@@ -553,7 +554,7 @@ fn run_check_plan(a: &PlanArgs) -> Result<u8, CliError> {
     } else {
         outln!(
             "check of `{}`: {} poses {} a change of {} um of platform error in any single parameter with power {}{}",
-            loaded.description.name,
+            loaded.description().name,
             p.poses,
             if p.reached { "detect" } else { "do NOT detect" },
             a.detect_um,

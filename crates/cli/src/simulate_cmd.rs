@@ -8,10 +8,10 @@ use tricept_plant::{Campaign, Plant, PoseOrder};
 
 use crate::args::{
     MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs, TruthArgs, machine_with_noise,
-    parse_effects, parse_errors, pose_targets,
+    parse_errors, pose_targets,
 };
-use crate::args::{parse_numbers, positive};
 use crate::cli_error::CliError;
+use tricept_ident::{parse_effects, parse_numbers, positive};
 
 /// `tricept simulate`.
 #[derive(Debug, Args)]

@@ -19,11 +19,19 @@
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
+// Layer 0: errors, limits and inputs.
 mod error;
+mod inputs;
+pub mod limits;
 
 pub use error::{
     Classify, EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error,
     ErrorKind,
+};
+pub use inputs::{
+    HeadAngles, LoadedMachine, Poses, SensorNoise, Triple, TrueErrors, check_commands,
+    description_error, load_machine, parse_effects, parse_head_angles, parse_numbers, positive,
+    read_data, read_data_from,
 };
 
 // Transitional: the engine's API as it was when it was `tricept-ident`,
