@@ -84,7 +84,7 @@ pub fn run(a: &CheckArgs) -> Result<u8, CliError> {
     }
     let history = match &a.history {
         Some(path) => {
-            let time = crate::machine_file::utc_now();
+            let time = tricept_ident::machine_file::utc_now();
             let unix_s = std::time::SystemTime::now()
                 .duration_since(std::time::UNIX_EPOCH)
                 .map_or(0.0, |d| d.as_secs_f64());

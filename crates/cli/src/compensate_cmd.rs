@@ -16,7 +16,6 @@ use crate::args::FitSettings;
 use crate::args::{TruthArgs, load, parse_errors};
 use crate::cli_error::{CliError, EXIT_INADEQUATE, EXIT_NOT_CONVERGED};
 use crate::ident_cmd::{fit_from_file, rejected_json, report_exit};
-use crate::machine_file;
 use tricept_ident::parse_effects;
 
 /// The largest interpolation error (um) the default table spacing allows.
@@ -96,7 +95,7 @@ fn machines(a: &CompensateArgs) -> Result<Pair, CliError> {
         Some(data) => {
             let fit = fit_from_file(data, &a.settings)?;
             let code = fit.exit_code();
-            machine_file::write_rule("compensate", code, fit.refusal().unwrap_or(""), a.force)?;
+            crate::files::write_rule("compensate", code, fit.refusal().unwrap_or(""), a.force)?;
             out.insert("data_file".into(), data.display().to_string().into());
             out.insert("converged".into(), fit.verdict.converged.into());
             out.insert("adequate".into(), fit.verdict.adequate.into());
@@ -132,7 +131,7 @@ fn machines(a: &CompensateArgs) -> Result<Pair, CliError> {
             } else {
                 (0, "")
             };
-            machine_file::write_rule(
+            crate::files::write_rule(
                 &format!("compensate --machine {}", loaded.source()),
                 code,
                 why,

@@ -15,8 +15,8 @@ use crate::args::{
     MachineArgs, NoiseArgs, load_with_noise, machine_with_noise, pose_targets, read_data,
 };
 use crate::cli_error::CliError;
-use crate::machine_file;
 use tricept_ident::LoadedMachine;
+use tricept_ident::machine_file;
 
 /// `tricept diagnose`.
 #[derive(Debug, Args)]
@@ -216,7 +216,7 @@ fn write_extended(
             )
         })
         .collect();
-    let forced = machine_file::write_rule(
+    let forced = crate::files::write_rule(
         &format!("--write-machine {}", path.display()),
         if problems.is_empty() {
             0
@@ -288,7 +288,7 @@ fn write_extended(
         c.applies = deployed.applied;
         c.records = deployed.recorded;
     }
-    machine_file::write(path, &description)
+    crate::files::write_machine(path, &description)
 }
 
 /// The vocabulary for `tricept diagnose --help`, from the registry: each

@@ -20,8 +20,8 @@ use tricept_model::effects::EffectName;
 
 use crate::args::{IdentifyArgs, load_with_noise, parse_head_angles, read_data};
 use crate::cli_error::{CliError, EXIT_NOT_CONVERGED};
-use crate::machine_file;
 use tricept_ident::limits;
+use tricept_ident::machine_file;
 use tricept_ident::{check_commands, parse_numbers, positive};
 
 /// Exit code of a fit that converged but that the user must not trust as
@@ -499,7 +499,7 @@ fn write_machine(
 ) -> Result<Value, CliError> {
     // The caller refused a non-zero code without --force; with it the
     // file says it was forced (the one rule of `machine_file::write_rule`).
-    let forced = machine_file::write_rule(
+    let forced = crate::files::write_rule(
         &format!("--write-machine {}", path.display()),
         code,
         &refusal_reason(fit),
@@ -581,6 +581,6 @@ fn write_machine(
             held.join(", ")
         }
     ));
-    machine_file::write(path, &d)?;
+    crate::files::write_machine(path, &d)?;
     Ok(json!({"written": path.display().to_string(), "held_at_nominal": held}))
 }

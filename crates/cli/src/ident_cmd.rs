@@ -22,8 +22,8 @@ use crate::args::{
     read_data, spinner,
 };
 use crate::cli_error::{CliError, EXIT_INADEQUATE, EXIT_NOT_CONVERGED};
-use crate::machine_file;
 use tricept_ident::LoadedMachine;
+use tricept_ident::machine_file;
 
 /// `tricept identifiability`.
 #[derive(Debug, Args)]
@@ -321,7 +321,7 @@ pub fn report_exit(verb: &str, code: u8, why: &str) {
 /// (then only with `force`, marked as forced). Returns an error when it
 /// refuses.
 fn write_calibrated(path: &Path, data: &Path, fit: &Fit, force: bool) -> Result<(), CliError> {
-    let forced = machine_file::write_rule(
+    let forced = crate::files::write_rule(
         &format!("--write-machine {}", path.display()),
         fit.exit_code(),
         &fit.reason(),
@@ -346,7 +346,7 @@ fn write_calibrated(path: &Path, data: &Path, fit: &Fit, force: bool) -> Result<
         },
         None,
     )?;
-    machine_file::write(path, &d)
+    crate::files::write_machine(path, &d)
 }
 
 /// The rejected poses as JSON: 1-based pose number, file line, size.

@@ -32,7 +32,6 @@ mod files;
 mod fusion_cmd;
 mod ident_cmd;
 mod kinematics_cmd;
-mod machine_file;
 mod output;
 mod plan_cmd;
 mod simulate_cmd;

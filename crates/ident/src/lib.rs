@@ -23,6 +23,7 @@
 mod error;
 mod inputs;
 pub mod limits;
+pub mod machine_file;
 
 pub use error::{
     Classify, EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error,
