@@ -48,12 +48,13 @@ pub fn plotted(path: &Path, result: Result<(), tricept_plot::PlotError>) -> Resu
     Ok(())
 }
 
-/// Writes a machine description to `path` atomically.
+/// Writes a machine description to `path` atomically, its calibration
+/// record sealed (`tricept_ident::machine_file::write`).
 pub fn write_machine(
     path: &Path,
     d: &tricept_kinematics::MachineDescription,
 ) -> Result<(), CliError> {
-    write_text(path, &(d.to_json() + "\n"))
+    written(path, tricept_ident::machine_file::write(path, d))
 }
 
 /// The one rule for writing a calibration

@@ -342,6 +342,7 @@ pub fn calibrated_description(
             .collect::<Result<_, Error>>()?,
         rejected_lines: p.rejected_lines,
         leg_tables_digest: d.leg_effects.tables_digest(),
+        seal: None,
         data_file: data_name,
         data_sha256: sha256_file(p.data_file)?,
         date,
@@ -358,6 +359,17 @@ pub fn calibrated_description(
     d.validate()
         .map_err(|e| Error::other(format!("the calibrated machine is not valid: {e}")))?;
     Ok(d)
+}
+
+/// Writes a machine description to `path` atomically (a crash or a full
+/// disk leaves the previous file), its calibration record sealed last
+/// ([`MachineDescription::seal`]), so that a file loads back only as it
+/// was written.
+pub fn write(path: &Path, d: &MachineDescription) -> std::io::Result<()> {
+    let mut sealed = d.clone();
+    sealed.seal();
+    let text = sealed.to_json() + "\n";
+    tricept_data::write_atomic(path, |w| w.write_all(text.as_bytes()))
 }
 
 #[cfg(test)]
