@@ -119,10 +119,10 @@ impl Entry {
 /// The entries of a history file (none when it does not exist).
 pub fn read(path: &std::path::Path) -> Result<Vec<Entry>, CheckError> {
     let file = path.display();
-    let text = match std::fs::read_to_string(path) {
+    let text = match tricept_data::read_json_text(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(CheckError::History(format!("{file}: {e}"))),
+        Err(e) => return Err(CheckError::HistoryLine(format!("{file}: {e}"))),
     };
     text.lines()
         .enumerate()

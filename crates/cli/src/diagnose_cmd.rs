@@ -113,8 +113,8 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
     }
     if let Some(path) = &a.plausibility {
         let file = path.display().to_string();
-        let text =
-            std::fs::read_to_string(path).map_err(|e| CliError::input(format!("{file}: {e}")))?;
+        let text = tricept_data::read_json_text(path)
+            .map_err(|e| CliError::input(format!("{file}: {e}")))?;
         options.plausibility = Plausibility::with_overrides(&text)
             .map_err(|e| CliError::input(format!("{file}: {e}")))?;
     }

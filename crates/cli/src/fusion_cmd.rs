@@ -280,7 +280,7 @@ pub fn run(a: &IdentifyArgs) -> Result<u8, CliError> {
         options.screen = None;
     }
     if let Some(path) = &x.plausibility {
-        let text = std::fs::read_to_string(path)
+        let text = tricept_data::read_json_text(path)
             .map_err(|e| CliError::input(format!("--plausibility {}: {e}", path.display())))?;
         options.plausibility = FusionPlausibility::with_overrides(&text)
             .map_err(|e| CliError::input(format!("--plausibility {}: {e}", path.display())))?;

@@ -282,7 +282,7 @@ fn parse_head_errors(spec: &str, m: &tricept_kinematics::Machine) -> Result<Vec<
             Ok(tricept_plant::random_head_errors(scale, seed))
         }
         path => {
-            let text = std::fs::read_to_string(path)
+            let text = tricept_data::read_json_text(std::path::Path::new(path))
                 .map_err(|e| CliError::input(format!("{flag}: {path}: {e}")))?;
             tricept_model::HeadParameterSet::head13(&m.head)
                 .parse_values(&text)

@@ -434,7 +434,7 @@ impl TrueErrors {
             )),
             TrueErrors::File(path) => {
                 let name = path.display();
-                let text = std::fs::read_to_string(path)
+                let text = tricept_data::read_json_text(path)
                     .map_err(|e| Error::input(format!("{name}: {e}")))?;
                 set.parse_values(&text)
                     .map_err(|e| Error::input(format!("{name}: {e}")))
@@ -457,7 +457,8 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
     for spec in specs {
         let (text, origin) = match spec.strip_prefix('@') {
             Some(path) => (
-                std::fs::read_to_string(path).map_err(|e| Error::input(format!("{path}: {e}")))?,
+                tricept_data::read_json_text(Path::new(path))
+                    .map_err(|e| Error::input(format!("{path}: {e}")))?,
                 path.to_string(),
             ),
             None => (spec.clone(), "--truth-effect".to_string()),

@@ -227,7 +227,7 @@ impl MachineDescription {
 
     /// Reads, parses and validates a description file.
     pub fn from_file(path: &std::path::Path) -> Result<MachineDescription, DescriptionError> {
-        let text = std::fs::read_to_string(path).map_err(|source| DescriptionError::Io {
+        let text = tricept_data::read_json_text(path).map_err(|source| DescriptionError::Io {
             path: path.display().to_string(),
             source,
         })?;

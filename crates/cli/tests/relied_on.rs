@@ -1,9 +1,13 @@
+//! What the verbs rely on is sealed and bounded.
+//!
 //! What `tricept check` judges by is sealed: a calibrated file whose
 //! standard deviations, sensor noise, correlations, offsets or
 //! temperature were edited after the calibration is refused (exit 2,
 //! naming the field) by every verb that loads it, so an inflated
 //! `std_dev_mm` or a quieter `sensors` noise can no longer hide a real
 //! 20 um slip from the check; the file as written loads everywhere.
+//! Every JSON input has a size bound: a device or a runaway file is
+//! refused with exit 2 after 64 MiB instead of exhausting the memory.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -19,8 +23,8 @@ fn tricept(dir: &Path, args: &[&str]) -> Output {
     out
 }
 
-fn workdir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tricept-sealed-{}", std::process::id()));
+fn workdir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tricept-relied-on-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
@@ -37,7 +41,7 @@ fn truth_of(csv: &str) -> serde_json::Map<String, serde_json::Value> {
 
 #[test]
 fn an_edited_judged_field_is_refused_by_name_and_cannot_hide_a_slip() {
-    let dir = workdir();
+    let dir = workdir("sealed");
     let d = dir.as_path();
     let ok = |args: &[&str]| {
         let out = tricept(d, args);
@@ -149,5 +153,80 @@ fn an_edited_judged_field_is_refused_by_name_and_cannot_hide_a_slip() {
         "again.json",
     ]);
     ok(&["ik", "0", "0", "750", "--machine", "again.json"]);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn every_json_input_is_bounded() {
+    let dir = workdir("bounded");
+    let d = dir.as_path();
+    let out = tricept(d, &["simulate", "--poses", "random:40,3", "--out", "d.csv"]);
+    assert_eq!(out.status.code(), Some(0));
+    let out = tricept(
+        d,
+        &["identify", "--data", "d.csv", "--write-machine", "m.json"],
+    );
+    assert_eq!(out.status.code(), Some(0));
+    let z = "/dev/zero";
+    let cases: [(&str, Vec<&str>); 7] = [
+        ("machine", vec!["ik", "0", "0", "750", "--machine", z]),
+        (
+            "history",
+            vec![
+                "check",
+                "--machine",
+                "m.json",
+                "--data",
+                "d.csv",
+                "--history",
+                z,
+            ],
+        ),
+        ("truth", vec!["simulate", "--truth", z, "--out", "t.csv"]),
+        (
+            "truth-effect",
+            vec!["simulate", "--truth-effect", "@/dev/zero", "--out", "t.csv"],
+        ),
+        (
+            "plausibility",
+            vec!["diagnose", "--data", "d.csv", "--plausibility", z],
+        ),
+        (
+            "features",
+            vec![
+                "identify",
+                "--data",
+                "d.csv",
+                "--touch",
+                "d.csv",
+                "--features",
+                z,
+            ],
+        ),
+        (
+            "fused-plausibility",
+            vec![
+                "identify",
+                "--data",
+                "d.csv",
+                "--head",
+                "none",
+                "--plausibility",
+                z,
+            ],
+        ),
+    ];
+    let mut failures = Vec::new();
+    for (case, args) in cases {
+        let out = tricept(d, &args);
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        if out.status.code() != Some(2)
+            || !err.contains("64 MiB")
+            || err.trim().lines().count() != 1
+        {
+            failures.push(format!("{case}: {:?} {err}", out.status.code()));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
     std::fs::remove_dir_all(&dir).ok();
 }
