@@ -20,6 +20,11 @@
 )]
 
 mod error;
+mod export;
+pub use export::{
+    AxisSummary, Controller, Export, ExportError, ExportOptions, ExportRequest, ExportSummary,
+    NotExported, export,
+};
 
 pub use error::{
     Classify, EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error,
