@@ -8,7 +8,7 @@
 //! `E_i(q) = lead_i 1e-6 q + T_i(q)` (mm) longer than its geometry
 //! (`LegEffectsDescription`). A control's leadscrew or pitch-error
 //! compensation is zero at the reference point; the constant `E_i(q_ref)`
-//! goes into the leg's zero instead (see [`LegCorrection::zero_mm`]).
+//! goes into the leg's zero instead (`AxisSummary::zero_mm`).
 
 use nalgebra::Vector3;
 use tricept_kinematics::Machine;

@@ -21,6 +21,8 @@ pub fn table(d: &MachineDescription, m: &Machine, axes: &[AxisSummary]) -> Strin
         "# tricept export: the calibrated geometry of the Tricept for the PKM transformation (docs/controllers.md)\n# machine base frame Oxyz (platform joints in the platform frame O'x'y'z'), mm and rad\n# leg length = |A_i - B_i|; axis position = leg length - LEG<i>.zero\nname,value,unit,meaning\n",
     );
     let mut row = |name: String, value: String, unit: &str, meaning: String| {
+        // The meaning is free text: no comma may split its column.
+        let meaning = meaning.replace(',', ";");
         s.push_str(&format!("{name},{value},{unit},{meaning}\n"));
     };
     for (label, joints, frame) in [
@@ -83,7 +85,7 @@ pub fn table(d: &MachineDescription, m: &Machine, axes: &[AxisSummary]) -> Strin
             format!("{:.6}", a.zero_mm),
             "mm",
             format!(
-                "axis {}: leg length at axis position 0 (the calibrated leg offset, plus the table's constant {:.6} mm, minus half the backlash)",
+                "axis {}: leg length at axis position 0 = the calibrated leg offset + the table's constant {:.6} mm - half the backlash",
                 a.axis, a.offset_mm
             ),
         );

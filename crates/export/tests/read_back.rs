@@ -531,3 +531,35 @@ fn every_control_reads_back_what_tricept_deploys_and_a_misreading_fails() {
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// Compliance depends on the pose: no axis table carries it, and the
+/// summary says how large it is; geometry.csv is a 4-column table.
+#[test]
+fn compliance_is_listed_as_not_exported_with_its_size() {
+    let mut d = MachineDescription::from_file(&fixture("lead")).unwrap();
+    let plain = plan(&d, &ExportOptions::new(Controller::Heidenhain)).unwrap();
+    assert!(
+        !plain
+            .summary
+            .not_exported
+            .iter()
+            .any(|n| n.what == "compliance")
+    );
+    // 30 um/kN at 1 m, about what the diagnosis finds in
+    // fixtures/data/diagnose-hidden-effect.csv: tens of um of leg length.
+    d.leg_effects.compliance_um_per_kn_at_1m = 30.0;
+    let p = plan(&d, &ExportOptions::new(Controller::Heidenhain)).unwrap();
+    let c = p
+        .summary
+        .not_exported
+        .iter()
+        .find(|n| n.what == "compliance")
+        .unwrap();
+    assert!(c.size_um > 1.0 && c.size_um < 200.0, "{c:?}");
+    for l in file(&p, "geometry.csv")
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+    {
+        assert_eq!(l.split(',').count(), 4, "{l}");
+    }
+}
