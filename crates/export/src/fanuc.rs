@@ -267,4 +267,28 @@ mod tests {
         assert!((a.output_mm(1000.0, 1.0) + 0.010).abs() < 0.0006);
         assert!((a.output_mm(700.0, 1.0) - 0.005).abs() < 0.0006);
     }
+
+    #[test]
+    fn the_magnification_grows_until_each_increment_fits_and_clipping_is_said() {
+        let leg = |ppm: f64| LegCorrection {
+            leg: 0,
+            lead_ppm: ppm,
+            table: None,
+            reference_mm: 800.0,
+            lo_mm: 640.0,
+            hi_mm: 1040.0,
+        };
+        // 5000 ppm over ~3.2 mm sections: 16 um a section, 7 at the most:
+        // magnification 3.
+        let a = plan(&leg(5000.0), 128, 0, 1.0, 7);
+        assert_eq!(a.magnification, 3);
+        assert!(!a.clipped);
+        assert!(a.increments.iter().all(|v| v.abs() <= 7));
+        // 200 um a section cannot fit 1 x 100: clipped, and the error
+        // says so.
+        let b = plan(&leg(62_500.0), 128, 0, 1.0, 1);
+        assert!(b.clipped);
+        assert_eq!(b.magnification, MAX_MAGNIFICATION);
+        assert!(b.format_error_um > 1000.0, "{}", b.format_error_um);
+    }
 }

@@ -460,9 +460,25 @@ pub fn plan(
                         fanuc::MAX_MAGNIFICATION
                     ));
                 } else if a.format_error_um > options.tolerance_um {
+                    // A staircase misses by half a section's change plus
+                    // half a unit: the sections shrink with the points.
+                    let rounding_um = 0.5 * du * f64::from(a.magnification);
+                    let remedy = if rounding_um >= 0.5 * options.tolerance_um {
+                        format!(
+                            "lower --detection-unit-um ({du} um, magnification {}: half a unit is {rounding_um:.3} um)",
+                            a.magnification
+                        )
+                    } else {
+                        let points = a.increments.len() as f64 * (a.format_error_um - rounding_um)
+                            / (options.tolerance_um - rounding_um);
+                        format!(
+                            "raise --max-points (the points of the axis) to about {}",
+                            points.ceil()
+                        )
+                    };
                     limits.push(format!(
-                        "axis {}: format error {:.3} um past --tolerance-um {}: raise --max-points (the points of the axis) or lower --detection-unit-um ({du} um, magnification {})",
-                        names[i], a.format_error_um, options.tolerance_um, a.magnification
+                        "axis {}: format error {:.3} um past --tolerance-um {}: {remedy}",
+                        names[i], a.format_error_um, options.tolerance_um
                     ));
                 }
             }
