@@ -463,16 +463,17 @@ pub fn plan(
                     // A staircase misses by half a section's change plus
                     // half a unit: the sections shrink with the points.
                     let rounding_um = 0.5 * du * f64::from(a.magnification);
-                    let remedy = if rounding_um >= 0.5 * options.tolerance_um {
-                        format!(
-                            "lower --detection-unit-um ({du} um, magnification {}: half a unit is {rounding_um:.3} um)",
-                            a.magnification
-                        )
+                    let lower = format!(
+                        "lower --detection-unit-um ({du} um, magnification {}: half a unit is {rounding_um:.3} um)",
+                        a.magnification
+                    );
+                    let remedy = if rounding_um >= options.tolerance_um {
+                        lower
                     } else {
                         let points = a.increments.len() as f64 * (a.format_error_um - rounding_um)
                             / (options.tolerance_um - rounding_um);
                         format!(
-                            "raise --max-points (the points of the axis) to about {}",
+                            "raise --max-points (the points of the axis) to more than {}, or {lower}",
                             points.ceil()
                         )
                     };
