@@ -86,6 +86,7 @@ fn a_calibrated_machine_is_exported_with_its_summary() {
         assert!(a["format_error_um"].as_f64().unwrap() < 0.01, "{a}");
     }
     assert!(v["not_exported"].is_array());
+    assert!(v["platform_error_um"].as_f64().unwrap() < 0.05, "{v}");
     // The leg lead of the calibration is in the table: leg 1's lead of
     // about 50 ppm over the table's span.
     let ini = std::fs::read_to_string(out.join("AX_EEC_INI.SPF")).unwrap();

@@ -180,3 +180,26 @@ pub fn compliance_size_um(machine: &Machine, poses: &[Vector3<f64>]) -> Result<f
     }
     Ok(worst * 1e3)
 }
+
+/// The largest displacement (um) of the platform point over `poses` when
+/// each leg `i` is `deviation[i](q_i)` mm longer than `machine`'s IK
+/// commands it (the format errors of the written tables, read the way the
+/// control reads them).
+pub fn platform_error_um(
+    machine: &Machine,
+    poses: &[Vector3<f64>],
+    deviation: &[Box<dyn Fn(f64) -> f64>],
+) -> Result<f64, ExportError> {
+    let extended = ExtendedMachine::new(machine.clone());
+    let mut worst: f64 = 0.0;
+    for r in poses {
+        let q = extended.inverse(r)?.legs_mm;
+        let g = machine.inverse(r)?.legs_mm;
+        let moved: [f64; 3] =
+            std::array::from_fn(|i| g[i] + deviation.get(i).map_or(0.0, |d| d(q[i])));
+        let at = machine.forward(&g)?.position_mm;
+        let to = machine.forward(&moved)?.position_mm;
+        worst = worst.max((to - at).norm());
+    }
+    Ok(worst * 1e3)
+}

@@ -65,6 +65,10 @@ impl Export {
                 a.leg, a.axis, a.points, a.step_mm, a.min_mm, a.max_mm, a.format_error_um, a.reference_mm, a.offset_mm, a.zero_mm
             ));
         }
+        t.push_str(&format!(
+            "platform: the format errors move the platform point by up to {:.3} um over the workspace\n",
+            s.platform_error_um
+        ));
         for p in &s.parameters {
             t.push_str(&format!("set: {p}\n"));
         }
