@@ -174,5 +174,27 @@ fn bad_inputs_are_exit_2_and_say_why() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("`Q7`"), "{}", stderr(&o));
+
+    // A reference point off the stroke, a Fanuc option for another control.
+    let o = run(&[
+        "--machine",
+        &fixture("lead"),
+        "--controller",
+        "sinumerik",
+        "--reference-mm",
+        "0,800,800",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--reference-mm"), "{}", stderr(&o));
+    let o = run(&[
+        "--machine",
+        &fixture("lead"),
+        "--controller",
+        "heidenhain",
+        "--detection-unit-um",
+        "0.1",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("fanuc only"), "{}", stderr(&o));
     assert!(!out.exists());
 }
