@@ -134,67 +134,53 @@ fn past_the_tolerance_nothing_is_written_and_the_limit_is_named() {
 fn bad_inputs_are_exit_2_and_say_why() {
     let dir = workdir("bad");
     let out = dir.join("cnc");
-    let run = |args: &[&str]| {
-        let mut all = vec!["export", "--out", s(&out)];
-        all.extend_from_slice(args);
-        tricept(&all)
+    // Exit 2 with `says` in the message, and nothing written.
+    let refused = |machine: &str, controller: &str, more: &[&str], says: &str| {
+        let mut all = vec![
+            "export",
+            "--out",
+            s(&out),
+            "--machine",
+            machine,
+            "--controller",
+            controller,
+        ];
+        all.extend_from_slice(more);
+        let o = tricept(&all);
+        assert_eq!(o.status.code(), Some(2), "{all:?}");
+        assert!(stderr(&o).contains(says), "{all:?}: {}", stderr(&o));
+        assert!(!out.exists());
     };
-    let o = run(&["--machine", &fixture("lead"), "--controller", "haas"]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("haas"), "{}", stderr(&o));
-
+    let lead = fixture("lead");
+    refused(&lead, "haas", &[], "haas");
     let nominal = format!(
         "{}/../../fixtures/machines/tricept-paper.json",
         env!("CARGO_MANIFEST_DIR")
     );
-    let o = run(&["--machine", &nominal, "--controller", "fanuc"]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(
-        stderr(&o).contains("nothing to compensate beyond the nominal"),
-        "{}",
-        stderr(&o)
+    refused(
+        &nominal,
+        "fanuc",
+        &[],
+        "nothing to compensate beyond the nominal",
     );
-
     let mut v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(fixture("lead")).unwrap()).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(&lead).unwrap()).unwrap();
     v["leg_offsets_mm"][0] = serde_json::json!(0.9);
     let edited = dir.join("edited.json");
     std::fs::write(&edited, v.to_string()).unwrap();
-    let o = run(&["--machine", s(&edited), "--controller", "heidenhain"]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("leg_offsets_mm[0]"), "{}", stderr(&o));
-
-    let o = run(&[
-        "--machine",
-        &fixture("lead"),
-        "--controller",
-        "fanuc",
-        "--axis-names",
-        "U,V,Q7",
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("`Q7`"), "{}", stderr(&o));
-
+    refused(s(&edited), "heidenhain", &[], "leg_offsets_mm[0]");
+    refused(&lead, "fanuc", &["--axis-names", "U,V,Q7"], "`Q7`");
     // A reference point off the stroke, a Fanuc option for another control.
-    let o = run(&[
-        "--machine",
-        &fixture("lead"),
-        "--controller",
+    refused(
+        &lead,
         "sinumerik",
+        &["--reference-mm", "0,800,800"],
         "--reference-mm",
-        "0,800,800",
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("--reference-mm"), "{}", stderr(&o));
-    let o = run(&[
-        "--machine",
-        &fixture("lead"),
-        "--controller",
+    );
+    refused(
+        &lead,
         "heidenhain",
-        "--detection-unit-um",
-        "0.1",
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("fanuc only"), "{}", stderr(&o));
-    assert!(!out.exists());
+        &["--detection-unit-um", "0.1"],
+        "fanuc only",
+    );
 }
