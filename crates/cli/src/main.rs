@@ -28,6 +28,7 @@ mod compensate_cmd;
 mod diagnose_cmd;
 mod docs_cmd;
 mod effects_cmd;
+mod export_cmd;
 mod files;
 mod fusion_cmd;
 mod ident_cmd;
@@ -161,6 +162,13 @@ enum Command {
         after_help = "The keys are the simulator's inputs, in the units a machine builder quotes; the diagnosis fits its own parameters (`tricept docs diagnosis`).\n\nExamples:\n  tricept effects\n  tricept effects compliance\n  tricept effects --json | head -1"
     )]
     Effects(effects_cmd::EffectsArgs),
+    /// Compensation files a CNC control loads (Sinumerik, Fanuc,
+    /// Heidenhain) from a calibrated machine file, with the format error.
+    #[command(
+        allow_negative_numbers = true,
+        after_help = "Exit codes: 0 written; 3 a format error past --tolerance-um (nothing written; the report names the limit to raise); 2 bad input (an unknown controller, an axis name the control cannot accept, a machine file without a calibration or edited after it).\n\nExamples:\n  tricept export --machine calibrated.json --controller sinumerik --out cnc/\n  tricept export --machine calibrated.json --controller fanuc --axis-names U,V,W --detection-unit-um 0.1 --max-points 1000 --out cnc/ --json\nFormats, signs and units: `tricept docs controllers`"
+    )]
+    Export(export_cmd::ExportArgs),
 }
 
 /// The files a verb reads and writes, by flag (checked before it runs:
@@ -267,6 +275,9 @@ fn file_roles(command: &Command) -> files::FileRoles {
                 r.output("--history", h);
             }
         }
+        Command::Export(a) => {
+            r.input("--machine", &a.machine);
+        }
         Command::Plan(a) => {
             machine(&mut r, &a.machine);
             r.inputs("--data", &a.data);
@@ -299,6 +310,7 @@ fn run(cli: Cli) -> Result<u8, CliError> {
         Command::Docs(a) => docs_cmd::run(&a),
         Command::Effects(a) => effects_cmd::run(&a),
         Command::Check(a) => check_cmd::run(&a),
+        Command::Export(a) => export_cmd::run(&a),
     }
 }
 

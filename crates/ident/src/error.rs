@@ -13,6 +13,7 @@ use tricept_check::CheckError;
 use tricept_data::DataError;
 use tricept_diagnose::{DeployError, DiagnoseError};
 use tricept_engine::{IdentError, RecordError};
+use tricept_export::ExportError;
 use tricept_kinematics::{DescriptionError, KinematicsError};
 use tricept_model::ModelError;
 use tricept_plant::PlantError;
@@ -302,6 +303,17 @@ impl Classify for StudyError {
             StudyError::Check(e) => e.kind(),
             StudyError::Invalid(_) => ErrorKind::Input,
             _ => ErrorKind::Other,
+        }
+    }
+}
+
+impl Classify for ExportError {
+    /// A failed write is not the input's fault; everything else is.
+    fn kind(&self) -> ErrorKind {
+        match self {
+            ExportError::Io { .. } => ErrorKind::Other,
+            ExportError::Kinematics(e) => e.kind(),
+            _ => ErrorKind::Input,
         }
     }
 }

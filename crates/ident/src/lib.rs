@@ -24,6 +24,11 @@ mod error;
 mod inputs;
 pub mod limits;
 pub mod machine_file;
+mod export;
+pub use export::{
+    AxisSummary, Controller, Export, ExportError, ExportOptions, ExportRequest, ExportSummary,
+    NotExported, export,
+};
 
 pub use error::{
     Classify, EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error,
