@@ -21,9 +21,11 @@ use crate::args::{
     MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs, machine_with_noise, pose_targets, read_data,
 };
 use crate::cli_error::CliError;
-use crate::fusion_cmd::{eval_options, fused_model, fusion_error, tracker_target};
 use tricept_ident::limits;
-use tricept_ident::{parse_numbers, positive};
+use tricept_ident::{
+    EffectNames, EvalGrid, HeadAngles, HeadModel, TrackerTargetSpec, eval_options, fused_model,
+    parse_numbers, positive,
+};
 
 /// The instrument to plan for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -98,7 +100,7 @@ pub struct PlanArgs {
     /// default): `tip`, `X,Y,Z` (a known offset, mm, spindle frame at zero
     /// head angles) or `free`.
     #[arg(long, value_name = "tip|X,Y,Z|free", allow_hyphen_values = true)]
-    pub tracker_target: Option<String>,
+    pub tracker_target: Option<TrackerTargetSpec>,
     /// Standard deviation of a known target offset, um.
     #[arg(long, default_value_t = 5.0, value_name = "UM")]
     pub tracker_target_sigma_um: f64,
@@ -121,7 +123,7 @@ pub struct PlanArgs {
     pub touch: TouchSphereArgs,
     /// Effects in the model (as for `identify --effects`).
     #[arg(long, value_name = "NAMES", value_delimiter = ',')]
-    pub effects: Vec<String>,
+    pub effects: Vec<EffectNames>,
     /// The accuracy to reach, um: the report recommends the smallest
     /// planned k that predicts it and leaves its rows enough redundancy to
     /// check the fit.
@@ -138,10 +140,10 @@ pub struct PlanArgs {
     pub passes: usize,
     /// Evaluation grid of the tool tip (as for `identify`).
     #[arg(long, default_value = "2,8,3", value_name = "RINGS,PER_RING,LEVELS")]
-    pub eval_grid: String,
+    pub eval_grid: EvalGrid,
     /// Head angles of the evaluation grid, deg.
     #[arg(long, default_value = "0,90,180,270:15,35", value_name = "H1S:H2S")]
-    pub eval_head_angles_deg: String,
+    pub eval_head_angles_deg: HeadAngles,
     /// Write the planned poses for the largest k (CSV
     /// `q1,q2,q3,h1,h2[,extension_mm],x,y,z[,length][,feature]`: nominal
     /// tool tip, bar length, feature touched).
@@ -188,8 +190,9 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
     let k: &[usize] = if a.k.is_empty() { &default_k } else { &a.k };
     let m = machine_with_noise(&a.machine, &a.noise)?;
     let set = a.params.set()?;
-    let model = fused_model(&m, &set, &a.effects, Some("head13"))?;
-    let options = eval_options(&m, &a.eval_grid, &a.eval_head_angles_deg)?;
+    let effects = crate::args::effect_names(&a.effects);
+    let model = fused_model(&m, &set, &effects, HeadModel::Head13)?;
+    let options = eval_options(&m, a.eval_grid, &a.eval_head_angles_deg)?;
     if k.contains(&0) {
         return Err(CliError::input("--k: expected positive whole numbers"));
     }
@@ -216,8 +219,7 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
         Some(path) => {
             let data = read_data(path, &m)?;
             let f =
-                information_factor(&model, &[Source::internal(&data, m.sensors.logged_sigma())])
-                    .map_err(fusion_error)?;
+                information_factor(&model, &[Source::internal(&data, m.sensors.logged_sigma())])?;
             (f, data.poses.len())
         }
         None => {
@@ -230,7 +232,7 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
     let (poses, source, centre) = match a.instrument {
         Instrument::Check => return run_check_plan(a),
         Instrument::Tracker => {
-            let target = tracker_target(a.tracker_target.as_deref(), a.tracker_target_sigma_um)?;
+            let target = TrackerTargetSpec::required(a.tracker_target, a.tracker_target_sigma_um)?;
             let (h1, h2) = parse_head_angles("--head-angles-deg", &a.head_angles_deg)?;
             if a.extensions
                 .iter()
@@ -251,12 +253,12 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
                 )));
             }
             let poses = with_extensions(&head_angle_poses(&m, &points, &h1, &h2), &a.extensions);
-            let data = nominal_tracker_data(&model, &poses).map_err(study_error)?;
+            let data = nominal_tracker_data(&model, &poses)?;
             let options = TrackerOptions {
                 sigma_um: instrument_sigma(a, a.tracker_sigma_um, "--tracker-sigma-um")?,
                 target,
             };
-            let source = Source::tracker(&data, &options).map_err(fusion_error)?;
+            let source = Source::tracker(&data, &options)?;
             (poses, source, None)
         }
         Instrument::Ballbar | Instrument::Touch => {
@@ -289,7 +291,7 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
                 )));
             }
             let source = if touch {
-                let data = nominal_touch_data(&poses, 1).map_err(study_error)?;
+                let data = nominal_touch_data(&poses, 1)?;
                 let features = touch_features(
                     a.touch.touch_sphere_radius_mm,
                     a.touch.touch_stylus_radius_mm,
@@ -298,14 +300,14 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
                 let options = tricept_engine::fusion::TouchOptions {
                     sigma_um: instrument_sigma(a, a.touch.touch_sigma_um, "--touch-sigma-um")?,
                 };
-                Source::touch(&data, &features, &options).map_err(fusion_error)?
+                Source::touch(&data, &features, &options)?
             } else {
-                let data = nominal_ballbar_data(&model, &poses, &centre).map_err(study_error)?;
+                let data = nominal_ballbar_data(&model, &poses, &centre)?;
                 let options = tricept_engine::fusion::BallbarOptions {
                     sigma_um: instrument_sigma(a, a.ballbar_sigma_um, "--ballbar-sigma-um")?,
                     ..Default::default()
                 };
-                Source::ballbar(&data, &options).map_err(fusion_error)?
+                Source::ballbar(&data, &options)?
             };
             let poses = poses.into_iter().map(|p| (p, 0.0)).collect();
             (poses, source, Some(centre))
@@ -317,13 +319,12 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
         e.dedup();
         e.len() >= 2
     };
-    let rows = candidate_rows(&model, &source).map_err(study_error)?;
-    let mut problem =
-        PlanProblem::new(&model, &f_int, &rows, &options.eval_poses).map_err(study_error)?;
+    let rows = candidate_rows(&model, &source)?;
+    let mut problem = PlanProblem::new(&model, &f_int, &rows, &options.eval_poses)?;
     if axis {
         problem = problem.with_tool_axis();
     }
-    let result = plan(&problem, k, a.passes, a.random_baseline, a.seed).map_err(study_error)?;
+    let result = plan(&problem, k, a.passes, a.random_baseline, a.seed)?;
     let recommended = result.recommended(a.target_um, None);
     if let (Some(path), Some(last)) = (&a.out, result.rows.last()) {
         let p = vec![0.0; model.len()];
@@ -336,9 +337,7 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
                     extension_mm,
                     ..Default::default()
                 };
-                let (x, _) = model
-                    .spindle_point(&p, &pose, &effector)
-                    .map_err(fusion_error)?;
+                let (x, _) = model.spindle_point(&p, &pose, &effector)?;
                 Ok(PlannedPose {
                     pose,
                     extension_mm,
@@ -464,14 +463,6 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
     Ok(0)
 }
 
-fn study_error(e: tricept_study::StudyError) -> CliError {
-    match e {
-        tricept_study::StudyError::Ident(e) => fusion_error(e),
-        tricept_study::StudyError::Invalid(m) => CliError::input(m),
-        e => CliError::other(e.to_string()),
-    }
-}
-
 /// `tricept plan --instrument check`: the fewest poses, up to `--k` (default
 /// 20), whose check detects a change of `--detect-um` of platform error in
 /// any single parameter with `--power` (`tricept_study::check_plan`).
@@ -515,8 +506,7 @@ fn run_check_plan(a: &PlanArgs) -> Result<u8, CliError> {
         a.power,
         tricept_check::DEFAULT_ALPHA,
         budget,
-    )
-    .map_err(study_error)?;
+    )?;
     if let Some(out) = &a.out {
         let m = loaded.machine();
         let mut records = Vec::with_capacity(p.targets_mm.len());

@@ -25,6 +25,11 @@ mod inputs;
 pub mod limits;
 pub mod machine_file;
 
+// Layer 1: the workflows.
+mod calibrate;
+mod compensate;
+mod identifiability;
+
 pub use error::{
     Classify, EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error,
     ErrorKind,
@@ -33,6 +38,21 @@ pub use inputs::{
     HeadAngles, LoadedMachine, Poses, SensorNoise, Triple, TrueErrors, check_commands,
     description_error, load_machine, parse_effects, parse_head_angles, parse_numbers, positive,
     read_data, read_data_from,
+};
+
+pub use calibrate::values::{
+    EffectNames, EvalGrid, HeadModel, LengthSigma, TrackerTargetSpec, eval_options, fused_model,
+};
+pub use calibrate::{
+    CalibrateRequest, Calibration, Data, FusedSources, Written, calibrate, exit_line,
+};
+
+pub use compensate::{
+    Calibrated, CompensateRequest, Compensation, CorrectedTarget, MAP_FILES, TABLE_ERROR_LIMIT_UM,
+    TABLE_FILES, compensate,
+};
+pub use identifiability::{
+    Campaign, Identifiability, IdentifiabilityRequest, assess_identifiability,
 };
 
 // Transitional: the engine's API as it was when it was `tricept-ident`,
