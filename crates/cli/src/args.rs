@@ -371,9 +371,3 @@ impl ExternalArgs {
 pub fn effect_names(lists: &[EffectNames]) -> Vec<EffectName> {
     lists.iter().flat_map(|l| l.0.iter().copied()).collect()
 }
-
-/// `H1S:H2S` lists of degrees.
-pub fn parse_head_angles(flag: &str, text: &str) -> Result<(Vec<f64>, Vec<f64>), CliError> {
-    let h = tricept_ident::parse_head_angles(flag, text)?;
-    Ok((h.h1_deg, h.h2_deg))
-}

@@ -206,7 +206,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         }
         Command::Simulate(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses);
+            r.input_if_file("--poses", &a.poses.to_string());
             if let Some(t) = &a.truth.truth {
                 r.input_if_file("--truth", t);
             }
@@ -239,7 +239,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         }
         Command::Detectability(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses);
+            r.input_if_file("--poses", &a.poses.to_string());
             r.inputs("--data", &a.data);
         }
         Command::Compensate(a) => {
@@ -269,8 +269,8 @@ fn file_roles(command: &Command) -> files::FileRoles {
         Command::Plan(a) => {
             machine(&mut r, &a.machine);
             r.inputs("--data", &a.data);
-            r.input_if_file("--poses", &a.poses);
-            r.input_if_file("--candidates", &a.candidates);
+            r.input_if_file("--poses", &a.poses.to_string());
+            r.input_if_file("--candidates", &a.candidates.to_string());
             if let Some(p) = &a.out {
                 r.output("--out", p);
             }

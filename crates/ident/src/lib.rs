@@ -29,6 +29,7 @@ pub mod machine_file;
 mod calibrate;
 mod compensate;
 mod identifiability;
+mod plan;
 
 pub use error::{
     Classify, EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error,
@@ -54,6 +55,7 @@ pub use compensate::{
 pub use identifiability::{
     Campaign, Identifiability, IdentifiabilityRequest, assess_identifiability,
 };
+pub use plan::{Instrument, Plan, PlanRequest, plan};
 
 // Transitional: the engine's API as it was when it was `tricept-ident`,
 // curated by issue 27 ("One door") into the workflows above.
