@@ -9,15 +9,19 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use nalgebra::Vector3;
+use nalgebra::{DMatrix, Vector3};
 use serde_json::{Value, json};
-use tricept_data::{ExternalData, PlannedPose};
-use tricept_engine::fusion::{Source, TrackerOptions, head_angle_poses, information_factor};
+use tricept_data::{ExternalData, ExternalPose, PlannedPose};
+use tricept_engine::fusion::{
+    FusedModel, Source, TrackerOptions, head_angle_poses, information_factor,
+};
+use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_model::effects::EffectName;
 use tricept_study::plan::{
-    PlanProblem, candidate_rows, internal_factor, nominal_ballbar_data, nominal_touch_data,
-    nominal_tracker_data, plan as study_plan, sphere_candidates, with_extensions,
+    Plan as StudyPlan, PlanProblem, PlanRow, candidate_rows, internal_factor, nominal_ballbar_data,
+    nominal_touch_data, nominal_tracker_data, plan as study_plan, sphere_candidates,
+    with_extensions,
 };
 
 use crate::calibrate::values::{
@@ -281,6 +285,46 @@ pub fn plan(a: &PlanRequest) -> Result<Plan, Error> {
     let set = a.parameter_set.clone();
     let model = fused_model(&m, &set, &a.effects, HeadModel::Head13)?;
     let options = eval_options(&m, a.eval_grid, &a.eval_head_angles_deg)?;
+    check_sizes(a, k)?;
+    let (f_int, internal_poses) = internal_information(a, &m, &model)?;
+    if a.instrument == Instrument::Check {
+        return check_plan(a, &loaded);
+    }
+    let (poses, source, centre) = candidates(a, &m, &model)?;
+    let axis = a.instrument == Instrument::Tracker && {
+        let mut e = a.extensions.clone();
+        e.sort_by(f64::total_cmp);
+        e.dedup();
+        e.len() >= 2
+    };
+    let rows = candidate_rows(&model, &source)?;
+    let mut problem = PlanProblem::new(&model, &f_int, &rows, &options.eval_poses)?;
+    if axis {
+        problem = problem.with_tool_axis();
+    }
+    let result = study_plan(&problem, k, a.passes, a.random_baseline, a.seed)?;
+    let out = match (&a.out, result.rows.last()) {
+        (Some(_), Some(last)) => Some(planned_poses(a, &model, &poses, centre, last)?),
+        _ => None,
+    };
+    let (json, text) = report(
+        a,
+        &result,
+        poses.len(),
+        axis,
+        options.eval_poses.len(),
+        internal_poses,
+    );
+    Ok(Plan {
+        json,
+        text,
+        out,
+        warnings: loaded.warnings().to_vec(),
+    })
+}
+
+/// Refuses sizes no plan can use.
+fn check_sizes(a: &PlanRequest, k: &[usize]) -> Result<(), Error> {
     if k.contains(&0) {
         return Err(Error::input("--k: expected positive whole numbers"));
     }
@@ -303,23 +347,47 @@ pub fn plan(a: &PlanRequest) -> Result<Plan, Error> {
             return Err(Error::input(format!("{flag}: {n}; at most {max}")));
         }
     }
-    let (f_int, internal_poses) = match &a.data {
+    Ok(())
+}
+
+/// The information of the internal campaign (its data's commands, or its
+/// pose set) and its number of poses.
+fn internal_information(
+    a: &PlanRequest,
+    m: &Machine,
+    model: &FusedModel,
+) -> Result<(DMatrix<f64>, usize), Error> {
+    Ok(match &a.data {
         Some(path) => {
-            let data = path.read(&m)?;
+            let data = path.read(m)?;
             let f =
-                information_factor(&model, &[Source::internal(&data, m.sensors.logged_sigma())])?;
+                information_factor(model, &[Source::internal(&data, m.sensors.logged_sigma())])?;
             (f, data.poses.len())
         }
         None => {
             let poses = a.poses()?;
-            let targets = poses.targets(&m)?;
-            let f = internal_factor(&model, &targets)
+            let targets = poses.targets(m)?;
+            let f = internal_factor(model, &targets)
                 .map_err(|e| Error::input(format!("--poses {poses}: {e}")))?;
             (f, targets.len())
         }
-    };
-    let (poses, source, centre) = match a.instrument {
-        Instrument::Check => return check_plan(a, &loaded),
+    })
+}
+
+/// A candidate pose and its target's extension along the tool, mm.
+type Candidate = (ExternalPose, f64);
+
+/// The candidates of an instrument, its nominal source and the centre of a
+/// ballbar's pivot or a touched sphere, mm.
+type Candidates = (Vec<Candidate>, Source, Option<Vector3<f64>>);
+
+/// The candidate poses of the instrument, its nominal source and the
+/// centre of a ballbar's pivot or a touched sphere.
+fn candidates(a: &PlanRequest, m: &Machine, model: &FusedModel) -> Result<Candidates, Error> {
+    Ok(match a.instrument {
+        Instrument::Check => {
+            return Err(Error::input("plan: a check has no candidate measurements"));
+        }
         Instrument::Tracker => {
             let target = TrackerTargetSpec::required(a.tracker_target, a.tracker_target_sigma_um)?;
             let (h1, h2) = (&a.head_angles_deg.h1_deg, &a.head_angles_deg.h2_deg);
@@ -332,7 +400,7 @@ pub fn plan(a: &PlanRequest) -> Result<Plan, Error> {
                 ));
             }
             let candidates = a.candidates()?;
-            let points = candidates.targets(&m)?;
+            let points = candidates.targets(m)?;
             let count = points.len() * h1.len() * h2.len() * a.extensions.len().max(1);
             if count > limits::MAX_CANDIDATES {
                 return Err(Error::input(format!(
@@ -342,8 +410,8 @@ pub fn plan(a: &PlanRequest) -> Result<Plan, Error> {
                     limits::MAX_CANDIDATES
                 )));
             }
-            let poses = with_extensions(&head_angle_poses(&m, &points, h1, h2), &a.extensions);
-            let data = nominal_tracker_data(&model, &poses)?;
+            let poses = with_extensions(&head_angle_poses(m, &points, h1, h2), &a.extensions);
+            let data = nominal_tracker_data(model, &poses)?;
             let options = TrackerOptions {
                 sigma_um: instrument_sigma(a, a.tracker_sigma_um, "--tracker-sigma-um")?,
                 target,
@@ -373,7 +441,7 @@ pub fn plan(a: &PlanRequest) -> Result<Plan, Error> {
                     limits::MAX_CANDIDATES
                 )));
             }
-            let poses = sphere_candidates(&m, &centre, radius, a.ballbar_candidates);
+            let poses = sphere_candidates(m, &centre, radius, a.ballbar_candidates);
             if poses.len() < 4 {
                 return Err(Error::input(format!(
                     "{flag} {text}: the machine reaches only {} positions around this point",
@@ -392,7 +460,7 @@ pub fn plan(a: &PlanRequest) -> Result<Plan, Error> {
                 };
                 Source::touch(&data, &features, &options)?
             } else {
-                let data = nominal_ballbar_data(&model, &poses, &centre)?;
+                let data = nominal_ballbar_data(model, &poses, &centre)?;
                 let options = tricept_engine::fusion::BallbarOptions {
                     sigma_um: instrument_sigma(a, a.ballbar_sigma_um, "--ballbar-sigma-um")?,
                     ..Default::default()
@@ -402,60 +470,66 @@ pub fn plan(a: &PlanRequest) -> Result<Plan, Error> {
             let poses = poses.into_iter().map(|p| (p, 0.0)).collect();
             (poses, source, Some(centre))
         }
-    };
-    let axis = a.instrument == Instrument::Tracker && {
-        let mut e = a.extensions.clone();
-        e.sort_by(f64::total_cmp);
-        e.dedup();
-        e.len() >= 2
-    };
-    let rows = candidate_rows(&model, &source)?;
-    let mut problem = PlanProblem::new(&model, &f_int, &rows, &options.eval_poses)?;
-    if axis {
-        problem = problem.with_tool_axis();
-    }
-    let result = study_plan(&problem, k, a.passes, a.random_baseline, a.seed)?;
-    let recommended = result.recommended(a.target_um, None);
-    let mut out = None;
-    if let (Some(_), Some(last)) = (&a.out, result.rows.last()) {
-        let p = vec![0.0; model.len()];
-        let records = last
-            .selection
-            .iter()
-            .map(|&c| {
-                let (pose, extension_mm) = poses[c];
-                let effector = tricept_model::Effector {
-                    extension_mm,
-                    ..Default::default()
-                };
-                let (x, _) = model.spindle_point(&p, &pose, &effector)?;
-                Ok(PlannedPose {
-                    pose,
-                    extension_mm,
-                    tip_mm: Some(x.into()),
-                    length_mm: match a.instrument {
-                        Instrument::Ballbar => centre.map(|c| (x - c).norm()),
-                        _ => None,
-                    },
-                    feature: (a.instrument == Instrument::Touch).then_some(1),
-                    line: 0,
-                })
+    })
+}
+
+/// The planned poses of the largest k, to write.
+fn planned_poses(
+    a: &PlanRequest,
+    model: &FusedModel,
+    poses: &[Candidate],
+    centre: Option<Vector3<f64>>,
+    last: &PlanRow,
+) -> Result<OutFile, Error> {
+    let p = vec![0.0; model.len()];
+    let records = last
+        .selection
+        .iter()
+        .map(|&c| {
+            let (pose, extension_mm) = poses[c];
+            let effector = tricept_model::Effector {
+                extension_mm,
+                ..Default::default()
+            };
+            let (x, _) = model.spindle_point(&p, &pose, &effector)?;
+            Ok(PlannedPose {
+                pose,
+                extension_mm,
+                tip_mm: Some(x.into()),
+                length_mm: match a.instrument {
+                    Instrument::Ballbar => centre.map(|c| (x - c).norm()),
+                    _ => None,
+                },
+                feature: (a.instrument == Instrument::Touch).then_some(1),
+                line: 0,
             })
-            .collect::<Result<Vec<_>, Error>>()?;
-        let comments = vec![format!(
-            "planned by tricept {} for a {:?}: {} measurements, RMS predicted tool-tip sd after touch-off {:.1} um, tool axis {:.1} arcsec, redundancy {:.1}",
-            env!("CARGO_PKG_VERSION"),
-            a.instrument,
-            last.k,
-            last.planned_um,
-            last.axis_arcsec,
-            last.redundancy
-        )];
-        out = Some(OutFile::Planned { records, comments });
-    }
+        })
+        .collect::<Result<Vec<_>, Error>>()?;
+    let comments = vec![format!(
+        "planned by tricept {} for a {:?}: {} measurements, RMS predicted tool-tip sd after touch-off {:.1} um, tool axis {:.1} arcsec, redundancy {:.1}",
+        env!("CARGO_PKG_VERSION"),
+        a.instrument,
+        last.k,
+        last.planned_um,
+        last.axis_arcsec,
+        last.redundancy
+    )];
+    Ok(OutFile::Planned { records, comments })
+}
+
+/// The JSON and the text report of an instrument's plan.
+fn report(
+    a: &PlanRequest,
+    result: &StudyPlan,
+    candidates: usize,
+    axis: bool,
+    eval_poses: usize,
+    internal_poses: usize,
+) -> (Value, String) {
+    let recommended = result.recommended(a.target_um, None);
     let json = json!({
         "instrument": format!("{:?}", a.instrument).to_lowercase(),
-        "candidates": poses.len(),
+        "candidates": candidates,
         "criterion": if axis {
             "RMS over the evaluation poses of the predicted tool-tip standard deviation after touch-off and of the tool axis' times 100 mm, um"
         } else {
@@ -481,9 +555,9 @@ pub fn plan(a: &PlanRequest) -> Result<Plan, Error> {
             s,
             "{:?}: {} candidates; criterion: RMS predicted tool-tip sd after touch-off{} over {} tool poses (um)",
             a.instrument,
-            poses.len(),
+            candidates,
             if axis { " and tool axis x 100 mm" } else { "" },
-            options.eval_poses.len()
+            eval_poses
         );
         wln!(
             s,
@@ -550,12 +624,7 @@ pub fn plan(a: &PlanRequest) -> Result<Plan, Error> {
             "note: a linear-Gaussian prediction of variance only; an unmodelled effect's bias is not in it (docs/hybrid.md)"
         );
     }
-    Ok(Plan {
-        json,
-        text,
-        out,
-        warnings: loaded.warnings().to_vec(),
-    })
+    (json, text)
 }
 
 /// `tricept plan --instrument check`: the fewest poses, up to `--k` (default
