@@ -478,3 +478,44 @@ pub fn exit_line(verb: &str, code: u8, why: &str) -> Option<String> {
     (code == EXIT_INADEQUATE || code == EXIT_NOT_CONVERGED)
         .then(|| format!("{verb}: exit {code}: {why} (see the warnings)"))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fixture() -> PathBuf {
+        PathBuf::from(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/data/table2-grid-seed1.csv"
+        ))
+    }
+
+    #[test]
+    fn data_in_memory_calibrate_as_the_file_does_but_write_no_machine_file() {
+        let from_file = calibrate(&CalibrateRequest::new(Data::File(fixture()))).unwrap();
+        let mut dataset = tricept_data::read_path(&fixture()).unwrap();
+        dataset.source = "numpy columns".into();
+        let mut in_memory = calibrate(&CalibrateRequest::new(Data::InMemory(dataset))).unwrap();
+        assert_eq!(from_file.exit_code(), 0, "{}", from_file.report());
+        assert_eq!(in_memory.exit_code(), from_file.exit_code());
+        assert_eq!(in_memory.estimates(), from_file.estimates());
+        assert_eq!(in_memory.to_json()["data_file"], "numpy columns");
+        let e = in_memory
+            .write_machine(
+                &std::env::temp_dir().join("tricept-never-written.json"),
+                false,
+            )
+            .unwrap_err();
+        assert_eq!(e.exit_code(), crate::EXIT_INPUT, "{e}");
+        assert!(e.message().contains("give the data as a file"), "{e}");
+    }
+
+    #[test]
+    fn a_tolerance_out_of_range_is_an_input_error_before_anything_is_read() {
+        let mut request = CalibrateRequest::new(Data::File("no-such-file.csv".into()));
+        request.tolerance_mm = 0.0;
+        let e = calibrate(&request).unwrap_err();
+        assert_eq!(e.exit_code(), crate::EXIT_INPUT);
+        assert!(e.message().starts_with("--tolerance-mm"), "{e}");
+    }
+}
