@@ -2,7 +2,8 @@
 //! the mapping from an error's kind to the exit code lives in the door
 //! (`tricept_ident::Classify`), so data too small to fit, a pose line the
 //! machine cannot take and an invalid option exit alike from `identify`
-//! (alone and fused), `identifiability`, `compensate` and `diagnose`.
+//! (alone and fused), `identifiability`, `compensate`, `diagnose` and
+//! `plan`.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -99,6 +100,7 @@ fn too_few_poses_is_an_input_error_from_every_verb() {
             "--effects",
             "leg-lead",
         ],
+        vec!["identifiability", "--data", "tiny.csv"],
         vec!["compensate", "--data", "tiny.csv"],
         vec!["diagnose", "--data", "tiny.csv"],
     ];
@@ -116,6 +118,7 @@ fn a_pose_the_machine_cannot_take_is_an_input_error_from_every_verb() {
         vec!["identifiability", "--data", "far.csv"],
         vec!["compensate", "--data", "far.csv"],
         vec!["diagnose", "--data", "far.csv"],
+        vec!["plan", "--instrument", "touch", "--data", "far.csv"],
     ];
     same_code(&dir, "unreachable pose", 2, "far.csv: line", &verbs);
     std::fs::remove_dir_all(&dir).ok();
