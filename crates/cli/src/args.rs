@@ -1,8 +1,10 @@
 //! Arguments and loaders shared by several verbs: the machine and its
 //! sensor noise, the parameter set, pose sets, measured data, true errors
 //! and effects of simulated machines, the settings of `identify` (its fit,
-//! its external measurements and head) that `compensate` and the fused
-//! path share, number lists, progress display.
+//! its external measurements and head) and the door's requests they make
+//! (`FitSettings::request`, `ExternalArgs::sources`; `compensate` shares
+//! them), progress display. Typed values are parsed by the door's
+//! `FromStr` types as clap value parsers.
 
 use std::path::{Path, PathBuf};
 
