@@ -34,6 +34,7 @@ pub const TABLE_FILES: &[&str] = &["table.csv", "leg-tables.csv"];
 
 /// Where the calibrated machine comes from.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub enum Calibrated {
     /// Calibrated here from data.
     Data(Box<CalibrateRequest>),

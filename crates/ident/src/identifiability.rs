@@ -16,6 +16,7 @@ use crate::inputs::{Poses, SensorNoise, load_machine};
 
 /// The poses to assess.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub enum Campaign {
     /// Target points of a pose set, commanded by the nominal inverse
     /// kinematics.

@@ -44,6 +44,7 @@ macro_rules! wln {
 
 /// The instrument to plan for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Instrument {
     /// A laser tracker or CMM on a target in the spindle.
     Tracker,

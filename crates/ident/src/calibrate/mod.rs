@@ -32,6 +32,7 @@ use values::{EvalGrid, HeadModel, LengthSigma, TrackerTargetSpec};
 /// Measured data of the UP limb's sensors: a file (`q1,q2,q3,phi,theta,s`,
 /// docs/data-format.md) or a dataset already in memory.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub enum Data {
     /// A measured-data CSV file.
     File(PathBuf),
