@@ -194,6 +194,20 @@ pub fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
     bar
 }
 
+/// A spinner on stderr while the door works on the data file `data`
+/// (terminal only, for files of about 50 000 poses or more).
+pub fn spinner(what: &str, data: &Path) -> indicatif::ProgressBar {
+    use indicatif::{ProgressBar, ProgressDrawTarget};
+    // About 60 bytes a pose.
+    if std::fs::metadata(data).map_or(0, |m| m.len()) < 3_000_000 {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    bar.set_message(format!("{what}: {}", data.display()));
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
+}
+
 /// Parses `table2`, `zero`, `random:MAG[,SEED]` or a JSON file of
 /// parameter values (`tricept_ident::TrueErrors`).
 pub fn parse_errors(spec: &str, set: &ParameterSet) -> Result<Vec<f64>, CliError> {

@@ -61,7 +61,13 @@ pub fn calibrate_request(a: &IdentifyArgs) -> CalibrateRequest {
 
 /// `tricept identify`.
 pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
-    let mut calibration = calibrate(&calibrate_request(a))?;
+    let spin = crate::args::spinner(
+        "identify: reading, screening and fitting (Gauss-Newton on the exact model)",
+        &a.data,
+    );
+    let calibration = calibrate(&calibrate_request(a));
+    spin.finish_and_clear();
+    let mut calibration = calibration?;
     crate::output::warn_all(calibration.machine_warnings());
     let written = a
         .write_machine
