@@ -1,15 +1,20 @@
 //! Arguments and loaders shared by several verbs: the machine and its
 //! sensor noise, the parameter set, pose sets, measured data, true errors
 //! and effects of simulated machines, the settings of `identify` (its fit,
-//! its external measurements and head) that `compensate` and the fused
-//! path share, number lists, progress display.
+//! its external measurements and head) and the door's requests they make
+//! (`FitSettings::request`, `ExternalArgs::sources`; `compensate` shares
+//! them), progress display. Typed values are parsed by the door's
+//! `FromStr` types as clap value parsers.
 
 use std::path::{Path, PathBuf};
 
 use clap::Args;
 use nalgebra::Vector3;
 use tricept_data::Dataset;
-use tricept_ident::{LoadedMachine, Poses, SensorNoise, TrueErrors};
+use tricept_ident::{
+    CalibrateRequest, Data, EffectName, EffectNames, EvalGrid, FusedSources, HeadAngles, HeadModel,
+    LengthSigma, LoadedMachine, Poses, SensorNoise, TrackerTargetSpec, Triple, TrueErrors,
+};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 
@@ -58,14 +63,19 @@ pub struct ParamArgs {
     /// Parameter set: `paper15` (the paper's 15, under its frame
     /// conventions) or `full21` (all joint and length errors; reports the
     /// rigid-body gauges as unidentifiable).
-    #[arg(long, default_value = "paper15", value_name = "SET")]
-    pub params: String,
+    #[arg(long, default_value = "paper15", value_name = "SET", value_parser = parameter_set)]
+    pub params: ParameterSet,
+}
+
+/// `--params` as a parameter set.
+fn parameter_set(label: &str) -> Result<ParameterSet, CliError> {
+    ParameterSet::by_label(label).map_err(|e| CliError::input(e.to_string()))
 }
 
 impl ParamArgs {
     /// The parameter set named by `--params`.
     pub fn set(&self) -> Result<ParameterSet, CliError> {
-        ParameterSet::by_label(&self.params).map_err(|e| CliError::input(format!("--params: {e}")))
+        Ok(self.params.clone())
     }
 }
 
@@ -184,14 +194,16 @@ pub fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
     bar
 }
 
-/// A spinner on stderr while a long step runs (terminal only).
-pub fn spinner(what: String, poses: usize) -> indicatif::ProgressBar {
+/// A spinner on stderr while the door works on the data file `data`
+/// (terminal only, for files of about 50 000 poses or more).
+pub fn spinner(what: &str, data: &Path) -> indicatif::ProgressBar {
     use indicatif::{ProgressBar, ProgressDrawTarget};
-    if poses < 50_000 {
+    // About 60 bytes a pose.
+    if std::fs::metadata(data).map_or(0, |m| m.len()) < 3_000_000 {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
-    bar.set_message(what);
+    bar.set_message(format!("{what}: {}", data.display()));
     bar.enable_steady_tick(std::time::Duration::from_millis(200));
     bar
 }
@@ -213,6 +225,20 @@ pub struct FitSettings {
     pub noise: NoiseArgs,
     #[command(flatten)]
     pub machine: MachineArgs,
+}
+
+impl FitSettings {
+    /// The door's calibration request of these settings for `data`
+    /// (internal; the caller adds external sources).
+    pub fn request(&self, data: &Path) -> CalibrateRequest {
+        let mut request = CalibrateRequest::new(Data::File(data.to_path_buf()));
+        request.machine = self.machine.machine.clone();
+        request.noise = self.noise.overrides();
+        request.parameter_set = self.params.params.clone();
+        request.robust = !self.fit.no_robust;
+        request.tolerance_mm = self.fit.tolerance_mm;
+        request
+    }
 }
 
 /// `tricept identify`.
@@ -252,7 +278,7 @@ pub struct ExternalArgs {
     /// from the tip, mm, spindle frame at zero head angles) or `free`
     /// (unknown: the tool tip is then not calibrated).
     #[arg(long, value_name = "tip|X,Y,Z|free", allow_hyphen_values = true)]
-    pub tracker_target: Option<String>,
+    pub tracker_target: Option<TrackerTargetSpec>,
     /// Standard deviation of a known target offset, um.
     #[arg(long, default_value_t = 5.0, value_name = "UM")]
     pub tracker_target_sigma_um: f64,
@@ -265,11 +291,11 @@ pub struct ExternalArgs {
     /// Standard deviation of the bar's length (its certificate), um, or
     /// `free` (the machine's scale then stays invisible to the ballbar).
     #[arg(long, default_value = "1", value_name = "UM|free")]
-    pub ballbar_length_sigma_um: String,
+    pub ballbar_length_sigma_um: Option<LengthSigma>,
     /// Offset of the spindle ball from the tool tip, mm (spindle frame at
     /// zero head angles).
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    pub ballbar_ball_mm: Option<String>,
+    pub ballbar_ball_mm: Option<Triple>,
     /// Touch-offs (CSV `q1,q2,q3,h1,h2,feature`); repeatable; needs --features.
     #[arg(long, value_name = "FILE.csv")]
     pub touch: Vec<PathBuf>,
@@ -282,19 +308,19 @@ pub struct ExternalArgs {
     /// The head's parameters: `head13` (default with external data) or
     /// `none` (the head held nominal).
     #[arg(long, value_name = "head13|none")]
-    pub head: Option<String>,
+    pub head: Option<HeadModel>,
     /// Effects to fit with the geometry (names from `tricept diagnose`):
     /// any of the registry's fusable effects, comma-separated (the help
     /// lists them).
     #[arg(long, value_name = "NAMES", value_delimiter = ',', help = effects_help())]
-    pub effects: Vec<String>,
+    pub effects: Vec<EffectNames>,
     /// Evaluation grid of the predicted tool tip: platform points of
     /// `polar_grid(RINGS, PER_RING, LEVELS)`.
     #[arg(long, default_value = "2,8,3", value_name = "RINGS,PER_RING,LEVELS")]
-    pub eval_grid: String,
+    pub eval_grid: Option<EvalGrid>,
     /// Head angles of the evaluation grid, deg: `H1,H1,...:H2,H2,...`.
     #[arg(long, default_value = "0,90,180,270:15,35", value_name = "H1S:H2S")]
-    pub eval_head_angles_deg: String,
+    pub eval_head_angles_deg: Option<HeadAngles>,
     /// Override plausible ranges of the head, tool and instrument
     /// estimates: a JSON object `{"tool_length_mm": [-5, 5]}` (keys and
     /// defaults in docs/hybrid.md).
@@ -326,10 +352,38 @@ impl ExternalArgs {
             || self.head.is_some()
             || !self.effects.is_empty()
     }
+
+    /// The door's fused sources of these flags.
+    pub fn sources(&self) -> FusedSources {
+        let mut x = FusedSources::default();
+        x.tracker = self.tracker.clone();
+        x.tracker_sigma_um = self.tracker_sigma_um;
+        x.tracker_target = self.tracker_target;
+        x.tracker_target_sigma_um = self.tracker_target_sigma_um;
+        x.ballbar = self.ballbar.clone();
+        x.ballbar_sigma_um = self.ballbar_sigma_um;
+        if let Some(l) = self.ballbar_length_sigma_um {
+            x.ballbar_length_sigma = l;
+        }
+        x.ballbar_ball_mm = self.ballbar_ball_mm;
+        x.touch = self.touch.clone();
+        x.features = self.features.clone();
+        x.touch_sigma_um = self.touch_sigma_um;
+        x.head = self.head.unwrap_or_default();
+        x.effects = effect_names(&self.effects);
+        if let Some(g) = self.eval_grid {
+            x.eval_grid = g;
+        }
+        if let Some(h) = &self.eval_head_angles_deg {
+            x.eval_head_angles = h.clone();
+        }
+        x.plausibility = self.plausibility.clone();
+        x.tool_axis_warn_arcsec = self.tool_axis_warn_arcsec;
+        x
+    }
 }
 
-/// `H1S:H2S` lists of degrees.
-pub fn parse_head_angles(flag: &str, text: &str) -> Result<(Vec<f64>, Vec<f64>), CliError> {
-    let h = tricept_ident::parse_head_angles(flag, text)?;
-    Ok((h.h1_deg, h.h2_deg))
+/// The effect names of `--effects` values.
+pub fn effect_names(lists: &[EffectNames]) -> Vec<EffectName> {
+    lists.iter().flat_map(|l| l.0.iter().copied()).collect()
 }

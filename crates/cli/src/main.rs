@@ -30,7 +30,6 @@ mod docs_cmd;
 mod effects_cmd;
 mod export_cmd;
 mod files;
-mod fusion_cmd;
 mod ident_cmd;
 mod kinematics_cmd;
 mod output;
@@ -197,7 +196,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         Command::Docs(_) | Command::Effects(_) => {}
         Command::Identifiability(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses);
+            r.input_if_file("--poses", &a.poses.to_string());
             r.inputs("--data", &a.data);
         }
         Command::Identify(a) => {
@@ -215,7 +214,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         }
         Command::Simulate(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses);
+            r.input_if_file("--poses", &a.poses.to_string());
             if let Some(t) = &a.truth.truth {
                 r.input_if_file("--truth", t);
             }
@@ -248,7 +247,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         }
         Command::Detectability(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses);
+            r.input_if_file("--poses", &a.poses.to_string());
             r.inputs("--data", &a.data);
         }
         Command::Compensate(a) => {
@@ -281,8 +280,8 @@ fn file_roles(command: &Command) -> files::FileRoles {
         Command::Plan(a) => {
             machine(&mut r, &a.machine);
             r.inputs("--data", &a.data);
-            r.input_if_file("--poses", &a.poses);
-            r.input_if_file("--candidates", &a.candidates);
+            r.input_if_file("--poses", &a.poses.to_string());
+            r.input_if_file("--candidates", &a.candidates.to_string());
             if let Some(p) = &a.out {
                 r.output("--out", p);
             }
@@ -314,10 +313,38 @@ fn run(cli: Cli) -> Result<u8, CliError> {
     }
 }
 
+/// The one-line message of a flag value refused by one of the door's
+/// parsers (`tricept_ident::Triple`, `TrackerTargetSpec`, ...): the flag,
+/// then the door's message (unless it names the flag already). `None` for
+/// every other clap error, which clap prints itself.
+fn value_error(e: &clap::Error) -> Option<String> {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    use std::error::Error as _;
+    if e.kind() != ErrorKind::ValueValidation {
+        return None;
+    }
+    let ours = e.source()?.downcast_ref::<CliError>()?;
+    let flag = match e.get(ContextKind::InvalidArg) {
+        Some(ContextValue::String(arg)) => arg.split_whitespace().next().unwrap_or_default(),
+        _ => "",
+    };
+    Some(if flag.is_empty() || ours.message().starts_with(flag) {
+        ours.message().to_string()
+    } else {
+        format!("{flag}: {ours}")
+    })
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
+            // A flag value the door's parser refused: one line naming the
+            // flag, exit 2, as every input error.
+            if let Some(line) = value_error(&e) {
+                errln!("error: {line}");
+                return ExitCode::from(tricept_ident::EXIT_INPUT);
+            }
             // clap prints help/version to stdout (exit 0) and usage errors
             // to stderr (exit 2).
             let _ = e.print();

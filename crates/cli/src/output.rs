@@ -81,6 +81,13 @@ pub fn write_err_line(args: std::fmt::Arguments<'_>) {
     let _ = err.write_fmt(args).and_then(|_| err.write_all(b"\n"));
 }
 
+/// Each of `warnings` on stderr as `warning: ...`.
+pub fn warn_all(warnings: &[String]) {
+    for w in warnings {
+        errln!("warning: {w}");
+    }
+}
+
 /// Stdout as a [`Write`] for bulk output (CSV): a failed write marks stdout
 /// closed (keeping an error that is not a closed pipe for [`finish`]) and
 /// reports success, so that a writer stops caring; a loop producing the

@@ -521,8 +521,9 @@ pub struct Triple(pub [f64; 3]);
 impl FromStr for Triple {
     type Err = Error;
 
+    /// Its message names no flag: the caller's parser does.
     fn from_str(text: &str) -> Result<Triple, Error> {
-        let v = parse_numbers("X,Y,Z", text, 3)?;
+        let v = parse_numbers("X,Y,Z", text, 3).map_err(|e| without_flag(e, "X,Y,Z"))?;
         Ok(Triple([v[0], v[1], v[2]]))
     }
 }
@@ -546,8 +547,21 @@ pub struct HeadAngles {
 impl FromStr for HeadAngles {
     type Err = Error;
 
+    /// Its message names no flag: the caller's parser does.
     fn from_str(text: &str) -> Result<HeadAngles, Error> {
-        parse_head_angles("H1S:H2S", text)
+        parse_head_angles("H1S:H2S", text).map_err(|e| without_flag(e, "H1S:H2S"))
+    }
+}
+
+/// `e` without the `flag: ` its message starts with.
+fn without_flag(e: Error, flag: &str) -> Error {
+    match e
+        .message()
+        .strip_prefix(flag)
+        .and_then(|m| m.strip_prefix(": "))
+    {
+        Some(m) => Error::new(e.kind(), m),
+        None => e,
     }
 }
 
