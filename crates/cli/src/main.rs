@@ -207,14 +207,14 @@ fn file_roles(command: &Command) -> files::FileRoles {
         }
         Command::Simulate(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses);
+            r.input_if_file("--poses", &a.poses.to_string());
             if let Some(t) = &a.truth.truth {
                 r.input_if_file("--truth", t);
             }
             for e in &a.truth.truth_effects {
                 r.input_if_file("--truth-effect", e);
             }
-            r.input_if_file("--head-errors", &a.head_errors);
+            r.input_if_file("--head-errors", &a.head_errors.to_string());
             r.inputs("--tracker-poses", &a.tracker_poses);
             r.inputs("--ballbar-poses", &a.ballbar_poses);
             r.inputs("--touch-poses", &a.touch_poses);
@@ -240,7 +240,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         }
         Command::Detectability(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses);
+            r.input_if_file("--poses", &a.poses.to_string());
             r.inputs("--data", &a.data);
         }
         Command::Compensate(a) => {
@@ -306,6 +306,15 @@ fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
+            // A typed value refused by its parser (the door's `FromStr`):
+            // one line, the door's message (exit 2).
+            if e.kind() == clap::error::ErrorKind::ValueValidation
+                && let Some(door) = std::error::Error::source(&e)
+                    .and_then(|s| s.downcast_ref::<tricept_ident::Error>())
+            {
+                errln!("error: {door}");
+                return ExitCode::from(cli_error::EXIT_INPUT);
+            }
             // clap prints help/version to stdout (exit 0) and usage errors
             // to stderr (exit 2).
             let _ = e.print();

@@ -344,6 +344,18 @@ impl fmt::Display for Poses {
 }
 
 impl Poses {
+    /// The paper's grid of 75 poses (`grid`).
+    pub fn grid() -> Poses {
+        Poses {
+            spec: "grid".to_string(),
+            kind: PosesKind::Set(PoseSet::Grid {
+                rings: 3,
+                per_ring: 8,
+                levels: 3,
+            }),
+        }
+    }
+
     /// The target points on `machine`, mm.
     pub fn targets(&self, machine: &Machine) -> Result<Vec<Vector3<f64>>, Error> {
         match &self.kind {

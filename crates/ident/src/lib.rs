@@ -25,6 +25,16 @@ mod inputs;
 pub mod limits;
 pub mod machine_file;
 
+// Workflows of the diagnosis, the check, the simulator and the kinematics
+// (issue 27, helper B).
+mod check;
+mod data_input;
+mod detectability;
+mod diagnosis;
+mod effects;
+pub mod kinematics;
+mod simulate;
+
 pub use error::{
     Classify, EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error,
     ErrorKind,
@@ -34,6 +44,21 @@ pub use inputs::{
     description_error, load_machine, parse_effects, parse_head_angles, parse_numbers, positive,
     read_data, read_data_from,
 };
+
+pub use check::{CheckRequest, CheckResult, check};
+pub use data_input::DataInput;
+pub use detectability::{DetectabilityReport, DetectabilityRequest, detectability};
+pub use diagnosis::{Deployed, DiagnoseRequest, DiagnoseResult, diagnose, vocabulary_help};
+pub use effects::{EffectList, effects};
+pub use simulate::{
+    BallbarSimulation, HeadErrors, SimulateRequest, Simulation, TouchSimulation, TrackerSimulation,
+    simulate,
+};
+pub use tricept_check::history::Trend;
+pub use tricept_check::{CheckReport, DEFAULT_ALPHA as DEFAULT_CHECK_ALPHA};
+pub use tricept_diagnose::detect::Detectability;
+pub use tricept_diagnose::{Diagnosis, ResidualPlot};
+pub use tricept_plant::Effect;
 
 // Transitional: the engine's API as it was when it was `tricept-ident`,
 // curated by issue 27 ("One door") into the workflows above.
