@@ -283,4 +283,40 @@ mod tests {
             assert!(e.message().starts_with(missing), "{}", e.message());
         }
     }
+
+    #[test]
+    fn a_check_against_its_own_calibration_is_unchanged_and_kept_in_the_history() {
+        let data = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/data/table2-grid-seed1.csv"
+        );
+        let dir = std::env::temp_dir().join(format!("tricept-door-check-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let machine = dir.join("calibrated.json");
+        let history = dir.join("checks.jsonl");
+        std::fs::remove_file(&history).ok();
+        let d = crate::diagnose(DiagnoseRequest::new(paper(), data)).unwrap();
+        d.write_machine(&machine, false).unwrap();
+        for n in 1..=2 {
+            let loaded = load_machine(Some(&machine), &SensorNoise::default()).unwrap();
+            let mut r = CheckRequest::new(loaded, data);
+            r.history = Some(history.clone());
+            let result = check(r).unwrap();
+            assert!(!result.changed());
+            assert_eq!(result.exit_code(), EXIT_OK);
+            assert!(result.exit_reason().is_none());
+            let v: Value = serde_json::from_str(&result.to_json()).unwrap();
+            assert_eq!(v["history"]["checks"], n);
+            assert_eq!(v["data_file"], data);
+            assert!(!result.trends().is_empty());
+            assert!(result.to_text().contains(&format!("({n} checks):")));
+        }
+        let mut r = CheckRequest::new(
+            load_machine(Some(&machine), &SensorNoise::default()).unwrap(),
+            data,
+        );
+        r.alpha = 0.7;
+        assert!(check(r).unwrap_err().message().starts_with("--alpha"));
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }

@@ -369,3 +369,46 @@ pub fn vocabulary_help() -> String {
         .collect();
     format!("Effects of the vocabulary:\n{}", lines.join("\n"))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{EXIT_INPUT, SensorNoise, load_machine};
+
+    const DATA: &str = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/data/table2-grid-seed1.csv"
+    );
+
+    #[test]
+    fn data_in_memory_diagnose_as_their_file_and_only_a_file_is_recorded() {
+        let m = load_machine(None, &SensorNoise::default()).unwrap();
+        let from_file = diagnose(DiagnoseRequest::new(m.clone(), DATA)).unwrap();
+        let data = tricept_data::read_path(Path::new(DATA)).unwrap();
+        let from_memory = diagnose(DiagnoseRequest::new(m, data)).unwrap();
+        assert_eq!(from_file.to_json(), from_memory.to_json());
+        assert_eq!(from_file.exit_code(), EXIT_OK);
+        assert!(from_file.exit_reason().is_none());
+        let out =
+            std::env::temp_dir().join(format!("tricept-door-diagnose-{}.json", std::process::id()));
+        let e = from_memory.write_machine(&out, false).unwrap_err();
+        assert_eq!(e.exit_code(), EXIT_INPUT);
+        assert!(!out.exists());
+        assert_eq!(from_file.write_machine(&out, false).unwrap(), None);
+        let written = load_machine(Some(&out), &SensorNoise::default()).unwrap();
+        let record = written.description().calibration.as_ref().unwrap();
+        assert_eq!(record.method, "diagnose");
+        assert!(record.adequate && !record.forced);
+        std::fs::remove_file(&out).ok();
+    }
+
+    #[test]
+    fn a_bad_temperature_noise_is_an_input_error() {
+        let m = load_machine(None, &SensorNoise::default()).unwrap();
+        let mut r = DiagnoseRequest::new(m, DATA);
+        r.temperature_noise_k = Some(-1.0);
+        let e = diagnose(r).unwrap_err();
+        assert_eq!(e.exit_code(), EXIT_INPUT);
+        assert!(e.message().starts_with("--temperature-noise"));
+    }
+}
