@@ -52,7 +52,7 @@ pub use diagnosis::{Deployed, DiagnoseRequest, DiagnoseResult, diagnose, vocabul
 pub use effects::{EffectList, effects};
 pub use simulate::{
     BallbarSimulation, HeadErrors, SimulateRequest, Simulation, TouchSimulation, TrackerSimulation,
-    simulate,
+    TruthEffects, simulate,
 };
 pub use tricept_check::history::Trend;
 pub use tricept_check::{CheckReport, DEFAULT_ALPHA as DEFAULT_CHECK_ALPHA};

@@ -114,6 +114,47 @@ impl HeadErrors {
     }
 }
 
+/// One `--truth-effect` value: a JSON object or an array of them, inline
+/// or from `@FILE`, each effect validated ([`crate::parse_effects`]); a
+/// typed flag value.
+///
+/// # Example
+/// ```
+/// let t: tricept_ident::TruthEffects = r#"{"effect":"leg-lead","ppm":[50,-30,40]}"#.parse().unwrap();
+/// assert_eq!(t.effects().len(), 1);
+/// assert!(t.to_string().starts_with("{"));
+/// assert!(r#"{"effect":"nothing"}"#.parse::<tricept_ident::TruthEffects>().is_err());
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct TruthEffects {
+    spec: String,
+    effects: Vec<Effect>,
+}
+
+impl FromStr for TruthEffects {
+    type Err = Error;
+
+    fn from_str(spec: &str) -> Result<TruthEffects, Error> {
+        Ok(TruthEffects {
+            spec: spec.to_string(),
+            effects: crate::parse_effects(&[spec.to_string()])?,
+        })
+    }
+}
+
+impl fmt::Display for TruthEffects {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.spec)
+    }
+}
+
+impl TruthEffects {
+    /// The effects, validated.
+    pub fn effects(&self) -> &[Effect] {
+        &self.effects
+    }
+}
+
 /// A laser tracker measuring the simulated machine at planned poses.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrackerSimulation {
