@@ -25,7 +25,7 @@ use tricept_plant::{
 };
 
 use crate::error::{EXIT_OK, Error};
-use crate::inputs::{LoadedMachine, Poses, TrueErrors, positive};
+use crate::inputs::{LoadedMachine, Poses, TrueErrors, positive, random_spec};
 
 /// Head errors of a simulated machine (`--head-errors`): `zero`,
 /// `random:SCALE[,SEED]` (each of the 13 parameters SCALE times its
@@ -60,22 +60,12 @@ impl FromStr for HeadErrors {
         Ok(match s {
             "zero" => HeadErrors::Zero,
             s if s.starts_with("random:") => {
-                let parts: Vec<&str> = s["random:".len()..].split(',').collect();
-                let scale: f64 = parts[0]
-                    .parse()
-                    .ok()
-                    .filter(|v: &f64| v.is_finite() && (0.0..=100.0).contains(v))
-                    .ok_or_else(|| {
-                        Error::input(format!(
-                            "{flag} `{s}`: expected random:SCALE[,SEED] with SCALE (times the typical sizes) from 0 to 100"
-                        ))
-                    })?;
-                let seed: u64 = match parts.get(1) {
-                    Some(t) => t.parse().map_err(|_| {
-                        Error::input(format!("{flag} `{s}`: SEED must be a whole number"))
-                    })?,
-                    None => 0,
-                };
+                let (scale, seed) = random_spec(
+                    flag,
+                    s,
+                    100.0,
+                    "random:SCALE[,SEED] with SCALE (times the typical sizes) from 0 to 100",
+                )?;
                 HeadErrors::Random { scale, seed }
             }
             path => HeadErrors::File(PathBuf::from(path)),
