@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use tricept_ident::{
-    DetectabilityRequest, DiagnoseRequest, DiagnoseResult, Poses, ResidualPlot, detectability,
-    diagnose,
+    DataInput, DetectabilityRequest, DiagnoseRequest, DiagnoseResult, LoadedMachine, Poses,
+    ResidualPlot, detectability, diagnose,
 };
 
-use crate::args::{MachineArgs, NoiseArgs, load_with_noise};
+use crate::args::{MachineArgs, NoiseArgs, load_with_noise, read_data};
 use crate::cli_error::CliError;
 
 pub use tricept_ident::vocabulary_help;
@@ -91,8 +91,9 @@ pub struct DetectabilityArgs {
 
 /// `tricept diagnose`.
 pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
-    let mut request =
-        DiagnoseRequest::new(load_with_noise(&a.machine, &a.noise)?, a.data.as_path());
+    let loaded = load_with_noise(&a.machine, &a.noise)?;
+    let data = read_with_progress(&a.data, &loaded)?;
+    let mut request = DiagnoseRequest::new(loaded, data);
     request.noise_from_data = a.noise_from_data;
     request.temperature_noise_k = a.temperature_noise;
     request.plausibility = a.plausibility.clone();
@@ -117,6 +118,14 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
         errln!("{why}");
     }
     Ok(result.exit_code())
+}
+
+/// The data file read with a progress bar (large files on a terminal).
+fn read_with_progress(path: &Path, loaded: &LoadedMachine) -> Result<DataInput, CliError> {
+    Ok(DataInput::Read {
+        file: path.to_path_buf(),
+        data: read_data(path, loaded.machine())?,
+    })
 }
 
 /// Writes the extended machine, naming the file (and a forced write's
@@ -157,7 +166,10 @@ fn plot_residuals(dir: &Path, plots: &[ResidualPlot]) -> Result<(), CliError> {
 pub fn run_detectability(a: &DetectabilityArgs) -> Result<u8, CliError> {
     let mut request =
         DetectabilityRequest::new(load_with_noise(&a.machine, &a.noise)?, a.poses.clone());
-    request.data = a.data.as_deref().map(Into::into);
+    request.data = match &a.data {
+        Some(path) => Some(read_with_progress(path, &request.machine)?),
+        None => None,
+    };
     request.both_directions = a.both_directions;
     request.temperature_drift_k = a.temperature_drift;
     let report = detectability(request)?;

@@ -12,7 +12,8 @@ use tricept_kinematics::Machine;
 use crate::error::Error;
 use crate::inputs::{check_commands, read_data};
 
-/// Measured data: a file to read or a data set in memory.
+/// Measured data: a file to read, a file already read, or a data set in
+/// memory.
 ///
 /// # Example
 /// ```
@@ -27,6 +28,15 @@ pub enum DataInput {
     File(PathBuf),
     /// Data already in memory; its `source` names it in messages.
     Memory(Dataset),
+    /// A measured-data file the caller has read already (with a progress
+    /// display, say): the data are used, the file names them and is what
+    /// a calibration record hashes.
+    Read {
+        /// The file the data were read from.
+        file: PathBuf,
+        /// Its data.
+        data: Dataset,
+    },
 }
 
 impl From<&str> for DataInput {
@@ -58,7 +68,7 @@ impl DataInput {
     /// set's source.
     pub fn name(&self) -> String {
         match self {
-            DataInput::File(p) => p.display().to_string(),
+            DataInput::File(p) | DataInput::Read { file: p, .. } => p.display().to_string(),
             DataInput::Memory(d) => d.source.clone(),
         }
     }
@@ -66,7 +76,7 @@ impl DataInput {
     /// The file, when the data come from one.
     pub fn path(&self) -> Option<&Path> {
         match self {
-            DataInput::File(p) => Some(p),
+            DataInput::File(p) | DataInput::Read { file: p, .. } => Some(p),
             DataInput::Memory(_) => None,
         }
     }
@@ -77,7 +87,7 @@ impl DataInput {
     pub fn load(&self, machine: &Machine) -> Result<Dataset, Error> {
         match self {
             DataInput::File(p) => read_data(p, machine),
-            DataInput::Memory(d) => {
+            DataInput::Memory(d) | DataInput::Read { data: d, .. } => {
                 check_commands(
                     &d.source,
                     d.poses.iter().map(|p| (p.line, p.commands_mm)),
@@ -109,7 +119,7 @@ mod tests {
         let ok = DataInput::from(data.clone()).load(&m).unwrap();
         assert_eq!(ok, data);
         data.poses[0].commands_mm[1] = 5000.0;
-        let input = DataInput::from(data);
+        let input = DataInput::from(data.clone());
         assert_eq!(input.name(), "numpy");
         assert!(input.path().is_none());
         let e = input.load(&m).unwrap_err();
@@ -119,6 +129,14 @@ mod tests {
             "{}",
             e.message()
         );
+        let read = DataInput::Read {
+            file: PathBuf::from("read.csv"),
+            data,
+        };
+        assert_eq!(read.name(), "read.csv");
+        assert_eq!(read.path(), Some(Path::new("read.csv")));
+        let e = read.load(&m).unwrap_err();
+        assert!(e.message().starts_with("numpy: line 7"), "{}", e.message());
         let missing = DataInput::from("no-such-dir/data.csv")
             .load(&m)
             .unwrap_err();
