@@ -9,11 +9,10 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use nalgebra::Vector3;
 use tricept_data::Dataset;
 use tricept_ident::{
     CalibrateRequest, Data, EffectName, EffectNames, EvalGrid, FusedSources, HeadAngles, HeadModel,
-    LengthSigma, LoadedMachine, Poses, SensorNoise, TrackerTargetSpec, Triple, TrueErrors,
+    LengthSigma, LoadedMachine, SensorNoise, TrackerTargetSpec, Triple,
 };
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
@@ -146,11 +145,6 @@ pub fn load(args: &MachineArgs) -> Result<LoadedMachine, CliError> {
     load_with_noise(args, &NoiseArgs::default())
 }
 
-/// Loads the machine and applies the noise overrides.
-pub fn machine_with_noise(args: &MachineArgs, noise: &NoiseArgs) -> Result<Machine, CliError> {
-    Ok(load_with_noise(args, noise)?.machine().clone())
-}
-
 /// [`load`] with the noise overrides applied to the machine.
 pub fn load_with_noise(args: &MachineArgs, noise: &NoiseArgs) -> Result<LoadedMachine, CliError> {
     let loaded = tricept_ident::load_machine(args.machine.as_deref(), &noise.overrides())?;
@@ -171,11 +165,6 @@ pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, CliError> {
         tricept_ident::read_data_from(bar.wrap_read(std::io::BufReader::new(f)), &file, machine)?;
     bar.finish_and_clear();
     Ok(data)
-}
-
-/// The target points of a `--poses` spec (`tricept_ident::Poses`).
-pub fn pose_targets(spec: &str, machine: &Machine) -> Result<Vec<Vector3<f64>>, CliError> {
-    spec.parse::<Poses>()?.targets(machine)
 }
 
 /// A progress bar on stderr; invisible when stderr is not a terminal or for
@@ -206,12 +195,6 @@ pub fn spinner(what: &str, data: &Path) -> indicatif::ProgressBar {
     bar.set_message(format!("{what}: {}", data.display()));
     bar.enable_steady_tick(std::time::Duration::from_millis(200));
     bar
-}
-
-/// Parses `table2`, `zero`, `random:MAG[,SEED]` or a JSON file of
-/// parameter values (`tricept_ident::TrueErrors`).
-pub fn parse_errors(spec: &str, set: &ParameterSet) -> Result<Vec<f64>, CliError> {
-    spec.parse::<TrueErrors>()?.values(set)
 }
 
 /// The fit settings of `identify` and `compensate`.

@@ -1,4 +1,4 @@
 //! The CLI's error is the door's: a one-line message whose kind decides
 //! the exit code, one mapping for every verb (`tricept_ident::Error`).
 
-pub use tricept_ident::{EXIT_INADEQUATE, EXIT_OTHER, Error as CliError};
+pub use tricept_ident::{EXIT_OTHER, Error as CliError};

@@ -48,31 +48,6 @@ pub fn plotted(path: &Path, result: Result<(), tricept_plot::PlotError>) -> Resu
     Ok(())
 }
 
-/// Writes a machine description to `path` atomically, its calibration
-/// record sealed (`tricept_ident::machine_file::write`).
-pub fn write_machine(
-    path: &Path,
-    d: &tricept_kinematics::MachineDescription,
-) -> Result<(), CliError> {
-    written(path, tricept_ident::machine_file::write(path, d))
-}
-
-/// The one rule for writing a calibration
-/// (`tricept_ident::machine_file::write_rule`), with the warning of a
-/// forced write on stderr.
-pub fn write_rule(
-    what: &str,
-    code: u8,
-    why: &str,
-    force: bool,
-) -> Result<Option<String>, CliError> {
-    let forced = tricept_ident::machine_file::write_rule(what, code, why, force)?;
-    if forced.is_some() {
-        errln!("warning: {what}: written with --force although {why}");
-    }
-    Ok(forced)
-}
-
 /// Writes `text` to `path` atomically (see [`write_with`]).
 pub fn write_text(path: &Path, text: &str) -> Result<(), CliError> {
     write_with(path, |w| w.write_all(text.as_bytes()))

@@ -221,7 +221,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
             for e in &a.truth.truth_effects {
                 r.input_if_file("--truth-effect", e);
             }
-            r.input_if_file("--head-errors", &a.head_errors);
+            r.input_if_file("--head-errors", &a.head_errors.to_string());
             r.inputs("--tracker-poses", &a.tracker_poses);
             r.inputs("--ballbar-poses", &a.ballbar_poses);
             r.inputs("--touch-poses", &a.touch_poses);

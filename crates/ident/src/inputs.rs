@@ -344,6 +344,18 @@ impl fmt::Display for Poses {
 }
 
 impl Poses {
+    /// The paper's grid of 75 poses (`grid`).
+    pub fn grid() -> Poses {
+        Poses {
+            spec: "grid".to_string(),
+            kind: PosesKind::Set(PoseSet::Grid {
+                rings: 3,
+                per_ring: 8,
+                levels: 3,
+            }),
+        }
+    }
+
     /// The target points on `machine`, mm.
     pub fn targets(&self, machine: &Machine) -> Result<Vec<Vector3<f64>>, Error> {
         match &self.kind {
@@ -397,28 +409,43 @@ impl FromStr for TrueErrors {
             "table2" => TrueErrors::Table2,
             "zero" => TrueErrors::Zero,
             s if s.starts_with("random:") => {
-                let parts: Vec<&str> = s["random:".len()..].split(',').collect();
                 let max = tricept_model::MAX_PARAMETER_ERROR.0;
-                let magnitude_mm: f64 = parts[0]
-                    .parse()
-                    .ok()
-                    .filter(|v: &f64| v.is_finite() && (0.0..=max).contains(v))
-                    .ok_or_else(|| {
-                        Error::input(format!(
-                            "errors `{s}`: expected random:MAG_MM[,SEED] with MAG_MM from 0 to {max} mm"
-                        ))
-                    })?;
-                let seed: u64 = match parts.get(1) {
-                    Some(t) => t.parse().map_err(|_| {
-                        Error::input(format!("errors `{s}`: SEED must be a whole number"))
-                    })?,
-                    None => 0,
-                };
+                let (magnitude_mm, seed) = random_spec(
+                    "errors",
+                    s,
+                    max,
+                    &format!("random:MAG_MM[,SEED] with MAG_MM from 0 to {max} mm"),
+                )?;
                 TrueErrors::Random { magnitude_mm, seed }
             }
             path => TrueErrors::File(PathBuf::from(path)),
         })
     }
+}
+
+/// The size (from 0 to `max`) and seed (default 0) of a
+/// `random:SIZE[,SEED]` spec, or an input error naming `flag` and saying
+/// what was `expected`.
+pub(crate) fn random_spec(
+    flag: &str,
+    spec: &str,
+    max: f64,
+    expected: &str,
+) -> Result<(f64, u64), Error> {
+    let rest = spec.strip_prefix("random:").unwrap_or(spec);
+    let mut parts = rest.split(',');
+    let size: f64 = parts
+        .next()
+        .and_then(|t| t.parse().ok())
+        .filter(|v: &f64| v.is_finite() && (0.0..=max).contains(v))
+        .ok_or_else(|| Error::input(format!("{flag} `{spec}`: expected {expected}")))?;
+    let seed: u64 = match parts.next() {
+        Some(t) => t
+            .parse()
+            .map_err(|_| Error::input(format!("{flag} `{spec}`: SEED must be a whole number")))?,
+        None => 0,
+    };
+    Ok((size, seed))
 }
 
 impl TrueErrors {

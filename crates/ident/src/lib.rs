@@ -36,6 +36,16 @@ mod compensate;
 mod identifiability;
 mod plan;
 
+// Workflows of the diagnosis, the check, the simulator and the kinematics
+// (issue 27, helper B).
+mod check;
+mod data_input;
+mod detectability;
+mod diagnosis;
+mod effects;
+pub mod kinematics;
+mod simulate;
+
 pub use error::{
     Classify, EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error,
     ErrorKind,
@@ -53,14 +63,28 @@ pub use calibrate::{
     CalibrateRequest, Calibration, Data, FusedSources, Written, calibrate, exit_line,
 };
 
+pub use check::{CheckRequest, CheckResult, check};
 pub use compensate::{
     Calibrated, CompensateRequest, Compensation, CorrectedTarget, MAP_FILES, TABLE_ERROR_LIMIT_UM,
     TABLE_FILES, compensate,
 };
+pub use data_input::DataInput;
+pub use detectability::{DetectabilityReport, DetectabilityRequest, detectability};
+pub use diagnosis::{Deployed, DiagnoseRequest, DiagnoseResult, diagnose, vocabulary_help};
+pub use effects::{EffectList, effects};
 pub use identifiability::{
     Campaign, Identifiability, IdentifiabilityRequest, assess_identifiability,
 };
 pub use plan::{Instrument, Plan, PlanRequest, plan};
+pub use simulate::{
+    BallbarSimulation, HeadErrors, SimulateRequest, Simulation, TouchSimulation, TrackerSimulation,
+    TruthEffects, simulate,
+};
+pub use tricept_check::history::Trend;
+pub use tricept_check::{CheckReport, DEFAULT_ALPHA as DEFAULT_CHECK_ALPHA};
+pub use tricept_diagnose::detect::Detectability;
+pub use tricept_diagnose::{Diagnosis, ResidualPlot};
+pub use tricept_plant::Effect;
 
 // Transitional: the engine's API as it was when it was `tricept-ident`,
 // curated by issue 27 ("One door") into the workflows above. Not `Start`

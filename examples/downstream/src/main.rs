@@ -3,7 +3,11 @@
 //! measured-data CSV (`tricept_ident::calibrate`, what `tricept identify`
 //! runs), refuses to go on unless the verdict says the calibration can be
 //! trusted, writes the calibrated machine file by the one write rule, and
-//! prints the calibrated leg commands for a few targets.
+//! prints the calibrated leg commands for a few targets; then it diagnoses
+//! the same data, deploys the final model and writes it as a calibrated
+//! machine file (what `tricept diagnose --write-machine` runs), and checks
+//! the data against the calibration (what `tricept check` runs: has the
+//! machine changed since?).
 //!
 //! ```sh
 //! cargo run -p tricept-example-downstream -- fixtures/data/table2-grid-seed1.csv [calibrated.json]
@@ -13,7 +17,10 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use tricept_ident::nalgebra::Vector3;
-use tricept_ident::{CalibrateRequest, Calibration, Data, Error, ExtendedMachine, calibrate};
+use tricept_ident::{
+    CalibrateRequest, Calibration, CheckRequest, Data, DiagnoseRequest, EXIT_OK, Error,
+    ExtendedMachine, SensorNoise, calibrate, check, diagnose, load_machine,
+};
 
 fn main() -> ExitCode {
     let mut args = std::env::args().skip(1);
@@ -30,19 +37,23 @@ fn main() -> ExitCode {
         || std::env::temp_dir().join("tricept-downstream-calibrated.json"),
         PathBuf::from,
     );
-    match run(&data, &out) {
+    let deployed = out.with_extension("deployed.json");
+    let steps = run(&data, &out)
+        .and_then(|()| diagnose_and_deploy(&data, &deployed))
+        .and_then(|()| check_against(&out, &data));
+    match steps {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
-            ExitCode::from(e.exit_code())
+            ExitCode::from(e.downcast_ref::<Error>().map_or(1, Error::exit_code))
         }
     }
 }
 
-fn run(data: &Path, out: &Path) -> Result<(), Error> {
+fn run(data: &Path, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let mut calibration = identify(data)?;
     write_machine(&mut calibration, out)?;
-    command(&calibration)
+    Ok(command(&calibration)?)
 }
 
 /// Step 1: calibrate from the UP limb's sensors and judge the verdict.
@@ -89,4 +100,39 @@ fn command(calibration: &Calibration) -> Result<(), Error> {
         println!("{},{},{},{},{},{}", r.x, r.y, r.z, q[0], q[1], q[2]);
     }
     Ok(())
+}
+
+/// Step 4: diagnoses the data (does the geometric model explain them, and if not,
+/// which effect does), refuses to go on unless the final model explains
+/// them, deploys it (the calibrated leg commands at the centre) and writes
+/// it to `out` as a calibrated machine file.
+fn diagnose_and_deploy(path: &Path, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    let nominal = load_machine(None, &SensorNoise::default())?;
+    let result = diagnose(DiagnoseRequest::new(nominal, path.to_path_buf()))?;
+    println!("diagnosis: {:?}", result.diagnosis().verdict);
+    if let Some(why) = result.exit_reason() {
+        return Err(why.into());
+    }
+    let deployed = result.deploy()?;
+    let q = ExtendedMachine::new(deployed.machine)
+        .inverse(&Vector3::new(0.0, 0.0, 750.0))?
+        .legs_mm;
+    println!("deployed: leg commands at the centre {q:?} mm");
+    if let Some(warning) = result.write_machine(out, false)? {
+        eprintln!("warning: {warning}");
+    }
+    println!("wrote {}", out.display());
+    Ok(())
+}
+
+/// Step 5: checks the data against the calibrated machine file `calibrated`: has
+/// the machine changed since its calibration?
+fn check_against(calibrated: &Path, path: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    let machine = load_machine(Some(calibrated), &SensorNoise::default())?;
+    let result = check(CheckRequest::new(machine, path.to_path_buf()))?;
+    print!("{}", result.to_text());
+    match result.exit_reason() {
+        None if result.exit_code() == EXIT_OK => Ok(()),
+        why => Err(why.unwrap_or_default().into()),
+    }
 }
