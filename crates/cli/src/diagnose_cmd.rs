@@ -357,10 +357,10 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<u8, CliError> {
             // machine.
             let mut plant = Plant::geometric(m.clone(), GeometricErrors::default());
             if drift_k != 0.0 {
-                plant.effects = vec![Effect::Thermal {
+                plant.effects = vec![Effect::from(tricept_plant::effects::Thermal {
                     drift_k,
                     expansion_ppm_per_k: 0.0,
-                }];
+                })];
             }
             plant
                 .simulate(&campaign)

@@ -44,11 +44,7 @@ fn simulate(effects: Vec<Effect>) -> Value {
         .flat_map(|p| p.readings.to_array())
         .map(bits)
         .collect();
-    let temps: Vec<String> = data
-        .poses
-        .iter()
-        .map(|p| bits(p.temp_c.unwrap()))
-        .collect();
+    let temps: Vec<String> = data.poses.iter().map(|p| bits(p.temp_c.unwrap())).collect();
     let approach: Vec<[i8; 3]> = data.poses.iter().map(|p| p.approach.unwrap()).collect();
     let mut spindle = Vec::new();
     for r in [

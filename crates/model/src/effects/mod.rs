@@ -29,9 +29,15 @@
 //! its deployment, the calibration record's check, [`UnknownEffect`] and
 //! the CLI help iterate it; no other code names an effect to classify it.
 //!
-//! Adding an effect: its file here, its registry line, the plant's
-//! simulation of it (`tricept_plant::Effect`) and its docs; the compiler
-//! flags anything else.
+//! Each file also says how the plant simulator puts its effect into a
+//! machine ([`Simulation`], in the spec): the `--truth-effect` input type
+//! with its keys and units (re-exported as [`simulated`]`::LegLead`, ...)
+//! and its [`Simulate`] hooks (kinematics, temperature, leg lengths,
+//! readings, logged rows), which the plant calls without naming any
+//! effect.
+//!
+//! Adding an effect: its file here (with its simulation), its registry
+//! line and its docs; the compiler flags anything else.
 //!
 //! The same functions serve the plant simulator (which applies them to a
 //! simulated machine) and the diagnosis (which fits them to measured data),
@@ -53,6 +59,7 @@ use serde::{Deserialize, Serialize};
 mod deployment;
 mod forms;
 mod generic;
+mod simulation;
 mod spec;
 
 pub use deployment::{pose_free_leg_extra_per_mm, static_leg_extra_per_mm};
@@ -61,6 +68,7 @@ pub use forms::{
     normalised_coordinate, periodic_extra_mm, segment_extra_mm,
 };
 pub use generic::{GenericFamily, GenericSpec};
+pub use simulation::{EffectKey, PoseState, Simulate, SimulateObject, Simulation, parse};
 pub use spec::{
     Basis, CHANNELS, Deployment, EffectSpec, Entries, Judged, Judgement, Kind, KnownAlias,
     LegContext, LegDeployment, Magnitude, Measure, Needs, Parameter, PlausibleRange, PlotAxes,
@@ -78,6 +86,13 @@ macro_rules! registry {
         #[serde(rename_all = "kebab-case")]
         pub enum EffectName {
             $($(#[$doc])* $variant,)*
+        }
+
+        /// The simulator's input of each effect, named as its variant
+        /// (`simulated::LegLead { ppm }`): its magnitude in the units a
+        /// machine builder quotes, with its [`Simulate`] hooks.
+        pub mod simulated {
+            $(pub use super::$module::$variant;)*
         }
 
         impl EffectName {
@@ -400,6 +415,8 @@ mod tests {
             let s = e.spec();
             assert_eq!(serde_json::to_value(e).unwrap(), s.name);
             assert_eq!(s.name.parse::<EffectName>(), Ok(e));
+            assert_eq!(s.simulation.tag, s.name);
+            assert!(s.simulation.cause == e, "{e}");
             let k = s.parameters.len();
             let entries = match s.kind {
                 Kind::Leg(f) => Some((f(&at).unwrap(), true)),

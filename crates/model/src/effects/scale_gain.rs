@@ -7,6 +7,9 @@ use super::spec::{
     Basis, Deployment, EffectSpec, Entries, Judged, Kind, KnownAlias, Magnitude, Measure, Needs,
     Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
 };
+use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse};
+use super::{CauseName, EffectName};
+use serde::{Deserialize, Serialize};
 
 pub(super) const SPEC: EffectSpec = EffectSpec {
     name: "scale-gain",
@@ -48,6 +51,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
         why: "a scale gain g reads exactly like the machine scaled by 1 + g with a lead g on every leg",
         separate_by: "one external length: a laser interferometer or gauge-block measurement of the UP-limb stroke or of one platform displacement fixes the gain; the machine's own sensors never can",
     }],
+    simulation: SIMULATION,
 };
 
 fn entries(up: &UpJoints) -> Entries {
@@ -57,4 +61,30 @@ fn entries(up: &UpJoints) -> Entries {
 /// Reading error of a scale with gain error `ppm` at extension `q4_mm`, mm.
 pub fn scale_gain_error_mm(ppm: f64, q4_mm: f64) -> f64 {
     ppm * 1e-6 * q4_mm
+}
+
+/// The simulator's `scale-gain`: gain error of the linear scale.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScaleGain {
+    /// Gain error, ppm.
+    pub ppm: f64,
+}
+
+const SIMULATION: Simulation = Simulation {
+    tag: "scale-gain",
+    cause: CauseName::Catalogue(EffectName::ScaleGain),
+    keys: &[EffectKey::new("ppm", "ppm", "gain error of the linear scale")],
+    parse: parse::<ScaleGain>,
+    typical: || Box::new(ScaleGain { ppm: 50.0 }),
+};
+
+impl Simulate for ScaleGain {
+    fn simulation(&self) -> &'static Simulation {
+        &SIMULATION
+    }
+
+    fn reading_error(&self, _s: &PoseState, up: &UpJoints, r: &mut [f64; 3]) {
+        r[2] += scale_gain_error_mm(self.ppm, up.q4_mm);
+    }
 }

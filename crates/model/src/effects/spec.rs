@@ -15,6 +15,7 @@ use tricept_kinematics::description::{ControllerDescription, LegEffectsDescripti
 use tricept_kinematics::{KinematicsError, Machine, UpJoints};
 
 use super::forms::{legendre_p2, legendre_p3};
+use super::simulation::Simulation;
 
 /// An effect of the vocabulary.
 #[derive(Debug, Clone, Copy)]
@@ -53,6 +54,8 @@ pub struct EffectSpec {
     pub realistic: fn(&Machine) -> Vec<Magnitude>,
     /// Effects it is known to be confused with, and what separates them.
     pub aliases: &'static [KnownAlias],
+    /// How the plant simulator puts it into a machine.
+    pub simulation: Simulation,
 }
 
 /// A parameter of an effect in a model.
