@@ -8,8 +8,7 @@ use super::spec::{
     Basis, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, Magnitude, Measure, Needs,
     Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
 };
-use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse};
-use super::{CauseName, EffectName};
+use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
 use serde::{Deserialize, Serialize};
 
 pub(super) const SPEC: EffectSpec = EffectSpec {
@@ -65,6 +64,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     },
     aliases: &[],
     simulation: SIMULATION,
+    common_part: None,
 };
 
 /// Without logged directions every leg counts as extending.
@@ -95,13 +95,13 @@ pub struct Backlash {
 
 const SIMULATION: Simulation = Simulation {
     tag: "backlash",
-    cause: CauseName::Catalogue(EffectName::Backlash),
-    keys: &[EffectKey::new(
+    cause: "backlash",
+        keys: &[EffectKey::new(
         "um",
         "um",
         "lost motion of each leg [3]; with --both-directions the data show it",
     )],
-    parse: parse::<Backlash>,
+    parse: parse_input::<Backlash>,
     typical: || {
         Box::new(Backlash {
             um: [6.0, 5.0, 8.0],

@@ -10,8 +10,7 @@ use super::spec::{
     Basis, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, LegDeployment, Magnitude,
     Measure, Needs, Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
 };
-use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse};
-use super::{CauseName, EffectName};
+use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
 use serde::{Deserialize, Serialize};
 
 pub(super) const SPEC: EffectSpec = EffectSpec {
@@ -51,6 +50,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     },
     aliases: &[],
     simulation: SIMULATION,
+    common_part: None,
 };
 
 /// The tension on the nominal machine at the commands; compliance `c`
@@ -135,13 +135,13 @@ pub struct Compliance {
 
 const SIMULATION: Simulation = Simulation {
     tag: "compliance",
-    cause: CauseName::Catalogue(EffectName::Compliance),
-    keys: &[EffectKey::positive(
+    cause: "compliance",
+        keys: &[EffectKey::positive(
         "stiffness_n_per_um_at_1m",
         "N/um",
         "axial stiffness of a leg 1 m long (scales as 1/length); loads from the machine file's `loads`",
     )],
-    parse: parse::<Compliance>,
+    parse: parse_input::<Compliance>,
     typical: || {
         Box::new(Compliance {
             stiffness_n_per_um_at_1m: 33.6,

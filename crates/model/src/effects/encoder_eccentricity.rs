@@ -8,8 +8,7 @@ use super::spec::{
     Basis, Deployment, EffectSpec, Entries, Judged, Kind, KnownAlias, Magnitude, Measure, Needs,
     Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
 };
-use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse};
-use super::{CauseName, EffectName};
+use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
 use serde::{Deserialize, Serialize};
 
 const ARCSEC: Parameter = Parameter {
@@ -79,8 +78,10 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
         with: "encoder-gain",
         why: "over the encoders' small angles (|angle| < 0.6 rad) a gain error and the sine part of an eccentricity are nearly the same curve",
         separate_by: "an external angle reference (autocollimator or inclinometer) at about +-30 deg of the U joint",
+        structural: None,
     }],
     simulation: SIMULATION,
+    common_part: None,
 };
 
 fn entries(up: &UpJoints) -> Entries {
@@ -116,8 +117,8 @@ pub struct EncoderEccentricity {
 
 const SIMULATION: Simulation = Simulation {
     tag: "encoder-eccentricity",
-    cause: CauseName::Catalogue(EffectName::EncoderEccentricity),
-    keys: &[
+    cause: "encoder-eccentricity",
+        keys: &[
         EffectKey::new(
             "phi_arcsec",
             "arcsec",
@@ -127,7 +128,7 @@ const SIMULATION: Simulation = Simulation {
         EffectKey::new("theta_arcsec", "arcsec", "amplitude on the theta encoder"),
         EffectKey::new("theta_phase_deg", "deg", "its phase"),
     ],
-    parse: parse::<EncoderEccentricity>,
+    parse: parse_input::<EncoderEccentricity>,
     typical: || {
         Box::new(EncoderEccentricity {
             phi_arcsec: 10.0,

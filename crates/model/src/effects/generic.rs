@@ -189,6 +189,7 @@ impl GenericFamily {
                 with: "leg-drift",
                 why: "a drifting scale and uniformly growing legs move the readings alike",
                 separate_by: "an external reading of the platform at a repeated pose (dial indicator or touch probe): the machine's own sensors cannot tell a drifting scale from growing legs",
+                structural: None,
             }],
             ..spec(
                 "reading-drift",

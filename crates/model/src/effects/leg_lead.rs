@@ -5,11 +5,10 @@ use tricept_kinematics::description::LegEffectsDescription;
 use tricept_kinematics::{KinematicsError, Machine, UpJoints};
 
 use super::spec::{
-    Basis, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, LegDeployment, Magnitude,
+    Basis, CommonPart, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, LegDeployment, Magnitude,
     Measure, Needs, Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
 };
-use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse};
-use super::{CauseName, EffectName};
+use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
 use serde::{Deserialize, Serialize};
 
 pub(super) const SPEC: EffectSpec = EffectSpec {
@@ -65,6 +64,11 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     },
     aliases: &[],
     simulation: SIMULATION,
+    common_part: Some(CommonPart {
+        label: "leg-lead (equal on all legs)",
+        as_alias: "leg-lead (common part)",
+        parameter: "lead_ppm (every leg)",
+    }),
 };
 
 fn entries(at: &LegContext<'_>) -> Result<Entries, KinematicsError> {
@@ -97,13 +101,13 @@ pub struct LegLead {
 
 const SIMULATION: Simulation = Simulation {
     tag: "leg-lead",
-    cause: CauseName::Catalogue(EffectName::LegLead),
-    keys: &[EffectKey::new(
+    cause: "leg-lead",
+        keys: &[EffectKey::new(
         "ppm",
         "ppm",
         "lead error of each leg [3]: the leg grows by ppm 1e-6 q",
     )],
-    parse: parse::<LegLead>,
+    parse: parse_input::<LegLead>,
     typical: || {
         Box::new(LegLead {
             ppm: [50.0, -30.0, 40.0],

@@ -68,11 +68,11 @@ pub use forms::{
     normalised_coordinate, periodic_extra_mm, segment_extra_mm,
 };
 pub use generic::{GenericFamily, GenericSpec};
-pub use simulation::{EffectKey, PoseState, Simulate, SimulateObject, Simulation, parse};
+pub use simulation::{EffectKey, PoseState, Simulate, SimulateObject, Simulation, parse_input};
 pub use spec::{
-    Basis, CHANNELS, Deployment, EffectSpec, Entries, Judged, Judgement, Kind, KnownAlias,
-    LegContext, LegDeployment, Magnitude, Measure, Needs, Parameter, PlausibleRange, PlotAxes,
-    XAxis, YAxis,
+    Basis, CHANNELS, CommonPart, Deployment, EffectSpec, Entries, Judged, Judgement, Kind,
+    KnownAlias, LegContext, LegDeployment, Magnitude, Measure, Needs, Parameter, PlausibleRange,
+    PlotAxes, Structural, XAxis, YAxis,
 };
 
 /// The registry: the enum of the vocabulary (its variants in this order,
@@ -92,7 +92,7 @@ macro_rules! registry {
         /// (`simulated::LegLead { ppm }`): its magnitude in the units a
         /// machine builder quotes, with its [`Simulate`] hooks.
         pub mod simulated {
-            $(pub use super::$module::$variant;)*
+            $(pub use crate::effects::$module::$variant;)*
         }
 
         impl EffectName {
@@ -184,6 +184,29 @@ impl EffectName {
     /// The effects that are terms of a model, in registry order.
     pub fn terms() -> impl Iterator<Item = EffectName> {
         EffectName::ALL.into_iter().filter(|e| e.is_term())
+    }
+
+    /// The structural aliases of the registry: `(effect with the common
+    /// part, effect whose parameter it reads as, how)`, each declared by the
+    /// second ([`KnownAlias::structural`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_model::effects::EffectName;
+    /// let (common, other, s) = EffectName::structural_aliases().next().unwrap();
+    /// assert_eq!((common.as_str(), other.as_str()), ("leg-lead", "scale-gain"));
+    /// assert!(common.spec().common_part.is_some());
+    /// assert!((s.says)(50.0, 2.0).contains("50.0"));
+    /// ```
+    pub fn structural_aliases()
+    -> impl Iterator<Item = (EffectName, EffectName, &'static Structural)> {
+        EffectName::ALL.into_iter().flat_map(|other| {
+            other.spec().aliases.iter().filter_map(move |a| {
+                let s = a.structural.as_ref()?;
+                let common = s.common_of.parse::<EffectName>().ok()?;
+                Some((common, other, s))
+            })
+        })
     }
 
     /// Its judged quantities ([`EffectSpec::plausible`]), each with its
@@ -416,7 +439,7 @@ mod tests {
             assert_eq!(serde_json::to_value(e).unwrap(), s.name);
             assert_eq!(s.name.parse::<EffectName>(), Ok(e));
             assert_eq!(s.simulation.tag, s.name);
-            assert!(s.simulation.cause == e, "{e}");
+            assert_eq!(s.simulation.cause, s.name);
             let k = s.parameters.len();
             let entries = match s.kind {
                 Kind::Leg(f) => Some((f(&at).unwrap(), true)),
@@ -447,6 +470,12 @@ mod tests {
                 }
             }
             for a in s.aliases {
+                if let Some(st) = &a.structural {
+                    assert_eq!(st.common_of, a.with, "{e}");
+                    let common: EffectName = st.common_of.parse().unwrap();
+                    assert!(common.spec().common_part.is_some(), "{e}");
+                    assert_eq!(k, 1, "{e}");
+                }
                 let other: CauseName = a.with.parse().unwrap();
                 assert!(
                     other.known_aliases().iter().all(|b| b.with != s.name),

@@ -2,8 +2,7 @@
 //! term of a model: the rows are set aside).
 
 use super::spec::{Deployment, EffectSpec, Kind, Needs, PlotAxes, XAxis, YAxis};
-use super::simulation::{EffectKey, Simulate, Simulation, parse};
-use super::{CauseName, EffectName};
+use super::simulation::{EffectKey, Simulate, Simulation, parse_input};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
@@ -26,6 +25,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     realistic: |_| Vec::new(),
     aliases: &[],
     simulation: SIMULATION,
+    common_part: None,
 };
 
 /// The simulator's gross reading errors in a few rows.
@@ -40,8 +40,8 @@ pub struct Outliers {
 
 const SIMULATION: Simulation = Simulation {
     tag: "outliers",
-    cause: CauseName::Catalogue(EffectName::Outliers),
-    keys: &[
+    cause: "outliers",
+        keys: &[
         EffectKey::new("count", "-", "number of corrupted rows"),
         EffectKey::new(
             "size_sigma",
@@ -49,7 +49,7 @@ const SIMULATION: Simulation = Simulation {
             "size of each error in noise standard deviations (random sign)",
         ),
     ],
-    parse: parse::<Outliers>,
+    parse: parse_input::<Outliers>,
     typical: || {
         Box::new(Outliers {
             count: 2,

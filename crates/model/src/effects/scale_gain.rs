@@ -5,10 +5,9 @@ use tricept_kinematics::UpJoints;
 
 use super::spec::{
     Basis, Deployment, EffectSpec, Entries, Judged, Kind, KnownAlias, Magnitude, Measure, Needs,
-    Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
+    Parameter, PlausibleRange, PlotAxes, Structural, XAxis, YAxis,
 };
-use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse};
-use super::{CauseName, EffectName};
+use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
 use serde::{Deserialize, Serialize};
 
 pub(super) const SPEC: EffectSpec = EffectSpec {
@@ -50,8 +49,20 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
         with: "leg-lead",
         why: "a scale gain g reads exactly like the machine scaled by 1 + g with a lead g on every leg",
         separate_by: "one external length: a laser interferometer or gauge-block measurement of the UP-limb stroke or of one platform displacement fixes the gain; the machine's own sensors never can",
+        structural: Some(Structural {
+            common_of: "leg-lead",
+            // The legs read 1 + g too long (a lead of g on every leg) and
+            // the UP limb's scale 1 / (1 + g) (a gain of -g), in ppm.
+            scaled_machine: (1e6, -1e6),
+            says: |mean, sd| {
+                format!(
+                    "the mean lead {mean:.1} +- {sd:.1} ppm is indistinguishable from a scale gain of {mean:.1} ppm with every lead reduced by it"
+                )
+            },
+        }),
     }],
     simulation: SIMULATION,
+    common_part: None,
 };
 
 fn entries(up: &UpJoints) -> Entries {
@@ -73,9 +84,9 @@ pub struct ScaleGain {
 
 const SIMULATION: Simulation = Simulation {
     tag: "scale-gain",
-    cause: CauseName::Catalogue(EffectName::ScaleGain),
-    keys: &[EffectKey::new("ppm", "ppm", "gain error of the linear scale")],
-    parse: parse::<ScaleGain>,
+    cause: "scale-gain",
+        keys: &[EffectKey::new("ppm", "ppm", "gain error of the linear scale")],
+    parse: parse_input::<ScaleGain>,
     typical: || Box::new(ScaleGain { ppm: 50.0 }),
 };
 

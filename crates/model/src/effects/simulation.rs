@@ -15,8 +15,6 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 use tricept_kinematics::{Machine, UpJoints};
 
-use super::CauseName;
-
 /// One input key of a simulated effect.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct EffectKey {
@@ -132,14 +130,15 @@ pub struct Simulation {
     /// Its JSON tag (`leg-lead`), as `--truth-effect` takes it (an effect of
     /// the vocabulary's is its report name).
     pub tag: &'static str,
-    /// The name a perfect diagnosis would give it: its name in the
-    /// vocabulary, or for an effect outside it the generic family of its
-    /// form.
-    pub cause: CauseName,
+    /// The report name of the cause a perfect diagnosis would give it: its
+    /// name in the vocabulary, or for an effect outside it the generic
+    /// family of its form (a name, as [`KnownAlias::with`](super::KnownAlias):
+    /// the tests of the registry and of the plant check that it is one).
+    pub cause: &'static str,
     /// Its input keys, in the order of its JSON.
     pub keys: &'static [EffectKey],
     /// Reads its input from the JSON object without the tag
-    /// ([`parse`] of its input type).
+    /// ([`parse_input`] of its input type).
     pub parse: fn(serde_json::Value) -> Result<Box<dyn Simulate>, serde_json::Error>,
     /// An example at a typical size (what a real machine of the paper's
     /// class might show, or a size the diagnosis' docs use).
@@ -148,7 +147,7 @@ pub struct Simulation {
 
 /// Reads an effect's input of type `T` from its JSON object (the
 /// [`Simulation::parse`] of an effect).
-pub fn parse<T: Simulate + DeserializeOwned + 'static>(
+pub fn parse_input<T: Simulate + DeserializeOwned + 'static>(
     value: serde_json::Value,
 ) -> Result<Box<dyn Simulate>, serde_json::Error> {
     Ok(Box::new(serde_json::from_value::<T>(value)?))

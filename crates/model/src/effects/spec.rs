@@ -56,6 +56,9 @@ pub struct EffectSpec {
     pub aliases: &'static [KnownAlias],
     /// How the plant simulator puts it into a machine.
     pub simulation: Simulation,
+    /// Its common part, for an effect with one parameter per leg whose
+    /// equal value on every leg is an alternative of its own.
+    pub common_part: Option<CommonPart>,
 }
 
 /// A parameter of an effect in a model.
@@ -474,7 +477,7 @@ pub struct PlotAxes {
 
 /// A known confusion: another cause whose signature reads like this one's,
 /// why, and what measurement separates them.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy)]
 pub struct KnownAlias {
     /// The other cause's report name (an effect or a generic family; a
     /// test of the registry checks that it is one).
@@ -483,4 +486,38 @@ pub struct KnownAlias {
     pub why: &'static str,
     /// What separates them.
     pub separate_by: &'static str,
+    /// When the alias holds on every campaign by construction: how.
+    pub structural: Option<Structural>,
+}
+
+/// An alias that holds on every campaign: the common part (the mean over
+/// the legs) of the per-leg parameters of one effect reads exactly as the
+/// declaring effect's single parameter, with the machine scaled (a scale
+/// gain `g` reads like the machine scaled by `1 + g` with a lead `g` on
+/// every leg).
+#[derive(Debug, Clone, Copy)]
+pub struct Structural {
+    /// The effect whose per-leg parameters have the common part (its
+    /// report name; it declares its [`CommonPart`]).
+    pub common_of: &'static str,
+    /// The change, per unit `g` of a machine scaled by `1 + g` (to first
+    /// order), of each parameter of `common_of` and of the declaring
+    /// effect's parameter, in their units.
+    pub scaled_machine: (f64, f64),
+    /// What a report says of a significant common part, from its mean and
+    /// standard deviation.
+    pub says: fn(f64, f64) -> String,
+}
+
+/// The common part of an effect with one parameter per leg: the same
+/// value on every leg, an alternative of its own in the alias analysis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CommonPart {
+    /// Its label as an alternative (`leg-lead (equal on all legs)`).
+    pub label: &'static str,
+    /// Its label as one side of a structural alias (`leg-lead (common
+    /// part)`).
+    pub as_alias: &'static str,
+    /// Its one parameter (`lead_ppm (every leg)`).
+    pub parameter: &'static str,
 }

@@ -8,8 +8,7 @@ use super::spec::{
     Basis, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, Magnitude, Measure, Needs,
     Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
 };
-use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse};
-use super::{CauseName, EffectName};
+use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
 use serde::{Deserialize, Serialize};
 
 /// The reference temperature of dimensional metrology (ISO 1), °C: the
@@ -55,6 +54,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     },
     aliases: &[],
     simulation: SIMULATION,
+    common_part: None,
 };
 
 /// Without a logged temperature the legs are at the reference.
@@ -90,8 +90,8 @@ pub struct Thermal {
 
 const SIMULATION: Simulation = Simulation {
     tag: "thermal",
-    cause: CauseName::Catalogue(EffectName::Thermal),
-    keys: &[
+    cause: "thermal",
+        keys: &[
         EffectKey::new(
             "drift_k",
             "K",
@@ -103,7 +103,7 @@ const SIMULATION: Simulation = Simulation {
             "the legs' expansion coefficient (steel 11.5; 0 for a temperature log alone)",
         ),
     ],
-    parse: parse::<Thermal>,
+    parse: parse_input::<Thermal>,
     typical: || {
         Box::new(Thermal {
             drift_k: 3.0,

@@ -8,8 +8,7 @@ use super::spec::{
     Deployment, EffectSpec, Judged, Kind, Magnitude, Measure, Needs, Parameter, PlausibleRange,
     PlotAxes, XAxis, YAxis,
 };
-use super::simulation::{EffectKey, Simulate, Simulation, parse};
-use super::{CauseName, EffectName};
+use super::simulation::{EffectKey, Simulate, Simulation, parse_input};
 use serde::{Deserialize, Serialize};
 
 pub(super) const SPEC: EffectSpec = EffectSpec {
@@ -49,6 +48,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     },
     aliases: &[],
     simulation: SIMULATION,
+    common_part: None,
 };
 
 fn apply(machine: &mut Machine, p: &[f64]) {
@@ -88,13 +88,13 @@ pub struct TubeTwist {
 
 const SIMULATION: Simulation = Simulation {
     tag: "tube-twist",
-    cause: CauseName::Catalogue(EffectName::TubeTwist),
-    keys: &[EffectKey::new(
+    cause: "tube-twist",
+        keys: &[EffectKey::new(
         "arcsec_per_100mm",
         "arcsec/100mm",
         "platform twist about the limb axis per 100 mm of extension from the middle plane",
     )],
-    parse: parse::<TubeTwist>,
+    parse: parse_input::<TubeTwist>,
     typical: || {
         Box::new(TubeTwist {
             arcsec_per_100mm: 30.0,

@@ -8,8 +8,7 @@ use super::spec::{
     Deployment, EffectSpec, Judged, Kind, Magnitude, Measure, Needs, Parameter, PlausibleRange,
     PlotAxes, XAxis, YAxis,
 };
-use super::simulation::{EffectKey, Simulate, Simulation, parse};
-use super::{CauseName, EffectName};
+use super::simulation::{EffectKey, Simulate, Simulation, parse_input};
 use serde::{Deserialize, Serialize};
 
 pub(super) const SPEC: EffectSpec = EffectSpec {
@@ -75,6 +74,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     },
     aliases: &[],
     simulation: SIMULATION,
+    common_part: None,
 };
 
 fn apply(machine: &mut Machine, p: &[f64]) {
@@ -110,8 +110,8 @@ pub struct UjointAxes {
 
 const SIMULATION: Simulation = Simulation {
     tag: "ujoint-axes",
-    cause: CauseName::Catalogue(EffectName::UjointAxes),
-    keys: &[
+    cause: "ujoint-axes",
+        keys: &[
         EffectKey::new(
             "skew_arcsec",
             "arcsec",
@@ -119,7 +119,7 @@ const SIMULATION: Simulation = Simulation {
         ),
         EffectKey::new("offset_um", "um", "distance between the two axes"),
     ],
-    parse: parse::<UjointAxes>,
+    parse: parse_input::<UjointAxes>,
     typical: || {
         Box::new(UjointAxes {
             skew_arcsec: 60.0,

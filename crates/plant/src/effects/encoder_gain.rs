@@ -5,8 +5,7 @@
 use serde::{Deserialize, Serialize};
 use tricept_kinematics::UpJoints;
 use tricept_model::effects::{
-    CauseName, EffectKey, GenericFamily, PoseState, Simulate, Simulation, encoder_gain_error_rad,
-    parse,
+    EffectKey, PoseState, Simulate, Simulation, encoder_gain_error_rad, parse_input,
 };
 
 /// Gain errors of the U-joint encoders.
@@ -21,12 +20,12 @@ pub struct EncoderGain {
 
 pub(super) const SIMULATION: Simulation = Simulation {
     tag: "encoder-gain",
-    cause: CauseName::Generic(GenericFamily::EncoderGain),
+    cause: "encoder-gain",
     keys: &[
         EffectKey::new("phi_ppm", "ppm", "gain error of the phi encoder"),
         EffectKey::new("theta_ppm", "ppm", "gain error of the theta encoder"),
     ],
-    parse: parse::<EncoderGain>,
+    parse: parse_input::<EncoderGain>,
     typical: || {
         Box::new(EncoderGain {
             phi_ppm: 100.0,

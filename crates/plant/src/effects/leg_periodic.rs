@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 use tricept_kinematics::Machine;
 use tricept_model::effects::{
-    CauseName, EffectKey, GenericFamily, PoseState, Simulate, Simulation, parse, periodic_extra_mm,
+    EffectKey, PoseState, Simulate, Simulation, parse_input, periodic_extra_mm,
 };
 
 /// Shape of a periodic leg-length error.
@@ -38,7 +38,7 @@ pub struct LegPeriodic {
 
 pub(super) const SIMULATION: Simulation = Simulation {
     tag: "leg-periodic",
-    cause: CauseName::Generic(GenericFamily::LegPeriodic),
+    cause: "leg-periodic",
     keys: &[
         EffectKey::new("um", "um", "amplitude of each leg [3]"),
         EffectKey::positive("period_mm", "mm", "period: the screw lead"),
@@ -49,7 +49,7 @@ pub(super) const SIMULATION: Simulation = Simulation {
             "`sine` (default) or `sawtooth` (outside the dictionary)",
         ),
     ],
-    parse: parse::<LegPeriodic>,
+    parse: parse_input::<LegPeriodic>,
     typical: || {
         Box::new(LegPeriodic {
             um: [4.0, 4.0, 4.0],

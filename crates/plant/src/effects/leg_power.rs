@@ -6,8 +6,7 @@
 use serde::{Deserialize, Serialize};
 use tricept_kinematics::Machine;
 use tricept_model::effects::{
-    CauseName, EffectKey, GenericFamily, PoseState, Simulate, Simulation, normalised_coordinate,
-    parse,
+    EffectKey, PoseState, Simulate, Simulation, normalised_coordinate, parse_input,
 };
 
 pub(super) fn default_centre_mm() -> f64 {
@@ -72,7 +71,7 @@ pub struct LegPower {
 
 pub(super) const SIMULATION: Simulation = Simulation {
     tag: "leg-power",
-    cause: CauseName::Generic(GenericFamily::LegPolynomial),
+    cause: "leg-polynomial",
     keys: &[
         UM_AT_HALF_WIDTH,
         EffectKey::positive(
@@ -83,7 +82,7 @@ pub(super) const SIMULATION: Simulation = Simulation {
         CENTRE,
         HALF_WIDTH,
     ],
-    parse: parse::<LegPower>,
+    parse: parse_input::<LegPower>,
     typical: || {
         Box::new(LegPower {
             um: [30.0, -20.0, 25.0],

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 use tricept_kinematics::Machine;
-use tricept_model::effects::{CauseName, GenericFamily, PoseState, Simulate, Simulation, parse};
+use tricept_model::effects::{PoseState, Simulate, Simulation, parse_input};
 
 use super::leg_power::{
     CENTRE, HALF_WIDTH, UM_AT_HALF_WIDTH, add_power_law, default_centre_mm, default_half_width_mm,
@@ -28,9 +28,9 @@ pub struct LegQuadratic {
 
 pub(super) const SIMULATION: Simulation = Simulation {
     tag: "leg-quadratic",
-    cause: CauseName::Generic(GenericFamily::LegPolynomial),
+    cause: "leg-polynomial",
     keys: &[UM_AT_HALF_WIDTH, CENTRE, HALF_WIDTH],
-    parse: parse::<LegQuadratic>,
+    parse: parse_input::<LegQuadratic>,
     typical: || {
         Box::new(LegQuadratic {
             um: [30.0, -20.0, 25.0],

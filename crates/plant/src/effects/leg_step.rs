@@ -6,7 +6,7 @@
 use serde::{Deserialize, Serialize};
 use tricept_kinematics::Machine;
 use tricept_model::effects::{
-    CauseName, EffectKey, GenericFamily, PoseState, Simulate, Simulation, parse, segment_extra_mm,
+    EffectKey, PoseState, Simulate, Simulation, parse_input, segment_extra_mm,
 };
 
 /// A worn segment of the legs' ball screws.
@@ -23,7 +23,7 @@ pub struct LegStep {
 
 pub(super) const SIMULATION: Simulation = Simulation {
     tag: "leg-step",
-    cause: CauseName::Generic(GenericFamily::LegStep),
+    cause: "leg-step",
     keys: &[
         EffectKey::new(
             "um",
@@ -33,7 +33,7 @@ pub(super) const SIMULATION: Simulation = Simulation {
         EffectKey::new("from_mm", "mm", "start of the worn segment, leg command"),
         EffectKey::new("to_mm", "mm", "end of the worn segment, leg command"),
     ],
-    parse: parse::<LegStep>,
+    parse: parse_input::<LegStep>,
     typical: || {
         Box::new(LegStep {
             um: [20.0, 0.0, 0.0],

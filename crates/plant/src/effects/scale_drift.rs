@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 use tricept_kinematics::UpJoints;
 use tricept_model::effects::{
-    CauseName, EffectKey, GenericFamily, PoseState, Simulate, Simulation, linear_drift, parse,
+    EffectKey, PoseState, Simulate, Simulation, linear_drift, parse_input,
 };
 
 /// A drift of the scale reading over the campaign.
@@ -18,13 +18,13 @@ pub struct ScaleDrift {
 
 pub(super) const SIMULATION: Simulation = Simulation {
     tag: "scale-drift",
-    cause: CauseName::Generic(GenericFamily::ReadingDrift),
+    cause: "reading-drift",
     keys: &[EffectKey::new(
         "um",
         "um",
         "drift of the scale reading from the first pose to the last, linear in time",
     )],
-    parse: parse::<ScaleDrift>,
+    parse: parse_input::<ScaleDrift>,
     typical: || Box::new(ScaleDrift { um: 4.0 }),
 };
 
