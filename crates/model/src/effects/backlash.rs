@@ -65,6 +65,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     aliases: &[],
     simulation: SIMULATION,
     common_part: None,
+    check: None,
 };
 
 /// Without logged directions every leg counts as extending.

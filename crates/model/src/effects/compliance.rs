@@ -51,6 +51,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     aliases: &[],
     simulation: SIMULATION,
     common_part: None,
+    check: None,
 };
 
 /// The tension on the nominal machine at the commands; compliance `c`

@@ -82,6 +82,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     }],
     simulation: SIMULATION,
     common_part: None,
+    check: None,
 };
 
 fn entries(up: &UpJoints) -> Entries {

@@ -5,7 +5,7 @@ use tricept_kinematics::description::LegEffectsDescription;
 use tricept_kinematics::{KinematicsError, Machine, UpJoints};
 
 use super::spec::{
-    Basis, CommonPart, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, LegDeployment, Magnitude,
+    CheckColumns, CheckRole, CheckWhen,    Basis, CommonPart, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, LegDeployment, Magnitude,
     Measure, Needs, Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
 };
 use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
@@ -68,6 +68,12 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
         label: "leg-lead (equal on all legs)",
         as_alias: "leg-lead (common part)",
         parameter: "lead_ppm (every leg)",
+    }),
+    check: Some(CheckRole {
+        name: "common leg lead",
+        parameters: &["lead_ppm"],
+        when: CheckWhen::WithoutTemperatures,
+        columns: CheckColumns::Legs(|command_mm, _| leg_lead_extra_mm(1.0, command_mm)),
     }),
 };
 

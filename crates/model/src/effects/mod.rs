@@ -70,9 +70,9 @@ pub use forms::{
 pub use generic::{GenericFamily, GenericSpec};
 pub use simulation::{EffectKey, PoseState, Simulate, SimulateObject, Simulation, parse_input};
 pub use spec::{
-    Basis, CHANNELS, CommonPart, Deployment, EffectSpec, Entries, Judged, Judgement, Kind,
-    KnownAlias, LegContext, LegDeployment, Magnitude, Measure, Needs, Parameter, PlausibleRange,
-    PlotAxes, Structural, XAxis, YAxis,
+    Basis, CHANNELS, CheckColumns, CheckRole, CheckWhen, CommonPart, Deployment, EffectSpec,
+    Entries, Judged, Judgement, Kind, KnownAlias, LegContext, LegDeployment, Magnitude, Measure,
+    Needs, Parameter, PlausibleRange, PlotAxes, Structural, XAxis, YAxis,
 };
 
 /// The registry: the enum of the vocabulary (its variants in this order,

@@ -26,6 +26,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     aliases: &[],
     simulation: SIMULATION,
     common_part: None,
+    check: None,
 };
 
 /// The simulator's gross reading errors in a few rows.

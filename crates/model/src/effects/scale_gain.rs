@@ -4,7 +4,7 @@
 use tricept_kinematics::UpJoints;
 
 use super::spec::{
-    Basis, Deployment, EffectSpec, Entries, Judged, Kind, KnownAlias, Magnitude, Measure, Needs,
+    CheckColumns, CheckRole, CheckWhen,    Basis, Deployment, EffectSpec, Entries, Judged, Kind, KnownAlias, Magnitude, Measure, Needs,
     Parameter, PlausibleRange, PlotAxes, Structural, XAxis, YAxis,
 };
 use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
@@ -63,6 +63,12 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     }],
     simulation: SIMULATION,
     common_part: None,
+    check: Some(CheckRole {
+        name: "scale gain",
+        parameters: &["scale_gain_ppm"],
+        when: CheckWhen::Always,
+        columns: CheckColumns::Readings(entries),
+    }),
 };
 
 fn entries(up: &UpJoints) -> Entries {

@@ -59,6 +59,46 @@ pub struct EffectSpec {
     /// Its common part, for an effect with one parameter per leg whose
     /// equal value on every leg is an alternative of its own.
     pub common_part: Option<CommonPart>,
+    /// Whether `tricept check` considers it a candidate change, and how.
+    pub check: Option<CheckRole>,
+}
+
+/// How `tricept check` considers an effect (or a generic family) as a
+/// candidate change between a calibration and a check.
+#[derive(Debug, Clone, Copy)]
+pub struct CheckRole {
+    /// Its name in a check's report (`scale gain`).
+    pub name: &'static str,
+    /// Its parameters in the check, units in the names.
+    pub parameters: &'static [&'static str],
+    /// When it is a candidate.
+    pub when: CheckWhen,
+    /// What one unit of each parameter changes at a pose.
+    pub columns: CheckColumns,
+}
+
+/// When a [`CheckRole`] is a candidate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CheckWhen {
+    /// Always.
+    Always,
+    /// When both the check and the calibration logged a temperature.
+    WithTemperatures,
+    /// When they did not both log one.
+    WithoutTemperatures,
+}
+
+/// What one unit of a [`CheckRole`]'s parameters changes at a pose.
+#[derive(Debug, Clone, Copy)]
+pub enum CheckColumns {
+    /// Every leg's length (one parameter), mm per unit, from the leg's
+    /// command (mm) and the temperature since the calibration (K; 0 when
+    /// not both logged one): it moves the platform.
+    Legs(fn(f64, f64) -> f64),
+    /// The readings, linearly in the parameters: the entries with the UP
+    /// limb at its predicted joints ([`Basis::Reading`] only); the sensor,
+    /// not the machine.
+    Readings(fn(&UpJoints) -> Entries),
 }
 
 /// A parameter of an effect in a model.

@@ -5,7 +5,7 @@ use tricept_kinematics::{KinematicsError, Machine};
 use tricept_kinematics::description::ControllerDescription;
 
 use super::spec::{
-    Basis, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, Magnitude, Measure, Needs,
+    CheckColumns, CheckRole, CheckWhen,    Basis, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, Magnitude, Measure, Needs,
     Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
 };
 use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
@@ -55,6 +55,12 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     aliases: &[],
     simulation: SIMULATION,
     common_part: None,
+    check: Some(CheckRole {
+        name: "thermal growth",
+        parameters: &["expansion_ppm_per_k"],
+        when: CheckWhen::WithTemperatures,
+        columns: CheckColumns::Legs(|command_mm, delta_k| thermal_extra_mm(1.0, command_mm, delta_k)),
+    }),
 };
 
 /// Without a logged temperature the legs are at the reference.

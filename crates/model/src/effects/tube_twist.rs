@@ -49,6 +49,7 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
     aliases: &[],
     simulation: SIMULATION,
     common_part: None,
+    check: None,
 };
 
 fn apply(machine: &mut Machine, p: &[f64]) {
