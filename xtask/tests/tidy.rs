@@ -104,6 +104,18 @@ fn modules(src: &Path) -> BTreeMap<Module, PathBuf> {
 /// (each replaced by a space, so that nothing inside them reads as a
 /// path).
 fn strip(text: &str) -> String {
+    strip_keeping(text, false)
+}
+
+/// The code of a file without comments (doc comments and their examples
+/// included), string literals kept.
+fn without_comments(text: &str) -> String {
+    strip_keeping(text, true)
+}
+
+/// [`strip`], keeping the string literals when `strings` (character
+/// literals and raw strings are dropped either way).
+fn strip_keeping(text: &str, strings: bool) -> String {
     let c: Vec<char> = text.chars().collect();
     let mut out = String::with_capacity(text.len());
     let mut i = 0;
@@ -154,6 +166,7 @@ fn strip(text: &str) -> String {
             i = j;
             out.push(' ');
         } else if c[i] == '"' {
+            let start = i;
             i += 1;
             while i < c.len() && c[i] != '"' {
                 if c[i] == '\\' {
@@ -162,7 +175,11 @@ fn strip(text: &str) -> String {
                 i += 1;
             }
             i += 1;
-            out.push(' ');
+            if strings {
+                out.extend(&c[start..i.min(c.len())]);
+            } else {
+                out.push(' ');
+            }
         } else if c[i] == '\'' {
             // A character literal ('x', '\n', '\u{..}') or a lifetime.
             if next == Some('\\') {
@@ -676,57 +693,6 @@ const ONE_FILE_EFFECTS: &[(&str, &str)] = &[
     ("encoder-eccentricity", "EncoderEccentricity"),
     ("compliance", "Compliance"),
 ];
-
-/// The code of a file without its comments (doc comments and their
-/// examples included), string literals kept.
-fn without_comments(text: &str) -> String {
-    let c: Vec<char> = text.chars().collect();
-    let mut out = String::with_capacity(text.len());
-    let mut i = 0;
-    while i < c.len() {
-        let next = c.get(i + 1).copied();
-        if c[i] == '/' && next == Some('/') {
-            while i < c.len() && c[i] != '\n' {
-                i += 1;
-            }
-        } else if c[i] == '/' && next == Some('*') {
-            let mut depth = 0;
-            while i < c.len() {
-                if c[i] == '/' && c.get(i + 1) == Some(&'*') {
-                    depth += 1;
-                    i += 2;
-                } else if c[i] == '*' && c.get(i + 1) == Some(&'/') {
-                    depth -= 1;
-                    i += 2;
-                    if depth == 0 {
-                        break;
-                    }
-                } else {
-                    i += 1;
-                }
-            }
-        } else if c[i] == '"' {
-            out.push('"');
-            i += 1;
-            while i < c.len() && c[i] != '"' {
-                if c[i] == '\\' {
-                    out.push(c[i]);
-                    i += 1;
-                }
-                if let Some(&ch) = c.get(i) {
-                    out.push(ch);
-                }
-                i += 1;
-            }
-            out.push('"');
-            i += 1;
-        } else {
-            out.push(c[i]);
-            i += 1;
-        }
-    }
-    out
-}
 
 /// Whether `code` names the effect: its report name quoted, or its variant
 /// as a whole identifier.

@@ -7,7 +7,7 @@ use tricept_kinematics::Machine;
 use tricept_model::effects::{PoseState, Simulate, Simulation, parse_input};
 
 use super::leg_power::{
-    CENTRE, HALF_WIDTH, UM_AT_HALF_WIDTH, add_power_law, default_centre_mm, default_half_width_mm,
+    CENTRE, HALF_WIDTH, LegPower, UM_AT_HALF_WIDTH, default_centre_mm, default_half_width_mm,
 };
 
 /// A leg-length error quadratic in the leg length.
@@ -45,14 +45,14 @@ impl Simulate for LegQuadratic {
         &SIMULATION
     }
 
-    fn extra_leg_length(&self, _nominal: &Machine, s: &PoseState, legs_mm: &mut [f64; 3]) {
-        add_power_law(
-            legs_mm,
-            &s.commands_mm,
-            &self.um,
-            2.0,
-            self.centre_mm,
-            self.half_width_mm,
-        );
+    /// The power law of exponent 2.
+    fn extra_leg_length(&self, nominal: &Machine, s: &PoseState, legs_mm: &mut [f64; 3]) {
+        let power = LegPower {
+            um: self.um,
+            exponent: 2.0,
+            centre_mm: self.centre_mm,
+            half_width_mm: self.half_width_mm,
+        };
+        power.extra_leg_length(nominal, s, legs_mm);
     }
 }
