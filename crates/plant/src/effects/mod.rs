@@ -160,10 +160,11 @@ impl Effect {
     /// # Example
     /// ```
     /// use tricept_plant::Effect;
-    /// use tricept_plant::effects::Compliance;
-    /// assert!(Effect::from(Compliance { stiffness_n_per_um_at_1m: 33.6 }).validate().is_ok());
-    /// let e = Effect::from(Compliance { stiffness_n_per_um_at_1m: -5.0 }).validate().unwrap_err();
-    /// assert!(e.contains("stiffness_n_per_um_at_1m"), "{e}");
+    /// use tricept_plant::effects::LegPower;
+    /// let shape = |exponent| LegPower { um: [30.0, -20.0, 25.0], exponent, centre_mm: 845.0, half_width_mm: 250.0 };
+    /// assert!(Effect::from(shape(1.5)).validate().is_ok());
+    /// let e = Effect::from(shape(-1.5)).validate().unwrap_err();
+    /// assert!(e.contains("exponent"), "{e}");
     /// ```
     pub fn validate(&self) -> Result<(), String> {
         const LIMIT: f64 = 1e6;
@@ -230,10 +231,10 @@ impl Effect {
     /// # Example
     /// ```
     /// use tricept_plant::Effect;
-    /// use tricept_plant::effects::Compliance;
-    /// let keys = Effect::from(Compliance { stiffness_n_per_um_at_1m: 33.6 }).keys();
-    /// assert_eq!(keys[0].key, "stiffness_n_per_um_at_1m");
-    /// assert_eq!(keys[0].unit, "N/um");
+    /// use tricept_plant::effects::Thermal;
+    /// let keys = Effect::from(Thermal { drift_k: 3.0, expansion_ppm_per_k: 11.5 }).keys();
+    /// assert_eq!(keys[1].key, "expansion_ppm_per_k");
+    /// assert_eq!(keys[1].unit, "ppm/K");
     /// ```
     pub fn keys(&self) -> &'static [EffectKey] {
         self.simulation().keys
@@ -329,7 +330,7 @@ impl<'de> Deserialize<'de> for Effect {
 /// # Example
 /// ```
 /// let all = tricept_plant::effects::typical_effects();
-/// assert!(all.iter().any(|e| e.tag() == "compliance"));
+/// assert!(all.iter().any(|e| e.tag() == "leg-step"));
 /// for e in &all {
 ///     assert!(e.validate().is_ok());
 /// }
@@ -367,6 +368,24 @@ mod listing_tests {
         for e in typical_effects() {
             assert_eq!(e.name().as_str(), e.simulation().cause);
         }
+    }
+
+    /// (Moved from the doc examples of `validate`, `keys` and
+    /// `typical_effects`.)
+    #[test]
+    fn a_compliance_needs_a_positive_stiffness() {
+        let stiffness = |s| {
+            Effect::from(Compliance {
+                stiffness_n_per_um_at_1m: s,
+            })
+        };
+        assert!(stiffness(33.6).validate().is_ok());
+        let e = stiffness(-5.0).validate().unwrap_err();
+        assert!(e.contains("stiffness_n_per_um_at_1m"), "{e}");
+        let keys = stiffness(33.6).keys();
+        assert_eq!(keys[0].key, "stiffness_n_per_um_at_1m");
+        assert_eq!(keys[0].unit, "N/um");
+        assert!(typical_effects().iter().any(|e| e.tag() == "compliance"));
     }
 
     #[test]
