@@ -48,26 +48,26 @@ fn plant(name: &str) -> Plant {
         set.to_errors(&set.table2()),
     );
     p.effects = match name {
-        "pitch" => vec![Effect::LegPeriodic {
+        "pitch" => vec![Effect::from(tricept_plant::effects::LegPeriodic {
             um: [4.0, 4.0, 4.0],
             period_mm: 10.0,
             phase_deg: [30.0, 150.0, 270.0],
             waveform: Waveform::Sine,
-        }],
-        "bowed" => vec![Effect::LegPeriodic {
+        })],
+        "bowed" => vec![Effect::from(tricept_plant::effects::LegPeriodic {
             um: [16.0, 14.0, 18.0],
             period_mm: 800.0,
             phase_deg: [40.0, 200.0, 310.0],
             waveform: Waveform::Sine,
-        }],
-        "worn" => vec![Effect::LegStep {
+        })],
+        "worn" => vec![Effect::from(tricept_plant::effects::LegStep {
             um: [4.0, 0.0, 0.0],
             from_mm: 720.0,
             to_mm: 960.0,
-        }],
-        _ => vec![Effect::LegLead {
+        })],
+        _ => vec![Effect::from(tricept_plant::effects::LegLead {
             ppm: [50.0, -30.0, 40.0],
-        }],
+        })],
     };
     p
 }

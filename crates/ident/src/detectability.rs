@@ -82,10 +82,10 @@ pub fn detectability(request: DetectabilityRequest) -> Result<DetectabilityRepor
             let mut plant = Plant::geometric(m.clone(), GeometricErrors::default());
             let drift_k = request.temperature_drift_k;
             if drift_k != 0.0 {
-                plant.effects = vec![Effect::Thermal {
+                plant.effects = vec![Effect::from(tricept_plant::effects::Thermal {
                     drift_k,
                     expansion_ppm_per_k: 0.0,
-                }];
+                })];
             }
             let data = plant
                 .simulate(&campaign)
