@@ -10,5 +10,7 @@ rm -rf "$venv"
 python3 -m venv "$venv"
 "$venv/bin/python" -m pip install --quiet "./python[test]"
 cargo build --quiet -p tricept-cli
-cd python
-MPLBACKEND=Agg "../$venv/bin/python" -m pytest -q tests
+# From the tests' own folder, so that `import tricept` is the installed
+# package, not the source folder beside pyproject.toml.
+cd python/tests
+MPLBACKEND=Agg "../../$venv/bin/python" -m pytest -q -p no:cacheprovider .

@@ -5,8 +5,15 @@
 //! points are solved in parallel (rayon) with the GIL released, each point
 //! independently, so the result is the same at any thread count.
 //!
+//! The workflows (identify, diagnose, check, simulate) are the door's, the
+//! same calls the CLI's verbs make: their JSON is the CLI's `--json`, their
+//! exit codes the CLI's. Data come as a CSV file or as CSV text the Python
+//! half writes from column arrays (shortest round-trip numbers: the same
+//! bits as the arrays), read by the same strict reader.
+//!
 //! Errors the input causes raise `tricept.InputError` (a `ValueError`)
-//! with the one-line message the CLI prints.
+//! with the one-line message the CLI prints; a machine file refused by the
+//! write rule raises `tricept.UntrustedError` with the exit code.
 
 use std::borrow::Cow;
 use std::path::PathBuf;
@@ -17,13 +24,23 @@ use pyo3::create_exception;
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use tricept_ident::nalgebra::Vector3;
-use tricept_ident::{ExtendedMachine, HeadBranch, KinematicsError, SensorNoise};
+use tricept_ident::{
+    CalibrateRequest, CheckRequest, Data, DataInput, DiagnoseRequest, ExtendedMachine, HeadBranch,
+    KinematicsError, LoadedMachine, ParameterSet, Poses, SensorNoise, SimulateRequest, TrueErrors,
+};
 
 create_exception!(
     _tricept,
     InputError,
     pyo3::exceptions::PyValueError,
     "Bad input: a file, an array or an option; the message names the file, line and column, or the row."
+);
+
+create_exception!(
+    _tricept,
+    UntrustedError,
+    pyo3::exceptions::PyRuntimeError,
+    "A result that is not to be trusted was asked to be written (the CLI's refusal: exit code 3 or 4); `force=True` writes it, marked as forced."
 );
 
 /// The input error of a door error, or of any message.
@@ -36,6 +53,9 @@ fn input_error(message: impl Into<String>) -> PyErr {
 fn door_error(e: tricept_ident::Error) -> PyErr {
     match e.kind() {
         tricept_ident::ErrorKind::Input => input_error(e.message()),
+        tricept_ident::ErrorKind::Inadequate | tricept_ident::ErrorKind::NotConverged => {
+            UntrustedError::new_err((e.message().to_string(), e.exit_code()))
+        }
         _ => pyo3::exceptions::PyRuntimeError::new_err(e.message().to_string()),
     }
 }
@@ -228,10 +248,296 @@ impl Machine {
     }
 }
 
+/// The machine of a workflow: a file, or the embedded Table 1 machine,
+/// with sensor-noise overrides.
+fn machine_of(path: Option<PathBuf>, noise: SensorNoise) -> PyResult<LoadedMachine> {
+    tricept_ident::load_machine(path.as_deref(), &noise).map_err(door_error)
+}
+
+/// Data given as a file path or as CSV text (named `name` in messages),
+/// checked against `machine`'s stroke.
+fn data_of(
+    path: Option<PathBuf>,
+    csv_text: Option<&str>,
+    name: &str,
+    machine: &tricept_ident::Machine,
+) -> PyResult<DataInput> {
+    match (path, csv_text) {
+        (Some(path), None) => Ok(DataInput::File(path)),
+        (None, Some(text)) => Ok(DataInput::Memory(
+            tricept_ident::read_data_from(text.as_bytes(), name, machine).map_err(door_error)?,
+        )),
+        _ => Err(input_error("data: give a CSV path or a mapping of column arrays")),
+    }
+}
+
+/// A calibration (`tricept identify`): its verdict, estimates, covariance,
+/// JSON and report, and the machine file it may write.
+#[pyclass(module = "tricept._tricept", unsendable)]
+struct Calibration {
+    inner: tricept_ident::Calibration,
+}
+
+#[pymethods]
+impl Calibration {
+    /// 0 trusted, 3 the model does not explain the data or the campaign
+    /// is too small, 4 not converged: the CLI's exit code.
+    #[getter]
+    fn exit_code(&self) -> u8 {
+        self.inner.exit_code()
+    }
+
+    /// The parameter names, in the order of the covariance.
+    #[getter]
+    fn names(&self) -> Vec<String> {
+        self.inner.estimates().into_iter().map(|(n, _, _)| n).collect()
+    }
+
+    /// The estimates by name (mm, rad).
+    #[getter]
+    fn estimates(&self) -> Vec<(String, f64)> {
+        self.inner.estimates().into_iter().map(|(n, v, _)| (n, v)).collect()
+    }
+
+    /// Their standard deviations by name (mm, rad; `None`: held).
+    #[getter]
+    fn sd(&self) -> Vec<(String, Option<f64>)> {
+        self.inner.estimates().into_iter().map(|(n, _, s)| (n, s)).collect()
+    }
+
+    /// The estimates' covariance (mm^2, rad^2), in the order of `names`.
+    #[getter]
+    fn covariance<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let c = self.inner.covariance();
+        Array2::from_shape_fn((c.nrows(), c.ncols()), |(i, j)| c[(i, j)]).into_pyarray(py)
+    }
+
+    /// The warnings of the fit, one line each.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.inner.warnings().to_vec()
+    }
+
+    /// The JSON `tricept identify --json` prints.
+    fn to_json(&self) -> String {
+        self.inner.to_json().to_string()
+    }
+
+    /// The text report `tricept identify` prints.
+    fn report(&self) -> String {
+        self.inner.report()
+    }
+
+    /// Writes the calibrated machine file by the CLI's rule: a fit whose
+    /// exit code is not 0 raises `UntrustedError` unless `force`; data
+    /// given as arrays cannot be recorded and raise `InputError`.
+    #[pyo3(signature = (path, force=false))]
+    fn write_machine(&mut self, path: PathBuf, force: bool) -> PyResult<String> {
+        let written = self.inner.write_machine(&path, force).map_err(door_error)?;
+        Ok(written.path().display().to_string())
+    }
+}
+
+/// Identifies the machine from measured data (`tricept identify`).
+#[pyfunction]
+#[pyo3(signature = (path=None, csv_text=None, name="<arrays>".to_string(), machine=None, params="paper15".to_string(), robust=true, tolerance_mm=None, angle_noise_arcsec=None, length_noise_um=None, readings_per_pose=None))]
+#[allow(clippy::too_many_arguments)]
+fn identify(
+    py: Python<'_>,
+    path: Option<PathBuf>,
+    csv_text: Option<String>,
+    name: String,
+    machine: Option<PathBuf>,
+    params: String,
+    robust: bool,
+    tolerance_mm: Option<f64>,
+    angle_noise_arcsec: Option<f64>,
+    length_noise_um: Option<f64>,
+    readings_per_pose: Option<u32>,
+) -> PyResult<Calibration> {
+    let noise = SensorNoise {
+        angle_noise_arcsec,
+        length_noise_um,
+        readings_per_pose,
+    };
+    let data = match (path, csv_text) {
+        (Some(path), None) => Data::File(path),
+        (None, Some(text)) => {
+            let loaded = machine_of(machine.clone(), noise)?;
+            Data::InMemory(
+                tricept_ident::read_data_from(text.as_bytes(), &name, loaded.machine())
+                    .map_err(door_error)?,
+            )
+        }
+        _ => return Err(input_error("data: give a CSV path or a mapping of column arrays")),
+    };
+    let mut request = CalibrateRequest::new(data);
+    request.machine = machine;
+    request.noise = noise;
+    request.parameter_set = ParameterSet::by_label(&params).map_err(|e| input_error(format!("params: {e}")))?;
+    request.robust = robust;
+    if let Some(t) = tolerance_mm {
+        request.tolerance_mm = t;
+    }
+    // Under the GIL: a fused calibration's sources are not `Send`.
+    let _ = py;
+    let inner = tricept_ident::calibrate(&request).map_err(door_error)?;
+    Ok(Calibration { inner })
+}
+
+/// A diagnosis (`tricept diagnose`): its exit code, JSON, report, and the
+/// extended machine file it may write.
+#[pyclass(module = "tricept._tricept")]
+struct Diagnosis {
+    inner: tricept_ident::DiagnoseResult,
+}
+
+#[pymethods]
+impl Diagnosis {
+    /// 0 the final model explains the data, 3 it does not.
+    #[getter]
+    fn exit_code(&self) -> u8 {
+        self.inner.exit_code()
+    }
+
+    /// The JSON `tricept diagnose --json` prints.
+    fn to_json(&self) -> String {
+        self.inner.to_json()
+    }
+
+    /// The text report `tricept diagnose` prints.
+    fn report(&self) -> String {
+        self.inner.to_text()
+    }
+
+    /// Writes the deployed machine file by the CLI's rule (`UntrustedError`
+    /// unless the final model explains the data, or `force`).
+    #[pyo3(signature = (path, force=false))]
+    fn write_machine(&self, path: PathBuf, force: bool) -> PyResult<Option<String>> {
+        self.inner.write_machine(&path, force).map_err(door_error)
+    }
+}
+
+/// Diagnoses measured data (`tricept diagnose`).
+#[pyfunction]
+#[pyo3(signature = (path=None, csv_text=None, name="<arrays>".to_string(), machine=None, noise_from_data=false, dictionary=true))]
+fn diagnose(
+    py: Python<'_>,
+    path: Option<PathBuf>,
+    csv_text: Option<String>,
+    name: String,
+    machine: Option<PathBuf>,
+    noise_from_data: bool,
+    dictionary: bool,
+) -> PyResult<Diagnosis> {
+    let loaded = machine_of(machine, SensorNoise::default())?;
+    let data = data_of(path, csv_text.as_deref(), &name, loaded.machine())?;
+    let mut request = DiagnoseRequest::new(loaded, data);
+    request.noise_from_data = noise_from_data;
+    request.dictionary = dictionary;
+    let inner = py
+        .detach(|| tricept_ident::diagnose(request))
+        .map_err(door_error)?;
+    Ok(Diagnosis { inner })
+}
+
+/// A check against a calibration (`tricept check`).
+#[pyclass(module = "tricept._tricept", frozen)]
+struct CheckResult {
+    inner: tricept_ident::CheckResult,
+}
+
+#[pymethods]
+impl CheckResult {
+    /// 0 unchanged, 3 changed: the CLI's exit code.
+    #[getter]
+    fn exit_code(&self) -> u8 {
+        self.inner.exit_code()
+    }
+
+    /// The JSON `tricept check --json` prints.
+    fn to_json(&self) -> String {
+        self.inner.to_json()
+    }
+
+    /// The text report `tricept check` prints.
+    fn report(&self) -> String {
+        self.inner.to_text()
+    }
+}
+
+/// Checks measured data against a calibrated machine file (`tricept check`).
+#[pyfunction]
+#[pyo3(signature = (machine, path=None, csv_text=None, name="<arrays>".to_string(), alpha=None, history=None))]
+fn check(
+    py: Python<'_>,
+    machine: PathBuf,
+    path: Option<PathBuf>,
+    csv_text: Option<String>,
+    name: String,
+    alpha: Option<f64>,
+    history: Option<PathBuf>,
+) -> PyResult<CheckResult> {
+    let loaded = machine_of(Some(machine), SensorNoise::default())?;
+    let data = data_of(path, csv_text.as_deref(), &name, loaded.machine())?;
+    let mut request = CheckRequest::new(loaded, data);
+    if let Some(a) = alpha {
+        request.alpha = a;
+    }
+    request.history = history;
+    let inner = py
+        .detach(|| tricept_ident::check(request))
+        .map_err(door_error)?;
+    Ok(CheckResult { inner })
+}
+
+/// Simulates a campaign (`tricept simulate`); returns the CSV text the CLI
+/// writes (the Python half turns it into column arrays).
+#[pyfunction]
+#[pyo3(signature = (machine=None, truth="table2".to_string(), effects=Vec::new(), poses="grid".to_string(), seed=1, params="paper15".to_string(), both_directions=false, noise_factor=1.0))]
+#[allow(clippy::too_many_arguments)]
+fn simulate_csv(
+    py: Python<'_>,
+    machine: Option<PathBuf>,
+    truth: String,
+    effects: Vec<String>,
+    poses: String,
+    seed: u64,
+    params: String,
+    both_directions: bool,
+    noise_factor: f64,
+) -> PyResult<String> {
+    let mut request = SimulateRequest::new(machine_of(machine, SensorNoise::default())?);
+    request.truth = truth
+        .parse::<TrueErrors>()
+        .map_err(|e| input_error(format!("truth: {e}")))?;
+    request.truth_effects = tricept_ident::parse_effects(&effects).map_err(door_error)?;
+    request.poses = poses.parse::<Poses>().map_err(door_error)?;
+    request.seed = seed;
+    request.parameter_set = ParameterSet::by_label(&params).map_err(|e| input_error(format!("params: {e}")))?;
+    request.both_directions = both_directions;
+    request.noise_factor = noise_factor;
+    let sim = py
+        .detach(|| tricept_ident::simulate(request))
+        .map_err(door_error)?;
+    let mut text = Vec::new();
+    tricept_data::write_to(&mut text, sim.data(), sim.comments())
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+    String::from_utf8(text).map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))
+}
+
 /// The compiled half of the `tricept` package.
 #[pymodule]
 fn _tricept(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Machine>()?;
+    m.add_class::<Calibration>()?;
+    m.add_class::<Diagnosis>()?;
+    m.add_class::<CheckResult>()?;
+    m.add_function(wrap_pyfunction!(identify, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnose, m)?)?;
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate_csv, m)?)?;
     m.add("InputError", m.py().get_type::<InputError>())?;
+    m.add("UntrustedError", m.py().get_type::<UntrustedError>())?;
     Ok(())
 }

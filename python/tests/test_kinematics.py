@@ -29,7 +29,7 @@ def test_ik_and_fk_equal_the_cli_batch(cli, tmp_path):
     m = tricept.Machine.paper()
     pts = workspace_points(200, 1)
     (tmp_path / "p.csv").write_text(
-        "x,y,z\n" + "\n".join(",".join(repr(v) for v in p) for p in pts) + "\n"
+        "x,y,z\n" + "\n".join(",".join(repr(float(v)) for v in p) for p in pts) + "\n"
     )
     out = cli("ik", "--input", tmp_path / "p.csv")
     assert out.returncode == 0, out.stderr
@@ -39,7 +39,7 @@ def test_ik_and_fk_equal_the_cli_batch(cli, tmp_path):
     for j, key in enumerate(["q1", "q2", "q3", "phi", "theta", "q4"]):
         np.testing.assert_allclose(q[:, j], rows[:, header.index(key)], rtol=0, atol=1e-9)
     (tmp_path / "q.csv").write_text(
-        "q1,q2,q3\n" + "\n".join(",".join(repr(v) for v in r) for r in q[:, :3]) + "\n"
+        "q1,q2,q3\n" + "\n".join(",".join(repr(float(v)) for v in r) for r in q[:, :3]) + "\n"
     )
     out = cli("fk", "--input", tmp_path / "q.csv")
     assert out.returncode == 0, out.stderr
@@ -58,7 +58,7 @@ def test_tool_ik_equals_the_cli_batch(cli, tmp_path):
     axes = np.tile([0.1, -0.05, 1.0], (50, 1))
     (tmp_path / "t.csv").write_text(
         "x,y,z,ax,ay,az\n"
-        + "\n".join(",".join(repr(v) for v in [*t, *a]) for t, a in zip(tips, axes))
+        + "\n".join(",".join(repr(float(v)) for v in [*t, *a]) for t, a in zip(tips, axes))
         + "\n"
     )
     out = cli("tool-ik", "--input", tmp_path / "t.csv")
@@ -100,7 +100,7 @@ def test_a_long_call_releases_the_gil():
     """While one thread solves a large batch, another thread runs Python
     code: with the GIL held it could not tick until the batch ended."""
     m = tricept.Machine.paper()
-    pts = np.tile(workspace_points(1000, 4), (400, 1))
+    pts = np.tile(workspace_points(1000, 4), (3000, 1))
     ticks = []
     done = threading.Event()
 

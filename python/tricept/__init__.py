@@ -10,17 +10,198 @@ library as the ``tricept`` command line (lengths in mm, angles in rad)::
 Arrays are read in place when they are C-contiguous float64 (anything else
 is converted once); the points are solved in parallel with the GIL released.
 Bad input raises :class:`InputError`, a :class:`ValueError`.
+
+The workflows are the CLI's, through the same library calls:
+:func:`identify` (``tricept identify``), :func:`diagnose`, :func:`check` and
+:func:`simulate`. Data are a CSV path or a mapping of the CSV's column names
+to 1-D arrays (a pandas DataFrame is one); results carry the CLI's exit
+code and ``to_json()`` is the CLI's ``--json``.
 """
 
+import json
 import os
-from typing import Union
+from typing import Mapping, Optional, Sequence, Union
 
 import numpy as np
 
 from . import _tricept
-from ._tricept import InputError
+from ._tricept import InputError, UntrustedError
 
-__all__ = ["InputError", "Machine"]
+__all__ = [
+    "InputError",
+    "UntrustedError",
+    "Machine",
+    "Calibration",
+    "Diagnosis",
+    "CheckResult",
+    "identify",
+    "diagnose",
+    "check",
+    "simulate",
+]
+
+Diagnosis = _tricept.Diagnosis
+CheckResult = _tricept.CheckResult
+
+PathLike = Union[str, os.PathLike]
+
+
+def _data(data) -> dict:
+    """The data argument as keyword arguments of the compiled workflows:
+    a path, or CSV text written from a mapping of column arrays with
+    shortest round-trip numbers (the same float64 bits)."""
+    if isinstance(data, (str, os.PathLike)):
+        return {"path": os.fspath(data)}
+    try:
+        names = [str(k) for k in data.keys()]
+    except AttributeError:
+        raise InputError("data: expected a CSV path or a mapping of column names to arrays") from None
+    columns = []
+    for k in names:
+        c = np.asarray(data[k])
+        if c.ndim != 1:
+            raise InputError(f"data: column `{k}` is not one-dimensional (shape {c.shape})")
+        columns.append(c)
+    n = {len(c) for c in columns}
+    if len(n) > 1:
+        raise InputError(f"data: the columns have different lengths {sorted(n)}")
+    lines = [",".join(names)]
+    for row in zip(*columns):
+        lines.append(",".join(_cell(v) for v in row))
+    return {"csv_text": "\n".join(lines) + "\n"}
+
+
+def _cell(v) -> str:
+    if isinstance(v, (float, np.floating)):
+        return repr(float(v))
+    if isinstance(v, (bool, np.bool_)):
+        return "1" if v else "0"
+    return str(v)
+
+
+class Calibration:
+    """A calibration (``tricept identify``): ``exit_code`` (0 trusted, 3
+    the model does not explain the data or the campaign is too small, 4 not
+    converged), ``estimates`` and ``sd`` by parameter name (mm, rad; an sd
+    of ``None`` is a held parameter), ``covariance`` (in the order of
+    ``names``), ``warnings``, ``to_json()``, ``report()`` and
+    ``write_machine(path, force=False)``."""
+
+    __slots__ = ("_c",)
+
+    def __init__(self, compiled: "_tricept.Calibration"):
+        self._c = compiled
+
+    @property
+    def exit_code(self) -> int:
+        return self._c.exit_code
+
+    @property
+    def names(self) -> "list[str]":
+        return self._c.names
+
+    @property
+    def estimates(self) -> "dict[str, float]":
+        return dict(self._c.estimates)
+
+    @property
+    def sd(self) -> "dict[str, Optional[float]]":
+        return dict(self._c.sd)
+
+    @property
+    def covariance(self) -> np.ndarray:
+        return self._c.covariance
+
+    @property
+    def warnings(self) -> "list[str]":
+        return self._c.warnings
+
+    def to_json(self) -> str:
+        """The JSON ``tricept identify --json`` prints."""
+        return self._c.to_json()
+
+    def report(self) -> str:
+        """The report ``tricept identify`` prints."""
+        return self._c.report()
+
+    def write_machine(self, path: PathLike, force: bool = False) -> str:
+        """Writes the calibrated machine file by the CLI's rule: a result
+        that is not to be trusted raises :class:`UntrustedError` unless
+        ``force``; a calibration from arrays cannot record its data file
+        and raises :class:`InputError`."""
+        return self._c.write_machine(os.fspath(path), force)
+
+    def __repr__(self) -> str:
+        return f"Calibration(exit_code={self.exit_code}, parameters={len(self.names)})"
+
+
+def identify(data, machine: Optional[PathLike] = None, **options) -> "Calibration":
+    """Identifies the machine's geometric errors from measured data, as
+    ``tricept identify`` does.
+
+    ``data``: a CSV path, or a mapping of the CSV's column names
+    (``q1, q2, q3, phi, theta, s`` and the optional ones) to 1-D arrays.
+    ``machine``: a machine file (default: the built-in Table 1 machine).
+    Options: ``params`` (``"paper15"`` or ``"full21"``), ``robust`` (reject
+    gross readings, default True), ``tolerance_mm``, ``angle_noise_arcsec``,
+    ``length_noise_um``, ``readings_per_pose``.
+
+    Returns a :class:`Calibration`: ``exit_code`` (0, 3 or 4 as the CLI),
+    ``estimates`` and ``sd`` (dicts, mm and rad), ``covariance`` (ndarray,
+    in the order of ``names``), ``to_json()`` (the CLI's ``--json``),
+    ``report()`` and ``write_machine(path, force=False)``.
+    """
+    return Calibration(
+        _tricept.identify(
+            machine=None if machine is None else os.fspath(machine), **_data(data), **options
+        )
+    )
+
+
+def diagnose(data, machine: Optional[PathLike] = None, **options) -> "Diagnosis":
+    """Does the geometric model explain the data, and if not, which effect
+    does (``tricept diagnose``)? Options: ``noise_from_data``,
+    ``dictionary``. Returns a :class:`Diagnosis` with ``exit_code``,
+    ``to_json()``, ``report()`` and ``write_machine(path, force=False)``."""
+    return _tricept.diagnose(
+        machine=None if machine is None else os.fspath(machine), **_data(data), **options
+    )
+
+
+def check(machine: PathLike, data, **options) -> "CheckResult":
+    """Has the machine changed since its calibration (``tricept check``)?
+    ``machine`` is the calibrated machine file. Options: ``alpha``,
+    ``history``. Returns a :class:`CheckResult` with ``exit_code``,
+    ``to_json()`` and ``report()``."""
+    return _tricept.check(os.fspath(machine), **_data(data), **options)
+
+
+def simulate(
+    machine: Optional[PathLike] = None,
+    truth: str = "table2",
+    effects: Sequence[Union[str, Mapping]] = (),
+    poses: str = "grid",
+    seed: int = 1,
+    **options,
+) -> "dict[str, np.ndarray]":
+    """Simulates a campaign on a machine with true errors (``tricept
+    simulate``): ``truth`` (``table2``, ``zero``, ``random:MAG_MM[,SEED]`` or
+    a JSON file), ``effects`` (JSON objects or dicts, as ``--truth-effect``),
+    ``poses`` (a ``--poses`` spec), ``seed``; options ``params``,
+    ``both_directions``, ``noise_factor``. Returns the CSV's columns as
+    arrays (the file ``tricept simulate --out`` writes, read back)."""
+    text = _tricept.simulate_csv(
+        machine=None if machine is None else os.fspath(machine),
+        truth=truth,
+        effects=[e if isinstance(e, str) else json.dumps(e) for e in effects],
+        poses=poses,
+        seed=seed,
+        **options,
+    )
+    lines = [l for l in text.splitlines() if l and not l.startswith("#")]
+    header = lines[0].split(",")
+    rows = [l.split(",") for l in lines[1:]]
+    return {name: np.array([float(r[j]) for r in rows]) for j, name in enumerate(header)}
 
 
 def _points(values, name: str) -> np.ndarray:

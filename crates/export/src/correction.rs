@@ -15,7 +15,7 @@ use tricept_kinematics::Machine;
 use tricept_kinematics::description::LegTableDescription;
 use tricept_model::ExtendedMachine;
 
-use crate::ExportError;
+use crate::types::ExportError;
 
 /// Margin added to each end of the stroke the workspace uses, mm.
 pub const STROKE_MARGIN_MM: f64 = 2.0;

@@ -10,7 +10,7 @@
 
 use tricept_kinematics::{Machine, MachineDescription};
 
-use crate::AxisSummary;
+use crate::types::AxisSummary;
 
 /// The file's name.
 pub const FILE: &str = "geometry.csv";

@@ -571,7 +571,7 @@ fn compliance_is_listed_as_not_exported_with_its_size() {
             .summary
             .not_exported
             .iter()
-            .any(|n| n.what == "compliance")
+            .any(|n| n.what == "leg_effects.compliance_um_per_kn_at_1m")
     );
     // 30 um/kN at 1 m, about what the diagnosis finds in
     // fixtures/data/diagnose-hidden-effect.csv: tens of um of leg length.
@@ -581,7 +581,7 @@ fn compliance_is_listed_as_not_exported_with_its_size() {
         .summary
         .not_exported
         .iter()
-        .find(|n| n.what == "compliance")
+        .find(|n| n.what == "leg_effects.compliance_um_per_kn_at_1m")
         .unwrap();
     assert!(c.size_um > 1.0 && c.size_um < 200.0, "{c:?}");
     for l in file(&p, "geometry.csv")

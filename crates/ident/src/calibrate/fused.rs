@@ -20,8 +20,7 @@ use tricept_kinematics::description::ExternalSourceRecord;
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
-use super::FusedSources;
-use super::values::{TrackerTargetSpec, eval_options, fused_model};
+use super::values::{FusedSources, TrackerTargetSpec, eval_options, fused_model};
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error};
 use crate::inputs::{LoadedMachine, check_commands, positive};
 use crate::{limits, machine_file};

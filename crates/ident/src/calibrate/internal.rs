@@ -9,6 +9,7 @@ use std::path::Path;
 
 use serde_json::{Map, Value, json};
 use tricept_data::Dataset;
+use tricept_engine::IdentError;
 use tricept_engine::{
     GeometricModel, Identification, IdentifyOptions, PredictedAccuracy, Rejection, Verdict,
     identify, identify_robust, likely_causes,
@@ -18,7 +19,6 @@ use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
 use super::advice::{campaign_advice, predicted_accuracy};
-use super::fit_error;
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error};
 use crate::inputs::LoadedMachine;
 use crate::machine_file;
@@ -313,4 +313,18 @@ pub(crate) fn rejected_json(rejected: &[Rejection]) -> Value {
             )
             .collect(),
     )
+}
+
+/// An identification error of the data `source`, with the line of a pose
+/// that cannot be reached.
+pub(crate) fn fit_error(source: &str, e: &IdentError) -> Error {
+    match e {
+        IdentError::Kinematics {
+            line, source: k, ..
+        } => Error::new(
+            crate::Classify::kind(e),
+            format!("{source}: line {line}: the commands of this pose cannot be reached: {k}"),
+        ),
+        e => Error::with_context(source, e),
+    }
 }

@@ -19,15 +19,14 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 use tricept_data::Dataset;
-use tricept_engine::IdentError;
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
-use tricept_model::effects::EffectName;
 
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, Error};
-use crate::inputs::{HeadAngles, LoadedMachine, SensorNoise, Triple, check_commands, load_machine};
+use crate::inputs::{LoadedMachine, SensorNoise, check_commands, load_machine};
 use crate::machine_file;
-use values::{EvalGrid, HeadModel, LengthSigma, TrackerTargetSpec};
+pub(crate) use internal::fit_error;
+pub use values::FusedSources;
 
 /// Measured data of the UP limb's sensors: a file (`q1,q2,q3,phi,theta,s`,
 /// docs/data-format.md) or a dataset already in memory.
@@ -113,73 +112,6 @@ impl CalibrateRequest {
             tolerance_mm: tricept_engine::DEFAULT_TOLERANCE_MM,
             fused: None,
             for_machine_file: false,
-        }
-    }
-}
-
-/// External measurements and the head model of a fused calibration.
-#[derive(Debug, Clone)]
-#[non_exhaustive]
-pub struct FusedSources {
-    /// Laser-tracker or CMM point files.
-    pub tracker: Vec<PathBuf>,
-    /// Standard deviation of a tracker coordinate for rows without one, um.
-    pub tracker_sigma_um: f64,
-    /// Where the tracker's target sits (required with a tracker).
-    pub tracker_target: Option<TrackerTargetSpec>,
-    /// Standard deviation of a known target offset, um.
-    pub tracker_target_sigma_um: f64,
-    /// Ballbar reading files.
-    pub ballbar: Vec<PathBuf>,
-    /// Standard deviation of a ballbar reading for rows without one, um.
-    pub ballbar_sigma_um: f64,
-    /// The bar length's uncertainty.
-    pub ballbar_length_sigma: LengthSigma,
-    /// Offset of the spindle ball from the tool tip, mm.
-    pub ballbar_ball_mm: Option<Triple>,
-    /// Touch-off files (need `features`).
-    pub touch: Vec<PathBuf>,
-    /// The features file of the touch-offs.
-    pub features: Option<PathBuf>,
-    /// Standard deviation of a touch for rows without one, um.
-    pub touch_sigma_um: f64,
-    /// The head's parameters.
-    pub head: HeadModel,
-    /// Effects fitted with the geometry.
-    pub effects: Vec<EffectName>,
-    /// Evaluation grid of the predicted tool tip.
-    pub eval_grid: EvalGrid,
-    /// Head angles of the evaluation grid, deg.
-    pub eval_head_angles: HeadAngles,
-    /// Overrides of the plausible ranges (a JSON file).
-    pub plausibility: Option<PathBuf>,
-    /// Warn when the predicted tool-axis uncertainty exceeds this, arcsec.
-    pub tool_axis_warn_arcsec: f64,
-}
-
-impl Default for FusedSources {
-    fn default() -> FusedSources {
-        FusedSources {
-            tracker: Vec::new(),
-            tracker_sigma_um: 10.0,
-            tracker_target: None,
-            tracker_target_sigma_um: 5.0,
-            ballbar: Vec::new(),
-            ballbar_sigma_um: 1.0,
-            ballbar_length_sigma: LengthSigma::Known(1.0),
-            ballbar_ball_mm: None,
-            touch: Vec::new(),
-            features: None,
-            touch_sigma_um: 1.5,
-            head: HeadModel::Head13,
-            effects: Vec::new(),
-            eval_grid: EvalGrid::default(),
-            eval_head_angles: HeadAngles {
-                h1_deg: vec![0.0, 90.0, 180.0, 270.0],
-                h2_deg: vec![15.0, 35.0],
-            },
-            plausibility: None,
-            tool_axis_warn_arcsec: 30.0,
         }
     }
 }
@@ -385,6 +317,15 @@ impl Calibration {
             .collect()
     }
 
+    /// The covariance of the estimates (mm², rad², mm·rad), in the order
+    /// of [`Calibration::estimates`]; held parameters have zero rows.
+    pub fn covariance(&self) -> &nalgebra::DMatrix<f64> {
+        match &self.fit {
+            Fit::Internal(f) => &f.id.covariance,
+            Fit::Fused(f) => &f.fit.covariance,
+        }
+    }
+
     /// The poses rejected as gross errors (internal fit) as JSON: 1-based
     /// pose number, file line, size.
     pub fn rejected_json(&self) -> Value {
@@ -450,20 +391,6 @@ impl Calibration {
             path: path.to_path_buf(),
             forced,
         })
-    }
-}
-
-/// An identification error of the data `source`, with the line of a pose
-/// that cannot be reached.
-pub(crate) fn fit_error(source: &str, e: &IdentError) -> Error {
-    match e {
-        IdentError::Kinematics {
-            line, source: k, ..
-        } => Error::new(
-            crate::Classify::kind(e),
-            format!("{source}: line {line}: the commands of this pose cannot be reached: {k}"),
-        ),
-        e => Error::with_context(source, e),
     }
 }
 

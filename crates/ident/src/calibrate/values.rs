@@ -6,6 +6,7 @@
 //! evaluation options they build.
 
 use std::fmt;
+use std::path::PathBuf;
 use std::str::FromStr;
 
 use tricept_engine::fusion::{FusedModel, FusionOptions, TrackerTarget, evaluation_poses};
@@ -14,7 +15,7 @@ use tricept_model::ParameterSet;
 use tricept_model::effects::EffectName;
 
 use crate::error::Error;
-use crate::inputs::{HeadAngles, parse_numbers, positive};
+use crate::inputs::{HeadAngles, Triple, parse_numbers, positive};
 use crate::limits;
 
 /// Where a tracker's target sits (`--tracker-target`): there is no default,
@@ -299,4 +300,71 @@ pub(crate) fn head_angles_text(angles: &HeadAngles) -> String {
             .join(",")
     };
     format!("{}:{}", list(&angles.h1_deg), list(&angles.h2_deg))
+}
+
+/// External measurements and the head model of a fused calibration.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct FusedSources {
+    /// Laser-tracker or CMM point files.
+    pub tracker: Vec<PathBuf>,
+    /// Standard deviation of a tracker coordinate for rows without one, um.
+    pub tracker_sigma_um: f64,
+    /// Where the tracker's target sits (required with a tracker).
+    pub tracker_target: Option<TrackerTargetSpec>,
+    /// Standard deviation of a known target offset, um.
+    pub tracker_target_sigma_um: f64,
+    /// Ballbar reading files.
+    pub ballbar: Vec<PathBuf>,
+    /// Standard deviation of a ballbar reading for rows without one, um.
+    pub ballbar_sigma_um: f64,
+    /// The bar length's uncertainty.
+    pub ballbar_length_sigma: LengthSigma,
+    /// Offset of the spindle ball from the tool tip, mm.
+    pub ballbar_ball_mm: Option<Triple>,
+    /// Touch-off files (need `features`).
+    pub touch: Vec<PathBuf>,
+    /// The features file of the touch-offs.
+    pub features: Option<PathBuf>,
+    /// Standard deviation of a touch for rows without one, um.
+    pub touch_sigma_um: f64,
+    /// The head's parameters.
+    pub head: HeadModel,
+    /// Effects fitted with the geometry.
+    pub effects: Vec<EffectName>,
+    /// Evaluation grid of the predicted tool tip.
+    pub eval_grid: EvalGrid,
+    /// Head angles of the evaluation grid, deg.
+    pub eval_head_angles: HeadAngles,
+    /// Overrides of the plausible ranges (a JSON file).
+    pub plausibility: Option<PathBuf>,
+    /// Warn when the predicted tool-axis uncertainty exceeds this, arcsec.
+    pub tool_axis_warn_arcsec: f64,
+}
+
+impl Default for FusedSources {
+    fn default() -> FusedSources {
+        FusedSources {
+            tracker: Vec::new(),
+            tracker_sigma_um: 10.0,
+            tracker_target: None,
+            tracker_target_sigma_um: 5.0,
+            ballbar: Vec::new(),
+            ballbar_sigma_um: 1.0,
+            ballbar_length_sigma: LengthSigma::Known(1.0),
+            ballbar_ball_mm: None,
+            touch: Vec::new(),
+            features: None,
+            touch_sigma_um: 1.5,
+            head: HeadModel::Head13,
+            effects: Vec::new(),
+            eval_grid: EvalGrid::default(),
+            eval_head_angles: HeadAngles {
+                h1_deg: vec![0.0, 90.0, 180.0, 270.0],
+                h2_deg: vec![15.0, 35.0],
+            },
+            plausibility: None,
+            tool_axis_warn_arcsec: 30.0,
+        }
+    }
 }
