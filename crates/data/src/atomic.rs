@@ -245,6 +245,71 @@ mod tests {
         std::fs::remove_dir_all(&d).ok();
     }
 
+    /// Runs `f` on its own thread and returns its result, failing the test
+    /// when it takes more than 10 s (a writer that retries forever).
+    fn promptly<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let _ = tx.send(f());
+        });
+        rx.recv_timeout(std::time::Duration::from_secs(10))
+            .expect("the write did not return within 10 s")
+    }
+
+    #[test]
+    fn a_missing_directory_is_an_error_at_once() {
+        let d = dir("missing");
+        let target = d.join("no").join("such").join("machine.json");
+        let e = promptly(move || write_atomic(&target, |w| w.write_all(b"x")).unwrap_err());
+        assert_eq!(e.kind(), io::ErrorKind::NotFound, "{e}");
+        assert!(entries(&d).is_empty(), "{:?}", entries(&d));
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_read_only_directory_is_an_error_at_once() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = dir("readonly");
+        std::fs::set_permissions(&d, std::fs::Permissions::from_mode(0o555)).unwrap();
+        // A privileged user writes into a read-only directory all the same;
+        // a file system that refuses even root (sysfs) stands in then.
+        let privileged = std::fs::write(d.join("probe"), "").is_ok();
+        let read_only = if privileged {
+            PathBuf::from("/sys")
+        } else {
+            d.clone()
+        };
+        if read_only.is_dir() {
+            let target = read_only.join(format!("tricept-atomic-{}.json", std::process::id()));
+            let written = target.clone();
+            let e = promptly(move || write_atomic(&written, |w| w.write_all(b"x")).unwrap_err());
+            assert_eq!(e.kind(), io::ErrorKind::PermissionDenied, "{e}");
+            assert!(!target.exists());
+        }
+        std::fs::set_permissions(&d, std::fs::Permissions::from_mode(0o755)).unwrap();
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    #[test]
+    fn the_temporary_file_lies_beside_its_target() {
+        let d = dir("beside");
+        let target = d.join("machine.json");
+        let mut seen = Vec::new();
+        write_atomic(&target, |w| {
+            // While the content is written, the target's directory holds
+            // the temporary file and nothing else.
+            seen = entries(&d);
+            w.write_all(b"new")
+        })
+        .unwrap();
+        assert_eq!(seen.len(), 1, "{seen:?}");
+        assert!(seen[0].starts_with(".machine.json.tmp-"), "{seen:?}");
+        assert_eq!(entries(&d), vec!["machine.json".to_string()]);
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
+        std::fs::remove_dir_all(&d).ok();
+    }
+
     #[test]
     fn a_directory_is_not_replaced() {
         let d = dir("isdir");
