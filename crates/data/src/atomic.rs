@@ -58,10 +58,7 @@ where
     F: FnOnce(&mut dyn Write) -> io::Result<()>,
 {
     let target = resolve(path)?;
-    let dir = match target.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
+    let dir = directory_of(&target);
     let (tmp_path, file) = create_temporary(&dir, &target)?;
     let result = (|| {
         if let Ok(meta) = std::fs::metadata(&target) {
@@ -93,6 +90,15 @@ where
     }
 }
 
+/// The directory `target` lies in, the one synced after the rename: its
+/// parent, `.` for a bare file name (whose parent is empty).
+fn directory_of(target: &Path) -> PathBuf {
+    match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
 /// The file a write to `path` replaces: `path` itself, or what a symbolic
 /// link at `path` points to (followed to the end).
 fn resolve(path: &Path) -> io::Result<PathBuf> {
@@ -118,9 +124,11 @@ fn resolve(path: &Path) -> io::Result<PathBuf> {
     Err(io::Error::other("too many levels of symbolic links"))
 }
 
+/// The number of the next temporary file of this process.
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
 /// A new, exclusively created temporary file beside `target`.
 fn create_temporary(dir: &Path, target: &Path) -> io::Result<(PathBuf, File)> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
     let name = target
         .file_name()
         .map_or_else(|| "file".into(), |n| n.to_string_lossy().into_owned());
@@ -311,10 +319,35 @@ mod tests {
     }
 
     #[test]
+    fn the_directory_of_a_bare_file_name_is_the_current_one() {
+        assert_eq!(directory_of(Path::new("machine.json")), Path::new("."));
+        assert_eq!(directory_of(Path::new("out/m.json")), Path::new("out"));
+        assert_eq!(directory_of(Path::new("/data/m.json")), Path::new("/data"));
+    }
+
+    #[test]
+    fn a_temporary_name_already_taken_is_skipped() {
+        let d = dir("taken");
+        let target = d.join("machine.json");
+        // Every name the next 200 temporary files of this process would take.
+        let next = COUNTER.load(Ordering::Relaxed);
+        for n in next..next + 200 {
+            let name = format!(".machine.json.tmp-{}-{n}", std::process::id());
+            std::fs::write(d.join(name), "someone else's").unwrap();
+        }
+        write_atomic(&target, |w| w.write_all(b"new")).unwrap();
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
+        // The other files are left alone.
+        assert_eq!(entries(&d).len(), 201);
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    #[test]
     fn a_directory_is_not_replaced() {
         let d = dir("isdir");
         let e = write_atomic(&d, |w| w.write_all(b"x")).unwrap_err();
-        assert!(e.to_string().contains("directory"), "{e}");
+        assert_eq!(e.kind(), io::ErrorKind::IsADirectory);
+        assert_eq!(e.to_string(), "is a directory, not a file");
         assert!(d.is_dir());
         std::fs::remove_dir_all(&d).ok();
     }
