@@ -84,7 +84,7 @@ const TARGETS: &[Target] = &[
     },
 ];
 
-/// The part `.ci/run` runs: the verdict and the atomic writes (about 25
+/// The part `.ci/run` runs: the verdict and the atomic writes (11.5
 /// minutes on the 2-core build machine; docs/testing.md).
 pub const CI_TARGETS: [&str; 2] = ["verdict", "atomic"];
 
@@ -267,6 +267,7 @@ pub fn run(args: MutantsArgs) -> Result<(), String> {
     let mut rows = Vec::new();
     for r in runs(&args)? {
         let out = root.join("target").join("mutants").join(&r.0);
+        std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
         let argv = mutants_args(&r, &args, &out);
         eprintln!("cargo {}", argv.join(" "));
         let started = std::time::Instant::now();
