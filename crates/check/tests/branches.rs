@@ -330,3 +330,98 @@ fn the_report_shows_lengths_in_um_and_the_shortlist() {
     r.shortlist.truncate(1);
     assert!(!r.to_text().contains("cannot tell apart"));
 }
+
+#[test]
+fn a_candidate_the_campaign_cannot_see_is_named() {
+    // Every pose at the calibration's temperature: a thermal growth has no
+    // effect on any reading (its columns are proportional to T - T_cal).
+    let m = Machine::paper();
+    let set = ParameterSet::paper15();
+    let reference =
+        Reference::new(m.clone(), set, DMatrix::zeros(15, 15), [0.0; 3], Some(20.0)).unwrap();
+    let mut data = campaign(&m, &[], 20, 5, 1.0);
+    for p in data.poses.iter_mut() {
+        p.temp_c = Some(20.0);
+    }
+    let r = check(&reference, &data, &CheckOptions::for_machine(&m)).unwrap();
+    let thermal = r
+        .candidates
+        .iter()
+        .find(|c| c.name == "thermal growth")
+        .unwrap();
+    assert!(thermal.detectable.iter().all(Option::is_none));
+    assert_eq!(
+        r.warnings,
+        vec!["this campaign cannot see a change of thermal growth".to_string()]
+    );
+    // A campaign that sees every candidate warns of none, and is not blind:
+    // 20 spread poses see a leg's length change of a few um, not 1 mm.
+    let r = run(&m, &campaign(&m, &[], 20, 5, 1.0));
+    assert!(r.warnings.is_empty());
+    assert!(!r.is_blind());
+    assert!(r.smallest_detectable_mm().unwrap() < 0.1);
+}
+
+#[test]
+fn a_pose_out_of_reach_is_named_by_its_number() {
+    let m = Machine::paper();
+    let mut data = campaign(&m, &[], 10, 6, 1.0);
+    data.poses[2].commands_mm = [1e5, 1.0, 1.0];
+    match check(&reference(&m), &data, &CheckOptions::for_machine(&m)) {
+        Err(CheckError::Kinematics { pose, .. }) => assert_eq!(pose, 3),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn noise_free_changes_come_back_exactly() {
+    // Without noise a slipped leg's length, fitted alone, is the slip (to
+    // the linearisation, well under 1 %), and it moves the platform.
+    let m = Machine::paper();
+    let r = run(&m, &campaign(&m, &[("dq2", 0.025)], 20, 2, 0.0));
+    let leg = r.candidates.iter().find(|c| c.name == "leg 2").unwrap();
+    let (alone, sd) = leg.alone[0].unwrap();
+    assert!((alone - 0.025).abs() < 2.5e-4, "{alone}");
+    assert!(sd > 0.0 && sd < 0.25);
+    // A leg's length change moves the platform by about as much (the legs
+    // carry it), more in some places than others.
+    let (mean, max) = (leg.platform_mean_um, leg.platform_max_um);
+    assert!(mean > 0.25 * 25.0 && mean < 4.0 * 25.0, "{mean}");
+    assert!(max > mean && max < 8.0 * 25.0, "{max}");
+    // A sensor's gain moves no platform.
+    let scale = r
+        .candidates
+        .iter()
+        .find(|c| c.name == "scale gain")
+        .unwrap();
+    assert_eq!((scale.platform_mean_um, scale.platform_max_um), (0.0, 0.0));
+}
+
+#[test]
+fn the_leg_ranges_hold_the_workspace_centre() {
+    let m = Machine::paper();
+    let ranges = leg_ranges(&m).unwrap();
+    let centre = m
+        .inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0))
+        .unwrap()
+        .legs_mm;
+    for i in 0..3 {
+        let (lo, hi) = ranges[i];
+        assert!(
+            lo > 100.0 && lo < centre[i] && centre[i] < hi,
+            "leg {i}: {lo}..{hi}"
+        );
+    }
+}
+
+#[test]
+fn sensors_a_thousand_times_noisier_are_blind() {
+    let m = Machine::paper();
+    let data = campaign(&m, &[], 20, 5, 1.0);
+    let mut options = CheckOptions::for_machine(&m);
+    assert!(!check(&reference(&m), &data, &options).unwrap().is_blind());
+    options.sigma = options.sigma.map(|s| 1000.0 * s);
+    let r = check(&reference(&m), &data, &options).unwrap();
+    assert!(r.is_blind());
+    assert!(r.smallest_detectable_mm().is_none_or(|d| d > 1.0));
+}
