@@ -425,3 +425,17 @@ fn sensors_a_thousand_times_noisier_are_blind() {
     assert!(r.is_blind());
     assert!(r.smallest_detectable_mm().is_none_or(|d| d > 1.0));
 }
+
+#[test]
+fn an_uncertain_calibration_is_checked_with_four_poses() {
+    // More determined directions (15) than readings (12): the check still
+    // runs, its consistency test on 12 - 3 degrees of freedom.
+    let m = Machine::paper();
+    let set = ParameterSet::paper15();
+    let covariance = DMatrix::identity(15, 15) * 1e-4;
+    let reference = Reference::new(m.clone(), set, covariance, [0.0; 3], None).unwrap();
+    let data = campaign(&m, &[], 4, 9, 1.0);
+    let r = check(&reference, &data, &CheckOptions::for_machine(&m)).unwrap();
+    assert_eq!(r.consistency.dof, 9);
+    assert_test(&r.consistency, 0.005, "consistency");
+}
