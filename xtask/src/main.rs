@@ -6,6 +6,7 @@
 mod checks;
 mod fig3;
 mod hybrid;
+mod mutants;
 mod reproduction;
 mod study;
 
@@ -62,6 +63,11 @@ enum Command {
     /// Check that Cargo.toml's rust-version (and the README's) is at least
     /// that of every locked dependency (`cargo metadata --locked`).
     Msrv,
+    /// Mutation testing of the decision files (the verdict, the check, the
+    /// diagnosis' selection and admission, the deployment, the controller
+    /// export, atomic writes, the statistics) with cargo-mutants at a pinned
+    /// version, installed when missing; see docs/testing.md.
+    Mutants(mutants::MutantsArgs),
 }
 
 fn main() -> ExitCode {
@@ -78,6 +84,7 @@ fn main() -> ExitCode {
         } => fig3::run_compensation(seeds, &out, spacing),
         Command::OneBuild => checks::one_build(),
         Command::Msrv => checks::msrv(),
+        Command::Mutants(args) => mutants::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

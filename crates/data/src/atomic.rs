@@ -58,10 +58,7 @@ where
     F: FnOnce(&mut dyn Write) -> io::Result<()>,
 {
     let target = resolve(path)?;
-    let dir = match target.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
+    let dir = directory_of(&target);
     let (tmp_path, file) = create_temporary(&dir, &target)?;
     let result = (|| {
         if let Ok(meta) = std::fs::metadata(&target) {
@@ -93,6 +90,15 @@ where
     }
 }
 
+/// The directory `target` lies in, the one synced after the rename: its
+/// parent, `.` for a bare file name (whose parent is empty).
+fn directory_of(target: &Path) -> PathBuf {
+    match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
 /// The file a write to `path` replaces: `path` itself, or what a symbolic
 /// link at `path` points to (followed to the end).
 fn resolve(path: &Path) -> io::Result<PathBuf> {
@@ -118,9 +124,11 @@ fn resolve(path: &Path) -> io::Result<PathBuf> {
     Err(io::Error::other("too many levels of symbolic links"))
 }
 
+/// The number of the next temporary file of this process.
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
 /// A new, exclusively created temporary file beside `target`.
 fn create_temporary(dir: &Path, target: &Path) -> io::Result<(PathBuf, File)> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
     let name = target
         .file_name()
         .map_or_else(|| "file".into(), |n| n.to_string_lossy().into_owned());
@@ -245,11 +253,101 @@ mod tests {
         std::fs::remove_dir_all(&d).ok();
     }
 
+    /// Runs `f` on its own thread and returns its result, failing the test
+    /// when it takes more than 10 s (a writer that retries forever).
+    fn promptly<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let _ = tx.send(f());
+        });
+        rx.recv_timeout(std::time::Duration::from_secs(10))
+            .expect("the write did not return within 10 s")
+    }
+
+    #[test]
+    fn a_missing_directory_is_an_error_at_once() {
+        let d = dir("missing");
+        let target = d.join("no").join("such").join("machine.json");
+        let e = promptly(move || write_atomic(&target, |w| w.write_all(b"x")).unwrap_err());
+        assert_eq!(e.kind(), io::ErrorKind::NotFound, "{e}");
+        assert!(entries(&d).is_empty(), "{:?}", entries(&d));
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_read_only_directory_is_an_error_at_once() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = dir("readonly");
+        std::fs::set_permissions(&d, std::fs::Permissions::from_mode(0o555)).unwrap();
+        // A privileged user writes into a read-only directory all the same;
+        // a file system that refuses even root (sysfs) stands in then.
+        let privileged = std::fs::write(d.join("probe"), "").is_ok();
+        let read_only = if privileged {
+            PathBuf::from("/sys")
+        } else {
+            d.clone()
+        };
+        if read_only.is_dir() {
+            let target = read_only.join(format!("tricept-atomic-{}.json", std::process::id()));
+            let written = target.clone();
+            let e = promptly(move || write_atomic(&written, |w| w.write_all(b"x")).unwrap_err());
+            assert_eq!(e.kind(), io::ErrorKind::PermissionDenied, "{e}");
+            assert!(!target.exists());
+        }
+        std::fs::set_permissions(&d, std::fs::Permissions::from_mode(0o755)).unwrap();
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    #[test]
+    fn the_temporary_file_lies_beside_its_target() {
+        let d = dir("beside");
+        let target = d.join("machine.json");
+        let mut seen = Vec::new();
+        write_atomic(&target, |w| {
+            // While the content is written, the target's directory holds
+            // the temporary file and nothing else.
+            seen = entries(&d);
+            w.write_all(b"new")
+        })
+        .unwrap();
+        assert_eq!(seen.len(), 1, "{seen:?}");
+        assert!(seen[0].starts_with(".machine.json.tmp-"), "{seen:?}");
+        assert_eq!(entries(&d), vec!["machine.json".to_string()]);
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    #[test]
+    fn the_directory_of_a_bare_file_name_is_the_current_one() {
+        assert_eq!(directory_of(Path::new("machine.json")), Path::new("."));
+        assert_eq!(directory_of(Path::new("out/m.json")), Path::new("out"));
+        assert_eq!(directory_of(Path::new("/data/m.json")), Path::new("/data"));
+    }
+
+    #[test]
+    fn a_temporary_name_already_taken_is_skipped() {
+        let d = dir("taken");
+        let target = d.join("machine.json");
+        // Every name the next 200 temporary files of this process would take.
+        let next = COUNTER.load(Ordering::Relaxed);
+        for n in next..next + 200 {
+            let name = format!(".machine.json.tmp-{}-{n}", std::process::id());
+            std::fs::write(d.join(name), "someone else's").unwrap();
+        }
+        write_atomic(&target, |w| w.write_all(b"new")).unwrap();
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
+        // The other files are left alone.
+        assert_eq!(entries(&d).len(), 201);
+        std::fs::remove_dir_all(&d).ok();
+    }
+
     #[test]
     fn a_directory_is_not_replaced() {
         let d = dir("isdir");
         let e = write_atomic(&d, |w| w.write_all(b"x")).unwrap_err();
-        assert!(e.to_string().contains("directory"), "{e}");
+        assert_eq!(e.kind(), io::ErrorKind::IsADirectory);
+        assert_eq!(e.to_string(), "is a directory, not a file");
         assert!(d.is_dir());
         std::fs::remove_dir_all(&d).ok();
     }

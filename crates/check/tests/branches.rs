@@ -1,0 +1,441 @@
+//! Every verdict of a check and the numbers it reports, branch by branch
+//! (issue 32): "changed, unexplained" and "cause unknown", the p-values
+//! and degrees of freedom of its tests, the refusal of options no check can
+//! use, the campaign's mean temperature, and the report's units and lines.
+//!
+//! The reference is a perfectly known machine (zero covariance), so that
+//! each expectation follows from what the plant was given and from the
+//! documented test: the consistency statistic has `3n - 3` degrees of
+//! freedom and is compared at `alpha / 2`, each candidate at
+//! [`family_level`], the remaining misfit is `T0 - dT_best` on `3n - 3 -
+//! dim best` degrees of freedom. P-values are recomputed with
+//! `tricept_numerics::stats::chi2_sf`, itself tested against closed forms
+//! (crates/numerics/tests/stats_reference.rs).
+
+use nalgebra::DMatrix;
+use tricept_check::{
+    Candidate, CheckError, CheckOptions, CheckReport, CheckVerdict, ChiSquare, Reference, check,
+    family_level, leg_ranges,
+};
+use tricept_data::Dataset;
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+use tricept_numerics::stats::chi2_sf;
+use tricept_plant::{Campaign, Plant};
+
+fn reference(m: &Machine) -> Reference {
+    let set = ParameterSet::paper15();
+    Reference::new(m.clone(), set, DMatrix::zeros(15, 15), [0.0; 3], None).unwrap()
+}
+
+/// A check campaign of `n` random poses on a machine whose errors are
+/// `changes` (parameter name, mm), its true noise `noise_factor` times the
+/// stated one.
+fn campaign(m: &Machine, changes: &[(&str, f64)], n: usize, seed: u64, noise: f64) -> Dataset {
+    let set = ParameterSet::paper15();
+    let mut e = vec![0.0; set.len()];
+    for (name, v) in changes {
+        e[set.index_of(name).unwrap()] = *v;
+    }
+    let mut c = Campaign::random(m, n, seed);
+    c.noise_factor = noise;
+    Plant::geometric(m.clone(), set.to_errors(&e))
+        .simulate(&c)
+        .unwrap()
+}
+
+fn run(m: &Machine, data: &Dataset) -> CheckReport {
+    check(&reference(m), data, &CheckOptions::for_machine(m)).unwrap()
+}
+
+/// Asserts that `t` is the chi-square test of its statistic at `tail`.
+fn assert_test(t: &ChiSquare, tail: f64, what: &str) {
+    assert!(t.dof > 0, "{what}");
+    let p = chi2_sf(t.statistic, t.dof as f64);
+    assert!(
+        (t.p_value - p).abs() <= 1e-12 * p,
+        "{what}: p {} vs {p}",
+        t.p_value
+    );
+    assert!(t.p_value < 1.0, "{what}");
+    if p > 1e-300 {
+        assert!((t.ln_p_value - p.ln()).abs() < 1e-9, "{what}: ln p");
+    }
+    let at_critical = chi2_sf(t.critical, t.dof as f64);
+    assert!(
+        (at_critical - tail).abs() < 1e-6 * tail,
+        "{what}: critical {} has tail {at_critical}, not {tail}",
+        t.critical
+    );
+}
+
+fn level(m: &Machine, temperatures: bool) -> f64 {
+    let candidates = Candidate::all(leg_ranges(m).unwrap(), None, temperatures);
+    family_level(0.01, &candidates)
+}
+
+#[test]
+fn an_unchanged_machine_has_tests_with_their_degrees_of_freedom_and_p_values() {
+    let m = Machine::paper();
+    let data = campaign(&m, &[], 20, 7, 1.0);
+    let r = run(&m, &data);
+    assert_eq!(r.verdict, CheckVerdict::Unchanged);
+    assert!(!r.changed && r.most_likely.is_none() && r.remaining.is_none());
+    assert_eq!(r.poses, 20);
+    // 60 readings less the three offsets.
+    assert_eq!(r.consistency.dof, 57);
+    assert_test(&r.consistency, 0.005, "consistency");
+    assert!(r.consistency.statistic <= r.consistency.critical);
+    let level = level(&m, false);
+    for c in &r.candidates {
+        assert_test(&c.test, level, &c.name);
+        assert_eq!(
+            c.significant,
+            c.test.statistic > c.test.critical,
+            "{}",
+            c.name
+        );
+        assert!(!c.significant, "{}", c.name);
+        assert!(c.test.dof <= c.parameters.len() && c.fitted <= c.parameters.len());
+    }
+    let text = r.to_text();
+    assert!(text.starts_with("verdict: UNCHANGED"), "{text}");
+    assert!(
+        text.contains("chi2") && text.contains("for 57 dof"),
+        "{text}"
+    );
+}
+
+#[test]
+fn one_slipped_leg_is_changed_and_explained() {
+    let m = Machine::paper();
+    let r = run(&m, &campaign(&m, &[("dq2", 0.025)], 20, 2, 1.0));
+    assert_eq!(r.verdict, CheckVerdict::Changed);
+    let best = &r.candidates[r.most_likely.unwrap()];
+    assert_eq!(best.name, "leg 2");
+    let rest = r.remaining.unwrap();
+    assert_eq!(rest.dof, 57 - best.test.dof);
+    assert!((rest.statistic - (r.consistency.statistic - best.test.statistic)).abs() < 1e-6);
+    assert_test(&rest, 0.005, "remaining");
+    assert!(rest.statistic <= rest.critical);
+    assert!(!r.to_text().contains("no single change"));
+}
+
+#[test]
+fn two_changes_are_changed_but_unexplained() {
+    let m = Machine::paper();
+    // Two legs slipped by 50 um in opposite directions: no single
+    // candidate holds both.
+    let data = campaign(&m, &[("dq1", 0.05), ("dq3", -0.05)], 20, 4, 1.0);
+    let r = run(&m, &data);
+    assert!(r.changed);
+    assert_eq!(r.verdict, CheckVerdict::ChangedUnexplained);
+    assert_eq!(r.verdict.as_str(), "changed-unexplained");
+    let best = &r.candidates[r.most_likely.unwrap()];
+    assert!(
+        best.name == "leg 1" || best.name == "leg 3",
+        "{}",
+        best.name
+    );
+    let rest = r.remaining.unwrap();
+    assert_eq!(rest.dof, 57 - best.test.dof);
+    assert!((rest.statistic - (r.consistency.statistic - best.test.statistic)).abs() < 1e-6);
+    assert_test(&rest, 0.005, "remaining");
+    assert!(rest.statistic > rest.critical);
+    let text = r.to_text();
+    assert!(
+        text.starts_with("verdict: CHANGED, and no single change explains it all: most likely leg"),
+        "{text}"
+    );
+    assert!(text.contains(&format!(
+        "after the most likely change: chi2 {:.1} for {} dof",
+        rest.statistic, rest.dof
+    )));
+}
+
+#[test]
+fn more_noise_than_stated_is_a_change_of_unknown_cause() {
+    // The readings' noise 1.25 times the stated one over 100 poses: the
+    // consistency statistic is 1.56 chi2(297), beyond its 0.5 % point (about
+    // 366) with probability 0.995, while each candidate's 1.56 chi2(k) passes
+    // its Bonferroni level with probability under 0.008: no candidate
+    // explains it in about nine checks out of ten.
+    let m = Machine::paper();
+    let mut unknown = 0;
+    for seed in 0..5 {
+        let r = run(&m, &campaign(&m, &[], 100, 30 + seed, 1.25));
+        assert_eq!(r.consistency.dof, 297);
+        assert!(r.changed, "seed {seed}");
+        assert!(
+            r.consistency.statistic > r.consistency.critical,
+            "seed {seed}"
+        );
+        if r.candidates.iter().all(|c| !c.significant) {
+            unknown += 1;
+            assert_eq!(r.verdict, CheckVerdict::ChangedUnexplained, "seed {seed}");
+            assert!(r.most_likely.is_none() && r.remaining.is_none());
+            assert!(r.shortlist.is_empty());
+            let text = r.to_text();
+            assert!(
+                text.starts_with("verdict: CHANGED, cause unknown"),
+                "{text}"
+            );
+        }
+    }
+    assert!(unknown >= 3, "{unknown} of 5");
+}
+
+#[test]
+fn options_no_check_can_use_are_refused() {
+    let m = Machine::paper();
+    let data = campaign(&m, &[], 8, 1, 1.0);
+    let reference = reference(&m);
+    let good = CheckOptions::for_machine(&m);
+    assert!(check(&reference, &data, &good).is_ok());
+    let mut cases: Vec<(CheckOptions, &str)> = Vec::new();
+    for alpha in [0.0, -0.01, 0.5, 0.7, f64::NAN] {
+        cases.push((
+            CheckOptions {
+                alpha,
+                ..good.clone()
+            },
+            "false-alarm probability",
+        ));
+    }
+    for power in [0.0, -0.5, 1.0, 1.5, f64::NAN] {
+        cases.push((
+            CheckOptions {
+                power,
+                ..good.clone()
+            },
+            "power",
+        ));
+    }
+    for c in 0..3 {
+        for bad in [0.0, -1e-6, f64::NAN, f64::INFINITY] {
+            let mut sigma = good.sigma;
+            sigma[c] = bad;
+            cases.push((
+                CheckOptions {
+                    sigma,
+                    ..good.clone()
+                },
+                "noise",
+            ));
+        }
+    }
+    cases.push((
+        CheckOptions {
+            points_mm: Vec::new(),
+            ..good.clone()
+        },
+        "evaluation points",
+    ));
+    for (options, what) in &cases {
+        match check(&reference, &data, options) {
+            Err(CheckError::Invalid(message)) => assert!(message.contains(what), "{message}"),
+            other => panic!("{options:?}: {other:?}"),
+        }
+    }
+    // Just inside the ranges.
+    for (alpha, power) in [(0.49, 0.01), (1e-6, 0.999)] {
+        let options = CheckOptions {
+            alpha,
+            power,
+            ..good.clone()
+        };
+        let r = check(&reference, &data, &options).unwrap();
+        assert_eq!(r.alpha, alpha);
+    }
+}
+
+#[test]
+fn three_distinct_poses_are_blind() {
+    let m = Machine::paper();
+    let mut data = campaign(&m, &[], 8, 1, 1.0);
+    for j in 3..8 {
+        data.poses[j].commands_mm = data.poses[j % 3].commands_mm;
+    }
+    let e = check(&reference(&m), &data, &CheckOptions::for_machine(&m)).unwrap_err();
+    assert!(matches!(e, CheckError::Blind(_)), "{e:?}");
+    data.poses[7].commands_mm = campaign(&m, &[], 8, 1, 1.0).poses[7].commands_mm;
+    assert!(check(&reference(&m), &data, &CheckOptions::for_machine(&m)).is_ok());
+}
+
+#[test]
+fn the_campaign_temperature_is_its_mean() {
+    let m = Machine::paper();
+    let set = ParameterSet::paper15();
+    let reference =
+        Reference::new(m.clone(), set, DMatrix::zeros(15, 15), [0.0; 3], Some(20.0)).unwrap();
+    let mut data = campaign(&m, &[], 10, 3, 1.0);
+    let temps = [21.0, 22.0, 23.5, 20.5, 24.0, 22.0, 21.5, 23.0, 22.5, 25.0];
+    for (p, t) in data.poses.iter_mut().zip(temps) {
+        p.temp_c = Some(t);
+    }
+    // 225.0 / 10.
+    let options = CheckOptions::for_machine(&m);
+    let r = check(&reference, &data, &options).unwrap();
+    assert_eq!(r.temperature_c, Some(22.5));
+    assert!(r.candidates.iter().any(|c| c.name == "thermal growth"));
+    assert!(
+        r.to_text()
+            .contains("structure temperature at the check: 22.50 °C")
+    );
+    for p in data.poses.iter_mut() {
+        p.temp_c = p.temp_c.map(|t| t + 2.5);
+    }
+    let r = check(&reference, &data, &options).unwrap();
+    assert_eq!(r.temperature_c, Some(25.0));
+    // One pose without a temperature: no campaign temperature, no thermal
+    // candidate.
+    data.poses[4].temp_c = None;
+    let r3 = check(&reference, &data, &options).unwrap();
+    assert_eq!(r3.temperature_c, None);
+    assert!(r3.candidates.iter().all(|c| c.name != "thermal growth"));
+    assert!(!r3.to_text().contains("structure temperature"));
+}
+
+#[test]
+fn the_report_shows_lengths_in_um_and_the_shortlist() {
+    let m = Machine::paper();
+    let mut r = run(&m, &campaign(&m, &[("dq2", 0.025)], 20, 2, 1.0));
+    let b = r.most_likely.unwrap();
+    {
+        let c = &mut r.candidates[b];
+        assert_eq!(c.parameters[0], "dq2_mm");
+        c.estimate = vec![0.0253, 12.0, -40.0, 0.0];
+        c.std_dev = vec![Some(0.0012), Some(5.0), Some(3.0), None];
+        c.detectable = vec![Some(0.0049), Some(61.0), None, None];
+        c.platform_mean_um = 17.26;
+        c.platform_max_um = 31.5;
+    }
+    r.offsets_change = [0.0, 0.0, -0.00125];
+    r.shortlist = vec!["leg 2".into(), "base joint B2".into()];
+    let text = r.to_text();
+    let first = text.lines().next().unwrap();
+    assert_eq!(
+        first,
+        "verdict: CHANGED: most likely leg 2 (dq2 = +25.3 +- 1.2 um, lead2 = +12.0 +- 5.0 ppm, p2_leg2 = -40.0 +- 3.0 um), which moves the platform by 17.3 um on average and up to 31.5 um over the workspace"
+    );
+    let second = text.lines().nth(1).unwrap();
+    assert!(
+        second.starts_with("  the check cannot tell apart: leg 2, base joint B2 (each explains"),
+        "{second}"
+    );
+    assert!(text.contains("s -1.25 um"), "{text}");
+    let row = text.lines().find(|l| l.starts_with("leg 2 ")).unwrap();
+    assert!(row.contains("dq2 4.9 um, lead2 61.0 ppm"), "{row}");
+    // One candidate alone: no shortlist line.
+    r.shortlist.truncate(1);
+    assert!(!r.to_text().contains("cannot tell apart"));
+}
+
+#[test]
+fn a_candidate_the_campaign_cannot_see_is_named() {
+    // Every pose at the calibration's temperature: a thermal growth has no
+    // effect on any reading (its columns are proportional to T - T_cal).
+    let m = Machine::paper();
+    let set = ParameterSet::paper15();
+    let reference =
+        Reference::new(m.clone(), set, DMatrix::zeros(15, 15), [0.0; 3], Some(20.0)).unwrap();
+    let mut data = campaign(&m, &[], 20, 5, 1.0);
+    for p in data.poses.iter_mut() {
+        p.temp_c = Some(20.0);
+    }
+    let r = check(&reference, &data, &CheckOptions::for_machine(&m)).unwrap();
+    let thermal = r
+        .candidates
+        .iter()
+        .find(|c| c.name == "thermal growth")
+        .unwrap();
+    assert!(thermal.detectable.iter().all(Option::is_none));
+    assert_eq!(
+        r.warnings,
+        vec!["this campaign cannot see a change of thermal growth".to_string()]
+    );
+    // A campaign that sees every candidate warns of none, and is not blind:
+    // 20 spread poses see a leg's length change of a few um, not 1 mm.
+    let r = run(&m, &campaign(&m, &[], 20, 5, 1.0));
+    assert!(r.warnings.is_empty());
+    assert!(!r.is_blind());
+    assert!(r.smallest_detectable_mm().unwrap() < 0.1);
+}
+
+#[test]
+fn a_pose_out_of_reach_is_named_by_its_number() {
+    let m = Machine::paper();
+    let mut data = campaign(&m, &[], 10, 6, 1.0);
+    data.poses[2].commands_mm = [1e5, 1.0, 1.0];
+    match check(&reference(&m), &data, &CheckOptions::for_machine(&m)) {
+        Err(CheckError::Kinematics { pose, .. }) => assert_eq!(pose, 3),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn noise_free_changes_come_back_exactly() {
+    // Without noise a slipped leg's length, fitted alone, is the slip (to
+    // the linearisation, well under 1 %), and it moves the platform.
+    let m = Machine::paper();
+    let r = run(&m, &campaign(&m, &[("dq2", 0.025)], 20, 2, 0.0));
+    let leg = r.candidates.iter().find(|c| c.name == "leg 2").unwrap();
+    let (alone, sd) = leg.alone[0].unwrap();
+    assert!((alone - 0.025).abs() < 2.5e-4, "{alone}");
+    assert!(sd > 0.0 && sd < 0.25);
+    // A leg's length change moves the platform by about as much (the legs
+    // carry it), more in some places than others.
+    let (mean, max) = (leg.platform_mean_um, leg.platform_max_um);
+    assert!(mean > 0.25 * 25.0 && mean < 4.0 * 25.0, "{mean}");
+    assert!(max > mean && max < 8.0 * 25.0, "{max}");
+    // A sensor's gain moves no platform.
+    let scale = r
+        .candidates
+        .iter()
+        .find(|c| c.name == "scale gain")
+        .unwrap();
+    assert_eq!((scale.platform_mean_um, scale.platform_max_um), (0.0, 0.0));
+}
+
+#[test]
+fn the_leg_ranges_hold_the_workspace_centre() {
+    let m = Machine::paper();
+    let ranges = leg_ranges(&m).unwrap();
+    let centre = m
+        .inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0))
+        .unwrap()
+        .legs_mm;
+    for i in 0..3 {
+        let (lo, hi) = ranges[i];
+        assert!(
+            lo > 100.0 && lo < centre[i] && centre[i] < hi,
+            "leg {i}: {lo}..{hi}"
+        );
+    }
+}
+
+#[test]
+fn sensors_a_thousand_times_noisier_are_blind() {
+    let m = Machine::paper();
+    let data = campaign(&m, &[], 20, 5, 1.0);
+    let mut options = CheckOptions::for_machine(&m);
+    assert!(!check(&reference(&m), &data, &options).unwrap().is_blind());
+    options.sigma = options.sigma.map(|s| 1000.0 * s);
+    let r = check(&reference(&m), &data, &options).unwrap();
+    assert!(r.is_blind());
+    assert!(r.smallest_detectable_mm().is_none_or(|d| d > 1.0));
+}
+
+#[test]
+fn an_uncertain_calibration_is_checked_with_four_poses() {
+    // More determined directions (15) than readings (12): the check still
+    // runs, its consistency test on 12 - 3 degrees of freedom.
+    let m = Machine::paper();
+    let set = ParameterSet::paper15();
+    let covariance = DMatrix::identity(15, 15) * 1e-4;
+    let reference = Reference::new(m.clone(), set, covariance, [0.0; 3], None).unwrap();
+    let data = campaign(&m, &[], 4, 9, 1.0);
+    let r = check(&reference, &data, &CheckOptions::for_machine(&m)).unwrap();
+    assert_eq!(r.consistency.dof, 9);
+    assert_test(&r.consistency, 0.005, "consistency");
+}
