@@ -65,7 +65,7 @@ pub fn run(a: &CheckArgs) -> Result<u8, CliError> {
 fn plot_trends(dir: &Path, trends: &[Trend]) -> Result<(), CliError> {
     crate::files::create_dir(dir)?;
     for t in trends {
-        let path = dir.join(format!("check-{}.svg", t.name));
+        let path = crate::files::output_in("--plot", dir, &format!("check-{}.svg", t.name))?;
         let x: Vec<f64> = (1..=t.values.len()).map(|i| i as f64).collect();
         let title = format!("{} over the checks ({})", t.name, t.unit);
         let y_label = format!("{} ({})", t.name, t.unit);

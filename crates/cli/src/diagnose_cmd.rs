@@ -142,7 +142,7 @@ fn write_machine(result: &DiagnoseResult, path: &Path, force: bool) -> Result<()
 fn plot_residuals(dir: &Path, plots: &[ResidualPlot]) -> Result<(), CliError> {
     crate::files::create_dir(dir)?;
     for p in plots {
-        let path = dir.join(format!("residual-{}.svg", p.effect));
+        let path = crate::files::output_in("--plots", dir, &format!("residual-{}.svg", p.effect))?;
         let drawn = tricept_plot::scatter(
             &path,
             &tricept_plot::Axes {

@@ -115,6 +115,17 @@ impl FileRoles {
     /// that is a directory, and one whose directory does not exist (unless
     /// the verb creates it).
     pub fn check(&self) -> Result<(), CliError> {
+        // Kept for the files whose names only the results decide (plots).
+        let known = self
+            .inputs
+            .iter()
+            .map(|(f, p)| (f.clone(), p.clone(), "input"));
+        let known = known.chain(
+            self.outputs
+                .iter()
+                .map(|(f, p)| (f.clone(), p.clone(), "output")),
+        );
+        let _ = KNOWN_FILES.set(known.collect());
         for (i, (flag, input)) in self.inputs.iter().enumerate() {
             if let Some((_, first)) = self.inputs[..i]
                 .iter()
@@ -167,6 +178,28 @@ impl FileRoles {
             }
         }
         Ok(())
+    }
+}
+
+/// The run's inputs and outputs known beforehand (flag, path, role), set
+/// by [`FileRoles::check`].
+static KNOWN_FILES: std::sync::OnceLock<Vec<(String, PathBuf, &'static str)>> =
+    std::sync::OnceLock::new();
+
+/// `dir/name`, an output whose name the results decide (a plot per
+/// effect or quantity), refused (exit 2) when it is one of the run's
+/// inputs or other outputs (a history, a machine file), as
+/// [`FileRoles::check`] refuses the outputs known beforehand.
+pub fn output_in(flag: &str, dir: &Path, name: &str) -> Result<PathBuf, CliError> {
+    let out = dir.join(name);
+    let known = KNOWN_FILES.get().map_or(&[][..], Vec::as_slice);
+    match known.iter().find(|(_, p, _)| same_file(&out, p)) {
+        Some((other, p, role)) => Err(CliError::input(format!(
+            "{flag} {}: is also the {role} {other} {}; writing it would destroy that file: choose another directory",
+            out.display(),
+            p.display()
+        ))),
+        None => Ok(out),
     }
 }
 

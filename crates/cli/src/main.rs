@@ -345,10 +345,20 @@ fn main() -> ExitCode {
                 errln!("error: {line}");
                 return ExitCode::from(tricept_ident::EXIT_INPUT);
             }
-            // clap prints help/version to stdout (exit 0) and usage errors
-            // to stderr (exit 2).
-            let _ = e.print();
-            return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
+            // Usage errors go to stderr (exit 2); help and version are
+            // output like any other (a full disk is a failure, exit 1).
+            if e.use_stderr() {
+                let _ = e.print();
+                return ExitCode::from(2);
+            }
+            output::write_text(&e.render().to_string());
+            return match output::finish() {
+                Some(err) => {
+                    errln!("error: stdout: {err}: the output is incomplete");
+                    ExitCode::from(cli_error::EXIT_OTHER)
+                }
+                None => ExitCode::SUCCESS,
+            };
         }
     };
     let code = match run(cli) {
