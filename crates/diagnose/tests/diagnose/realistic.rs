@@ -9,9 +9,7 @@
 //! `cargo test -p tricept-diagnose --test realistic -- --nocapture` prints
 //! the `TALLY` lines quoted in `docs/diagnosis.md`.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use rand_pcg::Pcg64Mcg;
 use tricept_diagnose::{Diagnosis, Plausibility, RejectStage};
 use tricept_kinematics::Machine;

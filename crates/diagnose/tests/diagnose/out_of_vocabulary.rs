@@ -13,9 +13,7 @@
 //! below detection in most sets); at every size it must not be named as
 //! an eccentricity alone.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use tricept_diagnose::detect::detectability;
 use tricept_diagnose::{Diagnosis, Verdict};
 use tricept_engine::GeometricModel;

@@ -8,9 +8,7 @@
 //! `cargo test -p tricept-diagnose --test noise_from_data -- --nocapture`
 //! prints the tallies.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use tricept_diagnose::{NoiseSource, diagnose};
 use tricept_kinematics::Machine;
 

@@ -5,9 +5,7 @@
 //! `cargo test -p tricept-diagnose --test small_campaigns -- --nocapture`
 //! prints the tallies.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use tricept_diagnose::first_non_finite;
 use tricept_model::effects::EffectName as E;
 
