@@ -5,7 +5,7 @@
 //! found adequate with no cause named; when it is the stated noise, the
 //! check must agree.
 //!
-//! `cargo test -p tricept-diagnose --test noise_from_data -- --nocapture`
+//! `cargo test -p tricept-diagnose --test diagnose noise_from_data:: -- --nocapture`
 //! prints the tallies.
 
 use crate::common::*;

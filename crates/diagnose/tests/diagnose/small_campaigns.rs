@@ -2,7 +2,7 @@
 //! scale in a 40-pose campaign (the mean of 3 readings) must be flagged as
 //! an outlier, by its line, and never explained as a physical effect.
 //!
-//! `cargo test -p tricept-diagnose --test small_campaigns -- --nocapture`
+//! `cargo test -p tricept-diagnose --test diagnose small_campaigns:: -- --nocapture`
 //! prints the tallies.
 
 use crate::common::*;
