@@ -672,7 +672,14 @@ mod tests { use crate::only_tests::T; }
 /// `docs/...`, ...), without patterns (`*`, `<name>`).
 fn named_paths(map: &str) -> Vec<String> {
     const TOP: &[&str] = &[
-        "crates/", "xtask/", "benches/", "examples/", "fixtures/", "docs/", "fuzz/", ".ci/",
+        "crates/",
+        "xtask/",
+        "benches/",
+        "examples/",
+        "fixtures/",
+        "docs/",
+        "fuzz/",
+        ".ci/",
     ];
     map.split('`')
         .skip(1)

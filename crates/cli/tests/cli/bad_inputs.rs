@@ -80,7 +80,7 @@ fn replace_field(row: &str, index: usize, value: &str) -> String {
 /// The table of bad inputs: each an exit code 2 and a message naming the
 /// problem (the tests are the named cases below).
 fn bad_inputs_cases(dir: &Path) -> Vec<Case> {
-    let csv = good_csv(&dir);
+    let csv = good_csv(dir);
     let (_, header, rows) = split(&csv);
     let base = header.clone();
     let id = |file: &'static str| {
@@ -895,7 +895,7 @@ fn bad_external_cases(dir: &Path) -> Vec<Case> {
         .collect();
     std::fs::write(dir.join("poses.csv"), poses_csv(&tips, &axes, None)).unwrap();
     ok(
-        &dir,
+        dir,
         &[
             "simulate",
             "--poses",
@@ -920,7 +920,7 @@ fn bad_external_cases(dir: &Path) -> Vec<Case> {
         .collect();
     std::fs::write(dir.join("flat.csv"), poses_csv(&bar_tips, &axes[..8], None)).unwrap();
     ok(
-        &dir,
+        dir,
         &[
             "simulate",
             "--poses",
@@ -941,7 +941,7 @@ fn bad_external_cases(dir: &Path) -> Vec<Case> {
     )
     .unwrap();
     ok(
-        &dir,
+        dir,
         &[
             "simulate",
             "--poses",
@@ -959,7 +959,7 @@ fn bad_external_cases(dir: &Path) -> Vec<Case> {
     let z = [[0.0, 0.0, 1.0]; 5];
     std::fs::write(dir.join("still.csv"), poses_csv(&tips[..5], &z, None)).unwrap();
     ok(
-        &dir,
+        dir,
         &[
             "simulate",
             "--poses",
@@ -1264,7 +1264,7 @@ fn bad_external_cases(dir: &Path) -> Vec<Case> {
 /// in another format, calibrated machine files edited by hand; each an
 /// exit code 2 with one line naming the file, line and column or the flag.
 fn unusable_cases(dir: &Path) -> Vec<Case> {
-    let csv = good_csv(&dir);
+    let csv = good_csv(dir);
     std::fs::write(dir.join("good.csv"), &csv).unwrap();
     let (_, header, rows) = split(&csv);
     // A tracker file of this campaign (12 tool poses).
@@ -1286,7 +1286,7 @@ fn unusable_cases(dir: &Path) -> Vec<Case> {
         .collect();
     std::fs::write(dir.join("poses.csv"), poses_csv(&tips, &axes, None)).unwrap();
     ok(
-        &dir,
+        dir,
         &[
             "simulate",
             "--poses",
@@ -1315,7 +1315,7 @@ fn unusable_cases(dir: &Path) -> Vec<Case> {
     control[1] = replace_field(&control[1], 0, "7\u{1b}[2J7");
     // A calibrated machine file and hand edits of it.
     ok(
-        &dir,
+        dir,
         &[
             "identify",
             "--data",
