@@ -873,10 +873,9 @@ fn poses_csv(tips: &[[f64; 3]], axes: &[[f64; 3]], extension: Option<&[f64]>) ->
     s.into_bytes()
 }
 
-/// The table of bad external-instrument inputs (trackers, ballbars,
-/// touch-offs): each an exit code 2 and a message naming the problem.
-fn bad_external_cases(dir: &Path) -> Vec<Case> {
-    // Good files: internal data, 12 spread tracker points, a ballbar.
+/// 12 tool poses spread over the workspace: tips on a 250 mm circle at
+/// three heights, tool axes tilted 0.4 in turn.
+fn spread_tool_poses() -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
     let tips: Vec<[f64; 3]> = (0..12)
         .map(|j| {
             let a = j as f64 * std::f64::consts::FRAC_PI_6;
@@ -893,6 +892,14 @@ fn bad_external_cases(dir: &Path) -> Vec<Case> {
             [0.4 * a.cos(), 0.4 * a.sin(), 1.0]
         })
         .collect();
+    (tips, axes)
+}
+
+/// The table of bad external-instrument inputs (trackers, ballbars,
+/// touch-offs): each an exit code 2 and a message naming the problem.
+fn bad_external_cases(dir: &Path) -> Vec<Case> {
+    // Good files: internal data, 12 spread tracker points, a ballbar.
+    let (tips, axes) = spread_tool_poses();
     std::fs::write(dir.join("poses.csv"), poses_csv(&tips, &axes, None)).unwrap();
     ok(
         dir,
@@ -1268,22 +1275,7 @@ fn unusable_cases(dir: &Path) -> Vec<Case> {
     std::fs::write(dir.join("good.csv"), &csv).unwrap();
     let (_, header, rows) = split(&csv);
     // A tracker file of this campaign (12 tool poses).
-    let tips: Vec<[f64; 3]> = (0..12)
-        .map(|j| {
-            let a = j as f64 * std::f64::consts::FRAC_PI_6;
-            [
-                250.0 * a.cos(),
-                250.0 * a.sin(),
-                1050.0 + 10.0 * (j % 3) as f64,
-            ]
-        })
-        .collect();
-    let axes: Vec<[f64; 3]> = (0..12)
-        .map(|j| {
-            let a = j as f64 * 1.9;
-            [0.4 * a.cos(), 0.4 * a.sin(), 1.0]
-        })
-        .collect();
+    let (tips, axes) = spread_tool_poses();
     std::fs::write(dir.join("poses.csv"), poses_csv(&tips, &axes, None)).unwrap();
     ok(
         dir,
