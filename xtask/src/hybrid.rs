@@ -538,7 +538,9 @@ fn run_machine(
             .collect::<Option<_>>()
             .ok_or("instrument data unusable")?;
         let f = identify_fused(model, &sources, &options).map_err(|e| match e {
-            tricept_engine::IdentError::Source { message, .. } if message.starts_with("too few") => {
+            tricept_engine::IdentError::Source { message, .. }
+                if message.starts_with("too few") =>
+            {
                 "too few measurements for the unknowns"
             }
             tricept_engine::IdentError::NuisanceUnidentifiable { .. } => {
