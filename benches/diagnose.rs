@@ -21,10 +21,10 @@ fn data(n: usize, seed: u64, effects: Vec<Effect>) -> tricept_data::Dataset {
     let m = Machine::paper();
     let set = ParameterSet::paper15();
     let mut plant = Plant::geometric(m.clone(), set.to_errors(&random_errors(15, 0.25, seed)));
-    plant.effects = vec![Effect::Thermal {
+    plant.effects = vec![Effect::from(tricept_plant::effects::Thermal {
         drift_k: 2.0,
         expansion_ppm_per_k: 0.0,
-    }];
+    })];
     plant.effects.extend(effects);
     let mut d = plant.simulate(&Campaign::random(&m, n, seed)).unwrap();
     for (j, p) in d.poses.iter_mut().enumerate() {
@@ -45,12 +45,12 @@ fn diagnosis(c: &mut Criterion) {
             data(
                 200,
                 2,
-                vec![Effect::LegPeriodic {
+                vec![Effect::from(tricept_plant::effects::LegPeriodic {
                     um: [4.0; 3],
                     period_mm: 10.0,
                     phase_deg: [0.0, 120.0, 240.0],
                     waveform: Waveform::Sine,
-                }],
+                })],
             ),
         ),
         (
@@ -59,10 +59,10 @@ fn diagnosis(c: &mut Criterion) {
                 200,
                 4,
                 vec![
-                    Effect::LegLead {
+                    Effect::from(tricept_plant::effects::LegLead {
                         ppm: [80.0, -60.0, 50.0],
-                    },
-                    Effect::ScaleDrift { um: 4.0 },
+                    }),
+                    Effect::from(tricept_plant::effects::ScaleDrift { um: 4.0 }),
                 ],
             ),
         ),

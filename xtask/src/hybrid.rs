@@ -213,18 +213,20 @@ fn plant(m: &Machine, scenario: Scenario, seed: u64, head_scale: f64) -> Plant {
     let gain = draw(50.0, 150.0);
     let mut p = Plant::geometric(m.clone(), set.to_errors(&module));
     p.head_errors = random_head_errors(head_scale, seed);
-    let compliance = Effect::Compliance {
+    let compliance = Effect::from(tricept_plant::effects::Compliance {
         stiffness_n_per_um_at_1m: stiffness_for_platform_deflection(m, 12.0),
-    };
+    });
     p.effects = match scenario {
         Scenario::None => vec![],
         Scenario::Compliance => vec![compliance],
-        Scenario::LegLead => vec![Effect::LegLead { ppm: lead }],
-        Scenario::ScaleGain => vec![Effect::ScaleGain { ppm: gain }],
+        Scenario::LegLead => vec![Effect::from(tricept_plant::effects::LegLead { ppm: lead })],
+        Scenario::ScaleGain => vec![Effect::from(tricept_plant::effects::ScaleGain {
+            ppm: gain,
+        })],
         Scenario::All => vec![
             compliance,
-            Effect::LegLead { ppm: lead },
-            Effect::ScaleGain { ppm: gain },
+            Effect::from(tricept_plant::effects::LegLead { ppm: lead }),
+            Effect::from(tricept_plant::effects::ScaleGain { ppm: gain }),
         ],
     };
     p

@@ -106,6 +106,18 @@ fn modules(src: &Path) -> BTreeMap<Module, PathBuf> {
 /// (each replaced by a space, so that nothing inside them reads as a
 /// path).
 fn strip(text: &str) -> String {
+    strip_keeping(text, false)
+}
+
+/// The code of a file without comments (doc comments and their examples
+/// included), string literals kept.
+fn without_comments(text: &str) -> String {
+    strip_keeping(text, true)
+}
+
+/// [`strip`], keeping the string literals when `strings` (character
+/// literals and raw strings are dropped either way).
+fn strip_keeping(text: &str, strings: bool) -> String {
     let c: Vec<char> = text.chars().collect();
     let mut out = String::with_capacity(text.len());
     let mut i = 0;
@@ -156,6 +168,7 @@ fn strip(text: &str) -> String {
             i = j;
             out.push(' ');
         } else if c[i] == '"' {
+            let start = i;
             i += 1;
             while i < c.len() && c[i] != '"' {
                 if c[i] == '\\' {
@@ -164,7 +177,11 @@ fn strip(text: &str) -> String {
                 i += 1;
             }
             i += 1;
-            out.push(' ');
+            if strings {
+                out.extend(&c[start..i.min(c.len())]);
+            } else {
+                out.push(' ');
+            }
         } else if c[i] == '\'' {
             // A character literal ('x', '\n', '\u{..}') or a lifetime.
             if next == Some('\\') {
@@ -735,4 +752,102 @@ fn the_map_reader_finds_repository_paths() {
          `tests/<crate>/main.rs` or `crates/a b`; `.ci/run`",
     );
     assert_eq!(found, ["crates/x/src/lib.rs", "docs/", ".ci/run"]);
+}
+
+// One vocabulary of effects (issue 27): an effect of the registry is named
+// in its own file and its registry line, nowhere else in the libraries'
+// code; every other file reaches it through the registry.
+
+/// The effects checked, each with its report name and its variant
+/// (`EffectName::TubeTwist`, the simulator's input `TubeTwist`).
+const ONE_FILE_EFFECTS: &[(&str, &str)] = &[
+    ("tube-twist", "TubeTwist"),
+    ("encoder-eccentricity", "EncoderEccentricity"),
+    ("compliance", "Compliance"),
+];
+
+/// Whether `code` names the effect: its report name quoted, or its variant
+/// as a whole identifier.
+fn names_effect(code: &str, name: &str, variant: &str) -> bool {
+    if code.contains(&format!("\"{name}\"")) {
+        return true;
+    }
+    code.match_indices(variant).any(|(at, _)| {
+        let before = code[..at].chars().next_back();
+        let after = code[at + variant.len()..].chars().next();
+        !before.is_some_and(is_ident) && !after.is_some_and(is_ident)
+    })
+}
+
+/// The files of `crates/*/src` whose code outside tests names the effect.
+fn files_naming(root: &Path, name: &str, variant: &str) -> Vec<String> {
+    let mut found = Vec::new();
+    let Ok(entries) = std::fs::read_dir(root.join("crates")) else {
+        return found;
+    };
+    let mut stack: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path().join("src")))
+        .collect();
+    while let Some(p) = stack.pop() {
+        if p.is_dir() {
+            if let Ok(entries) = std::fs::read_dir(&p) {
+                stack.extend(entries.filter_map(|e| e.ok().map(|e| e.path())));
+            }
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            let text = std::fs::read_to_string(&p).unwrap_or_default();
+            if names_effect(&without_tests(&without_comments(&text)), name, variant) {
+                found.push(relative(root, &p));
+            }
+        }
+    }
+    found.sort();
+    found
+}
+
+/// `tube-twist`, `encoder-eccentricity` and `compliance` are each named in
+/// at most 2 files of the libraries' code: the effect's own file and the
+/// registry line (`crates/model/src/effects/mod.rs`).
+#[test]
+fn an_effect_is_named_in_its_file_and_the_registry_only() {
+    let root = workspace();
+    let registry = "crates/model/src/effects/mod.rs".to_string();
+    for (name, variant) in ONE_FILE_EFFECTS {
+        let files = files_naming(&root, name, variant);
+        let own = format!("crates/model/src/effects/{}.rs", name.replace('-', "_"));
+        assert!(
+            files.contains(&own) && files.contains(&registry),
+            "{name}: not found in its file and the registry: {files:?}"
+        );
+        assert!(
+            files.len() <= 2,
+            "{name} is named in {} files (at most 2: its file and the registry line): {files:?}",
+            files.len()
+        );
+    }
+}
+
+/// The counter itself: a name in a comment or a test does not count, a
+/// quoted name or a whole variant does.
+#[test]
+fn the_effect_counter_reads_code_only() {
+    let code = "// \"tube-twist\" and TubeTwist in a comment\n/// TubeTwist in a doc\nfn f() {}\n#[cfg(test)]\nmod tests { const X: &str = \"tube-twist\"; }\n";
+    assert!(!names_effect(
+        &without_tests(&without_comments(code)),
+        "tube-twist",
+        "TubeTwist"
+    ));
+    for named in [
+        "const X: &str = \"tube-twist\";",
+        "let e = EffectName::TubeTwist;",
+    ] {
+        assert!(
+            names_effect(&without_comments(named), "tube-twist", "TubeTwist"),
+            "{named}"
+        );
+    }
+    assert!(!names_effect(
+        "TubeTwister; tube-twist-ish",
+        "tube-twist",
+        "TubeTwist"
+    ));
 }

@@ -11,6 +11,11 @@
 //! | `scale gain` | `scale_gain_ppm` | `s 1e-6` on the scale | none: the sensor, not the machine |
 //! | `encoder gains` | `phi_gain_ppm`, `theta_gain_ppm` | `phi 1e-6`, `theta 1e-6` | none |
 //!
+//! The last rows are the registry's: every effect or generic family whose
+//! spec has a [`CheckRole`] (`thermal`, `leg-lead`'s common part,
+//! `scale-gain`, `encoder-gain`) is a candidate with its name, parameters
+//! and columns, when its condition on the logged temperatures holds.
+//!
 //! `J21` is the reading Jacobian of the 21 joint and length errors
 //! (eq. 9), `P21` the platform point's ([`tricept_model::position_error_jacobian`]),
 //! both at the pose. A zero jump of a sensor is not a candidate: the
@@ -19,8 +24,12 @@
 
 use nalgebra::Vector3;
 use serde::Serialize;
+use tricept_kinematics::UpJoints;
 use tricept_model::ErrorJacobian;
-use tricept_model::effects::{legendre_p2, legendre_p3, normalised_coordinate};
+use tricept_model::effects::{
+    Basis, CheckColumns, CheckRole, CheckWhen, EffectName, GenericFamily, legendre_p2, legendre_p3,
+    normalised_coordinate,
+};
 
 /// The most parameters a candidate has.
 pub(crate) const MAX_PARAMETERS: usize = 4;
@@ -61,18 +70,67 @@ pub struct Candidate {
     what: What,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy)]
 enum What {
     /// Leg `i` over its command range `(lo, hi)` in the workspace, mm.
     Leg(usize, (f64, f64)),
     Base(usize),
     Platform(usize),
-    Thermal {
-        reference_c: f64,
+    /// A change the registry declares, with the calibration's temperature
+    /// when both logged one.
+    Registry {
+        role: &'static CheckRole,
+        reference_c: Option<f64>,
     },
-    CommonLead,
-    ScaleGain,
-    EncoderGains,
+}
+
+impl PartialEq for What {
+    fn eq(&self, other: &What) -> bool {
+        match (self, other) {
+            (What::Leg(i, r), What::Leg(j, s)) => i == j && r == s,
+            (What::Base(i), What::Base(j)) | (What::Platform(i), What::Platform(j)) => i == j,
+            (
+                What::Registry {
+                    role: a,
+                    reference_c: x,
+                },
+                What::Registry {
+                    role: b,
+                    reference_c: y,
+                },
+            ) => a.name == b.name && x == y,
+            _ => false,
+        }
+    }
+}
+
+/// The check roles of the registry, in its order: the effects', then the
+/// generic families'.
+fn registry_roles() -> impl Iterator<Item = &'static CheckRole> {
+    let effects = EffectName::ALL
+        .into_iter()
+        .filter_map(|e| e.spec().check.as_ref());
+    let generic = GenericFamily::ALL
+        .into_iter()
+        .filter_map(|g| g.spec().check.as_ref());
+    effects.chain(generic)
+}
+
+impl What {
+    /// The temperature change since the calibration at `temp_c` (0 unless
+    /// both logged one).
+    fn delta_k(&self, temp_c: Option<f64>) -> f64 {
+        match (self, temp_c) {
+            (
+                What::Registry {
+                    reference_c: Some(r),
+                    ..
+                },
+                Some(t),
+            ) => t - r,
+            _ => 0.0,
+        }
+    }
 }
 
 /// What the columns of one pose are computed from.
@@ -140,32 +198,31 @@ impl Candidate {
                 ));
             }
         }
-        match (reference_c, check_has_temperature) {
-            (Some(t), true) => v.push(Candidate::new(
-                "thermal growth".into(),
-                CandidateKind::Thermal,
-                &["expansion_ppm_per_k".into()],
-                What::Thermal { reference_c: t },
-            )),
-            _ => v.push(Candidate::new(
-                "common leg lead".into(),
-                CandidateKind::Thermal,
-                &["lead_ppm".into()],
-                What::CommonLead,
-            )),
+        let both = reference_c.filter(|_| check_has_temperature);
+        for role in registry_roles() {
+            let applies = match role.when {
+                CheckWhen::Always => true,
+                CheckWhen::WithTemperatures => both.is_some(),
+                CheckWhen::WithoutTemperatures => both.is_none(),
+            };
+            if !applies {
+                continue;
+            }
+            let kind = match role.columns {
+                CheckColumns::Legs(_) => CandidateKind::Thermal,
+                CheckColumns::Readings(_) => CandidateKind::Sensor,
+            };
+            let parameters: Vec<String> = role.parameters.iter().map(|p| p.to_string()).collect();
+            v.push(Candidate::new(
+                role.name.into(),
+                kind,
+                &parameters,
+                What::Registry {
+                    role,
+                    reference_c: both,
+                },
+            ));
         }
-        v.push(Candidate::new(
-            "scale gain".into(),
-            CandidateKind::Sensor,
-            &["scale_gain_ppm".into()],
-            What::ScaleGain,
-        ));
-        v.push(Candidate::new(
-            "encoder gains".into(),
-            CandidateKind::Sensor,
-            &["phi_gain_ppm".into(), "theta_gain_ppm".into()],
-            What::EncoderGains,
-        ));
         v
     }
 
@@ -214,22 +271,29 @@ impl Candidate {
                         out[c][a] = j[(c, 7 * i + 3 + a)];
                     }
                 }
-                What::Thermal { reference_c } => {
-                    let dt = p.temp_c.map_or(0.0, |t| t - reference_c);
-                    out[c][0] = (0..3).map(|i| j[(c, 7 * i + 6)] * q[i] * 1e-6 * dt).sum();
-                }
-                What::CommonLead => {
-                    out[c][0] = (0..3).map(|i| j[(c, 7 * i + 6)] * q[i] * 1e-6).sum();
-                }
-                What::ScaleGain => {
-                    if c == 2 {
-                        out[c][0] = p.readings[2] * 1e-6;
+                What::Registry { role, .. } => match role.columns {
+                    CheckColumns::Legs(f) => {
+                        let dt = self.what.delta_k(p.temp_c);
+                        out[c][0] = (0..3).map(|i| j[(c, 7 * i + 6)] * f(q[i], dt)).sum();
                     }
-                }
-                What::EncoderGains => {
-                    if c < 2 {
-                        out[c][c] = p.readings[c] * 1e-6;
-                    }
+                    CheckColumns::Readings(_) => {}
+                },
+            }
+        }
+        if let What::Registry { role, .. } = self.what
+            && let CheckColumns::Readings(f) = role.columns
+        {
+            let up = UpJoints {
+                phi_rad: p.readings[0],
+                theta_rad: p.readings[1],
+                q4_mm: p.readings[2],
+            };
+            for (t, basis, value) in f(&up) {
+                if let Basis::Reading(c) = basis
+                    && c < 3
+                    && t < MAX_PARAMETERS
+                {
+                    out[c][t] += value;
                 }
             }
         }
@@ -256,14 +320,13 @@ impl Candidate {
             }
             What::Base(i) => (0..3).map(|a| col(7 * i + a) * v(a)).sum(),
             What::Platform(i) => (0..3).map(|a| col(7 * i + 3 + a) * v(a)).sum(),
-            What::Thermal { reference_c } => {
-                let dt = temp_c.map_or(0.0, |t| t - reference_c);
-                (0..3)
-                    .map(|i| col(7 * i + 6) * q[i] * 1e-6 * dt * v(0))
-                    .sum()
-            }
-            What::CommonLead => (0..3).map(|i| col(7 * i + 6) * q[i] * 1e-6 * v(0)).sum(),
-            What::ScaleGain | What::EncoderGains => Vector3::zeros(),
+            What::Registry { role, .. } => match role.columns {
+                CheckColumns::Legs(f) => {
+                    let dt = self.what.delta_k(temp_c);
+                    (0..3).map(|i| col(7 * i + 6) * f(q[i], dt) * v(0)).sum()
+                }
+                CheckColumns::Readings(_) => Vector3::zeros(),
+            },
         }
     }
 }

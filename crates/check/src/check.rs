@@ -90,7 +90,7 @@ impl CheckOptions {
             alpha: DEFAULT_ALPHA,
             power: DEFAULT_POWER,
             sigma: machine.sensors.logged_sigma(),
-            points_mm: machine.workspace.polar_grid(2, 8, 3),
+            points_mm: tricept_engine::accuracy_points(machine),
         }
     }
 }

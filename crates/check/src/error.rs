@@ -23,10 +23,12 @@ pub enum CheckError {
         /// The kinematic failure.
         source: tricept_kinematics::KinematicsError,
     },
-    /// The history file holds a line that is not a check.
+    /// The history file cannot be read as a history (a line that is not a
+    /// check, a file that cannot be read or is beyond the JSON inputs'
+    /// size bound): the input's fault.
     #[error("{0}")]
     HistoryLine(String),
-    /// The history file cannot be read or written.
+    /// The history file cannot be written.
     #[error("{0}")]
     History(String),
 }

@@ -15,7 +15,10 @@
 //!
 //! The file is rewritten whole at every append through
 //! [`tricept_data::write_atomic`], so that a crash never leaves half a
-//! line; a line that does not parse is an error naming it.
+//! line; a line that does not parse is an error naming it. Appends hold an
+//! exclusive lock on a lock file beside the history (`FILE.jsonl.lock`,
+//! left in place) from the read to the rename, so that checks appending to
+//! the same history at once keep every record.
 
 use serde::{Deserialize, Serialize};
 
@@ -116,10 +119,10 @@ impl Entry {
 /// The entries of a history file (none when it does not exist).
 pub fn read(path: &std::path::Path) -> Result<Vec<Entry>, CheckError> {
     let file = path.display();
-    let text = match std::fs::read_to_string(path) {
+    let text = match tricept_data::read_json_text(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(CheckError::History(format!("{file}: {e}"))),
+        Err(e) => return Err(CheckError::HistoryLine(format!("{file}: {e}"))),
     };
     text.lines()
         .enumerate()
@@ -135,8 +138,20 @@ pub fn read(path: &std::path::Path) -> Result<Vec<Entry>, CheckError> {
         .collect()
 }
 
-/// Appends `entry` to the history file `path` (rewritten atomically).
+/// Appends `entry` to the history file `path` (rewritten atomically,
+/// under an exclusive lock on `PATH.lock`: concurrent appends all land).
 pub fn append(path: &std::path::Path, entry: &Entry) -> Result<Vec<Entry>, CheckError> {
+    let failed = |e: std::io::Error| CheckError::History(format!("{}: {e}", path.display()));
+    let mut lock_name = path.as_os_str().to_owned();
+    lock_name.push(".lock");
+    let lock = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(std::path::PathBuf::from(lock_name))
+        .map_err(failed)?;
+    lock.lock().map_err(failed)?;
+    // The lock is released when `lock` is dropped, after the rename.
     let mut entries = read(path)?;
     entries.push(entry.clone());
     let mut text = String::new();
@@ -249,4 +264,54 @@ fn slope(x: &[f64], y: &[f64], sd: &[f64]) -> Option<(f64, f64)> {
         .map(|((x, y), w)| w * (x - mx) * (y - my))
         .sum();
     Some((sxy / sxx, (1.0 / sxx).sqrt()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn entry(writer: usize, i: usize) -> Entry {
+        Entry {
+            time: format!("2026-12-03T00:00:{i:02}Z"),
+            unix_s: i as f64,
+            machine: format!("writer{writer}"),
+            data_file: format!("day{i}.csv"),
+            verdict: "unchanged".into(),
+            most_likely: None,
+            shortlist: Vec::new(),
+            consistency: (1.0, 3, 0.8),
+            quantities: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn concurrent_appends_keep_every_record() {
+        let dir = std::env::temp_dir().join(format!("tricept-history-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("h.jsonl");
+        let _ = std::fs::remove_file(&path);
+        std::thread::scope(|s| {
+            for writer in 0..2 {
+                let path = &path;
+                s.spawn(move || {
+                    for i in 0..50 {
+                        append(path, &entry(writer, i)).unwrap();
+                    }
+                });
+            }
+        });
+        let kept = read(&path).unwrap();
+        assert_eq!(kept.len(), 100);
+        for writer in 0..2 {
+            let name = format!("writer{writer}");
+            let days: Vec<String> = kept
+                .iter()
+                .filter(|e| e.machine == name)
+                .map(|e| e.data_file.clone())
+                .collect();
+            let expected: Vec<String> = (0..50).map(|i| format!("day{i}.csv")).collect();
+            assert_eq!(days, expected, "{name}: every append, in its order");
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }

@@ -234,9 +234,11 @@ fn a_warmer_machine_is_found_as_thermal_growth() {
     for seed in 0..10 {
         let (mut plant, reference) = calibrated(400 + seed);
         // 3 K warmer than at the calibration: steel legs 11.5 ppm/K longer.
-        plant.effects.push(Effect::LegLead {
-            ppm: [11.5 * 3.0; 3],
-        });
+        plant
+            .effects
+            .push(Effect::from(tricept_plant::effects::LegLead {
+                ppm: [11.5 * 3.0; 3],
+            }));
         let r = run(
             &reference,
             &check_campaign(&plant, seed + 400, CALIBRATION_C + 3.0),
@@ -289,11 +291,13 @@ fn a_worn_screw_segment_is_found_on_its_leg() {
             .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
         let mut um = [0.0; 3];
         um[leg] = 30.0;
-        plant.effects.push(Effect::LegStep {
-            um,
-            from_mm: 0.5 * (lo + hi),
-            to_mm: hi + 100.0,
-        });
+        plant
+            .effects
+            .push(Effect::from(tricept_plant::effects::LegStep {
+                um,
+                from_mm: 0.5 * (lo + hi),
+                to_mm: hi + 100.0,
+            }));
         let r = run(
             &reference,
             &check_campaign(&plant, seed + 500, CALIBRATION_C),

@@ -1,22 +1,19 @@
-//! `tricept diagnose` and `tricept detectability`.
+//! `tricept diagnose` and `tricept detectability`: flags into a request
+//! of the door (`tricept_ident::diagnose`, `tricept_ident::detectability`),
+//! the result printed, the residual plots drawn.
 
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use serde_json::{Map, json};
-use tricept_diagnose::detect::{advise, realistic, term_detectability};
-use tricept_diagnose::{DiagnoseError, DiagnoseOptions, Plausibility, deploy, diagnose};
-use tricept_engine::GeometricModel;
-use tricept_model::effects::EffectName;
-use tricept_model::{GeometricErrors, ParameterSet};
-use tricept_plant::{Campaign, Effect, Plant, PoseOrder};
-
-use crate::args::{
-    LoadedMachine, MachineArgs, NoiseArgs, load_with_noise, machine_with_noise, pose_targets,
-    read_data,
+use tricept_ident::{
+    DataInput, DetectabilityRequest, DiagnoseRequest, DiagnoseResult, LoadedMachine, Poses,
+    ResidualPlot, detectability, diagnose,
 };
+
+use crate::args::{MachineArgs, NoiseArgs, load_with_noise, read_data};
 use crate::cli_error::CliError;
-use crate::machine_file;
+
+pub use tricept_ident::vocabulary_help;
 
 /// `tricept diagnose`.
 #[derive(Debug, Args)]
@@ -72,8 +69,8 @@ pub struct DiagnoseArgs {
 #[derive(Debug, Args)]
 pub struct DetectabilityArgs {
     /// Pose set (as for `identifiability`; positions in mm).
-    #[arg(long, default_value = "grid", conflicts_with = "data")]
-    pub poses: String,
+    #[arg(long, default_value = "grid", conflicts_with = "data", value_parser = clap::value_parser!(Poses))]
+    pub poses: Poses,
     /// Assess a logged campaign instead: its commands and their logged
     /// context (temperatures, times, approach directions) from this
     /// measured-data file; its readings are not used.
@@ -94,340 +91,92 @@ pub struct DetectabilityArgs {
 
 /// `tricept diagnose`.
 pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
-    let (machine, data) = (&a.machine, a.data.as_path());
-    let loaded = load_with_noise(machine, &a.noise)?;
-    let m = loaded.machine.clone();
-    let dataset = read_data(data, &m)?;
-    let source = data.display().to_string();
-    let mut options = DiagnoseOptions::for_machine(&m);
-    options.noise_from_data = a.noise_from_data;
-    options.rank_reference = loaded.rank_reference()?;
-    options.dictionary.enabled = !a.no_dictionary;
-    if let Some(k) = a.temperature_noise {
-        if !(k.is_finite() && k >= 0.0) {
-            return Err(CliError::input(format!(
-                "--temperature-noise: must be a non-negative number of kelvin, got {k}"
-            )));
-        }
-        options.temperature_sigma_k = k;
-    }
-    if let Some(path) = &a.plausibility {
-        let file = path.display().to_string();
-        let text =
-            std::fs::read_to_string(path).map_err(|e| CliError::input(format!("{file}: {e}")))?;
-        options.plausibility = Plausibility::with_overrides(&text)
-            .map_err(|e| CliError::input(format!("{file}: {e}")))?;
-    }
-    let d = diagnose(&m, &dataset, &options).map_err(|e| diagnose_error(&source, e))?;
+    let loaded = load_with_noise(&a.machine, &a.noise)?;
+    let data = read_with_progress(&a.data, &loaded)?;
+    let mut request = DiagnoseRequest::new(loaded, data);
+    request.noise_from_data = a.noise_from_data;
+    request.temperature_noise_k = a.temperature_noise;
+    request.plausibility = a.plausibility.clone();
+    request.dictionary = !a.no_dictionary;
+    let result = diagnose(request)?;
     if let Some(dir) = &a.plots {
-        crate::files::create_dir(dir)?;
-        for p in &d.plots {
-            let path = dir.join(format!("residual-{}.svg", p.effect));
-            let drawn = tricept_plot::scatter(
-                &path,
-                &tricept_plot::Axes {
-                    title: &format!("{}: {}, before and after", p.effect, p.y_label),
-                    x_label: &p.x_label,
-                    y_label: &p.y_label,
-                    log_x: false,
-                    log_y: false,
-                },
-                &[
-                    ("geometric model".to_string(), p.before.clone()),
-                    (format!("with {}", p.effect), p.after.clone()),
-                ],
-            );
-            crate::files::plotted(&path, drawn)?;
-        }
+        plot_residuals(dir, result.plots())?;
     }
-    let written = a.write_machine.as_ref().map(|path| {
-        write_extended(
-            path,
-            data,
-            &loaded,
-            options.rank_reference.as_ref(),
-            &dataset,
-            &d,
-            a.force,
-        )
-    });
-    if machine.json {
-        outln!("{}", d.to_json());
+    let written = a
+        .write_machine
+        .as_ref()
+        .map(|path| write_machine(&result, path, a.force));
+    if a.machine.json {
+        outln!("{}", result.to_json());
     } else {
-        crate::output::write_text(&d.to_text(&source));
+        crate::output::write_text(&result.to_text());
     }
-    match written {
-        Some(Err(e)) => Err(e),
-        // The verdict in the exit code as in identify's: 3 when the final
-        // model (geometric plus the named causes) leaves a misfit.
-        _ if !d.final_adequate => {
-            errln!(
-                "diagnose: exit {}: the final model does not explain the data: {}",
-                crate::cli_error::EXIT_INADEQUATE,
-                d.unexplained
-                    .as_deref()
-                    .unwrap_or("a remainder is reported (see the report)")
-            );
-            Ok(crate::cli_error::EXIT_INADEQUATE)
-        }
-        _ => Ok(0),
+    if let Some(Err(e)) = written {
+        return Err(e);
     }
+    if let Some(why) = result.exit_reason() {
+        errln!("{why}");
+    }
+    Ok(result.exit_code())
 }
 
-fn write_extended(
-    path: &Path,
-    data: &Path,
-    loaded: &LoadedMachine,
-    rank_reference: Option<&tricept_kinematics::Machine>,
-    dataset: &tricept_data::Dataset,
-    d: &tricept_diagnose::Diagnosis,
-    force: bool,
-) -> Result<(), CliError> {
-    // What a machine file cannot hold: a misfit the final model leaves
-    // (every named cause is deployed, or recorded, or reported as not
-    // worth deploying).
-    let mut problems = Vec::new();
-    if !d.final_adequate {
-        problems.push(match &d.unexplained {
-            Some(u) => u.clone(),
-            None => "the final model does not explain the data (a remainder is reported)".into(),
-        });
-    }
-    // An alias is deployed with the member the final model carries; the
-    // file's warnings name the alternatives and what would separate them
-    // (an exact alias, such as a lead common to all legs against a scale
-    // gain, is never separated by the machine's own sensors).
-    let notes: Vec<String> = d
-        .aliases
-        .iter()
-        .map(|a| {
-            let names: Vec<&str> = a.effects.iter().map(|e| e.as_str()).collect();
-            format!(
-                "{} cannot be told apart{} ({}); the file deploys {}; to separate them: {}",
-                names.join(" / "),
-                if a.exact {
-                    " by these sensors"
-                } else {
-                    " on this campaign"
-                },
-                a.why,
-                a.in_model.as_str(),
-                a.separate_by
-            )
-        })
-        .collect();
-    let forced = machine_file::write_rule(
-        &format!("--write-machine {}", path.display()),
-        if problems.is_empty() {
-            0
-        } else {
-            crate::cli_error::EXIT_INADEQUATE
-        },
-        &problems.join("; "),
-        force,
-    )?;
-    let deployed = deploy(&loaded.machine, rank_reference, dataset, d)
-        .map_err(|e| CliError::other(e.to_string()))?;
-    let g = ParameterSet::paper15().len();
-    let mut effects = Map::new();
-    for ((name, v), sd) in deployed
-        .id
-        .names
-        .iter()
-        .zip(&deployed.id.estimate)
-        .zip(&deployed.id.std_dev)
-        .skip(g)
-    {
-        effects.insert(name.clone(), json!({"value": v, "std_dev": sd}));
-    }
-    // The period of each periodic term, beside its amplitudes, and the
-    // edges of each step beside its height.
-    for t in &d.model_terms {
-        if let (true, Some(p)) = (t.deployed, t.period_mm) {
-            effects.insert(
-                format!("{}.period_mm", t.effect),
-                json!({"value": p, "std_dev": serde_json::Value::Null}),
-            );
-        }
-        if let (true, Some(edges), [leg]) = (t.deployed, t.edges_mm, t.legs.as_slice()) {
-            for (side, value) in ["from", "to"].into_iter().zip(edges) {
-                let name = format!("{}.leg{leg}_{side}_mm", t.effect);
-                // Its profile-likelihood half-width, when the report has it.
-                let sd = d
-                    .causes
-                    .iter()
-                    .flat_map(|c| &c.parameters)
-                    .find(|p| p.name == name && p.value == value)
-                    .and_then(|p| p.std_dev);
-                effects.insert(name, json!({"value": value, "std_dev": sd}));
-            }
-        }
-    }
-    let rejected_lines = d.outlier_lines();
-    let warnings = problems.into_iter().chain(notes).collect();
-    let mut description = machine_file::calibrated_description(
-        loaded,
-        &deployed.machine,
-        &machine_file::FitRecord::of_identification(&deployed.id),
-        machine_file::Provenance {
-            method: "diagnose",
-            data_file: data,
-            parameter_set: "paper15",
-            rejected_lines,
-            adequate: forced.is_none(),
-            forced,
-            warnings,
-            effects,
-            n_geometric: g,
-            external: Vec::new(),
-            temperature_c: machine_file::mean_temperature_c(dataset),
-        },
-        deployed.controller,
-    )?;
-    if let Some(c) = description.calibration.as_mut() {
-        c.applies = deployed.applied;
-        c.records = deployed.recorded;
-    }
-    machine_file::write(path, &description)
+/// The data file read with a progress bar (large files on a terminal).
+fn read_with_progress(path: &Path, loaded: &LoadedMachine) -> Result<DataInput, CliError> {
+    Ok(DataInput::Read {
+        file: path.to_path_buf(),
+        data: read_data(path, loaded.machine())?,
+    })
 }
 
-/// The vocabulary for `tricept diagnose --help`, from the registry: each
-/// effect, its physics, its parameters (units in the names) and where
-/// `--write-machine` puts it.
-pub fn vocabulary_help() -> String {
-    let lines: Vec<String> = EffectName::ALL
-        .iter()
-        .map(|e| {
-            let s = e.spec();
-            let params = e.parameter_names();
-            format!(
-                "  {}: {}{}; --write-machine: {}",
-                s.name,
-                s.physics.replace('`', ""),
-                if params.is_empty() {
-                    String::new()
-                } else {
-                    format!(" ({})", params.join(", "))
-                },
-                s.deployment.label()
-            )
-        })
-        .collect();
-    format!("Effects of the vocabulary:\n{}", lines.join("\n"))
+/// Writes the extended machine, naming the file (and a forced write's
+/// warning) on stderr.
+fn write_machine(result: &DiagnoseResult, path: &Path, force: bool) -> Result<(), CliError> {
+    if let Some(warning) = result.write_machine(path, force)? {
+        errln!("warning: {warning}");
+    }
+    errln!("wrote {}", path.display());
+    Ok(())
 }
 
-/// The CLI error of a failed diagnosis: everything the data cause is an
-/// input error (exit 2), naming the file.
-fn diagnose_error(source: &str, e: DiagnoseError) -> CliError {
-    match e {
-        DiagnoseError::Ident(tricept_engine::IdentError::Kinematics {
-            line, source: k, ..
-        }) => CliError::input(format!(
-            "{source}: line {line}: the commands of this pose cannot be reached: {k}"
-        )),
-        DiagnoseError::Ident(
-            tricept_engine::IdentError::TooFewPoses { .. }
-            | tricept_engine::IdentError::TooFewDistinctPoses { .. },
-        ) => CliError::input(format!("{source}: {e}")),
-        DiagnoseError::Ident(e) => CliError::other(format!("{source}: {e}")),
-        e => CliError::input(format!("{source}: {e}")),
+/// One SVG per named cause: its residuals before and after.
+fn plot_residuals(dir: &Path, plots: &[ResidualPlot]) -> Result<(), CliError> {
+    crate::files::create_dir(dir)?;
+    for p in plots {
+        let path = dir.join(format!("residual-{}.svg", p.effect));
+        let drawn = tricept_plot::scatter(
+            &path,
+            &tricept_plot::Axes {
+                title: &format!("{}: {}, before and after", p.effect, p.y_label),
+                x_label: &p.x_label,
+                y_label: &p.y_label,
+                log_x: false,
+                log_y: false,
+            },
+            &[
+                ("geometric model".to_string(), p.before.clone()),
+                (format!("with {}", p.effect), p.after.clone()),
+            ],
+        );
+        crate::files::plotted(&path, drawn)?;
     }
+    Ok(())
 }
 
 /// `tricept detectability`.
 pub fn run_detectability(a: &DetectabilityArgs) -> Result<u8, CliError> {
-    let (machine, poses, both_directions, drift_k) = (
-        &a.machine,
-        a.poses.as_str(),
-        a.both_directions,
-        a.temperature_drift,
-    );
-    let m = machine_with_noise(machine, &a.noise)?;
-    let mut campaign = Campaign::from_targets(&m, Vec::new(), 1);
-    let data = match &a.data {
-        // A logged campaign: its poses with their own context.
-        Some(path) => read_data(path, &m)?,
-        None => {
-            campaign.targets_mm = pose_targets(poses, &m)?;
-            if both_directions {
-                campaign.order = PoseOrder::BothDirections;
-            }
-            // The logged context of the campaign (times, temperature with
-            // the stated drift, approach directions), on the nominal
-            // machine.
-            let mut plant = Plant::geometric(m.clone(), GeometricErrors::default());
-            if drift_k != 0.0 {
-                plant.effects = vec![Effect::Thermal {
-                    drift_k,
-                    expansion_ppm_per_k: 0.0,
-                }];
-            }
-            plant
-                .simulate(&campaign)
-                .map_err(|e| CliError::input(format!("--poses {poses}: {e}")))?
-        }
+    let mut request =
+        DetectabilityRequest::new(load_with_noise(&a.machine, &a.noise)?, a.poses.clone());
+    request.data = match &a.data {
+        Some(path) => Some(read_with_progress(path, &request.machine)?),
+        None => None,
     };
-    let sigma = campaign.noise.logged_sigma();
-    let geometric = GeometricModel::new(m.clone(), ParameterSet::paper15());
-    let mut rows = Vec::new();
-    for (c, v, label) in realistic(&m) {
-        if let Some(d) = term_detectability(&geometric, &c, &v, &data.poses, sigma, 1e-3) {
-            let advice = advise(&d, data.poses.len(), campaign.noise.readings_per_pose);
-            rows.push((label, d, advice));
-        }
+    request.both_directions = a.both_directions;
+    request.temperature_drift_k = a.temperature_drift;
+    let report = detectability(request)?;
+    if a.machine.json {
+        outln!("{}", report.to_json());
+    } else {
+        crate::output::write_text(&report.to_text());
     }
-    if machine.json {
-        let v: Vec<serde_json::Value> = rows
-            .iter()
-            .map(|(label, d, advice)| serde_json::json!({"magnitude": label, "analysis": d, "advice": advice}))
-            .collect();
-        outln!(
-            "{}",
-            serde_json::json!({"poses": data.poses.len(), "readings_per_pose": campaign.noise.readings_per_pose, "effects": v})
-        );
-        return Ok(0);
-    }
-    match &a.data {
-        Some(path) => outln!(
-            "{} logged poses of {}, mean of {} readings, with their logged context",
-            data.poses.len(),
-            path.display(),
-            campaign.noise.readings_per_pose
-        ),
-        None => outln!(
-            "{} logged poses ({}{}), mean of {} readings, temperature drift {} K",
-            data.poses.len(),
-            poses,
-            if both_directions {
-                ", both approach directions"
-            } else {
-                ""
-            },
-            campaign.noise.readings_per_pose,
-            drift_k
-        ),
-    }
-    outln!(
-        "| effect | magnitude | power | detectable from | geometric held-out rms | halved from | largest bias (mm) | advice |"
-    );
-    outln!("|---|---|---|---|---|---|---|---|");
-    for (label, d, advice) in rows {
-        let bias = d
-            .bias
-            .first()
-            .map_or("-".to_string(), |(n, b)| format!("{n} {b:+.4}"));
-        outln!(
-            "| {} | {label} | {:.3} | x{:.2} | {:.2} | x{:.2} | {bias} | {advice} |",
-            d.effect,
-            d.power,
-            d.detectable_multiple,
-            d.expected_rms_geometric,
-            d.halving_multiple
-        );
-    }
-    outln!(
-        "the stated sensor noise can be checked only against repeated poses: revisit at least {} poses on separate visits (`simulate --revisit`) to use `diagnose --noise-from-data`",
-        tricept_diagnose::MIN_PURE_ERROR_DOF
-    );
-    Ok(0)
+    Ok(report.exit_code())
 }

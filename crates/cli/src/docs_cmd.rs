@@ -17,7 +17,7 @@ pub struct DocsArgs {
 }
 
 /// Every page: name, what it holds, text (Markdown).
-const PAGES: [(&str, &str, &str); 9] = [
+const PAGES: [(&str, &str, &str); 10] = [
     (
         "data-format",
         "the measured-data CSV, the external measurements, the machine JSON, every output file (columns, keys, units)",
@@ -47,6 +47,11 @@ const PAGES: [(&str, &str, &str); 9] = [
         "check",
         "`tricept check`: has the machine changed since its calibration? The test, the candidates, planning a check, measured rates",
         include_str!("../../../docs/check.md"),
+    ),
+    (
+        "controllers",
+        "`tricept export`: the compensation files of Sinumerik, Fanuc and Heidenhain controls, signs, units, limits, format errors",
+        include_str!("../../../docs/controllers.md"),
     ),
     (
         "reliability",

@@ -237,15 +237,15 @@ mod tests {
                 // A path through a directory that does not exist cannot be
                 // written: refused as such.
                 let e = r.check().unwrap_err();
-                assert!(e.message.contains("does not exist"), "{}", e.message);
+                assert!(e.message().contains("does not exist"), "{}", e.message());
                 continue;
             }
             let e = r.check().unwrap_err();
-            assert_eq!(e.code, 2);
+            assert_eq!(e.exit_code(), 2);
             assert!(
-                e.message.contains("is also the input --data"),
+                e.message().contains("is also the input --data"),
                 "{}",
-                e.message
+                e.message()
             );
         }
         #[cfg(unix)]
@@ -260,7 +260,12 @@ mod tests {
         let mut r = FileRoles::default();
         r.output("--out", &d.join("a.csv"))
             .output("--tracker-out", &d.join("a.csv"));
-        assert!(r.check().unwrap_err().message.contains("the output --out"));
+        assert!(
+            r.check()
+                .unwrap_err()
+                .message()
+                .contains("the output --out")
+        );
         std::fs::remove_dir_all(&d).ok();
     }
 }

@@ -1,19 +1,19 @@
 //! The kinematics verbs: `ik`, `fk`, `tool-ik` (one point from the command
-//! line, or many from `--input FILE.csv|-`), and `machine`.
+//! line, or many from `--input FILE.csv|-`), and `machine`; the workflows
+//! are the door's (`tricept_ident::kinematics`).
 //!
 //! A calibrated machine file's static leg effects (lead, compliance) are
-//! applied ([`tricept_model::ExtendedMachine`]).
+//! applied (`tricept_ident::ExtendedMachine`).
 
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_cli::batch::{self, BatchError, Verb};
-use tricept_kinematics::{Machine, MachineDescription};
-use tricept_model::ExtendedMachine;
+use tricept_ident::ExtendedMachine;
+use tricept_ident::kinematics::{Verb, machine_summary, solve_batch, solve_point};
 
 use crate::args::{MachineArgs, load};
 use crate::cli_error::CliError;
-use crate::output::{Field, print_record, stdout_closed};
+use crate::output::stdout_closed;
 
 /// Where the points of a batch come from.
 #[derive(Debug, Args, Clone)]
@@ -102,7 +102,7 @@ fn kinematics(
     input: &InputArgs,
     machine: &MachineArgs,
 ) -> Result<u8, CliError> {
-    let m = ExtendedMachine::new(load(machine)?.machine);
+    let loaded = load(machine)?;
     if let Some(path) = &input.input {
         if point.iter().any(Option::is_some) {
             return Err(CliError::input(format!(
@@ -116,49 +116,30 @@ fn kinematics(
                 verb.name()
             )));
         }
-        return run_batch(verb, &m, path);
+        return run_batch(verb, &ExtendedMachine::new(loaded.machine().clone()), path);
     }
     let values: Vec<f64> = point.iter().map(|v| v.unwrap_or(f64::NAN)).collect();
-    let cells = verb
-        .solve(&m, &values)
-        .map_err(|e| CliError::kinematics(verb.name(), &e))?;
-    let fields: Vec<Field> = verb
-        .keys()
-        .iter()
-        .zip(verb.units())
-        .zip(cells)
-        .map(|((k, u), c)| (*k, c.to_json(), *u))
-        .collect();
-    print_record(machine.json, &fields);
-    Ok(0)
+    let solution = solve_point(verb, &loaded, &values)?;
+    if machine.json {
+        outln!("{}", solution.to_json());
+    } else {
+        crate::output::write_text(&solution.to_text());
+    }
+    Ok(solution.exit_code())
 }
 
+/// Streams the points of `path` (`-`: stdin) to stdout as CSV.
 fn run_batch(verb: Verb, m: &ExtendedMachine, path: &std::path::Path) -> Result<u8, CliError> {
     let out = std::io::BufWriter::with_capacity(1 << 16, crate::output::Stdout);
-    let result = if path.as_os_str() == "-" {
-        batch::run(
-            verb,
-            m,
-            std::io::stdin().lock(),
-            "stdin",
-            out,
-            stdout_closed,
-        )
+    let label = path.display().to_string();
+    if path.as_os_str() == "-" {
+        let stdin = std::io::stdin().lock();
+        solve_batch(verb, m, stdin, "stdin", &label, out, stdout_closed)?;
     } else {
-        let name = path.display().to_string();
-        let f = std::fs::File::open(path).map_err(|e| CliError::input(format!("{name}: {e}")))?;
-        batch::run(verb, m, f, &name, out, stdout_closed)
-    };
-    let file = path.display().to_string();
-    match result {
-        Ok(_) => Ok(0),
-        Err(BatchError::Input(message)) => Err(CliError::input(message)),
-        Err(BatchError::Point { line, source }) => Err(CliError::kinematics(
-            &format!("{} --input {file}: line {line}", verb.name()),
-            &source,
-        )),
-        Err(BatchError::Output(message)) => Err(CliError::other(format!("stdout: {message}"))),
+        let f = std::fs::File::open(path).map_err(|e| CliError::input(format!("{label}: {e}")))?;
+        solve_batch(verb, m, f, &label, &label, out, stdout_closed)?;
     }
+    Ok(0)
 }
 
 /// `tricept ik X Y Z`.
@@ -186,91 +167,9 @@ pub fn tool_ik(a: &ToolIkArgs) -> Result<u8, CliError> {
 pub fn print_machine(a: &MachineVerbArgs) -> Result<u8, CliError> {
     let loaded = load(&a.machine)?;
     if a.machine.json {
-        outln!("{}", loaded.description.to_json());
-        return Ok(0);
+        outln!("{}", loaded.description().to_json());
+    } else {
+        crate::output::write_text(&machine_summary(&loaded));
     }
-    summary(&loaded.description, &loaded.machine, &loaded.source);
     Ok(0)
-}
-
-fn summary(d: &MachineDescription, m: &Machine, source: &str) {
-    let v = |p: &nalgebra::Vector3<f64>| format!("({:.3}, {:.3}, {:.3})", p.x, p.y, p.z);
-    outln!("{} (from {source})", d.name);
-    if let Some(n) = &d.notes {
-        outln!("  notes: {n}");
-    }
-    for i in 0..3 {
-        outln!(
-            "  leg {}: base joint B{} {} mm, platform joint A{} {} mm, length offset {:.4} mm",
-            i + 1,
-            i + 1,
-            v(&m.base_joints_mm[i]),
-            i + 1,
-            v(&m.platform_joints_mm[i]),
-            m.leg_offsets_mm[i]
-        );
-    }
-    let u = &m.up_limb;
-    outln!(
-        "  UP limb: {} U joint; axis skew {:.3e} rad, axis offset {:.4} mm, twist {:.3e} rad/mm about {:.1} mm",
-        u.axis_order,
-        u.axis_skew_rad,
-        u.axis_offset_mm,
-        u.twist_rad_per_mm,
-        u.twist_reference_mm
-    );
-    let w = &m.workspace;
-    outln!(
-        "  workspace: cylinder of radius {} mm, z from {} to {} mm",
-        w.radius_mm,
-        w.z_min_mm,
-        w.z_max_mm
-    );
-    let l = &d.limits;
-    outln!(
-        "  limits: leg stroke {:?} mm, UP stroke {:?} mm, tilt {} deg",
-        l.leg_stroke_mm,
-        l.up_stroke_mm,
-        l.max_tilt_deg
-    );
-    let s = &d.sensors;
-    outln!(
-        "  sensors: encoder noise {} arcsec, scale noise {} um per reading, mean of {}",
-        s.angle_noise_arcsec,
-        s.length_noise_um,
-        s.readings_per_pose
-    );
-    let e = &d.leg_effects;
-    if !e.is_zero() {
-        outln!(
-            "  leg effects (applied by ik, fk, tool-ik, compensate): lead {:?} ppm, compliance {} um/kN at 1 m",
-            e.lead_ppm,
-            e.compliance_um_per_kn_at_1m
-        );
-    }
-    if let Some(c) = &d.controller {
-        outln!(
-            "  controller parameters: backlash {:?} um per leg axis, thermal expansion {} ppm/K from {} °C",
-            c.backlash_um,
-            c.thermal_expansion_ppm_per_k,
-            c.reference_temperature_c
-        );
-    }
-    if let Some(c) = &d.calibration {
-        outln!(
-            "  calibration: {} from {} ({}, sha256 {}), {}: {} parameters, {} held, chi2/dof {:.3}, converged {}, adequate {}{}",
-            c.method,
-            c.data_file,
-            c.date,
-            &c.data_sha256[..c.data_sha256.len().min(12)],
-            c.parameter_set,
-            c.estimates_mm.len(),
-            c.held.len(),
-            c.chi2_per_dof,
-            c.converged,
-            c.adequate,
-            if c.forced { ", FORCED" } else { "" }
-        );
-    }
-    outln!("  (tricept machine --json prints the description file)");
 }

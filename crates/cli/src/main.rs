@@ -28,12 +28,10 @@ mod compensate_cmd;
 mod diagnose_cmd;
 mod docs_cmd;
 mod effects_cmd;
+mod export_cmd;
 mod files;
-mod fusion_cmd;
 mod ident_cmd;
 mod kinematics_cmd;
-mod limits;
-mod machine_file;
 mod output;
 mod plan_cmd;
 mod simulate_cmd;
@@ -163,6 +161,13 @@ enum Command {
         after_help = "The keys are the simulator's inputs, in the units a machine builder quotes; the diagnosis fits its own parameters (`tricept docs diagnosis`).\n\nExamples:\n  tricept effects\n  tricept effects compliance\n  tricept effects --json | head -1"
     )]
     Effects(effects_cmd::EffectsArgs),
+    /// Compensation files a CNC control loads (Sinumerik, Fanuc,
+    /// Heidenhain) from a calibrated machine file, with the format error.
+    #[command(
+        allow_negative_numbers = true,
+        after_help = "Exit codes: 0 written; 3 a format error past --tolerance-um (nothing written; the report names the limit to raise); 2 bad input (an unknown controller, an axis name the control cannot accept, a machine file without a calibration or edited after it).\n\nExamples:\n  tricept export --machine calibrated.json --controller sinumerik --out cnc/\n  tricept export --machine calibrated.json --controller fanuc --axis-names U,V,W --detection-unit-um 0.1 --max-points 1000 --out cnc/ --json\nFormats, signs and units: `tricept docs controllers`"
+    )]
+    Export(export_cmd::ExportArgs),
 }
 
 /// The files a verb reads and writes, by flag (checked before it runs:
@@ -191,7 +196,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         Command::Docs(_) | Command::Effects(_) => {}
         Command::Identifiability(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses);
+            r.input_if_file("--poses", &a.poses.to_string());
             r.inputs("--data", &a.data);
         }
         Command::Identify(a) => {
@@ -209,14 +214,14 @@ fn file_roles(command: &Command) -> files::FileRoles {
         }
         Command::Simulate(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses);
+            r.input_if_file("--poses", &a.poses.to_string());
             if let Some(t) = &a.truth.truth {
                 r.input_if_file("--truth", t);
             }
             for e in &a.truth.truth_effects {
                 r.input_if_file("--truth-effect", e);
             }
-            r.input_if_file("--head-errors", &a.head_errors);
+            r.input_if_file("--head-errors", &a.head_errors.to_string());
             r.inputs("--tracker-poses", &a.tracker_poses);
             r.inputs("--ballbar-poses", &a.ballbar_poses);
             r.inputs("--touch-poses", &a.touch_poses);
@@ -242,7 +247,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         }
         Command::Detectability(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses);
+            r.input_if_file("--poses", &a.poses.to_string());
             r.inputs("--data", &a.data);
         }
         Command::Compensate(a) => {
@@ -269,11 +274,14 @@ fn file_roles(command: &Command) -> files::FileRoles {
                 r.output("--history", h);
             }
         }
+        Command::Export(a) => {
+            r.input("--machine", &a.machine);
+        }
         Command::Plan(a) => {
             machine(&mut r, &a.machine);
             r.inputs("--data", &a.data);
-            r.input_if_file("--poses", &a.poses);
-            r.input_if_file("--candidates", &a.candidates);
+            r.input_if_file("--poses", &a.poses.to_string());
+            r.input_if_file("--candidates", &a.candidates.to_string());
             if let Some(p) = &a.out {
                 r.output("--out", p);
             }
@@ -301,13 +309,42 @@ fn run(cli: Cli) -> Result<u8, CliError> {
         Command::Docs(a) => docs_cmd::run(&a),
         Command::Effects(a) => effects_cmd::run(&a),
         Command::Check(a) => check_cmd::run(&a),
+        Command::Export(a) => export_cmd::run(&a),
     }
+}
+
+/// The one-line message of a flag value refused by one of the door's
+/// parsers (`tricept_ident::Triple`, `TrackerTargetSpec`, ...): the flag,
+/// then the door's message (unless it names the flag already). `None` for
+/// every other clap error, which clap prints itself.
+fn value_error(e: &clap::Error) -> Option<String> {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    use std::error::Error as _;
+    if e.kind() != ErrorKind::ValueValidation {
+        return None;
+    }
+    let ours = e.source()?.downcast_ref::<CliError>()?;
+    let flag = match e.get(ContextKind::InvalidArg) {
+        Some(ContextValue::String(arg)) => arg.split_whitespace().next().unwrap_or_default(),
+        _ => "",
+    };
+    Some(if flag.is_empty() || ours.message().starts_with(flag) {
+        ours.message().to_string()
+    } else {
+        format!("{flag}: {ours}")
+    })
 }
 
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
+            // A flag value the door's parser refused: one line naming the
+            // flag, exit 2, as every input error.
+            if let Some(line) = value_error(&e) {
+                errln!("error: {line}");
+                return ExitCode::from(tricept_ident::EXIT_INPUT);
+            }
             // clap prints help/version to stdout (exit 0) and usage errors
             // to stderr (exit 2).
             let _ = e.print();
@@ -317,8 +354,8 @@ fn main() -> ExitCode {
     let code = match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            errln!("error: {}", e.message);
-            e.code
+            errln!("error: {}", e.message());
+            e.exit_code()
         }
     };
     // Output that did not reach stdout (a full disk, an I/O error; not a

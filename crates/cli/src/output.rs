@@ -19,8 +19,6 @@ use std::io::Write;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use serde_json::{Map, Value};
-
 static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
 static STDOUT_ERROR: Mutex<Option<String>> = Mutex::new(None);
 
@@ -81,6 +79,13 @@ pub fn write_err_line(args: std::fmt::Arguments<'_>) {
     let _ = err.write_fmt(args).and_then(|_| err.write_all(b"\n"));
 }
 
+/// Each of `warnings` on stderr as `warning: ...`.
+pub fn warn_all(warnings: &[String]) {
+    for w in warnings {
+        errln!("warning: {w}");
+    }
+}
+
 /// Stdout as a [`Write`] for bulk output (CSV): a failed write marks stdout
 /// closed (keeping an error that is not a closed pipe for [`finish`]) and
 /// reports success, so that a writer stops caring; a loop producing the
@@ -104,39 +109,5 @@ impl Write for Stdout {
             failed(&e);
         }
         Ok(())
-    }
-}
-
-/// One field of a record: its key (the JSON key and CSV column), value and
-/// unit for the text output (empty when it has none).
-pub type Field = (&'static str, Value, &'static str);
-
-/// Prints `fields` as a JSON object (in order) or as aligned
-/// `key = value unit` lines.
-pub fn print_record(json: bool, fields: &[Field]) {
-    if json {
-        let map: Map<String, Value> = fields
-            .iter()
-            .map(|(k, v, _)| (k.to_string(), v.clone()))
-            .collect();
-        outln!("{}", Value::Object(map));
-    } else {
-        let width = fields.iter().map(|(k, _, _)| k.len()).max().unwrap_or(0);
-        for (k, v, unit) in fields {
-            let text = match v {
-                Value::Number(n) => match (n.as_u64(), n.as_f64()) {
-                    (Some(i), _) => i.to_string(),
-                    (None, Some(x)) => format!("{x:.9}"),
-                    _ => n.to_string(),
-                },
-                Value::String(s) => s.clone(),
-                other => other.to_string(),
-            };
-            if unit.is_empty() {
-                outln!("{k:>width$} = {text}");
-            } else {
-                outln!("{k:>width$} = {text} {unit}");
-            }
-        }
     }
 }

@@ -1,16 +1,16 @@
-//! `tricept simulate`: a measured-data CSV from a simulated machine.
+//! `tricept simulate`: a measured-data CSV from a simulated machine. The
+//! flags into a request of the door (`tricept_ident::simulate`), the
+//! simulated data written.
 
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_engine::GeometricModel;
-use tricept_plant::{Campaign, Plant, PoseOrder};
-
-use crate::args::{
-    MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs, TruthArgs, machine_with_noise,
-    parse_effects, parse_errors, pose_targets,
+use tricept_ident::{
+    BallbarSimulation, HeadErrors, Poses, SimulateRequest, TouchSimulation, TrackerSimulation,
+    Triple, parse_effects, parse_numbers, simulate,
 };
-use crate::args::{parse_numbers, positive};
+
+use crate::args::{MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs, TruthArgs, load_with_noise};
 use crate::cli_error::CliError;
 
 /// `tricept simulate`.
@@ -19,8 +19,8 @@ pub struct SimulateArgs {
     #[command(flatten)]
     pub truth: TruthArgs,
     /// Pose set (as for `identifiability`; positions in mm).
-    #[arg(long, default_value = "grid")]
-    pub poses: String,
+    #[arg(long, default_value = "grid", value_parser = clap::value_parser!(Poses))]
+    pub poses: Poses,
     /// Seed of the sensor noise (a whole number).
     #[arg(long, default_value_t = 1, value_name = "N")]
     pub seed: u64,
@@ -41,8 +41,8 @@ pub struct SimulateArgs {
     /// Head errors of the simulated machine: `zero`, `random:SCALE[,SEED]`
     /// (each of the 13 parameters SCALE times its typical size, times 0.5-1,
     /// random sign), or a JSON file `{name: value}` (docs/hybrid.md).
-    #[arg(long, default_value = "zero", value_name = "HEAD")]
-    pub head_errors: String,
+    #[arg(long, default_value = "zero", value_name = "HEAD", value_parser = clap::value_parser!(HeadErrors))]
+    pub head_errors: HeadErrors,
     /// Also write laser-tracker points (CSV) measured at the poses of
     /// --tracker-poses.
     #[arg(long, value_name = "FILE.csv")]
@@ -66,9 +66,10 @@ pub struct SimulateArgs {
         long,
         default_value = "0,0,0",
         value_name = "X,Y,Z",
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = clap::value_parser!(Triple)
     )]
-    pub tracker_target_mm: String,
+    pub tracker_target_mm: Triple,
     /// Noise of a tracker coordinate, um.
     #[arg(long, default_value_t = 10.0, value_name = "UM")]
     pub tracker_sigma_um: f64,
@@ -83,9 +84,10 @@ pub struct SimulateArgs {
         long,
         default_value = "0,0,1250",
         value_name = "X,Y,Z",
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = clap::value_parser!(Triple)
     )]
-    pub ballbar_pivot_mm: String,
+    pub ballbar_pivot_mm: Triple,
     /// The bar's reading minus the true distance, um.
     #[arg(
         long,
@@ -136,309 +138,112 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
             "--json: needs --out FILE.csv (without it the CSV itself goes to stdout)",
         ));
     }
-    let m = machine_with_noise(&a.machine, &a.noise)?;
-    let set = a.params.set()?;
-    let truth = a.truth.truth.as_deref().unwrap_or("table2");
-    let values = parse_errors(truth, &set)?;
-    let targets = pose_targets(&a.poses, &m)?;
-    let mut campaign = Campaign::from_targets(&m, targets, a.seed);
-    if a.both_directions {
-        campaign.order = PoseOrder::BothDirections;
+    let mut request = SimulateRequest::new(load_with_noise(&a.machine, &a.noise)?);
+    request.parameter_set = a.params.set()?;
+    if let Some(truth) = &a.truth.truth {
+        request.truth = truth.parse()?;
     }
-    if !(a.noise_factor.is_finite() && a.noise_factor > 0.0) {
-        return Err(CliError::input(format!(
-            "--noise-factor: must be a positive number, got {}",
-            a.noise_factor
-        )));
+    request.truth_effects = parse_effects(&a.truth.truth_effects)?;
+    request.head_errors = a.head_errors.clone();
+    request.poses = a.poses.clone();
+    request.seed = a.seed;
+    request.both_directions = a.both_directions;
+    request.revisit = a.revisit;
+    request.noise_factor = a.noise_factor;
+    request.tracker = tracker(a)?;
+    request.ballbar = ballbar(a)?;
+    request.touch = touch(a)?;
+    let sim = simulate(request)?;
+    let written = |path: &std::path::Path, r| crate::files::written(path, r);
+    if let (Some(out), Some((data, c))) = (&a.tracker_out, sim.tracker()) {
+        written(out, tricept_data::write_external_path(out, data, c))?;
     }
-    campaign.revisits = a.revisit;
-    campaign.noise_factor = a.noise_factor;
-    let mut plant = Plant::geometric(m.clone(), set.to_errors(&values));
-    plant.effects = parse_effects(&a.truth.truth_effects)?;
-    plant.head_errors = parse_head_errors(&a.head_errors, &m)?;
-    let data = plant
-        .simulate(&campaign)
-        .map_err(|e| CliError::input(format!("simulate: {e}")))?;
-    let model = GeometricModel::new(m.clone(), set.clone());
-    let mut comments = vec![
-        format!(
-            "simulated by tricept {} on `{}`",
-            env!("CARGO_PKG_VERSION"),
-            m.name
-        ),
-        format!(
-            "pose set `{}` ({} poses{}{}), seed {}",
-            a.poses,
-            data.poses.len(),
-            if a.both_directions {
-                ", both approach directions"
-            } else {
-                ""
-            },
-            if a.revisit > 0 {
-                format!(", the first {} revisited at the end", a.revisit)
-            } else {
-                String::new()
-            },
-            a.seed
-        ),
-        format!(
-            "noise per reading: {:.3} arcsec, {:.3} um, mean of {}{}",
-            m.sensors.angle_rad / tricept_kinematics::units::RAD_PER_ARCSEC,
-            m.sensors.length_mm * 1e3,
-            m.sensors.readings_per_pose,
-            if a.noise_factor == 1.0 {
-                String::new()
-            } else {
-                format!(" (stated; the true noise is {} times it)", a.noise_factor)
-            }
-        ),
-        format!(
-            "true errors ({}, mm): {}",
-            model.parameter_set().label(),
-            serde_json::Value::Object(set.values_to_map(&values))
-        ),
-        format!(
-            "sensor zero offsets (phi rad, theta rad, s mm): {:?}",
-            plant.sensor_offsets
-        ),
-    ];
-    for e in &plant.effects {
-        comments.push(format!(
-            "effect: {}",
-            serde_json::to_string(e).unwrap_or_default()
-        ));
+    if let (Some(out), Some((data, c))) = (&a.ballbar_out, sim.ballbar()) {
+        written(out, tricept_data::write_external_path(out, data, c))?;
     }
-    if !plant.head_errors.is_empty() {
-        comments.push(format!(
-            "head errors (head13): {}",
-            serde_json::Value::Object(
-                tricept_model::HeadParameterSet::head13(&m.head).values_to_map(&plant.head_errors)
-            )
-        ));
+    if let (Some(out), Some(features_out), Some((data, c, features))) =
+        (&a.touch_out, &a.features_out, sim.touch())
+    {
+        written(out, tricept_data::write_external_path(out, data, c))?;
+        crate::files::write_text(features_out, features)?;
     }
-    simulate_external(a, &plant, &comments)?;
     match &a.out {
         Some(path) => {
-            crate::files::written(path, tricept_data::write_path(path, &data, &comments))?;
+            written(
+                path,
+                tricept_data::write_path(path, sim.data(), sim.comments()),
+            )?;
             if a.machine.json {
-                outln!(
-                    "{}",
-                    serde_json::json!({
-                        "out": path.display().to_string(),
-                        "poses": data.poses.len(),
-                        "seed": a.seed,
-                        "machine": m.name,
-                        "parameter_set": set.label(),
-                        "truth_mm": serde_json::Value::Object(set.values_to_map(&values)),
-                        "truth_effects": plant.effects,
-                        "sensor_offsets": {"phi_rad": plant.sensor_offsets[0], "theta_rad": plant.sensor_offsets[1], "s_mm": plant.sensor_offsets[2]},
-                    })
-                );
+                outln!("{}", sim.to_json(path));
             } else {
-                errln!(
-                    "{} poses to {} (machine `{}`, true errors `{truth}`, {} effect(s), seed {})",
-                    data.poses.len(),
-                    path.display(),
-                    m.name,
-                    plant.effects.len(),
-                    a.seed
-                );
+                errln!("{}", sim.to_text(path));
             }
         }
         // A closed stdout (`| head`) is not an error: the writer swallows it.
         None => tricept_data::write_to(
             std::io::BufWriter::new(crate::output::Stdout),
-            &data,
-            &comments,
+            sim.data(),
+            sim.comments(),
         )
         .map_err(|e| CliError::other(format!("stdout: {e}")))?,
     }
-    Ok(0)
+    Ok(sim.exit_code())
 }
 
-/// Parses `--head-errors`.
-fn parse_head_errors(spec: &str, m: &tricept_kinematics::Machine) -> Result<Vec<f64>, CliError> {
-    let flag = "--head-errors";
-    match spec {
-        "zero" => Ok(Vec::new()),
-        s if s.starts_with("random:") => {
-            let parts: Vec<&str> = s["random:".len()..].split(',').collect();
-            let scale: f64 = parts[0]
-                .parse()
-                .ok()
-                .filter(|v: &f64| v.is_finite() && (0.0..=100.0).contains(v))
-                .ok_or_else(|| {
-                    CliError::input(format!(
-                        "{flag} `{s}`: expected random:SCALE[,SEED] with SCALE (times the typical sizes) from 0 to 100"
-                    ))
-                })?;
-            let seed: u64 = match parts.get(1) {
-                Some(t) => t.parse().map_err(|_| {
-                    CliError::input(format!("{flag} `{s}`: SEED must be a whole number"))
-                })?,
-                None => 0,
-            };
-            Ok(tricept_plant::random_head_errors(scale, seed))
-        }
-        path => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| CliError::input(format!("{flag}: {path}: {e}")))?;
-            tricept_model::HeadParameterSet::head13(&m.head)
-                .parse_values(&text)
-                .map_err(|e| CliError::input(format!("{flag}: {path}: {e}")))
-        }
-    }
-}
-
-/// The poses of a poses file (every record with its extension).
-fn read_poses(path: &std::path::Path) -> Result<Vec<(tricept_data::ExternalPose, f64)>, CliError> {
-    Ok(
-        tricept_data::read_external_path::<tricept_data::PlannedPose>(path)
-            .map_err(|e| CliError::input(e.to_string()))?
-            .records
-            .iter()
-            .map(|p| (p.pose, p.extension_mm))
-            .collect(),
-    )
-}
-
-/// Writes the external instruments' files that were asked for.
-fn simulate_external(a: &SimulateArgs, plant: &Plant, comments: &[String]) -> Result<(), CliError> {
-    let failed = |e: tricept_plant::PlantError| CliError::input(format!("simulate: {e}"));
+/// The tracker to simulate: --tracker-out and --tracker-poses together.
+fn tracker(a: &SimulateArgs) -> Result<Option<TrackerSimulation>, CliError> {
     match (&a.tracker_out, &a.tracker_poses) {
-        (Some(out), Some(poses)) => {
+        (Some(_), Some(poses)) => {
             let f = parse_numbers("--tracker-frame-mm-rad", &a.tracker_frame_mm_rad, 6)?;
-            let t = parse_numbers("--tracker-target-mm", &a.tracker_target_mm, 3)?;
-            let tracker = tricept_plant::Tracker {
-                frame: nalgebra::Isometry3::new(
-                    nalgebra::Vector3::new(f[0], f[1], f[2]),
-                    nalgebra::Vector3::new(f[3], f[4], f[5]),
-                ),
-                target_offset_mm: nalgebra::Vector3::new(t[0], t[1], t[2]),
-                sigma_um: positive("--tracker-sigma-um", a.tracker_sigma_um)?,
-                setup: 1,
-            };
-            let data = tracker
-                .measure(plant, &read_poses(poses)?, a.seed)
-                .map_err(failed)?;
-            let mut c = comments.to_vec();
-            c.push(format!(
-                "tracker: frame (mm, rad) {}, target offset (mm) {}, {} um per coordinate",
-                a.tracker_frame_mm_rad, a.tracker_target_mm, a.tracker_sigma_um
-            ));
-            crate::files::written(out, tricept_data::write_external_path(out, &data, &c))?;
+            Ok(Some(TrackerSimulation {
+                poses: poses.clone(),
+                frame_mm_rad: [f[0], f[1], f[2], f[3], f[4], f[5]],
+                target_mm: a.tracker_target_mm.0,
+                sigma_um: a.tracker_sigma_um,
+            }))
         }
-        (None, None) => {}
-        _ => {
-            return Err(CliError::input(
-                "--tracker-out and --tracker-poses go together",
-            ));
-        }
+        (None, None) => Ok(None),
+        _ => Err(CliError::input(
+            "--tracker-out and --tracker-poses go together",
+        )),
     }
-    match (&a.ballbar_out, &a.ballbar_poses) {
-        (Some(out), Some(poses)) => {
-            let p = parse_numbers("--ballbar-pivot-mm", &a.ballbar_pivot_mm, 3)?;
-            let bar = tricept_plant::Ballbar {
-                pivot_mm: nalgebra::Vector3::new(p[0], p[1], p[2]),
-                length_error_um: a.ballbar_length_error_um,
-                ball_offset_mm: nalgebra::Vector3::zeros(),
-                sigma_um: positive("--ballbar-sigma-um", a.ballbar_sigma_um)?,
-                setup: 1,
-            };
-            let poses: Vec<_> = read_poses(poses)?.into_iter().map(|(p, _)| p).collect();
-            let data = bar.measure(plant, &poses, a.seed).map_err(failed)?;
-            let mut c = comments.to_vec();
-            c.push(format!(
-                "ballbar: pivot (mm) {}, length error {} um, {} um per reading",
-                a.ballbar_pivot_mm, a.ballbar_length_error_um, a.ballbar_sigma_um
-            ));
-            crate::files::written(out, tricept_data::write_external_path(out, &data, &c))?;
-        }
-        (None, None) => {}
-        _ => {
-            return Err(CliError::input(
-                "--ballbar-out and --ballbar-poses go together",
-            ));
-        }
-    }
-    match (&a.touch_out, &a.features_out, &a.touch_poses) {
-        (Some(out), Some(features_out), Some(poses)) => {
-            simulate_touches(a, plant, comments, out, features_out, poses)?
-        }
-        (None, None, None) => {}
-        _ => {
-            return Err(CliError::input(
-                "--touch-out, --features-out and --touch-poses go together",
-            ));
-        }
-    }
-    Ok(())
 }
 
-/// Writes simulated touch-offs on the reference sphere at the planned
-/// touches, and the features file a user would write.
-fn simulate_touches(
-    a: &SimulateArgs,
-    plant: &Plant,
-    comments: &[String],
-    out: &std::path::Path,
-    features_out: &std::path::Path,
-    poses: &std::path::Path,
-) -> Result<(), CliError> {
-    let c = parse_numbers("--touch-sphere-mm", &a.touch.touch_sphere_mm, 3)?;
-    let centre = nalgebra::Vector3::new(c[0], c[1], c[2]);
-    let probe = tricept_plant::TouchProbe {
-        stylus_radius_mm: positive("--touch-stylus-radius-mm", a.touch.touch_stylus_radius_mm)?,
-        stylus_radius_error_um: a.touch_stylus_error_um,
-        stylus_radius_sigma_um: positive("--touch-stylus-sigma-um", a.touch.touch_stylus_sigma_um)?,
-        sigma_um: positive("--touch-sigma-um", a.touch.touch_sigma_um)?,
-        features: vec![tricept_plant::TouchFeature::Sphere {
-            id: 1,
-            centre_mm: centre,
-            radius_mm: positive("--touch-sphere-radius-mm", a.touch.touch_sphere_radius_mm)?,
-        }],
-    };
-    let planned = tricept_data::read_external_path::<tricept_data::PlannedPose>(poses)
-        .map_err(|e| CliError::input(e.to_string()))?;
-    let nominal = &plant.nominal;
-    let targets = planned
-        .records
-        .iter()
-        .map(|p| {
-            let at = |e: tricept_kinematics::KinematicsError| {
-                CliError::input(format!("{}: line {}: {e}", planned.source, p.line))
-            };
-            if p.feature.is_some_and(|f| f != 1) {
-                return Err(CliError::input(format!(
-                    "{}: line {}, column `feature`: the simulated probe touches sphere 1 only",
-                    planned.source, p.line
-                )));
-            }
-            let up = nominal.forward(&p.pose.commands_mm).map_err(at)?.up;
-            let tool = nominal.tool_forward(&up, p.pose.head_rad);
-            Ok(tricept_plant::TouchTarget {
-                feature: 1,
-                tip_mm: tool.tip_mm,
-                axis: tool.axis,
-                approach: (centre - tool.tip_mm).normalize(),
-            })
-        })
-        .collect::<Result<Vec<_>, CliError>>()?;
-    let data = probe
-        .measure(plant, &targets, a.seed)
-        .map_err(|e| CliError::input(format!("simulate: {}: {e}", planned.source)))?;
-    let mut c = comments.to_vec();
-    c.push(format!(
-        "touch probe: sphere 1 at (mm) {}, radius {} mm; stylus {} mm ({} um off); {} um per touch",
-        a.touch.touch_sphere_mm,
-        a.touch.touch_sphere_radius_mm,
-        a.touch.touch_stylus_radius_mm,
-        a.touch_stylus_error_um,
-        a.touch.touch_sigma_um
-    ));
-    crate::files::written(out, tricept_data::write_external_path(out, &data, &c))?;
-    let features = serde_json::to_string_pretty(&probe.features_file(0.5))
-        .map_err(|e| CliError::other(e.to_string()))?;
-    crate::files::write_text(features_out, &(features + "\n"))
+/// The ballbar to simulate: --ballbar-out and --ballbar-poses together.
+fn ballbar(a: &SimulateArgs) -> Result<Option<BallbarSimulation>, CliError> {
+    match (&a.ballbar_out, &a.ballbar_poses) {
+        (Some(_), Some(poses)) => Ok(Some(BallbarSimulation {
+            poses: poses.clone(),
+            pivot_mm: a.ballbar_pivot_mm.0,
+            length_error_um: a.ballbar_length_error_um,
+            sigma_um: a.ballbar_sigma_um,
+        })),
+        (None, None) => Ok(None),
+        _ => Err(CliError::input(
+            "--ballbar-out and --ballbar-poses go together",
+        )),
+    }
+}
+
+/// The touch probe to simulate: --touch-out, --features-out and
+/// --touch-poses together.
+fn touch(a: &SimulateArgs) -> Result<Option<TouchSimulation>, CliError> {
+    match (&a.touch_out, &a.features_out, &a.touch_poses) {
+        (Some(_), Some(_), Some(poses)) => {
+            let c = parse_numbers("--touch-sphere-mm", &a.touch.touch_sphere_mm, 3)?;
+            Ok(Some(TouchSimulation {
+                poses: poses.clone(),
+                sphere_mm: [c[0], c[1], c[2]],
+                sphere_radius_mm: a.touch.touch_sphere_radius_mm,
+                stylus_radius_mm: a.touch.touch_stylus_radius_mm,
+                stylus_sigma_um: a.touch.touch_stylus_sigma_um,
+                stylus_error_um: a.touch_stylus_error_um,
+                sigma_um: a.touch.touch_sigma_um,
+            }))
+        }
+        (None, None, None) => Ok(None),
+        _ => Err(CliError::input(
+            "--touch-out, --features-out and --touch-poses go together",
+        )),
+    }
 }

@@ -44,6 +44,7 @@
 )]
 
 mod atomic;
+mod bounded;
 mod error;
 mod external;
 mod pose;
@@ -53,6 +54,7 @@ mod targets;
 mod write;
 
 pub use atomic::write_atomic;
+pub use bounded::{MAX_JSON_BYTES, read_json_text};
 pub use error::DataError;
 pub use external::{
     BallbarData, BallbarReading, ExternalData, ExternalPose, ExternalRecord, Feature, Features,

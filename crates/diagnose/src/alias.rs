@@ -25,7 +25,7 @@
 
 use nalgebra::{DMatrix, DVector};
 use tricept_data::Dataset;
-use tricept_model::effects::{CauseName, EffectName, Needs};
+use tricept_model::effects::{CauseName, CommonPart, EffectName, Needs, Structural};
 use tricept_numerics::stats::chi2_isf;
 
 use crate::fit::{Fit, term_estimates};
@@ -58,9 +58,11 @@ struct Alternative {
     columns: DMatrix<f64>,
     /// Parameter names of `columns`.
     params: Vec<String>,
+    /// Whether it is the common part of a term with one parameter per leg
+    /// (its registry spec's [`CommonPart`]): one column, the sum of the
+    /// term's.
+    common: bool,
 }
-
-const LEAD: Term = Term::Catalogue(EffectName::LegLead);
 
 /// Why two candidates cannot be told apart, and what separates them: a
 /// refinement of a generic term, an alias the registry knows (declared by
@@ -152,18 +154,31 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
                     term: *t,
                     params: t.params(),
                     columns: cols,
+                    common: false,
                 });
             }
         }
-        if let Some(cols) = lin.extra_columns(&LEAD) {
-            let sum = cols.column(0) + cols.column(1) + cols.column(2);
-            alternatives.push(Alternative {
-                name: CauseName::Catalogue(EffectName::LegLead),
-                label: "leg-lead (equal on all legs)".into(),
-                term: LEAD,
-                params: vec!["lead_ppm (every leg)".into()],
-                columns: DMatrix::from_columns(&[sum]),
-            });
+        // The common parts the registry declares (an equal lead on all
+        // legs).
+        for e in EffectName::ALL {
+            let Some(part) = e.spec().common_part else {
+                continue;
+            };
+            let term = Term::Catalogue(e);
+            if let Some(cols) = lin.extra_columns(&term)
+                && cols.ncols() > 0
+            {
+                let sum = (1..cols.ncols())
+                    .fold(cols.column(0).into_owned(), |acc, j| acc + cols.column(j));
+                alternatives.push(Alternative {
+                    name: term.name(),
+                    label: part.label.into(),
+                    term,
+                    params: vec![part.parameter.into()],
+                    columns: DMatrix::from_columns(&[sum]),
+                    common: true,
+                });
+            }
         }
         // Refinements of the generic leg terms in the model (the quartic
         // part of a curved leg error, the second harmonic of a periodic one): a catalogue term that only mops up what the
@@ -181,6 +196,7 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
                         term: *t,
                         params: (1..=k).map(|j| format!("refinement{j}")).collect(),
                         columns: cols,
+                        common: false,
                     });
                 }
             }
@@ -200,6 +216,7 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
                 term: t,
                 params: g.params(),
                 columns: lin.dense(&cols),
+                common: false,
             });
         }
         let mut members: Vec<(Alternative, f64, Vec<Estimate>, bool)> = Vec::new();
@@ -231,14 +248,15 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
                     std_dev: Some(*sd),
                 })
                 .collect();
-            // The equal lead's plausibility is that of each leg's lead.
-            let check_values: Vec<f64> = if alt.label.contains("equal") {
-                vec![values[0]; 3]
+            // A common part's plausibility is that of each leg's parameter.
+            let legs = alt.term.param_count();
+            let check_values: Vec<f64> = if alt.common {
+                vec![values[0]; legs]
             } else {
                 values.clone()
             };
-            let check_cov = if alt.label.contains("equal") {
-                DMatrix::from_diagonal_element(3, 3, s.covariance[(0, 0)])
+            let check_cov = if alt.common {
+                DMatrix::from_diagonal_element(legs, legs, s.covariance[(0, 0)])
             } else {
                 s.covariance.clone()
             };
@@ -272,12 +290,14 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
                 }),
             }
         }
-        // An equal lead is the full lead's special case: name it alone.
-        if members.iter().any(|m| m.0.label.contains("equal")) {
-            members.retain(|m| {
-                m.0.name != CauseName::Catalogue(EffectName::LegLead) || m.0.label.contains("equal")
-            });
-        }
+        // A common part (an equal lead) is the full term's special case:
+        // name it alone.
+        let common: Vec<CauseName> = members
+            .iter()
+            .filter(|m| m.0.common)
+            .map(|m| m.0.name)
+            .collect();
+        members.retain(|m| m.0.common || !common.contains(&m.0.name));
         if members.is_empty() {
             continue;
         }
@@ -379,47 +399,69 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
             }
         }
     }
-    // Structural: a significant common lead is a scale gain.
-    let lead_term = LEAD;
-    if let Some(i) = terms.iter().position(|t| *t == lead_term) {
-        let already = out.aliases.iter().any(|al| {
-            al.effects
-                .contains(&CauseName::Catalogue(EffectName::ScaleGain))
-                && al
-                    .effects
-                    .contains(&CauseName::Catalogue(EffectName::LegLead))
-        });
-        let (v, cov) = term_estimates(fit, &lead_term);
-        let mean = v.iter().sum::<f64>() / 3.0;
-        let var = cov.iter().sum::<f64>() / 9.0;
-        let sd = var.max(0.0).sqrt();
-        let scale_in_model = terms.contains(&Term::Catalogue(EffectName::ScaleGain));
-        if !already && !scale_in_model && mean.abs() > 3.0 * sd && offsets.get(i).is_some() {
-            let (why, separate_by) = explain(
-                CauseName::Catalogue(EffectName::LegLead),
-                CauseName::Catalogue(EffectName::ScaleGain),
-                "scale-gain",
-            );
-            out.aliases.push(Alias {
-                effects: vec![
-                    CauseName::Catalogue(EffectName::LegLead),
-                    CauseName::Catalogue(EffectName::ScaleGain),
-                ],
-                descriptions: vec!["leg-lead (common part)".into(), "scale-gain".into()],
-                why: format!(
-                    "{why}: the mean lead {mean:.1} +- {sd:.1} ppm is indistinguishable from a scale gain of {mean:.1} ppm with every lead reduced by it"
-                ),
-                separate_by,
-                exact: true,
-                lambda_unexplained: 0.0,
-                in_model: CauseName::Catalogue(EffectName::LegLead),
-                parameters: vec![Estimate {
-                    name: "scale-gain.scale_gain_ppm".into(),
-                    value: mean,
-                    std_dev: Some(sd),
-                }],
-            });
-        }
+    // Structural, as the registry declares it: a significant common lead
+    // is a scale gain.
+    for (common, other, structural) in EffectName::structural_aliases() {
+        structural_alias(&mut out, fit, &terms, &offsets, common, other, structural);
     }
     out
+}
+
+/// A structural alias of the registry ([`EffectName::structural_aliases`]):
+/// when the model carries `common` (a leg lead) and not `other` (a scale
+/// gain), and `common`'s common part is significant (beyond 3 standard
+/// deviations), the two are reported as one exact alias set.
+fn structural_alias(
+    out: &mut Aliases,
+    fit: &Fit,
+    terms: &[Term],
+    offsets: &[usize],
+    common: EffectName,
+    other: EffectName,
+    structural: &Structural,
+) {
+    let (common_name, other_name) = (CauseName::Catalogue(common), CauseName::Catalogue(other));
+    let common_term = Term::Catalogue(common);
+    let Some(i) = terms.iter().position(|t| *t == common_term) else {
+        return;
+    };
+    let already = out
+        .aliases
+        .iter()
+        .any(|al| al.effects.contains(&other_name) && al.effects.contains(&common_name));
+    let (v, cov) = term_estimates(fit, &common_term);
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let var = cov.iter().sum::<f64>() / (n * n);
+    let sd = var.max(0.0).sqrt();
+    let other_in_model = terms.contains(&Term::Catalogue(other));
+    let significant = mean.abs() > 3.0 * sd;
+    if already || other_in_model || !significant || offsets.get(i).is_none() {
+        return;
+    }
+    let (why, separate_by) = explain(common_name, other_name, other.as_str());
+    let part = common
+        .spec()
+        .common_part
+        .map_or(common.as_str(), |p: CommonPart| p.as_alias);
+    out.aliases.push(Alias {
+        effects: vec![common_name, other_name],
+        descriptions: vec![part.into(), other.as_str().into()],
+        why: format!("{why}: {}", (structural.says)(mean, sd)),
+        separate_by,
+        exact: true,
+        lambda_unexplained: 0.0,
+        in_model: common_name,
+        parameters: other
+            .spec()
+            .parameters
+            .iter()
+            .take(1)
+            .map(|p| Estimate {
+                name: format!("{other}.{}", p.name),
+                value: mean,
+                std_dev: Some(sd),
+            })
+            .collect(),
+    });
 }

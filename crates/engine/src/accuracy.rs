@@ -42,6 +42,20 @@ pub const DEFAULT_TOLERANCE_MM: f64 = 0.25;
 /// is at most this fraction of the uncalibrated machine's.
 pub const WORTHWHILE_RATIO: f64 = 0.5;
 
+/// The evaluation points of a predicted platform accuracy, mm: the
+/// workspace's polar grid of 2 rings of 8 points on 3 levels (51 points).
+/// The one grid of every accuracy the project predicts (identify, check,
+/// the campaign study).
+///
+/// # Example
+/// ```
+/// let m = tricept_kinematics::Machine::paper();
+/// assert_eq!(tricept_engine::accuracy_points(&m).len(), 51);
+/// ```
+pub fn accuracy_points(m: &Machine) -> Vec<Vector3<f64>> {
+    m.workspace.polar_grid(2, 8, 3)
+}
+
 /// The predicted platform accuracy of a calibration.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct PredictedAccuracy {

@@ -72,7 +72,9 @@ mod suspects;
 mod table;
 mod verdict;
 
-pub use accuracy::{AccuracyModel, DEFAULT_TOLERANCE_MM, PredictedAccuracy, WORTHWHILE_RATIO};
+pub use accuracy::{
+    AccuracyModel, DEFAULT_TOLERANCE_MM, PredictedAccuracy, WORTHWHILE_RATIO, accuracy_points,
+};
 pub use compensate::{Compensation, compensation, corrected_commands};
 pub use error::IdentError;
 pub use identify::{

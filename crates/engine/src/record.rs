@@ -37,6 +37,24 @@ pub enum RecordError {
     /// The record cannot be read as one this version writes.
     #[error("calibration record: {0}")]
     Unreadable(String),
+    /// Fields a later verb judges by (standard deviations, correlations,
+    /// sensor offsets and noise, temperature, fit quality) differ from the
+    /// values the record was sealed with.
+    #[error(
+        "{} edited after the calibration (the record's seal does not match): a later check judges the machine by {}; restore the file, or calibrate again",
+        .fields.iter().map(|f| format!("`{f}`")).collect::<Vec<_>>().join(", "),
+        if .fields.len() == 1 { "it" } else { "them" }
+    )]
+    Edited {
+        /// The edited fields, as named in the file.
+        fields: Vec<&'static str>,
+    },
+    /// The record has no seal: written before records were sealed, or the
+    /// seal was removed.
+    #[error(
+        "the calibration record has no `seal` (written by a tricept before 0.1.0's sealed records, or the seal was removed), so edits of its standard deviations, noise or temperature cannot be seen; calibrate again, or remove the `calibration` record to use the file as a plain description"
+    )]
+    Unsealed,
     /// Fields of the description differ from the geometry rebuilt from the
     /// record.
     #[error(
@@ -77,12 +95,20 @@ pub enum RecordError {
 ///     effects: Default::default(),
 ///     sensor_offsets: SensorOffsetsDescription { phi_rad: 0.0, theta_rad: 0.0, s_mm: 0.0, std_dev: [0.0; 3] },
 ///     applies: vec![], records: vec![], held: vec![], chi2_per_dof: 1.0, dof: 1, converged: true, adequate: true, forced: false,
-///     warnings: vec![], poses_used: 75, temperature_c: None, rejected_lines: vec![], leg_tables_digest: None, external_sources: vec![],
+///     warnings: vec![], poses_used: 75, temperature_c: None, rejected_lines: vec![], leg_tables_digest: None, seal: None, external_sources: vec![],
 ///     data_file: "d.csv".into(), data_sha256: String::new(), date: String::new(),
 ///     tool_version: String::new(), relative_to: m.name.clone(), relative_to_machine: None,
 ///     nominal,
 /// }));
+/// // Written files are sealed; an unsealed record is refused.
+/// assert!(check_calibration_record(&d).is_err());
+/// d.seal();
 /// assert!(check_calibration_record(&d).is_ok());
+/// // An edit of a judged field is caught and named.
+/// let mut edited = d.clone();
+/// edited.sensors.length_noise_um *= 2.0;
+/// let e = check_calibration_record(&edited).unwrap_err().to_string();
+/// assert!(e.contains("`sensors` edited"), "{e}");
 /// // An edit of the geometry without the record is caught and named.
 /// d.leg_offsets_mm[0] += 5.0;
 /// let e = check_calibration_record(&d).unwrap_err().to_string();
@@ -93,6 +119,11 @@ pub fn check_calibration_record(d: &MachineDescription) -> Result<(), RecordErro
         return Ok(());
     };
     let unreadable = |why: String| RecordError::Unreadable(why);
+    match d.edited_sealed_fields() {
+        Err(()) => return Err(RecordError::Unsealed),
+        Ok(fields) if !fields.is_empty() => return Err(RecordError::Edited { fields }),
+        Ok(_) => {}
+    }
     if !RECORD_METHODS.contains(&c.method.as_str()) {
         return Err(unreadable(format!(
             "unknown method `{}` (this version writes {})",

@@ -13,6 +13,7 @@ use tricept_check::CheckError;
 use tricept_data::DataError;
 use tricept_diagnose::{DeployError, DiagnoseError};
 use tricept_engine::{IdentError, RecordError};
+use tricept_export::ExportError;
 use tricept_kinematics::{DescriptionError, KinematicsError};
 use tricept_model::ModelError;
 use tricept_plant::PlantError;
@@ -46,6 +47,12 @@ pub enum ErrorKind {
     /// Anything else: a numerical failure, an I/O failure of an output
     /// (exit code 1).
     Other,
+    /// A result that is not to be trusted because its model does not
+    /// explain the data (exit code 3): a refused write, say.
+    Inadequate,
+    /// A result that is not to be trusted because its fit did not converge
+    /// (exit code 4).
+    NotConverged,
 }
 
 impl ErrorKind {
@@ -54,6 +61,26 @@ impl ErrorKind {
         match self {
             ErrorKind::Input => EXIT_INPUT,
             ErrorKind::Other => EXIT_OTHER,
+            ErrorKind::Inadequate => EXIT_INADEQUATE,
+            ErrorKind::NotConverged => EXIT_NOT_CONVERGED,
+        }
+    }
+
+    /// The kind whose exit code is `code` (a verdict's code: 3 inadequate,
+    /// 4 not converged, 2 input; anything else is [`ErrorKind::Other`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{ErrorKind, EXIT_INADEQUATE};
+    /// assert_eq!(ErrorKind::of_exit_code(EXIT_INADEQUATE), ErrorKind::Inadequate);
+    /// assert_eq!(ErrorKind::of_exit_code(EXIT_INADEQUATE).exit_code(), EXIT_INADEQUATE);
+    /// ```
+    pub fn of_exit_code(code: u8) -> ErrorKind {
+        match code {
+            EXIT_INPUT => ErrorKind::Input,
+            EXIT_INADEQUATE => ErrorKind::Inadequate,
+            EXIT_NOT_CONVERGED => ErrorKind::NotConverged,
+            _ => ErrorKind::Other,
         }
     }
 }
@@ -88,6 +115,14 @@ pub struct Error {
 }
 
 impl Error {
+    /// An error of the given kind.
+    pub fn new(kind: ErrorKind, message: impl Into<String>) -> Error {
+        Error {
+            kind,
+            message: message.into(),
+        }
+    }
+
     /// An error of the user's input (exit code 2).
     pub fn input(message: impl Into<String>) -> Error {
         Error {
@@ -112,6 +147,15 @@ impl Error {
         }
     }
 
+    /// A library error with `context: ` before its message, keeping its
+    /// kind.
+    pub fn with_context(context: impl fmt::Display, e: &(impl Classify + fmt::Display)) -> Error {
+        Error {
+            kind: e.kind(),
+            message: format!("{context}: {e}"),
+        }
+    }
+
     /// The same error with `context: ` before its message (a file, a flag).
     #[must_use]
     pub fn in_file(self, context: impl fmt::Display) -> Error {
@@ -126,7 +170,8 @@ impl Error {
         self.kind
     }
 
-    /// The process exit code: 2 for input, 1 for anything else.
+    /// The process exit code: 2 for input, 3 and 4 for an untrusted
+    /// result, 1 for anything else.
     pub fn exit_code(&self) -> u8 {
         self.kind.exit_code()
     }
@@ -258,6 +303,17 @@ impl Classify for StudyError {
             StudyError::Check(e) => e.kind(),
             StudyError::Invalid(_) => ErrorKind::Input,
             _ => ErrorKind::Other,
+        }
+    }
+}
+
+impl Classify for ExportError {
+    /// A failed write is not the input's fault; everything else is.
+    fn kind(&self) -> ErrorKind {
+        match self {
+            ExportError::Io { .. } => ErrorKind::Other,
+            ExportError::Kinematics(e) => e.kind(),
+            _ => ErrorKind::Input,
         }
     }
 }

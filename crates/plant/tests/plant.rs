@@ -127,7 +127,9 @@ fn effects_add_what_their_physics_says() {
 
     // A scale gain changes the scale reading only, by g q4.
     let mut gain = base.clone();
-    gain.effects = vec![Effect::ScaleGain { ppm: 120.0 }];
+    gain.effects = vec![Effect::from(tricept_plant::effects::ScaleGain {
+        ppm: 120.0,
+    })];
     for (a, b) in gain.true_poses(&c).unwrap().iter().zip(&clean) {
         let (ra, rb) = (a.readings.to_array(), b.readings.to_array());
         assert_eq!((ra[0], ra[1]), (rb[0], rb[1]));
@@ -138,7 +140,7 @@ fn effects_add_what_their_physics_says() {
     // the actual machine's FK of the lengthened legs puts it.
     let ppm = [80.0, -40.0, 60.0];
     let mut lead = base.clone();
-    lead.effects = vec![Effect::LegLead { ppm }];
+    lead.effects = vec![Effect::from(tricept_plant::effects::LegLead { ppm })];
     for t in lead.true_poses(&c).unwrap() {
         let legs: [f64; 3] = std::array::from_fn(|i| t.commands_mm[i] * (1.0 + ppm[i] * 1e-6));
         let fk = actual.forward(&legs).unwrap();
@@ -149,9 +151,9 @@ fn effects_add_what_their_physics_says() {
     // stiffness (the tension taken at the nominal joints of the command).
     let stiffness = 40.0;
     let mut soft = base.clone();
-    soft.effects = vec![Effect::Compliance {
+    soft.effects = vec![Effect::from(tricept_plant::effects::Compliance {
         stiffness_n_per_um_at_1m: stiffness,
-    }];
+    })];
     let mut sag = 0.0;
     for t in soft.true_poses(&c).unwrap() {
         let nominal_up = base.nominal.forward(&t.commands_mm).unwrap().up;
@@ -171,10 +173,10 @@ fn effects_add_what_their_physics_says() {
     // A temperature drift: the logged temperature rises linearly by the
     // drift (to the logger's noise), the legs grow alpha q dT.
     let mut warm = base.clone();
-    warm.effects = vec![Effect::Thermal {
+    warm.effects = vec![Effect::from(tricept_plant::effects::Thermal {
         drift_k: 3.0,
         expansion_ppm_per_k: 11.5,
-    }];
+    })];
     let poses = warm.true_poses(&c).unwrap();
     let n = poses.len();
     for (j, t) in poses.iter().enumerate() {
@@ -191,10 +193,10 @@ fn outliers_corrupt_exactly_the_stated_number_of_readings_by_the_stated_size() {
     let c = Campaign::random(&base.nominal, 50, 6);
     let clean = base.simulate(&c).unwrap();
     let mut bad = base.clone();
-    bad.effects = vec![Effect::Outliers {
+    bad.effects = vec![Effect::from(tricept_plant::effects::Outliers {
         count: 3,
         size_sigma: 400.0,
-    }];
+    })];
     let corrupted = bad.simulate(&c).unwrap();
     let sigma = c.noise.logged_sigma();
     let mut changed = Vec::new();
@@ -244,12 +246,12 @@ fn effects_outside_the_vocabulary_add_what_their_physics_says() {
     // Ball-screw pitch error: A sin(2 pi q / P + psi) on each leg, in mm.
     let (um, period, phase) = ([4.0, 3.0, 5.0], 10.0, [0.0, 90.0, 200.0]);
     let mut pitch = base.clone();
-    pitch.effects = vec![Effect::LegPeriodic {
+    pitch.effects = vec![Effect::from(tricept_plant::effects::LegPeriodic {
         um,
         period_mm: period,
         phase_deg: phase,
         waveform: Waveform::Sine,
-    }];
+    })];
     for t in pitch.true_poses(&c).unwrap() {
         let extra: [f64; 3] = std::array::from_fn(|i| {
             um[i]
@@ -259,12 +261,12 @@ fn effects_outside_the_vocabulary_add_what_their_physics_says() {
         assert!(legs_reach(&t, extra) < 1e-9);
     }
     // A sawtooth rises from -A to A over each period.
-    pitch.effects = vec![Effect::LegPeriodic {
+    pitch.effects = vec![Effect::from(tricept_plant::effects::LegPeriodic {
         um,
         period_mm: period,
         phase_deg: [0.0; 3],
         waveform: Waveform::Sawtooth,
-    }];
+    })];
     for t in pitch.true_poses(&c).unwrap() {
         let extra: [f64; 3] = std::array::from_fn(|i| {
             let frac = (t.commands_mm[i] / period).rem_euclid(1.0);
@@ -275,23 +277,23 @@ fn effects_outside_the_vocabulary_add_what_their_physics_says() {
 
     // Quadratic and power-law leg errors about a centre.
     let mut quad = base.clone();
-    quad.effects = vec![Effect::LegQuadratic {
+    quad.effects = vec![Effect::from(tricept_plant::effects::LegQuadratic {
         um: [10.0, -8.0, 6.0],
         centre_mm: 845.0,
         half_width_mm: 250.0,
-    }];
+    })];
     for t in quad.true_poses(&c).unwrap() {
         let extra: [f64; 3] = std::array::from_fn(|i| {
             [10.0, -8.0, 6.0][i] * 1e-3 * ((t.commands_mm[i] - 845.0) / 250.0).powi(2)
         });
         assert!(legs_reach(&t, extra) < 1e-9);
     }
-    quad.effects = vec![Effect::LegPower {
+    quad.effects = vec![Effect::from(tricept_plant::effects::LegPower {
         um: [10.0, -8.0, 6.0],
         exponent: 1.5,
         centre_mm: 845.0,
         half_width_mm: 250.0,
-    }];
+    })];
     for t in quad.true_poses(&c).unwrap() {
         let extra: [f64; 3] = std::array::from_fn(|i| {
             [10.0, -8.0, 6.0][i] * 1e-3 * ((t.commands_mm[i] - 845.0) / 250.0).abs().powf(1.5)
@@ -303,11 +305,11 @@ fn effects_outside_the_vocabulary_add_what_their_physics_says() {
     // encoder reading (1 + g) times its angle.
     let mut drift = base.clone();
     drift.effects = vec![
-        Effect::ScaleDrift { um: 3.0 },
-        Effect::EncoderGain {
+        Effect::from(tricept_plant::effects::ScaleDrift { um: 3.0 }),
+        Effect::from(tricept_plant::effects::EncoderGain {
             phi_ppm: 200.0,
             theta_ppm: -100.0,
-        },
+        }),
     ];
     let poses = drift.true_poses(&c).unwrap();
     let n = poses.len();
@@ -320,7 +322,10 @@ fn effects_outside_the_vocabulary_add_what_their_physics_says() {
         assert!((ra[2] - rb[2] - expected).abs() < 1e-12);
     }
     // Their names are the generic families a perfect diagnosis would give.
-    assert!(Effect::ScaleDrift { um: 1.0 }.name() == GenericFamily::ReadingDrift);
+    assert!(
+        Effect::from(tricept_plant::effects::ScaleDrift { um: 1.0 }).name()
+            == GenericFamily::ReadingDrift
+    );
 }
 
 #[test]

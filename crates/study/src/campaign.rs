@@ -172,7 +172,7 @@ mod tests {
     fn a_few_optimal_poses_suffice_where_eight_grid_poses_do_not() {
         let m = Machine::paper();
         let set = ParameterSet::paper15();
-        let points = m.workspace.polar_grid(2, 8, 3);
+        let points = tricept_engine::accuracy_points(&m);
         let accuracy = AccuracyModel::new(&m, &set, &points, 0.25).unwrap();
         let (optimal, random) = worthwhile_campaigns(&m, &set, &accuracy).unwrap();
         let (optimal, random) = (optimal.unwrap(), random.unwrap());

@@ -280,7 +280,7 @@ pub fn plan_check(
 
 /// `mean_r |P21(r)[:, t]|` over the workspace's evaluation grid (mm/mm).
 fn platform_columns(machine: &Machine) -> Result<[f64; N_FULL], StudyError> {
-    let points = machine.workspace.polar_grid(2, 8, 3);
+    let points = tricept_engine::accuracy_points(machine);
     let mut sum = [0.0; N_FULL];
     for r in &points {
         let up = machine.inverse(r)?.up;

@@ -1,7 +1,7 @@
 //! A downstream program that diagnoses measured data and deploys what the
-//! diagnosis found, with `tricept-diagnose` as a library: it refuses to go
-//! on unless the final model explains the data, then deploys the model
-//! (`tricept_diagnose::deploy`: each term worth deploying where the
+//! diagnosis found, with `tricept-ident` as its only dependency: it
+//! refuses to go on unless the final model explains the data, then deploys
+//! the model (`DiagnoseResult::deploy`: each term worth deploying where the
 //! registry says it goes, a generic leg error as per-leg compensation
 //! tables) and prints what it applies and what it only records, the
 //! controller parameters of the dynamic effects and the calibrated leg
@@ -11,9 +11,8 @@
 //! cargo run -p tricept-example-deploy -- fixtures/data/diagnose-hidden-effect.csv
 //! ```
 
-use tricept_diagnose::{DiagnoseOptions, deploy, diagnose};
 use tricept_ident::nalgebra::Vector3;
-use tricept_ident::{ExtendedMachine, Machine, read_path};
+use tricept_ident::{DiagnoseRequest, ExtendedMachine, SensorNoise, diagnose, load_machine};
 
 /// The data file when none is given: a campaign with a hidden compliance.
 const DEFAULT_DATA: &str = concat!(
@@ -25,16 +24,16 @@ const DEFAULT_DATA: &str = concat!(
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::env::args().nth(1);
     let path = path.as_deref().unwrap_or(DEFAULT_DATA);
-    let data = read_path(path.as_ref())?;
-    let nominal = Machine::paper();
-    let d = diagnose(&nominal, &data, &DiagnoseOptions::for_machine(&nominal))?;
-    for c in &d.causes {
+    let loaded = load_machine(None, &SensorNoise::default())?;
+    let nominal = loaded.machine().clone();
+    let result = diagnose(DiagnoseRequest::new(loaded, path))?;
+    for c in &result.diagnosis().causes {
         println!("{}: {}", c.effect, c.description);
     }
-    if !d.final_adequate {
-        return Err("the final model does not explain the data (see the report)".into());
+    if let Some(why) = result.exit_reason() {
+        return Err(why.into());
     }
-    let deployed = deploy(&nominal, None, &data, &d)?;
+    let deployed = result.deploy()?;
     for line in &deployed.applied {
         println!("applies: {line}");
     }

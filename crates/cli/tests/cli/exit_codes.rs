@@ -153,3 +153,63 @@ fn every_verb_follows_the_one_exit_code_table() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// One library error, one exit code and one message, from every verb that
+/// reads measured data: a command outside the leg stroke is the input's
+/// fault (exit 2), named by file, line and column whichever verb meets it.
+#[test]
+fn the_same_bad_data_give_the_same_code_and_message_from_every_verb() {
+    // Its own directory: the other test removes its work directory.
+    let dir = std::env::temp_dir().join(format!("tricept-same-error-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let d = dir.as_path();
+    let good = fixture("table2-grid-seed1.csv");
+    assert_eq!(
+        code(
+            d,
+            &["diagnose", "--data", &good, "--write-machine", "cal.json"]
+        ),
+        0
+    );
+    // The first data row (line 7) commands leg 2 beyond its stroke.
+    let text = std::fs::read_to_string(&good).unwrap();
+    let bad: Vec<String> = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 6 {
+                let mut f: Vec<&str> = l.split(',').collect();
+                f[1] = "5000";
+                f.join(",")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect();
+    std::fs::write(dir.join("bad.csv"), bad.join("\n") + "\n").unwrap();
+    let verbs: [&[&str]; 6] = [
+        &["identify", "--data", "bad.csv"],
+        &["diagnose", "--data", "bad.csv"],
+        &["check", "--machine", "cal.json", "--data", "bad.csv"],
+        &["compensate", "--data", "bad.csv"],
+        &["detectability", "--data", "bad.csv"],
+        &["identifiability", "--data", "bad.csv"],
+    ];
+    let mut failures = Vec::new();
+    for args in verbs {
+        let out = support::tricept()
+            .args(args)
+            .current_dir(d)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let line = stderr.lines().last().unwrap_or_default();
+        if out.status.code() != Some(2)
+            || !line.starts_with("error: bad.csv: line 7, column `q2`: command 5000 mm")
+        {
+            failures.push(format!("{args:?}: exit {:?}: {stderr}", out.status.code()));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -193,7 +193,7 @@ impl Features {
     /// Reads and checks a features file.
     pub fn from_path(path: &Path) -> Result<Features, DataError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| DataError::Io {
+        let text = crate::read_json_text(path).map_err(|source| DataError::Io {
             file: file.clone(),
             source,
         })?;

@@ -47,10 +47,10 @@ fn plant(seed: u64, effect: Effect) -> Plant {
         2.0 * rng.random::<f64>() - 1.0,
     ];
     p.effects = vec![
-        Effect::Thermal {
+        Effect::from(tricept_plant::effects::Thermal {
             drift_k: 2.0,
             expansion_ppm_per_k: 0.0,
-        },
+        }),
         effect,
     ];
     p
@@ -164,39 +164,39 @@ fn leg_effects(seed: u64) -> Vec<(&'static str, Effect)> {
     vec![
         (
             "pitch 4 um / 10 mm",
-            Effect::LegPeriodic {
+            Effect::from(tricept_plant::effects::LegPeriodic {
                 um: [4.0, 4.0, 4.0],
                 period_mm: 10.0,
                 phase_deg: [u(0.0, 360.0), u(0.0, 360.0), u(0.0, 360.0)],
                 waveform: Waveform::Sine,
-            },
+            }),
         ),
         (
             "quadratic leg",
-            Effect::LegQuadratic {
+            Effect::from(tricept_plant::effects::LegQuadratic {
                 um: [u(20.0, 30.0), -u(10.0, 20.0), u(0.0, 10.0)],
                 centre_mm: 845.0,
                 half_width_mm: 250.0,
-            },
+            }),
         ),
         (
             // A screw bent into one arc over its length: a half sine
             // of 12-20 um over 400 mm, its crest anywhere.
             "bowed screw",
-            Effect::LegPeriodic {
+            Effect::from(tricept_plant::effects::LegPeriodic {
                 um: [u(12.0, 20.0), u(12.0, 20.0), u(12.0, 20.0)],
                 period_mm: 800.0,
                 phase_deg: [u(0.0, 360.0), u(0.0, 360.0), u(0.0, 360.0)],
                 waveform: Waveform::Sine,
-            },
+            }),
         ),
         (
             "worn segment",
-            Effect::LegStep {
+            Effect::from(tricept_plant::effects::LegStep {
                 um: [u(2.5, 3.5), 0.0, 0.0],
                 from_mm: u(700.0, 740.0),
                 to_mm: u(940.0, 980.0),
-            },
+            }),
         ),
     ]
 }
@@ -253,7 +253,7 @@ fn generic_leg_errors_are_deployed_and_pay_in_truth() {
                 ))
                 .collect::<Vec<_>>()
         );
-        if let Effect::LegStep { um, from_mm, to_mm } = o.effect {
+        if let Some(&tricept_plant::effects::LegStep { um, from_mm, to_mm }) = o.effect.input() {
             // The written table carries the simulated step, away from its
             // edges (beyond 15 mm: the edges are known to a few mm at
             // these sizes), to within 1 um.
@@ -333,20 +333,20 @@ fn a_marginal_effect_is_never_deployed_when_it_makes_the_truth_worse() {
                 (
                     seed,
                     "twist 30 arcsec / 100 mm",
-                    Effect::TubeTwist {
+                    Effect::from(tricept_plant::effects::TubeTwist {
                         arcsec_per_100mm: 30.0,
-                    },
+                    }),
                     EffectName::TubeTwist,
                 ),
                 (
                     seed,
                     "eccentricity 5 arcsec",
-                    Effect::EncoderEccentricity {
+                    Effect::from(tricept_plant::effects::EncoderEccentricity {
                         phi_arcsec: 5.0,
                         phi_phase_deg: 36.0 * seed as f64,
                         theta_arcsec: 5.0,
                         theta_phase_deg: 90.0 + 36.0 * seed as f64,
-                    },
+                    }),
                     EffectName::EncoderEccentricity,
                 ),
             ]

@@ -36,53 +36,53 @@ fn hidden(e: E, rng: &mut Pcg64Mcg, m: &Machine) -> Effect {
     match e {
         // Realistic: 50 ppm, 5 um, 2 K, 50 ppm, 5 arcsec, 30 arcsec or
         // 20 um, 30 arcsec over the stroke, 10 um at the platform.
-        E::LegLead => Effect::LegLead {
+        E::LegLead => Effect::from(tricept_plant::effects::LegLead {
             ppm: [
                 s[0] * u(50.0, 150.0),
                 s[1] * u(50.0, 150.0),
                 s[2] * u(50.0, 150.0),
             ],
-        },
-        E::Backlash => Effect::Backlash {
+        }),
+        E::Backlash => Effect::from(tricept_plant::effects::Backlash {
             um: [u(5.0, 15.0), u(5.0, 15.0), u(5.0, 15.0)],
-        },
-        E::Thermal => Effect::Thermal {
+        }),
+        E::Thermal => Effect::from(tricept_plant::effects::Thermal {
             drift_k: s[0] * u(2.0, 5.0),
             expansion_ppm_per_k: 11.5,
-        },
-        E::ScaleGain => Effect::ScaleGain {
+        }),
+        E::ScaleGain => Effect::from(tricept_plant::effects::ScaleGain {
             ppm: s[0] * u(50.0, 150.0),
-        },
-        E::EncoderEccentricity => Effect::EncoderEccentricity {
+        }),
+        E::EncoderEccentricity => Effect::from(tricept_plant::effects::EncoderEccentricity {
             phi_arcsec: u(5.0, 15.0),
             phi_phase_deg: u(0.0, 360.0),
             theta_arcsec: u(5.0, 15.0),
             theta_phase_deg: u(0.0, 360.0),
-        },
+        }),
         E::UjointAxes => {
             if s[2] > 0.0 {
-                Effect::UjointAxes {
+                Effect::from(tricept_plant::effects::UjointAxes {
                     skew_arcsec: s[0] * u(30.0, 90.0),
                     offset_um: 0.0,
-                }
+                })
             } else {
-                Effect::UjointAxes {
+                Effect::from(tricept_plant::effects::UjointAxes {
                     skew_arcsec: 0.0,
                     offset_um: s[1] * u(20.0, 60.0),
-                }
+                })
             }
         }
         // Over the workspace's stroke of the UP limb (650 to 940 mm).
-        E::TubeTwist => Effect::TubeTwist {
+        E::TubeTwist => Effect::from(tricept_plant::effects::TubeTwist {
             arcsec_per_100mm: s[0] * u(30.0, 90.0) / 2.9,
-        },
-        E::Compliance => Effect::Compliance {
+        }),
+        E::Compliance => Effect::from(tricept_plant::effects::Compliance {
             stiffness_n_per_um_at_1m: stiffness_for_platform_deflection(m, u(10.0, 30.0)),
-        },
-        E::Outliers => Effect::Outliers {
+        }),
+        E::Outliers => Effect::from(tricept_plant::effects::Outliers {
             count: 2 + (u(0.0, 3.999) as usize),
             size_sigma: u(300.0, 3000.0),
-        },
+        }),
     }
 }
 
@@ -186,7 +186,7 @@ fn check_effect(effect: E) {
             }
         }
         if effect == E::Outliers {
-            let Effect::Outliers { count, .. } = hidden[0] else {
+            let Some(&tricept_plant::effects::Outliers { count, .. }) = hidden[0].input() else {
                 unreachable!()
             };
             let rows = d
@@ -310,7 +310,7 @@ fn the_report_names_the_evidence_and_the_bias() {
         json["gain"]["holdout_rms_geometric"].as_f64().unwrap()
             > 2.0 * json["gain"]["holdout_rms_extended"].as_f64().unwrap()
     );
-    let Effect::ScaleGain { ppm } = hidden[0] else {
+    let Some(tricept_plant::effects::ScaleGain { ppm }) = hidden[0].input() else {
         unreachable!()
     };
     let est = json["extended"]["scale-gain.scale_gain_ppm"]["value"]

@@ -102,11 +102,13 @@ fn pitch_is_named() {
         "leg-periodic 4 um, 10 mm",
         0x9170,
         &SIZES,
-        |r| Effect::LegPeriodic {
-            um: [4.0; 3],
-            period_mm: 10.0,
-            phase_deg: std::array::from_fn(|_| uniform(r, 0.0, 360.0)),
-            waveform: Waveform::Sine,
+        |r| {
+            Effect::from(tricept_plant::effects::LegPeriodic {
+                um: [4.0; 3],
+                period_mm: 10.0,
+                phase_deg: std::array::from_fn(|_| uniform(r, 0.0, 360.0)),
+                waveform: Waveform::Sine,
+            })
         },
         |_, d| {
             d.causes.iter().any(|c| {
@@ -126,11 +128,11 @@ fn pitch_is_named() {
 /// The lead error implied by a quadratic centred away from the campaign's
 /// middle: its linear part over the campaign's commands (least squares).
 fn implied_leads(s: &Simulated) -> Vec<f64> {
-    let Effect::LegQuadratic {
+    let Some(&tricept_plant::effects::LegQuadratic {
         um,
         centre_mm,
         half_width_mm,
-    } = s.effects[0]
+    }) = s.effects[0].input()
     else {
         return vec![0.0; 3];
     };
@@ -159,10 +161,12 @@ fn quadratic_is_named() {
         "leg-quadratic 5-15 um",
         0x9a0d,
         &SIZES,
-        |r| Effect::LegQuadratic {
-            um: std::array::from_fn(|_| sign(r) * uniform(r, 5.0, 15.0)),
-            centre_mm: 845.0,
-            half_width_mm: 250.0,
+        |r| {
+            Effect::from(tricept_plant::effects::LegQuadratic {
+                um: std::array::from_fn(|_| sign(r) * uniform(r, 5.0, 15.0)),
+                centre_mm: 845.0,
+                half_width_mm: 250.0,
+            })
         },
         |_, d| {
             d.causes
@@ -208,7 +212,7 @@ fn worn_segment(r: &mut rand_pcg::Pcg64Mcg, set: u64) -> Effect {
         1 => (from, 1200.0),
         _ => (400.0, to),
     };
-    Effect::LegStep { um, from_mm, to_mm }
+    Effect::from(tricept_plant::effects::LegStep { um, from_mm, to_mm })
 }
 
 /// The edges of a step inside `[lo, hi]` with the jump of the leg's
@@ -229,7 +233,7 @@ fn jumps(h: f64, a: f64, b: f64, lo: f64, hi: f64) -> Vec<(f64, f64)> {
 /// deviations, with the same jumps of the leg's length within 3 standard
 /// deviations plus 0.3 um.
 fn step_found(s: &Simulated, d: &Diagnosis) -> bool {
-    let Effect::LegStep { um, from_mm, to_mm } = s.effects[0] else {
+    let Some(&tricept_plant::effects::LegStep { um, from_mm, to_mm }) = s.effects[0].input() else {
         return false;
     };
     let Some(leg) = um.iter().position(|u| *u != 0.0) else {
@@ -332,8 +336,10 @@ fn scale_drift_is_named() {
         "scale drift 2-6 um",
         0xd21f,
         &SIZES,
-        |r| Effect::ScaleDrift {
-            um: sign(r) * uniform(r, 2.0, 6.0),
+        |r| {
+            Effect::from(tricept_plant::effects::ScaleDrift {
+                um: sign(r) * uniform(r, 2.0, 6.0),
+            })
         },
         |_, d| {
             // The temperature follows time in these campaigns: a drift with
@@ -355,19 +361,20 @@ fn encoder_gain() {
         |r| {
             let g = sign(r) * uniform(r, 100.0, 300.0);
             if uniform(r, 0.0, 1.0) < 0.5 {
-                Effect::EncoderGain {
+                Effect::from(tricept_plant::effects::EncoderGain {
                     phi_ppm: g,
                     theta_ppm: 0.0,
-                }
+                })
             } else {
-                Effect::EncoderGain {
+                Effect::from(tricept_plant::effects::EncoderGain {
                     phi_ppm: 0.0,
                     theta_ppm: g,
-                }
+                })
             }
         },
         |s, d| {
-            let Effect::EncoderGain { phi_ppm, .. } = s.effects[0] else {
+            let Some(&tricept_plant::effects::EncoderGain { phi_ppm, .. }) = s.effects[0].input()
+            else {
                 return false;
             };
             let label = if phi_ppm != 0.0 {
@@ -399,19 +406,19 @@ fn unknown_forms_are_not_dressed_up() {
             let seed = base + i;
             let r = &mut rng(*base, seed);
             let e = if k == 0 {
-                Effect::LegPeriodic {
+                Effect::from(tricept_plant::effects::LegPeriodic {
                     um: [4.0; 3],
                     period_mm: 10.0,
                     phase_deg: std::array::from_fn(|_| uniform(r, 0.0, 360.0)),
                     waveform: Waveform::Sawtooth,
-                }
+                })
             } else {
-                Effect::LegPower {
+                Effect::from(tricept_plant::effects::LegPower {
                     um: std::array::from_fn(|_| sign(r) * uniform(r, 5.0, 15.0)),
                     exponent: 1.5,
                     centre_mm: 845.0,
                     half_width_mm: 250.0,
-                }
+                })
             };
             simulate(80, seed, vec![e], CampaignOptions::default())
         });

@@ -24,51 +24,51 @@ const SETS: u64 = 20;
 /// outliers, at most the 10 % of the poses the screen may set aside).
 fn hidden(e: E, r: &mut Pcg64Mcg, n: usize) -> Effect {
     match e {
-        E::LegLead => Effect::LegLead {
+        E::LegLead => Effect::from(tricept_plant::effects::LegLead {
             ppm: std::array::from_fn(|_| sign(r) * uniform(r, 50.0, 150.0)),
-        },
-        E::Backlash => Effect::Backlash {
+        }),
+        E::Backlash => Effect::from(tricept_plant::effects::Backlash {
             um: std::array::from_fn(|_| uniform(r, 5.0, 15.0)),
-        },
-        E::Thermal => Effect::Thermal {
+        }),
+        E::Thermal => Effect::from(tricept_plant::effects::Thermal {
             drift_k: sign(r) * uniform(r, 2.0, 5.0),
             expansion_ppm_per_k: 11.5,
-        },
-        E::ScaleGain => Effect::ScaleGain {
+        }),
+        E::ScaleGain => Effect::from(tricept_plant::effects::ScaleGain {
             ppm: sign(r) * uniform(r, 50.0, 150.0),
-        },
-        E::EncoderEccentricity => Effect::EncoderEccentricity {
+        }),
+        E::EncoderEccentricity => Effect::from(tricept_plant::effects::EncoderEccentricity {
             phi_arcsec: uniform(r, 20.0, 50.0),
             phi_phase_deg: uniform(r, 0.0, 360.0),
             theta_arcsec: uniform(r, 20.0, 50.0),
             theta_phase_deg: uniform(r, 0.0, 360.0),
-        },
+        }),
         E::UjointAxes => {
             if sign(r) > 0.0 {
-                Effect::UjointAxes {
+                Effect::from(tricept_plant::effects::UjointAxes {
                     skew_arcsec: sign(r) * uniform(r, 30.0, 90.0),
                     offset_um: 0.0,
-                }
+                })
             } else {
-                Effect::UjointAxes {
+                Effect::from(tricept_plant::effects::UjointAxes {
                     skew_arcsec: 0.0,
                     offset_um: sign(r) * uniform(r, 20.0, 60.0),
-                }
+                })
             }
         }
-        E::TubeTwist => Effect::TubeTwist {
+        E::TubeTwist => Effect::from(tricept_plant::effects::TubeTwist {
             arcsec_per_100mm: sign(r) * uniform(r, 30.0, 90.0) / 2.9,
-        },
-        E::Compliance => Effect::Compliance {
+        }),
+        E::Compliance => Effect::from(tricept_plant::effects::Compliance {
             stiffness_n_per_um_at_1m: stiffness_for_platform_deflection(
                 &Machine::paper(),
                 uniform(r, 10.0, 30.0),
             ),
-        },
-        E::Outliers => Effect::Outliers {
+        }),
+        E::Outliers => Effect::from(tricept_plant::effects::Outliers {
             count: (2 + (uniform(r, 0.0, 3.999) as usize)).min(n / 10),
             size_sigma: uniform(r, 300.0, 3000.0),
-        },
+        }),
     }
 }
 
@@ -77,7 +77,7 @@ fn hidden(e: E, r: &mut Pcg64Mcg, n: usize) -> Effect {
 fn alone(d: &Diagnosis, e: E, s: &Simulated) -> bool {
     let causes: Vec<CauseName> = d.causes.iter().map(|c| c.effect).collect();
     if e == E::Outliers {
-        let Effect::Outliers { count, .. } = s.effects[0] else {
+        let Some(&tricept_plant::effects::Outliers { count, .. }) = s.effects[0].input() else {
             return false;
         };
         return causes == vec![CauseName::Catalogue(e)]
@@ -235,16 +235,16 @@ fn aliases_of_lead_and_gain() {
             let seed = base + i;
             let r = &mut rng(*base, seed);
             let s = sign(r);
-            let gain = Effect::ScaleGain {
+            let gain = Effect::from(tricept_plant::effects::ScaleGain {
                 ppm: s * uniform(r, 50.0, 150.0),
-            };
+            });
             // The lead's common part has the gain's sign: a gain and a
             // common lead of opposite signs cancel (a scale gain reads as
             // an equal lead), and nothing of either is left in play.
             let mean = s * uniform(r, 40.0, 80.0);
-            let lead = Effect::LegLead {
+            let lead = Effect::from(tricept_plant::effects::LegLead {
                 ppm: std::array::from_fn(|_| mean + uniform(r, -30.0, 30.0)),
-            };
+            });
             let effects = match k {
                 0 => vec![gain],
                 1 => vec![gain, lead],
@@ -284,10 +284,10 @@ fn implausible_fits_are_rejected() {
     let make = |i: u64| {
         let seed = base + i;
         let r = &mut rng(base, seed);
-        let e = Effect::Thermal {
+        let e = Effect::from(tricept_plant::effects::Thermal {
             drift_k: sign(r) * uniform(r, 2.0, 5.0),
             expansion_ppm_per_k: 23.0,
-        };
+        });
         simulate(80, seed, vec![e], CampaignOptions::default())
     };
     let mut failures = Vec::new();

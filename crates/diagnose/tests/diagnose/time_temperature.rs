@@ -19,11 +19,11 @@ fn temperature_that_follows_time_makes_one_alias_set() {
             80,
             300 + seed,
             vec![
-                Effect::Thermal {
+                Effect::from(tricept_plant::effects::Thermal {
                     drift_k: 2.0,
                     expansion_ppm_per_k: 11.5,
-                },
-                Effect::ScaleDrift { um: 3.0 },
+                }),
+                Effect::from(tricept_plant::effects::ScaleDrift { um: 3.0 }),
             ],
             CampaignOptions::default(),
         )

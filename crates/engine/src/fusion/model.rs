@@ -251,10 +251,11 @@ impl FusedModel {
     /// The machine-scale direction: the change of the parameters per unit
     /// `g` when the whole machine (joints, head) is scaled by `1 + g`, the
     /// legs read `1 + g` too long (a lead of `g` on every leg) and the UP
-    /// limb's scale `1 / (1 + g)` (a gain of `-g`), to first order. The UP
-    /// limb's readings cannot see it; `None` unless the model carries
-    /// `leg-lead` and `scale-gain` and the module can represent a scaled
-    /// machine.
+    /// limb's scale `1 / (1 + g)` (a gain of `-g`), to first order: the
+    /// registry's structural alias ([`EffectName::structural_aliases`]).
+    /// The UP limb's readings cannot see it; `None` unless the model
+    /// carries both effects of the alias (`leg-lead` and `scale-gain`) and
+    /// the module can represent a scaled machine.
     ///
     /// # Example
     /// ```
@@ -268,8 +269,14 @@ impl FusedModel {
     /// assert_eq!(v[m.index_of("dxB3").unwrap()], 288.7);
     /// ```
     pub fn scale_direction(&self) -> Option<Vec<f64>> {
-        let lead = self.effect_column(EffectName::LegLead)?;
-        let gain = self.effect_column(EffectName::ScaleGain)?;
+        // The registry's structural alias: a scale gain reads like a scaled
+        // machine with a lead on every leg.
+        let (common, other, structural) = EffectName::structural_aliases().find(|(c, o, _)| {
+            self.effect_column(*c).is_some() && self.effect_column(*o).is_some()
+        })?;
+        let (per_leg, per_other) = structural.scaled_machine;
+        let lead = self.effect_column(common)?;
+        let gain = self.effect_column(other)?;
         let errors = tricept_model::GeometricErrors {
             db_mm: self.nominal.base_joints_mm,
             da_mm: self.nominal.platform_joints_mm,
@@ -278,10 +285,10 @@ impl FusedModel {
         let module = self.module.from_errors(&errors).ok()?;
         let mut v = vec![0.0; self.len()];
         v[..module.len()].copy_from_slice(&module);
-        for i in 0..3 {
-            v[lead + i] = 1e6;
+        for i in 0..common.parameter_count() {
+            v[lead + i] = per_leg;
         }
-        v[gain] = -1e6;
+        v[gain] = per_other;
         if let Some(h) = &self.head {
             let range = self.head_range();
             v[range].copy_from_slice(&h.scale_direction());

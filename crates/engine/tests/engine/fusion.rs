@@ -442,10 +442,10 @@ fn scaled_plant(g: f64) -> (Plant, Vec<f64>) {
     let module = set.from_errors(&errors).unwrap();
     let mut plant = Plant::geometric(m, errors);
     plant.effects = vec![
-        Effect::LegLead { ppm: [g * 1e6; 3] },
-        Effect::ScaleGain {
+        Effect::from(tricept_plant::effects::LegLead { ppm: [g * 1e6; 3] }),
+        Effect::from(tricept_plant::effects::ScaleGain {
             ppm: -g * 1e6 / (1.0 + g),
-        },
+        }),
     ];
     plant.head_errors = head_truth();
     (plant, module)

@@ -27,6 +27,7 @@ use crate::error::DescriptionError;
 
 mod geometry;
 mod record;
+mod seal;
 mod validate;
 
 use geometry::is_zero3;
@@ -173,6 +174,14 @@ pub struct CalibrationRecord {
     /// before tables existed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub leg_tables_digest: Option<String>,
+    /// Digests of every field a later verb judges by (the standard
+    /// deviations, correlations, sensor offsets, temperature, effects, fit
+    /// quality, and the machine's sensor noise and controller parameters),
+    /// by field name: [`MachineDescription::seal`] writes it,
+    /// [`MachineDescription::edited_sealed_fields`] names a field edited
+    /// since. Absent only on a record not yet written.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seal: Option<std::collections::BTreeMap<String, String>>,
     /// External measurements fused with the UP limb's data (tracker,
     /// ballbar, touch-off files), when there were any.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -218,7 +227,7 @@ impl MachineDescription {
 
     /// Reads, parses and validates a description file.
     pub fn from_file(path: &std::path::Path) -> Result<MachineDescription, DescriptionError> {
-        let text = std::fs::read_to_string(path).map_err(|source| DescriptionError::Io {
+        let text = tricept_data::read_json_text(path).map_err(|source| DescriptionError::Io {
             path: path.display().to_string(),
             source,
         })?;
@@ -434,6 +443,7 @@ mod tests {
             poses_used: 75,
             rejected_lines: Vec::new(),
             leg_tables_digest: None,
+            seal: None,
             external_sources: Vec::new(),
             data_file: "data.csv".into(),
             data_sha256: "0".repeat(64),

@@ -1,13 +1,15 @@
 //! `backlash`: lost motion of each actuated leg; the leg stops `b_i / 2`
 //! short of the command in the direction it came from (`b_i` in um).
 
-use tricept_kinematics::KinematicsError;
+use tricept_kinematics::{KinematicsError, Machine};
 use tricept_kinematics::description::ControllerDescription;
 
 use super::spec::{
     Basis, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, Magnitude, Measure, Needs,
     Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
 };
+use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
+use serde::{Deserialize, Serialize};
 
 pub(super) const SPEC: EffectSpec = EffectSpec {
     name: "backlash",
@@ -61,6 +63,9 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
         }]
     },
     aliases: &[],
+    simulation: SIMULATION,
+    common_part: None,
+    check: None,
 };
 
 /// Without logged directions every leg counts as extending.
@@ -79,4 +84,40 @@ fn set(c: &mut ControllerDescription, index: usize, value: f64) {
 /// the nut lags, so an extending leg stops short and a retracting one long.
 pub fn backlash_extra_mm(um: f64, dir: i8) -> f64 {
     -f64::from(dir) * 0.5 * um * 1e-3
+}
+
+/// The simulator's `backlash`: lost motion `um_i` per leg.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Backlash {
+    /// Backlash of each leg, um.
+    pub um: [f64; 3],
+}
+
+const SIMULATION: Simulation = Simulation {
+    tag: "backlash",
+    cause: "backlash",
+        keys: &[EffectKey::new(
+        "um",
+        "um",
+        "lost motion of each leg [3]; with --both-directions the data show it",
+    )],
+    parse: parse_input::<Backlash>,
+    typical: || {
+        Box::new(Backlash {
+            um: [6.0, 5.0, 8.0],
+        })
+    },
+};
+
+impl Simulate for Backlash {
+    fn simulation(&self) -> &'static Simulation {
+        &SIMULATION
+    }
+
+    fn extra_leg_length(&self, _nominal: &Machine, s: &PoseState, legs_mm: &mut [f64; 3]) {
+        for i in 0..3 {
+            legs_mm[i] += backlash_extra_mm(self.um[i], s.approach[i]);
+        }
+    }
 }

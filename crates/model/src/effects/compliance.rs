@@ -10,6 +10,8 @@ use super::spec::{
     Basis, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, LegDeployment, Magnitude,
     Measure, Needs, Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
 };
+use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
+use serde::{Deserialize, Serialize};
 
 pub(super) const SPEC: EffectSpec = EffectSpec {
     name: "compliance",
@@ -47,6 +49,9 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
         }]
     },
     aliases: &[],
+    simulation: SIMULATION,
+    common_part: None,
+    check: None,
 };
 
 /// The tension on the nominal machine at the commands; compliance `c`
@@ -118,5 +123,43 @@ pub fn stiffness_for_platform_deflection(machine: &Machine, deflection_um: f64) 
     match machine.forward_from(&legs, &ik.up) {
         Ok(fk) => (fk.position_mm - r).norm() * 1e3 / deflection_um,
         Err(_) => f64::NAN,
+    }
+}
+
+/// The simulator's axial leg deflection under gravity.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Compliance {
+    /// Axial stiffness of a leg of 1 m, N/um (scales as 1/length).
+    pub stiffness_n_per_um_at_1m: f64,
+}
+
+const SIMULATION: Simulation = Simulation {
+    tag: "compliance",
+    cause: "compliance",
+        keys: &[EffectKey::positive(
+        "stiffness_n_per_um_at_1m",
+        "N/um",
+        "axial stiffness of a leg 1 m long (scales as 1/length); loads from the machine file's `loads`",
+    )],
+    parse: parse_input::<Compliance>,
+    typical: || {
+        Box::new(Compliance {
+            stiffness_n_per_um_at_1m: 33.6,
+        })
+    },
+};
+
+impl Simulate for Compliance {
+    fn simulation(&self) -> &'static Simulation {
+        &SIMULATION
+    }
+
+    fn extra_leg_length(&self, nominal: &Machine, s: &PoseState, legs_mm: &mut [f64; 3]) {
+        let f = gravity_leg_tension_n(nominal, &s.nominal_up);
+        for i in 0..3 {
+            legs_mm[i] +=
+                compliance_extra_mm(self.stiffness_n_per_um_at_1m, f[i], s.commands_mm[i]);
+        }
     }
 }

@@ -8,6 +8,8 @@ use super::spec::{
     Basis, Deployment, EffectSpec, Entries, Judged, Kind, KnownAlias, Magnitude, Measure, Needs,
     Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
 };
+use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
+use serde::{Deserialize, Serialize};
 
 const ARCSEC: Parameter = Parameter {
     name: "",
@@ -76,7 +78,11 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
         with: "encoder-gain",
         why: "over the encoders' small angles (|angle| < 0.6 rad) a gain error and the sine part of an eccentricity are nearly the same curve",
         separate_by: "an external angle reference (autocollimator or inclinometer) at about +-30 deg of the U joint",
+        structural: None,
     }],
+    simulation: SIMULATION,
+    common_part: None,
+    check: None,
 };
 
 fn entries(up: &UpJoints) -> Entries {
@@ -94,4 +100,53 @@ fn entries(up: &UpJoints) -> Entries {
 /// Once-per-revolution encoder error at `angle_rad`, rad.
 pub fn eccentricity_error_rad(amplitude_arcsec: f64, phase_deg: f64, angle_rad: f64) -> f64 {
     amplitude_arcsec * RAD_PER_ARCSEC * (angle_rad + phase_deg.to_radians()).sin()
+}
+
+/// The simulator's once-per-revolution encoder errors.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EncoderEccentricity {
+    /// Amplitude on the phi encoder, arcsec.
+    pub phi_arcsec: f64,
+    /// Phase on the phi encoder, deg.
+    pub phi_phase_deg: f64,
+    /// Amplitude on the theta encoder, arcsec.
+    pub theta_arcsec: f64,
+    /// Phase on the theta encoder, deg.
+    pub theta_phase_deg: f64,
+}
+
+const SIMULATION: Simulation = Simulation {
+    tag: "encoder-eccentricity",
+    cause: "encoder-eccentricity",
+        keys: &[
+        EffectKey::new(
+            "phi_arcsec",
+            "arcsec",
+            "once-per-revolution amplitude on the phi encoder",
+        ),
+        EffectKey::new("phi_phase_deg", "deg", "its phase"),
+        EffectKey::new("theta_arcsec", "arcsec", "amplitude on the theta encoder"),
+        EffectKey::new("theta_phase_deg", "deg", "its phase"),
+    ],
+    parse: parse_input::<EncoderEccentricity>,
+    typical: || {
+        Box::new(EncoderEccentricity {
+            phi_arcsec: 10.0,
+            phi_phase_deg: 30.0,
+            theta_arcsec: 8.0,
+            theta_phase_deg: -60.0,
+        })
+    },
+};
+
+impl Simulate for EncoderEccentricity {
+    fn simulation(&self) -> &'static Simulation {
+        &SIMULATION
+    }
+
+    fn reading_error(&self, _s: &PoseState, up: &UpJoints, r: &mut [f64; 3]) {
+        r[0] += eccentricity_error_rad(self.phi_arcsec, self.phi_phase_deg, up.phi_rad);
+        r[1] += eccentricity_error_rad(self.theta_arcsec, self.theta_phase_deg, up.theta_rad);
+    }
 }

@@ -24,13 +24,15 @@
 //! drift over time recorded with the campaign's middle, not applied.
 
 use serde::{Deserialize, Serialize};
+use tricept_kinematics::UpJoints;
 
 use super::forms::{
-    legendre_p2, legendre_p3, normalised_coordinate, periodic_extra_mm, segment_extra_mm,
+    encoder_gain_error_rad, legendre_p2, legendre_p3, normalised_coordinate, periodic_extra_mm,
+    segment_extra_mm,
 };
 use super::spec::{
-    CHANNELS, Deployment, Judgement, KnownAlias, Measure, Needs, PlausibleRange, PlotAxes, XAxis,
-    YAxis,
+    Basis, CHANNELS, CheckColumns, CheckRole, CheckWhen, Deployment, Entries, Judgement,
+    KnownAlias, Measure, Needs, PlausibleRange, PlotAxes, XAxis, YAxis,
 };
 
 /// Families of generic terms: physically readable forms that are not
@@ -76,6 +78,8 @@ pub struct GenericSpec {
     pub aliases: &'static [KnownAlias],
     /// Where a fitted term goes in a machine file.
     pub deployment: Deployment,
+    /// Whether `tricept check` considers it a candidate change, and how.
+    pub check: Option<CheckRole>,
 }
 
 const fn range(
@@ -127,6 +131,7 @@ impl GenericFamily {
                 needs,
                 ranges,
                 aliases: &[],
+                check: None,
                 deployment: if !acts_on_legs {
                     Deployment::Sensor
                 } else if matches!(needs, Needs::PoseOrder) {
@@ -189,6 +194,7 @@ impl GenericFamily {
                 with: "leg-drift",
                 why: "a drifting scale and uniformly growing legs move the readings alike",
                 separate_by: "an external reading of the platform at a repeated pose (dial indicator or touch probe): the machine's own sensors cannot tell a drifting scale from growing legs",
+                structural: None,
             }],
             ..spec(
                 "reading-drift",
@@ -235,21 +241,29 @@ impl GenericFamily {
                 ),
             )],
         );
-        const ENCODER_GAIN: GenericSpec = spec(
-            "encoder-gain",
-            false,
-            Needs::Nothing,
-            &[(
-                None,
-                range(
-                    "gain_ppm",
-                    -1000.0,
-                    1000.0,
-                    "ppm",
-                    "encoder scaling or interpolation faults",
-                ),
-            )],
-        );
+        const ENCODER_GAIN: GenericSpec = GenericSpec {
+            check: Some(CheckRole {
+                name: "encoder gains",
+                parameters: &["phi_gain_ppm", "theta_gain_ppm"],
+                when: CheckWhen::Always,
+                columns: CheckColumns::Readings(encoder_gain_entries),
+            }),
+            ..spec(
+                "encoder-gain",
+                false,
+                Needs::Nothing,
+                &[(
+                    None,
+                    range(
+                        "gain_ppm",
+                        -1000.0,
+                        1000.0,
+                        "ppm",
+                        "encoder scaling or interpolation faults",
+                    ),
+                )],
+            )
+        };
         const SCALE_POLYNOMIAL: GenericSpec = spec(
             "scale-polynomial",
             false,
@@ -492,4 +506,21 @@ impl std::fmt::Display for GenericFamily {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.as_str())
     }
+}
+
+/// Per unit (ppm) of each encoder's gain error, its reading error with the
+/// UP limb at `up` (the check's candidate `encoder gains`).
+fn encoder_gain_entries(up: &UpJoints) -> Entries {
+    vec![
+        (
+            0,
+            Basis::Reading(0),
+            encoder_gain_error_rad(1.0, up.phi_rad),
+        ),
+        (
+            1,
+            Basis::Reading(1),
+            encoder_gain_error_rad(1.0, up.theta_rad),
+        ),
+    ]
 }

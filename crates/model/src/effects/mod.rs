@@ -29,9 +29,15 @@
 //! its deployment, the calibration record's check, [`UnknownEffect`] and
 //! the CLI help iterate it; no other code names an effect to classify it.
 //!
-//! Adding an effect: its file here, its registry line, the plant's
-//! simulation of it (`tricept_plant::Effect`) and its docs; the compiler
-//! flags anything else.
+//! Each file also says how the plant simulator puts its effect into a
+//! machine ([`Simulation`], in the spec): the `--truth-effect` input type
+//! with its keys and units (re-exported as [`simulated`]`::LegLead`, ...)
+//! and its [`Simulate`] hooks (kinematics, temperature, leg lengths,
+//! readings, logged rows), which the plant calls without naming any
+//! effect.
+//!
+//! Adding an effect: its file here (with its simulation), its registry
+//! line and its docs; the compiler flags anything else.
 //!
 //! The same functions serve the plant simulator (which applies them to a
 //! simulated machine) and the diagnosis (which fits them to measured data),
@@ -53,6 +59,7 @@ use serde::{Deserialize, Serialize};
 mod deployment;
 mod forms;
 mod generic;
+mod simulation;
 mod spec;
 
 pub use deployment::{pose_free_leg_extra_per_mm, static_leg_extra_per_mm};
@@ -61,10 +68,11 @@ pub use forms::{
     normalised_coordinate, periodic_extra_mm, segment_extra_mm,
 };
 pub use generic::{GenericFamily, GenericSpec};
+pub use simulation::{EffectKey, PoseState, Simulate, SimulateObject, Simulation, parse_input};
 pub use spec::{
-    Basis, CHANNELS, Deployment, EffectSpec, Entries, Judged, Judgement, Kind, KnownAlias,
-    LegContext, LegDeployment, Magnitude, Measure, Needs, Parameter, PlausibleRange, PlotAxes,
-    XAxis, YAxis,
+    Basis, CHANNELS, CheckColumns, CheckRole, CheckWhen, CommonPart, Deployment, EffectSpec,
+    Entries, Judged, Judgement, Kind, KnownAlias, LegContext, LegDeployment, Magnitude, Measure,
+    Needs, Parameter, PlausibleRange, PlotAxes, Structural, XAxis, YAxis,
 };
 
 /// The registry: the enum of the vocabulary (its variants in this order,
@@ -78,6 +86,13 @@ macro_rules! registry {
         #[serde(rename_all = "kebab-case")]
         pub enum EffectName {
             $($(#[$doc])* $variant,)*
+        }
+
+        /// The simulator's input of each effect, named as its variant
+        /// (`simulated::LegLead { ppm }`): its magnitude in the units a
+        /// machine builder quotes, with its [`Simulate`] hooks.
+        pub mod simulated {
+            $(pub use crate::effects::$module::$variant;)*
         }
 
         impl EffectName {
@@ -169,6 +184,29 @@ impl EffectName {
     /// The effects that are terms of a model, in registry order.
     pub fn terms() -> impl Iterator<Item = EffectName> {
         EffectName::ALL.into_iter().filter(|e| e.is_term())
+    }
+
+    /// The structural aliases of the registry: `(effect with the common
+    /// part, effect whose parameter it reads as, how)`, each declared by the
+    /// second ([`KnownAlias::structural`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_model::effects::EffectName;
+    /// let (common, other, s) = EffectName::structural_aliases().next().unwrap();
+    /// assert_eq!((common.as_str(), other.as_str()), ("leg-lead", "scale-gain"));
+    /// assert!(common.spec().common_part.is_some());
+    /// assert!((s.says)(50.0, 2.0).contains("50.0"));
+    /// ```
+    pub fn structural_aliases()
+    -> impl Iterator<Item = (EffectName, EffectName, &'static Structural)> {
+        EffectName::ALL.into_iter().flat_map(|other| {
+            other.spec().aliases.iter().filter_map(move |a| {
+                let s = a.structural.as_ref()?;
+                let common = s.common_of.parse::<EffectName>().ok()?;
+                Some((common, other, s))
+            })
+        })
     }
 
     /// Its judged quantities ([`EffectSpec::plausible`]), each with its
@@ -400,6 +438,8 @@ mod tests {
             let s = e.spec();
             assert_eq!(serde_json::to_value(e).unwrap(), s.name);
             assert_eq!(s.name.parse::<EffectName>(), Ok(e));
+            assert_eq!(s.simulation.tag, s.name);
+            assert_eq!(s.simulation.cause, s.name);
             let k = s.parameters.len();
             let entries = match s.kind {
                 Kind::Leg(f) => Some((f(&at).unwrap(), true)),
@@ -430,6 +470,12 @@ mod tests {
                 }
             }
             for a in s.aliases {
+                if let Some(st) = &a.structural {
+                    assert_eq!(st.common_of, a.with, "{e}");
+                    let common: EffectName = st.common_of.parse().unwrap();
+                    assert!(common.spec().common_part.is_some(), "{e}");
+                    assert_eq!(k, 1, "{e}");
+                }
                 let other: CauseName = a.with.parse().unwrap();
                 assert!(
                     other.known_aliases().iter().all(|b| b.with != s.name),

@@ -4,9 +4,11 @@
 use tricept_kinematics::UpJoints;
 
 use super::spec::{
-    Basis, Deployment, EffectSpec, Entries, Judged, Kind, KnownAlias, Magnitude, Measure, Needs,
-    Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
+    CheckColumns, CheckRole, CheckWhen,    Basis, Deployment, EffectSpec, Entries, Judged, Kind, KnownAlias, Magnitude, Measure, Needs,
+    Parameter, PlausibleRange, PlotAxes, Structural, XAxis, YAxis,
 };
+use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
+use serde::{Deserialize, Serialize};
 
 pub(super) const SPEC: EffectSpec = EffectSpec {
     name: "scale-gain",
@@ -47,7 +49,26 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
         with: "leg-lead",
         why: "a scale gain g reads exactly like the machine scaled by 1 + g with a lead g on every leg",
         separate_by: "one external length: a laser interferometer or gauge-block measurement of the UP-limb stroke or of one platform displacement fixes the gain; the machine's own sensors never can",
+        structural: Some(Structural {
+            common_of: "leg-lead",
+            // The legs read 1 + g too long (a lead of g on every leg) and
+            // the UP limb's scale 1 / (1 + g) (a gain of -g), in ppm.
+            scaled_machine: (1e6, -1e6),
+            says: |mean, sd| {
+                format!(
+                    "the mean lead {mean:.1} +- {sd:.1} ppm is indistinguishable from a scale gain of {mean:.1} ppm with every lead reduced by it"
+                )
+            },
+        }),
     }],
+    simulation: SIMULATION,
+    common_part: None,
+    check: Some(CheckRole {
+        name: "scale gain",
+        parameters: &["scale_gain_ppm"],
+        when: CheckWhen::Always,
+        columns: CheckColumns::Readings(entries),
+    }),
 };
 
 fn entries(up: &UpJoints) -> Entries {
@@ -57,4 +78,30 @@ fn entries(up: &UpJoints) -> Entries {
 /// Reading error of a scale with gain error `ppm` at extension `q4_mm`, mm.
 pub fn scale_gain_error_mm(ppm: f64, q4_mm: f64) -> f64 {
     ppm * 1e-6 * q4_mm
+}
+
+/// The simulator's `scale-gain`: gain error of the linear scale.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScaleGain {
+    /// Gain error, ppm.
+    pub ppm: f64,
+}
+
+const SIMULATION: Simulation = Simulation {
+    tag: "scale-gain",
+    cause: "scale-gain",
+        keys: &[EffectKey::new("ppm", "ppm", "gain error of the linear scale")],
+    parse: parse_input::<ScaleGain>,
+    typical: || Box::new(ScaleGain { ppm: 50.0 }),
+};
+
+impl Simulate for ScaleGain {
+    fn simulation(&self) -> &'static Simulation {
+        &SIMULATION
+    }
+
+    fn reading_error(&self, _s: &PoseState, up: &UpJoints, r: &mut [f64; 3]) {
+        r[2] += scale_gain_error_mm(self.ppm, up.q4_mm);
+    }
 }

@@ -15,6 +15,7 @@ use tricept_kinematics::description::{ControllerDescription, LegEffectsDescripti
 use tricept_kinematics::{KinematicsError, Machine, UpJoints};
 
 use super::forms::{legendre_p2, legendre_p3};
+use super::simulation::Simulation;
 
 /// An effect of the vocabulary.
 #[derive(Debug, Clone, Copy)]
@@ -53,6 +54,51 @@ pub struct EffectSpec {
     pub realistic: fn(&Machine) -> Vec<Magnitude>,
     /// Effects it is known to be confused with, and what separates them.
     pub aliases: &'static [KnownAlias],
+    /// How the plant simulator puts it into a machine.
+    pub simulation: Simulation,
+    /// Its common part, for an effect with one parameter per leg whose
+    /// equal value on every leg is an alternative of its own.
+    pub common_part: Option<CommonPart>,
+    /// Whether `tricept check` considers it a candidate change, and how.
+    pub check: Option<CheckRole>,
+}
+
+/// How `tricept check` considers an effect (or a generic family) as a
+/// candidate change between a calibration and a check.
+#[derive(Debug, Clone, Copy)]
+pub struct CheckRole {
+    /// Its name in a check's report (`scale gain`).
+    pub name: &'static str,
+    /// Its parameters in the check, units in the names.
+    pub parameters: &'static [&'static str],
+    /// When it is a candidate.
+    pub when: CheckWhen,
+    /// What one unit of each parameter changes at a pose.
+    pub columns: CheckColumns,
+}
+
+/// When a [`CheckRole`] is a candidate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CheckWhen {
+    /// Always.
+    Always,
+    /// When both the check and the calibration logged a temperature.
+    WithTemperatures,
+    /// When they did not both log one.
+    WithoutTemperatures,
+}
+
+/// What one unit of a [`CheckRole`]'s parameters changes at a pose.
+#[derive(Debug, Clone, Copy)]
+pub enum CheckColumns {
+    /// Every leg's length (one parameter), mm per unit, from the leg's
+    /// command (mm) and the temperature since the calibration (K; 0 when
+    /// not both logged one): it moves the platform.
+    Legs(fn(f64, f64) -> f64),
+    /// The readings, linearly in the parameters: the entries with the UP
+    /// limb at its predicted joints ([`Basis::Reading`] only); the sensor,
+    /// not the machine.
+    Readings(fn(&UpJoints) -> Entries),
 }
 
 /// A parameter of an effect in a model.
@@ -471,7 +517,7 @@ pub struct PlotAxes {
 
 /// A known confusion: another cause whose signature reads like this one's,
 /// why, and what measurement separates them.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy)]
 pub struct KnownAlias {
     /// The other cause's report name (an effect or a generic family; a
     /// test of the registry checks that it is one).
@@ -480,4 +526,38 @@ pub struct KnownAlias {
     pub why: &'static str,
     /// What separates them.
     pub separate_by: &'static str,
+    /// When the alias holds on every campaign by construction: how.
+    pub structural: Option<Structural>,
+}
+
+/// An alias that holds on every campaign: the common part (the mean over
+/// the legs) of the per-leg parameters of one effect reads exactly as the
+/// declaring effect's single parameter, with the machine scaled (a scale
+/// gain `g` reads like the machine scaled by `1 + g` with a lead `g` on
+/// every leg).
+#[derive(Debug, Clone, Copy)]
+pub struct Structural {
+    /// The effect whose per-leg parameters have the common part (its
+    /// report name; it declares its [`CommonPart`]).
+    pub common_of: &'static str,
+    /// The change, per unit `g` of a machine scaled by `1 + g` (to first
+    /// order), of each parameter of `common_of` and of the declaring
+    /// effect's parameter, in their units.
+    pub scaled_machine: (f64, f64),
+    /// What a report says of a significant common part, from its mean and
+    /// standard deviation.
+    pub says: fn(f64, f64) -> String,
+}
+
+/// The common part of an effect with one parameter per leg: the same
+/// value on every leg, an alternative of its own in the alias analysis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CommonPart {
+    /// Its label as an alternative (`leg-lead (equal on all legs)`).
+    pub label: &'static str,
+    /// Its label as one side of a structural alias (`leg-lead (common
+    /// part)`).
+    pub as_alias: &'static str,
+    /// Its one parameter (`lead_ppm (every leg)`).
+    pub parameter: &'static str,
 }

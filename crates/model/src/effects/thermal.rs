@@ -1,13 +1,15 @@
 //! `thermal`: the legs grow `alpha q_i dT` with the structure temperature,
 //! referred to the metrology reference of 20 °C.
 
-use tricept_kinematics::KinematicsError;
+use tricept_kinematics::{KinematicsError, Machine};
 use tricept_kinematics::description::ControllerDescription;
 
 use super::spec::{
-    Basis, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, Magnitude, Measure, Needs,
+    CheckColumns, CheckRole, CheckWhen,    Basis, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, Magnitude, Measure, Needs,
     Parameter, PlausibleRange, PlotAxes, XAxis, YAxis,
 };
+use super::simulation::{EffectKey, PoseState, Simulate, Simulation, parse_input};
+use serde::{Deserialize, Serialize};
 
 /// The reference temperature of dimensional metrology (ISO 1), °C: the
 /// nominal lengths of the machine are taken to hold at it. (Referring the
@@ -51,6 +53,14 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
         }]
     },
     aliases: &[],
+    simulation: SIMULATION,
+    common_part: None,
+    check: Some(CheckRole {
+        name: "thermal growth",
+        parameters: &["expansion_ppm_per_k"],
+        when: CheckWhen::WithTemperatures,
+        columns: CheckColumns::Legs(|command_mm, delta_k| thermal_extra_mm(1.0, command_mm, delta_k)),
+    }),
 };
 
 /// Without a logged temperature the legs are at the reference.
@@ -71,4 +81,56 @@ fn set(c: &mut ControllerDescription, _index: usize, value: f64) {
 /// Thermal growth of a leg of length `command_mm` warmed by `delta_k`, mm.
 pub fn thermal_extra_mm(ppm_per_k: f64, command_mm: f64, delta_k: f64) -> f64 {
     ppm_per_k * 1e-6 * command_mm * delta_k
+}
+
+/// The simulator's `thermal`: a linear temperature drift over the campaign
+/// and the legs' growth.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Thermal {
+    /// Temperature change from the first to the last pose, K.
+    pub drift_k: f64,
+    /// Effective expansion coefficient of the legs, ppm/K (steel: 11.5).
+    pub expansion_ppm_per_k: f64,
+}
+
+const SIMULATION: Simulation = Simulation {
+    tag: "thermal",
+    cause: "thermal",
+        keys: &[
+        EffectKey::new(
+            "drift_k",
+            "K",
+            "temperature change from the first pose to the last",
+        ),
+        EffectKey::new(
+            "expansion_ppm_per_k",
+            "ppm/K",
+            "the legs' expansion coefficient (steel 11.5; 0 for a temperature log alone)",
+        ),
+    ],
+    parse: parse_input::<Thermal>,
+    typical: || {
+        Box::new(Thermal {
+            drift_k: 3.0,
+            expansion_ppm_per_k: 11.5,
+        })
+    },
+};
+
+impl Simulate for Thermal {
+    fn simulation(&self) -> &'static Simulation {
+        &SIMULATION
+    }
+
+    fn temperature_drift_k(&self, fraction: f64) -> f64 {
+        self.drift_k * fraction
+    }
+
+    fn extra_leg_length(&self, _nominal: &Machine, s: &PoseState, legs_mm: &mut [f64; 3]) {
+        for i in 0..3 {
+            legs_mm[i] +=
+                thermal_extra_mm(self.expansion_ppm_per_k, s.commands_mm[i], s.delta_temp_k);
+        }
+    }
 }

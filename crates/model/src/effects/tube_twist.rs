@@ -8,6 +8,8 @@ use super::spec::{
     Deployment, EffectSpec, Judged, Kind, Magnitude, Measure, Needs, Parameter, PlausibleRange,
     PlotAxes, XAxis, YAxis,
 };
+use super::simulation::{EffectKey, Simulate, Simulation, parse_input};
+use serde::{Deserialize, Serialize};
 
 pub(super) const SPEC: EffectSpec = EffectSpec {
     name: "tube-twist",
@@ -45,6 +47,9 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
         }]
     },
     aliases: &[],
+    simulation: SIMULATION,
+    common_part: None,
+    check: None,
 };
 
 fn apply(machine: &mut Machine, p: &[f64]) {
@@ -71,4 +76,39 @@ pub fn add_tube_twist(machine: &mut Machine, arcsec_per_100mm: f64) {
 /// workspace's middle plane on the axis.
 pub fn twist_reference_mm(machine: &Machine) -> f64 {
     machine.workspace.mid_plane_z_mm()
+}
+
+/// The simulator's platform twist about the limb axis, proportional to the
+/// extension from the workspace's middle plane.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TubeTwist {
+    /// Twist per 100 mm of extension, arcsec.
+    pub arcsec_per_100mm: f64,
+}
+
+const SIMULATION: Simulation = Simulation {
+    tag: "tube-twist",
+    cause: "tube-twist",
+        keys: &[EffectKey::new(
+        "arcsec_per_100mm",
+        "arcsec/100mm",
+        "platform twist about the limb axis per 100 mm of extension from the middle plane",
+    )],
+    parse: parse_input::<TubeTwist>,
+    typical: || {
+        Box::new(TubeTwist {
+            arcsec_per_100mm: 30.0,
+        })
+    },
+};
+
+impl Simulate for TubeTwist {
+    fn simulation(&self) -> &'static Simulation {
+        &SIMULATION
+    }
+
+    fn modify_machine(&self, machine: &mut Machine) {
+        add_tube_twist(machine, self.arcsec_per_100mm);
+    }
 }

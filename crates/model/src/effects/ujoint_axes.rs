@@ -8,6 +8,8 @@ use super::spec::{
     Deployment, EffectSpec, Judged, Kind, Magnitude, Measure, Needs, Parameter, PlausibleRange,
     PlotAxes, XAxis, YAxis,
 };
+use super::simulation::{EffectKey, Simulate, Simulation, parse_input};
+use serde::{Deserialize, Serialize};
 
 pub(super) const SPEC: EffectSpec = EffectSpec {
     name: "ujoint-axes",
@@ -71,6 +73,9 @@ pub(super) const SPEC: EffectSpec = EffectSpec {
         ]
     },
     aliases: &[],
+    simulation: SIMULATION,
+    common_part: None,
+    check: None,
 };
 
 fn apply(machine: &mut Machine, p: &[f64]) {
@@ -91,4 +96,45 @@ fn apply(machine: &mut Machine, p: &[f64]) {
 pub fn add_ujoint_axis_errors(machine: &mut Machine, skew_arcsec: f64, offset_um: f64) {
     machine.up_limb.axis_skew_rad += skew_arcsec * RAD_PER_ARCSEC;
     machine.up_limb.axis_offset_mm += offset_um * 1e-3;
+}
+
+/// The simulator's U-joint axes that are not orthogonal and do not
+/// intersect.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UjointAxes {
+    /// Non-orthogonality, arcsec.
+    pub skew_arcsec: f64,
+    /// Distance between the axes, um.
+    pub offset_um: f64,
+}
+
+const SIMULATION: Simulation = Simulation {
+    tag: "ujoint-axes",
+    cause: "ujoint-axes",
+        keys: &[
+        EffectKey::new(
+            "skew_arcsec",
+            "arcsec",
+            "non-orthogonality of the UP limb's U-joint axes",
+        ),
+        EffectKey::new("offset_um", "um", "distance between the two axes"),
+    ],
+    parse: parse_input::<UjointAxes>,
+    typical: || {
+        Box::new(UjointAxes {
+            skew_arcsec: 60.0,
+            offset_um: 20.0,
+        })
+    },
+};
+
+impl Simulate for UjointAxes {
+    fn simulation(&self) -> &'static Simulation {
+        &SIMULATION
+    }
+
+    fn modify_machine(&self, machine: &mut Machine) {
+        add_ujoint_axis_errors(machine, self.skew_arcsec, self.offset_um);
+    }
 }

@@ -167,11 +167,21 @@ fn a_recalibration_keeps_a_record_the_file_is_checked_against() {
     let out = run(&["ik", "0", "0", "750", "--machine", m2.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out).contains("leg_offsets_mm[2]"), "{}", text(&out));
-    // A record that says the fit did not converge loads with a warning.
-    let mut c: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&m1).unwrap()).unwrap();
-    c["calibration"]["converged"] = false.into();
-    std::fs::write(&m1, serde_json::to_string(&c).unwrap()).unwrap();
+    // A record that says the fit did not converge (as tricept writes it,
+    // sealed: a hand edit of `converged` is refused) loads with a warning.
+    let mut c = tricept_kinematics::MachineDescription::from_file(&m1).unwrap();
+    c.calibration.as_mut().unwrap().converged = false;
+    let edited = dir.join("m1-edited.json");
+    std::fs::write(&edited, c.to_json()).unwrap();
+    let out = run(&["ik", "0", "0", "750", "--machine", edited.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out).contains("`calibration.converged` edited"),
+        "{}",
+        text(&out)
+    );
+    c.seal();
+    std::fs::write(&m1, c.to_json()).unwrap();
     let out = run(&["ik", "0", "0", "750", "--machine", m1.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0));
     assert!(String::from_utf8_lossy(&out.stderr).contains("did not converge"));

@@ -66,12 +66,14 @@ pub fn simulate(n: usize, seed: u64, effects: Vec<Effect>, c: CampaignOptions) -
     let m = Machine::paper();
     let set = ParameterSet::paper15();
     let mut plant = Plant::geometric(m.clone(), set.to_errors(&random_errors(15, 0.25, seed)));
-    let thermal = effects.iter().any(|e| matches!(e, Effect::Thermal { .. }));
+    let thermal = effects.iter().any(|e| e.tag() == "thermal");
     if !thermal {
-        plant.effects.push(Effect::Thermal {
-            drift_k: 2.0,
-            expansion_ppm_per_k: 0.0,
-        });
+        plant
+            .effects
+            .push(Effect::from(tricept_plant::effects::Thermal {
+                drift_k: 2.0,
+                expansion_ppm_per_k: 0.0,
+            }));
     }
     plant.effects.extend(effects.iter().cloned());
     let mut campaign = Campaign::random(&m, n, 7 * seed + 1);
@@ -204,37 +206,57 @@ pub fn group_found(d: &Diagnosis, label: &str) -> bool {
 
 /// The simulator's parameters in the diagnosis' parameterisation.
 pub fn true_parameters(e: &Effect) -> Option<Vec<f64>> {
-    Some(match e {
-        Effect::LegLead { ppm } => ppm.to_vec(),
-        Effect::Backlash { um } => um.to_vec(),
-        Effect::Thermal {
-            expansion_ppm_per_k,
-            ..
-        } => vec![*expansion_ppm_per_k],
-        Effect::ScaleGain { ppm } => vec![*ppm],
-        Effect::EncoderEccentricity {
-            phi_arcsec,
-            phi_phase_deg,
-            theta_arcsec,
-            theta_phase_deg,
-        } => {
-            let (sp, cp) = phi_phase_deg.to_radians().sin_cos();
-            let (st, ct) = theta_phase_deg.to_radians().sin_cos();
-            vec![
-                phi_arcsec * cp,
-                phi_arcsec * sp,
-                theta_arcsec * ct,
-                theta_arcsec * st,
-            ]
-        }
-        Effect::UjointAxes {
-            skew_arcsec,
-            offset_um,
-        } => vec![*skew_arcsec, *offset_um],
-        Effect::TubeTwist { arcsec_per_100mm } => vec![*arcsec_per_100mm],
-        Effect::Compliance {
-            stiffness_n_per_um_at_1m,
-        } => vec![1000.0 / stiffness_n_per_um_at_1m],
-        _ => return None,
-    })
+    use tricept_plant::effects::{
+        Backlash, Compliance, EncoderEccentricity, LegLead, ScaleGain, Thermal, TubeTwist,
+        UjointAxes,
+    };
+    if let Some(LegLead { ppm }) = e.input() {
+        return Some(ppm.to_vec());
+    }
+    if let Some(Backlash { um }) = e.input() {
+        return Some(um.to_vec());
+    }
+    if let Some(Thermal {
+        expansion_ppm_per_k,
+        ..
+    }) = e.input()
+    {
+        return Some(vec![*expansion_ppm_per_k]);
+    }
+    if let Some(ScaleGain { ppm }) = e.input() {
+        return Some(vec![*ppm]);
+    }
+    if let Some(EncoderEccentricity {
+        phi_arcsec,
+        phi_phase_deg,
+        theta_arcsec,
+        theta_phase_deg,
+    }) = e.input()
+    {
+        let (sp, cp) = phi_phase_deg.to_radians().sin_cos();
+        let (st, ct) = theta_phase_deg.to_radians().sin_cos();
+        return Some(vec![
+            phi_arcsec * cp,
+            phi_arcsec * sp,
+            theta_arcsec * ct,
+            theta_arcsec * st,
+        ]);
+    }
+    if let Some(UjointAxes {
+        skew_arcsec,
+        offset_um,
+    }) = e.input()
+    {
+        return Some(vec![*skew_arcsec, *offset_um]);
+    }
+    if let Some(TubeTwist { arcsec_per_100mm }) = e.input() {
+        return Some(vec![*arcsec_per_100mm]);
+    }
+    if let Some(Compliance {
+        stiffness_n_per_um_at_1m,
+    }) = e.input()
+    {
+        return Some(vec![1000.0 / stiffness_n_per_um_at_1m]);
+    }
+    None
 }

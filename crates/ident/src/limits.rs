@@ -1,4 +1,4 @@
-//! The largest sizes and values the verbs accept, checked before anything
+//! The largest sizes and values the workflows accept, checked before anything
 //! is allocated or computed (exit 2 beyond them), so that no input value
 //! makes a verb exhaust the memory or run without end. Listed in
 //! docs/reliability.md; generated pose sets are bounded by

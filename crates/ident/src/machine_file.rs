@@ -2,6 +2,10 @@
 //! format that every `--machine` loads, with a `calibration` record of the
 //! estimates, their uncertainties and correlations, the sensor offsets,
 //! what was held and why, the fit's quality and its provenance.
+//!
+//! Transitional public module: the workflows of `calibrate` and
+//! `diagnosis` write these files; the CLI's verbs call it until they call
+//! the workflows.
 
 use std::path::Path;
 
@@ -16,8 +20,8 @@ use tricept_kinematics::description::{
 };
 use tricept_kinematics::{Machine, MachineDescription};
 
-use crate::args::LoadedMachine;
-use crate::cli_error::CliError;
+use crate::error::Error;
+use crate::inputs::LoadedMachine;
 
 /// What the record says beyond the fit itself.
 pub struct Provenance<'a> {
@@ -124,33 +128,24 @@ impl<'a> FitRecord<'a> {
 /// with `--force`, and the file then says so (`calibration.forced`, its
 /// name, its first warning). `why` is the reason of a non-zero code.
 ///
-/// Returns the reason a forced write carries (`None` for a trusted fit),
-/// or refuses with the fit's exit code, naming `what` (the flag and file).
-pub fn write_rule(
-    what: &str,
-    code: u8,
-    why: &str,
-    force: bool,
-) -> Result<Option<String>, CliError> {
+/// Returns the reason a forced write carries (`None` for a trusted fit;
+/// the caller warns that the file is written although `why`), or refuses
+/// with the fit's exit code, naming `what` (the flag and file).
+pub fn write_rule(what: &str, code: u8, why: &str, force: bool) -> Result<Option<String>, Error> {
     match (code, force) {
         (0, _) => Ok(None),
-        (_, true) => {
-            errln!("warning: {what}: written with --force although {why}");
-            Ok(Some(why.to_string()))
-        }
-        (_, false) => Err(CliError {
-            code,
-            message: format!(
-                "{what}: not written: {why}; --force writes it anyway, marked as forced"
-            ),
-        }),
+        (_, true) => Ok(Some(why.to_string())),
+        (_, false) => Err(Error::new(
+            crate::ErrorKind::of_exit_code(code),
+            format!("{what}: not written: {why}; --force writes it anyway, marked as forced"),
+        )),
     }
 }
 
 /// SHA-256 of a file's bytes, lower-case hex.
-pub fn sha256_file(path: &Path) -> Result<String, CliError> {
+pub fn sha256_file(path: &Path) -> Result<String, Error> {
     let bytes =
-        std::fs::read(path).map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+        std::fs::read(path).map_err(|e| Error::input(format!("{}: {e}", path.display())))?;
     let digest = Sha256::digest(&bytes);
     Ok(digest.iter().map(|b| format!("{b:02x}")).collect())
 }
@@ -263,12 +258,12 @@ pub fn calibrated_description(
     id: &FitRecord<'_>,
     p: Provenance<'_>,
     controller: Option<tricept_kinematics::description::ControllerDescription>,
-) -> Result<MachineDescription, CliError> {
+) -> Result<MachineDescription, Error> {
     let nominal = base.nominal_description();
     let date = utc_now();
     let data_name = p.data_file.display().to_string();
     let mut d = identified.to_description();
-    d.controller = controller.or(base.description.controller);
+    d.controller = controller.or(base.description().controller);
     let status = match (&p.forced, p.adequate) {
         (Some(why), _) => format!(" (FORCED: {why})"),
         (None, false) => " (the model does not explain the data)".to_string(),
@@ -285,7 +280,7 @@ pub fn calibrated_description(
         env!("CARGO_PKG_VERSION"),
         p.method,
         data_name,
-        base.description.name
+        base.description().name
     ));
     let n = p.n_geometric.min(id.names.len());
     let mut estimates = Map::new();
@@ -344,16 +339,17 @@ pub fn calibrated_description(
                     ..record.clone()
                 })
             })
-            .collect::<Result<_, CliError>>()?,
+            .collect::<Result<_, Error>>()?,
         rejected_lines: p.rejected_lines,
         leg_tables_digest: d.leg_effects.tables_digest(),
+        seal: None,
         data_file: data_name,
         data_sha256: sha256_file(p.data_file)?,
         date,
         tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        relative_to: base.description.name.clone(),
-        relative_to_machine: base.description.calibration.as_ref().map(|_| {
-            let mut b = base.description.clone();
+        relative_to: base.description().name.clone(),
+        relative_to_machine: base.description().calibration.as_ref().map(|_| {
+            let mut b = base.description().clone();
             b.calibration = None;
             Box::new(b)
         }),
@@ -361,13 +357,19 @@ pub fn calibrated_description(
     }));
     // What is written must load back.
     d.validate()
-        .map_err(|e| CliError::other(format!("the calibrated machine is not valid: {e}")))?;
+        .map_err(|e| Error::other(format!("the calibrated machine is not valid: {e}")))?;
     Ok(d)
 }
 
-/// Writes a description to `path`.
-pub fn write(path: &Path, d: &MachineDescription) -> Result<(), CliError> {
-    crate::files::write_text(path, &(d.to_json() + "\n"))
+/// Writes a machine description to `path` atomically (a crash or a full
+/// disk leaves the previous file), its calibration record sealed last
+/// ([`MachineDescription::seal`]), so that a file loads back only as it
+/// was written.
+pub fn write(path: &Path, d: &MachineDescription) -> std::io::Result<()> {
+    let mut sealed = d.clone();
+    sealed.seal();
+    let text = sealed.to_json() + "\n";
+    tricept_data::write_atomic(path, |w| w.write_all(text.as_bytes()))
 }
 
 #[cfg(test)]

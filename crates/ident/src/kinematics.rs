@@ -1,3 +1,9 @@
+//! The kinematics workflows (`tricept ik`, `fk`, `tool-ik` and `machine`):
+//! one point solved on a machine with its static leg effects applied
+//! ([`solve_point`]), many points streamed from CSV ([`run`],
+//! [`solve_batch`]), and the summary of a machine description
+//! ([`machine_summary`]).
+//!
 //! Batch kinematics: many points from a CSV stream through `ik`, `fk` or
 //! `tool-ik`, written as CSV with the keys of the verbs' `--json` output as
 //! columns (inputs first), in input order.
@@ -14,9 +20,13 @@ use std::io::{Read, Write};
 
 use nalgebra::Vector3;
 use rayon::prelude::*;
+use serde_json::{Map, Value};
 use tricept_data::NumericRows;
 use tricept_kinematics::{HeadBranch, KinematicsError};
 use tricept_model::ExtendedMachine;
+
+use crate::error::{EXIT_OK, Error};
+use crate::inputs::LoadedMachine;
 
 /// Rows solved per block.
 pub const BLOCK_ROWS: usize = 8192;
@@ -233,9 +243,9 @@ fn write_cell(out: &mut Vec<u8>, c: Cell) {
 ///
 /// # Example
 /// ```
-/// use tricept_cli::batch::{Verb, run};
-/// use tricept_model::ExtendedMachine;
-/// let m = ExtendedMachine::new(tricept_kinematics::Machine::paper());
+/// use tricept_ident::kinematics::{Verb, run};
+/// use tricept_ident::{ExtendedMachine, Machine};
+/// let m = ExtendedMachine::new(Machine::paper());
 /// let mut out = Vec::new();
 /// let n = run(Verb::Ik, &m, "x,y,z\n0,0,750\n".as_bytes(), "points.csv", &mut out, || false).unwrap();
 /// assert_eq!(n, 1);
@@ -352,5 +362,241 @@ fn stream<const N: usize, R: Read, W: Write>(
         if block.len() < BLOCK_ROWS || stop() {
             return Ok(());
         }
+    }
+}
+
+/// Runs `verb` on every row of `input` ([`run`]) as the CLI does:
+/// `file` names the input in its messages, `label` in the message of a
+/// point that cannot be solved (`VERB --input LABEL: line N: ...`, of that
+/// error's kind); a failed write is an error of kind other naming stdout.
+pub fn solve_batch<R: Read, W: Write>(
+    verb: Verb,
+    machine: &ExtendedMachine,
+    input: R,
+    file: &str,
+    label: &str,
+    out: W,
+    stop: impl Fn() -> bool,
+) -> Result<usize, Error> {
+    run(verb, machine, input, file, out, stop).map_err(|e| match e {
+        BatchError::Input(message) => Error::input(message),
+        BatchError::Point { line, source } => Error::with_context(
+            format!("{} --input {label}: line {line}", verb.name()),
+            &source,
+        ),
+        BatchError::Output(message) => Error::other(format!("stdout: {message}")),
+    })
+}
+
+/// One point solved by a kinematics verb.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointSolution {
+    verb: Verb,
+    cells: Vec<Cell>,
+}
+
+/// Solves one point (`point` in the order of [`Verb::inputs`]) on
+/// `machine` with its static leg effects applied; an unreachable point is
+/// an input error naming the verb.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{Verb, solve_point};
+/// use tricept_ident::{SensorNoise, load_machine};
+/// let m = load_machine(None, &SensorNoise::default()).unwrap();
+/// let s = solve_point(Verb::Ik, &m, &[0.0, 0.0, 750.0]).unwrap();
+/// assert!(s.to_json().starts_with(r#"{"x":0.0,"y":0.0,"z":750.0,"q1":773.3"#));
+/// assert!(solve_point(Verb::Ik, &m, &[0.0, 0.0, 5000.0]).is_err());
+/// ```
+pub fn solve_point(
+    verb: Verb,
+    machine: &LoadedMachine,
+    point: &[f64],
+) -> Result<PointSolution, Error> {
+    if point.len() != verb.inputs().len() {
+        return Err(Error::input(format!(
+            "{}: expected {} values ({}), got {}",
+            verb.name(),
+            verb.inputs().len(),
+            verb.inputs().join(", "),
+            point.len()
+        )));
+    }
+    let m = ExtendedMachine::new(machine.machine().clone());
+    let cells = verb
+        .solve(&m, point)
+        .map_err(|e| Error::with_context(verb.name(), &e))?;
+    Ok(PointSolution { verb, cells })
+}
+
+impl PointSolution {
+    /// The values in the order of [`Verb::keys`].
+    pub fn cells(&self) -> &[Cell] {
+        &self.cells
+    }
+
+    /// Always 0: a solved point has no verdict.
+    pub fn exit_code(&self) -> u8 {
+        EXIT_OK
+    }
+
+    /// The solution as one JSON object, the verb's keys in order.
+    pub fn to_json(&self) -> String {
+        let map: Map<String, Value> = self
+            .verb
+            .keys()
+            .iter()
+            .zip(&self.cells)
+            .map(|(k, c)| (k.to_string(), c.to_json()))
+            .collect();
+        Value::Object(map).to_string()
+    }
+
+    /// The solution as aligned `key = value unit` lines.
+    pub fn to_text(&self) -> String {
+        let keys = self.verb.keys();
+        let width = keys.iter().map(|k| k.len()).max().unwrap_or(0);
+        let mut out = String::new();
+        for ((k, unit), c) in keys.iter().zip(self.verb.units()).zip(&self.cells) {
+            let text = match c {
+                Cell::Num(x) => format!("{x:.9}"),
+                Cell::Int(i) => i.to_string(),
+                Cell::Bool(b) => b.to_string(),
+            };
+            if unit.is_empty() {
+                out.push_str(&format!("{k:>width$} = {text}\n"));
+            } else {
+                out.push_str(&format!("{k:>width$} = {text} {unit}\n"));
+            }
+        }
+        out
+    }
+}
+
+/// A summary of the machine in use with units (`tricept machine`): the
+/// joints, the UP limb, the workspace, the limits, the sensors, the leg
+/// effects, the controller parameters and the calibration record.
+pub fn machine_summary(loaded: &LoadedMachine) -> String {
+    let (d, m, source) = (loaded.description(), loaded.machine(), loaded.source());
+    let v = |p: &Vector3<f64>| format!("({:.3}, {:.3}, {:.3})", p.x, p.y, p.z);
+    let mut lines = vec![format!("{} (from {source})", d.name)];
+    if let Some(n) = &d.notes {
+        lines.push(format!("  notes: {n}"));
+    }
+    for i in 0..3 {
+        lines.push(format!(
+            "  leg {}: base joint B{} {} mm, platform joint A{} {} mm, length offset {:.4} mm",
+            i + 1,
+            i + 1,
+            v(&m.base_joints_mm[i]),
+            i + 1,
+            v(&m.platform_joints_mm[i]),
+            m.leg_offsets_mm[i]
+        ));
+    }
+    let u = &m.up_limb;
+    lines.push(format!(
+        "  UP limb: {} U joint; axis skew {:.3e} rad, axis offset {:.4} mm, twist {:.3e} rad/mm about {:.1} mm",
+        u.axis_order,
+        u.axis_skew_rad,
+        u.axis_offset_mm,
+        u.twist_rad_per_mm,
+        u.twist_reference_mm
+    ));
+    let w = &m.workspace;
+    lines.push(format!(
+        "  workspace: cylinder of radius {} mm, z from {} to {} mm",
+        w.radius_mm, w.z_min_mm, w.z_max_mm
+    ));
+    let l = &d.limits;
+    lines.push(format!(
+        "  limits: leg stroke {:?} mm, UP stroke {:?} mm, tilt {} deg",
+        l.leg_stroke_mm, l.up_stroke_mm, l.max_tilt_deg
+    ));
+    let s = &d.sensors;
+    lines.push(format!(
+        "  sensors: encoder noise {} arcsec, scale noise {} um per reading, mean of {}",
+        s.angle_noise_arcsec, s.length_noise_um, s.readings_per_pose
+    ));
+    let e = &d.leg_effects;
+    if !e.is_zero() {
+        lines.push(format!(
+            "  leg effects (applied by ik, fk, tool-ik, compensate): lead {:?} ppm, compliance {} um/kN at 1 m",
+            e.lead_ppm, e.compliance_um_per_kn_at_1m
+        ));
+    }
+    if let Some(c) = &d.controller {
+        lines.push(format!(
+            "  controller parameters: backlash {:?} um per leg axis, thermal expansion {} ppm/K from {} °C",
+            c.backlash_um, c.thermal_expansion_ppm_per_k, c.reference_temperature_c
+        ));
+    }
+    if let Some(c) = &d.calibration {
+        lines.push(format!(
+            "  calibration: {} from {} ({}, sha256 {}), {}: {} parameters, {} held, chi2/dof {:.3}, converged {}, adequate {}{}",
+            c.method,
+            c.data_file,
+            c.date,
+            &c.data_sha256[..c.data_sha256.len().min(12)],
+            c.parameter_set,
+            c.estimates_mm.len(),
+            c.held.len(),
+            c.chi2_per_dof,
+            c.converged,
+            c.adequate,
+            if c.forced { ", FORCED" } else { "" }
+        ));
+    }
+    lines.push("  (tricept machine --json prints the description file)".to_string());
+    lines.join("\n") + "\n"
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{SensorNoise, load_machine};
+
+    #[test]
+    fn ik_then_fk_returns_the_point_and_text_aligns_keys_with_units() {
+        let m = load_machine(None, &SensorNoise::default()).unwrap();
+        let ik = solve_point(Verb::Ik, &m, &[100.0, -50.0, 760.0]).unwrap();
+        let q: Vec<f64> = ik.cells()[3..6]
+            .iter()
+            .map(|c| match c {
+                Cell::Num(x) => *x,
+                _ => f64::NAN,
+            })
+            .collect();
+        let fk = solve_point(Verb::Fk, &m, &q).unwrap();
+        let v: Value = serde_json::from_str(&fk.to_json()).unwrap();
+        for (k, want) in [("x", 100.0), ("y", -50.0), ("z", 760.0)] {
+            assert!((v[k].as_f64().unwrap() - want).abs() < 1e-6, "{k}");
+        }
+        let text = ik.to_text();
+        assert!(
+            text.lines().nth(3).unwrap().starts_with("   q1 = "),
+            "{text}"
+        );
+        assert!(text.lines().nth(3).unwrap().ends_with(" mm"), "{text}");
+        assert!(text.lines().all(|l| l.contains(" = ")));
+        assert!(solve_point(Verb::Ik, &m, &[0.0, 0.0]).is_err());
+    }
+
+    #[test]
+    fn a_batch_point_out_of_reach_names_the_verb_input_and_line() {
+        let m = ExtendedMachine::new(tricept_kinematics::Machine::paper());
+        let csv = "x,y,z\n0,0,750\n0,0,5000\n";
+        let mut out = Vec::new();
+        let e = solve_batch(Verb::Ik, &m, csv.as_bytes(), "stdin", "-", &mut out, || {
+            false
+        })
+        .unwrap_err();
+        assert_eq!(e.exit_code(), crate::EXIT_INPUT);
+        assert!(
+            e.message().starts_with("ik --input -: line 3: "),
+            "{}",
+            e.message()
+        );
+        assert_eq!(String::from_utf8(out).unwrap().lines().count(), 2);
     }
 }

@@ -1,0 +1,100 @@
+//! `tricept export`: a calibrated machine file to the files a CNC control
+//! loads (`tricept_ident::export`): flags to an `ExportRequest`, one door
+//! call, the report printed.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use tricept_ident::{Controller, ExportOptions, ExportRequest};
+
+use crate::cli_error::CliError;
+
+/// `tricept export`.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// The calibrated machine file (`diagnose --write-machine`,
+    /// `identify --write-machine`).
+    #[arg(long, value_name = "CAL.json")]
+    pub machine: PathBuf,
+    /// The control: sinumerik, fanuc or heidenhain.
+    #[arg(long, value_parser = parse_controller, value_name = "CONTROL")]
+    pub controller: Controller,
+    /// The directory the files go into (created when missing).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// The three leg axes' names on the control (default: X1,Y1,Z1 for
+    /// sinumerik, U,V,W for fanuc and heidenhain).
+    #[arg(long, value_parser = parse_three_names, value_name = "A,B,C")]
+    pub axis_names: Option<[String; 3]>,
+    /// The most compensation points per axis the control takes (default:
+    /// 200 sinumerik, the MD38000 of an 808D; 128 fanuc; 256 heidenhain).
+    #[arg(long, value_name = "N")]
+    pub max_points: Option<usize>,
+    /// Fanuc: the detection unit, um (default 1).
+    #[arg(long, value_name = "UM")]
+    pub detection_unit_um: Option<f64>,
+    /// Fanuc: the largest value of one pitch compensation point, in
+    /// detection units times the magnification (default 127).
+    #[arg(long, value_name = "N")]
+    pub max_increment: Option<u32>,
+    /// The largest format error accepted, um: past it nothing is written
+    /// and the exit code is 3.
+    #[arg(long, default_value_t = 1.0, value_name = "UM")]
+    pub tolerance_um: f64,
+    /// Each leg axis' reference point, mm (default: the legs' commands at
+    /// the centre of the workspace).
+    #[arg(long, value_parser = parse_three_mm, value_name = "Q1,Q2,Q3", allow_hyphen_values = true)]
+    pub reference_mm: Option<[f64; 3]>,
+    /// Print machine-readable JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_controller(s: &str) -> Result<Controller, String> {
+    s.parse()
+}
+
+fn three<T>(s: &str, parse: impl Fn(&str) -> Result<T, String>) -> Result<[T; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let [a, b, c] = parts.as_slice() else {
+        return Err(format!("expected three comma-separated values, got `{s}`"));
+    };
+    Ok([parse(a)?, parse(b)?, parse(c)?])
+}
+
+fn parse_three_names(s: &str) -> Result<[String; 3], String> {
+    three(s, |p| Ok(p.to_string()))
+}
+
+fn parse_three_mm(s: &str) -> Result<[f64; 3], String> {
+    three(s, |p| {
+        p.parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("`{p}` is not a number of mm"))
+    })
+}
+
+/// `tricept export`.
+pub fn run(a: &ExportArgs) -> Result<u8, CliError> {
+    let request = ExportRequest {
+        machine: a.machine.clone(),
+        options: ExportOptions {
+            axis_names: a.axis_names.clone(),
+            max_points: a.max_points,
+            detection_unit_um: a.detection_unit_um,
+            max_increment: a.max_increment,
+            tolerance_um: a.tolerance_um,
+            reference_mm: a.reference_mm,
+            ..ExportOptions::new(a.controller)
+        },
+        out: a.out.clone(),
+    };
+    let e = tricept_ident::export(&request)?;
+    if a.json {
+        outln!("{}", e.json(&a.out));
+    } else {
+        crate::output::write_text(&e.text(&a.out));
+    }
+    Ok(e.exit_code)
+}

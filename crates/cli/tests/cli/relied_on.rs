@@ -1,0 +1,232 @@
+//! What the verbs rely on is sealed and bounded.
+//!
+//! What `tricept check` judges by is sealed: a calibrated file whose
+//! standard deviations, sensor noise, correlations, offsets or
+//! temperature were edited after the calibration is refused (exit 2,
+//! naming the field) by every verb that loads it, so an inflated
+//! `std_dev_mm` or a quieter `sensors` noise can no longer hide a real
+//! 20 um slip from the check; the file as written loads everywhere.
+//! Every JSON input has a size bound: a device or a runaway file is
+//! refused with exit 2 after 64 MiB instead of exhausting the memory.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn tricept(dir: &Path, args: &[&str]) -> Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_tricept"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    out
+}
+
+fn workdir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tricept-relied-on-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The true errors a simulated file's comment records.
+fn truth_of(csv: &str) -> serde_json::Map<String, serde_json::Value> {
+    let line = csv
+        .lines()
+        .find(|l| l.starts_with("# true errors"))
+        .unwrap();
+    serde_json::from_str(&line[line.find('{').unwrap()..]).unwrap()
+}
+
+#[test]
+fn an_edited_judged_field_is_refused_by_name_and_cannot_hide_a_slip() {
+    let dir = workdir("sealed");
+    let d = dir.as_path();
+    let ok = |args: &[&str]| {
+        let out = tricept(d, args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
+    };
+    ok(&[
+        "simulate",
+        "--truth",
+        "random:0.25,5",
+        "--poses",
+        "random:80,3",
+        "--out",
+        "cal.csv",
+    ]);
+    ok(&[
+        "identify",
+        "--data",
+        "cal.csv",
+        "--write-machine",
+        "cal.json",
+    ]);
+    // The day's campaign: leg 2 slipped by 20 um.
+    let csv = std::fs::read_to_string(dir.join("cal.csv")).unwrap();
+    let mut truth = truth_of(&csv);
+    let dq2 = truth["dq2"].as_f64().unwrap();
+    truth.insert("dq2".into(), (dq2 + 0.020).into());
+    std::fs::write(
+        dir.join("slipped.json"),
+        serde_json::to_string(&truth).unwrap(),
+    )
+    .unwrap();
+    ok(&[
+        "simulate",
+        "--truth",
+        "slipped.json",
+        "--poses",
+        "random:20,9",
+        "--seed",
+        "4",
+        "--out",
+        "day.csv",
+    ]);
+    let check = |machine: &str| tricept(d, &["check", "--machine", machine, "--data", "day.csv"]);
+    // The file as written: the slip is seen.
+    assert_eq!(check("cal.json").status.code(), Some(3));
+
+    let original: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("cal.json")).unwrap()).unwrap();
+    type Edit = fn(&mut serde_json::Value);
+    let edits: [(&str, &str, Edit); 6] = [
+        ("std-dev", "`calibration.std_dev_mm`", |v| {
+            let sd = v["calibration"]["std_dev_mm"].as_object_mut().unwrap();
+            for x in sd.values_mut() {
+                if let Some(s) = x.as_f64() {
+                    *x = (s * 100.0).into();
+                }
+            }
+        }),
+        ("noise", "`sensors`", |v| {
+            v["sensors"]["angle_noise_arcsec"] = 8.0.into();
+            v["sensors"]["length_noise_um"] = 5.0.into();
+        }),
+        ("correlations", "`calibration.correlations`", |v| {
+            v["calibration"]["correlations"]["matrix"][0][1] = 0.0.into();
+        }),
+        ("offsets", "`calibration.sensor_offsets`", |v| {
+            let s = v["calibration"]["sensor_offsets"]["s_mm"].as_f64().unwrap();
+            v["calibration"]["sensor_offsets"]["s_mm"] = (s + 0.02).into();
+        }),
+        ("temperature", "`calibration.temperature_c`", |v| {
+            v["calibration"]["temperature_c"] = 24.0.into();
+        }),
+        ("seal-removed", "has no `seal`", |v| {
+            v["calibration"].as_object_mut().unwrap().remove("seal");
+        }),
+    ];
+    let mut failures = Vec::new();
+    for (case, needle, edit) in edits {
+        let mut v = original.clone();
+        edit(&mut v);
+        let file = format!("edited-{case}.json");
+        std::fs::write(dir.join(&file), serde_json::to_string_pretty(&v).unwrap()).unwrap();
+        for verb in [
+            vec!["check", "--machine", &file, "--data", "day.csv"],
+            vec!["ik", "0", "0", "750", "--machine", &file],
+        ] {
+            let out = tricept(d, &verb);
+            let err = String::from_utf8_lossy(&out.stderr).into_owned();
+            if out.status.code() != Some(2) || !err.contains(needle) || !err.contains(&file) {
+                failures.push(format!(
+                    "{case} ({}): {:?} {err}",
+                    verb[0],
+                    out.status.code()
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    // The file written again from a loaded calibrated machine keeps a
+    // valid seal (a recalibration writes its own).
+    ok(&[
+        "identify",
+        "--data",
+        "cal.csv",
+        "--machine",
+        "cal.json",
+        "--write-machine",
+        "again.json",
+    ]);
+    ok(&["ik", "0", "0", "750", "--machine", "again.json"]);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn every_json_input_is_bounded() {
+    let dir = workdir("bounded");
+    let d = dir.as_path();
+    let out = tricept(d, &["simulate", "--poses", "random:40,3", "--out", "d.csv"]);
+    assert_eq!(out.status.code(), Some(0));
+    let out = tricept(
+        d,
+        &["identify", "--data", "d.csv", "--write-machine", "m.json"],
+    );
+    assert_eq!(out.status.code(), Some(0));
+    let z = "/dev/zero";
+    let cases: [(&str, Vec<&str>); 7] = [
+        ("machine", vec!["ik", "0", "0", "750", "--machine", z]),
+        (
+            "history",
+            vec![
+                "check",
+                "--machine",
+                "m.json",
+                "--data",
+                "d.csv",
+                "--history",
+                z,
+            ],
+        ),
+        ("truth", vec!["simulate", "--truth", z, "--out", "t.csv"]),
+        (
+            "truth-effect",
+            vec!["simulate", "--truth-effect", "@/dev/zero", "--out", "t.csv"],
+        ),
+        (
+            "plausibility",
+            vec!["diagnose", "--data", "d.csv", "--plausibility", z],
+        ),
+        (
+            "features",
+            vec![
+                "identify",
+                "--data",
+                "d.csv",
+                "--touch",
+                "d.csv",
+                "--features",
+                z,
+            ],
+        ),
+        (
+            "fused-plausibility",
+            vec![
+                "identify",
+                "--data",
+                "d.csv",
+                "--head",
+                "none",
+                "--plausibility",
+                z,
+            ],
+        ),
+    ];
+    let mut failures = Vec::new();
+    for (case, args) in cases {
+        let out = tricept(d, &args);
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        if out.status.code() != Some(2)
+            || !err.contains("64 MiB")
+            || err.trim().lines().count() != 1
+        {
+            failures.push(format!("{case}: {:?} {err}", out.status.code()));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    std::fs::remove_dir_all(&dir).ok();
+}

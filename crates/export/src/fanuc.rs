@@ -1,0 +1,294 @@
+//! Fanuc: pitch error compensation (parameters 3620-3624 per axis, the
+//! values as pitch error compensation data `N10000+n P..`) and backlash
+//! (parameter 1851), in detection units.
+//!
+//! How the control reads it (docs/controllers.md, with the sources): the
+//! points are numbered, point `n` at `P_n = P_ref + (n - n_ref) h` with
+//! `n_ref` (3620) the point of the reference position and `h` (3624) the
+//! interval; the value of point `n` is the *increment* of the compensation
+//! over the section from `P_(n-1)` to `P_n`, in detection units times the
+//! magnification (3623); the compensation is output section by section (a
+//! staircase, no interpolation), zero in the reference position's own
+//! section, and added to the commanded position.
+
+use crate::correction::LegCorrection;
+
+/// Check points per section when a table's error is measured.
+const CHECKS_PER_SECTION: usize = 16;
+
+/// The largest magnification parameter 3623 takes.
+pub const MAX_MAGNIFICATION: u32 = 100;
+
+/// One axis' pitch error compensation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FanucAxis {
+    /// Number of the point of the reference position (3620).
+    pub reference_point: usize,
+    /// Number of the farthest point on the negative side (3621).
+    pub first_point: usize,
+    /// Number of the farthest point on the positive side (3622).
+    pub last_point: usize,
+    /// Magnification (3623).
+    pub magnification: u32,
+    /// Interval of the points (3624), detection units.
+    pub interval_units: u64,
+    /// The interval, mm.
+    pub interval_mm: f64,
+    /// The position of the reference point, mm.
+    pub reference_mm: f64,
+    /// The value of each point from `first_point` to `last_point`
+    /// (increments, in detection units times the magnification).
+    pub increments: Vec<i64>,
+    /// Whether an increment had to be clipped to the range a point takes
+    /// (the magnification is at its largest).
+    pub clipped: bool,
+    /// The constant taken out of the correction so that the reference
+    /// position's own section reads zero (added to the leg's zero), mm.
+    pub shift_mm: f64,
+    /// Largest difference between the compensation as output and the
+    /// exact correction, over the stroke, um.
+    pub format_error_um: f64,
+}
+
+impl FanucAxis {
+    /// The compensation output at commanded position `q_mm` (mm, added to
+    /// the command): the staircase of the accumulated increments.
+    pub fn output_mm(&self, q_mm: f64, detection_unit_um: f64) -> f64 {
+        let k = section(q_mm, self.reference_mm, self.interval_mm);
+        let lo = self.first_point as i64 - self.reference_point as i64;
+        let hi = self.last_point as i64 - self.reference_point as i64;
+        let k = k.clamp(lo, hi);
+        let unit = f64::from(self.magnification) * detection_unit_um * 1e-3;
+        accumulated(&self.increments, lo, k) as f64 * unit
+    }
+}
+
+/// The section (relative to the reference point's) that holds `q`: the
+/// section `k` runs from `P_ref + (k - 1) h` (excluded) to `P_ref + k h`.
+fn section(q_mm: f64, reference_mm: f64, interval_mm: f64) -> i64 {
+    ((q_mm - reference_mm) / interval_mm - 1e-12).ceil() as i64
+}
+
+/// The accumulated compensation of section `k` (relative numbering, the
+/// first point at `lo`): the sum of the increments from the reference
+/// point outwards.
+fn accumulated(increments: &[i64], lo: i64, k: i64) -> i64 {
+    let at = |j: i64| increments.get((j - lo) as usize).copied().unwrap_or(0);
+    if k >= 0 {
+        (1..=k).map(at).sum()
+    } else {
+        -(k + 1..=0).map(at).sum::<i64>()
+    }
+}
+
+/// `leg`'s correction as Fanuc pitch error compensation on at most
+/// `max_points` points, numbered from `first_number`, in detection units
+/// of `detection_unit_um` with increments of at most `max_increment`.
+pub fn plan(
+    leg: &LegCorrection,
+    max_points: usize,
+    first_number: usize,
+    detection_unit_um: f64,
+    max_increment: u32,
+) -> FanucAxis {
+    let du_mm = detection_unit_um * 1e-3;
+    let stroke = leg.hi_mm - leg.lo_mm;
+    let interval_units = ((stroke / (max_points.max(3) - 2) as f64) / du_mm).ceil() as u64;
+    let h = interval_units.max(1) as f64 * du_mm;
+    let q_ref = leg.reference_mm;
+    let k_lo = section(leg.lo_mm, q_ref, h);
+    let k_hi = section(leg.hi_mm, q_ref, h);
+    let midrange = |k: i64| {
+        let (a, b) = (q_ref + (k - 1) as f64 * h, q_ref + k as f64 * h);
+        let (lo, hi) = (0..=CHECKS_PER_SECTION)
+            .map(|j| leg.relative_mm(a + (b - a) * j as f64 / CHECKS_PER_SECTION as f64))
+            .chain(
+                leg.knots_mm()
+                    .into_iter()
+                    .filter(|q| *q > a && *q <= b)
+                    .map(|q| leg.relative_mm(q)),
+            )
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            });
+        0.5 * (lo + hi)
+    };
+    let shift_mm = midrange(0);
+    // The best staircase: each section at the middle of the correction's
+    // range over it (negated: the compensation is added to the command).
+    let target: Vec<f64> = (k_lo..=k_hi)
+        .map(|k| {
+            if k == 0 {
+                0.0
+            } else {
+                -(midrange(k) - shift_mm)
+            }
+        })
+        .collect();
+    let mut chosen = None;
+    for m in 1..=MAX_MAGNIFICATION {
+        let unit = f64::from(m) * du_mm;
+        let (increments, clipped) = increments_of(&target, k_lo, unit, max_increment);
+        let last = m == MAX_MAGNIFICATION;
+        if !clipped || last {
+            chosen = Some((m, increments, clipped));
+            break;
+        }
+    }
+    let (magnification, increments, clipped) = chosen.unwrap_or((1, Vec::new(), true));
+    let reference_point = first_number + (-k_lo) as usize;
+    let mut axis = FanucAxis {
+        reference_point,
+        first_point: first_number,
+        last_point: first_number + (k_hi - k_lo) as usize,
+        magnification,
+        interval_units,
+        interval_mm: h,
+        reference_mm: q_ref,
+        increments,
+        clipped,
+        shift_mm,
+        format_error_um: 0.0,
+    };
+    let start = q_ref + (k_lo - 1) as f64 * h;
+    axis.format_error_um = leg
+        .check_points_mm(start, h, CHECKS_PER_SECTION)
+        .into_iter()
+        .map(|q| {
+            let exact = -(leg.relative_mm(q) - shift_mm);
+            (axis.output_mm(q, detection_unit_um) - exact).abs() * 1e3
+        })
+        .fold(0.0, f64::max);
+    axis
+}
+
+/// The increments (units of `unit_mm`) whose accumulation from the
+/// reference section (index `-k_lo` of `target`) follows `target`
+/// (mm), each within `max_increment` (clipped, and said so, when not).
+fn increments_of(target: &[f64], k_lo: i64, unit_mm: f64, max_increment: u32) -> (Vec<i64>, bool) {
+    let r = (-k_lo) as usize;
+    let cap = i64::from(max_increment);
+    let mut increments = vec![0i64; target.len()];
+    let mut clipped = false;
+    // Outwards from the reference: positive side, point k carries
+    // A_k - A_(k-1); negative side, point k+1 carries A_(k+1) - A_k.
+    let mut acc = 0i64;
+    for j in r + 1..target.len() {
+        let want = (target[j] / unit_mm).round() as i64;
+        let v = (want - acc).clamp(-cap, cap);
+        clipped |= v != want - acc;
+        increments[j] = v;
+        acc += v;
+    }
+    let mut acc = 0i64;
+    for j in (0..r).rev() {
+        let want = (target[j] / unit_mm).round() as i64;
+        // A_j = A_(j+1) - v_(j+1).
+        let v = (acc - want).clamp(-cap, cap);
+        clipped |= v != acc - want;
+        increments[j + 1] = v;
+        acc -= v;
+    }
+    (increments, clipped)
+}
+
+/// The pitch error compensation data (`N10000+n P..`), every axis.
+pub fn pitch_tape(axes: &[FanucAxis]) -> String {
+    let mut s = String::from("%\n");
+    for a in axes {
+        for (j, v) in a.increments.iter().enumerate() {
+            s.push_str(&format!("N{}P{v}\n", 10000 + a.first_point + j));
+        }
+    }
+    s.push_str("%\n");
+    s
+}
+
+/// The parameters (`N<number>A<axis>P<value>`): 1851 backlash, 3620-3624.
+pub fn parameter_tape(axes: &[FanucAxis], backlash_units: &[i64; 3]) -> String {
+    let row = |number: u32, values: Vec<String>| {
+        let mut line = format!("N{number}");
+        for (i, v) in values.iter().enumerate() {
+            line.push_str(&format!("A{}P{v}", i + 1));
+        }
+        line.push('\n');
+        line
+    };
+    let mut s = String::from("%\n");
+    s.push_str(&row(
+        1851,
+        backlash_units.iter().map(i64::to_string).collect(),
+    ));
+    s.push_str(&row(
+        3620,
+        axes.iter().map(|a| a.reference_point.to_string()).collect(),
+    ));
+    s.push_str(&row(
+        3621,
+        axes.iter().map(|a| a.first_point.to_string()).collect(),
+    ));
+    s.push_str(&row(
+        3622,
+        axes.iter().map(|a| a.last_point.to_string()).collect(),
+    ));
+    s.push_str(&row(
+        3623,
+        axes.iter().map(|a| a.magnification.to_string()).collect(),
+    ));
+    s.push_str(&row(
+        3624,
+        axes.iter().map(|a| a.interval_units.to_string()).collect(),
+    ));
+    s.push_str("%\n");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_lead_error_is_a_staircase_zero_in_the_reference_section() {
+        let leg = LegCorrection {
+            leg: 0,
+            lead_ppm: 50.0,
+            table: None,
+            reference_mm: 800.0,
+            lo_mm: 640.0,
+            hi_mm: 1040.0,
+        };
+        let a = plan(&leg, 128, 0, 1.0, 127);
+        assert!(a.last_point - a.first_point < 128);
+        assert_eq!(a.output_mm(800.0, 1.0), 0.0);
+        // 50 ppm over a section of ~3.2 mm: a staircase misses by half a
+        // step (0.08 um) plus half a detection unit.
+        assert!(a.format_error_um < 0.6, "{}", a.format_error_um);
+        // 200 mm above the reference the axis is 10 um long: -10 um.
+        assert!((a.output_mm(1000.0, 1.0) + 0.010).abs() < 0.0006);
+        assert!((a.output_mm(700.0, 1.0) - 0.005).abs() < 0.0006);
+    }
+
+    #[test]
+    fn the_magnification_grows_until_each_increment_fits_and_clipping_is_said() {
+        let leg = |ppm: f64| LegCorrection {
+            leg: 0,
+            lead_ppm: ppm,
+            table: None,
+            reference_mm: 800.0,
+            lo_mm: 640.0,
+            hi_mm: 1040.0,
+        };
+        // 5000 ppm over ~3.2 mm sections: 16 um a section, 7 at the most:
+        // magnification 3.
+        let a = plan(&leg(5000.0), 128, 0, 1.0, 7);
+        assert_eq!(a.magnification, 3);
+        assert!(!a.clipped);
+        assert!(a.increments.iter().all(|v| v.abs() <= 7));
+        // 200 um a section cannot fit 1 x 100: clipped, and the error
+        // says so.
+        let b = plan(&leg(62_500.0), 128, 0, 1.0, 1);
+        assert!(b.clipped);
+        assert_eq!(b.magnification, MAX_MAGNIFICATION);
+        assert!(b.format_error_um > 1000.0, "{}", b.format_error_um);
+    }
+}

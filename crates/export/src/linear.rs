@@ -1,0 +1,173 @@
+//! A leg's correction resampled into an absolute table read by linear
+//! interpolation between equally spaced points, the end values holding
+//! beyond them: the shape of Sinumerik's `$AA_ENC_COMP` and Heidenhain's
+//! `*.COM` tables.
+//!
+//! The grid is the deployed table's own (extended over the stroke) when
+//! the control takes that many points, so that the written table is the
+//! deployed one; else the stroke is resampled on the most points the
+//! control takes and the cost is measured: [`LinearTable::format_error_um`]
+//! is the largest difference between the written table, read the way the
+//! control reads it (rounded values included), and the exact correction,
+//! over the stroke.
+
+use crate::correction::LegCorrection;
+
+/// Spacing of a table for a leg without a compensation table (a lead
+/// error alone is linear: any spacing is exact), mm.
+pub const PLAIN_STEP_MM: f64 = 10.0;
+
+/// Check points per grid cell when a table's error is measured.
+const CHECKS_PER_CELL: usize = 8;
+
+/// A resampled absolute table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearTable {
+    /// Axis position of the first point, mm.
+    pub start_mm: f64,
+    /// Spacing of the points, mm.
+    pub step_mm: f64,
+    /// The leg's extra length at each point relative to the reference
+    /// point, mm, rounded to the control's resolution.
+    pub values_mm: Vec<f64>,
+    /// The constant taken out of the values so that the table reads zero
+    /// at the reference point (added to the leg's zero), mm.
+    pub shift_mm: f64,
+    /// Points the deployed table's own spacing would need over the stroke
+    /// (what to raise the point limit to for an exact table).
+    pub points_needed: usize,
+    /// Largest difference between the table as read and the exact
+    /// correction over the stroke, um.
+    pub format_error_um: f64,
+}
+
+impl LinearTable {
+    /// The table read at `q_mm` by linear interpolation, the end values
+    /// beyond the points, mm.
+    pub fn read_mm(&self, q_mm: f64) -> f64 {
+        read_linear(self.start_mm, self.step_mm, &self.values_mm, q_mm)
+    }
+
+    /// Position of the last point, mm.
+    pub fn end_mm(&self) -> f64 {
+        self.start_mm + self.step_mm * self.values_mm.len().saturating_sub(1) as f64
+    }
+}
+
+/// Linear interpolation of `values` at `start + k step`, the end values
+/// beyond them (zero for no values).
+fn read_linear(start_mm: f64, step_mm: f64, values: &[f64], q_mm: f64) -> f64 {
+    let Some(last) = values.len().checked_sub(1) else {
+        return 0.0;
+    };
+    if last == 0 {
+        return values[0];
+    }
+    let x = ((q_mm - start_mm) / step_mm).clamp(0.0, last as f64);
+    let k = (x.floor() as usize).min(last - 1);
+    let f = x - k as f64;
+    values[k] + f * (values[k + 1] - values[k])
+}
+
+/// Rounds `v` to a multiple of `resolution`.
+fn round_to(v: f64, resolution: f64) -> f64 {
+    (v / resolution).round() * resolution
+}
+
+/// `leg`'s correction as a linear table of at most `max_points` points,
+/// its values rounded to `resolution_mm`.
+pub fn resample(leg: &LegCorrection, max_points: usize, resolution_mm: f64) -> LinearTable {
+    let (lo, hi) = (leg.lo_mm, leg.hi_mm);
+    let stroke = hi - lo;
+    // The deployed table's own grid, extended to cover the stroke.
+    let (start, step, points_needed) = match &leg.table {
+        Some(t) if t.step_mm > 0.0 => {
+            let below = ((t.start_mm - lo) / t.step_mm).ceil();
+            let start = t.start_mm - below * t.step_mm;
+            let n = ((hi - start) / t.step_mm).ceil() as usize + 1;
+            (start, t.step_mm, n)
+        }
+        _ => {
+            let n = (stroke / PLAIN_STEP_MM).ceil() as usize + 1;
+            (lo, stroke / (n - 1) as f64, n)
+        }
+    };
+    let (start, step) = if points_needed <= max_points {
+        (start, step)
+    } else {
+        let n = max_points.max(2);
+        (lo, stroke / (n - 1) as f64)
+    };
+    let n = (((hi - start) / step - 1e-9).ceil() as usize + 1).max(2);
+    let exact: Vec<f64> = (0..n)
+        .map(|k| leg.relative_mm(start + step * k as f64))
+        .collect();
+    // Zero at the reference point as read (the values are shifted by a
+    // constant: linear interpolation shifts by the same constant).
+    let shift_mm = read_linear(start, step, &exact, leg.reference_mm);
+    let values_mm: Vec<f64> = exact
+        .iter()
+        .map(|v| round_to(v - shift_mm, resolution_mm))
+        .collect();
+    let mut table = LinearTable {
+        start_mm: start,
+        step_mm: step,
+        values_mm,
+        shift_mm,
+        points_needed,
+        format_error_um: 0.0,
+    };
+    table.format_error_um = leg
+        .check_points_mm(start, step, CHECKS_PER_CELL)
+        .into_iter()
+        .map(|q| (table.read_mm(q) - (leg.relative_mm(q) - shift_mm)).abs() * 1e3)
+        .fold(0.0, f64::max);
+    table
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tricept_kinematics::description::LegTableDescription;
+
+    fn leg(table: Option<LegTableDescription>) -> LegCorrection {
+        LegCorrection {
+            leg: 0,
+            lead_ppm: 50.0,
+            table,
+            reference_mm: 800.0,
+            lo_mm: 640.0,
+            hi_mm: 1040.0,
+        }
+    }
+
+    #[test]
+    fn a_lead_error_alone_is_exact_and_zero_at_the_reference() {
+        let t = resample(&leg(None), 200, 1e-6);
+        assert!(t.format_error_um < 0.002, "{}", t.format_error_um);
+        assert!(t.read_mm(800.0).abs() < 1e-6);
+        // 50 ppm over 200 mm above the reference: 10 um.
+        assert!((t.read_mm(1000.0) - 0.010).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_table_that_fits_is_kept_and_one_that_does_not_costs_its_error() {
+        // A 4 um sine of period 10 mm on 0.5 mm points.
+        let values: Vec<f64> = (0..801)
+            .map(|k| 4.0 * (std::f64::consts::TAU * k as f64 * 0.5 / 10.0).sin())
+            .collect();
+        let table = LegTableDescription::new(1, 640.0, 0.5, values);
+        let fits = resample(&leg(Some(table.clone())), 1000, 1e-6);
+        assert_eq!(fits.points_needed, 801);
+        assert!(fits.format_error_um < 0.002, "{}", fits.format_error_um);
+        let coarse = resample(&leg(Some(table)), 200, 1e-6);
+        assert_eq!(coarse.values_mm.len(), 200);
+        // Linear interpolation over ~2 mm of a 10 mm period: about
+        // A (1 - cos(pi h / P)) = 0.76 um.
+        assert!(
+            coarse.format_error_um > 0.3 && coarse.format_error_um < 1.5,
+            "{}",
+            coarse.format_error_um
+        );
+    }
+}

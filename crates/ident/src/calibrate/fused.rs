@@ -1,0 +1,475 @@
+//! The fused calibration: the module, the head and every instrument's
+//! nuisance in one fit from the internal data and external measurements
+//! (laser tracker, ballbar, touch-offs; `tricept_engine::fusion`), its
+//! verdict (every source checkable, explained and every estimate
+//! plausible), its JSON, its text report and its calibrated machine file.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde_json::{Value, json};
+use tricept_data::{
+    BallbarReading, Dataset, ExternalData, ExternalRecord, Features, TouchReading, TrackerPoint,
+};
+use tricept_engine::IdentError;
+use tricept_engine::fusion::{
+    BallbarOptions, FusedModel, Fusion, FusionPlausibility, Source, SourceKind, TouchOptions,
+    TrackerOptions, TrackerTarget, identify_fused,
+};
+use tricept_kinematics::description::ExternalSourceRecord;
+use tricept_kinematics::{Machine, MachineDescription};
+use tricept_model::ParameterSet;
+
+use super::FusedSources;
+use super::values::{TrackerTargetSpec, eval_options, fused_model};
+use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error};
+use crate::inputs::{LoadedMachine, check_commands, positive};
+use crate::{limits, machine_file};
+
+/// A fused fit with its model and its sources.
+#[derive(Debug)]
+pub(crate) struct FusedFit {
+    pub model: FusedModel,
+    pub fit: Fusion,
+    pub sources: Vec<Source>,
+    /// The module's parameter set label.
+    pub set_label: String,
+    /// The outcome of a write, for the JSON (`deployed`).
+    pub deployed: Option<Value>,
+}
+
+/// Fits `x` with the internal `data` on `loaded`; `for_machine_file`
+/// refuses up front fitted effects, which the machine format cannot carry.
+pub(crate) fn fit(
+    loaded: &LoadedMachine,
+    set: &ParameterSet,
+    data: &Dataset,
+    x: &FusedSources,
+    robust: bool,
+    for_machine_file: bool,
+) -> Result<FusedFit, Error> {
+    let machine = loaded.machine();
+    if x.tracker.is_empty() && x.tracker_target.is_some() {
+        return Err(Error::input(
+            "--tracker-target: there is no --tracker file to state the target of",
+        ));
+    }
+    let mut model = fused_model(machine, set, &x.effects, x.head)?;
+    if for_machine_file && !model.effects().is_empty() {
+        let names: Vec<&str> = model.effects().iter().map(|e| e.as_str()).collect();
+        return Err(Error::input(format!(
+            "--write-machine: {} fitted, but the machine format cannot carry {}; write a geometric fit (without --effects) or compensate with the fused model",
+            names.join(", "),
+            if names.len() == 1 { "it" } else { "them" }
+        )));
+    }
+    // A calibrated machine: the rank decision of its nominal machine, as in
+    // the internal calibration (docs/identifiability.md).
+    if let Some(reference) = loaded.rank_reference()? {
+        model = model.with_rank_reference(reference)?;
+    }
+    let mut options = eval_options(machine, x.eval_grid, &x.eval_head_angles)?;
+    if !robust {
+        options.screen = None;
+    }
+    if let Some(path) = &x.plausibility {
+        let text = tricept_data::read_json_text(path)
+            .map_err(|e| Error::input(format!("--plausibility {}: {e}", path.display())))?;
+        options.plausibility = FusionPlausibility::with_overrides(&text)
+            .map_err(|e| Error::input(format!("--plausibility {}: {e}", path.display())))?;
+    }
+    options.tool_axis_arcsec = positive("--tool-axis-warn-arcsec", x.tool_axis_warn_arcsec)?;
+    let sources = sources(x, data, machine)?;
+    let fit = identify_fused(&model, &sources, &options)?;
+    Ok(FusedFit {
+        model,
+        fit,
+        sources,
+        set_label: set.label().to_string(),
+        deployed: None,
+    })
+}
+
+/// The sources: the internal data and every external file.
+fn sources(x: &FusedSources, data: &Dataset, machine: &Machine) -> Result<Vec<Source>, Error> {
+    let mut sources = vec![Source::internal(data, machine.sensors.logged_sigma())];
+    let target = if x.tracker.is_empty() {
+        TrackerTarget::Free
+    } else {
+        TrackerTargetSpec::required(x.tracker_target, x.tracker_target_sigma_um)?
+    };
+    let tracker = TrackerOptions {
+        sigma_um: positive("--tracker-sigma-um", x.tracker_sigma_um)?,
+        target,
+    };
+    sources.extend(external_sources(
+        &x.tracker,
+        "tracker",
+        machine,
+        |r: &TrackerPoint| (r.line, r.pose.commands_mm),
+        |d| Source::tracker(d, &tracker),
+    )?);
+    let ball = match x.ballbar_ball_mm {
+        Some(t) => {
+            if let Some(v) = t.0.iter().find(|v| v.abs() > limits::MAX_TOOL_OFFSET_MM) {
+                return Err(Error::input(format!(
+                    "--ballbar-ball-mm: {v} mm is beyond ±{} mm from the tool tip",
+                    limits::MAX_TOOL_OFFSET_MM
+                )));
+            }
+            t.0
+        }
+        None => [0.0; 3],
+    };
+    let ballbar = BallbarOptions {
+        sigma_um: positive("--ballbar-sigma-um", x.ballbar_sigma_um)?,
+        length_sigma_um: x.ballbar_length_sigma.sigma_um(),
+        ball_offset_mm: ball,
+    };
+    sources.extend(external_sources(
+        &x.ballbar,
+        "ballbar",
+        machine,
+        |r: &BallbarReading| (r.line, r.pose.commands_mm),
+        |d| Source::ballbar(d, &ballbar),
+    )?);
+    if !x.touch.is_empty() {
+        let Some(features) = &x.features else {
+            return Err(Error::input(
+                "--touch needs --features FILE.json (the spheres and planes touched)",
+            ));
+        };
+        let features = Features::from_path(features)?;
+        let touch = TouchOptions {
+            sigma_um: positive("--touch-sigma-um", x.touch_sigma_um)?,
+        };
+        sources.extend(external_sources(
+            &x.touch,
+            "touch",
+            machine,
+            |r: &TouchReading| (r.line, r.pose.commands_mm),
+            |d| Source::touch(d, &features, &touch),
+        )?);
+    }
+    Ok(sources)
+}
+
+/// Reads the external files `paths` of one kind, checks their commands
+/// against the leg stroke (`at` gives a record's line and commands) and
+/// makes each a source labelled `kind`, `kind2`, ...
+fn external_sources<T: ExternalRecord>(
+    paths: &[PathBuf],
+    kind: &str,
+    machine: &Machine,
+    at: impl Fn(&T) -> (u64, [f64; 3]),
+    source: impl Fn(&ExternalData<T>) -> Result<Source, IdentError>,
+) -> Result<Vec<Source>, Error> {
+    paths
+        .iter()
+        .enumerate()
+        .map(|(k, path)| {
+            let d = tricept_data::read_external_path::<T>(path)?;
+            check_commands(&d.source, d.records.iter().map(&at), machine)?;
+            let label = if k == 0 {
+                kind.to_string()
+            } else {
+                format!("{kind}{}", k + 1)
+            };
+            Ok(source(&d)?.with_label(label))
+        })
+        .collect()
+}
+
+impl FusedFit {
+    /// 4 not converged, 3 converged but not to be trusted (a source not
+    /// explained or not checkable, an implausible estimate), else 0.
+    pub fn exit_code(&self) -> u8 {
+        if !self.fit.converged {
+            EXIT_NOT_CONVERGED
+        } else if !self.fit.is_trustworthy() {
+            EXIT_INADEQUATE
+        } else {
+            EXIT_OK
+        }
+    }
+
+    /// Why the fit must not be deployed, in one clause per reason.
+    pub fn refusal_reason(&self) -> String {
+        let fit = &self.fit;
+        let mut why = Vec::new();
+        if !fit.verdict.converged {
+            why.push("the fused fit did not converge".to_string());
+        }
+        for s in fit.sources.iter().filter(|s| !s.checkable) {
+            why.push(format!(
+                "{} cannot be checked: at least {} more records make it checkable",
+                s.label,
+                s.more_records.unwrap_or(1)
+            ));
+        }
+        let unexplained: Vec<&str> = fit
+            .sources
+            .iter()
+            .filter(|s| s.checkable && !s.explained())
+            .map(|s| s.label.as_str())
+            .collect();
+        if !unexplained.is_empty() {
+            why.push(format!(
+                "the model does not explain {}",
+                unexplained.join(", ")
+            ));
+        }
+        if !fit.implausible.is_empty() {
+            let names: Vec<&str> = fit.implausible.iter().map(|i| i.name.as_str()).collect();
+            why.push(format!("implausible estimates: {}", names.join(", ")));
+        }
+        if why.is_empty() {
+            "see the warnings".into()
+        } else {
+            format!("{} (see the warnings)", why.join("; "))
+        }
+    }
+
+    /// The one-line summary of a non-zero exit code.
+    pub fn exit_line(&self) -> Option<String> {
+        match self.exit_code() {
+            EXIT_NOT_CONVERGED => Some(format!(
+                "identify: exit {EXIT_NOT_CONVERGED}: the fused fit did not converge"
+            )),
+            EXIT_INADEQUATE => Some(format!(
+                "identify: exit {EXIT_INADEQUATE}: the fit completed but must not be trusted as it stands: {}",
+                self.refusal_reason()
+            )),
+            _ => None,
+        }
+    }
+
+    /// The parameters held at nominal (not seen by the data).
+    fn held(&self) -> Vec<String> {
+        self.fit
+            .std_dev
+            .iter()
+            .zip(&self.fit.names)
+            .filter(|(sd, _)| sd.is_none())
+            .map(|(_, n)| n.clone())
+            .collect()
+    }
+
+    /// The calibrated machine: the module explicit, the head's fields and
+    /// angle offsets from the estimate, and the `calibration` record (with
+    /// every external file, its hash and its fitted nuisance).
+    pub fn description(
+        &self,
+        loaded: &LoadedMachine,
+        data: &Path,
+        forced: Option<String>,
+    ) -> Result<MachineDescription, Error> {
+        let fit = &self.fit;
+        let external: Vec<(&Path, ExternalSourceRecord)> = self
+            .sources
+            .iter()
+            .zip(&fit.sources)
+            .filter(|(s, _)| s.kind() != SourceKind::Internal)
+            .map(|(s, f)| {
+                let nuisance = f
+                    .nuisance_names
+                    .iter()
+                    .zip(f.nuisance.iter().zip(&f.nuisance_std_dev))
+                    .map(|(n, (v, sd))| (n.clone(), json!({"value": v, "std_dev": sd})))
+                    .collect();
+                let record = ExternalSourceRecord {
+                    kind: s.kind().as_str().to_string(),
+                    file: s.file().to_string(),
+                    sha256: String::new(),
+                    records: f.records,
+                    chi2_per_dof: f
+                        .reduced_chi_square
+                        .is_finite()
+                        .then_some(f.reduced_chi_square),
+                    redundancy: f.redundancy,
+                    checkable: f.checkable,
+                    rejected_lines: fit
+                        .rejected
+                        .iter()
+                        .filter(|r| r.label == f.label)
+                        .map(|r| r.line)
+                        .collect(),
+                    nuisance,
+                };
+                (Path::new(s.file()), record)
+            })
+            .collect();
+        let mut d = machine_file::calibrated_description(
+            loaded,
+            &self.model.machine_at(&fit.estimate),
+            &machine_file::FitRecord::of_fusion(fit),
+            machine_file::Provenance {
+                method: "identify (fused)",
+                data_file: data,
+                parameter_set: &format!("{} + head", self.set_label),
+                rejected_lines: fit
+                    .rejected
+                    .iter()
+                    .filter(|r| r.label == "internal")
+                    .map(|r| r.line)
+                    .collect(),
+                adequate: fit.is_trustworthy(),
+                forced,
+                warnings: fit.warnings.clone(),
+                effects: serde_json::Map::new(),
+                n_geometric: fit.names.len(),
+                external,
+                temperature_c: None,
+            },
+            None,
+        )?;
+        let files: Vec<&str> = self.sources.iter().map(|s| s.file()).collect();
+        let held = self.held();
+        d.notes = Some(format!(
+            "{}; identified from {}; held at nominal (not seen by the data): {}",
+            d.notes.unwrap_or_default(),
+            files.join(", "),
+            if held.is_empty() {
+                "none".to_string()
+            } else {
+                held.join(", ")
+            }
+        ));
+        Ok(d)
+    }
+
+    /// Records a written file (or a refused one) for the JSON.
+    pub fn record_write(&mut self, path: &Path, written: bool) {
+        self.deployed = Some(if written {
+            json!({"written": path.display().to_string(), "held_at_nominal": self.held()})
+        } else {
+            json!({"written": Value::Null, "refused": path.display().to_string()})
+        });
+    }
+
+    /// The JSON of `identify --json` with external data.
+    pub fn to_json(&self, loaded: &LoadedMachine, data_name: &str) -> Value {
+        let mut v = self.fit.to_json(&self.model);
+        if let Value::Object(o) = &mut v {
+            o.insert("machine".into(), loaded.description().name.clone().into());
+            o.insert("data_file".into(), data_name.into());
+            if let Some(d) = &self.deployed {
+                o.insert("deployed".into(), d.clone());
+            }
+        }
+        v
+    }
+
+    /// The text report.
+    pub fn report(&self) -> String {
+        let mut s = String::new();
+        self.write_report(&mut s);
+        s
+    }
+
+    fn write_report(&self, s: &mut String) {
+        let (model, fit) = (&self.model, &self.fit);
+        let list: Vec<String> = self
+            .sources
+            .iter()
+            .map(|s| format!("{} {} ({} records)", s.label(), s.file(), s.records()))
+            .collect();
+        let _ = writeln!(s, "fused identification: {}", list.join(", "));
+        for r in &fit.rejected {
+            let _ = writeln!(s, "{}", r.to_text());
+        }
+        let effects: Vec<&str> = model.effects().iter().map(|e| e.as_str()).collect();
+        let _ = writeln!(
+            s,
+            "model: {}{}{}; {} in {} Gauss-Newton iterations",
+            model.module().label(),
+            if effects.is_empty() {
+                String::new()
+            } else {
+                format!(" + {}", effects.join(", "))
+            },
+            if model.head().is_some() {
+                " + head13"
+            } else {
+                ""
+            },
+            if fit.converged {
+                "converged"
+            } else {
+                "NOT converged"
+            },
+            fit.iterations
+        );
+        let _ = writeln!(s, "{:>34} {:>14} {:>12}", "parameter", "estimate", "sd");
+        for ((n, v), sd) in fit.names.iter().zip(&fit.estimate).zip(&fit.std_dev) {
+            let _ = match sd {
+                Some(sd) => writeln!(s, "{n:>34} {v:>14.6e} {sd:>12.3e}"),
+                None => writeln!(s, "{n:>34} {v:>14.6e} {:>12}", "held"),
+            };
+        }
+        for src in &fit.sources {
+            let check = if src.checkable {
+                format!(
+                    "chi2/dof {:.3} (p = {:.2e})",
+                    src.reduced_chi_square, src.p_value
+                )
+            } else {
+                format!(
+                    "NOT checkable (needs {:.0}; at least {} more records)",
+                    src.min_redundancy,
+                    src.more_records.unwrap_or(1)
+                )
+            };
+            let _ = writeln!(
+                s,
+                "{} ({}): {} records, redundancy {:.1}: {check}{}; largest {:.1} sigma at line {}",
+                src.label,
+                src.file,
+                src.records,
+                src.redundancy,
+                src.rms_um
+                    .map(|r| format!(", rms {r:.2} um"))
+                    .unwrap_or_default(),
+                src.max_standardised.0,
+                src.max_standardised.1
+            );
+            for ((n, v), sd) in src
+                .nuisance_names
+                .iter()
+                .zip(&src.nuisance)
+                .zip(&src.nuisance_std_dev)
+            {
+                let _ = writeln!(s, "  {n:>32} {v:>14.6e} {sd:>12.3e}");
+            }
+        }
+        s.push_str(&fit.report.to_text());
+        let v = &fit.verdict;
+        let _ = writeln!(
+            s,
+            "verdict: {}, {}, {}, {}",
+            if v.converged {
+                "converged"
+            } else {
+                "NOT converged"
+            },
+            if v.checkable {
+                "every source checkable"
+            } else {
+                "NOT every source checkable"
+            },
+            if v.adequate {
+                "adequate (the model explains every source to its stated noise)"
+            } else {
+                "NOT adequate"
+            },
+            if v.plausible {
+                "every estimate plausible"
+            } else {
+                "implausible estimates"
+            }
+        );
+        for w in &fit.warnings {
+            let _ = writeln!(s, "WARNING: {w}");
+        }
+    }
+}

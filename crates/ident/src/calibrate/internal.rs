@@ -1,0 +1,316 @@
+//! The calibration from the UP limb's sensors alone: the robust fit of the
+//! geometric parameters and the sensor offsets, its verdict (with the
+//! likely causes of an inconsistent fit), the platform accuracy it
+//! predicts and the advice of a campaign too small to calibrate; its JSON,
+//! its text report and its calibrated machine file.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use serde_json::{Map, Value, json};
+use tricept_data::Dataset;
+use tricept_engine::{
+    GeometricModel, Identification, IdentifyOptions, PredictedAccuracy, Rejection, Verdict,
+    identify, identify_robust, likely_causes,
+};
+use tricept_kinematics::units::RAD_PER_ARCSEC;
+use tricept_kinematics::{Machine, MachineDescription};
+use tricept_model::ParameterSet;
+
+use super::advice::{campaign_advice, predicted_accuracy};
+use super::fit_error;
+use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error};
+use crate::inputs::LoadedMachine;
+use crate::machine_file;
+
+/// A fit from the internal data, with everything the outputs need.
+#[derive(Debug)]
+pub(crate) struct InternalFit {
+    /// The model (increments on the loaded machine, with its rank rule).
+    pub model: GeometricModel,
+    /// The identification on the kept poses.
+    pub id: Identification,
+    /// Poses rejected as gross errors.
+    pub rejected: Vec<Rejection>,
+    /// The verdict, with the likely causes of an inconsistent fit and the
+    /// advice of a campaign too small to calibrate added to its warnings.
+    pub verdict: Verdict,
+    /// The platform accuracy the fit predicts, against the machine's
+    /// tolerance.
+    pub accuracy: PredictedAccuracy,
+    /// Mean logged structure temperature of the data, °C.
+    pub temperature_c: Option<f64>,
+}
+
+/// Identifies `set` from `dataset` against `loaded` (robust unless told
+/// not to); the rank rule of a calibrated machine is its nominal
+/// machine's.
+pub(crate) fn fit(
+    loaded: &LoadedMachine,
+    set: &ParameterSet,
+    dataset: &Dataset,
+    robust: bool,
+    tolerance_mm: f64,
+) -> Result<InternalFit, Error> {
+    let m = loaded.machine();
+    let mut model = GeometricModel::new(m.clone(), set.clone());
+    if let Some(reference) = loaded.rank_reference()? {
+        model = model.with_rank_reference(reference);
+    }
+    let options = IdentifyOptions::for_machine(m);
+    let source = dataset.source.as_str();
+    let (id, rejected) = if robust {
+        identify_robust(&model, dataset, &options).map_err(|e| fit_error(source, &e))?
+    } else {
+        (
+            identify(&model, dataset, &options).map_err(|e| fit_error(source, &e))?,
+            Vec::new(),
+        )
+    };
+    let mut verdict = id.verdict();
+    if verdict.inconsistent {
+        for c in likely_causes(m, set, dataset, &options, id.stats.reduced_chi_square) {
+            verdict.warnings.push(format!(
+                "likely cause: {} (undone, the data fit with chi2/dof {:.2})",
+                c.description, c.chi2_per_dof
+            ));
+        }
+    }
+    let accuracy = predicted_accuracy(m, set, &id, tolerance_mm)?;
+    if !accuracy.worthwhile {
+        verdict
+            .warnings
+            .push(campaign_advice(m, set, &accuracy, id.residuals.len())?);
+    }
+    Ok(InternalFit {
+        model,
+        id,
+        rejected,
+        verdict,
+        accuracy,
+        temperature_c: machine_file::mean_temperature_c(dataset),
+    })
+}
+
+impl InternalFit {
+    /// 0 converged, adequate and worthwhile; 3 converged but inadequate, or
+    /// a campaign too small to calibrate; 4 not converged.
+    pub fn exit_code(&self) -> u8 {
+        if !self.verdict.converged {
+            EXIT_NOT_CONVERGED
+        } else if !self.verdict.adequate || !self.accuracy.worthwhile {
+            EXIT_INADEQUATE
+        } else {
+            EXIT_OK
+        }
+    }
+
+    /// Why the fit must not be deployed (`None` when it may).
+    pub fn refusal(&self) -> Option<&'static str> {
+        if !self.verdict.converged {
+            Some("the fit did not converge")
+        } else if self.verdict.inconsistent {
+            Some("the data cannot come from the described machine")
+        } else if !self.verdict.adequate {
+            Some("the model does not explain the data")
+        } else if !self.accuracy.worthwhile {
+            Some("the campaign is too small to calibrate the machine")
+        } else {
+            None
+        }
+    }
+
+    /// The reason of a non-zero exit code in one phrase, with the first
+    /// likely cause when one was found.
+    pub fn reason(&self) -> String {
+        let why = self.refusal().unwrap_or("");
+        match self
+            .verdict
+            .warnings
+            .iter()
+            .find_map(|w| w.strip_prefix("likely cause: "))
+        {
+            Some(cause) => format!("{why}; likely cause: {cause}"),
+            None => why.to_string(),
+        }
+    }
+
+    /// The identified machine.
+    pub fn identified(&self) -> Machine {
+        self.model.machine_at(&self.id.estimate)
+    }
+
+    /// The calibrated machine's description, its record saying `forced`.
+    pub fn description(
+        &self,
+        loaded: &LoadedMachine,
+        data: &Path,
+        forced: Option<String>,
+    ) -> Result<MachineDescription, Error> {
+        machine_file::calibrated_description(
+            loaded,
+            &self.identified(),
+            &machine_file::FitRecord::of_identification(&self.id),
+            machine_file::Provenance {
+                method: "identify",
+                data_file: data,
+                parameter_set: self.model.parameter_set().label(),
+                rejected_lines: self.rejected.iter().map(|r| r.line).collect(),
+                adequate: self.verdict.adequate,
+                forced,
+                warnings: self.verdict.warnings.clone(),
+                effects: Map::new(),
+                n_geometric: self.id.names.len(),
+                external: Vec::new(),
+                temperature_c: self.temperature_c,
+            },
+            None,
+        )
+    }
+
+    /// The JSON of `identify --json`.
+    pub fn to_json(&self, loaded: &LoadedMachine, data_name: &str) -> Value {
+        let id = &self.id;
+        let mut v = id.to_json();
+        if let Value::Object(o) = &mut v {
+            // One standard deviation per estimate, with its unit: the
+            // estimate's (what `std_dev` holds too, for scripts written
+            // before), not the design's prediction at the starting point,
+            // which `identifiability` reports.
+            let estimates: Map<String, Value> = id
+                .names
+                .iter()
+                .zip(&id.estimate)
+                .map(|(n, v)| (n.clone(), (*v).into()))
+                .collect();
+            let sd = o.get("std_dev").cloned().unwrap_or(Value::Null);
+            o.insert("estimates_mm".into(), Value::Object(estimates));
+            o.insert("std_dev_mm".into(), sd);
+            o.insert("rejected".into(), rejected_json(&self.rejected));
+            o.insert("warnings".into(), self.verdict.warnings.clone().into());
+            o.insert(
+                "predicted_accuracy".into(),
+                serde_json::to_value(self.accuracy).unwrap_or(Value::Null),
+            );
+            o.insert("worthwhile".into(), self.accuracy.worthwhile.into());
+            o.insert("machine".into(), loaded.description().name.clone().into());
+            o.insert("data_file".into(), data_name.into());
+        }
+        v
+    }
+
+    /// The text report: the verdict, its reason and the likely cause
+    /// first, the estimates after.
+    pub fn report(&self, loaded: &LoadedMachine, data_name: &str) -> String {
+        let mut s = String::new();
+        self.write_report(&mut s, loaded, data_name);
+        s
+    }
+
+    fn write_report(&self, s: &mut String, loaded: &LoadedMachine, data: &str) {
+        let id = &self.id;
+        let a = &self.accuracy;
+        let _ = writeln!(
+            s,
+            "verdict: {}, {}, {}",
+            if self.verdict.converged {
+                "converged"
+            } else {
+                "NOT converged"
+            },
+            if self.verdict.adequate {
+                "adequate (the model explains the data to the sensor noise)"
+            } else {
+                "NOT adequate (the model does not explain the data)"
+            },
+            if a.worthwhile {
+                "worthwhile (it at least halves the platform error)"
+            } else {
+                "NOT worthwhile (the campaign is too small to calibrate)"
+            }
+        );
+        let (causes, others): (Vec<&String>, Vec<&String>) = self
+            .verdict
+            .warnings
+            .iter()
+            .partition(|w| w.starts_with("likely cause"));
+        for w in causes.iter().chain(&others) {
+            let _ = writeln!(s, "WARNING: {w}");
+        }
+        let _ = writeln!(
+            s,
+            "predicted platform error after calibration: {:.4} mm rms (up to {:.4} mm at one of {} points), against {:.4} mm without calibration ({} mm per parameter)",
+            a.after_rms_mm, a.after_max_mm, a.points, a.before_rms_mm, a.tolerance_mm
+        );
+        for r in &self.rejected {
+            let why = match r.residual_sigma {
+                Some(z) => format!("a reading {z:.1} noise standard deviations off (gross error)"),
+                None => "the fitted machine cannot reach its commands".to_string(),
+            };
+            let _ = writeln!(
+                s,
+                "rejected pose {} (line {} of {data}): {why}",
+                r.pose + 1,
+                r.line
+            );
+        }
+        let _ = writeln!(
+            s,
+            "{} poses of {data} against `{}`, parameter set {}: {} in {} Gauss-Newton iterations",
+            id.residuals.len(),
+            loaded.description().name,
+            self.model.parameter_set().label(),
+            if id.converged {
+                "converged"
+            } else {
+                "NOT converged"
+            },
+            id.iterations
+        );
+        if !(self.verdict.converged && self.verdict.adequate && a.worthwhile) {
+            let _ = writeln!(
+                s,
+                "(the estimates below are not to be trusted as a calibration: see the verdict above)"
+            );
+        }
+        let _ = writeln!(s, "{:>6} {:>12} {:>10}", "param", "estimate mm", "sd mm");
+        for ((n, v), sd) in id.names.iter().zip(&id.estimate).zip(&id.std_dev) {
+            let _ = match sd {
+                Some(sd) => writeln!(s, "{n:>6} {v:>12.5} {sd:>10.5}"),
+                None => writeln!(s, "{n:>6} {v:>12.5} {:>10}", "held"),
+            };
+        }
+        let arcsec = RAD_PER_ARCSEC;
+        let _ = writeln!(
+            s,
+            "sensor offsets: phi {:.6} rad, theta {:.6} rad, s {:.4} mm",
+            id.offsets[0], id.offsets[1], id.offsets[2]
+        );
+        let (z, j) = id.stats.max_standardised;
+        let _ = writeln!(
+            s,
+            "residual rms: phi {:.3} arcsec, theta {:.3} arcsec, s {:.3} um; chi2/dof {:.3} (dof {}, p = {:.2e}); largest {z:.1} sigma at pose {} (line {})",
+            id.stats.rms[0] / arcsec,
+            id.stats.rms[1] / arcsec,
+            id.stats.rms[2] * 1e3,
+            id.stats.reduced_chi_square,
+            id.stats.dof,
+            self.verdict.chi_square_p_value,
+            j + 1,
+            id.lines.get(j).copied().unwrap_or(0)
+        );
+        s.push_str(&id.report.to_text());
+    }
+}
+
+/// The rejected poses as JSON: 1-based pose number, file line, size.
+pub(crate) fn rejected_json(rejected: &[Rejection]) -> Value {
+    Value::Array(
+        rejected
+            .iter()
+            .map(
+                |r| json!({"pose": r.pose + 1, "line": r.line, "residual_sigma": r.residual_sigma}),
+            )
+            .collect(),
+    )
+}

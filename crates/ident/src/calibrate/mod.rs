@@ -1,0 +1,523 @@
+//! Calibrate: identify the machine from the UP limb's sensors alone
+//! ([`internal`]) or fused with external measurements that also calibrate
+//! the head ([`fused`]); the verdict and its exit code, the accuracy the
+//! calibration predicts, the advice of a campaign too small to calibrate
+//! ([`advice`]), and the calibrated machine file with its record, written
+//! by the one write rule ([`crate::machine_file::write_rule`]).
+//!
+//! [`calibrate`] takes a [`CalibrateRequest`] (the data as a file or in
+//! memory, the machine, the parameter set, the external sources) and
+//! returns a [`Calibration`]: what `tricept identify` prints (its text
+//! report, its JSON) and writes.
+
+mod advice;
+mod fused;
+mod internal;
+pub(crate) mod values;
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+use tricept_data::Dataset;
+use tricept_engine::IdentError;
+use tricept_kinematics::{Machine, MachineDescription};
+use tricept_model::ParameterSet;
+use tricept_model::effects::EffectName;
+
+use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, Error};
+use crate::inputs::{HeadAngles, LoadedMachine, SensorNoise, Triple, check_commands, load_machine};
+use crate::machine_file;
+use values::{EvalGrid, HeadModel, LengthSigma, TrackerTargetSpec};
+
+/// Measured data of the UP limb's sensors: a file (`q1,q2,q3,phi,theta,s`,
+/// docs/data-format.md) or a dataset already in memory.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum Data {
+    /// A measured-data CSV file.
+    File(PathBuf),
+    /// Poses in memory; its `source` names it in messages. A machine file
+    /// records the hash of its data, so it can be written only from a
+    /// [`Data::File`].
+    InMemory(Dataset),
+}
+
+impl Data {
+    /// The name of the data in messages and reports.
+    pub fn name(&self) -> String {
+        match self {
+            Data::File(p) => p.display().to_string(),
+            Data::InMemory(d) => d.source.clone(),
+        }
+    }
+
+    /// The data, checked against the leg stroke of `machine`.
+    pub(crate) fn read(&self, machine: &Machine) -> Result<Dataset, Error> {
+        match self {
+            Data::File(p) => crate::inputs::read_data(p, machine),
+            Data::InMemory(d) => {
+                check_commands(
+                    &d.source,
+                    d.poses.iter().map(|p| (p.line, p.commands_mm)),
+                    machine,
+                )?;
+                Ok(d.clone())
+            }
+        }
+    }
+}
+
+/// What to calibrate from, and how.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::{CalibrateRequest, Data, calibrate};
+/// let calibration = calibrate(&CalibrateRequest::new(Data::File("data.csv".into())))?;
+/// println!("exit code {}", calibration.exit_code());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct CalibrateRequest {
+    /// The internal data.
+    pub data: Data,
+    /// Machine description file (default: the embedded Table 1 machine).
+    pub machine: Option<PathBuf>,
+    /// Sensor-noise overrides.
+    pub noise: SensorNoise,
+    /// The geometric parameters to identify (default `paper15`).
+    pub parameter_set: ParameterSet,
+    /// Reject poses with a gross reading error (default true).
+    pub robust: bool,
+    /// Manufacturing tolerance of each geometric parameter, mm (above 0,
+    /// at most 10): the campaign must at least halve the platform error it
+    /// gives.
+    pub tolerance_mm: f64,
+    /// External measurements and the head: the fused calibration.
+    pub fused: Option<FusedSources>,
+    /// The calibration is meant to be written as a machine file: what the
+    /// format cannot carry (fitted effects) is refused before fitting.
+    pub for_machine_file: bool,
+}
+
+impl CalibrateRequest {
+    /// The internal calibration of `data` on the Table 1 machine with the
+    /// defaults.
+    pub fn new(data: Data) -> CalibrateRequest {
+        CalibrateRequest {
+            data,
+            machine: None,
+            noise: SensorNoise::default(),
+            parameter_set: ParameterSet::paper15(),
+            robust: true,
+            tolerance_mm: tricept_engine::DEFAULT_TOLERANCE_MM,
+            fused: None,
+            for_machine_file: false,
+        }
+    }
+}
+
+/// External measurements and the head model of a fused calibration.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct FusedSources {
+    /// Laser-tracker or CMM point files.
+    pub tracker: Vec<PathBuf>,
+    /// Standard deviation of a tracker coordinate for rows without one, um.
+    pub tracker_sigma_um: f64,
+    /// Where the tracker's target sits (required with a tracker).
+    pub tracker_target: Option<TrackerTargetSpec>,
+    /// Standard deviation of a known target offset, um.
+    pub tracker_target_sigma_um: f64,
+    /// Ballbar reading files.
+    pub ballbar: Vec<PathBuf>,
+    /// Standard deviation of a ballbar reading for rows without one, um.
+    pub ballbar_sigma_um: f64,
+    /// The bar length's uncertainty.
+    pub ballbar_length_sigma: LengthSigma,
+    /// Offset of the spindle ball from the tool tip, mm.
+    pub ballbar_ball_mm: Option<Triple>,
+    /// Touch-off files (need `features`).
+    pub touch: Vec<PathBuf>,
+    /// The features file of the touch-offs.
+    pub features: Option<PathBuf>,
+    /// Standard deviation of a touch for rows without one, um.
+    pub touch_sigma_um: f64,
+    /// The head's parameters.
+    pub head: HeadModel,
+    /// Effects fitted with the geometry.
+    pub effects: Vec<EffectName>,
+    /// Evaluation grid of the predicted tool tip.
+    pub eval_grid: EvalGrid,
+    /// Head angles of the evaluation grid, deg.
+    pub eval_head_angles: HeadAngles,
+    /// Overrides of the plausible ranges (a JSON file).
+    pub plausibility: Option<PathBuf>,
+    /// Warn when the predicted tool-axis uncertainty exceeds this, arcsec.
+    pub tool_axis_warn_arcsec: f64,
+}
+
+impl Default for FusedSources {
+    fn default() -> FusedSources {
+        FusedSources {
+            tracker: Vec::new(),
+            tracker_sigma_um: 10.0,
+            tracker_target: None,
+            tracker_target_sigma_um: 5.0,
+            ballbar: Vec::new(),
+            ballbar_sigma_um: 1.0,
+            ballbar_length_sigma: LengthSigma::Known(1.0),
+            ballbar_ball_mm: None,
+            touch: Vec::new(),
+            features: None,
+            touch_sigma_um: 1.5,
+            head: HeadModel::Head13,
+            effects: Vec::new(),
+            eval_grid: EvalGrid::default(),
+            eval_head_angles: HeadAngles {
+                h1_deg: vec![0.0, 90.0, 180.0, 270.0],
+                h2_deg: vec![15.0, 35.0],
+            },
+            plausibility: None,
+            tool_axis_warn_arcsec: 30.0,
+        }
+    }
+}
+
+#[derive(Debug)]
+enum Fit {
+    Internal(Box<internal::InternalFit>),
+    Fused(Box<fused::FusedFit>),
+}
+
+/// A calibration: the fit, its verdict and exit code, its report and JSON,
+/// and the machine file it may write.
+#[derive(Debug)]
+pub struct Calibration {
+    loaded: LoadedMachine,
+    data: Data,
+    fit: Fit,
+}
+
+/// A machine file written: where, and why it was written although its fit
+/// is not to be trusted (with `force`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct Written {
+    path: PathBuf,
+    forced: Option<String>,
+}
+
+impl Written {
+    /// The file written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The warning of a forced write (`None` for a trusted fit).
+    pub fn forced_warning(&self) -> Option<String> {
+        self.forced.as_ref().map(|why| {
+            format!(
+                "--write-machine {}: written with --force although {why}",
+                self.path.display()
+            )
+        })
+    }
+}
+
+/// Calibrates as `request` says: loads the machine, reads the data, fits
+/// (fused when external sources are given), and judges the fit.
+///
+/// Errors are input errors (exit code 2) for bad files, flags and data too
+/// small to fit; a fit that completes returns its verdict in
+/// [`Calibration::exit_code`].
+pub fn calibrate(request: &CalibrateRequest) -> Result<Calibration, Error> {
+    let tolerance_mm = request.tolerance_mm;
+    if !(tolerance_mm.is_finite() && tolerance_mm > 0.0 && tolerance_mm <= 10.0) {
+        return Err(Error::input(format!(
+            "--tolerance-mm: the manufacturing tolerance must be a number of mm above 0 and at most 10, got {tolerance_mm}"
+        )));
+    }
+    let loaded = load_machine(request.machine.as_deref(), &request.noise)?;
+    let set = &request.parameter_set;
+    let fit = match &request.fused {
+        None => {
+            let dataset = request.data.read(loaded.machine())?;
+            Fit::Internal(Box::new(internal::fit(
+                &loaded,
+                set,
+                &dataset,
+                request.robust,
+                tolerance_mm,
+            )?))
+        }
+        Some(x) => {
+            let dataset = request.data.read(loaded.machine())?;
+            Fit::Fused(Box::new(fused::fit(
+                &loaded,
+                set,
+                &dataset,
+                x,
+                request.robust,
+                request.for_machine_file,
+            )?))
+        }
+    };
+    Ok(Calibration {
+        loaded,
+        data: request.data.clone(),
+        fit,
+    })
+}
+
+impl Calibration {
+    /// The exit code of the verdict: 0 to be trusted; 3 converged but the
+    /// model does not explain the data, the campaign is too small to
+    /// calibrate, or (fused) a source cannot be checked or an estimate is
+    /// implausible; 4 not converged.
+    pub fn exit_code(&self) -> u8 {
+        match &self.fit {
+            Fit::Internal(f) => f.exit_code(),
+            Fit::Fused(f) => f.exit_code(),
+        }
+    }
+
+    /// Whether the fit converged.
+    pub fn converged(&self) -> bool {
+        match &self.fit {
+            Fit::Internal(f) => f.verdict.converged,
+            Fit::Fused(f) => f.fit.converged,
+        }
+    }
+
+    /// Whether the model explains the data (fused: every source, every
+    /// estimate plausible).
+    pub fn adequate(&self) -> bool {
+        match &self.fit {
+            Fit::Internal(f) => f.verdict.adequate,
+            Fit::Fused(f) => f.fit.is_trustworthy(),
+        }
+    }
+
+    /// Why the calibration is not to be trusted, in one phrase (empty when
+    /// it is).
+    pub fn reason(&self) -> String {
+        match &self.fit {
+            Fit::Internal(f) => f.reason(),
+            Fit::Fused(f) if f.exit_code() != 0 => f.refusal_reason(),
+            Fit::Fused(_) => String::new(),
+        }
+    }
+
+    /// Why the calibration must not be deployed, in one phrase (`None` when
+    /// it may): the internal fit's verdict; for a fused fit as
+    /// [`Calibration::reason`].
+    pub fn refusal(&self) -> Option<String> {
+        match &self.fit {
+            Fit::Internal(f) => f.refusal().map(String::from),
+            Fit::Fused(f) => (f.exit_code() != 0).then(|| f.refusal_reason()),
+        }
+    }
+
+    /// The fit's warnings (likely causes, the campaign advice, unexplained
+    /// sources, implausible estimates), one line each.
+    pub fn warnings(&self) -> &[String] {
+        match &self.fit {
+            Fit::Internal(f) => &f.verdict.warnings,
+            Fit::Fused(f) => &f.fit.warnings,
+        }
+    }
+
+    /// The warnings the machine file loaded calls for (a forced or
+    /// inadequate calibration it holds).
+    pub fn machine_warnings(&self) -> &[String] {
+        self.loaded.warnings()
+    }
+
+    /// Lines for the error stream after the report: a fused fit's
+    /// warnings (`warning: ...`).
+    pub fn notices(&self) -> Vec<String> {
+        match &self.fit {
+            Fit::Internal(_) => Vec::new(),
+            Fit::Fused(f) => f
+                .fit
+                .warnings
+                .iter()
+                .map(|w| format!("warning: {w}"))
+                .collect(),
+        }
+    }
+
+    /// The one-line summary of a non-zero exit code (`identify: exit 3:
+    /// ...`), `None` for 0.
+    pub fn exit_line(&self) -> Option<String> {
+        match &self.fit {
+            Fit::Internal(f) => exit_line("identify", f.exit_code(), &f.reason()),
+            Fit::Fused(f) => f.exit_line(),
+        }
+    }
+
+    /// The machine calibrated against, as loaded.
+    pub fn loaded(&self) -> &LoadedMachine {
+        &self.loaded
+    }
+
+    /// The identified machine.
+    pub fn identified(&self) -> Machine {
+        match &self.fit {
+            Fit::Internal(f) => f.identified(),
+            Fit::Fused(f) => f.model.machine_at(&f.fit.estimate),
+        }
+    }
+
+    /// The estimates by parameter name (mm, rad; fused: with the head and
+    /// effects), with their standard deviations (`None`: held).
+    pub fn estimates(&self) -> Vec<(String, f64, Option<f64>)> {
+        let (names, estimate, sd) = match &self.fit {
+            Fit::Internal(f) => (&f.id.names, &f.id.estimate, &f.id.std_dev),
+            Fit::Fused(f) => (&f.fit.names, &f.fit.estimate, &f.fit.std_dev),
+        };
+        names
+            .iter()
+            .zip(estimate.iter())
+            .zip(sd)
+            .map(|((n, v), s)| (n.clone(), *v, *s))
+            .collect()
+    }
+
+    /// The poses rejected as gross errors (internal fit) as JSON: 1-based
+    /// pose number, file line, size.
+    pub fn rejected_json(&self) -> Value {
+        match &self.fit {
+            Fit::Internal(f) => internal::rejected_json(&f.rejected),
+            Fit::Fused(_) => Value::Array(Vec::new()),
+        }
+    }
+
+    /// The JSON `tricept identify --json` prints.
+    pub fn to_json(&self) -> Value {
+        let name = self.data.name();
+        match &self.fit {
+            Fit::Internal(f) => f.to_json(&self.loaded, &name),
+            Fit::Fused(f) => f.to_json(&self.loaded, &name),
+        }
+    }
+
+    /// The text report `tricept identify` prints.
+    pub fn report(&self) -> String {
+        match &self.fit {
+            Fit::Internal(f) => f.report(&self.loaded, &self.data.name()),
+            Fit::Fused(f) => f.report(),
+        }
+    }
+
+    /// The calibrated machine's description with its `calibration` record
+    /// (`forced`: why it is written although not to be trusted).
+    pub fn description(&self, forced: Option<String>) -> Result<MachineDescription, Error> {
+        let Data::File(data) = &self.data else {
+            return Err(Error::input(
+                "--write-machine: the calibration record holds the data file's hash: give the data as a file",
+            ));
+        };
+        match &self.fit {
+            Fit::Internal(f) => f.description(&self.loaded, data, forced),
+            Fit::Fused(f) => f.description(&self.loaded, data, forced),
+        }
+    }
+
+    /// Writes the calibrated machine file at `path` atomically, by the one
+    /// write rule: a fit whose exit code is not 0 is refused (an error of
+    /// that code) unless `force`, and the file then says it was forced.
+    pub fn write_machine(&mut self, path: &Path, force: bool) -> Result<Written, Error> {
+        let what = format!("--write-machine {}", path.display());
+        let code = self.exit_code();
+        let forced = match machine_file::write_rule(&what, code, &self.reason(), force) {
+            Ok(forced) => forced,
+            Err(e) => {
+                if let Fit::Fused(f) = &mut self.fit {
+                    f.record_write(path, false);
+                }
+                return Err(e);
+            }
+        };
+        let d = self.description(forced.clone())?;
+        machine_file::write(path, &d)
+            .map_err(|e| Error::other(format!("{}: not written: {e}", path.display())))?;
+        if let Fit::Fused(f) = &mut self.fit {
+            f.record_write(path, true);
+        }
+        Ok(Written {
+            path: path.to_path_buf(),
+            forced,
+        })
+    }
+}
+
+/// An identification error of the data `source`, with the line of a pose
+/// that cannot be reached.
+pub(crate) fn fit_error(source: &str, e: &IdentError) -> Error {
+    match e {
+        IdentError::Kinematics {
+            line, source: k, ..
+        } => Error::new(
+            crate::Classify::kind(e),
+            format!("{source}: line {line}: the commands of this pose cannot be reached: {k}"),
+        ),
+        e => Error::with_context(source, e),
+    }
+}
+
+/// Writes `text` to `path` atomically; on failure the previous file is
+/// intact and the error (exit code 1) names the file.
+pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), Error> {
+    tricept_data::write_atomic(path, |w| w.write_all(text.as_bytes()))
+        .map_err(|e| Error::other(format!("{}: not written: {e}", path.display())))
+}
+
+/// The one-line summary of a non-zero verdict (`VERB: exit CODE: WHY (see
+/// the warnings)`) for 3 and 4, else `None`.
+pub fn exit_line(verb: &str, code: u8, why: &str) -> Option<String> {
+    (code == EXIT_INADEQUATE || code == EXIT_NOT_CONVERGED)
+        .then(|| format!("{verb}: exit {code}: {why} (see the warnings)"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fixture() -> PathBuf {
+        PathBuf::from(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/data/table2-grid-seed1.csv"
+        ))
+    }
+
+    #[test]
+    fn data_in_memory_calibrate_as_the_file_does_but_write_no_machine_file() {
+        let from_file = calibrate(&CalibrateRequest::new(Data::File(fixture()))).unwrap();
+        let mut dataset = tricept_data::read_path(&fixture()).unwrap();
+        dataset.source = "numpy columns".into();
+        let mut in_memory = calibrate(&CalibrateRequest::new(Data::InMemory(dataset))).unwrap();
+        assert_eq!(from_file.exit_code(), 0, "{}", from_file.report());
+        assert_eq!(in_memory.exit_code(), from_file.exit_code());
+        assert_eq!(in_memory.estimates(), from_file.estimates());
+        assert_eq!(in_memory.to_json()["data_file"], "numpy columns");
+        let e = in_memory
+            .write_machine(
+                &std::env::temp_dir().join("tricept-never-written.json"),
+                false,
+            )
+            .unwrap_err();
+        assert_eq!(e.exit_code(), crate::EXIT_INPUT, "{e}");
+        assert!(e.message().contains("give the data as a file"), "{e}");
+    }
+
+    #[test]
+    fn a_tolerance_out_of_range_is_an_input_error_before_anything_is_read() {
+        let mut request = CalibrateRequest::new(Data::File("no-such-file.csv".into()));
+        request.tolerance_mm = 0.0;
+        let e = calibrate(&request).unwrap_err();
+        assert_eq!(e.exit_code(), crate::EXIT_INPUT);
+        assert!(e.message().starts_with("--tolerance-mm"), "{e}");
+    }
+}

@@ -1,0 +1,322 @@
+//! The check workflow (`tricept check`): has the machine changed since its
+//! calibration? A short check campaign from the machine's own sensors
+//! tested against the calibrated machine file (`tricept_check`), with an
+//! optional history (JSON lines, appended) and its trends.
+//!
+//! The verdict's exit code: 0 unchanged, 3 changed; a machine file without
+//! a calibration record and a campaign that cannot see a change are input
+//! errors (exit code 2).
+
+use std::path::{Path, PathBuf};
+
+use serde_json::{Value, json};
+use tricept_check::history::{Entry, Trend, append, trends};
+use tricept_check::{CheckError, CheckOptions, CheckReport, Reference};
+
+use crate::data_input::DataInput;
+use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
+use crate::inputs::LoadedMachine;
+
+/// A check campaign against a calibrated machine.
+///
+/// # Example
+/// ```no_run
+/// use std::path::Path;
+/// use tricept_ident::{CheckRequest, SensorNoise, check, load_machine};
+/// let calibrated = load_machine(Some(Path::new("calibrated.json")), &SensorNoise::default())?;
+/// let result = check(CheckRequest::new(calibrated, "today.csv"))?;
+/// print!("{}", result.to_text());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct CheckRequest {
+    /// The calibrated machine (a machine file with its calibration record).
+    pub machine: LoadedMachine,
+    /// The check campaign's measured data (with `temp_c` the legs' thermal
+    /// state is checked too).
+    pub data: DataInput,
+    /// Family-wise false-alarm probability of the verdict, in (0, 0.5).
+    pub alpha: f64,
+    /// A history (JSON lines) to append the check to; its trends are
+    /// reported.
+    pub history: Option<PathBuf>,
+}
+
+impl CheckRequest {
+    /// A check of `data` against `machine` at the default false-alarm
+    /// probability, without history.
+    pub fn new(machine: LoadedMachine, data: impl Into<DataInput>) -> CheckRequest {
+        CheckRequest {
+            machine,
+            data: data.into(),
+            alpha: tricept_check::DEFAULT_ALPHA,
+            history: None,
+        }
+    }
+}
+
+/// The history a check was appended to.
+#[derive(Debug, Clone)]
+struct History {
+    file: PathBuf,
+    checks: usize,
+    trends: Vec<Trend>,
+}
+
+/// A check's report, its verdict and the history's trends.
+#[derive(Debug, Clone)]
+pub struct CheckResult {
+    report: CheckReport,
+    reference: String,
+    machine: String,
+    data: String,
+    history: Option<History>,
+}
+
+/// Runs the check: the reference from the machine's calibration record,
+/// the data read, the history read (refused before the check when it
+/// cannot be), the test, and the entry appended to the history.
+pub fn check(request: CheckRequest) -> Result<CheckResult, Error> {
+    let loaded = &request.machine;
+    let machine = loaded.source().to_string();
+    let reference = Reference::from_description(loaded.description())
+        .map_err(|e| Error::input(format!("{machine}: {e}")))?;
+    let data_name = request.data.name();
+    let data = request.data.load(loaded.machine())?;
+    let alpha = request.alpha;
+    if !(alpha > 0.0 && alpha < 0.5) {
+        return Err(Error::input(format!(
+            "--alpha: the false-alarm probability must lie between 0 and 0.5, got {alpha}"
+        )));
+    }
+    if let Some(h) = &request.history {
+        // A history that cannot be read is refused before the check runs.
+        tricept_check::history::read(h)?;
+    }
+    let mut options = CheckOptions::for_machine(loaded.machine());
+    options.alpha = alpha;
+    let report = tricept_check::check(&reference, &data, &options).map_err(|e| match e {
+        CheckError::Blind(_) => Error::with_context(&data_name, &e),
+        e => Error::from(e),
+    })?;
+    if report.is_blind() {
+        return Err(Error::input(format!(
+            "{data_name}: the check's poses cannot see a change: no leg or joint change of less than 1 mm would be detected ({} poses); plan them with `tricept plan --instrument check`",
+            report.poses
+        )));
+    }
+    let history = match &request.history {
+        Some(path) => Some(append_to(path, &report, &machine, &data_name)?),
+        None => None,
+    };
+    Ok(CheckResult {
+        report,
+        reference: reference.name().to_string(),
+        machine,
+        data: data_name,
+        history,
+    })
+}
+
+/// Appends the check to the history at `path` and computes its trends.
+fn append_to(
+    path: &Path,
+    report: &CheckReport,
+    machine: &str,
+    data: &str,
+) -> Result<History, Error> {
+    let time = crate::machine_file::utc_now();
+    let unix_s = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64());
+    let entry = Entry::of(report, &time, unix_s, machine, data);
+    let entries = append(path, &entry)?;
+    Ok(History {
+        file: path.to_path_buf(),
+        checks: entries.len(),
+        trends: trends(&entries),
+    })
+}
+
+impl CheckResult {
+    /// The check's report: the verdict, the candidates, the most likely
+    /// change.
+    pub fn report(&self) -> &CheckReport {
+        &self.report
+    }
+
+    /// Whether the machine changed since its calibration.
+    pub fn changed(&self) -> bool {
+        self.report.changed
+    }
+
+    /// 0 unchanged, 3 changed.
+    pub fn exit_code(&self) -> u8 {
+        if self.changed() {
+            EXIT_INADEQUATE
+        } else {
+            EXIT_OK
+        }
+    }
+
+    /// What changed, one line, when the exit code is not 0.
+    pub fn exit_reason(&self) -> Option<String> {
+        let r = &self.report;
+        if !r.changed {
+            return None;
+        }
+        let what = match r.most_likely {
+            Some(i) if r.shortlist.len() > 1 => format!(
+                "most likely {} (cannot be told apart from {})",
+                r.candidates[i].name,
+                r.shortlist[1..].join(", ")
+            ),
+            Some(i) => format!("most likely {}", r.candidates[i].name),
+            None => "cause unknown".to_string(),
+        };
+        Some(format!(
+            "check: exit {EXIT_INADEQUATE}: the machine changed since its calibration ({}): {what}",
+            self.data
+        ))
+    }
+
+    /// The trends of the history's key quantities (empty without history).
+    pub fn trends(&self) -> &[Trend] {
+        self.history.as_ref().map_or(&[], |h| &h.trends)
+    }
+
+    /// The report as JSON (one line, as `tricept check --json` prints it):
+    /// the report's fields, the machine and data files, the history.
+    pub fn to_json(&self) -> String {
+        let mut v = serde_json::to_value(&self.report).unwrap_or(Value::Null);
+        if let Value::Object(o) = &mut v {
+            o.insert("machine".into(), self.machine.clone().into());
+            o.insert("data_file".into(), self.data.clone().into());
+            if let Some(h) = &self.history {
+                o.insert(
+                    "history".into(),
+                    json!({"file": h.file.display().to_string(), "checks": h.checks, "trends": h.trends}),
+                );
+            }
+        }
+        v.to_string()
+    }
+
+    /// The report as text, with one line per trend of the history.
+    pub fn to_text(&self) -> String {
+        let mut out = format!(
+            "check of {} against `{}` ({})\n",
+            self.data, self.reference, self.machine
+        );
+        out.push_str(&self.report.to_text());
+        if let Some(h) = &self.history {
+            out.push_str(&format!(
+                "history {} ({} checks):\n",
+                h.file.display(),
+                h.checks
+            ));
+            for trend in &h.trends {
+                out.push_str(&format!("  {}\n", trend_text(trend)));
+            }
+        }
+        out
+    }
+}
+
+/// One line of a trend: the last value against its band, the slope.
+fn trend_text(t: &Trend) -> String {
+    let last = t.values.len().saturating_sub(1);
+    let value = t.values.get(last).copied().unwrap_or(f64::NAN);
+    let band = t.band.get(last).copied().unwrap_or(f64::NAN);
+    let slope = match t.slope_per_day {
+        Some((s, sd)) => format!("; slope {s:+.2} +- {sd:.2} {}/day", t.unit),
+        None => String::new(),
+    };
+    let outside = if t.outside.is_empty() {
+        "inside its band at every check".to_string()
+    } else {
+        format!(
+            "OUTSIDE its band at check(s) {}",
+            t.outside
+                .iter()
+                .map(|i| (i + 1).to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    };
+    format!(
+        "{}: last {value:+.2} {} (band +-{band:.2}){slope}; {outside}",
+        t.name, t.unit
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{DetectabilityRequest, DiagnoseRequest, SensorNoise, load_machine};
+
+    fn paper() -> LoadedMachine {
+        load_machine(None, &SensorNoise::default()).unwrap()
+    }
+
+    #[test]
+    fn a_machine_without_calibration_record_cannot_be_checked() {
+        let e = check(CheckRequest::new(paper(), "data.csv")).unwrap_err();
+        assert_eq!(e.exit_code(), crate::EXIT_INPUT);
+        assert!(
+            e.message().starts_with("the built-in Table 1 machine: "),
+            "{}",
+            e.message()
+        );
+    }
+
+    #[test]
+    fn missing_data_exit_with_the_same_code_from_every_workflow() {
+        let missing = "no-such-dir/today.csv";
+        let d = crate::diagnose(DiagnoseRequest::new(paper(), missing)).unwrap_err();
+        let mut r = DetectabilityRequest::new(paper(), crate::Poses::grid());
+        r.data = Some(missing.into());
+        let t = crate::detectability(r).unwrap_err();
+        for e in [d, t] {
+            assert_eq!(e.exit_code(), crate::EXIT_INPUT);
+            assert!(e.message().starts_with(missing), "{}", e.message());
+        }
+    }
+
+    #[test]
+    fn a_check_against_its_own_calibration_is_unchanged_and_kept_in_the_history() {
+        let data = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../fixtures/data/table2-grid-seed1.csv"
+        );
+        let dir = std::env::temp_dir().join(format!("tricept-door-check-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let machine = dir.join("calibrated.json");
+        let history = dir.join("checks.jsonl");
+        std::fs::remove_file(&history).ok();
+        let d = crate::diagnose(DiagnoseRequest::new(paper(), data)).unwrap();
+        d.write_machine(&machine, false).unwrap();
+        for n in 1..=2 {
+            let loaded = load_machine(Some(&machine), &SensorNoise::default()).unwrap();
+            let mut r = CheckRequest::new(loaded, data);
+            r.history = Some(history.clone());
+            let result = check(r).unwrap();
+            assert!(!result.changed());
+            assert_eq!(result.exit_code(), EXIT_OK);
+            assert!(result.exit_reason().is_none());
+            let v: Value = serde_json::from_str(&result.to_json()).unwrap();
+            assert_eq!(v["history"]["checks"], n);
+            assert_eq!(v["data_file"], data);
+            assert!(!result.trends().is_empty());
+            assert!(result.to_text().contains(&format!("({n} checks):")));
+        }
+        let mut r = CheckRequest::new(
+            load_machine(Some(&machine), &SensorNoise::default()).unwrap(),
+            data,
+        );
+        r.alpha = 0.7;
+        assert!(check(r).unwrap_err().message().starts_with("--alpha"));
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

@@ -1,0 +1,722 @@
+//! Compensate (`tricept compensate`): from data (calibrated here) or from a
+//! calibrated machine file (with the static leg effects a diagnosis wrote
+//! into it), the corrected commands of target points, the volumetric error
+//! map on a plane before and after (against a simulated true machine when
+//! its errors are given), and the compensation table a controller looks up,
+//! with its measured interpolation error.
+//!
+//! [`compensate`] computes; the result writes its CSV files
+//! ([`Compensation::map_csv`], [`Compensation::write_tables`]) and gives
+//! the cells of its heat maps ([`Compensation::maps`]).
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use nalgebra::Vector3;
+use serde_json::{Map, Value, json};
+use tricept_engine::{CompensationTable, ExtendedMachine};
+use tricept_kinematics::description::LegTableDescription;
+use tricept_model::{ErrorMap, MapStats, ParameterSet};
+
+use crate::calibrate::{CalibrateRequest, calibrate, exit_line, write_text};
+use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, Error};
+use crate::inputs::{SensorNoise, TrueErrors, load_machine, parse_effects};
+use crate::machine_file::write_rule;
+
+/// The largest interpolation error (um) the default table spacing allows.
+pub const TABLE_ERROR_LIMIT_UM: f64 = 1.0;
+
+/// The files of a map directory.
+pub const MAP_FILES: &[&str] = &["map.csv", "correction.svg", "before.svg", "after.svg"];
+/// The files of a table directory (the second only for a machine with
+/// per-leg compensation tables).
+pub const TABLE_FILES: &[&str] = &["table.csv", "leg-tables.csv"];
+
+/// Where the calibrated machine comes from.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum Calibrated {
+    /// Calibrated here from data.
+    Data(Box<CalibrateRequest>),
+    /// A calibrated machine file, compensated against the nominal machine
+    /// its record holds.
+    MachineFile(Option<PathBuf>),
+}
+
+/// What to compensate, and what to produce.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct CompensateRequest {
+    /// The calibrated machine.
+    pub calibrated: Calibrated,
+    /// Compensate even from a calibration that is not to be trusted.
+    pub force: bool,
+    /// The true errors of a simulated machine (before/after maps).
+    pub truth: Option<TrueErrors>,
+    /// The true machine's unmodelled effects (JSON specs; need `truth`).
+    pub truth_effects: Vec<String>,
+    /// The parameter set of `truth`.
+    pub parameter_set: ParameterSet,
+    /// Plane of the map, z in mm (default: the workspace's middle plane).
+    pub plane_z_mm: Option<f64>,
+    /// Lattice spacing of the map, mm (at least 1).
+    pub spacing_mm: f64,
+    /// Target points to correct (CSV x,y,z).
+    pub targets: Option<PathBuf>,
+    /// The directory the map is written to (named in the JSON).
+    pub map_dir: Option<PathBuf>,
+    /// The directory the compensation table is written to: the table is
+    /// built when given.
+    pub table_dir: Option<PathBuf>,
+    /// Grid spacing of the table, mm (default: the coarsest whose
+    /// interpolation error is below [`TABLE_ERROR_LIMIT_UM`]).
+    pub table_spacing_mm: Option<f64>,
+}
+
+impl CompensateRequest {
+    /// A compensation of `calibrated` with the defaults (10 mm map).
+    pub fn new(calibrated: Calibrated) -> CompensateRequest {
+        CompensateRequest {
+            calibrated,
+            force: false,
+            truth: None,
+            truth_effects: Vec::new(),
+            parameter_set: ParameterSet::paper15(),
+            plane_z_mm: None,
+            spacing_mm: 10.0,
+            targets: None,
+            map_dir: None,
+            table_dir: None,
+            table_spacing_mm: None,
+        }
+    }
+}
+
+/// A target (mm) and its corrected leg commands (mm).
+pub type CorrectedTarget = (Vector3<f64>, [f64; 3]);
+
+/// The compensation table and what it was built from.
+#[derive(Debug, Clone)]
+struct Table {
+    table: CompensationTable,
+    error_um: f64,
+    path: PathBuf,
+    leg_tables: Vec<LegTableDescription>,
+    legs_path: PathBuf,
+}
+
+/// A compensation: its JSON fields, maps, table and corrected targets.
+#[derive(Debug, Clone)]
+pub struct Compensation {
+    out: Map<String, Value>,
+    nominal: ExtendedMachine,
+    calibrated: ExtendedMachine,
+    predicted: ErrorMap,
+    truth: Option<(ErrorMap, ErrorMap)>,
+    table: Option<Table>,
+    targets: Option<Vec<CorrectedTarget>>,
+    warnings: Vec<String>,
+    machine_warnings: Vec<String>,
+    code: u8,
+    why: String,
+    z_mm: f64,
+    spacing_mm: f64,
+}
+
+/// The two machines of a compensation and where they came from.
+struct Pair {
+    nominal: ExtendedMachine,
+    calibrated: ExtendedMachine,
+    out: Map<String, Value>,
+    warnings: Vec<String>,
+    machine_warnings: Vec<String>,
+    code: u8,
+    why: String,
+}
+
+fn machines(r: &CompensateRequest) -> Result<Pair, Error> {
+    let mut out = Map::new();
+    match &r.calibrated {
+        Calibrated::Data(request) => {
+            let fit = calibrate(request)?;
+            let code = fit.exit_code();
+            write_rule(
+                "compensate",
+                code,
+                &fit.refusal().unwrap_or_default(),
+                r.force,
+            )?;
+            out.insert("data_file".into(), request.data.name().into());
+            out.insert("converged".into(), fit.converged().into());
+            out.insert("adequate".into(), fit.adequate().into());
+            out.insert("rejected".into(), fit.rejected_json());
+            Ok(Pair {
+                nominal: ExtendedMachine::new(fit.loaded().machine().clone()),
+                calibrated: ExtendedMachine::new(fit.identified()),
+                out,
+                warnings: fit.warnings().to_vec(),
+                machine_warnings: fit.machine_warnings().to_vec(),
+                code,
+                why: fit.reason(),
+            })
+        }
+        Calibrated::MachineFile(path) => {
+            let loaded = load_machine(path.as_deref(), &SensorNoise::default())?;
+            let Some(c) = &loaded.description().calibration else {
+                return Err(Error::input(format!(
+                    "compensate: give --data FILE.csv to identify from, or a calibrated machine file as --machine ({} holds no `calibration` record)",
+                    loaded.source()
+                )));
+            };
+            let nominal = c
+                .nominal
+                .build()
+                .map_err(|e| crate::inputs::description_error(loaded.source(), &e))?;
+            let (code, why) = if !c.converged {
+                (EXIT_NOT_CONVERGED, "its calibration did not converge")
+            } else if c.forced || !c.adequate {
+                (
+                    EXIT_INADEQUATE,
+                    "its calibration is not to be trusted (written with --force, or its model did not explain its data)",
+                )
+            } else {
+                (0, "")
+            };
+            write_rule(
+                &format!("compensate --machine {}", loaded.source()),
+                code,
+                why,
+                r.force,
+            )?;
+            out.insert("machine".into(), loaded.description().name.clone().into());
+            out.insert("converged".into(), c.converged.into());
+            out.insert("adequate".into(), c.adequate.into());
+            Ok(Pair {
+                nominal: ExtendedMachine::new(nominal),
+                calibrated: ExtendedMachine::new(loaded.machine().clone()),
+                out,
+                warnings: Vec::new(),
+                machine_warnings: loaded.warnings().to_vec(),
+                code,
+                why: why.to_string(),
+            })
+        }
+    }
+}
+
+fn stats_json(s: &MapStats) -> Value {
+    json!({"max_mm": s.max_mm, "min_mm": s.min_mm, "mean_mm": s.mean_mm, "rms_mm": s.rms_mm})
+}
+
+/// Compensates as `request` says.
+pub fn compensate(request: &CompensateRequest) -> Result<Compensation, Error> {
+    let spacing = request.spacing_mm;
+    if !(spacing.is_finite() && spacing >= 1.0) {
+        return Err(Error::input(format!(
+            "--spacing: the map's lattice spacing must be at least 1 mm, got {spacing} mm"
+        )));
+    }
+    if let Some(h) = request.table_spacing_mm
+        && !(h.is_finite() && h >= 1.0)
+    {
+        return Err(Error::input(format!(
+            "--table-spacing: the table's grid spacing must be at least 1 mm, got {h} mm"
+        )));
+    }
+    let Pair {
+        nominal,
+        calibrated,
+        mut out,
+        mut warnings,
+        machine_warnings,
+        code,
+        why,
+    } = machines(request)?;
+    let w = nominal.machine().workspace;
+    let z = request.plane_z_mm.unwrap_or_else(|| w.mid_plane_z_mm());
+    if !(z.is_finite() && z >= w.z_min_mm && z <= w.z_max_mm) {
+        return Err(Error::input(format!(
+            "--plane-z: {z} mm is outside the workspace, whose z runs from {} to {} mm",
+            w.z_min_mm, w.z_max_mm
+        )));
+    }
+    let points = std::f64::consts::PI * (w.radius_mm / spacing + 1.0).powi(2);
+    if points > crate::limits::MAX_MAP_POINTS as f64 {
+        return Err(Error::input(format!(
+            "--spacing {spacing} mm: about {points:.0} map points, more than {}; a coarser spacing is needed",
+            crate::limits::MAX_MAP_POINTS
+        )));
+    }
+    let grid = w.disc_grid(z, spacing);
+    // What compensation changes, as the calibrated model sees it: nominal
+    // commands, positions by the calibrated machine.
+    let context = "compensation map";
+    let mut predicted = Vec::with_capacity(grid.len());
+    for r in &grid {
+        let ik = nominal
+            .inverse(r)
+            .map_err(|e| Error::with_context(context, &e))?;
+        let p = calibrated
+            .forward_from(&ik.legs_mm, &ik.up)
+            .map_err(|e| Error::with_context(context, &e))?;
+        predicted.push(p.position_mm - r);
+    }
+    let predicted = ErrorMap {
+        targets_mm: grid.clone(),
+        errors_mm: predicted,
+    };
+    out.insert("plane_z_mm".into(), z.into());
+    out.insert("grid_points".into(), grid.len().into());
+    out.insert(
+        "predicted_correction".into(),
+        stats_json(&predicted.stats()),
+    );
+    let truth = truth_maps(request, &nominal, &calibrated, &grid)?;
+    if let Some((before, after)) = &truth {
+        let residual = after.without_mean_translation();
+        let t = after.mean_translation_mm();
+        out.insert("before".into(), stats_json(&before.stats()));
+        out.insert("after".into(), stats_json(&after.stats()));
+        out.insert(
+            "after_without_translation".into(),
+            stats_json(&residual.stats()),
+        );
+        out.insert("translation_mm".into(), json!([t.x, t.y, t.z]));
+    }
+    if let Some(dir) = &request.map_dir {
+        out.insert("map".into(), dir.display().to_string().into());
+    }
+    let table = match &request.table_dir {
+        Some(dir) => Some(table(request, dir, &nominal, &calibrated, &mut warnings)?),
+        None => None,
+    };
+    if let Some(t) = &table {
+        let mut entry = json!({
+            "file": t.path.display().to_string(),
+            "spacing_mm": t.table.spacing_mm,
+            "counts": t.table.counts,
+            "interpolation_error_um": t.error_um,
+        });
+        if !t.leg_tables.is_empty() {
+            entry["leg_tables"] = t.legs_path.display().to_string().into();
+        }
+        out.insert("table".into(), entry);
+    }
+    out.insert("warnings".into(), warnings.clone().into());
+    let targets = match &request.targets {
+        Some(path) => Some(corrected_targets(path, &calibrated)?),
+        None => None,
+    };
+    Ok(Compensation {
+        out,
+        nominal,
+        calibrated,
+        predicted,
+        truth,
+        table,
+        targets,
+        warnings,
+        machine_warnings,
+        code,
+        why,
+        z_mm: z,
+        spacing_mm: spacing,
+    })
+}
+
+/// The compensation table (the per-leg tables exported as they are: the
+/// controller's pitch-error compensation on each leg axis; the workspace
+/// table carries the rest, which is smooth).
+fn table(
+    request: &CompensateRequest,
+    dir: &Path,
+    nominal: &ExtendedMachine,
+    calibrated: &ExtendedMachine,
+    warnings: &mut Vec<String>,
+) -> Result<Table, Error> {
+    let w = &nominal.machine().workspace;
+    let leg_tables = calibrated.machine().leg_effects.tables.clone();
+    let calibrated = if leg_tables.is_empty() {
+        calibrated.clone()
+    } else {
+        let mut m = calibrated.machine().clone();
+        m.leg_effects.tables.clear();
+        ExtendedMachine::new(m)
+    };
+    let context = "compensation map";
+    let (table, error_um) = match request.table_spacing_mm {
+        Some(h) => {
+            let t = CompensationTable::build(nominal, &calibrated, w, h)
+                .map_err(|e| Error::input(format!("--table-spacing {h}: {e}")))?;
+            let e = t
+                .interpolation_error_um(nominal, &calibrated, w)
+                .map_err(|e| Error::with_context(context, &e))?;
+            (t, e)
+        }
+        None => CompensationTable::with_error_below(nominal, &calibrated, w, TABLE_ERROR_LIMIT_UM)
+            .map_err(|e| Error::with_context(context, &e))?,
+    };
+    if error_um >= TABLE_ERROR_LIMIT_UM {
+        warnings.push(format!(
+            "the compensation table's interpolation error is {error_um:.3} um at {} mm spacing, above {TABLE_ERROR_LIMIT_UM} um: a finer --table-spacing reduces it",
+            table.spacing_mm
+        ));
+    }
+    Ok(Table {
+        table,
+        error_um,
+        path: dir.join(TABLE_FILES[0]),
+        leg_tables,
+        legs_path: dir.join(TABLE_FILES[1]),
+    })
+}
+
+/// Before/after maps of the simulated true machine.
+fn truth_maps(
+    request: &CompensateRequest,
+    nominal: &ExtendedMachine,
+    calibrated: &ExtendedMachine,
+    grid: &[Vector3<f64>],
+) -> Result<Option<(ErrorMap, ErrorMap)>, Error> {
+    let Some(truth) = &request.truth else {
+        if !request.truth_effects.is_empty() {
+            return Err(Error::input(
+                "--truth-effect: needs --truth (the true errors of the simulated machine)",
+            ));
+        }
+        return Ok(None);
+    };
+    let set = &request.parameter_set;
+    let mut plant = tricept_plant::Plant::geometric(
+        nominal.machine().clone(),
+        set.to_errors(&truth.values(set)?),
+    );
+    plant.effects = parse_effects(&request.truth_effects)?;
+    // Where the true machine goes when commanded by a machine's IK.
+    let map = |commanding: &ExtendedMachine| -> Result<ErrorMap, Error> {
+        let context = "compensation map";
+        let mut errors = Vec::with_capacity(grid.len());
+        for r in grid {
+            let q = commanding
+                .inverse(r)
+                .map_err(|e| Error::with_context(context, &e))?
+                .legs_mm;
+            errors.push(
+                plant
+                    .reach(&q)
+                    .map_err(|e| Error::with_context(context, &e))?
+                    - r,
+            );
+        }
+        Ok(ErrorMap {
+            targets_mm: grid.to_vec(),
+            errors_mm: errors,
+        })
+    };
+    Ok(Some((map(nominal)?, map(calibrated)?)))
+}
+
+fn corrected_targets(
+    path: &Path,
+    calibrated: &ExtendedMachine,
+) -> Result<Vec<CorrectedTarget>, Error> {
+    let points = tricept_data::read_targets(path)?;
+    let mut rows = Vec::with_capacity(points.len());
+    for (k, p) in points.iter().enumerate() {
+        let r = Vector3::from(*p);
+        let q = calibrated.inverse(&r).map_err(|e| {
+            Error::input(format!(
+                "{}: target {} ({}, {}, {} mm): {e}",
+                path.display(),
+                k + 1,
+                r.x,
+                r.y,
+                r.z
+            ))
+        })?;
+        rows.push((r, q.legs_mm));
+    }
+    Ok(rows)
+}
+
+impl Compensation {
+    /// 0, or the exit code of a calibration that is not to be trusted and
+    /// was compensated from with `force` (3, 4).
+    pub fn exit_code(&self) -> u8 {
+        self.code
+    }
+
+    /// The one-line summary of a non-zero exit code.
+    pub fn exit_line(&self) -> Option<String> {
+        exit_line("compensate", self.code, &self.why)
+    }
+
+    /// The warnings of the compensation (the calibration's, the table's).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// The warnings of the machine file loaded.
+    pub fn machine_warnings(&self) -> &[String] {
+        &self.machine_warnings
+    }
+
+    /// The corrected commands of the target points, when asked for.
+    pub fn corrected_targets(&self) -> Option<&[CorrectedTarget]> {
+        self.targets.as_deref()
+    }
+
+    /// The map of the predicted correction and, against a true machine,
+    /// the error maps before and after.
+    pub fn maps(&self) -> (&ErrorMap, Option<&(ErrorMap, ErrorMap)>) {
+        (&self.predicted, self.truth.as_ref())
+    }
+
+    /// The lattice spacing of the maps, mm.
+    pub fn spacing_mm(&self) -> f64 {
+        self.spacing_mm
+    }
+
+    /// The JSON `tricept compensate --json` prints.
+    pub fn to_json(&self) -> Value {
+        let mut out = self.out.clone();
+        if let Some(rows) = &self.targets {
+            out.insert(
+                "corrected_commands".into(),
+                Value::Array(
+                    rows.iter()
+                        .map(|(r, q)| json!({"x": r.x, "y": r.y, "z": r.z, "q1": q[0], "q2": q[1], "q3": q[2]}))
+                        .collect(),
+                ),
+            );
+        }
+        Value::Object(out)
+    }
+
+    /// The text report.
+    pub fn report(&self) -> String {
+        let out = &self.out;
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "compensation over the plane z = {} mm ({} points, {} mm lattice)",
+            self.z_mm,
+            self.predicted.targets_mm.len(),
+            self.spacing_mm
+        );
+        for key in [
+            "predicted_correction",
+            "before",
+            "after",
+            "after_without_translation",
+        ] {
+            if let Some(v) = out.get(key) {
+                let _ = writeln!(
+                    s,
+                    "{key:>26}: max {:.4} / min {:.4} / mean {:.4} mm",
+                    v["max_mm"].as_f64().unwrap_or(f64::NAN),
+                    v["min_mm"].as_f64().unwrap_or(f64::NAN),
+                    v["mean_mm"].as_f64().unwrap_or(f64::NAN)
+                );
+            }
+        }
+        if let Some(Value::Array(t)) = out.get("translation_mm") {
+            let t: Vec<f64> = t.iter().filter_map(Value::as_f64).collect();
+            if let [x, y, zt] = t[..] {
+                let _ = writeln!(
+                    s,
+                    "{:>26}: ({x:.4}, {y:.4}, {zt:.4}) mm",
+                    "rigid translation"
+                );
+            }
+        }
+        if let Some(m) = out.get("map").and_then(Value::as_str) {
+            let _ = writeln!(s, "{:>26}: {m}/map.csv and SVG heat maps", "per-point map");
+        }
+        if let Some(t) = out.get("table") {
+            let _ = writeln!(
+                s,
+                "{:>26}: {} ({} mm grid, {} nodes along x, y, z); trilinear interpolation error {:.3} um (largest over a lattice 4 times finer)",
+                "compensation table",
+                t["file"].as_str().unwrap_or(""),
+                t["spacing_mm"],
+                t["counts"],
+                t["interpolation_error_um"].as_f64().unwrap_or(f64::NAN)
+            );
+        }
+        for w in &self.warnings {
+            let _ = writeln!(s, "WARNING: {w}");
+        }
+        s
+    }
+
+    /// The per-point map as CSV: the predicted correction and, against a
+    /// true machine, the error before and after, mm.
+    pub fn map_csv(&self) -> String {
+        let (predicted, truth) = (&self.predicted, self.truth.as_ref());
+        let mut csv = String::new();
+        let _ = writeln!(
+            csv,
+            "# tricept compensate: per-point map on a plane, mm; correction = where the calibrated model says the nominal commands put the platform, minus the target"
+        );
+        if truth.is_some() {
+            let _ = writeln!(
+                csv,
+                "# before/after = where the simulated true machine goes when commanded by the nominal / calibrated IK, minus the target"
+            );
+        }
+        let mut header =
+            "x,y,z,correction_dx,correction_dy,correction_dz,correction_mm".to_string();
+        if truth.is_some() {
+            header.push_str(
+                ",before_dx,before_dy,before_dz,before_mm,after_dx,after_dy,after_dz,after_mm",
+            );
+        }
+        let _ = writeln!(csv, "{header}");
+        for (i, r) in predicted.targets_mm.iter().enumerate() {
+            let c = predicted.errors_mm[i];
+            let _ = write!(
+                csv,
+                "{},{},{},{},{},{},{}",
+                r.x,
+                r.y,
+                r.z,
+                c.x,
+                c.y,
+                c.z,
+                c.norm()
+            );
+            if let Some((b, a)) = truth {
+                let (b, a) = (b.errors_mm[i], a.errors_mm[i]);
+                let _ = write!(
+                    csv,
+                    ",{},{},{},{},{},{},{},{}",
+                    b.x,
+                    b.y,
+                    b.z,
+                    b.norm(),
+                    a.x,
+                    a.y,
+                    a.z,
+                    a.norm()
+                );
+            }
+            csv.push('\n');
+        }
+        csv
+    }
+
+    /// Writes the compensation table (and the per-leg tables of a machine
+    /// that has them) atomically into the table directory, creating it;
+    /// returns the files written.
+    pub fn write_tables(&self) -> Result<Vec<PathBuf>, Error> {
+        let Some(t) = &self.table else {
+            return Ok(Vec::new());
+        };
+        if let Some(dir) = t.path.parent() {
+            std::fs::create_dir_all(dir).map_err(|e| {
+                Error::other(format!(
+                    "{}: cannot create the directory: {e}",
+                    dir.display()
+                ))
+            })?;
+        }
+        write_text(&t.path, &self.table_csv(t))?;
+        let mut written = vec![t.path.clone()];
+        if !t.leg_tables.is_empty() {
+            write_text(
+                &t.legs_path,
+                &leg_tables_csv(&t.leg_tables, self.calibrated.machine()),
+            )?;
+            written.push(t.legs_path.clone());
+        }
+        Ok(written)
+    }
+
+    fn table_csv(&self, t: &Table) -> String {
+        let (tb, error_um) = (&t.table, t.error_um);
+        let o = tb.origin_mm;
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "# tricept {} compensation table: leg-command corrections dq = q_calibrated - q_nominal (mm) on a regular grid",
+            env!("CARGO_PKG_VERSION")
+        );
+        let _ = writeln!(
+            s,
+            "# calibrated machine: {}",
+            self.calibrated.machine().name
+        );
+        let _ = writeln!(s, "# nominal machine: {}", self.nominal.machine().name);
+        let _ = writeln!(
+            s,
+            "# grid: origin_mm {} {} {}, spacing_mm {}, counts {} {} {}; node (i,j,k) at origin + spacing (i,j,k), i fastest",
+            o.x, o.y, o.z, tb.spacing_mm, tb.counts[0], tb.counts[1], tb.counts[2]
+        );
+        let _ = writeln!(
+            s,
+            "# lookup: command = nominal IK + trilinear interpolation of dq at the eight corners of the cell holding the target"
+        );
+        let _ = writeln!(
+            s,
+            "# interpolation_error_um {error_um:.6} (largest difference from the exact correction on the lattice of spacing {} mm inside the workspace)",
+            tb.spacing_mm / 4.0
+        );
+        let _ = writeln!(
+            s,
+            "# nodes the machine cannot reach are left out; every cell that meets the workspace has its eight corners"
+        );
+        let _ = writeln!(s, "i,j,k,x,y,z,dq1,dq2,dq3");
+        for k in 0..tb.counts[2] {
+            for j in 0..tb.counts[1] {
+                for i in 0..tb.counts[0] {
+                    let idx = i + tb.counts[0] * (j + tb.counts[1] * k);
+                    if let Some(dq) = tb.nodes[idx] {
+                        let r = o + Vector3::new(i as f64, j as f64, k as f64) * tb.spacing_mm;
+                        let _ = writeln!(
+                            s,
+                            "{i},{j},{k},{},{},{},{},{},{}",
+                            r.x, r.y, r.z, dq[0], dq[1], dq[2]
+                        );
+                    }
+                }
+            }
+        }
+        s
+    }
+}
+
+/// The per-leg compensation tables of `machine` as CSV: one row per point
+/// (`leg,command_mm,extra_length_um`), each table's range, spacing,
+/// interpolation and source in the header.
+fn leg_tables_csv(tables: &[LegTableDescription], machine: &tricept_kinematics::Machine) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# tricept {} per-leg compensation tables of {}: the extra length of each leg (um) at equally spaced leg commands (mm)",
+        env!("CARGO_PKG_VERSION"),
+        machine.name
+    );
+    let _ = writeln!(
+        s,
+        "# interpolation: linear between the points, the end values beyond them; applied on each leg axis after table.csv: the command q with q + extra(q) = the table's command (to first order q = command - extra(command), the form of a CNC controller's pitch-error compensation)"
+    );
+    for t in tables {
+        let _ = writeln!(
+            s,
+            "# leg {}: from {} mm every {} mm, {} points; {}",
+            t.leg,
+            t.start_mm,
+            t.step_mm,
+            t.extra_length_um.len(),
+            t.source
+        );
+    }
+    let _ = writeln!(s, "leg,command_mm,extra_length_um");
+    for t in tables {
+        for (k, v) in t.extra_length_um.iter().enumerate() {
+            let _ = writeln!(s, "{},{},{v}", t.leg, t.start_mm + t.step_mm * k as f64);
+        }
+    }
+    s
+}

@@ -1,0 +1,413 @@
+//! The diagnose-and-deploy workflow (`tricept diagnose`): does the
+//! geometric model explain the data, and if not, which unmodelled effect
+//! of the vocabulary (or generic term) does; then the final model deployed
+//! into a calibrated machine ([`DiagnoseResult::deploy`]) and written as a
+//! machine file with its calibration record
+//! ([`DiagnoseResult::write_machine`], under the one write rule,
+//! [`crate::machine_file::write_rule`]).
+//!
+//! The request takes the machine as loaded ([`crate::load_machine`]) and the
+//! data as a file or in memory ([`DataInput`]); the result carries the
+//! verdict and its exit code (0 the final model explains the data, 3 it
+//! does not), the JSON and the text report the CLI prints.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::{Map, json};
+use tricept_data::Dataset;
+use tricept_diagnose::{DiagnoseError, DiagnoseOptions, Diagnosis, Plausibility, ResidualPlot};
+use tricept_kinematics::{Machine, MachineDescription};
+use tricept_model::ParameterSet;
+
+use crate::data_input::DataInput;
+use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
+use crate::inputs::LoadedMachine;
+use crate::machine_file;
+
+pub use tricept_diagnose::Deployed;
+
+/// What to diagnose and how.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::{DiagnoseRequest, SensorNoise, diagnose, load_machine};
+/// let machine = load_machine(None, &SensorNoise::default())?;
+/// let result = diagnose(DiagnoseRequest::new(machine, "data.csv"))?;
+/// println!("{}", result.to_text());
+/// std::process::exit(i32::from(result.exit_code()));
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct DiagnoseRequest {
+    /// The machine the data were measured on (a calibrated machine file
+    /// keeps the rank decision of its nominal machine).
+    pub machine: LoadedMachine,
+    /// The measured data (context columns temp_c, time_s, dir1..3 are used
+    /// when present).
+    pub data: DataInput,
+    /// Estimate the sensor noise from repeated poses and test against it
+    /// (F tests) instead of the stated noise.
+    pub noise_from_data: bool,
+    /// Standard deviation of the logged temperature, K (default 0.02).
+    pub temperature_noise_k: Option<f64>,
+    /// A JSON file overriding physical ranges of the plausibility table.
+    pub plausibility: Option<PathBuf>,
+    /// Search the generic dictionary as well as the vocabulary (default).
+    pub dictionary: bool,
+}
+
+impl DiagnoseRequest {
+    /// A diagnosis of `data` measured on `machine`, with the default
+    /// options.
+    pub fn new(machine: LoadedMachine, data: impl Into<DataInput>) -> DiagnoseRequest {
+        DiagnoseRequest {
+            machine,
+            data: data.into(),
+            noise_from_data: false,
+            temperature_noise_k: None,
+            plausibility: None,
+            dictionary: true,
+        }
+    }
+}
+
+/// A diagnosis with what it needs to deploy its final model.
+#[derive(Debug, Clone)]
+pub struct DiagnoseResult {
+    diagnosis: Diagnosis,
+    source: String,
+    data_path: Option<PathBuf>,
+    data: Dataset,
+    machine: LoadedMachine,
+    rank_reference: Option<Machine>,
+}
+
+/// Diagnoses the request's data: every problem of the input is an error of
+/// kind input (exit code 2) naming the data.
+pub fn diagnose(request: DiagnoseRequest) -> Result<DiagnoseResult, Error> {
+    let DiagnoseRequest {
+        machine: loaded,
+        data,
+        noise_from_data,
+        temperature_noise_k,
+        plausibility,
+        dictionary,
+    } = request;
+    let m = loaded.machine();
+    let source = data.name();
+    let data_path = data.path().map(Path::to_path_buf);
+    let dataset = data.load(m)?;
+    let mut options = DiagnoseOptions::for_machine(m);
+    options.noise_from_data = noise_from_data;
+    options.rank_reference = loaded.rank_reference()?;
+    options.dictionary.enabled = dictionary;
+    if let Some(k) = temperature_noise_k {
+        if !(k.is_finite() && k >= 0.0) {
+            return Err(Error::input(format!(
+                "--temperature-noise: must be a non-negative number of kelvin, got {k}"
+            )));
+        }
+        options.temperature_sigma_k = k;
+    }
+    if let Some(path) = &plausibility {
+        let file = path.display().to_string();
+        let text =
+            tricept_data::read_json_text(path).map_err(|e| Error::input(format!("{file}: {e}")))?;
+        options.plausibility = Plausibility::with_overrides(&text)
+            .map_err(|e| Error::input(format!("{file}: {e}")))?;
+    }
+    let diagnosis = tricept_diagnose::diagnose(m, &dataset, &options)
+        .map_err(|e| diagnose_error(&source, e))?;
+    Ok(DiagnoseResult {
+        diagnosis,
+        source,
+        data_path,
+        data: dataset,
+        rank_reference: options.rank_reference,
+        machine: loaded,
+    })
+}
+
+/// A failed diagnosis, naming the data; an unreachable pose names its line.
+fn diagnose_error(source: &str, e: DiagnoseError) -> Error {
+    match &e {
+        DiagnoseError::Ident(tricept_engine::IdentError::Kinematics {
+            line, source: k, ..
+        }) => Error::input(format!(
+            "{source}: line {line}: the commands of this pose cannot be reached: {k}"
+        )),
+        _ => Error::with_context(source, &e),
+    }
+}
+
+impl DiagnoseResult {
+    /// The diagnosis: verdict, causes, aliases, remainder, model terms.
+    pub fn diagnosis(&self) -> &Diagnosis {
+        &self.diagnosis
+    }
+
+    /// Whether the final model (geometric plus the named causes) explains
+    /// the data.
+    pub fn explained(&self) -> bool {
+        self.diagnosis.final_adequate
+    }
+
+    /// 0 when the final model explains the data, 3 when it does not.
+    pub fn exit_code(&self) -> u8 {
+        if self.explained() {
+            EXIT_OK
+        } else {
+            EXIT_INADEQUATE
+        }
+    }
+
+    /// Why the exit code is not 0, one line (`None` when it is).
+    pub fn exit_reason(&self) -> Option<String> {
+        (!self.explained()).then(|| {
+            format!(
+                "diagnose: exit {EXIT_INADEQUATE}: the final model does not explain the data: {}",
+                self.diagnosis
+                    .unexplained
+                    .as_deref()
+                    .unwrap_or("a remainder is reported (see the report)")
+            )
+        })
+    }
+
+    /// The residual plots of the named causes (before and after).
+    pub fn plots(&self) -> &[ResidualPlot] {
+        &self.diagnosis.plots
+    }
+
+    /// The report as JSON (one line, as `tricept diagnose --json` prints it).
+    pub fn to_json(&self) -> String {
+        self.diagnosis.to_json().to_string()
+    }
+
+    /// The report as text.
+    pub fn to_text(&self) -> String {
+        self.diagnosis.to_text(&self.source)
+    }
+
+    /// Deploys the final model: each term worth deploying where the
+    /// registry says it goes, generic leg errors as compensation tables,
+    /// the controller parameters of dynamic effects.
+    pub fn deploy(&self) -> Result<Deployed, Error> {
+        Ok(tricept_diagnose::deploy(
+            self.machine.machine(),
+            self.rank_reference.as_ref(),
+            &self.data,
+            &self.diagnosis,
+        )?)
+    }
+
+    /// Why the final model cannot be written as a calibration: the misfit
+    /// it leaves (empty when it explains the data).
+    fn problems(&self) -> Vec<String> {
+        let d = &self.diagnosis;
+        if d.final_adequate {
+            return Vec::new();
+        }
+        vec![match &d.unexplained {
+            Some(u) => u.clone(),
+            None => "the final model does not explain the data (a remainder is reported)".into(),
+        }]
+    }
+
+    /// The calibrated machine of the final model as a description with its
+    /// calibration record (method `diagnose`), under the write rule: refused
+    /// (exit 3) when the data are not explained, unless `force`. Returns
+    /// the description and, for a forced one, why it is not to be trusted.
+    /// `what` names the output in messages.
+    pub fn extended_description(
+        &self,
+        what: &str,
+        force: bool,
+    ) -> Result<(MachineDescription, Option<String>), Error> {
+        let d = &self.diagnosis;
+        let problems = self.problems();
+        let code = if problems.is_empty() {
+            EXIT_OK
+        } else {
+            EXIT_INADEQUATE
+        };
+        let forced = machine_file::write_rule(what, code, &problems.join("; "), force)?;
+        let Some(data_file) = &self.data_path else {
+            return Err(Error::input(format!(
+                "{what}: the record hashes the data file: diagnose a data file to write a machine"
+            )));
+        };
+        let deployed = self.deploy()?;
+        let g = ParameterSet::paper15().len();
+        let mut description = machine_file::calibrated_description(
+            &self.machine,
+            &deployed.machine,
+            &machine_file::FitRecord::of_identification(&deployed.id),
+            machine_file::Provenance {
+                method: "diagnose",
+                data_file,
+                parameter_set: "paper15",
+                rejected_lines: d.outlier_lines(),
+                adequate: forced.is_none(),
+                forced: forced.clone(),
+                warnings: problems.into_iter().chain(alias_notes(d)).collect(),
+                effects: effect_records(d, &deployed, g),
+                n_geometric: g,
+                external: Vec::new(),
+                temperature_c: machine_file::mean_temperature_c(&self.data),
+            },
+            deployed.controller,
+        )?;
+        if let Some(c) = description.calibration.as_mut() {
+            c.applies = deployed.applied;
+            c.records = deployed.recorded;
+        }
+        Ok((description, forced))
+    }
+
+    /// Writes the calibrated machine of the final model to `path`
+    /// atomically ([`DiagnoseResult::extended_description`]); returns the
+    /// warning of a forced write (`--write-machine PATH: written with
+    /// --force although ...`).
+    pub fn write_machine(&self, path: &Path, force: bool) -> Result<Option<String>, Error> {
+        let what = format!("--write-machine {}", path.display());
+        let (description, forced) = self.extended_description(&what, force)?;
+        crate::machine_file::write(path, &description)
+            .map_err(|e| Error::other(format!("{}: not written: {e}", path.display())))?;
+        Ok(forced.map(|why| format!("{what}: written with --force although {why}")))
+    }
+}
+
+/// An alias is deployed with the member the final model carries; the
+/// file's warnings name the alternatives and what would separate them (an
+/// exact alias, such as a lead common to all legs against a scale gain, is
+/// never separated by the machine's own sensors).
+fn alias_notes(d: &Diagnosis) -> Vec<String> {
+    d.aliases
+        .iter()
+        .map(|a| {
+            let names: Vec<&str> = a.effects.iter().map(|e| e.as_str()).collect();
+            format!(
+                "{} cannot be told apart{} ({}); the file deploys {}; to separate them: {}",
+                names.join(" / "),
+                if a.exact {
+                    " by these sensors"
+                } else {
+                    " on this campaign"
+                },
+                a.why,
+                a.in_model.as_str(),
+                a.separate_by
+            )
+        })
+        .collect()
+}
+
+/// The record's effect parameters (`{name: {"value", "std_dev"}}`): the
+/// deployed fit's beyond the `g` geometric ones, the period of each
+/// periodic term beside its amplitudes and the edges of each step beside
+/// its height.
+fn effect_records(d: &Diagnosis, deployed: &Deployed, g: usize) -> Map<String, serde_json::Value> {
+    let mut effects = Map::new();
+    for ((name, v), sd) in deployed
+        .id
+        .names
+        .iter()
+        .zip(&deployed.id.estimate)
+        .zip(&deployed.id.std_dev)
+        .skip(g)
+    {
+        effects.insert(name.clone(), json!({"value": v, "std_dev": sd}));
+    }
+    for t in &d.model_terms {
+        if let (true, Some(p)) = (t.deployed, t.period_mm) {
+            effects.insert(
+                format!("{}.period_mm", t.effect),
+                json!({"value": p, "std_dev": serde_json::Value::Null}),
+            );
+        }
+        if let (true, Some(edges), [leg]) = (t.deployed, t.edges_mm, t.legs.as_slice()) {
+            for (side, value) in ["from", "to"].into_iter().zip(edges) {
+                let name = format!("{}.leg{leg}_{side}_mm", t.effect);
+                // Its profile-likelihood half-width, when the report has it.
+                let sd = d
+                    .causes
+                    .iter()
+                    .flat_map(|c| &c.parameters)
+                    .find(|p| p.name == name && p.value == value)
+                    .and_then(|p| p.std_dev);
+                effects.insert(name, json!({"value": value, "std_dev": sd}));
+            }
+        }
+    }
+    effects
+}
+
+/// The vocabulary, from the registry: each effect, its physics, its
+/// parameters (units in the names) and where a written machine puts it
+/// (`tricept diagnose --help`).
+pub fn vocabulary_help() -> String {
+    let lines: Vec<String> = tricept_model::effects::EffectName::ALL
+        .iter()
+        .map(|e| {
+            let s = e.spec();
+            let params = e.parameter_names();
+            format!(
+                "  {}: {}{}; --write-machine: {}",
+                s.name,
+                s.physics.replace('`', ""),
+                if params.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", params.join(", "))
+                },
+                s.deployment.label()
+            )
+        })
+        .collect();
+    format!("Effects of the vocabulary:\n{}", lines.join("\n"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{EXIT_INPUT, SensorNoise, load_machine};
+
+    const DATA: &str = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../fixtures/data/table2-grid-seed1.csv"
+    );
+
+    #[test]
+    fn data_in_memory_diagnose_as_their_file_and_only_a_file_is_recorded() {
+        let m = load_machine(None, &SensorNoise::default()).unwrap();
+        let from_file = diagnose(DiagnoseRequest::new(m.clone(), DATA)).unwrap();
+        let data = tricept_data::read_path(Path::new(DATA)).unwrap();
+        let from_memory = diagnose(DiagnoseRequest::new(m, data)).unwrap();
+        assert_eq!(from_file.to_json(), from_memory.to_json());
+        assert_eq!(from_file.exit_code(), EXIT_OK);
+        assert!(from_file.exit_reason().is_none());
+        let out =
+            std::env::temp_dir().join(format!("tricept-door-diagnose-{}.json", std::process::id()));
+        let e = from_memory.write_machine(&out, false).unwrap_err();
+        assert_eq!(e.exit_code(), EXIT_INPUT);
+        assert!(!out.exists());
+        assert_eq!(from_file.write_machine(&out, false).unwrap(), None);
+        let written = load_machine(Some(&out), &SensorNoise::default()).unwrap();
+        let record = written.description().calibration.as_ref().unwrap();
+        assert_eq!(record.method, "diagnose");
+        assert!(record.adequate && !record.forced);
+        std::fs::remove_file(&out).ok();
+    }
+
+    #[test]
+    fn a_bad_temperature_noise_is_an_input_error() {
+        let m = load_machine(None, &SensorNoise::default()).unwrap();
+        let mut r = DiagnoseRequest::new(m, DATA);
+        r.temperature_noise_k = Some(-1.0);
+        let e = diagnose(r).unwrap_err();
+        assert_eq!(e.exit_code(), EXIT_INPUT);
+        assert!(e.message().starts_with("--temperature-noise"));
+    }
+}

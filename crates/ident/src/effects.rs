@@ -1,0 +1,122 @@
+//! The effects a simulated machine can hide (`tricept effects`): each one's
+//! keys, their units and a typical example (what `simulate
+//! --truth-effect` takes), and whether the diagnosis names it (in its
+//! vocabulary) or describes it through a generic family.
+
+use serde_json::{Value, json};
+use tricept_plant::Effect;
+use tricept_plant::effects::typical_effects;
+
+use crate::error::{EXIT_OK, Error};
+
+/// The effects listed: all, or the one asked for.
+#[derive(Debug, Clone)]
+pub struct EffectList {
+    effects: Vec<Effect>,
+}
+
+/// The simulator's effects, or the one named `name` (`leg-lead`,
+/// `compliance`, ...): an input error naming the effects when there is no
+/// such effect.
+///
+/// # Example
+/// ```
+/// let all = tricept_ident::effects(None).unwrap();
+/// assert!(all.to_text().contains("leg-lead"));
+/// assert!(tricept_ident::effects(Some("nothing")).is_err());
+/// ```
+pub fn effects(name: Option<&str>) -> Result<EffectList, Error> {
+    let all = typical_effects();
+    let Some(name) = name else {
+        return Ok(EffectList { effects: all });
+    };
+    let found: Vec<Effect> = all.iter().filter(|e| e.tag() == name).cloned().collect();
+    if found.is_empty() {
+        return Err(Error::input(format!(
+            "effects: no simulated effect `{}`; the effects are {}",
+            name.chars().take(40).collect::<String>().escape_debug(),
+            all.iter().map(Effect::tag).collect::<Vec<_>>().join(", ")
+        )));
+    }
+    Ok(EffectList { effects: found })
+}
+
+impl EffectList {
+    /// The effects, each at its typical magnitude.
+    pub fn effects(&self) -> &[Effect] {
+        &self.effects
+    }
+
+    /// Always 0: a listing has no verdict.
+    pub fn exit_code(&self) -> u8 {
+        EXIT_OK
+    }
+
+    /// One JSON object per line (as `tricept effects --json` prints them):
+    /// `effect`, `in_vocabulary`, `diagnosed_as`, `keys` (`key`, `unit`,
+    /// `meaning`) and `example`.
+    pub fn to_json(&self) -> Result<String, Error> {
+        let mut out = String::new();
+        for e in &self.effects {
+            let keys: Vec<Value> = e
+                .keys()
+                .iter()
+                .map(|k| json!({"key": k.key, "unit": k.unit, "meaning": k.meaning}))
+                .collect();
+            let line = json!({
+                "effect": e.tag(),
+                "in_vocabulary": e.in_vocabulary(),
+                "diagnosed_as": e.name().to_string(),
+                "keys": keys,
+                "example": serde_json::to_value(e).map_err(|x| Error::other(x.to_string()))?,
+            });
+            out.push_str(&format!("{line}\n"));
+        }
+        Ok(out)
+    }
+
+    /// The listing as text: each effect, its keys with units and meanings,
+    /// and its typical `--truth-effect`.
+    pub fn to_text(&self) -> String {
+        let mut out = String::new();
+        for e in &self.effects {
+            let example = serde_json::to_string(e).unwrap_or_default();
+            let named = if e.in_vocabulary() {
+                "in the diagnosis' vocabulary".to_string()
+            } else {
+                format!("outside the vocabulary: described as `{}`", e.name())
+            };
+            out.push_str(&format!("{} ({named})\n", e.tag()));
+            let width = e.keys().iter().map(|k| k.key.len()).max().unwrap_or(0);
+            for k in e.keys() {
+                out.push_str(&format!(
+                    "  {:<width$}  {:<12} {}\n",
+                    k.key, k.unit, k.meaning
+                ));
+            }
+            out.push_str(&format!("  typical: --truth-effect '{example}'\n\n"));
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_effect_is_one_json_line_and_an_unknown_one_is_an_input_error() {
+        let one = effects(Some("leg-lead")).unwrap();
+        let json = one.to_json().unwrap();
+        assert_eq!(json.lines().count(), 1);
+        let v: Value = serde_json::from_str(json.trim()).unwrap();
+        assert_eq!(v["effect"], "leg-lead");
+        assert!(one.to_text().starts_with("leg-lead ("));
+        let all = effects(None).unwrap();
+        assert!(all.effects().len() > 1);
+        assert_eq!(all.to_json().unwrap().lines().count(), all.effects().len());
+        let e = effects(Some("nothing")).unwrap_err();
+        assert_eq!(e.exit_code(), crate::EXIT_INPUT);
+        assert!(e.message().contains("leg-lead"), "{}", e.message());
+    }
+}

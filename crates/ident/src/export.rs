@@ -1,0 +1,113 @@
+//! `export`: a calibrated machine file translated into the files a CNC
+//! control loads (`tricept-export`): a typed [`ExportRequest`] to an
+//! [`Export`] with its exit code, its JSON and its text report.
+
+use std::path::PathBuf;
+
+use tricept_kinematics::MachineDescription;
+
+use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
+
+pub use tricept_export::{
+    AxisSummary, Controller, ExportError, ExportOptions, ExportSummary, NotExported,
+};
+
+/// What to export, and where.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExportRequest {
+    /// The calibrated machine file.
+    pub machine: PathBuf,
+    /// The control and its limits.
+    pub options: ExportOptions,
+    /// The directory the files go into.
+    pub out: PathBuf,
+}
+
+/// The outcome of an export.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Export {
+    /// The summary (the JSON of `--json`).
+    pub summary: ExportSummary,
+    /// Whether the files were written (not when a format error is past
+    /// the tolerance).
+    pub written: bool,
+    /// 0 written; 3 a format error past the tolerance (nothing written).
+    pub exit_code: u8,
+}
+
+impl Export {
+    /// The summary as JSON, with `written` and the output directory.
+    pub fn json(&self, out: &std::path::Path) -> serde_json::Value {
+        let mut v = serde_json::to_value(&self.summary).unwrap_or_default();
+        if let serde_json::Value::Object(o) = &mut v {
+            o.insert("out".into(), out.display().to_string().into());
+            o.insert("written".into(), self.written.into());
+        }
+        v
+    }
+
+    /// The text report.
+    pub fn text(&self, out: &std::path::Path) -> String {
+        let s = &self.summary;
+        let mut t = format!(
+            "{} export {} {}\n",
+            s.controller,
+            if self.written {
+                "written to"
+            } else {
+                "NOT written to"
+            },
+            out.display()
+        );
+        for a in &s.axes {
+            t.push_str(&format!(
+                "leg {} -> axis {}: {} points every {:.4} mm from {:.3} to {:.3} mm, format error {:.3} um; reference {:.3} mm, offset {:+.6} mm, zero {:.6} mm\n",
+                a.leg, a.axis, a.points, a.step_mm, a.min_mm, a.max_mm, a.format_error_um, a.reference_mm, a.offset_mm, a.zero_mm
+            ));
+        }
+        t.push_str(&format!(
+            "platform: the format errors move the platform point by up to {:.3} um over the workspace\n",
+            s.platform_error_um
+        ));
+        for p in &s.parameters {
+            t.push_str(&format!("set: {p}\n"));
+        }
+        for n in &s.not_exported {
+            t.push_str(&format!(
+                "not exported: {} ({:.3} um): {}\n",
+                n.what, n.size_um, n.why
+            ));
+        }
+        for l in &s.limits {
+            t.push_str(&format!("limit: {l}\n"));
+        }
+        if self.written {
+            t.push_str(&format!("files: {}\n", s.files.join(", ")));
+        }
+        t
+    }
+}
+
+/// Loads the calibrated machine file (refusing one edited after its
+/// calibration), plans the export and, when every axis is within the
+/// tolerance, writes the files atomically.
+pub fn export(request: &ExportRequest) -> Result<Export, Error> {
+    let source = request.machine.display().to_string();
+    let description = MachineDescription::from_file(&request.machine)
+        .map_err(|e| Error::from(e).in_file(&source))?;
+    tricept_engine::check_calibration_record(&description)
+        .map_err(|e| Error::from(e).in_file(&source))?;
+    let plan = tricept_export::plan(&description, &request.options).map_err(|e| match e {
+        ExportError::NoCalibration => Error::from(e).in_file(&source),
+        e => Error::from(e),
+    })?;
+    let written = plan.summary.within_tolerance;
+    if written {
+        plan.write(&request.out)?;
+    }
+    Ok(Export {
+        summary: plan.summary,
+        written,
+        exit_code: if written { EXIT_OK } else { EXIT_INADEQUATE },
+    })
+}

@@ -1,0 +1,151 @@
+//! What a pose set (or a logged campaign's commands) and the UP limb's
+//! sensors can identify: rank, singular values, observability indices and
+//! the unidentifiable combinations, before any measurement
+//! (`tricept identifiability`).
+
+use std::path::PathBuf;
+
+use serde_json::Value;
+use tricept_data::MeasuredPose;
+use tricept_engine::{GeometricModel, IdentifiabilityReport, IdentifyOptions};
+use tricept_model::ParameterSet;
+
+use crate::calibrate::{Data, fit_error};
+use crate::error::Error;
+use crate::inputs::{Poses, SensorNoise, load_machine};
+
+/// The poses to assess.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum Campaign {
+    /// Target points of a pose set, commanded by the nominal inverse
+    /// kinematics.
+    Poses(Poses),
+    /// The commands of a logged campaign (its readings are not used).
+    Data(Data),
+}
+
+/// What to assess.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct IdentifiabilityRequest {
+    /// The poses.
+    pub campaign: Campaign,
+    /// Machine description file (default: the embedded Table 1 machine).
+    pub machine: Option<PathBuf>,
+    /// Sensor-noise overrides.
+    pub noise: SensorNoise,
+    /// The geometric parameters (default `paper15`).
+    pub parameter_set: ParameterSet,
+}
+
+impl IdentifiabilityRequest {
+    /// The assessment of `campaign` on the Table 1 machine for `paper15`.
+    pub fn new(campaign: Campaign) -> IdentifiabilityRequest {
+        IdentifiabilityRequest {
+            campaign,
+            machine: None,
+            noise: SensorNoise::default(),
+            parameter_set: ParameterSet::paper15(),
+        }
+    }
+}
+
+/// The identifiability of a campaign.
+#[derive(Debug, Clone)]
+pub struct Identifiability {
+    report: IdentifiabilityReport,
+    machine_name: String,
+    axis_order: String,
+    parameter_set: String,
+    campaign: String,
+    warnings: Vec<String>,
+}
+
+/// Assesses what `request`'s campaign can identify.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{Campaign, IdentifiabilityRequest, assess_identifiability};
+/// let r = assess_identifiability(&IdentifiabilityRequest::new(Campaign::Poses("grid".parse()?)))?;
+/// assert_eq!(r.to_json()["parameter_set"], "paper15");
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+pub fn assess_identifiability(request: &IdentifiabilityRequest) -> Result<Identifiability, Error> {
+    let loaded = load_machine(request.machine.as_deref(), &request.noise)?;
+    let m = loaded.machine();
+    let set = &request.parameter_set;
+    let (commands, campaign, source) = match &request.campaign {
+        Campaign::Data(data) => (data.read(m)?.poses, data.name(), data.name()),
+        Campaign::Poses(poses) => {
+            let targets = poses.targets(m)?;
+            let mut commands = Vec::with_capacity(targets.len());
+            for (i, r) in targets.iter().enumerate() {
+                let ik = m.inverse(r).map_err(|e| {
+                    Error::input(format!(
+                        "--poses {poses}: pose {} ({:.3}, {:.3}, {:.3} mm): {e}",
+                        i + 1,
+                        r.x,
+                        r.y,
+                        r.z
+                    ))
+                })?;
+                commands.push(MeasuredPose {
+                    commands_mm: ik.legs_mm,
+                    ..Default::default()
+                });
+            }
+            (commands, poses.to_string(), format!("--poses {poses}"))
+        }
+    };
+    let model = GeometricModel::new(m.clone(), set.clone());
+    let report = tricept_engine::identifiability(
+        &model,
+        &vec![0.0; set.len()],
+        &commands,
+        &IdentifyOptions::for_machine(m),
+    )
+    .map_err(|e| fit_error(&source, &e))?;
+    Ok(Identifiability {
+        report,
+        machine_name: m.name.clone(),
+        axis_order: m.up_limb.axis_order.to_string(),
+        parameter_set: set.label().to_string(),
+        campaign,
+        warnings: loaded.warnings().to_vec(),
+    })
+}
+
+impl Identifiability {
+    /// The engine's report.
+    pub fn report(&self) -> &IdentifiabilityReport {
+        &self.report
+    }
+
+    /// The warnings of the machine file loaded.
+    pub fn machine_warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// The JSON `tricept identifiability --json` prints.
+    pub fn to_json(&self) -> Value {
+        let mut v = self.report.to_json();
+        if let Value::Object(o) = &mut v {
+            o.insert("parameter_set".into(), self.parameter_set.clone().into());
+            o.insert("axis_order".into(), self.axis_order.clone().into());
+        }
+        v
+    }
+
+    /// The text report.
+    pub fn to_text(&self) -> String {
+        format!(
+            "{} ({} U joint), parameter set {}, pose set `{}`\n{}",
+            self.machine_name,
+            self.axis_order,
+            self.parameter_set,
+            self.campaign,
+            self.report.to_text()
+        )
+    }
+}

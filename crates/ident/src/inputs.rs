@@ -1,0 +1,619 @@
+//! What every workflow takes in: a machine (a description file or the
+//! embedded Table 1 machine, with sensor-noise overrides), measured data
+//! checked against that machine, pose sets, true errors and effects of a
+//! simulated machine, and the typed values of the CLI's flags (`X,Y,Z`
+//! triples, head-angle lists), each parsed by [`std::str::FromStr`] so the
+//! binary can use them as clap value parsers.
+//!
+//! Every problem is an [`Error`] of kind input (exit code 2) naming the
+//! file, the line and the column, or the value at fault.
+
+use std::fmt;
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+use nalgebra::Vector3;
+use tricept_data::Dataset;
+use tricept_kinematics::units::RAD_PER_ARCSEC;
+use tricept_kinematics::{
+    DescriptionError, KinematicsError, MAX_POSES, Machine, MachineDescription, PoseSet,
+    PoseSetError,
+};
+use tricept_model::ParameterSet;
+use tricept_plant::Effect;
+
+use crate::error::Error;
+use crate::limits;
+
+/// Sensor-noise overrides of a machine (default: the description's).
+///
+/// # Example
+/// ```
+/// use tricept_ident::{SensorNoise, load_machine};
+/// let noise = SensorNoise { angle_noise_arcsec: Some(2.0), ..SensorNoise::default() };
+/// let loaded = load_machine(None, &noise).unwrap();
+/// assert!((loaded.machine().sensors.angle_rad - 2.0 / 206_264.806).abs() < 1e-9);
+/// ```
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SensorNoise {
+    /// Encoder noise of one reading (standard deviation), arcsec.
+    pub angle_noise_arcsec: Option<f64>,
+    /// Linear-scale noise of one reading (standard deviation), um.
+    pub length_noise_um: Option<f64>,
+    /// Readings averaged into one logged value.
+    pub readings_per_pose: Option<u32>,
+}
+
+/// A machine as loaded: its description (with the calibration record of a
+/// calibrated machine), the validated machine built from it (with the
+/// noise overrides applied), where it came from, and the warnings its
+/// record calls for (a forced or inadequate calibration).
+#[derive(Debug, Clone)]
+pub struct LoadedMachine {
+    description: MachineDescription,
+    machine: Machine,
+    source: String,
+    warnings: Vec<String>,
+}
+
+impl LoadedMachine {
+    /// The description as read.
+    pub fn description(&self) -> &MachineDescription {
+        &self.description
+    }
+
+    /// The validated machine, noise overrides applied.
+    pub fn machine(&self) -> &Machine {
+        &self.machine
+    }
+
+    /// The file name, or `the built-in Table 1 machine`.
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// Warnings about the calibration the file holds (forced, not
+    /// converged, not adequate), one line each.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// The machine whose structure decides the rank rule: the nominal
+    /// machine a calibrated file was calibrated from, else none (this
+    /// machine).
+    pub fn rank_reference(&self) -> Result<Option<Machine>, Error> {
+        match &self.description.calibration {
+            None => Ok(None),
+            Some(c) => c
+                .nominal
+                .build()
+                .map(Some)
+                .map_err(|e| description_error(&self.source, &e)),
+        }
+    }
+
+    /// The nominal machine a calibrated file records, as a description
+    /// without calibration of its own.
+    pub fn nominal_description(&self) -> MachineDescription {
+        match &self.description.calibration {
+            Some(c) => (*c.nominal).clone(),
+            None => {
+                let mut d = self.description.clone();
+                d.calibration = None;
+                d
+            }
+        }
+    }
+}
+
+/// The input error of a description that cannot be loaded, naming the
+/// file (and the line and column of a JSON error).
+pub fn description_error(path: &str, e: &DescriptionError) -> Error {
+    let message = match e {
+        DescriptionError::Json { source } => format!(
+            "{path}: line {}, column {}: {}",
+            source.line(),
+            source.column(),
+            strip_position(&source.to_string())
+        ),
+        DescriptionError::Io { .. } => e.to_string(),
+        _ => format!("{path}: {e}"),
+    };
+    Error::input(message)
+}
+
+/// serde_json appends " at line L column C"; the message states it up front.
+fn strip_position(s: &str) -> String {
+    match s.rfind(" at line ") {
+        Some(i) => s[..i].to_string(),
+        None => s.to_string(),
+    }
+}
+
+/// Loads the machine file at `path`, or the embedded Table 1 machine, and
+/// applies the noise overrides: the workspace must be reachable and a
+/// calibration record must be intact (an edited calibrated file is
+/// refused).
+///
+/// # Example
+/// ```
+/// use tricept_ident::{SensorNoise, load_machine};
+/// let loaded = load_machine(None, &SensorNoise::default()).unwrap();
+/// assert_eq!(loaded.source(), "the built-in Table 1 machine");
+/// assert!(loaded.warnings().is_empty());
+/// ```
+pub fn load_machine(path: Option<&Path>, noise: &SensorNoise) -> Result<LoadedMachine, Error> {
+    let (description, source) = match path {
+        None => (
+            MachineDescription::paper(),
+            "the built-in Table 1 machine".to_string(),
+        ),
+        Some(path) => {
+            let source = path.display().to_string();
+            (
+                MachineDescription::from_file(path).map_err(|e| description_error(&source, &e))?,
+                source,
+            )
+        }
+    };
+    let mut machine = description
+        .build()
+        .map_err(|e| description_error(&source, &e))?;
+    if let Some((r, why)) = machine.unreachable_workspace_point() {
+        let w = &machine.workspace;
+        return Err(Error::input(format!(
+            "{source}: the workspace (radius {} mm, z from {} to {} mm) is not within the machine's reach: at ({:.1}, {:.1}, {:.1}) mm: {why}; shrink `workspace` or correct `limits`",
+            w.radius_mm, w.z_min_mm, w.z_max_mm, r.x, r.y, r.z
+        )));
+    }
+    tricept_engine::check_calibration_record(&description)
+        .map_err(|e| Error::input(format!("{source}: {e}")))?;
+    let mut warnings = Vec::new();
+    if let Some(c) = &description.calibration {
+        if c.forced {
+            warnings.push(format!(
+                "{source} holds a calibration written with --force although it is not to be trusted (converged: {}, adequate: {})",
+                c.converged, c.adequate
+            ));
+        } else if !c.converged {
+            warnings.push(format!(
+                "{source} holds a calibration whose fit did not converge: its estimates are not a calibration"
+            ));
+        } else if !c.adequate {
+            warnings.push(format!(
+                "{source} holds a calibration whose model did not explain its data (chi2/dof {:.2})",
+                c.chi2_per_dof
+            ));
+        }
+    }
+    apply_noise(&mut machine, noise)?;
+    Ok(LoadedMachine {
+        description,
+        machine,
+        source,
+        warnings,
+    })
+}
+
+/// Applies sensor-noise overrides to a machine (each must be positive).
+fn apply_noise(m: &mut Machine, noise: &SensorNoise) -> Result<(), Error> {
+    if let Some(a) = noise.angle_noise_arcsec {
+        m.sensors.angle_rad = positive("--angle-noise-arcsec", a)? * RAD_PER_ARCSEC;
+    }
+    if let Some(l) = noise.length_noise_um {
+        m.sensors.length_mm = positive("--length-noise-um", l)? * 1e-3;
+    }
+    if let Some(k) = noise.readings_per_pose {
+        if k == 0 {
+            return Err(Error::input("--readings-per-pose: must be at least 1"));
+        }
+        m.sensors.readings_per_pose = k;
+    }
+    Ok(())
+}
+
+/// `v` if it is a positive finite number, else an input error naming `flag`.
+///
+/// # Example
+/// ```
+/// assert!(tricept_ident::positive("--sigma-um", 0.0).is_err());
+/// assert_eq!(tricept_ident::positive("--sigma-um", 2.5).unwrap(), 2.5);
+/// ```
+pub fn positive(flag: &str, v: f64) -> Result<f64, Error> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(Error::input(format!(
+            "{flag}: must be a positive number, got {v}"
+        )))
+    }
+}
+
+/// Reads a measured-data file and refuses commands outside the machine's
+/// stroke; every problem is an input error naming file, line and column.
+pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, Error> {
+    let file = path.display().to_string();
+    let f = std::fs::File::open(path).map_err(|e| Error::input(format!("{file}: {e}")))?;
+    read_data_from(std::io::BufReader::new(f), &file, machine)
+}
+
+/// [`read_data`] from a reader (a file wrapped in a progress display, say);
+/// `file` names it in messages.
+pub fn read_data_from(
+    reader: impl BufRead,
+    file: &str,
+    machine: &Machine,
+) -> Result<Dataset, Error> {
+    let data = tricept_data::read_from(reader, file)?;
+    // Commands the machine cannot take are input errors too, found here
+    // with their line rather than deep inside the solver.
+    check_commands(
+        &data.source,
+        data.poses.iter().map(|p| (p.line, p.commands_mm)),
+        machine,
+    )?;
+    Ok(data)
+}
+
+/// Refuses leg commands outside the machine's stroke: an input error naming
+/// the file, the line and the column (`records` give line and commands).
+pub fn check_commands(
+    file: &str,
+    records: impl Iterator<Item = (u64, [f64; 3])>,
+    machine: &Machine,
+) -> Result<(), Error> {
+    for (line, q) in records {
+        if let Err(e) = machine.check_commands(&q) {
+            let message = match e {
+                KinematicsError::OutOfStroke {
+                    leg,
+                    length_mm,
+                    min_mm,
+                    max_mm,
+                } => format!(
+                    "{file}: line {line}, column `q{leg}`: command {length_mm} mm is outside the leg stroke [{min_mm}, {max_mm}] mm"
+                ),
+                e => format!("{file}: line {line}: {e}"),
+            };
+            return Err(Error::input(message));
+        }
+    }
+    Ok(())
+}
+
+/// A set of target points (`--poses`): a generated [`PoseSet`]
+/// (`grid`, `grid:R,P,L`, `random:N[,SEED]`, `disc:SPACING[,Z]`), the
+/// D-optimal `optimal:N`, or a CSV file of `x,y,z` (mm).
+///
+/// # Example
+/// ```
+/// use tricept_ident::{Machine, Poses};
+/// let poses: Poses = "random:10,1".parse().unwrap();
+/// assert_eq!(poses.targets(&Machine::paper()).unwrap().len(), 10);
+/// assert!("optimal:0".parse::<Poses>().is_err());
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct Poses {
+    spec: String,
+    kind: PosesKind,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum PosesKind {
+    Optimal(usize),
+    Set(PoseSet),
+    File(PathBuf),
+}
+
+impl FromStr for Poses {
+    type Err = Error;
+
+    fn from_str(spec: &str) -> Result<Poses, Error> {
+        let kind = if let Some(n) = spec.strip_prefix("optimal:") {
+            let n: usize = n
+                .parse()
+                .ok()
+                .filter(|n| (1..=MAX_POSES).contains(n))
+                .ok_or_else(|| {
+                    Error::input(format!(
+                        "--poses `{spec}`: expected optimal:N with N a whole number from 1 to {MAX_POSES}"
+                    ))
+                })?;
+            PosesKind::Optimal(n)
+        } else {
+            let set: PoseSet = spec
+                .parse()
+                .map_err(|e: PoseSetError| Error::input(e.to_string()))?;
+            match set {
+                PoseSet::File(path) => PosesKind::File(path),
+                set => PosesKind::Set(set),
+            }
+        };
+        Ok(Poses {
+            spec: spec.to_string(),
+            kind,
+        })
+    }
+}
+
+impl fmt::Display for Poses {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.spec)
+    }
+}
+
+impl Poses {
+    /// The paper's grid of 75 poses (`grid`).
+    pub fn grid() -> Poses {
+        Poses {
+            spec: "grid".to_string(),
+            kind: PosesKind::Set(PoseSet::Grid {
+                rings: 3,
+                per_ring: 8,
+                levels: 3,
+            }),
+        }
+    }
+
+    /// The target points on `machine`, mm.
+    pub fn targets(&self, machine: &Machine) -> Result<Vec<Vector3<f64>>, Error> {
+        match &self.kind {
+            PosesKind::Optimal(n) => {
+                tricept_study::campaign::d_optimal_targets(machine, &ParameterSet::paper15(), *n)
+                    .map_err(|e| Error::other(format!("--poses `{}`: {e}", self.spec)))
+            }
+            PosesKind::Set(set) => Ok(set.generate(&machine.workspace).unwrap_or_default()),
+            PosesKind::File(path) => Ok(tricept_data::read_targets(path)?
+                .into_iter()
+                .map(Vector3::from)
+                .collect()),
+        }
+    }
+}
+
+/// True geometric errors of a simulated machine (`--truth`): `table2`,
+/// `zero`, `random:MAG_MM[,SEED]` (uniform in ±MAG_MM) or a JSON file
+/// `{name: mm}`.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{ParameterSet, TrueErrors};
+/// let set = ParameterSet::paper15();
+/// let e: TrueErrors = "random:0.1,3".parse().unwrap();
+/// assert!(e.values(&set).unwrap().iter().all(|v| v.abs() <= 0.1));
+/// assert!("random:x".parse::<TrueErrors>().is_err());
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub enum TrueErrors {
+    /// The paper's Table 2.
+    Table2,
+    /// No error.
+    Zero,
+    /// Uniform in ±`magnitude_mm`, drawn from `seed`.
+    Random {
+        /// Half-width of the uniform distribution, mm.
+        magnitude_mm: f64,
+        /// Seed of the draw.
+        seed: u64,
+    },
+    /// A JSON file of parameter values, mm or rad.
+    File(PathBuf),
+}
+
+impl FromStr for TrueErrors {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<TrueErrors, Error> {
+        Ok(match s {
+            "table2" => TrueErrors::Table2,
+            "zero" => TrueErrors::Zero,
+            s if s.starts_with("random:") => {
+                let max = tricept_model::MAX_PARAMETER_ERROR.0;
+                let (magnitude_mm, seed) = random_spec(
+                    "errors",
+                    s,
+                    max,
+                    &format!("random:MAG_MM[,SEED] with MAG_MM from 0 to {max} mm"),
+                )?;
+                TrueErrors::Random { magnitude_mm, seed }
+            }
+            path => TrueErrors::File(PathBuf::from(path)),
+        })
+    }
+}
+
+/// The size (from 0 to `max`) and seed (default 0) of a
+/// `random:SIZE[,SEED]` spec, or an input error naming `flag` and saying
+/// what was `expected`.
+pub(crate) fn random_spec(
+    flag: &str,
+    spec: &str,
+    max: f64,
+    expected: &str,
+) -> Result<(f64, u64), Error> {
+    let rest = spec.strip_prefix("random:").unwrap_or(spec);
+    let mut parts = rest.split(',');
+    let size: f64 = parts
+        .next()
+        .and_then(|t| t.parse().ok())
+        .filter(|v: &f64| v.is_finite() && (0.0..=max).contains(v))
+        .ok_or_else(|| Error::input(format!("{flag} `{spec}`: expected {expected}")))?;
+    let seed: u64 = match parts.next() {
+        Some(t) => t
+            .parse()
+            .map_err(|_| Error::input(format!("{flag} `{spec}`: SEED must be a whole number")))?,
+        None => 0,
+    };
+    Ok((size, seed))
+}
+
+impl TrueErrors {
+    /// The values of `set`'s parameters (mm, rad).
+    pub fn values(&self, set: &ParameterSet) -> Result<Vec<f64>, Error> {
+        match self {
+            TrueErrors::Table2 => Ok(set.table2()),
+            TrueErrors::Zero => Ok(vec![0.0; set.len()]),
+            TrueErrors::Random { magnitude_mm, seed } => Ok(tricept_plant::random_errors(
+                set.len(),
+                *magnitude_mm,
+                *seed,
+            )),
+            TrueErrors::File(path) => {
+                let name = path.display();
+                let text = tricept_data::read_json_text(path)
+                    .map_err(|e| Error::input(format!("{name}: {e}")))?;
+                set.parse_values(&text)
+                    .map_err(|e| Error::input(format!("{name}: {e}")))
+            }
+        }
+    }
+}
+
+/// Parses `--truth-effect` values: JSON objects (or arrays of them),
+/// inline or from `@FILE`, each validated.
+///
+/// # Example
+/// ```
+/// let effects = tricept_ident::parse_effects(&[r#"{"effect":"leg-lead","ppm":[50,-30,40]}"#.to_string()]).unwrap();
+/// assert_eq!(effects.len(), 1);
+/// assert!(tricept_ident::parse_effects(&["{\"effect\":\"nothing\"}".to_string()]).is_err());
+/// ```
+pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
+    let mut out = Vec::new();
+    for spec in specs {
+        let (text, origin) = match spec.strip_prefix('@') {
+            Some(path) => (
+                tricept_data::read_json_text(Path::new(path))
+                    .map_err(|e| Error::input(format!("{path}: {e}")))?,
+                path.to_string(),
+            ),
+            None => (spec.clone(), "--truth-effect".to_string()),
+        };
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| Error::input(format!("{origin}: {e}")))?;
+        let items = match value {
+            serde_json::Value::Array(a) => a,
+            v => vec![v],
+        };
+        for item in items {
+            let effect: Effect =
+                serde_json::from_value(item).map_err(|e| Error::input(format!("{origin}: {e}")))?;
+            effect
+                .validate()
+                .map_err(|why| Error::input(format!("{origin}: {why}")))?;
+            out.push(effect);
+        }
+    }
+    Ok(out)
+}
+
+/// `count` comma-separated finite numbers within ±[`limits::MAX_COORDINATE`]
+/// (mm, deg or rad), or an input error naming `flag`.
+///
+/// # Example
+/// ```
+/// assert_eq!(tricept_ident::parse_numbers("--at", "1,2.5,-3", 3).unwrap(), vec![1.0, 2.5, -3.0]);
+/// assert!(tricept_ident::parse_numbers("--at", "1,2", 3).is_err());
+/// ```
+pub fn parse_numbers(flag: &str, text: &str, count: usize) -> Result<Vec<f64>, Error> {
+    let values: Result<Vec<f64>, _> = text.split(',').map(|t| t.trim().parse::<f64>()).collect();
+    match values {
+        Ok(v) if v.len() == count && v.iter().all(|x| x.is_finite()) => {
+            if let Some(x) = v.iter().find(|x| x.abs() > limits::MAX_COORDINATE) {
+                return Err(Error::input(format!(
+                    "{flag}: {x} is beyond ±{} (mm, deg or rad): not a value for this machine",
+                    limits::MAX_COORDINATE
+                )));
+            }
+            Ok(v)
+        }
+        _ => Err(Error::input(format!(
+            "{flag}: expected {count} comma-separated numbers, got `{text}`"
+        ))),
+    }
+}
+
+/// An `X,Y,Z` triple (mm): a typed flag value.
+///
+/// # Example
+/// ```
+/// let t: tricept_ident::Triple = "0,0,1150".parse().unwrap();
+/// assert_eq!(t.0, [0.0, 0.0, 1150.0]);
+/// assert!("0,0".parse::<tricept_ident::Triple>().is_err());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Triple(pub [f64; 3]);
+
+impl FromStr for Triple {
+    type Err = Error;
+
+    /// Its message names no flag: the caller's parser does.
+    fn from_str(text: &str) -> Result<Triple, Error> {
+        let v = parse_numbers("X,Y,Z", text, 3).map_err(|e| without_flag(e, "X,Y,Z"))?;
+        Ok(Triple([v[0], v[1], v[2]]))
+    }
+}
+
+/// Head-angle lists `H1,H1,...:H2,H2,...` in degrees: a typed flag value.
+///
+/// # Example
+/// ```
+/// let h: tricept_ident::HeadAngles = "0,90:15,35".parse().unwrap();
+/// assert_eq!((h.h1_deg.len(), h.h2_deg.len()), (2, 2));
+/// assert!("0,90".parse::<tricept_ident::HeadAngles>().is_err());
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeadAngles {
+    /// Angles of the first head axis, deg.
+    pub h1_deg: Vec<f64>,
+    /// Angles of the second head axis, deg.
+    pub h2_deg: Vec<f64>,
+}
+
+impl FromStr for HeadAngles {
+    type Err = Error;
+
+    /// Its message names no flag: the caller's parser does.
+    fn from_str(text: &str) -> Result<HeadAngles, Error> {
+        parse_head_angles("H1S:H2S", text).map_err(|e| without_flag(e, "H1S:H2S"))
+    }
+}
+
+/// `e` without the `flag: ` its message starts with.
+fn without_flag(e: Error, flag: &str) -> Error {
+    match e
+        .message()
+        .strip_prefix(flag)
+        .and_then(|m| m.strip_prefix(": "))
+    {
+        Some(m) => Error::new(e.kind(), m),
+        None => e,
+    }
+}
+
+/// `H1S:H2S` lists of degrees, or an input error naming `flag`.
+pub fn parse_head_angles(flag: &str, text: &str) -> Result<HeadAngles, Error> {
+    let Some((a, b)) = text.split_once(':') else {
+        return Err(Error::input(format!(
+            "{flag}: expected `H1,H1,...:H2,H2,...` in degrees, got `{text}`"
+        )));
+    };
+    Ok(HeadAngles {
+        h1_deg: parse_list(flag, a)?,
+        h2_deg: parse_list(flag, b)?,
+    })
+}
+
+/// A list of angles in degrees, `a,b,c`, at most
+/// [`limits::MAX_HEAD_ANGLES`].
+fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>, Error> {
+    let n = text.split(',').count();
+    if n > limits::MAX_HEAD_ANGLES {
+        return Err(Error::input(format!(
+            "{flag}: {n} angles; at most {} per head axis",
+            limits::MAX_HEAD_ANGLES
+        )));
+    }
+    parse_numbers(flag, text, n)
+}
