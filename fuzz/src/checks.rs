@@ -1,7 +1,7 @@
 //! The properties the fuzz targets check, one function per target.
 //!
 //! Shared by the libFuzzer targets in `fuzz_targets/` and by the ordinary
-//! regression test `crates/engine/tests/fuzz_regressions.rs`, which replays
+//! regression test `crates/engine/tests/engine/fuzz_regressions.rs`, which replays
 //! every file under `fuzz/seeds/` and `fuzz/regressions/` on each
 //! `cargo test`. A crash input found by `cargo fuzz` is committed to
 //! `fuzz/regressions/<target>/` once the bug is fixed.

@@ -9,6 +9,8 @@
 //!   upward fails, and every module must be in a layer.
 //! - **No circles.** No two files of a crate import each other, directly
 //!   or through others, except the pairs listed in [`ALLOWED_CIRCLES`].
+//! - **The map.** ARCHITECTURE.md names every crate directory, and every
+//!   repository path it names exists.
 //!
 //! An edge is a path in a file's code outside its tests (`#[cfg(test)]`
 //! items) that resolves to another file's module; a path to an item that a
@@ -680,6 +682,76 @@ mod tests { use crate::only_tests::T; }
     assert!(!found.iter().any(|(p, _)| p.contains("commented")
         || p.contains("in_string")
         || p.contains("only_tests")));
+}
+
+/// The repository paths ARCHITECTURE.md names: backquoted text that starts
+/// with a top-level directory of the repository (`crates/...`,
+/// `docs/...`, ...), without patterns (`*`, `<name>`).
+fn named_paths(map: &str) -> Vec<String> {
+    const TOP: &[&str] = &[
+        "crates/",
+        "xtask/",
+        "benches/",
+        "examples/",
+        "fixtures/",
+        "docs/",
+        "fuzz/",
+        ".ci/",
+    ];
+    map.split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|s| TOP.iter().any(|t| s.starts_with(t)))
+        .filter(|s| !s.contains(['*', '<', ' ']))
+        .map(str::to_string)
+        .collect()
+}
+
+/// ARCHITECTURE.md is the map of the crates: every crate directory of the
+/// workspace (`crates/*`, `examples/*`, `xtask`, `benches`) is named in
+/// it, and every repository path it names exists.
+#[test]
+fn the_architecture_map_names_every_crate_and_only_paths_that_exist() {
+    let root = workspace();
+    let map = std::fs::read_to_string(root.join("ARCHITECTURE.md")).unwrap_or_default();
+    assert!(!map.is_empty(), "ARCHITECTURE.md is missing");
+    let mut problems = Vec::new();
+    let mut crates = vec!["xtask".to_string(), "benches".to_string()];
+    for parent in ["crates", "examples"] {
+        let Ok(entries) = std::fs::read_dir(root.join(parent)) else {
+            problems.push(format!("no {parent}/ directory"));
+            continue;
+        };
+        for e in entries.flatten() {
+            if e.path().join("Cargo.toml").is_file() {
+                crates.push(format!("{parent}/{}", e.file_name().to_string_lossy()));
+            }
+        }
+    }
+    for c in &crates {
+        if !map.contains(&format!("`{c}`")) && !map.contains(&format!("`{c}/")) {
+            problems.push(format!("ARCHITECTURE.md does not name `{c}`"));
+        }
+    }
+    let paths = named_paths(&map);
+    for p in &paths {
+        if !root.join(p).exists() {
+            problems.push(format!("ARCHITECTURE.md names `{p}`, which does not exist"));
+        }
+    }
+    assert!(crates.len() >= 15, "the crates were not found: {crates:?}");
+    assert!(paths.len() >= 10, "too few paths found: {paths:?}");
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// The path reader itself: top-level paths only, patterns left out.
+#[test]
+fn the_map_reader_finds_repository_paths() {
+    let found = named_paths(
+        "a `crates/x/src/lib.rs` and `docs/` but not `lib.rs`, `crates/*/src`, \
+         `tests/<crate>/main.rs` or `crates/a b`; `.ci/run`",
+    );
+    assert_eq!(found, ["crates/x/src/lib.rs", "docs/", ".ci/run"]);
 }
 
 // One vocabulary of effects (issue 27): an effect of the registry is named

@@ -20,7 +20,7 @@
 //!    the geometric model plus any terms.
 //! 3. **The fit core** (`fit.rs`): a fitted model, the settings every fit
 //!    shares, cross-validation, residuals, the outlier screen.
-//! 4. **The analyses**: the linearised score of further terms (`linear.rs`),
+//! 4. **The analyses**: the linearised score of further terms (`linear/`),
 //!    the generic dictionary and its period scan (`dictionary.rs`), pure
 //!    error (`noise.rs`), selection from one pool with admission on the
 //!    final model (`select.rs`), aliases (`alias.rs`), the platform's

@@ -1,6 +1,7 @@
 //! How many self-calibration poses, and which, make a campaign worth
 //! deploying: the advice of a refused campaign
-//! ([`tricept_engine::PredictedAccuracy`]).
+//! ([`tricept_engine::PredictedAccuracy`]), and the poses of
+//! `--poses optimal:N`.
 //!
 //! For a pose count `n` on a ladder of sizes, the `n` poses are chosen from
 //! the candidate grid of the workspace ([`crate::optimise::candidate_grid`])

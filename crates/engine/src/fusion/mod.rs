@@ -23,6 +23,15 @@
 //!   causes tested by refitting ([`FusionCause`]).
 //!
 //! Lengths in mm, angles in rad, instrument noise in um.
+//!
+//! The fusion lives in the engine rather than a crate of its own because
+//! it *is* the identification with more row blocks: it shares the solver
+//! core, the rank rule, the report type and the iteration, and with the
+//! internal data alone it reproduces [`crate::identify`] bit for bit
+//! (tested; up to one evaluation block of 4096 poses, beyond which
+//! `identify`'s parallel blocks merge the same rows in another order, equal
+//! to rounding). A separate crate would have had to make those internals
+//! public.
 
 mod ballbar;
 mod causes;

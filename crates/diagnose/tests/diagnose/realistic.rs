@@ -6,12 +6,10 @@
 //! of a scale gain with an equal lead of the legs reported whenever either
 //! is in play; implausible fits rejected with their reason.
 //!
-//! `cargo test -p tricept-diagnose --test realistic -- --nocapture` prints
+//! `cargo test -p tricept-diagnose --test diagnose realistic:: -- --nocapture` prints
 //! the `TALLY` lines quoted in `docs/diagnosis.md`.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use rand_pcg::Pcg64Mcg;
 use tricept_diagnose::{Diagnosis, Plausibility, RejectStage};
 use tricept_kinematics::Machine;

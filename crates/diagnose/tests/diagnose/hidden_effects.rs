@@ -16,9 +16,7 @@
 //! with half the readings, at half the cost; the realistic campaigns are
 //! in `realistic.rs` and `out_of_vocabulary.rs`.)
 
-mod common;
-
-use common::true_parameters;
+use crate::common::true_parameters;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;

@@ -2,12 +2,10 @@
 //! scale in a 40-pose campaign (the mean of 3 readings) must be flagged as
 //! an outlier, by its line, and never explained as a physical effect.
 //!
-//! `cargo test -p tricept-diagnose --test small_campaigns -- --nocapture`
+//! `cargo test -p tricept-diagnose --test diagnose small_campaigns:: -- --nocapture`
 //! prints the tallies.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use tricept_diagnose::first_non_finite;
 use tricept_model::effects::EffectName as E;
 

@@ -1,13 +1,10 @@
 //! `tricept docs`: every page the help texts name is in the binary, and
 //! every page of docs/ is embedded as it is in the repository.
 
-use std::process::Command;
+use crate::support;
 
 fn tricept(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_tricept"))
-        .args(args)
-        .output()
-        .expect("run tricept");
+    let out = support::tricept().args(args).output().expect("run tricept");
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),

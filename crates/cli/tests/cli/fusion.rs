@@ -4,8 +4,7 @@
 //! model's tool tip where it is asked to be; an unexplained source ends
 //! with exit code 3 and says so.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
 use nalgebra::Vector3;
 use tricept_data::ExternalPose;
@@ -13,29 +12,7 @@ use tricept_engine::fusion::FusedModel;
 use tricept_kinematics::Machine;
 use tricept_model::{Effector, ParameterSet};
 
-fn tricept(dir: &Path, args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_tricept"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
-}
-
-fn ok(dir: &Path, args: &[&str]) -> Vec<u8> {
-    let out = tricept(dir, args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out.stdout
-}
-
-fn workdir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tricept-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::support::{ok, run_in as tricept, workdir};
 
 /// In `dir`: 20 planned tracker poses (`points.csv`), then the simulated
 /// machine's internal data (`internal.csv`, head errors `random:1,5`) and

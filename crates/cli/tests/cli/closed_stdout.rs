@@ -2,16 +2,13 @@
 //! where `head` has already gone): no panic, and the exit code the verb
 //! would have had anyway (files it writes are still written).
 
-use std::process::{Command, Stdio};
+use crate::support::{fixture, workdir};
 
-fn fixture(name: &str) -> String {
-    format!("{}/../../fixtures/{name}", env!("CARGO_MANIFEST_DIR"))
-}
+use std::process::{Command, Stdio};
 
 #[test]
 fn every_verb_survives_a_closed_stdout() {
-    let dir = std::env::temp_dir().join(format!("tricept-closed-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = workdir("closed");
     let good = fixture("data/table2-grid-seed1.csv");
     let hidden = fixture("data/diagnose-hidden-effect.csv");
     let points = dir.join("points.csv");

@@ -10,9 +10,7 @@
 //! solution); the combination itself is checked against the model's
 //! geometry.
 
-mod common;
-
-use common::{
+use crate::common::{
     head_truth, internal, known_target, spread_poses, table2_plant, tracker, tracker_points,
 };
 use nalgebra::{Rotation3, Vector3};

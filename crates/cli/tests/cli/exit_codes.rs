@@ -4,29 +4,20 @@
 //! did not converge; 2 bad input; 1 anything else. The same data give the
 //! same code with and without `--write-machine`.
 
+use crate::support;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn code(dir: &Path, args: &[&str]) -> i32 {
-    let out = Command::new(env!("CARGO_BIN_EXE_tricept"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
-    out.status.code().unwrap()
+    support::run_in(dir, args).status.code().unwrap()
 }
 
 fn fixture(name: &str) -> String {
-    format!("{}/../../fixtures/data/{name}", env!("CARGO_MANIFEST_DIR"))
+    support::fixture(&format!("data/{name}"))
 }
 
 fn workdir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tricept-exit-codes-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    support::fresh_workdir("exit-codes")
 }
 
 #[test]
@@ -206,7 +197,7 @@ fn the_same_bad_data_give_the_same_code_and_message_from_every_verb() {
     ];
     let mut failures = Vec::new();
     for args in verbs {
-        let out = Command::new(env!("CARGO_BIN_EXE_tricept"))
+        let out = support::tricept()
             .args(args)
             .current_dir(d)
             .output()

@@ -3,18 +3,9 @@
 //! problem (file, line and column where there is one), nothing on stdout,
 //! and never a panic.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
-fn tricept() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_tricept"))
-}
-
-fn workdir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tricept-bad-inputs-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::support::{fresh_workdir, ok, tricept, workdir};
 
 /// A valid measured-data file (the paper's machine, Table 2), as text.
 fn good_csv(dir: &Path) -> String {
@@ -86,10 +77,10 @@ fn replace_field(row: &str, index: usize, value: &str) -> String {
     f.join(",")
 }
 
-#[test]
-fn bad_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
-    let dir = workdir();
-    let csv = good_csv(&dir);
+/// The table of bad inputs: each an exit code 2 and a message naming the
+/// problem (the tests are the named cases below).
+fn bad_inputs_cases(dir: &Path) -> Vec<Case> {
+    let csv = good_csv(dir);
     let (_, header, rows) = split(&csv);
     let base = header.clone();
     let id = |file: &'static str| {
@@ -508,8 +499,208 @@ fn bad_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
         cases.push(c);
     }
     assert!(cases.len() >= 25, "{} cases", cases.len());
-    run_cases(&dir, &cases);
+    cases
+}
+
+/// A table of cases, built in a directory.
+type Table = fn(&Path) -> Vec<Case>;
+
+/// Runs the case `name` of `table` alone, in a directory of its own
+/// (`tag` names it) holding what the whole table's run would have left
+/// there before it: the table's files, and those of the cases before it.
+fn run_named(table: Table, tag: &str, name: &str) {
+    let dir = fresh_workdir(&format!("bad-inputs-{tag}"));
+    let cases = table(&dir);
+    let k = cases
+        .iter()
+        .position(|c| c.name == name)
+        .unwrap_or_else(|| panic!("no case named `{name}`"));
+    for c in &cases[..k] {
+        for (file, content) in &c.files {
+            std::fs::write(dir.join(file), content).unwrap();
+        }
+    }
+    run_cases(&dir, &cases[k..=k]);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Every case of `table` has a test of its own: the names in `tested` are
+/// the table's, each once.
+fn every_case_is_tested(table: Table, tag: &str, tested: &[&str]) {
+    let dir = fresh_workdir(&format!("bad-inputs-{tag}"));
+    let names: Vec<&str> = table(&dir).iter().map(|c| c.name).collect();
+    std::fs::remove_dir_all(&dir).ok();
+    let mut unique = names.clone();
+    unique.sort_unstable();
+    unique.dedup();
+    assert_eq!(unique.len(), names.len(), "case names repeat: {names:?}");
+    let untested: Vec<String> = names
+        .iter()
+        .filter(|n| !tested.contains(n))
+        .map(|n| format!("{} = {n:?};", slug(n)))
+        .collect();
+    assert!(
+        untested.is_empty(),
+        "cases without a test:\n{}",
+        untested.join("\n")
+    );
+    let unknown: Vec<&&str> = tested.iter().filter(|n| !names.contains(n)).collect();
+    assert!(unknown.is_empty(), "tests of no case: {unknown:?}");
+}
+
+/// A case name as a test name.
+fn slug(name: &str) -> String {
+    let mut s: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    while s.contains("__") {
+        s = s.replace("__", "_");
+    }
+    s.trim_matches('_').to_string()
+}
+
+/// One test per case of a table: `module = table; test = "case name"; ...`.
+/// The module also checks that every case of the table is tested.
+macro_rules! named_cases {
+    ($module:ident = $table:ident; $($test:ident = $name:literal;)*) => {
+        mod $module {
+            $(
+                #[test]
+                fn $test() {
+                    super::run_named(
+                        super::$table,
+                        concat!(stringify!($module), "-", stringify!($test)),
+                        $name,
+                    );
+                }
+            )*
+            #[test]
+            fn every_case_is_tested() {
+                super::every_case_is_tested(
+                    super::$table,
+                    stringify!($module),
+                    &[$($name),*],
+                );
+            }
+        }
+    };
+}
+
+named_cases! {
+    bad_inputs_get_exit_code_2_and_a_message_naming_the_problem = bad_inputs_cases;
+    empty_file = "empty file";
+    header_only = "header only";
+    missing_column = "missing column";
+    misspelt_column = "misspelt column";
+    non_numeric_field = "non-numeric field";
+    nan = "NaN";
+    infinity = "infinity";
+    wrong_column_count = "wrong column count";
+    angles_in_degrees = "angles in degrees";
+    command_beyond_the_stroke = "command beyond the stroke";
+    no_assembly_for_the_commands = "no assembly for the commands";
+    too_few_poses = "too few poses";
+    duplicate_row = "duplicate row";
+    negative_command = "negative command";
+    bad_approach_direction = "bad approach direction";
+    partial_direction_columns = "partial direction columns";
+    implausible_temperature = "implausible temperature";
+    missing_data_file = "missing data file";
+    not_text = "not text";
+    unknown_machine_key = "unknown machine key";
+    negative_radius = "negative radius";
+    coincident_joints = "coincident joints";
+    malformed_json = "malformed JSON";
+    inverted_stroke = "inverted stroke";
+    missing_machine_file = "missing machine file";
+    diagnose_every_row_with_q1_and_q2_swapped = "diagnose: every row with q1 and q2 swapped";
+    diagnose_one_pose_logged_again_and_again = "diagnose: one pose logged again and again";
+    diagnose_noise_from_data_without_repeated_poses = "diagnose: noise from data without repeated poses";
+    diagnose_unknown_plausibility_quantity = "diagnose: unknown plausibility quantity";
+    diagnose_negative_temperature_noise = "diagnose: negative temperature noise";
+    ik_with_a_word = "ik with a word";
+    ik_out_of_reach = "ik out of reach";
+    fk_without_assembly = "fk without assembly";
+    unknown_verb = "unknown verb";
+    unknown_parameter_set = "unknown parameter set";
+    bad_pose_set = "bad pose set";
+    negative_noise = "negative noise";
+    missing_errors_file = "missing errors file";
+    bad_effect = "bad effect";
+    too_few_poses_to_diagnose = "too few poses to diagnose";
+    unknown_error_parameter = "unknown error parameter";
+}
+
+named_cases! {
+    bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem = bad_external_cases;
+    tracker_missing_column = "tracker: missing column";
+    tracker_not_a_number = "tracker: not a number";
+    tracker_head_angles_in_degrees = "tracker: head angles in degrees";
+    tracker_non_positive_sigma = "tracker: non-positive sigma";
+    tracker_repeated_row = "tracker: repeated row";
+    tracker_command_outside_the_stroke = "tracker: command outside the stroke";
+    tracker_two_points = "tracker: two points";
+    tracker_points_on_one_line = "tracker: points on one line";
+    tracker_one_tool_orientation = "tracker: one tool orientation";
+    ballbar_length_in_um = "ballbar: length in um";
+    ballbar_ball_in_one_plane = "ballbar: ball in one plane";
+    touch_unknown_feature = "touch: unknown feature";
+    touch_no_features_file = "touch: no features file";
+    features_not_json = "features: not JSON";
+    unknown_effect = "unknown effect";
+    bad_tracker_target = "bad tracker target";
+    tracker_target_not_stated = "tracker target not stated";
+    plan_tracker_target_not_stated = "plan: tracker target not stated";
+    bad_head = "bad head";
+    write_machine_with_effects = "write-machine with effects";
+    plan_zero_measurements = "plan: zero measurements";
+    plan_unreachable_pivot = "plan: unreachable pivot";
+    simulate_tracker_output_without_poses = "simulate: tracker output without poses";
+    simulate_unknown_head_parameter = "simulate: unknown head parameter";
+}
+
+named_cases! {
+    values_sizes_and_files_no_verb_can_use_get_exit_code_2 = unusable_cases;
+    tracker_x_of_1e300 = "tracker x of 1e300";
+    features_radius_of_1e308 = "features radius of 1e308";
+    truth_of_1e308 = "truth of 1e308";
+    workspace_beyond_the_stroke = "workspace beyond the stroke";
+    plan_output_in_a_missing_directory = "plan output in a missing directory";
+    s_of_1e308_for_the_diagnosis = "s of 1e308 for the diagnosis";
+    head_errors_of_1e300 = "head errors of 1e300";
+    negative_stiffness = "negative stiffness";
+    duplicate_key_in_a_truth_file = "duplicate key in a truth file";
+    negative_accuracy_target = "negative accuracy target";
+    accuracy_target_not_a_number = "accuracy target not a number";
+    the_same_tracker_file_twice = "the same tracker file twice";
+    header_only_batch_file = "header-only batch file";
+    tolerance_of_1_mm = "tolerance of -1 mm";
+    no_optimal_poses = "no optimal poses";
+    huge_evaluation_grid = "huge evaluation grid";
+    huge_candidate_grid = "huge candidate grid";
+    ten_million_ballbar_candidates = "ten million ballbar candidates";
+    a_ball_1e308_mm_from_the_tip = "a ball 1e308 mm from the tip";
+    a_1_mm_table = "a 1 mm table";
+    dev_zero_as_data = "/dev/zero as data";
+    old_mac_line_ends = "old Mac line ends";
+    tab_separated = "tab-separated";
+    no_header = "no header";
+    a_100_kb_field = "a 100 kB field";
+    a_10_mb_line = "a 10 MB line";
+    control_characters = "control characters";
+    a_tracker_file_given_as_measured_data = "a tracker file given as measured data";
+    leg_offset_edited = "leg offset edited";
+    nominal_edited = "nominal edited";
+    estimate_edited = "estimate edited";
+    unknown_method = "unknown method";
+    unknown_parameter_set = "unknown parameter set";
 }
 
 /// Runs every case in `dir`; every broken expectation is collected, so
@@ -564,7 +755,7 @@ fn run_cases(dir: &Path, cases: &[Case]) {
 /// exit code 0.
 #[test]
 fn a_duplicated_row_with_swapped_commands_is_flagged_not_fatal() {
-    let dir = workdir().join("swapped-row");
+    let dir = workdir("bad-inputs").join("swapped-row");
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("dup.csv");
     let out = tricept()
@@ -682,22 +873,9 @@ fn poses_csv(tips: &[[f64; 3]], axes: &[[f64; 3]], extension: Option<&[f64]>) ->
     s.into_bytes()
 }
 
-/// Runs `tricept` in `dir`, asserting success.
-fn ok(dir: &Path, args: &[&str]) -> Vec<u8> {
-    let out = tricept().args(args).current_dir(dir).output().unwrap();
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out.stdout
-}
-
-#[test]
-fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
-    let dir = std::env::temp_dir().join(format!("tricept-bad-external-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    // Good files: internal data, 12 spread tracker points, a ballbar.
+/// 12 tool poses spread over the workspace: tips on a 250 mm circle at
+/// three heights, tool axes tilted 0.4 in turn.
+fn spread_tool_poses() -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
     let tips: Vec<[f64; 3]> = (0..12)
         .map(|j| {
             let a = j as f64 * std::f64::consts::FRAC_PI_6;
@@ -714,9 +892,17 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
             [0.4 * a.cos(), 0.4 * a.sin(), 1.0]
         })
         .collect();
+    (tips, axes)
+}
+
+/// The table of bad external-instrument inputs (trackers, ballbars,
+/// touch-offs): each an exit code 2 and a message naming the problem.
+fn bad_external_cases(dir: &Path) -> Vec<Case> {
+    // Good files: internal data, 12 spread tracker points, a ballbar.
+    let (tips, axes) = spread_tool_poses();
     std::fs::write(dir.join("poses.csv"), poses_csv(&tips, &axes, None)).unwrap();
     ok(
-        &dir,
+        dir,
         &[
             "simulate",
             "--poses",
@@ -741,7 +927,7 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
         .collect();
     std::fs::write(dir.join("flat.csv"), poses_csv(&bar_tips, &axes[..8], None)).unwrap();
     ok(
-        &dir,
+        dir,
         &[
             "simulate",
             "--poses",
@@ -762,7 +948,7 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
     )
     .unwrap();
     ok(
-        &dir,
+        dir,
         &[
             "simulate",
             "--poses",
@@ -780,7 +966,7 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
     let z = [[0.0, 0.0, 1.0]; 5];
     std::fs::write(dir.join("still.csv"), poses_csv(&tips[..5], &z, None)).unwrap();
     ok(
-        &dir,
+        dir,
         &[
             "simulate",
             "--poses",
@@ -1076,8 +1262,7 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
     for (c, a) in cases.iter_mut().zip(args) {
         c.args = a;
     }
-    run_cases(&dir, &cases);
-    std::fs::remove_dir_all(&dir).ok();
+    cases
 }
 
 /// Values, sizes and files no verb can use (issue 17): numbers beyond
@@ -1085,33 +1270,15 @@ fn bad_external_inputs_get_exit_code_2_and_a_message_naming_the_problem() {
 /// overflow, sizes that would exhaust the memory or run without end, files
 /// in another format, calibrated machine files edited by hand; each an
 /// exit code 2 with one line naming the file, line and column or the flag.
-#[test]
-fn values_sizes_and_files_no_verb_can_use_get_exit_code_2() {
-    let dir = std::env::temp_dir().join(format!("tricept-bad-limits-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let csv = good_csv(&dir);
+fn unusable_cases(dir: &Path) -> Vec<Case> {
+    let csv = good_csv(dir);
     std::fs::write(dir.join("good.csv"), &csv).unwrap();
     let (_, header, rows) = split(&csv);
     // A tracker file of this campaign (12 tool poses).
-    let tips: Vec<[f64; 3]> = (0..12)
-        .map(|j| {
-            let a = j as f64 * std::f64::consts::FRAC_PI_6;
-            [
-                250.0 * a.cos(),
-                250.0 * a.sin(),
-                1050.0 + 10.0 * (j % 3) as f64,
-            ]
-        })
-        .collect();
-    let axes: Vec<[f64; 3]> = (0..12)
-        .map(|j| {
-            let a = j as f64 * 1.9;
-            [0.4 * a.cos(), 0.4 * a.sin(), 1.0]
-        })
-        .collect();
+    let (tips, axes) = spread_tool_poses();
     std::fs::write(dir.join("poses.csv"), poses_csv(&tips, &axes, None)).unwrap();
     ok(
-        &dir,
+        dir,
         &[
             "simulate",
             "--poses",
@@ -1140,7 +1307,7 @@ fn values_sizes_and_files_no_verb_can_use_get_exit_code_2() {
     control[1] = replace_field(&control[1], 0, "7\u{1b}[2J7");
     // A calibrated machine file and hand edits of it.
     ok(
-        &dir,
+        dir,
         &[
             "identify",
             "--data",
@@ -1651,15 +1818,13 @@ fn values_sizes_and_files_no_verb_can_use_get_exit_code_2() {
             a(&["machine", "--machine", "e5.json"]),
         ),
     ];
-    let cases: Vec<Case> = cases
+    cases
         .into_iter()
         .map(|(mut c, args)| {
             c.args = args;
             c
         })
-        .collect();
-    run_cases(&dir, &cases);
-    std::fs::remove_dir_all(&dir).ok();
+        .collect()
 }
 
 /// Inputs that look odd but are fine: a machine file with a byte-order

@@ -5,12 +5,10 @@
 //! found adequate with no cause named; when it is the stated noise, the
 //! check must agree.
 //!
-//! `cargo test -p tricept-diagnose --test noise_from_data -- --nocapture`
+//! `cargo test -p tricept-diagnose --test diagnose noise_from_data:: -- --nocapture`
 //! prints the tallies.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use tricept_diagnose::{NoiseSource, diagnose};
 use tricept_kinematics::Machine;
 

@@ -2,7 +2,7 @@
 //! same property checks the `cargo fuzz` targets run (`fuzz/src/checks.rs`),
 //! so a fixed crash stays fixed on every `cargo test`.
 
-#[path = "../../../fuzz/src/checks.rs"]
+#[path = "../../../../fuzz/src/checks.rs"]
 mod checks;
 
 use std::path::{Path, PathBuf};

@@ -4,8 +4,8 @@
 //! dictionary must describe them (family, leg or channel, period).
 //!
 //! Expectations come from the simulator's inputs only. Each case prints
-//! `TALLY` lines (`cargo test -p tricept-diagnose --test out_of_vocabulary
-//! -- --nocapture`), quoted in `docs/diagnosis.md`.
+//! `TALLY` lines (`cargo test -p tricept-diagnose --test diagnose
+//! out_of_vocabulary:: -- --nocapture`), quoted in `docs/diagnosis.md`.
 //!
 //! What is asserted is what the campaigns can physically show (design and
 //! detectability numbers in `docs/diagnosis.md`): a 100-300 ppm encoder
@@ -13,9 +13,7 @@
 //! below detection in most sets); at every size it must not be named as
 //! an eccentricity alone.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use tricept_diagnose::detect::detectability;
 use tricept_diagnose::{Diagnosis, Verdict};
 use tricept_engine::GeometricModel;

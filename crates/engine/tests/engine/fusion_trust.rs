@@ -8,9 +8,7 @@
 //! the instruments' frames and target offsets, the errors planted in the
 //! files), never from the fit.
 
-mod common;
-
-use common::{internal, known_target, spread_poses, table2_plant, tracker, tracker_points};
+use crate::common::{internal, known_target, spread_poses, table2_plant, tracker, tracker_points};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use tricept_data::{ExternalPose, TrackerData};

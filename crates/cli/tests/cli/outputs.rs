@@ -10,36 +10,9 @@
 //!   is refused before anything is computed, and the input is untouched.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 
-fn tricept() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_tricept"))
-}
-
-fn fixture(name: &str) -> String {
-    format!("{}/../../fixtures/{name}", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn workdir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tricept-outputs-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn run(args: &[&str]) -> Output {
-    let out = tricept().args(args).output().unwrap();
-    assert!(
-        !String::from_utf8_lossy(&out.stderr).contains("panicked"),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+use crate::support::{fixture, fresh_workdir, run, stderr, tricept};
 
 /// The files of a directory other than `keep`, sorted (temporaries left
 /// behind would show here).
@@ -106,7 +79,7 @@ fn fill(dir: &Path) {
 
 #[test]
 fn a_full_file_system_leaves_every_previous_output_intact() {
-    let dir = workdir("full");
+    let dir = fresh_workdir("outputs-full");
     let data = fixture("data/table2-grid-seed1.csv");
     // Good outputs, written where there is room.
     let good = dir.join("good");
@@ -188,7 +161,7 @@ fn a_full_file_system_leaves_every_previous_output_intact() {
 
 #[test]
 fn a_read_only_directory_leaves_the_previous_machine_file_intact() {
-    let dir = workdir("readonly");
+    let dir = fresh_workdir("outputs-readonly");
     let data = fixture("data/table2-grid-seed1.csv");
     let Some(fs) = Tmpfs::mount(&dir.join("ro"), 1024) else {
         return;
@@ -223,7 +196,7 @@ fn lcg(state: &mut u64) -> u64 {
 
 #[test]
 fn kill_9_at_any_moment_leaves_the_old_machine_file_or_a_complete_new_one() {
-    let dir = workdir("kill");
+    let dir = fresh_workdir("outputs-kill");
     let data = fixture("data/table2-grid-seed1.csv");
     let m = dir.join("calibrated.json");
     // The old file: the nominal machine's description.
@@ -281,7 +254,7 @@ fn kill_9_at_any_moment_leaves_the_old_machine_file_or_a_complete_new_one() {
 
 #[test]
 fn a_stdout_that_cannot_be_written_is_exit_1_with_a_message() {
-    let dir = workdir("devfull");
+    let dir = fresh_workdir("outputs-devfull");
     let data = fixture("data/table2-grid-seed1.csv");
     let points = dir.join("points.csv");
     let mut csv = "x,y,z\n".to_string();
@@ -331,7 +304,7 @@ fn a_stdout_that_cannot_be_written_is_exit_1_with_a_message() {
 
 #[test]
 fn an_output_that_is_an_input_is_refused_before_anything_is_computed() {
-    let dir = workdir("same");
+    let dir = fresh_workdir("outputs-same");
     let data = dir.join("data.csv");
     std::fs::copy(fixture("data/table2-grid-seed1.csv"), &data).unwrap();
     let original = std::fs::read(&data).unwrap();

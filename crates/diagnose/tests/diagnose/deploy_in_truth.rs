@@ -8,8 +8,6 @@
 //! expectation comes from the simulator's inputs and the plant's true
 //! machine, never from the code under test.
 
-mod common;
-
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;

@@ -3,33 +3,7 @@
 //! (exit 3, named), against a file without a record or with a campaign that
 //! sees nothing (exit 2), and its history and trend plots.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn tricept(dir: &Path, args: &[&str]) -> Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_tricept"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    assert!(
-        !String::from_utf8_lossy(&out.stderr).contains("panicked"),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn workdir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tricept-check-cli-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::support::{fresh_workdir, run_in as tricept, stderr};
 
 /// The true errors a simulated file's comment records.
 fn truth_of(csv: &str) -> serde_json::Map<String, serde_json::Value> {
@@ -43,7 +17,7 @@ fn truth_of(csv: &str) -> serde_json::Map<String, serde_json::Value> {
 
 #[test]
 fn a_calibrated_machine_is_checked_from_its_own_sensors() {
-    let dir = workdir();
+    let dir = fresh_workdir("check-cli");
     let d = dir.as_path();
     let ok = |args: &[&str]| {
         let out = tricept(d, args);

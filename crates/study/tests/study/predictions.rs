@@ -9,9 +9,7 @@
 //! table's sizes and at twice them; a known 20 mm target offset stated
 //! correctly must deliver within 1.2 times the target at the tip.
 
-mod common;
-
-use common::independent::{TrueMachine, TrueTracker, normal};
+use crate::common::independent::{TrueMachine, TrueTracker, normal};
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;

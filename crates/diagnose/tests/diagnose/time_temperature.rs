@@ -6,9 +6,7 @@
 //! cause beside a temperature term, and the report says which campaign
 //! separates them.
 
-mod common;
-
-use common::{CampaignOptions, run_case, simulate, tally};
+use crate::common::{CampaignOptions, run_case, simulate, tally};
 use tricept_model::effects::{CauseName, Needs};
 use tricept_plant::effects::Effect;
 

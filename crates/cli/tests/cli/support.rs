@@ -1,0 +1,67 @@
+//! What every CLI test needs: the `tricept` binary, a work directory per
+//! test (or per module), the repository's fixtures, and runs that fail the
+//! test on a panic.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The `tricept` binary this package builds.
+pub fn tricept() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_tricept"))
+}
+
+/// `tricept-{name}-{pid}` in the temporary directory, created if needed
+/// (what is already in it stays: tests that share it write their own files).
+pub fn workdir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tricept-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// [`workdir`] emptied first.
+pub fn fresh_workdir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tricept-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The path of `fixtures/{name}` in the repository.
+pub fn fixture(name: &str) -> String {
+    format!("{}/../../fixtures/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Runs `tricept args`; a panic fails the test.
+pub fn run(args: &[&str]) -> Output {
+    no_panic(args, tricept().args(args).output().unwrap())
+}
+
+/// Runs `tricept args` in `dir`; a panic fails the test.
+pub fn run_in(dir: &Path, args: &[&str]) -> Output {
+    no_panic(
+        args,
+        tricept().args(args).current_dir(dir).output().unwrap(),
+    )
+}
+
+fn no_panic(args: &[&str], out: Output) -> Output {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    out
+}
+
+/// Runs `tricept args` in `dir`, asserting success; its stdout.
+pub fn ok(dir: &Path, args: &[&str]) -> Vec<u8> {
+    let out = run_in(dir, args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out.stdout
+}
+
+/// The stderr of a run, as text.
+pub fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}

@@ -1,0 +1,9 @@
+//! The identification engine's integration tests, one binary: the internal
+//! identification, the fused identification and its trust, and the fuzz
+//! regressions (one module per subject; shared helpers in `common`).
+
+mod common;
+mod fusion;
+mod fusion_trust;
+mod fuzz_regressions;
+mod identification;

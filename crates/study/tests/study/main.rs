@@ -1,0 +1,12 @@
+//! The study's integration tests, one binary: planning, the check's plan,
+//! differencing, invisible errors, predictions against independent
+//! machines, and the study itself (one module per subject; an independent
+//! simulator in `common`).
+
+mod check_plan;
+mod common;
+mod differencing;
+mod invisible;
+mod plan;
+mod predictions;
+mod study;
