@@ -230,3 +230,132 @@ fn every_json_input_is_bounded() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn help_and_version_to_a_full_disk_fail() {
+    let dir = workdir("full");
+    for args in [
+        vec!["--help"],
+        vec!["--version"],
+        vec!["identify", "--help"],
+    ] {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_tricept"))
+            .args(&args)
+            .current_dir(&dir)
+            .stdout(full)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains("incomplete"),
+            "{args:?}"
+        );
+        // To a pipe they still succeed.
+        assert_eq!(tricept(&dir, &args).status.code(), Some(0), "{args:?}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn plots_never_overwrite_an_input_or_the_history() {
+    let dir = workdir("plots");
+    let d = dir.as_path();
+    let fixture = format!(
+        "{}/../../fixtures/data/diagnose-hidden-effect.csv",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    // The plots of this file's diagnosis, by name.
+    let out = tricept(d, &["diagnose", "--data", &fixture, "--plots", "p"]);
+    assert_eq!(out.status.code(), Some(0));
+    let plot = std::fs::read_dir(dir.join("p"))
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .file_name();
+    let plot = plot.to_str().unwrap();
+    // The data file where the plot would go: refused, the data intact.
+    std::fs::create_dir_all(dir.join("q")).unwrap();
+    let data = std::fs::read(&fixture).unwrap();
+    std::fs::write(dir.join("q").join(plot), &data).unwrap();
+    let as_input = format!("q/{plot}");
+    let out = tricept(d, &["diagnose", "--data", &as_input, "--plots", "q"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("is also the input --data"));
+    assert_eq!(std::fs::read(dir.join("q").join(plot)).unwrap(), data);
+    // check --plot: a history file named as a trend plot is not overwritten.
+    let ok = |args: &[&str]| {
+        let out = tricept(d, args);
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
+    };
+    ok(&[
+        "simulate",
+        "--truth",
+        "random:0.25,5",
+        "--poses",
+        "random:80,3",
+        "--out",
+        "cal.csv",
+    ]);
+    ok(&[
+        "identify",
+        "--data",
+        "cal.csv",
+        "--write-machine",
+        "cal.json",
+    ]);
+    std::fs::create_dir_all(dir.join("t")).unwrap();
+    for seed in ["4", "5", "6"] {
+        ok(&[
+            "simulate",
+            "--truth",
+            "random:0.25,5",
+            "--poses",
+            "random:20,9",
+            "--seed",
+            seed,
+            "--out",
+            "day.csv",
+        ]);
+        ok(&[
+            "check",
+            "--machine",
+            "cal.json",
+            "--data",
+            "day.csv",
+            "--history",
+            "t/check-dq1.svg",
+        ]);
+    }
+    let history = std::fs::read(dir.join("t/check-dq1.svg")).unwrap();
+    let out = tricept(
+        d,
+        &[
+            "check",
+            "--machine",
+            "cal.json",
+            "--data",
+            "day.csv",
+            "--history",
+            "t/check-dq1.svg",
+            "--plot",
+            "t",
+        ],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("is also the output --history"));
+    // The refusal comes after the append: the history keeps every record.
+    let after = std::fs::read(dir.join("t/check-dq1.svg")).unwrap();
+    assert!(after.starts_with(&history) && after.len() > history.len());
+    std::fs::remove_dir_all(&dir).ok();
+}
