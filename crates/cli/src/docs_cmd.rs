@@ -17,7 +17,7 @@ pub struct DocsArgs {
 }
 
 /// Every page: name, what it holds, text (Markdown).
-const PAGES: [(&str, &str, &str); 10] = [
+const PAGES: [(&str, &str, &str); 12] = [
     (
         "data-format",
         "the measured-data CSV, the external measurements, the machine JSON, every output file (columns, keys, units)",
@@ -57,6 +57,16 @@ const PAGES: [(&str, &str, &str); 10] = [
         "reliability",
         "bad-input handling, robust estimation, fuzzing",
         include_str!("../../../docs/reliability.md"),
+    ),
+    (
+        "testing",
+        "how the tests are laid out, mutation testing of the decision code (`cargo xtask mutants`), measured counts",
+        include_str!("../../../docs/testing.md"),
+    ),
+    (
+        "python",
+        "the `tricept` Python package: install, API, what it shares with the CLI, the example",
+        include_str!("../../../docs/python.md"),
     ),
     (
         "reproduction",
