@@ -273,7 +273,7 @@ fn data_of(
 
 /// A calibration (`tricept identify`): its verdict, estimates, covariance,
 /// JSON and report, and the machine file it may write.
-#[pyclass(module = "tricept._tricept", unsendable)]
+#[pyclass(module = "tricept._tricept")]
 struct Calibration {
     inner: tricept_ident::Calibration,
 }
@@ -379,9 +379,9 @@ fn identify(
     if let Some(t) = tolerance_mm {
         request.tolerance_mm = t;
     }
-    // Under the GIL: a fused calibration's sources are not `Send`.
-    let _ = py;
-    let inner = tricept_ident::calibrate(&request).map_err(door_error)?;
+    let inner = py
+        .detach(|| tricept_ident::calibrate(&request))
+        .map_err(door_error)?;
     Ok(Calibration { inner })
 }
 

@@ -189,7 +189,7 @@ impl Sink {
 }
 
 /// What every kind of source provides to the fused identification.
-pub(crate) trait SourceRows: Sync + std::fmt::Debug {
+pub(crate) trait SourceRows: Send + Sync + std::fmt::Debug {
     /// The kind of instrument.
     fn kind(&self) -> SourceKind;
     /// The file (or label) the records came from.
