@@ -3,17 +3,7 @@
 //! (exit 3, named), against a file without a record or with a campaign that
 //! sees nothing (exit 2), and its history and trend plots.
 
-use crate::support::{fresh_workdir, run_in as tricept, stderr};
-
-/// The true errors a simulated file's comment records.
-fn truth_of(csv: &str) -> serde_json::Map<String, serde_json::Value> {
-    let line = csv
-        .lines()
-        .find(|l| l.starts_with("# true errors"))
-        .unwrap();
-    let json = &line[line.find('{').unwrap()..];
-    serde_json::from_str(json).unwrap()
-}
+use crate::support::{fresh_workdir, run_in as tricept, stderr, truth_of};
 
 #[test]
 fn a_calibrated_machine_is_checked_from_its_own_sensors() {

@@ -9,34 +9,13 @@
 //! Every JSON input has a size bound: a device or a runaway file is
 //! refused with exit 2 after 64 MiB instead of exhausting the memory.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn tricept(dir: &Path, args: &[&str]) -> Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_tricept"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
-    out
-}
+use crate::support::{fresh_workdir, run_in as tricept, truth_of};
 
-fn workdir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tricept-relied-on-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// The true errors a simulated file's comment records.
-fn truth_of(csv: &str) -> serde_json::Map<String, serde_json::Value> {
-    let line = csv
-        .lines()
-        .find(|l| l.starts_with("# true errors"))
-        .unwrap();
-    serde_json::from_str(&line[line.find('{').unwrap()..]).unwrap()
+/// A work directory of this module's test `name`, emptied first.
+fn workdir(name: &str) -> std::path::PathBuf {
+    fresh_workdir(&format!("relied-on-{name}"))
 }
 
 #[test]

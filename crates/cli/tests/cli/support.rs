@@ -65,3 +65,12 @@ pub fn ok(dir: &Path, args: &[&str]) -> Vec<u8> {
 pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
+
+/// The true errors a simulated file's comment records (`# true errors`).
+pub fn truth_of(csv: &str) -> serde_json::Map<String, serde_json::Value> {
+    let line = csv
+        .lines()
+        .find(|l| l.starts_with("# true errors"))
+        .unwrap();
+    serde_json::from_str(&line[line.find('{').unwrap()..]).unwrap()
+}
