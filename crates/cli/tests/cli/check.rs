@@ -3,7 +3,7 @@
 //! (exit 3, named), against a file without a record or with a campaign that
 //! sees nothing (exit 2), and its history and trend plots.
 
-use crate::support::{fresh_workdir, run_in as tricept, stderr, truth_of};
+use crate::support::{calibrated_machine, fresh_workdir, run_in as tricept, stderr, truth_of};
 
 #[test]
 fn a_calibrated_machine_is_checked_from_its_own_sensors() {
@@ -14,22 +14,7 @@ fn a_calibrated_machine_is_checked_from_its_own_sensors() {
         assert_eq!(out.status.code(), Some(0), "{args:?}: {}", stderr(&out));
         out
     };
-    ok(&[
-        "simulate",
-        "--truth",
-        "random:0.25,5",
-        "--poses",
-        "random:80,3",
-        "--out",
-        "cal.csv",
-    ]);
-    ok(&[
-        "identify",
-        "--data",
-        "cal.csv",
-        "--write-machine",
-        "cal.json",
-    ]);
+    calibrated_machine(d);
     // Unchanged: another day, other poses, the sensors re-referenced.
     ok(&[
         "simulate",

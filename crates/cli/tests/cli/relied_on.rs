@@ -11,7 +11,7 @@
 
 use std::process::Command;
 
-use crate::support::{fresh_workdir, run_in as tricept, truth_of};
+use crate::support::{calibrated_machine, fresh_workdir, ok, run_in as tricept, truth_of};
 
 /// A work directory of this module's test `name`, emptied first.
 fn workdir(name: &str) -> std::path::PathBuf {
@@ -22,27 +22,7 @@ fn workdir(name: &str) -> std::path::PathBuf {
 fn an_edited_judged_field_is_refused_by_name_and_cannot_hide_a_slip() {
     let dir = workdir("sealed");
     let d = dir.as_path();
-    let ok = |args: &[&str]| {
-        let out = tricept(d, args);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
-    };
-    ok(&[
-        "simulate",
-        "--truth",
-        "random:0.25,5",
-        "--poses",
-        "random:80,3",
-        "--out",
-        "cal.csv",
-    ]);
-    ok(&[
-        "identify",
-        "--data",
-        "cal.csv",
-        "--write-machine",
-        "cal.json",
-    ]);
+    calibrated_machine(d);
     // The day's campaign: leg 2 slipped by 20 um.
     let csv = std::fs::read_to_string(dir.join("cal.csv")).unwrap();
     let mut truth = truth_of(&csv);
@@ -53,17 +33,20 @@ fn an_edited_judged_field_is_refused_by_name_and_cannot_hide_a_slip() {
         serde_json::to_string(&truth).unwrap(),
     )
     .unwrap();
-    ok(&[
-        "simulate",
-        "--truth",
-        "slipped.json",
-        "--poses",
-        "random:20,9",
-        "--seed",
-        "4",
-        "--out",
-        "day.csv",
-    ]);
+    ok(
+        d,
+        &[
+            "simulate",
+            "--truth",
+            "slipped.json",
+            "--poses",
+            "random:20,9",
+            "--seed",
+            "4",
+            "--out",
+            "day.csv",
+        ],
+    );
     let check = |machine: &str| tricept(d, &["check", "--machine", machine, "--data", "day.csv"]);
     // The file as written: the slip is seen.
     assert_eq!(check("cal.json").status.code(), Some(3));
@@ -122,16 +105,19 @@ fn an_edited_judged_field_is_refused_by_name_and_cannot_hide_a_slip() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     // The file written again from a loaded calibrated machine keeps a
     // valid seal (a recalibration writes its own).
-    ok(&[
-        "identify",
-        "--data",
-        "cal.csv",
-        "--machine",
-        "cal.json",
-        "--write-machine",
-        "again.json",
-    ]);
-    ok(&["ik", "0", "0", "750", "--machine", "again.json"]);
+    ok(
+        d,
+        &[
+            "identify",
+            "--data",
+            "cal.csv",
+            "--machine",
+            "cal.json",
+            "--write-machine",
+            "again.json",
+        ],
+    );
+    ok(d, &["ik", "0", "0", "750", "--machine", "again.json"]);
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -267,49 +253,35 @@ fn plots_never_overwrite_an_input_or_the_history() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("is also the input --data"));
     assert_eq!(std::fs::read(dir.join("q").join(plot)).unwrap(), data);
     // check --plot: a history file named as a trend plot is not overwritten.
-    let ok = |args: &[&str]| {
-        let out = tricept(d, args);
-        let err = String::from_utf8_lossy(&out.stderr).into_owned();
-        assert_eq!(out.status.code(), Some(0), "{args:?}: {err}");
-    };
-    ok(&[
-        "simulate",
-        "--truth",
-        "random:0.25,5",
-        "--poses",
-        "random:80,3",
-        "--out",
-        "cal.csv",
-    ]);
-    ok(&[
-        "identify",
-        "--data",
-        "cal.csv",
-        "--write-machine",
-        "cal.json",
-    ]);
+    calibrated_machine(d);
     std::fs::create_dir_all(dir.join("t")).unwrap();
     for seed in ["4", "5", "6"] {
-        ok(&[
-            "simulate",
-            "--truth",
-            "random:0.25,5",
-            "--poses",
-            "random:20,9",
-            "--seed",
-            seed,
-            "--out",
-            "day.csv",
-        ]);
-        ok(&[
-            "check",
-            "--machine",
-            "cal.json",
-            "--data",
-            "day.csv",
-            "--history",
-            "t/check-dq1.svg",
-        ]);
+        ok(
+            d,
+            &[
+                "simulate",
+                "--truth",
+                "random:0.25,5",
+                "--poses",
+                "random:20,9",
+                "--seed",
+                seed,
+                "--out",
+                "day.csv",
+            ],
+        );
+        ok(
+            d,
+            &[
+                "check",
+                "--machine",
+                "cal.json",
+                "--data",
+                "day.csv",
+                "--history",
+                "t/check-dq1.svg",
+            ],
+        );
     }
     let history = std::fs::read(dir.join("t/check-dq1.svg")).unwrap();
     let out = tricept(

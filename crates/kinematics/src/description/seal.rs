@@ -18,7 +18,6 @@ use super::MachineDescription;
 /// in a description (`None` when the description has no calibration).
 fn sealed_fields(d: &MachineDescription) -> Option<Vec<(&'static str, String)>> {
     let c = d.calibration.as_deref()?;
-    let text = |v: &dyn erased::Json| v.json();
     Some(vec![
         ("calibration.std_dev_mm", text(&c.std_dev_mm)),
         ("calibration.correlations", text(&c.correlations)),
@@ -37,20 +36,9 @@ fn sealed_fields(d: &MachineDescription) -> Option<Vec<(&'static str, String)>> 
     ])
 }
 
-/// Serialising through a trait object, so one list holds every field.
-mod erased {
-    /// A value's compact JSON text.
-    pub trait Json {
-        /// The text (empty if it cannot be written, which plain data
-        /// cannot fail).
-        fn json(&self) -> String;
-    }
-
-    impl<T: serde::Serialize> Json for T {
-        fn json(&self) -> String {
-            serde_json::to_string(self).unwrap_or_default()
-        }
-    }
+/// A value's compact JSON text (plain data cannot fail to serialise).
+fn text(value: &impl serde::Serialize) -> String {
+    serde_json::to_string(value).unwrap_or_default()
 }
 
 /// 64-bit FNV-1a of a text, in hex.
