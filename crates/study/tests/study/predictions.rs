@@ -9,7 +9,6 @@
 //! table's sizes and at twice them; a known 20 mm target offset stated
 //! correctly must deliver within 1.2 times the target at the tip.
 
-use crate::common::independent::{TrueMachine, TrueTracker, normal};
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -27,6 +26,7 @@ use tricept_study::plan::{
     PlanProblem, candidate_rows, internal_factor, nominal_ballbar_data, nominal_tracker_data, plan,
     sphere_candidates, with_extensions,
 };
+use tricept_truth::{TrueMachine, TrueTracker, normal};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Instrument {

@@ -24,18 +24,12 @@
 //! - A tracker at a random pose 1-3 m from the workspace (any rotation),
 //!   10 um per coordinate; a ballbar, 1 um per reading.
 
-#![allow(dead_code)]
-
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
 use rand_pcg::Pcg64Mcg;
 
-/// Rotation about the unit axis `k` by `angle` (Rodrigues).
-pub fn rot(k: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
-    let kx = Matrix3::new(0.0, -k.z, k.y, k.z, 0.0, -k.x, -k.y, k.x, 0.0);
-    Matrix3::identity() + kx * angle.sin() + kx * kx * (1.0 - angle.cos())
-}
+use crate::{ARCSEC_PER_RAD, normal, normal3, rot};
 
 fn rx(a: f64) -> Matrix3<f64> {
     let (s, c) = a.sin_cos();
@@ -68,11 +62,17 @@ fn table1() -> serde_json::Value {
 /// A general two-axis head, platform frame at zero head angles.
 #[derive(Debug, Clone)]
 pub struct TrueHead {
+    /// First (outer) axis direction, unit.
     pub k1: Vector3<f64>,
+    /// A point of the first axis, mm.
     pub p1: Vector3<f64>,
+    /// Second (inner) axis direction, unit.
     pub k2: Vector3<f64>,
+    /// A point of the second axis, mm.
     pub p2: Vector3<f64>,
+    /// The tool tip, mm.
     pub tip: Vector3<f64>,
+    /// The tool direction, unit.
     pub direction: Vector3<f64>,
     /// Kinematic angle = command + zero, rad.
     pub zeros: [f64; 2],
@@ -96,9 +96,13 @@ impl TrueHead {
 /// A true machine.
 #[derive(Debug, Clone)]
 pub struct TrueMachine {
+    /// Base joints `B_i`, base frame, mm.
     pub base: [Vector3<f64>; 3],
+    /// Platform joints `A_i`, platform frame, mm.
     pub platform: [Vector3<f64>; 3],
+    /// True leg length minus command, mm.
     pub leg_offsets_mm: [f64; 3],
+    /// The two-axis head.
     pub head: TrueHead,
     /// phi rad, theta rad, s mm.
     pub sensor_offsets: [f64; 3],
@@ -120,15 +124,6 @@ fn tilted(v: &Vector3<f64>, sigma: f64, rng: &mut Pcg64Mcg) -> Vector3<f64> {
     let b = v.cross(&a);
     let (x, y): (f64, f64) = (StandardNormal.sample(rng), StandardNormal.sample(rng));
     (v + a * sigma * x + b * sigma * y).normalize()
-}
-
-/// One standard normal draw.
-pub fn normal(rng: &mut Pcg64Mcg) -> f64 {
-    StandardNormal.sample(rng)
-}
-
-fn normal3(rng: &mut Pcg64Mcg, sigma: f64) -> Vector3<f64> {
-    Vector3::from_fn(|_, _| sigma * normal(rng))
 }
 
 impl TrueMachine {
@@ -218,15 +213,25 @@ impl TrueMachine {
     /// Newton on `|r + R A_i - B_i| = q_i + dq_i`, central differences,
     /// step halving; panics unless the lengths close to 1e-10 mm.
     pub fn forward(&self, q: &[f64; 3]) -> [f64; 3] {
+        self.forward_lengths(&std::array::from_fn(|i| q[i] + self.leg_offsets_mm[i]))
+    }
+
+    /// The UP limb's joints `(phi, theta, q4)` for true leg lengths
+    /// `lengths_mm` (`|r + R A_i - B_i|`, the leg offsets and any effect a
+    /// test adds already in them); panics unless they close to 1e-10 mm.
+    pub fn forward_lengths(&self, lengths_mm: &[f64; 3]) -> [f64; 3] {
         let residual = |x: &[f64; 3]| -> Vector3<f64> {
             let r_mat = rx(x[0]) * ry(x[1]);
             let r = r_mat * Vector3::new(0.0, 0.0, x[2]);
             Vector3::from_fn(|i, _| {
-                (r + r_mat * self.platform[i] - self.base[i]).norm()
-                    - (q[i] + self.leg_offsets_mm[i])
+                (r + r_mat * self.platform[i] - self.base[i]).norm() - lengths_mm[i]
             })
         };
-        let mut x = [0.0, 0.0, (q[0] + q[1] + q[2]) / 3.0];
+        let mut x = [
+            0.0,
+            0.0,
+            (lengths_mm[0] + lengths_mm[1] + lengths_mm[2]) / 3.0,
+        ];
         for _ in 0..100 {
             let f = residual(&x);
             if f.norm() < 1e-10 {
@@ -252,7 +257,7 @@ impl TrueMachine {
                 t *= 0.5;
             }
         }
-        panic!("the independent forward kinematics did not close at {q:?}");
+        panic!("the independent forward kinematics did not close at {lengths_mm:?}");
     }
 
     /// The platform's pose `(r, R)` for leg commands `q`.
@@ -287,50 +292,76 @@ impl TrueMachine {
     /// the sensor offsets plus the mean of 3 readings' noise (0.8 arcsec,
     /// 0.5 um each).
     pub fn readings(&self, q: &[f64; 3], rng: &mut Pcg64Mcg) -> [f64; 3] {
-        let j = self.forward(q);
-        let sigma = [
-            0.8 / 206_264.806_247_096_36,
-            0.8 / 206_264.806_247_096_36,
-            0.5e-3,
-        ];
+        self.sensed(&self.forward(q), &SensorNoise::DOCUMENTED, rng)
+    }
+
+    /// Logged readings of joints `joints` (`[phi, theta, q4]`, rad, rad,
+    /// mm): the joints plus the sensor offsets plus the mean of
+    /// `noise.readings_per_pose` readings' noise.
+    pub fn sensed(&self, joints: &[f64; 3], noise: &SensorNoise, rng: &mut Pcg64Mcg) -> [f64; 3] {
+        let sigma = noise.sigma();
+        let n = noise.readings_per_pose.max(1);
         std::array::from_fn(|c| {
-            let mean: f64 = (0..3).map(|_| normal(rng)).sum::<f64>() / 3.0;
-            j[c] + self.sensor_offsets[c] + sigma[c] * mean
+            let mean: f64 = (0..n).map(|_| normal(rng)).sum::<f64>() / n as f64;
+            joints[c] + self.sensor_offsets[c] + sigma[c] * mean
+        })
+    }
+
+    /// The machine `kelvin` K warmer than at its calibration, every length
+    /// of the structure grown by `ppm_per_k` (base and platform joints
+    /// about the frames' origins, and the legs: the true length of leg `i`
+    /// becomes `(q_i + dq_i) (1 + e)`, which a test applies through
+    /// [`TrueMachine::warm_lengths`]).
+    pub fn warmed(&self, ppm_per_k: f64, kelvin: f64) -> TrueMachine {
+        let e = 1.0 + ppm_per_k * 1e-6 * kelvin;
+        let mut m = self.clone();
+        m.base = self.base.map(|b| b * e);
+        m.platform = self.platform.map(|a| a * e);
+        m
+    }
+
+    /// True leg lengths at commands `q` with leg `i` `kelvin[i]` K warmer
+    /// (growth `ppm_per_k`): `(q_i + dq_i) (1 + ppm_per_k 1e-6 kelvin_i)`.
+    pub fn warm_lengths(&self, q: &[f64; 3], ppm_per_k: f64, kelvin: [f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|i| {
+            (q[i] + self.leg_offsets_mm[i]) * (1.0 + ppm_per_k * 1e-6 * kelvin[i])
         })
     }
 }
 
-/// A tracker station: `y = R^T (x - c)` in its own coordinates.
-#[derive(Debug, Clone)]
-pub struct TrueTracker {
-    pub rotation: Matrix3<f64>,
-    pub position_mm: Vector3<f64>,
+/// The noise of the UP limb's sensors, as `docs/data-format.md` states it:
+/// one reading's standard deviation and the number of readings averaged
+/// per pose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorNoise {
+    /// One encoder reading, arcsec.
+    pub angle_arcsec: f64,
+    /// One scale reading, um.
+    pub length_um: f64,
+    /// Readings averaged per logged row.
+    pub readings_per_pose: usize,
 }
 
-impl TrueTracker {
-    /// A station 1-3 m from the workspace centre (0, 0, 1100) mm, in a
-    /// random direction, turned by a random rotation.
-    pub fn random(seed: u64) -> TrueTracker {
-        let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x7ac4_0001);
-        let dir = normal3(&mut rng, 1.0).normalize();
-        let distance = 1000.0 + 2000.0 * rng.random::<f64>();
-        let q: [f64; 4] = std::array::from_fn(|_| StandardNormal.sample(&mut rng));
-        let rotation =
-            UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]))
-                .to_rotation_matrix()
-                .into_inner();
-        TrueTracker {
-            rotation,
-            position_mm: Vector3::new(0.0, 0.0, 1100.0) + dir * distance,
+impl SensorNoise {
+    /// The documented default: 0.8 arcsec, 0.5 um, the mean of 3.
+    pub const DOCUMENTED: SensorNoise = SensorNoise {
+        angle_arcsec: 0.8,
+        length_um: 0.5,
+        readings_per_pose: 3,
+    };
+
+    /// This noise times `factor` (a sensor noisier than stated).
+    pub fn times(self, factor: f64) -> SensorNoise {
+        SensorNoise {
+            angle_arcsec: self.angle_arcsec * factor,
+            length_um: self.length_um * factor,
+            ..self
         }
     }
 
-    /// A measurement of `x` (base frame) with 10 um noise per coordinate.
-    pub fn measure(&self, x: &Vector3<f64>, rng: &mut Pcg64Mcg) -> [f64; 3] {
-        let y = self.rotation.transpose() * (x - self.position_mm);
-        std::array::from_fn(|c| {
-            let z: f64 = StandardNormal.sample(rng);
-            y[c] + 0.010 * z
-        })
+    /// One reading's standard deviation `[rad, rad, mm]`.
+    pub fn sigma(&self) -> [f64; 3] {
+        let rad = self.angle_arcsec / ARCSEC_PER_RAD;
+        [rad, rad, self.length_um * 1e-3]
     }
 }

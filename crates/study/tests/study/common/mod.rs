@@ -1,3 +1,0 @@
-//! Helpers of the study's tests.
-
-pub mod independent;
