@@ -9,13 +9,11 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use tricept_data::Dataset;
-use tricept_ident::{
-    CalibrateRequest, Data, EffectName, EffectNames, EvalGrid, FusedSources, HeadAngles, HeadModel,
-    LengthSigma, LoadedMachine, SensorNoise, TrackerTargetSpec, Triple,
+use tricept_ident::advanced::{
+    Dataset, EffectName, EffectNames, EvalGrid, FusedSources, HeadAngles, HeadModel, LengthSigma,
+    TrackerTargetSpec, Triple,
 };
-use tricept_kinematics::Machine;
-use tricept_model::ParameterSet;
+use tricept_ident::{CalibrateRequest, Data, LoadedMachine, Machine, ParameterSet, SensorNoise};
 
 use crate::cli_error::CliError;
 
@@ -154,15 +152,18 @@ pub fn load_with_noise(args: &MachineArgs, noise: &NoiseArgs) -> Result<LoadedMa
     Ok(loaded)
 }
 
-/// Reads a measured-data file (`tricept_ident::read_data_from`) with a
+/// Reads a measured-data file (`tricept_ident::advanced::read_data_from`) with a
 /// progress bar over the bytes read (drawn only on a terminal).
 pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, CliError> {
     let file = path.display().to_string();
     let f = std::fs::File::open(path).map_err(|e| CliError::input(format!("{file}: {e}")))?;
     let size = f.metadata().map(|m| m.len()).unwrap_or(0);
     let bar = progress_bar(size, &format!("reading {file}"));
-    let data =
-        tricept_ident::read_data_from(bar.wrap_read(std::io::BufReader::new(f)), &file, machine)?;
+    let data = tricept_ident::advanced::read_data_from(
+        bar.wrap_read(std::io::BufReader::new(f)),
+        &file,
+        machine,
+    )?;
     bar.finish_and_clear();
     Ok(data)
 }

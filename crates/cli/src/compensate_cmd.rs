@@ -6,13 +6,13 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use tricept_ident::{Calibrated, CompensateRequest, Compensation, TrueErrors, compensate};
-use tricept_model::ErrorMap;
+use tricept_ident::advanced::{ErrorMap, TrueErrors};
+use tricept_ident::{Calibrated, CompensateRequest, Compensation, compensate};
 
 use crate::args::{FitSettings, TruthArgs};
 use crate::cli_error::CliError;
 
-pub use tricept_ident::{MAP_FILES, TABLE_FILES};
+pub use tricept_ident::advanced::{MAP_FILES, TABLE_FILES};
 
 /// `tricept compensate`.
 #[derive(Debug, Args)]

@@ -5,7 +5,8 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_ident::{Controller, ExportOptions, ExportRequest};
+use tricept_ident::ExportRequest;
+use tricept_ident::advanced::{Controller, ExportOptions};
 
 use crate::cli_error::CliError;
 

@@ -4,9 +4,10 @@
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
-use tricept_ident::{
-    EffectNames, EvalGrid, HeadAngles, PlanRequest, Poses, TrackerTargetSpec, Triple, parse_numbers,
+use tricept_ident::advanced::{
+    EffectNames, EvalGrid, HeadAngles, TrackerTargetSpec, Triple, parse_numbers,
 };
+use tricept_ident::{PlanRequest, Poses};
 
 use crate::args::{MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs};
 use crate::cli_error::CliError;

@@ -5,10 +5,11 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_ident::{
-    BallbarSimulation, HeadErrors, Poses, SimulateRequest, TouchSimulation, TrackerSimulation,
-    Triple, parse_effects, parse_numbers, simulate,
+use tricept_ident::advanced::{
+    BallbarSimulation, HeadErrors, TouchSimulation, TrackerSimulation, Triple, parse_effects,
+    parse_numbers,
 };
+use tricept_ident::{Poses, SimulateRequest, simulate};
 
 use crate::args::{MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs, TruthArgs, load_with_noise};
 use crate::cli_error::CliError;
