@@ -25,7 +25,7 @@ use pyo3::prelude::*;
 use rayon::prelude::*;
 use tricept_ident::nalgebra::Vector3;
 use tricept_ident::{
-    CalibrateRequest, CheckRequest, Data, DataInput, DiagnoseRequest, ExtendedMachine,
+    CalibrateRequest, CheckRequest, DataInput, DiagnoseRequest, ExtendedMachine,
     LoadedMachine, ParameterSet, Poses, SensorNoise, SimulateRequest,
 };
 use tricept_ident::advanced::{HeadBranch, KinematicsError, TrueErrors};
@@ -362,10 +362,10 @@ fn identify(
         readings_per_pose,
     };
     let data = match (path, csv_text) {
-        (Some(path), None) => Data::File(path),
+        (Some(path), None) => DataInput::File(path),
         (None, Some(text)) => {
             let loaded = machine_of(machine.clone(), noise)?;
-            Data::InMemory(
+            DataInput::Memory(
                 tricept_ident::advanced::read_data_from(text.as_bytes(), &name, loaded.machine())
                     .map_err(door_error)?,
             )
@@ -381,7 +381,7 @@ fn identify(
         request.tolerance_mm = t;
     }
     let inner = py
-        .detach(|| tricept_ident::calibrate(&request))
+        .detach(|| tricept_ident::calibrate(request))
         .map_err(door_error)?;
     Ok(Calibration { inner })
 }

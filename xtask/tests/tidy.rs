@@ -873,7 +873,6 @@ const DOOR_ROOT: &[&str] = &[
     "solve_point",
     // Their requests, and what a request's constructor needs.
     "CalibrateRequest",
-    "Data",
     "Calibrated",
     "Campaign",
     "CheckRequest",

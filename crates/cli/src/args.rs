@@ -13,7 +13,7 @@ use tricept_ident::advanced::{
     Dataset, EffectName, EffectNames, EvalGrid, FusedSources, HeadAngles, HeadModel, LengthSigma,
     TrackerTargetSpec, Triple,
 };
-use tricept_ident::{CalibrateRequest, Data, LoadedMachine, Machine, ParameterSet, SensorNoise};
+use tricept_ident::{CalibrateRequest, LoadedMachine, Machine, ParameterSet, SensorNoise};
 
 use crate::cli_error::CliError;
 
@@ -215,7 +215,7 @@ impl FitSettings {
     /// The door's calibration request of these settings for `data`
     /// (internal; the caller adds external sources).
     pub fn request(&self, data: &Path) -> CalibrateRequest {
-        let mut request = CalibrateRequest::new(Data::File(data.to_path_buf()));
+        let mut request = CalibrateRequest::new(data);
         request.machine = self.machine.machine.clone();
         request.noise = self.noise.overrides();
         request.parameter_set = self.params.params.clone();

@@ -84,7 +84,7 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
     request.map_dir = a.map.clone();
     request.table_dir = a.table.clone();
     request.table_spacing_mm = a.table_spacing;
-    let c = compensate(&request)?;
+    let c = compensate(request)?;
     crate::output::warn_all(c.machine_warnings());
     if let Some(dir) = &a.map {
         write_map(dir, &c)?;

@@ -91,7 +91,7 @@ pub fn run(a: &ExportArgs) -> Result<u8, CliError> {
         },
         out: a.out.clone(),
     };
-    let e = tricept_ident::export(&request)?;
+    let e = tricept_ident::export(request)?;
     if a.json {
         outln!("{}", e.json(&a.out));
     } else {

@@ -161,7 +161,7 @@ fn request(a: &PlanArgs) -> Result<PlanRequest, CliError> {
     r.k = a.k.clone();
     r.detect_um = a.detect_um;
     r.power = a.power;
-    r.data = a.data.clone().map(tricept_ident::Data::File);
+    r.data = a.data.clone().map(tricept_ident::DataInput::File);
     r.poses = Some(a.poses.clone());
     r.candidates = Some(a.candidates.clone());
     r.head_angles_deg = a.head_angles_deg.clone();
@@ -195,7 +195,7 @@ fn request(a: &PlanArgs) -> Result<PlanRequest, CliError> {
 
 /// `tricept plan`.
 pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
-    let plan = tricept_ident::plan(&request(a)?)?;
+    let plan = tricept_ident::plan(request(a)?)?;
     crate::output::warn_all(plan.machine_warnings());
     if let Some(path) = &a.out
         && plan.write_out(path)?

@@ -138,7 +138,7 @@ fn machines(r: &CompensateRequest) -> Result<Pair, Error> {
     let mut out = Map::new();
     match &r.calibrated {
         Calibrated::Data(request) => {
-            let fit = calibrate(request)?;
+            let fit = calibrate(CalibrateRequest::clone(request))?;
             let code = fit.exit_code();
             write_rule(
                 "compensate",
@@ -209,7 +209,8 @@ fn stats_json(s: &MapStats) -> Value {
 }
 
 /// Compensates as `request` says.
-pub fn compensate(request: &CompensateRequest) -> Result<Compensation, Error> {
+pub fn compensate(request: CompensateRequest) -> Result<Compensation, Error> {
+    let request = &request;
     let spacing = request.spacing_mm;
     if !(spacing.is_finite() && spacing >= 1.0) {
         return Err(Error::input(format!(

@@ -10,6 +10,22 @@
 //! `tricept-check`, `tricept-study`, `tricept-plant`, `tricept-model`,
 //! `tricept-kinematics` and `tricept-data`. ARCHITECTURE.md draws the split.
 //!
+//! One request style: every workflow takes its request **by value**
+//! (`calibrate(CalibrateRequest::new("data.csv"))`), and measured data are
+//! always a [`DataInput`] (a file, a file already read, or a data set in
+//! memory). A request describes one run and is spent by it: by value, the
+//! workflow keeps the data it was given (a calibration holds its data
+//! without copying them), and a caller can move a request to another thread
+//! (the Python binding runs every workflow with the GIL released). The
+//! constructor takes the few values a request cannot do without; the rest
+//! are public fields with the CLI's defaults.
+//!
+//! The root is a curated set: the workflows (one function per verb), their
+//! requests and results, the error with its exit codes, and the domain
+//! types every user needs. The typed values requests are made of, the parts
+//! of results and the few low-level items code beside the door needs are in
+//! [`advanced`].
+//!
 //! Errors: every failure is an [`Error`] whose [`ErrorKind`] decides the
 //! process exit code, one mapping for every verb ([`Error::exit_code`]).
 //!
@@ -61,7 +77,7 @@ pub use plan::plan;
 pub use simulate::simulate;
 
 // Their requests, and what a request's constructor needs.
-pub use calibrate::{CalibrateRequest, Data};
+pub use calibrate::CalibrateRequest;
 pub use check::CheckRequest;
 pub use compensate::{Calibrated, CompensateRequest};
 pub use detectability::DetectabilityRequest;
