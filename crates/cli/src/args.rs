@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use tricept_ident::advanced::{
-    Dataset, EffectName, EffectNames, EvalGrid, FusedSources, HeadAngles, HeadModel, LengthSigma,
-    TrackerTargetSpec, Triple,
+    Dataset, Effect, EffectName, EffectNames, EvalGrid, FusedSources, HeadAngles, HeadModel,
+    LengthSigma, TrackerTargetSpec, Triple, TrueErrors, TruthEffects,
 };
 use tricept_ident::{CalibrateRequest, LoadedMachine, Machine, ParameterSet, SensorNoise};
 
@@ -83,13 +83,33 @@ pub struct TruthArgs {
     /// True geometric errors of the simulated machine: `table2`, `zero`,
     /// `random:MAG_MM[,SEED]` (uniform in +-MAG_MM) or a JSON file
     /// `{name: mm}` (simulate's default: table2).
-    #[arg(long, value_name = "ERRORS", alias = "errors")]
-    pub truth: Option<String>,
+    #[arg(
+        long,
+        value_name = "ERRORS",
+        alias = "errors",
+        value_parser = clap::value_parser!(TrueErrors)
+    )]
+    pub truth: Option<TrueErrors>,
     /// An unmodelled effect of the true machine: a JSON object (or @FILE),
     /// e.g. '{"effect":"leg-lead","ppm":[50,-30,40]}' (magnitudes in the
     /// units their keys name: ppm, um, K, arcsec, N/um); repeatable.
-    #[arg(long = "truth-effect", value_name = "JSON", alias = "effect")]
-    pub truth_effects: Vec<String>,
+    #[arg(
+        long = "truth-effect",
+        value_name = "JSON",
+        alias = "effect",
+        value_parser = clap::value_parser!(TruthEffects)
+    )]
+    pub truth_effects: Vec<TruthEffects>,
+}
+
+impl TruthArgs {
+    /// The effects of every `--truth-effect`, in order.
+    pub fn effects(&self) -> Vec<Effect> {
+        self.truth_effects
+            .iter()
+            .flat_map(|t| t.effects().iter().cloned())
+            .collect()
+    }
 }
 
 /// A reference sphere touched by a probe in the spindle (feature 1 of the
@@ -102,9 +122,10 @@ pub struct TouchSphereArgs {
         long,
         default_value = "0,0,1150",
         value_name = "X,Y,Z",
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = clap::value_parser!(Triple)
     )]
-    pub touch_sphere_mm: String,
+    pub touch_sphere_mm: Triple,
     /// The reference sphere's radius, mm.
     #[arg(long, default_value_t = 12.7, value_name = "MM")]
     pub touch_sphere_radius_mm: f64,

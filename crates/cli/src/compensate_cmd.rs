@@ -6,7 +6,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use tricept_ident::advanced::{ErrorMap, TrueErrors};
+use tricept_ident::advanced::ErrorMap;
 use tricept_ident::{Calibrated, CompensateRequest, Compensation, compensate};
 
 use crate::args::{FitSettings, TruthArgs};
@@ -70,13 +70,8 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
     };
     let mut request = CompensateRequest::new(calibrated);
     request.force = a.force;
-    request.truth = a
-        .truth
-        .truth
-        .as_deref()
-        .map(str::parse::<TrueErrors>)
-        .transpose()?;
-    request.truth_effects = a.truth.truth_effects.clone();
+    request.truth = a.truth.truth.clone();
+    request.truth_effects = a.truth.effects();
     request.parameter_set = a.settings.params.params.clone();
     request.plane_z_mm = a.plane_z;
     request.spacing_mm = a.spacing;

@@ -4,9 +4,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
-use tricept_ident::advanced::{
-    EffectNames, EvalGrid, HeadAngles, TrackerTargetSpec, Triple, parse_numbers,
-};
+use tricept_ident::advanced::{EffectNames, EvalGrid, HeadAngles, TrackerTargetSpec, Triple};
 use tricept_ident::{PlanRequest, Poses};
 
 use crate::args::{MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs};
@@ -156,7 +154,6 @@ impl Instrument {
 
 /// The door's request of `plan`'s flags.
 fn request(a: &PlanArgs) -> Result<PlanRequest, CliError> {
-    let sphere = parse_numbers("--touch-sphere-mm", &a.touch.touch_sphere_mm, 3)?;
     let mut r = PlanRequest::new(a.instrument.door());
     r.k = a.k.clone();
     r.detect_um = a.detect_um;
@@ -174,7 +171,7 @@ fn request(a: &PlanArgs) -> Result<PlanRequest, CliError> {
     r.ballbar_pivot_mm = a.ballbar_pivot_mm;
     r.ballbar_length_mm = a.ballbar_length_mm;
     r.ballbar_candidates = a.ballbar_candidates;
-    r.touch_sphere_mm = Triple([sphere[0], sphere[1], sphere[2]]);
+    r.touch_sphere_mm = a.touch.touch_sphere_mm;
     r.touch_sphere_radius_mm = a.touch.touch_sphere_radius_mm;
     r.touch_stylus_radius_mm = a.touch.touch_stylus_radius_mm;
     r.touch_stylus_sigma_um = a.touch.touch_stylus_sigma_um;

@@ -8,6 +8,7 @@
 //!   sets it ([`std::str::FromStr`], so the binary's clap value parsers
 //!   are these types): [`Triple`] (`X,Y,Z`), [`HeadAngles`],
 //!   [`TrueErrors`] (`--truth`), [`TruthEffects`] (`--truth-effect`),
+//!   [`FrameMmRad`] (`--tracker-frame-mm-rad`),
 //!   [`HeadErrors`], [`TrackerTargetSpec`], [`LengthSigma`], [`HeadModel`],
 //!   [`EffectNames`], [`EvalGrid`]; and the parts of a request:
 //!   [`FusedSources`], the simulated instruments, the export's
@@ -30,7 +31,7 @@ pub use crate::export::{
     AxisSummary, Controller, ExportError, ExportOptions, ExportSummary, NotExported,
 };
 pub use crate::inputs::{
-    HeadAngles, Triple, TrueErrors, parse_effects, parse_numbers, read_data_from,
+    FrameMmRad, HeadAngles, Triple, TrueErrors, parse_effects, parse_numbers, read_data_from,
 };
 pub use crate::kinematics::{BLOCK_ROWS, BatchError, Cell, machine_summary, run, solve_batch};
 pub use crate::simulate::{

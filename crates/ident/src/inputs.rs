@@ -550,6 +550,30 @@ impl FromStr for Triple {
     }
 }
 
+/// A frame `X,Y,Z,RX,RY,RZ`: a translation (mm) and a rotation vector
+/// (rad); a typed flag value.
+///
+/// # Example
+/// ```
+/// let f: tricept_ident::advanced::FrameMmRad = "1500,-800,200,0.1,0.2,0.3".parse().unwrap();
+/// assert_eq!(f.0, [1500.0, -800.0, 200.0, 0.1, 0.2, 0.3]);
+/// let e = "1,2,3".parse::<tricept_ident::advanced::FrameMmRad>().unwrap_err();
+/// assert_eq!(e.message(), "expected 6 comma-separated numbers, got `1,2,3`");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameMmRad(pub [f64; 6]);
+
+impl FromStr for FrameMmRad {
+    type Err = Error;
+
+    /// Its message names no flag: the caller's parser does.
+    fn from_str(text: &str) -> Result<FrameMmRad, Error> {
+        const NAME: &str = "X,Y,Z,RX,RY,RZ";
+        let v = parse_numbers(NAME, text, 6).map_err(|e| without_flag(e, NAME))?;
+        Ok(FrameMmRad([v[0], v[1], v[2], v[3], v[4], v[5]]))
+    }
+}
+
 /// Head-angle lists `H1,H1,...:H2,H2,...` in degrees: a typed flag value.
 ///
 /// # Example
