@@ -25,9 +25,10 @@ use pyo3::prelude::*;
 use rayon::prelude::*;
 use tricept_ident::nalgebra::Vector3;
 use tricept_ident::{
-    CalibrateRequest, CheckRequest, Data, DataInput, DiagnoseRequest, ExtendedMachine, HeadBranch,
-    KinematicsError, LoadedMachine, ParameterSet, Poses, SensorNoise, SimulateRequest, TrueErrors,
+    CalibrateRequest, CheckRequest, DataInput, DiagnoseRequest, ExtendedMachine,
+    LoadedMachine, ParameterSet, Poses, SensorNoise, SimulateRequest,
 };
+use tricept_ident::advanced::{HeadBranch, KinematicsError, TrueErrors};
 
 create_exception!(
     _tricept,
@@ -265,7 +266,7 @@ fn data_of(
     match (path, csv_text) {
         (Some(path), None) => Ok(DataInput::File(path)),
         (None, Some(text)) => Ok(DataInput::Memory(
-            tricept_ident::read_data_from(text.as_bytes(), name, machine).map_err(door_error)?,
+            tricept_ident::advanced::read_data_from(text.as_bytes(), name, machine).map_err(door_error)?,
         )),
         _ => Err(input_error("data: give a CSV path or a mapping of column arrays")),
     }
@@ -361,11 +362,11 @@ fn identify(
         readings_per_pose,
     };
     let data = match (path, csv_text) {
-        (Some(path), None) => Data::File(path),
+        (Some(path), None) => DataInput::File(path),
         (None, Some(text)) => {
             let loaded = machine_of(machine.clone(), noise)?;
-            Data::InMemory(
-                tricept_ident::read_data_from(text.as_bytes(), &name, loaded.machine())
+            DataInput::Memory(
+                tricept_ident::advanced::read_data_from(text.as_bytes(), &name, loaded.machine())
                     .map_err(door_error)?,
             )
         }
@@ -380,7 +381,7 @@ fn identify(
         request.tolerance_mm = t;
     }
     let inner = py
-        .detach(|| tricept_ident::calibrate(&request))
+        .detach(|| tricept_ident::calibrate(request))
         .map_err(door_error)?;
     Ok(Calibration { inner })
 }
@@ -511,7 +512,7 @@ fn simulate_csv(
     request.truth = truth
         .parse::<TrueErrors>()
         .map_err(|e| input_error(format!("truth: {e}")))?;
-    request.truth_effects = tricept_ident::parse_effects(&effects).map_err(door_error)?;
+    request.truth_effects = tricept_ident::advanced::parse_effects(&effects).map_err(door_error)?;
     request.poses = poses.parse::<Poses>().map_err(door_error)?;
     request.seed = seed;
     request.parameter_set = ParameterSet::by_label(&params).map_err(|e| input_error(format!("params: {e}")))?;

@@ -851,3 +851,161 @@ fn the_effect_counter_reads_code_only() {
         "TubeTwist"
     ));
 }
+
+// The door's root (issue 27): `tricept-ident`'s root is a curated list,
+// like grep-searcher's. A new public item goes into `tricept_ident::advanced`
+// unless it is one of these kinds; then it is added here.
+
+/// Every name `crates/ident/src/lib.rs` makes public at the crate root,
+/// by kind.
+const DOOR_ROOT: &[&str] = &[
+    // The workflows: one function per verb.
+    "assess_identifiability",
+    "calibrate",
+    "check",
+    "compensate",
+    "detectability",
+    "diagnose",
+    "effects",
+    "export",
+    "plan",
+    "simulate",
+    "solve_point",
+    // Their requests, and what a request's constructor needs.
+    "CalibrateRequest",
+    "Calibrated",
+    "Campaign",
+    "CheckRequest",
+    "CompensateRequest",
+    "DetectabilityRequest",
+    "DiagnoseRequest",
+    "ExportRequest",
+    "IdentifiabilityRequest",
+    "Instrument",
+    "KinematicsVerb",
+    "PlanRequest",
+    "SimulateRequest",
+    // Their results.
+    "Calibration",
+    "CheckResult",
+    "Compensation",
+    "DetectabilityReport",
+    "DiagnoseResult",
+    "EffectList",
+    "Export",
+    "Identifiability",
+    "PointSolution",
+    "Plan",
+    "Simulation",
+    // The error and the exit codes.
+    "EXIT_INADEQUATE",
+    "EXIT_INPUT",
+    "EXIT_NOT_CONVERGED",
+    "EXIT_OK",
+    "EXIT_OTHER",
+    "Error",
+    "ErrorKind",
+    // The domain.
+    "DataInput",
+    "ExtendedMachine",
+    "LoadedMachine",
+    "Machine",
+    "ParameterSet",
+    "Poses",
+    "SensorNoise",
+    "load_machine",
+    "nalgebra",
+    // Everything else, behind one module.
+    "advanced",
+];
+
+/// `tree` with every `name as alias` replaced by `alias`.
+fn renamed(tree: &str) -> String {
+    let mut parts = tree.split(" as ");
+    let mut out = parts.next().unwrap_or_default().to_string();
+    for part in parts {
+        let kept = out.trim_end_matches(is_ident).len();
+        out.truncate(kept);
+        out.push_str(part);
+    }
+    out
+}
+
+/// The names a crate root's code makes public: the last segment (or the
+/// alias) of every `pub use` path, and every `pub` item's name.
+fn public_names(code: &str) -> BTreeSet<String> {
+    let code = without_tests(&strip(code));
+    let mut names = BTreeSet::new();
+    let words: Vec<&str> = code.split_whitespace().collect();
+    for (k, w) in words.iter().enumerate() {
+        if *w != "pub" {
+            continue;
+        }
+        let item = [
+            "mod", "fn", "struct", "enum", "const", "static", "type", "trait", "macro",
+        ];
+        if words.get(k + 1).is_some_and(|w| item.contains(w))
+            && let Some(name) = words.get(k + 2)
+        {
+            names.insert(name.chars().take_while(|c| is_ident(*c)).collect());
+        }
+    }
+    let mut rest = code.as_str();
+    while let Some(at) = rest.find("pub use ") {
+        let before = &rest[..at];
+        let after = &rest[at + "pub use ".len()..];
+        let end = after.find(';').unwrap_or(after.len());
+        if !before.ends_with(|c: char| is_ident(c)) {
+            for path in expand(&renamed(&after[..end])) {
+                if let Some(name) = path.last() {
+                    names.insert(name.clone());
+                }
+            }
+        }
+        rest = &after[end..];
+    }
+    names
+}
+
+/// The door's root is the curated list: nothing more (a new item goes into
+/// `advanced` or into [`DOOR_ROOT`] with its kind), nothing less (the list
+/// stays true).
+#[test]
+fn the_door_s_root_is_its_curated_list() {
+    let lib = workspace().join("crates/ident/src/lib.rs");
+    let code = std::fs::read_to_string(&lib).unwrap_or_default();
+    assert!(!code.is_empty(), "{} is missing", lib.display());
+    let root = public_names(&code);
+    let curated: BTreeSet<String> = DOOR_ROOT.iter().map(|s| s.to_string()).collect();
+    let extra: Vec<&String> = root.difference(&curated).collect();
+    let missing: Vec<&String> = curated.difference(&root).collect();
+    assert!(
+        extra.is_empty(),
+        "tricept-ident's root grew past its curated list (xtask/tests/tidy.rs DOOR_ROOT): {extra:?}; \
+         put them in `tricept_ident::advanced`, or add them to the list with their kind"
+    );
+    assert!(
+        missing.is_empty(),
+        "DOOR_ROOT names what tricept-ident's root no longer has: {missing:?}"
+    );
+    assert!(root.len() <= 55, "{} names at the root", root.len());
+}
+
+/// The root reader itself: re-exports with braces and renames, public
+/// items, and not `pub(crate)` re-exports nor test items.
+#[test]
+fn the_root_reader_finds_public_names() {
+    let names = public_names(
+        "mod a;\npub mod b;\npub use a::{C, d::{E, F as G}};\npub use h::I as J;\n\
+         pub(crate) use a::K;\npub fn l() {}\npub struct M;\npub const N: u8 = 0;\n\
+         // pub use a::Commented;\npub use nalgebra;\n#[cfg(test)]\npub use a::T;\n",
+    );
+    let expected = ["C", "E", "G", "J", "b", "l", "M", "N", "nalgebra"];
+    assert_eq!(
+        names,
+        expected
+            .iter()
+            .map(|s| s.to_string())
+            .collect::<BTreeSet<_>>()
+    );
+}

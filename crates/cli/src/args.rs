@@ -9,13 +9,11 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use tricept_data::Dataset;
-use tricept_ident::{
-    CalibrateRequest, Data, EffectName, EffectNames, EvalGrid, FusedSources, HeadAngles, HeadModel,
-    LengthSigma, LoadedMachine, SensorNoise, TrackerTargetSpec, Triple,
+use tricept_ident::advanced::{
+    Dataset, Effect, EffectName, EffectNames, EvalGrid, FusedSources, HeadAngles, HeadModel,
+    LengthSigma, TrackerTargetSpec, Triple, TrueErrors, TruthEffects,
 };
-use tricept_kinematics::Machine;
-use tricept_model::ParameterSet;
+use tricept_ident::{CalibrateRequest, LoadedMachine, Machine, ParameterSet, SensorNoise};
 
 use crate::cli_error::CliError;
 
@@ -85,13 +83,33 @@ pub struct TruthArgs {
     /// True geometric errors of the simulated machine: `table2`, `zero`,
     /// `random:MAG_MM[,SEED]` (uniform in +-MAG_MM) or a JSON file
     /// `{name: mm}` (simulate's default: table2).
-    #[arg(long, value_name = "ERRORS", alias = "errors")]
-    pub truth: Option<String>,
+    #[arg(
+        long,
+        value_name = "ERRORS",
+        alias = "errors",
+        value_parser = clap::value_parser!(TrueErrors)
+    )]
+    pub truth: Option<TrueErrors>,
     /// An unmodelled effect of the true machine: a JSON object (or @FILE),
     /// e.g. '{"effect":"leg-lead","ppm":[50,-30,40]}' (magnitudes in the
     /// units their keys name: ppm, um, K, arcsec, N/um); repeatable.
-    #[arg(long = "truth-effect", value_name = "JSON", alias = "effect")]
-    pub truth_effects: Vec<String>,
+    #[arg(
+        long = "truth-effect",
+        value_name = "JSON",
+        alias = "effect",
+        value_parser = clap::value_parser!(TruthEffects)
+    )]
+    pub truth_effects: Vec<TruthEffects>,
+}
+
+impl TruthArgs {
+    /// The effects of every `--truth-effect`, in order.
+    pub fn effects(&self) -> Vec<Effect> {
+        self.truth_effects
+            .iter()
+            .flat_map(|t| t.effects().iter().cloned())
+            .collect()
+    }
 }
 
 /// A reference sphere touched by a probe in the spindle (feature 1 of the
@@ -104,9 +122,10 @@ pub struct TouchSphereArgs {
         long,
         default_value = "0,0,1150",
         value_name = "X,Y,Z",
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = clap::value_parser!(Triple)
     )]
-    pub touch_sphere_mm: String,
+    pub touch_sphere_mm: Triple,
     /// The reference sphere's radius, mm.
     #[arg(long, default_value_t = 12.7, value_name = "MM")]
     pub touch_sphere_radius_mm: f64,
@@ -154,15 +173,18 @@ pub fn load_with_noise(args: &MachineArgs, noise: &NoiseArgs) -> Result<LoadedMa
     Ok(loaded)
 }
 
-/// Reads a measured-data file (`tricept_ident::read_data_from`) with a
+/// Reads a measured-data file (`tricept_ident::advanced::read_data_from`) with a
 /// progress bar over the bytes read (drawn only on a terminal).
 pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, CliError> {
     let file = path.display().to_string();
     let f = std::fs::File::open(path).map_err(|e| CliError::input(format!("{file}: {e}")))?;
     let size = f.metadata().map(|m| m.len()).unwrap_or(0);
     let bar = progress_bar(size, &format!("reading {file}"));
-    let data =
-        tricept_ident::read_data_from(bar.wrap_read(std::io::BufReader::new(f)), &file, machine)?;
+    let data = tricept_ident::advanced::read_data_from(
+        bar.wrap_read(std::io::BufReader::new(f)),
+        &file,
+        machine,
+    )?;
     bar.finish_and_clear();
     Ok(data)
 }
@@ -214,7 +236,7 @@ impl FitSettings {
     /// The door's calibration request of these settings for `data`
     /// (internal; the caller adds external sources).
     pub fn request(&self, data: &Path) -> CalibrateRequest {
-        let mut request = CalibrateRequest::new(Data::File(data.to_path_buf()));
+        let mut request = CalibrateRequest::new(data);
         request.machine = self.machine.machine.clone();
         request.noise = self.noise.overrides();
         request.parameter_set = self.params.params.clone();

@@ -6,13 +6,13 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use tricept_ident::{Calibrated, CompensateRequest, Compensation, TrueErrors, compensate};
-use tricept_model::ErrorMap;
+use tricept_ident::advanced::ErrorMap;
+use tricept_ident::{Calibrated, CompensateRequest, Compensation, compensate};
 
 use crate::args::{FitSettings, TruthArgs};
 use crate::cli_error::CliError;
 
-pub use tricept_ident::{MAP_FILES, TABLE_FILES};
+pub use tricept_ident::advanced::{MAP_FILES, TABLE_FILES};
 
 /// `tricept compensate`.
 #[derive(Debug, Args)]
@@ -70,13 +70,8 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
     };
     let mut request = CompensateRequest::new(calibrated);
     request.force = a.force;
-    request.truth = a
-        .truth
-        .truth
-        .as_deref()
-        .map(str::parse::<TrueErrors>)
-        .transpose()?;
-    request.truth_effects = a.truth.truth_effects.clone();
+    request.truth = a.truth.truth.clone();
+    request.truth_effects = a.truth.effects();
     request.parameter_set = a.settings.params.params.clone();
     request.plane_z_mm = a.plane_z;
     request.spacing_mm = a.spacing;
@@ -84,7 +79,7 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
     request.map_dir = a.map.clone();
     request.table_dir = a.table.clone();
     request.table_spacing_mm = a.table_spacing;
-    let c = compensate(&request)?;
+    let c = compensate(request)?;
     crate::output::warn_all(c.machine_warnings());
     if let Some(dir) = &a.map {
         write_map(dir, &c)?;

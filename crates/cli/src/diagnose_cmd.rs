@@ -5,15 +5,16 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
+use tricept_ident::advanced::ResidualPlot;
 use tricept_ident::{
     DataInput, DetectabilityRequest, DiagnoseRequest, DiagnoseResult, LoadedMachine, Poses,
-    ResidualPlot, detectability, diagnose,
+    detectability, diagnose,
 };
 
 use crate::args::{MachineArgs, NoiseArgs, load_with_noise, read_data};
 use crate::cli_error::CliError;
 
-pub use tricept_ident::vocabulary_help;
+pub use tricept_ident::advanced::vocabulary_help;
 
 /// `tricept diagnose`.
 #[derive(Debug, Args)]

@@ -5,7 +5,8 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_ident::{Controller, ExportOptions, ExportRequest};
+use tricept_ident::ExportRequest;
+use tricept_ident::advanced::{Controller, ExportOptions};
 
 use crate::cli_error::CliError;
 
@@ -90,7 +91,7 @@ pub fn run(a: &ExportArgs) -> Result<u8, CliError> {
         },
         out: a.out.clone(),
     };
-    let e = tricept_ident::export(&request)?;
+    let e = tricept_ident::export(request)?;
     if a.json {
         outln!("{}", e.json(&a.out));
     } else {

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use tricept_ident::{
-    CalibrateRequest, Campaign, Data, IdentifiabilityRequest, Poses, assess_identifiability,
+    CalibrateRequest, Campaign, DataInput, IdentifiabilityRequest, Poses, assess_identifiability,
     calibrate,
 };
 
@@ -34,14 +34,14 @@ pub struct IdentifiabilityArgs {
 /// `tricept identifiability`.
 pub fn run_identifiability(a: &IdentifiabilityArgs) -> Result<u8, CliError> {
     let campaign = match &a.data {
-        Some(path) => Campaign::Data(Data::File(path.clone())),
+        Some(path) => Campaign::Data(DataInput::File(path.clone())),
         None => Campaign::Poses(a.poses.clone()),
     };
     let mut request = IdentifiabilityRequest::new(campaign);
     request.machine = a.machine.machine.clone();
     request.noise = a.noise.overrides();
     request.parameter_set = a.params.params.clone();
-    let result = assess_identifiability(&request)?;
+    let result = assess_identifiability(request)?;
     crate::output::warn_all(result.machine_warnings());
     if a.machine.json {
         outln!("{}", result.to_json());
@@ -65,7 +65,7 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
         "identify: reading, screening and fitting (Gauss-Newton on the exact model)",
         &a.data,
     );
-    let calibration = calibrate(&calibrate_request(a));
+    let calibration = calibrate(calibrate_request(a));
     spin.finish_and_clear();
     let mut calibration = calibration?;
     crate::output::warn_all(calibration.machine_warnings());

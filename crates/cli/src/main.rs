@@ -179,6 +179,15 @@ fn file_roles(command: &Command) -> files::FileRoles {
             r.input("--machine", p);
         }
     };
+    // The true errors' file, and the effects' `@FILE`s.
+    let truth_inputs = |r: &mut files::FileRoles, t: &args::TruthArgs| {
+        if let Some(tricept_ident::advanced::TrueErrors::File(p)) = &t.truth {
+            r.input_if_file("--truth", &p.to_string_lossy());
+        }
+        for e in &t.truth_effects {
+            r.input_if_file("--truth-effect", &e.to_string());
+        }
+    };
     match command {
         Command::Ik(a) => {
             machine(&mut r, &a.machine);
@@ -215,12 +224,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         Command::Simulate(a) => {
             machine(&mut r, &a.machine);
             r.input_if_file("--poses", &a.poses.to_string());
-            if let Some(t) = &a.truth.truth {
-                r.input_if_file("--truth", t);
-            }
-            for e in &a.truth.truth_effects {
-                r.input_if_file("--truth-effect", e);
-            }
+            truth_inputs(&mut r, &a.truth);
             r.input_if_file("--head-errors", &a.head_errors.to_string());
             r.inputs("--tracker-poses", &a.tracker_poses);
             r.inputs("--ballbar-poses", &a.ballbar_poses);
@@ -254,12 +258,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
             machine(&mut r, &a.settings.machine);
             r.inputs("--data", &a.data);
             r.inputs("--targets", &a.targets);
-            if let Some(t) = &a.truth.truth {
-                r.input_if_file("--truth", t);
-            }
-            for e in &a.truth.truth_effects {
-                r.input_if_file("--truth-effect", e);
-            }
+            truth_inputs(&mut r, &a.truth);
             if let Some(d) = &a.map {
                 r.outputs_in("--map", d, compensate_cmd::MAP_FILES);
             }

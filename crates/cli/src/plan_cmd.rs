@@ -4,9 +4,8 @@
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
-use tricept_ident::{
-    EffectNames, EvalGrid, HeadAngles, PlanRequest, Poses, TrackerTargetSpec, Triple, parse_numbers,
-};
+use tricept_ident::advanced::{EffectNames, EvalGrid, HeadAngles, TrackerTargetSpec, Triple};
+use tricept_ident::{PlanRequest, Poses};
 
 use crate::args::{MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs};
 use crate::cli_error::CliError;
@@ -155,12 +154,11 @@ impl Instrument {
 
 /// The door's request of `plan`'s flags.
 fn request(a: &PlanArgs) -> Result<PlanRequest, CliError> {
-    let sphere = parse_numbers("--touch-sphere-mm", &a.touch.touch_sphere_mm, 3)?;
     let mut r = PlanRequest::new(a.instrument.door());
     r.k = a.k.clone();
     r.detect_um = a.detect_um;
     r.power = a.power;
-    r.data = a.data.clone().map(tricept_ident::Data::File);
+    r.data = a.data.clone().map(tricept_ident::DataInput::File);
     r.poses = Some(a.poses.clone());
     r.candidates = Some(a.candidates.clone());
     r.head_angles_deg = a.head_angles_deg.clone();
@@ -173,7 +171,7 @@ fn request(a: &PlanArgs) -> Result<PlanRequest, CliError> {
     r.ballbar_pivot_mm = a.ballbar_pivot_mm;
     r.ballbar_length_mm = a.ballbar_length_mm;
     r.ballbar_candidates = a.ballbar_candidates;
-    r.touch_sphere_mm = Triple([sphere[0], sphere[1], sphere[2]]);
+    r.touch_sphere_mm = a.touch.touch_sphere_mm;
     r.touch_sphere_radius_mm = a.touch.touch_sphere_radius_mm;
     r.touch_stylus_radius_mm = a.touch.touch_stylus_radius_mm;
     r.touch_stylus_sigma_um = a.touch.touch_stylus_sigma_um;
@@ -194,7 +192,7 @@ fn request(a: &PlanArgs) -> Result<PlanRequest, CliError> {
 
 /// `tricept plan`.
 pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
-    let plan = tricept_ident::plan(&request(a)?)?;
+    let plan = tricept_ident::plan(request(a)?)?;
     crate::output::warn_all(plan.machine_warnings());
     if let Some(path) = &a.out
         && plan.write_out(path)?

@@ -5,10 +5,10 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_ident::{
-    BallbarSimulation, HeadErrors, Poses, SimulateRequest, TouchSimulation, TrackerSimulation,
-    Triple, parse_effects, parse_numbers, simulate,
+use tricept_ident::advanced::{
+    BallbarSimulation, FrameMmRad, HeadErrors, TouchSimulation, TrackerSimulation, Triple,
 };
+use tricept_ident::{Poses, SimulateRequest, simulate};
 
 use crate::args::{MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs, TruthArgs, load_with_noise};
 use crate::cli_error::CliError;
@@ -57,9 +57,10 @@ pub struct SimulateArgs {
         long,
         default_value = "1500,-800,200,0.1,0.2,0.3",
         value_name = "X,Y,Z,RX,RY,RZ",
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = clap::value_parser!(FrameMmRad)
     )]
-    pub tracker_frame_mm_rad: String,
+    pub tracker_frame_mm_rad: FrameMmRad,
     /// The tracker target's offset from the tool tip, mm (spindle frame at
     /// zero head angles).
     #[arg(
@@ -141,9 +142,9 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
     let mut request = SimulateRequest::new(load_with_noise(&a.machine, &a.noise)?);
     request.parameter_set = a.params.set()?;
     if let Some(truth) = &a.truth.truth {
-        request.truth = truth.parse()?;
+        request.truth = truth.clone();
     }
-    request.truth_effects = parse_effects(&a.truth.truth_effects)?;
+    request.truth_effects = a.truth.effects();
     request.head_errors = a.head_errors.clone();
     request.poses = a.poses.clone();
     request.seed = a.seed;
@@ -193,15 +194,12 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
 /// The tracker to simulate: --tracker-out and --tracker-poses together.
 fn tracker(a: &SimulateArgs) -> Result<Option<TrackerSimulation>, CliError> {
     match (&a.tracker_out, &a.tracker_poses) {
-        (Some(_), Some(poses)) => {
-            let f = parse_numbers("--tracker-frame-mm-rad", &a.tracker_frame_mm_rad, 6)?;
-            Ok(Some(TrackerSimulation {
-                poses: poses.clone(),
-                frame_mm_rad: [f[0], f[1], f[2], f[3], f[4], f[5]],
-                target_mm: a.tracker_target_mm.0,
-                sigma_um: a.tracker_sigma_um,
-            }))
-        }
+        (Some(_), Some(poses)) => Ok(Some(TrackerSimulation {
+            poses: poses.clone(),
+            frame_mm_rad: a.tracker_frame_mm_rad.0,
+            target_mm: a.tracker_target_mm.0,
+            sigma_um: a.tracker_sigma_um,
+        })),
         (None, None) => Ok(None),
         _ => Err(CliError::input(
             "--tracker-out and --tracker-poses go together",
@@ -229,18 +227,15 @@ fn ballbar(a: &SimulateArgs) -> Result<Option<BallbarSimulation>, CliError> {
 /// --touch-poses together.
 fn touch(a: &SimulateArgs) -> Result<Option<TouchSimulation>, CliError> {
     match (&a.touch_out, &a.features_out, &a.touch_poses) {
-        (Some(_), Some(_), Some(poses)) => {
-            let c = parse_numbers("--touch-sphere-mm", &a.touch.touch_sphere_mm, 3)?;
-            Ok(Some(TouchSimulation {
-                poses: poses.clone(),
-                sphere_mm: [c[0], c[1], c[2]],
-                sphere_radius_mm: a.touch.touch_sphere_radius_mm,
-                stylus_radius_mm: a.touch.touch_stylus_radius_mm,
-                stylus_sigma_um: a.touch.touch_stylus_sigma_um,
-                stylus_error_um: a.touch_stylus_error_um,
-                sigma_um: a.touch.touch_sigma_um,
-            }))
-        }
+        (Some(_), Some(_), Some(poses)) => Ok(Some(TouchSimulation {
+            poses: poses.clone(),
+            sphere_mm: a.touch.touch_sphere_mm.0,
+            sphere_radius_mm: a.touch.touch_sphere_radius_mm,
+            stylus_radius_mm: a.touch.touch_stylus_radius_mm,
+            stylus_sigma_um: a.touch.touch_stylus_sigma_um,
+            stylus_error_um: a.touch_stylus_error_um,
+            sigma_um: a.touch.touch_sigma_um,
+        })),
         (None, None, None) => Ok(None),
         _ => Err(CliError::input(
             "--touch-out, --features-out and --touch-poses go together",

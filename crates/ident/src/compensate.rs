@@ -17,10 +17,11 @@ use serde_json::{Map, Value, json};
 use tricept_engine::{CompensationTable, ExtendedMachine};
 use tricept_kinematics::description::LegTableDescription;
 use tricept_model::{ErrorMap, MapStats, ParameterSet};
+use tricept_plant::Effect;
 
 use crate::calibrate::{CalibrateRequest, calibrate, exit_line, write_text};
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, Error};
-use crate::inputs::{SensorNoise, TrueErrors, load_machine, parse_effects};
+use crate::inputs::{SensorNoise, TrueErrors, load_machine};
 use crate::machine_file::write_rule;
 
 /// The largest interpolation error (um) the default table spacing allows.
@@ -53,8 +54,8 @@ pub struct CompensateRequest {
     pub force: bool,
     /// The true errors of a simulated machine (before/after maps).
     pub truth: Option<TrueErrors>,
-    /// The true machine's unmodelled effects (JSON specs; need `truth`).
-    pub truth_effects: Vec<String>,
+    /// The true machine's unmodelled effects (need `truth`).
+    pub truth_effects: Vec<Effect>,
     /// The parameter set of `truth`.
     pub parameter_set: ParameterSet,
     /// Plane of the map, z in mm (default: the workspace's middle plane).
@@ -138,7 +139,7 @@ fn machines(r: &CompensateRequest) -> Result<Pair, Error> {
     let mut out = Map::new();
     match &r.calibrated {
         Calibrated::Data(request) => {
-            let fit = calibrate(request)?;
+            let fit = calibrate(CalibrateRequest::clone(request))?;
             let code = fit.exit_code();
             write_rule(
                 "compensate",
@@ -209,7 +210,8 @@ fn stats_json(s: &MapStats) -> Value {
 }
 
 /// Compensates as `request` says.
-pub fn compensate(request: &CompensateRequest) -> Result<Compensation, Error> {
+pub fn compensate(request: CompensateRequest) -> Result<Compensation, Error> {
+    let request = &request;
     let spacing = request.spacing_mm;
     if !(spacing.is_finite() && spacing >= 1.0) {
         return Err(Error::input(format!(
@@ -391,7 +393,7 @@ fn truth_maps(
         nominal.machine().clone(),
         set.to_errors(&truth.values(set)?),
     );
-    plant.effects = parse_effects(&request.truth_effects)?;
+    plant.effects = request.truth_effects.clone();
     // Where the true machine goes when commanded by a machine's IK.
     let map = |commanding: &ExtendedMachine| -> Result<ErrorMap, Error> {
         let context = "compensation map";

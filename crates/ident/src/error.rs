@@ -89,7 +89,8 @@ impl ErrorKind {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::{Classify, ErrorKind, IdentError};
+/// use tricept_ident::ErrorKind;
+/// use tricept_ident::advanced::{Classify, IdentError};
 /// let e = IdentError::Invalid("alpha must lie in (0, 0.5)".into());
 /// assert_eq!(e.kind(), ErrorKind::Input);
 /// ```

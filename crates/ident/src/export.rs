@@ -91,7 +91,8 @@ impl Export {
 /// Loads the calibrated machine file (refusing one edited after its
 /// calibration), plans the export and, when every axis is within the
 /// tolerance, writes the files atomically.
-pub fn export(request: &ExportRequest) -> Result<Export, Error> {
+pub fn export(request: ExportRequest) -> Result<Export, Error> {
+    let request = &request;
     let source = request.machine.display().to_string();
     let description = MachineDescription::from_file(&request.machine)
         .map_err(|e| Error::from(e).in_file(&source))?;

@@ -10,7 +10,8 @@ use tricept_data::MeasuredPose;
 use tricept_engine::{GeometricModel, IdentifiabilityReport, IdentifyOptions};
 use tricept_model::ParameterSet;
 
-use crate::calibrate::{Data, fit_error};
+use crate::calibrate::fit_error;
+use crate::data_input::DataInput;
 use crate::error::Error;
 use crate::inputs::{Poses, SensorNoise, load_machine};
 
@@ -22,7 +23,7 @@ pub enum Campaign {
     /// kinematics.
     Poses(Poses),
     /// The commands of a logged campaign (its readings are not used).
-    Data(Data),
+    Data(DataInput),
 }
 
 /// What to assess.
@@ -67,16 +68,16 @@ pub struct Identifiability {
 /// # Example
 /// ```
 /// use tricept_ident::{Campaign, IdentifiabilityRequest, assess_identifiability};
-/// let r = assess_identifiability(&IdentifiabilityRequest::new(Campaign::Poses("grid".parse()?)))?;
+/// let r = assess_identifiability(IdentifiabilityRequest::new(Campaign::Poses("grid".parse()?)))?;
 /// assert_eq!(r.to_json()["parameter_set"], "paper15");
 /// # Ok::<(), tricept_ident::Error>(())
 /// ```
-pub fn assess_identifiability(request: &IdentifiabilityRequest) -> Result<Identifiability, Error> {
+pub fn assess_identifiability(request: IdentifiabilityRequest) -> Result<Identifiability, Error> {
     let loaded = load_machine(request.machine.as_deref(), &request.noise)?;
     let m = loaded.machine();
     let set = &request.parameter_set;
     let (commands, campaign, source) = match &request.campaign {
-        Campaign::Data(data) => (data.read(m)?.poses, data.name(), data.name()),
+        Campaign::Data(data) => (data.load(m)?.poses, data.name(), data.name()),
         Campaign::Poses(poses) => {
             let targets = poses.targets(m)?;
             let mut commands = Vec::with_capacity(targets.len());

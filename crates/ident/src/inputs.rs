@@ -214,12 +214,6 @@ fn apply_noise(m: &mut Machine, noise: &SensorNoise) -> Result<(), Error> {
 }
 
 /// `v` if it is a positive finite number, else an input error naming `flag`.
-///
-/// # Example
-/// ```
-/// assert!(tricept_ident::positive("--sigma-um", 0.0).is_err());
-/// assert_eq!(tricept_ident::positive("--sigma-um", 2.5).unwrap(), 2.5);
-/// ```
 pub fn positive(flag: &str, v: f64) -> Result<f64, Error> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
@@ -378,7 +372,8 @@ impl Poses {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::{ParameterSet, TrueErrors};
+/// use tricept_ident::ParameterSet;
+/// use tricept_ident::advanced::TrueErrors;
 /// let set = ParameterSet::paper15();
 /// let e: TrueErrors = "random:0.1,3".parse().unwrap();
 /// assert!(e.values(&set).unwrap().iter().all(|v| v.abs() <= 0.1));
@@ -475,9 +470,9 @@ impl TrueErrors {
 ///
 /// # Example
 /// ```
-/// let effects = tricept_ident::parse_effects(&[r#"{"effect":"leg-lead","ppm":[50,-30,40]}"#.to_string()]).unwrap();
+/// let effects = tricept_ident::advanced::parse_effects(&[r#"{"effect":"leg-lead","ppm":[50,-30,40]}"#.to_string()]).unwrap();
 /// assert_eq!(effects.len(), 1);
-/// assert!(tricept_ident::parse_effects(&["{\"effect\":\"nothing\"}".to_string()]).is_err());
+/// assert!(tricept_ident::advanced::parse_effects(&["{\"effect\":\"nothing\"}".to_string()]).is_err());
 /// ```
 pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
     let mut out = Vec::new();
@@ -513,8 +508,8 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
 ///
 /// # Example
 /// ```
-/// assert_eq!(tricept_ident::parse_numbers("--at", "1,2.5,-3", 3).unwrap(), vec![1.0, 2.5, -3.0]);
-/// assert!(tricept_ident::parse_numbers("--at", "1,2", 3).is_err());
+/// assert_eq!(tricept_ident::advanced::parse_numbers("--at", "1,2.5,-3", 3).unwrap(), vec![1.0, 2.5, -3.0]);
+/// assert!(tricept_ident::advanced::parse_numbers("--at", "1,2", 3).is_err());
 /// ```
 pub fn parse_numbers(flag: &str, text: &str, count: usize) -> Result<Vec<f64>, Error> {
     let values: Result<Vec<f64>, _> = text.split(',').map(|t| t.trim().parse::<f64>()).collect();
@@ -538,9 +533,9 @@ pub fn parse_numbers(flag: &str, text: &str, count: usize) -> Result<Vec<f64>, E
 ///
 /// # Example
 /// ```
-/// let t: tricept_ident::Triple = "0,0,1150".parse().unwrap();
+/// let t: tricept_ident::advanced::Triple = "0,0,1150".parse().unwrap();
 /// assert_eq!(t.0, [0.0, 0.0, 1150.0]);
-/// assert!("0,0".parse::<tricept_ident::Triple>().is_err());
+/// assert!("0,0".parse::<tricept_ident::advanced::Triple>().is_err());
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Triple(pub [f64; 3]);
@@ -555,13 +550,37 @@ impl FromStr for Triple {
     }
 }
 
+/// A frame `X,Y,Z,RX,RY,RZ`: a translation (mm) and a rotation vector
+/// (rad); a typed flag value.
+///
+/// # Example
+/// ```
+/// let f: tricept_ident::advanced::FrameMmRad = "1500,-800,200,0.1,0.2,0.3".parse().unwrap();
+/// assert_eq!(f.0, [1500.0, -800.0, 200.0, 0.1, 0.2, 0.3]);
+/// let e = "1,2,3".parse::<tricept_ident::advanced::FrameMmRad>().unwrap_err();
+/// assert_eq!(e.message(), "expected 6 comma-separated numbers, got `1,2,3`");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameMmRad(pub [f64; 6]);
+
+impl FromStr for FrameMmRad {
+    type Err = Error;
+
+    /// Its message names no flag: the caller's parser does.
+    fn from_str(text: &str) -> Result<FrameMmRad, Error> {
+        const NAME: &str = "X,Y,Z,RX,RY,RZ";
+        let v = parse_numbers(NAME, text, 6).map_err(|e| without_flag(e, NAME))?;
+        Ok(FrameMmRad([v[0], v[1], v[2], v[3], v[4], v[5]]))
+    }
+}
+
 /// Head-angle lists `H1,H1,...:H2,H2,...` in degrees: a typed flag value.
 ///
 /// # Example
 /// ```
-/// let h: tricept_ident::HeadAngles = "0,90:15,35".parse().unwrap();
+/// let h: tricept_ident::advanced::HeadAngles = "0,90:15,35".parse().unwrap();
 /// assert_eq!((h.h1_deg.len(), h.h2_deg.len()), (2, 2));
-/// assert!("0,90".parse::<tricept_ident::HeadAngles>().is_err());
+/// assert!("0,90".parse::<tricept_ident::advanced::HeadAngles>().is_err());
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct HeadAngles {
@@ -616,4 +635,20 @@ fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>, Error> {
         )));
     }
     parse_numbers(flag, text, n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn positive_takes_positive_finite_numbers_only() {
+        assert!(positive("--sigma-um", 0.0).is_err());
+        assert!(positive("--sigma-um", f64::NAN).is_err());
+        assert_eq!(positive("--sigma-um", 2.5).unwrap(), 2.5);
+        assert_eq!(
+            positive("--sigma-um", -1.0).unwrap_err().message(),
+            "--sigma-um: must be a positive number, got -1"
+        );
+    }
 }

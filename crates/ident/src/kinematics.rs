@@ -243,7 +243,8 @@ fn write_cell(out: &mut Vec<u8>, c: Cell) {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::kinematics::{Verb, run};
+/// use tricept_ident::KinematicsVerb as Verb;
+/// use tricept_ident::advanced::run;
 /// use tricept_ident::{ExtendedMachine, Machine};
 /// let m = ExtendedMachine::new(Machine::paper());
 /// let mut out = Vec::new();
@@ -401,7 +402,7 @@ pub struct PointSolution {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::kinematics::{Verb, solve_point};
+/// use tricept_ident::{KinematicsVerb as Verb, solve_point};
 /// use tricept_ident::{SensorNoise, load_machine};
 /// let m = load_machine(None, &SensorNoise::default()).unwrap();
 /// let s = solve_point(Verb::Ik, &m, &[0.0, 0.0, 750.0]).unwrap();

@@ -10,6 +10,22 @@
 //! `tricept-check`, `tricept-study`, `tricept-plant`, `tricept-model`,
 //! `tricept-kinematics` and `tricept-data`. ARCHITECTURE.md draws the split.
 //!
+//! One request style: every workflow takes its request **by value**
+//! (`calibrate(CalibrateRequest::new("data.csv"))`), and measured data are
+//! always a [`DataInput`] (a file, a file already read, or a data set in
+//! memory). A request describes one run and is spent by it: by value, the
+//! workflow keeps the data it was given (a calibration holds its data
+//! without copying them), and a caller can move a request to another thread
+//! (the Python binding runs every workflow with the GIL released). The
+//! constructor takes the few values a request cannot do without; the rest
+//! are public fields with the CLI's defaults.
+//!
+//! The root is a curated set: the workflows (one function per verb), their
+//! requests and results, the error with its exit codes, and the domain
+//! types every user needs. The typed values requests are made of, the parts
+//! of results and the few low-level items code beside the door needs are in
+//! [`advanced`].
+//!
 //! Errors: every failure is an [`Error`] whose [`ErrorKind`] decides the
 //! process exit code, one mapping for every verb ([`Error::exit_code`]).
 //!
@@ -23,90 +39,80 @@
 mod error;
 mod export;
 mod inputs;
-pub mod limits;
-pub mod machine_file;
-pub use export::{
-    AxisSummary, Controller, Export, ExportError, ExportOptions, ExportRequest, ExportSummary,
-    NotExported, export,
-};
+mod limits;
+mod machine_file;
 
 // Layer 1: the workflows.
 mod calibrate;
-mod compensate;
-mod identifiability;
-mod plan;
-
-// Workflows of the diagnosis, the check, the simulator and the kinematics
-// (issue 27, helper B).
 mod check;
+mod compensate;
 mod data_input;
 mod detectability;
 mod diagnosis;
 mod effects;
-pub mod kinematics;
+mod identifiability;
+mod kinematics;
+mod plan;
 mod simulate;
 
+// Layer 2: what a downstream crate may need besides the curated root.
+pub mod advanced;
+
+// The curated root: xtask/tests/tidy.rs holds this list and fails when the
+// root grows past it. A new item goes into `advanced` unless it is a
+// workflow, its request or result, the error, or a domain type every user
+// needs.
+
+// The workflows: one function per verb.
+pub use calibrate::calibrate;
+pub use check::check;
+pub use compensate::compensate;
+pub use detectability::detectability;
+pub use diagnosis::diagnose;
+pub use effects::effects;
+pub use export::export;
+pub use identifiability::assess_identifiability;
+pub use kinematics::solve_point;
+pub use plan::plan;
+pub use simulate::simulate;
+
+// Their requests, and what a request's constructor needs.
+pub use calibrate::CalibrateRequest;
+pub use check::CheckRequest;
+pub use compensate::{Calibrated, CompensateRequest};
+pub use detectability::DetectabilityRequest;
+pub use diagnosis::DiagnoseRequest;
+pub use export::ExportRequest;
+pub use identifiability::{Campaign, IdentifiabilityRequest};
+pub use kinematics::Verb as KinematicsVerb;
+pub use plan::{Instrument, PlanRequest};
+pub use simulate::SimulateRequest;
+
+// Their results, each with its verdict (`exit_code()`).
+pub use calibrate::Calibration;
+pub use check::CheckResult;
+pub use compensate::Compensation;
+pub use detectability::DetectabilityReport;
+pub use diagnosis::DiagnoseResult;
+pub use effects::EffectList;
+pub use export::Export;
+pub use identifiability::Identifiability;
+pub use kinematics::PointSolution;
+pub use plan::Plan;
+pub use simulate::Simulation;
+
+// The error and the exit codes.
 pub use error::{
-    Classify, EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error,
-    ErrorKind,
-};
-pub use inputs::{
-    HeadAngles, LoadedMachine, Poses, SensorNoise, Triple, TrueErrors, check_commands,
-    description_error, load_machine, parse_effects, parse_head_angles, parse_numbers, positive,
-    read_data, read_data_from,
+    EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error, ErrorKind,
 };
 
-pub use calibrate::values::{
-    EffectNames, EvalGrid, HeadModel, LengthSigma, TrackerTargetSpec, eval_options, fused_model,
-};
-pub use calibrate::{
-    CalibrateRequest, Calibration, Data, FusedSources, Written, calibrate, exit_line,
-};
-
-pub use check::{CheckRequest, CheckResult, check};
-pub use compensate::{
-    Calibrated, CompensateRequest, Compensation, CorrectedTarget, MAP_FILES, TABLE_ERROR_LIMIT_UM,
-    TABLE_FILES, compensate,
-};
+// The domain: the machine, the parameters, the data, the poses.
 pub use data_input::DataInput;
-pub use detectability::{DetectabilityReport, DetectabilityRequest, detectability};
-pub use diagnosis::{Deployed, DiagnoseRequest, DiagnoseResult, diagnose, vocabulary_help};
-pub use effects::{EffectList, effects};
-pub use identifiability::{
-    Campaign, Identifiability, IdentifiabilityRequest, assess_identifiability,
-};
-pub use plan::{Instrument, Plan, PlanRequest, plan};
-pub use simulate::{
-    BallbarSimulation, HeadErrors, SimulateRequest, Simulation, TouchSimulation, TrackerSimulation,
-    TruthEffects, simulate,
-};
-pub use tricept_check::history::Trend;
-pub use tricept_check::{CheckReport, DEFAULT_ALPHA as DEFAULT_CHECK_ALPHA};
-pub use tricept_diagnose::detect::Detectability;
-pub use tricept_diagnose::{Diagnosis, ResidualPlot};
-pub use tricept_plant::Effect;
+pub use inputs::{LoadedMachine, Poses, SensorNoise, load_machine};
+pub use nalgebra;
+pub use tricept_kinematics::Machine;
+pub use tricept_model::{ExtendedMachine, ParameterSet};
 
-// Transitional: the engine's API as it was when it was `tricept-ident`,
-// curated by issue 27 ("One door") into the workflows above. Not `Start`
-// nor `identify_from` (the study's and xtask's, through the engine), nor
-// the engine's `Compensation` (the door's is the workflow's result).
-pub use tricept_engine::fusion;
-pub use tricept_engine::{
-    ADEQUACY_ALPHA, AccuracyModel, BARELY_SEEN_STD_DEV_MM, Combination, CompensationTable,
-    CorrelatedPair, DEFAULT_TOLERANCE_MM, Design, GeometricModel, GeometricPredictor,
-    INCONSISTENT_CHI2_PER_DOF, IdentError, IdentifiabilityReport, Identification, IdentifyOptions,
-    LARGE_ESTIMATE_MM, LikelyCause, MAX_TABLE_NODES, NamedValues, Observability, PosePredictor,
-    PredictedAccuracy, RECORD_METHODS, ReadingModel, RecordError, Rejection, ResidualStats,
-    SPACING_LADDER_MM, Verdict, WORTHWHILE_RATIO, accuracy_points, check_calibration_record,
-    compensation, corrected_commands, design, identifiability, identify, identify_robust,
-    likely_causes, residuals_at, screen_gross_errors, screen_gross_errors_with_fit, solve_pose,
-};
-// What a downstream crate needs besides the door's own types: every crate
-// whose types the public API takes or returns, and those types at the root.
-pub use tricept_engine::{
-    BallbarData, DataError, Dataset, EffectName, Effector, ErrorMap, ExtendedMachine, ExternalPose,
-    Features, HeadBranch, HeadParameterSet, KinematicsError, LegGeometry, Machine,
-    MachineDescription, MapStats, MeasuredPose, ModelError, ParameterSet, Readings, TouchData,
-    TrackerData, UpJoints, Workspace, read_from, read_path,
-};
-pub use tricept_engine::{nalgebra, serde_json, tricept_data, tricept_kinematics, tricept_model};
+// Crate-internal shorthands (the workflows' files use `crate::NAME`).
+pub(crate) use error::Classify;
+pub(crate) use inputs::parse_effects;

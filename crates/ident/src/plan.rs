@@ -27,7 +27,8 @@ use tricept_study::plan::{
 use crate::calibrate::values::{
     EvalGrid, HeadModel, TrackerTargetSpec, eval_options, fused_model, head_angles_text,
 };
-use crate::calibrate::{Data, write_text};
+use crate::calibrate::write_text;
+use crate::data_input::DataInput;
 use crate::error::Error;
 use crate::inputs::{
     HeadAngles, LoadedMachine, Poses, SensorNoise, Triple, load_machine, positive,
@@ -71,7 +72,7 @@ pub struct PlanRequest {
     /// For a check: the power with which it is detected.
     pub power: f64,
     /// The internal campaign's data (only its commands are used).
-    pub data: Option<Data>,
+    pub data: Option<DataInput>,
     /// The internal campaign's pose set when no data are given (default
     /// `grid`).
     pub poses: Option<Poses>,
@@ -278,7 +279,8 @@ fn touch_features(
 }
 
 /// Plans as `request` says.
-pub fn plan(a: &PlanRequest) -> Result<Plan, Error> {
+pub fn plan(request: PlanRequest) -> Result<Plan, Error> {
+    let a = &request;
     let default_k = [3, 5, 8, 12, 20, 30, 50];
     let k: &[usize] = if a.k.is_empty() { &default_k } else { &a.k };
     let loaded = load_machine(a.machine.as_deref(), &a.noise)?;
@@ -360,7 +362,7 @@ fn internal_information(
 ) -> Result<(DMatrix<f64>, usize), Error> {
     Ok(match &a.data {
         Some(path) => {
-            let data = path.read(m)?;
+            let data = path.load(m)?;
             let f =
                 information_factor(model, &[Source::internal(&data, m.sensors.logged_sigma())])?;
             (f, data.poses.len())

@@ -33,9 +33,9 @@ use crate::inputs::{LoadedMachine, Poses, TrueErrors, positive, random_spec};
 ///
 /// # Example
 /// ```
-/// let h: tricept_ident::HeadErrors = "random:1,3".parse().unwrap();
+/// let h: tricept_ident::advanced::HeadErrors = "random:1,3".parse().unwrap();
 /// assert_eq!(h.to_string(), "random:1,3");
-/// assert!("random:x".parse::<tricept_ident::HeadErrors>().is_err());
+/// assert!("random:x".parse::<tricept_ident::advanced::HeadErrors>().is_err());
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub enum HeadErrors {
@@ -110,10 +110,10 @@ impl HeadErrors {
 ///
 /// # Example
 /// ```
-/// let t: tricept_ident::TruthEffects = r#"{"effect":"leg-lead","ppm":[50,-30,40]}"#.parse().unwrap();
+/// let t: tricept_ident::advanced::TruthEffects = r#"{"effect":"leg-lead","ppm":[50,-30,40]}"#.parse().unwrap();
 /// assert_eq!(t.effects().len(), 1);
 /// assert!(t.to_string().starts_with("{"));
-/// assert!(r#"{"effect":"nothing"}"#.parse::<tricept_ident::TruthEffects>().is_err());
+/// assert!(r#"{"effect":"nothing"}"#.parse::<tricept_ident::advanced::TruthEffects>().is_err());
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct TruthEffects {

@@ -18,8 +18,8 @@ use std::process::ExitCode;
 
 use tricept_ident::nalgebra::Vector3;
 use tricept_ident::{
-    CalibrateRequest, Calibration, CheckRequest, Data, DiagnoseRequest, EXIT_OK, Error,
-    ExtendedMachine, SensorNoise, calibrate, check, diagnose, load_machine,
+    CalibrateRequest, Calibration, CheckRequest, DiagnoseRequest, EXIT_OK, Error, ExtendedMachine,
+    SensorNoise, calibrate, check, diagnose, load_machine,
 };
 
 fn main() -> ExitCode {
@@ -58,7 +58,7 @@ fn run(data: &Path, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
 
 /// Step 1: calibrate from the UP limb's sensors and judge the verdict.
 fn identify(data: &Path) -> Result<Calibration, Error> {
-    let calibration = calibrate(&CalibrateRequest::new(Data::File(data.to_path_buf())))?;
+    let calibration = calibrate(CalibrateRequest::new(data))?;
     for w in calibration.warnings() {
         eprintln!("warning: {w}");
     }

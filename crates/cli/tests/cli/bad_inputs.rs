@@ -701,6 +701,14 @@ named_cases! {
     estimate_edited = "estimate edited";
     unknown_method = "unknown method";
     unknown_parameter_set = "unknown parameter set";
+    truth_not_a_spec = "truth not a spec";
+    compensate_truth_of_a_negative_size = "compensate: truth of a negative size";
+    compensate_truth_effect_not_json = "compensate: truth effect not JSON";
+    truth_effect_file_missing = "truth effect file missing";
+    touch_sphere_of_two_numbers = "touch sphere of two numbers";
+    plan_touch_sphere_not_a_number = "plan: touch sphere not a number";
+    tracker_frame_of_five_numbers = "tracker frame of five numbers";
+    tracker_frame_beyond_any_machine = "tracker frame beyond any machine";
 }
 
 /// Runs every case in `dir`; every broken expectation is collected, so
@@ -1816,6 +1824,104 @@ fn unusable_cases(dir: &Path) -> Vec<Case> {
                 &["e5.json", "unknown parameter set `paper16`"],
             ),
             a(&["machine", "--machine", "e5.json"]),
+        ),
+        // Flag values parsed by the door's types (clap value parsers): one
+        // line naming the flag, exit 2, before anything is read.
+        (
+            case(
+                "truth not a spec",
+                &[],
+                vec![],
+                2,
+                &["error: --truth: ", "`random:x`", "MAG_MM"],
+            ),
+            a(&["simulate", "--truth", "random:x"]),
+        ),
+        (
+            case(
+                "compensate: truth of a negative size",
+                &[],
+                vec![],
+                2,
+                &["error: --truth: ", "`random:-1`"],
+            ),
+            a(&["compensate", "--data", "good.csv", "--truth", "random:-1"]),
+        ),
+        (
+            case(
+                "compensate: truth effect not JSON",
+                &[],
+                vec![],
+                2,
+                &["error: --truth-effect: "],
+            ),
+            a(&[
+                "compensate",
+                "--data",
+                "good.csv",
+                "--truth",
+                "table2",
+                "--truth-effect",
+                "{oops",
+            ]),
+        ),
+        (
+            case(
+                "truth effect file missing",
+                &[],
+                vec![],
+                2,
+                &["error: --truth-effect: no-effect.json"],
+            ),
+            a(&["simulate", "--truth-effect", "@no-effect.json"]),
+        ),
+        (
+            case(
+                "touch sphere of two numbers",
+                &[],
+                vec![],
+                2,
+                &["error: --touch-sphere-mm: expected 3 comma-separated numbers, got `1,2`"],
+            ),
+            a(&["simulate", "--touch-sphere-mm", "1,2"]),
+        ),
+        (
+            case(
+                "plan: touch sphere not a number",
+                &[],
+                vec![],
+                2,
+                &["error: --touch-sphere-mm: expected 3 comma-separated numbers, got `x,0,0`"],
+            ),
+            a(&[
+                "plan",
+                "--instrument",
+                "touch",
+                "--touch-sphere-mm",
+                "x,0,0",
+            ]),
+        ),
+        (
+            case(
+                "tracker frame of five numbers",
+                &[],
+                vec![],
+                2,
+                &[
+                    "error: --tracker-frame-mm-rad: expected 6 comma-separated numbers, got `1,2,3,4,5`",
+                ],
+            ),
+            a(&["simulate", "--tracker-frame-mm-rad", "1,2,3,4,5"]),
+        ),
+        (
+            case(
+                "tracker frame beyond any machine",
+                &[],
+                vec![],
+                2,
+                &["error: --tracker-frame-mm-rad: 200000 is beyond ±100000"],
+            ),
+            a(&["simulate", "--tracker-frame-mm-rad", "2e5,0,0,0,0,0"]),
         ),
     ];
     cases

@@ -18,68 +18,31 @@ pub(crate) mod values;
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;
-use tricept_data::Dataset;
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
+use crate::data_input::DataInput;
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, Error};
-use crate::inputs::{LoadedMachine, SensorNoise, check_commands, load_machine};
+use crate::inputs::{LoadedMachine, SensorNoise, load_machine};
 use crate::machine_file;
 pub(crate) use internal::fit_error;
 pub use values::FusedSources;
-
-/// Measured data of the UP limb's sensors: a file (`q1,q2,q3,phi,theta,s`,
-/// docs/data-format.md) or a dataset already in memory.
-#[derive(Debug, Clone)]
-#[non_exhaustive]
-pub enum Data {
-    /// A measured-data CSV file.
-    File(PathBuf),
-    /// Poses in memory; its `source` names it in messages. A machine file
-    /// records the hash of its data, so it can be written only from a
-    /// [`Data::File`].
-    InMemory(Dataset),
-}
-
-impl Data {
-    /// The name of the data in messages and reports.
-    pub fn name(&self) -> String {
-        match self {
-            Data::File(p) => p.display().to_string(),
-            Data::InMemory(d) => d.source.clone(),
-        }
-    }
-
-    /// The data, checked against the leg stroke of `machine`.
-    pub(crate) fn read(&self, machine: &Machine) -> Result<Dataset, Error> {
-        match self {
-            Data::File(p) => crate::inputs::read_data(p, machine),
-            Data::InMemory(d) => {
-                check_commands(
-                    &d.source,
-                    d.poses.iter().map(|p| (p.line, p.commands_mm)),
-                    machine,
-                )?;
-                Ok(d.clone())
-            }
-        }
-    }
-}
 
 /// What to calibrate from, and how.
 ///
 /// # Example
 /// ```no_run
-/// use tricept_ident::{CalibrateRequest, Data, calibrate};
-/// let calibration = calibrate(&CalibrateRequest::new(Data::File("data.csv".into())))?;
+/// use tricept_ident::{CalibrateRequest, calibrate};
+/// let calibration = calibrate(CalibrateRequest::new("data.csv"))?;
 /// println!("exit code {}", calibration.exit_code());
 /// # Ok::<(), tricept_ident::Error>(())
 /// ```
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct CalibrateRequest {
-    /// The internal data.
-    pub data: Data,
+    /// The internal data (a machine file can be written only from data
+    /// given as a file: its record holds the file's hash).
+    pub data: DataInput,
     /// Machine description file (default: the embedded Table 1 machine).
     pub machine: Option<PathBuf>,
     /// Sensor-noise overrides.
@@ -102,9 +65,9 @@ pub struct CalibrateRequest {
 impl CalibrateRequest {
     /// The internal calibration of `data` on the Table 1 machine with the
     /// defaults.
-    pub fn new(data: Data) -> CalibrateRequest {
+    pub fn new(data: impl Into<DataInput>) -> CalibrateRequest {
         CalibrateRequest {
-            data,
+            data: data.into(),
             machine: None,
             noise: SensorNoise::default(),
             parameter_set: ParameterSet::paper15(),
@@ -127,7 +90,7 @@ enum Fit {
 #[derive(Debug)]
 pub struct Calibration {
     loaded: LoadedMachine,
-    data: Data,
+    data: DataInput,
     fit: Fit,
 }
 
@@ -163,7 +126,7 @@ impl Written {
 /// Errors are input errors (exit code 2) for bad files, flags and data too
 /// small to fit; a fit that completes returns its verdict in
 /// [`Calibration::exit_code`].
-pub fn calibrate(request: &CalibrateRequest) -> Result<Calibration, Error> {
+pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
     let tolerance_mm = request.tolerance_mm;
     if !(tolerance_mm.is_finite() && tolerance_mm > 0.0 && tolerance_mm <= 10.0) {
         return Err(Error::input(format!(
@@ -174,7 +137,7 @@ pub fn calibrate(request: &CalibrateRequest) -> Result<Calibration, Error> {
     let set = &request.parameter_set;
     let fit = match &request.fused {
         None => {
-            let dataset = request.data.read(loaded.machine())?;
+            let dataset = request.data.load(loaded.machine())?;
             Fit::Internal(Box::new(internal::fit(
                 &loaded,
                 set,
@@ -184,7 +147,7 @@ pub fn calibrate(request: &CalibrateRequest) -> Result<Calibration, Error> {
             )?))
         }
         Some(x) => {
-            let dataset = request.data.read(loaded.machine())?;
+            let dataset = request.data.load(loaded.machine())?;
             Fit::Fused(Box::new(fused::fit(
                 &loaded,
                 set,
@@ -197,7 +160,7 @@ pub fn calibrate(request: &CalibrateRequest) -> Result<Calibration, Error> {
     };
     Ok(Calibration {
         loaded,
-        data: request.data.clone(),
+        data: request.data,
         fit,
     })
 }
@@ -355,7 +318,7 @@ impl Calibration {
     /// The calibrated machine's description with its `calibration` record
     /// (`forced`: why it is written although not to be trusted).
     pub fn description(&self, forced: Option<String>) -> Result<MachineDescription, Error> {
-        let Data::File(data) = &self.data else {
+        let Some(data) = self.data.path() else {
             return Err(Error::input(
                 "--write-machine: the calibration record holds the data file's hash: give the data as a file",
             ));
@@ -421,10 +384,10 @@ mod tests {
 
     #[test]
     fn data_in_memory_calibrate_as_the_file_does_but_write_no_machine_file() {
-        let from_file = calibrate(&CalibrateRequest::new(Data::File(fixture()))).unwrap();
+        let from_file = calibrate(CalibrateRequest::new(fixture())).unwrap();
         let mut dataset = tricept_data::read_path(&fixture()).unwrap();
         dataset.source = "numpy columns".into();
-        let mut in_memory = calibrate(&CalibrateRequest::new(Data::InMemory(dataset))).unwrap();
+        let mut in_memory = calibrate(CalibrateRequest::new(dataset)).unwrap();
         assert_eq!(from_file.exit_code(), 0, "{}", from_file.report());
         assert_eq!(in_memory.exit_code(), from_file.exit_code());
         assert_eq!(in_memory.estimates(), from_file.estimates());
@@ -441,9 +404,9 @@ mod tests {
 
     #[test]
     fn a_tolerance_out_of_range_is_an_input_error_before_anything_is_read() {
-        let mut request = CalibrateRequest::new(Data::File("no-such-file.csv".into()));
+        let mut request = CalibrateRequest::new("no-such-file.csv");
         request.tolerance_mm = 0.0;
-        let e = calibrate(&request).unwrap_err();
+        let e = calibrate(request).unwrap_err();
         assert_eq!(e.exit_code(), crate::EXIT_INPUT);
         assert!(e.message().starts_with("--tolerance-mm"), "{e}");
     }

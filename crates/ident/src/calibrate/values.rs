@@ -23,7 +23,7 @@ use crate::limits;
 ///
 /// # Example
 /// ```
-/// use tricept_ident::TrackerTargetSpec;
+/// use tricept_ident::advanced::TrackerTargetSpec;
 /// assert_eq!("tip".parse::<TrackerTargetSpec>().unwrap(), TrackerTargetSpec::Tip);
 /// assert_eq!("0,0,20".parse::<TrackerTargetSpec>().unwrap(), TrackerTargetSpec::Offset([0.0, 0.0, 20.0]));
 /// assert!("1,2".parse::<TrackerTargetSpec>().is_err());
@@ -90,7 +90,7 @@ impl TrackerTargetSpec {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::LengthSigma;
+/// use tricept_ident::advanced::LengthSigma;
 /// assert_eq!("free".parse::<LengthSigma>().unwrap(), LengthSigma::Free);
 /// assert_eq!("1".parse::<LengthSigma>().unwrap(), LengthSigma::Known(1.0));
 /// assert!("0".parse::<LengthSigma>().is_err());
@@ -134,7 +134,7 @@ impl LengthSigma {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::HeadModel;
+/// use tricept_ident::advanced::HeadModel;
 /// assert_eq!("none".parse::<HeadModel>().unwrap(), HeadModel::Nominal);
 /// assert!("head15".parse::<HeadModel>().is_err());
 /// ```
@@ -166,7 +166,7 @@ impl FromStr for HeadModel {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::EffectNames;
+/// use tricept_ident::advanced::EffectNames;
 /// let e: EffectNames = "leg-lead,".parse().unwrap();
 /// assert_eq!(e.0.len(), 1);
 /// assert!("gravity".parse::<EffectNames>().unwrap_err().to_string().starts_with("unknown effect `gravity`"));
@@ -194,7 +194,7 @@ impl FromStr for EffectNames {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::EvalGrid;
+/// use tricept_ident::advanced::EvalGrid;
 /// assert_eq!("2,8,3".parse::<EvalGrid>().unwrap(), EvalGrid { rings: 2, per_ring: 8, levels: 3 });
 /// assert!("2,8,0".parse::<EvalGrid>().is_err());
 /// ```
