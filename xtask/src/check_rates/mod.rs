@@ -64,7 +64,7 @@ const BAD_PHI: Option<BadReading> = Some(BadReading::PhiArcsec(40.0));
 const JITTER_K: f64 = 0.3;
 
 /// The scenarios of the table, in its order.
-pub const SCENARIOS: [Scenario; 12] = [
+pub const SCENARIOS: [Scenario; 14] = [
     Scenario::unchanged("nothing changed"),
     Scenario {
         noise_factor: 1.5,
@@ -85,10 +85,15 @@ pub const SCENARIOS: [Scenario; 12] = [
     Scenario::changed("a leg slipped 20-25 um", Change::LegSlip),
     Scenario::changed("a joint moved 50-60 um", Change::JointMoved),
     Scenario::changed("two legs slipped +25, -25 um", Change::TwoLegs),
+    Scenario::changed("legs 4 K warmer, precise log", Change::WarmLegs(4.0)),
     Scenario {
         temp_jitter_k: JITTER_K,
         ..Scenario::changed("legs 4 K warmer, log 0.3 K jitter", Change::WarmLegs(4.0))
     },
+    Scenario::changed(
+        "structure 4 K warmer, precise log",
+        Change::WarmStructure(4.0),
+    ),
     Scenario {
         temp_jitter_k: JITTER_K,
         ..Scenario::changed(

@@ -91,6 +91,14 @@ fn a_change_under_more_noise_is_still_found() {
 }
 
 #[test]
+fn warm_legs_with_a_precise_temperature_log_are_named_thermal_growth() {
+    for k in POSES {
+        let t = tally("legs 4 K warmer, precise log", k);
+        assert!(at_least(t.right, 0.9), "{k} poses: {t:?}");
+    }
+}
+
+#[test]
 #[ignore = "needs issue 31 items 1-4"]
 fn noisier_sensors_are_not_a_change() {
     for k in POSES {
