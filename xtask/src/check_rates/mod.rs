@@ -133,6 +133,10 @@ pub struct Outcome {
     pub named: Vec<String>,
     /// The shortlist of changes the check cannot tell apart.
     pub shortlist: Vec<String>,
+    /// The line of the bad reading in the campaign's data, if any.
+    pub bad_line: Option<u64>,
+    /// The lines the check set aside as gross readings (`set_aside[].line`).
+    pub set_aside: Vec<u64>,
 }
 
 impl Outcome {
@@ -155,6 +159,12 @@ impl Outcome {
         named.sort();
         wanted.sort();
         named == wanted
+    }
+
+    /// Whether the bad reading (if one was hidden) is among the lines the
+    /// check set aside.
+    pub fn bad_set_aside(&self) -> bool {
+        self.bad_line.is_some_and(|l| self.set_aside.contains(&l))
     }
 
     /// Whether a change was found (exit 3) and every hidden change is
@@ -186,6 +196,19 @@ pub fn named(v: &Value) -> Vec<String> {
         .as_u64()
         .and_then(|i| v["candidates"][i as usize]["name"].as_str())
         .map(|s| vec![s.to_string()])
+        .unwrap_or_default()
+}
+
+/// The lines a check's JSON sets aside: `set_aside[].line` (or plain
+/// numbers), none when it has no `set_aside`.
+pub fn set_aside_lines(v: &Value) -> Vec<u64> {
+    v["set_aside"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .filter_map(|x| x["line"].as_u64().or_else(|| x.as_u64()))
+                .collect()
+        })
         .unwrap_or_default()
 }
 
@@ -247,8 +270,12 @@ pub fn outcomes(
             let name = format!("check-{s}-{k}-{c}.csv");
             let data = read_data_from(Cursor::new(to_csv(&rows)), &name, machine.loaded.machine())
                 .map_err(|e| e.to_string())?;
+            let bad_line = hidden
+                .bad_row
+                .and_then(|i| data.poses.get(i))
+                .map(|p| p.line);
             let request = CheckRequest::new(machine.loaded.clone(), DataInput::Memory(data));
-            let (exit, verdict, named, shortlist) = match check(request) {
+            let (exit, verdict, named, shortlist, set_aside) = match check(request) {
                 Ok(r) => {
                     let v: Value = serde_json::from_str(&r.to_json()).map_err(|e| e.to_string())?;
                     let verdict = v["verdict"].as_str().unwrap_or("?").to_string();
@@ -260,11 +287,18 @@ pub fn outcomes(
                                 .collect()
                         })
                         .unwrap_or_default();
-                    (r.exit_code(), verdict, named(&v), shortlist)
+                    (
+                        r.exit_code(),
+                        verdict,
+                        named(&v),
+                        shortlist,
+                        set_aside_lines(&v),
+                    )
                 }
                 Err(e) => (
                     e.exit_code(),
                     format!("error: {}", e.message()),
+                    Vec::new(),
                     Vec::new(),
                     Vec::new(),
                 ),
@@ -279,6 +313,8 @@ pub fn outcomes(
                 verdict,
                 named,
                 shortlist,
+                bad_line,
+                set_aside,
             })
         })
         .collect()
@@ -302,6 +338,9 @@ pub struct Tally {
     /// Campaigns of a hidden change where it was found and is named or on
     /// the shortlist ([`Outcome::listed`]).
     pub listed: usize,
+    /// Campaigns whose bad reading the check set aside
+    /// ([`Outcome::bad_set_aside`]).
+    pub bad_set_aside: usize,
     /// Campaigns per verdict.
     pub verdicts: BTreeMap<String, usize>,
 }
@@ -324,6 +363,7 @@ pub fn tallies(outcomes: &[Outcome]) -> Vec<Tally> {
                     exit_changed: 0,
                     right: 0,
                     listed: 0,
+                    bad_set_aside: 0,
                     verdicts: BTreeMap::new(),
                 });
                 let last = out.len() - 1;
@@ -335,6 +375,7 @@ pub fn tallies(outcomes: &[Outcome]) -> Vec<Tally> {
         t.exit_changed += usize::from(o.exit == EXIT_INADEQUATE);
         t.right += usize::from(o.right());
         t.listed += usize::from(o.listed());
+        t.bad_set_aside += usize::from(o.bad_set_aside());
         let verdict = match o.verdict.strip_prefix("error: ") {
             Some(_) => format!("exit {}", o.exit),
             None => o.verdict.clone(),
@@ -347,7 +388,7 @@ pub fn tallies(outcomes: &[Outcome]) -> Vec<Tally> {
 /// The tallies as the Markdown table of docs/check.md.
 pub fn table(tallies: &[Tally]) -> String {
     let mut s = String::from(
-        "| scenario | poses | exit 0 | exit 3 | said what was hidden | hidden change on the shortlist | verdicts |\n|---|---|---|---|---|---|---|\n",
+        "| scenario | poses | exit 0 | exit 3 | said what was hidden | hidden change on the shortlist | bad reading set aside | verdicts |\n|---|---|---|---|---|---|---|---|\n",
     );
     for t in tallies {
         let name = SCENARIOS.get(t.scenario).map_or("?", |s| s.name);
@@ -357,8 +398,12 @@ pub fn table(tallies: &[Tally]) -> String {
             Some(Change::None) | None => String::new(),
             Some(_) => format!("{}/{n}", t.listed),
         };
+        let set_aside = match SCENARIOS.get(t.scenario).and_then(|s| s.bad) {
+            Some(_) => format!("{}/{n}", t.bad_set_aside),
+            None => String::new(),
+        };
         s.push_str(&format!(
-            "| {name} | {} | {}/{n} | {}/{n} | {}/{n} | {listed} | {} |\n",
+            "| {name} | {} | {}/{n} | {}/{n} | {}/{n} | {listed} | {set_aside} | {} |\n",
             t.poses,
             t.exit_ok,
             t.exit_changed,
@@ -399,7 +444,7 @@ pub fn run(a: CheckRatesArgs) -> Result<(), String> {
     if a.verbose {
         for o in &outcomes {
             println!(
-                "{} | {} poses | #{} machine {} | hidden {} | exit {} {} | named {:?} | shortlist {:?} | {}",
+                "{} | {} poses | #{} machine {} | hidden {} | exit {} {} | named {:?} | shortlist {:?} | bad line {:?} set aside {:?} | {}",
                 SCENARIOS[o.scenario].name,
                 o.poses,
                 o.campaign,
@@ -409,6 +454,8 @@ pub fn run(a: CheckRatesArgs) -> Result<(), String> {
                 o.verdict,
                 o.named,
                 o.shortlist,
+                o.bad_line,
+                o.set_aside,
                 if o.right() { "right" } else { "WRONG" }
             );
         }

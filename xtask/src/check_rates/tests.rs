@@ -122,10 +122,12 @@ fn a_bad_reading_is_set_aside() {
         ] {
             let t = tally(name, k);
             assert!(at_least(t.exit_ok, 0.9), "{name}, {k} poses: {t:?}");
+            assert!(at_least(t.bad_set_aside, 0.9), "{name}, {k} poses: {t:?}");
         }
     }
     let t = tally("a leg slipped + one bad reading (s)", 20);
     assert!(at_least(t.right, 0.9), "{t:?}");
+    assert!(at_least(t.bad_set_aside, 0.9), "{t:?}");
 }
 
 #[test]
@@ -175,6 +177,9 @@ fn the_named_changes_are_the_set_when_the_check_gives_one() {
     });
     assert_eq!(named(&v), ["leg 1", "leg 3"]);
     assert!(named(&serde_json::json!({"most_likely": null})).is_empty());
+    let v = serde_json::json!({"set_aside": [{"line": 7, "reading": "s"}, 9]});
+    assert_eq!(set_aside_lines(&v), [7, 9]);
+    assert!(set_aside_lines(&serde_json::json!({})).is_empty());
 }
 
 #[test]
@@ -187,11 +192,14 @@ fn the_right_answer_is_exactly_the_hidden_change() {
         hidden: Hidden {
             names: names.iter().map(|s| s.to_string()).collect(),
             text: String::new(),
+            bad_row: None,
         },
         exit,
         verdict: String::new(),
         named: named.iter().map(|s| s.to_string()).collect(),
         shortlist: shortlist.iter().map(|s| s.to_string()).collect(),
+        bad_line: None,
+        set_aside: Vec::new(),
     };
     assert!(o(&[], 0, &[], &[]).right());
     assert!(!o(&[], 3, &["leg 1"], &[]).right());
@@ -221,4 +229,37 @@ fn the_right_answer_is_exactly_the_hidden_change() {
     );
     assert!(!o(&["platform joint A3"], 3, &["leg 3"], &["leg 3"]).listed());
     assert!(!o(&[], 3, &["leg 3"], &[]).listed());
+    let mut bad = o(&[], 0, &[], &[]);
+    assert!(!bad.bad_set_aside());
+    bad.bad_line = Some(9);
+    bad.set_aside = vec![4];
+    assert!(!bad.bad_set_aside());
+    bad.set_aside.push(9);
+    assert!(bad.bad_set_aside());
+}
+
+#[test]
+fn the_bad_reading_is_on_its_own_line_of_the_campaign() {
+    let m = &machines()[0];
+    let commands = m.commands(10).unwrap();
+    let scenario = &SCENARIOS[3];
+    assert_eq!(scenario.bad, Some(BadReading::ScaleUm(25.0)));
+    let mut rng = Pcg64Mcg::seed_from_u64(3);
+    let (rows, hidden) = m.campaign(scenario, commands, 0, &mut rng);
+    let mut rng = Pcg64Mcg::seed_from_u64(3);
+    let clean = m
+        .campaign(&Scenario::unchanged("clean"), commands, 0, &mut rng)
+        .0;
+    let i = hidden.bad_row.unwrap();
+    // The same draws but the one reading: 25 um on s, nothing else.
+    assert!((rows[i].readings[2] - clean[i].readings[2] - 0.025).abs() < 1e-12);
+    for (j, (a, b)) in rows.iter().zip(&clean).enumerate() {
+        assert_eq!(a.readings[..2], b.readings[..2]);
+        if j != i {
+            assert_eq!(a.readings, b.readings);
+        }
+    }
+    let o = outcomes(machines(), &[3], &[10], 1, SEED).unwrap();
+    let line = o[0].bad_line.unwrap();
+    assert!((2..=11).contains(&line), "{o:?}");
 }

@@ -104,6 +104,8 @@ pub struct Hidden {
     pub names: Vec<String>,
     /// A line describing the hidden change and its size.
     pub text: String,
+    /// The row (0-based) with the bad reading, if any.
+    pub bad_row: Option<usize>,
 }
 
 /// A true machine, its calibration and the check's planned poses.
@@ -221,20 +223,17 @@ impl Calibrated {
         }
         let mut slips_mm = [0.0; 3];
         let mut warm_k = 0.0;
-        let hidden = match scenario.change {
-            Change::None => Hidden {
-                names: Vec::new(),
-                text: "nothing".into(),
-            },
+        let (names, text): (Vec<String>, String) = match scenario.change {
+            Change::None => (Vec::new(), "nothing".into()),
             Change::LegSlip => {
                 let leg = index % 3;
                 let sign = if rng.random::<bool>() { 1.0 } else { -1.0 };
                 let um = sign * (20.0 + 5.0 * rng.random::<f64>());
                 slips_mm[leg] = um * 1e-3;
-                Hidden {
-                    names: vec![format!("leg {}", leg + 1)],
-                    text: format!("leg {} {um:+.1} um", leg + 1),
-                }
+                (
+                    vec![format!("leg {}", leg + 1)],
+                    format!("leg {} {um:+.1} um", leg + 1),
+                )
             }
             Change::JointMoved => {
                 let joint = index % 6;
@@ -247,29 +246,23 @@ impl Calibrated {
                     day.platform[joint - 3] += d;
                     format!("platform joint A{}", joint - 2)
                 };
-                Hidden {
-                    text: format!("{name} {um:.1} um"),
-                    names: vec![name],
-                }
+                (vec![name.clone()], format!("{name} {um:.1} um"))
             }
             Change::TwoLegs => {
                 let (a, b) = [(0, 2), (0, 1), (1, 2)][index % 3];
                 slips_mm[a] = 0.025;
                 slips_mm[b] = -0.025;
-                Hidden {
-                    names: vec![format!("leg {}", a + 1), format!("leg {}", b + 1)],
-                    text: format!("leg {} +25 um, leg {} -25 um", a + 1, b + 1),
-                }
+                (
+                    vec![format!("leg {}", a + 1), format!("leg {}", b + 1)],
+                    format!("leg {} +25 um, leg {} -25 um", a + 1, b + 1),
+                )
             }
             Change::WarmLegs(k) | Change::WarmStructure(k) => {
                 warm_k = k;
                 if matches!(scenario.change, Change::WarmStructure(_)) {
                     day = day.warmed(STEEL_PPM_PER_K, k);
                 }
-                Hidden {
-                    names: vec!["thermal growth".into()],
-                    text: format!("{k} K warmer"),
-                }
+                (vec!["thermal growth".into()], format!("{k} K warmer"))
             }
         };
         let noise = tricept_truth::SensorNoise::DOCUMENTED.times(scenario.noise_factor);
@@ -287,6 +280,7 @@ impl Calibrated {
                 }
             })
             .collect();
+        let mut bad_row = None;
         if let Some(bad) = scenario.bad {
             let i = rng.random_range(0..rows.len().max(1));
             if let Some(row) = rows.get_mut(i) {
@@ -294,8 +288,16 @@ impl Calibrated {
                     BadReading::ScaleUm(um) => row.readings[2] += um * 1e-3,
                     BadReading::PhiArcsec(a) => row.readings[0] += a / ARCSEC_PER_RAD,
                 }
+                bad_row = Some(i);
             }
         }
-        (rows, hidden)
+        (
+            rows,
+            Hidden {
+                names,
+                text,
+                bad_row,
+            },
+        )
     }
 }
