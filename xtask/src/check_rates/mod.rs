@@ -131,7 +131,8 @@ pub struct Outcome {
     /// The changes the check names: `changes[].name`, else the most likely
     /// candidate.
     pub named: Vec<String>,
-    /// The shortlist of changes the check cannot tell apart.
+    /// The changes the check cannot tell apart from those it names: its
+    /// shortlist and the named changes' aliases.
     pub shortlist: Vec<String>,
     /// The line of the bad reading in the campaign's data, if any.
     pub bad_line: Option<u64>,
@@ -141,8 +142,9 @@ pub struct Outcome {
 
 impl Outcome {
     /// Whether the check said what was hidden: exit 0 when nothing changed;
-    /// else exit 3 with the hidden changes named (thermal growth among the
-    /// named ones; any other change named exactly, no more and no fewer).
+    /// else exit 3 with the hidden changes named (a thermal growth, of the
+    /// legs or of the structure, among the named ones; any other change
+    /// named exactly, no more and no fewer).
     pub fn right(&self) -> bool {
         let wanted = &self.hidden.names;
         if wanted.is_empty() {
@@ -151,8 +153,8 @@ impl Outcome {
         if self.exit != EXIT_INADEQUATE {
             return false;
         }
-        if wanted.iter().any(|n| n == THERMAL) {
-            return self.named.iter().any(|n| n == THERMAL);
+        if wanted.iter().any(|n| is_thermal(n)) {
+            return self.named.iter().any(|n| is_thermal(n));
         }
         let mut named = self.named.clone();
         let mut wanted = wanted.clone();
@@ -172,16 +174,18 @@ impl Outcome {
     pub fn listed(&self) -> bool {
         self.exit == EXIT_INADEQUATE
             && !self.hidden.names.is_empty()
-            && self
-                .hidden
-                .names
-                .iter()
-                .all(|h| self.named.contains(h) || self.shortlist.contains(h))
+            && self.hidden.names.iter().all(|h| {
+                let said = |n: &String| n == h || (is_thermal(h) && is_thermal(n));
+                self.named.iter().chain(&self.shortlist).any(said)
+            })
     }
 }
 
-/// The name of the thermal-growth candidate.
-const THERMAL: &str = "thermal growth";
+/// Whether a candidate is a thermal growth: `thermal growth` (of the legs)
+/// or `thermal growth of the structure`.
+fn is_thermal(name: &str) -> bool {
+    name.starts_with("thermal growth")
+}
 
 /// The changes a check's JSON names: every `changes[].name`, else the
 /// `most_likely` candidate's name (none when unchanged).
@@ -199,17 +203,35 @@ pub fn named(v: &Value) -> Vec<String> {
         .unwrap_or_default()
 }
 
-/// The lines a check's JSON sets aside: `set_aside[].line` (or plain
-/// numbers), none when it has no `set_aside`.
+/// The lines a check's JSON sets aside as gross readings: `rejected[].line`
+/// (the key `identify` uses) or `set_aside[].line` (or plain numbers),
+/// none when it has neither.
 pub fn set_aside_lines(v: &Value) -> Vec<u64> {
-    v["set_aside"]
-        .as_array()
-        .map(|a| {
-            a.iter()
-                .filter_map(|x| x["line"].as_u64().or_else(|| x.as_u64()))
-                .collect()
-        })
-        .unwrap_or_default()
+    ["rejected", "set_aside"]
+        .iter()
+        .filter_map(|key| v[*key].as_array())
+        .flatten()
+        .filter_map(|x| x["line"].as_u64().or_else(|| x.as_u64()))
+        .collect()
+}
+
+/// The candidates a check's JSON says it cannot tell apart from what it
+/// names: the `shortlist` and every `changes[].aliases`.
+pub fn alike(v: &Value) -> Vec<String> {
+    let strings = |a: &Value| -> Vec<String> {
+        a.as_array()
+            .map(|l| {
+                l.iter()
+                    .filter_map(|n| n.as_str().map(String::from))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let mut out = strings(&v["shortlist"]);
+    for c in v["changes"].as_array().into_iter().flatten() {
+        out.extend(strings(&c["aliases"]));
+    }
+    out
 }
 
 /// Calibrates `count` true machines (seeds from `seed`) in parallel, their
@@ -279,14 +301,7 @@ pub fn outcomes(
                 Ok(r) => {
                     let v: Value = serde_json::from_str(&r.to_json()).map_err(|e| e.to_string())?;
                     let verdict = v["verdict"].as_str().unwrap_or("?").to_string();
-                    let shortlist = v["shortlist"]
-                        .as_array()
-                        .map(|l| {
-                            l.iter()
-                                .filter_map(|n| n.as_str().map(String::from))
-                                .collect()
-                        })
-                        .unwrap_or_default();
+                    let shortlist = alike(&v);
                     (
                         r.exit_code(),
                         verdict,

@@ -179,6 +179,13 @@ fn the_named_changes_are_the_set_when_the_check_gives_one() {
     assert!(named(&serde_json::json!({"most_likely": null})).is_empty());
     let v = serde_json::json!({"set_aside": [{"line": 7, "reading": "s"}, 9]});
     assert_eq!(set_aside_lines(&v), [7, 9]);
+    let v = serde_json::json!({"rejected": [{"pose": 3, "line": 4}]});
+    assert_eq!(set_aside_lines(&v), [4]);
+    let v = serde_json::json!({
+        "shortlist": ["leg 1", "platform joint A1"],
+        "changes": [{"name": "leg 1", "aliases": ["base joint B1"]}, {"name": "leg 2", "aliases": []}],
+    });
+    assert_eq!(alike(&v), ["leg 1", "platform joint A1", "base joint B1"]);
     assert!(set_aside_lines(&serde_json::json!({})).is_empty());
 }
 
@@ -218,6 +225,24 @@ fn the_right_answer_is_exactly_the_hidden_change() {
         .right()
     );
     assert!(!o(&["thermal growth"], 3, &["scale gain"], &[]).right());
+    assert!(
+        o(
+            &["thermal growth"],
+            3,
+            &["thermal growth of the structure"],
+            &[]
+        )
+        .right()
+    );
+    assert!(
+        o(
+            &["thermal growth"],
+            3,
+            &["scale gain"],
+            &["thermal growth of the structure"]
+        )
+        .listed()
+    );
     assert!(
         o(
             &["platform joint A3"],
