@@ -70,14 +70,20 @@ fn an_unchanged_machine_raises_at_most_one_alarm_in_ten() {
 
 #[test]
 fn a_single_change_is_found_and_named_alone() {
+    // Issue 31 asks 10 of 10 at the 20 poses of a planned check; 10 poses
+    // may miss one in 10.
+    let found = |k: usize, t: &Tally| match k {
+        20 => t.exit_changed == N,
+        _ => at_least(t.exit_changed, 0.9),
+    };
     for k in POSES {
         let t = tally("a leg slipped 20-25 um", k);
-        assert_eq!(t.exit_changed, N, "{k} poses: {t:?}");
+        assert!(found(k, t), "{k} poses: {t:?}");
         assert!(at_least(t.right, 0.9), "{k} poses: {t:?}");
         // A joint moved along its leg reads as the leg: the check says it
         // cannot tell them apart, the shortlist names both.
         let t = tally("a joint moved 50-60 um", k);
-        assert_eq!(t.exit_changed, N, "{k} poses: {t:?}");
+        assert!(found(k, t), "{k} poses: {t:?}");
         assert!(at_least(t.listed, 0.9), "{k} poses: {t:?}");
         assert!(at_least(t.right, 0.7), "{k} poses: {t:?}");
     }
