@@ -229,7 +229,11 @@ pub fn alike(v: &Value) -> Vec<String> {
     };
     let mut out = strings(&v["shortlist"]);
     for c in v["changes"].as_array().into_iter().flatten() {
-        out.extend(strings(&c["aliases"]));
+        for alias in strings(&c["aliases"]) {
+            if !out.contains(&alias) {
+                out.push(alias);
+            }
+        }
     }
     out
 }
