@@ -3,6 +3,7 @@
 //! `cargo xtask <verb>`; see `cargo xtask --help`. Each verb reproduces a
 //! figure or table that the docs quote, so anyone can rerun it.
 
+mod check_rates;
 mod checks;
 mod fig3;
 mod hybrid;
@@ -68,6 +69,10 @@ enum Command {
     /// export, atomic writes, the statistics) with cargo-mutants at a pinned
     /// version, installed when missing; see docs/testing.md.
     Mutants(mutants::MutantsArgs),
+    /// The false-alarm rate and the power of `tricept check` on machines
+    /// from the independent generator (tricept-truth), per scenario and
+    /// pose count: the table of docs/check.md, "Measured rates".
+    CheckRates(check_rates::CheckRatesArgs),
 }
 
 fn main() -> ExitCode {
@@ -85,6 +90,7 @@ fn main() -> ExitCode {
         Command::OneBuild => checks::one_build(),
         Command::Msrv => checks::msrv(),
         Command::Mutants(args) => mutants::run(args),
+        Command::CheckRates(args) => check_rates::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
