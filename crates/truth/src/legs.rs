@@ -64,6 +64,20 @@ pub enum LegEffect {
         /// Each leg's temperature above the logged one, K.
         kelvin: [f64; 3],
     },
+    /// Legs warming unevenly as the structure warms: leg `i` at
+    /// `T + kelvin_i (T - from) / (to - from)` (its own temperature
+    /// response: `kelvin_i` more than the logged rise from `from` to `to`),
+    /// growing `alpha (q_i + dq_i) (T_i - 20)`.
+    Warming {
+        /// `alpha`, ppm/K.
+        ppm_per_k: f64,
+        /// Each leg's extra warming over the logged rise, K.
+        kelvin: [f64; 3],
+        /// The logged temperature where the rise starts, deg C.
+        from_c: f64,
+        /// Where it ends, deg C.
+        to_c: f64,
+    },
 }
 
 /// What a leg effect may depend on besides the command.
@@ -105,6 +119,15 @@ impl LegEffect {
             }
             LegEffect::Heating { ppm_per_k, kelvin } => {
                 ppm_per_k * 1e-6 * (q[i] + offsets_mm[i]) * (at.temp_c + kelvin[i] - 20.0)
+            }
+            LegEffect::Warming {
+                ppm_per_k,
+                kelvin,
+                from_c,
+                to_c,
+            } => {
+                let leg_c = at.temp_c + kelvin[i] * (at.temp_c - from_c) / (to_c - from_c);
+                ppm_per_k * 1e-6 * (q[i] + offsets_mm[i]) * (leg_c - 20.0)
             }
         })
     }

@@ -37,7 +37,7 @@ const HELD_OUT: usize = 200;
 const WORSE: f64 = 1.10;
 
 /// The case names, in the order of [`effects`].
-const CASES: [&str; 12] = [
+const CASES: [&str; 15] = [
     "backlash",
     "leg lead",
     "quadratic leg",
@@ -50,6 +50,9 @@ const CASES: [&str; 12] = [
     "pitch + thermal",
     "quadratic + backlash",
     "nothing",
+    "uneven warming",
+    "uneven warming + backlash",
+    "mildly uneven warming",
 ];
 
 /// The leg effects of case `case` for machine `seed`.
@@ -80,6 +83,18 @@ fn effects(case: usize, seed: u64) -> Vec<LegEffect> {
         ppm_per_k: 11.5,
         kelvin: [0.0; 3],
     };
+    let warming = LegEffect::Warming {
+        ppm_per_k: 11.5,
+        kelvin: [4.0, 1.0, -2.0],
+        from_c: temperature(0, 2),
+        to_c: temperature(1, 2),
+    };
+    let mild = LegEffect::Warming {
+        ppm_per_k: 11.5,
+        kelvin: [u(0.3, 1.0), u(-0.3, 0.3), -u(0.3, 1.0)],
+        from_c: temperature(0, 2),
+        to_c: temperature(1, 2),
+    };
     let worn = LegEffect::Step {
         um: [u(2.5, 3.5), 0.0, 0.0],
         from_mm: u(700.0, 740.0),
@@ -97,7 +112,10 @@ fn effects(case: usize, seed: u64) -> Vec<LegEffect> {
         8 => vec![uneven, lead],
         9 => vec![pitch, thermal],
         10 => vec![quadratic, backlash],
-        _ => Vec::new(),
+        11 => Vec::new(),
+        12 => vec![warming],
+        13 => vec![warming, backlash],
+        _ => vec![mild],
     }
 }
 
