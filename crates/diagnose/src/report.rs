@@ -712,7 +712,7 @@ impl Diagnosis {
                 w!("deployed: {}{numbers}", t.description);
             } else {
                 w!(
-                    "seen, not worth deploying: {}{numbers} (not above {DEPLOY_BENEFIT_SD} sd out of sample)",
+                    "seen, not worth deploying: {}{numbers} (deployed only above {DEPLOY_BENEFIT_SD} sd out of sample and {DEPLOY_IMPROVEMENT_SD} sd of improvement)",
                     t.description
                 );
             }
