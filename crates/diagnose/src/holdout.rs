@@ -27,7 +27,10 @@
 //! judged as every other term). A term is deployed when its out-of-sample
 //! benefit exceeds [`DEPLOY_BENEFIT_SD`] standard deviations and its
 //! predicted improvement exceeds [`DEPLOY_IMPROVEMENT_SD`] standard
-//! deviations, each judged against the *deployed* model without it:
+//! deviations or is no larger than the out-of-sample benefit (plus its
+//! [`DEPLOY_BENEFIT_SD`] sd: the file moves the platform where the readings
+//! cannot see by no more than they see it gain, as a backlash visited from
+//! both directions does), each judged against the *deployed* model without it:
 //! backward elimination removes the least useful failing term (smallest
 //! improvement in standard deviations), refits the rest and judges them
 //! again. A term whose absence leaves a model that cannot be fitted is
@@ -207,7 +210,13 @@ fn judge(
         // Without it the model cannot be fitted: it is needed.
         (None, _, _) => true,
         (Some(_), Some(b), Some(g)) => {
-            b.mean_mm > DEPLOY_BENEFIT_SD * b.sd_mm && g.mean_mm > DEPLOY_IMPROVEMENT_SD * g.sd_mm
+            let seen = b.mean_mm > DEPLOY_BENEFIT_SD * b.sd_mm;
+            // It pays where the readings cannot see, or it moves the
+            // platform there by no more than the readings see it gain (so
+            // that it cannot lose more than it gains).
+            let unseen = g.mean_mm > DEPLOY_IMPROVEMENT_SD * g.sd_mm
+                || g.mean_mm <= b.mean_mm + DEPLOY_BENEFIT_SD * b.sd_mm;
+            seen && unseen
         }
         // No out-of-sample benefit can be had: nothing says it pays.
         _ => false,

@@ -364,7 +364,8 @@ pub const DEPLOY_BENEFIT_SD: f64 = 2.0;
 /// term's predicted improvement ([`ModelTerm::improvement_mm`], what the
 /// term moves where the readings cannot see) must exceed for the term to
 /// be deployed, besides its out-of-sample benefit: deploying it pays
-/// against the uncertainty it adds.
+/// against the uncertainty it adds (unless its improvement is no larger
+/// than its out-of-sample benefit: it cannot lose more than it gains).
 pub const DEPLOY_IMPROVEMENT_SD: f64 = 2.0;
 
 /// A residual plot: weighted residuals of a channel (or implied leg-length
