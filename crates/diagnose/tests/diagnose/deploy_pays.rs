@@ -14,8 +14,9 @@
 //!
 //! Required: no file written at exit 0 more than 10 % worse in truth than
 //! `identify`'s; a catalogue cause named at exit 0 has its true gain within
-//! 4 sd of its predicted gain (3 sd tallied). The CI test runs 12
-//! campaigns; `deploy_pays::tally` (`--ignored`) runs 66.
+//! 4 sd of its predicted gain, and (on the tally) within 3 sd in 95 % of
+//! the cases. The CI test runs 16 campaigns; `deploy_pays::tally`
+//! (`--ignored`) runs 90.
 
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
@@ -252,6 +253,8 @@ fn run(case: usize, seed: u64, n: usize) -> Outcome {
         .map(|r| (r, context()))
         .collect();
     let geometric_mm = rms(&true_errors(&truth, &legs, &geometric, None, &held_out));
+    // With DEPLOY_PAYS_ALL set, also what the file with every term of the
+    // final model would deliver (how the rule was weighed: `ALL` lines).
     if std::env::var_os("DEPLOY_PAYS_ALL").is_some() {
         let mut all = d.clone();
         all.model_terms.iter_mut().for_each(|t| t.deployed = true);
@@ -283,8 +286,10 @@ fn run(case: usize, seed: u64, n: usize) -> Outcome {
     }
 }
 
-/// Runs the campaigns and returns the failures and tallies.
-fn evaluate(cases: Vec<(usize, u64, usize)>) -> Vec<String> {
+/// Runs the campaigns and returns the failures (with `within3_share`, also
+/// fewer than 95 % of the named causes within 3 sd of their predicted
+/// gain: a share, asserted on the tally's 48, not on the CI test's 9).
+fn evaluate(cases: Vec<(usize, u64, usize)>, within3_share: bool) -> Vec<String> {
     let outcomes: Vec<Outcome> = cases
         .into_par_iter()
         .map(|(case, seed, n)| run(case, seed, n))
@@ -371,23 +376,28 @@ fn evaluate(cases: Vec<(usize, u64, usize)>) -> Vec<String> {
     println!(
         "TALLY named causes hold: {named} with a catalogue cause named at exit 0, true gain within 3 sd of the predicted {within3}, beyond 4 sd {beyond4}"
     );
+    if within3_share && (within3 as f64) < 0.95 * named as f64 {
+        failures.push(format!(
+            "{within3} of {named} named causes within 3 sd of their predicted gain (95 % required)"
+        ));
+    }
     failures
 }
 
-/// 12 campaigns: each case once (40, 80 or 200 poses), backlash twice.
+/// 16 campaigns: each case once (40, 80 or 200 poses), backlash twice.
 #[test]
 fn deployed_files_are_never_worse_in_truth() {
     let cases: Vec<(usize, u64, usize)> = (0..CASES.len())
         .map(|c| (c, c as u64, [40, 80, 200][c % 3]))
         .chain([(0, 11, 80)])
         .collect();
-    let failures = evaluate(cases);
+    let failures = evaluate(cases, false);
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// 66 campaigns: each case at 40, 80 and 200 poses on two machines.
+/// 90 campaigns: each case at 40, 80 and 200 poses on two machines.
 #[test]
-#[ignore = "the tally of docs/reliability.md: about 66 diagnoses"]
+#[ignore = "the tally of docs/reliability.md: 90 diagnoses"]
 fn tally() {
     let cases: Vec<(usize, u64, usize)> = (0..CASES.len())
         .flat_map(|c| {
@@ -396,6 +406,6 @@ fn tally() {
                 .flat_map(move |n| (0..2u64).map(move |s| (c, 100 + 7 * s + n as u64, n)))
         })
         .collect();
-    let failures = evaluate(cases);
+    let failures = evaluate(cases, true);
     assert!(failures.is_empty(), "{failures:#?}");
 }
