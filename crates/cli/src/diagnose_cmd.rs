@@ -52,7 +52,8 @@ pub struct DiagnoseArgs {
     /// tables (leg_effects.tables, applied by ik, fk, tool-ik and
     /// compensate), sensor corrections and time terms recorded only, and a
     /// `calibration` record saying what it applies and what it records.
-    /// A cause whose improvement is not above 2 sd is not deployed.
+    /// A cause is deployed only when the file with it is predicted better
+    /// than without it, out of sample and where the sensors cannot see.
     /// Refused when the data are not explained (exit 3).
     #[arg(long, value_name = "FILE.json")]
     pub write_machine: Option<PathBuf>,

@@ -25,7 +25,7 @@
 
 use nalgebra::{DMatrix, DVector};
 use tricept_data::Dataset;
-use tricept_model::effects::{CauseName, CommonPart, EffectName, Needs, Structural};
+use tricept_model::effects::{CauseName, CommonPart, EffectName, GenericFamily, Needs, Structural};
 use tricept_numerics::stats::chi2_isf;
 
 use crate::fit::{Fit, term_estimates};
@@ -366,11 +366,22 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
         let (_, separate_by) = explain(first.name(), timed[0].name(), &timed[0].label());
         out.aliases
             .retain(|a| !members.iter().any(|t| a.in_model == t.name()));
+        // Legs that drift unequally beside a uniform growth: the legs warm
+        // unevenly, and the growth is not named alone.
+        let uneven = uneven_legs(fit, &thermal, &timed);
+        if let Some(t) = uneven.filter(|_| !out.unnamed.contains(first)) {
+            out.unnamed.push(t);
+        }
         out.aliases.push(Alias {
             effects,
             descriptions: members.iter().map(Term::label).collect(),
             why: format!(
-                "the logged temperature followed the campaign's time (r = {r:+.3}): a change with temperature and a drift with time read alike, so none of these is independent of the other"
+                "the logged temperature followed the campaign's time (r = {r:+.3}): a change with temperature and a drift with time read alike, so none of these is independent of the other{}",
+                if uneven.is_some() {
+                    "; the legs drift unequally beside the uniform growth: the legs warm unevenly (a per-leg temperature response), which a uniform thermal expansion does not describe"
+                } else {
+                    ""
+                }
             ),
             separate_by,
             exact: false,
@@ -405,6 +416,30 @@ pub(crate) fn analyse(setup: &Setup<'_>, clean: &Dataset, fit: &Fit) -> Aliases 
         structural_alias(&mut out, fit, &terms, &offsets, common, other, structural);
     }
     out
+}
+
+/// The uniform thermal growth among `thermal` when a per-leg drift among
+/// `timed` (`leg-drift`) differs between legs beyond 3 standard deviations
+/// (any pair): legs warming unevenly.
+fn uneven_legs(fit: &Fit, thermal: &[Term], timed: &[Term]) -> Option<Term> {
+    let uniform = thermal
+        .iter()
+        .copied()
+        .find(|t| *t == Term::Catalogue(EffectName::Thermal))?;
+    let unequal = timed.iter().any(|t| {
+        let Term::Generic(g) = t else { return false };
+        if g.family != GenericFamily::LegDrift {
+            return false;
+        }
+        let (v, cov) = term_estimates(fit, t);
+        (0..v.len()).any(|i| {
+            (i + 1..v.len()).any(|j| {
+                let var = cov[(i, i)] + cov[(j, j)] - 2.0 * cov[(i, j)];
+                var > 0.0 && (v[i] - v[j]).abs() > 3.0 * var.sqrt()
+            })
+        })
+    });
+    unequal.then_some(uniform)
 }
 
 /// A structural alias of the registry ([`EffectName::structural_aliases`]):

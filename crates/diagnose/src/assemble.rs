@@ -6,7 +6,7 @@
 
 use tricept_data::Dataset;
 use tricept_kinematics::Machine;
-use tricept_model::effects::{CHANNELS, CauseName, Deployment, EffectName, GenericFamily};
+use tricept_model::effects::{CHANNELS, CauseName, EffectName, GenericFamily};
 use tricept_numerics::stats::chi2_sf;
 
 use crate::alias::{Aliases, analyse};
@@ -15,10 +15,11 @@ use crate::dictionary::Scored;
 use crate::error::DiagnoseError;
 use crate::fit::{Fit, clean_poses, estimates, residuals_of, without};
 use crate::gain::{improvement, volumetric_difference};
+use crate::holdout::deployable;
 use crate::noise::{Repeats, noise_check};
 use crate::report::{
-    Alias, Cause, CauseKind, ChannelRms, Diagnosis, Estimate, Evidence, FinalFit, Gain, ModelTerm,
-    Remainder, SIGNIFICANT_IMPROVEMENT_SD, TermScore, Verdict,
+    Alias, Cause, CauseKind, ChannelRms, Diagnosis, Estimate, Evidence, FinalFit, Gain, Remainder,
+    TermScore, Verdict,
 };
 use crate::residuals::{PlotOf, residual_plot, structure};
 use crate::select::{Selection, Setup};
@@ -136,12 +137,12 @@ pub(crate) fn report(
     // What is worth deploying, and the deployed model's improvement over
     // the geometric-only fit.
     let (model_terms, deployed_fit) = deployable(nominal, setup, &clean, &current);
-    let gained = improvement(
-        nominal,
-        &geo,
-        deployed_fit.as_ref().unwrap_or(&current),
-        fitter.options,
-    );
+    let deployed_fit = match deployed_fit {
+        Some(fit) => fit,
+        None if model_terms.iter().all(|t| t.deployed) => current.clone(),
+        None => geo.clone(),
+    };
+    let gained = improvement(nominal, &geo, &deployed_fit, fitter.options);
 
     let noise = noise_check(fitter, repeated, &current, data);
     let mut d = Diagnosis {
@@ -214,85 +215,6 @@ pub(crate) fn report(
         .filter_map(|p| residual_plot(p, nominal, &clean, &geo, &current, &fitter.sigma))
         .collect();
     Ok(d)
-}
-
-/// Every term of the final model `current` with its improvement (the
-/// final model against the final model without it, [`improvement`]) and
-/// whether it is deployed: a controller parameter always, any other term
-/// when its improvement exceeds [`SIGNIFICANT_IMPROVEMENT_SD`] standard
-/// deviations (against the truth: the deployed model's own platform
-/// uncertainty with the move's), or when the model without it cannot be
-/// fitted. With the
-/// model of the deployed terms refitted when some are left out.
-fn deployable(
-    nominal: &Machine,
-    setup: &Setup<'_>,
-    clean: &Dataset,
-    current: &Fit,
-) -> (Vec<ModelTerm>, Option<Fit>) {
-    let fitter = &setup.fitter;
-    let terms = current.model.terms();
-    let mut out: Vec<ModelTerm> = terms
-        .iter()
-        .map(|t| {
-            let controller = matches!(t, Term::Catalogue(e)
-                if matches!(e.spec().deployment, Deployment::Controller(_)));
-            let gained = if controller {
-                None
-            } else {
-                let others: Vec<Term> = terms.iter().copied().filter(|u| u != t).collect();
-                fitter
-                    .fit(fitter.model(&others), clean)
-                    .ok()
-                    .map(|without| improvement(nominal, &without, current, fitter.options))
-            };
-            let deployed = match gained {
-                None => true,
-                Some(Some(g)) => g.mean_mm > SIGNIFICANT_IMPROVEMENT_SD * g.sd_mm,
-                // The plane cannot be reached: nothing says it does not pay.
-                Some(None) => true,
-            };
-            let g = gained.flatten();
-            let (legs, channel, period_mm, edges_mm) = match t {
-                Term::Generic(g) => (
-                    g.legs().iter().map(|i| *i as u8 + 1).collect(),
-                    g.channel().map(|c| c as u8),
-                    g.period_mm,
-                    g.edges_mm,
-                ),
-                Term::Catalogue(_) => (Vec::new(), None, None, None),
-            };
-            ModelTerm {
-                effect: t.name(),
-                description: t.label(),
-                legs,
-                channel,
-                period_mm,
-                edges_mm,
-                deployed,
-                improvement_mm: g.map(|g| g.mean_mm),
-                improvement_sd_mm: g.map(|g| g.sd_mm),
-                difference_sd_mm: g.map(|g| g.difference_sd_mm),
-            }
-        })
-        .collect();
-    if out.iter().all(|t| t.deployed) {
-        return (out, None);
-    }
-    let kept: Vec<Term> = terms
-        .iter()
-        .zip(&out)
-        .filter(|(_, m)| m.deployed)
-        .map(|(t, _)| *t)
-        .collect();
-    match fitter.fit(fitter.model(&kept), clean) {
-        Ok(fit) => (out, Some(fit)),
-        Err(_) => {
-            // The model of the deployed terms cannot be fitted: deploy all.
-            out.iter_mut().for_each(|t| t.deployed = true);
-            (out, None)
-        }
-    }
 }
 
 /// The `outliers` cause: the flagged poses of `data`, their largest

@@ -23,7 +23,7 @@ use tricept_model::effects::{Basis, CHANNELS, CauseName, Deployment, GenericFami
 
 use crate::error::DeployError;
 use crate::model::ExtendedModel;
-use crate::report::{Diagnosis, ModelTerm};
+use crate::report::{DEPLOY_BENEFIT_SD, DEPLOY_IMPROVEMENT_SD, Diagnosis, ModelTerm};
 use crate::terms::{Frame, GenericTerm, Scope, Term};
 
 /// The deployable model of a diagnosis, refitted on its clean poses for
@@ -89,12 +89,10 @@ pub fn deploy(
         match (t.deployed, term_of(t)) {
             (true, Some(term)) => terms.push(term),
             (false, _) => recorded.push(format!(
-                "{}: seen, not worth deploying (improvement {} mm, not above 2 sd); not in the deployed model",
+                "{}: seen, not worth deploying (out-of-sample benefit {} mm, improvement {} mm; deployed only above {DEPLOY_BENEFIT_SD} sd and {DEPLOY_IMPROVEMENT_SD} sd); not in the deployed model",
                 t.description,
-                match (t.improvement_mm, t.improvement_sd_mm) {
-                    (Some(i), Some(sd)) => format!("{i:.4} +- {sd:.4}"),
-                    _ => "not computed".into(),
-                }
+                plus_minus(t.holdout_benefit_mm, t.holdout_benefit_sd_mm),
+                plus_minus(t.improvement_mm, t.improvement_sd_mm),
             )),
             (true, None) => return Err(DeployError::NotDeployable(t.description.clone())),
         }
@@ -161,6 +159,14 @@ pub fn deploy(
         applied,
         recorded,
     })
+}
+
+/// `value +- sd`, or "not computed".
+fn plus_minus(value: Option<f64>, sd: Option<f64>) -> String {
+    match (value, sd) {
+        (Some(v), Some(sd)) => format!("{v:.4} +- {sd:.4}"),
+        _ => "not computed".into(),
+    }
 }
 
 /// The term of a model term of the report.

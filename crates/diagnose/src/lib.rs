@@ -66,6 +66,7 @@ mod fit;
 mod alias;
 mod dictionary;
 mod gain;
+mod holdout;
 mod linear;
 mod noise;
 mod residuals;
@@ -86,9 +87,10 @@ pub use noise::NOISE_CHECK_LEVEL;
 pub use options::{DiagnoseOptions, DictionaryOptions, MIN_PURE_ERROR_DOF};
 pub use plausibility::{Plausibility, PlausibilityError, Range};
 pub use report::{
-    Alias, Cause, CauseKind, ChannelRms, Diagnosis, Estimate, Evidence, FinalFit, Gain, ModelTerm,
-    NoiseCheck, NoiseSource, PureError, RejectStage, Rejected, Remainder, ResidualPlot,
-    SIGNIFICANT_IMPROVEMENT_SD, Structure, TermScore, Tested, Verdict,
+    Alias, Cause, CauseKind, ChannelRms, DEPLOY_BENEFIT_SD, DEPLOY_IMPROVEMENT_SD, Diagnosis,
+    Estimate, Evidence, FinalFit, Gain, ModelTerm, NoiseCheck, NoiseSource, PureError, RejectStage,
+    Rejected, Remainder, ResidualPlot, SIGNIFICANT_IMPROVEMENT_SD, Structure, TermScore, Tested,
+    Verdict,
 };
 pub use run::diagnose;
 pub use terms::{

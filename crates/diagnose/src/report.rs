@@ -322,23 +322,51 @@ pub struct ModelTerm {
     pub period_mm: Option<f64>,
     /// The edges of a step, leg command `[from, to]`, mm.
     pub edges_mm: Option<[f64; 2]>,
-    /// Whether it is deployed: its improvement is significant, or it is a
-    /// controller parameter (backlash, thermal expansion: its gain is at
-    /// the approach directions and temperatures the controller knows).
+    /// Whether it is deployed: the file with it is predicted better than
+    /// the file without it, out of sample (its benefit,
+    /// [`ModelTerm::holdout_benefit_mm`], above [`DEPLOY_BENEFIT_SD`]
+    /// standard deviations) and where the readings cannot see (its
+    /// improvement above [`DEPLOY_IMPROVEMENT_SD`] standard deviations),
+    /// both against the deployed model without it; no term is exempt. Or
+    /// the model without it cannot be fitted.
     pub deployed: bool,
-    /// The mean platform error on the middle plane of the final model
-    /// without this term minus that of the final model, mm (`null` for a
-    /// controller parameter).
+    /// The mean platform error on the middle plane of the deployed model
+    /// without this term minus that of the deployed model (the final model
+    /// when every term is deployed), mm (`null` when the model without it
+    /// cannot be fitted or the plane reached).
     pub improvement_mm: Option<f64>,
     /// Its standard deviation against the truth ([`Gain::improvement_sd_mm`]), mm.
     pub improvement_sd_mm: Option<f64>,
     /// The standard deviation of the move alone ([`Gain::difference_sd_mm`]), mm.
     pub difference_sd_mm: Option<f64>,
+    /// The out-of-sample benefit of the term: the root mean square held-out
+    /// platform error (5-fold cross-validation, reading residuals mapped to
+    /// the platform) of the file without it minus that of the file with
+    /// it, mm (`null` when a fold cannot be fitted).
+    pub holdout_benefit_mm: Option<f64>,
+    /// Its standard deviation over the held-out poses, mm.
+    pub holdout_benefit_sd_mm: Option<f64>,
 }
 
 /// How many standard deviations ([`ModelTerm::improvement_sd_mm`]) a
-/// term's improvement must exceed for the term to be deployed.
+/// term's in-sample improvement had to exceed for the term to be deployed
+/// before the out-of-sample rule ([`DEPLOY_BENEFIT_SD`]); kept for callers
+/// that compare with it, no longer the rule.
 pub const SIGNIFICANT_IMPROVEMENT_SD: f64 = 2.0;
+
+/// How many standard deviations ([`ModelTerm::holdout_benefit_sd_mm`]) a
+/// term's out-of-sample benefit ([`ModelTerm::holdout_benefit_mm`]) must
+/// exceed for the term to be deployed: the file with it predicted better,
+/// out of sample, than the file without it, beyond its uncertainty.
+pub const DEPLOY_BENEFIT_SD: f64 = 2.0;
+
+/// How many standard deviations ([`ModelTerm::improvement_sd_mm`]) a
+/// term's predicted improvement ([`ModelTerm::improvement_mm`], what the
+/// term moves where the readings cannot see) must exceed for the term to
+/// be deployed, besides its out-of-sample benefit: deploying it pays
+/// against the uncertainty it adds (unless its improvement is no larger
+/// than its out-of-sample benefit: it cannot lose more than it gains).
+pub const DEPLOY_IMPROVEMENT_SD: f64 = 2.0;
 
 /// A residual plot: weighted residuals of a channel (or implied leg-length
 /// residuals) against the regressor that exposes a cause.
@@ -669,17 +697,23 @@ impl Diagnosis {
             );
         }
         for t in &self.model_terms {
-            let numbers = match (t.improvement_mm, t.improvement_sd_mm, t.difference_sd_mm) {
+            let mut numbers = match (t.improvement_mm, t.improvement_sd_mm, t.difference_sd_mm) {
                 (Some(i), Some(sd), Some(moved)) => {
                     format!(": improvement {i:.4} +- {sd:.4} mm (the move's own sd {moved:.4} mm)")
                 }
                 _ => String::new(),
             };
+            if let (Some(b), Some(sd)) = (t.holdout_benefit_mm, t.holdout_benefit_sd_mm) {
+                numbers.push_str(&format!(
+                    "{}out-of-sample benefit {b:.4} +- {sd:.4} mm",
+                    if numbers.is_empty() { ": " } else { "; " }
+                ));
+            }
             if t.deployed {
                 w!("deployed: {}{numbers}", t.description);
             } else {
                 w!(
-                    "seen, not worth deploying: {}{numbers} (not above {SIGNIFICANT_IMPROVEMENT_SD} sd)",
+                    "seen, not worth deploying: {}{numbers} (deployed only above {DEPLOY_BENEFIT_SD} sd out of sample and {DEPLOY_IMPROVEMENT_SD} sd of improvement)",
                     t.description
                 );
             }

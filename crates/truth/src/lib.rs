@@ -12,7 +12,11 @@
 //!   a machine warmed as a whole) and [`SensorNoise`];
 //! - `tracker.rs`: [`TrueTracker`], a laser tracker station;
 //! - `campaign.rs`: [`Row`] and [`to_csv`], a campaign written as the
-//!   documented data CSV.
+//!   documented data CSV;
+//! - `legs.rs`: [`LegEffect`], leg effects added to the true leg lengths
+//!   (backlash by the `dir` columns' sign, a lead, a quadratic leg, a pitch
+//!   error, a worn segment, legs heating evenly or unevenly), and where
+//!   the platform goes with them.
 //!
 //! This is test support: it panics on a machine its Newton iteration
 //! cannot close, and is not published.
@@ -32,10 +36,12 @@
 //! ```
 
 mod campaign;
+mod legs;
 mod machine;
 mod tracker;
 
 pub use campaign::{Row, to_csv};
+pub use legs::{LegContext, LegEffect};
 pub use machine::{SensorNoise, TrueHead, TrueMachine};
 pub use tracker::TrueTracker;
 

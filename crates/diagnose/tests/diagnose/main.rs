@@ -5,6 +5,7 @@
 
 mod common;
 mod deploy_in_truth;
+mod deploy_pays;
 mod hidden_effects;
 mod noise_from_data;
 mod out_of_vocabulary;

@@ -1,0 +1,320 @@
+//! Deploy by what the file will deliver: a term of the final model is
+//! deployed when the file with it is predicted better than the file
+//! without it, out of sample and where the readings cannot see.
+//!
+//! **The out-of-sample benefit.** K-fold cross-validation (the folds of
+//! [`crate::fit::Fitter::holdout_rms`]): the model with the term and the
+//! model without it are each fitted on K-1 folds, and each predicts the
+//! readings of the held-out fold. A held-out pose's reading residual
+//! (`phi`, `theta`, `s`) is mapped to the platform through the UP limb of
+//! the fitted model at the pose's predicted joints (the sensors measure
+//! where the platform went): `e_j`, mm. The benefit is the difference of
+//! the two files' root mean square held-out platform errors,
+//! `rms(e_without) - rms(e_with)`, and its standard deviation follows from
+//! the per-pose differences `d_j = |e_without_j|^2 - |e_with_j|^2`:
+//! `sd(d) / sqrt(n) / (rms_without + rms_with)`. A term fitted to noise
+//! has none.
+//!
+//! **What the readings cannot see.** Along the weak leg-length direction
+//! the sensors do not see where the platform goes
+//! (`docs/identifiability.md`): a held-out reading says nothing of it, and
+//! there a term's worth is the predicted improvement of
+//! [`crate::gain::improvement`] (how far the file without it puts the
+//! platform from where the file with it does), against its standard
+//! deviation (the uncertainty the term adds to the file, and the move's).
+//!
+//! **The rule** (no term is exempt: backlash and thermal expansion are
+//! judged as every other term). A term is deployed when its out-of-sample
+//! benefit exceeds [`DEPLOY_BENEFIT_SD`] standard deviations and its
+//! predicted improvement exceeds [`DEPLOY_IMPROVEMENT_SD`] standard
+//! deviations or is no larger than the out-of-sample benefit (plus its
+//! [`DEPLOY_BENEFIT_SD`] sd: the file moves the platform where the readings
+//! cannot see by no more than they see it gain, as a backlash visited from
+//! both directions does), each judged against the *deployed* model without it:
+//! backward elimination removes the least useful failing term (smallest
+//! improvement in standard deviations), refits the rest and judges them
+//! again. A term whose absence leaves a model that cannot be fitted is
+//! needed and deployed.
+
+use nalgebra::Vector3;
+use rayon::prelude::*;
+use tricept_data::{Dataset, MeasuredPose};
+use tricept_engine::ReadingModel;
+use tricept_kinematics::{Machine, UpJoints};
+
+use crate::fit::Fit;
+use crate::gain::improvement;
+use crate::model::ExtendedModel;
+use crate::report::{DEPLOY_BENEFIT_SD, DEPLOY_IMPROVEMENT_SD, ModelTerm};
+use crate::select::Setup;
+use crate::terms::Term;
+
+/// The out-of-sample benefit of one file over another, mm.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Benefit {
+    /// `rms(e_without) - rms(e_with)`, mm.
+    pub(crate) mean_mm: f64,
+    /// Its standard deviation from the held-out poses alone, mm.
+    pub(crate) sd_mm: f64,
+}
+
+/// Held-out platform errors (mm) of `model` on `data`, one per pose, each
+/// pose predicted by the fit on the other folds; `Err(fold)` (1-based)
+/// when a fold cannot be fitted or a pose predicted.
+pub(crate) fn platform_errors(
+    setup: &Setup<'_>,
+    model: &ExtendedModel,
+    data: &Dataset,
+) -> Result<Vec<Vector3<f64>>, usize> {
+    let fitter = &setup.fitter;
+    let k = fitter.options.folds.max(2);
+    let parts: Vec<Result<PoseErrors, usize>> = (0..k)
+        .into_par_iter()
+        .map(|fold| {
+            let train = data.subset(|j| j % k != fold);
+            let f = fitter.fit(model.clone(), &train).map_err(|_| fold + 1)?;
+            let held: Vec<(usize, &MeasuredPose)> = data
+                .poses
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| j % k == fold)
+                .collect();
+            pose_errors(&f, &held).ok_or(fold + 1)
+        })
+        .collect();
+    let mut out = vec![Vector3::zeros(); data.poses.len()];
+    for part in parts {
+        for (j, e) in part? {
+            out[j] = e;
+        }
+    }
+    Ok(out)
+}
+
+/// The platform error (mm) of each of `poses` under the fit `f`: the
+/// reading residual mapped through the UP limb's derivatives at the pose's
+/// predicted joints; `None` when a pose cannot be predicted.
+fn pose_errors(f: &Fit, poses: &[(usize, &MeasuredPose)]) -> Option<PoseErrors> {
+    let predictor = f.model.at(&f.id.estimate);
+    let limb = f.model.machine_at(&f.id.estimate).up_limb;
+    let mut jac = vec![0.0; 3 * f.id.estimate.len()];
+    let offsets = f.id.offsets;
+    poses
+        .iter()
+        .map(|(j, p)| {
+            let mut seed: Option<UpJoints> = None;
+            let g = predictor.predict(p, &mut seed, &mut jac).ok()?;
+            let up = seed?;
+            let y = p.readings.to_array();
+            let r: [f64; 3] = std::array::from_fn(|c| y[c] - g[c] - offsets[c]);
+            let mut e = Vector3::zeros();
+            for (c, h) in JOINT_STEPS.iter().enumerate() {
+                let at = |s: f64| {
+                    let mut a = up.to_array();
+                    a[c] += s;
+                    limb.pose(&UpJoints {
+                        phi_rad: a[0],
+                        theta_rad: a[1],
+                        q4_mm: a[2],
+                    })
+                    .position_mm
+                };
+                e += (at(*h) - at(-*h)) / (2.0 * h) * r[c];
+            }
+            e.iter().all(|v| v.is_finite()).then_some((*j, e))
+        })
+        .collect()
+}
+
+/// Each pose's index with its platform error, mm.
+type PoseErrors = Vec<(usize, Vector3<f64>)>;
+
+/// Central-difference steps of the UP limb's joints (rad, rad, mm).
+const JOINT_STEPS: [f64; 3] = [1e-6, 1e-6, 1e-3];
+
+/// The out-of-sample benefit of the file whose held-out platform errors
+/// are `with` over the one whose errors are `without` (the same poses).
+pub(crate) fn benefit(with: &[Vector3<f64>], without: &[Vector3<f64>]) -> Option<Benefit> {
+    let n = with.len();
+    if n < 2 || without.len() != n {
+        return None;
+    }
+    let d: Vec<f64> = with
+        .iter()
+        .zip(without)
+        .map(|(w, o)| o.norm_squared() - w.norm_squared())
+        .collect();
+    let mean_d = d.iter().sum::<f64>() / n as f64;
+    let var_d = d.iter().map(|v| (v - mean_d).powi(2)).sum::<f64>() / (n - 1) as f64;
+    let rms =
+        |e: &[Vector3<f64>]| (e.iter().map(|v| v.norm_squared()).sum::<f64>() / n as f64).sqrt();
+    let (rms_with, rms_without) = (rms(with), rms(without));
+    let total = rms_with + rms_without;
+    if !(total > 0.0 && total.is_finite()) {
+        return None;
+    }
+    Some(Benefit {
+        mean_mm: rms_without - rms_with,
+        sd_mm: (var_d / n as f64).sqrt() / total,
+    })
+}
+
+/// A term judged against the deployed model `with` (which holds it).
+struct Judged {
+    record: ModelTerm,
+    /// Whether it pays by both halves of the rule.
+    pays: bool,
+    /// How many standard deviations its predicted improvement is (the
+    /// least useful failing term goes first).
+    z: f64,
+}
+
+/// Judges `t` against the deployed model `with` (its held-out platform
+/// errors `full`): the model without it fitted, the predicted improvement
+/// of `with` over it, the out-of-sample benefit, and the rule.
+fn judge(
+    nominal: &Machine,
+    setup: &Setup<'_>,
+    clean: &Dataset,
+    with: &Fit,
+    full: Option<&[Vector3<f64>]>,
+    t: &Term,
+) -> Judged {
+    let fitter = &setup.fitter;
+    let others: Vec<Term> = with
+        .model
+        .terms()
+        .iter()
+        .copied()
+        .filter(|u| u != t)
+        .collect();
+    let model = fitter.model(&others);
+    let without = fitter.fit(model.clone(), clean).ok();
+    let gained = without
+        .as_ref()
+        .and_then(|w| improvement(nominal, w, with, fitter.options));
+    let held_out = match (full, &without) {
+        (Some(full), Some(_)) => platform_errors(setup, &model, clean)
+            .ok()
+            .and_then(|e| benefit(full, &e)),
+        _ => None,
+    };
+    let z = gained.map_or(f64::INFINITY, |g| {
+        if g.sd_mm > 0.0 {
+            g.mean_mm / g.sd_mm
+        } else {
+            f64::INFINITY
+        }
+    });
+    let pays = match (&without, held_out, gained) {
+        // Without it the model cannot be fitted: it is needed.
+        (None, _, _) => true,
+        (Some(_), Some(b), Some(g)) => {
+            let seen = b.mean_mm > DEPLOY_BENEFIT_SD * b.sd_mm;
+            // It pays where the readings cannot see, or it moves the
+            // platform there by no more than the readings see it gain (so
+            // that it cannot lose more than it gains).
+            let unseen = g.mean_mm > DEPLOY_IMPROVEMENT_SD * g.sd_mm
+                || g.mean_mm <= b.mean_mm + DEPLOY_BENEFIT_SD * b.sd_mm;
+            seen && unseen
+        }
+        // No out-of-sample benefit can be had: nothing says it pays.
+        _ => false,
+    };
+    let (legs, channel, period_mm, edges_mm) = match t {
+        Term::Generic(g) => (
+            g.legs().iter().map(|i| *i as u8 + 1).collect(),
+            g.channel().map(|c| c as u8),
+            g.period_mm,
+            g.edges_mm,
+        ),
+        Term::Catalogue(_) => (Vec::new(), None, None, None),
+    };
+    Judged {
+        record: ModelTerm {
+            effect: t.name(),
+            description: t.label(),
+            legs,
+            channel,
+            period_mm,
+            edges_mm,
+            deployed: pays,
+            improvement_mm: gained.map(|g| g.mean_mm),
+            improvement_sd_mm: gained.map(|g| g.sd_mm),
+            difference_sd_mm: gained.map(|g| g.difference_sd_mm),
+            holdout_benefit_mm: held_out.map(|b| b.mean_mm),
+            holdout_benefit_sd_mm: held_out.map(|b| b.sd_mm),
+        },
+        pays,
+        z,
+    }
+}
+
+/// Every term of the final model `current` with its predicted
+/// improvement ([`improvement`]), its out-of-sample benefit, and whether
+/// it is deployed (the module's rule), by backward elimination: every
+/// deployed term is judged against the deployed model without it, the
+/// least useful failing term (the smallest predicted improvement in
+/// standard deviations) leaves, the rest is refitted and judged again.
+/// A term left out keeps the numbers it was judged by. With the model of
+/// the deployed terms when some are left out (`None` when all are
+/// deployed, or none).
+pub(crate) fn deployable(
+    nominal: &Machine,
+    setup: &Setup<'_>,
+    clean: &Dataset,
+    current: &Fit,
+) -> (Vec<ModelTerm>, Option<Fit>) {
+    let fitter = &setup.fitter;
+    let terms = current.model.terms().to_vec();
+    let mut records: Vec<Option<ModelTerm>> = vec![None; terms.len()];
+    let mut with = current.clone();
+    let mut kept = terms.clone();
+    while !kept.is_empty() {
+        let full = platform_errors(setup, &with.model, clean).ok();
+        let judged: Vec<Judged> = kept
+            .par_iter()
+            .map(|t| judge(nominal, setup, clean, &with, full.as_deref(), t))
+            .collect();
+        let failing = judged
+            .iter()
+            .enumerate()
+            .filter(|(_, j)| !j.pays)
+            .min_by(|a, b| a.1.z.total_cmp(&b.1.z))
+            .map(|(k, _)| k);
+        for (t, j) in kept.iter().zip(&judged) {
+            if let Some(slot) = terms.iter().position(|u| u == t) {
+                records[slot] = Some(j.record.clone());
+            }
+        }
+        let Some(k) = failing else { break };
+        let gone = kept.remove(k);
+        if let Some(Some(r)) = terms
+            .iter()
+            .position(|u| *u == gone)
+            .map(|s| &mut records[s])
+        {
+            r.deployed = false;
+        }
+        if kept.is_empty() {
+            break;
+        }
+        match fitter.fit(fitter.model(&kept), clean) {
+            Ok(fit) => with = fit,
+            Err(_) => {
+                // The model of the remaining terms cannot be fitted:
+                // deploy none.
+                kept.clear();
+            }
+        }
+    }
+    let mut out: Vec<ModelTerm> = records.into_iter().flatten().collect();
+    for r in &mut out {
+        r.deployed = r.deployed && kept.iter().any(|t| t.label() == r.description);
+    }
+    if kept.len() == terms.len() || kept.is_empty() {
+        (out, None)
+    } else {
+        (out, Some(with))
+    }
+}

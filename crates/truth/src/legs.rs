@@ -1,0 +1,206 @@
+//! Leg effects a test adds to the true leg lengths, written from the
+//! documented conventions (`docs/diagnosis.md`, `docs/data-format.md`),
+//! never through the project's effect code: backlash by the sign of the
+//! `dir1..dir3` column (`dir` is +1 when the leg last extended; the leg
+//! stops `b/2` short in the direction it came from), a leg lead, a
+//! quadratic leg, a ball-screw pitch error, a worn segment, and legs that
+//! grow with temperature, each at its own temperature when they heat
+//! unevenly. With [`TrueMachine::position`] a test commands the true
+//! machine and sees where its platform goes.
+
+use nalgebra::Vector3;
+
+use crate::TrueMachine;
+
+/// A leg effect: an extra true length of each leg, mm, as a function of
+/// its command and the context of the pose ([`LegContext`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LegEffect {
+    /// Lost motion at reversal, um per leg: the true length is
+    /// `-dir_i b_i / 2` off.
+    Backlash {
+        /// `b_i`, um.
+        um: [f64; 3],
+    },
+    /// A lead error: `k_i q_i`.
+    Lead {
+        /// `k_i`, ppm.
+        ppm: [f64; 3],
+    },
+    /// A curved screw: `c_i ((q_i - centre) / half_width)^2`.
+    Quadratic {
+        /// `c_i`, um.
+        um: [f64; 3],
+        /// The centre of the curve, mm.
+        centre_mm: f64,
+        /// Its half width, mm.
+        half_width_mm: f64,
+    },
+    /// A ball-screw pitch error: `a_i sin(2 pi q_i / P + phase_i)`.
+    Pitch {
+        /// `a_i`, um.
+        um: [f64; 3],
+        /// `P`, mm.
+        period_mm: f64,
+        /// `phase_i`, deg.
+        phase_deg: [f64; 3],
+    },
+    /// A worn segment: `h_i` while `from <= q_i <= to`.
+    Step {
+        /// `h_i`, um.
+        um: [f64; 3],
+        /// Where it starts, mm.
+        from_mm: f64,
+        /// Where it ends, mm.
+        to_mm: f64,
+    },
+    /// Legs that grow with their own temperature, `alpha (q_i + dq_i)
+    /// (T + kelvin_i - 20)`: `T` the logged structure temperature, leg `i`
+    /// `kelvin_i` warmer than it (all zero: the documented uniform
+    /// `thermal`, legs at the logged temperature).
+    Heating {
+        /// `alpha`, ppm/K.
+        ppm_per_k: f64,
+        /// Each leg's temperature above the logged one, K.
+        kelvin: [f64; 3],
+    },
+    /// Legs warming unevenly as the structure warms: leg `i` at
+    /// `T + kelvin_i (T - from) / (to - from)` (its own temperature
+    /// response: `kelvin_i` more than the logged rise from `from` to `to`),
+    /// growing `alpha (q_i + dq_i) (T_i - 20)`.
+    Warming {
+        /// `alpha`, ppm/K.
+        ppm_per_k: f64,
+        /// Each leg's extra warming over the logged rise, K.
+        kelvin: [f64; 3],
+        /// The logged temperature where the rise starts, deg C.
+        from_c: f64,
+        /// Where it ends, deg C.
+        to_c: f64,
+    },
+}
+
+/// What a leg effect may depend on besides the command.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LegContext {
+    /// The logged structure temperature, deg C.
+    pub temp_c: f64,
+    /// The sign of each leg's last motion (+1: it extended).
+    pub directions: [i8; 3],
+}
+
+impl LegEffect {
+    /// Extra true length of each leg at commands `q` (mm) on a machine
+    /// whose leg offsets are `offsets_mm`, mm.
+    pub fn extra_mm(&self, q: &[f64; 3], offsets_mm: &[f64; 3], at: &LegContext) -> [f64; 3] {
+        std::array::from_fn(|i| match *self {
+            LegEffect::Backlash { um } => -f64::from(at.directions[i]) * um[i] * 1e-3 / 2.0,
+            LegEffect::Lead { ppm } => ppm[i] * 1e-6 * q[i],
+            LegEffect::Quadratic {
+                um,
+                centre_mm,
+                half_width_mm,
+            } => um[i] * 1e-3 * ((q[i] - centre_mm) / half_width_mm).powi(2),
+            LegEffect::Pitch {
+                um,
+                period_mm,
+                phase_deg,
+            } => {
+                um[i]
+                    * 1e-3
+                    * (std::f64::consts::TAU * q[i] / period_mm + phase_deg[i].to_radians()).sin()
+            }
+            LegEffect::Step { um, from_mm, to_mm } => {
+                if (from_mm..=to_mm).contains(&q[i]) {
+                    um[i] * 1e-3
+                } else {
+                    0.0
+                }
+            }
+            LegEffect::Heating { ppm_per_k, kelvin } => {
+                ppm_per_k * 1e-6 * (q[i] + offsets_mm[i]) * (at.temp_c + kelvin[i] - 20.0)
+            }
+            LegEffect::Warming {
+                ppm_per_k,
+                kelvin,
+                from_c,
+                to_c,
+            } => {
+                let leg_c = at.temp_c + kelvin[i] * (at.temp_c - from_c) / (to_c - from_c);
+                ppm_per_k * 1e-6 * (q[i] + offsets_mm[i]) * (leg_c - 20.0)
+            }
+        })
+    }
+}
+
+impl TrueMachine {
+    /// True leg lengths at commands `q` (mm) with `effects` at `at`.
+    pub fn lengths_with(&self, q: &[f64; 3], effects: &[LegEffect], at: &LegContext) -> [f64; 3] {
+        let mut l: [f64; 3] = std::array::from_fn(|i| q[i] + self.leg_offsets_mm[i]);
+        for e in effects {
+            let extra = e.extra_mm(q, &self.leg_offsets_mm, at);
+            for i in 0..3 {
+                l[i] += extra[i];
+            }
+        }
+        l
+    }
+
+    /// The platform point `O' = q4 R e_z` of the UP limb's joints
+    /// `[phi, theta, q4]` (`R = Rx(phi) Ry(theta)`), mm.
+    pub fn position(&self, joints: &[f64; 3]) -> Vector3<f64> {
+        let [phi, theta, q4] = *joints;
+        let r = crate::rot(&Vector3::x(), phi) * crate::rot(&Vector3::y(), theta);
+        r * Vector3::new(0.0, 0.0, q4)
+    }
+
+    /// Where the platform point goes at commands `q` with `effects` at
+    /// `at`, mm.
+    pub fn reach_with(&self, q: &[f64; 3], effects: &[LegEffect], at: &LegContext) -> Vector3<f64> {
+        self.position(&self.forward_lengths(&self.lengths_with(q, effects, at)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn backlash_shortens_the_leg_in_the_direction_it_came_from() {
+        let m = TrueMachine::documented();
+        let q = [800.0, 810.0, 820.0];
+        let e = [LegEffect::Backlash {
+            um: [10.0, 10.0, 10.0],
+        }];
+        let extended = LegContext {
+            temp_c: 20.0,
+            directions: [1, -1, 1],
+        };
+        let l = m.lengths_with(&q, &e, &extended);
+        assert!((l[0] - (800.0 - 0.005)).abs() < 1e-12);
+        assert!((l[1] - (810.0 + 0.005)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_platform_point_closes_the_legs() {
+        let m = TrueMachine::random(0.0, 3);
+        let at = LegContext {
+            temp_c: 22.0,
+            directions: [1, 1, 1],
+        };
+        let e = [LegEffect::Heating {
+            ppm_per_k: 11.5,
+            kelvin: [4.0, 1.0, -2.0],
+        }];
+        let q = [800.0, 790.0, 805.0];
+        let x = m.reach_with(&q, &e, &at);
+        // The documented machine: O' lies q4 along the limb from the U
+        // joint at the base origin.
+        let joints = m.forward_lengths(&m.lengths_with(&q, &e, &at));
+        assert!((x.norm() - joints[2]).abs() < 1e-9);
+        // Leg 1 is 6 K above 20 deg C: 11.5 ppm/K x 6 K of its length.
+        let l = m.lengths_with(&q, &e, &at);
+        let grown = 11.5e-6 * 6.0 * (800.0 + m.leg_offsets_mm[0]);
+        assert!((l[0] - (800.0 + m.leg_offsets_mm[0]) - grown).abs() < 1e-12);
+    }
+}
