@@ -29,7 +29,8 @@ use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 use serde_json::Value;
-use tricept_ident::{CheckRequest, DataInput, EXIT_INADEQUATE, EXIT_OK, check, read_data_from};
+use tricept_ident::advanced::read_data_from;
+use tricept_ident::{CheckRequest, DataInput, EXIT_INADEQUATE, EXIT_OK, check};
 use tricept_truth::to_csv;
 
 pub use truth_side::{BadReading, Calibrated, Change, Hidden, Scenario};

@@ -19,7 +19,7 @@ use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use tricept_ident::{
-    CalibrateRequest, Data, Instrument, LoadedMachine, PlanRequest, SensorNoise, calibrate,
+    CalibrateRequest, DataInput, Instrument, LoadedMachine, PlanRequest, SensorNoise, calibrate,
     load_machine, plan,
 };
 use tricept_truth::{ARCSEC_PER_RAD, Row, TrueMachine, normal, to_csv};
@@ -169,9 +169,9 @@ impl Calibrated {
         let data: PathBuf = dir.join("cal.csv");
         let machine_file = dir.join("cal.json");
         std::fs::write(&data, to_csv(&rows)).map_err(|e| format!("{}: {e}", data.display()))?;
-        let mut request = CalibrateRequest::new(Data::File(data.clone()));
+        let mut request = CalibrateRequest::new(DataInput::File(data.clone()));
         request.for_machine_file = true;
-        let mut calibration = calibrate(&request).map_err(|e| format!("machine {seed}: {e}"))?;
+        let mut calibration = calibrate(request).map_err(|e| format!("machine {seed}: {e}"))?;
         calibration
             .write_machine(&machine_file, false)
             .map_err(|e| format!("machine {seed}: identify: {e}"))?;
@@ -184,7 +184,7 @@ impl Calibrated {
             r.machine = Some(machine_file.clone());
             r.k = vec![k];
             r.out = Some(out.clone());
-            let p = plan(&r).map_err(|e| format!("machine {seed}: plan: {e}"))?;
+            let p = plan(r).map_err(|e| format!("machine {seed}: plan: {e}"))?;
             p.write_out(&out).map_err(|e| e.to_string())?;
             let text =
                 std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
