@@ -256,6 +256,7 @@ impl DiagnoseResult {
                 n_geometric: g,
                 external: Vec::new(),
                 temperature_c: machine_file::mean_temperature_c(&self.data),
+                accuracy: None,
             },
             deployed.controller,
         )?;

@@ -20,6 +20,7 @@
 )]
 
 // Layer 0: errors, limits and inputs.
+mod accuracy;
 mod error;
 mod export;
 mod inputs;
@@ -63,6 +64,7 @@ pub use calibrate::{
     CalibrateRequest, Calibration, Data, FusedSources, Written, calibrate, exit_line,
 };
 
+pub use accuracy::Accuracy;
 pub use check::{CheckRequest, CheckResult, check};
 pub use compensate::{
     Calibrated, CompensateRequest, Compensation, CorrectedTarget, MAP_FILES, TABLE_ERROR_LIMIT_UM,

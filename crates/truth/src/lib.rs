@@ -10,6 +10,8 @@
 //!   sensor offsets; forward kinematics by its own Newton iteration, from
 //!   commands or from true leg lengths, so that a test adds any leg effect;
 //!   a machine warmed as a whole) and [`SensorNoise`];
+//! - `effects.rs`: [`LegEffect`], leg effects a test hides in the true
+//!   machine's leg lengths (heating, lead, a curved screw, a slip);
 //! - `tracker.rs`: [`TrueTracker`], a laser tracker station;
 //! - `campaign.rs`: [`Row`] and [`to_csv`], a campaign written as the
 //!   documented data CSV.
@@ -32,10 +34,12 @@
 //! ```
 
 mod campaign;
+mod effects;
 mod machine;
 mod tracker;
 
 pub use campaign::{Row, to_csv};
+pub use effects::{DELIVERY_T, LegEffect};
 pub use machine::{SensorNoise, TrueHead, TrueMachine};
 pub use tracker::TrueTracker;
 

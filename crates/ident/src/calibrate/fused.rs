@@ -319,6 +319,7 @@ impl FusedFit {
                 n_geometric: fit.names.len(),
                 external,
                 temperature_c: None,
+                accuracy: None,
             },
             None,
         )?;

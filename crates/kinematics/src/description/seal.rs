@@ -18,7 +18,7 @@ use super::MachineDescription;
 /// in a description (`None` when the description has no calibration).
 fn sealed_fields(d: &MachineDescription) -> Option<Vec<(&'static str, String)>> {
     let c = d.calibration.as_deref()?;
-    Some(vec![
+    let mut fields = vec![
         ("calibration.std_dev_mm", text(&c.std_dev_mm)),
         ("calibration.correlations", text(&c.correlations)),
         ("calibration.sensor_offsets", text(&c.sensor_offsets)),
@@ -33,8 +33,19 @@ fn sealed_fields(d: &MachineDescription) -> Option<Vec<(&'static str, String)>> 
         ("calibration.poses_used", text(&c.poses_used)),
         ("sensors", text(&d.sensors)),
         ("controller", text(&d.controller)),
-    ])
+    ];
+    // The promise, in every record that has one or whose seal covers one
+    // (a file written before records carried it keeps its seal; one whose
+    // promise was removed by hand is refused).
+    let sealed = |seal: &BTreeMap<String, String>| seal.contains_key(ACCURACY);
+    if c.accuracy.is_some() || c.seal.as_ref().is_some_and(sealed) {
+        fields.push((ACCURACY, text(&c.accuracy)));
+    }
+    Some(fields)
 }
+
+/// The sealed name of the promise.
+const ACCURACY: &str = "calibration.accuracy";
 
 /// A value's compact JSON text (plain data cannot fail to serialise).
 fn text(value: &impl serde::Serialize) -> String {
@@ -117,6 +128,7 @@ mod tests {
             correlations: CorrelationsDescription::default(),
             effects: serde_json::Map::new(),
             sensor_offsets: SensorOffsetsDescription::default(),
+            accuracy: None,
             applies: Vec::new(),
             records: Vec::new(),
             held: Vec::new(),
