@@ -30,8 +30,14 @@
 
 use serde::Serialize;
 use serde_json::{Map, Value};
-use tricept_data::MeasuredPose;
-use tricept_engine::{AccuracyModel, CrossValidation, IdentError, Identification, ReadingModel};
+use std::sync::Arc;
+
+use tricept_data::Dataset;
+use tricept_diagnose::{ExtendedModel, Frame, GenericFamily, GenericTerm, Scope, Term};
+use tricept_engine::{
+    AccuracyModel, CrossValidation, GeometricModel, IdentError, Identification, IdentifyOptions,
+    ReadingModel,
+};
 use tricept_kinematics::Machine;
 use tricept_kinematics::description::AccuracyRecord;
 use tricept_model::ParameterSet;
@@ -139,6 +145,16 @@ impl Accuracy {
         }
     }
 
+    /// This promise with the structure part `(rms_mm, upper_mm)` added in
+    /// quadrature.
+    pub(crate) fn with_structure(mut self, (rms, upper): (f64, f64)) -> Accuracy {
+        self.parts.insert("structure_mm".into(), rms.into());
+        self.parts.insert("structure_upper_mm".into(), upper.into());
+        self.rms_mm = self.rms_mm.hypot(rms);
+        self.upper_mm = self.upper_mm.hypot(upper);
+        self
+    }
+
     /// The record a machine file carries (`calibration.accuracy`).
     pub fn record(&self) -> AccuracyRecord {
         AccuracyRecord {
@@ -172,17 +188,20 @@ impl Accuracy {
     }
 }
 
-/// The promise of `id`, fitted with `model` on `poses` (logged noise
+/// The promise of `id`, fitted with `model` on `data` (logged noise
 /// `sigma`) on machine `m`: its first `set.len()` parameters are the
-/// geometry of `set`, the rest deployed terms.
+/// geometry of `set`, the rest deployed terms; `geometric`: the geometric
+/// `base`: the model whose geometric estimate a model with richer legs
+/// checks (module docs).
 pub(crate) fn of_fit(
     m: &Machine,
     set: &ParameterSet,
     model: &dyn ReadingModel,
     id: &Identification,
-    poses: &[MeasuredPose],
-    sigma: &[f64; 3],
+    data: &Dataset,
+    options: &IdentifyOptions,
     tolerance_mm: f64,
+    base: Option<&ExtendedModel>,
 ) -> Result<Accuracy, Error> {
     let k = set.len();
     let context = |e: IdentError| Error::with_context("accuracy", &e);
@@ -192,10 +211,9 @@ pub(crate) fn of_fit(
             id.covariance.nrows()
         )));
     }
-    let model_points =
-        AccuracyModel::new(m, set, &tricept_engine::accuracy_points(m), tolerance_mm)
-            .map_err(context)?;
-    let geometric = id.covariance.view((0, 0), (k, k)).into_owned();
+    let points = AccuracyModel::new(m, set, &tricept_engine::accuracy_points(m), tolerance_mm)
+        .map_err(context)?;
+    let covariance = id.covariance.view((0, 0), (k, k)).into_owned();
     let held: Vec<usize> = id
         .design()
         .fixed()
@@ -203,13 +221,108 @@ pub(crate) fn of_fit(
         .copied()
         .filter(|&i| i < k)
         .collect();
-    let cv = tricept_engine::cross_validate(model, id, poses, m, sigma).map_err(context)?;
-    Accuracy::internal(
-        &model_points,
-        &geometric,
-        &held,
-        &cv,
-        id.covariance.nrows() > k,
+    let cv = tricept_engine::cross_validate(model, id, &data.poses, m, &options.sigma)
+        .map_err(context)?;
+    let mut a = Accuracy::internal(&points, &covariance, &held, &cv, id.covariance.nrows() > k)?;
+    if let Some(base) = base {
+        let structure = structure_part(&points, base, id, &covariance, data, options)?;
+        a = a.with_structure(structure);
+    }
+    Ok(a)
+}
+
+/// The model of `set` on `m` alone, in `data`'s frame: the base of an
+/// internal calibration's structure part.
+pub(crate) fn geometric_base(
+    geometric: &GeometricModel,
+    m: &Machine,
+    data: &Dataset,
+) -> ExtendedModel {
+    ExtendedModel::with_terms(geometric.clone(), &[], Arc::new(Frame::of(m, data)))
+}
+
+/// The shift of the geometric estimate over the workspace when every leg
+/// may also be a quadratic in its command (a lead, a curved screw), beyond
+/// what chance gives it, as `(rms_mm, upper_mm)` (module docs).
+fn structure_part(
+    points: &AccuracyModel,
+    base: &ExtendedModel,
+    id: &Identification,
+    covariance: &nalgebra::DMatrix<f64>,
+    data: &Dataset,
+    options: &IdentifyOptions,
+) -> Result<(f64, f64), Error> {
+    let k = covariance.nrows();
+    let legs = Term::Generic(GenericTerm::new(
+        GenericFamily::LegPolynomial,
+        Scope::AllLegs,
+    ));
+    let rich = base.with(&[base.terms(), &[legs]].concat());
+    // A richer model that cannot be fitted shows nothing.
+    let Ok(r) = tricept_engine::identify(&rich, data, options) else {
+        return Ok((0.0, 0.0));
+    };
+    let delta = nalgebra::DVector::from_fn(k, |i, _| r.estimate[i] - id.estimate[i]);
+    let d = r.covariance.view((0, 0), (k, k)) - covariance;
+    let context = |e: IdentError| Error::with_context("accuracy", &e);
+    let (shift, _) = points
+        .error_moments(&(&delta * delta.transpose()), &[])
+        .map_err(context)?;
+    let (chance, chance2) = points.error_moments(&d, &[]).map_err(context)?;
+    let sd = (2.0 * chance2.max(0.0)).sqrt();
+    let bias2 = shift - chance.max(0.0);
+    Ok((bias2.max(0.0).sqrt(), (bias2 + Z95 * sd).max(0.0).sqrt()))
+}
+
+/// The promise of a fused fit at the tool tip after touch-off: the tip's
+/// predicted covariance over the evaluation poses (`tip`) with its held
+/// parameters' share as the head part, and the external sources' residuals
+/// beyond their stated noise out of sample (module docs).
+pub(crate) fn of_fusion(fit: &tricept_engine::fusion::Fusion) -> Accuracy {
+    let tip = &fit.report.tool_tip;
+    let held_mm = tip.held_touch_off_rms_um * 1e-3;
+    let total_mm = tip.touch_off_rms_um * 1e-3;
+    let estimate_mm = (total_mm * total_mm - held_mm * held_mm).max(0.0).sqrt();
+    // One dominant weak direction: the chi-square of one degree of freedom.
+    let one_dof = 3.841_458_820_694_124_f64.sqrt();
+    let (mut unexplained, mut unexplained_upper) = (0.0_f64, 0.0_f64);
+    for s in fit
+        .sources
+        .iter()
+        .filter(|s| s.kind != tricept_engine::fusion::SourceKind::Internal)
+    {
+        let (Some(rms_um), chi2) = (s.rms_um, s.reduced_chi_square) else {
+            continue;
+        };
+        if !(chi2.is_finite() && chi2 > 0.0 && s.redundancy > 0.0) {
+            continue;
+        }
+        let nu = (s.rows as f64 * s.redundancy).max(1.0);
+        let noise_mm2 = (rms_um * 1e-3).powi(2) / chi2;
+        // Three coordinates of an isotropic error; deleted residuals are the
+        // fitted ones over the redundancy.
+        let excess = |c: f64| 3.0 * noise_mm2 * (c - 1.0).max(0.0) / s.redundancy;
+        unexplained = unexplained.max(excess(chi2));
+        unexplained_upper = unexplained_upper.max(excess(chi2 + Z95 * (2.0 / nu).sqrt()));
+    }
+    let mut parts = Map::new();
+    parts.insert("estimate_mm".into(), estimate_mm.into());
+    parts.insert("estimate_upper_mm".into(), (one_dof * estimate_mm).into());
+    parts.insert("unexplained_mm".into(), unexplained.sqrt().into());
+    parts.insert(
+        "unexplained_upper_mm".into(),
+        unexplained_upper.sqrt().into(),
+    );
+    parts.insert("head_mm".into(), held_mm.into());
+    parts.insert("head_upper_mm".into(), (one_dof * held_mm).into());
+    Accuracy::combine(
+        TOOL_TIP,
+        &[
+            (estimate_mm, one_dof * estimate_mm),
+            (unexplained.sqrt(), unexplained_upper.sqrt()),
+            (held_mm, one_dof * held_mm),
+        ],
+        parts,
     )
 }
 

@@ -33,15 +33,15 @@ fn effect(kind: u64, m: &Machine, rng: &mut Pcg64Mcg) -> LegEffect {
     let sign = |x: f64, r: bool| if r { x } else { -x };
     match kind {
         0 => LegEffect::EvenHeating {
-            kelvin: size(0.05, 3.0),
+            kelvin: size(0.01, 0.5),
             ppm_per_k: 11.5,
         },
         1 => LegEffect::UnevenHeating {
-            kelvin: [size(0.02, 3.0), size(0.02, 3.0), size(0.02, 3.0)],
+            kelvin: [size(0.01, 0.5), size(0.01, 0.5), size(0.01, 0.5)],
             ppm_per_k: 11.5,
         },
         2 => {
-            let ppm = [size(0.2, 40.0), size(0.2, 40.0), size(0.2, 40.0)];
+            let ppm = [size(0.2, 25.0), size(0.2, 25.0), size(0.2, 25.0)];
             LegEffect::Lead {
                 ppm: [
                     sign(ppm[0], ppm[1] > 2.0),
@@ -52,12 +52,12 @@ fn effect(kind: u64, m: &Machine, rng: &mut Pcg64Mcg) -> LegEffect {
         }
         3 => LegEffect::Quadratic {
             leg: (size(1.0, 3.0) as usize) % 3,
-            peak_um: size(0.5, 40.0),
+            peak_um: size(0.5, 12.0),
             stroke_mm: m.limits.leg_stroke_mm,
         },
         _ => LegEffect::Slip {
             leg: (size(1.0, 3.0) as usize) % 3,
-            um: size(0.5, 40.0),
+            um: size(0.5, 8.0),
             at: 0.3 + 0.4 * size(1.0, 2.0) - 0.4,
         },
     }

@@ -91,9 +91,10 @@ pub(crate) fn fit(
         set,
         &model,
         &id,
-        &kept.poses,
-        &options.sigma,
+        &kept,
+        &options,
         tolerance_mm,
+        Some(&crate::accuracy::geometric_base(&model, m, &kept)),
     )?;
     Ok(InternalFit {
         promise,
