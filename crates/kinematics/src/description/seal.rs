@@ -203,4 +203,41 @@ mod tests {
             assert_eq!(e.edited_sealed_fields(), Ok(vec![name]), "{name}");
         }
     }
+
+    #[test]
+    fn the_promise_is_sealed_once_a_record_has_one() {
+        // A record without a promise (written before it existed) keeps its
+        // seal; one with a promise names it when it is edited or removed.
+        let mut d = calibrated();
+        d.seal();
+        assert_eq!(d.edited_sealed_fields(), Ok(vec![]));
+        let c = d.calibration.as_mut().unwrap();
+        c.accuracy = Some(crate::description::AccuracyRecord {
+            rms_mm: 0.05,
+            upper_mm: 0.1,
+            point: "platform".into(),
+            parts: serde_json::Map::new(),
+        });
+        d.seal();
+        assert_eq!(d.edited_sealed_fields(), Ok(vec![]));
+        let mut better = d.clone();
+        better
+            .calibration
+            .as_mut()
+            .unwrap()
+            .accuracy
+            .as_mut()
+            .unwrap()
+            .upper_mm = 0.05;
+        assert_eq!(
+            better.edited_sealed_fields(),
+            Ok(vec!["calibration.accuracy"])
+        );
+        let mut removed = d.clone();
+        removed.calibration.as_mut().unwrap().accuracy = None;
+        assert_eq!(
+            removed.edited_sealed_fields(),
+            Ok(vec!["calibration.accuracy"])
+        );
+    }
 }
