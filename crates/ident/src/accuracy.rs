@@ -36,7 +36,6 @@ use tricept_data::Dataset;
 use tricept_diagnose::{ExtendedModel, Frame, GenericFamily, GenericTerm, Scope, Term};
 use tricept_engine::{
     AccuracyModel, CrossValidation, GeometricModel, IdentError, Identification, IdentifyOptions,
-    ReadingModel,
 };
 use tricept_kinematics::Machine;
 use tricept_kinematics::description::AccuracyRecord;
@@ -188,20 +187,18 @@ impl Accuracy {
     }
 }
 
-/// The promise of `id`, fitted with `model` on `data` (logged noise
-/// `sigma`) on machine `m`: its first `set.len()` parameters are the
-/// geometry of `set`, the rest deployed terms; `geometric`: the geometric
-/// `base`: the model whose geometric estimate a model with richer legs
-/// checks (module docs).
+/// The promise of `id`, fitted with `model` on `data` (logged noise in
+/// `options`) on machine `m`: its first `set.len()` parameters are the
+/// geometry of `set`, the rest deployed terms; a model with richer legs
+/// checks its geometric estimate (module docs).
 pub(crate) fn of_fit(
     m: &Machine,
     set: &ParameterSet,
-    model: &dyn ReadingModel,
+    model: &ExtendedModel,
     id: &Identification,
     data: &Dataset,
     options: &IdentifyOptions,
     tolerance_mm: f64,
-    base: Option<&ExtendedModel>,
 ) -> Result<Accuracy, Error> {
     let k = set.len();
     let context = |e: IdentError| Error::with_context("accuracy", &e);
@@ -223,12 +220,9 @@ pub(crate) fn of_fit(
         .collect();
     let cv = tricept_engine::cross_validate(model, id, &data.poses, m, &options.sigma)
         .map_err(context)?;
-    let mut a = Accuracy::internal(&points, &covariance, &held, &cv, id.covariance.nrows() > k)?;
-    if let Some(base) = base {
-        let structure = structure_part(&points, base, id, &covariance, data, options)?;
-        a = a.with_structure(structure);
-    }
-    Ok(a)
+    let a = Accuracy::internal(&points, &covariance, &held, &cv, id.covariance.nrows() > k)?;
+    let structure = structure_part(&points, model, id, &covariance, data, options)?;
+    Ok(a.with_structure(structure))
 }
 
 /// The model of `set` on `m` alone, in `data`'s frame: the base of an

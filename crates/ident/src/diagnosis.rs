@@ -274,7 +274,6 @@ impl DiagnoseResult {
             &deployed.clean,
             &tricept_engine::IdentifyOptions::for_machine(nominal),
             tricept_engine::DEFAULT_TOLERANCE_MM,
-            Some(&deployed.model),
         )?;
         let mut description = machine_file::calibrated_description(
             &self.machine,

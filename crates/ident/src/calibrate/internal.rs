@@ -89,12 +89,11 @@ pub(crate) fn fit(
     let promise = crate::accuracy::of_fit(
         m,
         set,
-        &model,
+        &crate::accuracy::geometric_base(&model, m, &kept),
         &id,
         &kept,
         &options,
         tolerance_mm,
-        Some(&crate::accuracy::geometric_base(&model, m, &kept)),
     )?;
     Ok(InternalFit {
         promise,
