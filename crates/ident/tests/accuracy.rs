@@ -143,7 +143,7 @@ fn campaign(seed: u64, dir: &Path, verb: Verb) -> Outcome {
         .collect();
     let data = dir.join(format!("campaign-{seed}.csv"));
     std::fs::write(&data, to_csv(&rows)).unwrap();
-    let targets = nominal.workspace.random_poses(TARGETS, seed ^ 0x7a26_e75);
+    let targets = nominal.workspace.random_poses(TARGETS, seed ^ 0x07a2_6e75);
     let mut c = calibrate(&CalibrateRequest::new(Data::File(data.clone()))).unwrap();
     let identify_file = dir.join(format!("identify-{seed}.json"));
     let mut outcome = Outcome {
