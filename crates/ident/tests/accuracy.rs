@@ -10,8 +10,9 @@
 //! file's `upper_mm` in at least 95 % of the files written with exit 0,
 //! and never beyond twice it.
 //!
-//! The CI test runs 24 campaigns; the tally of `docs/reliability.md` runs
-//! 200 (`cargo test -p tricept-ident --test accuracy -- --ignored
+//! The CI tests run 24 campaigns through `identify` and 12 through
+//! `diagnose --write-machine`; the tallies of `docs/reliability.md` run 200
+//! each (`cargo test -p tricept-ident --test accuracy -- --ignored
 //! --nocapture`).
 
 use std::path::Path;
@@ -162,6 +163,7 @@ fn campaign(seed: u64, dir: &Path, verb: Verb) -> Outcome {
             let json = c.to_json();
             let a = &json["accuracy"];
             assert_eq!(a["point"], "platform");
+            assert!(first_lines_state_it(&c.report()), "{}", c.report());
             outcome.rms_mm = a["rms_mm"].as_f64().unwrap();
             outcome.upper_mm = a["upper_mm"].as_f64().unwrap();
             outcome.parts = a["parts"].clone();
@@ -194,6 +196,7 @@ fn campaign(seed: u64, dir: &Path, verb: Verb) -> Outcome {
             let a = r.accuracy().unwrap();
             let json: serde_json::Value = serde_json::from_str(&r.to_json()).unwrap();
             assert_eq!(json["accuracy"]["upper_mm"].as_f64(), Some(a.upper_mm));
+            assert!(first_lines_state_it(&r.to_text()), "{}", r.to_text());
             outcome.rms_mm = a.rms_mm;
             outcome.upper_mm = a.upper_mm;
             outcome.parts = serde_json::Value::Object(a.parts.clone());
@@ -212,6 +215,14 @@ fn campaign(seed: u64, dir: &Path, verb: Verb) -> Outcome {
     assert!(count > TARGETS / 2, "seed {seed}: {count} targets reached");
     outcome.delivered_mm = (sum / count as f64).sqrt();
     outcome
+}
+
+/// Whether a report states the promise in its first lines.
+fn first_lines_state_it(report: &str) -> bool {
+    report
+        .lines()
+        .take(3)
+        .any(|l| l.starts_with("accuracy this file will deliver:"))
 }
 
 /// Where the true machine with `effects` puts the platform when the
@@ -343,6 +354,23 @@ fn an_edited_promise_is_refused() {
     let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(e.exit_code(), tricept_ident::EXIT_INPUT, "{e}");
     assert!(e.message().contains("calibration.accuracy"), "{e}");
+}
+
+#[test]
+fn diagnosed_files_state_and_keep_their_promise() {
+    let dir = scratch("diagnose-ci");
+    let (outcomes, written, within, beyond) = tally(2000..2012, &dir, Verb::Diagnose);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(
+        written >= 6,
+        "{written} files written of {}",
+        outcomes.len()
+    );
+    assert!(
+        written - within <= 1,
+        "{within} of {written} within the promise"
+    );
+    assert_eq!(beyond, 0, "a file delivered beyond twice its promise");
 }
 
 #[test]
