@@ -326,7 +326,7 @@ fn files_written_at_exit_0_deliver_their_promise_in_truth() {
 }
 
 #[test]
-#[ignore = "the tally of docs/reliability.md: 200 campaigns, minutes"]
+#[ignore = "the identify tally of docs/reliability.md: 200 campaigns"]
 fn tally_of_200_campaigns() {
     let dir = scratch("tally");
     let (outcomes, written, within, beyond) = tally(1000..1200, &dir, Verb::Identify);
@@ -374,7 +374,7 @@ fn diagnosed_files_state_and_keep_their_promise() {
 }
 
 #[test]
-#[ignore = "the diagnose tally of docs/reliability.md: minutes"]
+#[ignore = "the diagnose tally of docs/reliability.md: 200 campaigns"]
 fn tally_of_diagnosed_campaigns() {
     let dir = scratch("diagnose");
     let (outcomes, written, within, beyond) = tally(2000..2200, &dir, Verb::Diagnose);
