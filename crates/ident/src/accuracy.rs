@@ -48,10 +48,10 @@ const Z95: f64 = 1.644_853_626_951_472_2;
 
 /// The point a promise is of: the platform (UP limb alone) or the tool tip
 /// (after touch-off, where that applies).
-pub const PLATFORM: &str = "platform";
+pub(crate) const PLATFORM: &str = "platform";
 
 /// The point of a fused file's promise.
-pub const TOOL_TIP: &str = "tool tip";
+pub(crate) const TOOL_TIP: &str = "tool tip";
 
 /// The accuracy a machine file will deliver: the top-level `accuracy`
 /// object of every verb that writes one.
@@ -69,7 +69,7 @@ pub struct Accuracy {
     pub rms_mm: f64,
     /// A 95 % upper bound of the rms error delivered, mm.
     pub upper_mm: f64,
-    /// The point positioned: [`PLATFORM`] or [`TOOL_TIP`].
+    /// The point positioned: `platform` or `tool tip`.
     pub point: String,
     /// The parts it is made of (units in the names).
     pub parts: Map<String, Value>,
