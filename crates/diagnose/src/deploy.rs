@@ -43,6 +43,10 @@ pub struct Deployed {
     /// What it only records: sensor corrections, time terms, and the terms
     /// seen but not worth deploying, one line each.
     pub recorded: Vec<String>,
+    /// The deployed model `id` was fitted with.
+    pub model: ExtendedModel,
+    /// The poses it was fitted on.
+    pub clean: Dataset,
 }
 
 /// Fits the diagnosis' deployed model (the terms of the final model worth
@@ -158,6 +162,8 @@ pub fn deploy(
         controller,
         applied,
         recorded,
+        model,
+        clean,
     })
 }
 

@@ -160,14 +160,12 @@ impl AccuracyModel {
         self.before_rms_mm
     }
 
-    /// The predicted accuracy of an estimate with `covariance` (`k x k`,
-    /// mm^2; rows and columns of held parameters may be zero) whose
-    /// parameters `held` (indices) were held at their prior.
-    pub fn assess(
+    /// `covariance` with every `held` parameter at its prior `t^2`.
+    fn with_held(
         &self,
         covariance: &DMatrix<f64>,
         held: &[usize],
-    ) -> Result<PredictedAccuracy, IdentError> {
+    ) -> Result<DMatrix<f64>, IdentError> {
         let k = self.n_params();
         if covariance.shape() != (k, k) || held.iter().any(|&i| i >= k) {
             return Err(IdentError::Invalid(format!(
@@ -181,6 +179,41 @@ impl AccuracyModel {
         for &i in held {
             s[(i, i)] += t2;
         }
+        Ok(s)
+    }
+
+    /// The first two moments of the mean square platform error `e^T M e`
+    /// over the evaluation points (`M = mean_j P_j^T P_j`) for an error
+    /// `e ~ N(0, S)`, `S` as in [`AccuracyModel::assess`]:
+    /// `(trace(M S), trace(M S M S))`, mm^2 and mm^4. The square of the
+    /// first is the predicted rms; the second is what a quantile of the
+    /// rms needs (`e^T M e` is a weighted sum of chi-squares of one degree
+    /// of freedom, with mean `trace(M S)` and variance `2 trace(M S M S)`).
+    pub fn error_moments(
+        &self,
+        covariance: &DMatrix<f64>,
+        held: &[usize],
+    ) -> Result<(f64, f64), IdentError> {
+        let s = self.with_held(covariance, held)?;
+        let k = self.n_params();
+        let mut m = DMatrix::zeros(k, k);
+        for p in &self.jacobians {
+            m += p.transpose() * p;
+        }
+        m /= self.jacobians.len() as f64;
+        let ms = m * s;
+        Ok((ms.trace(), (&ms * &ms).trace()))
+    }
+
+    /// The predicted accuracy of an estimate with `covariance` (`k x k`,
+    /// mm^2; rows and columns of held parameters may be zero) whose
+    /// parameters `held` (indices) were held at their prior.
+    pub fn assess(
+        &self,
+        covariance: &DMatrix<f64>,
+        held: &[usize],
+    ) -> Result<PredictedAccuracy, IdentError> {
+        let s = self.with_held(covariance, held)?;
         let traces: Vec<f64> = self
             .jacobians
             .iter()

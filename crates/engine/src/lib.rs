@@ -65,6 +65,7 @@ mod gauss_newton;
 mod identify;
 mod model;
 mod options;
+mod promise;
 mod record;
 mod report;
 mod robust;
@@ -82,6 +83,7 @@ pub use identify::{
 };
 pub use model::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
 pub use options::IdentifyOptions;
+pub use promise::{CrossValidation, cross_validate};
 pub use record::{RECORD_METHODS, RecordError, check_calibration_record};
 pub use report::{Combination, CorrelatedPair, IdentifiabilityReport, NamedValues, Observability};
 pub use robust::{

@@ -93,7 +93,7 @@ pub enum RecordError {
 ///     estimates_mm: estimates, std_dev_mm: Default::default(),
 ///     correlations: CorrelationsDescription { names: vec![], matrix: vec![] },
 ///     effects: Default::default(),
-///     sensor_offsets: SensorOffsetsDescription { phi_rad: 0.0, theta_rad: 0.0, s_mm: 0.0, std_dev: [0.0; 3] },
+///     sensor_offsets: SensorOffsetsDescription { phi_rad: 0.0, theta_rad: 0.0, s_mm: 0.0, std_dev: [0.0; 3] }, accuracy: None,
 ///     applies: vec![], records: vec![], held: vec![], chi2_per_dof: 1.0, dof: 1, converged: true, adequate: true, forced: false,
 ///     warnings: vec![], poses_used: 75, temperature_c: None, rejected_lines: vec![], leg_tables_digest: None, seal: None, external_sources: vec![],
 ///     data_file: "d.csv".into(), data_sha256: String::new(), date: String::new(),

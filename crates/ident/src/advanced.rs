@@ -14,12 +14,14 @@
 //!   [`FusedSources`], the simulated instruments, the export's
 //!   [`ExportOptions`].
 //! - **Result parts**: the reports inside results ([`CheckReport`],
-//!   [`Diagnosis`], [`Detectability`], ...), the file names a workflow
+//!   [`Diagnosis`], [`Detectability`], ...), the [`Accuracy`] a written
+//!   file promises, the file names a workflow
 //!   writes, the batch kinematics ([`solve_batch`], [`run`]).
 //! - **Low level**: the error mapping of the internal crates' errors
 //!   ([`Classify`]), the kinematics' errors and branches, the data set in
 //!   memory ([`Dataset`]), and `serde_json`, whose `Value` results return.
 
+pub use crate::accuracy::Accuracy;
 pub use crate::calibrate::Written;
 pub use crate::calibrate::values::{
     EffectNames, EvalGrid, FusedSources, HeadModel, LengthSigma, TrackerTargetSpec,

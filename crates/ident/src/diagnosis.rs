@@ -12,6 +12,7 @@
 //! does not), the JSON and the text report the CLI prints.
 
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 use serde_json::{Map, json};
 use tricept_data::Dataset;
@@ -19,6 +20,7 @@ use tricept_diagnose::{DiagnoseError, DiagnoseOptions, Diagnosis, Plausibility, 
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
+use crate::accuracy::Accuracy;
 use crate::data_input::DataInput;
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::inputs::LoadedMachine;
@@ -81,6 +83,8 @@ pub struct DiagnoseResult {
     data: Dataset,
     machine: LoadedMachine,
     rank_reference: Option<Machine>,
+    /// The accuracy of the machine file written, once written.
+    promise: OnceLock<Accuracy>,
 }
 
 /// Diagnoses the request's data: every problem of the input is an error of
@@ -126,6 +130,7 @@ pub fn diagnose(request: DiagnoseRequest) -> Result<DiagnoseResult, Error> {
         data: dataset,
         rank_reference: options.rank_reference,
         machine: loaded,
+        promise: OnceLock::new(),
     })
 }
 
@@ -180,14 +185,34 @@ impl DiagnoseResult {
         &self.diagnosis.plots
     }
 
-    /// The report as JSON (one line, as `tricept diagnose --json` prints it).
+    /// The report as JSON (one line, as `tricept diagnose --json` prints
+    /// it), with the `accuracy` of the machine file once one is written.
     pub fn to_json(&self) -> String {
-        self.diagnosis.to_json().to_string()
+        let mut v = self.diagnosis.to_json();
+        if let (Some(a), serde_json::Value::Object(o)) = (self.accuracy(), &mut v) {
+            o.insert("accuracy".into(), a.to_json());
+        }
+        v.to_string()
     }
 
-    /// The report as text.
+    /// The report as text, the accuracy of the machine file first once
+    /// one is written.
     pub fn to_text(&self) -> String {
-        self.diagnosis.to_text(&self.source)
+        let text = self.diagnosis.to_text(&self.source);
+        match self.accuracy() {
+            // After the verdict's line.
+            Some(a) => match text.split_once('\n') {
+                Some((first, rest)) => format!("{first}\n{}\n{rest}", a.line()),
+                None => format!("{text}\n{}\n", a.line()),
+            },
+            None => text,
+        }
+    }
+
+    /// The accuracy the machine file written will deliver (`None` until
+    /// one is written, [`DiagnoseResult::write_machine`]).
+    pub fn accuracy(&self) -> Option<&Accuracy> {
+        self.promise.get()
     }
 
     /// Deploys the final model: each term worth deploying where the
@@ -240,6 +265,16 @@ impl DiagnoseResult {
         };
         let deployed = self.deploy()?;
         let g = ParameterSet::paper15().len();
+        let nominal = self.machine.machine();
+        let promise = crate::accuracy::of_fit(
+            nominal,
+            &ParameterSet::paper15(),
+            &deployed.model,
+            &deployed.id,
+            &deployed.clean,
+            &tricept_engine::IdentifyOptions::for_machine(nominal),
+            tricept_engine::DEFAULT_TOLERANCE_MM,
+        )?;
         let mut description = machine_file::calibrated_description(
             &self.machine,
             &deployed.machine,
@@ -256,6 +291,7 @@ impl DiagnoseResult {
                 n_geometric: g,
                 external: Vec::new(),
                 temperature_c: machine_file::mean_temperature_c(&self.data),
+                accuracy: Some(promise.record()),
             },
             deployed.controller,
         )?;
@@ -263,6 +299,7 @@ impl DiagnoseResult {
             c.applies = deployed.applied;
             c.records = deployed.recorded;
         }
+        let _ = self.promise.set(promise);
         Ok((description, forced))
     }
 

@@ -36,6 +36,7 @@
 )]
 
 // Layer 0: errors, limits and inputs.
+mod accuracy;
 mod error;
 mod export;
 mod inputs;

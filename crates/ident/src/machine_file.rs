@@ -51,6 +51,8 @@ pub struct Provenance<'a> {
     pub external: Vec<(&'a Path, ExternalSourceRecord)>,
     /// Mean logged structure temperature of the campaign, °C.
     pub temperature_c: Option<f64>,
+    /// The accuracy the file promises.
+    pub accuracy: Option<tricept_kinematics::description::AccuracyRecord>,
 }
 
 /// The mean logged structure temperature of `data`, °C, when every pose
@@ -306,6 +308,7 @@ pub fn calibrated_description(
             s_mm: id.offsets[2],
             std_dev: id.offsets_std_dev,
         },
+        accuracy: p.accuracy,
         applies: Vec::new(),
         records: Vec::new(),
         held: held(

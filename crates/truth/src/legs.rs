@@ -64,6 +64,26 @@ pub enum LegEffect {
         /// Each leg's temperature above the logged one, K.
         kelvin: [f64; 3],
     },
+    /// Legs warming through the campaign with no temperature logged: leg
+    /// `i` `kelvin_i` warmer at its end, linearly in the campaign's share
+    /// `t` ([`LegContext::campaign_share`]), growing `alpha q_i kelvin_i t`
+    /// (all `kelvin_i` equal: even heating).
+    Drift {
+        /// `alpha`, ppm/K.
+        ppm_per_k: f64,
+        /// Each leg's warming at the campaign's end, K.
+        kelvin: [f64; 3],
+    },
+    /// Leg `leg` slips by `um` at the campaign's share `at` (0..1), for
+    /// good: the delivered machine has slipped ([`LegEffect::delivered_mm`]).
+    Slip {
+        /// The leg (0-based).
+        leg: usize,
+        /// The slip, um.
+        um: f64,
+        /// When, as a share of the campaign.
+        at: f64,
+    },
     /// Legs warming unevenly as the structure warms: leg `i` at
     /// `T + kelvin_i (T - from) / (to - from)` (its own temperature
     /// response: `kelvin_i` more than the logged rise from `from` to `to`),
@@ -87,6 +107,25 @@ pub struct LegContext {
     pub temp_c: f64,
     /// The sign of each leg's last motion (+1: it extended).
     pub directions: [i8; 3],
+    /// How far through the campaign the pose is: 0 at its first pose, 1
+    /// at its last.
+    pub campaign_share: f64,
+}
+
+/// The campaign share of the machine a file is delivered to: the thermal
+/// state of the campaign's middle ([`LegEffect::Drift`]).
+pub const DELIVERY_T: f64 = 0.5;
+
+impl LegContext {
+    /// A pose `campaign_share` through a campaign at 20 deg C, every leg
+    /// last extended.
+    pub fn at_share(campaign_share: f64) -> LegContext {
+        LegContext {
+            temp_c: 20.0,
+            directions: [1; 3],
+            campaign_share,
+        }
+    }
 }
 
 impl LegEffect {
@@ -117,6 +156,16 @@ impl LegEffect {
                     0.0
                 }
             }
+            LegEffect::Drift { ppm_per_k, kelvin } => {
+                ppm_per_k * 1e-6 * q[i] * kelvin[i] * at.campaign_share
+            }
+            LegEffect::Slip { leg, um, at: when } => {
+                if i == leg % 3 && at.campaign_share >= when {
+                    um * 1e-3
+                } else {
+                    0.0
+                }
+            }
             LegEffect::Heating { ppm_per_k, kelvin } => {
                 ppm_per_k * 1e-6 * (q[i] + offsets_mm[i]) * (at.temp_c + kelvin[i] - 20.0)
             }
@@ -133,7 +182,33 @@ impl LegEffect {
     }
 }
 
+impl LegEffect {
+    /// The extra true length of each leg at commands `q` (mm) on the
+    /// machine a file is delivered to ([`DELIVERY_T`] of the campaign at
+    /// 20 deg C; a slip has slipped).
+    pub fn delivered_mm(&self, q: &[f64; 3], offsets_mm: &[f64; 3]) -> [f64; 3] {
+        let share = match self {
+            LegEffect::Slip { .. } => f64::INFINITY,
+            _ => DELIVERY_T,
+        };
+        self.extra_mm(q, offsets_mm, &LegContext::at_share(share))
+    }
+}
+
 impl TrueMachine {
+    /// True leg lengths at commands `q` (mm) on the machine a file is
+    /// delivered to ([`LegEffect::delivered_mm`]).
+    pub fn delivered_lengths(&self, q: &[f64; 3], effects: &[LegEffect]) -> [f64; 3] {
+        let mut l: [f64; 3] = std::array::from_fn(|i| q[i] + self.leg_offsets_mm[i]);
+        for e in effects {
+            let extra = e.delivered_mm(q, &self.leg_offsets_mm);
+            for i in 0..3 {
+                l[i] += extra[i];
+            }
+        }
+        l
+    }
+
     /// True leg lengths at commands `q` (mm) with `effects` at `at`.
     pub fn lengths_with(&self, q: &[f64; 3], effects: &[LegEffect], at: &LegContext) -> [f64; 3] {
         let mut l: [f64; 3] = std::array::from_fn(|i| q[i] + self.leg_offsets_mm[i]);
@@ -166,6 +241,31 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_slip_slips_at_its_share_and_stays_slipped_on_delivery() {
+        let m = TrueMachine::random(0.0, 3);
+        let q = [800.0, 820.0, 810.0];
+        let slip = LegEffect::Slip {
+            leg: 4,
+            um: 20.0,
+            at: 0.7,
+        };
+        let o = m.leg_offsets_mm;
+        assert_eq!(slip.extra_mm(&q, &o, &LegContext::at_share(0.6)), [0.0; 3]);
+        assert_eq!(
+            slip.extra_mm(&q, &o, &LegContext::at_share(0.8)),
+            [0.0, 0.02, 0.0]
+        );
+        assert_eq!(slip.delivered_mm(&q, &o), [0.0, 0.02, 0.0]);
+        // Warmth is delivered at the campaign's middle.
+        let drift = LegEffect::Drift {
+            ppm_per_k: 10.0,
+            kelvin: [1.0, 2.0, 0.0],
+        };
+        let d = drift.delivered_mm(&q, &o);
+        assert!((d[1] - 10e-6 * 820.0 * 2.0 * DELIVERY_T).abs() < 1e-15);
+    }
+
+    #[test]
     fn backlash_shortens_the_leg_in_the_direction_it_came_from() {
         let m = TrueMachine::documented();
         let q = [800.0, 810.0, 820.0];
@@ -173,8 +273,8 @@ mod tests {
             um: [10.0, 10.0, 10.0],
         }];
         let extended = LegContext {
-            temp_c: 20.0,
             directions: [1, -1, 1],
+            ..LegContext::at_share(0.0)
         };
         let l = m.lengths_with(&q, &e, &extended);
         assert!((l[0] - (800.0 - 0.005)).abs() < 1e-12);
@@ -186,7 +286,7 @@ mod tests {
         let m = TrueMachine::random(0.0, 3);
         let at = LegContext {
             temp_c: 22.0,
-            directions: [1, 1, 1],
+            ..LegContext::at_share(0.0)
         };
         let e = [LegEffect::Heating {
             ppm_per_k: 11.5,

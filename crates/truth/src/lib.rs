@@ -15,7 +15,8 @@
 //!   documented data CSV;
 //! - `legs.rs`: [`LegEffect`], leg effects added to the true leg lengths
 //!   (backlash by the `dir` columns' sign, a lead, a quadratic leg, a pitch
-//!   error, a worn segment, legs heating evenly or unevenly), and where
+//!   error, a worn segment, legs heating evenly or unevenly, legs warming
+//!   through a campaign with no log, a slip), and where
 //!   the platform goes with them.
 //!
 //! This is test support: it panics on a machine its Newton iteration
@@ -41,7 +42,7 @@ mod machine;
 mod tracker;
 
 pub use campaign::{Row, to_csv};
-pub use legs::{LegContext, LegEffect};
+pub use legs::{DELIVERY_T, LegContext, LegEffect};
 pub use machine::{SensorNoise, TrueHead, TrueMachine};
 pub use tracker::TrueTracker;
 

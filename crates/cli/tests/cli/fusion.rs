@@ -52,6 +52,19 @@ fn the_calibrated_machine_file_carries_the_head_and_tool_ik_uses_it() {
         .collect();
     let text = std::fs::read_to_string(dir.join("calibrated.json")).unwrap();
     assert!(text.contains("angle_offsets_rad") && text.contains("held at nominal"));
+    // The accuracy block: at the tool tip, in the JSON and in the file.
+    let a = &v["accuracy"];
+    assert_eq!(a["point"], "tool tip");
+    let (rms, upper) = (
+        a["rms_mm"].as_f64().unwrap(),
+        a["upper_mm"].as_f64().unwrap(),
+    );
+    assert!(rms > 0.0 && upper >= rms, "{a}");
+    let file: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(
+        file["calibration"]["accuracy"]["upper_mm"].as_f64(),
+        Some(upper)
+    );
     // tool-ik on the written machine: the fused model's tool tip lands on
     // the target to 1e-9 mm.
     for j in 0..12 {

@@ -152,6 +152,7 @@ fn campaign(
             let at = LegContext {
                 temp_c: temperature(j, n),
                 directions,
+                campaign_share: j as f64 / (n - 1).max(1) as f64,
             };
             let joints = truth.forward_lengths(&truth.lengths_with(&q, legs, &at));
             Row {
@@ -258,6 +259,7 @@ fn run(case: usize, seed: u64, n: usize) -> Outcome {
     let mut context = || LegContext {
         temp_c,
         directions: std::array::from_fn(|_| if rng.random::<bool>() { 1 } else { -1 }),
+        campaign_share: tricept_truth::DELIVERY_T,
     };
     let held_out: Vec<(Vector3<f64>, LegContext)> = nominal
         .workspace

@@ -319,6 +319,7 @@ impl FusedFit {
                 n_geometric: fit.names.len(),
                 external,
                 temperature_c: None,
+                accuracy: Some(crate::accuracy::of_fusion(fit).record()),
             },
             None,
         )?;
@@ -352,6 +353,10 @@ impl FusedFit {
         if let Value::Object(o) = &mut v {
             o.insert("machine".into(), loaded.description().name.clone().into());
             o.insert("data_file".into(), data_name.into());
+            o.insert(
+                "accuracy".into(),
+                crate::accuracy::of_fusion(&self.fit).to_json(),
+            );
             if let Some(d) = &self.deployed {
                 o.insert("deployed".into(), d.clone());
             }
@@ -374,6 +379,7 @@ impl FusedFit {
             .map(|s| format!("{} {} ({} records)", s.label(), s.file(), s.records()))
             .collect();
         let _ = writeln!(s, "fused identification: {}", list.join(", "));
+        let _ = writeln!(s, "{}", crate::accuracy::of_fusion(fit).line());
         for r in &fit.rejected {
             let _ = writeln!(s, "{}", r.to_text());
         }

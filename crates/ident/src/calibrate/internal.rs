@@ -19,6 +19,7 @@ use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
 use super::advice::{campaign_advice, predicted_accuracy};
+use crate::accuracy::Accuracy;
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error};
 use crate::inputs::LoadedMachine;
 use crate::machine_file;
@@ -40,6 +41,8 @@ pub(crate) struct InternalFit {
     pub accuracy: PredictedAccuracy,
     /// Mean logged structure temperature of the data, °C.
     pub temperature_c: Option<f64>,
+    /// The accuracy the calibrated machine file will deliver.
+    pub promise: Accuracy,
 }
 
 /// Identifies `set` from `dataset` against `loaded` (robust unless told
@@ -82,7 +85,18 @@ pub(crate) fn fit(
             .warnings
             .push(campaign_advice(m, set, &accuracy, id.residuals.len())?);
     }
+    let kept = dataset.subset(|j| !rejected.iter().any(|r| r.pose == j));
+    let promise = crate::accuracy::of_fit(
+        m,
+        set,
+        &crate::accuracy::geometric_base(&model, m, &kept),
+        &id,
+        &kept,
+        &options,
+        tolerance_mm,
+    )?;
     Ok(InternalFit {
+        promise,
         model,
         id,
         rejected,
@@ -163,6 +177,7 @@ impl InternalFit {
                 n_geometric: self.id.names.len(),
                 external: Vec::new(),
                 temperature_c: self.temperature_c,
+                accuracy: Some(self.promise.record()),
             },
             None,
         )
@@ -193,6 +208,7 @@ impl InternalFit {
                 serde_json::to_value(self.accuracy).unwrap_or(Value::Null),
             );
             o.insert("worthwhile".into(), self.accuracy.worthwhile.into());
+            o.insert("accuracy".into(), self.promise.to_json());
             o.insert("machine".into(), loaded.description().name.clone().into());
             o.insert("data_file".into(), data_name.into());
         }
@@ -229,6 +245,7 @@ impl InternalFit {
                 "NOT worthwhile (the campaign is too small to calibrate)"
             }
         );
+        let _ = writeln!(s, "{}", self.promise.line());
         let (causes, others): (Vec<&String>, Vec<&String>) = self
             .verdict
             .warnings

@@ -38,8 +38,9 @@ pub use geometry::{
     WorkspaceDescription,
 };
 pub use record::{
-    ControllerDescription, CorrelationsDescription, ExternalSourceRecord, HeldParameter,
-    Interpolation, LegEffectsDescription, LegTableDescription, SensorOffsetsDescription,
+    AccuracyRecord, ControllerDescription, CorrelationsDescription, ExternalSourceRecord,
+    HeldParameter, Interpolation, LegEffectsDescription, LegTableDescription,
+    SensorOffsetsDescription,
 };
 pub use validate::{MAX_TABLE_EXTRA_UM, MAX_TABLE_POINTS, MAX_TABLE_SLOPE_UM_PER_MM};
 
@@ -134,6 +135,10 @@ pub struct CalibrationRecord {
     pub effects: serde_json::Map<String, serde_json::Value>,
     /// Sensor zero offsets.
     pub sensor_offsets: SensorOffsetsDescription,
+    /// The accuracy the file promises (sealed; absent in files written
+    /// before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<AccuracyRecord>,
     /// What the file applies, one line per deployed part (a diagnosis':
     /// leg effects, compensation tables, the UP limb, controller
     /// parameters), and where it goes.
@@ -428,6 +433,7 @@ mod tests {
             correlations: CorrelationsDescription::default(),
             effects: serde_json::Map::new(),
             sensor_offsets: SensorOffsetsDescription::default(),
+            accuracy: None,
             applies: Vec::new(),
             records: Vec::new(),
             held: vec![HeldParameter {

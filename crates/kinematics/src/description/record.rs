@@ -244,6 +244,31 @@ impl Default for ControllerDescription {
     }
 }
 
+/// The accuracy a calibrated machine file promises
+/// (`docs/reliability.md`, "The accuracy block"): the predicted rms
+/// positioning error over the workspace, a 95 % upper bound of it, the
+/// point it is of, and the parts it is made of.
+///
+/// # Example
+/// ```
+/// use tricept_kinematics::description::AccuracyRecord;
+/// let a = AccuracyRecord { rms_mm: 0.004, upper_mm: 0.006, point: "platform".into(), parts: Default::default() };
+/// assert!(a.upper_mm >= a.rms_mm);
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AccuracyRecord {
+    /// Predicted rms positioning error over the workspace, mm.
+    pub rms_mm: f64,
+    /// A 95 % upper bound of the rms error the file delivers, mm.
+    pub upper_mm: f64,
+    /// The point positioned: `platform` or `tool tip`.
+    pub point: String,
+    /// The parts of the promise (units in the names).
+    #[serde(default, skip_serializing_if = "serde_json::Map::is_empty")]
+    pub parts: serde_json::Map<String, serde_json::Value>,
+}
+
 /// A parameter held at its prior value, and why.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -18,7 +18,7 @@ use super::MachineDescription;
 /// in a description (`None` when the description has no calibration).
 fn sealed_fields(d: &MachineDescription) -> Option<Vec<(&'static str, String)>> {
     let c = d.calibration.as_deref()?;
-    Some(vec![
+    let mut fields = vec![
         ("calibration.std_dev_mm", text(&c.std_dev_mm)),
         ("calibration.correlations", text(&c.correlations)),
         ("calibration.sensor_offsets", text(&c.sensor_offsets)),
@@ -33,8 +33,19 @@ fn sealed_fields(d: &MachineDescription) -> Option<Vec<(&'static str, String)>> 
         ("calibration.poses_used", text(&c.poses_used)),
         ("sensors", text(&d.sensors)),
         ("controller", text(&d.controller)),
-    ])
+    ];
+    // The promise, in every record that has one or whose seal covers one
+    // (a file written before records carried it keeps its seal; one whose
+    // promise was removed by hand is refused).
+    let sealed = |seal: &BTreeMap<String, String>| seal.contains_key(ACCURACY);
+    if c.accuracy.is_some() || c.seal.as_ref().is_some_and(sealed) {
+        fields.push((ACCURACY, text(&c.accuracy)));
+    }
+    Some(fields)
 }
+
+/// The sealed name of the promise.
+const ACCURACY: &str = "calibration.accuracy";
 
 /// A value's compact JSON text (plain data cannot fail to serialise).
 fn text(value: &impl serde::Serialize) -> String {
@@ -117,6 +128,7 @@ mod tests {
             correlations: CorrelationsDescription::default(),
             effects: serde_json::Map::new(),
             sensor_offsets: SensorOffsetsDescription::default(),
+            accuracy: None,
             applies: Vec::new(),
             records: Vec::new(),
             held: Vec::new(),
@@ -190,5 +202,42 @@ mod tests {
             edit(&mut e);
             assert_eq!(e.edited_sealed_fields(), Ok(vec![name]), "{name}");
         }
+    }
+
+    #[test]
+    fn the_promise_is_sealed_once_a_record_has_one() {
+        // A record without a promise (written before it existed) keeps its
+        // seal; one with a promise names it when it is edited or removed.
+        let mut d = calibrated();
+        d.seal();
+        assert_eq!(d.edited_sealed_fields(), Ok(vec![]));
+        let c = d.calibration.as_mut().unwrap();
+        c.accuracy = Some(crate::description::AccuracyRecord {
+            rms_mm: 0.05,
+            upper_mm: 0.1,
+            point: "platform".into(),
+            parts: serde_json::Map::new(),
+        });
+        d.seal();
+        assert_eq!(d.edited_sealed_fields(), Ok(vec![]));
+        let mut better = d.clone();
+        better
+            .calibration
+            .as_mut()
+            .unwrap()
+            .accuracy
+            .as_mut()
+            .unwrap()
+            .upper_mm = 0.05;
+        assert_eq!(
+            better.edited_sealed_fields(),
+            Ok(vec!["calibration.accuracy"])
+        );
+        let mut removed = d.clone();
+        removed.calibration.as_mut().unwrap().accuracy = None;
+        assert_eq!(
+            removed.edited_sealed_fields(),
+            Ok(vec!["calibration.accuracy"])
+        );
     }
 }

@@ -1,0 +1,364 @@
+//! The accuracy block: what a machine file will deliver, stated by every
+//! verb that writes one (`identify`, fused or not, and `diagnose
+//! --write-machine`) in its JSON (`accuracy`), its report's first lines and
+//! the file's sealed `calibration.accuracy` (`docs/reliability.md`, "The
+//! accuracy block").
+//!
+//! The promise is the root sum of squares of its parts, each a mean square
+//! over the workspace:
+//!
+//! - **estimate**: the estimate's covariance propagated to the workspace's
+//!   evaluation points (held parameters at their tolerance), the rms
+//!   `sqrt(trace(M S))` of [`tricept_engine::AccuracyModel`]; for a model
+//!   with more than the geometry (a diagnosis' deployed terms) the larger
+//!   of that and every fitted parameter's platform variance at the
+//!   campaign's poses ([`tricept_engine::CrossValidation::fit_variance_mm2`]);
+//! - **unexplained**: the mean square platform error the fitted model
+//!   leaves out of sample beyond the stated noise, from the deleted
+//!   residuals of the UP limb's readings mapped to the platform through the
+//!   limb's Jacobian ([`tricept_engine::cross_validate`]), never below
+//!   zero;
+//! - **head** (fused files): what the external data show of the head parts
+//!   they cannot calibrate.
+//!
+//! Its 95 % upper bound adds the parts' 95 % upper bounds in quadrature:
+//! the estimate's mean square `e^T M e` is a weighted sum of chi-squares,
+//! taken as `g chi2_nu` with the same mean and variance (`g = tr(MSMS) /
+//! tr(MS)`, `nu = tr(MS)^2 / tr(MSMS)`) and its 95 % quantile by
+//! Wilson-Hilferty; the unexplained mean square's bound is its estimate plus
+//! 1.645 standard errors.
+
+use serde::Serialize;
+use serde_json::{Map, Value};
+use std::sync::Arc;
+
+use tricept_data::Dataset;
+use tricept_diagnose::{ExtendedModel, Frame, GenericFamily, GenericTerm, Scope, Term};
+use tricept_engine::{
+    AccuracyModel, CrossValidation, GeometricModel, IdentError, Identification, IdentifyOptions,
+};
+use tricept_kinematics::Machine;
+use tricept_kinematics::description::AccuracyRecord;
+use tricept_model::ParameterSet;
+
+use crate::error::Error;
+
+/// The one-sided 95 % standard normal quantile.
+const Z95: f64 = 1.644_853_626_951_472_2;
+
+/// The point a promise is of: the platform (UP limb alone) or the tool tip
+/// (after touch-off, where that applies).
+pub(crate) const PLATFORM: &str = "platform";
+
+/// The point of a fused file's promise.
+pub(crate) const TOOL_TIP: &str = "tool tip";
+
+/// The accuracy a machine file will deliver: the top-level `accuracy`
+/// object of every verb that writes one.
+///
+/// # Example
+/// ```
+/// use tricept_ident::Accuracy;
+/// let a = Accuracy::combine("platform", &[(0.003, 0.004), (0.004, 0.006)], Default::default());
+/// assert!((a.rms_mm - 0.005).abs() < 1e-12);
+/// assert!(a.upper_mm >= a.rms_mm);
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Accuracy {
+    /// Predicted rms positioning error over the workspace, mm.
+    pub rms_mm: f64,
+    /// A 95 % upper bound of the rms error delivered, mm.
+    pub upper_mm: f64,
+    /// The point positioned: `platform` or `tool tip`.
+    pub point: String,
+    /// The parts it is made of (units in the names).
+    pub parts: Map<String, Value>,
+}
+
+impl Accuracy {
+    /// The promise of independent parts, each `(rms_mm, upper_mm)`, added in
+    /// quadrature, with `parts` describing them.
+    pub fn combine(point: &str, parts_mm: &[(f64, f64)], parts: Map<String, Value>) -> Accuracy {
+        let rss = |f: fn(&(f64, f64)) -> f64| parts_mm.iter().map(|p| f(p).powi(2)).sum::<f64>();
+        Accuracy {
+            rms_mm: rss(|p| p.0).sqrt(),
+            upper_mm: rss(|p| p.1).sqrt(),
+            point: point.to_string(),
+            parts,
+        }
+    }
+
+    /// The promise of an internal calibration: the estimate's covariance
+    /// over `model`'s evaluation points (`held` at their tolerance) and the
+    /// unexplained out-of-sample platform error `cv`; `terms`: the fit has
+    /// parameters beyond the geometry (the first `covariance.nrows()`),
+    /// whose platform variance at the campaign's poses counts too.
+    pub fn internal(
+        model: &AccuracyModel,
+        covariance: &nalgebra::DMatrix<f64>,
+        held: &[usize],
+        cv: &CrossValidation,
+        terms: bool,
+    ) -> Result<Accuracy, Error> {
+        let (m1, m2) = model
+            .error_moments(covariance, held)
+            .map_err(|e| Error::with_context("accuracy", &e))?;
+        // A misfit biases the estimate as extra noise of its size would:
+        // the estimate's part grows by the out-of-sample Birge ratio (its
+        // bound by the ratio's 95 % bound), never shrinks.
+        let birge = cv.chi2_per_reading.max(1.0);
+        let birge_upper = (cv.chi2_per_reading + Z95 * cv.chi2_se).max(1.0);
+        let (rms, upper) = estimate_part(m1, m2);
+        let mut estimate = (rms * birge.sqrt(), upper * birge_upper.sqrt());
+        if terms && cv.fit_variance_mm2 > estimate.0.powi(2) {
+            // Every fitted parameter at the campaign's poses: the bound
+            // keeps the geometric part's ratio to its mean.
+            let ratio = if estimate.0 > 0.0 {
+                (estimate.1 / estimate.0).powi(2)
+            } else {
+                1.0
+            };
+            estimate = (
+                cv.fit_variance_mm2.sqrt(),
+                (ratio * cv.fit_variance_mm2).sqrt(),
+            );
+        }
+        let unexplained = unexplained_part(cv);
+        let mut parts = Map::new();
+        parts.insert("estimate_mm".into(), estimate.0.into());
+        parts.insert("estimate_upper_mm".into(), estimate.1.into());
+        parts.insert("unexplained_mm".into(), unexplained.0.into());
+        parts.insert("unexplained_upper_mm".into(), unexplained.1.into());
+        parts.insert("cross_validated_poses".into(), cv.poses.into());
+        parts.insert(
+            "chi2_per_reading_out_of_sample".into(),
+            cv.chi2_per_reading.into(),
+        );
+        let a = Accuracy::combine(PLATFORM, &[estimate, unexplained], parts);
+        if a.rms_mm.is_finite() && a.upper_mm.is_finite() {
+            Ok(a)
+        } else {
+            Err(Error::other(
+                "accuracy: the estimate's covariance is not finite",
+            ))
+        }
+    }
+
+    /// This promise with the structure part `(rms_mm, upper_mm)` added in
+    /// quadrature.
+    pub(crate) fn with_structure(mut self, (rms, upper): (f64, f64)) -> Accuracy {
+        self.parts.insert("structure_mm".into(), rms.into());
+        self.parts.insert("structure_upper_mm".into(), upper.into());
+        self.rms_mm = self.rms_mm.hypot(rms);
+        self.upper_mm = self.upper_mm.hypot(upper);
+        self
+    }
+
+    /// The record a machine file carries (`calibration.accuracy`).
+    pub fn record(&self) -> AccuracyRecord {
+        AccuracyRecord {
+            rms_mm: self.rms_mm,
+            upper_mm: self.upper_mm,
+            point: self.point.clone(),
+            parts: self.parts.clone(),
+        }
+    }
+
+    /// The JSON object (`accuracy`).
+    pub fn to_json(&self) -> Value {
+        serde_json::to_value(self).unwrap_or(Value::Null)
+    }
+
+    /// The report's line.
+    pub fn line(&self) -> String {
+        let part = |k: &str| self.parts.get(k).and_then(Value::as_f64).unwrap_or(0.0);
+        let mut s = format!(
+            "accuracy this file will deliver: {:.4} mm rms at the {} over the workspace, at most {:.4} mm (95 % bound): estimate {:.4} mm, unexplained out of sample {:.4} mm",
+            self.rms_mm,
+            self.point,
+            self.upper_mm,
+            part("estimate_mm"),
+            part("unexplained_mm"),
+        );
+        if let Some(h) = self.parts.get("head_mm").and_then(Value::as_f64) {
+            s.push_str(&format!(", head parts not calibrated {h:.4} mm"));
+        }
+        s
+    }
+}
+
+/// The promise of `id`, fitted with `model` on `data` (logged noise in
+/// `options`) on machine `m`: its first `set.len()` parameters are the
+/// geometry of `set`, the rest deployed terms; a model with richer legs
+/// checks its geometric estimate (module docs).
+pub(crate) fn of_fit(
+    m: &Machine,
+    set: &ParameterSet,
+    model: &ExtendedModel,
+    id: &Identification,
+    data: &Dataset,
+    options: &IdentifyOptions,
+    tolerance_mm: f64,
+) -> Result<Accuracy, Error> {
+    let k = set.len();
+    let context = |e: IdentError| Error::with_context("accuracy", &e);
+    if id.covariance.nrows() < k {
+        return Err(Error::other(format!(
+            "accuracy: {} parameters fitted for a set of {k}",
+            id.covariance.nrows()
+        )));
+    }
+    let points = AccuracyModel::new(m, set, &tricept_engine::accuracy_points(m), tolerance_mm)
+        .map_err(context)?;
+    let covariance = id.covariance.view((0, 0), (k, k)).into_owned();
+    let held: Vec<usize> = id
+        .design()
+        .fixed()
+        .iter()
+        .copied()
+        .filter(|&i| i < k)
+        .collect();
+    let cv = tricept_engine::cross_validate(model, id, &data.poses, m, &options.sigma)
+        .map_err(context)?;
+    let a = Accuracy::internal(&points, &covariance, &held, &cv, id.covariance.nrows() > k)?;
+    let structure = structure_part(&points, model, id, &covariance, data, options)?;
+    Ok(a.with_structure(structure))
+}
+
+/// The model of `set` on `m` alone, in `data`'s frame: the base of an
+/// internal calibration's structure part.
+pub(crate) fn geometric_base(
+    geometric: &GeometricModel,
+    m: &Machine,
+    data: &Dataset,
+) -> ExtendedModel {
+    ExtendedModel::with_terms(geometric.clone(), &[], Arc::new(Frame::of(m, data)))
+}
+
+/// The shift of the geometric estimate over the workspace when every leg
+/// may also be a quadratic in its command (a lead, a curved screw), beyond
+/// what chance gives it, as `(rms_mm, upper_mm)` (module docs).
+fn structure_part(
+    points: &AccuracyModel,
+    base: &ExtendedModel,
+    id: &Identification,
+    covariance: &nalgebra::DMatrix<f64>,
+    data: &Dataset,
+    options: &IdentifyOptions,
+) -> Result<(f64, f64), Error> {
+    let k = covariance.nrows();
+    let legs = Term::Generic(GenericTerm::new(
+        GenericFamily::LegPolynomial,
+        Scope::AllLegs,
+    ));
+    let rich = base.with(&[base.terms(), &[legs]].concat());
+    // A richer model that cannot be fitted shows nothing.
+    let Ok(r) = tricept_engine::identify(&rich, data, options) else {
+        return Ok((0.0, 0.0));
+    };
+    let delta = nalgebra::DVector::from_fn(k, |i, _| r.estimate[i] - id.estimate[i]);
+    let d = r.covariance.view((0, 0), (k, k)) - covariance;
+    let context = |e: IdentError| Error::with_context("accuracy", &e);
+    let (shift, _) = points
+        .error_moments(&(&delta * delta.transpose()), &[])
+        .map_err(context)?;
+    let (chance, chance2) = points.error_moments(&d, &[]).map_err(context)?;
+    let sd = (2.0 * chance2.max(0.0)).sqrt();
+    let bias2 = shift - chance.max(0.0);
+    Ok((bias2.max(0.0).sqrt(), (bias2 + Z95 * sd).max(0.0).sqrt()))
+}
+
+/// The promise of a fused fit at the tool tip after touch-off: the tip's
+/// predicted covariance over the evaluation poses (`tip`) with its held
+/// parameters' share as the head part, and the external sources' residuals
+/// beyond their stated noise out of sample (module docs).
+pub(crate) fn of_fusion(fit: &tricept_engine::fusion::Fusion) -> Accuracy {
+    let tip = &fit.report.tool_tip;
+    let held_mm = tip.held_touch_off_rms_um * 1e-3;
+    let total_mm = tip.touch_off_rms_um * 1e-3;
+    let estimate_mm = (total_mm * total_mm - held_mm * held_mm).max(0.0).sqrt();
+    // One dominant weak direction: the chi-square of one degree of freedom.
+    let one_dof = 3.841_458_820_694_124_f64.sqrt();
+    let (mut unexplained, mut unexplained_upper) = (0.0_f64, 0.0_f64);
+    for s in fit
+        .sources
+        .iter()
+        .filter(|s| s.kind != tricept_engine::fusion::SourceKind::Internal)
+    {
+        let (Some(rms_um), chi2) = (s.rms_um, s.reduced_chi_square) else {
+            continue;
+        };
+        if !(chi2.is_finite() && chi2 > 0.0 && s.redundancy > 0.0) {
+            continue;
+        }
+        let nu = (s.rows as f64 * s.redundancy).max(1.0);
+        let noise_mm2 = (rms_um * 1e-3).powi(2) / chi2;
+        // Three coordinates of an isotropic error; deleted residuals are the
+        // fitted ones over the redundancy.
+        let excess = |c: f64| 3.0 * noise_mm2 * (c - 1.0).max(0.0) / s.redundancy;
+        unexplained = unexplained.max(excess(chi2));
+        unexplained_upper = unexplained_upper.max(excess(chi2 + Z95 * (2.0 / nu).sqrt()));
+    }
+    let mut parts = Map::new();
+    parts.insert("estimate_mm".into(), estimate_mm.into());
+    parts.insert("estimate_upper_mm".into(), (one_dof * estimate_mm).into());
+    parts.insert("unexplained_mm".into(), unexplained.sqrt().into());
+    parts.insert(
+        "unexplained_upper_mm".into(),
+        unexplained_upper.sqrt().into(),
+    );
+    parts.insert("head_mm".into(), held_mm.into());
+    parts.insert("head_upper_mm".into(), (one_dof * held_mm).into());
+    Accuracy::combine(
+        TOOL_TIP,
+        &[
+            (estimate_mm, one_dof * estimate_mm),
+            (unexplained.sqrt(), unexplained_upper.sqrt()),
+            (held_mm, one_dof * held_mm),
+        ],
+        parts,
+    )
+}
+
+/// The estimate's rms and 95 % bound from the moments `(tr(MS),
+/// tr(MSMS))` of its mean square (module docs).
+pub(crate) fn estimate_part(m1: f64, m2: f64) -> (f64, f64) {
+    if !(m1 > 0.0 && m2 > 0.0) {
+        let m = m1.max(0.0).sqrt();
+        return (m, m);
+    }
+    let g = m2 / m1;
+    let nu = m1 * m1 / m2;
+    let a = 2.0 / (9.0 * nu);
+    let q = g * nu * (1.0 - a + Z95 * a.sqrt()).max(0.0).powi(3);
+    (m1.sqrt(), q.max(m1).sqrt())
+}
+
+/// The unexplained part's rms and 95 % bound (module docs).
+pub(crate) fn unexplained_part(cv: &CrossValidation) -> (f64, f64) {
+    (
+        cv.excess_mm2.max(0.0).sqrt(),
+        (cv.excess_mm2 + Z95 * cv.excess_se_mm2).max(0.0).sqrt(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_estimate_bound_is_the_chi_square_quantile() {
+        // One parameter: e^T M e = m1 chi2_1, whose 95 % quantile is 3.84
+        // (Wilson-Hilferty gives 3.7 at one degree of freedom).
+        let (rms, upper) = estimate_part(4.0, 16.0);
+        assert!((rms - 2.0).abs() < 1e-12);
+        let q = upper * upper / 4.0;
+        assert!((3.5..4.0).contains(&q), "{q}");
+        // Many equal parameters: the mean square concentrates at its mean.
+        let (rms, upper) = estimate_part(1.0, 1e-4);
+        assert!(
+            (rms - 1.0).abs() < 1e-12 && upper > 1.0 && upper < 1.02,
+            "{upper}"
+        );
+    }
+}
