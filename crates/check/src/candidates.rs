@@ -31,6 +31,9 @@ use tricept_model::effects::{
     normalised_coordinate,
 };
 
+/// The name of the whole structure's thermal growth.
+pub(crate) const STRUCTURE: &str = "thermal growth of the structure";
+
 /// The most parameters a candidate has.
 pub(crate) const MAX_PARAMETERS: usize = 4;
 
@@ -82,6 +85,9 @@ enum What {
         role: &'static CheckRole,
         reference_c: Option<f64>,
     },
+    /// The whole structure grown by the campaign's mean temperature change
+    /// since the calibration, K.
+    Structure(f64),
 }
 
 impl PartialEq for What {
@@ -89,6 +95,7 @@ impl PartialEq for What {
         match (self, other) {
             (What::Leg(i, r), What::Leg(j, s)) => i == j && r == s,
             (What::Base(i), What::Base(j)) | (What::Platform(i), What::Platform(j)) => i == j,
+            (What::Structure(a), What::Structure(b)) => a == b,
             (
                 What::Registry {
                     role: a,
@@ -226,6 +233,44 @@ impl Candidate {
         v
     }
 
+    /// The candidates of a check whose campaign's mean temperature is
+    /// `check_c`: those of [`Candidate::all`], and when it differs from the
+    /// calibration's (`reference_c`), the thermal growth of the whole
+    /// structure (legs, base and platform joints and the UP limb grown
+    /// alike, the scale reading the longer limb): a machine scaled by
+    /// `1 + alpha dT` reads its angles unchanged and its scale `alpha dT q4`
+    /// longer, and its platform point `r` moves by `alpha dT r`.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_check::Candidate;
+    /// let ranges = [(700.0, 900.0); 3];
+    /// let warm = Candidate::for_check(ranges, Some(20.0), Some(24.0));
+    /// assert_eq!(warm.len(), Candidate::all(ranges, Some(20.0), true).len() + 1);
+    /// assert!(warm.iter().any(|c| c.name == "thermal growth of the structure"));
+    /// // At the calibration's temperature, or without one: none.
+    /// assert_eq!(Candidate::for_check(ranges, Some(20.0), Some(20.0)).len(), warm.len() - 1);
+    /// assert_eq!(Candidate::for_check(ranges, None, Some(24.0)).len(), warm.len() - 1);
+    /// ```
+    pub fn for_check(
+        leg_ranges_mm: [(f64, f64); 3],
+        reference_c: Option<f64>,
+        check_c: Option<f64>,
+    ) -> Vec<Candidate> {
+        let mut v = Candidate::all(leg_ranges_mm, reference_c, check_c.is_some());
+        if let (Some(r), Some(t)) = (reference_c, check_c)
+            && t != r
+        {
+            v.push(Candidate::new(
+                STRUCTURE.into(),
+                CandidateKind::Thermal,
+                &["structure_expansion_ppm_per_k".to_string()],
+                What::Structure(t - r),
+            ));
+        }
+        v
+    }
+
     /// Number of parameters.
     pub fn len(&self) -> usize {
         self.parameters.len()
@@ -278,7 +323,11 @@ impl Candidate {
                     }
                     CheckColumns::Readings(_) => {}
                 },
+                What::Structure(_) => {}
             }
+        }
+        if let What::Structure(dt) = self.what {
+            out[2][0] = p.readings[2] * 1e-6 * dt;
         }
         if let What::Registry { role, .. } = self.what
             && let CheckColumns::Readings(f) = role.columns
@@ -301,11 +350,12 @@ impl Candidate {
 
     /// The platform error (mm) a change `value` of this candidate causes at
     /// a target commanded with `commands_mm`, from the platform point's
-    /// Jacobian `p21` there; `temp_c` is the temperature of the machine
-    /// (thermal growth).
+    /// Jacobian `p21` there (`point_mm`, in the base frame); `temp_c` is
+    /// the temperature of the machine (thermal growth).
     pub(crate) fn platform_error(
         &self,
         p21: &ErrorJacobian,
+        point_mm: &Vector3<f64>,
         commands_mm: &[f64; 3],
         temp_c: Option<f64>,
         value: &[f64],
@@ -327,6 +377,7 @@ impl Candidate {
                 }
                 CheckColumns::Readings(_) => Vector3::zeros(),
             },
+            What::Structure(dt) => point_mm * (1e-6 * dt * v(0)),
         }
     }
 }
