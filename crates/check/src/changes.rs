@@ -37,8 +37,18 @@ use serde::Serialize;
 
 use crate::candidates::{Candidate, CandidateKind};
 use crate::check::{
-    ChiSquare, Impact, SHORTLIST_RATIO, SubFit, chi_square, fit_columns, unseen_limit,
+    CandidateResult, ChiSquare, Impact, SHORTLIST_RATIO, SubFit, chi_square, fit_columns,
+    unseen_limit,
 };
+
+/// The expansion of steel, ppm/K: the growth a structure's temperature
+/// change is stated at when its readings cannot show it.
+pub(crate) const STEEL_PPM_PER_K: f64 = 11.5;
+
+/// A growth of the structure the readings cannot show is worth a warning
+/// from this mean platform effect, um: half the 20 um a check is planned
+/// to detect (`tricept plan --instrument check`).
+const UNSEEN_GROWTH_UM: f64 = 10.0;
 
 /// One change of the set a check names.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -324,4 +334,36 @@ mod tests {
         let rows = [(S, -40.0, true), (T, -39.0, true), (T, -39.5, true)];
         assert_eq!(named_first(0, &rows), 2);
     }
+}
+
+/// The warning for a structure whose temperature differs from the
+/// calibration's when the readings show no thermal growth (no thermal
+/// change named, the structure's growth not significant): a linear scale
+/// that grows with the structure reads the longer limb as the same length,
+/// and the sensors then see nothing, while the platform is off by the
+/// growth. Stated at the expansion of steel, when its platform effect is
+/// at least 10 um.
+pub(crate) fn unseen_growth(
+    candidates: &[Candidate],
+    results: &[CandidateResult],
+    changes: &[Change],
+    impact: &Impact,
+    temp_c: Option<f64>,
+) -> Option<String> {
+    if changes.iter().any(|c| c.kind == CandidateKind::Thermal) {
+        return None;
+    }
+    let (i, dt) = candidates
+        .iter()
+        .enumerate()
+        .find_map(|(i, c)| c.structure_delta_k().map(|dt| (i, dt)))?;
+    if results.get(i)?.significant {
+        return None;
+    }
+    let (mean_um, max_um) = impact.of(&candidates[i], &[STEEL_PPM_PER_K], temp_c);
+    (mean_um >= UNSEEN_GROWTH_UM).then(|| {
+        format!(
+            "the structure is {dt:+.1} K from its calibration's temperature and the readings show no thermal growth: if the linear scale grows with the structure, the sensors cannot see it, and at {STEEL_PPM_PER_K} ppm/K (steel) it moves the platform by {mean_um:.1} um on average and up to {max_um:.1} um; check at the calibration's temperature or recalibrate at this one"
+        )
+    })
 }

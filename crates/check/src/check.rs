@@ -50,7 +50,7 @@ use tricept_numerics::linalg::{TriangularAccumulator, invert_upper, solve_upper}
 use tricept_numerics::stats::{chi2_isf, chi2_ln_sf, chi2_sf, required_noncentrality};
 
 use crate::candidates::{Candidate, CandidateKind, MAX_PARAMETERS, PoseTerms};
-use crate::changes::{Change, Problem, forward, named_first};
+use crate::changes::{Change, Problem, forward, named_first, unseen_growth};
 use crate::error::CheckError;
 use crate::reference::Reference;
 
@@ -460,6 +460,13 @@ pub fn check(
             invisible.join(", ")
         ));
     }
+    warnings.extend(unseen_growth(
+        &candidates,
+        &results,
+        &changes,
+        &impact,
+        check_temp,
+    ));
     Ok(CheckReport {
         verdict,
         changed,

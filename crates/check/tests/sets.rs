@@ -274,3 +274,49 @@ fn warm_legs_with_a_jittery_log_are_thermal_growth() {
     );
     assert!(named >= 9, "{found:?}");
 }
+
+/// The platform effect (um) a warning states: `moves the platform by X um`.
+fn stated_um(warning: &str) -> Option<f64> {
+    let rest = warning.split("moves the platform by ").nth(1)?;
+    rest.split(" um").next()?.parse().ok()
+}
+
+#[test]
+fn a_warm_structure_whose_scale_grows_too_is_unseen_and_said_so() {
+    let mut warned = 0;
+    let mut found = Vec::new();
+    for seed in 0..10 {
+        let (cold, reference) = calibrated(900 + seed);
+        let warm = grown(&cold, STEEL * WARMER_K * 1e-6, true);
+        let mut data = check_campaign(&warm, seed + 900, CALIBRATION_C + WARMER_K);
+        jitter(&mut data, 0.3, seed);
+        let r = run(&reference, &data);
+        let truth = platform_truth_um(&cold, &warm, &reference);
+        // The readings are the cold machine's: no change is named.
+        assert!(r.changes.is_empty(), "seed {seed}: {:?}", names(&r));
+        let stated = r.warnings.iter().find_map(|w| stated_um(w));
+        if let Some(um) = stated {
+            warned += 1;
+            assert!(
+                (um - truth).abs() < 0.15 * truth,
+                "seed {seed}: {um} um against {truth} um"
+            );
+        }
+        // Half a kelvin warmer: under 10 um, no warning.
+        let slightly = grown(&cold, STEEL * 0.5 * 1e-6, true);
+        let r = run(
+            &reference,
+            &check_campaign(&slightly, seed + 900, CALIBRATION_C + 0.5),
+        );
+        assert!(
+            r.warnings.iter().all(|w| stated_um(w).is_none()),
+            "seed {seed}: {:?}",
+            r.warnings
+        );
+        found.push(format!("{stated:?} truth {truth:.1} um"));
+    }
+    eprintln!(
+        "TALLY check whole structure and scale {WARMER_K} K warmer: {warned}/10 warned of the unseen growth {found:?}"
+    );
+    assert!(warned >= 9, "{found:?}");
+}
