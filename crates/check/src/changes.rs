@@ -304,38 +304,6 @@ pub(crate) fn forward(p: &Problem<'_>) -> ChangeSet {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    const S: CandidateKind = CandidateKind::Sensor;
-    const T: CandidateKind = CandidateKind::Thermal;
-    const L: CandidateKind = CandidateKind::Leg;
-
-    #[test]
-    fn a_thermal_growth_is_named_before_a_sensor_that_fits_alike() {
-        // The scale gain first, a thermal growth a factor 10 behind: named.
-        let rows = [
-            (L, -5.0, true),
-            (S, -40.0, true),
-            (T, -40.0 + 10f64.ln(), true),
-        ];
-        assert_eq!(named_first(1, &rows), 2);
-        // A factor 30 behind: the sensor stays.
-        let rows = [(S, -40.0, true), (T, -40.0 + 30f64.ln(), true)];
-        assert_eq!(named_first(0, &rows), 0);
-        // Not significant: the sensor stays.
-        let rows = [(S, -40.0, true), (T, -40.0, false)];
-        assert_eq!(named_first(0, &rows), 0);
-        // A leg first: never displaced by a thermal growth.
-        let rows = [(L, -40.0, true), (T, -40.0, true)];
-        assert_eq!(named_first(0, &rows), 0);
-        // Of two thermal growths, the more likely.
-        let rows = [(S, -40.0, true), (T, -39.0, true), (T, -39.5, true)];
-        assert_eq!(named_first(0, &rows), 2);
-    }
-}
-
 /// The warning for a structure whose temperature differs from the
 /// calibration's when the readings show no thermal growth (no thermal
 /// change named, the structure's growth not significant): a linear scale
@@ -366,4 +334,36 @@ pub(crate) fn unseen_growth(
             "the structure is {dt:+.1} K from its calibration's temperature and the readings show no thermal growth: if the linear scale grows with the structure, the sensors cannot see it, and at {STEEL_PPM_PER_K} ppm/K (steel) it moves the platform by {mean_um:.1} um on average and up to {max_um:.1} um; check at the calibration's temperature or recalibrate at this one"
         )
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const S: CandidateKind = CandidateKind::Sensor;
+    const T: CandidateKind = CandidateKind::Thermal;
+    const L: CandidateKind = CandidateKind::Leg;
+
+    #[test]
+    fn a_thermal_growth_is_named_before_a_sensor_that_fits_alike() {
+        // The scale gain first, a thermal growth a factor 10 behind: named.
+        let rows = [
+            (L, -5.0, true),
+            (S, -40.0, true),
+            (T, -40.0 + 10f64.ln(), true),
+        ];
+        assert_eq!(named_first(1, &rows), 2);
+        // A factor 30 behind: the sensor stays.
+        let rows = [(S, -40.0, true), (T, -40.0 + 30f64.ln(), true)];
+        assert_eq!(named_first(0, &rows), 0);
+        // Not significant: the sensor stays.
+        let rows = [(S, -40.0, true), (T, -40.0, false)];
+        assert_eq!(named_first(0, &rows), 0);
+        // A leg first: never displaced by a thermal growth.
+        let rows = [(L, -40.0, true), (T, -40.0, true)];
+        assert_eq!(named_first(0, &rows), 0);
+        // Of two thermal growths, the more likely.
+        let rows = [(S, -40.0, true), (T, -39.0, true), (T, -39.5, true)];
+        assert_eq!(named_first(0, &rows), 2);
+    }
 }
