@@ -11,18 +11,32 @@
 //! `chi2(k)` without a further change, `k` the degrees of freedom it adds.
 //! A leg tries each leading subset of its nested parameters (length, then
 //! lead, then its shapes), the smallest p-value speaking for it, as in the
-//! test of each candidate alone. The candidate with the smallest
-//! conditional p-value enters the set when its statistic exceeds the
-//! family-wise critical value of the check (Bonferroni over every test of
-//! every candidate, [`crate::family_level`]); the search stops at the
-//! first step where none does. The set is then refitted jointly: each
-//! change's estimate and standard deviation are those of the joint fit,
-//! and its platform effect is that of its joint estimate.
+//! test of each candidate alone.
 //!
-//! Significant candidates whose conditional p-value is within a factor 20
-//! of the entering one's explain the step as well: they are the change's
-//! `aliases`, which the check cannot tell apart from it.
+//! 1. **Enter.** The candidate with the smallest conditional p-value enters
+//!    when its statistic exceeds the family-wise critical value of the
+//!    check (Bonferroni over every test of every candidate,
+//!    [`crate::family_level`]). Of the significant candidates of its kind
+//!    whose p-value is within a factor 20 of it (they explain the step
+//!    alike), the one whose joint fit is the smallest change enters: the
+//!    sum of each estimate squared over its unseen limit squared (0.25 mm
+//!    for a length). Two legs slipped in opposite directions read, through
+//!    the weak common length of the legs, almost as one leg twice as far
+//!    and another half as far; the smaller pair is named, the other as its
+//!    alias.
+//! 2. **Stop** at the first step where no candidate is significant.
+//! 3. **Exchange.** A change of the set is replaced by a candidate outside
+//!    it while that makes the p-value of the set's joint statistic smaller
+//!    by more than a factor 20 (a greedy first step, a joint that mimics two
+//!    legs at once, is so undone).
 //!
+//! The set is then refitted jointly: each change's estimate and standard
+//! deviation are those of the joint fit, its platform effect that of its
+//! joint estimate, its test the likelihood ratio given the other changes;
+//! significant candidates outside the set whose test given the other
+//! changes has a p-value within a factor 20 of it are its `aliases`, which
+//! the check cannot tell apart from it.
+
 //! # Temperature before the sensors
 //!
 //! When a thermal growth and a sensor's gain explain a step alike (the
@@ -50,6 +64,9 @@ pub(crate) const STEEL_PPM_PER_K: f64 = 11.5;
 /// to detect (`tricept plan --instrument check`).
 const UNSEEN_GROWTH_UM: f64 = 10.0;
 
+/// At most this many exchanges follow the forward search.
+const MAX_EXCHANGES: usize = 8;
+
 /// One change of the set a check names.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Change {
@@ -69,11 +86,11 @@ pub struct Change {
     pub platform_mean_um: f64,
     /// The largest, um.
     pub platform_max_um: f64,
-    /// The conditional likelihood-ratio test with which it entered the set
-    /// (given the changes before it).
+    /// Its likelihood-ratio test given the other changes of the set.
     pub test: ChiSquare,
-    /// Candidates that explain that step as well (a conditional p-value
-    /// within a factor 20): the check cannot tell them apart from it.
+    /// Candidates outside the set that, given the other changes, explain
+    /// the readings as well (significant, a p-value within a factor 20):
+    /// the check cannot tell them apart from it.
     pub aliases: Vec<String>,
 }
 
@@ -151,6 +168,82 @@ impl Problem<'_> {
             .collect()
     }
 
+    /// The numbers of leading parameters candidate `c` is tried with: each
+    /// for a nested candidate, all of them otherwise.
+    fn sizes(&self, c: usize) -> Vec<usize> {
+        let n = self.candidates[c].len();
+        if self.candidates[c].is_nested() {
+            (1..=n).collect()
+        } else {
+            vec![n]
+        }
+    }
+
+    /// `ln p` of the joint fit of `set`.
+    fn ln_p(&self, set: &[(usize, usize)], columns: &[Vec<usize>]) -> f64 {
+        let (fit, _) = self.fit(set, columns);
+        chi_square(fit.statistic, fit.dof, self.level).ln_p_value
+    }
+
+    /// The exchange after the forward search: a change of the set is
+    /// replaced by a candidate outside it while that makes the joint fit's
+    /// p-value smaller by more than a factor 20 (the best such exchange
+    /// first); a greedy first step (a joint that mimics two legs at once)
+    /// is so undone.
+    fn exchange(&self, set: &mut [(usize, usize)], columns: &[Vec<usize>]) {
+        for _ in 0..MAX_EXCHANGES {
+            let bar = self.ln_p(set, columns) - SHORTLIST_RATIO.ln();
+            let mut best: Option<(f64, usize, (usize, usize))> = None;
+            for k in 0..set.len() {
+                for c in 0..self.candidates.len() {
+                    if set.iter().any(|&(s, _)| s == c) {
+                        continue;
+                    }
+                    for m in self.sizes(c) {
+                        let mut trial = set.to_vec();
+                        trial[k] = (c, m);
+                        let l = self.ln_p(&trial, columns);
+                        if l < bar && best.is_none_or(|(b, _, _)| l < b) {
+                            best = Some((l, k, (c, m)));
+                        }
+                    }
+                }
+            }
+            match best {
+                Some((_, k, cm)) => set[k] = cm,
+                None => break,
+            }
+        }
+    }
+
+    /// The test of change `k` of `set` given the others, and the
+    /// candidates outside the set that, given the others, explain the
+    /// readings as well (significant, a p-value within a factor 20).
+    fn given_others(
+        &self,
+        k: usize,
+        set: &[(usize, usize)],
+        columns: &[Vec<usize>],
+    ) -> (ChiSquare, Vec<String>) {
+        let mut others = set.to_vec();
+        let (c, _) = others.remove(k);
+        let (base, _) = self.fit(&others, columns);
+        let (with, _) = self.fit(set, columns);
+        let test = chi_square(
+            (with.statistic - base.statistic).max(0.0),
+            with.dof.saturating_sub(base.dof),
+            self.level,
+        );
+        let margin = test.ln_p_value + SHORTLIST_RATIO.ln();
+        let aliases = (0..self.candidates.len())
+            .filter(|&a| a != c && set.iter().all(|&(s, _)| s != a))
+            .filter_map(|a| self.step(a, &others, &base, columns))
+            .filter(|s| s.significant() && s.test.ln_p_value <= margin)
+            .map(|s| self.candidates[s.cand].name.clone())
+            .collect();
+        (test, aliases)
+    }
+
     /// The joint fit of `set` (candidate, leading parameters fitted), and
     /// the size of its changes.
     fn fit(&self, set: &[(usize, usize)], columns: &[Vec<usize>]) -> (SubFit, f64) {
@@ -184,15 +277,9 @@ impl Problem<'_> {
         base: &SubFit,
         columns: &[Vec<usize>],
     ) -> Option<Step> {
-        let n = self.candidates[c].len();
-        let sizes: Vec<usize> = if self.candidates[c].is_nested() {
-            (1..=n).collect()
-        } else {
-            vec![n]
-        };
         let mut with = set.to_vec();
         with.push((c, 0));
-        sizes
+        self.sizes(c)
             .into_iter()
             .filter_map(|m| {
                 if let Some(last) = with.last_mut() {
@@ -221,7 +308,6 @@ impl Problem<'_> {
 pub(crate) fn forward(p: &Problem<'_>) -> ChangeSet {
     let columns = p.columns();
     let mut set: Vec<(usize, usize)> = Vec::new();
-    let mut entered: Vec<(ChiSquare, Vec<String>)> = Vec::new();
     let (mut base, _) = p.fit(&set, &columns);
     while set.len() < p.candidates.len() {
         let steps: Vec<Step> = (0..p.candidates.len())
@@ -261,15 +347,14 @@ pub(crate) fn forward(p: &Problem<'_>) -> ChangeSet {
         else {
             break;
         };
-        let aliases = steps
-            .iter()
-            .filter(|s| s.cand != chosen.cand && s.significant() && s.test.ln_p_value <= margin)
-            .map(|s| p.candidates[s.cand].name.clone())
-            .collect();
         set.push((chosen.cand, chosen.fitted));
-        entered.push((chosen.test, aliases));
         base = p.fit(&set, &columns).0;
     }
+    p.exchange(&mut set, &columns);
+    let base = p.fit(&set, &columns).0;
+    let entered: Vec<(ChiSquare, Vec<String>)> = (0..set.len())
+        .map(|k| p.given_others(k, &set, &columns))
+        .collect();
     let mut at = 0;
     let changes = set
         .iter()
