@@ -7,11 +7,12 @@
 //! | `leg I` | `dqI_mm` (length: a slipped encoder or coupling), `leadI_ppm` (length proportional to the command), `p2_legI_um`, `p3_legI_um` (the quadratic and cubic Legendre shapes over the leg's command range in the workspace: a worn segment, a bent screw) | `J21[:, dq_I] (1, q_I 1e-6, P2(x_I) 1e-3, P3(x_I) 1e-3)` | `P21[:, dq_I]` times the same at `q_I(r)` |
 //! | `base joint BI`, `platform joint AI` | `dxBI_mm`, `dyBI_mm`, `dzBI_mm` (or `A`) | the joint's three columns of `J21` | the same columns of `P21` |
 //! | `thermal growth` (temperatures logged at the check and the calibration) | `expansion_ppm_per_k` | `sum_I J21[:, dq_I] q_I 1e-6 (T - T_cal)` | `sum_I P21[:, dq_I] q_I(r) 1e-6 (T - T_cal)` at the check's mean `T` |
+//! | `thermal growth of the structure` (the check's mean temperature more than 0.1 K from the calibration's) | `structure_expansion_ppm_per_k` | `q4 1e-6 (T - T_cal)` on the scale (the machine scaled by `1 + alpha dT` reads its angles unchanged) | `r 1e-6 (T - T_cal)` at the platform point `r` |
 //! | `common leg lead` (no temperatures) | `lead_ppm` | `sum_I J21[:, dq_I] q_I 1e-6` | `sum_I P21[:, dq_I] q_I(r) 1e-6` |
 //! | `scale gain` | `scale_gain_ppm` | `s 1e-6` on the scale | none: the sensor, not the machine |
 //! | `encoder gains` | `phi_gain_ppm`, `theta_gain_ppm` | `phi 1e-6`, `theta 1e-6` | none |
 //!
-//! The last rows are the registry's: every effect or generic family whose
+//! The last rows but the structure's are the registry's: every effect or generic family whose
 //! spec has a [`CheckRole`] (`thermal`, `leg-lead`'s common part,
 //! `scale-gain`, `encoder-gain`) is a candidate with its name, parameters
 //! and columns, when its condition on the logged temperatures holds.

@@ -91,15 +91,21 @@ impl CheckReport {
                 );
             }
         }
-        if !self.changes.is_empty() {
+        // The set, unless it is the most likely change alone, without
+        // aliases (the verdict line names it).
+        let alone = match (self.changes.as_slice(), best) {
+            ([one], Some(b)) => one.name == b.name && one.aliases.is_empty(),
+            _ => false,
+        };
+        if !self.changes.is_empty() && !alone {
             let list: Vec<String> = self.changes.iter().map(change_text).collect();
             let _ = writeln!(
                 s,
-                "changes (the smallest set that explains the readings, each significant given the ones before it): {}",
+                "changes (the smallest set that explains the readings, each tested given the others): {}",
                 list.join("; ")
             );
         }
-        if let Some(r) = &self.after_changes {
+        if let Some(r) = self.after_changes.as_ref().filter(|_| !alone) {
             let _ = writeln!(
                 s,
                 "after the changes: chi2 {:.1} for {} dof (p = {:.2e})",

@@ -133,6 +133,14 @@ fn one_slipped_leg_is_one_change() {
             let c = &r.changes[0];
             assert_eq!(c.parameters.len(), 1, "seed {seed}: {c:?}");
             assert!((c.estimate[0] - size_mm).abs() < 5.0 * c.std_dev[0].unwrap());
+            // Named by the verdict line; the set's line only for its aliases.
+            let text = r.to_text();
+            assert_eq!(
+                text.contains("changes (the smallest set"),
+                !c.aliases.is_empty(),
+                "{text}"
+            );
+            assert_eq!(text.contains("after the changes"), !c.aliases.is_empty());
         }
         found.push(format!("leg {} -> {:?}", leg + 1, names(&r)));
     }
