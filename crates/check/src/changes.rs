@@ -25,10 +25,6 @@
 //!    and another half as far; the smaller pair is named, the other as its
 //!    alias.
 //! 2. **Stop** at the first step where no candidate is significant.
-//! 3. **Exchange.** A change of the set is replaced by a candidate outside
-//!    it while that makes the p-value of the set's joint statistic smaller
-//!    by more than a factor 20 (a greedy first step, a joint that mimics two
-//!    legs at once, is so undone).
 //!
 //! The set is then refitted jointly: each change's estimate and standard
 //! deviation are those of the joint fit, its platform effect that of its
@@ -63,9 +59,6 @@ pub(crate) const STEEL_PPM_PER_K: f64 = 11.5;
 /// from this mean platform effect, um: half the 20 um a check is planned
 /// to detect (`tricept plan --instrument check`).
 const UNSEEN_GROWTH_UM: f64 = 10.0;
-
-/// At most this many exchanges follow the forward search.
-const MAX_EXCHANGES: usize = 8;
 
 /// One change of the set a check names.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -176,43 +169,6 @@ impl Problem<'_> {
             (1..=n).collect()
         } else {
             vec![n]
-        }
-    }
-
-    /// `ln p` of the joint fit of `set`.
-    fn ln_p(&self, set: &[(usize, usize)], columns: &[Vec<usize>]) -> f64 {
-        let (fit, _) = self.fit(set, columns);
-        chi_square(fit.statistic, fit.dof, self.level).ln_p_value
-    }
-
-    /// The exchange after the forward search: a change of the set is
-    /// replaced by a candidate outside it while that makes the joint fit's
-    /// p-value smaller by more than a factor 20 (the best such exchange
-    /// first); a greedy first step (a joint that mimics two legs at once)
-    /// is so undone.
-    fn exchange(&self, set: &mut [(usize, usize)], columns: &[Vec<usize>]) {
-        for _ in 0..MAX_EXCHANGES {
-            let bar = self.ln_p(set, columns) - SHORTLIST_RATIO.ln();
-            let mut best: Option<(f64, usize, (usize, usize))> = None;
-            for k in 0..set.len() {
-                for c in 0..self.candidates.len() {
-                    if set.iter().any(|&(s, _)| s == c) {
-                        continue;
-                    }
-                    for m in self.sizes(c) {
-                        let mut trial = set.to_vec();
-                        trial[k] = (c, m);
-                        let l = self.ln_p(&trial, columns);
-                        if l < bar && best.is_none_or(|(b, _, _)| l < b) {
-                            best = Some((l, k, (c, m)));
-                        }
-                    }
-                }
-            }
-            match best {
-                Some((_, k, cm)) => set[k] = cm,
-                None => break,
-            }
         }
     }
 
@@ -350,7 +306,6 @@ pub(crate) fn forward(p: &Problem<'_>) -> ChangeSet {
         set.push((chosen.cand, chosen.fitted));
         base = p.fit(&set, &columns).0;
     }
-    p.exchange(&mut set, &columns);
     let base = p.fit(&set, &columns).0;
     let entered: Vec<(ChiSquare, Vec<String>)> = (0..set.len())
         .map(|k| p.given_others(k, &set, &columns))

@@ -149,6 +149,45 @@ fn one_slipped_leg_is_one_change() {
 }
 
 #[test]
+fn a_leg_whose_lead_changed_is_one_change_with_its_lead() {
+    let mut named = 0;
+    let mut found = Vec::new();
+    for seed in 0..10 {
+        let (mut plant, reference) = calibrated(100 + seed);
+        let leg = (seed % 3) as usize;
+        let mut ppm = [0.0; 3];
+        ppm[leg] = 100.0;
+        plant.effects.push(Effect::from(LegLead { ppm }));
+        let r = run(
+            &reference,
+            &check_campaign(&plant, seed + 1100, CALIBRATION_C),
+        );
+        let n = leg + 1;
+        if let [c] = r.changes.as_slice()
+            && c.name == format!("leg {n}")
+            && c.parameters.len() >= 2
+        {
+            named += 1;
+            assert_eq!(c.parameters[1], format!("lead{n}_ppm"));
+            let sd = c.std_dev[1].unwrap();
+            assert!(
+                (c.estimate[1] - 100.0).abs() < 5.0 * sd,
+                "seed {seed}: {c:?}"
+            );
+        }
+        found.push(format!(
+            "leg {n} -> {:?}",
+            r.changes
+                .iter()
+                .map(|c| (&c.name, &c.parameters))
+                .collect::<Vec<_>>()
+        ));
+    }
+    eprintln!("TALLY check one leg's lead 100 ppm: {named}/10 that leg with its lead {found:?}");
+    assert!(named >= 9, "{found:?}");
+}
+
+#[test]
 fn an_unchanged_machine_names_no_change() {
     let mut named = Vec::new();
     for seed in 0..20 {
