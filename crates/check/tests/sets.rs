@@ -94,6 +94,11 @@ fn two_slipped_legs_are_both_named() {
             }
             let after = r.after_changes.unwrap();
             assert!(after.statistic <= after.critical, "seed {seed}: {after:?}");
+            // Each change, given the other, explains no more than the set.
+            let set = r.consistency.statistic - after.statistic;
+            for c in [a, b] {
+                assert!(c.test.statistic <= set + 1e-6, "seed {seed}: {c:?}");
+            }
             let text = r.to_text();
             assert!(
                 text.contains("changes (the smallest set") && text.contains("leg 3 (dq3 = -"),
