@@ -7,11 +7,12 @@
 //! | `leg I` | `dqI_mm` (length: a slipped encoder or coupling), `leadI_ppm` (length proportional to the command), `p2_legI_um`, `p3_legI_um` (the quadratic and cubic Legendre shapes over the leg's command range in the workspace: a worn segment, a bent screw) | `J21[:, dq_I] (1, q_I 1e-6, P2(x_I) 1e-3, P3(x_I) 1e-3)` | `P21[:, dq_I]` times the same at `q_I(r)` |
 //! | `base joint BI`, `platform joint AI` | `dxBI_mm`, `dyBI_mm`, `dzBI_mm` (or `A`) | the joint's three columns of `J21` | the same columns of `P21` |
 //! | `thermal growth` (temperatures logged at the check and the calibration) | `expansion_ppm_per_k` | `sum_I J21[:, dq_I] q_I 1e-6 (T - T_cal)` | `sum_I P21[:, dq_I] q_I(r) 1e-6 (T - T_cal)` at the check's mean `T` |
+//! | `thermal growth of the structure` (the check's mean temperature more than 0.1 K from the calibration's) | `structure_expansion_ppm_per_k` | `q4 1e-6 (T - T_cal)` on the scale (the machine scaled by `1 + alpha dT` reads its angles unchanged) | `r 1e-6 (T - T_cal)` at the platform point `r` |
 //! | `common leg lead` (no temperatures) | `lead_ppm` | `sum_I J21[:, dq_I] q_I 1e-6` | `sum_I P21[:, dq_I] q_I(r) 1e-6` |
 //! | `scale gain` | `scale_gain_ppm` | `s 1e-6` on the scale | none: the sensor, not the machine |
 //! | `encoder gains` | `phi_gain_ppm`, `theta_gain_ppm` | `phi 1e-6`, `theta 1e-6` | none |
 //!
-//! The last rows are the registry's: every effect or generic family whose
+//! The last rows but the structure's are the registry's: every effect or generic family whose
 //! spec has a [`CheckRole`] (`thermal`, `leg-lead`'s common part,
 //! `scale-gain`, `encoder-gain`) is a candidate with its name, parameters
 //! and columns, when its condition on the logged temperatures holds.
@@ -30,6 +31,15 @@ use tricept_model::effects::{
     Basis, CheckColumns, CheckRole, CheckWhen, EffectName, GenericFamily, legendre_p2, legendre_p3,
     normalised_coordinate,
 };
+
+/// The name of the whole structure's thermal growth.
+pub(crate) const STRUCTURE: &str = "thermal growth of the structure";
+
+/// A campaign's mean temperature this close to the calibration's (K) is
+/// the same: the structure's growth over it, at most 0.1 K times 11.5 ppm/K
+/// times 1.3 m, is under 2 um, and a logger's noise alone moves a mean by
+/// a few hundredths of a kelvin.
+pub(crate) const SAME_TEMPERATURE_K: f64 = 0.1;
 
 /// The most parameters a candidate has.
 pub(crate) const MAX_PARAMETERS: usize = 4;
@@ -82,6 +92,9 @@ enum What {
         role: &'static CheckRole,
         reference_c: Option<f64>,
     },
+    /// The whole structure grown by the campaign's mean temperature change
+    /// since the calibration, K.
+    Structure(f64),
 }
 
 impl PartialEq for What {
@@ -89,6 +102,7 @@ impl PartialEq for What {
         match (self, other) {
             (What::Leg(i, r), What::Leg(j, s)) => i == j && r == s,
             (What::Base(i), What::Base(j)) | (What::Platform(i), What::Platform(j)) => i == j,
+            (What::Structure(a), What::Structure(b)) => a == b,
             (
                 What::Registry {
                     role: a,
@@ -226,6 +240,53 @@ impl Candidate {
         v
     }
 
+    /// The candidates of a check whose campaign's mean temperature is
+    /// `check_c`: those of [`Candidate::all`], and when it differs from the
+    /// calibration's (`reference_c`) by more than 0.1 K, the thermal growth of the whole
+    /// structure (legs, base and platform joints and the UP limb grown
+    /// alike, the scale reading the longer limb): a machine scaled by
+    /// `1 + alpha dT` reads its angles unchanged and its scale `alpha dT q4`
+    /// longer, and its platform point `r` moves by `alpha dT r`.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_check::Candidate;
+    /// let ranges = [(700.0, 900.0); 3];
+    /// let warm = Candidate::for_check(ranges, Some(20.0), Some(24.0));
+    /// assert_eq!(warm.len(), Candidate::all(ranges, Some(20.0), true).len() + 1);
+    /// assert!(warm.iter().any(|c| c.name == "thermal growth of the structure"));
+    /// // At the calibration's temperature, or without one: none.
+    /// assert_eq!(Candidate::for_check(ranges, Some(20.0), Some(20.05)).len(), warm.len() - 1);
+    /// assert_eq!(Candidate::for_check(ranges, None, Some(24.0)).len(), warm.len() - 1);
+    /// ```
+    pub fn for_check(
+        leg_ranges_mm: [(f64, f64); 3],
+        reference_c: Option<f64>,
+        check_c: Option<f64>,
+    ) -> Vec<Candidate> {
+        let mut v = Candidate::all(leg_ranges_mm, reference_c, check_c.is_some());
+        if let (Some(r), Some(t)) = (reference_c, check_c)
+            && (t - r).abs() > SAME_TEMPERATURE_K
+        {
+            v.push(Candidate::new(
+                STRUCTURE.into(),
+                CandidateKind::Thermal,
+                &["structure_expansion_ppm_per_k".to_string()],
+                What::Structure(t - r),
+            ));
+        }
+        v
+    }
+
+    /// The temperature change (K) of the whole structure's thermal growth,
+    /// `None` for every other candidate.
+    pub(crate) fn structure_delta_k(&self) -> Option<f64> {
+        match self.what {
+            What::Structure(dt) => Some(dt),
+            _ => None,
+        }
+    }
+
     /// Number of parameters.
     pub fn len(&self) -> usize {
         self.parameters.len()
@@ -278,7 +339,11 @@ impl Candidate {
                     }
                     CheckColumns::Readings(_) => {}
                 },
+                What::Structure(_) => {}
             }
+        }
+        if let What::Structure(dt) = self.what {
+            out[2][0] = p.readings[2] * 1e-6 * dt;
         }
         if let What::Registry { role, .. } = self.what
             && let CheckColumns::Readings(f) = role.columns
@@ -301,11 +366,12 @@ impl Candidate {
 
     /// The platform error (mm) a change `value` of this candidate causes at
     /// a target commanded with `commands_mm`, from the platform point's
-    /// Jacobian `p21` there; `temp_c` is the temperature of the machine
-    /// (thermal growth).
+    /// Jacobian `p21` there (`point_mm`, in the base frame); `temp_c` is
+    /// the temperature of the machine (thermal growth).
     pub(crate) fn platform_error(
         &self,
         p21: &ErrorJacobian,
+        point_mm: &Vector3<f64>,
         commands_mm: &[f64; 3],
         temp_c: Option<f64>,
         value: &[f64],
@@ -327,6 +393,7 @@ impl Candidate {
                 }
                 CheckColumns::Readings(_) => Vector3::zeros(),
             },
+            What::Structure(dt) => point_mm * (1e-6 * dt * v(0)),
         }
     }
 }

@@ -50,6 +50,7 @@ use tricept_numerics::linalg::{TriangularAccumulator, invert_upper, solve_upper}
 use tricept_numerics::stats::{chi2_isf, chi2_ln_sf, chi2_sf, required_noncentrality};
 
 use crate::candidates::{Candidate, CandidateKind, MAX_PARAMETERS, PoseTerms};
+use crate::changes::{Change, Problem, forward, named_first, unseen_growth};
 use crate::error::CheckError;
 use crate::reference::Reference;
 
@@ -62,7 +63,7 @@ pub const DEFAULT_POWER: f64 = 0.95;
 /// Candidates whose p-value is within this factor of the best's explain
 /// the readings about as well (a likelihood ratio of 20, "strong evidence"
 /// on the usual scales, separates them).
-const SHORTLIST_RATIO: f64 = 20.0;
+pub(crate) const SHORTLIST_RATIO: f64 = 20.0;
 
 /// A campaign that cannot detect a change of this size (mm) in any leg or
 /// joint sees nothing worth a check.
@@ -193,8 +194,13 @@ pub struct CheckReport {
     pub shortlist: Vec<String>,
     /// The misfit the most likely change leaves.
     pub remaining: Option<ChiSquare>,
-    /// Every candidate, in the order of [`Candidate::all`].
+    /// Every candidate, in the order of [`Candidate::for_check`].
     pub candidates: Vec<CandidateResult>,
+    /// The smallest set of changes that explains the readings (a forward
+    /// search, `changes.rs`), when changed; the first is the most likely.
+    pub changes: Vec<Change>,
+    /// The misfit the set of changes leaves (when it is not empty).
+    pub after_changes: Option<ChiSquare>,
     /// Sensor offsets estimated at the check (rad, rad, mm).
     pub offsets: [f64; 3],
     /// Their standard deviations.
@@ -255,11 +261,8 @@ pub fn check(
     let machine = reference.machine();
     let k = model.names().len();
     let check_temp = mean_temperature(data);
-    let candidates = Candidate::all(
-        leg_ranges(machine)?,
-        reference.temperature_c(),
-        check_temp.is_some(),
-    );
+    let candidates =
+        Candidate::for_check(leg_ranges(machine)?, reference.temperature_c(), check_temp);
     let m_total: usize = candidates.iter().map(Candidate::len).sum();
     // The directions the calibration determined, with their variances.
     let eigen = reference.covariance().clone().symmetric_eigen();
@@ -305,7 +308,9 @@ pub fn check(
             j21: &j21,
             commands_mm: pose.commands_mm,
             readings: g,
-            temp_c: pose.temp_c,
+            // The campaign's mean: a short check's temperature is one, and
+            // the per-pose log's jitter would be errors in the variable.
+            temp_c: check_temp,
         };
         for c in 0..3 {
             let w = 1.0 / options.sigma[c];
@@ -397,6 +402,10 @@ pub fn check(
                 .then(b.1.test.statistic.total_cmp(&a.1.test.statistic))
         })
         .map(|(i, _)| i);
+    let rows: Vec<_> = (results.iter())
+        .map(|c| (c.kind, c.test.ln_p_value, c.significant))
+        .collect();
+    let best = best.map(|b| named_first(b, &rows));
     let (most_likely, shortlist, remaining, verdict) = match (changed, best) {
         (false, _) => (None, Vec::new(), None, CheckVerdict::Unchanged),
         (true, Some(b)) if results[b].significant => {
@@ -407,6 +416,7 @@ pub fn check(
                 .filter(|c| c.significant && c.test.ln_p_value <= margin)
                 .collect();
             close.sort_by(|a, b| a.test.ln_p_value.total_cmp(&b.test.ln_p_value));
+            close.sort_by_key(|c| c.name != results[b].name);
             let shortlist: Vec<String> = close.iter().map(|c| c.name.clone()).collect();
             let rest = chi_square(
                 (t0 - top).max(0.0),
@@ -422,6 +432,21 @@ pub fn check(
         }
         (true, _) => (None, Vec::new(), None, CheckVerdict::ChangedUnexplained),
     };
+    let set = forward(&Problem {
+        candidates: &candidates,
+        gram: &gram,
+        residual: nz - 1,
+        level,
+        impact: &impact,
+        temp_c: check_temp,
+    });
+    let (changes, after_changes) = if changed && !set.changes.is_empty() {
+        let rest = (t0 - set.statistic).max(0.0);
+        let after = chi_square(rest, dof0.saturating_sub(set.dof), alpha / 2.0);
+        (set.changes, Some(after))
+    } else {
+        (Vec::new(), None)
+    };
     let o = reference.offsets();
     let mut warnings = Vec::new();
     let invisible: Vec<&str> = results
@@ -435,6 +460,13 @@ pub fn check(
             invisible.join(", ")
         ));
     }
+    warnings.extend(unseen_growth(
+        &candidates,
+        &results,
+        &changes,
+        &impact,
+        check_temp,
+    ));
     Ok(CheckReport {
         verdict,
         changed,
@@ -445,6 +477,8 @@ pub fn check(
         shortlist,
         remaining,
         candidates: results,
+        changes,
+        after_changes,
         offsets,
         offsets_std_dev: offsets_sd,
         offsets_change: std::array::from_fn(|c| offsets[c] - o[c]),
@@ -480,7 +514,7 @@ pub fn family_level(alpha: f64, candidates: &[Candidate]) -> f64 {
 }
 
 /// The test of a statistic at `tail`.
-fn chi_square(statistic: f64, dof: usize, tail: f64) -> ChiSquare {
+pub(crate) fn chi_square(statistic: f64, dof: usize, tail: f64) -> ChiSquare {
     let k = dof.max(1) as f64;
     ChiSquare {
         statistic,
@@ -503,14 +537,14 @@ fn chi_square(statistic: f64, dof: usize, tail: f64) -> ChiSquare {
 /// candidate: statistic, degrees of freedom, estimate and standard
 /// deviation of each of them (`None`: a direction the campaign does not
 /// see, dropped by the size of its eigenvalue rather than inverted).
-struct SubFit {
-    statistic: f64,
-    dof: usize,
-    estimate: Vec<f64>,
-    std_dev: Vec<Option<f64>>,
+pub(crate) struct SubFit {
+    pub(crate) statistic: f64,
+    pub(crate) dof: usize,
+    pub(crate) estimate: Vec<f64>,
+    pub(crate) std_dev: Vec<Option<f64>>,
 }
 
-fn fit_columns(idx: &[usize], limits: &[f64], gram: &DMatrix<f64>, r: usize) -> SubFit {
+pub(crate) fn fit_columns(idx: &[usize], limits: &[f64], gram: &DMatrix<f64>, r: usize) -> SubFit {
     let n = idx.len();
     // Scaled to unit diagonal, so that the rank tolerance is relative.
     let scale: Vec<f64> = idx.iter().map(|&i| gram[(i, i)].max(0.0).sqrt()).collect();
@@ -638,7 +672,7 @@ fn assess(
 /// candidate's parameter counts as not seen: the class-1 tolerance of
 /// 0.25 mm for a length, 1000 ppm for a gain or lead, 250 um for a leg's
 /// shape, 100 ppm/K for an expansion.
-fn unseen_limit(parameter: &str) -> f64 {
+pub(crate) fn unseen_limit(parameter: &str) -> f64 {
     if parameter.ends_with("_mm") {
         0.25
     } else if parameter.ends_with("_um") {
@@ -652,8 +686,8 @@ fn unseen_limit(parameter: &str) -> f64 {
 
 /// The platform point's Jacobian at each evaluation target of the
 /// calibrated machine, with the commands that reach it.
-struct Impact {
-    at: Vec<(tricept_model::ErrorJacobian, [f64; 3])>,
+pub(crate) struct Impact {
+    at: Vec<(tricept_model::ErrorJacobian, Vector3<f64>, [f64; 3])>,
 }
 
 impl Impact {
@@ -669,18 +703,18 @@ impl Impact {
                 };
                 let ik = machine.inverse(r).map_err(e)?;
                 let p21 = position_error_jacobian(&machine.legs_at(&ik.up)).map_err(e)?;
-                Ok((p21, ik.legs_mm))
+                Ok((p21, *r, ik.legs_mm))
             })
             .collect::<Result<_, CheckError>>()?;
         Ok(Impact { at })
     }
 
     /// Mean and largest platform error (um) of a change `value`.
-    fn of(&self, cand: &Candidate, value: &[f64], temp_c: Option<f64>) -> (f64, f64) {
+    pub(crate) fn of(&self, cand: &Candidate, value: &[f64], temp_c: Option<f64>) -> (f64, f64) {
         let e: Vec<f64> = self
             .at
             .iter()
-            .map(|(p21, q)| cand.platform_error(p21, q, temp_c, value).norm() * 1e3)
+            .map(|(p21, r, q)| cand.platform_error(p21, r, q, temp_c, value).norm() * 1e3)
             .collect();
         let mean = e.iter().sum::<f64>() / e.len().max(1) as f64;
         (mean, e.iter().copied().fold(0.0, f64::max))

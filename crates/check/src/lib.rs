@@ -17,6 +17,8 @@
 //!   with its size, uncertainty and effect on the platform, the shortlist
 //!   of changes the campaign cannot tell apart;
 //! - [`Candidate`] (`candidates.rs`): what can have changed;
+//! - [`Change`] (`changes.rs`): the smallest set of changes that explains
+//!   the readings, by a forward search;
 //! - [`history`] (`history.rs`): checks appended to a JSON-lines file, and
 //!   the trend of the key quantities against their bands;
 //! - `report.rs`: the report as text.
@@ -49,6 +51,7 @@
 )]
 
 mod candidates;
+mod changes;
 mod check;
 mod error;
 pub mod history;
@@ -56,6 +59,7 @@ mod reference;
 mod report;
 
 pub use candidates::{Candidate, CandidateKind};
+pub use changes::Change;
 pub use check::{
     CandidateResult, CheckOptions, CheckReport, CheckVerdict, ChiSquare, DEFAULT_ALPHA,
     DEFAULT_POWER, check, family_level, leg_ranges,

@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 
+use crate::changes::Change;
 use crate::check::{CandidateResult, CheckReport, CheckVerdict};
 
 /// A parameter's value in the unit a person reads: um for a length
@@ -27,10 +28,16 @@ pub(crate) fn shown(parameter: &str, value: f64) -> (String, f64, &'static str) 
 
 /// `dq2 = +25.3 +- 1.2 um, lead2 = ...` for the components the campaign sees.
 pub(crate) fn estimate_text(c: &CandidateResult) -> String {
-    c.parameters
+    values_text(&c.parameters, &c.estimate, &c.std_dev)
+}
+
+/// `dq2 = +25.3 +- 1.2 um, ...` for each parameter with a standard
+/// deviation.
+fn values_text(parameters: &[String], estimate: &[f64], std_dev: &[Option<f64>]) -> String {
+    parameters
         .iter()
-        .zip(&c.estimate)
-        .zip(&c.std_dev)
+        .zip(estimate)
+        .zip(std_dev)
         .filter_map(|((p, v), sd)| {
             sd.map(|sd| {
                 let (name, v, unit) = shown(p, *v);
@@ -83,6 +90,27 @@ impl CheckReport {
                     "verdict: CHANGED, cause unknown: the readings do not fit the calibrated machine, and no leg, joint, thermal state or sensor gain explains them (run `tricept diagnose` on a full campaign)"
                 );
             }
+        }
+        // The set, unless it is the most likely change alone, without
+        // aliases (the verdict line names it).
+        let alone = match (self.changes.as_slice(), best) {
+            ([one], Some(b)) => one.name == b.name && one.aliases.is_empty(),
+            _ => false,
+        };
+        if !self.changes.is_empty() && !alone {
+            let list: Vec<String> = self.changes.iter().map(change_text).collect();
+            let _ = writeln!(
+                s,
+                "changes (the smallest set that explains the readings, each tested given the others): {}",
+                list.join("; ")
+            );
+        }
+        if let Some(r) = self.after_changes.as_ref().filter(|_| !alone) {
+            let _ = writeln!(
+                s,
+                "after the changes: chi2 {:.1} for {} dof (p = {:.2e})",
+                r.statistic, r.dof, r.p_value
+            );
         }
         let c = &self.consistency;
         let _ = writeln!(
@@ -146,4 +174,21 @@ impl CheckReport {
         }
         s
     }
+}
+
+/// `leg 1 (dq1 = +25.3 +- 2.6 um; moves the platform 30.1 um on average)`,
+/// with the candidates that explain it as well.
+fn change_text(c: &Change) -> String {
+    let aliases = if c.aliases.is_empty() {
+        String::new()
+    } else {
+        format!("; or, as well: {}", c.aliases.join(", "))
+    };
+    format!(
+        "{} ({}; moves the platform {:.1} um on average, up to {:.1} um{aliases})",
+        c.name,
+        values_text(&c.parameters, &c.estimate, &c.std_dev),
+        c.platform_mean_um,
+        c.platform_max_um
+    )
 }

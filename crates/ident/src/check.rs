@@ -175,6 +175,12 @@ impl CheckResult {
             Some(i) => format!("most likely {}", r.candidates[i].name),
             None => "cause unknown".to_string(),
         };
+        let what = if r.changes.len() > 1 {
+            let names: Vec<&str> = r.changes.iter().map(|c| c.name.as_str()).collect();
+            format!("{what}; the changes: {}", names.join(", "))
+        } else {
+            what
+        };
         Some(format!(
             "check: exit {EXIT_INADEQUATE}: the machine changed since its calibration ({}): {what}",
             self.data

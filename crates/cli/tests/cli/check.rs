@@ -217,3 +217,64 @@ fn a_calibrated_machine_is_checked_from_its_own_sensors() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn two_slipped_legs_are_both_in_the_changes_of_the_json() {
+    let dir = fresh_workdir("check-two-legs");
+    let d = dir.as_path();
+    calibrated_machine(d);
+    // Leg 1 25 um longer and leg 3 25 um shorter than at the calibration.
+    let csv = std::fs::read_to_string(dir.join("cal.csv")).unwrap();
+    let mut truth = truth_of(&csv);
+    for (leg, by) in [("dq1", 0.025), ("dq3", -0.025)] {
+        let v = truth[leg].as_f64().unwrap();
+        truth.insert(leg.into(), (v + by).into());
+    }
+    std::fs::write(d.join("two.json"), serde_json::to_string(&truth).unwrap()).unwrap();
+    let simulate = [
+        "simulate",
+        "--truth",
+        "two.json",
+        "--poses",
+        "random:20,12",
+        "--seed",
+        "8",
+        "--out",
+        "two.csv",
+    ];
+    assert_eq!(tricept(d, &simulate).status.code(), Some(0));
+    let check = ["check", "--machine", "cal.json", "--data", "two.csv"];
+    let out = tricept(d, &[&check[..], &["--json"]].concat());
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("the changes: leg"),
+        "{}",
+        stderr(&out)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let changes = v["changes"].as_array().unwrap();
+    let named: Vec<&str> = changes
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(named.len(), 2, "{named:?}");
+    assert!(
+        named.contains(&"leg 1") && named.contains(&"leg 3"),
+        "{named:?}"
+    );
+    for c in changes {
+        let leg = &c["name"].as_str().unwrap()[4..];
+        assert_eq!(c["parameters"][0], format!("dq{leg}_mm"));
+        let (e, sd) = (
+            c["estimate"][0].as_f64().unwrap(),
+            c["std_dev"][0].as_f64().unwrap(),
+        );
+        let hidden = if leg == "1" { 0.025 } else { -0.025 };
+        assert!((e - hidden).abs() < 5.0 * sd, "{c}");
+        assert!(c["platform_mean_um"].as_f64().unwrap() > 5.0, "{c}");
+    }
+    // The text lists them.
+    let text = String::from_utf8_lossy(&tricept(d, &check).stdout).to_string();
+    assert!(text.contains("changes (the smallest set"), "{text}");
+    std::fs::remove_dir_all(&dir).ok();
+}
