@@ -50,8 +50,11 @@ use tricept_numerics::linalg::{TriangularAccumulator, invert_upper, solve_upper}
 use tricept_numerics::stats::{chi2_isf, chi2_ln_sf, chi2_sf, required_noncentrality};
 
 use crate::candidates::{Candidate, CandidateKind, MAX_PARAMETERS, PoseTerms};
+use crate::design::{Design, change_columns};
 use crate::error::CheckError;
+use crate::noise::{NoiseSeen, beyond_noise};
 use crate::reference::Reference;
+use crate::screen::{Rejected, screened};
 
 /// The default family-wise false-alarm probability.
 pub const DEFAULT_ALPHA: f64 = 0.01;
@@ -105,6 +108,9 @@ pub enum CheckVerdict {
     Changed,
     /// The machine changed, and no single candidate explains it all.
     ChangedUnexplained,
+    /// The readings scatter more than the stated noise, and no change
+    /// stands out beyond that scatter (`crate::noise`): not a change.
+    NoisierThanStated,
 }
 
 impl CheckVerdict {
@@ -114,6 +120,7 @@ impl CheckVerdict {
             CheckVerdict::Unchanged => "unchanged",
             CheckVerdict::Changed => "changed",
             CheckVerdict::ChangedUnexplained => "changed-unexplained",
+            CheckVerdict::NoisierThanStated => "noisier-than-stated",
         }
     }
 }
@@ -204,6 +211,11 @@ pub struct CheckReport {
     pub offsets_change: [f64; 3],
     /// The check campaign's mean structure temperature, °C, when logged.
     pub temperature_c: Option<f64>,
+    /// The noise the readings show against the stated one.
+    pub noise: NoiseSeen,
+    /// Poses set aside as gross readings (`crate::screen`); the verdict
+    /// comes from the rest.
+    pub rejected: Vec<Rejected>,
     /// What a person should know.
     pub warnings: Vec<String>,
 }
@@ -250,6 +262,15 @@ pub fn check(
     data: &Dataset,
     options: &CheckOptions,
 ) -> Result<CheckReport, CheckError> {
+    screened(reference, data, options)
+}
+
+/// The check of every pose of `data` (no screen), with its whitened rows.
+pub(crate) fn evaluate(
+    reference: &Reference,
+    data: &Dataset,
+    options: &CheckOptions,
+) -> Result<(CheckReport, Design), CheckError> {
     validate(data, options)?;
     let model = reference.model();
     let machine = reference.machine();
@@ -281,6 +302,10 @@ pub fn check(
         n_prior: prior.len(),
         n_candidates: m_total,
     };
+    let mut design = Design::new(
+        3 + prior.len() + m_total + 1,
+        prior.iter().map(|(l, _)| 1.0 / l.sqrt()).collect(),
+    );
     let predictor = model.at(&vec![0.0; k]);
     let set = model.parameter_set();
     let mut jac = vec![0.0; 3 * k];
@@ -324,6 +349,7 @@ pub fn check(
             }
             row[at] = w * (y[c] - g[c]);
             rows.acc.push_row(&row);
+            design.push(&row);
         }
     }
     // One pseudo-observation per determined direction: eta_t ~ N(0, lambda_t).
@@ -384,12 +410,14 @@ pub fn check(
             check_temp,
         ));
     }
-    let changed =
+    let fired =
         consistency.statistic > consistency.critical || results.iter().any(|c| c.significant);
+    beyond_noise(&mut results, t0, dof0, level);
+    let changed = results.iter().any(|c| c.significant);
     let best = results
         .iter()
         .enumerate()
-        .filter(|(_, c)| c.test.dof > 0)
+        .filter(|(_, c)| c.test.dof > 0 && (c.significant || !changed))
         .min_by(|a, b| {
             a.1.test
                 .ln_p_value
@@ -398,6 +426,7 @@ pub fn check(
         })
         .map(|(i, _)| i);
     let (most_likely, shortlist, remaining, verdict) = match (changed, best) {
+        (false, _) if fired => (None, Vec::new(), None, CheckVerdict::NoisierThanStated),
         (false, _) => (None, Vec::new(), None, CheckVerdict::Unchanged),
         (true, Some(b)) if results[b].significant => {
             let top = results[b].test.statistic;
@@ -435,7 +464,14 @@ pub fn check(
             invisible.join(", ")
         ));
     }
-    Ok(CheckReport {
+    let noise = NoiseSeen::of(
+        &design.fit(&change_columns(&results, most_likely)),
+        options.sigma,
+    );
+    if verdict == CheckVerdict::NoisierThanStated {
+        warnings.push(noise.warning());
+    }
+    let report = CheckReport {
         verdict,
         changed,
         alpha,
@@ -449,8 +485,11 @@ pub fn check(
         offsets_std_dev: offsets_sd,
         offsets_change: std::array::from_fn(|c| offsets[c] - o[c]),
         temperature_c: check_temp,
+        noise,
+        rejected: Vec::new(),
         warnings,
-    })
+    };
+    Ok((report, design))
 }
 
 impl CandidateResult {

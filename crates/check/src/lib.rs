@@ -19,6 +19,10 @@
 //! - [`Candidate`] (`candidates.rs`): what can have changed;
 //! - [`history`] (`history.rs`): checks appended to a JSON-lines file, and
 //!   the trend of the key quantities against their bands;
+//! - `noise.rs`: noise is not a change (a candidate must stand out beyond
+//!   the scatter the readings show; the `noisier-than-stated` verdict);
+//! - `screen.rs`: gross readings set aside by their line, the verdict from
+//!   the rest (`design.rs` keeps the whitened rows both need);
 //! - `report.rs`: the report as text.
 //!
 //! What a check cannot see: the head (it moves none of the UP limb's
@@ -50,10 +54,13 @@
 
 mod candidates;
 mod check;
+mod design;
 mod error;
 pub mod history;
+mod noise;
 mod reference;
 mod report;
+mod screen;
 
 pub use candidates::{Candidate, CandidateKind};
 pub use check::{
@@ -61,4 +68,6 @@ pub use check::{
     DEFAULT_POWER, check, family_level, leg_ranges,
 };
 pub use error::CheckError;
+pub use noise::{ChannelNoise, NoiseSeen};
 pub use reference::Reference;
+pub use screen::{MAX_SET_ASIDE_SHARE, Rejected, SCREEN_ALPHA};

@@ -55,6 +55,13 @@ impl CheckReport {
                     self.alpha
                 );
             }
+            (CheckVerdict::NoisierThanStated, _) => {
+                let _ = writeln!(
+                    s,
+                    "verdict: NOISIER THAN STATED: the readings scatter {:.2} times the stated noise and no change stands out beyond it (state the noise or service the sensors; false-alarm probability {})",
+                    self.noise.factor, self.alpha
+                );
+            }
             (v, Some(b)) => {
                 let _ = writeln!(
                     s,
@@ -97,6 +104,18 @@ impl CheckReport {
                 r.statistic, r.dof, r.p_value
             );
         }
+        let (n, t) = (&self.noise.seen, &self.noise.stated);
+        let _ = writeln!(
+            s,
+            "noise seen: {:.2} x the stated (per logged reading: phi {:.2} arcsec, theta {:.2} arcsec, s {:.2} um; stated {:.2}, {:.2}, {:.2})",
+            self.noise.factor,
+            n.phi_arcsec,
+            n.theta_arcsec,
+            n.s_um,
+            t.phi_arcsec,
+            t.theta_arcsec,
+            t.s_um
+        );
         let a = RAD_PER_ARCSEC;
         let d = self.offsets_change;
         let _ = writeln!(

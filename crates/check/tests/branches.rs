@@ -154,35 +154,152 @@ fn two_changes_are_changed_but_unexplained() {
 }
 
 #[test]
-fn more_noise_than_stated_is_a_change_of_unknown_cause() {
+fn more_noise_than_stated_is_noisier_than_stated_not_a_change() {
     // The readings' noise 1.25 times the stated one over 100 poses: the
     // consistency statistic is 1.56 chi2(297), beyond its 0.5 % point (about
-    // 366) with probability 0.995, while each candidate's 1.56 chi2(k) passes
-    // its Bonferroni level with probability under 0.008: no candidate
-    // explains it in about nine checks out of ten.
+    // 366) with probability 0.995, and a candidate's 1.56 chi2(k) may pass
+    // its Bonferroni level, but none stands out beyond the scatter the
+    // readings show (issue 31: the F test of crate::noise): noisier than
+    // stated, not a change. (Before issue 31 this was "changed, cause
+    // unknown".)
     let m = Machine::paper();
-    let mut unknown = 0;
     for seed in 0..5 {
         let r = run(&m, &campaign(&m, &[], 100, 30 + seed, 1.25));
         assert_eq!(r.consistency.dof, 297);
-        assert!(r.changed, "seed {seed}");
         assert!(
             r.consistency.statistic > r.consistency.critical,
             "seed {seed}"
         );
-        if r.candidates.iter().all(|c| !c.significant) {
-            unknown += 1;
-            assert_eq!(r.verdict, CheckVerdict::ChangedUnexplained, "seed {seed}");
-            assert!(r.most_likely.is_none() && r.remaining.is_none());
-            assert!(r.shortlist.is_empty());
-            let text = r.to_text();
-            assert!(
-                text.starts_with("verdict: CHANGED, cause unknown"),
-                "{text}"
-            );
+        assert!(!r.changed, "seed {seed}");
+        assert_eq!(r.verdict, CheckVerdict::NoisierThanStated, "seed {seed}");
+        assert_eq!(r.verdict.as_str(), "noisier-than-stated");
+        assert!(r.most_likely.is_none() && r.remaining.is_none());
+        assert!(r.shortlist.is_empty());
+        assert!(r.candidates.iter().all(|c| !c.significant));
+        // The noise it sees: 1.25 times the stated (the factor from 297
+        // degrees of freedom, sd 3 %; each channel from 99, sd 7 %).
+        assert!((r.noise.factor - 1.25).abs() < 0.12, "{:?}", r.noise);
+        let n = &r.noise;
+        for (seen, stated) in [
+            (n.seen.phi_arcsec, n.stated.phi_arcsec),
+            (n.seen.theta_arcsec, n.stated.theta_arcsec),
+            (n.seen.s_um, n.stated.s_um),
+        ] {
+            assert!((seen / stated - 1.25).abs() < 0.3, "{n:?}");
         }
+        assert!((n.stated.phi_arcsec - 0.8 / 3f64.sqrt()).abs() < 1e-9);
+        assert!((n.stated.s_um - 0.5 / 3f64.sqrt()).abs() < 1e-9);
+        let text = r.to_text();
+        assert!(
+            text.starts_with(&format!(
+                "verdict: NOISIER THAN STATED: the readings scatter {:.2} times the stated noise",
+                n.factor
+            )),
+            "{text}"
+        );
+        assert!(text.contains("noise seen: "), "{text}");
+        assert_eq!(r.warnings.len(), 1, "{:?}", r.warnings);
+        assert!(
+            r.warnings[0]
+                .contains("state the sensors' noise (`--angle-noise-arcsec`, `--length-noise-um`"),
+            "{:?}",
+            r.warnings
+        );
     }
-    assert!(unknown >= 3, "{unknown} of 5");
+}
+
+#[test]
+fn a_change_stands_out_beyond_a_larger_noise() {
+    // Leg 2 slipped by 40 um and the noise 1.5 times the stated: the slip
+    // stands out beyond the scatter it leaves (F test), the verdict names it,
+    // and the noise seen is that scatter, not the slip.
+    let m = Machine::paper();
+    let r = run(&m, &campaign(&m, &[("dq2", 0.04)], 20, 2, 1.5));
+    assert!(r.changed);
+    let best = &r.candidates[r.most_likely.unwrap()];
+    assert_eq!(best.name, "leg 2");
+    assert!(best.significant);
+    assert!((r.noise.factor - 1.5).abs() < 0.45, "{:?}", r.noise);
+    // The same campaign without the slip: noisier than stated.
+    let r = run(&m, &campaign(&m, &[], 20, 2, 1.5));
+    assert_eq!(r.verdict, CheckVerdict::NoisierThanStated);
+}
+
+#[test]
+fn the_noise_seen_at_the_stated_noise_is_about_one() {
+    let m = Machine::paper();
+    let r = run(&m, &campaign(&m, &[], 100, 12, 1.0));
+    assert_eq!(r.verdict, CheckVerdict::Unchanged);
+    assert!((r.noise.factor - 1.0).abs() < 0.1, "{:?}", r.noise);
+    assert!(r.rejected.is_empty() && r.warnings.is_empty());
+    // Without noise the readings scatter not at all.
+    let r = run(&m, &campaign(&m, &[], 20, 12, 0.0));
+    assert!(
+        r.noise.factor < 1e-3 && r.noise.seen.s_um < 1e-3,
+        "{:?}",
+        r.noise
+    );
+}
+
+#[test]
+fn gross_readings_beyond_the_cap_are_not_set_aside() {
+    // 20 poses: at most 2 set aside. Three gross readings are not a matter
+    // of gross readings: none is set aside, and the check of every pose is
+    // reported with a warning.
+    let m = Machine::paper();
+    let clean = campaign(&m, &[], 20, 8, 1.0);
+    let mut data = clean.clone();
+    for (j, p) in data.poses.iter_mut().enumerate() {
+        p.line = j as u64 + 2;
+    }
+    data.poses[3].readings.s_mm += 0.025;
+    data.poses[9].readings.s_mm += 0.025;
+    let r = run(&m, &data);
+    assert_eq!(
+        r.rejected.iter().map(|x| x.line).collect::<Vec<_>>(),
+        vec![5, 11],
+        "{:?}",
+        r.rejected
+    );
+    assert_eq!(r.poses, 18);
+    assert!(!r.changed);
+    data.poses[15].readings.theta_rad += 0.0002;
+    let r = run(&m, &data);
+    assert!(r.rejected.is_empty(), "{:?}", r.rejected);
+    assert_eq!(r.poses, 20);
+    assert!(
+        r.warnings
+            .iter()
+            .any(|w| w == "more than 2 of the 20 poses stand out from the rest: not a matter of gross readings, so none is set aside"),
+        "{:?}",
+        r.warnings
+    );
+}
+
+#[test]
+fn a_gross_reading_whose_pose_the_rest_needs_is_kept() {
+    // Eight rows at four distinct poses: without the one pose that holds
+    // the gross reading, three distinct poses are blind, so nothing is set
+    // aside and the verdict is that of every pose.
+    let m = Machine::paper();
+    let t = m.workspace.random_poses(4, 11);
+    let targets = [0, 1, 2, 3, 0, 1, 2, 0].map(|i| t[i]).to_vec();
+    let data = Plant::geometric(m.clone(), ParameterSet::paper15().to_errors(&[0.0; 15]))
+        .simulate(&Campaign::from_targets(&m, targets, 3))
+        .unwrap();
+    let mut bad = data.clone();
+    bad.poses[3].readings.s_mm += 0.025;
+    let r = run(&m, &bad);
+    assert!(r.rejected.is_empty(), "{:?}", r.rejected);
+    assert_eq!(r.poses, 8);
+    assert!(r.consistency.statistic > r.consistency.critical);
+    // The same reading at a pose that is repeated is set aside.
+    let mut bad = data;
+    bad.poses[0].readings.s_mm += 0.025;
+    let r = run(&m, &bad);
+    assert_eq!(r.rejected.len(), 1, "{:?}", r.rejected);
+    assert_eq!(r.rejected[0].pose, 1);
+    assert_eq!(r.rejected[0].column, "s");
 }
 
 #[test]
