@@ -38,7 +38,10 @@
 //! `chi2_1(0.95) = 3.84` of the best's explain the data as well and form the
 //! shortlist a check cannot separate. When the best leaves a misfit of its
 //! own (`T0 - dT_best` beyond its quantile), the change is reported as not
-//! explained by any single candidate.
+//! explained by any single candidate. A candidate must also stand out
+//! beyond the scatter the readings leave after it ([`crate::noise`]): tests
+//! that fire with none standing out are `noisier-than-stated`, not a change.
+//! [`check`] screens gross readings first ([`crate::screen`]).
 
 use nalgebra::{DMatrix, DVector, Vector3};
 use serde::Serialize;

@@ -161,6 +161,11 @@ mod tests {
         let mut r = vec![candidate(20.0, 1, level)];
         beyond_noise(&mut r, 77.0, 57, level);
         assert!(r[0].significant);
+        // A scatter of exactly 1 with a statistic between the chi-square
+        // (13.5) and F (15.3) quantiles: the chi-square test decides.
+        let mut r = vec![candidate(14.0, 1, level)];
+        beyond_noise(&mut r, 14.0 + 56.0, 57, level);
+        assert!(r[0].significant);
         // The same statistic with twice the scatter left: F = 20 / 2 = 10,
         // below 15.3.
         let mut r = vec![candidate(20.0, 1, level)];

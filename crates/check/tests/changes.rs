@@ -404,18 +404,24 @@ fn noisier_sensors_are_not_a_change() {
     );
 }
 
+/// Slips `leg` (0-based) of `plant` by 20-25 um either way, drawn from
+/// `seed`; returns the slip, mm.
+fn slip_a_leg(plant: &mut Plant, leg: usize, seed: u64) -> f64 {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let size_mm =
+        (20.0 + 5.0 * rng.random::<f64>()) * 1e-3 * if rng.random::<bool>() { 1.0 } else { -1.0 };
+    plant.errors.dq_mm[leg] += size_mm;
+    size_mm
+}
+
 #[test]
 fn a_slipped_leg_is_found_under_noisier_sensors() {
     let (mut first, mut named) = (0, 0);
     let mut found = Vec::new();
     for seed in 0..10 {
         let (mut plant, reference) = calibrated(700 + seed);
-        let mut rng = Pcg64Mcg::seed_from_u64(seed + 700);
         let leg = (seed % 3) as usize;
-        let size_mm = (20.0 + 5.0 * rng.random::<f64>())
-            * 1e-3
-            * if rng.random::<bool>() { 1.0 } else { -1.0 };
-        plant.errors.dq_mm[leg] += size_mm;
+        let size_mm = slip_a_leg(&mut plant, leg, seed + 700);
         let r = run(
             &reference,
             &noisy_campaign(&plant, seed + 700, CALIBRATION_C, NOISIER),
@@ -518,12 +524,8 @@ fn a_slipped_leg_with_a_bad_reading_is_still_named() {
     let mut found = Vec::new();
     for seed in 0..10 {
         let (mut plant, reference) = calibrated(900 + seed);
-        let mut rng = Pcg64Mcg::seed_from_u64(seed + 900);
         let leg = (seed % 3) as usize;
-        let size_mm = (20.0 + 5.0 * rng.random::<f64>())
-            * 1e-3
-            * if rng.random::<bool>() { 1.0 } else { -1.0 };
-        plant.errors.dq_mm[leg] += size_mm;
+        let size_mm = slip_a_leg(&mut plant, leg, seed + 900);
         let channel = (seed % 2) as usize * 2;
         let pose = (seed as usize * 3) % CHECK_POSES;
         let data = with_gross_reading(

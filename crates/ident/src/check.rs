@@ -156,7 +156,8 @@ impl CheckResult {
         self.report.changed
     }
 
-    /// 0 unchanged, 3 changed.
+    /// 0 unchanged (also noisier than stated, and after gross readings
+    /// were set aside: [`CheckResult::warnings`] says so), 3 changed.
     pub fn exit_code(&self) -> u8 {
         if self.changed() {
             EXIT_INADEQUATE
