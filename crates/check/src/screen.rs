@@ -136,7 +136,7 @@ fn worst(report: &CheckReport, design: &Design, sigma: [f64; 3]) -> Option<(usiz
             (
                 j,
                 Rejected {
-                    pose: j + 1,
+                    pose: 0,
                     line: 0,
                     residual_sigma: z.sqrt(),
                     column,

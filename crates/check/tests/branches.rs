@@ -277,6 +277,27 @@ fn gross_readings_beyond_the_cap_are_not_set_aside() {
 }
 
 #[test]
+fn a_reading_nine_noise_deviations_off_is_set_aside() {
+    // 2.5 um on the scale at a stated 0.29 um: its deleted residual, against
+    // the scatter of the other poses (about 1), is far beyond the screen's
+    // criterion (24.7 for 20 poses); against a scatter that counted it too
+    // (about 4) it would not be.
+    let m = Machine::paper();
+    let mut data = campaign(&m, &[], 20, 9, 1.0);
+    data.poses[6].readings.s_mm += 0.0025;
+    data.poses[6].line = 77;
+    let r = run(&m, &data);
+    assert_eq!(r.rejected.len(), 1, "{:?}", r.rejected);
+    assert_eq!((r.rejected[0].pose, r.rejected[0].line), (7, 77));
+    assert!(
+        (r.rejected[0].residual - 3.0).abs() < 0.5,
+        "{:?}",
+        r.rejected
+    );
+    assert_eq!(r.verdict, CheckVerdict::Unchanged);
+}
+
+#[test]
 fn a_gross_reading_whose_pose_the_rest_needs_is_kept() {
     // Eight rows at four distinct poses: without the one pose that holds
     // the gross reading, three distinct poses are blind, so nothing is set
