@@ -46,7 +46,7 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 
 use crate::candidates::{Candidate, CandidateKind};
-use crate::check::{
+use crate::parts::{
     CandidateResult, ChiSquare, Impact, SHORTLIST_RATIO, SubFit, chi_square, fit_columns,
     unseen_limit,
 };

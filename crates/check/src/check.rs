@@ -38,20 +38,29 @@
 //! `chi2_1(0.95) = 3.84` of the best's explain the data as well and form the
 //! shortlist a check cannot separate. When the best leaves a misfit of its
 //! own (`T0 - dT_best` beyond its quantile), the change is reported as not
-//! explained by any single candidate.
+//! explained by any single candidate. A candidate must also stand out
+//! beyond the scatter the readings leave after it ([`crate::noise`]): tests
+//! that fire with none standing out are `noisier-than-stated`, not a change.
+//! [`check`] screens gross readings first ([`crate::screen`]).
 
 use nalgebra::{DMatrix, DVector, Vector3};
 use serde::Serialize;
 use tricept_data::Dataset;
 use tricept_engine::ReadingModel;
 use tricept_kinematics::{Machine, UpJoints};
-use tricept_model::{error_jacobian_at, position_error_jacobian};
+use tricept_model::error_jacobian_at;
 use tricept_numerics::linalg::{TriangularAccumulator, invert_upper, solve_upper};
-use tricept_numerics::stats::{chi2_isf, chi2_ln_sf, chi2_sf, required_noncentrality};
+use tricept_numerics::stats::{chi2_isf, required_noncentrality};
 
 use crate::candidates::{Candidate, CandidateKind, MAX_PARAMETERS, PoseTerms};
 use crate::changes::{Change, Problem, forward, named_first, unseen_growth};
+use crate::design::{Design, change_columns};
 use crate::error::CheckError;
+use crate::noise::{NoiseSeen, beyond_noise};
+use crate::parts::{
+    CandidateResult, ChiSquare, Impact, Rejected, SHORTLIST_RATIO, SubFit, chi_square, fit_columns,
+    unseen_limit,
+};
 use crate::reference::Reference;
 
 /// The default family-wise false-alarm probability.
@@ -59,11 +68,6 @@ pub const DEFAULT_ALPHA: f64 = 0.01;
 
 /// Power at which the detectable changes are stated.
 pub const DEFAULT_POWER: f64 = 0.95;
-
-/// Candidates whose p-value is within this factor of the best's explain
-/// the readings about as well (a likelihood ratio of 20, "strong evidence"
-/// on the usual scales, separates them).
-pub(crate) const SHORTLIST_RATIO: f64 = 20.0;
 
 /// A campaign that cannot detect a change of this size (mm) in any leg or
 /// joint sees nothing worth a check.
@@ -106,6 +110,9 @@ pub enum CheckVerdict {
     Changed,
     /// The machine changed, and no single candidate explains it all.
     ChangedUnexplained,
+    /// The readings scatter more than the stated noise, and no change
+    /// stands out beyond that scatter (`crate::noise`): not a change.
+    NoisierThanStated,
 }
 
 impl CheckVerdict {
@@ -115,64 +122,9 @@ impl CheckVerdict {
             CheckVerdict::Unchanged => "unchanged",
             CheckVerdict::Changed => "changed",
             CheckVerdict::ChangedUnexplained => "changed-unexplained",
+            CheckVerdict::NoisierThanStated => "noisier-than-stated",
         }
     }
-}
-
-/// A chi-square test: statistic, degrees of freedom, p-value and the
-/// critical value it was compared with.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct ChiSquare {
-    /// The statistic.
-    pub statistic: f64,
-    /// Degrees of freedom.
-    pub dof: usize,
-    /// `P(chi2_dof > statistic)`.
-    pub p_value: f64,
-    /// Its natural logarithm, finite where the p-value underflows: how
-    /// candidates with very strong evidence are ranked.
-    pub ln_p_value: f64,
-    /// The critical value of the test.
-    pub critical: f64,
-}
-
-/// What the check says of one candidate.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct CandidateResult {
-    /// `leg 1`, `base joint B2`, ...
-    pub name: String,
-    /// Its kind.
-    pub kind: CandidateKind,
-    /// Parameter names with their units.
-    pub parameters: Vec<String>,
-    /// How many of the parameters (the leading ones) the reported change
-    /// fits: a leg's length alone for a slip, its shapes too for a worn
-    /// segment.
-    pub fitted: usize,
-    /// Estimated change of each parameter (in its unit; 0 for a parameter
-    /// not fitted or a component the campaign does not see).
-    pub estimate: Vec<f64>,
-    /// Standard deviation of each (`None` for a component not seen).
-    pub std_dev: Vec<Option<f64>>,
-    /// The likelihood-ratio test of the change.
-    pub test: ChiSquare,
-    /// The test passed at the family-wise level.
-    pub significant: bool,
-    /// The change of each parameter alone that the check detects with the
-    /// stated power at the family-wise level (`None`: not seen).
-    pub detectable: Vec<Option<f64>>,
-    /// Each parameter fitted alone: its estimate and standard deviation
-    /// (what a history follows from check to check).
-    pub alone: Vec<Option<(f64, f64)>>,
-    /// The change of each parameter alone beyond which the check flags it
-    /// (its standard deviation alone times the family-wise critical value:
-    /// the band of a history's trend).
-    pub flagged_beyond: Vec<Option<f64>>,
-    /// Mean and largest platform error over the evaluation points that the
-    /// estimated change causes, um (0 for a sensor).
-    pub platform_mean_um: f64,
-    /// See `platform_mean_um`.
-    pub platform_max_um: f64,
 }
 
 /// The result of a check.
@@ -210,6 +162,11 @@ pub struct CheckReport {
     pub offsets_change: [f64; 3],
     /// The check campaign's mean structure temperature, °C, when logged.
     pub temperature_c: Option<f64>,
+    /// The noise the readings show against the stated one.
+    pub noise: NoiseSeen,
+    /// Poses set aside as gross readings (`crate::screen`); the verdict
+    /// comes from the rest.
+    pub rejected: Vec<Rejected>,
     /// What a person should know.
     pub warnings: Vec<String>,
 }
@@ -222,40 +179,12 @@ struct Rows {
     n_candidates: usize,
 }
 
-/// Checks `data` against `reference` (see the module docs).
-///
-/// # Example
-/// ```
-/// use tricept_check::{CheckOptions, CheckVerdict, Reference, check};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// use tricept_plant::{Campaign, Plant};
-/// let m = Machine::paper();
-/// let set = ParameterSet::paper15();
-/// // A perfectly known machine; a check of 20 random poses on it.
-/// let reference = Reference::new(m.clone(), set.clone(), nalgebra::DMatrix::zeros(15, 15), [0.0; 3], None).unwrap();
-/// let data = Plant::geometric(m.clone(), set.to_errors(&[0.0; 15]))
-///     .simulate(&Campaign::random(&m, 20, 1))
-///     .unwrap();
-/// let report = check(&reference, &data, &CheckOptions::for_machine(&m)).unwrap();
-/// assert_eq!(report.verdict, CheckVerdict::Unchanged);
-/// // Leg 2 slipped by 25 um: found, and named.
-/// let mut e = [0.0; 15];
-/// e[set.index_of("dq2").unwrap()] = 0.025;
-/// let data = Plant::geometric(m.clone(), set.to_errors(&e))
-///     .simulate(&Campaign::random(&m, 20, 2))
-///     .unwrap();
-/// let report = check(&reference, &data, &CheckOptions::for_machine(&m)).unwrap();
-/// assert_eq!(report.verdict, CheckVerdict::Changed);
-/// let best = &report.candidates[report.most_likely.unwrap()];
-/// assert_eq!(best.name, "leg 2");
-/// assert!((best.estimate[0] - 0.025).abs() < 5.0 * best.std_dev[0].unwrap());
-/// ```
-pub fn check(
+/// The check of every pose of `data` (no screen), with its whitened rows.
+pub(crate) fn evaluate(
     reference: &Reference,
     data: &Dataset,
     options: &CheckOptions,
-) -> Result<CheckReport, CheckError> {
+) -> Result<(CheckReport, Design), CheckError> {
     validate(data, options)?;
     let model = reference.model();
     let machine = reference.machine();
@@ -284,6 +213,10 @@ pub fn check(
         n_prior: prior.len(),
         n_candidates: m_total,
     };
+    let mut design = Design::new(
+        3 + prior.len() + m_total + 1,
+        prior.iter().map(|(l, _)| 1.0 / l.sqrt()).collect(),
+    );
     let predictor = model.at(&vec![0.0; k]);
     let set = model.parameter_set();
     let mut jac = vec![0.0; 3 * k];
@@ -329,6 +262,7 @@ pub fn check(
             }
             row[at] = w * (y[c] - g[c]);
             rows.acc.push_row(&row);
+            design.push(&row);
         }
     }
     // One pseudo-observation per determined direction: eta_t ~ N(0, lambda_t).
@@ -389,12 +323,14 @@ pub fn check(
             check_temp,
         ));
     }
-    let changed =
+    let fired =
         consistency.statistic > consistency.critical || results.iter().any(|c| c.significant);
+    beyond_noise(&mut results, t0, dof0, level);
+    let changed = results.iter().any(|c| c.significant);
     let best = results
         .iter()
         .enumerate()
-        .filter(|(_, c)| c.test.dof > 0)
+        .filter(|(_, c)| c.test.dof > 0 && (c.significant || !changed))
         .min_by(|a, b| {
             a.1.test
                 .ln_p_value
@@ -407,6 +343,7 @@ pub fn check(
         .collect();
     let best = best.map(|b| named_first(b, &rows));
     let (most_likely, shortlist, remaining, verdict) = match (changed, best) {
+        (false, _) if fired => (None, Vec::new(), None, CheckVerdict::NoisierThanStated),
         (false, _) => (None, Vec::new(), None, CheckVerdict::Unchanged),
         (true, Some(b)) if results[b].significant => {
             let top = results[b].test.statistic;
@@ -447,6 +384,18 @@ pub fn check(
     } else {
         (Vec::new(), None)
     };
+    // Several changes that together explain the readings explain them,
+    // though no single change does.
+    let verdict = match &after_changes {
+        Some(after)
+            if verdict == CheckVerdict::ChangedUnexplained
+                && changes.len() > 1
+                && after.statistic <= after.critical =>
+        {
+            CheckVerdict::Changed
+        }
+        _ => verdict,
+    };
     let o = reference.offsets();
     let mut warnings = Vec::new();
     let invisible: Vec<&str> = results
@@ -467,7 +416,14 @@ pub fn check(
         &impact,
         check_temp,
     ));
-    Ok(CheckReport {
+    let noise = NoiseSeen::of(
+        &design.fit(&change_columns(&results, most_likely)),
+        options.sigma,
+    );
+    if verdict == CheckVerdict::NoisierThanStated {
+        warnings.push(noise.warning());
+    }
+    let report = CheckReport {
         verdict,
         changed,
         alpha,
@@ -483,15 +439,11 @@ pub fn check(
         offsets_std_dev: offsets_sd,
         offsets_change: std::array::from_fn(|c| offsets[c] - o[c]),
         temperature_c: check_temp,
+        noise,
+        rejected: Vec::new(),
         warnings,
-    })
-}
-
-impl CandidateResult {
-    /// True when no component of the candidate is seen.
-    fn moves_nothing_seen(&self) -> bool {
-        self.detectable.iter().all(Option::is_none)
-    }
+    };
+    Ok((report, design))
 }
 
 /// The level of each candidate's test: Bonferroni over every test of the
@@ -511,83 +463,6 @@ pub fn family_level(alpha: f64, candidates: &[Candidate]) -> f64 {
         .map(|c| if c.is_nested() { c.len() } else { 1 })
         .sum();
     alpha / (2.0 * tests.max(1) as f64)
-}
-
-/// The test of a statistic at `tail`.
-pub(crate) fn chi_square(statistic: f64, dof: usize, tail: f64) -> ChiSquare {
-    let k = dof.max(1) as f64;
-    ChiSquare {
-        statistic,
-        dof,
-        p_value: if dof > 0 { chi2_sf(statistic, k) } else { 1.0 },
-        ln_p_value: if dof > 0 {
-            chi2_ln_sf(statistic, k)
-        } else {
-            0.0
-        },
-        critical: if dof > 0 {
-            chi2_isf(tail, k)
-        } else {
-            f64::INFINITY
-        },
-    }
-}
-
-/// The likelihood-ratio fit of the first `n` columns `idx[..n]` of a
-/// candidate: statistic, degrees of freedom, estimate and standard
-/// deviation of each of them (`None`: a direction the campaign does not
-/// see, dropped by the size of its eigenvalue rather than inverted).
-pub(crate) struct SubFit {
-    pub(crate) statistic: f64,
-    pub(crate) dof: usize,
-    pub(crate) estimate: Vec<f64>,
-    pub(crate) std_dev: Vec<Option<f64>>,
-}
-
-pub(crate) fn fit_columns(idx: &[usize], limits: &[f64], gram: &DMatrix<f64>, r: usize) -> SubFit {
-    let n = idx.len();
-    // Scaled to unit diagonal, so that the rank tolerance is relative.
-    let scale: Vec<f64> = idx.iter().map(|&i| gram[(i, i)].max(0.0).sqrt()).collect();
-    let top = scale.iter().copied().fold(0.0, f64::max);
-    // A parameter whose change the campaign sees, alone, no better than
-    // to its unseen limit (the manufacturing tolerance for a length) is
-    // not seen: fitting it would only pass its noise on to the others.
-    let kept: Vec<usize> = (0..n)
-        .filter(|&a| scale[a] > 0.0 && scale[a] > 1e-9 * top && 1.0 / scale[a] < limits[a])
-        .collect();
-    let mut fit = SubFit {
-        statistic: 0.0,
-        dof: 0,
-        estimate: vec![0.0; n],
-        std_dev: vec![None; n],
-    };
-    if kept.is_empty() {
-        return fit;
-    }
-    let q = kept.len();
-    let s = DMatrix::from_fn(q, q, |a, b| {
-        gram[(idx[kept[a]], idx[kept[b]])] / (scale[kept[a]] * scale[kept[b]])
-    });
-    let eig = s.symmetric_eigen();
-    let emax = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
-    let mut inv = DMatrix::zeros(q, q);
-    for e in 0..q {
-        let l = eig.eigenvalues[e];
-        if l > 1e-10 * emax {
-            let u = eig.eigenvectors.column(e);
-            inv += u * u.transpose() / l;
-            fit.dof += 1;
-        }
-    }
-    let gs = DVector::from_fn(q, |a, _| gram[(idx[kept[a]], r)] / scale[kept[a]]);
-    let x = &inv * &gs;
-    fit.statistic = gs.dot(&x);
-    for (a, &i) in kept.iter().enumerate() {
-        fit.estimate[i] = x[a] / scale[i];
-        let v = inv[(a, a)];
-        fit.std_dev[i] = (v > 0.0).then(|| v.sqrt() / scale[i]);
-    }
-    fit
 }
 
 /// The test, estimate and effects of one candidate, from the reduced Gram
@@ -665,59 +540,6 @@ fn assess(
         flagged_beyond,
         platform_mean_um,
         platform_max_um,
-    }
-}
-
-/// The standard deviation (in the parameter's unit) beyond which a
-/// candidate's parameter counts as not seen: the class-1 tolerance of
-/// 0.25 mm for a length, 1000 ppm for a gain or lead, 250 um for a leg's
-/// shape, 100 ppm/K for an expansion.
-pub(crate) fn unseen_limit(parameter: &str) -> f64 {
-    if parameter.ends_with("_mm") {
-        0.25
-    } else if parameter.ends_with("_um") {
-        250.0
-    } else if parameter.ends_with("_ppm_per_k") {
-        100.0
-    } else {
-        1000.0
-    }
-}
-
-/// The platform point's Jacobian at each evaluation target of the
-/// calibrated machine, with the commands that reach it.
-pub(crate) struct Impact {
-    at: Vec<(tricept_model::ErrorJacobian, Vector3<f64>, [f64; 3])>,
-}
-
-impl Impact {
-    fn new(machine: &Machine, points: &[Vector3<f64>]) -> Result<Impact, CheckError> {
-        let at = points
-            .iter()
-            .enumerate()
-            .map(|(j, r)| {
-                let e = |source| CheckError::Kinematics {
-                    pose: j + 1,
-                    line: 0,
-                    source,
-                };
-                let ik = machine.inverse(r).map_err(e)?;
-                let p21 = position_error_jacobian(&machine.legs_at(&ik.up)).map_err(e)?;
-                Ok((p21, *r, ik.legs_mm))
-            })
-            .collect::<Result<_, CheckError>>()?;
-        Ok(Impact { at })
-    }
-
-    /// Mean and largest platform error (um) of a change `value`.
-    pub(crate) fn of(&self, cand: &Candidate, value: &[f64], temp_c: Option<f64>) -> (f64, f64) {
-        let e: Vec<f64> = self
-            .at
-            .iter()
-            .map(|(p21, r, q)| cand.platform_error(p21, r, q, temp_c, value).norm() * 1e3)
-            .collect();
-        let mean = e.iter().sum::<f64>() / e.len().max(1) as f64;
-        (mean, e.iter().copied().fold(0.0, f64::max))
     }
 }
 

@@ -21,6 +21,10 @@
 //!   the readings, by a forward search;
 //! - [`history`] (`history.rs`): checks appended to a JSON-lines file, and
 //!   the trend of the key quantities against their bands;
+//! - `noise.rs`: noise is not a change (a candidate must stand out beyond
+//!   the scatter the readings show; the `noisier-than-stated` verdict);
+//! - `screen.rs`: gross readings set aside by their line, the verdict from
+//!   the rest (`design.rs` keeps the whitened rows both need);
 //! - `report.rs`: the report as text.
 //!
 //! What a check cannot see: the head (it moves none of the UP limb's
@@ -53,16 +57,22 @@
 mod candidates;
 mod changes;
 mod check;
+mod design;
 mod error;
 pub mod history;
+mod noise;
+mod parts;
 mod reference;
 mod report;
+mod screen;
 
 pub use candidates::{Candidate, CandidateKind};
 pub use changes::Change;
 pub use check::{
-    CandidateResult, CheckOptions, CheckReport, CheckVerdict, ChiSquare, DEFAULT_ALPHA,
-    DEFAULT_POWER, check, family_level, leg_ranges,
+    CheckOptions, CheckReport, CheckVerdict, DEFAULT_ALPHA, DEFAULT_POWER, family_level, leg_ranges,
 };
 pub use error::CheckError;
+pub use noise::{ChannelNoise, NoiseSeen};
+pub use parts::{CandidateResult, ChiSquare, Rejected};
 pub use reference::Reference;
+pub use screen::{MAX_SET_ASIDE_SHARE, SCREEN_ALPHA, check};

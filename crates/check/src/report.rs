@@ -6,7 +6,8 @@ use std::fmt::Write as _;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 
 use crate::changes::Change;
-use crate::check::{CandidateResult, CheckReport, CheckVerdict};
+use crate::check::{CheckReport, CheckVerdict};
+use crate::parts::CandidateResult;
 
 /// A parameter's value in the unit a person reads: um for a length
 /// (parameters ending in `_mm`), the parameter's own unit otherwise.
@@ -60,6 +61,13 @@ impl CheckReport {
                     s,
                     "verdict: UNCHANGED: the readings are consistent with the calibrated machine (false-alarm probability {})",
                     self.alpha
+                );
+            }
+            (CheckVerdict::NoisierThanStated, _) => {
+                let _ = writeln!(
+                    s,
+                    "verdict: NOISIER THAN STATED: the readings scatter {:.2} times the stated noise and no change stands out beyond it (state the noise or service the sensors; false-alarm probability {})",
+                    self.noise.factor, self.alpha
                 );
             }
             (v, Some(b)) => {
@@ -125,6 +133,18 @@ impl CheckReport {
                 r.statistic, r.dof, r.p_value
             );
         }
+        let (n, t) = (&self.noise.seen, &self.noise.stated);
+        let _ = writeln!(
+            s,
+            "noise seen: {:.2} x the stated (per logged reading: phi {:.2} arcsec, theta {:.2} arcsec, s {:.2} um; stated {:.2}, {:.2}, {:.2})",
+            self.noise.factor,
+            n.phi_arcsec,
+            n.theta_arcsec,
+            n.s_um,
+            t.phi_arcsec,
+            t.theta_arcsec,
+            t.s_um
+        );
         let a = RAD_PER_ARCSEC;
         let d = self.offsets_change;
         let _ = writeln!(

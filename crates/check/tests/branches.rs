@@ -122,15 +122,14 @@ fn one_slipped_leg_is_changed_and_explained() {
 }
 
 #[test]
-fn two_changes_are_changed_but_unexplained() {
+fn two_changes_no_single_one_explains_are_one_set() {
     let m = Machine::paper();
     // Two legs slipped by 50 um in opposite directions: no single
-    // candidate holds both.
+    // candidate holds both, the set of the two does (issue 31).
     let data = campaign(&m, &[("dq1", 0.05), ("dq3", -0.05)], 20, 4, 1.0);
     let r = run(&m, &data);
     assert!(r.changed);
-    assert_eq!(r.verdict, CheckVerdict::ChangedUnexplained);
-    assert_eq!(r.verdict.as_str(), "changed-unexplained");
+    assert_eq!(r.verdict, CheckVerdict::Changed);
     let best = &r.candidates[r.most_likely.unwrap()];
     assert!(
         best.name == "leg 1" || best.name == "leg 3",
@@ -142,9 +141,46 @@ fn two_changes_are_changed_but_unexplained() {
     assert!((rest.statistic - (r.consistency.statistic - best.test.statistic)).abs() < 1e-6);
     assert_test(&rest, 0.005, "remaining");
     assert!(rest.statistic > rest.critical);
+    let mut named: Vec<&str> = r.changes.iter().map(|c| c.name.as_str()).collect();
+    named.sort_unstable();
+    assert_eq!(named, ["leg 1", "leg 3"]);
+    let after = r.after_changes.unwrap();
+    assert_test(&after, 0.005, "after the changes");
+    assert!(after.statistic <= after.critical);
+    let text = r.to_text();
+    assert!(text.starts_with("verdict: CHANGED"), "{text}");
+    assert!(!text.contains("no single change explains"), "{text}");
+}
+
+#[test]
+fn a_change_no_candidate_holds_is_changed_unexplained() {
+    let m = Machine::paper();
+    // The scale reads 30 um too long over the upper half of its travel (a
+    // damaged scale: no candidate is a step of the scale), and leg 2
+    // slipped 50 um, which the candidates hold.
+    let mut data = campaign(&m, &[("dq2", 0.05)], 20, 6, 1.0);
+    let mut s: Vec<f64> = data.poses.iter().map(|p| p.readings.s_mm).collect();
+    s.sort_by(f64::total_cmp);
+    let median = s[s.len() / 2];
+    for p in &mut data.poses {
+        if p.readings.s_mm > median {
+            p.readings.s_mm += 0.03;
+        }
+    }
+    let r = run(&m, &data);
+    assert!(r.changed);
+    assert_eq!(
+        r.verdict,
+        CheckVerdict::ChangedUnexplained,
+        "{}",
+        r.to_text()
+    );
+    assert_eq!(r.verdict.as_str(), "changed-unexplained");
+    let rest = r.remaining.unwrap();
+    assert!(rest.statistic > rest.critical);
     let text = r.to_text();
     assert!(
-        text.starts_with("verdict: CHANGED, and no single change explains it all: most likely leg"),
+        text.starts_with("verdict: CHANGED, and no single change explains it all: most likely"),
         "{text}"
     );
     assert!(text.contains(&format!(
@@ -154,35 +190,173 @@ fn two_changes_are_changed_but_unexplained() {
 }
 
 #[test]
-fn more_noise_than_stated_is_a_change_of_unknown_cause() {
+fn more_noise_than_stated_is_noisier_than_stated_not_a_change() {
     // The readings' noise 1.25 times the stated one over 100 poses: the
     // consistency statistic is 1.56 chi2(297), beyond its 0.5 % point (about
-    // 366) with probability 0.995, while each candidate's 1.56 chi2(k) passes
-    // its Bonferroni level with probability under 0.008: no candidate
-    // explains it in about nine checks out of ten.
+    // 366) with probability 0.995, and a candidate's 1.56 chi2(k) may pass
+    // its Bonferroni level, but none stands out beyond the scatter the
+    // readings show (issue 31: the F test of crate::noise): noisier than
+    // stated, not a change. (Before issue 31 this was "changed, cause
+    // unknown".)
     let m = Machine::paper();
-    let mut unknown = 0;
     for seed in 0..5 {
         let r = run(&m, &campaign(&m, &[], 100, 30 + seed, 1.25));
         assert_eq!(r.consistency.dof, 297);
-        assert!(r.changed, "seed {seed}");
         assert!(
             r.consistency.statistic > r.consistency.critical,
             "seed {seed}"
         );
-        if r.candidates.iter().all(|c| !c.significant) {
-            unknown += 1;
-            assert_eq!(r.verdict, CheckVerdict::ChangedUnexplained, "seed {seed}");
-            assert!(r.most_likely.is_none() && r.remaining.is_none());
-            assert!(r.shortlist.is_empty());
-            let text = r.to_text();
-            assert!(
-                text.starts_with("verdict: CHANGED, cause unknown"),
-                "{text}"
-            );
+        assert!(!r.changed, "seed {seed}");
+        assert_eq!(r.verdict, CheckVerdict::NoisierThanStated, "seed {seed}");
+        assert_eq!(r.verdict.as_str(), "noisier-than-stated");
+        assert!(r.most_likely.is_none() && r.remaining.is_none());
+        assert!(r.shortlist.is_empty());
+        assert!(r.candidates.iter().all(|c| !c.significant));
+        // The noise it sees: 1.25 times the stated (the factor from 297
+        // degrees of freedom, sd 3 %; each channel from 99, sd 7 %).
+        assert!((r.noise.factor - 1.25).abs() < 0.12, "{:?}", r.noise);
+        let n = &r.noise;
+        for (seen, stated) in [
+            (n.seen.phi_arcsec, n.stated.phi_arcsec),
+            (n.seen.theta_arcsec, n.stated.theta_arcsec),
+            (n.seen.s_um, n.stated.s_um),
+        ] {
+            assert!((seen / stated - 1.25).abs() < 0.3, "{n:?}");
         }
+        assert!((n.stated.phi_arcsec - 0.8 / 3f64.sqrt()).abs() < 1e-9);
+        assert!((n.stated.s_um - 0.5 / 3f64.sqrt()).abs() < 1e-9);
+        let text = r.to_text();
+        assert!(
+            text.starts_with(&format!(
+                "verdict: NOISIER THAN STATED: the readings scatter {:.2} times the stated noise",
+                n.factor
+            )),
+            "{text}"
+        );
+        assert!(text.contains("noise seen: "), "{text}");
+        assert_eq!(r.warnings.len(), 1, "{:?}", r.warnings);
+        assert!(
+            r.warnings[0]
+                .contains("state the sensors' noise (`--angle-noise-arcsec`, `--length-noise-um`"),
+            "{:?}",
+            r.warnings
+        );
     }
-    assert!(unknown >= 3, "{unknown} of 5");
+}
+
+#[test]
+fn a_change_stands_out_beyond_a_larger_noise() {
+    // Leg 2 slipped by 40 um and the noise 1.5 times the stated: the slip
+    // stands out beyond the scatter it leaves (F test), the verdict names it,
+    // and the noise seen is that scatter, not the slip.
+    let m = Machine::paper();
+    let r = run(&m, &campaign(&m, &[("dq2", 0.04)], 20, 2, 1.5));
+    assert!(r.changed);
+    let best = &r.candidates[r.most_likely.unwrap()];
+    assert_eq!(best.name, "leg 2");
+    assert!(best.significant);
+    assert!((r.noise.factor - 1.5).abs() < 0.45, "{:?}", r.noise);
+    // The same campaign without the slip: noisier than stated.
+    let r = run(&m, &campaign(&m, &[], 20, 2, 1.5));
+    assert_eq!(r.verdict, CheckVerdict::NoisierThanStated);
+}
+
+#[test]
+fn the_noise_seen_at_the_stated_noise_is_about_one() {
+    let m = Machine::paper();
+    let r = run(&m, &campaign(&m, &[], 100, 12, 1.0));
+    assert_eq!(r.verdict, CheckVerdict::Unchanged);
+    assert!((r.noise.factor - 1.0).abs() < 0.1, "{:?}", r.noise);
+    assert!(r.rejected.is_empty() && r.warnings.is_empty());
+    // Without noise the readings scatter not at all.
+    let r = run(&m, &campaign(&m, &[], 20, 12, 0.0));
+    assert!(
+        r.noise.factor < 1e-3 && r.noise.seen.s_um < 1e-3,
+        "{:?}",
+        r.noise
+    );
+}
+
+#[test]
+fn gross_readings_beyond_the_cap_are_not_set_aside() {
+    // 20 poses: at most 2 set aside. Three gross readings are not a matter
+    // of gross readings: none is set aside, and the check of every pose is
+    // reported with a warning.
+    let m = Machine::paper();
+    let clean = campaign(&m, &[], 20, 8, 1.0);
+    let mut data = clean.clone();
+    for (j, p) in data.poses.iter_mut().enumerate() {
+        p.line = j as u64 + 2;
+    }
+    data.poses[3].readings.s_mm += 0.025;
+    data.poses[9].readings.s_mm += 0.025;
+    let r = run(&m, &data);
+    assert_eq!(
+        r.rejected.iter().map(|x| x.line).collect::<Vec<_>>(),
+        vec![5, 11],
+        "{:?}",
+        r.rejected
+    );
+    assert_eq!(r.poses, 18);
+    assert!(!r.changed);
+    data.poses[15].readings.theta_rad += 0.0002;
+    let r = run(&m, &data);
+    assert!(r.rejected.is_empty(), "{:?}", r.rejected);
+    assert_eq!(r.poses, 20);
+    assert!(
+        r.warnings
+            .iter()
+            .any(|w| w == "more than 2 of the 20 poses stand out from the rest: not a matter of gross readings, so none is set aside"),
+        "{:?}",
+        r.warnings
+    );
+}
+
+#[test]
+fn a_reading_nine_noise_deviations_off_is_set_aside() {
+    // 2.5 um on the scale at a stated 0.29 um: its deleted residual, against
+    // the scatter of the other poses (about 1), is far beyond the screen's
+    // criterion (24.7 for 20 poses); against a scatter that counted it too
+    // (about 4) it would not be.
+    let m = Machine::paper();
+    let mut data = campaign(&m, &[], 20, 9, 1.0);
+    data.poses[6].readings.s_mm += 0.0025;
+    data.poses[6].line = 77;
+    let r = run(&m, &data);
+    assert_eq!(r.rejected.len(), 1, "{:?}", r.rejected);
+    assert_eq!((r.rejected[0].pose, r.rejected[0].line), (7, 77));
+    assert!(
+        (r.rejected[0].residual - 3.0).abs() < 0.5,
+        "{:?}",
+        r.rejected
+    );
+    assert_eq!(r.verdict, CheckVerdict::Unchanged);
+}
+
+#[test]
+fn a_gross_reading_whose_pose_the_rest_needs_is_kept() {
+    // Eight rows at four distinct poses: without the one pose that holds
+    // the gross reading, three distinct poses are blind, so nothing is set
+    // aside and the verdict is that of every pose.
+    let m = Machine::paper();
+    let t = m.workspace.random_poses(4, 11);
+    let targets = [0, 1, 2, 3, 0, 1, 2, 0].map(|i| t[i]).to_vec();
+    let data = Plant::geometric(m.clone(), ParameterSet::paper15().to_errors(&[0.0; 15]))
+        .simulate(&Campaign::from_targets(&m, targets, 3))
+        .unwrap();
+    let mut bad = data.clone();
+    bad.poses[3].readings.s_mm += 0.025;
+    let r = run(&m, &bad);
+    assert!(r.rejected.is_empty(), "{:?}", r.rejected);
+    assert_eq!(r.poses, 8);
+    assert!(r.consistency.statistic > r.consistency.critical);
+    // The same reading at a pose that is repeated is set aside.
+    let mut bad = data;
+    bad.poses[0].readings.s_mm += 0.025;
+    let r = run(&m, &bad);
+    assert_eq!(r.rejected.len(), 1, "{:?}", r.rejected);
+    assert_eq!(r.rejected[0].pose, 1);
+    assert_eq!(r.rejected[0].column, "s");
 }
 
 #[test]

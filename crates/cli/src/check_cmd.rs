@@ -55,6 +55,9 @@ pub fn run(a: &CheckArgs) -> Result<u8, CliError> {
     } else {
         crate::output::write_text(&result.to_text());
     }
+    for w in result.warnings() {
+        errln!("check: warning: {w}");
+    }
     if let Some(why) = result.exit_reason() {
         errln!("{why}");
     }

@@ -3,15 +3,18 @@
 //! tested against the calibrated machine file (`tricept_check`), with an
 //! optional history (JSON lines, appended) and its trends.
 //!
-//! The verdict's exit code: 0 unchanged, 3 changed; a machine file without
-//! a calibration record and a campaign that cannot see a change are input
-//! errors (exit code 2).
+//! The verdict's exit code: 0 unchanged, 3 changed; 0 too for readings
+//! noisier than stated with no change standing out beyond that noise, and
+//! for a campaign whose gross readings were set aside and whose other poses
+//! are unchanged, each with a warning ([`CheckResult::warnings`]); a machine
+//! file without a calibration record and a campaign that cannot see a
+//! change are input errors (exit code 2).
 
 use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
 use tricept_check::history::{Entry, Trend, append, trends};
-use tricept_check::{CheckError, CheckOptions, CheckReport, Reference};
+use tricept_check::{CheckError, CheckOptions, CheckReport, CheckVerdict, Reference};
 
 use crate::data_input::DataInput;
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
@@ -72,6 +75,7 @@ pub struct CheckResult {
     machine: String,
     data: String,
     history: Option<History>,
+    readings_per_pose: u32,
 }
 
 /// Runs the check: the reference from the machine's calibration record,
@@ -116,6 +120,7 @@ pub fn check(request: CheckRequest) -> Result<CheckResult, Error> {
         machine,
         data: data_name,
         history,
+        readings_per_pose: loaded.machine().sensors.readings_per_pose.max(1),
     })
 }
 
@@ -151,7 +156,8 @@ impl CheckResult {
         self.report.changed
     }
 
-    /// 0 unchanged, 3 changed.
+    /// 0 unchanged (also noisier than stated, and after gross readings
+    /// were set aside: [`CheckResult::warnings`] says so), 3 changed.
     pub fn exit_code(&self) -> u8 {
         if self.changed() {
             EXIT_INADEQUATE
@@ -185,6 +191,38 @@ impl CheckResult {
             "check: exit {EXIT_INADEQUATE}: the machine changed since its calibration ({}): {what}",
             self.data
         ))
+    }
+
+    /// What a person should know although the exit code is 0 or 3, one
+    /// line each (the CLI prints them on stderr): readings noisier than
+    /// stated, with the noise to state (per reading, as the
+    /// `--angle-noise-arcsec` and `--length-noise-um` flags and the machine
+    /// file's `sensors` take it), and each gross reading set aside, by its
+    /// line.
+    pub fn warnings(&self) -> Vec<String> {
+        let r = &self.report;
+        let mut out = Vec::new();
+        if r.verdict == CheckVerdict::NoisierThanStated {
+            let per_reading = f64::from(self.readings_per_pose).sqrt();
+            let n = &r.noise.seen;
+            out.push(format!(
+                "{}: the readings are noisier than stated ({:.2} times; per logged reading phi {:.2} arcsec, theta {:.2} arcsec, s {:.2} um) and no change stands out beyond that noise: not a change of the machine; state the noise (--angle-noise-arcsec {:.2} --length-noise-um {:.2}) or service the sensors",
+                self.data,
+                r.noise.factor,
+                n.phi_arcsec,
+                n.theta_arcsec,
+                n.s_um,
+                n.phi_arcsec.max(n.theta_arcsec) * per_reading,
+                n.s_um * per_reading
+            ));
+        }
+        for x in &r.rejected {
+            out.push(format!(
+                "{}: a gross reading set aside: line {} (pose {}), {} off by {:+.1} {}; the verdict comes from the other {} poses",
+                self.data, x.line, x.pose, x.column, x.residual, x.unit, r.poses
+            ));
+        }
+        out
     }
 
     /// The trends of the history's key quantities (empty without history).

@@ -1,8 +1,8 @@
 //! The CI-sized rates: 10 campaigns per scenario and pose count on 4
 //! machines from the independent generator, held to what issue 31 asks of
-//! the check. The tests marked `ignore` state what the check does not do
-//! yet (issue 31 items 1-4: noise, bad readings, sets of changes,
-//! temperature); the harness reads their results unchanged once it does.
+//! the check. The test marked `ignore` states what the check does not do
+//! yet: name two slipped legs in 9 of 10 campaigns (a slipped leg is often
+//! named as its own platform joint).
 
 use std::sync::OnceLock;
 
@@ -105,7 +105,6 @@ fn warm_legs_with_a_precise_temperature_log_are_named_thermal_growth() {
 }
 
 #[test]
-#[ignore = "needs issue 31 items 1-4"]
 fn noisier_sensors_are_not_a_change() {
     for k in POSES {
         let t = tally("nothing changed, 1.5x noise", k);
@@ -119,7 +118,6 @@ fn noisier_sensors_are_not_a_change() {
 }
 
 #[test]
-#[ignore = "needs issue 31 items 1-4"]
 fn a_bad_reading_is_set_aside() {
     for k in POSES {
         for name in [
@@ -137,14 +135,13 @@ fn a_bad_reading_is_set_aside() {
 }
 
 #[test]
-#[ignore = "needs issue 31 items 1-4"]
+#[ignore = "not met yet: a slipped leg is named as its own platform joint in about half the campaigns (docs/check.md, Measured rates)"]
 fn two_slipped_legs_are_both_named() {
     let t = tally("two legs slipped +25, -25 um", 20);
     assert!(at_least(t.right, 0.9), "{t:?}");
 }
 
 #[test]
-#[ignore = "needs issue 31 items 1-4"]
 fn a_warm_machine_is_named_thermal_growth() {
     for name in [
         "legs 4 K warmer, log 0.3 K jitter",

@@ -49,6 +49,12 @@ pub fn mean_temperature(data: &Dataset) -> Option<f64> {
 /// The check campaign of `plant`: 20 random poses, the sensors
 /// re-referenced (offsets moved by up to 0.01 rad and 5 mm), at `temp_c`.
 pub fn check_campaign(plant: &Plant, seed: u64, temp_c: f64) -> Dataset {
+    noisy_campaign(plant, seed, temp_c, 1.0)
+}
+
+/// [`check_campaign`] with the sensors' true noise `noise` times the
+/// stated one.
+pub fn noisy_campaign(plant: &Plant, seed: u64, temp_c: f64, noise: f64) -> Dataset {
     let mut plant = plant.clone();
     let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0xc4ec);
     let jump = [0.01, 0.01, 5.0];
@@ -57,6 +63,7 @@ pub fn check_campaign(plant: &Plant, seed: u64, temp_c: f64) -> Dataset {
     });
     let mut campaign = Campaign::random(&plant.nominal, CHECK_POSES, seed + 1000);
     campaign.start_temp_c = temp_c;
+    campaign.noise_factor = noise;
     plant.simulate(&campaign).unwrap()
 }
 

@@ -278,3 +278,99 @@ fn two_slipped_legs_are_both_in_the_changes_of_the_json() {
     assert!(text.contains("changes (the smallest set"), "{text}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn noisier_sensors_and_a_bad_reading_exit_0_with_a_warning() {
+    // Issue 31: sensors 1.5 times noisier than stated are not a change
+    // (verdict noisier-than-stated, exit 0, the noise to state on stderr);
+    // one reading 25 um off is set aside by its line (exit 0).
+    let dir = fresh_workdir("check-cli-noise");
+    let d = dir.as_path();
+    calibrated_machine(d);
+    let simulate = |extra: &[&str], out: &str| {
+        let mut args = vec![
+            "simulate",
+            "--truth",
+            "random:0.25,5",
+            "--poses",
+            "random:20,9",
+            "--seed",
+            "4",
+            "--out",
+            out,
+        ];
+        args.extend_from_slice(extra);
+        let o = tricept(d, &args);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    };
+    simulate(&["--noise-factor", "1.5"], "noisy.csv");
+    let check = |extra: &[&str], data: &str| {
+        let mut args = vec!["check", "--machine", "cal.json", "--data", data, "--json"];
+        args.extend_from_slice(extra);
+        let out = tricept(d, &args);
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (out.status.code(), stderr(&out), v)
+    };
+    let (code, err, v) = check(&[], "noisy.csv");
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(v["verdict"], "noisier-than-stated", "{v}");
+    assert_eq!(v["changed"], false);
+    let factor = v["noise"]["factor"].as_f64().unwrap();
+    assert!((factor - 1.5).abs() < 0.4, "{factor}");
+    // The stated noise per logged reading: 0.8 arcsec and 0.5 um, mean of 3.
+    let stated = v["noise"]["stated"]["s_um"].as_f64().unwrap();
+    assert!((stated - 0.5 / 3f64.sqrt()).abs() < 1e-9, "{stated}");
+    let line = err
+        .lines()
+        .find(|l| l.starts_with("check: warning: noisy.csv: the readings are noisier than stated"))
+        .unwrap_or_else(|| panic!("{err}"));
+    assert!(
+        line.contains("state the noise (--angle-noise-arcsec "),
+        "{line}"
+    );
+    assert!(line.ends_with("or service the sensors"), "{line}");
+    // Stating the noise the sensors have: unchanged, no warning.
+    let (code, err, v) = check(
+        &["--angle-noise-arcsec", "1.2", "--length-noise-um", "0.75"],
+        "noisy.csv",
+    );
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(v["verdict"], "unchanged", "{v}");
+    assert!(!err.contains("warning"), "{err}");
+    // One bad reading: the scale 25 um off at the 9th pose.
+    simulate(&[], "day1.csv");
+    let csv = std::fs::read_to_string(dir.join("day1.csv")).unwrap();
+    let header = csv.lines().position(|l| l.starts_with("q1,")).unwrap();
+    let pose = 9;
+    let bad_line = header + pose; // 0-based index of the pose's row
+    let edited: Vec<String> = csv
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i != bad_line {
+                return l.to_string();
+            }
+            let mut f: Vec<String> = l.split(',').map(str::to_string).collect();
+            f[5] = format!("{}", f[5].parse::<f64>().unwrap() + 0.025);
+            f.join(",")
+        })
+        .collect();
+    std::fs::write(dir.join("bad.csv"), edited.join("\n") + "\n").unwrap();
+    let (code, err, v) = check(&[], "bad.csv");
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(v["verdict"], "unchanged", "{v}");
+    let file_line = bad_line as u64 + 1;
+    assert_eq!(v["rejected"].as_array().unwrap().len(), 1, "{v}");
+    assert_eq!(v["rejected"][0]["line"], file_line, "{v}");
+    assert_eq!(v["rejected"][0]["pose"], pose, "{v}");
+    assert_eq!(v["rejected"][0]["column"], "s", "{v}");
+    let off = v["rejected"][0]["residual"].as_f64().unwrap();
+    assert!((off - 25.0).abs() < 2.5, "{off}");
+    assert!(
+        err.contains(&format!(
+            "check: warning: bad.csv: a gross reading set aside: line {file_line} (pose {pose}), s off by +"
+        )),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
