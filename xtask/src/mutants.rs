@@ -50,7 +50,15 @@ const TARGETS: &[Target] = &[
     },
     Target {
         name: "check",
-        files: &["crates/check/src/check.rs", "crates/check/src/report.rs"],
+        files: &[
+            "crates/check/src/check.rs",
+            "crates/check/src/parts.rs",
+            "crates/check/src/changes.rs",
+            "crates/check/src/noise.rs",
+            "crates/check/src/screen.rs",
+            "crates/check/src/design.rs",
+            "crates/check/src/report.rs",
+        ],
         package: "tricept-check",
         tests: &["tricept-check"],
     },

@@ -1,7 +1,6 @@
 //! What the check's campaign tests share: a true machine calibrated from
 //! 80 random poses, a check campaign of 20 random poses with freshly
 //! re-referenced sensors, the check at its defaults.
-#![allow(dead_code)]
 
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};

@@ -8,12 +8,10 @@
 //! of what was hidden, its size, and its effect on the platform from the
 //! plant's own forward kinematics (`Plant::reach`), not from the check's
 //! linear model.
-//! `cargo test -p tricept-check --test sets -- --nocapture` prints the
+//! `cargo test -p tricept-check --test check sets:: -- --nocapture` prints the
 //! TALLY lines quoted in docs/check.md.
 
-mod common;
-
-use common::{CALIBRATION_C, calibrated, check_campaign, run};
+use crate::common::{CALIBRATION_C, calibrated, check_campaign, run};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use rand_pcg::Pcg64Mcg;

@@ -6,13 +6,11 @@
 //! it with 20 random poses and freshly re-referenced sensors (a power cycle
 //! between the calibration and the check): unchanged, or with one change
 //! hidden in the plant. Every expectation comes from the plant's inputs.
-//! `cargo test -p tricept-check --test changes -- --nocapture` prints the
+//! `cargo test -p tricept-check --test check changes:: -- --nocapture` prints the
 //! TALLY lines quoted in docs/check.md. The last tests (issue 31) make the
 //! sensors noisier than stated and add a gross reading.
 
-mod common;
-
-use common::{
+use crate::common::{
     CALIBRATION_C, CHECK_POSES, calibrated, check_campaign, direction, most_likely, noisy_campaign,
     run,
 };
