@@ -232,8 +232,8 @@ pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, Error> {
     read_data_from(std::io::BufReader::new(f), &file, machine)
 }
 
-/// [`read_data`] from a reader (a file wrapped in a progress display, say);
-/// `file` names it in messages.
+/// The measured data (docs/data-format.md) read from a reader (a file
+/// wrapped in a progress display, say); `file` names it in messages.
 pub fn read_data_from(
     reader: impl BufRead,
     file: &str,
@@ -503,7 +503,7 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
     Ok(out)
 }
 
-/// `count` comma-separated finite numbers within ±[`limits::MAX_COORDINATE`]
+/// `count` comma-separated finite numbers within ±1e5
 /// (mm, deg or rad), or an input error naming `flag`.
 ///
 /// # Example
