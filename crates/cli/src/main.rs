@@ -313,7 +313,7 @@ fn run(cli: Cli) -> Result<u8, CliError> {
 }
 
 /// The one-line message of a flag value refused by one of the door's
-/// parsers (`tricept_ident::Triple`, `TrackerTargetSpec`, ...): the flag,
+/// parsers (`tricept_ident::advanced::Triple`, `TrackerTargetSpec`, ...): the flag,
 /// then the door's message (unless it names the flag already). `None` for
 /// every other clap error, which clap prints itself.
 fn value_error(e: &clap::Error) -> Option<String> {

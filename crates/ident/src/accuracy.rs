@@ -58,7 +58,7 @@ pub(crate) const TOOL_TIP: &str = "tool tip";
 ///
 /// # Example
 /// ```
-/// use tricept_ident::Accuracy;
+/// use tricept_ident::advanced::Accuracy;
 /// let a = Accuracy::combine("platform", &[(0.003, 0.004), (0.004, 0.006)], Default::default());
 /// assert!((a.rms_mm - 0.005).abs() < 1e-12);
 /// assert!(a.upper_mm >= a.rms_mm);

@@ -1,6 +1,6 @@
 //! One exit code per library error, whichever verb meets it (issue 27):
 //! the mapping from an error's kind to the exit code lives in the door
-//! (`tricept_ident::Classify`), so data too small to fit, a pose line the
+//! (`tricept_ident::advanced::Classify`), so data too small to fit, a pose line the
 //! machine cannot take and an invalid option exit alike from `identify`
 //! (alone and fused), `identifiability`, `compensate`, `diagnose` and
 //! `plan`.
