@@ -3,7 +3,7 @@
 //! (exit 3, named), against a file without a record or with a campaign that
 //! sees nothing (exit 2), and its history and trend plots.
 
-use crate::support::{calibrated_machine, fresh_workdir, run_in as tricept, stderr, truth_of};
+use crate::support::{calibrated_machine, fresh_workdir, moved_truth, run_in as tricept, stderr};
 
 #[test]
 fn a_calibrated_machine_is_checked_from_its_own_sensors() {
@@ -45,15 +45,7 @@ fn a_calibrated_machine_is_checked_from_its_own_sensors() {
         "{text}"
     );
     // Leg 2 slipped by 25 um: the truth of the calibration plus the slip.
-    let csv = std::fs::read_to_string(dir.join("cal.csv")).unwrap();
-    let mut truth = truth_of(&csv);
-    let dq2 = truth["dq2"].as_f64().unwrap();
-    truth.insert("dq2".into(), (dq2 + 0.025).into());
-    std::fs::write(
-        dir.join("slipped.json"),
-        serde_json::to_string(&truth).unwrap(),
-    )
-    .unwrap();
+    moved_truth(d, &[("dq2", 0.025)], "slipped.json");
     ok(&[
         "simulate",
         "--truth",
@@ -224,13 +216,7 @@ fn two_slipped_legs_are_both_in_the_changes_of_the_json() {
     let d = dir.as_path();
     calibrated_machine(d);
     // Leg 1 25 um longer and leg 3 25 um shorter than at the calibration.
-    let csv = std::fs::read_to_string(dir.join("cal.csv")).unwrap();
-    let mut truth = truth_of(&csv);
-    for (leg, by) in [("dq1", 0.025), ("dq3", -0.025)] {
-        let v = truth[leg].as_f64().unwrap();
-        truth.insert(leg.into(), (v + by).into());
-    }
-    std::fs::write(d.join("two.json"), serde_json::to_string(&truth).unwrap()).unwrap();
+    moved_truth(d, &[("dq1", 0.025), ("dq3", -0.025)], "two.json");
     let simulate = [
         "simulate",
         "--truth",

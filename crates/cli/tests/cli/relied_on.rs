@@ -11,7 +11,7 @@
 
 use std::process::Command;
 
-use crate::support::{calibrated_machine, fresh_workdir, ok, run_in as tricept, truth_of};
+use crate::support::{calibrated_machine, fresh_workdir, moved_truth, ok, run_in as tricept};
 
 /// A work directory of this module's test `name`, emptied first.
 fn workdir(name: &str) -> std::path::PathBuf {
@@ -24,15 +24,7 @@ fn an_edited_judged_field_is_refused_by_name_and_cannot_hide_a_slip() {
     let d = dir.as_path();
     calibrated_machine(d);
     // The day's campaign: leg 2 slipped by 20 um.
-    let csv = std::fs::read_to_string(dir.join("cal.csv")).unwrap();
-    let mut truth = truth_of(&csv);
-    let dq2 = truth["dq2"].as_f64().unwrap();
-    truth.insert("dq2".into(), (dq2 + 0.020).into());
-    std::fs::write(
-        dir.join("slipped.json"),
-        serde_json::to_string(&truth).unwrap(),
-    )
-    .unwrap();
+    moved_truth(d, &[("dq2", 0.020)], "slipped.json");
     ok(
         d,
         &[

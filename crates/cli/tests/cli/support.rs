@@ -75,6 +75,19 @@ pub fn truth_of(csv: &str) -> serde_json::Map<String, serde_json::Value> {
     serde_json::from_str(&line[line.find('{').unwrap()..]).unwrap()
 }
 
+/// Writes `dir/out`: the true errors of the calibration campaign in `dir`
+/// (`cal.csv`, [`calibrated_machine`]) with each `(parameter, mm)` of
+/// `moves` added, for `simulate --truth out`: the machine after a change.
+pub fn moved_truth(dir: &Path, moves: &[(&str, f64)], out: &str) {
+    let csv = std::fs::read_to_string(dir.join("cal.csv")).unwrap();
+    let mut truth = truth_of(&csv);
+    for (name, by) in moves {
+        let v = truth[*name].as_f64().unwrap();
+        truth.insert((*name).into(), (v + by).into());
+    }
+    std::fs::write(dir.join(out), serde_json::to_string(&truth).unwrap()).unwrap();
+}
+
 /// The calibration the check tests start from, in `dir`: `cal.csv`, 80
 /// random poses of a machine with random errors of up to 0.25 mm (seed 5),
 /// and `cal.json`, the machine `identify` writes from it (exit 0 asserted).
