@@ -12,6 +12,8 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
+use crate::parts::{CandidateResult, seen_inverse};
+
 /// The whitened rows of a check (see the module docs).
 #[derive(Debug, Clone)]
 pub(crate) struct Design {
@@ -90,16 +92,7 @@ impl Design {
             if d > 0.0 { 1.0 / d.sqrt() } else { 0.0 }
         });
         let scaled = DMatrix::from_fn(q, q, |i, j| normal[(i, j)] * scale[i] * scale[j]);
-        let eig = scaled.symmetric_eigen();
-        let top = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
-        let mut inv = DMatrix::zeros(q, q);
-        for e in 0..q {
-            let l = eig.eigenvalues[e];
-            if l > 1e-10 * top {
-                let u = eig.eigenvectors.column(e);
-                inv += u * u.transpose() / l;
-            }
-        }
+        let (inv, _) = seen_inverse(scaled);
         let cov = DMatrix::from_fn(q, q, |i, j| inv[(i, j)] * scale[i] * scale[j]);
         let beta = &cov * rhs;
         let residual: Vec<f64> = (b - &x * &beta).iter().copied().collect();
@@ -134,10 +127,7 @@ impl DesignFit {
 /// The candidate columns (counted from the first candidate column) of the
 /// change `best` of `results` names: its fitted parameters the campaign
 /// sees; none without a change.
-pub(crate) fn change_columns(
-    results: &[crate::parts::CandidateResult],
-    best: Option<usize>,
-) -> Vec<usize> {
+pub(crate) fn change_columns(results: &[CandidateResult], best: Option<usize>) -> Vec<usize> {
     let Some(b) = best else {
         return Vec::new();
     };

@@ -113,6 +113,26 @@ pub(crate) struct SubFit {
     pub(crate) std_dev: Vec<Option<f64>>,
 }
 
+/// The inverse of the symmetric, unit-diagonal-scaled matrix `s` on the
+/// directions it determines (eigenvalues above 1e-10 times the largest;
+/// the others are left out, not inverted), and how many those are.
+pub(crate) fn seen_inverse(s: DMatrix<f64>) -> (DMatrix<f64>, usize) {
+    let q = s.nrows();
+    let eig = s.symmetric_eigen();
+    let emax = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
+    let mut inv = DMatrix::zeros(q, q);
+    let mut rank = 0;
+    for e in 0..q {
+        let l = eig.eigenvalues[e];
+        if l > 1e-10 * emax {
+            let u = eig.eigenvectors.column(e);
+            inv += u * u.transpose() / l;
+            rank += 1;
+        }
+    }
+    (inv, rank)
+}
+
 pub(crate) fn fit_columns(idx: &[usize], limits: &[f64], gram: &DMatrix<f64>, r: usize) -> SubFit {
     let n = idx.len();
     // Scaled to unit diagonal, so that the rank tolerance is relative.
@@ -137,17 +157,8 @@ pub(crate) fn fit_columns(idx: &[usize], limits: &[f64], gram: &DMatrix<f64>, r:
     let s = DMatrix::from_fn(q, q, |a, b| {
         gram[(idx[kept[a]], idx[kept[b]])] / (scale[kept[a]] * scale[kept[b]])
     });
-    let eig = s.symmetric_eigen();
-    let emax = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
-    let mut inv = DMatrix::zeros(q, q);
-    for e in 0..q {
-        let l = eig.eigenvalues[e];
-        if l > 1e-10 * emax {
-            let u = eig.eigenvectors.column(e);
-            inv += u * u.transpose() / l;
-            fit.dof += 1;
-        }
-    }
+    let (inv, rank) = seen_inverse(s);
+    fit.dof = rank;
     let gs = DVector::from_fn(q, |a, _| gram[(idx[kept[a]], r)] / scale[kept[a]]);
     let x = &inv * &gs;
     fit.statistic = gs.dot(&x);
