@@ -73,7 +73,10 @@ const TARGETS: &[Target] = &[
     },
     Target {
         name: "deploy",
-        files: &["crates/diagnose/src/deploy.rs"],
+        files: &[
+            "crates/diagnose/src/deploy.rs",
+            "crates/diagnose/src/holdout.rs",
+        ],
         package: "tricept-diagnose",
         tests: &["tricept-diagnose", "tricept-example-deploy"],
     },

@@ -43,7 +43,7 @@ use tricept_engine::ReadingModel;
 use tricept_kinematics::{Machine, UpJoints};
 
 use crate::fit::Fit;
-use crate::gain::improvement;
+use crate::gain::{Improvement, improvement};
 use crate::model::ExtendedModel;
 use crate::report::{DEPLOY_BENEFIT_SD, DEPLOY_IMPROVEMENT_SD, ModelTerm};
 use crate::select::Setup;
@@ -199,28 +199,8 @@ fn judge(
             .and_then(|e| benefit(full, &e)),
         _ => None,
     };
-    let z = gained.map_or(f64::INFINITY, |g| {
-        if g.sd_mm > 0.0 {
-            g.mean_mm / g.sd_mm
-        } else {
-            f64::INFINITY
-        }
-    });
-    let pays = match (&without, held_out, gained) {
-        // Without it the model cannot be fitted: it is needed.
-        (None, _, _) => true,
-        (Some(_), Some(b), Some(g)) => {
-            let seen = b.mean_mm > DEPLOY_BENEFIT_SD * b.sd_mm;
-            // It pays where the readings cannot see, or it moves the
-            // platform there by no more than the readings see it gain (so
-            // that it cannot lose more than it gains).
-            let unseen = g.mean_mm > DEPLOY_IMPROVEMENT_SD * g.sd_mm
-                || g.mean_mm <= b.mean_mm + DEPLOY_BENEFIT_SD * b.sd_mm;
-            seen && unseen
-        }
-        // No out-of-sample benefit can be had: nothing says it pays.
-        _ => false,
-    };
+    let z = improvement_sds(gained);
+    let pays = rule(without.is_some(), held_out, gained);
     let (legs, channel, period_mm, edges_mm) = match t {
         Term::Generic(g) => (
             g.legs().iter().map(|i| *i as u8 + 1).collect(),
@@ -247,6 +227,39 @@ fn judge(
         },
         pays,
         z,
+    }
+}
+
+/// How many standard deviations the predicted improvement `gained` is
+/// (infinite when it is unknown or has no spread: such a term goes last).
+fn improvement_sds(gained: Option<Improvement>) -> f64 {
+    gained.map_or(f64::INFINITY, |g| {
+        if g.sd_mm > 0.0 {
+            g.mean_mm / g.sd_mm
+        } else {
+            f64::INFINITY
+        }
+    })
+}
+
+/// The module's rule: whether a term pays, given whether the model
+/// without it could be fitted (`fitted_without`), its out-of-sample
+/// benefit `held_out` and its predicted improvement `gained`.
+fn rule(fitted_without: bool, held_out: Option<Benefit>, gained: Option<Improvement>) -> bool {
+    match (fitted_without, held_out, gained) {
+        // Without it the model cannot be fitted: it is needed.
+        (false, _, _) => true,
+        (true, Some(b), Some(g)) => {
+            let seen = b.mean_mm > DEPLOY_BENEFIT_SD * b.sd_mm;
+            // It pays where the readings cannot see, or it moves the
+            // platform there by no more than the readings see it gain (so
+            // that it cannot lose more than it gains).
+            let unseen = g.mean_mm > DEPLOY_IMPROVEMENT_SD * g.sd_mm
+                || g.mean_mm <= b.mean_mm + DEPLOY_BENEFIT_SD * b.sd_mm;
+            seen && unseen
+        }
+        // No out-of-sample benefit can be had: nothing says it pays.
+        _ => false,
     }
 }
 
@@ -316,5 +329,117 @@ pub(crate) fn deployable(
         (out, None)
     } else {
         (out, Some(with))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The out-of-sample benefit against sums worked by hand, and the
+    //! deployment rule against the module's documented statement, at and
+    //! around its thresholds (2 standard deviations each, `report.rs`).
+    use super::*;
+
+    fn b(mean_mm: f64, sd_mm: f64) -> Option<Benefit> {
+        Some(Benefit { mean_mm, sd_mm })
+    }
+
+    fn g(mean_mm: f64, sd_mm: f64) -> Option<Improvement> {
+        Some(Improvement {
+            mean_mm,
+            sd_mm,
+            difference_sd_mm: sd_mm,
+        })
+    }
+
+    #[test]
+    fn the_benefit_is_the_difference_of_the_rms_errors_with_its_sd() {
+        let with = [
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::new(0.0, 1.0, 0.0),
+            Vector3::new(0.0, 0.0, 1.0),
+        ];
+        let without = [
+            Vector3::new(2.0, 0.0, 0.0),
+            Vector3::new(0.0, 3.0, 0.0),
+            Vector3::new(1.0, 2.0, 3.0),
+        ];
+        // |e|^2: with 1, 1, 1 (rms 1); without 4, 9, 14 (rms 3).
+        // d = 3, 8, 13: mean 8, sample variance (25 + 0 + 25) / 2 = 25,
+        // sd(d) / sqrt(3) / (1 + 3) = 5 / sqrt(3) / 4.
+        let got = benefit(&with, &without).expect("three poses");
+        assert!((got.mean_mm - 2.0).abs() < 1e-12, "{got:?}");
+        assert!(
+            (got.sd_mm - 5.0 / 3f64.sqrt() / 4.0).abs() < 1e-12,
+            "{got:?}"
+        );
+        // Two poses are enough: |e|^2 with 1, 4 and without 9, 16 (d = 8,
+        // 12: variance 8, sd(d) / sqrt(2) = 2), rms sqrt(2.5) and sqrt(12.5).
+        let two = benefit(
+            &[Vector3::new(1.0, 0.0, 0.0), Vector3::new(0.0, 2.0, 0.0)],
+            &[Vector3::new(3.0, 0.0, 0.0), Vector3::new(0.0, 0.0, 4.0)],
+        )
+        .expect("two poses");
+        let (rw, ro) = (2.5f64.sqrt(), 12.5f64.sqrt());
+        assert!((two.mean_mm - (ro - rw)).abs() < 1e-12, "{two:?}");
+        assert!((two.sd_mm - 2.0 / (ro + rw)).abs() < 1e-12, "{two:?}");
+    }
+
+    #[test]
+    fn no_benefit_without_two_poses_matching_lengths_or_a_finite_error() {
+        let one = [Vector3::new(1.0, 0.0, 0.0)];
+        assert!(benefit(&one, &one).is_none());
+        let two = [Vector3::new(1.0, 0.0, 0.0); 2];
+        let three = [Vector3::new(1.0, 0.0, 0.0); 3];
+        assert!(benefit(&two, &three).is_none());
+        let zero = [Vector3::zeros(); 3];
+        assert!(benefit(&zero, &zero).is_none());
+        let infinite = [Vector3::new(f64::INFINITY, 0.0, 0.0); 3];
+        assert!(benefit(&three, &infinite).is_none());
+        // Equal errors: no benefit, no spread.
+        let same = benefit(&three, &three).expect("finite");
+        assert_eq!((same.mean_mm, same.sd_mm), (0.0, 0.0));
+    }
+
+    #[test]
+    fn a_term_the_model_cannot_do_without_is_deployed() {
+        assert!(rule(false, None, None));
+        assert!(rule(false, b(-1.0, 0.1), g(-1.0, 0.1)));
+    }
+
+    #[test]
+    fn without_both_numbers_nothing_says_a_term_pays() {
+        assert!(!rule(true, None, g(10.0, 1.0)));
+        assert!(!rule(true, b(10.0, 1.0), None));
+        assert!(!rule(true, None, None));
+    }
+
+    #[test]
+    fn the_out_of_sample_benefit_must_exceed_two_sd() {
+        // Improvement 3 sd: the second half holds.
+        assert!(rule(true, b(1.0, 0.4), g(3.0, 1.0)));
+        // Exactly 2 sd does not exceed 2 sd.
+        assert!(!rule(true, b(1.0, 0.5), g(3.0, 1.0)));
+        assert!(!rule(true, b(-1.0, 0.1), g(3.0, 1.0)));
+    }
+
+    #[test]
+    fn the_improvement_must_exceed_two_sd_or_be_no_larger_than_the_benefit() {
+        // Benefit 1 +- 0.25 (4 sd): its upper bound 1 + 2 * 0.25 = 1.5.
+        let seen = b(1.0, 0.25);
+        // 1.5 sd, but no larger than 1.5: it cannot lose more than it gains.
+        assert!(rule(true, seen, g(1.5, 1.0)));
+        // 1.6 sd and larger than 1.5.
+        assert!(!rule(true, seen, g(1.6, 1.0)));
+        // Exactly 2 sd does not exceed 2 sd.
+        assert!(!rule(true, seen, g(2.0, 1.0)));
+        assert!(rule(true, seen, g(2.5, 1.0)));
+    }
+
+    #[test]
+    fn the_least_useful_term_is_the_one_with_fewest_improvement_sds() {
+        assert_eq!(improvement_sds(g(3.0, 1.5)), 2.0);
+        assert_eq!(improvement_sds(g(-1.0, 4.0)), -0.25);
+        assert_eq!(improvement_sds(g(1.0, 0.0)), f64::INFINITY);
+        assert_eq!(improvement_sds(None), f64::INFINITY);
     }
 }
