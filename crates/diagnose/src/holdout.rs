@@ -433,6 +433,8 @@ mod tests {
         // Exactly 2 sd does not exceed 2 sd.
         assert!(!rule(true, seen, g(2.0, 1.0)));
         assert!(rule(true, seen, g(2.5, 1.0)));
+        // 3.5 sd of a spread of 0.5 (larger than 1.5): 2 sd is 1.0 there.
+        assert!(rule(true, seen, g(1.75, 0.5)));
     }
 
     #[test]
@@ -440,6 +442,7 @@ mod tests {
         assert_eq!(improvement_sds(g(3.0, 1.5)), 2.0);
         assert_eq!(improvement_sds(g(-1.0, 4.0)), -0.25);
         assert_eq!(improvement_sds(g(1.0, 0.0)), f64::INFINITY);
+        assert_eq!(improvement_sds(g(-1.0, 0.0)), f64::INFINITY);
         assert_eq!(improvement_sds(None), f64::INFINITY);
     }
 }

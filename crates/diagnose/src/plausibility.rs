@@ -196,6 +196,20 @@ mod tests {
         assert_eq!(keys, documented);
     }
 
+    /// An overridden range is the one judged by (issue 32: the key of a
+    /// judged quantity must find its override): aluminium legs' 20 to 26
+    /// ppm/K, from the module's example.
+    #[test]
+    fn an_overridden_range_replaces_the_specs_own() {
+        let json = r#"{"thermal.expansion_ppm_per_k": [20, 26]}"#;
+        let p = Plausibility::with_overrides(json).expect("a known key");
+        // 12 ppm/K: plausible for steel (8 to 16), not for aluminium.
+        assert!(judge(&Plausibility::default(), EffectName::Thermal, &[12.0], 0.5).is_ok());
+        let too_low = judge(&p, EffectName::Thermal, &[12.0], 0.5).unwrap_err();
+        assert!(too_low.contains("outside 20 to 26 ppm/K"), "{too_low}");
+        assert!(judge(&p, EffectName::Thermal, &[23.0], 0.5).is_ok());
+    }
+
     /// A table without a key still judges by the spec's own range.
     #[test]
     fn a_missing_key_is_still_checked() {

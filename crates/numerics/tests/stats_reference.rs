@@ -10,12 +10,16 @@
 //!   `erfc(sqrt(x/2)) + sqrt(2x/pi) exp(-x/2)`, with `erfc` from its Taylor
 //!   series (small arguments) or its continued fraction (large ones),
 //!   written below;
-//! - `I_x(a, 1) = x^a`, `I_x(1, b) = 1 - (1 - x)^b`.
+//! - `I_x(a, 1) = x^a`, `I_x(1, b) = 1 - (1 - x)^b`;
+//! - `Gamma(1/4) = 3.6256099082219083119` (OEIS A068466), `Gamma(1/3) =
+//!   2.6789385347077476337` (A073005), `Gamma(1/10) = Gamma(1.1) / 0.1` with
+//!   `Gamma(1.1) = 0.95135076986687318363` (Abramowitz and Stegun, table
+//!   6.1): below 1/2, where `ln_gamma` reflects.
 
 use std::f64::consts::PI;
 
 use tricept_numerics::stats::{
-    beta_inc, chi2_isf, chi2_ln_sf, chi2_sf, chi2_two_sided, f_sf, gamma_p,
+    beta_inc, chi2_isf, chi2_ln_sf, chi2_sf, chi2_two_sided, f_sf, gamma_p, ln_gamma,
 };
 
 /// `ln P(X > x)` for an even `k`, by the Poisson sum.
@@ -253,4 +257,25 @@ fn incomplete_beta_against_closed_forms_and_off_its_domain() {
     }
     assert_eq!(f_sf(f64::INFINITY, 2.0, 3.0), 0.0);
     assert_eq!(f_sf(-1.0, 2.0, 3.0), 1.0);
+}
+
+#[test]
+fn ln_gamma_below_one_half_reflects() {
+    for (x, gamma) in [
+        (0.25, 3.625_609_908_221_908_3),
+        (1.0 / 3.0, 2.678_938_534_707_747_6),
+        (0.1, 9.513_507_698_668_731_8),
+    ] {
+        assert_relative(ln_gamma(x), f64::ln(gamma), 1e-13, &format!("{x}"));
+    }
+    // The incomplete beta function needs it for a small shape: I_x(a, 1) = x^a.
+    for x in [0.01f64, 0.3, 0.9] {
+        assert_relative(beta_inc(0.2, 1.0, x), x.powf(0.2), 1e-12, "I_x(0.2, 1)");
+        assert_relative(
+            beta_inc(1.0, 0.3, x),
+            1.0 - (1.0 - x).powf(0.3),
+            1e-12,
+            "I_x(1, 0.3)",
+        );
+    }
 }
