@@ -262,9 +262,9 @@ fn incomplete_beta_against_closed_forms_and_off_its_domain() {
 #[test]
 fn ln_gamma_below_one_half_reflects() {
     for (x, gamma) in [
-        (0.25, 3.625_609_908_221_908_3),
+        (0.25, 3.625_609_908_221_908),
         (1.0 / 3.0, 2.678_938_534_707_747_6),
-        (0.1, 9.513_507_698_668_731_8),
+        (0.1, 9.513_507_698_668_732),
     ] {
         assert_relative(ln_gamma(x), f64::ln(gamma), 1e-13, &format!("{x}"));
     }
