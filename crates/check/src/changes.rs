@@ -557,11 +557,22 @@ mod tests {
         gram: &DMatrix<f64>,
         start: &[(usize, usize)],
     ) -> Vec<usize> {
+        // The check's other candidates: sensors, never traded.
+        let mut kinds = kinds.to_vec();
+        let mut sizes = sizes.to_vec();
+        kinds.resize(12, S);
+        sizes.resize(12, vec![1]);
         let mut set = start.to_vec();
-        exchange(kinds, sizes, &judge(gram), &mut set);
+        exchange(&kinds, &sizes, &judge(gram), &mut set);
         let mut named: Vec<usize> = set.iter().map(|&(c, _)| c).collect();
         named.sort_unstable();
         named
+    }
+
+    #[test]
+    fn a_parameter_must_make_the_readings_20_times_likelier() {
+        // 2 ln 20 = ln 400.
+        assert!((parameter_penalty() - 5.991_464_547_107_98).abs() < 1e-12);
     }
 
     #[test]
