@@ -269,10 +269,19 @@ fn structure_part(
 }
 
 /// The promise of a fused fit at the tool tip after touch-off: the tip's
-/// predicted covariance over the evaluation poses (`tip`) with its held
-/// parameters' share as the head part, and the external sources' residuals
-/// beyond their stated noise out of sample (module docs).
-pub(crate) fn of_fusion(fit: &tricept_engine::fusion::Fusion) -> Accuracy {
+/// predicted covariance over the evaluation poses (`tip`) without the held
+/// parameters as the estimate part; the held parameters' share (their
+/// invisible combinations at their typical sizes) scaled by the size the
+/// data show of this head ([`head_scale`]) as the head part; the external
+/// sources' residuals beyond their stated noise out of sample; and, when
+/// sources that cannot be checked on their own were accepted because they
+/// agree with the checked fit, the tip's shift they bring beyond chance
+/// (`unchecked`, `(rms_mm, upper_mm)`; module docs).
+pub(crate) fn of_fusion(
+    model: &tricept_engine::fusion::FusedModel,
+    fit: &tricept_engine::fusion::Fusion,
+    unchecked: Option<(f64, f64)>,
+) -> Accuracy {
     let tip = &fit.report.tool_tip;
     let held_mm = tip.held_touch_off_rms_um * 1e-3;
     let total_mm = tip.touch_off_rms_um * 1e-3;
@@ -299,6 +308,8 @@ pub(crate) fn of_fusion(fit: &tricept_engine::fusion::Fusion) -> Accuracy {
         unexplained = unexplained.max(excess(chi2));
         unexplained_upper = unexplained_upper.max(excess(chi2 + Z95 * (2.0 / nu).sqrt()));
     }
+    let size = head_scale(model, fit);
+    let head = (held_mm * size.scale, one_dof * held_mm * size.upper);
     let mut parts = Map::new();
     parts.insert("estimate_mm".into(), estimate_mm.into());
     parts.insert("estimate_upper_mm".into(), (one_dof * estimate_mm).into());
@@ -307,17 +318,75 @@ pub(crate) fn of_fusion(fit: &tricept_engine::fusion::Fusion) -> Accuracy {
         "unexplained_upper_mm".into(),
         unexplained_upper.sqrt().into(),
     );
-    parts.insert("head_mm".into(), held_mm.into());
-    parts.insert("head_upper_mm".into(), (one_dof * held_mm).into());
-    Accuracy::combine(
-        TOOL_TIP,
-        &[
-            (estimate_mm, one_dof * estimate_mm),
-            (unexplained.sqrt(), unexplained_upper.sqrt()),
-            (held_mm, one_dof * held_mm),
-        ],
-        parts,
-    )
+    parts.insert("head_mm".into(), head.0.into());
+    parts.insert("head_upper_mm".into(), head.1.into());
+    parts.insert("head_at_typical_size_mm".into(), held_mm.into());
+    parts.insert("head_size_seen".into(), size.scale.into());
+    parts.insert("head_size_seen_upper".into(), size.upper.into());
+    parts.insert("head_parameters_seen".into(), size.seen.into());
+    let mut list = vec![
+        (estimate_mm, one_dof * estimate_mm),
+        (unexplained.sqrt(), unexplained_upper.sqrt()),
+        head,
+    ];
+    if let Some((rms, upper)) = unchecked {
+        parts.insert("unchecked_mm".into(), rms.into());
+        parts.insert("unchecked_upper_mm".into(), upper.into());
+        list.push((rms, upper));
+    }
+    Accuracy::combine(TOOL_TIP, &list, parts)
+}
+
+/// The size of a head's errors the data show, in units of the parameters'
+/// typical sizes: the head parameters the data see (`n` of them, estimate
+/// `e_j`, standard deviation `s_j`, typical size `t_j`) give `S = sum
+/// (e_j / t_j)^2`, whose mean is `n c^2 + sum (s_j / t_j)^2` for a head of
+/// `c` typical sizes; the scale is the moment estimate `c^2 = (S - sum (s_j
+/// / t_j)^2) / n` (never below zero), its 95 % upper bound `S / chi2_n(5
+/// %)`. A fit that sees no head parameter keeps the typical size (1, 1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct HeadScale {
+    /// The moment estimate `c`.
+    pub scale: f64,
+    /// Its 95 % upper bound.
+    pub upper: f64,
+    /// Head parameters seen.
+    pub seen: usize,
+}
+
+/// The size of the head's errors the data show ([`HeadScale`]).
+pub(crate) fn head_scale(
+    model: &tricept_engine::fusion::FusedModel,
+    fit: &tricept_engine::fusion::Fusion,
+) -> HeadScale {
+    let typical = model.typical_sizes();
+    let (mut sum, mut noise, mut seen) = (0.0, 0.0, 0usize);
+    for j in model.head_range() {
+        let (Some(Some(sd)), Some(e), Some(t)) =
+            (fit.std_dev.get(j), fit.estimate.get(j), typical.get(j))
+        else {
+            continue;
+        };
+        if *t > 0.0 && e.is_finite() && sd.is_finite() {
+            sum += (e / t).powi(2);
+            noise += (sd / t).powi(2);
+            seen += 1;
+        }
+    }
+    if seen == 0 {
+        return HeadScale {
+            scale: 1.0,
+            upper: 1.0,
+            seen,
+        };
+    }
+    let n = seen as f64;
+    let low = tricept_numerics::stats::chi2_isf(0.95, n);
+    HeadScale {
+        scale: ((sum - noise).max(0.0) / n).sqrt(),
+        upper: if low > 0.0 { (sum / low).sqrt() } else { 1.0 },
+        seen,
+    }
 }
 
 /// The estimate's rms and 95 % bound from the moments `(tr(MS),
