@@ -18,8 +18,13 @@
 //!   residuals of the UP limb's readings mapped to the platform through the
 //!   limb's Jacobian ([`tricept_engine::cross_validate`]), never below
 //!   zero;
-//! - **head** (fused files): what the external data show of the head parts
-//!   they cannot calibrate.
+//! - **head** (fused files): the head parts the external data cannot
+//!   calibrate, their invisible combinations at their typical sizes scaled
+//!   by the size the data show of this head (`head_scale`: the head
+//!   parameters they do see, against their typical sizes);
+//! - **unchecked** (fused files): the tool tip's shift beyond chance that
+//!   sources which cannot be checked on their own, accepted because they
+//!   agree with the checked fit of the others, bring.
 //!
 //! Its 95 % upper bound adds the parts' 95 % upper bounds in quadrature:
 //! the estimate's mean square `e^T M e` is a weighted sum of chi-squares,
