@@ -178,11 +178,12 @@ impl Plans {
         }
     }
 
+    /// The first `k` of the 12 planned points, or of the 30.
     fn tracker(&self, k: usize) -> &[Planned] {
-        if k == 12 {
-            &self.tracker12
+        if k <= 12 {
+            &self.tracker12[..k]
         } else {
-            &self.tracker30
+            &self.tracker30[..k.min(30)]
         }
     }
 }
@@ -615,6 +616,20 @@ fn touches_that_disagree_with_the_tracker_are_still_refused() {
     let file = dir.join("m.json");
     assert!(c.write_machine(&file, false).is_err());
     assert!(!file.exists());
+    // A tracker that cannot be checked beside the internal data alone (which
+    // do not see the head): nothing outside the machine checks it, refused.
+    let config = Config {
+        tracker: Some((6, Target::Tip)),
+        ballbar: None,
+        touch: None,
+        touch_beyond_mm: 0.0,
+    };
+    let (_, request) = campaign(&config, &plans, 8, &dir);
+    let c = calibrate(request).unwrap();
+    let json = c.to_json();
+    assert_eq!(source(&json, "tracker")["checkable"], false, "{json}");
+    assert_eq!(c.exit_code(), 3, "{}", c.report());
+    assert!(json["unchecked"].is_null(), "{}", json["unchecked"]);
     // A disagreement of 0.05 mm the test cannot see: written, the shift the
     // touches bring in the promise, and the file within it in truth.
     let o = run(&twelve_points_and_touches(12, 0.05), &plans, 8, &dir, false);

@@ -184,9 +184,10 @@ pub(crate) fn fit(
 }
 
 /// The external sources of `fit` that cannot be checked on their own,
-/// tested against the fit of the others when that fit can be trusted
-/// (they agree when their added chi-square passes and the fit with them
-/// is otherwise trustworthy); `again` reads the sources anew.
+/// tested against the fit of the others when that fit holds an external
+/// source and can be trusted (they agree when their added chi-square
+/// passes and the fit with them is otherwise trustworthy); `again` reads
+/// the sources anew.
 fn unchecked(
     model: &FusedModel,
     fit: &Fusion,
@@ -216,6 +217,12 @@ fn unchecked(
         .into_iter()
         .filter(|s| !labels.iter().any(|l| l == s.label()))
         .collect();
+    // Something outside the machine must check them: the internal data do
+    // not see the head (a tracker or ballbar that cannot be checked, with
+    // the internal data alone, stays refused).
+    if rest.iter().all(|s| s.kind() == SourceKind::Internal) {
+        return Ok(None);
+    }
     // The others alone must be a fit that can be trusted.
     let Ok(checked) = identify_fused(model, &rest, options) else {
         return Ok(None);
