@@ -365,32 +365,42 @@ pub(crate) fn head_scale(
     fit: &tricept_engine::fusion::Fusion,
 ) -> HeadScale {
     let typical = model.typical_sizes();
-    let (mut sum, mut noise, mut seen) = (0.0, 0.0, 0usize);
-    for j in model.head_range() {
-        let (Some(Some(sd)), Some(e), Some(t)) =
-            (fit.std_dev.get(j), fit.estimate.get(j), typical.get(j))
-        else {
-            continue;
-        };
-        if *t > 0.0 && e.is_finite() && sd.is_finite() {
-            sum += (e / t).powi(2);
-            noise += (sd / t).powi(2);
-            seen += 1;
+    let seen: Vec<(f64, f64, f64)> = model
+        .head_range()
+        .filter_map(|j| {
+            let sd = (*fit.std_dev.get(j)?)?;
+            Some((*fit.estimate.get(j)?, sd, *typical.get(j)?))
+        })
+        .collect();
+    HeadScale::of(&seen)
+}
+
+impl HeadScale {
+    /// The scale of the head parameters seen, each `(estimate, standard
+    /// deviation, typical size)` (one without a positive typical size or
+    /// with a value that is not finite is left out).
+    pub(crate) fn of(seen: &[(f64, f64, f64)]) -> HeadScale {
+        let (mut sum, mut noise, mut n) = (0.0, 0.0, 0usize);
+        for &(e, sd, t) in seen {
+            if t > 0.0 && e.is_finite() && sd.is_finite() {
+                sum += (e / t).powi(2);
+                noise += (sd / t).powi(2);
+                n += 1;
+            }
         }
-    }
-    if seen == 0 {
-        return HeadScale {
-            scale: 1.0,
-            upper: 1.0,
-            seen,
-        };
-    }
-    let n = seen as f64;
-    let low = tricept_numerics::stats::chi2_isf(0.95, n);
-    HeadScale {
-        scale: ((sum - noise).max(0.0) / n).sqrt(),
-        upper: if low > 0.0 { (sum / low).sqrt() } else { 1.0 },
-        seen,
+        if n == 0 {
+            return HeadScale {
+                scale: 1.0,
+                upper: 1.0,
+                seen: 0,
+            };
+        }
+        let low = tricept_numerics::stats::chi2_isf(0.95, n as f64);
+        HeadScale {
+            scale: ((sum - noise).max(0.0) / n as f64).sqrt(),
+            upper: if low > 0.0 { (sum / low).sqrt() } else { 1.0 },
+            seen: n,
+        }
     }
 }
 
@@ -419,6 +429,27 @@ pub(crate) fn unexplained_part(cv: &CrossValidation) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_head_scale_is_what_the_seen_parameters_show() {
+        // Eleven parameters seen at twice their typical sizes, exactly: a
+        // head of two typical sizes; the bound S / chi2_11(5 %) = 44 / 4.57.
+        let seen = vec![(0.6, 0.0, 0.3); 11];
+        let h = HeadScale::of(&seen);
+        assert!((h.scale - 2.0).abs() < 1e-12, "{h:?}");
+        assert!(
+            (h.upper - (44.0_f64 / 4.574_813).sqrt()).abs() < 1e-3,
+            "{h:?}"
+        );
+        assert_eq!(h.seen, 11);
+        // Estimates no larger than their noise show no head beyond it.
+        let h = HeadScale::of(&[(0.01, 0.02, 0.3), (-0.01, 0.02, 0.1)]);
+        assert_eq!(h.scale, 0.0);
+        assert!(h.upper > 0.0);
+        // Nothing seen: the typical size.
+        let h = HeadScale::of(&[(1.0, f64::NAN, 0.3)]);
+        assert_eq!((h.scale, h.upper, h.seen), (1.0, 1.0, 0));
+    }
 
     #[test]
     fn the_estimate_bound_is_the_chi_square_quantile() {
