@@ -44,7 +44,7 @@ use tricept_engine::{
 };
 use tricept_kinematics::Machine;
 use tricept_kinematics::description::AccuracyRecord;
-use tricept_model::ParameterSet;
+use tricept_model::{Effector, ParameterSet};
 
 use crate::error::Error;
 
@@ -281,10 +281,12 @@ fn structure_part(
 /// sources' residuals beyond their stated noise out of sample; and, when
 /// sources that cannot be checked on their own were accepted because they
 /// agree with the checked fit, the tip's shift they bring beyond chance
-/// (`unchecked`, `(rms_mm, upper_mm)`; module docs).
+/// (`unchecked`, `(rms_mm, upper_mm)`); `structure`: [`fused_structure`]
+/// (module docs).
 pub(crate) fn of_fusion(
     model: &tricept_engine::fusion::FusedModel,
     fit: &tricept_engine::fusion::Fusion,
+    structure: (f64, f64),
     unchecked: Option<(f64, f64)>,
 ) -> Accuracy {
     let tip = &fit.report.tool_tip;
@@ -329,10 +331,13 @@ pub(crate) fn of_fusion(
     parts.insert("head_size_seen".into(), size.scale.into());
     parts.insert("head_size_seen_upper".into(), size.upper.into());
     parts.insert("head_parameters_seen".into(), size.seen.into());
+    parts.insert("structure_mm".into(), structure.0.into());
+    parts.insert("structure_upper_mm".into(), structure.1.into());
     let mut list = vec![
         (estimate_mm, one_dof * estimate_mm),
         (unexplained.sqrt(), unexplained_upper.sqrt()),
         head,
+        structure,
     ];
     if let Some((rms, upper)) = unchecked {
         parts.insert("unchecked_mm".into(), rms.into());
@@ -340,6 +345,80 @@ pub(crate) fn of_fusion(
         list.push((rms, upper));
     }
     Accuracy::combine(TOOL_TIP, &list, parts)
+}
+
+/// The structure part of a fused fit: where the geometric fit (`fit`)
+/// and the same sources fitted with a lead on every leg (`rich`, its model
+/// `rich_model`) put the tool tip at the same commands, over the
+/// evaluation poses after touch-off (the mean difference removed): the
+/// mean square difference `D`, less what chance gives it (`tr(M V)`, `M =
+/// mean_e G_e^T G_e` with `G_e` the rich model's tip Jacobian less its
+/// mean over the poses, `V` the rich covariance less the geometric one in
+/// its coordinates: Hausman); its bound adds 1.645 `sqrt(2 tr(MVMV))`.
+/// `(0, 0)` when a tip cannot be had.
+pub(crate) fn fused_structure(
+    model: &tricept_engine::fusion::FusedModel,
+    fit: &tricept_engine::fusion::Fusion,
+    rich_model: &tricept_engine::fusion::FusedModel,
+    rich: &tricept_engine::fusion::Fusion,
+    eval: &[tricept_data::ExternalPose],
+) -> (f64, f64) {
+    let (k, kr) = (model.len(), rich_model.len());
+    // The geometric parameters' places among the rich model's.
+    let index: Vec<usize> = rich_model
+        .module_range()
+        .chain(rich_model.head_range())
+        .collect();
+    if index.len() != k || fit.estimate.len() != k || rich.estimate.len() != kr {
+        return (0.0, 0.0);
+    }
+    let tip = Effector::default();
+    let diffs: Option<Vec<nalgebra::Vector3<f64>>> = eval
+        .iter()
+        .map(|pose| {
+            let r = rich_model.spindle_point(&rich.estimate, pose, &tip).ok()?;
+            let g = model.spindle_point(&fit.estimate, pose, &tip).ok()?;
+            Some(r.0 - g.0)
+        })
+        .collect();
+    let Some(diffs) = diffs else {
+        return (0.0, 0.0);
+    };
+    let Ok(g) = rich_model.spindle_jacobians(&rich.estimate, eval, &[tip]) else {
+        return (0.0, 0.0);
+    };
+    let g: Vec<&nalgebra::DMatrix<f64>> = g.iter().filter_map(|v| v.first()).collect();
+    let n = diffs.len().max(1) as f64;
+    let centre = diffs.iter().sum::<nalgebra::Vector3<f64>>() / n;
+    let shift = diffs
+        .iter()
+        .map(|d| (d - centre).norm_squared())
+        .sum::<f64>()
+        / n;
+    let mean = g
+        .iter()
+        .fold(nalgebra::DMatrix::zeros(3, kr), |a, b| a + *b)
+        / n;
+    let mut m = nalgebra::DMatrix::zeros(kr, kr);
+    for ge in &g {
+        let c = *ge - &mean;
+        m += c.transpose() * c;
+    }
+    m /= n;
+    let mut v = rich.covariance.clone();
+    for (a, &ia) in index.iter().enumerate() {
+        for (b, &ib) in index.iter().enumerate() {
+            v[(ia, ib)] -= fit.covariance[(a, b)];
+        }
+    }
+    let mv = &m * &v;
+    let chance = mv.trace();
+    let sd = (2.0 * (&mv * &mv).trace().max(0.0)).sqrt();
+    let bias2 = shift - chance.max(0.0);
+    if !(bias2.is_finite() && sd.is_finite()) {
+        return (0.0, 0.0);
+    }
+    (bias2.max(0.0).sqrt(), (bias2 + Z95 * sd).max(0.0).sqrt())
 }
 
 /// The size of a head's errors the data show, in units of the parameters'

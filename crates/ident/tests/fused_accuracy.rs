@@ -31,7 +31,9 @@ use tricept_ident::{
     CalibrateRequest, DataInput, Instrument, KinematicsVerb, Machine, PlanRequest, SensorNoise,
     calibrate, load_machine, plan, solve_point,
 };
-use tricept_truth::{Row, TrueBallbar, TrueMachine, TrueSphere, TrueTracker, normal, to_csv};
+use tricept_truth::{
+    LegEffect, Row, TrueBallbar, TrueMachine, TrueSphere, TrueTracker, normal, to_csv,
+};
 
 /// Held-out tool poses per file.
 const TARGETS: usize = 60;
@@ -66,6 +68,31 @@ struct Config {
     /// The probe's stylus centre beyond the tool tip the other instruments
     /// measure, mm (0: as documented; otherwise touches that disagree).
     touch_beyond_mm: f64,
+    /// A static leg effect hidden in the true leg lengths ([`leg_effect`]).
+    leg_effects: bool,
+}
+
+/// A static leg effect hidden in the true leg lengths of machine `seed`
+/// (every instrument and the delivery see it): a lead of each leg
+/// (0.2-25 ppm) or a curved screw on one leg (0.5-12 um), log-uniform
+/// sizes from invisible to plainly not geometric.
+fn leg_effect(seed: u64, m: &Machine) -> LegEffect {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x1e6e_ffec);
+    let mut size = |lo: f64, hi: f64| lo * (hi / lo).powf(rng.random::<f64>());
+    if seed.is_multiple_of(2) {
+        LegEffect::Lead {
+            ppm: [size(0.2, 25.0), -size(0.2, 25.0), size(0.2, 25.0)],
+        }
+    } else {
+        let mut um = [0.0; 3];
+        um[(seed / 2 % 3) as usize] = size(0.5, 12.0);
+        let [start, end] = m.limits.leg_stroke_mm;
+        LegEffect::Quadratic {
+            um,
+            centre_mm: 0.5 * (start + end),
+            half_width_mm: 0.5 * (end - start),
+        }
+    }
 }
 
 impl Config {
@@ -91,12 +118,14 @@ fn configurations() -> Vec<Config> {
         ballbar: None,
         touch: None,
         touch_beyond_mm: 0.0,
+        leg_effects: false,
     };
     let ballbar = Config {
         tracker: None,
         ballbar: Some(30),
         touch: None,
         touch_beyond_mm: 0.0,
+        leg_effects: false,
     };
     let mut out = vec![
         tracker(12, Target::Tip),
@@ -227,8 +256,16 @@ fn campaign(
     plans: &Plans,
     seed: u64,
     dir: &Path,
-) -> (TrueMachine, CalibrateRequest) {
+) -> (TrueMachine, CalibrateRequest, Vec<LegEffect>) {
     let nominal = Machine::paper();
+    let effects: Vec<LegEffect> = if config.leg_effects {
+        vec![leg_effect(seed, &nominal)]
+    } else {
+        Vec::new()
+    };
+    let joints = |truth: &TrueMachine, q: &[f64; 3]| {
+        truth.forward_lengths(&truth.delivered_lengths(q, &effects))
+    };
     // Head errors of the head table's sizes, twice and three times them.
     let truth = TrueMachine::random(1.0 + (seed % 3) as f64, seed);
     let mut rng = Pcg64Mcg::seed_from_u64(seed.wrapping_mul(0x9e37_79b9) ^ 0xf05e);
@@ -240,7 +277,11 @@ fn campaign(
         .filter_map(|r| nominal.inverse(r).ok().map(|s| s.legs_mm))
         .map(|q| Row {
             commands_mm: q,
-            readings: truth.readings(&q, &mut rng),
+            readings: truth.sensed(
+                &joints(&truth, &q),
+                &tricept_truth::SensorNoise::DOCUMENTED,
+                &mut rng,
+            ),
             temp_c: None,
             directions: None,
         })
@@ -256,7 +297,7 @@ fn campaign(
         };
         let mut text = String::from("q1,q2,q3,h1,h2,x,y,z,extension_mm\n");
         for p in plans.tracker(k) {
-            let at = truth.spindle_point(&p.q, p.h, p.extension_mm, &offset);
+            let at = truth.spindle_point_at(&joints(&truth, &p.q), p.h, p.extension_mm, &offset);
             let y = station.measure(&at, &mut rng);
             text.push_str(&csv_line(&[
                 p.q[0],
@@ -287,7 +328,7 @@ fn campaign(
         };
         let mut text = String::from("q1,q2,q3,h1,h2,length\n");
         for p in &plans.ballbar30 {
-            let length = bar.read(&truth, &p.q, p.h, &Vector3::zeros(), &mut rng);
+            let length = bar.read(&truth, &p.q, p.h, &Vector3::zeros(), &effects, &mut rng);
             text.push_str(&csv_line(&[p.q[0], p.q[1], p.q[2], p.h[0], p.h[1], length]));
         }
         let path = dir.join(format!("ballbar-{seed}.csv"));
@@ -305,7 +346,7 @@ fn campaign(
         };
         let mut text = String::from("q1,q2,q3,h1,h2,feature\n");
         for p in &plans.touch24[..config.touch.unwrap_or(0).min(plans.touch24.len())] {
-            let q = sphere.touch(&truth, &p.q, p.h, &mut rng).unwrap();
+            let q = sphere.touch(&truth, &p.q, p.h, &effects, &mut rng).unwrap();
             text.push_str(&csv_line(&[q[0], q[1], q[2], p.h[0], p.h[1], 1.0]));
         }
         let path = dir.join(format!("touch-{seed}.csv"));
@@ -324,7 +365,7 @@ fn campaign(
     let mut request = CalibrateRequest::new(DataInput::File(internal));
     request.fused = Some(x);
     request.for_machine_file = true;
-    (truth, request)
+    (truth, request, effects)
 }
 
 /// Held-out tool poses: the documented machine's tool tip and axis at
@@ -353,7 +394,7 @@ fn targets(seed: u64) -> Vec<[f64; 6]> {
 
 /// The rms tool-tip error after touch-off the true machine delivers when
 /// commanded with the machine file `file` through the door's `tool-ik`.
-fn delivered(file: &Path, truth: &TrueMachine, targets: &[[f64; 6]]) -> f64 {
+fn delivered(file: &Path, truth: &TrueMachine, effects: &[LegEffect], targets: &[[f64; 6]]) -> f64 {
     let loaded = load_machine(Some(file), &SensorNoise::default()).unwrap();
     let errors: Vec<Vector3<f64>> = targets
         .iter()
@@ -369,7 +410,12 @@ fn delivered(file: &Path, truth: &TrueMachine, targets: &[[f64; 6]]) -> f64 {
             let q = [at("q1"), at("q2"), at("q3")];
             let h = [at("h1"), at("h2")];
             Some(
-                truth.spindle_point(&q, h, 0.0, &Vector3::zeros()) - Vector3::new(t[0], t[1], t[2]),
+                truth.spindle_point_at(
+                    &truth.forward_lengths(&truth.delivered_lengths(&q, effects)),
+                    h,
+                    0.0,
+                    &Vector3::zeros(),
+                ) - Vector3::new(t[0], t[1], t[2]),
             )
         })
         .collect();
@@ -391,7 +437,7 @@ fn delivered(file: &Path, truth: &TrueMachine, targets: &[[f64; 6]]) -> f64 {
 /// Calibrates `config` on machine `seed`, writes the file (`force`: even
 /// when refused) and measures it.
 fn run(config: &Config, plans: &Plans, seed: u64, dir: &Path, force: bool) -> Outcome {
-    let (truth, request) = campaign(config, plans, seed, dir);
+    let (truth, request, effects) = campaign(config, plans, seed, dir);
     let mut c = calibrate(request).unwrap();
     let json = c.to_json();
     let a = &json["accuracy"];
@@ -424,7 +470,7 @@ fn run(config: &Config, plans: &Plans, seed: u64, dir: &Path, force: bool) -> Ou
         (outcome.rms_mm, outcome.upper_mm),
         "the file promises what the JSON says"
     );
-    outcome.delivered_mm = delivered(&file, &truth, &targets(seed));
+    outcome.delivered_mm = delivered(&file, &truth, &effects, &targets(seed));
     outcome
 }
 
@@ -436,10 +482,14 @@ fn scratch(name: &str) -> PathBuf {
 
 /// The tally of `seeds` per configuration: prints one TALLY line each and
 /// returns (files written at exit 0, within the promise, beyond 2x).
-fn tally(seeds: std::ops::Range<u64>, dir: &Path) -> (usize, usize, usize) {
+fn tally(seeds: std::ops::Range<u64>, leg_effects: bool, dir: &Path) -> (usize, usize, usize) {
     let plans = Plans::new(dir);
     let (mut written, mut within, mut beyond, mut typical) = (0, 0, 0, 0);
     for (i, config) in configurations().iter().enumerate() {
+        let config = &Config {
+            leg_effects,
+            ..*config
+        };
         let outcomes: Vec<Outcome> = seeds
             .clone()
             .map(|s| run(config, &plans, 100 * i as u64 + s, dir, false))
@@ -475,8 +525,9 @@ fn tally(seeds: std::ops::Range<u64>, dir: &Path) -> (usize, usize, usize) {
             .map(|o| o.delivered_mm / o.upper_mm)
             .fold(0.0, f64::max);
         println!(
-            "TALLY {}: machines {}, written (exit 0) {}, within upper_mm {w}, beyond 2x {b}, worst delivered/upper {worst:.2}; head at its typical size: within {typical_within}",
+            "TALLY {}{}: machines {}, written (exit 0) {}, within upper_mm {w}, beyond 2x {b}, worst delivered/upper {worst:.2}; head at its typical size: within {typical_within}",
             config.name(),
+            if leg_effects { " + leg effect" } else { "" },
             outcomes.len(),
             ok.len()
         );
@@ -495,7 +546,7 @@ fn tally(seeds: std::ops::Range<u64>, dir: &Path) -> (usize, usize, usize) {
 #[ignore = "the fused tally of docs/reliability.md: 30 machines per configuration"]
 fn fused_files_keep_their_promise_tally() {
     let dir = scratch("tally");
-    let (written, within, beyond) = tally(0..30, &dir);
+    let (written, within, beyond) = tally(0..30, false, &dir);
     let _ = std::fs::remove_dir_all(&dir);
     assert!(written > 0);
     assert!(
@@ -508,7 +559,7 @@ fn fused_files_keep_their_promise_tally() {
 #[test]
 fn one_fused_file_per_configuration_keeps_its_promise() {
     let dir = scratch("ci");
-    let (written, within, beyond) = tally(0..2, &dir);
+    let (written, within, beyond) = tally(0..2, false, &dir);
     let _ = std::fs::remove_dir_all(&dir);
     assert!(written >= 16, "{written} of 24 files written");
     assert!(
@@ -527,6 +578,7 @@ fn twelve_points_and_touches(touches: usize, beyond_mm: f64) -> Config {
         ballbar: None,
         touch: Some(touches),
         touch_beyond_mm: beyond_mm,
+        leg_effects: false,
     }
 }
 
@@ -554,7 +606,7 @@ fn touches_that_cannot_be_checked_but_agree_with_the_tracker_are_deployed_and_na
     // within it in truth.
     for (touches, seed) in [(8, 7), (12, 8)] {
         let config = twelve_points_and_touches(touches, 0.0);
-        let (_, request) = campaign(&config, &plans, seed, &dir);
+        let (_, request, _) = campaign(&config, &plans, seed, &dir);
         let c = calibrate(request).unwrap();
         let json = c.to_json();
         assert_eq!(source(&json, "touch")["checkable"], false, "{json}");
@@ -596,7 +648,7 @@ fn touches_that_disagree_with_the_tracker_are_still_refused() {
     // holds: the touches say the tool is longer than the tracker says.
     let dir = scratch("disagree");
     let plans = Plans::new(&dir);
-    let (_, request) = campaign(&twelve_points_and_touches(12, 0.3), &plans, 8, &dir);
+    let (_, request, _) = campaign(&twelve_points_and_touches(12, 0.3), &plans, 8, &dir);
     let mut c = calibrate(request).unwrap();
     let json = c.to_json();
     assert_eq!(c.exit_code(), 3, "{}", c.report());
@@ -623,8 +675,9 @@ fn touches_that_disagree_with_the_tracker_are_still_refused() {
         ballbar: None,
         touch: None,
         touch_beyond_mm: 0.0,
+        leg_effects: false,
     };
-    let (_, request) = campaign(&config, &plans, 8, &dir);
+    let (_, request, _) = campaign(&config, &plans, 8, &dir);
     let c = calibrate(request).unwrap();
     let json = c.to_json();
     assert_eq!(source(&json, "tracker")["checkable"], false, "{json}");
@@ -637,4 +690,18 @@ fn touches_that_disagree_with_the_tracker_are_still_refused() {
     assert!(o.parts["unchecked_mm"].as_f64().unwrap() > 0.005, "{o:?}");
     assert!(o.delivered_mm <= o.upper_mm, "{o:?}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+#[ignore = "the fused tally with a leg effect of docs/reliability.md: 30 machines per configuration"]
+fn fused_files_with_a_leg_effect_keep_their_promise_tally() {
+    let dir = scratch("tally-effects");
+    let (written, within, beyond) = tally(0..30, true, &dir);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(written > 0);
+    assert!(
+        within as f64 >= 0.95 * written as f64,
+        "{within} of {written}"
+    );
+    assert_eq!(beyond, 0);
 }

@@ -4,12 +4,27 @@
 //! plus an offset) to a pivot on the table; the probe's stylus centre is
 //! the tool tip, and it triggers where the stylus ball of radius `r`
 //! touches a sphere of radius `R`, `|x - c| = R + r`, latching the leg
-//! commands of that moment.
+//! commands of that moment. Leg effects (`effects`) are in the true leg
+//! lengths in the state of delivery ([`TrueMachine::delivered_lengths`]).
 
 use nalgebra::{Matrix3, Vector3};
 use rand_pcg::Pcg64Mcg;
 
-use crate::{TrueMachine, normal};
+use crate::{LegEffect, TrueMachine, normal};
+
+/// The spindle point beyond the tool tip at commands `q` with `effects` in
+/// the true leg lengths.
+fn spindle(
+    truth: &TrueMachine,
+    q: &[f64; 3],
+    h: [f64; 2],
+    extension_mm: f64,
+    offset_mm: &Vector3<f64>,
+    effects: &[LegEffect],
+) -> Vector3<f64> {
+    let joints = truth.forward_lengths(&truth.delivered_lengths(q, effects));
+    truth.spindle_point_at(&joints, h, extension_mm, offset_mm)
+}
 
 /// A ballbar on a pivot, read to 1 um.
 #[derive(Debug, Clone, Copy)]
@@ -29,9 +44,10 @@ impl TrueBallbar {
         q: &[f64; 3],
         h: [f64; 2],
         ball_mm: &Vector3<f64>,
+        effects: &[LegEffect],
         rng: &mut Pcg64Mcg,
     ) -> f64 {
-        let x = truth.spindle_point(q, h, 0.0, ball_mm);
+        let x = spindle(truth, q, h, 0.0, ball_mm, effects);
         (x - self.pivot_mm).norm() + 1e-3 * self.sigma_um * normal(rng)
     }
 }
@@ -68,12 +84,13 @@ impl TrueSphere {
         truth: &TrueMachine,
         q0: &[f64; 3],
         h: [f64; 2],
+        effects: &[LegEffect],
         rng: &mut Pcg64Mcg,
     ) -> Option<[f64; 3]> {
         let documented = TrueMachine::documented();
         let tip = |m: &TrueMachine, q: &[f64; 3]| m.spindle_point(q, h, 0.0, &Vector3::zeros());
         let stylus =
-            |q: &[f64; 3]| truth.spindle_point(q, h, self.beyond_tip_mm, &Vector3::zeros());
+            |q: &[f64; 3]| spindle(truth, q, h, self.beyond_tip_mm, &Vector3::zeros(), effects);
         // The documented tip's Jacobian in the commands, central differences.
         let mut j = Matrix3::zeros();
         for c in 0..3 {

@@ -19,6 +19,7 @@ use tricept_engine::fusion::{
 use tricept_kinematics::description::ExternalSourceRecord;
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
+use tricept_model::effects::EffectName;
 
 use super::values::{FusedSources, TrackerTargetSpec, eval_options, fused_model};
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error};
@@ -38,6 +39,9 @@ pub(crate) struct FusedFit {
     /// External sources that cannot be checked on their own, tested
     /// against the checkable fit of the others (`None`: nothing to test).
     pub unchecked: Option<Unchecked>,
+    /// The promise's structure part `(rms_mm, upper_mm)`
+    /// (`accuracy::fused_structure`).
+    pub structure: (f64, f64),
 }
 
 /// External sources that cannot be checked on their own (too little
@@ -173,6 +177,18 @@ pub(crate) fn fit(
     let all = sources(x, data, machine)?;
     let fit = identify_fused(&model, &all, &options)?;
     let unchecked = unchecked(&model, &fit, &options, || sources(x, data, machine))?;
+    // The geometric estimate's shift when every leg may have a lead.
+    let mut structure = (0.0, 0.0);
+    if model.effects().is_empty() && fit.converged {
+        let mut rich = fused_model(machine, set, &[EffectName::LegLead], x.head)?;
+        if let Some(reference) = loaded.rank_reference()? {
+            rich = rich.with_rank_reference(reference)?;
+        }
+        if let Ok(r) = identify_fused(&rich, &all, &options) {
+            structure =
+                crate::accuracy::fused_structure(&model, &fit, &rich, &r, &options.eval_poses);
+        }
+    }
     Ok(FusedFit {
         model,
         fit,
@@ -180,6 +196,7 @@ pub(crate) fn fit(
         set_label: set.label().to_string(),
         deployed: None,
         unchecked,
+        structure,
     })
 }
 
@@ -392,6 +409,7 @@ impl FusedFit {
         crate::accuracy::of_fusion(
             &self.model,
             &self.fit,
+            self.structure,
             self.unchecked
                 .as_ref()
                 .filter(|u| u.agrees())
