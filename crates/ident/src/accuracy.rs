@@ -22,6 +22,9 @@
 //!   calibrate, their invisible combinations at their typical sizes scaled
 //!   by the size the data show of this head (`head_scale`: the head
 //!   parameters they do see, against their typical sizes);
+//! - **structure** (fused files): where a fit of the same sources with a
+//!   lead on every leg puts the tool tip, against the geometric fit, beyond
+//!   chance (`fused_structure`);
 //! - **unchecked** (fused files): the tool tip's shift beyond chance that
 //!   sources which cannot be checked on their own, accepted because they
 //!   agree with the checked fit of the others, bring.

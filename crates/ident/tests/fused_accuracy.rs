@@ -17,9 +17,10 @@
 //! The configurations are those the tool accepts: a tracker with k = 12 and
 //! 30 points, its target at the tip, at a stated 20 mm offset and free; a
 //! ballbar with 30 readings; each with 24 touch-offs on a sphere beside
-//! it. The CI test runs two machines per configuration; the tally of
-//! `docs/reliability.md` runs 30 (`cargo test -p tricept-ident --test
-//! fused_accuracy -- --ignored --nocapture`).
+//! it. The CI test runs two machines per configuration; the tallies of
+//! `docs/reliability.md` run 30, without and with a static leg effect
+//! hidden in every instrument's true leg lengths (`cargo test -p
+//! tricept-ident --test fused_accuracy -- --ignored --nocapture`).
 
 use std::path::{Path, PathBuf};
 
