@@ -18,8 +18,16 @@
 //!   residuals of the UP limb's readings mapped to the platform through the
 //!   limb's Jacobian ([`tricept_engine::cross_validate`]), never below
 //!   zero;
-//! - **head** (fused files): what the external data show of the head parts
-//!   they cannot calibrate.
+//! - **head** (fused files): the head parts the external data cannot
+//!   calibrate, their invisible combinations at their typical sizes scaled
+//!   by the size the data show of this head (`head_scale`: the head
+//!   parameters they do see, against their typical sizes);
+//! - **structure** (fused files): where a fit of the same sources with a
+//!   lead on every leg puts the tool tip, against the geometric fit, beyond
+//!   chance (`fused_structure`);
+//! - **unchecked** (fused files): the tool tip's shift beyond chance that
+//!   sources which cannot be checked on their own, accepted because they
+//!   agree with the checked fit of the others, bring.
 //!
 //! Its 95 % upper bound adds the parts' 95 % upper bounds in quadrature:
 //! the estimate's mean square `e^T M e` is a weighted sum of chi-squares,
@@ -39,7 +47,7 @@ use tricept_engine::{
 };
 use tricept_kinematics::Machine;
 use tricept_kinematics::description::AccuracyRecord;
-use tricept_model::ParameterSet;
+use tricept_model::{Effector, ParameterSet};
 
 use crate::error::Error;
 
@@ -269,10 +277,21 @@ fn structure_part(
 }
 
 /// The promise of a fused fit at the tool tip after touch-off: the tip's
-/// predicted covariance over the evaluation poses (`tip`) with its held
-/// parameters' share as the head part, and the external sources' residuals
-/// beyond their stated noise out of sample (module docs).
-pub(crate) fn of_fusion(fit: &tricept_engine::fusion::Fusion) -> Accuracy {
+/// predicted covariance over the evaluation poses (`tip`) without the held
+/// parameters as the estimate part; the held parameters' share (their
+/// invisible combinations at their typical sizes) scaled by the size the
+/// data show of this head ([`head_scale`]) as the head part; the external
+/// sources' residuals beyond their stated noise out of sample; and, when
+/// sources that cannot be checked on their own were accepted because they
+/// agree with the checked fit, the tip's shift they bring beyond chance
+/// (`unchecked`, `(rms_mm, upper_mm)`); `structure`: [`fused_structure`]
+/// (module docs).
+pub(crate) fn of_fusion(
+    model: &tricept_engine::fusion::FusedModel,
+    fit: &tricept_engine::fusion::Fusion,
+    structure: (f64, f64),
+    unchecked: Option<(f64, f64)>,
+) -> Accuracy {
     let tip = &fit.report.tool_tip;
     let held_mm = tip.held_touch_off_rms_um * 1e-3;
     let total_mm = tip.touch_off_rms_um * 1e-3;
@@ -299,6 +318,8 @@ pub(crate) fn of_fusion(fit: &tricept_engine::fusion::Fusion) -> Accuracy {
         unexplained = unexplained.max(excess(chi2));
         unexplained_upper = unexplained_upper.max(excess(chi2 + Z95 * (2.0 / nu).sqrt()));
     }
+    let size = head_scale(model, fit);
+    let head = (held_mm * size.scale, one_dof * held_mm * size.upper);
     let mut parts = Map::new();
     parts.insert("estimate_mm".into(), estimate_mm.into());
     parts.insert("estimate_upper_mm".into(), (one_dof * estimate_mm).into());
@@ -307,17 +328,162 @@ pub(crate) fn of_fusion(fit: &tricept_engine::fusion::Fusion) -> Accuracy {
         "unexplained_upper_mm".into(),
         unexplained_upper.sqrt().into(),
     );
-    parts.insert("head_mm".into(), held_mm.into());
-    parts.insert("head_upper_mm".into(), (one_dof * held_mm).into());
-    Accuracy::combine(
-        TOOL_TIP,
-        &[
-            (estimate_mm, one_dof * estimate_mm),
-            (unexplained.sqrt(), unexplained_upper.sqrt()),
-            (held_mm, one_dof * held_mm),
-        ],
-        parts,
-    )
+    parts.insert("head_mm".into(), head.0.into());
+    parts.insert("head_upper_mm".into(), head.1.into());
+    parts.insert("head_at_typical_size_mm".into(), held_mm.into());
+    parts.insert("head_size_seen".into(), size.scale.into());
+    parts.insert("head_size_seen_upper".into(), size.upper.into());
+    parts.insert("head_parameters_seen".into(), size.seen.into());
+    parts.insert("structure_mm".into(), structure.0.into());
+    parts.insert("structure_upper_mm".into(), structure.1.into());
+    let mut list = vec![
+        (estimate_mm, one_dof * estimate_mm),
+        (unexplained.sqrt(), unexplained_upper.sqrt()),
+        head,
+        structure,
+    ];
+    if let Some((rms, upper)) = unchecked {
+        parts.insert("unchecked_mm".into(), rms.into());
+        parts.insert("unchecked_upper_mm".into(), upper.into());
+        list.push((rms, upper));
+    }
+    Accuracy::combine(TOOL_TIP, &list, parts)
+}
+
+/// The structure part of a fused fit: where the geometric fit (`fit`)
+/// and the same sources fitted with a lead on every leg (`rich`, its model
+/// `rich_model`) put the tool tip at the same commands, over the
+/// evaluation poses after touch-off (the mean difference removed): the
+/// mean square difference `D`, less what chance gives it (`tr(M V)`, `M =
+/// mean_e G_e^T G_e` with `G_e` the rich model's tip Jacobian less its
+/// mean over the poses, `V` the rich covariance less the geometric one in
+/// its coordinates: Hausman); its bound adds 1.645 `sqrt(2 tr(MVMV))`.
+/// `(0, 0)` when a tip cannot be had.
+pub(crate) fn fused_structure(
+    model: &tricept_engine::fusion::FusedModel,
+    fit: &tricept_engine::fusion::Fusion,
+    rich_model: &tricept_engine::fusion::FusedModel,
+    rich: &tricept_engine::fusion::Fusion,
+    eval: &[tricept_data::ExternalPose],
+) -> (f64, f64) {
+    let (k, kr) = (model.len(), rich_model.len());
+    // The geometric parameters' places among the rich model's.
+    let index: Vec<usize> = rich_model
+        .module_range()
+        .chain(rich_model.head_range())
+        .collect();
+    if index.len() != k || fit.estimate.len() != k || rich.estimate.len() != kr {
+        return (0.0, 0.0);
+    }
+    let tip = Effector::default();
+    let diffs: Option<Vec<nalgebra::Vector3<f64>>> = eval
+        .iter()
+        .map(|pose| {
+            let r = rich_model.spindle_point(&rich.estimate, pose, &tip).ok()?;
+            let g = model.spindle_point(&fit.estimate, pose, &tip).ok()?;
+            Some(r.0 - g.0)
+        })
+        .collect();
+    let Some(diffs) = diffs else {
+        return (0.0, 0.0);
+    };
+    let Ok(g) = rich_model.spindle_jacobians(&rich.estimate, eval, &[tip]) else {
+        return (0.0, 0.0);
+    };
+    let g: Vec<&nalgebra::DMatrix<f64>> = g.iter().filter_map(|v| v.first()).collect();
+    let n = diffs.len().max(1) as f64;
+    let centre = diffs.iter().sum::<nalgebra::Vector3<f64>>() / n;
+    let shift = diffs
+        .iter()
+        .map(|d| (d - centre).norm_squared())
+        .sum::<f64>()
+        / n;
+    let mean = g
+        .iter()
+        .fold(nalgebra::DMatrix::zeros(3, kr), |a, b| a + *b)
+        / n;
+    let mut m = nalgebra::DMatrix::zeros(kr, kr);
+    for ge in &g {
+        let c = *ge - &mean;
+        m += c.transpose() * c;
+    }
+    m /= n;
+    let mut v = rich.covariance.clone();
+    for (a, &ia) in index.iter().enumerate() {
+        for (b, &ib) in index.iter().enumerate() {
+            v[(ia, ib)] -= fit.covariance[(a, b)];
+        }
+    }
+    let mv = &m * &v;
+    let chance = mv.trace();
+    let sd = (2.0 * (&mv * &mv).trace().max(0.0)).sqrt();
+    let bias2 = shift - chance.max(0.0);
+    if !(bias2.is_finite() && sd.is_finite()) {
+        return (0.0, 0.0);
+    }
+    (bias2.max(0.0).sqrt(), (bias2 + Z95 * sd).max(0.0).sqrt())
+}
+
+/// The size of a head's errors the data show, in units of the parameters'
+/// typical sizes: the head parameters the data see (`n` of them, estimate
+/// `e_j`, standard deviation `s_j`, typical size `t_j`) give `S = sum
+/// (e_j / t_j)^2`, whose mean is `n c^2 + sum (s_j / t_j)^2` for a head of
+/// `c` typical sizes; the scale is the moment estimate `c^2 = (S - sum (s_j
+/// / t_j)^2) / n` (never below zero), its 95 % upper bound `S / chi2_n(5
+/// %)`. A fit that sees no head parameter keeps the typical size (1, 1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct HeadScale {
+    /// The moment estimate `c`.
+    pub scale: f64,
+    /// Its 95 % upper bound.
+    pub upper: f64,
+    /// Head parameters seen.
+    pub seen: usize,
+}
+
+/// The size of the head's errors the data show ([`HeadScale`]).
+pub(crate) fn head_scale(
+    model: &tricept_engine::fusion::FusedModel,
+    fit: &tricept_engine::fusion::Fusion,
+) -> HeadScale {
+    let typical = model.typical_sizes();
+    let seen: Vec<(f64, f64, f64)> = model
+        .head_range()
+        .filter_map(|j| {
+            let sd = (*fit.std_dev.get(j)?)?;
+            Some((*fit.estimate.get(j)?, sd, *typical.get(j)?))
+        })
+        .collect();
+    HeadScale::of(&seen)
+}
+
+impl HeadScale {
+    /// The scale of the head parameters seen, each `(estimate, standard
+    /// deviation, typical size)` (one without a positive typical size or
+    /// with a value that is not finite is left out).
+    pub(crate) fn of(seen: &[(f64, f64, f64)]) -> HeadScale {
+        let (mut sum, mut noise, mut n) = (0.0, 0.0, 0usize);
+        for &(e, sd, t) in seen {
+            if t > 0.0 && e.is_finite() && sd.is_finite() {
+                sum += (e / t).powi(2);
+                noise += (sd / t).powi(2);
+                n += 1;
+            }
+        }
+        if n == 0 {
+            return HeadScale {
+                scale: 1.0,
+                upper: 1.0,
+                seen: 0,
+            };
+        }
+        let low = tricept_numerics::stats::chi2_isf(0.95, n as f64);
+        HeadScale {
+            scale: ((sum - noise).max(0.0) / n as f64).sqrt(),
+            upper: if low > 0.0 { (sum / low).sqrt() } else { 1.0 },
+            seen: n,
+        }
+    }
 }
 
 /// The estimate's rms and 95 % bound from the moments `(tr(MS),
@@ -345,6 +511,27 @@ pub(crate) fn unexplained_part(cv: &CrossValidation) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_head_scale_is_what_the_seen_parameters_show() {
+        // Eleven parameters seen at twice their typical sizes, exactly: a
+        // head of two typical sizes; the bound S / chi2_11(5 %) = 44 / 4.57.
+        let seen = vec![(0.6, 0.0, 0.3); 11];
+        let h = HeadScale::of(&seen);
+        assert!((h.scale - 2.0).abs() < 1e-12, "{h:?}");
+        assert!(
+            (h.upper - (44.0_f64 / 4.574_813).sqrt()).abs() < 1e-3,
+            "{h:?}"
+        );
+        assert_eq!(h.seen, 11);
+        // Estimates no larger than their noise show no head beyond it.
+        let h = HeadScale::of(&[(0.01, 0.02, 0.3), (-0.01, 0.02, 0.1)]);
+        assert_eq!(h.scale, 0.0);
+        assert!(h.upper > 0.0);
+        // Nothing seen: the typical size.
+        let h = HeadScale::of(&[(1.0, f64::NAN, 0.3)]);
+        assert_eq!((h.scale, h.upper, h.seen), (1.0, 1.0, 0));
+    }
 
     #[test]
     fn the_estimate_bound_is_the_chi_square_quantile() {

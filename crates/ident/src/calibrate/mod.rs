@@ -190,7 +190,7 @@ impl Calibration {
     pub fn adequate(&self) -> bool {
         match &self.fit {
             Fit::Internal(f) => f.verdict.adequate,
-            Fit::Fused(f) => f.fit.is_trustworthy(),
+            Fit::Fused(f) => f.trusted(),
         }
     }
 
