@@ -164,8 +164,8 @@ fn machines(r: &CompensateRequest) -> Result<Pair, Error> {
                 why: fit.reason(),
             })
         }
-        Calibrated::MachineFile(path) => {
-            let loaded = path.clone().load()?;
+        Calibrated::MachineFile(machine) => {
+            let loaded = machine.clone().load()?;
             let Some(c) = &loaded.description().calibration else {
                 return Err(Error::input(format!(
                     "compensate: give --data FILE.csv to identify from, or a calibrated machine file as --machine ({} holds no `calibration` record)",
