@@ -141,8 +141,7 @@ impl Machine {
     /// refused with `InputError`.
     #[staticmethod]
     fn load(path: PathBuf) -> PyResult<Machine> {
-        let loaded =
-            MachineInput::from(path.as_path()).load().map_err(door_error)?;
+        let loaded = MachineInput::from(path).load().map_err(door_error)?;
         Ok(Machine {
             machine: ExtendedMachine::new(loaded.machine().clone()),
             source: loaded.source().to_string(),
