@@ -120,6 +120,75 @@ mod tests {
         assert!(e.message().contains("no/such/machine.json"), "{e}");
     }
 
+    /// Every request that needs a machine takes the one input, and a
+    /// machine file that is not there is the same input error from every
+    /// workflow, naming the file.
+    #[test]
+    fn a_missing_machine_file_is_the_same_error_from_every_workflow() {
+        use crate::compensate::{Calibrated, CompensateRequest, compensate};
+        use crate::export::{Controller, ExportOptions, ExportRequest, export};
+        use crate::inputs::Poses;
+        use crate::{calibrate, check, detectability, diagnosis, identifiability, plan, simulate};
+        let missing = "no/such/calibrated.json";
+        let machine = || MachineInput::from(missing);
+        let mut c = calibrate::CalibrateRequest::new("data.csv");
+        c.machine = machine();
+        let mut i = identifiability::IdentifiabilityRequest::new(identifiability::Campaign::Poses(
+            Poses::grid(),
+        ));
+        i.machine = machine();
+        let mut p = plan::PlanRequest::new(plan::Instrument::Tracker);
+        p.machine = machine();
+        let errors = [
+            ("calibrate", calibrate::calibrate(c).err()),
+            (
+                "identifiability",
+                identifiability::assess_identifiability(i).err(),
+            ),
+            ("plan", plan::plan(p).err()),
+            (
+                "check",
+                check::check(check::CheckRequest::new(machine(), "data.csv")).err(),
+            ),
+            (
+                "diagnose",
+                diagnosis::diagnose(diagnosis::DiagnoseRequest::new(machine(), "data.csv")).err(),
+            ),
+            (
+                "detectability",
+                detectability::detectability(detectability::DetectabilityRequest::new(
+                    machine(),
+                    Poses::grid(),
+                ))
+                .err(),
+            ),
+            (
+                "simulate",
+                simulate::simulate(simulate::SimulateRequest::new(machine())).err(),
+            ),
+            (
+                "compensate",
+                compensate(CompensateRequest::new(Calibrated::MachineFile(machine()))).err(),
+            ),
+            (
+                "export",
+                export(ExportRequest {
+                    machine: machine(),
+                    options: ExportOptions::new(Controller::Sinumerik),
+                    out: PathBuf::from("no/such/out"),
+                })
+                .err(),
+            ),
+        ];
+        for (workflow, e) in errors {
+            let Some(e) = e else {
+                panic!("{workflow}: ran without its machine file");
+            };
+            assert_eq!(e.exit_code(), crate::EXIT_INPUT, "{workflow}: {e}");
+            assert!(e.message().contains(missing), "{workflow}: {e}");
+        }
+    }
+
     #[test]
     fn the_noise_overrides_are_checked_when_the_machine_is_loaded() {
         let noise = SensorNoise {
