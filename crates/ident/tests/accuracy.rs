@@ -19,10 +19,12 @@ use std::path::Path;
 
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
-use tricept_ident::{
-    CalibrateRequest, Calibrated, CompensateRequest, DataInput, DiagnoseRequest, Machine,
-    SensorNoise, calibrate, compensate, diagnose, load_machine,
-};
+use tricept_ident::advanced::{SensorNoise, load_machine};
+use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+use tricept_ident::compensate::{Calibrated, CompensateRequest, compensate};
+use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+use tricept_ident::kinematics::{Machine, Vector3};
+use tricept_ident::{DataInput, MachineInput};
 use tricept_truth::{LegContext, LegEffect, Row, TrueMachine, to_csv};
 
 /// Held-out targets per file.
@@ -228,7 +230,7 @@ fn delivered(
     file: &Path,
     truth: &TrueMachine,
     effects: &[LegEffect],
-    targets: &[tricept_ident::nalgebra::Vector3<f64>],
+    targets: &[Vector3<f64>],
     dir: &Path,
 ) -> (f64, usize) {
     let csv: String = std::iter::once("x,y,z\n".to_string())
@@ -243,7 +245,7 @@ fn delivered(
         file.file_stem().unwrap().to_string_lossy()
     ));
     std::fs::write(&path, csv).unwrap();
-    let mut request = CompensateRequest::new(Calibrated::MachineFile(Some(file.to_path_buf())));
+    let mut request = CompensateRequest::new(Calibrated::MachineFile(MachineInput::from(file)));
     request.targets = Some(path);
     request.spacing_mm = 200.0;
     // identify's geometric file of a diagnosed campaign may be forced.
