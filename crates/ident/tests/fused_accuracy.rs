@@ -26,12 +26,11 @@ use std::path::{Path, PathBuf};
 
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
-use tricept_ident::advanced::{FusedSources, TrackerTargetSpec};
-use tricept_ident::nalgebra::Vector3;
-use tricept_ident::{
-    CalibrateRequest, DataInput, Instrument, KinematicsVerb, Machine, PlanRequest, SensorNoise,
-    calibrate, load_machine, plan, solve_point,
-};
+use tricept_ident::DataInput;
+use tricept_ident::advanced::{SensorNoise, TrackerTargetSpec, load_machine};
+use tricept_ident::calibrate::{CalibrateRequest, FusedSources, calibrate};
+use tricept_ident::kinematics::{Machine, Vector3, Verb as KinematicsVerb, solve_point};
+use tricept_ident::plan::{Instrument, PlanRequest, plan};
 use tricept_truth::{
     LegEffect, Row, TrueBallbar, TrueMachine, TrueSphere, TrueTracker, normal, to_csv,
 };
