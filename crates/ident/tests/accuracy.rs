@@ -405,8 +405,9 @@ fn tally_of_diagnosed_campaigns() {
         .filter(|o| o.exit == 0 && o.delivered_mm > 1.1 * o.geometric_mm)
         .count();
     println!(
-        "diagnose: campaigns {}, files written (exit 0) {written}, within the promise {within}, beyond 2x {beyond}, deployed worse than identify's file by more than 10 % {worse}",
-        outcomes.len()
+        "diagnose: campaigns {}, files written (exit 0) {written}, within the promise {within}, beyond 2x {beyond}, deployed worse than identify's file by more than 10 % {worse}, median delivered/upper {:.2}",
+        outcomes.len(),
+        median_ratio(&outcomes)
     );
     assert!(within as f64 >= 0.95 * written as f64);
     assert_eq!(beyond, 0);
