@@ -18,6 +18,12 @@
 //!   residuals of the UP limb's readings mapped to the platform through the
 //!   limb's Jacobian ([`tricept_engine::cross_validate`]), never below
 //!   zero;
+//! - **structure** (internal data, `diagnose`): how far the estimate moves
+//!   when every leg may also be a polynomial in its command (a lead, a
+//!   curved screw), beyond chance; its bound keeps the file's error within
+//!   the 95 % quantile of its distribution given the data, `N(D, S_rich)`
+//!   (`D` the move, `S_rich` the richer fit's covariance: a flat prior on
+//!   the bias), which a shift that chance happens to cancel does not fool;
 //! - **head** (fused files): the head parts the external data cannot
 //!   calibrate, their invisible combinations at their typical sizes scaled
 //!   by the size the data show of this head (`head_scale`: the head
@@ -229,8 +235,31 @@ pub(crate) fn of_fit(
     let cv = tricept_engine::cross_validate(model, id, &data.poses, m, &options.sigma)
         .map_err(context)?;
     let a = Accuracy::internal(&points, &covariance, &held, &cv, id.covariance.nrows() > k)?;
-    let structure = structure_part(&points, model, id, &covariance, data, options)?;
+    let fitted = Fitted {
+        points: &points,
+        model,
+        id,
+        covariance: &covariance,
+        held: &held,
+    };
+    let estimate_upper_mm = a
+        .parts
+        .get("estimate_upper_mm")
+        .and_then(Value::as_f64)
+        .unwrap_or(0.0);
+    let birge_upper = (cv.chi2_per_reading + Z95 * cv.chi2_se).max(1.0);
+    let structure = structure_part(&fitted, data, options, estimate_upper_mm, birge_upper)?;
     Ok(a.with_structure(structure))
+}
+
+/// A fit whose promise is being made: the evaluation points, the model
+/// and its identification, the geometry's covariance and held parameters.
+struct Fitted<'a> {
+    points: &'a AccuracyModel,
+    model: &'a ExtendedModel,
+    id: &'a Identification,
+    covariance: &'a nalgebra::DMatrix<f64>,
+    held: &'a [usize],
 }
 
 /// The model of `set` on `m` alone, in `data`'s frame: the base of an
@@ -244,36 +273,56 @@ pub(crate) fn geometric_base(
 }
 
 /// The shift of the geometric estimate over the workspace when every leg
-/// may also be a quadratic in its command (a lead, a curved screw), beyond
-/// what chance gives it, as `(rms_mm, upper_mm)` (module docs).
+/// may also be a polynomial in its command (a lead, a curved screw), as
+/// `(rms_mm, upper_mm)` (module docs): its rms is the shift beyond what
+/// chance gives it; its bound is what the structure adds to the
+/// estimate's bound `estimate_upper_mm` for the file's error to stay
+/// within the bound of its distribution given the data, `N(D, birge_upper
+/// S_rich)` ([`posterior_upper`]).
 fn structure_part(
-    points: &AccuracyModel,
-    base: &ExtendedModel,
-    id: &Identification,
-    covariance: &nalgebra::DMatrix<f64>,
+    f: &Fitted<'_>,
     data: &Dataset,
     options: &IdentifyOptions,
+    estimate_upper_mm: f64,
+    birge_upper: f64,
 ) -> Result<(f64, f64), Error> {
-    let k = covariance.nrows();
+    let k = f.covariance.nrows();
     let legs = Term::Generic(GenericTerm::new(
         GenericFamily::LegPolynomial,
         Scope::AllLegs,
     ));
-    let rich = base.with(&[base.terms(), &[legs]].concat());
+    let rich = f.model.with(&[f.model.terms(), &[legs]].concat());
     // A richer model that cannot be fitted shows nothing.
     let Ok(r) = tricept_engine::identify(&rich, data, options) else {
         return Ok((0.0, 0.0));
     };
-    let delta = nalgebra::DVector::from_fn(k, |i, _| r.estimate[i] - id.estimate[i]);
-    let d = r.covariance.view((0, 0), (k, k)) - covariance;
+    let delta = nalgebra::DVector::from_fn(k, |i, _| r.estimate[i] - f.id.estimate[i]);
+    let shifted = &delta * delta.transpose();
+    let rich_cov = r.covariance.view((0, 0), (k, k)).into_owned();
     let context = |e: IdentError| Error::with_context("accuracy", &e);
-    let (shift, _) = points
-        .error_moments(&(&delta * delta.transpose()), &[])
-        .map_err(context)?;
-    let (chance, chance2) = points.error_moments(&d, &[]).map_err(context)?;
-    let sd = (2.0 * chance2.max(0.0)).sqrt();
-    let bias2 = shift - chance.max(0.0);
-    Ok((bias2.max(0.0).sqrt(), (bias2 + Z95 * sd).max(0.0).sqrt()))
+    let moments = |c: &nalgebra::DMatrix<f64>, held: &[usize]| {
+        f.points.error_moments(c, held).map_err(context)
+    };
+    let (shift, _) = moments(&shifted, &[])?;
+    let (chance, _) = moments(&(&rich_cov - f.covariance), &[])?;
+    let scaled = rich_cov * birge_upper;
+    let (m1, m2) = moments(&scaled, f.held)?;
+    let (_, m2_shifted) = moments(&(&scaled + &shifted), f.held)?;
+    // D^T M S M D from tr(M (S + D D^T) M (S + D D^T)).
+    let cross = 0.5 * (m2_shifted - m2 - shift * shift);
+    let upper2 = posterior_upper(shift, m1, m2, cross).powi(2);
+    Ok((
+        (shift - chance.max(0.0)).max(0.0).sqrt(),
+        (upper2 - estimate_upper_mm.powi(2)).max(0.0).sqrt(),
+    ))
+}
+
+/// The 95 % bound of the rms of an error `e ~ N(d, S)` over the
+/// workspace, mm: `e^T M e` has mean `shift + m1` and variance `2 (m2 + 2
+/// cross)` (`shift = d^T M d`, `m1 = tr(M S)`, `m2 = tr(M S M S)`, `cross
+/// = d^T M S M d`), taken as `g chi2_nu` with those moments ([`estimate_part`]).
+pub(crate) fn posterior_upper(shift: f64, m1: f64, m2: f64, cross: f64) -> f64 {
+    estimate_part(shift.max(0.0) + m1, m2 + 2.0 * cross.max(0.0)).1
 }
 
 /// The promise of a fused fit at the tool tip after touch-off: the tip's
@@ -546,6 +595,28 @@ mod tests {
         assert!(
             (rms - 1.0).abs() < 1e-12 && upper > 1.0 && upper < 1.02,
             "{upper}"
+        );
+    }
+
+    #[test]
+    fn the_posterior_bound_follows_the_shift_and_its_spread() {
+        // No shift: the bound of the spread alone.
+        assert_eq!(
+            posterior_upper(0.0, 4.0, 16.0, 0.0),
+            estimate_part(4.0, 16.0).1
+        );
+        // One dimension, e ~ N(10, 1): e^2's 95 % quantile is (10 +
+        // 1.645)^2 = 135.6 (the other tail is negligible).
+        let upper = posterior_upper(100.0, 1.0, 1.0, 100.0);
+        assert!((upper - 11.645).abs() < 0.05, "{upper}");
+        // The shift's spread counts: without it the bound is too tight.
+        let tight = posterior_upper(100.0, 1.0, 1.0, 0.0);
+        assert!(tight < 11.3, "{tight}");
+        // A larger shift, a larger bound; a negative one is no shift.
+        assert!(posterior_upper(4.0, 1.0, 1.0, 4.0) > posterior_upper(1.0, 1.0, 1.0, 1.0));
+        assert_eq!(
+            posterior_upper(-1.0, 1.0, 1.0, 0.0),
+            posterior_upper(0.0, 1.0, 1.0, 0.0)
         );
     }
 }
