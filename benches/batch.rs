@@ -1,5 +1,5 @@
 //! Batch kinematics end to end: CSV text in, CSV text out, through
-//! `tricept_ident::advanced::run` (what `tricept ik --input` and `tricept fk
+//! `tricept_ident::kinematics::run` (what `tricept ik --input` and `tricept fk
 //! --input` run: parse, solve in parallel blocks, format). Target: at least
 //! 200 000 points/s.
 
@@ -7,8 +7,7 @@ use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use tricept_benches::workspace_points;
-use tricept_ident::KinematicsVerb as Verb;
-use tricept_ident::advanced::run;
+use tricept_ident::kinematics::{Verb, run};
 use tricept_kinematics::Machine;
 use tricept_model::ExtendedMachine;
 

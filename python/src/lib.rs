@@ -23,12 +23,13 @@ use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::create_exception;
 use pyo3::prelude::*;
 use rayon::prelude::*;
-use tricept_ident::nalgebra::Vector3;
-use tricept_ident::{
-    CalibrateRequest, CheckRequest, DataInput, DiagnoseRequest, ExtendedMachine,
-    LoadedMachine, ParameterSet, Poses, SensorNoise, SimulateRequest,
-};
-use tricept_ident::advanced::{HeadBranch, KinematicsError, TrueErrors};
+use tricept_ident::advanced::{LoadedMachine, ParameterSet, Poses, SensorNoise, TrueErrors};
+use tricept_ident::calibrate::CalibrateRequest;
+use tricept_ident::check::CheckRequest;
+use tricept_ident::diagnosis::DiagnoseRequest;
+use tricept_ident::kinematics::{ExtendedMachine, HeadBranch, KinematicsError, Vector3};
+use tricept_ident::simulate::SimulateRequest;
+use tricept_ident::{DataInput, MachineInput};
 
 create_exception!(
     _tricept,
@@ -130,7 +131,7 @@ impl Machine {
     #[staticmethod]
     fn paper() -> Machine {
         Machine {
-            machine: ExtendedMachine::new(tricept_ident::Machine::paper()),
+            machine: ExtendedMachine::new(tricept_ident::kinematics::Machine::paper()),
             source: "the built-in Table 1 machine".into(),
         }
     }
@@ -140,8 +141,7 @@ impl Machine {
     /// refused with `InputError`.
     #[staticmethod]
     fn load(path: PathBuf) -> PyResult<Machine> {
-        let loaded =
-            tricept_ident::load_machine(Some(&path), &SensorNoise::default()).map_err(door_error)?;
+        let loaded = MachineInput::from(path).load().map_err(door_error)?;
         Ok(Machine {
             machine: ExtendedMachine::new(loaded.machine().clone()),
             source: loaded.source().to_string(),
@@ -252,7 +252,7 @@ impl Machine {
 /// The machine of a workflow: a file, or the embedded Table 1 machine,
 /// with sensor-noise overrides.
 fn machine_of(path: Option<PathBuf>, noise: SensorNoise) -> PyResult<LoadedMachine> {
-    tricept_ident::load_machine(path.as_deref(), &noise).map_err(door_error)
+    MachineInput::new(path, noise).load().map_err(door_error)
 }
 
 /// Data given as a file path or as CSV text (named `name` in messages),
@@ -261,7 +261,7 @@ fn data_of(
     path: Option<PathBuf>,
     csv_text: Option<&str>,
     name: &str,
-    machine: &tricept_ident::Machine,
+    machine: &tricept_ident::kinematics::Machine,
 ) -> PyResult<DataInput> {
     match (path, csv_text) {
         (Some(path), None) => Ok(DataInput::File(path)),
@@ -276,7 +276,7 @@ fn data_of(
 /// JSON and report, and the machine file it may write.
 #[pyclass(module = "tricept._tricept")]
 struct Calibration {
-    inner: tricept_ident::Calibration,
+    inner: tricept_ident::calibrate::Calibration,
 }
 
 #[pymethods]
@@ -373,15 +373,14 @@ fn identify(
         _ => return Err(input_error("data: give a CSV path or a mapping of column arrays")),
     };
     let mut request = CalibrateRequest::new(data);
-    request.machine = machine;
-    request.noise = noise;
+    request.machine = MachineInput::new(machine, noise);
     request.parameter_set = ParameterSet::by_label(&params).map_err(|e| input_error(format!("params: {e}")))?;
     request.robust = robust;
     if let Some(t) = tolerance_mm {
         request.tolerance_mm = t;
     }
     let inner = py
-        .detach(|| tricept_ident::calibrate(request))
+        .detach(|| tricept_ident::calibrate::calibrate(request))
         .map_err(door_error)?;
     Ok(Calibration { inner })
 }
@@ -390,7 +389,7 @@ fn identify(
 /// extended machine file it may write.
 #[pyclass(module = "tricept._tricept")]
 struct Diagnosis {
-    inner: tricept_ident::DiagnoseResult,
+    inner: tricept_ident::diagnosis::DiagnoseResult,
 }
 
 #[pymethods]
@@ -437,7 +436,7 @@ fn diagnose(
     request.noise_from_data = noise_from_data;
     request.dictionary = dictionary;
     let inner = py
-        .detach(|| tricept_ident::diagnose(request))
+        .detach(|| tricept_ident::diagnosis::diagnose(request))
         .map_err(door_error)?;
     Ok(Diagnosis { inner })
 }
@@ -445,7 +444,7 @@ fn diagnose(
 /// A check against a calibration (`tricept check`).
 #[pyclass(module = "tricept._tricept", frozen)]
 struct CheckResult {
-    inner: tricept_ident::CheckResult,
+    inner: tricept_ident::check::CheckResult,
 }
 
 #[pymethods]
@@ -487,7 +486,7 @@ fn check(
     }
     request.history = history;
     let inner = py
-        .detach(|| tricept_ident::check(request))
+        .detach(|| tricept_ident::check::check(request))
         .map_err(door_error)?;
     Ok(CheckResult { inner })
 }
@@ -519,7 +518,7 @@ fn simulate_csv(
     request.both_directions = both_directions;
     request.noise_factor = noise_factor;
     let sim = py
-        .detach(|| tricept_ident::simulate(request))
+        .detach(|| tricept_ident::simulate::simulate(request))
         .map_err(door_error)?;
     let mut text = Vec::new();
     tricept_data::write_to(&mut text, sim.data(), sim.comments())

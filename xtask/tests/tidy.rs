@@ -853,50 +853,25 @@ fn the_effect_counter_reads_code_only() {
 }
 
 // The door's root (issue 27): `tricept-ident`'s root is a curated list,
-// like grep-searcher's. A new public item goes into `tricept_ident::advanced`
-// unless it is one of these kinds; then it is added here.
+// like grep-searcher's. A new public item goes into its workflow's module
+// or into `tricept_ident::advanced` unless it is one of these kinds; then
+// it is added here.
 
 /// Every name `crates/ident/src/lib.rs` makes public at the crate root,
 /// by kind.
 const DOOR_ROOT: &[&str] = &[
-    // The workflows: one function per verb.
-    "assess_identifiability",
+    // The workflows: one module each (its function, request and result).
     "calibrate",
     "check",
     "compensate",
     "detectability",
-    "diagnose",
+    "diagnosis",
     "effects",
     "export",
+    "identifiability",
+    "kinematics",
     "plan",
     "simulate",
-    "solve_point",
-    // Their requests, and what a request's constructor needs.
-    "CalibrateRequest",
-    "Calibrated",
-    "Campaign",
-    "CheckRequest",
-    "CompensateRequest",
-    "DetectabilityRequest",
-    "DiagnoseRequest",
-    "ExportRequest",
-    "IdentifiabilityRequest",
-    "Instrument",
-    "KinematicsVerb",
-    "PlanRequest",
-    "SimulateRequest",
-    // Their results.
-    "Calibration",
-    "CheckResult",
-    "Compensation",
-    "DetectabilityReport",
-    "DiagnoseResult",
-    "EffectList",
-    "Export",
-    "Identifiability",
-    "PointSolution",
-    "Plan",
-    "Simulation",
     // The error and the exit codes.
     "EXIT_INADEQUATE",
     "EXIT_INPUT",
@@ -905,16 +880,9 @@ const DOOR_ROOT: &[&str] = &[
     "EXIT_OTHER",
     "Error",
     "ErrorKind",
-    // The domain.
+    // The two inputs every request is made of.
     "DataInput",
-    "ExtendedMachine",
-    "LoadedMachine",
-    "Machine",
-    "ParameterSet",
-    "Poses",
-    "SensorNoise",
-    "load_machine",
-    "nalgebra",
+    "MachineInput",
     // Everything else, behind one module.
     "advanced",
 ];
@@ -988,7 +956,39 @@ fn the_door_s_root_is_its_curated_list() {
         missing.is_empty(),
         "DOOR_ROOT names what tricept-ident's root no longer has: {missing:?}"
     );
-    assert!(root.len() <= 55, "{} names at the root", root.len());
+    assert!(root.len() <= 21, "{} names at the root", root.len());
+}
+
+/// One machine input (issue 27): every request field that holds a machine
+/// is a `MachineInput`, so a downstream user learns one way to give it.
+#[test]
+fn every_request_takes_the_one_machine_input() {
+    let src = workspace().join("crates/ident/src");
+    let files = modules(&src);
+    assert!(files.len() > 10, "{} holds too few files", src.display());
+    let mut fields = 0;
+    let mut other = Vec::new();
+    for (module, path) in &files {
+        let code = without_tests(&strip(&std::fs::read_to_string(path).unwrap_or_default()));
+        for line in code.lines().map(str::trim) {
+            if let Some(ty) = line.strip_prefix("pub machine:") {
+                fields += 1;
+                if ty.trim().trim_end_matches(',') != "MachineInput" {
+                    other.push(format!("{}: {line}", label(module)));
+                }
+            }
+        }
+    }
+    assert!(
+        other.is_empty(),
+        "requests with their own machine type: {other:?}"
+    );
+    // calibrate, identifiability, plan, check, diagnose, detectability,
+    // simulate and export.
+    assert!(
+        fields >= 8,
+        "only {fields} request fields `pub machine:` found"
+    );
 }
 
 /// The root reader itself: re-exports with braces and renames, public

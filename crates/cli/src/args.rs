@@ -9,11 +9,15 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
+use tricept_ident::MachineInput;
 use tricept_ident::advanced::{
-    Dataset, Effect, EffectName, EffectNames, EvalGrid, FusedSources, HeadAngles, HeadModel,
-    LengthSigma, TrackerTargetSpec, Triple, TrueErrors, TruthEffects,
+    Dataset, EffectNames, EvalGrid, HeadAngles, HeadModel, LengthSigma, LoadedMachine,
+    ParameterSet, SensorNoise, TrackerTargetSpec, Triple, TrueErrors,
 };
-use tricept_ident::{CalibrateRequest, LoadedMachine, Machine, ParameterSet, SensorNoise};
+use tricept_ident::calibrate::{CalibrateRequest, FusedSources};
+use tricept_ident::effects::{Effect, EffectName};
+use tricept_ident::kinematics::Machine;
+use tricept_ident::simulate::TruthEffects;
 
 use crate::cli_error::CliError;
 
@@ -27,6 +31,14 @@ pub struct MachineArgs {
     /// Print machine-readable JSON instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+impl MachineArgs {
+    /// The machine every request takes: `--machine` (or the embedded
+    /// Table 1 machine) with the noise overrides of `noise`.
+    pub fn input(&self, noise: &NoiseArgs) -> MachineInput {
+        MachineInput::new(self.machine.clone(), noise.overrides())
+    }
 }
 
 /// Sensor-noise overrides (default: the machine description's).
@@ -158,7 +170,7 @@ pub struct FitArgs {
 }
 
 /// Loads the machine named by `--machine`, or the embedded default
-/// (`tricept_ident::load_machine`); warns on stderr when it holds a
+/// (`tricept_ident::MachineInput::load`); warns on stderr when it holds a
 /// calibration that was forced or did not explain its data.
 pub fn load(args: &MachineArgs) -> Result<LoadedMachine, CliError> {
     load_with_noise(args, &NoiseArgs::default())
@@ -166,7 +178,7 @@ pub fn load(args: &MachineArgs) -> Result<LoadedMachine, CliError> {
 
 /// [`load`] with the noise overrides applied to the machine.
 pub fn load_with_noise(args: &MachineArgs, noise: &NoiseArgs) -> Result<LoadedMachine, CliError> {
-    let loaded = tricept_ident::load_machine(args.machine.as_deref(), &noise.overrides())?;
+    let loaded = args.input(noise).load()?;
     for w in loaded.warnings() {
         errln!("warning: {w}");
     }
@@ -237,8 +249,7 @@ impl FitSettings {
     /// (internal; the caller adds external sources).
     pub fn request(&self, data: &Path) -> CalibrateRequest {
         let mut request = CalibrateRequest::new(data);
-        request.machine = self.machine.machine.clone();
-        request.noise = self.noise.overrides();
+        request.machine = self.machine.input(&self.noise);
         request.parameter_set = self.params.params.clone();
         request.robust = !self.fit.no_robust;
         request.tolerance_mm = self.fit.tolerance_mm;

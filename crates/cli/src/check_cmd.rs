@@ -5,8 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use tricept_ident::advanced::Trend;
-use tricept_ident::{CheckRequest, check};
+use tricept_ident::check::{CheckRequest, Trend, check};
 
 use crate::args::{MachineArgs, NoiseArgs, load_with_noise};
 use crate::cli_error::CliError;
@@ -19,7 +18,7 @@ pub struct CheckArgs {
     #[arg(long, value_name = "FILE.csv")]
     pub data: PathBuf,
     /// Family-wise false-alarm probability of the verdict.
-    #[arg(long, default_value_t = tricept_ident::advanced::DEFAULT_CHECK_ALPHA, value_name = "P")]
+    #[arg(long, default_value_t = tricept_ident::check::DEFAULT_ALPHA, value_name = "P")]
     pub alpha: f64,
     /// Append the check to this history (JSON lines: time, verdict, the
     /// changes and their sizes) and report the trends of its key

@@ -6,13 +6,14 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use tricept_ident::advanced::ErrorMap;
-use tricept_ident::{Calibrated, CompensateRequest, Compensation, compensate};
+use tricept_ident::compensate::{
+    Calibrated, CompensateRequest, Compensation, ErrorMap, compensate,
+};
 
-use crate::args::{FitSettings, TruthArgs};
+use crate::args::{FitSettings, NoiseArgs, TruthArgs};
 use crate::cli_error::CliError;
 
-pub use tricept_ident::advanced::{MAP_FILES, TABLE_FILES};
+pub use tricept_ident::compensate::{MAP_FILES, TABLE_FILES};
 
 /// `tricept compensate`.
 #[derive(Debug, Args)]
@@ -66,7 +67,7 @@ pub struct CompensateArgs {
 pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
     let calibrated = match &a.data {
         Some(data) => Calibrated::Data(Box::new(a.settings.request(data))),
-        None => Calibrated::MachineFile(a.settings.machine.machine.clone()),
+        None => Calibrated::MachineFile(a.settings.machine.input(&NoiseArgs::default())),
     };
     let mut request = CompensateRequest::new(calibrated);
     request.force = a.force;

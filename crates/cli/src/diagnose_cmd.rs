@@ -1,20 +1,19 @@
 //! `tricept diagnose` and `tricept detectability`: flags into a request
-//! of the door (`tricept_ident::diagnose`, `tricept_ident::detectability`),
+//! of the door (`tricept_ident::diagnosis`, `tricept_ident::detectability`),
 //! the result printed, the residual plots drawn.
 
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use tricept_ident::advanced::ResidualPlot;
-use tricept_ident::{
-    DataInput, DetectabilityRequest, DiagnoseRequest, DiagnoseResult, LoadedMachine, Poses,
-    detectability, diagnose,
-};
+use tricept_ident::DataInput;
+use tricept_ident::advanced::{LoadedMachine, Poses};
+use tricept_ident::detectability::{DetectabilityRequest, detectability};
+use tricept_ident::diagnosis::{DiagnoseRequest, DiagnoseResult, ResidualPlot, diagnose};
 
 use crate::args::{MachineArgs, NoiseArgs, load_with_noise, read_data};
 use crate::cli_error::CliError;
 
-pub use tricept_ident::advanced::vocabulary_help;
+pub use tricept_ident::diagnosis::vocabulary_help;
 
 /// `tricept diagnose`.
 #[derive(Debug, Args)]
@@ -166,12 +165,13 @@ fn plot_residuals(dir: &Path, plots: &[ResidualPlot]) -> Result<(), CliError> {
 
 /// `tricept detectability`.
 pub fn run_detectability(a: &DetectabilityArgs) -> Result<u8, CliError> {
-    let mut request =
-        DetectabilityRequest::new(load_with_noise(&a.machine, &a.noise)?, a.poses.clone());
-    request.data = match &a.data {
-        Some(path) => Some(read_with_progress(path, &request.machine)?),
+    let loaded = load_with_noise(&a.machine, &a.noise)?;
+    let data = match &a.data {
+        Some(path) => Some(read_with_progress(path, &loaded)?),
         None => None,
     };
+    let mut request = DetectabilityRequest::new(loaded, a.poses.clone());
+    request.data = data;
     request.both_directions = a.both_directions;
     request.temperature_drift_k = a.temperature_drift;
     let report = detectability(request)?;

@@ -22,7 +22,7 @@ pub struct EffectsArgs {
 
 /// Runs `tricept effects`.
 pub fn run(a: &EffectsArgs) -> Result<u8, CliError> {
-    let list = tricept_ident::effects(a.effect.as_deref())?;
+    let list = tricept_ident::effects::effects(a.effect.as_deref())?;
     if a.json {
         crate::output::write_text(&list.to_json()?);
     } else {

@@ -5,8 +5,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_ident::ExportRequest;
-use tricept_ident::advanced::{Controller, ExportOptions};
+use tricept_ident::export::{Controller, ExportOptions, ExportRequest};
 
 use crate::cli_error::CliError;
 
@@ -79,7 +78,7 @@ fn parse_three_mm(s: &str) -> Result<[f64; 3], String> {
 /// `tricept export`.
 pub fn run(a: &ExportArgs) -> Result<u8, CliError> {
     let request = ExportRequest {
-        machine: a.machine.clone(),
+        machine: a.machine.as_path().into(),
         options: ExportOptions {
             axis_names: a.axis_names.clone(),
             max_points: a.max_points,
@@ -91,7 +90,7 @@ pub fn run(a: &ExportArgs) -> Result<u8, CliError> {
         },
         out: a.out.clone(),
     };
-    let e = tricept_ident::export(request)?;
+    let e = tricept_ident::export::export(request)?;
     if a.json {
         outln!("{}", e.json(&a.out));
     } else {

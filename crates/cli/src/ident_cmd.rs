@@ -1,14 +1,14 @@
 //! The self-calibration verbs `identifiability` and `identify`: flags in,
-//! one call of the door (`tricept_ident::assess_identifiability`,
+//! one call of the door (`tricept_ident::identifiability`,
 //! `tricept_ident::calibrate`), the result out.
 
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_ident::{
-    CalibrateRequest, Campaign, DataInput, IdentifiabilityRequest, Poses, assess_identifiability,
-    calibrate,
-};
+use tricept_ident::DataInput;
+use tricept_ident::advanced::Poses;
+use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+use tricept_ident::identifiability::{Campaign, IdentifiabilityRequest, assess_identifiability};
 
 use crate::args::{IdentifyArgs, MachineArgs, NoiseArgs, ParamArgs};
 use crate::cli_error::CliError;
@@ -38,8 +38,7 @@ pub fn run_identifiability(a: &IdentifiabilityArgs) -> Result<u8, CliError> {
         None => Campaign::Poses(a.poses.clone()),
     };
     let mut request = IdentifiabilityRequest::new(campaign);
-    request.machine = a.machine.machine.clone();
-    request.noise = a.noise.overrides();
+    request.machine = a.machine.input(&a.noise);
     request.parameter_set = a.params.params.clone();
     let result = assess_identifiability(request)?;
     crate::output::warn_all(result.machine_warnings());

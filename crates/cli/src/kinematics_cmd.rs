@@ -1,16 +1,15 @@
 //! The kinematics verbs: `ik`, `fk`, `tool-ik` (one point from the command
 //! line, or many from `--input FILE.csv|-`), and `machine`; the workflows
-//! are the door's (`tricept_ident::solve_point`,
-//! `tricept_ident::advanced::solve_batch`).
+//! are the door's (`tricept_ident::kinematics::solve_point`,
+//! `tricept_ident::kinematics::solve_batch`).
 //!
 //! A calibrated machine file's static leg effects (lead, compliance) are
-//! applied (`tricept_ident::ExtendedMachine`).
+//! applied (`tricept_ident::kinematics::ExtendedMachine`).
 
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_ident::advanced::{machine_summary, solve_batch};
-use tricept_ident::{ExtendedMachine, KinematicsVerb as Verb, solve_point};
+use tricept_ident::kinematics::{ExtendedMachine, Verb, machine_summary, solve_batch, solve_point};
 
 use crate::args::{MachineArgs, load};
 use crate::cli_error::CliError;

@@ -4,8 +4,10 @@
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
-use tricept_ident::advanced::{EffectNames, EvalGrid, HeadAngles, TrackerTargetSpec, Triple};
-use tricept_ident::{PlanRequest, Poses};
+use tricept_ident::advanced::{
+    EffectNames, EvalGrid, HeadAngles, Poses, TrackerTargetSpec, Triple,
+};
+use tricept_ident::plan::{self as door, PlanRequest};
 
 use crate::args::{MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs};
 use crate::cli_error::CliError;
@@ -142,12 +144,12 @@ pub struct PlanArgs {
 
 impl Instrument {
     /// The door's instrument.
-    fn door(self) -> tricept_ident::Instrument {
+    fn door(self) -> door::Instrument {
         match self {
-            Instrument::Tracker => tricept_ident::Instrument::Tracker,
-            Instrument::Ballbar => tricept_ident::Instrument::Ballbar,
-            Instrument::Touch => tricept_ident::Instrument::Touch,
-            Instrument::Check => tricept_ident::Instrument::Check,
+            Instrument::Tracker => door::Instrument::Tracker,
+            Instrument::Ballbar => door::Instrument::Ballbar,
+            Instrument::Touch => door::Instrument::Touch,
+            Instrument::Check => door::Instrument::Check,
         }
     }
 }
@@ -184,15 +186,14 @@ fn request(a: &PlanArgs) -> Result<PlanRequest, CliError> {
     r.eval_grid = a.eval_grid;
     r.eval_head_angles_deg = a.eval_head_angles_deg.clone();
     r.out = a.out.clone();
-    r.machine = a.machine.machine.clone();
-    r.noise = a.noise.overrides();
+    r.machine = a.machine.input(&a.noise);
     r.parameter_set = a.params.params.clone();
     Ok(r)
 }
 
 /// `tricept plan`.
 pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
-    let plan = tricept_ident::plan(request(a)?)?;
+    let plan = door::plan(request(a)?)?;
     crate::output::warn_all(plan.machine_warnings());
     if let Some(path) = &a.out
         && plan.write_out(path)?

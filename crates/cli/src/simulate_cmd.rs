@@ -5,10 +5,10 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_ident::advanced::{
-    BallbarSimulation, FrameMmRad, HeadErrors, TouchSimulation, TrackerSimulation, Triple,
+use tricept_ident::advanced::{FrameMmRad, Poses, Triple};
+use tricept_ident::simulate::{
+    BallbarSimulation, HeadErrors, SimulateRequest, TouchSimulation, TrackerSimulation, simulate,
 };
-use tricept_ident::{Poses, SimulateRequest, simulate};
 
 use crate::args::{MachineArgs, NoiseArgs, ParamArgs, TouchSphereArgs, TruthArgs, load_with_noise};
 use crate::cli_error::CliError;

@@ -34,7 +34,12 @@
 //! backward elimination removes the least useful failing term (smallest
 //! improvement in standard deviations), refits the rest and judges them
 //! again. A term whose absence leaves a model that cannot be fitted is
-//! needed and deployed.
+//! needed and deployed. The predicted improvement's standard deviation
+//! takes the deployed model's own platform uncertainty at least as large
+//! as that of the deployed model with a polynomial on every leg that
+//! carries none ([`structured_sd`]): a move along the weak direction is
+//! trusted only when it stands out of what the legs' structure leaves
+//! unknown.
 
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -47,7 +52,8 @@ use crate::gain::{Improvement, improvement};
 use crate::model::ExtendedModel;
 use crate::report::{DEPLOY_BENEFIT_SD, DEPLOY_IMPROVEMENT_SD, ModelTerm};
 use crate::select::Setup;
-use crate::terms::Term;
+use crate::terms::{GenericTerm, Scope, Term};
+use tricept_model::effects::{EffectName, GenericFamily};
 
 /// The out-of-sample benefit of one file over another, mm.
 #[derive(Debug, Clone, Copy)]
@@ -159,6 +165,85 @@ pub(crate) fn benefit(with: &[Vector3<f64>], without: &[Vector3<f64>]) -> Option
     })
 }
 
+/// The deployed model terms are judged against: its fit, its held-out
+/// platform errors, and its platform's standard deviation when every leg
+/// may also carry a polynomial ([`structured_sd`]).
+#[derive(Clone, Copy)]
+struct Against<'a> {
+    fit: &'a Fit,
+    full: Option<&'a [Vector3<f64>]>,
+    structured_sd_mm: Option<f64>,
+}
+
+/// The deployed model's own platform standard deviation on the middle
+/// plane when every leg may also be a polynomial in its command (a lead,
+/// a curved screw: [`GenericFamily::LegPolynomial`] on all legs), mm;
+/// a leg whose command dependence the model already describes keeps its
+/// own ([`shapes_leg`]); `None` when that model cannot be fitted or every
+/// leg has one.
+///
+/// A move along the weak direction is made by a term's small correlation
+/// with it, scaled by the weak direction's large uncertainty; a term that
+/// is nearly right (a drift at a constant rate where the legs grow with
+/// their length, a polynomial beside an unexplained slip) moves it as far
+/// and as confidently, but wrongly. The readings cannot tell: only a move
+/// that stands out of what the legs' structure leaves unknown is trusted.
+fn structured_sd(nominal: &Machine, setup: &Setup<'_>, clean: &Dataset, with: &Fit) -> Option<f64> {
+    let fitter = &setup.fitter;
+    let carried = |leg: usize| with.model.terms().iter().any(|t| shapes_leg(t, leg));
+    let free: Vec<u8> = (0..3u8).filter(|&i| !carried(usize::from(i))).collect();
+    let legs: Vec<Term> = match free.as_slice() {
+        [] => return None,
+        [_, _, _] => vec![Term::Generic(GenericTerm::new(
+            GenericFamily::LegPolynomial,
+            Scope::AllLegs,
+        ))],
+        some => some
+            .iter()
+            .map(|&i| {
+                Term::Generic(GenericTerm::new(
+                    GenericFamily::LegPolynomial,
+                    Scope::Leg(i),
+                ))
+            })
+            .collect(),
+    };
+    let terms = [with.model.terms(), &legs].concat();
+    let rich = fitter.fit(fitter.model(&terms), clean).ok()?;
+    let g = improvement(nominal, with, &rich, fitter.options)?;
+    let own2 = g.sd_mm.powi(2) - g.difference_sd_mm.powi(2);
+    own2.is_finite().then(|| own2.max(0.0).sqrt())
+}
+
+/// Whether `t` already describes how leg `leg`'s length error varies with
+/// its command (a lead, a polynomial, a periodic error): that leg keeps its
+/// own description and gets no polynomial of [`structured_sd`].
+fn shapes_leg(t: &Term, leg: usize) -> bool {
+    match t {
+        Term::Catalogue(e) => *e == EffectName::LegLead,
+        Term::Generic(g) => {
+            matches!(
+                g.family,
+                GenericFamily::LegPolynomial | GenericFamily::LegPeriodic
+            ) && g.legs().contains(&leg)
+        }
+    }
+}
+
+/// `g` with its own part at least `structured_sd_mm` ([`structured_sd`]).
+fn with_structure(g: Improvement, structured_sd_mm: Option<f64>) -> Improvement {
+    let own = (g.sd_mm.powi(2) - g.difference_sd_mm.powi(2))
+        .max(0.0)
+        .sqrt();
+    match structured_sd_mm {
+        Some(s) if s > own => Improvement {
+            sd_mm: s.hypot(g.difference_sd_mm),
+            ..g
+        },
+        _ => g,
+    }
+}
+
 /// A term judged against the deployed model `with` (which holds it).
 struct Judged {
     record: ModelTerm,
@@ -176,10 +261,14 @@ fn judge(
     nominal: &Machine,
     setup: &Setup<'_>,
     clean: &Dataset,
-    with: &Fit,
-    full: Option<&[Vector3<f64>]>,
+    with: &Against<'_>,
     t: &Term,
 ) -> Judged {
+    let Against {
+        fit: with,
+        full,
+        structured_sd_mm,
+    } = *with;
     let fitter = &setup.fitter;
     let others: Vec<Term> = with
         .model
@@ -192,7 +281,8 @@ fn judge(
     let without = fitter.fit(model.clone(), clean).ok();
     let gained = without
         .as_ref()
-        .and_then(|w| improvement(nominal, w, with, fitter.options));
+        .and_then(|w| improvement(nominal, w, with, fitter.options))
+        .map(|g| with_structure(g, structured_sd_mm));
     let held_out = match (full, &without) {
         (Some(full), Some(_)) => platform_errors(setup, &model, clean)
             .ok()
@@ -285,9 +375,14 @@ pub(crate) fn deployable(
     let mut kept = terms.clone();
     while !kept.is_empty() {
         let full = platform_errors(setup, &with.model, clean).ok();
+        let against = Against {
+            fit: &with,
+            full: full.as_deref(),
+            structured_sd_mm: structured_sd(nominal, setup, clean, &with),
+        };
         let judged: Vec<Judged> = kept
             .par_iter()
-            .map(|t| judge(nominal, setup, clean, &with, full.as_deref(), t))
+            .map(|t| judge(nominal, setup, clean, &against, t))
             .collect();
         let failing = judged
             .iter()
@@ -444,5 +539,52 @@ mod tests {
         assert_eq!(improvement_sds(g(1.0, 0.0)), f64::INFINITY);
         assert_eq!(improvement_sds(g(-1.0, 0.0)), f64::INFINITY);
         assert_eq!(improvement_sds(None), f64::INFINITY);
+    }
+
+    #[test]
+    fn a_leg_described_in_its_command_keeps_its_own_description() {
+        let lead = Term::Catalogue(EffectName::LegLead);
+        let generic = |f, scope| Term::Generic(GenericTerm::new(f, scope));
+        for leg in 0..3 {
+            assert!(shapes_leg(&lead, leg));
+            assert!(shapes_leg(
+                &generic(GenericFamily::LegPeriodic, Scope::AllLegs),
+                leg
+            ));
+        }
+        let curved = generic(GenericFamily::LegPolynomial, Scope::Leg(1));
+        assert!(shapes_leg(&curved, 1));
+        assert!(!shapes_leg(&curved, 0) && !shapes_leg(&curved, 2));
+        // Time, temperature and readings say nothing of the command.
+        for t in [
+            Term::Catalogue(EffectName::Thermal),
+            Term::Catalogue(EffectName::Backlash),
+            Term::Catalogue(EffectName::ScaleGain),
+            generic(GenericFamily::LegDrift, Scope::AllLegs),
+        ] {
+            assert!(!shapes_leg(&t, 0), "{t:?}");
+        }
+    }
+
+    #[test]
+    fn the_structure_widens_only_the_files_own_uncertainty() {
+        // own 0.03, move 0.04: sd 0.05.
+        let g = Improvement {
+            mean_mm: 0.12,
+            sd_mm: 0.05,
+            difference_sd_mm: 0.04,
+        };
+        // A structured own sd of 0.09 replaces the own 0.03, the move's
+        // 0.04 stays: sqrt(0.09^2 + 0.04^2).
+        let w = with_structure(g, Some(0.09));
+        assert!((w.sd_mm - 0.09_f64.hypot(0.04)).abs() < 1e-12, "{w:?}");
+        assert_eq!((w.mean_mm, w.difference_sd_mm), (0.12, 0.04));
+        // The 0.12 move was 2.4 sd, it is no longer 2.
+        assert!(w.mean_mm < DEPLOY_IMPROVEMENT_SD * w.sd_mm);
+        // A smaller structured sd, or none, changes nothing.
+        for s in [Some(0.02), Some(0.03), None] {
+            let same = with_structure(g, s);
+            assert_eq!(same.sd_mm, g.sd_mm, "{s:?}");
+        }
     }
 }

@@ -18,8 +18,22 @@
 //!   residuals of the UP limb's readings mapped to the platform through the
 //!   limb's Jacobian ([`tricept_engine::cross_validate`]), never below
 //!   zero;
-//! - **head** (fused files): what the external data show of the head parts
-//!   they cannot calibrate.
+//! - **structure** (internal data, `diagnose`): how far the estimate moves
+//!   when every leg may also be a polynomial in its command (a lead, a
+//!   curved screw), beyond chance; its bound keeps the file's error within
+//!   the 95 % quantile of its distribution given the data, `N(D, S_rich)`
+//!   (`D` the move, `S_rich` the richer fit's covariance: a flat prior on
+//!   the bias), which a shift that chance happens to cancel does not fool;
+//! - **head** (fused files): the head parts the external data cannot
+//!   calibrate, their invisible combinations at their typical sizes scaled
+//!   by the size the data show of this head (`head_scale`: the head
+//!   parameters they do see, against their typical sizes);
+//! - **structure** (fused files): where a fit of the same sources with a
+//!   lead on every leg puts the tool tip, against the geometric fit, beyond
+//!   chance (`fused_structure`);
+//! - **unchecked** (fused files): the tool tip's shift beyond chance that
+//!   sources which cannot be checked on their own, accepted because they
+//!   agree with the checked fit of the others, bring.
 //!
 //! Its 95 % upper bound adds the parts' 95 % upper bounds in quadrature:
 //! the estimate's mean square `e^T M e` is a weighted sum of chi-squares,
@@ -39,7 +53,7 @@ use tricept_engine::{
 };
 use tricept_kinematics::Machine;
 use tricept_kinematics::description::AccuracyRecord;
-use tricept_model::ParameterSet;
+use tricept_model::{Effector, ParameterSet};
 
 use crate::error::Error;
 
@@ -221,8 +235,31 @@ pub(crate) fn of_fit(
     let cv = tricept_engine::cross_validate(model, id, &data.poses, m, &options.sigma)
         .map_err(context)?;
     let a = Accuracy::internal(&points, &covariance, &held, &cv, id.covariance.nrows() > k)?;
-    let structure = structure_part(&points, model, id, &covariance, data, options)?;
+    let fitted = Fitted {
+        points: &points,
+        model,
+        id,
+        covariance: &covariance,
+        held: &held,
+    };
+    let estimate_upper_mm = a
+        .parts
+        .get("estimate_upper_mm")
+        .and_then(Value::as_f64)
+        .unwrap_or(0.0);
+    let birge_upper = (cv.chi2_per_reading + Z95 * cv.chi2_se).max(1.0);
+    let structure = structure_part(&fitted, data, options, estimate_upper_mm, birge_upper)?;
     Ok(a.with_structure(structure))
+}
+
+/// A fit whose promise is being made: the evaluation points, the model
+/// and its identification, the geometry's covariance and held parameters.
+struct Fitted<'a> {
+    points: &'a AccuracyModel,
+    model: &'a ExtendedModel,
+    id: &'a Identification,
+    covariance: &'a nalgebra::DMatrix<f64>,
+    held: &'a [usize],
 }
 
 /// The model of `set` on `m` alone, in `data`'s frame: the base of an
@@ -236,43 +273,74 @@ pub(crate) fn geometric_base(
 }
 
 /// The shift of the geometric estimate over the workspace when every leg
-/// may also be a quadratic in its command (a lead, a curved screw), beyond
-/// what chance gives it, as `(rms_mm, upper_mm)` (module docs).
+/// may also be a polynomial in its command (a lead, a curved screw), as
+/// `(rms_mm, upper_mm)` (module docs): its rms is the shift beyond what
+/// chance gives it; its bound is what the structure adds to the
+/// estimate's bound `estimate_upper_mm` for the file's error to stay
+/// within the bound of its distribution given the data, `N(D, birge_upper
+/// S_rich)` ([`posterior_upper`]).
 fn structure_part(
-    points: &AccuracyModel,
-    base: &ExtendedModel,
-    id: &Identification,
-    covariance: &nalgebra::DMatrix<f64>,
+    f: &Fitted<'_>,
     data: &Dataset,
     options: &IdentifyOptions,
+    estimate_upper_mm: f64,
+    birge_upper: f64,
 ) -> Result<(f64, f64), Error> {
-    let k = covariance.nrows();
+    let k = f.covariance.nrows();
     let legs = Term::Generic(GenericTerm::new(
         GenericFamily::LegPolynomial,
         Scope::AllLegs,
     ));
-    let rich = base.with(&[base.terms(), &[legs]].concat());
+    let rich = f.model.with(&[f.model.terms(), &[legs]].concat());
     // A richer model that cannot be fitted shows nothing.
     let Ok(r) = tricept_engine::identify(&rich, data, options) else {
         return Ok((0.0, 0.0));
     };
-    let delta = nalgebra::DVector::from_fn(k, |i, _| r.estimate[i] - id.estimate[i]);
-    let d = r.covariance.view((0, 0), (k, k)) - covariance;
+    let delta = nalgebra::DVector::from_fn(k, |i, _| r.estimate[i] - f.id.estimate[i]);
+    let shifted = &delta * delta.transpose();
+    let rich_cov = r.covariance.view((0, 0), (k, k)).into_owned();
     let context = |e: IdentError| Error::with_context("accuracy", &e);
-    let (shift, _) = points
-        .error_moments(&(&delta * delta.transpose()), &[])
-        .map_err(context)?;
-    let (chance, chance2) = points.error_moments(&d, &[]).map_err(context)?;
-    let sd = (2.0 * chance2.max(0.0)).sqrt();
-    let bias2 = shift - chance.max(0.0);
-    Ok((bias2.max(0.0).sqrt(), (bias2 + Z95 * sd).max(0.0).sqrt()))
+    let moments = |c: &nalgebra::DMatrix<f64>, held: &[usize]| {
+        f.points.error_moments(c, held).map_err(context)
+    };
+    let (shift, _) = moments(&shifted, &[])?;
+    let (chance, _) = moments(&(&rich_cov - f.covariance), &[])?;
+    let scaled = rich_cov * birge_upper;
+    let (m1, m2) = moments(&scaled, f.held)?;
+    let (_, m2_shifted) = moments(&(&scaled + &shifted), f.held)?;
+    // D^T M S M D from tr(M (S + D D^T) M (S + D D^T)).
+    let cross = 0.5 * (m2_shifted - m2 - shift * shift);
+    let upper2 = posterior_upper(shift, m1, m2, cross).powi(2);
+    Ok((
+        (shift - chance.max(0.0)).max(0.0).sqrt(),
+        (upper2 - estimate_upper_mm.powi(2)).max(0.0).sqrt(),
+    ))
+}
+
+/// The 95 % bound of the rms of an error `e ~ N(d, S)` over the
+/// workspace, mm: `e^T M e` has mean `shift + m1` and variance `2 (m2 + 2
+/// cross)` (`shift = d^T M d`, `m1 = tr(M S)`, `m2 = tr(M S M S)`, `cross
+/// = d^T M S M d`), taken as `g chi2_nu` with those moments ([`estimate_part`]).
+pub(crate) fn posterior_upper(shift: f64, m1: f64, m2: f64, cross: f64) -> f64 {
+    estimate_part(shift.max(0.0) + m1, m2 + 2.0 * cross.max(0.0)).1
 }
 
 /// The promise of a fused fit at the tool tip after touch-off: the tip's
-/// predicted covariance over the evaluation poses (`tip`) with its held
-/// parameters' share as the head part, and the external sources' residuals
-/// beyond their stated noise out of sample (module docs).
-pub(crate) fn of_fusion(fit: &tricept_engine::fusion::Fusion) -> Accuracy {
+/// predicted covariance over the evaluation poses (`tip`) without the held
+/// parameters as the estimate part; the held parameters' share (their
+/// invisible combinations at their typical sizes) scaled by the size the
+/// data show of this head ([`head_scale`]) as the head part; the external
+/// sources' residuals beyond their stated noise out of sample; and, when
+/// sources that cannot be checked on their own were accepted because they
+/// agree with the checked fit, the tip's shift they bring beyond chance
+/// (`unchecked`, `(rms_mm, upper_mm)`); `structure`: [`fused_structure`]
+/// (module docs).
+pub(crate) fn of_fusion(
+    model: &tricept_engine::fusion::FusedModel,
+    fit: &tricept_engine::fusion::Fusion,
+    structure: (f64, f64),
+    unchecked: Option<(f64, f64)>,
+) -> Accuracy {
     let tip = &fit.report.tool_tip;
     let held_mm = tip.held_touch_off_rms_um * 1e-3;
     let total_mm = tip.touch_off_rms_um * 1e-3;
@@ -299,6 +367,8 @@ pub(crate) fn of_fusion(fit: &tricept_engine::fusion::Fusion) -> Accuracy {
         unexplained = unexplained.max(excess(chi2));
         unexplained_upper = unexplained_upper.max(excess(chi2 + Z95 * (2.0 / nu).sqrt()));
     }
+    let size = head_scale(model, fit);
+    let head = (held_mm * size.scale, one_dof * held_mm * size.upper);
     let mut parts = Map::new();
     parts.insert("estimate_mm".into(), estimate_mm.into());
     parts.insert("estimate_upper_mm".into(), (one_dof * estimate_mm).into());
@@ -307,17 +377,162 @@ pub(crate) fn of_fusion(fit: &tricept_engine::fusion::Fusion) -> Accuracy {
         "unexplained_upper_mm".into(),
         unexplained_upper.sqrt().into(),
     );
-    parts.insert("head_mm".into(), held_mm.into());
-    parts.insert("head_upper_mm".into(), (one_dof * held_mm).into());
-    Accuracy::combine(
-        TOOL_TIP,
-        &[
-            (estimate_mm, one_dof * estimate_mm),
-            (unexplained.sqrt(), unexplained_upper.sqrt()),
-            (held_mm, one_dof * held_mm),
-        ],
-        parts,
-    )
+    parts.insert("head_mm".into(), head.0.into());
+    parts.insert("head_upper_mm".into(), head.1.into());
+    parts.insert("head_at_typical_size_mm".into(), held_mm.into());
+    parts.insert("head_size_seen".into(), size.scale.into());
+    parts.insert("head_size_seen_upper".into(), size.upper.into());
+    parts.insert("head_parameters_seen".into(), size.seen.into());
+    parts.insert("structure_mm".into(), structure.0.into());
+    parts.insert("structure_upper_mm".into(), structure.1.into());
+    let mut list = vec![
+        (estimate_mm, one_dof * estimate_mm),
+        (unexplained.sqrt(), unexplained_upper.sqrt()),
+        head,
+        structure,
+    ];
+    if let Some((rms, upper)) = unchecked {
+        parts.insert("unchecked_mm".into(), rms.into());
+        parts.insert("unchecked_upper_mm".into(), upper.into());
+        list.push((rms, upper));
+    }
+    Accuracy::combine(TOOL_TIP, &list, parts)
+}
+
+/// The structure part of a fused fit: where the geometric fit (`fit`)
+/// and the same sources fitted with a lead on every leg (`rich`, its model
+/// `rich_model`) put the tool tip at the same commands, over the
+/// evaluation poses after touch-off (the mean difference removed): the
+/// mean square difference `D`, less what chance gives it (`tr(M V)`, `M =
+/// mean_e G_e^T G_e` with `G_e` the rich model's tip Jacobian less its
+/// mean over the poses, `V` the rich covariance less the geometric one in
+/// its coordinates: Hausman); its bound adds 1.645 `sqrt(2 tr(MVMV))`.
+/// `(0, 0)` when a tip cannot be had.
+pub(crate) fn fused_structure(
+    model: &tricept_engine::fusion::FusedModel,
+    fit: &tricept_engine::fusion::Fusion,
+    rich_model: &tricept_engine::fusion::FusedModel,
+    rich: &tricept_engine::fusion::Fusion,
+    eval: &[tricept_data::ExternalPose],
+) -> (f64, f64) {
+    let (k, kr) = (model.len(), rich_model.len());
+    // The geometric parameters' places among the rich model's.
+    let index: Vec<usize> = rich_model
+        .module_range()
+        .chain(rich_model.head_range())
+        .collect();
+    if index.len() != k || fit.estimate.len() != k || rich.estimate.len() != kr {
+        return (0.0, 0.0);
+    }
+    let tip = Effector::default();
+    let diffs: Option<Vec<nalgebra::Vector3<f64>>> = eval
+        .iter()
+        .map(|pose| {
+            let r = rich_model.spindle_point(&rich.estimate, pose, &tip).ok()?;
+            let g = model.spindle_point(&fit.estimate, pose, &tip).ok()?;
+            Some(r.0 - g.0)
+        })
+        .collect();
+    let Some(diffs) = diffs else {
+        return (0.0, 0.0);
+    };
+    let Ok(g) = rich_model.spindle_jacobians(&rich.estimate, eval, &[tip]) else {
+        return (0.0, 0.0);
+    };
+    let g: Vec<&nalgebra::DMatrix<f64>> = g.iter().filter_map(|v| v.first()).collect();
+    let n = diffs.len().max(1) as f64;
+    let centre = diffs.iter().sum::<nalgebra::Vector3<f64>>() / n;
+    let shift = diffs
+        .iter()
+        .map(|d| (d - centre).norm_squared())
+        .sum::<f64>()
+        / n;
+    let mean = g
+        .iter()
+        .fold(nalgebra::DMatrix::zeros(3, kr), |a, b| a + *b)
+        / n;
+    let mut m = nalgebra::DMatrix::zeros(kr, kr);
+    for ge in &g {
+        let c = *ge - &mean;
+        m += c.transpose() * c;
+    }
+    m /= n;
+    let mut v = rich.covariance.clone();
+    for (a, &ia) in index.iter().enumerate() {
+        for (b, &ib) in index.iter().enumerate() {
+            v[(ia, ib)] -= fit.covariance[(a, b)];
+        }
+    }
+    let mv = &m * &v;
+    let chance = mv.trace();
+    let sd = (2.0 * (&mv * &mv).trace().max(0.0)).sqrt();
+    let bias2 = shift - chance.max(0.0);
+    if !(bias2.is_finite() && sd.is_finite()) {
+        return (0.0, 0.0);
+    }
+    (bias2.max(0.0).sqrt(), (bias2 + Z95 * sd).max(0.0).sqrt())
+}
+
+/// The size of a head's errors the data show, in units of the parameters'
+/// typical sizes: the head parameters the data see (`n` of them, estimate
+/// `e_j`, standard deviation `s_j`, typical size `t_j`) give `S = sum
+/// (e_j / t_j)^2`, whose mean is `n c^2 + sum (s_j / t_j)^2` for a head of
+/// `c` typical sizes; the scale is the moment estimate `c^2 = (S - sum (s_j
+/// / t_j)^2) / n` (never below zero), its 95 % upper bound `S / chi2_n(5
+/// %)`. A fit that sees no head parameter keeps the typical size (1, 1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct HeadScale {
+    /// The moment estimate `c`.
+    pub scale: f64,
+    /// Its 95 % upper bound.
+    pub upper: f64,
+    /// Head parameters seen.
+    pub seen: usize,
+}
+
+/// The size of the head's errors the data show ([`HeadScale`]).
+pub(crate) fn head_scale(
+    model: &tricept_engine::fusion::FusedModel,
+    fit: &tricept_engine::fusion::Fusion,
+) -> HeadScale {
+    let typical = model.typical_sizes();
+    let seen: Vec<(f64, f64, f64)> = model
+        .head_range()
+        .filter_map(|j| {
+            let sd = (*fit.std_dev.get(j)?)?;
+            Some((*fit.estimate.get(j)?, sd, *typical.get(j)?))
+        })
+        .collect();
+    HeadScale::of(&seen)
+}
+
+impl HeadScale {
+    /// The scale of the head parameters seen, each `(estimate, standard
+    /// deviation, typical size)` (one without a positive typical size or
+    /// with a value that is not finite is left out).
+    pub(crate) fn of(seen: &[(f64, f64, f64)]) -> HeadScale {
+        let (mut sum, mut noise, mut n) = (0.0, 0.0, 0usize);
+        for &(e, sd, t) in seen {
+            if t > 0.0 && e.is_finite() && sd.is_finite() {
+                sum += (e / t).powi(2);
+                noise += (sd / t).powi(2);
+                n += 1;
+            }
+        }
+        if n == 0 {
+            return HeadScale {
+                scale: 1.0,
+                upper: 1.0,
+                seen: 0,
+            };
+        }
+        let low = tricept_numerics::stats::chi2_isf(0.95, n as f64);
+        HeadScale {
+            scale: ((sum - noise).max(0.0) / n as f64).sqrt(),
+            upper: if low > 0.0 { (sum / low).sqrt() } else { 1.0 },
+            seen: n,
+        }
+    }
 }
 
 /// The estimate's rms and 95 % bound from the moments `(tr(MS),
@@ -347,6 +562,27 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_head_scale_is_what_the_seen_parameters_show() {
+        // Eleven parameters seen at twice their typical sizes, exactly: a
+        // head of two typical sizes; the bound S / chi2_11(5 %) = 44 / 4.57.
+        let seen = vec![(0.6, 0.0, 0.3); 11];
+        let h = HeadScale::of(&seen);
+        assert!((h.scale - 2.0).abs() < 1e-12, "{h:?}");
+        assert!(
+            (h.upper - (44.0_f64 / 4.574_813).sqrt()).abs() < 1e-3,
+            "{h:?}"
+        );
+        assert_eq!(h.seen, 11);
+        // Estimates no larger than their noise show no head beyond it.
+        let h = HeadScale::of(&[(0.01, 0.02, 0.3), (-0.01, 0.02, 0.1)]);
+        assert_eq!(h.scale, 0.0);
+        assert!(h.upper > 0.0);
+        // Nothing seen: the typical size.
+        let h = HeadScale::of(&[(1.0, f64::NAN, 0.3)]);
+        assert_eq!((h.scale, h.upper, h.seen), (1.0, 1.0, 0));
+    }
+
+    #[test]
     fn the_estimate_bound_is_the_chi_square_quantile() {
         // One parameter: e^T M e = m1 chi2_1, whose 95 % quantile is 3.84
         // (Wilson-Hilferty gives 3.7 at one degree of freedom).
@@ -359,6 +595,28 @@ mod tests {
         assert!(
             (rms - 1.0).abs() < 1e-12 && upper > 1.0 && upper < 1.02,
             "{upper}"
+        );
+    }
+
+    #[test]
+    fn the_posterior_bound_follows_the_shift_and_its_spread() {
+        // No shift: the bound of the spread alone.
+        assert_eq!(
+            posterior_upper(0.0, 4.0, 16.0, 0.0),
+            estimate_part(4.0, 16.0).1
+        );
+        // One dimension, e ~ N(10, 1): e^2's 95 % quantile is (10 +
+        // 1.645)^2 = 135.6 (the other tail is negligible).
+        let upper = posterior_upper(100.0, 1.0, 1.0, 100.0);
+        assert!((upper - 11.645).abs() < 0.05, "{upper}");
+        // The shift's spread counts: without it the bound is too tight.
+        let tight = posterior_upper(100.0, 1.0, 1.0, 0.0);
+        assert!(tight < 11.3, "{tight}");
+        // A larger shift, a larger bound; a negative one is no shift.
+        assert!(posterior_upper(4.0, 1.0, 1.0, 4.0) > posterior_upper(1.0, 1.0, 1.0, 1.0));
+        assert_eq!(
+            posterior_upper(-1.0, 1.0, 1.0, 0.0),
+            posterior_upper(0.0, 1.0, 1.0, 0.0)
         );
     }
 }

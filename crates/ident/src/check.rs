@@ -13,21 +13,22 @@
 use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
-use tricept_check::history::{Entry, Trend, append, trends};
-use tricept_check::{CheckError, CheckOptions, CheckReport, CheckVerdict, Reference};
+use tricept_check::history::{Entry, append, trends};
+use tricept_check::{CheckError, CheckOptions, CheckVerdict, Reference};
 
 use crate::data_input::DataInput;
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
-use crate::inputs::LoadedMachine;
+use crate::machine_input::MachineInput;
+
+pub use tricept_check::history::Trend;
+pub use tricept_check::{CheckReport, DEFAULT_ALPHA};
 
 /// A check campaign against a calibrated machine.
 ///
 /// # Example
 /// ```no_run
-/// use std::path::Path;
-/// use tricept_ident::{CheckRequest, SensorNoise, check, load_machine};
-/// let calibrated = load_machine(Some(Path::new("calibrated.json")), &SensorNoise::default())?;
-/// let result = check(CheckRequest::new(calibrated, "today.csv"))?;
+/// use tricept_ident::check::{CheckRequest, check};
+/// let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
 /// print!("{}", result.to_text());
 /// # Ok::<(), tricept_ident::Error>(())
 /// ```
@@ -35,7 +36,7 @@ use crate::inputs::LoadedMachine;
 #[non_exhaustive]
 pub struct CheckRequest {
     /// The calibrated machine (a machine file with its calibration record).
-    pub machine: LoadedMachine,
+    pub machine: MachineInput,
     /// The check campaign's measured data (with `temp_c` the legs' thermal
     /// state is checked too).
     pub data: DataInput,
@@ -49,9 +50,9 @@ pub struct CheckRequest {
 impl CheckRequest {
     /// A check of `data` against `machine` at the default false-alarm
     /// probability, without history.
-    pub fn new(machine: LoadedMachine, data: impl Into<DataInput>) -> CheckRequest {
+    pub fn new(machine: impl Into<MachineInput>, data: impl Into<DataInput>) -> CheckRequest {
         CheckRequest {
-            machine,
+            machine: machine.into(),
             data: data.into(),
             alpha: tricept_check::DEFAULT_ALPHA,
             history: None,
@@ -82,7 +83,7 @@ pub struct CheckResult {
 /// the data read, the history read (refused before the check when it
 /// cannot be), the test, and the entry appended to the history.
 pub fn check(request: CheckRequest) -> Result<CheckResult, Error> {
-    let loaded = &request.machine;
+    let loaded = &request.machine.load()?;
     let machine = loaded.source().to_string();
     let reference = Reference::from_description(loaded.description())
         .map_err(|e| Error::input(format!("{machine}: {e}")))?;
@@ -298,7 +299,9 @@ fn trend_text(t: &Trend) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{DetectabilityRequest, DiagnoseRequest, SensorNoise, load_machine};
+    use crate::detectability::DetectabilityRequest;
+    use crate::diagnosis::DiagnoseRequest;
+    use crate::inputs::{LoadedMachine, SensorNoise, load_machine};
 
     fn paper() -> LoadedMachine {
         load_machine(None, &SensorNoise::default()).unwrap()
@@ -318,10 +321,10 @@ mod tests {
     #[test]
     fn missing_data_exit_with_the_same_code_from_every_workflow() {
         let missing = "no-such-dir/today.csv";
-        let d = crate::diagnose(DiagnoseRequest::new(paper(), missing)).unwrap_err();
-        let mut r = DetectabilityRequest::new(paper(), crate::Poses::grid());
+        let d = crate::diagnosis::diagnose(DiagnoseRequest::new(paper(), missing)).unwrap_err();
+        let mut r = DetectabilityRequest::new(paper(), crate::inputs::Poses::grid());
         r.data = Some(missing.into());
-        let t = crate::detectability(r).unwrap_err();
+        let t = crate::detectability::detectability(r).unwrap_err();
         for e in [d, t] {
             assert_eq!(e.exit_code(), crate::EXIT_INPUT);
             assert!(e.message().starts_with(missing), "{}", e.message());
@@ -339,7 +342,7 @@ mod tests {
         let machine = dir.join("calibrated.json");
         let history = dir.join("checks.jsonl");
         std::fs::remove_file(&history).ok();
-        let d = crate::diagnose(DiagnoseRequest::new(paper(), data)).unwrap();
+        let d = crate::diagnosis::diagnose(DiagnoseRequest::new(paper(), data)).unwrap();
         d.write_machine(&machine, false).unwrap();
         for n in 1..=2 {
             let loaded = load_machine(Some(&machine), &SensorNoise::default()).unwrap();

@@ -16,13 +16,16 @@ use nalgebra::Vector3;
 use serde_json::{Map, Value, json};
 use tricept_engine::{CompensationTable, ExtendedMachine};
 use tricept_kinematics::description::LegTableDescription;
-use tricept_model::{ErrorMap, MapStats, ParameterSet};
+use tricept_model::{MapStats, ParameterSet};
 use tricept_plant::Effect;
 
 use crate::calibrate::{CalibrateRequest, calibrate, exit_line, write_text};
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, Error};
-use crate::inputs::{SensorNoise, TrueErrors, load_machine};
+use crate::inputs::TrueErrors;
 use crate::machine_file::write_rule;
+use crate::machine_input::MachineInput;
+
+pub use tricept_model::ErrorMap;
 
 /// The largest interpolation error (um) the default table spacing allows.
 pub const TABLE_ERROR_LIMIT_UM: f64 = 1.0;
@@ -41,7 +44,7 @@ pub enum Calibrated {
     Data(Box<CalibrateRequest>),
     /// A calibrated machine file, compensated against the nominal machine
     /// its record holds.
-    MachineFile(Option<PathBuf>),
+    MachineFile(MachineInput),
 }
 
 /// What to compensate, and what to produce.
@@ -161,8 +164,8 @@ fn machines(r: &CompensateRequest) -> Result<Pair, Error> {
                 why: fit.reason(),
             })
         }
-        Calibrated::MachineFile(path) => {
-            let loaded = load_machine(path.as_deref(), &SensorNoise::default())?;
+        Calibrated::MachineFile(machine) => {
+            let loaded = machine.clone().load()?;
             let Some(c) = &loaded.description().calibration else {
                 return Err(Error::input(format!(
                     "compensate: give --data FILE.csv to identify from, or a calibrated machine file as --machine ({} holds no `calibration` record)",

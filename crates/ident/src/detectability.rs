@@ -5,21 +5,24 @@
 //! advice on the campaign.
 
 use serde_json::{Value, json};
-use tricept_diagnose::detect::{Detectability, advise, realistic, term_detectability};
+use tricept_diagnose::detect::{advise, realistic, term_detectability};
 use tricept_engine::GeometricModel;
 use tricept_model::{GeometricErrors, ParameterSet};
 use tricept_plant::{Campaign, Effect, Plant, PoseOrder};
 
 use crate::data_input::DataInput;
 use crate::error::{EXIT_OK, Error};
-use crate::inputs::{LoadedMachine, Poses};
+use crate::inputs::Poses;
+use crate::machine_input::MachineInput;
+
+pub use tricept_diagnose::detect::Detectability;
 
 /// The campaign to assess.
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct DetectabilityRequest {
     /// The machine and its sensor noise.
-    pub machine: LoadedMachine,
+    pub machine: MachineInput,
     /// The planned poses (ignored when `data` is given).
     pub poses: Poses,
     /// A logged campaign instead: its commands and logged context
@@ -35,9 +38,9 @@ pub struct DetectabilityRequest {
 impl DetectabilityRequest {
     /// The planned campaign `poses` on `machine`, one direction, a drift of
     /// 2 K.
-    pub fn new(machine: LoadedMachine, poses: Poses) -> DetectabilityRequest {
+    pub fn new(machine: impl Into<MachineInput>, poses: Poses) -> DetectabilityRequest {
         DetectabilityRequest {
-            machine,
+            machine: machine.into(),
             poses,
             data: None,
             both_directions: false,
@@ -57,7 +60,8 @@ pub struct DetectabilityReport {
 
 /// Assesses the request's campaign.
 pub fn detectability(request: DetectabilityRequest) -> Result<DetectabilityReport, Error> {
-    let m = request.machine.machine();
+    let loaded = request.machine.clone().load()?;
+    let m = loaded.machine();
     let mut campaign = Campaign::from_targets(m, Vec::new(), 1);
     let (data, described) = match &request.data {
         // A logged campaign: its poses with their own context.

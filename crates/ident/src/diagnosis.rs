@@ -3,11 +3,12 @@
 //! of the vocabulary (or generic term) does; then the final model deployed
 //! into a calibrated machine ([`DiagnoseResult::deploy`]) and written as a
 //! machine file with its calibration record
-//! ([`DiagnoseResult::write_machine`], under the one write rule,
-//! [`crate::machine_file::write_rule`]).
+//! ([`DiagnoseResult::write_machine`], under the one write rule of every
+//! machine file written).
 //!
-//! The request takes the machine as loaded ([`crate::load_machine`]) and the
-//! data as a file or in memory ([`DataInput`]); the result carries the
+//! The request takes the machine as every request does
+//! ([`crate::MachineInput`]) and the data as a file or in memory
+//! ([`DataInput`]); the result carries the
 //! verdict and its exit code (0 the final model explains the data, 3 it
 //! does not), the JSON and the text report the CLI prints.
 
@@ -16,7 +17,7 @@ use std::sync::OnceLock;
 
 use serde_json::{Map, json};
 use tricept_data::Dataset;
-use tricept_diagnose::{DiagnoseError, DiagnoseOptions, Diagnosis, Plausibility, ResidualPlot};
+use tricept_diagnose::{DiagnoseError, DiagnoseOptions, Plausibility};
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
@@ -25,16 +26,17 @@ use crate::data_input::DataInput;
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::inputs::LoadedMachine;
 use crate::machine_file;
+use crate::machine_input::MachineInput;
 
-pub use tricept_diagnose::Deployed;
+pub use tricept_diagnose::{Deployed, Diagnosis, ResidualPlot};
 
 /// What to diagnose and how.
 ///
 /// # Example
 /// ```no_run
-/// use tricept_ident::{DiagnoseRequest, SensorNoise, diagnose, load_machine};
-/// let machine = load_machine(None, &SensorNoise::default())?;
-/// let result = diagnose(DiagnoseRequest::new(machine, "data.csv"))?;
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+/// let result = diagnose(DiagnoseRequest::new(MachineInput::default(), "data.csv"))?;
 /// println!("{}", result.to_text());
 /// std::process::exit(i32::from(result.exit_code()));
 /// # Ok::<(), tricept_ident::Error>(())
@@ -44,7 +46,7 @@ pub use tricept_diagnose::Deployed;
 pub struct DiagnoseRequest {
     /// The machine the data were measured on (a calibrated machine file
     /// keeps the rank decision of its nominal machine).
-    pub machine: LoadedMachine,
+    pub machine: MachineInput,
     /// The measured data (context columns temp_c, time_s, dir1..3 are used
     /// when present).
     pub data: DataInput,
@@ -62,9 +64,9 @@ pub struct DiagnoseRequest {
 impl DiagnoseRequest {
     /// A diagnosis of `data` measured on `machine`, with the default
     /// options.
-    pub fn new(machine: LoadedMachine, data: impl Into<DataInput>) -> DiagnoseRequest {
+    pub fn new(machine: impl Into<MachineInput>, data: impl Into<DataInput>) -> DiagnoseRequest {
         DiagnoseRequest {
-            machine,
+            machine: machine.into(),
             data: data.into(),
             noise_from_data: false,
             temperature_noise_k: None,
@@ -98,6 +100,7 @@ pub fn diagnose(request: DiagnoseRequest) -> Result<DiagnoseResult, Error> {
         plausibility,
         dictionary,
     } = request;
+    let loaded = loaded.load()?;
     let m = loaded.machine();
     let source = data.name();
     let data_path = data.path().map(Path::to_path_buf);
@@ -409,7 +412,8 @@ pub fn vocabulary_help() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{EXIT_INPUT, SensorNoise, load_machine};
+    use crate::EXIT_INPUT;
+    use crate::inputs::{SensorNoise, load_machine};
 
     const DATA: &str = concat!(
         env!("CARGO_MANIFEST_DIR"),

@@ -4,10 +4,12 @@
 //! vocabulary) or describes it through a generic family.
 
 use serde_json::{Value, json};
-use tricept_plant::Effect;
 use tricept_plant::effects::typical_effects;
 
 use crate::error::{EXIT_OK, Error};
+
+pub use tricept_model::effects::EffectName;
+pub use tricept_plant::Effect;
 
 /// The effects listed: all, or the one asked for.
 #[derive(Debug, Clone)]
@@ -21,9 +23,9 @@ pub struct EffectList {
 ///
 /// # Example
 /// ```
-/// let all = tricept_ident::effects(None).unwrap();
+/// let all = tricept_ident::effects::effects(None).unwrap();
 /// assert!(all.to_text().contains("leg-lead"));
-/// assert!(tricept_ident::effects(Some("nothing")).is_err());
+/// assert!(tricept_ident::effects::effects(Some("nothing")).is_err());
 /// ```
 pub fn effects(name: Option<&str>) -> Result<EffectList, Error> {
     let all = typical_effects();

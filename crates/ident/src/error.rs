@@ -90,8 +90,9 @@ impl ErrorKind {
 /// # Example
 /// ```
 /// use tricept_ident::ErrorKind;
-/// use tricept_ident::advanced::{Classify, IdentError};
-/// let e = IdentError::Invalid("alpha must lie in (0, 0.5)".into());
+/// use tricept_ident::advanced::Classify;
+/// use tricept_ident::export::ExportError;
+/// let e = ExportError::Options("--max-points: must be at least 2".into());
 /// assert_eq!(e.kind(), ErrorKind::Input);
 /// ```
 pub trait Classify {

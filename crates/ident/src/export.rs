@@ -7,16 +7,18 @@ use std::path::PathBuf;
 use tricept_kinematics::MachineDescription;
 
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
+use crate::machine_input::MachineInput;
 
 pub use tricept_export::{
     AxisSummary, Controller, ExportError, ExportOptions, ExportSummary, NotExported,
 };
 
 /// What to export, and where.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct ExportRequest {
-    /// The calibrated machine file.
-    pub machine: PathBuf,
+    /// The calibrated machine file (read as written: an input without a
+    /// file is refused).
+    pub machine: MachineInput,
     /// The control and its limits.
     pub options: ExportOptions,
     /// The directory the files go into.
@@ -93,9 +95,14 @@ impl Export {
 /// tolerance, writes the files atomically.
 pub fn export(request: ExportRequest) -> Result<Export, Error> {
     let request = &request;
-    let source = request.machine.display().to_string();
-    let description = MachineDescription::from_file(&request.machine)
-        .map_err(|e| Error::from(e).in_file(&source))?;
+    let Some(path) = request.machine.path() else {
+        return Err(Error::input(
+            "export: a calibrated machine file is needed (a machine file written by `tricept identify --write-machine`)",
+        ));
+    };
+    let source = path.display().to_string();
+    let description =
+        MachineDescription::from_file(path).map_err(|e| Error::from(e).in_file(&source))?;
     tricept_engine::check_calibration_record(&description)
         .map_err(|e| Error::from(e).in_file(&source))?;
     let plan = tricept_export::plan(&description, &request.options).map_err(|e| match e {

@@ -3,17 +3,18 @@
 //! the unidentifiable combinations, before any measurement
 //! (`tricept identifiability`).
 
-use std::path::PathBuf;
-
 use serde_json::Value;
 use tricept_data::MeasuredPose;
-use tricept_engine::{GeometricModel, IdentifiabilityReport, IdentifyOptions};
+use tricept_engine::{GeometricModel, IdentifyOptions};
 use tricept_model::ParameterSet;
 
 use crate::calibrate::fit_error;
 use crate::data_input::DataInput;
 use crate::error::Error;
-use crate::inputs::{Poses, SensorNoise, load_machine};
+use crate::inputs::Poses;
+use crate::machine_input::MachineInput;
+
+pub use tricept_engine::IdentifiabilityReport;
 
 /// The poses to assess.
 #[derive(Debug, Clone)]
@@ -32,10 +33,8 @@ pub enum Campaign {
 pub struct IdentifiabilityRequest {
     /// The poses.
     pub campaign: Campaign,
-    /// Machine description file (default: the embedded Table 1 machine).
-    pub machine: Option<PathBuf>,
-    /// Sensor-noise overrides.
-    pub noise: SensorNoise,
+    /// The machine (default: the embedded Table 1 machine).
+    pub machine: MachineInput,
     /// The geometric parameters (default `paper15`).
     pub parameter_set: ParameterSet,
 }
@@ -45,8 +44,7 @@ impl IdentifiabilityRequest {
     pub fn new(campaign: Campaign) -> IdentifiabilityRequest {
         IdentifiabilityRequest {
             campaign,
-            machine: None,
-            noise: SensorNoise::default(),
+            machine: MachineInput::default(),
             parameter_set: ParameterSet::paper15(),
         }
     }
@@ -67,13 +65,13 @@ pub struct Identifiability {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::{Campaign, IdentifiabilityRequest, assess_identifiability};
+/// use tricept_ident::identifiability::{Campaign, IdentifiabilityRequest, assess_identifiability};
 /// let r = assess_identifiability(IdentifiabilityRequest::new(Campaign::Poses("grid".parse()?)))?;
 /// assert_eq!(r.to_json()["parameter_set"], "paper15");
 /// # Ok::<(), tricept_ident::Error>(())
 /// ```
 pub fn assess_identifiability(request: IdentifiabilityRequest) -> Result<Identifiability, Error> {
-    let loaded = load_machine(request.machine.as_deref(), &request.noise)?;
+    let loaded = request.machine.load()?;
     let m = loaded.machine();
     let set = &request.parameter_set;
     let (commands, campaign, source) = match &request.campaign {

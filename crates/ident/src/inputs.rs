@@ -30,7 +30,7 @@ use crate::limits;
 ///
 /// # Example
 /// ```
-/// use tricept_ident::{SensorNoise, load_machine};
+/// use tricept_ident::advanced::{SensorNoise, load_machine};
 /// let noise = SensorNoise { angle_noise_arcsec: Some(2.0), ..SensorNoise::default() };
 /// let loaded = load_machine(None, &noise).unwrap();
 /// assert!((loaded.machine().sensors.angle_rad - 2.0 / 206_264.806).abs() < 1e-9);
@@ -54,6 +54,7 @@ pub struct LoadedMachine {
     description: MachineDescription,
     machine: Machine,
     source: String,
+    path: Option<PathBuf>,
     warnings: Vec<String>,
 }
 
@@ -71,6 +72,11 @@ impl LoadedMachine {
     /// The file name, or `the built-in Table 1 machine`.
     pub fn source(&self) -> &str {
         &self.source
+    }
+
+    /// The file it was loaded from (none: the embedded Table 1 machine).
+    pub fn path(&self) -> Option<&Path> {
+        self.path.as_deref()
     }
 
     /// Warnings about the calibration the file holds (forced, not
@@ -138,7 +144,7 @@ fn strip_position(s: &str) -> String {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::{SensorNoise, load_machine};
+/// use tricept_ident::advanced::{SensorNoise, load_machine};
 /// let loaded = load_machine(None, &SensorNoise::default()).unwrap();
 /// assert_eq!(loaded.source(), "the built-in Table 1 machine");
 /// assert!(loaded.warnings().is_empty());
@@ -192,6 +198,7 @@ pub fn load_machine(path: Option<&Path>, noise: &SensorNoise) -> Result<LoadedMa
         description,
         machine,
         source,
+        path: path.map(Path::to_path_buf),
         warnings,
     })
 }
@@ -282,7 +289,8 @@ pub fn check_commands(
 ///
 /// # Example
 /// ```
-/// use tricept_ident::{Machine, Poses};
+/// use tricept_ident::advanced::Poses;
+/// use tricept_ident::kinematics::Machine;
 /// let poses: Poses = "random:10,1".parse().unwrap();
 /// assert_eq!(poses.targets(&Machine::paper()).unwrap().len(), 10);
 /// assert!("optimal:0".parse::<Poses>().is_err());
@@ -372,8 +380,7 @@ impl Poses {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::ParameterSet;
-/// use tricept_ident::advanced::TrueErrors;
+/// use tricept_ident::advanced::{ParameterSet, TrueErrors};
 /// let set = ParameterSet::paper15();
 /// let e: TrueErrors = "random:0.1,3".parse().unwrap();
 /// assert!(e.values(&set).unwrap().iter().all(|v| v.abs() <= 0.1));

@@ -18,15 +18,16 @@
 
 use std::io::{Read, Write};
 
-use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde_json::{Map, Value};
 use tricept_data::NumericRows;
-use tricept_kinematics::{HeadBranch, KinematicsError};
-use tricept_model::ExtendedMachine;
 
 use crate::error::{EXIT_OK, Error};
 use crate::inputs::LoadedMachine;
+
+pub use nalgebra::Vector3;
+pub use tricept_kinematics::{HeadBranch, KinematicsError, Machine, MachineDescription};
+pub use tricept_model::ExtendedMachine;
 
 /// Rows solved per block.
 pub const BLOCK_ROWS: usize = 8192;
@@ -243,9 +244,7 @@ fn write_cell(out: &mut Vec<u8>, c: Cell) {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::KinematicsVerb as Verb;
-/// use tricept_ident::advanced::run;
-/// use tricept_ident::{ExtendedMachine, Machine};
+/// use tricept_ident::kinematics::{ExtendedMachine, Machine, Verb, run};
 /// let m = ExtendedMachine::new(Machine::paper());
 /// let mut out = Vec::new();
 /// let n = run(Verb::Ik, &m, "x,y,z\n0,0,750\n".as_bytes(), "points.csv", &mut out, || false).unwrap();
@@ -402,9 +401,9 @@ pub struct PointSolution {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::{KinematicsVerb as Verb, solve_point};
-/// use tricept_ident::{SensorNoise, load_machine};
-/// let m = load_machine(None, &SensorNoise::default()).unwrap();
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::kinematics::{Verb, solve_point};
+/// let m = MachineInput::default().load().unwrap();
 /// let s = solve_point(Verb::Ik, &m, &[0.0, 0.0, 750.0]).unwrap();
 /// assert!(s.to_json().starts_with(r#"{"x":0.0,"y":0.0,"z":750.0,"q1":773.3"#));
 /// assert!(solve_point(Verb::Ik, &m, &[0.0, 0.0, 5000.0]).is_err());
@@ -555,7 +554,7 @@ pub fn machine_summary(loaded: &LoadedMachine) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{SensorNoise, load_machine};
+    use crate::inputs::{SensorNoise, load_machine};
 
     #[test]
     fn ik_then_fk_returns_the_point_and_text_aligns_keys_with_units() {

@@ -11,20 +11,25 @@
 //! `tricept-kinematics` and `tricept-data`. ARCHITECTURE.md draws the split.
 //!
 //! One request style: every workflow takes its request **by value**
-//! (`calibrate(CalibrateRequest::new("data.csv"))`), and measured data are
-//! always a [`DataInput`] (a file, a file already read, or a data set in
-//! memory). A request describes one run and is spent by it: by value, the
-//! workflow keeps the data it was given (a calibration holds its data
-//! without copying them), and a caller can move a request to another thread
-//! (the Python binding runs every workflow with the GIL released). The
+//! (`calibrate::calibrate(CalibrateRequest::new("data.csv"))`); a machine is
+//! always a [`MachineInput`] (a description file with sensor-noise
+//! overrides, or a machine loaded already) and measured data are always a
+//! [`DataInput`] (a file, a file already read, or a data set in memory). A
+//! request describes one run and is spent by it: by value, the workflow
+//! keeps the data it was given (a calibration holds its data without
+//! copying them), and a caller can move a request to another thread (the
+//! Python binding runs every workflow with the GIL released). The
 //! constructor takes the few values a request cannot do without; the rest
 //! are public fields with the CLI's defaults.
 //!
-//! The root is a curated set: the workflows (one function per verb), their
-//! requests and results, the error with its exit codes, and the domain
-//! types every user needs. The typed values requests are made of, the parts
-//! of results and the few low-level items code beside the door needs are in
-//! [`advanced`].
+//! The root is a curated handful: one module per workflow ([`calibrate`],
+//! [`check`], [`compensate`], [`detectability`], [`diagnosis`],
+//! [`effects`], [`export`], [`identifiability`], [`kinematics`], [`plan`],
+//! [`simulate`]), each with its function, its request, its result and the
+//! parts they are made of; the error with its exit codes; and the two
+//! inputs. The typed values several requests share, the machine loaded
+//! ahead of a workflow and the few low-level items code beside the door
+//! needs are in [`advanced`].
 //!
 //! Errors: every failure is an [`Error`] whose [`ErrorKind`] decides the
 //! process exit code, one mapping for every verb ([`Error::exit_code`]).
@@ -37,82 +42,42 @@
 
 // Layer 0: errors, limits and inputs.
 mod accuracy;
+mod data_input;
 mod error;
-mod export;
 mod inputs;
 mod limits;
 mod machine_file;
+mod machine_input;
 
-// Layer 1: the workflows.
-mod calibrate;
-mod check;
-mod compensate;
-mod data_input;
-mod detectability;
-mod diagnosis;
-mod effects;
-mod identifiability;
-mod kinematics;
-mod plan;
-mod simulate;
+// Layer 1: the workflows, one public module each (its function, its
+// request, its result and the parts they are made of).
+pub mod calibrate;
+pub mod check;
+pub mod compensate;
+pub mod detectability;
+pub mod diagnosis;
+pub mod effects;
+pub mod export;
+pub mod identifiability;
+pub mod kinematics;
+pub mod plan;
+pub mod simulate;
 
-// Layer 2: what a downstream crate may need besides the curated root.
+// Layer 2: what a downstream crate may need besides the workflows.
 pub mod advanced;
 
 // The curated root: xtask/tests/tidy.rs holds this list and fails when the
-// root grows past it. A new item goes into `advanced` unless it is a
-// workflow, its request or result, the error, or a domain type every user
-// needs.
-
-// The workflows: one function per verb.
-pub use calibrate::calibrate;
-pub use check::check;
-pub use compensate::compensate;
-pub use detectability::detectability;
-pub use diagnosis::diagnose;
-pub use effects::effects;
-pub use export::export;
-pub use identifiability::assess_identifiability;
-pub use kinematics::solve_point;
-pub use plan::plan;
-pub use simulate::simulate;
-
-// Their requests, and what a request's constructor needs.
-pub use calibrate::CalibrateRequest;
-pub use check::CheckRequest;
-pub use compensate::{Calibrated, CompensateRequest};
-pub use detectability::DetectabilityRequest;
-pub use diagnosis::DiagnoseRequest;
-pub use export::ExportRequest;
-pub use identifiability::{Campaign, IdentifiabilityRequest};
-pub use kinematics::Verb as KinematicsVerb;
-pub use plan::{Instrument, PlanRequest};
-pub use simulate::SimulateRequest;
-
-// Their results, each with its verdict (`exit_code()`).
-pub use calibrate::Calibration;
-pub use check::CheckResult;
-pub use compensate::Compensation;
-pub use detectability::DetectabilityReport;
-pub use diagnosis::DiagnoseResult;
-pub use effects::EffectList;
-pub use export::Export;
-pub use identifiability::Identifiability;
-pub use kinematics::PointSolution;
-pub use plan::Plan;
-pub use simulate::Simulation;
+// root grows past it. A new item goes into its workflow's module, or into
+// `advanced`, unless every user needs it.
 
 // The error and the exit codes.
 pub use error::{
     EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error, ErrorKind,
 };
 
-// The domain: the machine, the parameters, the data, the poses.
+// The two inputs every workflow is fed: the machine and the measured data.
 pub use data_input::DataInput;
-pub use inputs::{LoadedMachine, Poses, SensorNoise, load_machine};
-pub use nalgebra;
-pub use tricept_kinematics::Machine;
-pub use tricept_model::{ExtendedMachine, ParameterSet};
+pub use machine_input::MachineInput;
 
 // Crate-internal shorthands (the workflows' files use `crate::NAME`).
 pub(crate) use error::Classify;

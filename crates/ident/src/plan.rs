@@ -30,10 +30,9 @@ use crate::calibrate::values::{
 use crate::calibrate::write_text;
 use crate::data_input::DataInput;
 use crate::error::Error;
-use crate::inputs::{
-    HeadAngles, LoadedMachine, Poses, SensorNoise, Triple, load_machine, positive,
-};
+use crate::inputs::{HeadAngles, LoadedMachine, Poses, Triple, positive};
 use crate::limits;
+use crate::machine_input::MachineInput;
 
 /// A line of a report (`writeln!` whose result, always `Ok` on a
 /// `String`, is dropped).
@@ -124,10 +123,8 @@ pub struct PlanRequest {
     pub eval_head_angles_deg: HeadAngles,
     /// Where the planned poses are to be written ([`Plan::write_out`]).
     pub out: Option<PathBuf>,
-    /// Machine description file (default: the embedded Table 1 machine).
-    pub machine: Option<PathBuf>,
-    /// Sensor-noise overrides.
-    pub noise: SensorNoise,
+    /// The machine (default: the embedded Table 1 machine).
+    pub machine: MachineInput,
     /// The module's parameter set.
     pub parameter_set: ParameterSet,
 }
@@ -172,8 +169,7 @@ impl PlanRequest {
                 h2_deg: vec![15.0, 35.0],
             },
             out: None,
-            machine: None,
-            noise: SensorNoise::default(),
+            machine: MachineInput::default(),
             parameter_set: ParameterSet::paper15(),
         }
     }
@@ -283,7 +279,7 @@ pub fn plan(request: PlanRequest) -> Result<Plan, Error> {
     let a = &request;
     let default_k = [3, 5, 8, 12, 20, 30, 50];
     let k: &[usize] = if a.k.is_empty() { &default_k } else { &a.k };
-    let loaded = load_machine(a.machine.as_deref(), &a.noise)?;
+    let loaded = a.machine.clone().load()?;
     let m = loaded.machine().clone();
     let set = a.parameter_set.clone();
     let model = fused_model(&m, &set, &a.effects, HeadModel::Head13)?;
@@ -634,7 +630,7 @@ fn report(
 /// 20), whose check detects a change of `--detect-um` of platform error in
 /// any single parameter with `--power` (`tricept_study::check_plan`).
 fn check_plan(a: &PlanRequest, loaded: &LoadedMachine) -> Result<Plan, Error> {
-    let Some(path) = &a.machine else {
+    let Some(path) = loaded.path() else {
         return Err(Error::input(
             "plan --instrument check: --machine CALIBRATED.json is needed (a check is planned for a calibrated machine and its record)",
         ));

@@ -25,7 +25,8 @@ use tricept_plant::{
 };
 
 use crate::error::{EXIT_OK, Error};
-use crate::inputs::{LoadedMachine, Poses, TrueErrors, positive, random_spec};
+use crate::inputs::{Poses, TrueErrors, positive, random_spec};
+use crate::machine_input::MachineInput;
 
 /// Head errors of a simulated machine (`--head-errors`): `zero`,
 /// `random:SCALE[,SEED]` (each of the 13 parameters SCALE times its
@@ -33,9 +34,9 @@ use crate::inputs::{LoadedMachine, Poses, TrueErrors, positive, random_spec};
 ///
 /// # Example
 /// ```
-/// let h: tricept_ident::advanced::HeadErrors = "random:1,3".parse().unwrap();
+/// let h: tricept_ident::simulate::HeadErrors = "random:1,3".parse().unwrap();
 /// assert_eq!(h.to_string(), "random:1,3");
-/// assert!("random:x".parse::<tricept_ident::advanced::HeadErrors>().is_err());
+/// assert!("random:x".parse::<tricept_ident::simulate::HeadErrors>().is_err());
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub enum HeadErrors {
@@ -110,10 +111,10 @@ impl HeadErrors {
 ///
 /// # Example
 /// ```
-/// let t: tricept_ident::advanced::TruthEffects = r#"{"effect":"leg-lead","ppm":[50,-30,40]}"#.parse().unwrap();
+/// let t: tricept_ident::simulate::TruthEffects = r#"{"effect":"leg-lead","ppm":[50,-30,40]}"#.parse().unwrap();
 /// assert_eq!(t.effects().len(), 1);
 /// assert!(t.to_string().starts_with("{"));
-/// assert!(r#"{"effect":"nothing"}"#.parse::<tricept_ident::advanced::TruthEffects>().is_err());
+/// assert!(r#"{"effect":"nothing"}"#.parse::<tricept_ident::simulate::TruthEffects>().is_err());
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct TruthEffects {
@@ -197,8 +198,9 @@ pub struct TouchSimulation {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::{SensorNoise, SimulateRequest, load_machine, simulate};
-/// let mut request = SimulateRequest::new(load_machine(None, &SensorNoise::default()).unwrap());
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::simulate::{SimulateRequest, simulate};
+/// let mut request = SimulateRequest::new(MachineInput::default());
 /// request.poses = "random:25,1".parse().unwrap();
 /// let sim = simulate(request).unwrap();
 /// assert_eq!(sim.data().poses.len(), 25);
@@ -207,7 +209,7 @@ pub struct TouchSimulation {
 #[non_exhaustive]
 pub struct SimulateRequest {
     /// The nominal machine and its stated sensor noise.
-    pub machine: LoadedMachine,
+    pub machine: MachineInput,
     /// The parameter set of the true errors.
     pub parameter_set: ParameterSet,
     /// True geometric errors (default: Table 2).
@@ -237,9 +239,9 @@ pub struct SimulateRequest {
 impl SimulateRequest {
     /// Table 2 errors on `machine`, the `grid` pose set, seed 1, the stated
     /// noise, no effect and no external instrument.
-    pub fn new(machine: LoadedMachine) -> SimulateRequest {
+    pub fn new(machine: impl Into<MachineInput>) -> SimulateRequest {
         SimulateRequest {
-            machine,
+            machine: machine.into(),
             parameter_set: ParameterSet::paper15(),
             truth: TrueErrors::Table2,
             truth_effects: Vec::new(),
@@ -271,7 +273,8 @@ pub struct Simulation {
 /// Simulates the request's campaign (and instruments); every problem of
 /// the request is an input error (exit code 2).
 pub fn simulate(request: SimulateRequest) -> Result<Simulation, Error> {
-    let m = request.machine.machine();
+    let loaded = request.machine.clone().load()?;
+    let m = loaded.machine();
     let set = &request.parameter_set;
     let values = request.truth.values(set)?;
     let targets = request.poses.targets(m)?;
@@ -291,7 +294,7 @@ pub fn simulate(request: SimulateRequest) -> Result<Simulation, Error> {
     plant.effects = request.truth_effects.clone();
     plant.head_errors = request.head_errors.values(m)?;
     let data = plant.simulate(&campaign).map_err(failed)?;
-    let comments = comments(&request, &plant, &values, data.poses.len());
+    let comments = comments(&request, m, &plant, &values, data.poses.len());
     let truth_mm = Value::Object(set.values_to_map(&values));
     let summary = json!({
         "poses": data.poses.len(),
@@ -346,8 +349,13 @@ fn joined(v: &[f64]) -> String {
 }
 
 /// The comment lines of the simulated data file: who simulated what.
-fn comments(r: &SimulateRequest, plant: &Plant, values: &[f64], poses: usize) -> Vec<String> {
-    let m = r.machine.machine();
+fn comments(
+    r: &SimulateRequest,
+    m: &Machine,
+    plant: &Plant,
+    values: &[f64],
+    poses: usize,
+) -> Vec<String> {
     let set = &r.parameter_set;
     let model = GeometricModel::new(m.clone(), set.clone());
     let mut comments = vec![
@@ -598,7 +606,7 @@ impl Simulation {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{SensorNoise, load_machine};
+    use crate::inputs::{SensorNoise, load_machine};
 
     fn request() -> SimulateRequest {
         SimulateRequest::new(load_machine(None, &SensorNoise::default()).unwrap())

@@ -199,21 +199,28 @@ impl TrueMachine {
     /// True leg lengths at commands `q` (mm) on the machine a file is
     /// delivered to ([`LegEffect::delivered_mm`]).
     pub fn delivered_lengths(&self, q: &[f64; 3], effects: &[LegEffect]) -> [f64; 3] {
-        let mut l: [f64; 3] = std::array::from_fn(|i| q[i] + self.leg_offsets_mm[i]);
-        for e in effects {
-            let extra = e.delivered_mm(q, &self.leg_offsets_mm);
-            for i in 0..3 {
-                l[i] += extra[i];
-            }
-        }
-        l
+        self.summed(
+            q,
+            effects
+                .iter()
+                .map(|e| e.delivered_mm(q, &self.leg_offsets_mm)),
+        )
     }
 
     /// True leg lengths at commands `q` (mm) with `effects` at `at`.
     pub fn lengths_with(&self, q: &[f64; 3], effects: &[LegEffect], at: &LegContext) -> [f64; 3] {
+        self.summed(
+            q,
+            effects
+                .iter()
+                .map(|e| e.extra_mm(q, &self.leg_offsets_mm, at)),
+        )
+    }
+
+    /// The true leg lengths at commands `q` (mm) plus every `extras` term.
+    fn summed(&self, q: &[f64; 3], extras: impl Iterator<Item = [f64; 3]>) -> [f64; 3] {
         let mut l: [f64; 3] = std::array::from_fn(|i| q[i] + self.leg_offsets_mm[i]);
-        for e in effects {
-            let extra = e.extra_mm(q, &self.leg_offsets_mm, at);
+        for extra in extras {
             for i in 0..3 {
                 l[i] += extra[i];
             }

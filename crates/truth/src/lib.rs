@@ -11,6 +11,8 @@
 //!   commands or from true leg lengths, so that a test adds any leg effect;
 //!   a machine warmed as a whole) and [`SensorNoise`];
 //! - `tracker.rs`: [`TrueTracker`], a laser tracker station;
+//! - `instruments.rs`: [`TrueBallbar`] and [`TrueSphere`], a ballbar on a
+//!   pivot and a touch probe latching its commands on a reference sphere;
 //! - `campaign.rs`: [`Row`] and [`to_csv`], a campaign written as the
 //!   documented data CSV;
 //! - `legs.rs`: [`LegEffect`], leg effects added to the true leg lengths
@@ -37,11 +39,13 @@
 //! ```
 
 mod campaign;
+mod instruments;
 mod legs;
 mod machine;
 mod tracker;
 
 pub use campaign::{Row, to_csv};
+pub use instruments::{TrueBallbar, TrueSphere};
 pub use legs::{DELIVERY_T, LegContext, LegEffect};
 pub use machine::{SensorNoise, TrueHead, TrueMachine};
 pub use tracker::TrueTracker;

@@ -262,7 +262,14 @@ impl TrueMachine {
 
     /// The platform's pose `(r, R)` for leg commands `q`.
     pub fn platform_pose(&self, q: &[f64; 3]) -> (Vector3<f64>, Matrix3<f64>) {
-        let [phi, theta, q4] = self.forward(q);
+        self.platform_pose_at(&self.forward(q))
+    }
+
+    /// The platform's pose `(r, R)` at the UP limb's joints `(phi, theta,
+    /// q4)` (from [`TrueMachine::forward_lengths`] when a leg effect is in
+    /// the true lengths).
+    pub fn platform_pose_at(&self, joints: &[f64; 3]) -> (Vector3<f64>, Matrix3<f64>) {
+        let [phi, theta, q4] = *joints;
         let r_mat = rx(phi) * ry(theta);
         (r_mat * Vector3::new(0.0, 0.0, q4), r_mat)
     }
@@ -277,7 +284,19 @@ impl TrueMachine {
         extension_mm: f64,
         offset_mm: &Vector3<f64>,
     ) -> Vector3<f64> {
-        let (r, r_mat) = self.platform_pose(q);
+        self.spindle_point_at(&self.forward(q), h, extension_mm, offset_mm)
+    }
+
+    /// [`TrueMachine::spindle_point`] at the UP limb's joints `(phi, theta,
+    /// q4)` instead of commands.
+    pub fn spindle_point_at(
+        &self,
+        joints: &[f64; 3],
+        h: [f64; 2],
+        extension_mm: f64,
+        offset_mm: &Vector3<f64>,
+    ) -> Vector3<f64> {
+        let (r, r_mat) = self.platform_pose_at(joints);
         let x = self.head.tip + self.head.direction * extension_mm + offset_mm;
         r + r_mat * self.head.point(h, &x)
     }

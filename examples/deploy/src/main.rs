@@ -11,8 +11,9 @@
 //! cargo run -p tricept-example-deploy -- fixtures/data/diagnose-hidden-effect.csv
 //! ```
 
-use tricept_ident::nalgebra::Vector3;
-use tricept_ident::{DiagnoseRequest, ExtendedMachine, SensorNoise, diagnose, load_machine};
+use tricept_ident::MachineInput;
+use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+use tricept_ident::kinematics::{ExtendedMachine, Vector3};
 
 /// The data file when none is given: a campaign with a hidden compliance.
 const DEFAULT_DATA: &str = concat!(
@@ -24,7 +25,7 @@ const DEFAULT_DATA: &str = concat!(
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::env::args().nth(1);
     let path = path.as_deref().unwrap_or(DEFAULT_DATA);
-    let loaded = load_machine(None, &SensorNoise::default())?;
+    let loaded = MachineInput::default().load()?;
     let nominal = loaded.machine().clone();
     let result = diagnose(DiagnoseRequest::new(loaded, path))?;
     for c in &result.diagnosis().causes {

@@ -16,11 +16,11 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use tricept_ident::nalgebra::Vector3;
-use tricept_ident::{
-    CalibrateRequest, Calibration, CheckRequest, DiagnoseRequest, EXIT_OK, Error, ExtendedMachine,
-    SensorNoise, calibrate, check, diagnose, load_machine,
-};
+use tricept_ident::calibrate::{CalibrateRequest, Calibration, calibrate};
+use tricept_ident::check::{CheckRequest, check};
+use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+use tricept_ident::kinematics::{ExtendedMachine, Vector3};
+use tricept_ident::{EXIT_OK, Error, MachineInput};
 
 fn main() -> ExitCode {
     let mut args = std::env::args().skip(1);
@@ -107,7 +107,7 @@ fn command(calibration: &Calibration) -> Result<(), Error> {
 /// them, deploys it (the calibrated leg commands at the centre) and writes
 /// it to `out` as a calibrated machine file.
 fn diagnose_and_deploy(path: &Path, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
-    let nominal = load_machine(None, &SensorNoise::default())?;
+    let nominal = MachineInput::default();
     let result = diagnose(DiagnoseRequest::new(nominal, path.to_path_buf()))?;
     println!("diagnosis: {:?}", result.diagnosis().verdict);
     if let Some(why) = result.exit_reason() {
@@ -128,7 +128,7 @@ fn diagnose_and_deploy(path: &Path, out: &Path) -> Result<(), Box<dyn std::error
 /// Step 5: checks the data against the calibrated machine file `calibrated`: has
 /// the machine changed since its calibration?
 fn check_against(calibrated: &Path, path: &Path) -> Result<(), Box<dyn std::error::Error>> {
-    let machine = load_machine(Some(calibrated), &SensorNoise::default())?;
+    let machine = MachineInput::from(calibrated);
     let result = check(CheckRequest::new(machine, path.to_path_buf()))?;
     print!("{}", result.to_text());
     match result.exit_reason() {

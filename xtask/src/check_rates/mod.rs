@@ -30,7 +30,8 @@ use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 use serde_json::Value;
 use tricept_ident::advanced::read_data_from;
-use tricept_ident::{CheckRequest, DataInput, EXIT_INADEQUATE, EXIT_OK, check};
+use tricept_ident::check::{CheckRequest, check};
+use tricept_ident::{DataInput, EXIT_INADEQUATE, EXIT_OK};
 use tricept_truth::to_csv;
 
 pub use truth_side::{BadReading, Calibrated, Change, Hidden, Scenario};

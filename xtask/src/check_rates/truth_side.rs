@@ -18,10 +18,10 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
-use tricept_ident::{
-    CalibrateRequest, DataInput, Instrument, LoadedMachine, PlanRequest, SensorNoise, calibrate,
-    load_machine, plan,
-};
+use tricept_ident::advanced::{LoadedMachine, SensorNoise, load_machine};
+use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+use tricept_ident::plan::{Instrument, PlanRequest, plan};
+use tricept_ident::{DataInput, MachineInput};
 use tricept_truth::{ARCSEC_PER_RAD, Row, TrueMachine, normal, to_csv};
 
 /// Temperature of the calibration campaign, °C.
@@ -181,7 +181,7 @@ impl Calibrated {
         for &k in pose_counts {
             let out = dir.join(format!("check-{k}.csv"));
             let mut r = PlanRequest::new(Instrument::Check);
-            r.machine = Some(machine_file.clone());
+            r.machine = MachineInput::from(machine_file.clone());
             r.k = vec![k];
             r.out = Some(out.clone());
             let p = plan(r).map_err(|e| format!("machine {seed}: plan: {e}"))?;

@@ -19,6 +19,7 @@ use tricept_engine::fusion::{
 use tricept_kinematics::description::ExternalSourceRecord;
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
+use tricept_model::effects::EffectName;
 
 use super::values::{FusedSources, TrackerTargetSpec, eval_options, fused_model};
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error};
@@ -35,6 +36,101 @@ pub(crate) struct FusedFit {
     pub set_label: String,
     /// The outcome of a write, for the JSON (`deployed`).
     pub deployed: Option<Value>,
+    /// External sources that cannot be checked on their own, tested
+    /// against the checkable fit of the others (`None`: nothing to test).
+    pub unchecked: Option<Unchecked>,
+    /// The promise's structure part `(rms_mm, upper_mm)`
+    /// (`accuracy::fused_structure`).
+    pub structure: (f64, f64),
+}
+
+/// External sources that cannot be checked on their own (too little
+/// redundancy: a gross error would fit them) tested against the fit of the
+/// other sources, which can be: the chi-square they add to it, and how far
+/// they move the tool tip.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Unchecked {
+    /// Their labels.
+    pub labels: Vec<String>,
+    /// The fit with them converged, is plausible, and explains every
+    /// source that can be checked.
+    pub others_fine: bool,
+    /// The chi-square they add to the fit of the others.
+    pub delta_chi2: f64,
+    /// Its degrees of freedom (the redundancy they add).
+    pub dof: f64,
+    /// `P(chi2 > delta_chi2)`.
+    pub p_value: f64,
+    /// The tool tip's rms shift after touch-off over the evaluation poses
+    /// between the fits with and without them, mm.
+    pub shift_mm: f64,
+    /// What chance gives that shift in mean square: the tip's predicted
+    /// variance after touch-off without them less with them (the held
+    /// parameters at the size the data show of the head), mm^2.
+    pub chance_mm2: f64,
+}
+
+impl Unchecked {
+    /// They agree with the checked fit: their added chi-square passes its
+    /// test at the adequacy level, and the fit with them may otherwise be
+    /// trusted.
+    pub fn agrees(&self) -> bool {
+        self.others_fine && self.p_value > tricept_engine::ADEQUACY_ALPHA
+    }
+
+    /// The promise's part `(rms_mm, upper_mm)`: the tip's shift beyond
+    /// chance (a Hausman comparison of the two fits), its bound adding
+    /// 1.645 times the chance's standard deviation (`sqrt(2)` times its
+    /// mean at most).
+    pub fn part_mm(&self) -> (f64, f64) {
+        let bias2 = self.shift_mm.powi(2) - self.chance_mm2;
+        let sd = std::f64::consts::SQRT_2 * self.chance_mm2;
+        (
+            bias2.max(0.0).sqrt(),
+            (bias2 + 1.644_853_626_951_472_2 * sd).max(0.0).sqrt(),
+        )
+    }
+
+    /// The JSON (`unchecked`).
+    pub fn to_json(&self) -> Value {
+        let (rms, upper) = self.part_mm();
+        json!({
+            "sources": self.labels,
+            "agrees_with_checked_fit": self.agrees(),
+            "added_chi_square": self.delta_chi2,
+            "added_dof": self.dof,
+            "p_value": self.p_value,
+            "tip_shift_mm": self.shift_mm,
+            "unchecked_mm": rms,
+            "unchecked_upper_mm": upper,
+        })
+    }
+
+    /// The report's line.
+    pub fn line(&self) -> String {
+        let (rms, upper) = self.part_mm();
+        format!(
+            "unchecked: {} cannot be checked on {} own; {} the checked fit of the other sources (added chi-square {:.1} for {:.1} degrees of freedom, p = {:.2e}); the tool tip rests on {} by {:.4} mm rms after touch-off, {:.4} mm beyond chance (95 % bound {:.4} mm, in the promise)",
+            self.labels.join(", "),
+            if self.labels.len() == 1 {
+                "its"
+            } else {
+                "their"
+            },
+            if self.agrees() {
+                "it agrees with"
+            } else {
+                "it DISAGREES with"
+            },
+            self.delta_chi2,
+            self.dof,
+            self.p_value,
+            if self.labels.len() == 1 { "it" } else { "them" },
+            self.shift_mm,
+            rms,
+            upper
+        )
+    }
 }
 
 /// Fits `x` with the internal `data` on `loaded`; `for_machine_file`
@@ -78,15 +174,124 @@ pub(crate) fn fit(
             .map_err(|e| Error::input(format!("--plausibility {}: {e}", path.display())))?;
     }
     options.tool_axis_arcsec = positive("--tool-axis-warn-arcsec", x.tool_axis_warn_arcsec)?;
-    let sources = sources(x, data, machine)?;
-    let fit = identify_fused(&model, &sources, &options)?;
+    let all = sources(x, data, machine)?;
+    let fit = identify_fused(&model, &all, &options)?;
+    let unchecked = unchecked(&model, &fit, &options, || sources(x, data, machine))?;
+    // The geometric estimate's shift when every leg may have a lead.
+    let mut structure = (0.0, 0.0);
+    if model.effects().is_empty() && fit.converged {
+        let mut rich = fused_model(machine, set, &[EffectName::LegLead], x.head)?;
+        if let Some(reference) = loaded.rank_reference()? {
+            rich = rich.with_rank_reference(reference)?;
+        }
+        if let Ok(r) = identify_fused(&rich, &all, &options) {
+            structure =
+                crate::accuracy::fused_structure(&model, &fit, &rich, &r, &options.eval_poses);
+        }
+    }
     Ok(FusedFit {
         model,
         fit,
-        sources,
+        sources: all,
         set_label: set.label().to_string(),
         deployed: None,
+        unchecked,
+        structure,
     })
+}
+
+/// The external sources of `fit` that cannot be checked on their own,
+/// tested against the fit of the others when that fit holds an external
+/// source and can be trusted (they agree when their added chi-square
+/// passes and the fit with them is otherwise trustworthy); `again` reads
+/// the sources anew.
+fn unchecked(
+    model: &FusedModel,
+    fit: &Fusion,
+    options: &tricept_engine::fusion::FusionOptions,
+    again: impl Fn() -> Result<Vec<Source>, Error>,
+) -> Result<Option<Unchecked>, Error> {
+    let labels: Vec<String> = fit
+        .sources
+        .iter()
+        .filter(|s| !s.checkable)
+        .map(|s| s.label.clone())
+        .collect();
+    if labels.is_empty()
+        || fit.is_trustworthy()
+        || fit
+            .sources
+            .iter()
+            .any(|s| !s.checkable && s.kind == SourceKind::Internal)
+    {
+        return Ok(None);
+    }
+    // Everything else about the fit with them may be trusted.
+    let others_fine = fit.converged
+        && fit.implausible.is_empty()
+        && fit.sources.iter().all(|s| !s.checkable || s.explained());
+    let rest: Vec<Source> = again()?
+        .into_iter()
+        .filter(|s| !labels.iter().any(|l| l == s.label()))
+        .collect();
+    // Something outside the machine must check them: the internal data do
+    // not see the head (a tracker or ballbar that cannot be checked, with
+    // the internal data alone, stays refused).
+    if rest.iter().all(|s| s.kind() == SourceKind::Internal) {
+        return Ok(None);
+    }
+    // The others alone must be a fit that can be trusted.
+    let Ok(checked) = identify_fused(model, &rest, options) else {
+        return Ok(None);
+    };
+    if !checked.is_trustworthy() {
+        return Ok(None);
+    }
+    let sum = |f: &Fusion, g: fn(&tricept_engine::fusion::SourceFit) -> f64| {
+        f.sources.iter().map(g).sum::<f64>()
+    };
+    let delta_chi2 = (sum(fit, |s| s.chi_square) - sum(&checked, |s| s.chi_square)).max(0.0);
+    let dof = sum(fit, |s| s.redundancy) - sum(&checked, |s| s.redundancy);
+    if dof < 1.0 {
+        return Ok(None);
+    }
+    let tips = |m: &Machine| -> Option<Vec<nalgebra::Vector3<f64>>> {
+        options
+            .eval_poses
+            .iter()
+            .map(|p| {
+                let up = m.forward(&p.commands_mm).ok()?.up;
+                Some(m.tool_forward(&up, p.head_rad).tip_mm)
+            })
+            .collect()
+    };
+    let (Some(with), Some(without)) = (
+        tips(&model.machine_at(&fit.estimate)),
+        tips(&model.machine_at(&checked.estimate)),
+    ) else {
+        return Ok(None);
+    };
+    let d: Vec<nalgebra::Vector3<f64>> = with.iter().zip(&without).map(|(a, b)| a - b).collect();
+    let n = d.len().max(1) as f64;
+    let mean = d.iter().sum::<nalgebra::Vector3<f64>>() / n;
+    let shift_mm = (d.iter().map(|x| (x - mean).norm_squared()).sum::<f64>() / n).sqrt();
+    // The tip's predicted variance after touch-off, the held parameters at
+    // the size the data show of the head (`accuracy::head_scale`).
+    let tip = |f: &Fusion| {
+        let t = &f.report.tool_tip;
+        let held = t.held_touch_off_rms_um * 1e-3;
+        let seen = held * crate::accuracy::head_scale(model, f).scale;
+        (t.touch_off_rms_um * 1e-3).powi(2) - held * held + seen * seen
+    };
+    Ok(Some(Unchecked {
+        labels,
+        others_fine,
+        delta_chi2,
+        dof,
+        p_value: tricept_numerics::stats::chi2_sf(delta_chi2, dof),
+        shift_mm,
+        chance_mm2: (tip(&checked) - tip(fit)).max(0.0),
+    }))
 }
 
 /// The sources: the internal data and every external file.
@@ -185,11 +390,31 @@ impl FusedFit {
     pub fn exit_code(&self) -> u8 {
         if !self.fit.converged {
             EXIT_NOT_CONVERGED
-        } else if !self.fit.is_trustworthy() {
+        } else if !self.trusted() {
             EXIT_INADEQUATE
         } else {
             EXIT_OK
         }
+    }
+
+    /// Whether the fit may be deployed: trustworthy, or only external
+    /// sources that cannot be checked on their own stand in the way and
+    /// they agree with the checked fit of the others ([`Unchecked`]).
+    pub fn trusted(&self) -> bool {
+        self.fit.is_trustworthy() || self.unchecked.as_ref().is_some_and(Unchecked::agrees)
+    }
+
+    /// The promise of the written file (`accuracy`).
+    pub fn accuracy(&self) -> crate::accuracy::Accuracy {
+        crate::accuracy::of_fusion(
+            &self.model,
+            &self.fit,
+            self.structure,
+            self.unchecked
+                .as_ref()
+                .filter(|u| u.agrees())
+                .map(Unchecked::part_mm),
+        )
     }
 
     /// Why the fit must not be deployed, in one clause per reason.
@@ -204,6 +429,15 @@ impl FusedFit {
                 "{} cannot be checked: at least {} more records make it checkable",
                 s.label,
                 s.more_records.unwrap_or(1)
+            ));
+        }
+        if let Some(u) = self.unchecked.as_ref().filter(|u| !u.agrees()) {
+            why.push(format!(
+                "{} disagree with the checked fit of the other sources (added chi-square {:.1} for {:.1} degrees of freedom, p = {:.1e})",
+                u.labels.join(", "),
+                u.delta_chi2,
+                u.dof,
+                u.p_value
             ));
         }
         let unexplained: Vec<&str> = fit
@@ -312,14 +546,14 @@ impl FusedFit {
                     .filter(|r| r.label == "internal")
                     .map(|r| r.line)
                     .collect(),
-                adequate: fit.is_trustworthy(),
+                adequate: self.trusted(),
                 forced,
                 warnings: fit.warnings.clone(),
                 effects: serde_json::Map::new(),
                 n_geometric: fit.names.len(),
                 external,
                 temperature_c: None,
-                accuracy: Some(crate::accuracy::of_fusion(fit).record()),
+                accuracy: Some(self.accuracy().record()),
             },
             None,
         )?;
@@ -353,10 +587,10 @@ impl FusedFit {
         if let Value::Object(o) = &mut v {
             o.insert("machine".into(), loaded.description().name.clone().into());
             o.insert("data_file".into(), data_name.into());
-            o.insert(
-                "accuracy".into(),
-                crate::accuracy::of_fusion(&self.fit).to_json(),
-            );
+            o.insert("accuracy".into(), self.accuracy().to_json());
+            if let Some(u) = &self.unchecked {
+                o.insert("unchecked".into(), u.to_json());
+            }
             if let Some(d) = &self.deployed {
                 o.insert("deployed".into(), d.clone());
             }
@@ -379,7 +613,10 @@ impl FusedFit {
             .map(|s| format!("{} {} ({} records)", s.label(), s.file(), s.records()))
             .collect();
         let _ = writeln!(s, "fused identification: {}", list.join(", "));
-        let _ = writeln!(s, "{}", crate::accuracy::of_fusion(fit).line());
+        let _ = writeln!(s, "{}", self.accuracy().line());
+        if let Some(u) = &self.unchecked {
+            let _ = writeln!(s, "{}", u.line());
+        }
         for r in &fit.rejected {
             let _ = writeln!(s, "{}", r.to_text());
         }

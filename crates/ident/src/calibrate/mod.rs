@@ -1,9 +1,9 @@
 //! Calibrate: identify the machine from the UP limb's sensors alone
-//! ([`internal`]) or fused with external measurements that also calibrate
-//! the head ([`fused`]); the verdict and its exit code, the accuracy the
+//! (`internal.rs`) or fused with external measurements that also calibrate
+//! the head (`fused.rs`); the verdict and its exit code, the accuracy the
 //! calibration predicts, the advice of a campaign too small to calibrate
-//! ([`advice`]), and the calibrated machine file with its record, written
-//! by the one write rule ([`crate::machine_file::write_rule`]).
+//! (`advice.rs`), and the calibrated machine file with its record, written
+//! by the one write rule of every machine file (`machine_file.rs`).
 //!
 //! [`calibrate`] takes a [`CalibrateRequest`] (the data as a file or in
 //! memory, the machine, the parameter set, the external sources) and
@@ -23,8 +23,9 @@ use tricept_model::ParameterSet;
 
 use crate::data_input::DataInput;
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, Error};
-use crate::inputs::{LoadedMachine, SensorNoise, load_machine};
+use crate::inputs::LoadedMachine;
 use crate::machine_file;
+use crate::machine_input::MachineInput;
 pub(crate) use internal::fit_error;
 pub use values::FusedSources;
 
@@ -32,7 +33,7 @@ pub use values::FusedSources;
 ///
 /// # Example
 /// ```no_run
-/// use tricept_ident::{CalibrateRequest, calibrate};
+/// use tricept_ident::calibrate::{CalibrateRequest, calibrate};
 /// let calibration = calibrate(CalibrateRequest::new("data.csv"))?;
 /// println!("exit code {}", calibration.exit_code());
 /// # Ok::<(), tricept_ident::Error>(())
@@ -43,10 +44,8 @@ pub struct CalibrateRequest {
     /// The internal data (a machine file can be written only from data
     /// given as a file: its record holds the file's hash).
     pub data: DataInput,
-    /// Machine description file (default: the embedded Table 1 machine).
-    pub machine: Option<PathBuf>,
-    /// Sensor-noise overrides.
-    pub noise: SensorNoise,
+    /// The machine (default: the embedded Table 1 machine).
+    pub machine: MachineInput,
     /// The geometric parameters to identify (default `paper15`).
     pub parameter_set: ParameterSet,
     /// Reject poses with a gross reading error (default true).
@@ -68,8 +67,7 @@ impl CalibrateRequest {
     pub fn new(data: impl Into<DataInput>) -> CalibrateRequest {
         CalibrateRequest {
             data: data.into(),
-            machine: None,
-            noise: SensorNoise::default(),
+            machine: MachineInput::default(),
             parameter_set: ParameterSet::paper15(),
             robust: true,
             tolerance_mm: tricept_engine::DEFAULT_TOLERANCE_MM,
@@ -133,7 +131,7 @@ pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
             "--tolerance-mm: the manufacturing tolerance must be a number of mm above 0 and at most 10, got {tolerance_mm}"
         )));
     }
-    let loaded = load_machine(request.machine.as_deref(), &request.noise)?;
+    let loaded = request.machine.load()?;
     let set = &request.parameter_set;
     let fit = match &request.fused {
         None => {
@@ -190,7 +188,7 @@ impl Calibration {
     pub fn adequate(&self) -> bool {
         match &self.fit {
             Fit::Internal(f) => f.verdict.adequate,
-            Fit::Fused(f) => f.fit.is_trustworthy(),
+            Fit::Fused(f) => f.trusted(),
         }
     }
 
@@ -366,7 +364,7 @@ pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), Error> {
 
 /// The one-line summary of a non-zero verdict (`VERB: exit CODE: WHY (see
 /// the warnings)`) for 3 and 4, else `None`.
-pub fn exit_line(verb: &str, code: u8, why: &str) -> Option<String> {
+pub(crate) fn exit_line(verb: &str, code: u8, why: &str) -> Option<String> {
     (code == EXIT_INADEQUATE || code == EXIT_NOT_CONVERGED)
         .then(|| format!("{verb}: exit {code}: {why} (see the warnings)"))
 }
