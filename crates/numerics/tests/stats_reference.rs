@@ -158,6 +158,28 @@ fn chi_square_tails_near_the_mean_use_the_series() {
 }
 
 #[test]
+fn chi_square_tails_on_each_side_of_the_switch() {
+    // x = k - 2 (x/2 = k/2 - 1), where the continued fraction divides by
+    // zero: the series must answer. And tails of 1e-9 to 1e-20 between
+    // k + 2 and 2k + 3, where `1 - P` by the series would keep only 7 to
+    // no digits: the continued fraction must answer.
+    for (x, k) in [
+        (8.0, 10),
+        (18.0, 20),
+        (98.0, 100),
+        (200.0, 100),
+        (250.0, 124),
+        (120.0, 50),
+    ] {
+        let want = reference_ln_sf(x, k);
+        let what = format!("({x}, {k})");
+        assert!(want.is_finite(), "{what}");
+        assert_relative(chi2_sf(x, k as f64), want.exp(), 1e-11, &what);
+        assert_relative(chi2_ln_sf(x, k as f64), want, 1e-11, &what);
+    }
+}
+
+#[test]
 fn chi_square_log_tails_beyond_underflow() {
     for (x, k) in [
         (100.0, 3),
@@ -233,6 +255,12 @@ fn incomplete_beta_against_closed_forms_and_off_its_domain() {
             let want = 1.0 - (1.0 - xa).powf(a);
             assert_relative(beta_inc(1.0, a, x), want, 1e-12, "I_x(1, b)");
         }
+    }
+    // Small values keep their digits: `I_x(1, b) = -expm1(b ln1p(-x))`
+    // near 1e-7 (the form `1 - I_{1-x}(b, 1)` would keep 9 digits).
+    for (x, b) in [(1e-8f64, 10.0f64), (1e-10, 3.0), (1e-9, 40.0)] {
+        let want = -(b * (-x).ln_1p()).exp_m1();
+        assert_relative(beta_inc(1.0, b, x), want, 1e-12, "small I_x(1, b)");
     }
     assert_eq!(beta_inc(2.0, 3.0, 0.0), 0.0);
     assert_eq!(beta_inc(2.0, 3.0, 1.0), 1.0);
