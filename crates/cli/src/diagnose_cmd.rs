@@ -8,7 +8,9 @@ use clap::Args;
 use tricept_ident::DataInput;
 use tricept_ident::advanced::{LoadedMachine, Poses};
 use tricept_ident::detectability::{DetectabilityRequest, detectability};
-use tricept_ident::diagnosis::{DiagnoseRequest, DiagnoseResult, ResidualPlot, diagnose};
+use tricept_ident::diagnosis::{
+    DeployRule, DiagnoseRequest, DiagnoseResult, ResidualPlot, diagnose,
+};
 
 use crate::args::{MachineArgs, NoiseArgs, load_with_noise, read_data};
 use crate::cli_error::CliError;
@@ -60,6 +62,13 @@ pub struct DiagnoseArgs {
     /// says so.
     #[arg(long, requires = "write_machine")]
     pub force: bool,
+    /// How a term is judged worth deploying: `confident` (its move where
+    /// the sensors cannot see beyond 2 sd: no file worse in the tallies)
+    /// or `expected-error` (also when the file with it has the smaller
+    /// expected error and its move is at least 1 sd: more files gain, a
+    /// few per hundred lose more than 10 %; docs/diagnosis.md).
+    #[arg(long, value_name = "RULE", default_value = "confident", value_parser = deploy_rule)]
+    pub deploy_rule: DeployRule,
     #[command(flatten)]
     pub noise: NoiseArgs,
     #[command(flatten)]
@@ -90,6 +99,11 @@ pub struct DetectabilityArgs {
     pub machine: MachineArgs,
 }
 
+/// `--deploy-rule` as a deploy rule.
+fn deploy_rule(name: &str) -> Result<DeployRule, CliError> {
+    name.parse().map_err(CliError::input)
+}
+
 /// `tricept diagnose`.
 pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
     let loaded = load_with_noise(&a.machine, &a.noise)?;
@@ -99,6 +113,7 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
     request.temperature_noise_k = a.temperature_noise;
     request.plausibility = a.plausibility.clone();
     request.dictionary = !a.no_dictionary;
+    request.deploy_rule = a.deploy_rule;
     let result = diagnose(request)?;
     if let Some(dir) = &a.plots {
         plot_residuals(dir, result.plots())?;

@@ -116,12 +116,14 @@ pub(crate) fn improvement(
         return None;
     }
     let at_p = positions(better, p, &commanded)?;
-    let mean = at_p
+    let misses: Vec<f64> = at_p
         .iter()
         .zip(&commanded)
         .map(|(x, (r, _, _))| (x - r).norm())
-        .sum::<f64>()
-        / commanded.len() as f64;
+        .collect();
+    let count = misses.len() as f64;
+    let mean = misses.iter().sum::<f64>() / count;
+    let rms = (misses.iter().map(|m| m * m).sum::<f64>() / count).sqrt();
     // The uncertainty on every fourth target (the platform's derivatives
     // are smooth over the plane).
     let sampled: Vec<(Vector3<f64>, [f64; 3], UpJoints)> =
@@ -163,6 +165,7 @@ pub(crate) fn improvement(
     let moved = sd(&difference);
     Some(Improvement {
         mean_mm: mean,
+        rms_mm: rms,
         sd_mm: own.hypot(moved),
         difference_sd_mm: moved,
     })
@@ -174,6 +177,8 @@ pub(crate) struct Improvement {
     /// Mean platform error on the middle plane of the base fit's commands
     /// under the better model, mm.
     pub(crate) mean_mm: f64,
+    /// Root mean square of the same platform errors, mm.
+    pub(crate) rms_mm: f64,
     /// Its standard deviation against the truth: the better model's own
     /// platform uncertainty and the difference's, in quadrature, mm.
     pub(crate) sd_mm: f64,

@@ -50,6 +50,7 @@ use tricept_kinematics::{Machine, UpJoints};
 use crate::fit::Fit;
 use crate::gain::{Improvement, improvement};
 use crate::model::ExtendedModel;
+use crate::options::DeployRule;
 use crate::report::{DEPLOY_BENEFIT_SD, DEPLOY_IMPROVEMENT_SD, ModelTerm};
 use crate::select::Setup;
 use crate::terms::{GenericTerm, Scope, Term};
@@ -166,21 +167,25 @@ pub(crate) fn benefit(with: &[Vector3<f64>], without: &[Vector3<f64>]) -> Option
 }
 
 /// The deployed model terms are judged against: its fit, its held-out
-/// platform errors, and its platform's standard deviation when every leg
-/// may also carry a polynomial ([`structured_sd`]).
+/// platform errors, its platform's standard deviation when every leg may
+/// also carry a polynomial ([`structured_sd`]), the richer model itself,
+/// and the deployed model's expected squared error against it
+/// ([`expected_error`]).
 #[derive(Clone, Copy)]
 struct Against<'a> {
     fit: &'a Fit,
     full: Option<&'a [Vector3<f64>]>,
     structured_sd_mm: Option<f64>,
+    /// The richer fit, `None` when every leg is shaped already (the
+    /// deployed model is then its own reference).
+    rich: Option<&'a Fit>,
+    /// The deployed model's expected mean squared platform error, mm^2.
+    expected_mse_mm2: Option<f64>,
 }
 
-/// The deployed model's own platform standard deviation on the middle
-/// plane when every leg may also be a polynomial in its command (a lead,
-/// a curved screw: [`GenericFamily::LegPolynomial`] on all legs), mm;
-/// a leg whose command dependence the model already describes keeps its
-/// own ([`shapes_leg`]); `None` when that model cannot be fitted or every
-/// leg has one.
+/// The deployed model `with` and a polynomial on every leg it does not
+/// shape ([`shapes_leg`]), fitted; `None` when every leg has one or that
+/// model cannot be fitted.
 ///
 /// A move along the weak direction is made by a term's small correlation
 /// with it, scaled by the weak direction's large uncertainty; a term that
@@ -188,7 +193,7 @@ struct Against<'a> {
 /// their length, a polynomial beside an unexplained slip) moves it as far
 /// and as confidently, but wrongly. The readings cannot tell: only a move
 /// that stands out of what the legs' structure leaves unknown is trusted.
-fn structured_sd(nominal: &Machine, setup: &Setup<'_>, clean: &Dataset, with: &Fit) -> Option<f64> {
+fn richer(setup: &Setup<'_>, clean: &Dataset, with: &Fit) -> Option<Fit> {
     let fitter = &setup.fitter;
     let carried = |leg: usize| with.model.terms().iter().any(|t| shapes_leg(t, leg));
     let free: Vec<u8> = (0..3u8).filter(|&i| !carried(usize::from(i))).collect();
@@ -209,10 +214,31 @@ fn structured_sd(nominal: &Machine, setup: &Setup<'_>, clean: &Dataset, with: &F
             .collect(),
     };
     let terms = [with.model.terms(), &legs].concat();
-    let rich = fitter.fit(fitter.model(&terms), clean).ok()?;
-    let g = improvement(nominal, with, &rich, fitter.options)?;
+    fitter.fit(fitter.model(&terms), clean).ok()
+}
+
+/// The deployed model's own platform standard deviation on the middle
+/// plane under the richer model ([`richer`]), from the improvement `g` of
+/// the richer model over it: its own part, mm.
+fn structured_sd(g: Improvement) -> Option<f64> {
     let own2 = g.sd_mm.powi(2) - g.difference_sd_mm.powi(2);
     own2.is_finite().then(|| own2.max(0.0).sqrt())
+}
+
+/// The expected mean squared platform error on the middle plane (mm^2)
+/// of a file whose model is nested in a reference model, from the
+/// improvement `g` of the reference over it and the reference's own
+/// platform standard deviation `reference_sd_mm`: an unbiased risk
+/// estimate (Mallows' `C_p` on the platform). The file's error is the
+/// reference's minus the difference `D` of the two (`rms D^2` over the
+/// plane); nested least squares make `D` uncorrelated with the file, so its
+/// variance is the reference's less `var D` (Hausman,
+/// `difference_sd_mm^2`), and its squared bias is `E|D|^2 - var D`,
+/// estimated by `rms D^2 - var D`, at least 0.
+fn expected_error(g: Improvement, reference_sd_mm: f64) -> f64 {
+    let var_d = g.difference_sd_mm.powi(2);
+    let bias2 = (g.rms_mm.powi(2) - var_d).max(0.0);
+    (reference_sd_mm.powi(2) - var_d).max(0.0) + bias2
 }
 
 /// Whether `t` already describes how leg `leg`'s length error varies with
@@ -268,6 +294,8 @@ fn judge(
         fit: with,
         full,
         structured_sd_mm,
+        rich,
+        expected_mse_mm2,
     } = *with;
     let fitter = &setup.fitter;
     let others: Vec<Term> = with
@@ -279,10 +307,22 @@ fn judge(
         .collect();
     let model = fitter.model(&others);
     let without = fitter.fit(model.clone(), clean).ok();
-    let gained = without
+    let moved = without
         .as_ref()
-        .and_then(|w| improvement(nominal, w, with, fitter.options))
-        .map(|g| with_structure(g, structured_sd_mm));
+        .and_then(|w| improvement(nominal, w, with, fitter.options));
+    let gained = moved.map(|g| with_structure(g, structured_sd_mm));
+    // Both files' expected errors against the reference: the richer
+    // model, or the deployed model itself when it shapes every leg (its
+    // squared bias 0, its variance its own).
+    let expected = match rich {
+        Some(r) => without
+            .as_ref()
+            .and_then(|w| improvement(nominal, w, r, fitter.options))
+            .zip(structured_sd_mm)
+            .map(|(g, sd)| expected_error(g, sd))
+            .and_then(|o| expected_mse_mm2.map(|w| (w, o))),
+        None => moved.and_then(|g| structured_sd(g).map(|sd| (sd * sd, expected_error(g, sd)))),
+    };
     let held_out = match (full, &without) {
         (Some(full), Some(_)) => platform_errors(setup, &model, clean)
             .ok()
@@ -290,7 +330,13 @@ fn judge(
         _ => None,
     };
     let z = improvement_sds(gained);
-    let pays = rule(without.is_some(), held_out, gained);
+    let pays = rule(
+        fitter.options.deploy_rule,
+        without.is_some(),
+        held_out,
+        gained,
+        expected,
+    );
     let (legs, channel, period_mm, edges_mm) = match t {
         Term::Generic(g) => (
             g.legs().iter().map(|i| *i as u8 + 1).collect(),
@@ -314,6 +360,8 @@ fn judge(
             difference_sd_mm: gained.map(|g| g.difference_sd_mm),
             holdout_benefit_mm: held_out.map(|b| b.mean_mm),
             holdout_benefit_sd_mm: held_out.map(|b| b.sd_mm),
+            expected_rms_with_mm: expected.map(|(w, _)| w.sqrt()),
+            expected_rms_without_mm: expected.map(|(_, o)| o.sqrt()),
         },
         pays,
         z,
@@ -332,10 +380,18 @@ fn improvement_sds(gained: Option<Improvement>) -> f64 {
     })
 }
 
-/// The module's rule: whether a term pays, given whether the model
-/// without it could be fitted (`fitted_without`), its out-of-sample
-/// benefit `held_out` and its predicted improvement `gained`.
-fn rule(fitted_without: bool, held_out: Option<Benefit>, gained: Option<Improvement>) -> bool {
+/// The module's rule: whether a term pays under `policy`, given whether
+/// the model without it could be fitted (`fitted_without`), its
+/// out-of-sample benefit `held_out`, its predicted improvement `gained`
+/// and the expected mean squared errors of the files with and without it
+/// (`expected`, mm^2, [`expected_error`]).
+fn rule(
+    policy: DeployRule,
+    fitted_without: bool,
+    held_out: Option<Benefit>,
+    gained: Option<Improvement>,
+    expected: Option<(f64, f64)>,
+) -> bool {
     match (fitted_without, held_out, gained) {
         // Without it the model cannot be fitted: it is needed.
         (false, _, _) => true,
@@ -344,14 +400,25 @@ fn rule(fitted_without: bool, held_out: Option<Benefit>, gained: Option<Improvem
             // It pays where the readings cannot see, or it moves the
             // platform there by no more than the readings see it gain (so
             // that it cannot lose more than it gains).
-            let unseen = g.mean_mm > DEPLOY_IMPROVEMENT_SD * g.sd_mm
+            let confident = g.mean_mm > DEPLOY_IMPROVEMENT_SD * g.sd_mm
                 || g.mean_mm <= b.mean_mm + DEPLOY_BENEFIT_SD * b.sd_mm;
-            seen && unseen
+            // The file with it is expected better, by a move of at least
+            // one standard deviation.
+            let expected_better = expected.is_some_and(|(with, without)| with < without)
+                && g.mean_mm >= EXPECTED_ERROR_MIN_SD * g.sd_mm;
+            seen && match policy {
+                DeployRule::Confident => confident,
+                DeployRule::ExpectedError => confident || expected_better,
+            }
         }
         // No out-of-sample benefit can be had: nothing says it pays.
         _ => false,
     }
 }
+
+/// The least predicted improvement, in its standard deviations, of a term
+/// [`DeployRule::ExpectedError`] deploys for its expected error alone.
+const EXPECTED_ERROR_MIN_SD: f64 = 1.0;
 
 /// Every term of the final model `current` with its predicted
 /// improvement ([`improvement`]), its out-of-sample benefit, and whether
@@ -375,10 +442,23 @@ pub(crate) fn deployable(
     let mut kept = terms.clone();
     while !kept.is_empty() {
         let full = platform_errors(setup, &with.model, clean).ok();
+        let rich = richer(setup, clean, &with);
+        // The deployed model against the richer one (with none, see
+        // `judge`).
+        let (structured_sd_mm, expected_mse_mm2) = match &rich {
+            Some(r) => {
+                let g = improvement(nominal, &with, r, fitter.options);
+                let sd = g.and_then(structured_sd);
+                (sd, g.zip(sd).map(|(g, sd)| expected_error(g, sd)))
+            }
+            None => (None, None),
+        };
         let against = Against {
             fit: &with,
             full: full.as_deref(),
-            structured_sd_mm: structured_sd(nominal, setup, clean, &with),
+            structured_sd_mm,
+            rich: rich.as_ref(),
+            expected_mse_mm2,
         };
         let judged: Vec<Judged> = kept
             .par_iter()
@@ -441,6 +521,7 @@ mod tests {
     fn g(mean_mm: f64, sd_mm: f64) -> Option<Improvement> {
         Some(Improvement {
             mean_mm,
+            rms_mm: mean_mm,
             sd_mm,
             difference_sd_mm: sd_mm,
         })
@@ -497,24 +578,48 @@ mod tests {
 
     #[test]
     fn a_term_the_model_cannot_do_without_is_deployed() {
-        assert!(rule(false, None, None));
-        assert!(rule(false, b(-1.0, 0.1), g(-1.0, 0.1)));
+        assert!(rule(DeployRule::Confident, false, None, None, None));
+        assert!(rule(
+            DeployRule::Confident,
+            false,
+            b(-1.0, 0.1),
+            g(-1.0, 0.1),
+            None
+        ));
     }
 
     #[test]
     fn without_both_numbers_nothing_says_a_term_pays() {
-        assert!(!rule(true, None, g(10.0, 1.0)));
-        assert!(!rule(true, b(10.0, 1.0), None));
-        assert!(!rule(true, None, None));
+        assert!(!rule(DeployRule::Confident, true, None, g(10.0, 1.0), None));
+        assert!(!rule(DeployRule::Confident, true, b(10.0, 1.0), None, None));
+        assert!(!rule(DeployRule::Confident, true, None, None, None));
     }
 
     #[test]
     fn the_out_of_sample_benefit_must_exceed_two_sd() {
         // Improvement 3 sd: the second half holds.
-        assert!(rule(true, b(1.0, 0.4), g(3.0, 1.0)));
+        assert!(rule(
+            DeployRule::Confident,
+            true,
+            b(1.0, 0.4),
+            g(3.0, 1.0),
+            None
+        ));
         // Exactly 2 sd does not exceed 2 sd.
-        assert!(!rule(true, b(1.0, 0.5), g(3.0, 1.0)));
-        assert!(!rule(true, b(-1.0, 0.1), g(3.0, 1.0)));
+        assert!(!rule(
+            DeployRule::Confident,
+            true,
+            b(1.0, 0.5),
+            g(3.0, 1.0),
+            None
+        ));
+        assert!(!rule(
+            DeployRule::Confident,
+            true,
+            b(-1.0, 0.1),
+            g(3.0, 1.0),
+            None
+        ));
     }
 
     #[test]
@@ -522,14 +627,14 @@ mod tests {
         // Benefit 1 +- 0.25 (4 sd): its upper bound 1 + 2 * 0.25 = 1.5.
         let seen = b(1.0, 0.25);
         // 1.5 sd, but no larger than 1.5: it cannot lose more than it gains.
-        assert!(rule(true, seen, g(1.5, 1.0)));
+        assert!(rule(DeployRule::Confident, true, seen, g(1.5, 1.0), None));
         // 1.6 sd and larger than 1.5.
-        assert!(!rule(true, seen, g(1.6, 1.0)));
+        assert!(!rule(DeployRule::Confident, true, seen, g(1.6, 1.0), None));
         // Exactly 2 sd does not exceed 2 sd.
-        assert!(!rule(true, seen, g(2.0, 1.0)));
-        assert!(rule(true, seen, g(2.5, 1.0)));
+        assert!(!rule(DeployRule::Confident, true, seen, g(2.0, 1.0), None));
+        assert!(rule(DeployRule::Confident, true, seen, g(2.5, 1.0), None));
         // 3.5 sd of a spread of 0.5 (larger than 1.5): 2 sd is 1.0 there.
-        assert!(rule(true, seen, g(1.75, 0.5)));
+        assert!(rule(DeployRule::Confident, true, seen, g(1.75, 0.5), None));
     }
 
     #[test]
@@ -571,6 +676,7 @@ mod tests {
         // own 0.03, move 0.04: sd 0.05.
         let g = Improvement {
             mean_mm: 0.12,
+            rms_mm: 0.12,
             sd_mm: 0.05,
             difference_sd_mm: 0.04,
         };
@@ -586,5 +692,111 @@ mod tests {
             let same = with_structure(g, s);
             assert_eq!(same.sd_mm, g.sd_mm, "{s:?}");
         }
+    }
+
+    fn with_rms(mean_mm: f64, rms_mm: f64, sd_mm: f64, difference_sd_mm: f64) -> Improvement {
+        Improvement {
+            mean_mm,
+            rms_mm,
+            sd_mm,
+            difference_sd_mm,
+        }
+    }
+
+    #[test]
+    fn the_expected_error_is_the_references_variance_less_the_moves_plus_its_squared_bias() {
+        // Reference sd 0.10, the move's sd 0.06, rms of the move 0.08:
+        // variance 0.01 - 0.0036 = 0.0064, squared bias 0.0064 - 0.0036 =
+        // 0.0028: 0.0092 mm^2.
+        let e = expected_error(with_rms(0.07, 0.08, 0.2, 0.06), 0.10);
+        assert!((e - 0.0092).abs() < 1e-15, "{e}");
+        // A move smaller than its sd shows no bias (never negative): the
+        // file is the reference less the move's variance.
+        let e = expected_error(with_rms(0.03, 0.04, 0.2, 0.06), 0.10);
+        assert!((e - 0.0064).abs() < 1e-15, "{e}");
+        // A move's variance beyond the reference's (rounding) leaves no
+        // negative variance: the squared bias alone, 0.05^2 - 0.04^2.
+        let e = expected_error(with_rms(0.05, 0.05, 0.2, 0.04), 0.03);
+        assert!((e - 0.0009).abs() < 1e-15, "{e}");
+        // The deployed model as its own reference (no move): its variance.
+        let e = expected_error(with_rms(0.0, 0.0, 0.1, 0.0), 0.1);
+        assert!((e - 0.01).abs() < 1e-15, "{e}");
+    }
+
+    #[test]
+    fn the_expected_error_rule_adds_files_expected_better_by_a_move_of_one_sd() {
+        let seen = b(1.0, 0.25);
+        let better = Some((0.01, 0.02));
+        let worse = Some((0.02, 0.01));
+        // 1.6 sd, larger than the benefit (and its 2 sd, 1.5): the confident rule keeps it
+        // back, the expected-error rule deploys it when the file with it is
+        // expected better.
+        assert!(!rule(
+            DeployRule::Confident,
+            true,
+            seen,
+            g(1.6, 1.0),
+            better
+        ));
+        assert!(rule(
+            DeployRule::ExpectedError,
+            true,
+            seen,
+            g(1.6, 1.0),
+            better
+        ));
+        assert!(!rule(
+            DeployRule::ExpectedError,
+            true,
+            seen,
+            g(1.6, 1.0),
+            worse
+        ));
+        assert!(!rule(
+            DeployRule::ExpectedError,
+            true,
+            seen,
+            g(1.6, 1.0),
+            Some((0.01, 0.01))
+        ));
+        assert!(!rule(
+            DeployRule::ExpectedError,
+            true,
+            seen,
+            g(1.6, 1.0),
+            None
+        ));
+        // Exactly one sd is enough, less is not.
+        assert!(rule(
+            DeployRule::ExpectedError,
+            true,
+            seen,
+            g(1.6, 1.6),
+            better
+        ));
+        assert!(!rule(
+            DeployRule::ExpectedError,
+            true,
+            seen,
+            g(1.59, 1.6),
+            better
+        ));
+        // The out-of-sample benefit is still required.
+        assert!(!rule(
+            DeployRule::ExpectedError,
+            true,
+            b(1.0, 0.5),
+            g(3.0, 1.0),
+            better
+        ));
+        // What the confident rule deploys, it deploys.
+        assert!(rule(
+            DeployRule::ExpectedError,
+            true,
+            seen,
+            g(2.5, 1.0),
+            worse
+        ));
+        assert!(rule(DeployRule::ExpectedError, false, None, None, None));
     }
 }

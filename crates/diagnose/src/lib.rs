@@ -84,7 +84,7 @@ pub use error::{DeployError, DiagnoseError};
 pub use finite::first_non_finite;
 pub use model::ExtendedModel;
 pub use noise::NOISE_CHECK_LEVEL;
-pub use options::{DiagnoseOptions, DictionaryOptions, MIN_PURE_ERROR_DOF};
+pub use options::{DeployRule, DiagnoseOptions, DictionaryOptions, MIN_PURE_ERROR_DOF};
 pub use plausibility::{Plausibility, PlausibilityError, Range};
 pub use report::{
     Alias, Cause, CauseKind, ChannelRms, DEPLOY_BENEFIT_SD, DEPLOY_IMPROVEMENT_SD, Diagnosis,

@@ -36,6 +36,62 @@ pub struct DiagnoseOptions {
     /// of a calibrated one: docs/identifiability.md); `None`: the machine
     /// diagnosed.
     pub rank_reference: Option<Machine>,
+    /// How a term of the final model is judged worth deploying
+    /// ([`DeployRule`]; default [`DeployRule::Confident`]).
+    pub deploy_rule: DeployRule,
+}
+
+/// How a term of the final model is judged worth deploying. Both deploy a
+/// term only when its out-of-sample benefit exceeds
+/// [`crate::DEPLOY_BENEFIT_SD`] standard deviations; they differ where the
+/// readings cannot see (the weak leg-length direction,
+/// `docs/diagnosis.md`, "Deploy by what the file will deliver").
+///
+/// # Example
+/// ```
+/// use tricept_diagnose::{DeployRule, DiagnoseOptions};
+/// use tricept_kinematics::Machine;
+/// let mut options = DiagnoseOptions::for_machine(&Machine::paper());
+/// assert_eq!(options.deploy_rule, DeployRule::Confident);
+/// options.deploy_rule = "expected-error".parse().unwrap();
+/// assert_eq!(options.deploy_rule, DeployRule::ExpectedError);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DeployRule {
+    /// The term's predicted improvement exceeds
+    /// [`crate::DEPLOY_IMPROVEMENT_SD`] standard deviations of what the file
+    /// does not know, or the term moves the platform where the readings
+    /// cannot see by no more than they see it gain: in every tally of
+    /// `docs/reliability.md`, no deployed file more than 10 % worse in
+    /// truth than the geometric-only one.
+    #[default]
+    Confident,
+    /// Also deploy a term when the file with it has the smaller expected
+    /// error ([`crate::ModelTerm::expected_rms_with_mm`]) and its predicted
+    /// improvement is at least one standard deviation: more files gain
+    /// (the pitch errors the confident rule keeps back among them), and
+    /// some lose: measured, a few per hundred files more than 10 % worse.
+    ExpectedError,
+}
+
+impl DeployRule {
+    /// The rule's name on the command line and in the JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            DeployRule::Confident => "confident",
+            DeployRule::ExpectedError => "expected-error",
+        }
+    }
+}
+
+impl std::str::FromStr for DeployRule {
+    type Err = String;
+    fn from_str(s: &str) -> Result<DeployRule, String> {
+        [DeployRule::Confident, DeployRule::ExpectedError]
+            .into_iter()
+            .find(|r| r.name() == s)
+            .ok_or_else(|| format!("unknown deploy rule {s:?} (confident, expected-error)"))
+    }
 }
 
 /// Smallest degrees of freedom of pure error per channel for
@@ -59,6 +115,7 @@ impl DiagnoseOptions {
             temperature_sigma_k: 0.02,
             max_error_mm: 20.0,
             rank_reference: None,
+            deploy_rule: DeployRule::Confident,
         }
     }
 }

@@ -346,6 +346,15 @@ pub struct ModelTerm {
     pub holdout_benefit_mm: Option<f64>,
     /// Its standard deviation over the held-out poses, mm.
     pub holdout_benefit_sd_mm: Option<f64>,
+    /// The expected root mean square platform error on the middle plane of
+    /// the deployed model with this term, mm: its estimated squared bias and
+    /// variance against the richest model the data support (the deployed
+    /// model with a polynomial on every leg it does not shape), an unbiased
+    /// risk estimate (`null` when a model cannot be fitted or the plane
+    /// reached).
+    pub expected_rms_with_mm: Option<f64>,
+    /// The same for the deployed model without this term, mm.
+    pub expected_rms_without_mm: Option<f64>,
 }
 
 /// How many standard deviations ([`ModelTerm::improvement_sd_mm`]) a

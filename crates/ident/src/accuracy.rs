@@ -341,12 +341,10 @@ pub(crate) fn of_fusion(
     structure: (f64, f64),
     unchecked: Option<(f64, f64)>,
 ) -> Accuracy {
-    let tip = &fit.report.tool_tip;
-    let held_mm = tip.held_touch_off_rms_um * 1e-3;
-    let total_mm = tip.touch_off_rms_um * 1e-3;
-    let estimate_mm = (total_mm * total_mm - held_mm * held_mm).max(0.0).sqrt();
+    let held_mm = fit.report.tool_tip.held_touch_off_rms_um * 1e-3;
+    let estimate_mm = fused_estimate_mm(fit);
     // One dominant weak direction: the chi-square of one degree of freedom.
-    let one_dof = 3.841_458_820_694_124_f64.sqrt();
+    let one_dof = ONE_DOF_95;
     let (mut unexplained, mut unexplained_upper) = (0.0_f64, 0.0_f64);
     for s in fit
         .sources
@@ -402,12 +400,16 @@ pub(crate) fn of_fusion(
 /// The structure part of a fused fit: where the geometric fit (`fit`)
 /// and the same sources fitted with a lead on every leg (`rich`, its model
 /// `rich_model`) put the tool tip at the same commands, over the
-/// evaluation poses after touch-off (the mean difference removed): the
-/// mean square difference `D`, less what chance gives it (`tr(M V)`, `M =
-/// mean_e G_e^T G_e` with `G_e` the rich model's tip Jacobian less its
-/// mean over the poses, `V` the rich covariance less the geometric one in
-/// its coordinates: Hausman); its bound adds 1.645 `sqrt(2 tr(MVMV))`.
-/// `(0, 0)` when a tip cannot be had.
+/// evaluation poses after touch-off (the mean difference removed), as
+/// `(rms_mm, upper_mm)`. Its rms is the mean square difference `D` less
+/// what chance gives it (`tr(M V)`, `M = mean_e G_e^T G_e` with `G_e` the
+/// rich model's tip Jacobian less its mean over the poses, `V` the rich
+/// covariance less the geometric one in its coordinates: Hausman). Its
+/// bound is, as for internal files ([`posterior_upper`]), what it adds to
+/// the estimate's bound for the file's error to stay within the 95 %
+/// quantile of its distribution given the data, `N(d, S_rich)` (`d` the
+/// tip differences, a flat prior on the bias), which a shift that chance
+/// happens to cancel does not fool. `(0, 0)` when a tip cannot be had.
 pub(crate) fn fused_structure(
     model: &tricept_engine::fusion::FusedModel,
     fit: &tricept_engine::fusion::Fusion,
@@ -463,14 +465,39 @@ pub(crate) fn fused_structure(
             v[(ia, ib)] -= fit.covariance[(a, b)];
         }
     }
-    let mv = &m * &v;
-    let chance = mv.trace();
-    let sd = (2.0 * (&mv * &mv).trace().max(0.0)).sqrt();
+    let chance = (&m * &v).trace();
     let bias2 = shift - chance.max(0.0);
-    if !(bias2.is_finite() && sd.is_finite()) {
+    // The moments of the tip error's mean square under N(d, S_rich):
+    // `cross = (G^T d)^T S (G^T d) / n^2` with `G^T d = sum_e G_e^T d_e`.
+    let s_rich = &rich.covariance;
+    let ms = &m * s_rich;
+    let gd = g
+        .iter()
+        .zip(&diffs)
+        .fold(nalgebra::DVector::zeros(kr), |a, (ge, d)| {
+            a + (*ge - &mean).transpose() * (d - centre)
+        });
+    let cross = (gd.transpose() * s_rich * &gd)[(0, 0)] / (n * n);
+    let upper2 = posterior_upper(shift, ms.trace(), (&ms * &ms).trace(), cross).powi(2);
+    let estimate_upper = ONE_DOF_95 * fused_estimate_mm(fit);
+    let upper = (upper2 - estimate_upper.powi(2)).max(0.0).sqrt();
+    if !(bias2.is_finite() && upper.is_finite()) {
         return (0.0, 0.0);
     }
-    (bias2.max(0.0).sqrt(), (bias2 + Z95 * sd).max(0.0).sqrt())
+    (bias2.max(0.0).sqrt(), upper)
+}
+
+/// The 95 % quantile of the root of a chi-square of one degree of
+/// freedom: the bound of an error along one dominant weak direction.
+const ONE_DOF_95: f64 = 1.959_963_984_540_054;
+
+/// A fused fit's tool-tip rms after touch-off from its estimate's
+/// covariance alone (the held parameters' share removed), mm.
+fn fused_estimate_mm(fit: &tricept_engine::fusion::Fusion) -> f64 {
+    let tip = &fit.report.tool_tip;
+    let held_mm = tip.held_touch_off_rms_um * 1e-3;
+    let total_mm = tip.touch_off_rms_um * 1e-3;
+    (total_mm * total_mm - held_mm * held_mm).max(0.0).sqrt()
 }
 
 /// The size of a head's errors the data show, in units of the parameters'

@@ -28,7 +28,7 @@ use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
 
-pub use tricept_diagnose::{Deployed, Diagnosis, ResidualPlot};
+pub use tricept_diagnose::{DeployRule, Deployed, Diagnosis, ResidualPlot};
 
 /// What to diagnose and how.
 ///
@@ -59,6 +59,9 @@ pub struct DiagnoseRequest {
     pub plausibility: Option<PathBuf>,
     /// Search the generic dictionary as well as the vocabulary (default).
     pub dictionary: bool,
+    /// How a term is judged worth deploying (default
+    /// [`DeployRule::Confident`]; JSON `deploy_rule`).
+    pub deploy_rule: DeployRule,
 }
 
 impl DiagnoseRequest {
@@ -72,6 +75,7 @@ impl DiagnoseRequest {
             temperature_noise_k: None,
             plausibility: None,
             dictionary: true,
+            deploy_rule: DeployRule::Confident,
         }
     }
 }
@@ -85,6 +89,7 @@ pub struct DiagnoseResult {
     data: Dataset,
     machine: LoadedMachine,
     rank_reference: Option<Machine>,
+    deploy_rule: DeployRule,
     /// The accuracy of the machine file written, once written.
     promise: OnceLock<Accuracy>,
 }
@@ -99,6 +104,7 @@ pub fn diagnose(request: DiagnoseRequest) -> Result<DiagnoseResult, Error> {
         temperature_noise_k,
         plausibility,
         dictionary,
+        deploy_rule,
     } = request;
     let loaded = loaded.load()?;
     let m = loaded.machine();
@@ -109,6 +115,7 @@ pub fn diagnose(request: DiagnoseRequest) -> Result<DiagnoseResult, Error> {
     options.noise_from_data = noise_from_data;
     options.rank_reference = loaded.rank_reference()?;
     options.dictionary.enabled = dictionary;
+    options.deploy_rule = deploy_rule;
     if let Some(k) = temperature_noise_k {
         if !(k.is_finite() && k >= 0.0) {
             return Err(Error::input(format!(
@@ -132,6 +139,7 @@ pub fn diagnose(request: DiagnoseRequest) -> Result<DiagnoseResult, Error> {
         data_path,
         data: dataset,
         rank_reference: options.rank_reference,
+        deploy_rule,
         machine: loaded,
         promise: OnceLock::new(),
     })
@@ -192,8 +200,11 @@ impl DiagnoseResult {
     /// it), with the `accuracy` of the machine file once one is written.
     pub fn to_json(&self) -> String {
         let mut v = self.diagnosis.to_json();
-        if let (Some(a), serde_json::Value::Object(o)) = (self.accuracy(), &mut v) {
-            o.insert("accuracy".into(), a.to_json());
+        if let serde_json::Value::Object(o) = &mut v {
+            o.insert("deploy_rule".into(), self.deploy_rule.name().into());
+            if let Some(a) = self.accuracy() {
+                o.insert("accuracy".into(), a.to_json());
+            }
         }
         v.to_string()
     }

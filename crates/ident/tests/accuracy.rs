@@ -14,7 +14,8 @@
 //! `diagnose --write-machine`; the tallies of `docs/reliability.md` run 200
 //! each (`cargo test -p tricept-ident --test accuracy -- --ignored
 //! --nocapture`; `TRICEPT_TALLY_SEED_OFFSET=2000` runs them on another 200
-//! seeds each).
+//! seeds each; `TRICEPT_TALLY_DEPLOY_RULE=expected-error` diagnoses with
+//! that deploy rule).
 
 use std::path::Path;
 
@@ -23,7 +24,7 @@ use rand_pcg::Pcg64Mcg;
 use tricept_ident::advanced::{SensorNoise, load_machine};
 use tricept_ident::calibrate::{CalibrateRequest, calibrate};
 use tricept_ident::compensate::{Calibrated, CompensateRequest, compensate};
-use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+use tricept_ident::diagnosis::{DeployRule, DiagnoseRequest, diagnose};
 use tricept_ident::kinematics::{Machine, Vector3};
 use tricept_ident::{DataInput, MachineInput};
 use tricept_truth::{LegContext, LegEffect, Row, TrueMachine, to_csv};
@@ -185,7 +186,9 @@ fn campaign(seed: u64, dir: &Path, verb: Verb) -> Outcome {
             let (sum, count) = delivered(&identify_file, &truth, &effects, &targets, dir);
             outcome.geometric_mm = (sum / count as f64).sqrt();
             let loaded = load_machine(None, &SensorNoise::default()).unwrap();
-            let r = diagnose(DiagnoseRequest::new(loaded, DataInput::File(data.clone()))).unwrap();
+            let mut request = DiagnoseRequest::new(loaded, DataInput::File(data.clone()));
+            request.deploy_rule = deploy_rule();
+            let r = diagnose(request).unwrap();
             outcome.exit = r.exit_code();
             if outcome.exit != 0 {
                 return outcome;
@@ -297,6 +300,14 @@ fn tally(
     (outcomes, n, within, beyond)
 }
 
+/// The deploy rule of the diagnosed campaigns: `TRICEPT_TALLY_DEPLOY_RULE`
+/// (`confident`, the default, or `expected-error`).
+fn deploy_rule() -> DeployRule {
+    std::env::var("TRICEPT_TALLY_DEPLOY_RULE")
+        .map(|s| s.parse().expect("TRICEPT_TALLY_DEPLOY_RULE: a deploy rule"))
+        .unwrap_or_default()
+}
+
 /// The 200 seeds of a tally from `first`, moved by
 /// `TRICEPT_TALLY_SEED_OFFSET` (another seed set: `2000` runs the identify
 /// tally on seeds 3000-3199).
@@ -406,12 +417,18 @@ fn tally_of_diagnosed_campaigns() {
         .iter()
         .filter(|o| o.exit == 0 && o.delivered_mm > 1.1 * o.geometric_mm)
         .count();
+    let rule = deploy_rule();
     println!(
-        "diagnose: campaigns {}, files written (exit 0) {written}, within the promise {within}, beyond 2x {beyond}, deployed worse than identify's file by more than 10 % {worse}, median delivered/upper {:.2}",
+        "diagnose ({}): campaigns {}, files written (exit 0) {written}, within the promise {within}, beyond 2x {beyond}, deployed worse than identify's file by more than 10 % {worse}, median delivered/upper {:.2}",
+        rule.name(),
         outcomes.len(),
         median_ratio(&outcomes)
     );
     assert!(within as f64 >= 0.95 * written as f64);
     assert_eq!(beyond, 0);
-    assert_eq!(worse, 0, "deployed files worse than identify's");
+    // The expected-error rule trades a few worse files for more gains
+    // (docs/reliability.md): its count is reported, not required.
+    if rule == DeployRule::Confident {
+        assert_eq!(worse, 0, "deployed files worse than identify's");
+    }
 }

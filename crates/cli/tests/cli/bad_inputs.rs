@@ -488,6 +488,11 @@ fn bad_inputs_cases(dir: &Path) -> Vec<Case> {
             diag("good.csv", &["--temperature-noise", "-1"]),
             &["--temperature-noise"][..],
         ),
+        (
+            "diagnose: unknown deploy rule",
+            diag("good.csv", &["--deploy-rule", "always"]),
+            &["--deploy-rule", "confident, expected-error"][..],
+        ),
     ] {
         let mut c = case(name, &[], vec![], 2, needles);
         c.args = args;
@@ -625,6 +630,7 @@ named_cases! {
     diagnose_noise_from_data_without_repeated_poses = "diagnose: noise from data without repeated poses";
     diagnose_unknown_plausibility_quantity = "diagnose: unknown plausibility quantity";
     diagnose_negative_temperature_noise = "diagnose: negative temperature noise";
+    diagnose_unknown_deploy_rule = "diagnose: unknown deploy rule";
     ik_with_a_word = "ik with a word";
     ik_out_of_reach = "ik out of reach";
     fk_without_assembly = "fk without assembly";

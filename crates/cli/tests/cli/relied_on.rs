@@ -302,3 +302,40 @@ fn plots_never_overwrite_an_input_or_the_history() {
     assert!(after.starts_with(&history) && after.len() > history.len());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `diagnose --json` says which deploy rule judged the terms (the default
+/// `confident`, or `--deploy-rule expected-error`), and states every
+/// model term's expected errors with and without it.
+#[test]
+fn the_deploy_rule_and_the_expected_errors_are_in_the_json() {
+    let dir = workdir("deploy-rule");
+    let d = dir.as_path();
+    let fixture = format!(
+        "{}/../../fixtures/data/diagnose-hidden-effect.csv",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    for (extra, name) in [
+        (&[][..], "confident"),
+        (&["--deploy-rule", "expected-error"][..], "expected-error"),
+    ] {
+        let mut args = vec!["diagnose", "--json", "--data", &fixture];
+        args.extend_from_slice(extra);
+        let out = tricept(d, &args);
+        assert_eq!(out.status.code(), Some(0), "{args:?}");
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(json["deploy_rule"], name);
+        let terms = json["model_terms"].as_array().expect("model_terms");
+        assert!(!terms.is_empty());
+        for t in terms {
+            let (with, without) = (
+                t["expected_rms_with_mm"].as_f64(),
+                t["expected_rms_without_mm"].as_f64(),
+            );
+            assert!(
+                with.is_some_and(|w| w >= 0.0) && without.is_some_and(|w| w >= 0.0),
+                "{t}"
+            );
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
