@@ -420,7 +420,8 @@ impl Diagnosis {
 
 /// Diagnoses measured data (`tricept diagnose`).
 #[pyfunction]
-#[pyo3(signature = (path=None, csv_text=None, name="<arrays>".to_string(), machine=None, noise_from_data=false, dictionary=true))]
+#[pyo3(signature = (path=None, csv_text=None, name="<arrays>".to_string(), machine=None, noise_from_data=false, dictionary=true, deploy_rule="confident".to_string()))]
+#[allow(clippy::too_many_arguments)]
 fn diagnose(
     py: Python<'_>,
     path: Option<PathBuf>,
@@ -429,12 +430,15 @@ fn diagnose(
     machine: Option<PathBuf>,
     noise_from_data: bool,
     dictionary: bool,
+    deploy_rule: String,
 ) -> PyResult<Diagnosis> {
+    let deploy_rule = deploy_rule.parse().map_err(input_error)?;
     let loaded = machine_of(machine, SensorNoise::default())?;
     let data = data_of(path, csv_text.as_deref(), &name, loaded.machine())?;
     let mut request = DiagnoseRequest::new(loaded, data);
     request.noise_from_data = noise_from_data;
     request.dictionary = dictionary;
+    request.deploy_rule = deploy_rule;
     let inner = py
         .detach(|| tricept_ident::diagnosis::diagnose(request))
         .map_err(door_error)?;

@@ -86,6 +86,12 @@ def test_diagnose_and_check_equal_the_cli(cli, tmp_path):
     d = tricept.diagnose(HIDDEN)
     assert d.exit_code == code
     assert json.loads(d.to_json()) == expected
+    code, expected = cli_json(cli, "diagnose", "--data", HIDDEN, "--deploy-rule", "expected-error")
+    d = tricept.diagnose(HIDDEN, deploy_rule="expected-error")
+    assert json.loads(d.to_json()) == expected
+    assert expected["deploy_rule"] == "expected-error"
+    with pytest.raises(tricept.InputError, match="expected-error"):
+        tricept.diagnose(HIDDEN, deploy_rule="always")
     # A calibration, then a check of another day's campaign.
     assert cli("simulate", "--truth", "random:0.25,5", "--poses", "random:80,3", "--out", tmp_path / "cal.csv").returncode == 0
     assert cli("identify", "--data", tmp_path / "cal.csv", "--write-machine", tmp_path / "cal.json").returncode == 0

@@ -89,8 +89,12 @@ def diagnose(
     *,
     noise_from_data: bool = False,
     dictionary: bool = True,
+    deploy_rule: str = "confident",
 ) -> Diagnosis:
-    """Does the geometric model explain the data (tricept diagnose)?"""
+    """Does the geometric model explain the data (tricept diagnose)?
+
+    ``deploy_rule``: ``"confident"`` or ``"expected-error"`` (``--deploy-rule``).
+    """
 
 def check(
     machine: PathLike,
