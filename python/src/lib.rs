@@ -266,9 +266,12 @@ fn data_of(
     match (path, csv_text) {
         (Some(path), None) => Ok(DataInput::File(path)),
         (None, Some(text)) => Ok(DataInput::Memory(
-            tricept_ident::advanced::read_data_from(text.as_bytes(), name, machine).map_err(door_error)?,
+            tricept_ident::advanced::read_data_from(text.as_bytes(), name, machine)
+                .map_err(door_error)?,
         )),
-        _ => Err(input_error("data: give a CSV path or a mapping of column arrays")),
+        _ => Err(input_error(
+            "data: give a CSV path or a mapping of column arrays",
+        )),
     }
 }
 
@@ -291,19 +294,31 @@ impl Calibration {
     /// The parameter names, in the order of the covariance.
     #[getter]
     fn names(&self) -> Vec<String> {
-        self.inner.estimates().into_iter().map(|(n, _, _)| n).collect()
+        self.inner
+            .estimates()
+            .into_iter()
+            .map(|(n, _, _)| n)
+            .collect()
     }
 
     /// The estimates by name (mm, rad).
     #[getter]
     fn estimates(&self) -> Vec<(String, f64)> {
-        self.inner.estimates().into_iter().map(|(n, v, _)| (n, v)).collect()
+        self.inner
+            .estimates()
+            .into_iter()
+            .map(|(n, v, _)| (n, v))
+            .collect()
     }
 
     /// Their standard deviations by name (mm, rad; `None`: held).
     #[getter]
     fn sd(&self) -> Vec<(String, Option<f64>)> {
-        self.inner.estimates().into_iter().map(|(n, _, s)| (n, s)).collect()
+        self.inner
+            .estimates()
+            .into_iter()
+            .map(|(n, _, s)| (n, s))
+            .collect()
     }
 
     /// The estimates' covariance (mm^2, rad^2), in the order of `names`.
@@ -370,11 +385,16 @@ fn identify(
                     .map_err(door_error)?,
             )
         }
-        _ => return Err(input_error("data: give a CSV path or a mapping of column arrays")),
+        _ => {
+            return Err(input_error(
+                "data: give a CSV path or a mapping of column arrays",
+            ));
+        }
     };
     let mut request = CalibrateRequest::new(data);
     request.machine = MachineInput::new(machine, noise);
-    request.parameter_set = ParameterSet::by_label(&params).map_err(|e| input_error(format!("params: {e}")))?;
+    request.parameter_set =
+        ParameterSet::by_label(&params).map_err(|e| input_error(format!("params: {e}")))?;
     request.robust = robust;
     if let Some(t) = tolerance_mm {
         request.tolerance_mm = t;
@@ -518,7 +538,8 @@ fn simulate_csv(
     request.truth_effects = tricept_ident::advanced::parse_effects(&effects).map_err(door_error)?;
     request.poses = poses.parse::<Poses>().map_err(door_error)?;
     request.seed = seed;
-    request.parameter_set = ParameterSet::by_label(&params).map_err(|e| input_error(format!("params: {e}")))?;
+    request.parameter_set =
+        ParameterSet::by_label(&params).map_err(|e| input_error(format!("params: {e}")))?;
     request.both_directions = both_directions;
     request.noise_factor = noise_factor;
     let sim = py
