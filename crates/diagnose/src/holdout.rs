@@ -195,7 +195,15 @@ struct Against<'a> {
 /// that stands out of what the legs' structure leaves unknown is trusted.
 fn richer(setup: &Setup<'_>, clean: &Dataset, with: &Fit) -> Option<Fit> {
     let fitter = &setup.fitter;
-    let carried = |leg: usize| with.model.terms().iter().any(|t| shapes_leg(t, leg));
+    let terms = richer_terms(with.model.terms())?;
+    fitter.fit(fitter.model(&terms), clean).ok()
+}
+
+/// The terms of [`richer`]: `terms` and a polynomial on every leg none of
+/// them shapes (one term over all legs when no leg is shaped); `None` when
+/// every leg is shaped.
+fn richer_terms(terms: &[Term]) -> Option<Vec<Term>> {
+    let carried = |leg: usize| terms.iter().any(|t| shapes_leg(t, leg));
     let free: Vec<u8> = (0..3u8).filter(|&i| !carried(usize::from(i))).collect();
     let legs: Vec<Term> = match free.as_slice() {
         [] => return None,
@@ -213,8 +221,7 @@ fn richer(setup: &Setup<'_>, clean: &Dataset, with: &Fit) -> Option<Fit> {
             })
             .collect(),
     };
-    let terms = [with.model.terms(), &legs].concat();
-    fitter.fit(fitter.model(&terms), clean).ok()
+    Some([terms, &legs].concat())
 }
 
 /// The deployed model's own platform standard deviation on the middle
@@ -798,5 +805,46 @@ mod tests {
             worse
         ));
         assert!(rule(DeployRule::ExpectedError, false, None, None, None));
+    }
+
+    #[test]
+    fn the_richer_model_adds_a_polynomial_on_every_leg_nothing_shapes() {
+        let generic = |f, scope| Term::Generic(GenericTerm::new(f, scope));
+        let polynomial = |scope| generic(GenericFamily::LegPolynomial, scope);
+        let thermal = Term::Catalogue(EffectName::Thermal);
+        // No leg shaped: one polynomial over all legs, after the terms.
+        assert_eq!(
+            richer_terms(&[thermal]),
+            Some(vec![thermal, polynomial(Scope::AllLegs)])
+        );
+        assert_eq!(richer_terms(&[]), Some(vec![polynomial(Scope::AllLegs)]));
+        // Leg 2 (index 1) shaped by its own polynomial: legs 1 and 3 get one each.
+        let curved = polynomial(Scope::Leg(1));
+        assert_eq!(
+            richer_terms(&[curved, thermal]),
+            Some(vec![
+                curved,
+                thermal,
+                polynomial(Scope::Leg(0)),
+                polynomial(Scope::Leg(2))
+            ])
+        );
+        // Every leg shaped (a lead, a periodic error on all legs): none.
+        assert_eq!(richer_terms(&[Term::Catalogue(EffectName::LegLead)]), None);
+        assert_eq!(
+            richer_terms(&[thermal, generic(GenericFamily::LegPeriodic, Scope::AllLegs)]),
+            None
+        );
+    }
+
+    #[test]
+    fn the_structured_sd_is_the_own_part_of_the_improvements_sd() {
+        // sd 0.05 of which the move 0.04: own 0.03.
+        let own = structured_sd(with_rms(0.1, 0.1, 0.05, 0.04)).expect("finite");
+        assert!((own - 0.03).abs() < 1e-12, "{own}");
+        // A move's sd beyond the total (rounding): no own part, not NaN.
+        assert_eq!(structured_sd(with_rms(0.1, 0.1, 0.04, 0.05)), Some(0.0));
+        assert_eq!(structured_sd(with_rms(0.1, 0.1, f64::NAN, 0.05)), None);
+        assert_eq!(structured_sd(with_rms(0.1, 0.1, f64::INFINITY, 0.05)), None);
     }
 }
