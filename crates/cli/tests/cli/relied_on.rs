@@ -217,14 +217,19 @@ fn help_and_version_to_a_full_disk_fail() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The fixture of a campaign with a hidden effect the diagnosis names.
+fn hidden_effect() -> String {
+    format!(
+        "{}/../../fixtures/data/diagnose-hidden-effect.csv",
+        env!("CARGO_MANIFEST_DIR")
+    )
+}
+
 #[test]
 fn plots_never_overwrite_an_input_or_the_history() {
     let dir = workdir("plots");
     let d = dir.as_path();
-    let fixture = format!(
-        "{}/../../fixtures/data/diagnose-hidden-effect.csv",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let fixture = hidden_effect();
     // The plots of this file's diagnosis, by name.
     let out = tricept(d, &["diagnose", "--data", &fixture, "--plots", "p"]);
     assert_eq!(out.status.code(), Some(0));
@@ -310,10 +315,7 @@ fn plots_never_overwrite_an_input_or_the_history() {
 fn the_deploy_rule_and_the_expected_errors_are_in_the_json() {
     let dir = workdir("deploy-rule");
     let d = dir.as_path();
-    let fixture = format!(
-        "{}/../../fixtures/data/diagnose-hidden-effect.csv",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let fixture = hidden_effect();
     for (extra, name) in [
         (&[][..], "confident"),
         (&["--deploy-rule", "expected-error"][..], "expected-error"),
