@@ -694,6 +694,10 @@ mod tests {
         assert_eq!((w.mean_mm, w.difference_sd_mm), (0.12, 0.04));
         // The 0.12 move was 2.4 sd, it is no longer 2.
         assert!(w.mean_mm < DEPLOY_IMPROVEMENT_SD * w.sd_mm);
+        // Between the own 0.03 and the whole 0.05: it replaces the own
+        // part, sqrt(0.05^2 + 0.04^2).
+        let w = with_structure(g, Some(0.05));
+        assert!((w.sd_mm - 0.05_f64.hypot(0.04)).abs() < 1e-12, "{w:?}");
         // A smaller structured sd, or none, changes nothing.
         for s in [Some(0.02), Some(0.03), None] {
             let same = with_structure(g, s);
