@@ -718,6 +718,13 @@ impl Diagnosis {
                     if numbers.is_empty() { ": " } else { "; " }
                 ));
             }
+            if let (Some(with), Some(without)) = (t.expected_rms_with_mm, t.expected_rms_without_mm)
+            {
+                numbers.push_str(&format!(
+                    "{}expected rms error {with:.4} mm with it, {without:.4} mm without",
+                    if numbers.is_empty() { ": " } else { "; " }
+                ));
+            }
             if t.deployed {
                 w!("deployed: {}{numbers}", t.description);
             } else {
