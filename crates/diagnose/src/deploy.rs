@@ -285,7 +285,7 @@ fn leg_tables(
         let extra_um = |q: f64| -> Result<f64, DeployError> {
             let pose = MeasuredPose {
                 commands_mm: [q; 3],
-                approach: None,
+                // The default's: no approach direction, time or temperature.
                 ..Default::default()
             };
             let mut mm = machine.leg_effects.table_extra_mm(&pose.commands_mm)[leg];

@@ -11,6 +11,12 @@
 //!   series (small arguments) or its continued fraction (large ones),
 //!   written below;
 //! - `I_x(a, 1) = x^a`, `I_x(1, b) = 1 - (1 - x)^b`;
+//! - `I_x(a, b)` for integers by the binomial sum `sum_{j>=a} C(a+b-1, j)
+//!   x^j (1-x)^(a+b-1-j)` (small values between `beta_inc`'s switch and
+//!   `(a + 1) / (a + 2b)`);
+//! - `I_x(a, b)` for an integer `a` by the negative binomial tail
+//!   `(1-x)^b sum_{j>=a} (b)_j / j! x^j` (small values just below the switch
+//!   for `b < 1`);
 //! - `Gamma(1/4) = 3.6256099082219083119` (OEIS A068466), `Gamma(1/3) =
 //!   2.6789385347077476337` (A073005), `Gamma(1/10) = Gamma(1.1) / 0.1` with
 //!   `Gamma(1.1) = 0.95135076986687318363` (Abramowitz and Stegun, table
@@ -285,6 +291,113 @@ fn incomplete_beta_against_closed_forms_and_off_its_domain() {
     }
     assert_eq!(f_sf(f64::INFINITY, 2.0, 3.0), 0.0);
     assert_eq!(f_sf(-1.0, 2.0, 3.0), 1.0);
+}
+
+/// `I_x(a, b)` for integers `a, b >= 1` by the binomial sum
+/// `sum_{j=a}^{n} C(n, j) x^j (1 - x)^(n - j)`, `n = a + b - 1` (the
+/// probability of at least `a` successes in `n` trials): every term is
+/// positive, the first from logarithms of the factors of `C(n, a)`, the
+/// next ones by the ratio `(n - j) / (j + 1) * x / (1 - x)`.
+fn beta_inc_binomial(a: u32, b: u32, x: f64) -> f64 {
+    let n = a + b - 1;
+    let ln_choose: f64 = (1..=a)
+        .map(|i| (f64::from(n - a + i) / f64::from(i)).ln())
+        .sum();
+    let mut term = (ln_choose + f64::from(a) * x.ln() + f64::from(n - a) * (-x).ln_1p()).exp();
+    let mut sum = 0.0;
+    for j in a..=n {
+        sum += term;
+        term *= f64::from(n - j) / f64::from(j + 1) * x / (1.0 - x);
+    }
+    sum
+}
+
+#[test]
+fn small_incomplete_beta_below_the_switch_keeps_its_digits() {
+    // Between (a + 1) / (a + 2b) and the switch (a + 1) / (a + b + 2) (for
+    // b > 2), I_x(a, b) far below its mean is small: computed as
+    // 1 - I_{1-x}(b, a) it would keep only the digits above 1e-16.
+    for (a, b, x) in [(200, 200, 0.34), (100, 300, 0.15), (60, 60, 0.36)] {
+        let (fa, fb) = (f64::from(a), f64::from(b));
+        assert!(x > (fa + 1.0) / (fa + 2.0 * fb) && x < (fa + 1.0) / (fa + fb + 2.0));
+        let want = beta_inc_binomial(a, b, x);
+        assert!(want < 1e-3, "I_{x}({a}, {b}) = {want:e} is not small");
+        assert_relative(
+            beta_inc(fa, fb, x),
+            want,
+            1e-11,
+            &format!("I_{x}({a}, {b})"),
+        );
+    }
+    // The reference itself: I_x(1, b) = 1 - (1 - x)^b, I_x(a, 1) = x^a.
+    assert_relative(
+        beta_inc_binomial(1, 5, 0.2),
+        1.0 - 0.8f64.powi(5),
+        1e-14,
+        "sum (1, 5)",
+    );
+    assert_relative(
+        beta_inc_binomial(4, 1, 0.3),
+        0.3f64.powi(4),
+        1e-14,
+        "sum (4, 1)",
+    );
+}
+
+/// `I_x(a, b)` for an integer `a >= 1` and any `b > 0` by the negative
+/// binomial tail `(1 - x)^b sum_{j>=a} (b)_j / j! x^j` (`(b)_j` the rising
+/// factorial; the whole sum over `j >= 0` is `(1 - x)^(-b)`, and `I_x(1, b)
+/// = 1 - (1 - x)^b`): positive terms, the first from logarithms, the next
+/// ones by the ratio `(b + j) / (j + 1) * x`, summed until the rest
+/// (below `term / (1 - x)` for `b < 1`) is under 1e-18 of the sum.
+fn beta_inc_negative_binomial(a: u32, b: f64, x: f64) -> f64 {
+    let ln_first: f64 = (0..a)
+        .map(|i| ((b + f64::from(i)) / f64::from(i + 1)).ln())
+        .sum();
+    let mut term = (ln_first + b * (-x).ln_1p() + f64::from(a) * x.ln()).exp();
+    let mut sum = 0.0;
+    let mut j = f64::from(a);
+    while term > 1e-18 * (1.0 - x) * sum {
+        sum += term;
+        term *= (b + j) / (j + 1.0) * x;
+        j += 1.0;
+    }
+    sum
+}
+
+#[test]
+fn incomplete_beta_just_below_the_switch_for_a_small_b() {
+    // For b < 1 and a large, I_x(a, b) is small up to the switch (a + 1) /
+    // (a + b + 2); the symmetric form 1 - I_{1-x}(b, a) keeps only its
+    // digits above the rounding of the front factor (about 1e-12 of 1).
+    // Points of the last 1 / (a + b + 2) below the switch.
+    for (a, b) in [(1000, 0.01), (1000, 0.001), (100, 0.001)] {
+        let fa = f64::from(a);
+        let (low, switch) = (fa / (fa + b + 2.0), (fa + 1.0) / (fa + b + 2.0));
+        for t in [0.0, 0.5, 0.9] {
+            let x = low + t * (switch - low);
+            let want = beta_inc_negative_binomial(a, b, x);
+            assert!(want < 1e-2, "I_{x}({a}, {b}) = {want:e} is not small");
+            assert_relative(beta_inc(fa, b, x), want, 1e-11, &format!("I_{x}({a}, {b})"));
+        }
+    }
+    // The reference itself: I_x(1, b) = 1 - (1 - x)^b; for an integer b it
+    // is the binomial sum.
+    for (x, b) in [(0.3f64, 0.5f64), (0.9, 0.01)] {
+        let want = -(b * (-x).ln_1p()).exp_m1();
+        assert_relative(
+            beta_inc_negative_binomial(1, b, x),
+            want,
+            1e-13,
+            "tail (1, b)",
+        );
+    }
+    assert_relative(
+        beta_inc_negative_binomial(7, 3.0, 0.4),
+        beta_inc_binomial(7, 3, 0.4),
+        1e-13,
+        "tail (7, 3)",
+    );
 }
 
 #[test]

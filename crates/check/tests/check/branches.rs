@@ -613,3 +613,94 @@ fn an_uncertain_calibration_is_checked_with_four_poses() {
     assert_eq!(r.consistency.dof, 9);
     assert_test(&r.consistency, 0.005, "consistency");
 }
+
+#[test]
+fn a_campaign_that_sees_changes_only_beyond_a_millimetre_is_blind() {
+    // Sensors 200 and 300 times noisier, a level of 1e-6 and a power of
+    // 0.99: the legs and joints are seen, their smallest detectable change
+    // on either side of 1 mm (the documented limit of a blind campaign).
+    let m = Machine::paper();
+    let data = campaign(&m, &[], 20, 5, 1.0);
+    for (factor, blind) in [(200.0, false), (300.0, true)] {
+        let mut options = CheckOptions::for_machine(&m);
+        options.alpha = 1e-6;
+        options.power = 0.99;
+        options.sigma = options.sigma.map(|s| factor * s);
+        let r = check(&reference(&m), &data, &options).unwrap();
+        let d = r.smallest_detectable_mm().expect("a change is detectable");
+        assert_eq!(d > 1.0, blind, "x{factor}: {d} mm");
+        assert_eq!(r.is_blind(), blind, "x{factor}: {d} mm");
+        // A parameter alone counts as seen only with a standard deviation
+        // below its class-1 tolerance (0.25 mm, 250 um, 100 ppm/K, else
+        // 1000 ppm); so noisy, some are not.
+        let limit = |p: &str| match p {
+            p if p.ends_with("_mm") => 0.25,
+            p if p.ends_with("_um") => 250.0,
+            p if p.ends_with("_ppm_per_k") => 100.0,
+            _ => 1000.0,
+        };
+        let mut unseen = 0;
+        for c in &r.candidates {
+            for (p, alone) in c.parameters.iter().zip(&c.alone) {
+                match alone {
+                    Some((_, sd)) => assert!(*sd < limit(p), "{} {p}: {sd}", c.name),
+                    None => unseen += 1,
+                }
+            }
+        }
+        assert!(unseen > 0, "x{factor}");
+    }
+}
+
+#[test]
+fn a_workspace_out_of_reach_names_its_first_pose() {
+    // The workspace's polar grid 5 m above the machine: its first pose
+    // (numbered from 1, no data line) is out of reach.
+    let mut m = Machine::paper();
+    m.workspace.z_min_mm = 5000.0;
+    m.workspace.z_max_mm = 6000.0;
+    match leg_ranges(&m) {
+        Err(tricept_check::CheckError::Kinematics { pose, line, .. }) => {
+            assert_eq!((pose, line), (1, 0));
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn a_detectable_change_is_detected_with_the_stated_power() {
+    // Each parameter alone: flagged beyond c sd (c the two-sided critical
+    // value of the family-wise level) and detectable at delta sd, where the
+    // test detects a change of delta sd with the stated power:
+    // Phi(delta - c) + Phi(-delta - c) = power (Phi from the chi-square
+    // tail of one degree of freedom: P(|Z| > x) = chi2_sf(x^2, 1)).
+    use tricept_numerics::stats::chi2_sf;
+    let phi = |x: f64| {
+        let tail = 0.5 * chi2_sf(x * x, 1.0);
+        if x < 0.0 { tail } else { 1.0 - tail }
+    };
+    let m = Machine::paper();
+    let data = campaign(&m, &[], 20, 5, 1.0);
+    let options = CheckOptions::for_machine(&m);
+    let r = check(&reference(&m), &data, &options).unwrap();
+    let mut seen = 0;
+    for c in &r.candidates {
+        for i in 0..c.parameters.len() {
+            let (Some((_, sd)), Some(d), Some(f)) =
+                (c.alone[i], c.detectable[i], c.flagged_beyond[i])
+            else {
+                continue;
+            };
+            let (critical, delta) = (f / sd, d / sd);
+            let power = phi(delta - critical) + phi(-delta - critical);
+            assert!(
+                (power - options.power).abs() < 1e-6,
+                "{} {}: {power}",
+                c.name,
+                c.parameters[i]
+            );
+            seen += 1;
+        }
+    }
+    assert!(seen >= 10, "{seen}");
+}

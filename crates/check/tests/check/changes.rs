@@ -71,6 +71,10 @@ fn a_slipped_leg_is_found_and_named() {
         plant.errors.dq_mm[leg] += size_mm;
         let r = run(&reference, &check_campaign(&plant, seed, CALIBRATION_C));
         let name = most_likely(&r).unwrap_or("none").to_string();
+        // The shortlist starts with the change named.
+        if r.most_likely.is_some() {
+            assert_eq!(r.shortlist.first(), Some(&name), "seed {seed}");
+        }
         let truth = format!("leg {}", leg + 1);
         if r.shortlist.contains(&truth) {
             listed += 1;
