@@ -52,6 +52,8 @@ fn term(effect: CauseName, legs: &[u8], channel: Option<u8>, deployed: bool) -> 
         difference_sd_mm: None,
         holdout_benefit_mm: None,
         holdout_benefit_sd_mm: None,
+        expected_rms_with_mm: None,
+        expected_rms_without_mm: None,
     }
 }
 
