@@ -248,6 +248,14 @@ fn expected_error(g: Improvement, reference_sd_mm: f64) -> f64 {
     (reference_sd_mm.powi(2) - var_d).max(0.0) + bias2
 }
 
+/// The reference's own platform standard deviation ([`structured_sd`])
+/// and the nested file's expected mean squared error against it
+/// ([`expected_error`]), both from the improvement `g` of the reference
+/// over the file.
+fn against_reference(g: Improvement) -> Option<(f64, f64)> {
+    structured_sd(g).map(|sd| (sd, expected_error(g, sd)))
+}
+
 /// Whether `t` already describes how leg `leg`'s length error varies with
 /// its command (a lead, a polynomial, a periodic error): that leg keeps its
 /// own description and gets no polynomial of [`structured_sd`].
@@ -328,7 +336,9 @@ fn judge(
             .zip(structured_sd_mm)
             .map(|(g, sd)| expected_error(g, sd))
             .and_then(|o| expected_mse_mm2.map(|w| (w, o))),
-        None => moved.and_then(|g| structured_sd(g).map(|sd| (sd * sd, expected_error(g, sd)))),
+        None => moved
+            .and_then(against_reference)
+            .map(|(sd, error)| (sd * sd, error)),
     };
     let held_out = match (full, &without) {
         (Some(full), Some(_)) => platform_errors(setup, &model, clean)
@@ -453,11 +463,9 @@ pub(crate) fn deployable(
         // The deployed model against the richer one (with none, see
         // `judge`).
         let (structured_sd_mm, expected_mse_mm2) = match &rich {
-            Some(r) => {
-                let g = improvement(nominal, &with, r, fitter.options);
-                let sd = g.and_then(structured_sd);
-                (sd, g.zip(sd).map(|(g, sd)| expected_error(g, sd)))
-            }
+            Some(r) => improvement(nominal, &with, r, fitter.options)
+                .and_then(against_reference)
+                .unzip(),
             None => (None, None),
         };
         let against = Against {
@@ -850,5 +858,20 @@ mod tests {
         assert_eq!(structured_sd(with_rms(0.1, 0.1, 0.04, 0.05)), Some(0.0));
         assert_eq!(structured_sd(with_rms(0.1, 0.1, f64::NAN, 0.05)), None);
         assert_eq!(structured_sd(with_rms(0.1, 0.1, f64::INFINITY, 0.05)), None);
+    }
+
+    #[test]
+    fn the_reference_is_priced_from_one_improvement() {
+        // The reference's own sd 0.10 beside a move of sd 0.06 (total
+        // sqrt(0.0136)), the move's rms 0.08: the reference's sd 0.10 and
+        // the file's expected error 0.0092 mm^2 (worked above).
+        let (sd, error) =
+            against_reference(with_rms(0.07, 0.08, 0.0136_f64.sqrt(), 0.06)).expect("finite");
+        assert!((sd - 0.10).abs() < 1e-12, "{sd}");
+        assert!((error - 0.0092).abs() < 1e-12, "{error}");
+        assert_eq!(
+            against_reference(with_rms(0.07, 0.08, f64::NAN, 0.06)),
+            None
+        );
     }
 }
