@@ -321,9 +321,11 @@ fn leg_tables(
             }
             worst = worst.max(error(0.5 * (from + to))?);
         }
+        // Beside an edge: at the neighbouring numbers on either side, the
+        // one-sided limits of the error (the table is continuous there).
         let mut at_edges: f64 = 0.0;
         for (e, _) in &edges {
-            for q in [e - 1e-6 * step, e + 1e-6 * step] {
+            for q in [e.next_down(), e.next_up()] {
                 at_edges = at_edges.max(error(q)?);
             }
         }

@@ -403,3 +403,68 @@ fn an_effect_with_a_parameter_per_leg_deploys_each_to_its_leg() {
     );
     assert!(d.recorded.is_empty(), "{:#?}", d.recorded);
 }
+
+#[test]
+fn a_polynomial_table_reports_its_largest_interpolation_error_anywhere_on_the_stroke() {
+    // A cubic leg error, 60 um ((q - 600 mm) / 100 mm)^3 on leg 3 (its
+    // stroke lies above 600 mm, so the power is a polynomial there):
+    // its curvature, and the table's interpolation error with it, grows
+    // along the stroke and is largest in the last spacing.
+    let s = simulate(
+        80,
+        11,
+        vec![Effect::from(tricept_plant::effects::LegPower {
+            um: [0.0, 0.0, 60.0],
+            exponent: 3.0,
+            centre_mm: 600.0,
+            half_width_mm: 100.0,
+        })],
+        CampaignOptions::default(),
+    );
+    let (lo, hi) = stroke(&s.data, 2);
+    assert!(lo > 600.0, "{lo}");
+    let d = deploy_terms(
+        &s.data,
+        vec![term(
+            CauseName::Generic(GenericFamily::LegPolynomial),
+            &[3],
+            None,
+            true,
+        )],
+    );
+    let t = table(&d, 3);
+    assert_spans(t, (lo, hi), (hi - lo) / 200.0);
+    // The fitted polynomial by its documented basis: p1 x + p2 P2(x) +
+    // p3 P3(x) um, x the command mapped from the stroke onto [-1, 1].
+    let p = ["leg3_p1_um", "leg3_p2_um", "leg3_p3_um"].map(|n| fitted(&d, n));
+    let f_um = |q: f64| {
+        let x = (2.0 * q - lo - hi) / (hi - lo);
+        p[0] * x + p[1] * 0.5 * (3.0 * x * x - 1.0) + p[2] * 0.5 * (5.0 * x.powi(3) - 3.0 * x)
+    };
+    let n = t.extra_length_um.len();
+    let at = |k: usize| t.start_mm + t.step_mm * k as f64;
+    for (k, v) in t.extra_length_um.iter().enumerate() {
+        // The table's values differ from the polynomial by one constant
+        // (a leg offset belongs to the geometry).
+        let shift = t.extra_length_um[0] - f_um(at(0));
+        assert!(
+            (v - shift - f_um(at(k))).abs() < 1e-6,
+            "{v} at {} mm",
+            at(k)
+        );
+    }
+    // The error of linear interpolation at each spacing's midpoint.
+    let errors: Vec<f64> = (0..n - 1)
+        .map(|k| (0.5 * (f_um(at(k)) + f_um(at(k + 1))) - f_um(0.5 * (at(k) + at(k + 1)))).abs())
+        .collect();
+    let largest = errors.iter().copied().fold(0.0, f64::max);
+    let first_half = errors[..n / 2].iter().copied().fold(0.0, f64::max);
+    // The simulated curvature makes the last spacings' error stand out.
+    assert!(largest > 1.4 * first_half + 2e-3, "{largest} {first_half}");
+    let reported = number_after(&t.source, "largest interpolation error ");
+    assert!(
+        (reported - largest).abs() < 6e-4,
+        "{reported} um, expected {largest} um: {}",
+        t.source
+    );
+}
