@@ -81,6 +81,8 @@ fn an_unchanged_machine_has_tests_with_their_degrees_of_freedom_and_p_values() {
     let r = run(&m, &data);
     assert_eq!(r.verdict, CheckVerdict::Unchanged);
     assert!(!r.changed && r.most_likely.is_none() && r.remaining.is_none());
+    // No set of changes, and no misfit after one.
+    assert!(r.changes.is_empty() && r.after_changes.is_none());
     assert_eq!(r.poses, 20);
     // 60 readings less the three offsets.
     assert_eq!(r.consistency.dof, 57);
@@ -119,6 +121,34 @@ fn one_slipped_leg_is_changed_and_explained() {
     assert_test(&rest, 0.005, "remaining");
     assert!(rest.statistic <= rest.critical);
     assert!(!r.to_text().contains("no single change"));
+    assert_shortlist(&r);
+    // Other candidates take up part of the slip and pass their test, but
+    // far less likely than the leg: not on the shortlist.
+    assert!(
+        r.candidates
+            .iter()
+            .any(|c| c.significant && !r.shortlist.contains(&c.name)),
+        "{:?}",
+        r.shortlist
+    );
+}
+
+/// The shortlist is the documented one: the most likely change first,
+/// then every candidate that stands out (significant) with a p-value
+/// within a factor 20 of it.
+fn assert_shortlist(r: &CheckReport) {
+    let best = &r.candidates[r.most_likely.unwrap()];
+    assert_eq!(r.shortlist.first(), Some(&best.name));
+    let mut expected: Vec<&str> = r
+        .candidates
+        .iter()
+        .filter(|c| c.significant && c.test.ln_p_value <= best.test.ln_p_value + 20f64.ln())
+        .map(|c| c.name.as_str())
+        .collect();
+    let mut listed: Vec<&str> = r.shortlist.iter().map(String::as_str).collect();
+    expected.sort_unstable();
+    listed.sort_unstable();
+    assert_eq!(listed, expected);
 }
 
 #[test]
@@ -211,6 +241,7 @@ fn more_noise_than_stated_is_noisier_than_stated_not_a_change() {
         assert_eq!(r.verdict.as_str(), "noisier-than-stated");
         assert!(r.most_likely.is_none() && r.remaining.is_none());
         assert!(r.shortlist.is_empty());
+        assert!(r.changes.is_empty() && r.after_changes.is_none());
         assert!(r.candidates.iter().all(|c| !c.significant));
         // The noise it sees: 1.25 times the stated (the factor from 297
         // degrees of freedom, sd 3 %; each channel from 99, sd 7 %).
@@ -748,4 +779,8 @@ fn the_most_likely_change_is_one_that_stands_out_beyond_the_noise() {
     assert!(best.significant, "{}", best.name);
     assert_eq!(best.test.ln_p_value, smallest(true));
     assert!(!r.to_text().contains("cause unknown"), "{}", r.to_text());
+    // The leg, within a factor 20 of it, is not on the shortlist: it does
+    // not stand out.
+    assert!(leg2.test.ln_p_value <= best.test.ln_p_value + 20f64.ln());
+    assert_shortlist(&r);
 }
