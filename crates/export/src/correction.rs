@@ -20,6 +20,9 @@ use crate::types::ExportError;
 /// Margin added to each end of the stroke the workspace uses, mm.
 pub const STROKE_MARGIN_MM: f64 = 2.0;
 
+/// Rings of the workspace's end discs on which the stroke is sought.
+const DISC_RINGS: usize = 32;
+
 /// One leg's exact correction.
 #[derive(Debug, Clone)]
 pub struct LegCorrection {
@@ -97,13 +100,26 @@ pub fn leg_corrections(
     let w = &machine.workspace;
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
-    // The workspace cylinder's surface and axis: the leg commands are
-    // extreme on its boundary.
+    // The leg commands are extreme on the workspace cylinder's boundary
+    // (a leg's length has no stationary point inside), its end discs
+    // included: a leg is shortest on the lower disc about below its base
+    // joint, at three quarters of the radius on the paper machine. So the
+    // discs are sampled on rings 1/32 of the radius apart (the length
+    // there is within 0.05 mm of its least, well inside the margin), the
+    // side on 10 levels.
     let levels = 9;
     let angles = 72;
+    let disc_rings: Vec<f64> = (0..=DISC_RINGS)
+        .map(|k| k as f64 / DISC_RINGS as f64)
+        .collect();
     for l in 0..=levels {
         let z = w.z_min_mm + (w.z_max_mm - w.z_min_mm) * l as f64 / levels as f64;
-        for ring in [0.0, 0.5, 1.0] {
+        let rings: &[f64] = if l == 0 || l == levels {
+            &disc_rings
+        } else {
+            &[0.0, 1.0]
+        };
+        for &ring in rings {
             for a in 0..angles {
                 let phi = std::f64::consts::TAU * a as f64 / angles as f64;
                 let r = Vector3::new(
@@ -202,4 +218,134 @@ pub fn platform_error_um(
         worst = worst.max((to - at).norm());
     }
     Ok(worst * 1e3)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn leg(lo_mm: f64, hi_mm: f64, table: Option<LegTableDescription>) -> LegCorrection {
+        LegCorrection {
+            leg: 0,
+            lead_ppm: 0.0,
+            table,
+            reference_mm: lo_mm,
+            lo_mm,
+            hi_mm,
+        }
+    }
+
+    #[test]
+    fn the_knots_are_the_table_points_inside_the_stroke() {
+        // Points at 100, 102, ..., 118 mm; the stroke 103 to 111 mm.
+        let t = LegTableDescription::new(1, 100.0, 2.0, vec![0.0; 10]);
+        assert_eq!(
+            leg(103.0, 111.0, Some(t)).knots_mm(),
+            [104.0, 106.0, 108.0, 110.0]
+        );
+        assert!(leg(103.0, 111.0, None).knots_mm().is_empty());
+    }
+
+    #[test]
+    fn the_check_points_fill_every_cell_and_flank_every_knot() {
+        // The grid 100 + 4 k mm over the stroke 100 to 108 mm, 2 points a
+        // cell: both ends of each of the 2 cells and its middle, then the
+        // stroke's ends.
+        assert_eq!(
+            leg(100.0, 108.0, None).check_points_mm(100.0, 4.0, 2),
+            [100.0, 102.0, 104.0, 104.0, 106.0, 108.0, 100.0, 108.0]
+        );
+        // A table's point at 104 mm inside the stroke 101 to 107 mm: the
+        // grid's points inside the stroke, the knot and a um on each side.
+        let t = LegTableDescription::new(1, 100.0, 4.0, vec![0.0; 3]);
+        assert_eq!(
+            leg(101.0, 107.0, Some(t)).check_points_mm(100.0, 4.0, 1),
+            [
+                104.0,
+                104.0,
+                104.0 - 1e-6,
+                104.0,
+                104.0 + 1e-6,
+                101.0,
+                107.0
+            ]
+        );
+    }
+
+    #[test]
+    fn a_reference_point_outside_the_stroke_is_refused() {
+        let mut legs = [0, 1, 2].map(|i| LegCorrection {
+            leg: i,
+            ..leg(100.0, 108.0, None)
+        });
+        assert!(check_references(&legs).is_ok());
+        legs[2].reference_mm = 108.0;
+        assert!(check_references(&legs).is_ok());
+        for outside in [99.5, 108.5, f64::NAN] {
+            legs[1].reference_mm = outside;
+            let e = check_references(&legs).unwrap_err().to_string();
+            assert!(
+                e.contains(&format!("leg 2's reference point {outside} mm is outside"))
+                    && e.contains("(100 to 108 mm)"),
+                "{e}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_stroke_holds_every_command_of_the_workspace_with_its_margin() {
+        // The paper machine's leg commands over its workspace cylinder,
+        // sampled inside and out on a finer grid than the export's (every
+        // 1/40 of the radius and of the height, every degree): the stroke
+        // is each extreme widened by the 2 mm margin and rounded outwards
+        // to a whole mm. (Leg 1 is shortest at 0.75 of the radius on the
+        // lower disc: a stroke sought on the side and the axis alone
+        // missed 1.4 mm of it.)
+        let m = Machine::paper();
+        let legs = leg_corrections(&m, None).unwrap();
+        let w = &m.workspace;
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for l in 0..=40 {
+            let z = w.z_min_mm + (w.z_max_mm - w.z_min_mm) * f64::from(l) / 40.0;
+            for ring in (0..=40).map(|k| f64::from(k) / 40.0) {
+                for a in 0..360 {
+                    let phi = f64::from(a).to_radians();
+                    let r = Vector3::new(
+                        ring * w.radius_mm * phi.cos(),
+                        ring * w.radius_mm * phi.sin(),
+                        z,
+                    );
+                    let q = m.inverse(&r).unwrap().legs_mm;
+                    for i in 0..3 {
+                        lo[i] = lo[i].min(q[i]);
+                        hi[i] = hi[i].max(q[i]);
+                    }
+                }
+            }
+        }
+        for (i, l) in legs.iter().enumerate() {
+            assert_eq!(l.leg, i);
+            assert_eq!(l.lo_mm, l.lo_mm.round());
+            assert_eq!(l.hi_mm, l.hi_mm.round());
+            assert!(
+                l.lo_mm <= lo[i] - STROKE_MARGIN_MM + 0.01
+                    && l.lo_mm > lo[i] - STROKE_MARGIN_MM - 1.01,
+                "leg {i}: {} for {}",
+                l.lo_mm,
+                lo[i]
+            );
+            assert!(
+                l.hi_mm >= hi[i] + STROKE_MARGIN_MM - 0.01
+                    && l.hi_mm < hi[i] + STROKE_MARGIN_MM + 1.01,
+                "leg {i}: {} for {}",
+                l.hi_mm,
+                hi[i]
+            );
+            // The reference point: the leg's command at the workspace's centre.
+            let centre = Vector3::new(0.0, 0.0, 0.5 * (w.z_min_mm + w.z_max_mm));
+            assert!((l.reference_mm - m.inverse(&centre).unwrap().legs_mm[i]).abs() < 1e-9);
+        }
+        let given = leg_corrections(&m, Some([700.0, 800.0, 900.0])).unwrap();
+        assert_eq!(given.map(|l| l.reference_mm), [700.0, 800.0, 900.0]);
+    }
 }

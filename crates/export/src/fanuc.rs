@@ -291,4 +291,94 @@ mod tests {
         assert_eq!(b.magnification, MAX_MAGNIFICATION);
         assert!(b.format_error_um > 1000.0, "{}", b.format_error_um);
     }
+
+    #[test]
+    fn a_section_holds_its_upper_end_and_not_its_lower() {
+        // Section k runs from P_ref + (k - 1) h (excluded) to P_ref + k h.
+        assert_eq!(section(10.0, 0.0, 2.0), 5);
+        assert_eq!(section(10.5, 0.0, 2.0), 6);
+        assert_eq!(section(8.5, 0.0, 2.0), 5);
+        assert_eq!(section(0.0, 0.0, 2.0), 0);
+        assert_eq!(section(-2.0, 0.0, 2.0), -1);
+        assert_eq!(section(-2.5, 0.0, 2.0), -1);
+        // 803.2 - 800 is 3.2000000000000455 in floating point: still the
+        // end of section 2 of 1.6 mm.
+        assert_eq!(section(803.2, 800.0, 1.6), 2);
+    }
+
+    #[test]
+    fn the_interval_is_the_stroke_over_the_sections_in_whole_detection_units() {
+        // 10 mm on 12 points: 10 sections of 1 mm (a point is the
+        // reference's, one the stroke's partial section).
+        let leg = LegCorrection {
+            leg: 0,
+            lead_ppm: 0.0,
+            table: None,
+            reference_mm: 105.0,
+            lo_mm: 100.0,
+            hi_mm: 110.0,
+        };
+        let a = plan(&leg, 12, 0, 1.0, 127);
+        assert_eq!((a.interval_units, a.interval_mm), (1000, 1.0));
+        assert_eq!(plan(&leg, 12, 0, 0.1, 127).interval_units, 10_000);
+        // 10 mm in 7 sections: 1.428... mm, rounded up to whole units.
+        let c = plan(&leg, 9, 0, 1.0, 127);
+        assert_eq!(c.interval_units, 1429);
+        assert!((c.interval_mm - 1.429).abs() < 1e-12);
+    }
+
+    #[test]
+    fn clipping_on_either_side_of_the_reference_is_said() {
+        // Three sections, the reference's the middle one; 1 um units, at
+        // most 3 a point. Above the reference point k carries A_k -
+        // A_(k-1); below, point k + 1 carries A_(k+1) - A_k.
+        assert_eq!(
+            increments_of(&[-0.002, 0.0, 0.002], -1, 0.001, 3),
+            (vec![0, 2, 2], false)
+        );
+        assert_eq!(
+            increments_of(&[0.0, 0.0, 0.010], -1, 0.001, 3),
+            (vec![0, 0, 3], true)
+        );
+        assert_eq!(
+            increments_of(&[-0.010, 0.0, 0.0], -1, 0.001, 3),
+            (vec![0, 3, 0], true)
+        );
+    }
+
+    #[test]
+    fn the_format_error_is_the_staircase_s_largest_miss() {
+        // A lead error with the reference point off the grid of whole mm:
+        // the format error is the largest difference between the staircase
+        // (read back) and the exact correction, searched here on a grid of
+        // 1 um and on either side of every section's end.
+        let leg = LegCorrection {
+            leg: 0,
+            lead_ppm: 300.0,
+            table: None,
+            reference_mm: 800.37,
+            lo_mm: 640.0,
+            hi_mm: 1040.0,
+        };
+        let a = plan(&leg, 128, 0, 0.1, 127);
+        let exact = |q: f64| -(leg.relative_mm(q) - a.shift_mm);
+        let miss = |q: f64| (a.output_mm(q, 0.1) - exact(q)).abs() * 1e3;
+        let mut largest: f64 = 0.0;
+        for j in 0..=400_000 {
+            largest = largest.max(miss(640.0 + f64::from(j) * 1e-3));
+        }
+        let first =
+            a.reference_mm + (a.first_point as f64 - a.reference_point as f64) * a.interval_mm;
+        for k in 0..=a.increments.len() {
+            let end = first + a.interval_mm * k as f64;
+            if (leg.lo_mm..=leg.hi_mm).contains(&end) {
+                largest = largest.max(miss(end)).max(miss(end + 1e-9));
+            }
+        }
+        assert!(
+            (a.format_error_um - largest).abs() < 2e-3,
+            "{} um reported, {largest} um found",
+            a.format_error_um
+        );
+    }
 }

@@ -170,4 +170,54 @@ mod tests {
             coarse.format_error_um
         );
     }
+
+    #[test]
+    fn a_table_s_grid_is_extended_to_cover_the_stroke() {
+        // Points every 0.5 mm from 641.3 mm: extended down to the first
+        // point of that grid at or below the stroke's 640 mm, 639.8 mm.
+        let table = LegTableDescription::new(1, 641.3, 0.5, vec![0.0; 700]);
+        let t = resample(&leg(Some(table)), 10_000, 1e-6);
+        assert!((t.start_mm - 639.8).abs() < 1e-9, "{}", t.start_mm);
+        assert_eq!(t.step_mm, 0.5);
+        // Up to the first point at or above 1040 mm: 1040.3 mm.
+        assert!((t.end_mm() - 1040.3).abs() < 1e-9, "{}", t.end_mm());
+        assert_eq!(t.points_needed, t.values_mm.len());
+    }
+
+    #[test]
+    fn without_a_table_the_points_are_at_most_the_plain_step_apart() {
+        for table in [
+            None,
+            // A table without a spacing is no grid to keep.
+            Some(LegTableDescription::new(1, 640.0, 0.0, vec![0.0; 3])),
+        ] {
+            let t = resample(&leg(table), 200, 1e-6);
+            // 400 mm of stroke: 41 points, 10 mm apart.
+            assert_eq!(t.start_mm, 640.0);
+            assert_eq!(t.values_mm.len(), 41);
+            assert!((t.step_mm - PLAIN_STEP_MM).abs() < 1e-12, "{}", t.step_mm);
+            assert_eq!(t.points_needed, 41);
+        }
+    }
+
+    #[test]
+    fn the_table_reads_zero_at_a_reference_between_its_points() {
+        // A 4 um sine of period 10 mm on 0.5 mm points; the reference at
+        // 800.2 mm.
+        let values: Vec<f64> = (0..801)
+            .map(|k| 4.0 * (std::f64::consts::TAU * k as f64 * 0.5 / 10.0).sin())
+            .collect();
+        let mut l = leg(Some(LegTableDescription::new(1, 640.0, 0.5, values)));
+        l.reference_mm = 800.2;
+        // Resampled on 200 points (2 mm apart): the exact correction read
+        // at the reference between them is not zero.
+        let t = resample(&l, 200, 1e-6);
+        assert!(t.shift_mm.abs() > 1e-5, "{}", t.shift_mm);
+        assert!(t.read_mm(800.2).abs() <= 1e-6, "{}", t.read_mm(800.2));
+        // Every point is the exact correction less the shift.
+        for (k, v) in t.values_mm.iter().enumerate() {
+            let q = t.start_mm + t.step_mm * k as f64;
+            assert!((v - (l.relative_mm(q) - t.shift_mm)).abs() <= 0.5e-6 + 1e-12);
+        }
+    }
 }

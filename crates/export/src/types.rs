@@ -236,3 +236,36 @@ pub struct ExportSummary {
     /// The limits to raise for the axes past the tolerance.
     pub limits: Vec<String>,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn controllers_are_named_as_on_the_command_line() {
+        let names = Controller::ALL.map(Controller::as_str);
+        assert_eq!(names, ["sinumerik", "fanuc", "heidenhain"]);
+    }
+
+    #[test]
+    fn axis_names_follow_each_control_s_rule() {
+        let ok = |c: Controller, n: &str| c.check_axis_name(n).is_ok();
+        // Sinumerik: 1 to 8 upper-case letters, digits or `_`, a letter first.
+        for n in ["X1", "AX_3", "ABCDEFGH"] {
+            assert!(ok(Controller::Sinumerik, n), "{n}");
+        }
+        for n in ["", "1X", "x1", "ABCDEFGHI", "A-1"] {
+            assert!(!ok(Controller::Sinumerik, n), "{n}");
+        }
+        // Fanuc: one of X Y Z A B C U V W.
+        assert!(ok(Controller::Fanuc, "U") && ok(Controller::Fanuc, "W"));
+        for n in ["", "UV", "Q", "U1"] {
+            assert!(!ok(Controller::Fanuc, n), "{n}");
+        }
+        // Heidenhain: such a letter and at most one digit.
+        assert!(ok(Controller::Heidenhain, "U") && ok(Controller::Heidenhain, "V2"));
+        for n in ["", "UA", "Q1", "U12", "2"] {
+            assert!(!ok(Controller::Heidenhain, n), "{n}");
+        }
+    }
+}

@@ -1,0 +1,217 @@
+//! What an export's summary states, against the documented rules
+//! (docs/controllers.md): where a Fanuc axis' points lie (parameters 3620
+//! to 3624), the remedy a format error past the tolerance names, the size
+//! of a thermal growth a control cannot carry, the options refused, and
+//! the files written. Expected values come from the parameters the
+//! summary states and from the fixtures' controller block, not from the
+//! writers' code.
+
+use std::path::{Path, PathBuf};
+
+use tricept_export::{Controller, ExportError, ExportOptions, ExportPlan, plan};
+use tricept_kinematics::MachineDescription;
+
+fn fixture(name: &str) -> MachineDescription {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures")
+        .join(format!("{name}.json"));
+    MachineDescription::from_file(&path).unwrap()
+}
+
+/// The number after `key` in `text` (up to the next space, `;` or `)`).
+fn number_after(text: &str, key: &str) -> f64 {
+    let at = text
+        .find(key)
+        .unwrap_or_else(|| panic!("no {key:?} in {text}"))
+        + key.len();
+    let word = text[at..].split([' ', ';', ')', ',']).next().unwrap_or("");
+    word.parse()
+        .unwrap_or_else(|_| panic!("{word:?} after {key:?} in {text}"))
+}
+
+fn fanuc(max_points: usize, detection_unit_um: f64, tolerance_um: f64) -> ExportOptions {
+    let mut o = ExportOptions::new(Controller::Fanuc);
+    o.max_points = Some(max_points);
+    o.detection_unit_um = Some(detection_unit_um);
+    o.tolerance_um = tolerance_um;
+    o
+}
+
+#[test]
+fn a_fanuc_axis_s_points_lie_where_its_parameters_put_them() {
+    // Parameter 3620 is the reference point's number, 3621 and 3622 the
+    // first and last point's, 3624 the interval: point n compensates the
+    // section ending at P_ref + (n - n_ref) h.
+    let p = plan(&fixture("lead"), &fanuc(128, 0.1, 5.0)).unwrap();
+    for (axis, line) in p.summary.axes.iter().zip(&p.summary.parameters) {
+        let n_ref = number_after(line, "3620 = ");
+        let first = number_after(line, "3621 = ");
+        let last = number_after(line, "3622 = ");
+        let h = axis.step_mm;
+        assert!(
+            (h - number_after(line, "3624 = ") * 1e-4).abs() < 1e-12,
+            "{line}"
+        );
+        assert_eq!(axis.points as f64, last - first + 1.0, "{line}");
+        let at = |n: f64| axis.reference_mm + (n - n_ref) * h;
+        assert!((axis.min_mm - at(first)).abs() < 1e-9, "{axis:?} {line}");
+        assert!((axis.max_mm - at(last)).abs() < 1e-9, "{axis:?} {line}");
+        // The points cover the reference point, below and above.
+        assert!(axis.min_mm < axis.reference_mm && axis.reference_mm < axis.max_mm);
+    }
+}
+
+#[test]
+fn a_fanuc_format_error_past_the_tolerance_names_its_remedy() {
+    // Few points (large sections) and a tolerance below the staircase's
+    // miss: the summary says so, and names the points that would do
+    // (the miss less half a unit shrinks with the points) or, when half a
+    // unit alone is past the tolerance, a finer unit.
+    let d = fixture("lead");
+    let p = plan(&d, &fanuc(12, 0.1, 1.0)).unwrap();
+    assert!(!p.summary.within_tolerance);
+    for (axis, line) in p.summary.axes.iter().zip(&p.summary.parameters) {
+        let named = format!("axis {}: ", axis.axis);
+        let limit = p.summary.limits.iter().find(|l| l.starts_with(&named));
+        let Some(limit) = limit else {
+            assert!(axis.format_error_um <= 1.0, "{axis:?}");
+            continue;
+        };
+        assert!(axis.format_error_um > 1.0, "{axis:?}");
+        assert!(
+            limit.contains(&format!(
+                "format error {:.3} um past --tolerance-um 1:",
+                axis.format_error_um
+            )),
+            "{limit}"
+        );
+        let magnification = number_after(line, "3623 = ");
+        let half_unit = 0.5 * 0.1 * magnification;
+        assert!(
+            limit.contains(&format!("half a unit is {half_unit:.3} um")),
+            "{limit}"
+        );
+        let points = number_after(limit, "to more than ");
+        let needed = axis.points as f64 * (axis.format_error_um - half_unit) / (1.0 - half_unit);
+        assert_eq!(points, needed.ceil(), "{limit}");
+        assert!(points > axis.points as f64, "{limit}");
+    }
+    assert!(!p.summary.limits.is_empty());
+    // Within the tolerance: no limit.
+    let loose = plan(&d, &fanuc(12, 0.1, 1000.0)).unwrap();
+    assert!(loose.summary.within_tolerance && loose.summary.limits.is_empty());
+    // Half a unit of 10 um alone is past a 1 um tolerance: a finer unit.
+    let coarse = plan(&d, &fanuc(128, 10.0, 1.0)).unwrap();
+    for limit in &coarse.summary.limits {
+        assert!(
+            limit.contains(": lower --detection-unit-um (10 um"),
+            "{limit}"
+        );
+        assert!(!limit.contains("--max-points"), "{limit}");
+    }
+    assert!(!coarse.summary.limits.is_empty());
+}
+
+#[test]
+fn a_thermal_growth_a_control_cannot_carry_is_listed_with_its_size() {
+    // The lead fixture's legs grow 11.5 ppm/K (its controller block); a
+    // Fanuc export carries no thermal parameter: the growth per K of the
+    // longest leg command is listed, um.
+    let d = fixture("lead");
+    let alpha = d.controller.unwrap().thermal_expansion_ppm_per_k;
+    assert!((alpha - 11.5).abs() < 0.01, "{alpha}");
+    let p = plan(&d, &fanuc(128, 0.1, 5.0)).unwrap();
+    let thermal = p
+        .summary
+        .not_exported
+        .iter()
+        .find(|n| n.what == "thermal growth, per K")
+        .unwrap();
+    // The longest command lies in the last point's section.
+    let (last, h) = p
+        .summary
+        .axes
+        .iter()
+        .map(|a| (a.max_mm, a.step_mm))
+        .fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
+    let per_k_um = |q_mm: f64| alpha * 1e-6 * q_mm * 1e3;
+    assert!(
+        thermal.size_um <= per_k_um(last) && thermal.size_um >= per_k_um(last - h),
+        "{} um, {} to {} um",
+        thermal.size_um,
+        per_k_um(last - h),
+        per_k_um(last)
+    );
+    // Sinumerik carries it.
+    let s = plan(&d, &ExportOptions::new(Controller::Sinumerik)).unwrap();
+    assert!(
+        s.summary
+            .not_exported
+            .iter()
+            .all(|n| !n.what.contains("thermal"))
+    );
+}
+
+#[test]
+fn options_no_control_can_use_are_refused() {
+    let d = fixture("lead");
+    let refused = |o: ExportOptions, flag: &str| match plan(&d, &o) {
+        Err(ExportError::Options(m)) => assert!(m.starts_with(flag), "{m}"),
+        other => panic!("{flag}: {other:?}"),
+    };
+    for tolerance in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let mut o = ExportOptions::new(Controller::Sinumerik);
+        o.tolerance_um = tolerance;
+        refused(o, "--tolerance-um");
+    }
+    for points in [2, 100_001] {
+        let mut o = ExportOptions::new(Controller::Heidenhain);
+        o.max_points = Some(points);
+        refused(o, "--max-points");
+    }
+    for c in [Controller::Sinumerik, Controller::Heidenhain] {
+        let mut o = ExportOptions::new(c);
+        o.detection_unit_um = Some(1.0);
+        refused(o, "--detection-unit-um");
+        let mut o = ExportOptions::new(c);
+        o.max_increment = Some(7);
+        refused(o, "--max-increment");
+    }
+    for du in [0.0, -0.1, 100.5, f64::NAN] {
+        refused(fanuc(128, du, 5.0), "--detection-unit-um");
+    }
+    let mut o = fanuc(128, 1.0, 5.0);
+    o.max_increment = Some(0);
+    refused(o, "--max-increment");
+    // At the ends of their ranges the options are taken.
+    let mut o = fanuc(3, 100.0, 5.0);
+    o.max_increment = Some(1);
+    assert!(plan(&d, &o).is_ok());
+    assert!(plan(&d, &fanuc(128, 0.001, 5.0)).is_ok());
+    let mut o = ExportOptions::new(Controller::Sinumerik);
+    o.max_points = Some(100_000);
+    assert!(plan(&d, &o).is_ok());
+}
+
+#[test]
+fn the_files_are_written_as_planned() {
+    let p: ExportPlan = plan(
+        &fixture("lead"),
+        &ExportOptions::new(Controller::Heidenhain),
+    )
+    .unwrap();
+    let dir: PathBuf =
+        std::env::temp_dir().join(format!("tricept-export-summary-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    // Written into a directory made for it.
+    p.write(&dir.join("out")).unwrap();
+    for (name, text) in &p.files {
+        let written = std::fs::read_to_string(dir.join("out").join(name)).unwrap();
+        assert_eq!(&written, text, "{name}");
+    }
+    assert_eq!(
+        std::fs::read_dir(dir.join("out")).unwrap().count(),
+        p.files.len()
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
