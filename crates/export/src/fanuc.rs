@@ -61,6 +61,14 @@ impl FanucAxis {
         let unit = f64::from(self.magnification) * detection_unit_um * 1e-3;
         accumulated(&self.increments, lo, k) as f64 * unit
     }
+
+    /// The leg's length as the control leaves it at command `q_mm` minus
+    /// the exact one, mm: the output is added to the command, which the
+    /// exact correction wants shortened by `E(q) - E(q_ref)` less the
+    /// shift.
+    pub fn deviation_mm(&self, leg: &LegCorrection, q_mm: f64, detection_unit_um: f64) -> f64 {
+        self.output_mm(q_mm, detection_unit_um) + (leg.relative_mm(q_mm) - self.shift_mm)
+    }
 }
 
 /// The section (relative to the reference point's) that holds `q`: the
@@ -154,10 +162,7 @@ pub fn plan(
     axis.format_error_um = leg
         .check_points_mm(start, h, CHECKS_PER_SECTION)
         .into_iter()
-        .map(|q| {
-            let exact = -(leg.relative_mm(q) - shift_mm);
-            (axis.output_mm(q, detection_unit_um) - exact).abs() * 1e3
-        })
+        .map(|q| axis.deviation_mm(leg, q, detection_unit_um).abs() * 1e3)
         .fold(0.0, f64::max);
     axis
 }

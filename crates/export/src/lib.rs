@@ -138,9 +138,7 @@ pub fn plan(
                 .collect();
             for (t, l) in tables.iter().zip(&legs) {
                 let (t, l) = (t.clone(), l.clone());
-                deviation.push(Box::new(move |q| {
-                    l.relative_mm(q) - t.shift_mm - t.read_mm(q)
-                }));
+                deviation.push(Box::new(move |q| t.deviation_mm(&l, q)));
             }
             for (i, t) in tables.iter().enumerate() {
                 axes.push(summarise(
@@ -226,9 +224,7 @@ pub fn plan(
             }
             for (a, l) in fanuc_axes.iter().zip(&legs) {
                 let (a, l) = (a.clone(), l.clone());
-                deviation.push(Box::new(move |q| {
-                    a.output_mm(q, du) + l.relative_mm(q) - a.shift_mm
-                }));
+                deviation.push(Box::new(move |q| a.deviation_mm(&l, q, du)));
             }
             for (i, a) in fanuc_axes.iter().enumerate() {
                 let start = a.reference_mm

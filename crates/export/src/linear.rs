@@ -48,6 +48,14 @@ impl LinearTable {
         read_linear(self.start_mm, self.step_mm, &self.values_mm, q_mm)
     }
 
+    /// The leg's length as the control leaves it at command `q_mm` minus
+    /// the exact one, mm: the control takes the table's value off the
+    /// command, which the exact correction wants shortened by `E(q) -
+    /// E(q_ref)` less the shift.
+    pub fn deviation_mm(&self, leg: &LegCorrection, q_mm: f64) -> f64 {
+        (leg.relative_mm(q_mm) - self.shift_mm) - self.read_mm(q_mm)
+    }
+
     /// Position of the last point, mm.
     pub fn end_mm(&self) -> f64 {
         self.start_mm + self.step_mm * self.values_mm.len().saturating_sub(1) as f64
@@ -120,7 +128,7 @@ pub fn resample(leg: &LegCorrection, max_points: usize, resolution_mm: f64) -> L
     table.format_error_um = leg
         .check_points_mm(start, step, CHECKS_PER_CELL)
         .into_iter()
-        .map(|q| (table.read_mm(q) - (leg.relative_mm(q) - shift_mm)).abs() * 1e3)
+        .map(|q| table.deviation_mm(leg, q).abs() * 1e3)
         .fold(0.0, f64::max);
     table
 }
