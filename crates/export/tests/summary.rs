@@ -68,8 +68,35 @@ fn a_fanuc_format_error_past_the_tolerance_names_its_remedy() {
     // (the miss less half a unit shrinks with the points) or, when half a
     // unit alone is past the tolerance, a finer unit.
     let d = fixture("lead");
-    let p = plan(&d, &fanuc(12, 0.1, 1.0)).unwrap();
+    let mut small_increments = fanuc(12, 0.1, 1.0);
+    // At most 7 units a point: the magnification grows past 1.
+    small_increments.max_increment = Some(7);
+    let mut magnified = false;
+    for o in [fanuc(12, 0.1, 1.0), small_increments] {
+        magnified |= assert_remedies(&plan(&d, &o).unwrap());
+    }
+    assert!(magnified);
+    // Within the tolerance: no limit.
+    let loose = plan(&d, &fanuc(12, 0.1, 1000.0)).unwrap();
+    assert!(loose.summary.within_tolerance && loose.summary.limits.is_empty());
+    // Half a unit of 10 um alone is past a 1 um tolerance: a finer unit.
+    let coarse = plan(&d, &fanuc(128, 10.0, 1.0)).unwrap();
+    for limit in &coarse.summary.limits {
+        assert!(
+            limit.contains(": lower --detection-unit-um (10 um"),
+            "{limit}"
+        );
+        assert!(!limit.contains("--max-points"), "{limit}");
+    }
+    assert!(!coarse.summary.limits.is_empty());
+}
+
+/// Asserts the remedy each axis past the tolerance of 1 um names: the
+/// points that would do, or a finer unit; whether an axis is magnified.
+fn assert_remedies(p: &ExportPlan) -> bool {
     assert!(!p.summary.within_tolerance);
+    assert!(!p.summary.limits.is_empty());
+    let mut magnified = false;
     for (axis, line) in p.summary.axes.iter().zip(&p.summary.parameters) {
         let named = format!("axis {}: ", axis.axis);
         let limit = p.summary.limits.iter().find(|l| l.starts_with(&named));
@@ -86,6 +113,7 @@ fn a_fanuc_format_error_past_the_tolerance_names_its_remedy() {
             "{limit}"
         );
         let magnification = number_after(line, "3623 = ");
+        magnified |= magnification > 1.0;
         let half_unit = 0.5 * 0.1 * magnification;
         assert!(
             limit.contains(&format!("half a unit is {half_unit:.3} um")),
@@ -96,20 +124,7 @@ fn a_fanuc_format_error_past_the_tolerance_names_its_remedy() {
         assert_eq!(points, needed.ceil(), "{limit}");
         assert!(points > axis.points as f64, "{limit}");
     }
-    assert!(!p.summary.limits.is_empty());
-    // Within the tolerance: no limit.
-    let loose = plan(&d, &fanuc(12, 0.1, 1000.0)).unwrap();
-    assert!(loose.summary.within_tolerance && loose.summary.limits.is_empty());
-    // Half a unit of 10 um alone is past a 1 um tolerance: a finer unit.
-    let coarse = plan(&d, &fanuc(128, 10.0, 1.0)).unwrap();
-    for limit in &coarse.summary.limits {
-        assert!(
-            limit.contains(": lower --detection-unit-um (10 um"),
-            "{limit}"
-        );
-        assert!(!limit.contains("--max-points"), "{limit}");
-    }
-    assert!(!coarse.summary.limits.is_empty());
+    magnified
 }
 
 #[test]
