@@ -230,3 +230,85 @@ fn the_files_are_written_as_planned() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_linear_table_past_the_tolerance_names_the_points_its_own_spacing_needs() {
+    // The pitch fixture's deployed table (every 10/24 mm) on 20 points:
+    // each axis misses the sine by far more than 1 um, and the summary
+    // names the control's point limit and the points the deployed
+    // table's own spacing needs over the written stroke.
+    let d = fixture("pitch");
+    let step_mm = d.leg_effects.tables[0].step_mm;
+    for (c, limit_name) in [
+        (Controller::Sinumerik, "MD38000 MM_ENC_COMP_MAX_POINTS"),
+        (Controller::Heidenhain, "the points a *.COM table takes"),
+    ] {
+        let mut o = ExportOptions::new(c);
+        o.max_points = Some(20);
+        o.tolerance_um = 1.0;
+        let p = plan(&d, &o).unwrap();
+        assert_eq!(p.summary.limits.len(), 3, "{:#?}", p.summary.limits);
+        for (axis, limit) in p.summary.axes.iter().zip(&p.summary.limits) {
+            assert!(axis.format_error_um > 1.0, "{axis:?}");
+            assert!(
+                limit.starts_with(&format!(
+                    "axis {}: format error {:.3} um past --tolerance-um 1: raise --max-points ({limit_name}) to ",
+                    axis.axis, axis.format_error_um
+                )),
+                "{limit}"
+            );
+            let needed = number_after(limit, ") to ");
+            let stroke = axis.max_mm - axis.min_mm;
+            assert!(
+                needed >= stroke / step_mm + 1.0 && needed <= stroke / step_mm + 3.0,
+                "{limit}: {stroke} mm every {step_mm} mm"
+            );
+        }
+        // Enough points: within the tolerance, no limit.
+        let mut o = ExportOptions::new(c);
+        o.max_points = Some(10_000);
+        o.tolerance_um = 1.0;
+        assert!(plan(&d, &o).unwrap().summary.limits.is_empty());
+    }
+}
+
+#[test]
+fn sinumerik_carries_a_thermal_growth_in_its_temperature_compensation() {
+    // The lead fixture's 11.5 ppm/K: a position-dependent temperature
+    // compensation per axis of slope -alpha 1e-6 per K (SD43910); a
+    // machine without thermal growth (the pitch fixture) has none.
+    let d = fixture("lead");
+    let alpha = d.controller.unwrap().thermal_expansion_ppm_per_k;
+    let p = plan(&d, &ExportOptions::new(Controller::Sinumerik)).unwrap();
+    let lines: Vec<&String> = p
+        .summary
+        .parameters
+        .iter()
+        .filter(|l| l.contains("TEMP_COMP_SLOPE"))
+        .collect();
+    assert_eq!(lines.len(), 3, "{:#?}", p.summary.parameters);
+    for (line, axis) in lines.iter().zip(["X1", "Y1", "Z1"]) {
+        assert!(
+            line.starts_with(&format!("{axis}: MD32750 TEMP_COMP_TYPE = 2")),
+            "{line}"
+        );
+        let slope = number_after(line, "SD43910 TEMP_COMP_SLOPE = ");
+        assert!((slope + alpha * 1e-6).abs() < 1e-11, "{line}");
+        assert!(line.contains("(T - 20 degC)"), "{line}");
+    }
+    let pitch = fixture("pitch");
+    assert_eq!(
+        pitch
+            .controller
+            .unwrap_or_default()
+            .thermal_expansion_ppm_per_k,
+        0.0
+    );
+    let p = plan(&pitch, &ExportOptions::new(Controller::Sinumerik)).unwrap();
+    assert!(
+        p.summary
+            .parameters
+            .iter()
+            .all(|l| !l.contains("TEMP_COMP"))
+    );
+}
