@@ -245,6 +245,14 @@ mod tests {
     fn controllers_are_named_as_on_the_command_line() {
         let names = Controller::ALL.map(Controller::as_str);
         assert_eq!(names, ["sinumerik", "fanuc", "heidenhain"]);
+        // Read back, in any case; an unknown name is refused.
+        for (c, name) in Controller::ALL.into_iter().zip(names) {
+            assert_eq!(name.parse::<Controller>(), Ok(c));
+            assert_eq!(name.to_uppercase().parse::<Controller>(), Ok(c));
+            assert_eq!(c.to_string(), name);
+        }
+        let e = "siemens".parse::<Controller>().unwrap_err();
+        assert!(e.starts_with("unknown controller `siemens`"), "{e}");
     }
 
     #[test]
