@@ -292,17 +292,10 @@ mod tests {
         }
     }
 
-    #[test]
-    fn the_stroke_holds_every_command_of_the_workspace_with_its_margin() {
-        // The paper machine's leg commands over its workspace cylinder,
-        // sampled inside and out on a finer grid than the export's (every
-        // 1/40 of the radius and of the height, every degree): the stroke
-        // is each extreme widened by the 2 mm margin and rounded outwards
-        // to a whole mm. (Leg 1 is shortest at 0.75 of the radius on the
-        // lower disc: a stroke sought on the side and the axis alone
-        // missed 1.4 mm of it.)
-        let m = Machine::paper();
-        let legs = leg_corrections(&m, None).unwrap();
+    /// Each leg's least and largest command over `m`'s workspace cylinder,
+    /// sampled inside and out every 1/40 of the radius and of the height,
+    /// every degree.
+    fn sampled_stroke(m: &Machine) -> ([f64; 3], [f64; 3]) {
         let w = &m.workspace;
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for l in 0..=40 {
@@ -323,28 +316,56 @@ mod tests {
                 }
             }
         }
-        for (i, l) in legs.iter().enumerate() {
-            assert_eq!(l.leg, i);
-            assert_eq!(l.lo_mm, l.lo_mm.round());
-            assert_eq!(l.hi_mm, l.hi_mm.round());
-            assert!(
-                l.lo_mm <= lo[i] - STROKE_MARGIN_MM + 0.01
-                    && l.lo_mm > lo[i] - STROKE_MARGIN_MM - 1.01,
-                "leg {i}: {} for {}",
-                l.lo_mm,
-                lo[i]
-            );
-            assert!(
-                l.hi_mm >= hi[i] + STROKE_MARGIN_MM - 0.01
-                    && l.hi_mm < hi[i] + STROKE_MARGIN_MM + 1.01,
-                "leg {i}: {} for {}",
-                l.hi_mm,
-                hi[i]
-            );
-            // The reference point: the leg's command at the workspace's centre.
-            let centre = Vector3::new(0.0, 0.0, 0.5 * (w.z_min_mm + w.z_max_mm));
-            assert!((l.reference_mm - m.inverse(&centre).unwrap().legs_mm[i]).abs() < 1e-9);
+        (lo, hi)
+    }
+
+    #[test]
+    fn the_stroke_holds_every_command_of_the_workspace_with_its_margin() {
+        // The paper machine's leg commands over its workspace, and over
+        // smaller and lower ones (other fractions of a mm at the ends), on
+        // a finer grid than the export's: the stroke is each extreme
+        // widened by the 2 mm margin and rounded outwards to a whole mm.
+        // (Leg 1 is shortest at 0.75 of the radius on the lower disc: a
+        // stroke sought on the side and the axis alone missed 1.4 mm of
+        // it.)
+        let paper = Machine::paper();
+        let mut machines = vec![paper.clone()];
+        for (radius, lower_mm) in [(0.9, 0.0), (0.8, 7.3), (0.7, 13.9)] {
+            let mut m = paper.clone();
+            m.workspace.radius_mm *= radius;
+            m.workspace.z_min_mm += lower_mm;
+            m.workspace.z_max_mm -= lower_mm;
+            machines.push(m);
         }
+        for m in &machines {
+            let legs = leg_corrections(m, None).unwrap();
+            let (lo, hi) = sampled_stroke(m);
+            let w = &m.workspace;
+            for (i, l) in legs.iter().enumerate() {
+                assert_eq!(l.leg, i);
+                assert_eq!(l.lo_mm, l.lo_mm.round());
+                assert_eq!(l.hi_mm, l.hi_mm.round());
+                assert!(
+                    l.lo_mm <= lo[i] - STROKE_MARGIN_MM + 0.06
+                        && l.lo_mm > lo[i] - STROKE_MARGIN_MM - 1.01,
+                    "leg {i}: {} for {}",
+                    l.lo_mm,
+                    lo[i]
+                );
+                assert!(
+                    l.hi_mm >= hi[i] + STROKE_MARGIN_MM - 0.06
+                        && l.hi_mm < hi[i] + STROKE_MARGIN_MM + 1.01,
+                    "leg {i}: {} for {}",
+                    l.hi_mm,
+                    hi[i]
+                );
+                // The reference point: the leg's command at the workspace's
+                // centre.
+                let centre = Vector3::new(0.0, 0.0, 0.5 * (w.z_min_mm + w.z_max_mm));
+                assert!((l.reference_mm - m.inverse(&centre).unwrap().legs_mm[i]).abs() < 1e-9);
+            }
+        }
+        let m = paper;
         let given = leg_corrections(&m, Some([700.0, 800.0, 900.0])).unwrap();
         assert_eq!(given.map(|l| l.reference_mm), [700.0, 800.0, 900.0]);
     }
