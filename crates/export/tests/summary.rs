@@ -59,6 +59,50 @@ fn a_fanuc_axis_s_points_lie_where_its_parameters_put_them() {
         // The points cover the reference point, below and above.
         assert!(axis.min_mm < axis.reference_mm && axis.reference_mm < axis.max_mm);
     }
+    // The three axes are numbered one after the other, from 0.
+    let numbers: Vec<(f64, f64)> = p
+        .summary
+        .parameters
+        .iter()
+        .map(|l| (number_after(l, "3621 = "), number_after(l, "3622 = ")))
+        .collect();
+    assert_eq!(numbers[0].0, 0.0);
+    for pair in numbers.windows(2) {
+        assert_eq!(pair[1].0, pair[0].1 + 1.0, "{numbers:?}");
+    }
+}
+
+#[test]
+fn each_linear_format_rounds_to_its_own_resolution() {
+    // The lead fixture's legs: a lead error (linear, so interpolation is
+    // exact) and no table. What is left is the rounding of the values:
+    // half of 1e-6 mm in a Sinumerik program, half of 1e-4 mm in a
+    // Heidenhain table (docs/controllers.md).
+    let d = fixture("lead");
+    assert!(d.leg_effects.tables.is_empty());
+    for (c, half_um) in [
+        (Controller::Sinumerik, 0.5e-3),
+        (Controller::Heidenhain, 0.05),
+    ] {
+        let p = plan(&d, &ExportOptions::new(c)).unwrap();
+        for axis in &p.summary.axes {
+            assert!(
+                axis.format_error_um <= half_um * (1.0 + 1e-6),
+                "{c}: {axis:?}"
+            );
+        }
+        // Heidenhain's rounding is seen (a lead of some ppm over 2 mm spans
+        // many 0.1 um steps).
+        if c == Controller::Heidenhain {
+            let largest = p
+                .summary
+                .axes
+                .iter()
+                .map(|a| a.format_error_um)
+                .fold(0.0, f64::max);
+            assert!(largest > 0.01, "{largest}");
+        }
+    }
 }
 
 #[test]
