@@ -251,6 +251,7 @@ pub fn parameter_tape(axes: &[FanucAxis], backlash_units: &[i64; 3]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use tricept_kinematics::description::LegTableDescription;
 
     #[test]
     fn a_lead_error_is_a_staircase_zero_in_the_reference_section() {
@@ -387,5 +388,38 @@ mod tests {
             "{} um reported, {largest} um found",
             a.format_error_um
         );
+    }
+
+    #[test]
+    fn each_section_sits_at_the_middle_of_the_correction_s_range_knots_included() {
+        // A deployed table zero but for a 10 um spike at one point, between
+        // the 16 samples of its section (sections of 4.0817 mm from the
+        // reference 800.37 mm, samples 0.2551 mm apart; the spike 0.02 mm
+        // wide, 0.127 mm from the nearest): the section's level is the middle
+        // of 0 and 10 um, and the format error half the spike.
+        let values: Vec<f64> = (0..20_001)
+            .map(|k| if k == 12_107 { 10.0 } else { 0.0 })
+            .collect();
+        let leg = LegCorrection {
+            leg: 0,
+            lead_ppm: 0.0,
+            table: Some(LegTableDescription::new(1, 640.0, 0.02, values)),
+            reference_mm: 800.37,
+            lo_mm: 640.0,
+            hi_mm: 1040.0,
+        };
+        let spike_mm = 640.0 + 0.02 * 12_107.0;
+        let a = plan(&leg, 100, 0, 0.1, 127);
+        assert_eq!(a.interval_units, 40_817);
+        let sample = (spike_mm - 800.37) / (a.interval_mm / 16.0);
+        assert!((sample - sample.round()).abs() > 0.4, "{sample}");
+        assert!(
+            (a.format_error_um - 5.0).abs() < 0.06,
+            "{}",
+            a.format_error_um
+        );
+        // The section holding the spike reads -5 um (the output is added to
+        // the command; the leg is 10 um long at the spike).
+        assert!((a.output_mm(spike_mm, 0.1) + 0.005).abs() < 0.06e-3);
     }
 }
