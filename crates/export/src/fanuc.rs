@@ -352,6 +352,26 @@ mod tests {
         );
     }
 
+    /// The largest miss of `a`'s staircase of `leg`, searched on a grid of
+    /// 1 um over 640 to 1040 mm and on either side of every section's end.
+    fn largest_miss_um(a: &FanucAxis, leg: &LegCorrection) -> f64 {
+        let exact = |q: f64| -(leg.relative_mm(q) - a.shift_mm);
+        let miss = |q: f64| (a.output_mm(q, 0.1) - exact(q)).abs() * 1e3;
+        let mut largest: f64 = 0.0;
+        for j in 0..=400_000 {
+            largest = largest.max(miss(640.0 + f64::from(j) * 1e-3));
+        }
+        let first =
+            a.reference_mm + (a.first_point as f64 - a.reference_point as f64) * a.interval_mm;
+        for k in 0..=a.increments.len() {
+            let end = first + a.interval_mm * k as f64;
+            if (leg.lo_mm..=leg.hi_mm).contains(&end) {
+                largest = largest.max(miss(end)).max(miss(end + 1e-9));
+            }
+        }
+        largest
+    }
+
     #[test]
     fn the_format_error_is_the_staircase_s_largest_miss() {
         // A lead error with the reference point off the grid of whole mm:
@@ -369,20 +389,29 @@ mod tests {
         // 100 points: sections of 4.0817 mm, whose ends a grid of 16
         // points a section started elsewhere misses by 0.05 mm or more.
         let a = plan(&leg, 100, 0, 0.1, 127);
-        let exact = |q: f64| -(leg.relative_mm(q) - a.shift_mm);
-        let miss = |q: f64| (a.output_mm(q, 0.1) - exact(q)).abs() * 1e3;
-        let mut largest: f64 = 0.0;
-        for j in 0..=400_000 {
-            largest = largest.max(miss(640.0 + f64::from(j) * 1e-3));
-        }
-        let first =
-            a.reference_mm + (a.first_point as f64 - a.reference_point as f64) * a.interval_mm;
-        for k in 0..=a.increments.len() {
-            let end = first + a.interval_mm * k as f64;
-            if (leg.lo_mm..=leg.hi_mm).contains(&end) {
-                largest = largest.max(miss(end)).max(miss(end + 1e-9));
-            }
-        }
+        let largest = largest_miss_um(&a, &leg);
+        assert!(
+            (a.format_error_um - largest).abs() < 2e-3,
+            "{} um reported, {largest} um found",
+            a.format_error_um
+        );
+        // A table rising 4 um/mm from 640 to 680 mm, flat above, the
+        // reference near the bottom: the largest misses lie in the sections
+        // of the rise (none at a knot).
+        let mut values = vec![160.0; 11];
+        values[0] = 0.0;
+        let leg = LegCorrection {
+            lead_ppm: 0.0,
+            table: Some(LegTableDescription::new(1, 640.0, 40.0, values)),
+            reference_mm: 660.37,
+            ..leg
+        };
+        let a = plan(&leg, 100, 0, 0.1, 127);
+        let largest = largest_miss_um(&a, &leg);
+        // Half of a section's rise, 4 um/mm over 4.0817 mm, and up to half
+        // a unit (the magnification 2 keeps 16 um within 127 units of 0.1).
+        assert_eq!(a.magnification, 2);
+        assert!((largest - 2.0 * a.interval_mm).abs() <= 0.1 + 1e-9, "{largest}");
         assert!(
             (a.format_error_um - largest).abs() < 2e-3,
             "{} um reported, {largest} um found",
