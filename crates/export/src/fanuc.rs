@@ -159,9 +159,16 @@ pub fn plan(
         format_error_um: 0.0,
     };
     let start = q_ref + (k_lo - 1) as f64 * h;
+    // A section's lower end belongs to the section below, and the
+    // staircase steps there: the miss just above it is checked too.
+    let sections = (k_hi - k_lo + 1) as usize;
+    let above_ends = (0..sections)
+        .map(|c| start + h * c as f64 + 1e-6)
+        .filter(|q| (leg.lo_mm..=leg.hi_mm).contains(q));
     axis.format_error_um = leg
         .check_points_mm(start, h, CHECKS_PER_SECTION)
         .into_iter()
+        .chain(above_ends)
         .map(|q| axis.deviation_mm(leg, q, detection_unit_um).abs() * 1e3)
         .fold(0.0, f64::max);
     axis
