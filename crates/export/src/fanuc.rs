@@ -359,11 +359,12 @@ mod tests {
         );
     }
 
-    /// The largest miss of `a`'s staircase of `leg`, searched on a grid of
-    /// 1 um over 640 to 1040 mm and on either side of every section's end.
-    fn largest_miss_um(a: &FanucAxis, leg: &LegCorrection) -> f64 {
+    /// The largest miss of `a`'s staircase of `leg` (in detection units of
+    /// `detection_unit_um`), searched on a grid of 1 um over 640 to 1040 mm
+    /// and on either side of every section's end.
+    fn largest_miss_um(a: &FanucAxis, leg: &LegCorrection, detection_unit_um: f64) -> f64 {
         let exact = |q: f64| -(leg.relative_mm(q) - a.shift_mm);
-        let miss = |q: f64| (a.output_mm(q, 0.1) - exact(q)).abs() * 1e3;
+        let miss = |q: f64| (a.output_mm(q, detection_unit_um) - exact(q)).abs() * 1e3;
         let mut largest: f64 = 0.0;
         for j in 0..=400_000 {
             largest = largest.max(miss(640.0 + f64::from(j) * 1e-3));
@@ -396,7 +397,7 @@ mod tests {
         // 100 points: sections of 4.0817 mm, whose ends a grid of 16
         // points a section started elsewhere misses by 0.05 mm or more.
         let a = plan(&leg, 100, 0, 0.1, 127);
-        let largest = largest_miss_um(&a, &leg);
+        let largest = largest_miss_um(&a, &leg, 0.1);
         assert!(
             (a.format_error_um - largest).abs() < 2e-3,
             "{} um reported, {largest} um found",
@@ -414,11 +415,14 @@ mod tests {
             ..leg
         };
         let a = plan(&leg, 100, 0, 0.1, 127);
-        let largest = largest_miss_um(&a, &leg);
+        let largest = largest_miss_um(&a, &leg, 0.1);
         // Half of a section's rise, 4 um/mm over 4.0817 mm, and up to half
         // a unit (the magnification 2 keeps 16 um within 127 units of 0.1).
         assert_eq!(a.magnification, 2);
-        assert!((largest - 2.0 * a.interval_mm).abs() <= 0.1 + 1e-9, "{largest}");
+        assert!(
+            (largest - 2.0 * a.interval_mm).abs() <= 0.1 + 1e-9,
+            "{largest}"
+        );
         assert!(
             (a.format_error_um - largest).abs() < 2e-3,
             "{} um reported, {largest} um found",
@@ -457,5 +461,46 @@ mod tests {
         // The section holding the spike reads -5 um (the output is added to
         // the command; the leg is 10 um long at the spike).
         assert!((a.output_mm(spike_mm, 0.1) + 0.005).abs() < 0.06e-3);
+    }
+
+    #[test]
+    fn the_miss_just_above_a_section_s_lower_end_is_counted() {
+        // A table rising from the stroke's start, 640 mm, to the upper end
+        // of the second section (sections of 4.082 mm, whole um, from the
+        // reference 660.37 mm), flat above: the largest miss lies in that section,
+        // fully inside the rise. Its level is rounded to whole units, so
+        // the miss is larger at one of its ends; a rise is chosen for which
+        // that is the lower end, which belongs to the section below (only
+        // approached from above, never a knot nor the stroke's end).
+        let h = 4.082;
+        let upper = 660.37 - 3.0 * h;
+        let (lower_above, upper_at) = (upper - h + 1e-9, upper);
+        let mut found = false;
+        for rise_um in (20..60).map(f64::from) {
+            let mut values = vec![rise_um; 51];
+            values[0] = 0.0;
+            let leg = LegCorrection {
+                leg: 0,
+                lead_ppm: 0.0,
+                table: Some(LegTableDescription::new(1, 640.0, upper - 640.0, values)),
+                reference_mm: 660.37,
+                lo_mm: 640.0,
+                hi_mm: 1040.0,
+            };
+            let a = plan(&leg, 100, 0, 1.0, 127);
+            assert!((a.interval_mm - h).abs() < 1e-12, "{}", a.interval_mm);
+            let miss = |q: f64| a.deviation_mm(&leg, q, 1.0).abs() * 1e3;
+            let largest = largest_miss_um(&a, &leg, 1.0);
+            if miss(lower_above) < largest - 1e-6 || miss(lower_above) < miss(upper_at) + 0.05 {
+                continue;
+            }
+            found = true;
+            assert!(
+                (a.format_error_um - largest).abs() < 2e-3,
+                "{rise_um} um: {} um reported, {largest} um found",
+                a.format_error_um
+            );
+        }
+        assert!(found);
     }
 }
