@@ -160,11 +160,9 @@ pub fn plan(
     };
     let start = q_ref + (k_lo - 1) as f64 * h;
     // A section's lower end belongs to the section below, and the
-    // staircase steps there: the miss just above it is checked too.
-    let sections = (k_hi - k_lo + 1) as usize;
-    let above_ends = (0..sections)
-        .map(|c| start + h * c as f64 + 1e-6)
-        .filter(|q| (leg.lo_mm..=leg.hi_mm).contains(q));
+    // staircase steps there: the miss just above it is checked too (in
+    // every section but the first, whose lower end lies below the stroke).
+    let above_ends = (k_lo + 1..=k_hi).map(|k| q_ref + (k - 1) as f64 * h + 1e-6);
     axis.format_error_um = leg
         .check_points_mm(start, h, CHECKS_PER_SECTION)
         .into_iter()
