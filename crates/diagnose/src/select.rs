@@ -43,6 +43,7 @@ use tricept_model::effects::EffectName;
 
 use crate::dictionary::{At, Dictionary, Scored};
 use crate::error::DiagnoseError;
+use crate::evidence::Reference;
 use crate::fit::{Fit, FitResult, Fitter, term_estimates};
 use crate::linear::Linearisation;
 use crate::plausibility::Plausibility;
@@ -111,11 +112,7 @@ impl ScreenPoint {
 impl Setup<'_> {
     /// The family-wise level of each half of the pool.
     pub(crate) fn alpha_share(&self) -> f64 {
-        if self.dictionary.is_empty() {
-            self.fitter.options.alpha
-        } else {
-            0.5 * self.fitter.options.alpha
-        }
+        alpha_share_of(self.fitter.options.alpha, self.dictionary.is_empty())
     }
 
     /// Number of tests of the half of the pool `term` belongs to.
@@ -159,12 +156,7 @@ impl Setup<'_> {
     /// effects not in its model (one linearisation for both; the last one
     /// is kept with its point).
     pub(crate) fn linear_screen(&self, fit: &Fit, data: &Dataset) -> Screen {
-        let catalogue: Vec<Term> = self
-            .available
-            .iter()
-            .map(|e| Term::Catalogue(*e))
-            .filter(|t| !fit.model.terms().iter().any(|u| u.overlaps(t)))
-            .collect();
+        let catalogue = catalogue_candidates(&self.available, fit.model.terms());
         if self.dictionary.is_empty() && catalogue.is_empty() {
             return Screen::default();
         }
@@ -227,20 +219,15 @@ impl Setup<'_> {
         with: &Fit,
         readings: usize,
     ) -> Evidence {
-        let delta = without.id.stats.chi_square - with.id.stats.chi_square;
-        let k = with
-            .id
-            .design()
-            .rank()
-            .saturating_sub(without.id.design().rank())
-            .max(1);
-        self.evidence_of(
-            term,
-            delta,
-            k,
-            (with.id.stats.chi_square, with.id.stats.dof),
-            readings,
-        )
+        let test = Nested::of_fits(
+            (without.id.stats.chi_square, without.id.design().rank()),
+            (
+                with.id.stats.chi_square,
+                with.id.stats.dof,
+                with.id.design().rank(),
+            ),
+        );
+        self.evidence_of(term, test, readings)
     }
 
     /// The score test of adding `term` to `current`: the evidence of its
@@ -253,40 +240,20 @@ impl Setup<'_> {
         rank: usize,
         readings: usize,
     ) -> Evidence {
-        let k = rank.max(1);
         let stats = &current.id.stats;
-        let with = (stats.chi_square - explained, stats.dof.saturating_sub(k));
-        self.evidence_of(term, explained, k, with, readings)
+        let test = Nested::of_score((stats.chi_square, stats.dof), explained, rank);
+        self.evidence_of(term, test, readings)
     }
 
-    /// The evidence of a drop of chi-square `delta` for `k` parameters, the
-    /// larger model leaving `(chi-square, dof)` `with`.
-    fn evidence_of(
-        &self,
-        term: &Term,
-        delta: f64,
-        k: usize,
-        with: (f64, usize),
-        readings: usize,
-    ) -> Evidence {
-        let reference = &self.fitter.reference;
-        let s2 = reference.scale(with.0, with.1);
-        let p = reference.p_value(delta / s2, k);
-        let m = self.multiplicity(term);
-        let ln_n = (readings as f64).ln();
-        Evidence {
-            delta_chi_square: delta,
-            dof: k,
-            p_value: p,
-            threshold: self.alpha_share() / m as f64,
-            delta_bic: delta - k as f64 * ln_n,
-            holdout_rms_without: None,
-            holdout_rms_with: None,
-            selected: false,
-            multiplicity: m,
-            p_adjusted: (p * m as f64).min(1.0),
-            penalised_gain: delta - k as f64 * ln_n - 2.0 * (self.alternatives(term) as f64).ln(),
-        }
+    /// The evidence of the nested test `test` of `term` ([`weigh`] with
+    /// the term's half of the pool and its family).
+    fn evidence_of(&self, term: &Term, test: Nested, readings: usize) -> Evidence {
+        let count = Count {
+            alpha_share: self.alpha_share(),
+            multiplicity: self.multiplicity(term),
+            alternatives: self.alternatives(term),
+        };
+        weigh(&self.fitter.reference, test, readings, count)
     }
 }
 
@@ -358,38 +325,34 @@ fn forward_step(
     tested: Option<&mut Vec<Tested>>,
 ) -> Option<(Trial, f64)> {
     let terms = current.model.terms().to_vec();
-    let mut pool: Vec<Term> = setup
-        .available
-        .iter()
-        .map(|e| Term::Catalogue(*e))
-        .filter(|t| !terms.iter().any(|u| u.overlaps(t)))
-        .collect();
+    let mut pool = catalogue_candidates(&setup.available, &terms);
     let alpha_share = setup.alpha_share();
     let screen = setup.linear_screen(current, clean);
     pool.extend(
         screen
             .dictionary
             .iter()
-            .filter(|s| s.p_adjusted < alpha_share)
+            .filter(|s| significant(s.p_adjusted, alpha_share))
             .take(setup.fitter.options.dictionary.refit_top)
             .map(|s| Term::Generic(s.term)),
     );
-    pool.retain(|t| !excluded.iter().any(|e| e.overlaps(t) || e == t));
-    let readings = 3 * clean.poses.len();
+    pool.retain(|t| not_excluded(excluded, t));
+    let readings = readings_of(clean.poses.len());
     // The score test: a catalogue effect that could not be admissible even
     // at SCORE_MARGIN times its linearised drop is not refitted.
-    let admissible = |e: &Evidence| e.p_adjusted < alpha_share && e.penalised_gain > 0.0;
     let mut judged: Vec<(Term, Evidence)> = Vec::new();
     pool.retain(|t| {
-        let Some(&(_, explained, rank)) = screen.catalogue.iter().find(|(c, _, _)| c == t) else {
+        let Some((explained, rank)) = score_of(&screen.catalogue, t) else {
             return true;
         };
         let at = |x: f64| setup.score_evidence(t, current, x, rank, readings);
-        if admissible(&at(SCORE_MARGIN * explained)) {
-            return true;
+        match shortlist(at, explained, alpha_share) {
+            None => true,
+            Some(evidence) => {
+                judged.push((*t, evidence));
+                false
+            }
         }
-        judged.push((*t, at(explained)));
-        false
     });
     let mut trials: Vec<Trial> = pool
         .par_iter()
@@ -410,17 +373,14 @@ fn forward_step(
         .collect();
     // Strongest first; among equals the catalogue.
     trials.sort_by(|a, b| {
-        b.evidence
-            .penalised_gain
-            .total_cmp(&a.evidence.penalised_gain)
-            .then(a.term.name().is_generic().cmp(&b.term.name().is_generic()))
+        stronger_first(
+            (&a.evidence, a.term.name().is_generic()),
+            (&b.evidence, b.term.name().is_generic()),
+        )
     });
     let mut winner = None;
     for t in trials.iter_mut() {
-        if winner.is_some()
-            || t.evidence.p_adjusted >= alpha_share
-            || t.evidence.penalised_gain <= 0.0
-        {
+        if winner.is_some() || !admissible(&t.evidence, alpha_share) {
             continue;
         }
         if let Err(reason) = setup.plausible(&t.fit, &t.term) {
@@ -439,20 +399,20 @@ fn forward_step(
             .ok();
         t.evidence.holdout_rms_without = *current_rms;
         t.evidence.holdout_rms_with = with;
-        match (*current_rms, with) {
-            (Some(a), Some(b)) if b < a => {
+        match predicts_better(*current_rms, with) {
+            Some(b) => {
                 t.evidence.selected = true;
                 winner = Some((t.term, b));
             }
-            (a, b) => reject(
+            None => reject(
                 rejected,
                 &t.fit,
                 &t.term,
                 RejectStage::Holdout,
                 format!(
                     "significant, but the held-out rms does not improve ({} -> {})",
-                    a.map_or("-".into(), |v| format!("{v:.3}")),
-                    b.map_or("-".into(), |v| format!("{v:.3}"))
+                    current_rms.map_or("-".into(), |v| format!("{v:.3}")),
+                    with.map_or("-".into(), |v| format!("{v:.3}"))
                 ),
             ),
         }
@@ -471,10 +431,10 @@ fn forward_step(
             .collect();
         // Strongest first; among equals the catalogue.
         tested.sort_by(|a, b| {
-            b.evidence
-                .penalised_gain
-                .total_cmp(&a.evidence.penalised_gain)
-                .then(a.effect.is_generic().cmp(&b.effect.is_generic()))
+            stronger_first(
+                (&a.evidence, a.effect.is_generic()),
+                (&b.evidence, b.effect.is_generic()),
+            )
         });
     }
     let (term, rms) = winner?;
@@ -487,8 +447,8 @@ fn forward_step(
 /// polynomial leg error that entered for a scale gain while an
 /// eccentricity was still unmodelled is a lead once the eccentricity is in).
 fn swaps(setup: &Setup<'_>, clean: &Dataset, mut current: Fit) -> Fit {
-    let readings = (3 * clean.poses.len()) as f64;
-    let bic = |f: &Fit| f.id.stats.chi_square + f.id.design().rank() as f64 * readings.ln();
+    let readings = readings_of(clean.poses.len());
+    let bic = |f: &Fit| bic_of(f.id.stats.chi_square, f.id.design().rank(), readings);
     loop {
         let terms = current.model.terms().to_vec();
         let options: Vec<(usize, Term)> = terms
@@ -513,9 +473,10 @@ fn swaps(setup: &Setup<'_>, clean: &Dataset, mut current: Fit) -> Fit {
                 Some((bic(&f), f))
             })
             .min_by(|a, b| a.0.total_cmp(&b.0));
-        match best {
-            Some((value, f)) if value < bic(&current) - 1e-6 => current = f,
-            _ => return current,
+        let now = bic(&current);
+        match best.filter(|(value, _)| lowers_bic(*value, now)) {
+            Some((_, f)) => current = f,
+            None => return current,
         }
     }
 }
@@ -529,7 +490,7 @@ fn final_tests(
     current_rms: f64,
 ) -> Vec<(Evidence, Option<f64>, bool)> {
     let terms = current.model.terms().to_vec();
-    let readings = 3 * clean.poses.len();
+    let readings = readings_of(clean.poses.len());
     (0..terms.len())
         .into_par_iter()
         .map(|slot| {
@@ -551,9 +512,7 @@ fn final_tests(
             let rms_without = setup.fitter.holdout_rms(&model, clean, &|_| true).ok();
             ev.holdout_rms_without = rms_without;
             ev.holdout_rms_with = Some(current_rms);
-            let pass = ev.p_adjusted < setup.alpha_share()
-                && ev.penalised_gain > 0.0
-                && rms_without.is_none_or(|w| current_rms < w);
+            let pass = holds_up(&ev, setup.alpha_share(), current_rms, rms_without);
             ev.selected = pass;
             (ev, rms_without, pass)
         })
@@ -632,13 +591,7 @@ pub(crate) fn select(
             };
             current_rms = Some(rms);
             let tests = final_tests(setup, clean, &current, rms);
-            let failing = tests
-                .iter()
-                .enumerate()
-                .filter(|(_, t)| !t.2 || rms > geometric_rms)
-                .min_by(|a, b| usefulness(a.1, rms).total_cmp(&usefulness(b.1, rms)))
-                .map(|(i, _)| i);
-            let Some(slot) = failing else {
+            let Some(slot) = least_useful_failing(&tests, rms, geometric_rms) else {
                 break;
             };
             let terms = current.model.terms().to_vec();
@@ -696,9 +649,203 @@ pub(crate) fn select(
     })
 }
 
-/// How much a cause helps held-out prediction (larger is more useful).
+// The rules of the module docs, as arithmetic on numbers (unit-tested in
+// `select/tests.rs` against values worked by hand from the rules).
+
+/// The readings of `poses` poses, three coordinates each: the `n` of the
+/// BIC's and the penalised gain's `ln n`.
+fn readings_of(poses: usize) -> usize {
+    3 * poses
+}
+
+/// The family-wise level of each half of the pool: `alpha` split evenly
+/// between the catalogue and the dictionary; all of it the catalogue's when
+/// the dictionary is empty.
+fn alpha_share_of(alpha: f64, dictionary_empty: bool) -> f64 {
+    if dictionary_empty { alpha } else { 0.5 * alpha }
+}
+
+/// The catalogue effects of `available` that no term of `terms` makes
+/// redundant, in the vocabulary's order: the catalogue's candidates.
+fn catalogue_candidates(available: &[EffectName], terms: &[Term]) -> Vec<Term> {
+    available
+        .iter()
+        .map(|e| Term::Catalogue(*e))
+        .filter(|t| !terms.iter().any(|u| u.overlaps(t)))
+        .collect()
+}
+
+/// Whether `t` may still be tried: neither a cause the admission removed
+/// (`excluded`) nor a term one of them makes redundant.
+fn not_excluded(excluded: &[Term], t: &Term) -> bool {
+    !excluded.iter().any(|e| e.overlaps(t) || e == t)
+}
+
+/// The linearised drop of chi-square and the rank of `t` in a screen's
+/// catalogue scores (`None` when it was not screened).
+fn score_of(catalogue: &[(Term, f64, usize)], t: &Term) -> Option<(f64, usize)> {
+    catalogue
+        .iter()
+        .find(|(c, _, _)| c == t)
+        .map(|&(_, explained, rank)| (explained, rank))
+}
+
+/// A nested test: the drop of chi-square `delta` for `k` added parameters,
+/// the larger model leaving `with` = (chi-square, degrees of freedom).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Nested {
+    delta: f64,
+    k: usize,
+    with: (f64, usize),
+}
+
+impl Nested {
+    /// The test of two fitted models, `without` = (chi-square, rank) and
+    /// `with` = (chi-square, dof, rank): `k` is the rank the larger one
+    /// adds (at least 1).
+    fn of_fits(without: (f64, usize), with: (f64, usize, usize)) -> Nested {
+        Nested {
+            delta: without.0 - with.0,
+            k: with.2.saturating_sub(without.1).max(1),
+            with: (with.0, with.1),
+        }
+    }
+
+    /// The score test of a linearised drop `explained` for `rank`
+    /// parameters (at least 1) on top of a fit leaving `current` =
+    /// (chi-square, dof).
+    fn of_score(current: (f64, usize), explained: f64, rank: usize) -> Nested {
+        let k = rank.max(1);
+        Nested {
+            delta: explained,
+            k,
+            with: (current.0 - explained, current.1.saturating_sub(k)),
+        }
+    }
+}
+
+/// How a candidate's test is counted: its half of the pool's level, the
+/// tests in that half (the multiplicity `m`), and the alternatives `m_c` of
+/// its family.
+#[derive(Debug, Clone, Copy)]
+struct Count {
+    alpha_share: f64,
+    multiplicity: usize,
+    alternatives: usize,
+}
+
+/// The evidence of a nested test with `readings` readings (the module
+/// docs' rules 1 and 2): the p-value of `delta / s2` (`s2` the larger
+/// model's residual variance, never below the noise) for `k` parameters,
+/// adjusted by the multiplicity (at most 1), against the level
+/// `alpha_share / m`; the BIC gain `delta - k ln n` and the penalised gain
+/// `G = delta - k ln n - 2 ln m_c`.
+fn weigh(reference: &Reference, test: Nested, readings: usize, count: Count) -> Evidence {
+    let Nested { delta, k, with } = test;
+    let s2 = reference.scale(with.0, with.1);
+    let p = reference.p_value(delta / s2, k);
+    let m = count.multiplicity;
+    let ln_n = (readings as f64).ln();
+    Evidence {
+        delta_chi_square: delta,
+        dof: k,
+        p_value: p,
+        threshold: count.alpha_share / m as f64,
+        delta_bic: delta - k as f64 * ln_n,
+        holdout_rms_without: None,
+        holdout_rms_with: None,
+        selected: false,
+        multiplicity: m,
+        p_adjusted: (p * m as f64).min(1.0),
+        penalised_gain: delta - k as f64 * ln_n - 2.0 * (count.alternatives as f64).ln(),
+    }
+}
+
+/// Whether an adjusted p-value is significant at its half's level.
+fn significant(p_adjusted: f64, alpha_share: f64) -> bool {
+    p_adjusted < alpha_share
+}
+
+/// Rules 1 and 2: the likelihood-ratio test passes and the penalised gain
+/// is positive.
+fn admissible(evidence: &Evidence, alpha_share: f64) -> bool {
+    significant(evidence.p_adjusted, alpha_share) && evidence.penalised_gain > 0.0
+}
+
+/// The score test's shortlist: `None` when a catalogue effect is to be
+/// refitted (admissible with [`SCORE_MARGIN`] times its linearised drop
+/// `explained`), else its evidence at `explained` (`score` gives the
+/// evidence of a drop).
+fn shortlist(
+    score: impl Fn(f64) -> Evidence,
+    explained: f64,
+    alpha_share: f64,
+) -> Option<Evidence> {
+    if admissible(&score(SCORE_MARGIN * explained), alpha_share) {
+        None
+    } else {
+        Some(score(explained))
+    }
+}
+
+/// The order of candidates: the largest penalised gain first; among equal
+/// gains the catalogue's (`generic` false) before the dictionary's.
+fn stronger_first(a: (&Evidence, bool), b: (&Evidence, bool)) -> std::cmp::Ordering {
+    b.0.penalised_gain
+        .total_cmp(&a.0.penalised_gain)
+        .then(a.1.cmp(&b.1))
+}
+
+/// Rule 4 of a forward step: the held-out RMS with the candidate, when it
+/// is below the current model's (both known).
+fn predicts_better(without: Option<f64>, with: Option<f64>) -> Option<f64> {
+    match (without, with) {
+        (Some(a), Some(b)) if b < a => Some(b),
+        _ => None,
+    }
+}
+
+/// Whether a cause holds up in the final model: admissible against the
+/// model without it, which predicts held-out poses strictly worse
+/// (`rms_without`, `None` when that model cannot be cross-validated: the
+/// cause is needed) than the final model's `rms`.
+fn holds_up(evidence: &Evidence, alpha_share: f64, rms: f64, rms_without: Option<f64>) -> bool {
+    admissible(evidence, alpha_share) && rms_without.is_none_or(|w| rms < w)
+}
+
+/// The cause the backward elimination removes: the least useful
+/// ([`usefulness`]; the first among equals) of those failing their
+/// final-model test, or of all when the final model's held-out `rms`
+/// exceeds the geometric model's.
+fn least_useful_failing(
+    tests: &[(Evidence, Option<f64>, bool)],
+    rms: f64,
+    geometric_rms: f64,
+) -> Option<usize> {
+    tests
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| !t.2 || rms > geometric_rms)
+        .min_by(|a, b| usefulness(a.1, rms).total_cmp(&usefulness(b.1, rms)))
+        .map(|(i, _)| i)
+}
+
+/// How much a cause helps held-out prediction (larger is more useful): the
+/// held-out RMS without it less the final model's `rms`; infinite when the
+/// model without it cannot be cross-validated.
 fn usefulness(test: &(Evidence, Option<f64>, bool), rms: f64) -> f64 {
     test.1.map_or(f64::INFINITY, |w| w - rms)
+}
+
+/// The BIC of a model: `chi-square + rank ln n` for `readings` readings.
+fn bic_of(chi_square: f64, rank: usize, readings: usize) -> f64 {
+    chi_square + rank as f64 * (readings as f64).ln()
+}
+
+/// A swap is made when it lowers the model's BIC by more than rounding
+/// (1e-6).
+fn lowers_bic(candidate: f64, current: f64) -> bool {
+    candidate < current - 1e-6
 }
 
 fn cv_failure(fold: usize) -> DiagnoseError {
@@ -706,3 +853,6 @@ fn cv_failure(fold: usize) -> DiagnoseError {
         "cross-validation fold {fold} cannot be fitted: too few or too similar poses in it"
     ))
 }
+
+#[cfg(test)]
+mod tests;

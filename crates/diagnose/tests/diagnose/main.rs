@@ -12,5 +12,6 @@ mod hidden_effects;
 mod noise_from_data;
 mod out_of_vocabulary;
 mod realistic;
+mod selection;
 mod small_campaigns;
 mod time_temperature;
