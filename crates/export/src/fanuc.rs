@@ -159,14 +159,18 @@ pub fn plan(
         format_error_um: 0.0,
     };
     let start = q_ref + (k_lo - 1) as f64 * h;
-    // A section's lower end belongs to the section below, and the
-    // staircase steps there: the miss just above it is checked too (in
-    // every section but the first, whose lower end lies below the stroke).
-    let above_ends = (k_lo + 1..=k_hi).map(|k| q_ref + (k - 1) as f64 * h + 1e-6);
+    // The staircase steps at each section's end, which belongs to the
+    // section below: the miss is checked at it and just above it (every
+    // section's end inside the stroke; the first section's lower end lies
+    // below it).
+    let ends = (k_lo..k_hi).flat_map(|k| {
+        let end = q_ref + k as f64 * h;
+        [end, end + 1e-6]
+    });
     axis.format_error_um = leg
         .check_points_mm(start, h, CHECKS_PER_SECTION)
         .into_iter()
-        .chain(above_ends)
+        .chain(ends)
         .map(|q| axis.deviation_mm(leg, q, detection_unit_um).abs() * 1e3)
         .fold(0.0, f64::max);
     axis
