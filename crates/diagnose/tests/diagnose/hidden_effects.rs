@@ -20,6 +20,7 @@ use crate::common::true_parameters;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
+use tricept_data::Dataset;
 use tricept_diagnose::{DiagnoseOptions, Diagnosis, diagnose};
 use tricept_kinematics::Machine;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
@@ -29,7 +30,7 @@ use tricept_plant::effects::Effect;
 use tricept_plant::{Campaign, Plant, PoseOrder, random_errors};
 
 /// An effect of random magnitude from the stated range.
-fn hidden(e: E, rng: &mut Pcg64Mcg, m: &Machine) -> Effect {
+pub(crate) fn hidden(e: E, rng: &mut Pcg64Mcg, m: &Machine) -> Effect {
     let mut sign = || if rng.random::<bool>() { 1.0 } else { -1.0 };
     let s: [f64; 4] = std::array::from_fn(|_| sign());
     let mut u = |a: f64, b: f64| a + (b - a) * rng.random::<f64>();
@@ -98,18 +99,35 @@ fn readings_per_pose(effects: &[E]) -> u32 {
 
 /// Simulates and diagnoses one dataset with `effects` hidden.
 fn run(effects: &[E], seed: u64, readings: u32) -> (Diagnosis, Vec<Effect>) {
+    let (data, sigma, effects) = campaign(effects, seed, 100, PoseOrder::BothDirections, readings);
+    let m = Machine::paper();
+    let mut options = DiagnoseOptions::for_machine(&m);
+    options.sigma = sigma;
+    (diagnose(&m, &data, &options).unwrap(), effects)
+}
+
+/// A campaign of `poses` random poses in `order` with `effects` hidden
+/// (random magnitudes from their stated ranges, random geometric errors
+/// uniform in +-0.5 mm, the temperature logged), every logged value the
+/// mean of `readings`: the data, the stated noise of a logged value and
+/// the hidden effects.
+pub(crate) fn campaign(
+    effects: &[E],
+    seed: u64,
+    poses: usize,
+    order: PoseOrder,
+    readings: u32,
+) -> (Dataset, [f64; 3], Vec<Effect>) {
     let m = Machine::paper();
     let set = ParameterSet::paper15();
     let mut rng = Pcg64Mcg::seed_from_u64(0xd1a6 ^ seed);
     let mut plant = Plant::geometric(m.clone(), set.to_errors(&random_errors(15, 0.5, seed)));
     plant.effects = effects.iter().map(|e| hidden(*e, &mut rng, &m)).collect();
-    let mut campaign = Campaign::random(&m, 100, 7 * seed + 1);
+    let mut campaign = Campaign::random(&m, poses, 7 * seed + 1);
     campaign.noise.readings_per_pose = readings;
-    campaign.order = PoseOrder::BothDirections;
+    campaign.order = order;
     let data = plant.simulate(&campaign).unwrap();
-    let mut options = DiagnoseOptions::for_machine(&m);
-    options.sigma = campaign.noise.logged_sigma();
-    (diagnose(&m, &data, &options).unwrap(), plant.effects)
+    (data, campaign.noise.logged_sigma(), plant.effects)
 }
 
 /// Whether `effect` is named first, or (for a scale gain, which no
