@@ -242,3 +242,56 @@ pub struct Rejected {
     /// `arcsec` or `um`.
     pub unit: &'static str,
 }
+
+#[cfg(test)]
+mod tests {
+    //! The parts' arithmetic against values worked by hand: a test of no
+    //! degrees of freedom, and the fit of a diagonal Gram matrix (each
+    //! column its own least squares: estimate `g_ir / g_ii`, statistic
+    //! `g_ir^2 / g_ii`, standard deviation `1 / sqrt(g_ii)`).
+    use super::*;
+
+    #[test]
+    fn a_test_of_no_degrees_of_freedom_never_rejects() {
+        // Nothing is left to test: whatever the statistic, p = 1 and the
+        // critical value is infinite.
+        for statistic in [0.0, 2.5, 40.0] {
+            let t = chi_square(statistic, 0, 0.005);
+            assert_eq!(t.p_value, 1.0, "{statistic}");
+            assert_eq!(t.ln_p_value, 0.0, "{statistic}");
+            assert_eq!(t.critical, f64::INFINITY, "{statistic}");
+        }
+        // One degree of freedom: p = erfc(sqrt(x / 2)); at x = 4,
+        // erfc(sqrt 2) = 0.0455003 (tables).
+        let t = chi_square(4.0, 1, 0.005);
+        assert!((t.p_value - 0.045_500_26).abs() < 1e-7, "{}", t.p_value);
+    }
+
+    #[test]
+    fn a_parameter_seen_no_better_than_its_limit_is_left_out() {
+        // Two parameters with uncorrelated columns: the first seen to
+        // 1 / sqrt(100) = 0.1 mm (under its 0.25 mm limit), the second to
+        // 1 / sqrt(4) = 0.5 mm (beyond it). Residual column r = 2.
+        let gram = DMatrix::from_row_slice(
+            3,
+            3,
+            &[
+                100.0, 0.0, 30.0, //
+                0.0, 4.0, 6.0, //
+                30.0, 6.0, 50.0,
+            ],
+        );
+        let fit = fit_columns(&[0, 1], &[0.25, 0.25], &gram, 2);
+        assert_eq!(fit.dof, 1);
+        assert!((fit.statistic - 9.0).abs() < 1e-12, "{}", fit.statistic);
+        assert!((fit.estimate[0] - 0.3).abs() < 1e-12, "{:?}", fit.estimate);
+        assert_eq!(fit.estimate[1], 0.0);
+        assert!((fit.std_dev[0].unwrap_or(f64::NAN) - 0.1).abs() < 1e-12);
+        assert_eq!(fit.std_dev[1], None);
+        // With a limit of 1 mm the second is seen too: 9 + 6^2 / 4.
+        let fit = fit_columns(&[0, 1], &[0.25, 1.0], &gram, 2);
+        assert_eq!(fit.dof, 2);
+        assert!((fit.statistic - 18.0).abs() < 1e-12, "{}", fit.statistic);
+        assert!((fit.estimate[1] - 1.5).abs() < 1e-12, "{:?}", fit.estimate);
+    }
+}
