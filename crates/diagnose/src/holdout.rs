@@ -66,27 +66,27 @@ pub(crate) struct Benefit {
 }
 
 /// Held-out platform errors (mm) of `model` on `data`, one per pose, each
-/// pose predicted by the fit on the other folds; `Err(fold)` (1-based)
-/// when a fold cannot be fitted or a pose predicted.
+/// pose predicted by the fit on the other folds (pose `j` is in fold
+/// `j % K`); `None` when a fold cannot be fitted or a pose predicted.
 pub(crate) fn platform_errors(
     setup: &Setup<'_>,
     model: &ExtendedModel,
     data: &Dataset,
-) -> Result<Vec<Vector3<f64>>, usize> {
+) -> Option<Vec<Vector3<f64>>> {
     let fitter = &setup.fitter;
     let k = fitter.options.folds.max(2);
-    let parts: Vec<Result<PoseErrors, usize>> = (0..k)
+    let parts: Vec<Option<PoseErrors>> = (0..k)
         .into_par_iter()
         .map(|fold| {
             let train = data.subset(|j| j % k != fold);
-            let f = fitter.fit(model.clone(), &train).map_err(|_| fold + 1)?;
+            let f = fitter.fit(model.clone(), &train).ok()?;
             let held: Vec<(usize, &MeasuredPose)> = data
                 .poses
                 .iter()
                 .enumerate()
                 .filter(|(j, _)| j % k == fold)
                 .collect();
-            pose_errors(&f, &held).ok_or(fold + 1)
+            pose_errors(&f, &held)
         })
         .collect();
     let mut out = vec![Vector3::zeros(); data.poses.len()];
@@ -95,7 +95,7 @@ pub(crate) fn platform_errors(
             out[j] = e;
         }
     }
-    Ok(out)
+    Some(out)
 }
 
 /// The platform error (mm) of each of `poses` under the fit `f`: the
@@ -341,9 +341,9 @@ fn judge(
             .map(|(sd, error)| (sd * sd, error)),
     };
     let held_out = match (full, &without) {
-        (Some(full), Some(_)) => platform_errors(setup, &model, clean)
-            .ok()
-            .and_then(|e| benefit(full, &e)),
+        (Some(full), Some(_)) => {
+            platform_errors(setup, &model, clean).and_then(|e| benefit(full, &e))
+        }
         _ => None,
     };
     let z = improvement_sds(gained);
@@ -458,7 +458,7 @@ pub(crate) fn deployable(
     let mut with = current.clone();
     let mut kept = terms.clone();
     while !kept.is_empty() {
-        let full = platform_errors(setup, &with.model, clean).ok();
+        let full = platform_errors(setup, &with.model, clean);
         let rich = richer(setup, clean, &with);
         // The deployed model against the richer one (with none, see
         // `judge`).
@@ -540,6 +540,37 @@ mod tests {
             sd_mm,
             difference_sd_mm: sd_mm,
         })
+    }
+
+    #[test]
+    fn a_held_out_pose_is_predicted_by_a_fit_without_its_fold() {
+        // Moving one pose's readings changes no other held-out error of its
+        // fold (their fit never saw it), changes its own, and changes poses
+        // of the other folds (whose fits did).
+        let (data, options) = crate::testing::campaign(40, 11, Vec::new());
+        let nominal = Machine::paper();
+        let errors = |d: &Dataset| {
+            let setup = Setup::new(&nominal, d, &options);
+            let model = setup.fitter.base_model();
+            platform_errors(&setup, &model, d).expect("every fold fits")
+        };
+        let before = errors(&data);
+        let k = options.folds;
+        let moved_pose = 7;
+        let mut moved = data.clone();
+        moved.poses[moved_pose].readings.phi_rad += 20.0 * options.sigma[0];
+        moved.poses[moved_pose].readings.s_mm += 20.0 * options.sigma[2];
+        let after = errors(&moved);
+        let fold = moved_pose % k;
+        for j in (0..data.poses.len()).filter(|j| *j != moved_pose && j % k == fold) {
+            assert_eq!(after[j], before[j], "pose {j} of the moved pose's fold");
+        }
+        assert_ne!(after[moved_pose], before[moved_pose]);
+        let others = (0..data.poses.len()).filter(|j| j % k != fold);
+        assert!(
+            others.clone().all(|j| after[j] != before[j]),
+            "{before:?}\n{after:?}"
+        );
     }
 
     #[test]

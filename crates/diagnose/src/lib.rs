@@ -57,6 +57,8 @@ mod finite;
 mod options;
 mod plausibility;
 mod report;
+#[cfg(test)]
+mod testing;
 // Layer 2: the model
 mod model;
 mod terms;

@@ -21,25 +21,19 @@
 //! 7. **Report**, with a last check that every number in it is finite.
 
 use std::borrow::Cow;
-use std::sync::Arc;
 
 use tricept_data::Dataset;
-use tricept_engine::GeometricModel;
 use tricept_kinematics::Machine;
-use tricept_model::ParameterSet;
-use tricept_model::effects::EffectName;
 
 use crate::assemble::{Outcome, report};
-use crate::dictionary::Dictionary;
 use crate::error::DiagnoseError;
 use crate::evidence::Reference;
 use crate::finite::first_non_finite;
-use crate::fit::{Fitter, clean_poses, residuals_of};
+use crate::fit::{clean_poses, residuals_of};
 use crate::noise::{pure_error, repeats};
 use crate::options::{DiagnoseOptions, MIN_PURE_ERROR_DOF};
 use crate::report::Diagnosis;
 use crate::select::{Setup, select};
-use crate::terms::{Frame, Term};
 
 /// Diagnoses `data` taken on a machine whose nominal model is `nominal`.
 ///
@@ -64,7 +58,6 @@ pub fn diagnose(
     check_values(data)?;
     let mut limitations = Vec::new();
     let data = numbered(data, &mut limitations);
-    let frame = Arc::new(Frame::of(nominal, &data));
     let repeated = repeats(&data, options.repeat_tolerance_mm);
     let distinct = n - repeated.dof();
     if distinct < 20 {
@@ -72,37 +65,17 @@ pub fn diagnose(
             "only {distinct} distinct leg commands among {n} rows (repeated commands do not count): at least 20 distinct poses are needed to fit and test the model",
         )));
     }
-    let mut geometric = GeometricModel::new(nominal.clone(), ParameterSet::paper15());
-    if let Some(reference) = &options.rank_reference {
-        geometric = geometric.with_rank_reference(reference.clone());
-    }
-    let available: Vec<EffectName> = EffectName::terms()
-        .filter(|e| Term::Catalogue(*e).available(&frame))
-        .collect();
-    let dictionary = Dictionary::new(&frame, &options.dictionary);
+    let mut setup = Setup::new(nominal, &data, options);
     if !options.dictionary.enabled {
         limitations.push(
             "the generic dictionary was not searched: effects outside the vocabulary can only be reported as unexplained".into(),
         );
     }
-    if frame.temperature.is_none() {
+    if setup.fitter.frame.temperature.is_none() {
         limitations.push(
             "the logged temperature is missing or varies by less than 0.25 K: thermal effects cannot be seen".into(),
         );
     }
-    let mut setup = Setup {
-        fitter: Fitter {
-            options,
-            sigma: options.sigma,
-            reference: Reference::stated(),
-            frame,
-            geometric,
-        },
-        dictionary,
-        plausibility: &options.plausibility,
-        available,
-        last_screen: Default::default(),
-    };
     if options.noise_from_data {
         let dof = repeated.dof();
         if dof < MIN_PURE_ERROR_DOF {

@@ -37,8 +37,13 @@
 //! and the reported gain uses the very same cross-validation, so a named
 //! cause never makes the held-out fit worse.
 
+use std::sync::Arc;
+
 use rayon::prelude::*;
 use tricept_data::Dataset;
+use tricept_engine::GeometricModel;
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
 use tricept_model::effects::EffectName;
 
 use crate::dictionary::{At, Dictionary, Scored};
@@ -46,9 +51,10 @@ use crate::error::DiagnoseError;
 use crate::evidence::Reference;
 use crate::fit::{Fit, FitResult, Fitter, term_estimates};
 use crate::linear::Linearisation;
+use crate::options::DiagnoseOptions;
 use crate::plausibility::Plausibility;
 use crate::report::{Estimate, Evidence, RejectStage, Rejected, Tested};
-use crate::terms::Term;
+use crate::terms::{Frame, Term};
 
 /// Everything the selection works with, fixed for one diagnosis: the fit
 /// core and the pool (the dictionary, the available effects of the
@@ -62,6 +68,41 @@ pub(crate) struct Setup<'a> {
     /// The last linear screen with the point it was made at: the
     /// selection's last step and the report's remainder screen the same fit.
     pub(crate) last_screen: std::sync::Mutex<Option<(ScreenPoint, Screen)>>,
+}
+
+impl<'a> Setup<'a> {
+    /// The fixed setup of a diagnosis of `data` (its poses numbered) on a
+    /// machine of nominal model `nominal`: the fit core at the stated
+    /// noise, the dictionary, and the effects of the vocabulary whose data
+    /// columns are present.
+    pub(crate) fn new(
+        nominal: &Machine,
+        data: &Dataset,
+        options: &'a DiagnoseOptions,
+    ) -> Setup<'a> {
+        let frame = Arc::new(Frame::of(nominal, data));
+        let mut geometric = GeometricModel::new(nominal.clone(), ParameterSet::paper15());
+        if let Some(reference) = &options.rank_reference {
+            geometric = geometric.with_rank_reference(reference.clone());
+        }
+        let available = EffectName::terms()
+            .filter(|e| Term::Catalogue(*e).available(&frame))
+            .collect();
+        let dictionary = Dictionary::new(&frame, &options.dictionary);
+        Setup {
+            fitter: Fitter {
+                options,
+                sigma: options.sigma,
+                reference: Reference::stated(),
+                frame,
+                geometric,
+            },
+            dictionary,
+            plausibility: &options.plausibility,
+            available,
+            last_screen: Default::default(),
+        }
+    }
 }
 
 /// A catalogue effect is refitted exactly when it could be admissible (its
@@ -284,6 +325,9 @@ struct Trial {
     evidence: Evidence,
 }
 
+/// Records `term` as rejected at `stage` with its estimates in `fit`; an
+/// earlier entry of the same term at the same stage is replaced (one entry
+/// per term and stage).
 fn reject(
     rejected: &mut Vec<Rejected>,
     fit: &Fit,

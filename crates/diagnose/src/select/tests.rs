@@ -353,3 +353,72 @@ fn a_swap_must_lower_the_bic_by_more_than_rounding() {
     assert!(!lowers_bic(100.0, 100.0));
     assert!(!lowers_bic(101.0, 100.0));
 }
+
+#[test]
+fn a_term_is_listed_once_per_stage_that_rejects_it() {
+    // The same term rejected again at the same stage replaces its entry
+    // (the later reason stands); at another stage it is listed beside it.
+    let (data, options) = crate::testing::campaign(30, 5, Vec::new());
+    let setup = Setup::new(&Machine::paper(), &data, &options);
+    let lead = Term::Catalogue(EffectName::LegLead);
+    let fit = setup
+        .fitter
+        .fit(setup.fitter.model(&[lead]), &data)
+        .expect("the lead's model fits");
+    let mut rejected = Vec::new();
+    reject(
+        &mut rejected,
+        &fit,
+        &lead,
+        RejectStage::Holdout,
+        "first".into(),
+    );
+    reject(
+        &mut rejected,
+        &fit,
+        &lead,
+        RejectStage::Holdout,
+        "again".into(),
+    );
+    let listed = |r: &[Rejected]| {
+        r.iter()
+            .map(|r| (r.description.clone(), r.stage, r.reason.clone()))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(
+        listed(&rejected),
+        [(lead.label(), RejectStage::Holdout, "again".to_string())]
+    );
+    reject(
+        &mut rejected,
+        &fit,
+        &lead,
+        RejectStage::FinalEvidence,
+        "final".into(),
+    );
+    assert_eq!(
+        listed(&rejected),
+        [
+            (lead.label(), RejectStage::Holdout, "again".to_string()),
+            (
+                lead.label(),
+                RejectStage::FinalEvidence,
+                "final".to_string()
+            )
+        ]
+    );
+    // Each entry carries the term's three parameters, named after it.
+    let names: Vec<&str> = rejected[1]
+        .parameters
+        .iter()
+        .map(|p| p.name.as_str())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "leg-lead.lead1_ppm",
+            "leg-lead.lead2_ppm",
+            "leg-lead.lead3_ppm"
+        ]
+    );
+}
