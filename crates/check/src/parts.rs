@@ -293,5 +293,21 @@ mod tests {
         assert_eq!(fit.dof, 2);
         assert!((fit.statistic - 18.0).abs() < 1e-12, "{}", fit.statistic);
         assert!((fit.estimate[1] - 1.5).abs() < 1e-12, "{:?}", fit.estimate);
+        // A column seen more than 1e9 times worse than the best is left out
+        // whatever its limit (the rank tolerance is relative): scales 1e10
+        // and 0.1 (seen to 10 ppm, under a 1000 ppm limit).
+        let gram = DMatrix::from_row_slice(
+            3,
+            3,
+            &[
+                1e20, 0.0, 1e10, //
+                0.0, 0.01, 0.02, //
+                1e10, 0.02, 50.0,
+            ],
+        );
+        let fit = fit_columns(&[0, 1], &[1000.0, 1000.0], &gram, 2);
+        assert_eq!(fit.dof, 1);
+        assert_eq!(fit.std_dev[1], None);
+        assert!((fit.statistic - 1.0).abs() < 1e-12, "{}", fit.statistic);
     }
 }
