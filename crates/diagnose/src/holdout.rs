@@ -574,6 +574,33 @@ mod tests {
     }
 
     #[test]
+    fn a_scale_reading_off_by_10_um_puts_the_platform_10_um_off_along_the_limb() {
+        // The linear scale measures the UP limb's prismatic joint: a reading
+        // 0.01 mm larger is a platform 0.01 mm further along the limb, so
+        // each pose's platform error moves by exactly 0.01 mm (the
+        // prismatic joint's derivative is a unit vector), whatever the pose.
+        let (data, options) = crate::testing::campaign(30, 13, Vec::new());
+        let setup = Setup::new(&Machine::paper(), &data, &options);
+        let fit = setup
+            .fitter
+            .fit(setup.fitter.base_model(), &data)
+            .expect("the geometric model fits");
+        let mut moved = data.clone();
+        for p in &mut moved.poses {
+            p.readings.s_mm += 0.01;
+        }
+        let errors = |d: &Dataset| {
+            let poses: Vec<(usize, &MeasuredPose)> = d.poses.iter().enumerate().collect();
+            pose_errors(&fit, &poses).expect("every pose predicted")
+        };
+        for ((j, before), (k, after)) in errors(&data).into_iter().zip(errors(&moved)) {
+            assert_eq!(j, k);
+            let moved_mm = (after - before).norm();
+            assert!((moved_mm - 0.01).abs() < 1e-9, "pose {j}: {moved_mm} mm");
+        }
+    }
+
+    #[test]
     fn the_benefit_is_the_difference_of_the_rms_errors_with_its_sd() {
         let with = [
             Vector3::new(1.0, 0.0, 0.0),
