@@ -138,3 +138,37 @@ pub(crate) fn change_columns(results: &[CandidateResult], best: Option<usize>) -
         .map(|t| start + t)
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    //! The design's fit against sums worked by hand.
+    use super::*;
+
+    #[test]
+    fn a_column_no_reading_sees_is_not_fitted() {
+        // Two poses, each channel's offset column one-hot, one candidate
+        // column of zeros, residual column last. The fit is the channel
+        // means (2, 2, 2): residuals -1, 0, 1, 1, 0, -1, misfit 4, each
+        // row's leverage 1/2 (two rows per offset); the zero column adds
+        // nothing and no NaN.
+        let mut design = Design::new(5, Vec::new());
+        for (channel, value) in [(0, 1.0), (1, 2.0), (2, 3.0), (0, 3.0), (1, 2.0), (2, 1.0)] {
+            let mut row = [0.0; 5];
+            row[channel] = 1.0;
+            row[4] = value;
+            design.push(&row);
+        }
+        let fit = design.fit(&[0]);
+        let expected = [-1.0, 0.0, 1.0, 1.0, 0.0, -1.0];
+        for (got, want) in fit.residual.iter().zip(expected) {
+            assert!((got - want).abs() < 1e-12, "{:?}", fit.residual);
+        }
+        assert!((fit.misfit - 4.0).abs() < 1e-12, "{}", fit.misfit);
+        assert!(
+            fit.leverage.iter().all(|h| (h - 0.5).abs() < 1e-12),
+            "{:?}",
+            fit.leverage
+        );
+        assert_eq!(fit.dof, 2);
+    }
+}

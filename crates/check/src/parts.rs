@@ -268,6 +268,17 @@ mod tests {
     }
 
     #[test]
+    fn a_matrix_that_determines_no_direction_inverts_to_nothing() {
+        let (inv, rank) = seen_inverse(DMatrix::zeros(2, 2));
+        assert_eq!(rank, 0);
+        assert_eq!(inv, DMatrix::zeros(2, 2));
+        // diag(4, 1): both seen, inverse diag(1/4, 1).
+        let (inv, rank) = seen_inverse(DMatrix::from_diagonal(&DVector::from_vec(vec![4.0, 1.0])));
+        assert_eq!(rank, 2);
+        assert!((inv[(0, 0)] - 0.25).abs() < 1e-15 && (inv[(1, 1)] - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
     fn a_parameter_seen_no_better_than_its_limit_is_left_out() {
         // Two parameters with uncorrelated columns: the first seen to
         // 1 / sqrt(100) = 0.1 mm (under its 0.25 mm limit), the second to
