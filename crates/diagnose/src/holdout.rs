@@ -490,15 +490,10 @@ pub(crate) fn deployable(
                 records[slot] = Some(j.record.clone());
             }
         }
+        // The failing term leaves (its record says it is not deployed);
+        // the rest are refitted and judged again, their records replaced.
         let Some(k) = failing else { break };
-        let gone = kept.remove(k);
-        if let Some(Some(r)) = terms
-            .iter()
-            .position(|u| *u == gone)
-            .map(|s| &mut records[s])
-        {
-            r.deployed = false;
-        }
+        kept.remove(k);
         if kept.is_empty() {
             break;
         }
@@ -507,14 +502,14 @@ pub(crate) fn deployable(
             Err(_) => {
                 // The model of the remaining terms cannot be fitted:
                 // deploy none.
+                for r in records.iter_mut().flatten() {
+                    r.deployed = false;
+                }
                 kept.clear();
             }
         }
     }
-    let mut out: Vec<ModelTerm> = records.into_iter().flatten().collect();
-    for r in &mut out {
-        r.deployed = r.deployed && kept.iter().any(|t| t.label() == r.description);
-    }
+    let out: Vec<ModelTerm> = records.into_iter().flatten().collect();
     if kept.len() == terms.len() || kept.is_empty() {
         (out, None)
     } else {
