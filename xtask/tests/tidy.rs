@@ -653,6 +653,34 @@ fn no_import_circles_between_files() {
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
 
+/// The longest a file of `crates/*/src` may be (ARCHITECTURE.md): a file
+/// that grows is split by job into a module directory.
+const MAX_FILE_LINES: usize = 900;
+
+#[test]
+fn no_crate_source_file_is_over_900_lines() {
+    let root = workspace();
+    let mut problems = Vec::new();
+    let mut files = 0;
+    for src in source_dirs(&root)
+        .iter()
+        .filter(|s| s.starts_with(root.join("crates")))
+    {
+        for path in modules(src).values() {
+            files += 1;
+            let lines = std::fs::read_to_string(path).map_or(0, |t| t.lines().count());
+            if lines > MAX_FILE_LINES {
+                problems.push(format!(
+                    "{}: {lines} lines, over {MAX_FILE_LINES}: split it by job into a module directory",
+                    relative(&root, path)
+                ));
+            }
+        }
+    }
+    assert!(files > 100, "only {files} crate source files were found");
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
 /// The parser itself: paths in use trees, inline paths, strings and
 /// comments ignored, tests cut.
 #[test]

@@ -26,6 +26,9 @@ pub enum DiagnoseError {
     /// The data cannot support a diagnosis.
     #[error("{0}")]
     Degenerate(String),
+    /// A cross-validation fold (counted from 0) cannot be fitted.
+    #[error("cross-validation fold {0} cannot be fitted: too few or too similar poses in it")]
+    FoldNotFitted(usize),
     /// A report number is not finite (a defect: reported rather than printed).
     #[error("internal error: the report's `{field}` is not a finite number")]
     NonFinite {

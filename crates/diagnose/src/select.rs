@@ -584,7 +584,7 @@ pub(crate) fn select(
     let geometric_rms = setup
         .fitter
         .holdout_rms(&geo.model, clean, &|_| true)
-        .map_err(cv_failure)?;
+        .map_err(DiagnoseError::FoldNotFitted)?;
     let mut rejected = Vec::new();
     let mut first_candidates = Vec::new();
     let mut current = geo.clone();
@@ -631,7 +631,7 @@ pub(crate) fn select(
                 None => setup
                     .fitter
                     .holdout_rms(&current.model, clean, &|_| true)
-                    .map_err(cv_failure)?,
+                    .map_err(DiagnoseError::FoldNotFitted)?,
             };
             current_rms = Some(rms);
             let tests = final_tests(setup, clean, &current, rms);
@@ -890,12 +890,6 @@ fn bic_of(chi_square: f64, rank: usize, readings: usize) -> f64 {
 /// (1e-6).
 fn lowers_bic(candidate: f64, current: f64) -> bool {
     candidate < current - 1e-6
-}
-
-fn cv_failure(fold: usize) -> DiagnoseError {
-    DiagnoseError::Degenerate(format!(
-        "cross-validation fold {fold} cannot be fitted: too few or too similar poses in it"
-    ))
 }
 
 #[cfg(test)]
