@@ -87,7 +87,11 @@ pub(crate) fn screened(
     let mut kept: Vec<usize> = (0..n).collect();
     let mut rejected: Vec<Rejected> = Vec::new();
     let mut current = (first.clone(), design);
-    while let Some((j, mut r)) = worst(&current.0, &current.1, options.sigma) {
+    while let Some((j, mut r)) = worst(
+        &current.1,
+        &change_columns(&current.0.candidates, current.0.most_likely),
+        options.sigma,
+    ) {
         if rejected.len() == cap {
             let mut report = first;
             report.warnings.push(format!(
@@ -119,10 +123,12 @@ pub(crate) fn screened(
 }
 
 /// The pose whose deleted residual stands out the most beyond the screen's
-/// criterion at the fit `report` rests on, by its index in the design
-/// (`pose` and `line` of the entry are left to the caller).
-fn worst(report: &CheckReport, design: &Design, sigma: [f64; 3]) -> Option<(usize, Rejected)> {
-    let fit = design.fit(&change_columns(&report.candidates, report.most_likely));
+/// criterion at the fit of `design` on the nuisance and the `change`
+/// columns (the fit the report rests on), by its index in the design
+/// (`pose` and `line` of the entry are left to the caller); `sigma` is the
+/// stated noise (rad, rad, mm).
+fn worst(design: &Design, change: &[usize], sigma: [f64; 3]) -> Option<(usize, Rejected)> {
+    let fit = design.fit(change);
     let n = design.poses();
     let crit = chi2_isf(SCREEN_ALPHA / n.max(1) as f64, 3.0);
     let nu = fit.dof;
@@ -162,6 +168,62 @@ fn worst(report: &CheckReport, design: &Design, sigma: [f64; 3]) -> Option<(usiz
                 },
             )
         })
+}
+
+#[cfg(test)]
+mod tests {
+    //! The screen's rule on a design of offsets alone, worked by hand.
+    use super::*;
+
+    /// Five poses, each channel's offset column one-hot and its whitened
+    /// residual last; the fifth pose's scale reading is `s`, the others
+    /// scatter about 0 with a sum of squares of 10 + 10 + 26 = 46.
+    fn five_poses(s: f64) -> Design {
+        let values = [
+            [2.0, -1.0, 3.0],
+            [-2.0, 1.0, -3.0],
+            [1.0, 2.0, -2.0],
+            [-1.0, -2.0, 2.0],
+            [0.0, 0.0, s],
+        ];
+        let mut design = Design::new(4, Vec::new());
+        for pose in values {
+            for (channel, value) in pose.into_iter().enumerate() {
+                let mut row = [0.0; 4];
+                row[channel] = 1.0;
+                row[3] = value;
+                design.push(&row);
+            }
+        }
+        design
+    }
+
+    /// `chi2_3(1 - 1e-3 / 5)`, the criterion for five poses: the tail of 3
+    /// degrees of freedom is `erfc(sqrt(x/2)) + sqrt(2x/pi) e^(-x/2)`,
+    /// 2e-4 at 19.6561 (bisection of the closed form).
+    const CRITERION_5: f64 = 19.6561;
+
+    #[test]
+    fn a_pose_stands_out_beyond_the_scatter_of_the_other_poses_only() {
+        assert!((chi2_isf(SCREEN_ALPHA / 5.0, 3.0) - CRITERION_5).abs() < 1e-3);
+        // With the offsets alone the fifth pose's deleted residual is its
+        // reading less the mean of the others (0): `s` on the scale; its
+        // statistic `T = |e|^2 n / (n - 1)` with `e = s - s/5`: `0.8 s^2`.
+        // The other poses leave their own sum of squares, 46, on
+        // `3n - 3 - 3 = 9` degrees of freedom: a scatter of 46/9 = 5.11
+        // times the stated variance. At s = 10, T = 80: 15.65 scatters,
+        // below the criterion (with 15 degrees of freedom instead of 9 it
+        // would be 26.1, above it).
+        assert!(worst(&five_poses(10.0), &[], [1e-6, 1e-6, 1e-3]).is_none());
+        // At s = 14, T = 156.8: 30.68 scatters, beyond it. The reading is
+        // 14 stated deviations (1 um each) from what the others predict.
+        let (pose, r) = worst(&five_poses(14.0), &[], [1e-6, 1e-6, 1e-3]).unwrap();
+        assert_eq!(pose, 4);
+        assert_eq!((r.column, r.unit), ("s", "um"));
+        assert!((r.residual - 14.0).abs() < 1e-9, "{r:?}");
+        let z: f64 = 156.8 / (46.0 / 9.0);
+        assert!((r.residual_sigma - z.sqrt()).abs() < 1e-9, "{r:?}");
+    }
 }
 
 #[cfg(test)]
