@@ -226,7 +226,7 @@ impl Problem<'_> {
         columns: &[Vec<usize>],
     ) -> (ChiSquare, Vec<String>) {
         let mut others = set.to_vec();
-        let (c, _) = others.remove(k);
+        others.remove(k);
         let (base, _) = self.fit(&others, columns);
         let (with, _) = self.fit(set, columns);
         let test = chi_square(
@@ -235,13 +235,21 @@ impl Problem<'_> {
             self.level,
         );
         let margin = test.ln_p_value + SHORTLIST_RATIO.ln();
-        let aliases = (0..self.candidates.len())
-            .filter(|&a| a != c && set.iter().all(|&(s, _)| s != a))
+        let aliases = self
+            .outside(set)
+            .into_iter()
             .filter_map(|a| self.step(a, &others, &base, columns))
             .filter(|s| s.significant() && s.test.ln_p_value <= margin)
             .map(|s| self.candidates[s.cand].name.clone())
             .collect();
         (test, aliases)
+    }
+
+    /// The candidates not in `set`, in order.
+    fn outside(&self, set: &[(usize, usize)]) -> Vec<usize> {
+        (0..self.candidates.len())
+            .filter(|&a| set.iter().all(|&(s, _)| s != a))
+            .collect()
     }
 
     /// The joint fit of `set` (candidate, leading parameters fitted), and
@@ -391,8 +399,9 @@ pub(crate) fn forward(p: &Problem<'_>) -> ChangeSet {
     let mut set: Vec<(usize, usize)> = Vec::new();
     let (mut base, _) = p.fit(&set, &columns);
     while set.len() < p.candidates.len() {
-        let steps: Vec<Step> = (0..p.candidates.len())
-            .filter(|c| set.iter().all(|(s, _)| s != c))
+        let steps: Vec<Step> = p
+            .outside(&set)
+            .into_iter()
             .filter_map(|c| p.step(c, &set, &base, &columns))
             .collect();
         let Some(best) = steps

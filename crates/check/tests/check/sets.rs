@@ -370,3 +370,47 @@ fn a_warm_structure_whose_scale_grows_too_is_unseen_and_said_so() {
     );
     assert!(warned >= 9, "{found:?}");
 }
+
+/// Two changes at once: a leg slipped while the structure is warm and its
+/// scale grows with it, the temperature logged with 0.3 K of jitter. The slip is named, and the growth the sensors cannot
+/// see is still said, with the plant's own platform effect of the growth
+/// (a named change that is not thermal growth does not silence it).
+#[test]
+fn a_slipped_leg_on_a_warm_structure_is_named_and_the_unseen_growth_said() {
+    let (mut named, mut warned) = (0, 0);
+    let mut found = Vec::new();
+    for seed in 0..6 {
+        let (cold, reference) = calibrated(1100 + seed);
+        let leg = (seed % 3) as usize;
+        let mut slipped = cold.clone();
+        slipped.errors.dq_mm[leg] += 0.040;
+        let e = STEEL * WARMER_K * 1e-6;
+        let warm = grown(&slipped, e, true);
+        let mut data = check_campaign(&warm, seed + 1100, CALIBRATION_C + WARMER_K);
+        jitter(&mut data, 0.3, seed);
+        let r = run(&reference, &data);
+        // The growth's own platform effect, from the plant: the slipped
+        // machine warm against the slipped machine cold.
+        let truth = platform_truth_um(&slipped, &warm, &reference);
+        let stated = r.warnings.iter().find_map(|w| stated_um(w));
+        let leg_name = format!("leg {}", leg + 1);
+        if r.changed && names(&r).first() == Some(&leg_name.as_str()) {
+            named += 1;
+        }
+        if let Some(um) = stated {
+            warned += 1;
+            assert!(
+                (um - truth).abs() < 0.15 * truth,
+                "seed {seed}: {um} um against {truth} um"
+            );
+        }
+        found.push(format!(
+            "{leg_name}: {:?}, {stated:?} truth {truth:.1} um",
+            names(&r)
+        ));
+    }
+    eprintln!(
+        "TALLY check a leg slipped 40 um, structure and scale {WARMER_K} K warmer: {named}/6 named the leg, {warned}/6 warned of the unseen growth {found:?}"
+    );
+    assert!(named >= 5 && warned >= 5, "{found:?}");
+}
