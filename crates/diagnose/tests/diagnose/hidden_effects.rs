@@ -118,11 +118,25 @@ pub(crate) fn campaign(
     order: PoseOrder,
     readings: u32,
 ) -> (Dataset, [f64; 3], Vec<Effect>) {
+    campaign_with(effects, &[], seed, poses, order, readings)
+}
+
+/// As [`campaign`], with `extra` effects of given magnitudes hidden too
+/// (after the random ones: the same seed draws the same magnitudes).
+pub(crate) fn campaign_with(
+    effects: &[E],
+    extra: &[Effect],
+    seed: u64,
+    poses: usize,
+    order: PoseOrder,
+    readings: u32,
+) -> (Dataset, [f64; 3], Vec<Effect>) {
     let m = Machine::paper();
     let set = ParameterSet::paper15();
     let mut rng = Pcg64Mcg::seed_from_u64(0xd1a6 ^ seed);
     let mut plant = Plant::geometric(m.clone(), set.to_errors(&random_errors(15, 0.5, seed)));
     plant.effects = effects.iter().map(|e| hidden(*e, &mut rng, &m)).collect();
+    plant.effects.extend_from_slice(extra);
     let mut campaign = Campaign::random(&m, poses, 7 * seed + 1);
     campaign.noise.readings_per_pose = readings;
     campaign.order = order;
