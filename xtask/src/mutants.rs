@@ -80,7 +80,7 @@ const TARGETS: &[Target] = &[
         package: "tricept-diagnose",
         tests: &["tricept-diagnose", "tricept-example-deploy"],
     },
-    // The controller export writers: mutated once the crate exists.
+    // The controller export writers (every file of the crate).
     Target {
         name: "export",
         files: &["crates/export/src/*.rs"],
@@ -106,7 +106,7 @@ pub struct MutantsArgs {
     /// Files to mutate (a default decision file, or any `crates/*/src`
     /// file: tested with its own package); every default target when none.
     files: Vec<PathBuf>,
-    /// Only the part CI runs (the verdict and the atomic writes).
+    /// Only the part CI runs ([`CI_TARGETS`]: the atomic writes).
     #[arg(long, conflicts_with = "files")]
     ci: bool,
     /// List the mutants instead of testing them.

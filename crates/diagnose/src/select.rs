@@ -667,7 +667,7 @@ pub(crate) fn select(
             };
             removed = true;
         }
-        if !removed || pruned_once {
+        if !another_pass(removed, pruned_once) {
             break;
         }
         pruned_once = true;
@@ -879,6 +879,14 @@ fn least_useful_failing(
 /// model without it cannot be cross-validated.
 fn usefulness(test: &(Evidence, Option<f64>, bool), rms: f64) -> f64 {
     test.1.map_or(f64::INFINITY, |w| w - rms)
+}
+
+/// Whether the selection makes one more pass (forward steps, swaps and
+/// the final model's admission) after an admission: only when the
+/// admission `removed` a cause, and only once (`pruned_once`: a pass after
+/// a removal was already made).
+fn another_pass(removed: bool, pruned_once: bool) -> bool {
+    removed && !pruned_once
 }
 
 /// The BIC of a model: `chi-square + rank ln n` for `readings` readings.

@@ -355,6 +355,17 @@ fn a_swap_must_lower_the_bic_by_more_than_rounding() {
 }
 
 #[test]
+fn one_more_pass_follows_a_removal_and_only_the_first() {
+    // The module docs: "If anything was removed, one more forward step is
+    // tried from the pruned model." No removal: no pass; a removal in the
+    // first admission: one pass; a removal in that pass's admission: none.
+    assert!(!another_pass(false, false));
+    assert!(another_pass(true, false));
+    assert!(!another_pass(true, true));
+    assert!(!another_pass(false, true));
+}
+
+#[test]
 fn a_term_is_listed_once_per_stage_that_rejects_it() {
     // The same term rejected again at the same stage replaces its entry
     // (the later reason stands); at another stage it is listed beside it.
