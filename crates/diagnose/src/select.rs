@@ -667,10 +667,11 @@ pub(crate) fn select(
             };
             removed = true;
         }
-        if !another_pass(removed, pruned_once) {
+        if another_pass(removed, pruned_once) {
+            pruned_once = true;
+        } else {
             break;
         }
-        pruned_once = true;
     }
     let current_rms = current_rms.unwrap_or(geometric_rms);
     let evidences = if current.model.terms().is_empty() {
