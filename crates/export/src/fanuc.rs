@@ -54,12 +54,7 @@ impl FanucAxis {
     /// The compensation output at commanded position `q_mm` (mm, added to
     /// the command): the staircase of the accumulated increments.
     pub fn output_mm(&self, q_mm: f64, detection_unit_um: f64) -> f64 {
-        let k = section(q_mm, self.reference_mm, self.interval_mm);
-        let lo = self.first_point as i64 - self.reference_point as i64;
-        let hi = self.last_point as i64 - self.reference_point as i64;
-        let k = k.clamp(lo, hi);
-        let unit = f64::from(self.magnification) * detection_unit_um * 1e-3;
-        accumulated(&self.increments, lo, k) as f64 * unit
+        self.levels().output_mm(q_mm, detection_unit_um)
     }
 
     /// The leg's length as the control leaves it at command `q_mm` minus
@@ -67,7 +62,53 @@ impl FanucAxis {
     /// exact correction wants shortened by `E(q) - E(q_ref)` less the
     /// shift.
     pub fn deviation_mm(&self, leg: &LegCorrection, q_mm: f64, detection_unit_um: f64) -> f64 {
-        self.output_mm(q_mm, detection_unit_um) + (leg.relative_mm(q_mm) - self.shift_mm)
+        self.levels().deviation_mm(leg, q_mm, detection_unit_um)
+    }
+
+    /// The accumulated compensation of every section, once: a table's
+    /// error is measured at many check points, each an index into it.
+    fn levels(&self) -> Levels<'_> {
+        let lo = self.first_point as i64 - self.reference_point as i64;
+        let hi = self.last_point as i64 - self.reference_point as i64;
+        let first = accumulated(&self.increments, lo, lo);
+        let above = (lo + 1..=hi).scan(first, |level, k| {
+            *level += increment(&self.increments, lo, k);
+            Some(*level)
+        });
+        Levels {
+            axis: self,
+            lo,
+            hi,
+            accumulated: std::iter::once(first).chain(above).collect(),
+        }
+    }
+}
+
+/// An axis' compensation with each section's accumulated increments
+/// (detection units times the magnification), sections `lo` to `hi`.
+struct Levels<'a> {
+    axis: &'a FanucAxis,
+    lo: i64,
+    hi: i64,
+    accumulated: Vec<i64>,
+}
+
+impl Levels<'_> {
+    /// [`FanucAxis::output_mm`].
+    fn output_mm(&self, q_mm: f64, detection_unit_um: f64) -> f64 {
+        let a = self.axis;
+        let k = section(q_mm, a.reference_mm, a.interval_mm).clamp(self.lo, self.hi);
+        let unit = f64::from(a.magnification) * detection_unit_um * 1e-3;
+        self.accumulated
+            .get((k - self.lo) as usize)
+            .copied()
+            .unwrap_or(0) as f64
+            * unit
+    }
+
+    /// [`FanucAxis::deviation_mm`].
+    fn deviation_mm(&self, leg: &LegCorrection, q_mm: f64, detection_unit_um: f64) -> f64 {
+        self.output_mm(q_mm, detection_unit_um) + (leg.relative_mm(q_mm) - self.axis.shift_mm)
     }
 }
 
@@ -77,11 +118,17 @@ fn section(q_mm: f64, reference_mm: f64, interval_mm: f64) -> i64 {
     ((q_mm - reference_mm) / interval_mm - 1e-12).ceil() as i64
 }
 
+/// The value of point `j` (relative numbering, the first point at `lo`;
+/// 0 beyond the points): the increment over the section up to it.
+fn increment(increments: &[i64], lo: i64, j: i64) -> i64 {
+    increments.get((j - lo) as usize).copied().unwrap_or(0)
+}
+
 /// The accumulated compensation of section `k` (relative numbering, the
 /// first point at `lo`): the sum of the increments from the reference
 /// point outwards.
 fn accumulated(increments: &[i64], lo: i64, k: i64) -> i64 {
-    let at = |j: i64| increments.get((j - lo) as usize).copied().unwrap_or(0);
+    let at = |j: i64| increment(increments, lo, j);
     if k >= 0 {
         (1..=k).map(at).sum()
     } else {
@@ -167,12 +214,14 @@ pub fn plan(
         let end = q_ref + k as f64 * h;
         [end, end + 1e-6]
     });
-    axis.format_error_um = leg
+    let levels = axis.levels();
+    let format_error_um = leg
         .check_points_mm(start, h, CHECKS_PER_SECTION)
         .into_iter()
         .chain(ends)
-        .map(|q| axis.deviation_mm(leg, q, detection_unit_um).abs() * 1e3)
+        .map(|q| levels.deviation_mm(leg, q, detection_unit_um).abs() * 1e3)
         .fold(0.0, f64::max);
+    axis.format_error_um = format_error_um;
     axis
 }
 
@@ -504,5 +553,70 @@ mod tests {
             );
         }
         assert!(found);
+    }
+
+    #[test]
+    fn a_hand_built_axis_outputs_its_values_summed_from_the_reference_outwards() {
+        // Points 10 to 15, the reference 12 at 100 mm, 1 mm apart, in
+        // units of 2 x 1 um. The module docs' reading: point n carries the
+        // increment over the section from P_(n-1) to P_n; the reference's
+        // own section (99, 100] outputs zero. Worked by hand:
+        // section (100, 101]: +4; (101, 102]: 4 + 1; (102, 103]: 5 + 2;
+        // (98, 99]: 0 - (-5) (the reference point's own value);
+        // (97, 98]: 5 - 3; the first point's value (7) lies below the
+        // table and never counts; beyond either end the end's level.
+        let a = FanucAxis {
+            reference_point: 12,
+            first_point: 10,
+            last_point: 15,
+            magnification: 2,
+            interval_units: 1000,
+            interval_mm: 1.0,
+            reference_mm: 100.0,
+            increments: vec![7, 3, -5, 4, 1, 2],
+            clipped: false,
+            shift_mm: 0.0,
+            format_error_um: 0.0,
+        };
+        let units = [(90.0, 2), (97.5, 2), (98.5, 5), (99.5, 0), (100.5, 4)]
+            .into_iter()
+            .chain([(101.5, 5), (102.5, 7), (110.0, 7)]);
+        for (q_mm, level) in units {
+            let expected_mm = f64::from(level) * 2.0 * 1e-3;
+            assert!(
+                (a.output_mm(q_mm, 1.0) - expected_mm).abs() < 1e-12,
+                "{q_mm} mm: {} mm, not {expected_mm}",
+                a.output_mm(q_mm, 1.0)
+            );
+        }
+        // A section's upper end belongs to it, its lower end to the one
+        // below.
+        assert!((a.output_mm(101.0, 1.0) - 0.008).abs() < 1e-12);
+        assert!((a.output_mm(98.0, 1.0) - 0.004).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_largest_point_count_is_planned_with_its_format_error() {
+        // --max-points' largest value (100000) over a 400 mm stroke in
+        // 1 um units: the interval is the stroke over the 99998 sections
+        // it may have, rounded up to whole units (4.00008 um -> 5 um). A
+        // 50 ppm lead moves 0.25 nm over a section: the staircase misses
+        // by half a unit, 0.5 um, plus at most that.
+        let leg = LegCorrection {
+            leg: 0,
+            lead_ppm: 50.0,
+            table: None,
+            reference_mm: 800.0,
+            lo_mm: 640.0,
+            hi_mm: 1040.0,
+        };
+        let a = plan(&leg, 100_000, 0, 1.0, 127);
+        assert_eq!(a.interval_units, 5);
+        assert_eq!(a.last_point - a.first_point + 1, 80_001);
+        assert!(
+            (0.5..0.51).contains(&a.format_error_um),
+            "{}",
+            a.format_error_um
+        );
     }
 }
