@@ -68,28 +68,27 @@ impl FanucAxis {
     /// The accumulated compensation of every section, once: a table's
     /// error is measured at many check points, each an index into it.
     fn levels(&self) -> Levels<'_> {
+        // The points from the first (3621) on, one increment each.
         let lo = self.first_point as i64 - self.reference_point as i64;
-        let hi = self.last_point as i64 - self.reference_point as i64;
         let first = accumulated(&self.increments, lo, lo);
-        let above = (lo + 1..=hi).scan(first, |level, k| {
+        let above = (lo + 1..lo + self.increments.len() as i64).scan(first, |level, k| {
             *level += increment(&self.increments, lo, k);
             Some(*level)
         });
         Levels {
             axis: self,
             lo,
-            hi,
             accumulated: std::iter::once(first).chain(above).collect(),
         }
     }
 }
 
 /// An axis' compensation with each section's accumulated increments
-/// (detection units times the magnification), sections `lo` to `hi`.
+/// (detection units times the magnification), from section `lo` (the
+/// first point's) on; beyond either end the end's.
 struct Levels<'a> {
     axis: &'a FanucAxis,
     lo: i64,
-    hi: i64,
     accumulated: Vec<i64>,
 }
 
@@ -97,13 +96,10 @@ impl Levels<'_> {
     /// [`FanucAxis::output_mm`].
     fn output_mm(&self, q_mm: f64, detection_unit_um: f64) -> f64 {
         let a = self.axis;
-        let k = section(q_mm, a.reference_mm, a.interval_mm).clamp(self.lo, self.hi);
+        let k = section(q_mm, a.reference_mm, a.interval_mm);
+        let index = (k - self.lo).clamp(0, self.accumulated.len() as i64 - 1);
         let unit = f64::from(a.magnification) * detection_unit_um * 1e-3;
-        self.accumulated
-            .get((k - self.lo) as usize)
-            .copied()
-            .unwrap_or(0) as f64
-            * unit
+        self.accumulated.get(index as usize).copied().unwrap_or(0) as f64 * unit
     }
 
     /// [`FanucAxis::deviation_mm`].
@@ -311,16 +307,22 @@ mod tests {
     use super::*;
     use tricept_kinematics::description::LegTableDescription;
 
-    #[test]
-    fn a_lead_error_is_a_staircase_zero_in_the_reference_section() {
-        let leg = LegCorrection {
+    /// A lead error of `ppm` on a leg of stroke 640 to 1040 mm, the
+    /// reference at 800 mm.
+    fn lead(ppm: f64) -> LegCorrection {
+        LegCorrection {
             leg: 0,
-            lead_ppm: 50.0,
+            lead_ppm: ppm,
             table: None,
             reference_mm: 800.0,
             lo_mm: 640.0,
             hi_mm: 1040.0,
-        };
+        }
+    }
+
+    #[test]
+    fn a_lead_error_is_a_staircase_zero_in_the_reference_section() {
+        let leg = lead(50.0);
         let a = plan(&leg, 128, 0, 1.0, 127);
         assert!(a.last_point - a.first_point < 128);
         assert_eq!(a.output_mm(800.0, 1.0), 0.0);
@@ -334,23 +336,15 @@ mod tests {
 
     #[test]
     fn the_magnification_grows_until_each_increment_fits_and_clipping_is_said() {
-        let leg = |ppm: f64| LegCorrection {
-            leg: 0,
-            lead_ppm: ppm,
-            table: None,
-            reference_mm: 800.0,
-            lo_mm: 640.0,
-            hi_mm: 1040.0,
-        };
         // 5000 ppm over ~3.2 mm sections: 16 um a section, 7 at the most:
         // magnification 3.
-        let a = plan(&leg(5000.0), 128, 0, 1.0, 7);
+        let a = plan(&lead(5000.0), 128, 0, 1.0, 7);
         assert_eq!(a.magnification, 3);
         assert!(!a.clipped);
         assert!(a.increments.iter().all(|v| v.abs() <= 7));
         // 200 um a section cannot fit 1 x 100: clipped, and the error
         // says so.
-        let b = plan(&leg(62_500.0), 128, 0, 1.0, 1);
+        let b = plan(&lead(62_500.0), 128, 0, 1.0, 1);
         assert!(b.clipped);
         assert_eq!(b.magnification, MAX_MAGNIFICATION);
         assert!(b.format_error_um > 1000.0, "{}", b.format_error_um);
@@ -602,14 +596,7 @@ mod tests {
         // it may have, rounded up to whole units (4.00008 um -> 5 um). A
         // 50 ppm lead moves 0.25 nm over a section: the staircase misses
         // by half a unit, 0.5 um, plus at most that.
-        let leg = LegCorrection {
-            leg: 0,
-            lead_ppm: 50.0,
-            table: None,
-            reference_mm: 800.0,
-            lo_mm: 640.0,
-            hi_mm: 1040.0,
-        };
+        let leg = lead(50.0);
         let a = plan(&leg, 100_000, 0, 1.0, 127);
         assert_eq!(a.interval_units, 5);
         assert_eq!(a.last_point - a.first_point + 1, 80_001);
