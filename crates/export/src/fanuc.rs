@@ -54,7 +54,7 @@ impl FanucAxis {
     /// The compensation output at commanded position `q_mm` (mm, added to
     /// the command): the staircase of the accumulated increments.
     pub fn output_mm(&self, q_mm: f64, detection_unit_um: f64) -> f64 {
-        self.levels().output_mm(q_mm, detection_unit_um)
+        self.staircase(detection_unit_um).output_mm(q_mm)
     }
 
     /// The leg's length as the control leaves it at command `q_mm` minus
@@ -62,12 +62,13 @@ impl FanucAxis {
     /// exact correction wants shortened by `E(q) - E(q_ref)` less the
     /// shift.
     pub fn deviation_mm(&self, leg: &LegCorrection, q_mm: f64, detection_unit_um: f64) -> f64 {
-        self.levels().deviation_mm(leg, q_mm, detection_unit_um)
+        self.staircase(detection_unit_um).deviation_mm(leg, q_mm)
     }
 
-    /// The accumulated compensation of every section, once: a table's
-    /// error is measured at many check points, each an index into it.
-    fn levels(&self) -> Levels<'_> {
+    /// The staircase the control outputs, each section's accumulated
+    /// increments summed once: for the many check points at which a
+    /// table's error is measured.
+    pub(crate) fn staircase(&self, detection_unit_um: f64) -> Staircase {
         // The points from the first (3621) on, one increment each.
         let lo = self.first_point as i64 - self.reference_point as i64;
         let first = accumulated(&self.increments, lo, lo);
@@ -75,36 +76,41 @@ impl FanucAxis {
             *level += increment(&self.increments, lo, k);
             Some(*level)
         });
-        Levels {
-            axis: self,
+        Staircase {
             lo,
+            reference_mm: self.reference_mm,
+            interval_mm: self.interval_mm,
+            unit_mm: f64::from(self.magnification) * detection_unit_um * 1e-3,
+            shift_mm: self.shift_mm,
             accumulated: std::iter::once(first).chain(above).collect(),
         }
     }
 }
 
-/// An axis' compensation with each section's accumulated increments
-/// (detection units times the magnification), from section `lo` (the
-/// first point's) on; beyond either end the end's.
-struct Levels<'a> {
-    axis: &'a FanucAxis,
+/// An axis' output: each section's accumulated increments (in units of
+/// `unit_mm`), from section `lo` (the first point's) on; beyond either
+/// end the end's.
+#[derive(Debug, Clone)]
+pub(crate) struct Staircase {
     lo: i64,
+    reference_mm: f64,
+    interval_mm: f64,
+    unit_mm: f64,
+    shift_mm: f64,
     accumulated: Vec<i64>,
 }
 
-impl Levels<'_> {
+impl Staircase {
     /// [`FanucAxis::output_mm`].
-    fn output_mm(&self, q_mm: f64, detection_unit_um: f64) -> f64 {
-        let a = self.axis;
-        let k = section(q_mm, a.reference_mm, a.interval_mm);
+    pub(crate) fn output_mm(&self, q_mm: f64) -> f64 {
+        let k = section(q_mm, self.reference_mm, self.interval_mm);
         let index = (k - self.lo).clamp(0, self.accumulated.len() as i64 - 1);
-        let unit = f64::from(a.magnification) * detection_unit_um * 1e-3;
-        self.accumulated.get(index as usize).copied().unwrap_or(0) as f64 * unit
+        self.accumulated.get(index as usize).copied().unwrap_or(0) as f64 * self.unit_mm
     }
 
     /// [`FanucAxis::deviation_mm`].
-    fn deviation_mm(&self, leg: &LegCorrection, q_mm: f64, detection_unit_um: f64) -> f64 {
-        self.output_mm(q_mm, detection_unit_um) + (leg.relative_mm(q_mm) - self.axis.shift_mm)
+    pub(crate) fn deviation_mm(&self, leg: &LegCorrection, q_mm: f64) -> f64 {
+        self.output_mm(q_mm) + (leg.relative_mm(q_mm) - self.shift_mm)
     }
 }
 
@@ -210,12 +216,12 @@ pub fn plan(
         let end = q_ref + k as f64 * h;
         [end, end + 1e-6]
     });
-    let levels = axis.levels();
+    let staircase = axis.staircase(detection_unit_um);
     let format_error_um = leg
         .check_points_mm(start, h, CHECKS_PER_SECTION)
         .into_iter()
         .chain(ends)
-        .map(|q| levels.deviation_mm(leg, q, detection_unit_um).abs() * 1e3)
+        .map(|q| staircase.deviation_mm(leg, q).abs() * 1e3)
         .fold(0.0, f64::max);
     axis.format_error_um = format_error_um;
     axis
@@ -409,7 +415,8 @@ mod tests {
     /// and on either side of every section's end.
     fn largest_miss_um(a: &FanucAxis, leg: &LegCorrection, detection_unit_um: f64) -> f64 {
         let exact = |q: f64| -(leg.relative_mm(q) - a.shift_mm);
-        let miss = |q: f64| (a.output_mm(q, detection_unit_um) - exact(q)).abs() * 1e3;
+        let output = a.staircase(detection_unit_um);
+        let miss = |q: f64| (output.output_mm(q) - exact(q)).abs() * 1e3;
         let mut largest: f64 = 0.0;
         for j in 0..=400_000 {
             largest = largest.max(miss(640.0 + f64::from(j) * 1e-3));

@@ -223,8 +223,8 @@ pub fn plan(
                 fanuc_axes.push(a);
             }
             for (a, l) in fanuc_axes.iter().zip(&legs) {
-                let (a, l) = (a.clone(), l.clone());
-                deviation.push(Box::new(move |q| a.deviation_mm(&l, q, du)));
+                let (a, l) = (a.staircase(du), l.clone());
+                deviation.push(Box::new(move |q| a.deviation_mm(&l, q)));
             }
             for (i, a) in fanuc_axes.iter().enumerate() {
                 let start = a.reference_mm
