@@ -275,7 +275,9 @@ impl Control for Sinumerik {
 struct Fanuc {
     /// Per axis: reference point, first point, magnification, interval.
     params: Vec<[i64; 4]>,
-    pitch: HashMap<i64, i64>,
+    /// The pitch values of the points numbered 0 to `n`, summed (over
+    /// every axis: a difference of two sums is one axis' sum).
+    summed: Vec<i64>,
     backlash: Vec<i64>,
     reference_mm: Vec<f64>,
     du_mm: f64,
@@ -297,7 +299,7 @@ impl Fanuc {
                 .collect();
             p.insert(number.parse().unwrap(), values);
         }
-        let pitch = file(plan, "PITCH.TXT")
+        let pitch: HashMap<i64, i64> = file(plan, "PITCH.TXT")
             .lines()
             .filter(|l| l.starts_with('N'))
             .map(|l| {
@@ -305,12 +307,19 @@ impl Fanuc {
                 (n.parse::<i64>().unwrap() - 10000, v.parse().unwrap())
             })
             .collect();
+        let last = pitch.keys().copied().max().unwrap_or(0);
+        let summed = (0..=last)
+            .scan(0, |sum, n| {
+                *sum += pitch.get(&n).copied().unwrap_or(0);
+                Some(*sum)
+            })
+            .collect();
         let g = geometry(file(plan, "geometry.csv"));
         Fanuc {
             params: (0..3)
                 .map(|i| [p[&3620][i], p[&3621][i], p[&3623][i], p[&3624][i]])
                 .collect(),
-            pitch,
+            summed,
             backlash: p[&1851].clone(),
             reference_mm: (1..=3)
                 .map(|i| g[&format!("LEG{i}.reference")].parse().unwrap())
@@ -329,12 +338,10 @@ impl Control for Fanuc {
         // accumulated from the reference point to n.
         let n = (reference as f64 + ((p - self.reference_mm[axis]) / h).ceil()).max(first as f64)
             as i64;
-        let v = |j: i64| self.pitch.get(&j).copied().unwrap_or(0);
-        let units: i64 = if n >= reference {
-            (reference + 1..=n).map(v).sum()
-        } else {
-            -(n + 1..=reference).map(v).sum::<i64>()
-        };
+        // From the reference outwards: the points reference + 1 to n, or
+        // minus n + 1 to reference.
+        let sum_to = |j: i64| self.summed[(j.max(0) as usize).min(self.summed.len() - 1)];
+        let units = sum_to(n) - sum_to(reference);
         let comp = units as f64 * magnification as f64 * self.du_mm;
         let backlash = self.backlash[axis] as f64 * self.du_mm;
         p + self.misread.sign * self.misread.scale * comp + if dir < 0 { -backlash } else { 0.0 }
