@@ -22,7 +22,9 @@ fn workspace() -> PathBuf {
 
 /// The quoted regexes of `exclude_re`.
 fn exclusions(config: &str) -> Vec<String> {
-    let start = config.find("exclude_re").expect("mutants.toml has exclude_re");
+    let start = config
+        .find("exclude_re")
+        .expect("mutants.toml has exclude_re");
     config[start..]
         .lines()
         .map(str::trim)
@@ -63,10 +65,8 @@ fn expand(re: &str) -> Vec<String> {
                     i += 1;
                     continue;
                 }
-                let (head, tail): (String, String) = (
-                    chars[..o].iter().collect(),
-                    chars[i + 1..].iter().collect(),
-                );
+                let (head, tail): (String, String) =
+                    (chars[..o].iter().collect(), chars[i + 1..].iter().collect());
                 return parts
                     .into_iter()
                     .map(|p| format!("{head}{p}{tail}"))
@@ -189,7 +189,10 @@ fn every_exclusion_points_at_the_code_it_replaces() {
 fn alternatives_are_expanded_and_escapes_kept_inside_them() {
     assert_eq!(
         expand(r"a\.rs:(1:2|3:4): replace > with >= "),
-        [r"a\.rs:1:2: replace > with >= ", r"a\.rs:3:4: replace > with >= "]
+        [
+            r"a\.rs:1:2: replace > with >= ",
+            r"a\.rs:3:4: replace > with >= "
+        ]
     );
     assert_eq!(
         expand(r"a:7:(21: replace > with >=|27: replace && with \|\|) in f"),

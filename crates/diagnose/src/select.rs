@@ -660,11 +660,7 @@ pub(crate) fn select(
             excluded.push(term);
             let others: Vec<Term> = terms.into_iter().filter(|t| *t != term).collect();
             current = setup.fitter.fit(setup.fitter.model(&others), clean)?;
-            current_rms = if others.is_empty() {
-                Some(geometric_rms)
-            } else {
-                None
-            };
+            current_rms = others.is_empty().then_some(geometric_rms);
             removed = true;
         }
         if another_pass(removed, pruned_once) {
@@ -882,10 +878,9 @@ fn usefulness(test: &(Evidence, Option<f64>, bool), rms: f64) -> f64 {
     test.1.map_or(f64::INFINITY, |w| w - rms)
 }
 
-/// Whether the selection makes one more pass (forward steps, swaps and
-/// the final model's admission) after an admission: only when the
-/// admission `removed` a cause, and only once (`pruned_once`: a pass after
-/// a removal was already made).
+/// Whether the selection makes one more pass (forward steps, swaps,
+/// admission) after an admission: only when it `removed` a cause, and only
+/// once (`pruned_once`: a pass after a removal was already made).
 fn another_pass(removed: bool, pruned_once: bool) -> bool {
     removed && !pruned_once
 }
