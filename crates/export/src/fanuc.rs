@@ -217,13 +217,12 @@ pub fn plan(
         [end, end + 1e-6]
     });
     let staircase = axis.staircase(detection_unit_um);
-    let format_error_um = leg
+    axis.format_error_um = leg
         .check_points_mm(start, h, CHECKS_PER_SECTION)
         .into_iter()
         .chain(ends)
         .map(|q| staircase.deviation_mm(leg, q).abs() * 1e3)
         .fold(0.0, f64::max);
-    axis.format_error_um = format_error_um;
     axis
 }
 
