@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_ident::export::{Controller, ExportOptions, ExportRequest};
+use tricept_ident::export::{ControlModel, Controller, ExportOptions, ExportRequest};
 
 use crate::cli_error::CliError;
 
@@ -16,25 +16,34 @@ pub struct ExportArgs {
     /// `identify --write-machine`).
     #[arg(long, value_name = "CAL.json")]
     pub machine: PathBuf,
-    /// The control: sinumerik, fanuc or heidenhain.
-    #[arg(long, value_parser = parse_controller, value_name = "CONTROL")]
-    pub controller: Controller,
-    /// The directory the files go into (created when missing).
+    /// The control's family: sinumerik, fanuc or heidenhain (its model
+    /// without --control: sinumerik-840d-sl, fanuc-0i, heidenhain-tnc640).
+    #[arg(long, value_parser = parse_controller, value_name = "FAMILY")]
+    pub controller: Option<Controller>,
+    /// The control model, whose limits the files keep:
+    /// sinumerik-840d-sl (default: a Tricept's control), sinumerik-828d,
+    /// sinumerik-808d, fanuc-0i, fanuc-30i, heidenhain-tnc640,
+    /// heidenhain-itnc530, heidenhain-tnc407.
+    #[arg(long, value_parser = parse_control, value_name = "MODEL")]
+    pub control: Option<ControlModel>,
+    /// The folder the files go into: missing (created), empty, or holding
+    /// a previous export, which is replaced whole.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// The three leg axes' names on the control (default: X1,Y1,Z1 for
     /// sinumerik, U,V,W for fanuc and heidenhain).
     #[arg(long, value_parser = parse_three_names, value_name = "A,B,C")]
     pub axis_names: Option<[String; 3]>,
-    /// The most compensation points per axis the control takes (default:
-    /// 200 sinumerik, the MD38000 of an 808D; 128 fanuc; 256 heidenhain).
+    /// The most compensation points per axis (default: the model's limit,
+    /// `control_limits` in the JSON; fanuc: a third of its point numbers).
     #[arg(long, value_name = "N")]
     pub max_points: Option<usize>,
     /// Fanuc: the detection unit, um (default 1).
     #[arg(long, value_name = "UM")]
     pub detection_unit_um: Option<f64>,
     /// Fanuc: the largest value of one pitch compensation point, in
-    /// detection units times the magnification (default 127).
+    /// detection units times the magnification (default: the model's
+    /// range, 7).
     #[arg(long, value_name = "N")]
     pub max_increment: Option<u32>,
     /// The largest format error accepted, um: past it nothing is written
@@ -52,6 +61,23 @@ pub struct ExportArgs {
 
 fn parse_controller(s: &str) -> Result<Controller, String> {
     s.parse()
+}
+
+fn parse_control(s: &str) -> Result<ControlModel, String> {
+    s.parse()
+}
+
+/// The model `--control` and `--controller` name together.
+fn model(a: &ExportArgs) -> Result<ControlModel, CliError> {
+    match (a.control, a.controller) {
+        (Some(m), Some(c)) if m.family() != c => Err(CliError::input(format!(
+            "--control {m} is a {} control, not {c} (--controller)",
+            m.family()
+        ))),
+        (Some(m), _) => Ok(m),
+        (None, Some(c)) => Ok(ControlModel::of_family(c)),
+        (None, None) => Ok(ControlModel::default()),
+    }
 }
 
 fn three<T>(s: &str, parse: impl Fn(&str) -> Result<T, String>) -> Result<[T; 3], String> {
@@ -86,7 +112,7 @@ pub fn run(a: &ExportArgs) -> Result<u8, CliError> {
             max_increment: a.max_increment,
             tolerance_um: a.tolerance_um,
             reference_mm: a.reference_mm,
-            ..ExportOptions::new(a.controller)
+            ..ExportOptions::for_model(model(a)?)
         },
         out: a.out.clone(),
     };

@@ -53,6 +53,22 @@ impl LegCorrection {
         self.extra_mm(q_mm) - self.extra_mm(self.reference_mm)
     }
 
+    /// The setpoint the PKM transformation sends for an exact leg command
+    /// `q_mm` (the axis position the machine file asks for), mm: the leg
+    /// length less the axis' zero, which holds the correction at the
+    /// reference and the table's `shift_mm` (`q + E(q) - E(q_ref) -
+    /// shift`).
+    pub fn setpoint_mm(&self, q_mm: f64, shift_mm: f64) -> f64 {
+        q_mm + self.relative_mm(q_mm) - shift_mm
+    }
+
+    /// The axis position the machine file asks for at setpoint `p_mm`:
+    /// the inverse of [`LegCorrection::setpoint_mm`].
+    pub fn exact_motor_mm(&self, p_mm: f64, shift_mm: f64) -> f64 {
+        let constant = self.extra_mm(self.reference_mm) + shift_mm;
+        settle(p_mm, |x| self.extra_mm(x) - constant)
+    }
+
     /// Positions where the exact correction has a kink (the table's
     /// points inside the stroke), mm: a format error is largest there.
     pub fn knots_mm(&self) -> Vec<f64> {
@@ -67,8 +83,26 @@ impl LegCorrection {
 
     /// Points at which a written table is compared with the exact
     /// correction: `per_cell` points in every cell of the grid
-    /// `start + k step`, and both sides of every knot.
+    /// `start + k step`, both sides of every knot, the stroke's ends.
     pub fn check_points_mm(&self, start_mm: f64, step_mm: f64, per_cell: usize) -> Vec<f64> {
+        let mut out = self.cell_points_mm(start_mm, step_mm, per_cell);
+        for q in self.knots_mm() {
+            out.extend([q - 1e-6, q, q + 1e-6]);
+        }
+        out.extend([self.lo_mm, self.hi_mm]);
+        out
+    }
+
+    /// [`LegCorrection::check_points_mm`] without the knots.
+    pub fn grid_points_mm(&self, start_mm: f64, step_mm: f64, per_cell: usize) -> Vec<f64> {
+        let mut out = self.cell_points_mm(start_mm, step_mm, per_cell);
+        out.extend([self.lo_mm, self.hi_mm]);
+        out
+    }
+
+    /// `per_cell` points in every cell of the grid `start + k step` that
+    /// lie in the stroke.
+    fn cell_points_mm(&self, start_mm: f64, step_mm: f64, per_cell: usize) -> Vec<f64> {
         let mut out = Vec::new();
         let cells = ((self.hi_mm - start_mm) / step_mm).ceil().max(0.0) as usize;
         for c in 0..cells {
@@ -79,13 +113,24 @@ impl LegCorrection {
                 }
             }
         }
-        for q in self.knots_mm() {
-            out.extend([q - 1e-6, q, q + 1e-6]);
-        }
-        out.push(self.lo_mm);
-        out.push(self.hi_mm);
         out
     }
+}
+
+/// Solves `x + error(x) = p` for `x` by fixed-point iteration: where an
+/// axis settles whose position is corrected by `error` (a correction's
+/// slope is far below 1: a table's is at most
+/// `tricept_kinematics::description::MAX_TABLE_SLOPE_UM_PER_MM`).
+pub fn settle(p_mm: f64, error: impl Fn(f64) -> f64) -> f64 {
+    let mut x = p_mm;
+    for _ in 0..100 {
+        let next = p_mm - error(x);
+        if (next - x).abs() <= 1e-10 {
+            return next;
+        }
+        x = next;
+    }
+    x
 }
 
 /// The three legs' corrections of `machine` (a calibrated machine with its

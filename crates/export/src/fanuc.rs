@@ -5,19 +5,44 @@
 //! How the control reads it (docs/controllers.md, with the sources): the
 //! points are numbered, point `n` at `P_n = P_ref + (n - n_ref) h` with
 //! `n_ref` (3620) the point of the reference position and `h` (3624) the
-//! interval; the value of point `n` is the *increment* of the compensation
-//! over the section from `P_(n-1)` to `P_n`, in detection units times the
-//! magnification (3623); the compensation is output section by section (a
-//! staircase, no interpolation), zero in the reference position's own
-//! section, and added to the commanded position.
+//! interval; "the compensation value is output at the compensation position
+//! No. corresponding to each section between the coordinates": the value of
+//! point `n` is the *increment* of the compensation over the section from
+//! `P_(n-1)` to `P_n`, in detection units times the magnification (3623),
+//! accumulated from the reference position outwards; the compensation is
+//! output section by section (a staircase, no interpolation), zero at the
+//! reference position, and added to the commanded position.
+//!
+//! Where in a section the step falls is not stated in the sources found:
+//! on entering the section (the level of point `n` over `(P_(n-1), P_n]`,
+//! [`StepAt::Entering`]) or on reaching the point (over `[P_n, P_(n+1))`,
+//! [`StepAt::Reaching`]). Either reading is the other shifted by one
+//! interval, so each level is planned for the two sections it may cover
+//! (the middle of the correction's range over both), and the format error
+//! is the worse of the two readings: the file is right whichever the
+//! control does.
 
 use crate::correction::LegCorrection;
+use crate::setup::{ControlFiles, Deviation, Setup};
 
 /// Check points per section when a table's error is measured.
 const CHECKS_PER_SECTION: usize = 16;
 
-/// The largest magnification parameter 3623 takes.
-pub const MAX_MAGNIFICATION: u32 = 100;
+/// Where in a section a control steps to the section's level.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepAt {
+    /// On entering the section: the level of point `n` holds over
+    /// `(P_(n-1), P_n]`.
+    Entering,
+    /// On reaching the point: the level of point `n` holds over
+    /// `[P_n, P_(n+1))`.
+    Reaching,
+}
+
+impl StepAt {
+    /// Both readings.
+    pub const BOTH: [StepAt; 2] = [StepAt::Entering, StepAt::Reaching];
+}
 
 /// One axis' pitch error compensation.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,33 +68,50 @@ pub struct FanucAxis {
     /// (the magnification is at its largest).
     pub clipped: bool,
     /// The constant taken out of the correction so that the reference
-    /// position's own section reads zero (added to the leg's zero), mm.
+    /// position reads zero (added to the leg's zero), mm.
     pub shift_mm: f64,
     /// Largest difference between the compensation as output and the
-    /// exact correction, over the stroke, um.
+    /// exact correction, over the stroke, in the worse of the two
+    /// readings of [`StepAt`], um.
     pub format_error_um: f64,
 }
 
 impl FanucAxis {
     /// The compensation output at commanded position `q_mm` (mm, added to
-    /// the command): the staircase of the accumulated increments.
-    pub fn output_mm(&self, q_mm: f64, detection_unit_um: f64) -> f64 {
-        self.staircase(detection_unit_um).output_mm(q_mm)
+    /// the command) when the control steps as `step_at` says: the
+    /// staircase of the accumulated increments.
+    pub fn output_mm(&self, q_mm: f64, detection_unit_um: f64, step_at: StepAt) -> f64 {
+        self.staircase(detection_unit_um).output_mm(q_mm, step_at)
     }
 
-    /// The leg's length as the control leaves it at command `q_mm` minus
-    /// the exact one, mm: the output is added to the command, which the
-    /// exact correction wants shortened by `E(q) - E(q_ref)` less the
-    /// shift.
-    pub fn deviation_mm(&self, leg: &LegCorrection, q_mm: f64, detection_unit_um: f64) -> f64 {
-        self.staircase(detection_unit_um).deviation_mm(leg, q_mm)
+    /// Where the control leaves the axis minus where the machine file asks
+    /// for it, mm, at the exact command `q_mm`: the control adds its output
+    /// to the setpoint the PKM transformation sends for it.
+    pub fn deviation_mm(
+        &self,
+        leg: &LegCorrection,
+        q_mm: f64,
+        detection_unit_um: f64,
+        step_at: StepAt,
+    ) -> f64 {
+        self.staircase(detection_unit_um)
+            .deviation_mm(leg, q_mm, step_at)
     }
 
-    /// The staircase the control outputs, each section's accumulated
+    /// The positions of the first and the last point, mm: the span both
+    /// readings of [`StepAt`] cover.
+    pub fn span_mm(&self) -> (f64, f64) {
+        let at = |n: usize| {
+            self.reference_mm + (n as f64 - self.reference_point as f64) * self.interval_mm
+        };
+        (at(self.first_point), at(self.last_point))
+    }
+
+    /// The staircase the control outputs, each level's accumulated
     /// increments summed once: for the many check points at which a
     /// table's error is measured.
     pub(crate) fn staircase(&self, detection_unit_um: f64) -> Staircase {
-        // The points from the first (3621) on, one increment each.
+        // The levels of the points from the first (3621) on.
         let lo = self.first_point as i64 - self.reference_point as i64;
         let first = accumulated(&self.increments, lo, lo);
         let above = (lo + 1..lo + self.increments.len() as i64).scan(first, |level, k| {
@@ -87,9 +129,9 @@ impl FanucAxis {
     }
 }
 
-/// An axis' output: each section's accumulated increments (in units of
-/// `unit_mm`), from section `lo` (the first point's) on; beyond either
-/// end the end's.
+/// An axis' output: each point's accumulated increments (in units of
+/// `unit_mm`), from point `lo` (the first point's) on; beyond either end
+/// the end's.
 #[derive(Debug, Clone)]
 pub(crate) struct Staircase {
     lo: i64,
@@ -102,20 +144,37 @@ pub(crate) struct Staircase {
 
 impl Staircase {
     /// [`FanucAxis::output_mm`].
-    pub(crate) fn output_mm(&self, q_mm: f64) -> f64 {
-        let k = section(q_mm, self.reference_mm, self.interval_mm);
+    pub(crate) fn output_mm(&self, q_mm: f64, step_at: StepAt) -> f64 {
+        let u = (q_mm - self.reference_mm) / self.interval_mm;
+        let k = match step_at {
+            StepAt::Entering => section(q_mm, self.reference_mm, self.interval_mm),
+            StepAt::Reaching => (u + 1e-12).floor() as i64,
+        };
         let index = (k - self.lo).clamp(0, self.accumulated.len() as i64 - 1);
         self.accumulated.get(index as usize).copied().unwrap_or(0) as f64 * self.unit_mm
     }
 
     /// [`FanucAxis::deviation_mm`].
-    pub(crate) fn deviation_mm(&self, leg: &LegCorrection, q_mm: f64) -> f64 {
-        self.output_mm(q_mm) + (leg.relative_mm(q_mm) - self.shift_mm)
+    pub(crate) fn deviation_mm(&self, leg: &LegCorrection, q_mm: f64, step_at: StepAt) -> f64 {
+        let p = leg.setpoint_mm(q_mm, self.shift_mm);
+        p + self.output_mm(p, step_at) - q_mm
+    }
+
+    /// The control's axis position minus the machine file's, mm, at
+    /// setpoint `p_mm`: the output is added to the command.
+    pub(crate) fn miss_at_setpoint_mm(
+        &self,
+        leg: &LegCorrection,
+        p_mm: f64,
+        step_at: StepAt,
+    ) -> f64 {
+        p_mm + self.output_mm(p_mm, step_at) - leg.exact_motor_mm(p_mm, self.shift_mm)
     }
 }
 
-/// The section (relative to the reference point's) that holds `q`: the
-/// section `k` runs from `P_ref + (k - 1) h` (excluded) to `P_ref + k h`.
+/// The section (relative to the reference point's) that holds `q` when
+/// the control steps on entering it: the section `k` runs from
+/// `P_ref + (k - 1) h` (excluded) to `P_ref + k h`.
 fn section(q_mm: f64, reference_mm: f64, interval_mm: f64) -> i64 {
     ((q_mm - reference_mm) / interval_mm - 1e-12).ceil() as i64
 }
@@ -126,7 +185,7 @@ fn increment(increments: &[i64], lo: i64, j: i64) -> i64 {
     increments.get((j - lo) as usize).copied().unwrap_or(0)
 }
 
-/// The accumulated compensation of section `k` (relative numbering, the
+/// The accumulated compensation of point `k` (relative numbering, the
 /// first point at `lo`): the sum of the increments from the reference
 /// point outwards.
 fn accumulated(increments: &[i64], lo: i64, k: i64) -> i64 {
@@ -138,64 +197,123 @@ fn accumulated(increments: &[i64], lo: i64, k: i64) -> i64 {
     }
 }
 
+/// The points (relative to the reference point's) an interval of `h`
+/// needs so that the first lies at or below `lo_mm` and the last at or
+/// above `hi_mm`.
+fn points_for(lo_mm: f64, hi_mm: f64, reference_mm: f64, h: f64) -> (i64, i64) {
+    let k_lo = ((lo_mm - reference_mm) / h + 1e-12).floor() as i64;
+    let k_hi = ((hi_mm - reference_mm) / h - 1e-12).ceil() as i64;
+    (k_lo, k_hi)
+}
+
+/// The smallest interval, in whole detection units of `du_mm`, whose
+/// points cover the stroke of `leg` with at most `max_points` points.
+fn interval_units(leg: &LegCorrection, max_points: usize, du_mm: f64) -> u64 {
+    let count = |units: u64| {
+        let (k_lo, k_hi) = points_for(leg.lo_mm, leg.hi_mm, leg.reference_mm, units as f64 * du_mm);
+        (k_hi - k_lo + 1) as usize
+    };
+    let stroke = leg.hi_mm - leg.lo_mm;
+    // At fewer units the points cannot cover the stroke; the count never
+    // grows with the interval.
+    let mut lo = ((stroke / (max_points.max(2) - 1) as f64) / du_mm)
+        .floor()
+        .max(1.0) as u64;
+    let mut hi = lo.max(1);
+    while count(hi) > max_points {
+        lo = hi;
+        hi = hi.saturating_mul(2);
+    }
+    if count(lo) <= max_points {
+        return lo;
+    }
+    // count(lo) > max_points >= count(hi).
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if count(mid) <= max_points {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
+}
+
 /// `leg`'s correction as Fanuc pitch error compensation on at most
 /// `max_points` points, numbered from `first_number`, in detection units
-/// of `detection_unit_um` with increments of at most `max_increment`.
+/// of `detection_unit_um` with increments of at most `max_increment` and
+/// a magnification of at most `max_magnification`.
 pub fn plan(
     leg: &LegCorrection,
     max_points: usize,
     first_number: usize,
     detection_unit_um: f64,
     max_increment: u32,
+    max_magnification: u32,
 ) -> FanucAxis {
     let du_mm = detection_unit_um * 1e-3;
-    let stroke = leg.hi_mm - leg.lo_mm;
-    let interval_units = ((stroke / (max_points.max(3) - 2) as f64) / du_mm).ceil() as u64;
-    let h = interval_units.max(1) as f64 * du_mm;
+    let interval_units = interval_units(leg, max_points, du_mm);
+    let h = interval_units as f64 * du_mm;
     let q_ref = leg.reference_mm;
-    let k_lo = section(leg.lo_mm, q_ref, h);
-    let k_hi = section(leg.hi_mm, q_ref, h);
-    let midrange = |k: i64| {
-        let (a, b) = (q_ref + (k - 1) as f64 * h, q_ref + k as f64 * h);
-        let (lo, hi) = (0..=CHECKS_PER_SECTION)
-            .map(|j| leg.relative_mm(a + (b - a) * j as f64 / CHECKS_PER_SECTION as f64))
-            .chain(
-                leg.knots_mm()
-                    .into_iter()
-                    .filter(|q| *q > a && *q <= b)
-                    .map(|q| leg.relative_mm(q)),
-            )
+    let (k_lo, k_hi) = points_for(leg.lo_mm, leg.hi_mm, q_ref, h);
+    // Over the span of the points, which both readings cover (the summary
+    // states it), not only the stroke.
+    let leg = &LegCorrection {
+        lo_mm: q_ref + k_lo as f64 * h,
+        hi_mm: q_ref + k_hi as f64 * h,
+        ..leg.clone()
+    };
+    // The middle of the correction's range over the two sections a level
+    // may cover, setpoints (P_(k-1), P_(k+1)) within the span: the
+    // control adds the level to the setpoint, and the file asks for the
+    // axis at `x` with `x + E(x) - E(q_ref) - shift = p`.
+    // The knots (kinks of the correction), once: a level takes those in
+    // its sections (a setpoint grows with the command).
+    let knots = leg.knots_mm();
+    let midrange = |k: i64, shift: f64| {
+        let a = (q_ref + (k - 1) as f64 * h).max(leg.lo_mm);
+        let b = (q_ref + (k + 1) as f64 * h).min(leg.hi_mm);
+        let checks = 2 * CHECKS_PER_SECTION;
+        let first = knots.partition_point(|q| leg.setpoint_mm(*q, shift) < a);
+        let inside = knots[first..]
+            .iter()
+            .map(|q| leg.setpoint_mm(*q, shift))
+            .take_while(|p| *p <= b);
+        let (lo, hi) = (0..=checks)
+            .map(|j| a + (b - a) * j as f64 / checks as f64)
+            .chain(inside)
+            .map(|p| leg.relative_mm(leg.exact_motor_mm(p, shift)))
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
                 (lo.min(v), hi.max(v))
             });
         0.5 * (lo + hi)
     };
-    let shift_mm = midrange(0);
-    // The best staircase: each section at the middle of the correction's
-    // range over it (negated: the compensation is added to the command).
+    // The shift centres the reference's own level; the setpoints it maps
+    // to depend on it a little: twice is enough.
+    let shift_mm = midrange(0, midrange(0, 0.0));
+    // The best staircase: each level at the middle of the correction's
+    // range (negated: the compensation is added to the command).
     let target: Vec<f64> = (k_lo..=k_hi)
         .map(|k| {
             if k == 0 {
                 0.0
             } else {
-                -(midrange(k) - shift_mm)
+                -(midrange(k, shift_mm) - shift_mm)
             }
         })
         .collect();
-    let mut chosen = None;
-    for m in 1..=MAX_MAGNIFICATION {
+    let mut chosen = (max_magnification.max(1), Vec::new(), true);
+    for m in 1..=max_magnification.max(1) {
         let unit = f64::from(m) * du_mm;
         let (increments, clipped) = increments_of(&target, k_lo, unit, max_increment);
-        let last = m == MAX_MAGNIFICATION;
-        if !clipped || last {
-            chosen = Some((m, increments, clipped));
+        if !clipped || m == max_magnification.max(1) {
+            chosen = (m, increments, clipped);
             break;
         }
     }
-    let (magnification, increments, clipped) = chosen.unwrap_or((1, Vec::new(), true));
-    let reference_point = first_number + (-k_lo) as usize;
+    let (magnification, increments, clipped) = chosen;
     let mut axis = FanucAxis {
-        reference_point,
+        reference_point: first_number + (-k_lo) as usize,
         first_point: first_number,
         last_point: first_number + (k_hi - k_lo) as usize,
         magnification,
@@ -207,23 +325,138 @@ pub fn plan(
         shift_mm,
         format_error_um: 0.0,
     };
+    // The staircase steps at the points (setpoints), the correction kinks
+    // at its knots (the setpoints they map to): the miss is checked at
+    // setpoints through the span, at each point and knot and on either
+    // side of it, in both readings.
     let start = q_ref + (k_lo - 1) as f64 * h;
-    // The staircase steps at each section's end, which belongs to the
-    // section below: the miss is checked at it and just above it (every
-    // section's end inside the stroke; the first section's lower end lies
-    // below it).
-    let ends = (k_lo..k_hi).flat_map(|k| {
-        let end = q_ref + k as f64 * h;
-        [end, end + 1e-6]
-    });
+    let points = (k_lo..=k_hi).map(|k| q_ref + k as f64 * h);
+    let kinks = knots.iter().map(|q| leg.setpoint_mm(*q, shift_mm));
     let staircase = axis.staircase(detection_unit_um);
     axis.format_error_um = leg
-        .check_points_mm(start, h, CHECKS_PER_SECTION)
+        .grid_points_mm(start, h, CHECKS_PER_SECTION)
         .into_iter()
-        .chain(ends)
-        .map(|q| staircase.deviation_mm(leg, q).abs() * 1e3)
+        .chain(points.chain(kinks).flat_map(|p| [p - 1e-6, p, p + 1e-6]))
+        .filter(|p| (leg.lo_mm..=leg.hi_mm).contains(p))
+        .flat_map(|p| StepAt::BOTH.map(|s| staircase.miss_at_setpoint_mm(leg, p, s).abs() * 1e3))
         .fold(0.0, f64::max);
     axis
+}
+
+/// The Fanuc files of `setup`: the pitch data and the parameter tape,
+/// the parameters to set, and the limits past the tolerance or the
+/// control's ranges (the range of a point, the point numbers).
+pub(crate) fn files(setup: &Setup) -> ControlFiles {
+    let options = setup.options;
+    let model = options.control;
+    let limits = model.limits();
+    let du = options.detection_unit_um.unwrap_or(1.0);
+    let range = limits.value_range.map_or(127, |l| l.value as u32);
+    let cap = options.max_increment.unwrap_or(range);
+    let max_magnification = limits.max_magnification.map_or(100, |l| l.value as u32);
+    let mut next = 0;
+    let axes: Vec<FanucAxis> = setup
+        .legs
+        .iter()
+        .map(|l| {
+            let a = plan(l, setup.max_points, next, du, cap, max_magnification);
+            next = a.last_point + 1;
+            a
+        })
+        .collect();
+    let staircases: Vec<Staircase> = axes.iter().map(|a| a.staircase(du)).collect();
+    let readings = StepAt::BOTH
+        .map(|step_at| {
+            std::array::from_fn(|i| {
+                let (s, l) = (staircases[i].clone(), setup.legs[i].clone());
+                Box::new(move |q| s.deviation_mm(&l, q, step_at)) as Deviation
+            })
+        })
+        .into();
+    let mut out = ControlFiles {
+        files: Vec::new(),
+        axes: Vec::new(),
+        parameters: Vec::new(),
+        limits: Vec::new(),
+        carries_thermal: false,
+        readings,
+    };
+    let names = &setup.names;
+    for (i, a) in axes.iter().enumerate() {
+        out.axes.push(setup.axis_summary(
+            i,
+            a.increments.len(),
+            a.interval_mm,
+            a.span_mm(),
+            a.format_error_um,
+            a.shift_mm,
+        ));
+        if a.clipped {
+            out.limits.push(format!(
+                "axis {}: a point's value exceeds {cap} (the range of a point on the {model}, or --max-increment) even at magnification {max_magnification} (parameter 3623): raise --max-points or --detection-unit-um",
+                names[i],
+            ));
+        } else if a.format_error_um > options.tolerance_um {
+            out.limits
+                .push(remedy(a, &names[i], du, options.tolerance_um));
+        }
+    }
+    if let Some(numbers) = limits.point_numbers
+        && next as u64 > numbers.value
+    {
+        out.limits.push(format!(
+            "the three axes need compensation point numbers 0 to {}: the {model} has 0 to {} ({}): lower --max-points to {}",
+            next - 1,
+            numbers.value - 1,
+            numbers.source,
+            numbers.value / 3
+        ));
+    }
+    let backlash_units = setup.params.backlash_um.map(|b| (b / du).round() as i64);
+    out.files.push(("PITCH.TXT".to_string(), pitch_tape(&axes)));
+    out.files.push((
+        "PARAM.TXT".to_string(),
+        parameter_tape(&axes, &backlash_units),
+    ));
+    for (i, (a, ax)) in axes.iter().zip(names).enumerate() {
+        out.parameters.push(format!(
+            "{ax} (axis {}): 1851 = {} (backlash, detection units of {du} um); 3620 = {}; 3621 = {}; 3622 = {}; 3623 = {}; 3624 = {} ({:.4} mm)",
+            i + 1,
+            backlash_units[i],
+            a.reference_point,
+            a.first_point,
+            a.last_point,
+            a.magnification,
+            a.interval_units,
+            a.interval_mm
+        ));
+    }
+    out
+}
+
+/// The remedy for axis `a` (named `name`) past the tolerance: a staircase
+/// misses by about half a level's change plus half a unit, and the levels'
+/// changes shrink with the points.
+fn remedy(a: &FanucAxis, name: &str, du: f64, tolerance_um: f64) -> String {
+    let rounding_um = 0.5 * du * f64::from(a.magnification);
+    let lower = format!(
+        "lower --detection-unit-um ({du} um, magnification {}: half a unit is {rounding_um:.3} um)",
+        a.magnification
+    );
+    let remedy = if rounding_um >= tolerance_um {
+        lower
+    } else {
+        let points = a.increments.len() as f64 * (a.format_error_um - rounding_um)
+            / (tolerance_um - rounding_um);
+        format!(
+            "raise --max-points (the points of the axis) to more than {}, or {lower}",
+            points.ceil()
+        )
+    };
+    format!(
+        "axis {name}: format error {:.3} um past --tolerance-um {tolerance_um}: {remedy}",
+        a.format_error_um
+    )
 }
 
 /// The increments (units of `unit_mm`) whose accumulation from the
@@ -326,32 +559,54 @@ mod tests {
     }
 
     #[test]
-    fn a_lead_error_is_a_staircase_zero_in_the_reference_section() {
+    fn a_lead_error_is_a_staircase_zero_at_the_reference_in_either_reading() {
         let leg = lead(50.0);
-        let a = plan(&leg, 128, 0, 1.0, 127);
+        let a = plan(&leg, 128, 0, 1.0, 127, 100);
         assert!(a.last_point - a.first_point < 128);
-        assert_eq!(a.output_mm(800.0, 1.0), 0.0);
-        // 50 ppm over a section of ~3.2 mm: a staircase misses by half a
-        // step (0.08 um) plus half a detection unit.
-        assert!(a.format_error_um < 0.6, "{}", a.format_error_um);
-        // 200 mm above the reference the axis is 10 um long: -10 um.
-        assert!((a.output_mm(1000.0, 1.0) + 0.010).abs() < 0.0006);
-        assert!((a.output_mm(700.0, 1.0) - 0.005).abs() < 0.0006);
+        for step_at in StepAt::BOTH {
+            assert_eq!(a.output_mm(800.0, 1.0, step_at), 0.0);
+            // 200 mm above the reference the axis is 10 um long: -10 um.
+            assert!((a.output_mm(1000.0, 1.0, step_at) + 0.010).abs() < 0.0008);
+            assert!((a.output_mm(700.0, 1.0, step_at) - 0.005).abs() < 0.0008);
+        }
+        // 50 ppm over two sections of ~3.15 mm (a level may cover either):
+        // a level misses by half its range (0.16 um) plus half a detection
+        // unit.
+        assert!(
+            a.format_error_um > 0.5 && a.format_error_um < 0.7,
+            "{}",
+            a.format_error_um
+        );
+    }
+
+    #[test]
+    fn the_two_readings_are_one_interval_apart() {
+        // Reaching a point outputs what entering its section did, one
+        // interval later.
+        let a = plan(&lead(300.0), 60, 0, 1.0, 127, 100);
+        for j in 0..4000 {
+            let q = 641.0 + 0.0997 * f64::from(j);
+            let entering = a.output_mm(q, 1.0, StepAt::Entering);
+            let reaching = a.output_mm(q + a.interval_mm, 1.0, StepAt::Reaching);
+            if q + a.interval_mm < 1039.0 {
+                assert!((entering - reaching).abs() < 1e-12, "{q}");
+            }
+        }
     }
 
     #[test]
     fn the_magnification_grows_until_each_increment_fits_and_clipping_is_said() {
-        // 5000 ppm over ~3.2 mm sections: 16 um a section, 7 at the most:
+        // 5000 ppm over ~3.15 mm sections: 16 um a section, 7 at the most:
         // magnification 3.
-        let a = plan(&lead(5000.0), 128, 0, 1.0, 7);
+        let a = plan(&lead(5000.0), 128, 0, 1.0, 7, 100);
         assert_eq!(a.magnification, 3);
         assert!(!a.clipped);
         assert!(a.increments.iter().all(|v| v.abs() <= 7));
         // 200 um a section cannot fit 1 x 100: clipped, and the error
         // says so.
-        let b = plan(&lead(62_500.0), 128, 0, 1.0, 1);
+        let b = plan(&lead(62_500.0), 128, 0, 1.0, 1, 100);
         assert!(b.clipped);
-        assert_eq!(b.magnification, MAX_MAGNIFICATION);
+        assert_eq!(b.magnification, 100);
         assert!(b.format_error_um > 1000.0, "{}", b.format_error_um);
     }
 
@@ -370,9 +625,10 @@ mod tests {
     }
 
     #[test]
-    fn the_interval_is_the_stroke_over_the_sections_in_whole_detection_units() {
-        // 10 mm on 12 points: 10 sections of 1 mm (a point is the
-        // reference's, one the stroke's partial section).
+    fn the_interval_is_the_smallest_whose_points_cover_the_stroke() {
+        // 10 mm around the reference at 105 mm: n points put (n - 1) / 2
+        // intervals on each side, so 12 points take 5 a side (one number
+        // unused): 1 mm; 9 points take 4 a side: 1.25 mm.
         let leg = LegCorrection {
             leg: 0,
             lead_ppm: 0.0,
@@ -381,13 +637,36 @@ mod tests {
             lo_mm: 100.0,
             hi_mm: 110.0,
         };
-        let a = plan(&leg, 12, 0, 1.0, 127);
+        let a = plan(&leg, 12, 0, 1.0, 127, 100);
         assert_eq!((a.interval_units, a.interval_mm), (1000, 1.0));
-        assert_eq!(plan(&leg, 12, 0, 0.1, 127).interval_units, 10_000);
-        // 10 mm in 7 sections: 1.428... mm, rounded up to whole units.
-        let c = plan(&leg, 9, 0, 1.0, 127);
-        assert_eq!(c.interval_units, 1429);
-        assert!((c.interval_mm - 1.429).abs() < 1e-12);
+        assert_eq!(a.span_mm(), (100.0, 110.0));
+        assert_eq!(plan(&leg, 12, 0, 0.1, 127, 100).interval_units, 10_000);
+        let c = plan(&leg, 9, 0, 1.0, 127, 100);
+        assert_eq!(c.interval_units, 1250);
+        assert_eq!(c.last_point - c.first_point + 1, 9);
+        // An off-centre reference: every number is used, the first point
+        // at or below the stroke, the last at or above it, and one unit
+        // less would need more points.
+        for (reference_mm, points) in [(101.3, 7), (108.9, 20), (100.0, 3)] {
+            let leg = LegCorrection {
+                reference_mm,
+                ..leg.clone()
+            };
+            let a = plan(&leg, points, 0, 1.0, 127, 100);
+            let (lo, hi) = a.span_mm();
+            assert!(lo <= 100.0 + 1e-9 && hi >= 110.0 - 1e-9, "{a:?}");
+            assert!(a.last_point - a.first_point < points);
+            let (k_lo, k_hi) = points_for(
+                100.0,
+                110.0,
+                reference_mm,
+                (a.interval_units - 1) as f64 * 1e-3,
+            );
+            assert!(
+                (k_hi - k_lo + 1) as usize > points,
+                "{reference_mm} {points}"
+            );
+        }
     }
 
     #[test]
@@ -410,33 +689,44 @@ mod tests {
     }
 
     /// The largest miss of `a`'s staircase of `leg` (in detection units of
-    /// `detection_unit_um`), searched on a grid of 1 um over 640 to 1040 mm
-    /// and on either side of every section's end.
+    /// `detection_unit_um`) in either reading: where the control leaves the
+    /// axis minus where the machine file asks for it, searched at setpoints
+    /// on a grid of 1 um over the span of the points and on either side of
+    /// every point.
     fn largest_miss_um(a: &FanucAxis, leg: &LegCorrection, detection_unit_um: f64) -> f64 {
-        let exact = |q: f64| -(leg.relative_mm(q) - a.shift_mm);
         let output = a.staircase(detection_unit_um);
-        let miss = |q: f64| (output.output_mm(q) - exact(q)).abs() * 1e3;
+        let miss = |p: f64| {
+            StepAt::BOTH
+                .map(|s| {
+                    let exact = crate::correction::settle(p, |x| leg.relative_mm(x) - a.shift_mm);
+                    (p + output.output_mm(p, s) - exact).abs() * 1e3
+                })
+                .into_iter()
+                .fold(0.0, f64::max)
+        };
+        let (first, last) = a.span_mm();
+        let steps = ((last - first) * 1e3).floor() as usize;
         let mut largest: f64 = 0.0;
-        for j in 0..=400_000 {
-            largest = largest.max(miss(640.0 + f64::from(j) * 1e-3));
+        for j in 0..=steps {
+            largest = largest.max(miss(first + j as f64 * 1e-3));
         }
-        let first =
-            a.reference_mm + (a.first_point as f64 - a.reference_point as f64) * a.interval_mm;
-        for k in 0..=a.increments.len() {
-            let end = first + a.interval_mm * k as f64;
-            if (leg.lo_mm..=leg.hi_mm).contains(&end) {
-                largest = largest.max(miss(end)).max(miss(end + 1e-9));
+        for k in 0..a.increments.len() {
+            let point = first + a.interval_mm * k as f64;
+            for p in [point - 1e-9, point, point + 1e-9] {
+                if (first..=last).contains(&p) {
+                    largest = largest.max(miss(p));
+                }
             }
         }
         largest
     }
 
     #[test]
-    fn the_format_error_is_the_staircase_s_largest_miss() {
+    fn the_format_error_is_the_staircase_s_largest_miss_in_either_reading() {
         // A lead error with the reference point off the grid of whole mm:
         // the format error is the largest difference between the staircase
-        // (read back) and the exact correction, searched here on a grid of
-        // 1 um and on either side of every section's end.
+        // (read back either way) and the exact correction, searched here on
+        // a grid of 1 um and on either side of every point.
         let leg = LegCorrection {
             leg: 0,
             lead_ppm: 300.0,
@@ -445,9 +735,7 @@ mod tests {
             lo_mm: 640.0,
             hi_mm: 1040.0,
         };
-        // 100 points: sections of 4.0817 mm, whose ends a grid of 16
-        // points a section started elsewhere misses by 0.05 mm or more.
-        let a = plan(&leg, 100, 0, 0.1, 127);
+        let a = plan(&leg, 100, 0, 0.1, 127, 100);
         let largest = largest_miss_um(&a, &leg, 0.1);
         assert!(
             (a.format_error_um - largest).abs() < 2e-3,
@@ -455,41 +743,61 @@ mod tests {
             a.format_error_um
         );
         // A table rising 4 um/mm from 640 to 680 mm, flat above, the
-        // reference near the bottom: the largest misses lie in the sections
-        // of the rise (none at a knot).
-        let mut values = vec![160.0; 11];
-        values[0] = 0.0;
-        let leg = LegCorrection {
-            lead_ppm: 0.0,
-            table: Some(LegTableDescription::new(1, 640.0, 40.0, values)),
-            reference_mm: 660.37,
-            ..leg
-        };
-        let a = plan(&leg, 100, 0, 0.1, 127);
-        let largest = largest_miss_um(&a, &leg, 0.1);
-        // Half of a section's rise, 4 um/mm over 4.0817 mm, and up to half
-        // a unit (the magnification 2 keeps 16 um within 127 units of 0.1).
-        assert_eq!(a.magnification, 2);
-        assert!(
-            (largest - 2.0 * a.interval_mm).abs() <= 0.1 + 1e-9,
-            "{largest}"
-        );
-        assert!(
-            (a.format_error_um - largest).abs() < 2e-3,
-            "{} um reported, {largest} um found",
-            a.format_error_um
-        );
+        // reference near the bottom: the largest misses lie in the rise,
+        // half of a level's range over its two sections (4 um/mm over 2
+        // h) and up to half a unit (the magnification 2 keeps 16 um
+        // within 127 units of 0.1).
+        for rise_end_mm in [680.0, 681.7, 683.3] {
+            let mut values = vec![160.0; 11];
+            values[0] = 0.0;
+            let leg = LegCorrection {
+                lead_ppm: 0.0,
+                table: Some(LegTableDescription::new(
+                    1,
+                    640.0,
+                    rise_end_mm - 640.0,
+                    values,
+                )),
+                reference_mm: 660.37,
+                ..leg.clone()
+            };
+            let a = plan(&leg, 100, 0, 0.1, 127, 100);
+            let largest = largest_miss_um(&a, &leg, 0.1);
+            assert_eq!(a.magnification, 2);
+            let slope = 160.0 / (rise_end_mm - 640.0);
+            assert!(
+                (largest - slope * a.interval_mm).abs() <= 0.1 + 1e-9,
+                "{rise_end_mm}: {largest}"
+            );
+            assert!(
+                (a.format_error_um - largest).abs() < 2e-3,
+                "{rise_end_mm}: {} um reported, {largest} um found",
+                a.format_error_um
+            );
+        }
     }
 
     #[test]
-    fn each_section_sits_at_the_middle_of_the_correction_s_range_knots_included() {
+    fn each_level_sits_at_the_middle_of_the_correction_s_range_knots_included() {
         // A deployed table zero but for a 10 um spike at one point, between
-        // the 16 samples of its section (sections of 4.0817 mm from the
-        // reference 800.37 mm, samples 0.2551 mm apart; the spike 0.02 mm
-        // wide, 0.127 mm from the nearest): the section's level is the middle
-        // of 0 and 10 um, and the format error half the spike.
+        // the samples a level's range is sought at (h/16 apart): the levels
+        // covering it sit at the middle of 0 and 10 um, and the format
+        // error is half the spike.
+        // The interval depends on the stroke and the reference alone: the
+        // spike is put at a table point halfway between two samples.
+        let plain = LegCorrection {
+            reference_mm: 800.37,
+            ..lead(0.0)
+        };
+        let h = plan(&plain, 100, 0, 0.1, 127, 100).interval_mm;
+        let spike = (12_000..12_200)
+            .find(|k| {
+                let sample = (640.0 + 0.02 * f64::from(*k) - 800.37) / (h / 16.0);
+                (sample - sample.floor() - 0.5).abs() < 0.15
+            })
+            .unwrap();
         let values: Vec<f64> = (0..20_001)
-            .map(|k| if k == 12_107 { 10.0 } else { 0.0 })
+            .map(|k| if k == spike { 10.0 } else { 0.0 })
             .collect();
         let leg = LegCorrection {
             leg: 0,
@@ -499,72 +807,31 @@ mod tests {
             lo_mm: 640.0,
             hi_mm: 1040.0,
         };
-        let spike_mm = 640.0 + 0.02 * 12_107.0;
-        let a = plan(&leg, 100, 0, 0.1, 127);
-        assert_eq!(a.interval_units, 40_817);
-        let sample = (spike_mm - 800.37) / (a.interval_mm / 16.0);
-        assert!((sample - sample.round()).abs() > 0.4, "{sample}");
+        let spike_mm = 640.0 + 0.02 * f64::from(spike);
+        let a = plan(&leg, 100, 0, 0.1, 127, 100);
+        assert_eq!(a.interval_mm, h);
         assert!(
             (a.format_error_um - 5.0).abs() < 0.06,
             "{}",
             a.format_error_um
         );
-        // The section holding the spike reads -5 um (the output is added to
-        // the command; the leg is 10 um long at the spike).
-        assert!((a.output_mm(spike_mm, 0.1) + 0.005).abs() < 0.06e-3);
-    }
-
-    #[test]
-    fn the_miss_just_above_a_section_s_lower_end_is_counted() {
-        // A table rising from the stroke's start, 640 mm, to the upper end
-        // of the second section (sections of 4.082 mm, whole um, from the
-        // reference 660.37 mm), flat above: the largest miss lies in that section,
-        // fully inside the rise. Its level is rounded to whole units, so
-        // the miss is larger at one of its ends; a rise is chosen for which
-        // that is the lower end, which belongs to the section below (only
-        // approached from above, never a knot nor the stroke's end).
-        let h = 4.082;
-        let upper = 660.37 - 3.0 * h;
-        let (lower_above, upper_at) = (upper - h + 1e-9, upper);
-        let mut found = false;
-        for rise_um in (20..60).map(f64::from) {
-            let mut values = vec![rise_um; 51];
-            values[0] = 0.0;
-            let leg = LegCorrection {
-                leg: 0,
-                lead_ppm: 0.0,
-                table: Some(LegTableDescription::new(1, 640.0, upper - 640.0, values)),
-                reference_mm: 660.37,
-                lo_mm: 640.0,
-                hi_mm: 1040.0,
-            };
-            let a = plan(&leg, 100, 0, 1.0, 127);
-            assert!((a.interval_mm - h).abs() < 1e-12, "{}", a.interval_mm);
-            let miss = |q: f64| a.deviation_mm(&leg, q, 1.0).abs() * 1e3;
-            let largest = largest_miss_um(&a, &leg, 1.0);
-            if miss(lower_above) < largest - 1e-6 || miss(lower_above) < miss(upper_at) + 0.05 {
-                continue;
-            }
-            found = true;
-            assert!(
-                (a.format_error_um - largest).abs() < 2e-3,
-                "{rise_um} um: {} um reported, {largest} um found",
-                a.format_error_um
-            );
+        // Either reading outputs -5 um at the spike (the output is added to
+        // the command; the leg is 10 um long there).
+        for step_at in StepAt::BOTH {
+            assert!((a.output_mm(spike_mm, 0.1, step_at) + 0.005).abs() < 0.06e-3);
         }
-        assert!(found);
     }
 
     #[test]
     fn a_hand_built_axis_outputs_its_values_summed_from_the_reference_outwards() {
         // Points 10 to 15, the reference 12 at 100 mm, 1 mm apart, in
         // units of 2 x 1 um. The module docs' reading: point n carries the
-        // increment over the section from P_(n-1) to P_n; the reference's
-        // own section (99, 100] outputs zero. Worked by hand:
-        // section (100, 101]: +4; (101, 102]: 4 + 1; (102, 103]: 5 + 2;
-        // (98, 99]: 0 - (-5) (the reference point's own value);
-        // (97, 98]: 5 - 3; the first point's value (7) lies below the
-        // table and never counts; beyond either end the end's level.
+        // increment over the section from P_(n-1) to P_n, accumulated from
+        // the reference outwards; entering: the level of point n over
+        // (P_(n-1), P_n]; reaching: over [P_n, P_(n+1)). Worked by hand, the
+        // levels: point 13: +4; 14: 4 + 1; 15: 5 + 2; 12: 0; 11: 0 - (-5)
+        // (the reference point's own value); 10: 5 - 3; the first point's
+        // value (7) never counts; beyond either end the end's level.
         let a = FanucAxis {
             reference_point: 12,
             first_point: 10,
@@ -578,32 +845,42 @@ mod tests {
             shift_mm: 0.0,
             format_error_um: 0.0,
         };
-        let units = [(90.0, 2), (97.5, 2), (98.5, 5), (99.5, 0), (100.5, 4)]
+        let entering = [(90.0, 2), (97.5, 2), (98.5, 5), (99.5, 0), (100.5, 4)]
             .into_iter()
             .chain([(101.5, 5), (102.5, 7), (110.0, 7)]);
-        for (q_mm, level) in units {
-            let expected_mm = f64::from(level) * 2.0 * 1e-3;
-            assert!(
-                (a.output_mm(q_mm, 1.0) - expected_mm).abs() < 1e-12,
-                "{q_mm} mm: {} mm, not {expected_mm}",
-                a.output_mm(q_mm, 1.0)
-            );
+        let reaching = [(90.0, 2), (97.5, 2), (98.5, 2), (99.5, 5), (100.5, 0)]
+            .into_iter()
+            .chain([(101.5, 4), (102.5, 5), (103.5, 7), (110.0, 7)]);
+        for (step_at, levels) in [
+            (StepAt::Entering, entering.collect::<Vec<_>>()),
+            (StepAt::Reaching, reaching.collect()),
+        ] {
+            for (q_mm, level) in levels {
+                let expected_mm = f64::from(level) * 2.0 * 1e-3;
+                let got = a.output_mm(q_mm, 1.0, step_at);
+                assert!(
+                    (got - expected_mm).abs() < 1e-12,
+                    "{step_at:?} {q_mm} mm: {got} mm, not {expected_mm}"
+                );
+            }
         }
-        // A section's upper end belongs to it, its lower end to the one
-        // below.
-        assert!((a.output_mm(101.0, 1.0) - 0.008).abs() < 1e-12);
-        assert!((a.output_mm(98.0, 1.0) - 0.004).abs() < 1e-12);
+        // Entering: a section's upper end belongs to it; reaching: a point
+        // takes its own level.
+        assert!((a.output_mm(101.0, 1.0, StepAt::Entering) - 0.008).abs() < 1e-12);
+        assert!((a.output_mm(98.0, 1.0, StepAt::Entering) - 0.004).abs() < 1e-12);
+        assert!((a.output_mm(101.0, 1.0, StepAt::Reaching) - 0.008).abs() < 1e-12);
+        assert!(a.output_mm(100.0, 1.0, StepAt::Reaching).abs() < 1e-12);
+        assert_eq!(a.span_mm(), (98.0, 103.0));
     }
 
     #[test]
     fn the_largest_point_count_is_planned_with_its_format_error() {
         // --max-points' largest value (100000) over a 400 mm stroke in
-        // 1 um units: the interval is the stroke over the 99998 sections
-        // it may have, rounded up to whole units (4.00008 um -> 5 um). A
-        // 50 ppm lead moves 0.25 nm over a section: the staircase misses
-        // by half a unit, 0.5 um, plus at most that.
+        // 1 um units: 4 um would take 100001 points, so 5 um. A 50 ppm
+        // lead moves 0.5 nm over two sections: the staircase misses by
+        // half a unit, 0.5 um, plus at most that.
         let leg = lead(50.0);
-        let a = plan(&leg, 100_000, 0, 1.0, 127);
+        let a = plan(&leg, 100_000, 0, 1.0, 127, 100);
         assert_eq!(a.interval_units, 5);
         assert_eq!(a.last_point - a.first_point + 1, 80_001);
         assert!(

@@ -27,17 +27,24 @@
 
 use std::path::Path;
 
-use tricept_kinematics::MachineDescription;
+use tricept_kinematics::{Machine, MachineDescription};
 
+pub mod control;
 pub mod correction;
 pub mod fanuc;
+mod folder;
 mod geometry;
 pub mod heidenhain;
 pub mod linear;
+mod setup;
 pub mod sinumerik;
 mod types;
 
+pub use control::{ControlLimits, ControlModel, Limit};
+pub use folder::check_out;
 pub use types::{AxisSummary, Controller, ExportError, ExportOptions, ExportSummary, NotExported};
+
+use setup::{ControlFiles, Setup};
 
 /// The files of an export and its summary.
 #[derive(Debug, Clone, PartialEq)]
@@ -49,20 +56,12 @@ pub struct ExportPlan {
 }
 
 impl ExportPlan {
-    /// Writes every file into `dir` (created when missing), each
-    /// atomically.
+    /// Writes the files into `dir` as one set: into a new folder beside
+    /// it, then put in its place in one step, so that `dir` holds the
+    /// previous export or this one, whole, never a mixture (a folder
+    /// holding anything but an export is refused: [`check_out`]).
     pub fn write(&self, dir: &Path) -> Result<(), ExportError> {
-        let io = |path: &Path, source| ExportError::Io {
-            path: path.display().to_string(),
-            source,
-        };
-        std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
-        for (name, text) in &self.files {
-            let path = dir.join(name);
-            tricept_data::write_atomic(&path, |w| w.write_all(text.as_bytes()))
-                .map_err(|e| io(&path, e))?;
-        }
-        Ok(())
+        folder::replace(dir, &self.files)
     }
 }
 
@@ -78,7 +77,74 @@ pub fn plan(
     let Some(record) = &description.calibration else {
         return Err(ExportError::NoCalibration);
     };
-    let c = options.controller;
+    let names = axis_names(options)?;
+    let warnings = check_options(options)?;
+    let machine = description.build()?;
+    let legs = correction::leg_corrections(&machine, options.reference_mm)?;
+    correction::check_references(&legs)?;
+    let params = description.controller.unwrap_or_default();
+    let setup = Setup {
+        legs,
+        names,
+        leg_offsets_mm: machine.leg_offsets_mm,
+        backlash_mm: params.backlash_um.map(|b| b * 1e-3),
+        params,
+        options,
+        max_points: options
+            .max_points
+            .unwrap_or(options.control.default_max_points()),
+    };
+    let mut control = match options.control.family() {
+        Controller::Sinumerik => sinumerik::files(&setup),
+        Controller::Heidenhain => heidenhain::files(&setup),
+        Controller::Fanuc => fanuc::files(&setup),
+    };
+    control.files.push((
+        geometry::FILE.to_string(),
+        geometry::table(description, &machine, &control.axes),
+    ));
+    let workspace_poses = machine.workspace.random_poses(200, 0x0e4b_0a7d);
+    let mut platform_error_um: f64 = 0.0;
+    for reading in &control.readings {
+        platform_error_um = platform_error_um.max(correction::platform_error_um(
+            &machine,
+            &workspace_poses,
+            reading,
+        )?);
+    }
+    let not_exported = not_exported(&machine, &setup, &control, record, &workspace_poses)?;
+    let ControlFiles {
+        mut files,
+        axes,
+        parameters,
+        limits,
+        ..
+    } = control;
+    let mut file_names: Vec<String> = files.iter().map(|(n, _)| n.clone()).collect();
+    file_names.push(SUMMARY_FILE.to_string());
+    let summary = ExportSummary {
+        controller: options.control.family(),
+        control: options.control,
+        control_limits: options.control.limits(),
+        files: file_names,
+        axes,
+        platform_error_um,
+        not_exported,
+        parameters,
+        tolerance_um: options.tolerance_um,
+        within_tolerance: limits.is_empty(),
+        limits,
+        warnings,
+    };
+    let json = serde_json::to_string_pretty(&summary).unwrap_or_default();
+    files.push((SUMMARY_FILE.to_string(), json + "\n"));
+    Ok(ExportPlan { summary, files })
+}
+
+/// The three axes' names: `--axis-names` or the control's defaults, each
+/// one the control accepts, none twice.
+fn axis_names(options: &ExportOptions) -> Result<[String; 3], ExportError> {
+    let c = options.control.family();
     let names: [String; 3] = match &options.axis_names {
         Some(n) => n.clone(),
         None => c.default_axis_names().map(String::from),
@@ -95,210 +161,21 @@ pub fn plan(
             )));
         }
     }
-    check_options(options)?;
-    let machine = description.build()?;
-    let legs = correction::leg_corrections(&machine, options.reference_mm)?;
-    correction::check_references(&legs)?;
-    let max_points = options.max_points.unwrap_or(c.default_max_points());
-    let controller_params = description.controller.unwrap_or_default();
-    let backlash_mm = controller_params.backlash_um.map(|b| b * 1e-3);
-    let mut parameters = Vec::new();
-    let mut limits = Vec::new();
-    let mut files = Vec::new();
-    let mut axes = Vec::new();
-    let mut carries_thermal = false;
-    let summarise = |i: usize, points, step, min, max, error: f64, shift: f64| {
-        let l = &legs[i];
-        let offset = l.extra_mm(l.reference_mm) + shift;
-        AxisSummary {
-            leg: i as u8 + 1,
-            axis: names[i].clone(),
-            points,
-            step_mm: step,
-            min_mm: min,
-            max_mm: max,
-            format_error_um: error,
-            reference_mm: l.reference_mm,
-            offset_mm: offset,
-            zero_mm: machine.leg_offsets_mm[i] + offset - 0.5 * backlash_mm[i],
-        }
-    };
-    // Each leg's length as the control leaves it minus the exact one, mm,
-    // at a leg command.
-    let mut deviation: Vec<Box<dyn Fn(f64) -> f64>> = Vec::new();
-    match c {
-        Controller::Sinumerik | Controller::Heidenhain => {
-            let resolution = match c {
-                Controller::Sinumerik => 10f64.powi(-(sinumerik::DECIMALS as i32)),
-                _ => 10f64.powi(-(heidenhain::DECIMALS as i32)),
-            };
-            let tables: Vec<linear::LinearTable> = legs
-                .iter()
-                .map(|l| linear::resample(l, max_points, resolution))
-                .collect();
-            for (t, l) in tables.iter().zip(&legs) {
-                let (t, l) = (t.clone(), l.clone());
-                deviation.push(Box::new(move |q| t.deviation_mm(&l, q)));
-            }
-            for (i, t) in tables.iter().enumerate() {
-                axes.push(summarise(
-                    i,
-                    t.values_mm.len(),
-                    t.step_mm,
-                    t.start_mm,
-                    t.end_mm(),
-                    t.format_error_um,
-                    t.shift_mm,
-                ));
-                if t.format_error_um > options.tolerance_um {
-                    limits.push(format!(
-                        "axis {}: format error {:.3} um past --tolerance-um {}: raise --max-points ({}) to {} (the deployed table's own spacing)",
-                        names[i],
-                        t.format_error_um,
-                        options.tolerance_um,
-                        match c {
-                            Controller::Sinumerik => "MD38000 MM_ENC_COMP_MAX_POINTS",
-                            _ => "the points a *.COM table takes",
-                        },
-                        t.points_needed
-                    ));
-                }
-            }
-            if c == Controller::Sinumerik {
-                files.push((
-                    "AX_EEC_INI.SPF".to_string(),
-                    sinumerik::table_program(&tables, &names),
-                ));
-                files.push((
-                    "MACHINE_DATA.TXT".to_string(),
-                    sinumerik::machine_data(
-                        &tables,
-                        &names,
-                        &backlash_mm,
-                        controller_params.thermal_expansion_ppm_per_k,
-                        controller_params.reference_temperature_c,
-                    ),
-                ));
-                carries_thermal = true;
-                for (i, ax) in names.iter().enumerate() {
-                    parameters.push(format!("{ax}: MD32700 ENC_COMP_ENABLE[0] = 1; MD38000 MM_ENC_COMP_MAX_POINTS[0] >= {}; MD32450 BACKLASH[0] = {:.6} mm", tables[i].values_mm.len(), backlash_mm[i]));
-                    if controller_params.thermal_expansion_ppm_per_k != 0.0 {
-                        parameters.push(format!(
-                            "{ax}: MD32750 TEMP_COMP_TYPE = 2 (position dependent); SD43900 TEMP_COMP_ABS_VALUE = 0; SD43920 TEMP_COMP_REF_POSITION = 0 mm; SD43910 TEMP_COMP_SLOPE = {:.6e} * (T - {} degC), set by the PLC",
-                            -controller_params.thermal_expansion_ppm_per_k * 1e-6,
-                            controller_params.reference_temperature_c
-                        ));
-                    }
-                }
-            } else {
-                for (t, ax) in tables.iter().zip(&names) {
-                    files.push((heidenhain::com_name(ax), heidenhain::com_table(t, ax)));
-                }
-                files.push((
-                    heidenhain::CMA_NAME.to_string(),
-                    heidenhain::cma_table(&names),
-                ));
-                files.push((
-                    "MACHINE_PARAMETERS.TXT".to_string(),
-                    heidenhain::machine_parameters(&names, &backlash_mm),
-                ));
-                for (i, ax) in names.iter().enumerate() {
-                    parameters.push(format!(
-                        "{ax}: MP_backLash = {:.4} mm; {} active in {}",
-                        backlash_mm[i],
-                        heidenhain::com_name(ax),
-                        heidenhain::CMA_NAME
-                    ));
-                }
-            }
-        }
-        Controller::Fanuc => {
-            let du = options.detection_unit_um.unwrap_or(1.0);
-            let cap = options.max_increment.unwrap_or(127);
-            let mut next = 0;
-            let mut fanuc_axes = Vec::new();
-            for l in &legs {
-                let a = fanuc::plan(l, max_points, next, du, cap);
-                next = a.last_point + 1;
-                fanuc_axes.push(a);
-            }
-            for (a, l) in fanuc_axes.iter().zip(&legs) {
-                let (a, l) = (a.staircase(du), l.clone());
-                deviation.push(Box::new(move |q| a.deviation_mm(&l, q)));
-            }
-            for (i, a) in fanuc_axes.iter().enumerate() {
-                let start = a.reference_mm
-                    + (a.first_point as f64 - a.reference_point as f64) * a.interval_mm;
-                axes.push(summarise(
-                    i,
-                    a.increments.len(),
-                    a.interval_mm,
-                    start,
-                    start + a.interval_mm * (a.increments.len() - 1) as f64,
-                    a.format_error_um,
-                    a.shift_mm,
-                ));
-                if a.clipped {
-                    limits.push(format!(
-                        "axis {}: a point's value exceeds --max-increment {cap} even at magnification {} (parameter 3623): raise --max-points or --max-increment",
-                        names[i],
-                        fanuc::MAX_MAGNIFICATION
-                    ));
-                } else if a.format_error_um > options.tolerance_um {
-                    // A staircase misses by half a section's change plus
-                    // half a unit: the sections shrink with the points.
-                    let rounding_um = 0.5 * du * f64::from(a.magnification);
-                    let lower = format!(
-                        "lower --detection-unit-um ({du} um, magnification {}: half a unit is {rounding_um:.3} um)",
-                        a.magnification
-                    );
-                    let remedy = if rounding_um >= options.tolerance_um {
-                        lower
-                    } else {
-                        let points = a.increments.len() as f64 * (a.format_error_um - rounding_um)
-                            / (options.tolerance_um - rounding_um);
-                        format!(
-                            "raise --max-points (the points of the axis) to more than {}, or {lower}",
-                            points.ceil()
-                        )
-                    };
-                    limits.push(format!(
-                        "axis {}: format error {:.3} um past --tolerance-um {}: {remedy}",
-                        names[i], a.format_error_um, options.tolerance_um
-                    ));
-                }
-            }
-            let backlash_units = controller_params
-                .backlash_um
-                .map(|b| (b / du).round() as i64);
-            files.push(("PITCH.TXT".to_string(), fanuc::pitch_tape(&fanuc_axes)));
-            files.push((
-                "PARAM.TXT".to_string(),
-                fanuc::parameter_tape(&fanuc_axes, &backlash_units),
-            ));
-            for (i, (a, ax)) in fanuc_axes.iter().zip(&names).enumerate() {
-                parameters.push(format!(
-                    "{ax} (axis {}): 1851 = {} (backlash, detection units of {du} um); 3620 = {}; 3621 = {}; 3622 = {}; 3623 = {}; 3624 = {} ({:.4} mm)",
-                    i + 1,
-                    backlash_units[i],
-                    a.reference_point,
-                    a.first_point,
-                    a.last_point,
-                    a.magnification,
-                    a.interval_units,
-                    a.interval_mm
-                ));
-            }
-        }
-    }
-    files.push((
-        geometry::FILE.to_string(),
-        geometry::table(description, &machine, &axes),
-    ));
-    let workspace_poses = machine.workspace.random_poses(200, 0x0e4b_0a7d);
-    let platform_error_um = correction::platform_error_um(&machine, &workspace_poses, &deviation)?;
+    Ok(names)
+}
+
+/// What the control's files cannot carry, with its size: the legs'
+/// gravity compliance, thermal growth where the control has no place for
+/// it, and the diagnosis' sensor-side corrections.
+fn not_exported(
+    machine: &Machine,
+    setup: &Setup,
+    control: &ControlFiles,
+    record: &tricept_kinematics::description::CalibrationRecord,
+    workspace_poses: &[nalgebra::Vector3<f64>],
+) -> Result<Vec<NotExported>, ExportError> {
     let mut not_exported = Vec::new();
-    let compliance = correction::compliance_size_um(&machine, &workspace_poses)?;
+    let compliance = correction::compliance_size_um(machine, workspace_poses)?;
     if compliance > 0.0 {
         not_exported.push(NotExported {
             what: "leg_effects.compliance_um_per_kn_at_1m".into(),
@@ -306,15 +183,16 @@ pub fn plan(
             why: "the legs' gravity compliance depends on the pose, not on one axis' position: it stays in tricept's own kinematics (ik, compensate --table)".into(),
         });
     }
-    let alpha = controller_params.thermal_expansion_ppm_per_k;
-    if alpha != 0.0 && !carries_thermal {
-        let longest = legs.iter().map(|l| l.hi_mm).fold(0.0, f64::max);
+    let alpha = setup.params.thermal_expansion_ppm_per_k;
+    if alpha != 0.0 && !control.carries_thermal {
+        let longest = setup.legs.iter().map(|l| l.hi_mm).fold(0.0, f64::max);
         not_exported.push(NotExported {
             what: "thermal growth, per K".into(),
             size_um: alpha * 1e-6 * longest * 1e3,
             why: format!(
-                "no per-axis thermal parameter of the {c} control is documented in the sources used (docs/controllers.md): the legs grow {alpha:.3} ppm/K from {} degC",
-                controller_params.reference_temperature_c
+                "no per-axis thermal parameter of the {} control is documented in the sources used (docs/controllers.md): the legs grow {alpha:.3} ppm/K from {} degC",
+                setup.options.control.family(),
+                setup.params.reference_temperature_c
             ),
         });
     }
@@ -329,27 +207,13 @@ pub fn plan(
             why: "a correction of the UP limb's readings: it changes no position the control commands".into(),
         });
     }
-    let mut file_names: Vec<String> = files.iter().map(|(n, _)| n.clone()).collect();
-    file_names.push(SUMMARY_FILE.to_string());
-    let summary = ExportSummary {
-        controller: c,
-        files: file_names,
-        axes,
-        platform_error_um,
-        not_exported,
-        parameters,
-        tolerance_um: options.tolerance_um,
-        within_tolerance: limits.is_empty(),
-        limits,
-    };
-    let json = serde_json::to_string_pretty(&summary).unwrap_or_default();
-    files.push((SUMMARY_FILE.to_string(), json + "\n"));
-    Ok(ExportPlan { summary, files })
+    Ok(not_exported)
 }
 
-/// Checks the options' ranges, and that the Fanuc-only ones are given to
-/// Fanuc only.
-fn check_options(o: &ExportOptions) -> Result<(), ExportError> {
+/// Checks the options' ranges, that the Fanuc-only ones are given to
+/// Fanuc only, and each against the model's limits: past a hard limit
+/// refused, past a stand-in a warning (returned).
+fn check_options(o: &ExportOptions) -> Result<Vec<String>, ExportError> {
     let bad = |m: String| Err(ExportError::Options(m));
     if !(o.tolerance_um.is_finite() && o.tolerance_um > 0.0) {
         return bad(format!(
@@ -362,7 +226,7 @@ fn check_options(o: &ExportOptions) -> Result<(), ExportError> {
     {
         return bad(format!("--max-points: must lie from 3 to 100000, got {n}"));
     }
-    if o.controller != Controller::Fanuc {
+    if o.control.family() != Controller::Fanuc {
         if o.detection_unit_um.is_some() {
             return bad("--detection-unit-um: applies to --controller fanuc only".into());
         }
@@ -380,5 +244,34 @@ fn check_options(o: &ExportOptions) -> Result<(), ExportError> {
     if o.max_increment == Some(0) {
         return bad("--max-increment: must be at least 1".into());
     }
-    Ok(())
+    let limits = o.control.limits();
+    let mut warnings = Vec::new();
+    let mut against = |flag: &str, asked: Option<u64>, limit: Option<Limit>| {
+        let (Some(asked), Some(limit)) = (asked, limit) else {
+            return Ok(());
+        };
+        if asked <= limit.value {
+            return Ok(());
+        }
+        let said = format!(
+            "{flag} {asked}: past the {}'s {} ({})",
+            o.control, limit.value, limit.source
+        );
+        if limit.hard {
+            return Err(ExportError::Options(said));
+        }
+        warnings.push(format!("{said}: check the control's manual"));
+        Ok(())
+    };
+    against(
+        "--max-points",
+        o.max_points.map(|n| n as u64),
+        Some(limits.points_per_axis),
+    )?;
+    against(
+        "--max-increment",
+        o.max_increment.map(u64::from),
+        limits.value_range,
+    )?;
+    Ok(warnings)
 }

@@ -12,6 +12,7 @@
 //! over the stroke.
 
 use crate::correction::LegCorrection;
+use crate::setup::{ControlFiles, Deviation, Setup};
 
 /// Spacing of a table for a leg without a compensation table (a lead
 /// error alone is linear: any spacing is exact), mm.
@@ -48,12 +49,18 @@ impl LinearTable {
         read_linear(self.start_mm, self.step_mm, &self.values_mm, q_mm)
     }
 
-    /// The leg's length as the control leaves it at command `q_mm` minus
-    /// the exact one, mm: the control takes the table's value off the
-    /// command, which the exact correction wants shortened by `E(q) -
-    /// E(q_ref)` less the shift.
+    /// The axis position the control settles at for setpoint `p_mm`: it
+    /// corrects the position by the table's value there, so the axis
+    /// stops where `x + table(x) = p`.
+    pub fn motor_mm(&self, p_mm: f64) -> f64 {
+        crate::correction::settle(p_mm, |x| self.read_mm(x))
+    }
+
+    /// Where the control leaves the axis minus where the machine file asks
+    /// for it, mm, at the exact command `q_mm` (the setpoint the PKM
+    /// transformation sends for it, through the control).
     pub fn deviation_mm(&self, leg: &LegCorrection, q_mm: f64) -> f64 {
-        (leg.relative_mm(q_mm) - self.shift_mm) - self.read_mm(q_mm)
+        self.motor_mm(leg.setpoint_mm(q_mm, self.shift_mm)) - q_mm
     }
 
     /// Position of the last point, mm.
@@ -83,7 +90,9 @@ fn round_to(v: f64, resolution: f64) -> f64 {
 }
 
 /// `leg`'s correction as a linear table of at most `max_points` points,
-/// its values rounded to `resolution_mm`.
+/// its values, its first point and its spacing rounded to
+/// `resolution_mm` (the decimals the control's file is written with: the
+/// points lie where the control reads them, not a rounding away).
 pub fn resample(leg: &LegCorrection, max_points: usize, resolution_mm: f64) -> LinearTable {
     let (lo, hi) = (leg.lo_mm, leg.hi_mm);
     let stroke = hi - lo;
@@ -106,7 +115,20 @@ pub fn resample(leg: &LegCorrection, max_points: usize, resolution_mm: f64) -> L
         let n = max_points.max(2);
         (lo, stroke / (n - 1) as f64)
     };
-    let n = (((hi - start) / step - 1e-9).ceil() as usize + 1).max(2);
+    // As written: the spacing to the resolution, the first point at or
+    // below the stroke's start.
+    let mut start = round_to(start, resolution_mm);
+    if start > lo {
+        start -= resolution_mm;
+    }
+    let points = |step: f64| (((hi - start) / step - 1e-9).ceil() as usize + 1).max(2);
+    let mut step = round_to(step, resolution_mm).max(resolution_mm);
+    // Rounded down, the spacing may need one point more than the control
+    // takes: then the next one up.
+    while points(step) > max_points.max(2) {
+        step += resolution_mm;
+    }
+    let n = points(step);
     let exact: Vec<f64> = (0..n)
         .map(|k| leg.relative_mm(start + step * k as f64))
         .collect();
@@ -125,12 +147,63 @@ pub fn resample(leg: &LegCorrection, max_points: usize, resolution_mm: f64) -> L
         points_needed,
         format_error_um: 0.0,
     };
-    table.format_error_um = leg
+    // Over every point's span, not only the stroke: the summary states the
+    // span.
+    let span = LegCorrection {
+        lo_mm: start,
+        hi_mm: table.end_mm(),
+        ..leg.clone()
+    };
+    table.format_error_um = span
         .check_points_mm(start, step, CHECKS_PER_CELL)
         .into_iter()
         .map(|q| table.deviation_mm(leg, q).abs() * 1e3)
         .fold(0.0, f64::max);
     table
+}
+
+/// The three legs of `setup` as linear tables rounded to `resolution_mm`,
+/// with their axes' summaries, how they leave the legs, and the limits
+/// past the tolerance (naming the control's point limit, `points_limit`):
+/// the part of [`ControlFiles`] the two linear formats share.
+pub(crate) fn plan_axes(
+    setup: &Setup,
+    resolution_mm: f64,
+    points_limit: &str,
+) -> (Vec<LinearTable>, ControlFiles) {
+    let tables: Vec<LinearTable> = setup
+        .legs
+        .iter()
+        .map(|l| resample(l, setup.max_points, resolution_mm))
+        .collect();
+    let mut out = ControlFiles {
+        files: Vec::new(),
+        axes: Vec::new(),
+        parameters: Vec::new(),
+        limits: Vec::new(),
+        carries_thermal: false,
+        readings: vec![std::array::from_fn(|i| {
+            let (t, l) = (tables[i].clone(), setup.legs[i].clone());
+            Box::new(move |q| t.deviation_mm(&l, q)) as Deviation
+        })],
+    };
+    for (i, t) in tables.iter().enumerate() {
+        out.axes.push(setup.axis_summary(
+            i,
+            t.values_mm.len(),
+            t.step_mm,
+            (t.start_mm, t.end_mm()),
+            t.format_error_um,
+            t.shift_mm,
+        ));
+        if t.format_error_um > setup.options.tolerance_um {
+            out.limits.push(format!(
+                "axis {}: format error {:.3} um past --tolerance-um {}: raise --max-points ({points_limit}) to {} (the deployed table's own spacing)",
+                setup.names[i], t.format_error_um, setup.options.tolerance_um, t.points_needed
+            ));
+        }
+    }
+    (tables, out)
 }
 
 #[cfg(test)]

@@ -5,6 +5,8 @@
 use serde::Serialize;
 use tricept_kinematics::{DescriptionError, KinematicsError};
 
+use crate::control::{ControlLimits, ControlModel};
+
 /// A failure of an export.
 #[derive(Debug, thiserror::Error)]
 pub enum ExportError {
@@ -32,6 +34,16 @@ pub enum ExportError {
     /// The calibrated machine cannot reach a point of its workspace.
     #[error("the calibrated machine: {0}")]
     Kinematics(#[from] KinematicsError),
+    /// The output folder cannot take the export (checked before any
+    /// work): it is a file, or it holds files that are not an export, or
+    /// the machine file itself.
+    #[error("{path}: {why}")]
+    Out {
+        /// The output folder as given.
+        path: String,
+        /// Why.
+        why: String,
+    },
     /// A file could not be written.
     #[error("{path}: {source}")]
     Io {
@@ -76,17 +88,6 @@ impl Controller {
         match self {
             Controller::Sinumerik => ["X1", "Y1", "Z1"],
             Controller::Fanuc | Controller::Heidenhain => ["U", "V", "W"],
-        }
-    }
-
-    /// The most compensation points per axis without `--max-points`:
-    /// 200 (a Sinumerik 808D's table), 128 (Fanuc), 256 (a Heidenhain
-    /// `*.COM` table).
-    pub fn default_max_points(self) -> usize {
-        match self {
-            Controller::Sinumerik => 200,
-            Controller::Fanuc => 128,
-            Controller::Heidenhain => 256,
         }
     }
 
@@ -139,17 +140,18 @@ impl std::fmt::Display for Controller {
 /// What the export is asked for.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExportOptions {
-    /// The control.
-    pub controller: Controller,
+    /// The control model (its family says which files are written).
+    pub control: ControlModel,
     /// The three leg axes' names (default: [`Controller::default_axis_names`]).
     pub axis_names: Option<[String; 3]>,
     /// The most compensation points per axis the control takes (default:
-    /// [`Controller::default_max_points`]).
+    /// [`ControlModel::default_max_points`]).
     pub max_points: Option<usize>,
     /// Fanuc: the detection unit, um (default 1).
     pub detection_unit_um: Option<f64>,
     /// Fanuc: the largest value of one pitch compensation point, in
-    /// detection units times the magnification (default 127).
+    /// detection units times the magnification (default: the model's
+    /// range, 7).
     pub max_increment: Option<u32>,
     /// The largest format error accepted, um.
     pub tolerance_um: f64,
@@ -159,10 +161,16 @@ pub struct ExportOptions {
 }
 
 impl ExportOptions {
-    /// The defaults for `controller`, tolerance 1 um.
+    /// The defaults for `controller`'s model of [`ControlModel::of_family`],
+    /// tolerance 1 um.
     pub fn new(controller: Controller) -> ExportOptions {
+        ExportOptions::for_model(ControlModel::of_family(controller))
+    }
+
+    /// The defaults for `control`, tolerance 1 um.
+    pub fn for_model(control: ControlModel) -> ExportOptions {
         ExportOptions {
-            controller,
+            control,
             axis_names: None,
             max_points: None,
             detection_unit_um: None,
@@ -215,8 +223,12 @@ pub struct NotExported {
 /// The summary of an export (the JSON the verb prints).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ExportSummary {
-    /// The control.
+    /// The control's family (which files).
     pub controller: Controller,
+    /// The control model.
+    pub control: ControlModel,
+    /// The model's limits, with their sources.
+    pub control_limits: ControlLimits,
     /// The files, in the output directory.
     pub files: Vec<String>,
     /// The leg axes.
@@ -233,8 +245,12 @@ pub struct ExportSummary {
     pub tolerance_um: f64,
     /// Whether every axis' format error is within the tolerance.
     pub within_tolerance: bool,
-    /// The limits to raise for the axes past the tolerance.
+    /// The limits to raise for the axes past the tolerance (or the
+    /// control's ranges the files would exceed): nothing is written.
     pub limits: Vec<String>,
+    /// Options past a limit the sources do not state as hard (the files
+    /// are written: check the control's manual).
+    pub warnings: Vec<String>,
 }
 
 #[cfg(test)]

@@ -10,7 +10,8 @@ use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::machine_input::MachineInput;
 
 pub use tricept_export::{
-    AxisSummary, Controller, ExportError, ExportOptions, ExportSummary, NotExported,
+    AxisSummary, ControlLimits, ControlModel, Controller, ExportError, ExportOptions,
+    ExportSummary, Limit, NotExported,
 };
 
 /// What to export, and where.
@@ -21,7 +22,8 @@ pub struct ExportRequest {
     pub machine: MachineInput,
     /// The control and its limits.
     pub options: ExportOptions,
-    /// The directory the files go into.
+    /// The folder the files go into: missing, empty, or holding a
+    /// previous export, which the new one replaces whole.
     pub out: PathBuf,
 }
 
@@ -53,7 +55,7 @@ impl Export {
         let s = &self.summary;
         let mut t = format!(
             "{} export {} {}\n",
-            s.controller,
+            s.control,
             if self.written {
                 "written to"
             } else {
@@ -83,6 +85,9 @@ impl Export {
         for l in &s.limits {
             t.push_str(&format!("limit: {l}\n"));
         }
+        for w in &s.warnings {
+            t.push_str(&format!("warning: {w}\n"));
+        }
         if self.written {
             t.push_str(&format!("files: {}\n", s.files.join(", ")));
         }
@@ -90,9 +95,11 @@ impl Export {
     }
 }
 
-/// Loads the calibrated machine file (refusing one edited after its
-/// calibration), plans the export and, when every axis is within the
-/// tolerance, writes the files atomically.
+/// Checks the output folder (a folder or nothing, holding at most a
+/// previous export and not the machine file), loads the calibrated machine
+/// file (refusing one edited after its calibration), plans the export and,
+/// when every axis is within the tolerance and the control's ranges,
+/// writes the files as one set (the previous export or this one, whole).
 pub fn export(request: ExportRequest) -> Result<Export, Error> {
     let request = &request;
     let Some(path) = request.machine.path() else {
@@ -101,6 +108,7 @@ pub fn export(request: ExportRequest) -> Result<Export, Error> {
         ));
     };
     let source = path.display().to_string();
+    tricept_export::check_out(&request.out, path)?;
     let description =
         MachineDescription::from_file(path).map_err(|e| Error::from(e).in_file(&source))?;
     tricept_engine::check_calibration_record(&description)

@@ -1,0 +1,288 @@
+//! The control models an export is written for: each model's family (the
+//! file formats) and its limits: compensation points per axis, the range
+//! of one value, the compensation point numbers the axes share, each with
+//! its source (docs/controllers.md quotes them).
+//!
+//! A limit is *hard* when a source states that the control takes no more:
+//! an option past it is refused. Where the sources the project could read
+//! give no limit, the model takes the narrowest value they document the
+//! control (or its smaller sibling) to take, says so, and lets the user
+//! raise it with a warning: a narrow limit costs format error, never a
+//! file the control refuses.
+
+use serde::Serialize;
+
+use crate::types::Controller;
+
+/// One limit of a control model, with where it comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Limit {
+    /// The value.
+    pub value: u64,
+    /// Whether a source states that the control takes no more (else the
+    /// value is the most the sources show it to take, and may be raised
+    /// with a warning).
+    pub hard: bool,
+    /// The source, or why the value is a stand-in.
+    pub source: &'static str,
+}
+
+/// A control model's limits (JSON `control_limits` of the summary).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ControlLimits {
+    /// The most compensation points one axis' table takes.
+    pub points_per_axis: Limit,
+    /// Fanuc: the compensation point numbers the axes share (0 to this
+    /// less one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub point_numbers: Option<Limit>,
+    /// Fanuc: the largest value of one point, in detection units times
+    /// the magnification (the range is minus to plus it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub value_range: Option<Limit>,
+    /// Fanuc: the largest magnification (parameter 3623).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_magnification: Option<Limit>,
+}
+
+/// A CNC control model (`--control`).
+///
+/// # Example
+/// ```
+/// use tricept_export::{ControlModel, Controller};
+/// let m: ControlModel = "fanuc-0i".parse().unwrap();
+/// assert_eq!(m.family(), Controller::Fanuc);
+/// assert_eq!(m.limits().value_range.unwrap().value, 7);
+/// assert_eq!(ControlModel::default().as_str(), "sinumerik-840d-sl");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub enum ControlModel {
+    /// Siemens SINUMERIK 840D sl: the Tricept's own control (the default).
+    #[default]
+    #[serde(rename = "sinumerik-840d-sl")]
+    Sinumerik840dSl,
+    /// Siemens SINUMERIK 828D.
+    #[serde(rename = "sinumerik-828d")]
+    Sinumerik828d,
+    /// Siemens SINUMERIK 808D.
+    #[serde(rename = "sinumerik-808d")]
+    Sinumerik808d,
+    /// FANUC Series 0i (and 16i/18i/21i).
+    #[serde(rename = "fanuc-0i")]
+    Fanuc0i,
+    /// FANUC Series 30i/31i/32i.
+    #[serde(rename = "fanuc-30i")]
+    Fanuc30i,
+    /// HEIDENHAIN TNC 640.
+    #[serde(rename = "heidenhain-tnc640")]
+    HeidenhainTnc640,
+    /// HEIDENHAIN iTNC 530.
+    #[serde(rename = "heidenhain-itnc530")]
+    HeidenhainItnc530,
+    /// HEIDENHAIN TNC 407 (and 415/425).
+    #[serde(rename = "heidenhain-tnc407")]
+    HeidenhainTnc407,
+}
+
+/// The Sinumerik 808D's table ([S1]).
+const SINUMERIK_808D_POINTS: Limit = Limit {
+    value: 200,
+    hard: true,
+    source: "SINUMERIK 808D function manual 01/2017 p. 106: \"Up to 200 interpolation points (N = 0...199) are possible.\"",
+};
+
+/// A TNC 407's `*.COM` table ([H4]).
+const TNC407_POINTS: Limit = Limit {
+    value: 256,
+    hard: true,
+    source: "HEIDENHAIN TNC 407 technical manual, module 9095, error 3: \"Compensation value table (.COM) has more than 256 entries\"",
+};
+
+/// FANUC's range of one point ([F6]).
+const FANUC_VALUE_RANGE: Limit = Limit {
+    value: 7,
+    hard: true,
+    source: "FANUC Series 0i/16i/18i pitch error compensation data: -7 to +7 a point, times the magnification (parameter 3623), as read from the parameter manuals by the outside review of tricept's issue 43 (the stored copies the project can read do not hold that page); taken for every FANUC model",
+};
+
+/// FANUC's parameter 3623 ([F1]).
+const FANUC_MAGNIFICATION: Limit = Limit {
+    value: 100,
+    hard: false,
+    source: "parameter 3623, pitch error compensation magnification: its range is not in the sources found; at most 100 is written",
+};
+
+/// FANUC's compensation point numbers: what the sources found show.
+const FANUC_POINT_NUMBERS: Limit = Limit {
+    value: 1024,
+    hard: false,
+    source: "the range of parameters 3620-3622 is not in the sources found; 0 to 1023 (the numbers of the Series 0i and 16i/18i, the smallest FANUC range commonly stated) is taken; raise --max-points only as far as the control's parameter manual allows",
+};
+
+impl ControlModel {
+    /// Every model, in the order `--control` lists them.
+    pub const ALL: [ControlModel; 8] = [
+        ControlModel::Sinumerik840dSl,
+        ControlModel::Sinumerik828d,
+        ControlModel::Sinumerik808d,
+        ControlModel::Fanuc0i,
+        ControlModel::Fanuc30i,
+        ControlModel::HeidenhainTnc640,
+        ControlModel::HeidenhainItnc530,
+        ControlModel::HeidenhainTnc407,
+    ];
+
+    /// The name on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ControlModel::Sinumerik840dSl => "sinumerik-840d-sl",
+            ControlModel::Sinumerik828d => "sinumerik-828d",
+            ControlModel::Sinumerik808d => "sinumerik-808d",
+            ControlModel::Fanuc0i => "fanuc-0i",
+            ControlModel::Fanuc30i => "fanuc-30i",
+            ControlModel::HeidenhainTnc640 => "heidenhain-tnc640",
+            ControlModel::HeidenhainItnc530 => "heidenhain-itnc530",
+            ControlModel::HeidenhainTnc407 => "heidenhain-tnc407",
+        }
+    }
+
+    /// The family: which files are written.
+    pub fn family(self) -> Controller {
+        match self {
+            ControlModel::Sinumerik840dSl
+            | ControlModel::Sinumerik828d
+            | ControlModel::Sinumerik808d => Controller::Sinumerik,
+            ControlModel::Fanuc0i | ControlModel::Fanuc30i => Controller::Fanuc,
+            ControlModel::HeidenhainTnc640
+            | ControlModel::HeidenhainItnc530
+            | ControlModel::HeidenhainTnc407 => Controller::Heidenhain,
+        }
+    }
+
+    /// The model `--controller FAMILY` alone stands for: the 840D sl (a
+    /// Tricept's control), the Series 0i, the TNC 640.
+    pub fn of_family(family: Controller) -> ControlModel {
+        match family {
+            Controller::Sinumerik => ControlModel::Sinumerik840dSl,
+            Controller::Fanuc => ControlModel::Fanuc0i,
+            Controller::Heidenhain => ControlModel::HeidenhainTnc640,
+        }
+    }
+
+    /// The model's limits, with their sources.
+    pub fn limits(self) -> ControlLimits {
+        let linear = |points_per_axis| ControlLimits {
+            points_per_axis,
+            point_numbers: None,
+            value_range: None,
+            max_magnification: None,
+        };
+        match self {
+            ControlModel::Sinumerik840dSl => linear(Limit {
+                value: 801,
+                hard: false,
+                source: "SINUMERIK 840D sl function manual 09/2009 p. 364 configures \"MD38000 $MM_ENC_COMP_MAX_POINTS >= 801\" (8 bytes of static user memory a value); the upper limit of MD38000 is not in the sources found",
+            }),
+            ControlModel::Sinumerik828d => linear(Limit {
+                hard: false,
+                source: "the 828D's MD38000 limit is not in the sources found: the 808D's documented 200 points are taken",
+                ..SINUMERIK_808D_POINTS
+            }),
+            ControlModel::Sinumerik808d => linear(SINUMERIK_808D_POINTS),
+            ControlModel::Fanuc0i | ControlModel::Fanuc30i => ControlLimits {
+                // The axes share the numbers: one axis may take them all
+                // but the three points each other axis needs at the least.
+                points_per_axis: Limit {
+                    value: FANUC_POINT_NUMBERS.value - 6,
+                    hard: false,
+                    source: "the compensation point numbers less three for each other axis",
+                },
+                point_numbers: Some(FANUC_POINT_NUMBERS),
+                value_range: Some(FANUC_VALUE_RANGE),
+                max_magnification: Some(FANUC_MAGNIFICATION),
+            },
+            ControlModel::HeidenhainTnc407 => linear(TNC407_POINTS),
+            ControlModel::HeidenhainTnc640 | ControlModel::HeidenhainItnc530 => linear(Limit {
+                hard: false,
+                source: "the entries a *.COM table takes on this control are not in the sources found: the TNC 407's documented 256 are taken",
+                ..TNC407_POINTS
+            }),
+        }
+    }
+
+    /// The points per axis without `--max-points`: the model's limit;
+    /// for Fanuc a third of the point numbers (three axes share them).
+    pub fn default_max_points(self) -> usize {
+        let l = self.limits();
+        match l.point_numbers {
+            Some(n) => (n.value / 3) as usize,
+            None => l.points_per_axis.value as usize,
+        }
+    }
+}
+
+impl std::str::FromStr for ControlModel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<ControlModel, String> {
+        let lower = s.to_ascii_lowercase();
+        ControlModel::ALL
+            .into_iter()
+            .find(|m| m.as_str() == lower)
+            .ok_or_else(|| {
+                format!(
+                    "unknown control model `{s}`: expected one of {}",
+                    ControlModel::ALL.map(ControlModel::as_str).join(", ")
+                )
+            })
+    }
+}
+
+impl std::fmt::Display for ControlModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn models_are_named_as_on_the_command_line_and_read_back() {
+        for m in ControlModel::ALL {
+            assert_eq!(m.as_str().parse::<ControlModel>(), Ok(m));
+            assert_eq!(m.as_str().to_uppercase().parse::<ControlModel>(), Ok(m));
+            assert!(m.as_str().starts_with(m.family().as_str()), "{m}");
+            assert_eq!(
+                serde_json::to_value(m).unwrap(),
+                serde_json::Value::from(m.as_str())
+            );
+        }
+        let e = "fanuc-31x".parse::<ControlModel>().unwrap_err();
+        assert!(e.contains("sinumerik-840d-sl"), "{e}");
+    }
+
+    #[test]
+    fn each_family_stands_for_one_of_its_models() {
+        for c in Controller::ALL {
+            assert_eq!(ControlModel::of_family(c).family(), c);
+        }
+    }
+
+    #[test]
+    fn only_fanuc_models_have_shared_numbers_and_a_value_range() {
+        for m in ControlModel::ALL {
+            let l = m.limits();
+            let fanuc = m.family() == Controller::Fanuc;
+            assert_eq!(l.point_numbers.is_some(), fanuc, "{m}");
+            assert_eq!(l.value_range.is_some(), fanuc, "{m}");
+            if let Some(n) = l.point_numbers {
+                // Three axes of at least three points each fit, and
+                // three of the default.
+                assert!(l.points_per_axis.value + 6 <= n.value, "{m}");
+                assert!(3 * m.default_max_points() as u64 <= n.value, "{m}");
+            }
+            assert!(m.default_max_points() as u64 <= l.points_per_axis.value);
+        }
+    }
+}
