@@ -165,7 +165,7 @@ enum Command {
     /// Heidenhain) from a calibrated machine file, with the format error.
     #[command(
         allow_negative_numbers = true,
-        after_help = "Exit codes: 0 written; 3 a format error past --tolerance-um (nothing written; the report names the limit to raise); 2 bad input (an unknown controller, an axis name the control cannot accept, a machine file without a calibration or edited after it).\n\nExamples:\n  tricept export --machine calibrated.json --controller sinumerik --out cnc/\n  tricept export --machine calibrated.json --controller fanuc --axis-names U,V,W --detection-unit-um 0.1 --max-points 1000 --out cnc/ --json\nFormats, signs and units: `tricept docs controllers`"
+        after_help = "Exit codes: 0 written; 3 a format error past --tolerance-um, or a range of the control the files would exceed (nothing written; the report names the limit); 2 bad input, checked before any work (an unknown control, an option past the model's documented limit, an axis name the control cannot accept, a machine file without a calibration or edited after it, an --out that is a file, holds files that are not an export, or holds the machine file).\n\nThe files are written as one set: a folder holding a previous export is replaced whole, never mixed.\n\nExamples:\n  tricept export --machine calibrated.json --out cnc/                 (a Tricept's SINUMERIK 840D sl)\n  tricept export --machine calibrated.json --control heidenhain-itnc530 --out cnc/\n  tricept export --machine calibrated.json --control fanuc-0i --axis-names U,V,W --detection-unit-um 0.1 --out cnc/ --json\nFormats, signs, units and each model's limits with their sources: `tricept docs controllers`"
     )]
     Export(export_cmd::ExportArgs),
 }

@@ -9,7 +9,7 @@
 //! **error**, as HEIDENHAIN enters it ("the axis-error is entered, with
 //! the correct sign ... The error is positive if the table travel is too
 //! long"; the nonlinear tables are the measured "error curve", plotted as
-//! "Error in Z [mm]"): how much longer the leg is than its position says,
+//! "Error in Z \[mm\]"): how much longer the leg is than its position says,
 //! `+E`, the same sign as Sinumerik's table. A table is fixed-width: a
 //! field runs from its column name's first character to the next name's,
 //! so every value is written left-aligned under its name. The `*.CMA`
