@@ -12,7 +12,88 @@
 
 use serde::Serialize;
 
-use crate::types::Controller;
+/// A CNC control.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Controller {
+    /// Siemens Sinumerik (840D, 828D, 808D).
+    Sinumerik,
+    /// Fanuc (Series 0i, 16i/18i/21i, 30i).
+    Fanuc,
+    /// Heidenhain (TNC, iTNC, MANUALplus).
+    Heidenhain,
+}
+
+impl Controller {
+    /// Every control, in the order `--controller` lists them.
+    pub const ALL: [Controller; 3] = [
+        Controller::Sinumerik,
+        Controller::Fanuc,
+        Controller::Heidenhain,
+    ];
+
+    /// The name on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Controller::Sinumerik => "sinumerik",
+            Controller::Fanuc => "fanuc",
+            Controller::Heidenhain => "heidenhain",
+        }
+    }
+
+    /// The axis names used without `--axis-names`.
+    pub fn default_axis_names(self) -> [&'static str; 3] {
+        match self {
+            Controller::Sinumerik => ["X1", "Y1", "Z1"],
+            Controller::Fanuc | Controller::Heidenhain => ["U", "V", "W"],
+        }
+    }
+
+    /// Whether `name` is an axis name the control accepts, else what it
+    /// accepts.
+    pub(crate) fn check_axis_name(self, name: &str) -> Result<(), &'static str> {
+        let b = name.as_bytes();
+        let ok = match self {
+            Controller::Sinumerik => {
+                (1..=8).contains(&b.len())
+                    && b[0].is_ascii_uppercase()
+                    && b.iter()
+                        .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || *c == b'_')
+            }
+            Controller::Fanuc => b.len() == 1 && b"XYZABCUVW".contains(&b[0]),
+            Controller::Heidenhain => {
+                (1..=2).contains(&b.len())
+                    && b"XYZABCUVW".contains(&b[0])
+                    && b[1..].iter().all(u8::is_ascii_digit)
+            }
+        };
+        ok.then_some(()).ok_or(match self {
+            Controller::Sinumerik => {
+                "a machine axis name: 1 to 8 upper-case letters, digits or `_`, starting with a letter"
+            }
+            Controller::Fanuc => "one of the letters X Y Z A B C U V W (parameter 1020)",
+            Controller::Heidenhain => "an axis key: X Y Z A B C U V or W, optionally one digit",
+        })
+    }
+}
+
+impl std::str::FromStr for Controller {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Controller, String> {
+        Controller::ALL
+            .into_iter()
+            .find(|c| c.as_str() == s.to_ascii_lowercase())
+            .ok_or_else(|| {
+                format!("unknown controller `{s}`: expected sinumerik, fanuc or heidenhain")
+            })
+    }
+}
+
+impl std::fmt::Display for Controller {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
 
 /// One limit of a control model, with where it comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -283,6 +364,42 @@ mod tests {
                 assert!(3 * m.default_max_points() as u64 <= n.value, "{m}");
             }
             assert!(m.default_max_points() as u64 <= l.points_per_axis.value);
+        }
+    }
+
+    #[test]
+    fn controllers_are_named_as_on_the_command_line() {
+        let names = Controller::ALL.map(Controller::as_str);
+        assert_eq!(names, ["sinumerik", "fanuc", "heidenhain"]);
+        // Read back, in any case; an unknown name is refused.
+        for (c, name) in Controller::ALL.into_iter().zip(names) {
+            assert_eq!(name.parse::<Controller>(), Ok(c));
+            assert_eq!(name.to_uppercase().parse::<Controller>(), Ok(c));
+            assert_eq!(c.to_string(), name);
+        }
+        let e = "siemens".parse::<Controller>().unwrap_err();
+        assert!(e.starts_with("unknown controller `siemens`"), "{e}");
+    }
+
+    #[test]
+    fn axis_names_follow_each_control_s_rule() {
+        let ok = |c: Controller, n: &str| c.check_axis_name(n).is_ok();
+        // Sinumerik: 1 to 8 upper-case letters, digits or `_`, a letter first.
+        for n in ["X1", "AX_3", "ABCDEFGH"] {
+            assert!(ok(Controller::Sinumerik, n), "{n}");
+        }
+        for n in ["", "1X", "x1", "ABCDEFGHI", "A-1"] {
+            assert!(!ok(Controller::Sinumerik, n), "{n}");
+        }
+        // Fanuc: one of X Y Z A B C U V W.
+        assert!(ok(Controller::Fanuc, "U") && ok(Controller::Fanuc, "W"));
+        for n in ["", "UV", "Q", "U1"] {
+            assert!(!ok(Controller::Fanuc, n), "{n}");
+        }
+        // Heidenhain: such a letter and at most one digit.
+        assert!(ok(Controller::Heidenhain, "U") && ok(Controller::Heidenhain, "V2"));
+        for n in ["", "UA", "Q1", "U12", "2"] {
+            assert!(!ok(Controller::Heidenhain, n), "{n}");
         }
     }
 }

@@ -25,8 +25,11 @@ use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use crate::SUMMARY_FILE;
 use crate::types::ExportError;
+
+/// The summary JSON file's name: the file that says which files an export
+/// folder holds.
+pub const SUMMARY_FILE: &str = "export.json";
 
 /// The number of the next temporary folder of this process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);

@@ -11,14 +11,19 @@
 //! What a control cannot carry is listed with its size
 //! ([`ExportSummary::not_exported`]).
 //!
+//! - `control.rs`: the control families and models, with each model's
+//!   sourced limits;
 //! - `correction.rs`: the exact per-leg correction and the stroke;
+//! - `setup.rs`: what each control's writer starts from and hands back;
 //! - `linear.rs`: absolute tables read by linear interpolation
 //!   (Sinumerik, Heidenhain);
 //! - `sinumerik.rs`, `fanuc.rs`, `heidenhain.rs`: one writer per control;
-//! - `geometry.rs`: the geometry table.
+//! - `geometry.rs`: the geometry table;
+//! - `folder.rs`: the export folder checked before any work and written
+//!   as one unit.
 //!
 //! [`plan`] is pure (the files as text and the summary); [`ExportPlan::write`]
-//! writes them atomically. docs/controllers.md documents every format.
+//! writes them as one set. docs/controllers.md documents every format.
 
 #![cfg_attr(
     not(test),
@@ -40,9 +45,9 @@ mod setup;
 pub mod sinumerik;
 mod types;
 
-pub use control::{ControlLimits, ControlModel, Limit};
-pub use folder::check_out;
-pub use types::{AxisSummary, Controller, ExportError, ExportOptions, ExportSummary, NotExported};
+pub use control::{ControlLimits, ControlModel, Controller, Limit};
+pub use folder::{SUMMARY_FILE, check_out};
+pub use types::{AxisSummary, ExportError, ExportOptions, ExportSummary, NotExported};
 
 use setup::{ControlFiles, Setup};
 
@@ -64,9 +69,6 @@ impl ExportPlan {
         folder::replace(dir, &self.files)
     }
 }
-
-/// The summary JSON file's name.
-pub const SUMMARY_FILE: &str = "export.json";
 
 /// The export of the calibrated machine `description` for the control of
 /// `options`: the files' text and the summary. Nothing is written.
