@@ -369,7 +369,8 @@ fn sinumerik_carries_a_thermal_growth_in_its_temperature_compensation() {
 #[test]
 fn a_fanuc_tape_keeps_the_range_of_a_point_and_of_the_point_numbers() {
     let d = fixture("pitch");
-    let values = |p: &ExportPlan| -> Vec<i64> {
+    // `N<10000 + number>P<value>` lines of the pitch tape.
+    let tape = |p: &ExportPlan| -> Vec<(u64, i64)> {
         p.files
             .iter()
             .find(|(n, _)| n == "PITCH.TXT")
@@ -377,20 +378,14 @@ fn a_fanuc_tape_keeps_the_range_of_a_point_and_of_the_point_numbers() {
             .1
             .lines()
             .filter_map(|l| l.strip_prefix('N'))
-            .map(|l| l.split_once('P').unwrap().1.parse().unwrap())
+            .map(|l| {
+                let (n, v) = l.split_once('P').unwrap();
+                (n.parse::<u64>().unwrap() - 10000, v.parse().unwrap())
+            })
             .collect()
     };
-    let numbers = |p: &ExportPlan| -> Vec<u64> {
-        p.files
-            .iter()
-            .find(|(n, _)| n == "PITCH.TXT")
-            .unwrap()
-            .1
-            .lines()
-            .filter_map(|l| l.strip_prefix('N'))
-            .map(|l| l.split_once('P').unwrap().0.parse::<u64>().unwrap() - 10000)
-            .collect()
-    };
+    let values = |p: &ExportPlan| tape(p).into_iter().map(|(_, v)| v).collect::<Vec<_>>();
+    let numbers = |p: &ExportPlan| tape(p).into_iter().map(|(n, _)| n).collect::<Vec<_>>();
     let many = plan(&d, &fanuc(1000, 0.1, 1.0)).unwrap();
     assert!(values(&many).iter().all(|v| v.abs() <= 7));
     assert!(!many.summary.within_tolerance);
