@@ -343,6 +343,81 @@ mod tests {
         assert!(e.contains("sinumerik-840d-sl"), "{e}");
     }
 
+    /// The models' table of docs/controllers.md states what the code
+    /// holds: each model's points per axis, whether that is a hard limit
+    /// or a stand-in, its value range and point numbers.
+    #[test]
+    fn the_docs_table_of_models_is_the_code_s() {
+        let docs = include_str!("../../../docs/controllers.md");
+        let table = &docs[docs.find("| `--control` |").unwrap()..];
+        let rows: Vec<&str> = table
+            .lines()
+            .skip(2)
+            .take_while(|l| l.starts_with('|'))
+            .collect();
+        assert_eq!(rows.len(), ControlModel::ALL.len());
+        for row in rows {
+            let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+            let name = cells[1].split('`').nth(1).unwrap();
+            let m: ControlModel = name.parse().unwrap();
+            let l = m.limits();
+            let points = cells[2];
+            assert!(
+                points.contains(&m.default_max_points().to_string()),
+                "{name}: {points}"
+            );
+            let stand_in = points.contains("stand-in");
+            assert_eq!(l.points_per_axis.hard, points.contains("hard"), "{name}");
+            if m.family() != Controller::Fanuc {
+                assert_eq!(stand_in, !l.points_per_axis.hard, "{name}");
+                assert!(points.contains(&l.points_per_axis.value.to_string()));
+            }
+            if let Some(r) = l.value_range {
+                assert!(
+                    cells[3].contains(&format!("-{} to +{}", r.value, r.value)),
+                    "{name}"
+                );
+                assert_eq!(cells[3].contains("hard"), r.hard, "{name}");
+            }
+            if let Some(n) = l.point_numbers {
+                assert!(
+                    cells[4].contains(&format!("0 to {}", n.value - 1)),
+                    "{name}"
+                );
+                assert_eq!(cells[4].contains("stand-in"), !n.hard, "{name}");
+            }
+        }
+    }
+
+    /// A stand-in says so in its source: the summary never presents a
+    /// guess as a vendor's number.
+    #[test]
+    fn every_stand_in_says_it_is_not_in_the_sources() {
+        for m in ControlModel::ALL {
+            let l = m.limits();
+            let all = [
+                Some(l.points_per_axis),
+                l.point_numbers,
+                l.value_range,
+                l.max_magnification,
+            ];
+            for limit in all.into_iter().flatten() {
+                assert!(!limit.source.is_empty(), "{m}");
+                if !limit.hard
+                    && limit.source
+                        != "the compensation point numbers less three for each other axis"
+                {
+                    assert!(
+                        limit.source.contains("not in the sources found")
+                            || limit.source.contains("upper limit"),
+                        "{m}: {}",
+                        limit.source
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn each_family_stands_for_one_of_its_models() {
         for c in Controller::ALL {
