@@ -252,6 +252,8 @@ pub fn plan(
     max_magnification: u32,
 ) -> FanucAxis {
     let du_mm = detection_unit_um * 1e-3;
+    // Three points at the least: the reference's and one each side.
+    let max_points = max_points.max(3);
     let interval_units = interval_units(leg, max_points, du_mm);
     let h = interval_units as f64 * du_mm;
     let q_ref = leg.reference_mm;
