@@ -85,24 +85,6 @@ impl LegCorrection {
     /// correction: `per_cell` points in every cell of the grid
     /// `start + k step`, both sides of every knot, the stroke's ends.
     pub fn check_points_mm(&self, start_mm: f64, step_mm: f64, per_cell: usize) -> Vec<f64> {
-        let mut out = self.cell_points_mm(start_mm, step_mm, per_cell);
-        for q in self.knots_mm() {
-            out.extend([q - 1e-6, q, q + 1e-6]);
-        }
-        out.extend([self.lo_mm, self.hi_mm]);
-        out
-    }
-
-    /// [`LegCorrection::check_points_mm`] without the knots.
-    pub fn grid_points_mm(&self, start_mm: f64, step_mm: f64, per_cell: usize) -> Vec<f64> {
-        let mut out = self.cell_points_mm(start_mm, step_mm, per_cell);
-        out.extend([self.lo_mm, self.hi_mm]);
-        out
-    }
-
-    /// `per_cell` points in every cell of the grid `start + k step` that
-    /// lie in the stroke.
-    fn cell_points_mm(&self, start_mm: f64, step_mm: f64, per_cell: usize) -> Vec<f64> {
         let mut out = Vec::new();
         let cells = ((self.hi_mm - start_mm) / step_mm).ceil().max(0.0) as usize;
         for c in 0..cells {
@@ -113,6 +95,11 @@ impl LegCorrection {
                 }
             }
         }
+        for q in self.knots_mm() {
+            out.extend([q - 1e-6, q, q + 1e-6]);
+        }
+        out.push(self.lo_mm);
+        out.push(self.hi_mm);
         out
     }
 }
@@ -125,7 +112,7 @@ pub fn settle(p_mm: f64, error: impl Fn(f64) -> f64) -> f64 {
     let mut x = p_mm;
     for _ in 0..100 {
         let next = p_mm - error(x);
-        if (next - x).abs() <= 1e-10 {
+        if (next - x).abs() <= 1e-10 || !next.is_finite() {
             return next;
         }
         x = next;

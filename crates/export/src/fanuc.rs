@@ -25,7 +25,7 @@
 use crate::correction::LegCorrection;
 use crate::setup::{ControlFiles, Deviation, Setup};
 
-/// Check points per section when a table's error is measured.
+/// Samples per section when a level's range is sought.
 const CHECKS_PER_SECTION: usize = 16;
 
 /// Where in a section a control steps to the section's level.
@@ -327,18 +327,18 @@ pub fn plan(
         shift_mm,
         format_error_um: 0.0,
     };
-    // The staircase steps at the points (setpoints), the correction kinks
-    // at its knots (the setpoints they map to): the miss is checked at
-    // setpoints through the span, at each point and knot and on either
-    // side of it, in both readings.
-    let start = q_ref + (k_lo - 1) as f64 * h;
+    // The staircase is constant between its points (setpoints) and the
+    // exact correction at a setpoint linear between the setpoints of its
+    // knots (a lead and a linearly interpolated table, solved for the axis
+    // position): their difference is largest at a point or a knot's
+    // setpoint, on one side or the other. The first and the last point are
+    // the span's ends.
     let points = (k_lo..=k_hi).map(|k| q_ref + k as f64 * h);
     let kinks = knots.iter().map(|q| leg.setpoint_mm(*q, shift_mm));
     let staircase = axis.staircase(detection_unit_um);
-    axis.format_error_um = leg
-        .grid_points_mm(start, h, CHECKS_PER_SECTION)
-        .into_iter()
-        .chain(points.chain(kinks).flat_map(|p| [p - 1e-6, p, p + 1e-6]))
+    axis.format_error_um = points
+        .chain(kinks)
+        .flat_map(|p| [p - 1e-6, p, p + 1e-6])
         .filter(|p| (leg.lo_mm..=leg.hi_mm).contains(p))
         .flat_map(|p| StepAt::BOTH.map(|s| staircase.miss_at_setpoint_mm(leg, p, s).abs() * 1e3))
         .fold(0.0, f64::max);
