@@ -84,20 +84,6 @@ impl FanucAxis {
         self.staircase(detection_unit_um).output_mm(q_mm, step_at)
     }
 
-    /// Where the control leaves the axis minus where the machine file asks
-    /// for it, mm, at the exact command `q_mm`: the control adds its output
-    /// to the setpoint the PKM transformation sends for it.
-    pub fn deviation_mm(
-        &self,
-        leg: &LegCorrection,
-        q_mm: f64,
-        detection_unit_um: f64,
-        step_at: StepAt,
-    ) -> f64 {
-        self.staircase(detection_unit_um)
-            .deviation_mm(leg, q_mm, step_at)
-    }
-
     /// The positions of the first and the last point, mm: the span both
     /// readings of [`StepAt`] cover.
     pub fn span_mm(&self) -> (f64, f64) {
@@ -154,7 +140,9 @@ impl Staircase {
         self.accumulated.get(index as usize).copied().unwrap_or(0) as f64 * self.unit_mm
     }
 
-    /// [`FanucAxis::deviation_mm`].
+    /// Where the control leaves the axis minus where the machine file asks
+    /// for it, mm, at the exact command `q_mm`: the control adds its output
+    /// to the setpoint the PKM transformation sends for it.
     pub(crate) fn deviation_mm(&self, leg: &LegCorrection, q_mm: f64, step_at: StepAt) -> f64 {
         let p = leg.setpoint_mm(q_mm, self.shift_mm);
         p + self.output_mm(p, step_at) - q_mm
