@@ -307,6 +307,54 @@ fn spread(g: &DMatrix<f64>, c: &DMatrix<f64>) -> (f64, f64) {
     ((sum / poses.max(1) as f64).sqrt(), max)
 }
 
+/// The tool's roll about its own axis, which the head's 13 parameters do
+/// not carry (a point on the tool sees none of it), at its typical size, as
+/// tool-tip combinations: one per source that measures a point at a stated
+/// offset `o` from the tip (a known tracker target, a ballbar's ball). The
+/// point turns with the roll by `roll (d x o)`, constant in the spindle
+/// frame, which the fit reads as a tool-tip shift: the tip keeps it. The
+/// typical roll is a second-axis tilt's (`ax2_tilt_a_rad`): a real head's
+/// second axis tilted along the axes' common normal turns the tool about the
+/// first axis, which at zero angles is the tool's (the 13 parameters take
+/// it as an `h1` zero and a tip shift, exact for points on the tool).
+fn roll_combinations(model: &FusedModel, sources: &[Source]) -> Vec<DVector<f64>> {
+    let (Some(head), Some(first)) = (model.head(), model.head_range().next()) else {
+        return Vec::new();
+    };
+    let k = model.len();
+    let typical = model.typical_sizes();
+    let column = |name: &str| model.index_of(name);
+    let (Some(tilt), Some(length), Some(shift_e), Some(shift_w)) = (
+        column("ax2_tilt_a_rad"),
+        column("tool_length_mm"),
+        column("tool_shift_e_mm"),
+        column("tool_shift_w_mm"),
+    ) else {
+        return Vec::new();
+    };
+    // The tool frame `d, e, w` (spindle frame at zero head angles): the
+    // tip's derivatives with respect to the tool's three shifts, turned
+    // back by the spindle's rotation.
+    let h = [0.0, 0.0];
+    let at = head.at(&vec![0.0; head.len()]);
+    let (_, jac) = at.point_jacobian(h, &Effector::default());
+    let back = at.spindle_rotation(h).transpose();
+    let frame = [length, shift_e, shift_w].map(|j| back * jac.column(j - first));
+    let d = frame[0];
+    sources
+        .iter()
+        .filter_map(Source::stated_offset_mm)
+        .map(|o| {
+            let turn = d.cross(&o) * typical[tilt];
+            let mut n = DVector::zeros(k);
+            for (j, f) in [length, shift_e, shift_w].into_iter().zip(&frame) {
+                n[j] = f.dot(&turn);
+            }
+            n
+        })
+        .collect()
+}
+
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn build_report(
     model: &FusedModel,
@@ -473,6 +521,9 @@ pub(crate) fn build_report(
     let mut held_cov = DMatrix::zeros(k, k);
     for (v, &f) in null.iter().zip(&union_decision.fixed) {
         let n = DVector::from_column_slice(v) * typical[f];
+        held_cov += &n * n.transpose();
+    }
+    for n in roll_combinations(model, sources) {
         held_cov += &n * n.transpose();
     }
     let total = covariance + &held_cov;
