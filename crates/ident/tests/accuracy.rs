@@ -274,9 +274,12 @@ fn terms_line(json: &str) -> String {
     };
     let f = &v["final"];
     let fit = format!(
-        "final chi2/dof {:.2} (p {:.3}); ",
+        "final chi2/dof {:.2} (p {:.3}), held-out rms {:.2} (noise = 1); ",
         f["chi_square"].as_f64().unwrap_or(f64::NAN) / f["dof"].as_f64().unwrap_or(f64::NAN),
-        f["p_value"].as_f64().unwrap_or(f64::NAN)
+        f["p_value"].as_f64().unwrap_or(f64::NAN),
+        v["gain"]["holdout_rms_extended"]
+            .as_f64()
+            .unwrap_or(f64::NAN)
     );
     fit + &v["model_terms"]
         .as_array()

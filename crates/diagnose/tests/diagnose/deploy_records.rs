@@ -54,6 +54,7 @@ fn term(effect: CauseName, legs: &[u8], channel: Option<u8>, deployed: bool) -> 
         holdout_benefit_sd_mm: None,
         expected_rms_with_mm: None,
         expected_rms_without_mm: None,
+        kept_back_because: (!deployed).then(|| "a reason".to_string()),
     }
 }
 
