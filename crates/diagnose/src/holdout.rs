@@ -432,8 +432,7 @@ fn kept_back_because(
     let z = improvement_sds(Some(g));
     if b.mean_mm <= DEPLOY_BENEFIT_SD * b.sd_mm {
         return Some(format!(
-            "the readings do not see it pay out of sample (benefit {:.4} +- {:.4} mm, not above {DEPLOY_BENEFIT_SD} sd)",
-            b.mean_mm, b.sd_mm
+            "the readings do not see it pay out of sample (its benefit not above {DEPLOY_BENEFIT_SD} sd)"
         ));
     }
     // It pays where the readings cannot see, or it moves the platform
@@ -446,25 +445,20 @@ fn kept_back_because(
     }
     match policy {
         DeployRule::Confident => Some(format!(
-            "the confident rule: its improvement {:.4} +- {:.4} mm is {z:.1} sd, not above {DEPLOY_IMPROVEMENT_SD} sd, and larger than the benefit the readings see",
-            g.mean_mm, g.sd_mm
+            "the confident rule (--deploy-rule confident): its improvement is {z:.1} sd, not above {DEPLOY_IMPROVEMENT_SD} sd, and larger than the benefit the readings see"
         )),
         DeployRule::ExpectedError => match expected {
             None => Some(format!(
-                "its expected errors could not be had, and its improvement {:.4} +- {:.4} mm is {z:.1} sd, not above {DEPLOY_IMPROVEMENT_SD} sd",
-                g.mean_mm, g.sd_mm
+                "its expected errors could not be had, and its improvement is {z:.1} sd, not above {DEPLOY_IMPROVEMENT_SD} sd"
             )),
-            Some((with, without)) if with >= without => Some(format!(
-                "the file with it is not expected better (expected rms {:.4} mm with it, {:.4} mm without)",
-                with.sqrt(),
-                without.sqrt()
-            )),
+            Some((with, without)) if with >= without => {
+                Some("the file with it is not expected better".into())
+            }
             // The file with it is expected better, by a move of at least
             // one standard deviation.
             Some(_) if g.mean_mm >= EXPECTED_ERROR_MIN_SD * g.sd_mm => None,
             Some(_) => Some(format!(
-                "its improvement {:.4} +- {:.4} mm is within its own uncertainty ({z:.1} sd, below {EXPECTED_ERROR_MIN_SD}): the file without it is as likely better",
-                g.mean_mm, g.sd_mm
+                "its improvement is within its own uncertainty ({z:.1} sd, below {EXPECTED_ERROR_MIN_SD}): the file without it is about as likely the better one"
             )),
         },
     }

@@ -608,8 +608,10 @@ fn tally_of_diagnosed_campaigns() {
     );
     assert!(within as f64 >= 0.95 * written as f64);
     assert_eq!(beyond, 0);
+    // One in every hundred files or part of a hundred (docs/reliability.md
+    // explains each).
     assert!(
-        worse.len() as f64 <= 0.01 * written as f64,
+        worse.len() <= written.div_ceil(100),
         "{} of {written} deployed files more than 10 % worse than identify's",
         worse.len()
     );

@@ -467,10 +467,11 @@ fn judge(outcomes: &[Outcome], rule: DeployRule, within3_share: bool) -> Vec<Str
 }
 
 /// How many of `written` files may be more than 10 % worse in truth than
-/// identify's under the default rule: one in a hundred, and the one CI
-/// campaign that is (a lead deployed at 1.4 sd, docs/reliability.md).
+/// identify's under the default rule: one in every hundred files or part
+/// of a hundred (the CI test's 15 have one: a lead deployed by its expected
+/// error at 1.4 sd, docs/reliability.md).
 fn worse_allowed(written: usize) -> usize {
-    (written / 100).max(1)
+    written.div_ceil(100)
 }
 
 /// The deployed terms of `d` whose predicted improvement is below
@@ -557,7 +558,11 @@ fn compare(a: DeployRule, outcomes_a: &[Outcome], b: DeployRule, outcomes_b: &[O
     );
 }
 
-/// 17 campaigns: each case once (40, 80 or 200 poses), backlash twice.
+/// 17 campaigns: each case once (40, 80 or 200 poses), backlash twice,
+/// under the default rule: at most the one file worse than identify's by
+/// more than 10 % (a lead deployed by its expected error at 1.4 sd: the
+/// rule's known risk), every kept-back term with its reason, no named
+/// cause beyond 4 sd.
 #[test]
 fn deployed_files_pay_in_truth() {
     let cases: Vec<(usize, u64, usize)> = (0..CASES.len())
@@ -588,6 +593,9 @@ fn tally() {
         .collect();
     let (judged, compared): (Vec<Outcome>, Vec<Outcome>) = both.into_iter().unzip();
     compare(rule, &judged, other, &compared);
+    // The other rule's tally, for the comparison (its failures are not
+    // this rule's).
+    let _ = judge(&compared, other, true);
     let failures = judge(&judged, rule, true);
     assert!(failures.is_empty(), "{failures:#?}");
 }
