@@ -647,7 +647,10 @@ fn the_default_rule_deploys_the_pitch_terms_the_confident_rule_keeps_back() {
         let kept = pitch(confident);
         assert!(!kept.deployed, "{}", confident.label);
         let why = kept.kept_back_because.expect("a reason");
-        assert!(why.starts_with("the confident rule: "), "{why}");
+        assert!(
+            why.starts_with("the confident rule (--deploy-rule confident): "),
+            "{why}"
+        );
         assert!(
             confident
                 .diagnosis
