@@ -18,7 +18,9 @@
 //!   few hundredths of a mm across it, the tool direction tilted; the
 //!   point `x` of the spindle goes to `p1 + Rot(k1, h1) (p2 + Rot(k2, h2)
 //!   (x - p2) - p1)`. Sizes scale with the head table's
-//!   (`TYPICAL_HEAD_ERRORS`: 0.3 mrad, 0.1 mm, 0.5 mrad, 0.3 mm, 0.05 mm).
+//!   (`TYPICAL_HEAD_ERRORS`: 0.3 mrad, 0.1 mm, 0.5 mrad, 0.3 mm, 0.05 mm),
+//!   all by one factor ([`TrueMachine::random`]) or each kind by its own
+//!   ([`HeadSizes`], [`TrueMachine::random_head`]).
 //! - The sensors: offsets, noise of 0.8 arcsec and 0.5 um per reading,
 //!   the mean of 3.
 //! - A tracker at a random pose 1-3 m from the workspace (any rotation),

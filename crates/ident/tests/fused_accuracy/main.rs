@@ -136,7 +136,7 @@ impl Machines {
         const TAILS: [f64; 4] = [0.5, 1.0, 2.0, 4.0];
         match self {
             Machines::Documented => TrueMachine::random(1.0 + (seed % 3) as f64, seed),
-            Machines::Tails if seed % 2 == 0 => {
+            Machines::Tails if seed.is_multiple_of(2) => {
                 TrueMachine::random(TAILS[(seed / 2 % 4) as usize], seed)
             }
             Machines::Tails => {
