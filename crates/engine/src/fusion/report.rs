@@ -737,3 +737,62 @@ impl FusionReport {
         s
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fusion::{TrackerOptions, TrackerTarget};
+    use tricept_kinematics::Machine;
+    use tricept_model::ParameterSet;
+
+    /// Three tracker points whose target is stated at `offset_mm`.
+    fn tracker(offset_mm: [f64; 3]) -> Source {
+        let csv = "q1,q2,q3,h1,h2,x,y,z\n800,800,800,0,0,1,2,3\n810,800,800,0,0,1,5,3\n800,820,800,0,0,4,2,3\n";
+        let data = tricept_data::read_external_from(csv.as_bytes(), "t.csv").unwrap();
+        let options = TrackerOptions {
+            sigma_um: 10.0,
+            target: TrackerTarget::Known {
+                offset_mm,
+                sigma_um: 5.0,
+            },
+        };
+        Source::tracker(&data, &options).unwrap()
+    }
+
+    #[test]
+    fn a_stated_offset_across_the_tool_turns_with_its_roll() {
+        // The Table 1 machine's head (fixtures/machines/tricept-paper.json):
+        // the tool along z' at
+        // zero angles, the second axis along x', so the tool frame is
+        // d = z', e = x', w = y'. A target at o = (16, -6, 10) mm turns by
+        // r (d x o) = r (6, 16, 0): a tip shift of 6 r along e and 16 r
+        // along w, at the typical axis tilt r = 0.3 mrad.
+        let model = FusedModel::new(Machine::paper(), ParameterSet::paper15(), &[], true).unwrap();
+        let rolls = roll_combinations(&model, &[tracker([16.0, -6.0, 10.0])]);
+        assert_eq!(rolls.len(), 1);
+        let at = |name: &str| rolls[0][model.index_of(name).unwrap()];
+        assert!(
+            (at("tool_shift_e_mm") - 6.0 * 3e-4).abs() < 1e-12,
+            "{}",
+            rolls[0]
+        );
+        assert!(
+            (at("tool_shift_w_mm") - 16.0 * 3e-4).abs() < 1e-12,
+            "{}",
+            rolls[0]
+        );
+        assert!(at("tool_length_mm").abs() < 1e-12);
+        let others: f64 = rolls[0].iter().map(|v| v * v).sum::<f64>()
+            - at("tool_shift_e_mm").powi(2)
+            - at("tool_shift_w_mm").powi(2);
+        assert!(others.abs() < 1e-20);
+        // Along the tool the roll moves nothing; a target at the tip and a
+        // free one have no stated offset; a nominal head has no roll.
+        let along = roll_combinations(&model, &[tracker([0.0, 0.0, 20.0])]);
+        assert!(along[0].norm() < 1e-12);
+        assert!(roll_combinations(&model, &[tracker([0.0; 3])]).is_empty());
+        let nominal =
+            FusedModel::new(Machine::paper(), ParameterSet::paper15(), &[], false).unwrap();
+        assert!(roll_combinations(&nominal, &[tracker([16.0, -6.0, 10.0])]).is_empty());
+    }
+}
