@@ -762,9 +762,8 @@ mod tests {
     #[test]
     fn a_stated_offset_across_the_tool_turns_with_its_roll() {
         // The Table 1 machine's head (fixtures/machines/tricept-paper.json):
-        // the tool along z' at
-        // zero angles, the second axis along x', so the tool frame is
-        // d = z', e = x', w = y'. A target at o = (16, -6, 10) mm turns by
+        // the tool along z' at zero angles, the second axis along x', so the
+        // tool frame is d = z', e = x', w = y'. A target at o = (16, -6, 10) mm turns by
         // r (d x o) = r (6, 16, 0): a tip shift of 6 r along e and 16 r
         // along w, at the typical axis tilt r = 0.3 mrad.
         let model = FusedModel::new(Machine::paper(), ParameterSet::paper15(), &[], true).unwrap();
