@@ -440,7 +440,7 @@ impl Diagnosis {
 
 /// Diagnoses measured data (`tricept diagnose`).
 #[pyfunction]
-#[pyo3(signature = (path=None, csv_text=None, name="<arrays>".to_string(), machine=None, noise_from_data=false, dictionary=true, deploy_rule="confident".to_string()))]
+#[pyo3(signature = (path=None, csv_text=None, name="<arrays>".to_string(), machine=None, noise_from_data=false, dictionary=true, deploy_rule="expected-error".to_string()))]
 #[allow(clippy::too_many_arguments)]
 fn diagnose(
     py: Python<'_>,

@@ -161,8 +161,8 @@ def identify(data, machine: Optional[PathLike] = None, **options) -> "Calibratio
 def diagnose(data, machine: Optional[PathLike] = None, **options) -> "Diagnosis":
     """Does the geometric model explain the data, and if not, which effect
     does (``tricept diagnose``)? Options: ``noise_from_data``,
-    ``dictionary``, ``deploy_rule`` (``"confident"`` or
-    ``"expected-error"``, as ``--deploy-rule``). Returns a :class:`Diagnosis` with ``exit_code``,
+    ``dictionary``, ``deploy_rule`` (``"expected-error"``, the default, or
+    ``"confident"``, as ``--deploy-rule``). Returns a :class:`Diagnosis` with ``exit_code``,
     ``to_json()``, ``report()`` and ``write_machine(path, force=False)``."""
     return _tricept.diagnose(
         machine=None if machine is None else os.fspath(machine), **_data(data), **options

@@ -62,12 +62,12 @@ pub struct DiagnoseArgs {
     /// says so.
     #[arg(long, requires = "write_machine")]
     pub force: bool,
-    /// How a term is judged worth deploying: `confident` (its move where
-    /// the sensors cannot see beyond 2 sd: no file worse in the tallies)
-    /// or `expected-error` (also when the file with it has the smaller
-    /// expected error and its move is at least 1 sd: more files gain, a
-    /// few per hundred lose more than 10 %; docs/diagnosis.md).
-    #[arg(long, value_name = "RULE", default_value = "confident", value_parser = deploy_rule)]
+    /// How a term is judged worth deploying: `expected-error` (the
+    /// default: the file the report expects to be best, a term whose file
+    /// has the smaller expected error by a move of at least 1 sd) or
+    /// `confident` (only a move beyond 2 sd where the sensors cannot see:
+    /// fewer files gain; docs/diagnosis.md, "Two rules").
+    #[arg(long, value_name = "RULE", default_value = "expected-error", value_parser = deploy_rule)]
     pub deploy_rule: DeployRule,
     #[command(flatten)]
     pub noise: NoiseArgs,

@@ -23,7 +23,7 @@ use tricept_model::effects::{Basis, CHANNELS, CauseName, Deployment, GenericFami
 
 use crate::error::DeployError;
 use crate::model::ExtendedModel;
-use crate::report::{DEPLOY_BENEFIT_SD, DEPLOY_IMPROVEMENT_SD, Diagnosis, ModelTerm};
+use crate::report::{Diagnosis, ModelTerm};
 use crate::terms::{Frame, GenericTerm, Scope, Term};
 
 /// The deployable model of a diagnosis, refitted on its clean poses for
@@ -93,10 +93,13 @@ pub fn deploy(
         match (t.deployed, term_of(t)) {
             (true, Some(term)) => terms.push(term),
             (false, _) => recorded.push(format!(
-                "{}: seen, not worth deploying (out-of-sample benefit {} mm, improvement {} mm; deployed only above {DEPLOY_BENEFIT_SD} sd and {DEPLOY_IMPROVEMENT_SD} sd); not in the deployed model",
+                "{}: seen, not worth deploying (out-of-sample benefit {} mm, improvement {} mm, expected rms {} mm with it, {} mm without); kept back because {}; not in the deployed model",
                 t.description,
                 plus_minus(t.holdout_benefit_mm, t.holdout_benefit_sd_mm),
                 plus_minus(t.improvement_mm, t.improvement_sd_mm),
+                number(t.expected_rms_with_mm),
+                number(t.expected_rms_without_mm),
+                t.kept_back_because.as_deref().unwrap_or("the deploy rule"),
             )),
             (true, None) => return Err(DeployError::NotDeployable(t.description.clone())),
         }
@@ -173,6 +176,11 @@ fn plus_minus(value: Option<f64>, sd: Option<f64>) -> String {
         (Some(v), Some(sd)) => format!("{v:.4} +- {sd:.4}"),
         _ => "not computed".into(),
     }
+}
+
+/// `value` for a record line (mm, 4 decimals), or "not computed".
+fn number(value: Option<f64>) -> String {
+    value.map_or_else(|| "not computed".into(), |v| format!("{v:.4}"))
 }
 
 /// The term of a model term of the report.

@@ -347,13 +347,14 @@ fn judge(
         _ => None,
     };
     let z = improvement_sds(gained);
-    let pays = rule(
+    let kept_back = kept_back_because(
         fitter.options.deploy_rule,
         without.is_some(),
         held_out,
         gained,
         expected,
     );
+    let pays = kept_back.is_none();
     let (legs, channel, period_mm, edges_mm) = match t {
         Term::Generic(g) => (
             g.legs().iter().map(|i| *i as u8 + 1).collect(),
@@ -379,6 +380,7 @@ fn judge(
             holdout_benefit_sd_mm: held_out.map(|b| b.sd_mm),
             expected_rms_with_mm: expected.map(|(w, _)| w.sqrt()),
             expected_rms_without_mm: expected.map(|(_, o)| o.sqrt()),
+            kept_back_because: kept_back,
         },
         pays,
         z,
@@ -397,44 +399,75 @@ fn improvement_sds(gained: Option<Improvement>) -> f64 {
     })
 }
 
-/// The module's rule: whether a term pays under `policy`, given whether
-/// the model without it could be fitted (`fitted_without`), its
+/// The module's rule: why a term is kept back under `policy`, given
+/// whether the model without it could be fitted (`fitted_without`), its
 /// out-of-sample benefit `held_out`, its predicted improvement `gained`
 /// and the expected mean squared errors of the files with and without it
-/// (`expected`, mm^2, [`expected_error`]).
-fn rule(
+/// (`expected`, mm^2, [`expected_error`]), in words for the report and the
+/// file; `None` when it pays.
+fn kept_back_because(
     policy: DeployRule,
     fitted_without: bool,
     held_out: Option<Benefit>,
     gained: Option<Improvement>,
     expected: Option<(f64, f64)>,
-) -> bool {
-    match (fitted_without, held_out, gained) {
+) -> Option<String> {
+    let (b, g) = match (fitted_without, held_out, gained) {
         // Without it the model cannot be fitted: it is needed.
-        (false, _, _) => true,
-        (true, Some(b), Some(g)) => {
-            let seen = b.mean_mm > DEPLOY_BENEFIT_SD * b.sd_mm;
-            // It pays where the readings cannot see, or it moves the
-            // platform there by no more than the readings see it gain (so
-            // that it cannot lose more than it gains).
-            let confident = g.mean_mm > DEPLOY_IMPROVEMENT_SD * g.sd_mm
-                || g.mean_mm <= b.mean_mm + DEPLOY_BENEFIT_SD * b.sd_mm;
+        (false, _, _) => return None,
+        (true, Some(b), Some(g)) => (b, g),
+        // No out-of-sample benefit can be had: nothing says it pays.
+        (true, None, _) => {
+            return Some(
+                "no out-of-sample benefit could be had (a fold cannot be fitted without it)".into(),
+            );
+        }
+        (true, Some(_), None) => {
+            return Some(
+                "its improvement where the readings cannot see could not be had (the middle plane not reached)"
+                    .into(),
+            );
+        }
+    };
+    let z = improvement_sds(Some(g));
+    if b.mean_mm <= DEPLOY_BENEFIT_SD * b.sd_mm {
+        return Some(format!(
+            "the readings do not see it pay out of sample (its benefit not above {DEPLOY_BENEFIT_SD} sd)"
+        ));
+    }
+    // It pays where the readings cannot see, or it moves the platform
+    // there by no more than the readings see it gain (so that it cannot
+    // lose more than it gains).
+    let confident = g.mean_mm > DEPLOY_IMPROVEMENT_SD * g.sd_mm
+        || g.mean_mm <= b.mean_mm + DEPLOY_BENEFIT_SD * b.sd_mm;
+    if confident {
+        return None;
+    }
+    match policy {
+        DeployRule::Confident => Some(format!(
+            "the confident rule (--deploy-rule confident): its improvement is {z:.1} sd, not above {DEPLOY_IMPROVEMENT_SD} sd, and larger than the benefit the readings see"
+        )),
+        DeployRule::ExpectedError => match expected {
+            None => Some(format!(
+                "its expected errors could not be had, and its improvement is {z:.1} sd, not above {DEPLOY_IMPROVEMENT_SD} sd"
+            )),
+            Some((with, without)) if with >= without => {
+                Some("the file with it is not expected better".into())
+            }
             // The file with it is expected better, by a move of at least
             // one standard deviation.
-            let expected_better = expected.is_some_and(|(with, without)| with < without)
-                && g.mean_mm >= EXPECTED_ERROR_MIN_SD * g.sd_mm;
-            seen && match policy {
-                DeployRule::Confident => confident,
-                DeployRule::ExpectedError => confident || expected_better,
-            }
-        }
-        // No out-of-sample benefit can be had: nothing says it pays.
-        _ => false,
+            Some(_) if g.mean_mm >= EXPECTED_ERROR_MIN_SD * g.sd_mm => None,
+            Some(_) => Some(format!(
+                "its improvement is within its own uncertainty ({z:.1} sd, below {EXPECTED_ERROR_MIN_SD}): the file without it is about as likely the better one"
+            )),
+        },
     }
 }
 
 /// The least predicted improvement, in its standard deviations, of a term
-/// [`DeployRule::ExpectedError`] deploys for its expected error alone.
+/// [`DeployRule::ExpectedError`] deploys for its expected error alone:
+/// below it the file without the term is about as likely the better one
+/// (measured: leg leads at 0.8 sd, 72 -> 94 and 67 -> 76 um).
 const EXPECTED_ERROR_MIN_SD: f64 = 1.0;
 
 /// Every term of the final model `current` with its predicted
@@ -503,7 +536,12 @@ pub(crate) fn deployable(
                 // The model of the remaining terms cannot be fitted:
                 // deploy none.
                 for r in records.iter_mut().flatten() {
-                    r.deployed = false;
+                    if r.deployed {
+                        r.deployed = false;
+                        r.kept_back_because = Some(
+                            "the model of the terms that pay cannot be fitted without the ones kept back: none is deployed".into(),
+                        );
+                    }
                 }
                 kept.clear();
             }

@@ -326,9 +326,11 @@ pub struct ModelTerm {
     /// the file without it, out of sample (its benefit,
     /// [`ModelTerm::holdout_benefit_mm`], above [`DEPLOY_BENEFIT_SD`]
     /// standard deviations) and where the readings cannot see (its
-    /// improvement above [`DEPLOY_IMPROVEMENT_SD`] standard deviations),
-    /// both against the deployed model without it; no term is exempt. Or
-    /// the model without it cannot be fitted.
+    /// improvement above [`DEPLOY_IMPROVEMENT_SD`] standard deviations, or,
+    /// under the default rule, the smaller expected error by an improvement
+    /// of at least one standard deviation: [`crate::DeployRule`]), both
+    /// against the deployed model without it; no term is exempt. Or the
+    /// model without it cannot be fitted.
     pub deployed: bool,
     /// The mean platform error on the middle plane of the deployed model
     /// without this term minus that of the deployed model (the final model
@@ -355,6 +357,12 @@ pub struct ModelTerm {
     pub expected_rms_with_mm: Option<f64>,
     /// The same for the deployed model without this term, mm.
     pub expected_rms_without_mm: Option<f64>,
+    /// Why the deploy rule keeps the term back, in words (`null` when it is
+    /// deployed): the readings do not see it pay out of sample, the file
+    /// with it is not expected better, its improvement is within its own
+    /// uncertainty, or (`--deploy-rule confident`) it is not confidently
+    /// better.
+    pub kept_back_because: Option<String>,
 }
 
 /// How many standard deviations ([`ModelTerm::improvement_sd_mm`]) a
@@ -729,8 +737,9 @@ impl Diagnosis {
                 w!("deployed: {}{numbers}", t.description);
             } else {
                 w!(
-                    "seen, not worth deploying: {}{numbers} (deployed only above {DEPLOY_BENEFIT_SD} sd out of sample and {DEPLOY_IMPROVEMENT_SD} sd of improvement)",
-                    t.description
+                    "seen, not worth deploying: {}{numbers}; kept back because {}",
+                    t.description,
+                    t.kept_back_because.as_deref().unwrap_or("the deploy rule")
                 );
             }
         }

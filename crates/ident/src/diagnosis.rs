@@ -60,7 +60,8 @@ pub struct DiagnoseRequest {
     /// Search the generic dictionary as well as the vocabulary (default).
     pub dictionary: bool,
     /// How a term is judged worth deploying (default
-    /// [`DeployRule::Confident`]; JSON `deploy_rule`).
+    /// [`DeployRule::ExpectedError`]: the file the report expects to be
+    /// best; JSON `deploy_rule`).
     pub deploy_rule: DeployRule,
 }
 
@@ -75,7 +76,7 @@ impl DiagnoseRequest {
             temperature_noise_k: None,
             plausibility: None,
             dictionary: true,
-            deploy_rule: DeployRule::Confident,
+            deploy_rule: DeployRule::default(),
         }
     }
 }

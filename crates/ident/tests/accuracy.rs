@@ -111,13 +111,20 @@ struct Outcome {
     /// (`diagnose`) what identify's geometric file delivers, written with
     /// `--force` when it must be.
     geometric_mm: f64,
+    /// (`diagnose`, compared) under the other deploy rule: its exit code,
+    /// what its file delivers, and whether it deploys other terms.
+    other: Option<(u8, f64, bool)>,
 }
 
 /// The verb that writes the file.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Verb {
     Identify,
-    Diagnose,
+    /// `diagnose --write-machine` under a deploy rule.
+    Diagnose(DeployRule),
+    /// `diagnose --write-machine` under a deploy rule and, compared, under
+    /// the other rule ([`other_rule`]).
+    DiagnoseCompared(DeployRule),
 }
 
 /// Campaign `seed`: simulated by the independent generator, calibrated
@@ -165,6 +172,7 @@ fn campaign(seed: u64, dir: &Path, verb: Verb) -> Outcome {
         delivered_mm: f64::NAN,
         parts: serde_json::Value::Null,
         geometric_mm: f64::NAN,
+        other: None,
     };
     let file = match verb {
         Verb::Identify => {
@@ -181,15 +189,38 @@ fn campaign(seed: u64, dir: &Path, verb: Verb) -> Outcome {
             c.write_machine(&identify_file, false).unwrap();
             identify_file
         }
-        Verb::Diagnose => {
+        Verb::Diagnose(rule) | Verb::DiagnoseCompared(rule) => {
             c.write_machine(&identify_file, true).unwrap();
             let (sum, count) = delivered(&identify_file, &truth, &effects, &targets, dir);
             outcome.geometric_mm = (sum / count as f64).sqrt();
-            let loaded = load_machine(None, &SensorNoise::default()).unwrap();
-            let mut request = DiagnoseRequest::new(loaded, DataInput::File(data.clone()));
-            request.deploy_rule = deploy_rule();
-            let r = diagnose(request).unwrap();
+            let diagnosed = |rule: DeployRule| {
+                let loaded = load_machine(None, &SensorNoise::default()).unwrap();
+                let mut request = DiagnoseRequest::new(loaded, DataInput::File(data.clone()));
+                request.deploy_rule = rule;
+                let r = diagnose(request).unwrap();
+                if std::env::var_os("TRICEPT_TALLY_TERMS").is_some() {
+                    eprintln!(
+                        "seed {seed} {} terms: {}",
+                        rule.name(),
+                        terms_line(&r.to_json())
+                    );
+                }
+                r
+            };
+            let r = diagnosed(rule);
             outcome.exit = r.exit_code();
+            if verb == Verb::DiagnoseCompared(rule) {
+                let o = diagnosed(other_rule(rule));
+                let changed = deployed_terms(&o.to_json()) != deployed_terms(&r.to_json());
+                let mut delivered_mm = f64::NAN;
+                if o.exit_code() == 0 {
+                    let file = dir.join(format!("diagnose-other-{seed}.json"));
+                    o.write_machine(&file, false).unwrap();
+                    let (sum, count) = delivered(&file, &truth, &effects, &targets, dir);
+                    delivered_mm = (sum / count as f64).sqrt();
+                }
+                outcome.other = Some((o.exit_code(), delivered_mm, changed));
+            }
             if outcome.exit != 0 {
                 return outcome;
             }
@@ -217,6 +248,63 @@ fn campaign(seed: u64, dir: &Path, verb: Verb) -> Outcome {
     assert!(count > TARGETS / 2, "seed {seed}: {count} targets reached");
     outcome.delivered_mm = (sum / count as f64).sqrt();
     outcome
+}
+
+/// The descriptions of the terms a diagnosis' JSON deploys.
+fn deployed_terms(json: &str) -> Vec<String> {
+    let v: serde_json::Value = serde_json::from_str(json).unwrap();
+    v["model_terms"]
+        .as_array()
+        .map(|terms| {
+            terms
+                .iter()
+                .filter(|t| t["deployed"] == true)
+                .filter_map(|t| t["description"].as_str().map(str::to_string))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Each model term of a diagnosis' JSON in a few numbers (um): how the
+/// deploy rule judged it.
+fn terms_line(json: &str) -> String {
+    let v: serde_json::Value = serde_json::from_str(json).unwrap();
+    let um = |t: &serde_json::Value, k: &str| {
+        t[k].as_f64()
+            .map_or("-".to_string(), |x| format!("{:.1}", 1e3 * x))
+    };
+    let f = &v["final"];
+    let fit = format!(
+        "final chi2/dof {:.2} (p {:.3}), held-out rms {:.2} (noise = 1); ",
+        f["chi_square"].as_f64().unwrap_or(f64::NAN) / f["dof"].as_f64().unwrap_or(f64::NAN),
+        f["p_value"].as_f64().unwrap_or(f64::NAN),
+        v["gain"]["holdout_rms_extended"]
+            .as_f64()
+            .unwrap_or(f64::NAN)
+    );
+    fit + &v["model_terms"]
+        .as_array()
+        .map(|terms| {
+            terms
+                .iter()
+                .map(|t| {
+                    format!(
+                        "{}{}: benefit {} +- {}, improvement {} +- {} (move {}), expected {} with, {} without",
+                        t["description"].as_str().unwrap_or("?"),
+                        if t["deployed"] == true { "" } else { " (kept back)" },
+                        um(t, "holdout_benefit_mm"),
+                        um(t, "holdout_benefit_sd_mm"),
+                        um(t, "improvement_mm"),
+                        um(t, "improvement_sd_mm"),
+                        um(t, "difference_sd_mm"),
+                        um(t, "expected_rms_with_mm"),
+                        um(t, "expected_rms_without_mm"),
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join("; ")
+        })
+        .unwrap_or_default()
 }
 
 /// Whether a report states the promise in its first lines.
@@ -301,22 +389,37 @@ fn tally(
 }
 
 /// The deploy rule of the diagnosed campaigns: `TRICEPT_TALLY_DEPLOY_RULE`
-/// (`confident`, the default, or `expected-error`).
+/// (`confident` or `expected-error`), or the default.
 fn deploy_rule() -> DeployRule {
     std::env::var("TRICEPT_TALLY_DEPLOY_RULE")
         .map(|s| s.parse().expect("TRICEPT_TALLY_DEPLOY_RULE: a deploy rule"))
         .unwrap_or_default()
 }
 
+/// The rule a tally compares `rule` with.
+fn other_rule(rule: DeployRule) -> DeployRule {
+    if rule == DeployRule::Confident {
+        DeployRule::ExpectedError
+    } else {
+        DeployRule::Confident
+    }
+}
+
 /// The 200 seeds of a tally from `first`, moved by
 /// `TRICEPT_TALLY_SEED_OFFSET` (another seed set: `2000` runs the identify
-/// tally on seeds 3000-3199).
-fn seeds(first: u64) -> std::ops::Range<u64> {
+/// tally on seeds 3000-3199); `TRICEPT_TALLY_SEEDS=2127,2174` runs only
+/// those of them.
+fn seeds(first: u64) -> Vec<u64> {
     let offset: u64 = std::env::var("TRICEPT_TALLY_SEED_OFFSET")
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(0);
-    first + offset..first + offset + 200
+    let only: Option<Vec<u64>> = std::env::var("TRICEPT_TALLY_SEEDS")
+        .ok()
+        .map(|v| v.split(',').filter_map(|s| s.trim().parse().ok()).collect());
+    (first + offset..first + offset + 200)
+        .filter(|s| only.as_ref().is_none_or(|o| o.contains(s)))
+        .collect()
 }
 
 fn scratch(name: &str) -> std::path::PathBuf {
@@ -350,7 +453,7 @@ fn files_written_at_exit_0_deliver_their_promise_in_truth() {
 #[ignore = "the identify tally of docs/reliability.md: 200 campaigns"]
 fn tally_of_200_campaigns() {
     let dir = scratch("tally");
-    let (outcomes, written, within, beyond) = tally(seeds(1000), &dir, Verb::Identify);
+    let (outcomes, written, within, beyond) = tally(seeds(1000).into_iter(), &dir, Verb::Identify);
     let _ = std::fs::remove_dir_all(&dir);
     println!(
         "campaigns {}, files written (exit 0) {written}, within the promise {within}, beyond 2x {beyond}, median delivered/upper {:.2}",
@@ -393,7 +496,8 @@ fn an_edited_promise_is_refused() {
 #[test]
 fn diagnosed_files_state_and_keep_their_promise() {
     let dir = scratch("diagnose-ci");
-    let (outcomes, written, within, beyond) = tally(2000..2012, &dir, Verb::Diagnose);
+    let (outcomes, written, within, beyond) =
+        tally(2000..2012, &dir, Verb::Diagnose(DeployRule::default()));
     let _ = std::fs::remove_dir_all(&dir);
     assert!(
         written >= 6,
@@ -412,11 +516,18 @@ fn diagnosed_files_state_and_keep_their_promise() {
 /// unexplained slip, a scale gain for a lead with a curved screw) moved the
 /// platform along the direction the readings cannot see, and were deployed
 /// worse than identify's file until the move had to stand out of the legs'
-/// structure (docs/diagnosis.md, `holdout::structured_sd`): none is now.
+/// structure (docs/diagnosis.md, `holdout::structured_sd`): under the
+/// confident rule, whose threshold that structure sets, none is now. (The
+/// default rule deploys the curved leg, 2127, by its expected error at 1.9
+/// sd: one of its explained worse files, docs/reliability.md.)
 #[test]
 fn moves_the_readings_cannot_see_are_not_deployed_worse() {
     let dir = scratch("weak-direction");
-    let (outcomes, _, _, _) = tally([2065, 2066, 2127, 2141].into_iter(), &dir, Verb::Diagnose);
+    let (outcomes, _, _, _) = tally(
+        [2065, 2066, 2127, 2141].into_iter(),
+        &dir,
+        Verb::Diagnose(DeployRule::Confident),
+    );
     let _ = std::fs::remove_dir_all(&dir);
     let worse: Vec<(u64, f64, f64)> = outcomes
         .iter()
@@ -433,24 +544,75 @@ fn moves_the_readings_cannot_see_are_not_deployed_worse() {
 #[ignore = "the diagnose tally of docs/reliability.md: 200 campaigns"]
 fn tally_of_diagnosed_campaigns() {
     let dir = scratch("diagnose");
-    let (outcomes, written, within, beyond) = tally(seeds(2000), &dir, Verb::Diagnose);
+    let (outcomes, written, within, beyond) = tally(
+        seeds(2000).into_iter(),
+        &dir,
+        Verb::DiagnoseCompared(deploy_rule()),
+    );
     let _ = std::fs::remove_dir_all(&dir);
-    let worse = outcomes
+    let worse: Vec<&Outcome> = outcomes
         .iter()
         .filter(|o| o.exit == 0 && o.delivered_mm > 1.1 * o.geometric_mm)
-        .count();
+        .collect();
     let rule = deploy_rule();
+    let sum = |f: &dyn Fn(&Outcome) -> Option<f64>| outcomes.iter().filter_map(f).sum::<f64>();
     println!(
-        "diagnose ({}): campaigns {}, files written (exit 0) {written}, within the promise {within}, beyond 2x {beyond}, deployed worse than identify's file by more than 10 % {worse}, median delivered/upper {:.2}",
+        "diagnose ({}): campaigns {}, files written (exit 0) {written}, within the promise {within}, beyond 2x {beyond}, deployed worse than identify's file by more than 10 % {}, median delivered/upper {:.2}, sum of delivered rms {:.2} mm",
         rule.name(),
         outcomes.len(),
-        median_ratio(&outcomes)
+        worse.len(),
+        median_ratio(&outcomes),
+        sum(&|o| (o.exit == 0).then_some(o.delivered_mm)),
+    );
+    for o in &worse {
+        println!(
+            "worse: seed {} delivered {:.1} um, identify's {:.1} um, {:?}",
+            o.seed,
+            1e3 * o.delivered_mm,
+            1e3 * o.geometric_mm,
+            o.effects
+        );
+    }
+    // Against the other rule, on the files both write at exit 0.
+    let both: Vec<(&Outcome, f64, bool)> = outcomes
+        .iter()
+        .filter_map(|o| match o.other {
+            Some((0, other_mm, changed)) if o.exit == 0 => Some((o, other_mm, changed)),
+            _ => None,
+        })
+        .collect();
+    let changed: Vec<&(&Outcome, f64, bool)> = both.iter().filter(|b| b.2).collect();
+    for (o, other_mm, _) in &changed {
+        println!(
+            "changed: seed {} identify {:.1} um, {} {:.1} um, {} {:.1} um",
+            o.seed,
+            1e3 * o.geometric_mm,
+            other_rule(rule).name(),
+            1e3 * other_mm,
+            rule.name(),
+            1e3 * o.delivered_mm
+        );
+    }
+    println!(
+        "diagnose ({}) against {}: written at exit 0 under both {}, changed {}, better {}, sum of delivered rms {:.2} mm -> {:.2} mm",
+        rule.name(),
+        other_rule(rule).name(),
+        both.len(),
+        changed.len(),
+        changed
+            .iter()
+            .filter(|(o, other, _)| o.delivered_mm < *other)
+            .count(),
+        both.iter().map(|b| b.1).sum::<f64>(),
+        both.iter().map(|b| b.0.delivered_mm).sum::<f64>(),
     );
     assert!(within as f64 >= 0.95 * written as f64);
     assert_eq!(beyond, 0);
-    // The expected-error rule trades a few worse files for more gains
-    // (docs/reliability.md): its count is reported, not required.
-    if rule == DeployRule::Confident {
-        assert_eq!(worse, 0, "deployed files worse than identify's");
-    }
+    // One in every hundred files or part of a hundred (docs/reliability.md
+    // explains each).
+    assert!(
+        worse.len() <= written.div_ceil(100),
+        "{} of {written} deployed files more than 10 % worse than identify's",
+        worse.len()
+    );
 }

@@ -47,7 +47,7 @@ mod tracker;
 pub use campaign::{Row, to_csv};
 pub use instruments::{TrueBallbar, TrueSphere};
 pub use legs::{DELIVERY_T, LegContext, LegEffect};
-pub use machine::{SensorNoise, TrueHead, TrueMachine};
+pub use machine::{HeadSizes, SensorNoise, TrueHead, TrueMachine};
 pub use tracker::TrueTracker;
 
 use nalgebra::{Matrix3, Vector3};

@@ -18,7 +18,9 @@
 //!   few hundredths of a mm across it, the tool direction tilted; the
 //!   point `x` of the spindle goes to `p1 + Rot(k1, h1) (p2 + Rot(k2, h2)
 //!   (x - p2) - p1)`. Sizes scale with the head table's
-//!   (`TYPICAL_HEAD_ERRORS`: 0.3 mrad, 0.1 mm, 0.5 mrad, 0.3 mm, 0.05 mm).
+//!   (`TYPICAL_HEAD_ERRORS`: 0.3 mrad, 0.1 mm, 0.5 mrad, 0.3 mm, 0.05 mm),
+//!   all by one factor ([`TrueMachine::random`]) or each kind by its own
+//!   ([`HeadSizes`], [`TrueMachine::random_head`]).
 //! - The sensors: offsets, noise of 0.8 arcsec and 0.5 um per reading,
 //!   the mean of 3.
 //! - A tracker at a random pose 1-3 m from the workspace (any rotation),
@@ -93,6 +95,40 @@ impl TrueHead {
     }
 }
 
+/// The sizes of a true head's errors by kind, in the head table's typical
+/// sizes (`TYPICAL_HEAD_ERRORS`: axis tilts 0.3 mrad, axis points 0.1 mm,
+/// angle zeros 0.5 mrad, the tool tip 0.1-0.5 mm along the tool and 0.05
+/// mm across it, the tool's tilt 0.3 mrad).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeadSizes {
+    /// The two axes' directions.
+    pub axis_tilts: f64,
+    /// The two axes' points.
+    pub axis_points: f64,
+    /// The two angle zeros.
+    pub angle_zeros: f64,
+    /// The tool tip along the tool.
+    pub tool_length: f64,
+    /// The tool tip across the tool.
+    pub tool_across: f64,
+    /// The tool's direction.
+    pub tool_tilt: f64,
+}
+
+impl HeadSizes {
+    /// Every kind `c` typical sizes.
+    pub fn all(c: f64) -> HeadSizes {
+        HeadSizes {
+            axis_tilts: c,
+            axis_points: c,
+            angle_zeros: c,
+            tool_length: c,
+            tool_across: c,
+            tool_tilt: c,
+        }
+    }
+}
+
 /// A true machine.
 #[derive(Debug, Clone)]
 pub struct TrueMachine {
@@ -129,7 +165,7 @@ fn tilted(v: &Vector3<f64>, sigma: f64, rng: &mut Pcg64Mcg) -> Vector3<f64> {
 impl TrueMachine {
     /// The documented machine itself (no errors, no sensor offsets).
     pub fn documented() -> TrueMachine {
-        let mut m = TrueMachine::random_sized(0.0, 0.0, 0);
+        let mut m = TrueMachine::random_sized(0.0, HeadSizes::all(0.0), 0);
         m.sensor_offsets = [0.0; 3];
         m.head.tip = vec3(&table1()["head"]["tool_tip_mm"]);
         m
@@ -138,10 +174,18 @@ impl TrueMachine {
     /// A machine: module errors N(0, 0.25 mm); head errors `head_scale`
     /// times the head table's sizes; seeded.
     pub fn random(head_scale: f64, seed: u64) -> TrueMachine {
-        TrueMachine::random_sized(0.25, head_scale, seed)
+        TrueMachine::random_sized(0.25, HeadSizes::all(head_scale), seed)
     }
 
-    fn random_sized(module_mm: f64, head_scale: f64, seed: u64) -> TrueMachine {
+    /// A machine whose head's errors are of different sizes by kind
+    /// (`sizes`, in the head table's typical sizes), as a real head's may
+    /// be: module errors N(0, 0.25 mm); seeded. With every size `c` it is
+    /// [`TrueMachine::random`]`(c, seed)`.
+    pub fn random_head(sizes: HeadSizes, seed: u64) -> TrueMachine {
+        TrueMachine::random_sized(0.25, sizes, seed)
+    }
+
+    fn random_sized(module_mm: f64, sizes: HeadSizes, seed: u64) -> TrueMachine {
         let d = table1();
         let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x1dea_0f00);
         let c = &d["placement"]["circular"];
@@ -175,11 +219,26 @@ impl TrueMachine {
         });
         let leg_offsets_mm = std::array::from_fn(|_| module_mm * normal(&mut rng));
         let h = &d["head"];
-        let s = head_scale;
-        let k1 = tilted(&vec3(&h["axis1_direction"]).normalize(), 3e-4 * s, &mut rng);
-        let k2 = tilted(&vec3(&h["axis2_direction"]).normalize(), 3e-4 * s, &mut rng);
+        let HeadSizes {
+            axis_tilts: tilts,
+            axis_points: points,
+            angle_zeros: zeros,
+            tool_length: length,
+            tool_across: across_size,
+            tool_tilt,
+        } = sizes;
+        let k1 = tilted(
+            &vec3(&h["axis1_direction"]).normalize(),
+            3e-4 * tilts,
+            &mut rng,
+        );
+        let k2 = tilted(
+            &vec3(&h["axis2_direction"]).normalize(),
+            3e-4 * tilts,
+            &mut rng,
+        );
         let direction0 = vec3(&h["tool_direction"]).normalize();
-        let direction = tilted(&direction0, 3e-4 * s, &mut rng);
+        let direction = tilted(&direction0, 3e-4 * tool_tilt, &mut rng);
         let along =
             (0.1 + 0.4 * rng.random::<f64>()) * if rng.random::<bool>() { 1.0 } else { -1.0 };
         let across = perpendicular(&direction0);
@@ -188,17 +247,17 @@ impl TrueMachine {
             StandardNormal.sample(&mut rng),
         );
         let tip = vec3(&h["tool_tip_mm"])
-            + direction0 * along * s
-            + across * 0.05 * s * e1
-            + direction0.cross(&across) * 0.05 * s * e2;
+            + direction0 * along * length
+            + across * 0.05 * across_size * e1
+            + direction0.cross(&across) * 0.05 * across_size * e2;
         let head = TrueHead {
             k1,
-            p1: vec3(&h["axis1_point_mm"]) + normal3(&mut rng, 0.1 * s),
+            p1: vec3(&h["axis1_point_mm"]) + normal3(&mut rng, 0.1 * points),
             k2,
-            p2: vec3(&h["axis2_point_mm"]) + normal3(&mut rng, 0.1 * s),
+            p2: vec3(&h["axis2_point_mm"]) + normal3(&mut rng, 0.1 * points),
             tip,
             direction,
-            zeros: std::array::from_fn(|_| 5e-4 * s * normal(&mut rng)),
+            zeros: std::array::from_fn(|_| 5e-4 * zeros * normal(&mut rng)),
         };
         TrueMachine {
             base,

@@ -309,15 +309,17 @@ fn plots_never_overwrite_an_input_or_the_history() {
 }
 
 /// `diagnose --json` says which deploy rule judged the terms (the default
-/// `confident`, or `--deploy-rule expected-error`), and states every
-/// model term's expected errors with and without it.
+/// `expected-error`, or `--deploy-rule confident`), and states every
+/// model term's expected errors with and without it, and why a term is
+/// kept back (`null` for a deployed one).
 #[test]
 fn the_deploy_rule_and_the_expected_errors_are_in_the_json() {
     let dir = workdir("deploy-rule");
     let d = dir.as_path();
     let fixture = hidden_effect();
     for (extra, name) in [
-        (&[][..], "confident"),
+        (&[][..], "expected-error"),
+        (&["--deploy-rule", "confident"][..], "confident"),
         (&["--deploy-rule", "expected-error"][..], "expected-error"),
     ] {
         let mut args = vec!["diagnose", "--json", "--data", &fixture];
@@ -337,6 +339,7 @@ fn the_deploy_rule_and_the_expected_errors_are_in_the_json() {
                 with.is_some_and(|w| w >= 0.0) && without.is_some_and(|w| w >= 0.0),
                 "{t}"
             );
+            assert_eq!(t["deployed"], t["kept_back_because"].is_null(), "{t}");
         }
     }
     std::fs::remove_dir_all(&dir).ok();

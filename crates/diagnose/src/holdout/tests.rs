@@ -16,6 +16,17 @@ fn g(mean_mm: f64, sd_mm: f64) -> Option<Improvement> {
     })
 }
 
+/// Whether the rule deploys the term: nothing keeps it back.
+fn rule(
+    policy: DeployRule,
+    fitted_without: bool,
+    held_out: Option<Benefit>,
+    gained: Option<Improvement>,
+    expected: Option<(f64, f64)>,
+) -> bool {
+    kept_back_because(policy, fitted_without, held_out, gained, expected).is_none()
+}
+
 #[test]
 fn a_held_out_pose_is_predicted_by_a_fit_without_its_fold() {
     // Moving one pose's readings changes no other held-out error of its
@@ -349,6 +360,59 @@ fn the_expected_error_rule_adds_files_expected_better_by_a_move_of_one_sd() {
         worse
     ));
     assert!(rule(DeployRule::ExpectedError, false, None, None, None));
+}
+
+#[test]
+fn a_term_kept_back_says_why() {
+    let seen = b(1.0, 0.25);
+    let why = |policy, held_out, gained, expected| {
+        kept_back_because(policy, true, held_out, gained, expected).expect("kept back")
+    };
+    // Not seen out of sample: said so, with its numbers, under either rule,
+    // even when the file with it is expected better.
+    for policy in [DeployRule::Confident, DeployRule::ExpectedError] {
+        let w = why(policy, b(0.2, 0.1), g(3.0, 1.0), Some((0.01, 0.04)));
+        assert!(
+            w.starts_with(
+                "the readings do not see it pay out of sample (its benefit not above 2 sd)"
+            ),
+            "{w}"
+        );
+    }
+    // Expected better by 1.6 sd: only the confident rule keeps it back, and
+    // names itself.
+    let w = why(DeployRule::Confident, seen, g(1.6, 1.0), Some((0.01, 0.04)));
+    assert!(
+        w.starts_with("the confident rule (--deploy-rule confident): its improvement is 1.6 sd, not above 2 sd"),
+        "{w}"
+    );
+    // Not expected better: the two expected errors.
+    let w = why(
+        DeployRule::ExpectedError,
+        seen,
+        g(1.6, 1.0),
+        Some((0.04, 0.01)),
+    );
+    assert_eq!(w, "the file with it is not expected better");
+    // Expected better, but by less than one sd.
+    let w = why(
+        DeployRule::ExpectedError,
+        seen,
+        g(1.6, 2.0),
+        Some((0.01, 0.04)),
+    );
+    assert!(
+        w.starts_with("its improvement is within its own uncertainty (0.8 sd, below 1)"),
+        "{w}"
+    );
+    // Nothing to judge by.
+    let w = why(DeployRule::ExpectedError, seen, g(1.6, 1.0), None);
+    assert!(w.starts_with("its expected errors could not be had"), "{w}");
+    assert!(
+        why(DeployRule::ExpectedError, None, g(1.0, 1.0), None)
+            .starts_with("no out-of-sample benefit")
+    );
+    assert!(why(DeployRule::ExpectedError, seen, None, None).starts_with("its improvement where"));
 }
 
 #[test]

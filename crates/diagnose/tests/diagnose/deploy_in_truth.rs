@@ -203,10 +203,12 @@ fn leg_effects(seed: u64) -> Vec<(&'static str, Effect)> {
 
 /// Three machines of each leg error (80, 80 and 120 poses): every data
 /// set is explained by a term of the dictionary and written (exit 0); a
-/// deployed leg term makes the machine at least 2x more accurate in truth
-/// than identify's file, 3x on average; a term seen but not worth
-/// deploying leaves identify's file; the true improvement is within 3 sd
-/// of the predicted one. A worn segment (a step: `leg-step`, its edges
+/// leg term deployed beyond 2 sd of its improvement makes the machine at
+/// least 2x more accurate in truth than identify's file, one deployed by
+/// its expected error alone (1-2 sd, the default rule) no more than 10 %
+/// worse, and the deployed machines are 3x more accurate on average; a term
+/// seen but not worth deploying leaves identify's file; the true
+/// improvement is within 3 sd of the predicted one. A worn segment (a step: `leg-step`, its edges
 /// scanned) is deployed as a table that carries the simulated step away
 /// from its edges to within 1 um.
 #[test]
@@ -286,7 +288,16 @@ fn generic_leg_errors_are_deployed_and_pay_in_truth() {
         if !o.written {
             failures.push(format!("{}: not explained, exit 3", o.label));
         }
-        if deployed_generic && ratio < 2.0 {
+        // Deployed by its expected error alone: an improvement of 1-2 sd,
+        // better in expectation; in truth one draw of the weak direction.
+        let by_expected_error = o.diagnosis.model_terms.iter().any(|t| {
+            t.deployed
+                && t.effect.is_generic()
+                && matches!((t.improvement_mm, t.improvement_sd_mm), (Some(i), Some(sd))
+                    if i <= tricept_diagnose::DEPLOY_IMPROVEMENT_SD * sd)
+        });
+        let floor = if by_expected_error { 1.0 / 1.1 } else { 2.0 };
+        if deployed_generic && ratio < floor {
             failures.push(format!("{}: deployed, x{ratio:.2}", o.label));
         }
         if nothing_deployed && (ratio - 1.0).abs() > 1e-6 {

@@ -12,11 +12,15 @@
 //! controller's backlash and thermal compensation applied as the file's
 //! `controller` block says), and the platform's true errors are compared.
 //!
-//! Required: no file written at exit 0 more than 10 % worse in truth than
-//! `identify`'s; a catalogue cause named at exit 0 has its true gain within
-//! 4 sd of its predicted gain, and (on the tally) within 3 sd in 95 % of
-//! the cases. The CI test runs 17 campaigns; `deploy_pays::tally`
-//! (`--ignored`) runs 96.
+//! Required under the default rule: at most one file written at exit 0 in
+//! a hundred (one in the CI test's 15) more than 10 % worse in truth than
+//! `identify`'s, and each a term deployed by its expected error alone (the
+//! rule's known risk: a file better in expectation, worse for some draws of
+//! the weak direction's error); a kept-back term says why; a catalogue
+//! cause named at exit 0 has its true gain within 4 sd of its predicted
+//! gain, and (on the tally) within 3 sd in 95 % of the cases. The CI test
+//! runs 17 campaigns; `deploy_pays::tally` (`--ignored`) runs 96 under both
+//! rules and compares them.
 
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
@@ -309,30 +313,47 @@ fn run(case: usize, seed: u64, n: usize, rule: DeployRule) -> Outcome {
     }
 }
 
-/// Runs the campaigns and returns the failures (with `within3_share`, also
-/// fewer than 95 % of the named causes within 3 sd of their predicted
-/// gain: a share, asserted on the tally's 48, not on the CI test's 9).
-fn evaluate(cases: Vec<(usize, u64, usize)>, within3_share: bool) -> Vec<String> {
-    // DEPLOY_PAYS_CASES=3,9 runs only those cases (by index in CASES);
-    // DEPLOY_PAYS_RULE=expected-error diagnoses with that deploy rule (its
-    // files more than 10 % worse are counted, not failures).
+/// The campaigns to run: `cases`, or with `DEPLOY_PAYS_CASES=3,9` only
+/// those cases (by index in [`CASES`]).
+fn selected(cases: Vec<(usize, u64, usize)>) -> Vec<(usize, u64, usize)> {
     let only: Option<Vec<usize>> = std::env::var("DEPLOY_PAYS_CASES")
         .ok()
         .map(|v| v.split(',').filter_map(|c| c.trim().parse().ok()).collect());
-    let rule: DeployRule = std::env::var("DEPLOY_PAYS_RULE")
-        .map(|s| s.parse().expect("DEPLOY_PAYS_RULE: a deploy rule"))
-        .unwrap_or_default();
-    let outcomes: Vec<Outcome> = cases
+    cases
         .into_iter()
         .filter(|(c, _, _)| only.as_ref().is_none_or(|o| o.contains(c)))
-        .collect::<Vec<_>>()
+        .collect()
+}
+
+/// The deploy rule the campaigns are diagnosed with: the default, or
+/// `DEPLOY_PAYS_RULE` (`confident`, `expected-error`).
+fn rule_of_run() -> DeployRule {
+    std::env::var("DEPLOY_PAYS_RULE")
+        .map(|s| s.parse().expect("DEPLOY_PAYS_RULE: a deploy rule"))
+        .unwrap_or_default()
+}
+
+/// Runs the campaigns under `rule` and returns the failures
+/// ([`judge`]).
+fn evaluate(cases: Vec<(usize, u64, usize)>, within3_share: bool) -> Vec<String> {
+    let rule = rule_of_run();
+    let outcomes: Vec<Outcome> = selected(cases)
         .into_par_iter()
         .map(|(case, seed, n)| run(case, seed, n, rule))
         .collect();
+    judge(&outcomes, rule, within3_share)
+}
+
+/// The failures of `outcomes` diagnosed under `rule`: a file written at
+/// exit 0 more than 10 % worse in truth than identify's (under the
+/// default rule), a named cause beyond 4 sd of its predicted gain (with
+/// `within3_share`, also fewer than 95 % within 3 sd: a share, asserted on
+/// the tally's 48, not on the CI test's 9).
+fn judge(outcomes: &[Outcome], rule: DeployRule, within3_share: bool) -> Vec<String> {
     let mut failures = Vec::new();
     let (mut written, mut deployed, mut worse) = (0, 0, 0);
     let (mut named, mut within3, mut beyond4) = (0, 0, 0);
-    for o in &outcomes {
+    for o in outcomes {
         let d = &o.diagnosis;
         let g = &d.gain;
         let catalogue: Vec<String> = d
@@ -342,10 +363,11 @@ fn evaluate(cases: Vec<(usize, u64, usize)>, within3_share: bool) -> Vec<String>
             .map(|c| format!("{:?}", c.effect))
             .collect();
         println!(
-            "{}: {:?}, exit {}; identify {:.1} um, deployed {:.1} um (x{:.2}); gain true {:.1} um, predicted {:.1?} +- {:.1?} um; causes {:?}; terms {:?}",
+            "{}: {:?}, exit {}, held-out rms {:.2} (noise = 1); identify {:.1} um, deployed {:.1} um (x{:.2}); gain true {:.1} um, predicted {:.1?} +- {:.1?} um; causes {:?}; terms {:?}",
             o.label,
             d.verdict,
             if o.exit0 { 0 } else { 3 },
+            g.holdout_rms_extended,
             1e3 * o.geometric_mm,
             1e3 * o.deployed_mm,
             o.deployed_mm / o.geometric_mm,
@@ -356,21 +378,7 @@ fn evaluate(cases: Vec<(usize, u64, usize)>, within3_share: bool) -> Vec<String>
                 .iter()
                 .map(|c| c.description.clone())
                 .collect::<Vec<_>>(),
-            d.model_terms
-                .iter()
-                .map(|t| format!(
-                    "{}{}: benefit {:.1?} +- {:.1?} um, improvement {:.1?} +- {:.1?} um (move {:.1?}), expected rms {:.1?} with, {:.1?} without",
-                    t.description,
-                    if t.deployed { "" } else { " (not deployed)" },
-                    t.holdout_benefit_mm.map(|v| 1e3 * v),
-                    t.holdout_benefit_sd_mm.map(|v| 1e3 * v),
-                    t.improvement_mm.map(|v| 1e3 * v),
-                    t.improvement_sd_mm.map(|v| 1e3 * v),
-                    t.difference_sd_mm.map(|v| 1e3 * v),
-                    t.expected_rms_with_mm.map(|v| 1e3 * v),
-                    t.expected_rms_without_mm.map(|v| 1e3 * v),
-                ))
-                .collect::<Vec<_>>()
+            terms(d)
         );
         if !o.exit0 {
             continue;
@@ -381,13 +389,36 @@ fn evaluate(cases: Vec<(usize, u64, usize)>, within3_share: bool) -> Vec<String>
             if o.deployed_mm > WORSE * o.geometric_mm {
                 worse += 1;
             }
-            if o.deployed_mm > WORSE * o.geometric_mm && rule == DeployRule::Confident {
-                failures.push(format!(
-                    "{}: deployed {:.1} um, identify's file {:.1} um",
+            if o.deployed_mm > WORSE * o.geometric_mm {
+                let risk = deployed_by_expected_error_alone(d);
+                println!(
+                    "WORSE {}: deployed {:.1} um, identify's file {:.1} um; deployed by the expected error alone: {risk:?}",
                     o.label,
                     1e3 * o.deployed_mm,
                     1e3 * o.geometric_mm
-                ));
+                );
+                // Under the default rule a worse file is only the expected
+                // error's known risk (a term whose file is better in
+                // expectation, deployed below 2 sd), and rare.
+                if rule == DeployRule::default() && risk.is_empty() {
+                    failures.push(format!(
+                        "{}: deployed {:.1} um, identify's file {:.1} um",
+                        o.label,
+                        1e3 * o.deployed_mm,
+                        1e3 * o.geometric_mm
+                    ));
+                }
+            }
+        }
+        // A term kept back says why, in the JSON and the report.
+        let text = d.to_text("campaign");
+        for t in d.model_terms.iter().filter(|t| !t.deployed) {
+            match &t.kept_back_because {
+                Some(why) if text.contains(&format!("kept back because {why}")) => {}
+                _ => failures.push(format!(
+                    "{}: {} kept back without its reason in the report",
+                    o.label, t.description
+                )),
             }
         }
         if let (false, Some(p), Some(sd)) =
@@ -409,13 +440,24 @@ fn evaluate(cases: Vec<(usize, u64, usize)>, within3_share: bool) -> Vec<String>
         }
     }
     println!(
-        "TALLY deploy pays ({}): {} campaigns, {written} written at exit 0, {deployed} with a term deployed, {worse} more than 10 % worse in truth than identify's file",
+        "TALLY deploy pays ({}): {} campaigns, {written} written at exit 0, {deployed} with a term deployed, {worse} more than 10 % worse in truth than identify's file, sum of delivered rms {:.2} mm",
         rule.name(),
-        outcomes.len()
+        outcomes.len(),
+        outcomes
+            .iter()
+            .filter(|o| o.exit0)
+            .map(|o| o.deployed_mm)
+            .sum::<f64>()
     );
     println!(
         "TALLY named causes hold: {named} with a catalogue cause named at exit 0, true gain within 3 sd of the predicted {within3}, beyond 4 sd {beyond4}"
     );
+    if rule == DeployRule::default() && worse > worse_allowed(written) {
+        failures.push(format!(
+            "{worse} of {written} files more than 10 % worse than identify's (at most {} allowed)",
+            worse_allowed(written)
+        ));
+    }
     if within3_share && (within3 as f64) < 0.95 * named as f64 {
         failures.push(format!(
             "{within3} of {named} named causes within 3 sd of their predicted gain (95 % required)"
@@ -424,9 +466,105 @@ fn evaluate(cases: Vec<(usize, u64, usize)>, within3_share: bool) -> Vec<String>
     failures
 }
 
-/// 17 campaigns: each case once (40, 80 or 200 poses), backlash twice.
+/// How many of `written` files may be more than 10 % worse in truth than
+/// identify's under the default rule: one in every hundred files or part
+/// of a hundred (the CI test's 15 have one: a lead deployed by its expected
+/// error at 1.4 sd, docs/reliability.md).
+fn worse_allowed(written: usize) -> usize {
+    written.div_ceil(100)
+}
+
+/// The deployed terms of `d` whose predicted improvement is below
+/// [`tricept_diagnose::DEPLOY_IMPROVEMENT_SD`] standard deviations: what
+/// the expected-error rule deploys and the confident one keeps back.
+fn deployed_by_expected_error_alone(d: &Diagnosis) -> Vec<String> {
+    d.model_terms
+        .iter()
+        .filter(|t| {
+            let two = tricept_diagnose::DEPLOY_IMPROVEMENT_SD;
+            t.deployed
+                && matches!(
+                    (t.improvement_mm, t.improvement_sd_mm, t.holdout_benefit_mm, t.holdout_benefit_sd_mm),
+                    (Some(i), Some(sd), Some(b), Some(b_sd)) if i <= two * sd && i > b + two * b_sd
+                )
+        })
+        .map(|t| t.description.clone())
+        .collect()
+}
+
+/// Each model term of `d` in a few numbers: how the deploy rule judged it.
+fn terms(d: &Diagnosis) -> Vec<String> {
+    d.model_terms
+        .iter()
+        .map(|t| format!(
+            "{}{}: benefit {:.1?} +- {:.1?} um, improvement {:.1?} +- {:.1?} um (move {:.1?}), expected rms {:.1?} with, {:.1?} without",
+            t.description,
+            if t.deployed { "" } else { " (not deployed)" },
+            t.holdout_benefit_mm.map(|v| 1e3 * v),
+            t.holdout_benefit_sd_mm.map(|v| 1e3 * v),
+            t.improvement_mm.map(|v| 1e3 * v),
+            t.improvement_sd_mm.map(|v| 1e3 * v),
+            t.difference_sd_mm.map(|v| 1e3 * v),
+            t.expected_rms_with_mm.map(|v| 1e3 * v),
+            t.expected_rms_without_mm.map(|v| 1e3 * v),
+        ))
+        .collect()
+}
+
+/// The same campaigns under two rules (`a` the one judged, `b` the
+/// comparison): the files written at exit 0 under both whose deployed
+/// terms differ, each in truth, and the sums of delivered rms. Prints a
+/// `COMPARE` line per changed file and a `TALLY compare` line.
+fn compare(a: DeployRule, outcomes_a: &[Outcome], b: DeployRule, outcomes_b: &[Outcome]) {
+    let deployed_terms = |o: &Outcome| -> Vec<String> {
+        o.diagnosis
+            .model_terms
+            .iter()
+            .filter(|t| t.deployed)
+            .map(|t| t.description.clone())
+            .collect()
+    };
+    let (mut changed, mut better, mut worse, mut sum_a, mut sum_b) = (0, 0, 0, 0.0, 0.0);
+    for (x, y) in outcomes_a.iter().zip(outcomes_b) {
+        if !(x.exit0 && y.exit0) {
+            continue;
+        }
+        sum_a += x.deployed_mm;
+        sum_b += y.deployed_mm;
+        if deployed_terms(x) == deployed_terms(y) {
+            continue;
+        }
+        changed += 1;
+        better += usize::from(x.deployed_mm < y.deployed_mm);
+        worse += usize::from(x.deployed_mm > WORSE * x.geometric_mm);
+        println!(
+            "COMPARE {}: identify {:.1} um, {} {:.1} um, {} {:.1} um; {} terms {:?}",
+            x.label,
+            1e3 * x.geometric_mm,
+            b.name(),
+            1e3 * y.deployed_mm,
+            a.name(),
+            1e3 * x.deployed_mm,
+            a.name(),
+            terms(&x.diagnosis)
+        );
+    }
+    println!(
+        "TALLY compare {} against {}: {changed} files changed of those written at exit 0 under both, {better} better, {worse} more than 10 % worse than identify's; sum of delivered rms {:.2} mm -> {:.2} mm",
+        a.name(),
+        b.name(),
+        sum_b,
+        sum_a
+    );
+}
+
+/// 17 campaigns: each case once (40, 80 or 200 poses), backlash twice,
+/// under the default rule: at most the one file worse than identify's by
+/// more than 10 % (a lead deployed by its expected error at 1.4 sd: the
+/// rule's known risk), every kept-back term with its reason, no named
+/// cause beyond 4 sd.
 #[test]
-fn deployed_files_are_never_worse_in_truth() {
+fn deployed_files_pay_in_truth() {
     let cases: Vec<(usize, u64, usize)> = (0..CASES.len())
         .map(|c| (c, c as u64, [40, 80, 200][c % 3]))
         .chain([(0, 11, 80)])
@@ -435,9 +573,10 @@ fn deployed_files_are_never_worse_in_truth() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// 96 campaigns: each case at 40, 80 and 200 poses on two machines.
+/// 96 campaigns: each case at 40, 80 and 200 poses on two machines,
+/// diagnosed under the rule of the run and (compared) under the other rule.
 #[test]
-#[ignore = "the tally of docs/reliability.md: 96 diagnoses"]
+#[ignore = "the tally of docs/reliability.md: 192 diagnoses"]
 fn tally() {
     let cases: Vec<(usize, u64, usize)> = (0..CASES.len())
         .flat_map(|c| {
@@ -446,21 +585,45 @@ fn tally() {
                 .flat_map(move |n| (0..2u64).map(move |s| (c, 100 + 7 * s + n as u64, n)))
         })
         .collect();
-    let failures = evaluate(cases, true);
+    let rule = rule_of_run();
+    let other = other_rule(rule);
+    let both: Vec<(Outcome, Outcome)> = selected(cases)
+        .into_par_iter()
+        .map(|(case, seed, n)| (run(case, seed, n, rule), run(case, seed, n, other)))
+        .collect();
+    let (judged, compared): (Vec<Outcome>, Vec<Outcome>) = both.into_iter().unzip();
+    compare(rule, &judged, other, &compared);
+    // The other rule's tally, for the comparison (its failures are not
+    // this rule's).
+    let _ = judge(&compared, other, true);
+    let failures = judge(&judged, rule, true);
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The rule a tally compares `rule` with.
+fn other_rule(rule: DeployRule) -> DeployRule {
+    if rule == DeployRule::Confident {
+        DeployRule::ExpectedError
+    } else {
+        DeployRule::Confident
+    }
 }
 
 /// The pitch errors the confident rule keeps back on the tally (their
 /// predicted improvement 1.0-1.7 sd, the out-of-sample benefit beyond 8
-/// sd): the expected-error rule deploys them, and in truth each file is
-/// better than the confident rule's and than identify's.
+/// sd): the default rule (expected error) deploys them, and in truth each
+/// file is better than the confident rule's and than identify's; the
+/// confident rule's report says why it keeps each back.
 #[test]
-fn the_expected_error_rule_deploys_the_kept_back_pitch_terms() {
-    let pitch_deployed = |o: &Outcome| {
+fn the_default_rule_deploys_the_pitch_terms_the_confident_rule_keeps_back() {
+    assert_eq!(DeployRule::default(), DeployRule::ExpectedError);
+    let pitch = |o: &Outcome| {
         o.diagnosis
             .model_terms
             .iter()
-            .any(|t| t.deployed && t.description.starts_with("leg-periodic"))
+            .find(|t| t.description.starts_with("leg-periodic"))
+            .cloned()
+            .expect("the pitch term")
     };
     let cases = [(3, 140, 40), (9, 180, 80), (9, 300, 200)];
     let outcomes: Vec<(Outcome, Outcome)> = cases
@@ -468,7 +631,7 @@ fn the_expected_error_rule_deploys_the_kept_back_pitch_terms() {
         .map(|(case, seed, n)| {
             (
                 run(case, seed, n, DeployRule::Confident),
-                run(case, seed, n, DeployRule::ExpectedError),
+                run(case, seed, n, DeployRule::default()),
             )
         })
         .collect();
@@ -481,20 +644,30 @@ fn the_expected_error_rule_deploys_the_kept_back_pitch_terms() {
             1e3 * expected.deployed_mm
         );
         assert!(confident.exit0 && expected.exit0, "{}", confident.label);
-        assert!(!pitch_deployed(confident), "{}", confident.label);
-        assert!(pitch_deployed(expected), "{}", expected.label);
+        let kept = pitch(confident);
+        assert!(!kept.deployed, "{}", confident.label);
+        let why = kept.kept_back_because.expect("a reason");
+        assert!(
+            why.starts_with("the confident rule (--deploy-rule confident): "),
+            "{why}"
+        );
+        assert!(
+            confident
+                .diagnosis
+                .to_text("campaign")
+                .contains(&format!("kept back because {why}")),
+            "{}",
+            confident.label
+        );
+        let term = pitch(expected);
+        assert!(term.deployed, "{}", expected.label);
+        assert_eq!(term.kept_back_because, None);
         assert!(
             expected.deployed_mm < confident.deployed_mm
                 && expected.deployed_mm < confident.geometric_mm,
             "{}",
             expected.label
         );
-        let term = expected
-            .diagnosis
-            .model_terms
-            .iter()
-            .find(|t| t.description.starts_with("leg-periodic"))
-            .expect("the pitch term");
         let (Some(with), Some(without)) = (term.expected_rms_with_mm, term.expected_rms_without_mm)
         else {
             panic!("{}: no expected errors", expected.label);

@@ -54,6 +54,7 @@ fn term(effect: CauseName, legs: &[u8], channel: Option<u8>, deployed: bool) -> 
         holdout_benefit_sd_mm: None,
         expected_rms_with_mm: None,
         expected_rms_without_mm: None,
+        kept_back_because: (!deployed).then(|| "a reason".to_string()),
     }
 }
 
@@ -198,6 +199,8 @@ fn records_sensor_and_time_terms_and_the_terms_not_worth_deploying() {
         seen.contains("out-of-sample benefit not computed mm, improvement not computed mm"),
         "{seen}"
     );
+    // And why each was kept back.
+    assert!(seen.contains("; kept back because a reason;"), "{seen}");
     // Neither applies a table; nothing else is applied but the scale gain's absence.
     assert!(d.machine.leg_effects.tables.is_empty(), "{:?}", d.applied);
 }

@@ -110,6 +110,10 @@ impl SourceRows for Ballbar {
         SourceKind::Ballbar
     }
 
+    fn stated_offset_mm(&self) -> Option<Vector3<f64>> {
+        Some(self.effector.offset_mm).filter(|o| o.norm() > 0.0)
+    }
+
     fn file(&self) -> &str {
         &self.file
     }

@@ -307,6 +307,54 @@ fn spread(g: &DMatrix<f64>, c: &DMatrix<f64>) -> (f64, f64) {
     ((sum / poses.max(1) as f64).sqrt(), max)
 }
 
+/// The tool's roll about its own axis, which the head's 13 parameters do
+/// not carry (a point on the tool sees none of it), at its typical size, as
+/// tool-tip combinations: one per source that measures a point at a stated
+/// offset `o` from the tip (a known tracker target, a ballbar's ball). The
+/// point turns with the roll by `roll (d x o)`, constant in the spindle
+/// frame, which the fit reads as a tool-tip shift: the tip keeps it. The
+/// typical roll is a second-axis tilt's (`ax2_tilt_a_rad`): a real head's
+/// second axis tilted along the axes' common normal turns the tool about the
+/// first axis, which at zero angles is the tool's (the 13 parameters take
+/// it as an `h1` zero and a tip shift, exact for points on the tool).
+fn roll_combinations(model: &FusedModel, sources: &[Source]) -> Vec<DVector<f64>> {
+    let (Some(head), Some(first)) = (model.head(), model.head_range().next()) else {
+        return Vec::new();
+    };
+    let k = model.len();
+    let typical = model.typical_sizes();
+    let column = |name: &str| model.index_of(name);
+    let (Some(tilt), Some(length), Some(shift_e), Some(shift_w)) = (
+        column("ax2_tilt_a_rad"),
+        column("tool_length_mm"),
+        column("tool_shift_e_mm"),
+        column("tool_shift_w_mm"),
+    ) else {
+        return Vec::new();
+    };
+    // The tool frame `d, e, w` (spindle frame at zero head angles): the
+    // tip's derivatives with respect to the tool's three shifts, turned
+    // back by the spindle's rotation.
+    let h = [0.0, 0.0];
+    let at = head.at(&vec![0.0; head.len()]);
+    let (_, jac) = at.point_jacobian(h, &Effector::default());
+    let back = at.spindle_rotation(h).transpose();
+    let frame = [length, shift_e, shift_w].map(|j| back * jac.column(j - first));
+    let d = frame[0];
+    sources
+        .iter()
+        .filter_map(Source::stated_offset_mm)
+        .map(|o| {
+            let turn = d.cross(&o) * typical[tilt];
+            let mut n = DVector::zeros(k);
+            for (j, f) in [length, shift_e, shift_w].into_iter().zip(&frame) {
+                n[j] = f.dot(&turn);
+            }
+            n
+        })
+        .collect()
+}
+
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn build_report(
     model: &FusedModel,
@@ -473,6 +521,9 @@ pub(crate) fn build_report(
     let mut held_cov = DMatrix::zeros(k, k);
     for (v, &f) in null.iter().zip(&union_decision.fixed) {
         let n = DVector::from_column_slice(v) * typical[f];
+        held_cov += &n * n.transpose();
+    }
+    for n in roll_combinations(model, sources) {
         held_cov += &n * n.transpose();
     }
     let total = covariance + &held_cov;
@@ -684,5 +735,63 @@ impl FusionReport {
             a.poses, a.rms_arcsec, a.max_arcsec, a.held_rms_arcsec
         ));
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fusion::{TrackerOptions, TrackerTarget};
+    use tricept_kinematics::Machine;
+    use tricept_model::ParameterSet;
+
+    /// Three tracker points whose target is stated at `offset_mm`.
+    fn tracker(offset_mm: [f64; 3]) -> Source {
+        let csv = "q1,q2,q3,h1,h2,x,y,z\n800,800,800,0,0,1,2,3\n810,800,800,0,0,1,5,3\n800,820,800,0,0,4,2,3\n";
+        let data = tricept_data::read_external_from(csv.as_bytes(), "t.csv").unwrap();
+        let options = TrackerOptions {
+            sigma_um: 10.0,
+            target: TrackerTarget::Known {
+                offset_mm,
+                sigma_um: 5.0,
+            },
+        };
+        Source::tracker(&data, &options).unwrap()
+    }
+
+    #[test]
+    fn a_stated_offset_across_the_tool_turns_with_its_roll() {
+        // The Table 1 machine's head (fixtures/machines/tricept-paper.json):
+        // the tool along z' at zero angles, the second axis along x', so the
+        // tool frame is d = z', e = x', w = y'. A target at o = (16, -6, 10) mm turns by
+        // r (d x o) = r (6, 16, 0): a tip shift of 6 r along e and 16 r
+        // along w, at the typical axis tilt r = 0.3 mrad.
+        let model = FusedModel::new(Machine::paper(), ParameterSet::paper15(), &[], true).unwrap();
+        let rolls = roll_combinations(&model, &[tracker([16.0, -6.0, 10.0])]);
+        assert_eq!(rolls.len(), 1);
+        let at = |name: &str| rolls[0][model.index_of(name).unwrap()];
+        assert!(
+            (at("tool_shift_e_mm") - 6.0 * 3e-4).abs() < 1e-12,
+            "{}",
+            rolls[0]
+        );
+        assert!(
+            (at("tool_shift_w_mm") - 16.0 * 3e-4).abs() < 1e-12,
+            "{}",
+            rolls[0]
+        );
+        assert!(at("tool_length_mm").abs() < 1e-12);
+        let others: f64 = rolls[0].iter().map(|v| v * v).sum::<f64>()
+            - at("tool_shift_e_mm").powi(2)
+            - at("tool_shift_w_mm").powi(2);
+        assert!(others.abs() < 1e-20);
+        // Along the tool the roll moves nothing; a target at the tip and a
+        // free one have no stated offset; a nominal head has no roll.
+        let along = roll_combinations(&model, &[tracker([0.0, 0.0, 20.0])]);
+        assert!(along[0].norm() < 1e-12);
+        assert!(roll_combinations(&model, &[tracker([0.0; 3])]).is_empty());
+        let nominal =
+            FusedModel::new(Machine::paper(), ParameterSet::paper15(), &[], false).unwrap();
+        assert!(roll_combinations(&nominal, &[tracker([16.0, -6.0, 10.0])]).is_empty());
     }
 }

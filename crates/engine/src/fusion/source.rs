@@ -226,6 +226,12 @@ pub(crate) trait SourceRows: Send + Sync + std::fmt::Debug {
     fn tracker_target(&self) -> Option<TrackerTarget> {
         None
     }
+    /// The stated offset from the tool tip (mm, spindle frame at zero head
+    /// angles) of the point the source measures, when it is stated and not
+    /// zero: a known tracker target's, a ballbar's ball's.
+    fn stated_offset_mm(&self) -> Option<Vector3<f64>> {
+        None
+    }
     /// The same records with another statement of the tracker target
     /// (tracker sources only): what the likely-cause search refits.
     fn with_tracker_target(&self, _target: TrackerTarget) -> Option<Box<dyn SourceRows>> {
@@ -414,6 +420,24 @@ impl Source {
     /// How the tracker target is stated (`None` for other sources).
     pub fn tracker_target(&self) -> Option<TrackerTarget> {
         self.rows.tracker_target()
+    }
+
+    /// The stated offset from the tool tip (mm, spindle frame at zero head
+    /// angles) of the point this source measures, when it is stated and not
+    /// zero: a known tracker target's, a ballbar's ball's.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_engine::fusion::{Source, TrackerOptions, TrackerTarget};
+    /// let csv = "q1,q2,q3,h1,h2,x,y,z\n800,800,800,0,0,1,2,3\n810,800,800,0,0,1,5,3\n800,820,800,0,0,4,2,3\n";
+    /// let data = tricept_data::read_external_from(csv.as_bytes(), "t.csv").unwrap();
+    /// let s = Source::tracker(&data, &TrackerOptions::default()).unwrap();
+    /// assert_eq!(s.stated_offset_mm(), None);
+    /// let t = s.with_tracker_target(TrackerTarget::Known { offset_mm: [0.0, 0.0, 20.0], sigma_um: 5.0 }).unwrap();
+    /// assert_eq!(t.stated_offset_mm(), Some(nalgebra::Vector3::new(0.0, 0.0, 20.0)));
+    /// ```
+    pub fn stated_offset_mm(&self) -> Option<Vector3<f64>> {
+        self.rows.stated_offset_mm()
     }
 }
 

@@ -196,6 +196,15 @@ impl SourceRows for Tracker {
         Some(self.target)
     }
 
+    fn stated_offset_mm(&self) -> Option<Vector3<f64>> {
+        match self.target {
+            TrackerTarget::Known { offset_mm, .. } => {
+                Some(Vector3::from(offset_mm)).filter(|o| o.norm() > 0.0)
+            }
+            TrackerTarget::Free => None,
+        }
+    }
+
     fn with_tracker_target(&self, target: TrackerTarget) -> Option<Box<dyn SourceRows>> {
         Some(Box::new(Tracker {
             target,

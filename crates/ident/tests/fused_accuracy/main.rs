@@ -14,25 +14,34 @@
 //! file's `upper_mm` in at least 95 % of the files written at exit 0, and
 //! never beyond twice it.
 //!
-//! The configurations are those the tool accepts: a tracker with k = 12 and
-//! 30 points, its target at the tip, at a stated 20 mm offset and free; a
-//! ballbar with 30 readings; each with 24 touch-offs on a sphere beside
-//! it. The CI test runs two machines per configuration; the tallies of
+//! The documented configurations: a tracker with k = 12 and 30 points, its
+//! target at the tip, at a stated 20 mm offset and free; a ballbar with 30
+//! readings; each with 24 touch-offs on a sphere beside it. The CI test
+//! runs two machines per configuration; the tallies of
 //! `docs/reliability.md` run 30, without and with a static leg effect
-//! hidden in every instrument's true leg lengths (`cargo test -p
-//! tricept-ident --test fused_accuracy -- --ignored --nocapture`).
+//! hidden in every instrument's true leg lengths. The tally at the tails
+//! runs every configuration the tool accepts (`tails::tail_configurations`: k =
+//! 12-60, planned and random poses, offsets along and across the tool, a
+//! ballbar's stated ball, touch-offs beside each, without the gross-error
+//! screen) on 16 machines each, heads half to four typical sizes off, alike
+//! or by kind (`cargo test -p tricept-ident --test fused_accuracy --
+//! --ignored --nocapture` runs the three).
 
+mod tails;
+
+use std::cell::RefCell;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use tricept_ident::DataInput;
-use tricept_ident::advanced::{SensorNoise, TrackerTargetSpec, load_machine};
+use tricept_ident::advanced::{SensorNoise, TrackerTargetSpec, Triple, load_machine};
 use tricept_ident::calibrate::{CalibrateRequest, FusedSources, calibrate};
 use tricept_ident::kinematics::{Machine, Vector3, Verb as KinematicsVerb, solve_point};
 use tricept_ident::plan::{Instrument, PlanRequest, plan};
 use tricept_truth::{
-    LegEffect, Row, TrueBallbar, TrueMachine, TrueSphere, TrueTracker, normal, to_csv,
+    HeadSizes, LegEffect, Row, TrueBallbar, TrueMachine, TrueSphere, TrueTracker, normal, to_csv,
 };
 
 /// Held-out tool poses per file.
@@ -43,26 +52,129 @@ const SPHERE_MM: [f64; 3] = [0.0, 0.0, 1150.0];
 const SPHERE_RADIUS_MM: f64 = 12.7;
 const STYLUS_MM: f64 = 1.0;
 
-/// The ballbar's pivot (`plan`'s default).
+/// The ballbar's pivot and length (`plan`'s defaults).
 const PIVOT_MM: [f64; 3] = [0.0, 0.0, 1250.0];
+const BALLBAR_MM: f64 = 150.0;
 
 /// Where the tracker's target sits, truly and as stated.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Target {
     Tip,
-    /// 20 mm beyond the tip along the tool, stated as such.
-    Offset,
-    /// 20 mm beyond the tip, stated `free`.
-    Free,
+    /// At this offset from the tip (mm, spindle frame at zero head
+    /// angles), stated as such.
+    Offset([f64; 3]),
+    /// At this offset from the tip, stated `free`.
+    Free([f64; 3]),
+}
+
+/// 20 mm beyond the tip along the tool.
+const ALONG: [f64; 3] = [0.0, 0.0, 20.0];
+
+/// 20 mm from the tip, mostly across the tool.
+const ACROSS: [f64; 3] = [16.0, -6.0, 10.0];
+
+impl Target {
+    /// Where the target truly sits from the tip, mm.
+    fn offset_mm(self) -> Vector3<f64> {
+        match self {
+            Target::Tip => Vector3::zeros(),
+            Target::Offset(v) | Target::Free(v) => Vector3::from(v),
+        }
+    }
+
+    /// What the campaign states (`--tracker-target`).
+    fn spec(self) -> TrackerTargetSpec {
+        match self {
+            Target::Tip => TrackerTargetSpec::Tip,
+            Target::Offset(v) => TrackerTargetSpec::Offset(v),
+            Target::Free(_) => TrackerTargetSpec::Free,
+        }
+    }
+
+    fn name(self) -> String {
+        let v = |v: [f64; 3]| format!("{},{},{}", v[0], v[1], v[2]);
+        match self {
+            Target::Tip => "Tip".into(),
+            Target::Offset(o) if o == ALONG => "Offset".into(),
+            Target::Free(o) if o == ALONG => "Free".into(),
+            Target::Offset(o) => format!("Offset {}", v(o)),
+            Target::Free(o) => format!("Free at {}", v(o)),
+        }
+    }
+}
+
+/// How an instrument's poses were chosen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Poses {
+    /// By the door's `plan`.
+    Planned,
+    /// At random: tracker points anywhere in the workspace with random
+    /// head angles; ballbar positions anywhere on the bar's sphere cap,
+    /// the tool tilted at random (the door's `tool-ik` of the nominal
+    /// machine).
+    Random,
+}
+
+/// The machines a tally calibrates: the size of their heads' errors (in
+/// the head table's typical sizes; machine `seed` has
+/// `sizes[seed % sizes.len()]`) and of their internal campaigns.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Machines {
+    /// Heads of one, two and three typical sizes; 60-120 internal poses.
+    Documented,
+    /// 40-200 internal poses; heads of half, one, two and four typical
+    /// sizes, every kind of error alike (even seeds) or each kind (axis
+    /// tilts, axis points, angle zeros, tool length, the tool tip across the
+    /// tool, the tool's tilt) its own size (odd seeds, as a real head's may
+    /// be): the tails.
+    Tails,
+}
+
+impl Machines {
+    /// The true machine `seed`.
+    fn truth(self, seed: u64) -> TrueMachine {
+        const TAILS: [f64; 4] = [0.5, 1.0, 2.0, 4.0];
+        match self {
+            Machines::Documented => TrueMachine::random(1.0 + (seed % 3) as f64, seed),
+            Machines::Tails if seed.is_multiple_of(2) => {
+                TrueMachine::random(TAILS[(seed / 2 % 4) as usize], seed)
+            }
+            Machines::Tails => {
+                let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x4ead_5e5e);
+                let mut size = || TAILS[(rng.random::<f64>() * 4.0) as usize % 4];
+                let sizes = HeadSizes {
+                    axis_tilts: size(),
+                    axis_points: size(),
+                    angle_zeros: size(),
+                    tool_length: size(),
+                    tool_across: size(),
+                    tool_tilt: size(),
+                };
+                TrueMachine::random_head(sizes, seed)
+            }
+        }
+    }
+
+    /// The internal campaign's poses, drawn by `rng`.
+    fn internal_poses(self, rng: &mut Pcg64Mcg) -> usize {
+        let (low, high) = match self {
+            Machines::Documented => (60, 120),
+            Machines::Tails => (40, 200),
+        };
+        low + (rng.random::<f64>() * (high - low + 1) as f64) as usize
+    }
 }
 
 /// One fused configuration.
 #[derive(Debug, Clone, Copy)]
 struct Config {
-    /// Tracker points and where the target sits.
-    tracker: Option<(usize, Target)>,
-    /// Ballbar readings.
-    ballbar: Option<usize>,
+    /// Tracker points, where the target sits, how the points were chosen.
+    tracker: Option<(usize, Target, Poses)>,
+    /// Ballbar readings and how their poses were chosen.
+    ballbar: Option<(usize, Poses)>,
+    /// The ballbar's ball's offset from the tool tip, stated (mm, spindle
+    /// frame at zero head angles; `--ballbar-ball-mm`).
+    ball_mm: [f64; 3],
     /// Touch-offs on the sphere.
     touch: Option<usize>,
     /// The probe's stylus centre beyond the tool tip the other instruments
@@ -70,6 +182,10 @@ struct Config {
     touch_beyond_mm: f64,
     /// A static leg effect hidden in the true leg lengths ([`leg_effect`]).
     leg_effects: bool,
+    /// The gross-error screen (`identify`'s default; `--no-robust` off).
+    robust: bool,
+    /// The true machines.
+    machines: Machines,
 }
 
 /// A static leg effect hidden in the true leg lengths of machine `seed`
@@ -96,43 +212,62 @@ fn leg_effect(seed: u64, m: &Machine) -> LegEffect {
 }
 
 impl Config {
-    fn name(&self) -> String {
-        let mut parts = Vec::new();
-        if let Some((k, t)) = self.tracker {
-            parts.push(format!("tracker k={k} target {t:?}"));
+    /// A configuration of one or more instruments, the rest as the
+    /// documented campaign has it (no leg effect, robust, heads of one to
+    /// three typical sizes).
+    fn of(
+        tracker: Option<(usize, Target, Poses)>,
+        ballbar: Option<(usize, Poses)>,
+        touch: Option<usize>,
+    ) -> Config {
+        Config {
+            tracker,
+            ballbar,
+            ball_mm: [0.0; 3],
+            touch,
+            touch_beyond_mm: 0.0,
+            leg_effects: false,
+            robust: true,
+            machines: Machines::Documented,
         }
-        if let Some(k) = self.ballbar {
-            parts.push(format!("ballbar k={k}"));
+    }
+
+    fn name(&self) -> String {
+        let random = |p: Poses| if p == Poses::Random { " random" } else { "" };
+        let mut parts = Vec::new();
+        if let Some((k, t, p)) = self.tracker {
+            parts.push(format!("tracker k={k}{} target {}", random(p), t.name()));
+        }
+        if let Some((k, p)) = self.ballbar {
+            let b = self.ball_mm;
+            let ball = if b == [0.0; 3] {
+                String::new()
+            } else {
+                format!(" ball at {},{},{}", b[0], b[1], b[2])
+            };
+            parts.push(format!("ballbar k={k}{}{ball}", random(p)));
         }
         if let Some(k) = self.touch {
             parts.push(format!("touch k={k}"));
         }
-        parts.join(" + ")
+        let mut name = parts.join(" + ");
+        if !self.robust {
+            name.push_str(" (no robust)");
+        }
+        name
     }
 }
 
-/// The configurations the tool accepts.
+/// The configurations of the documented tally.
 fn configurations() -> Vec<Config> {
-    let tracker = |k, t| Config {
-        tracker: Some((k, t)),
-        ballbar: None,
-        touch: None,
-        touch_beyond_mm: 0.0,
-        leg_effects: false,
-    };
-    let ballbar = Config {
-        tracker: None,
-        ballbar: Some(30),
-        touch: None,
-        touch_beyond_mm: 0.0,
-        leg_effects: false,
-    };
+    let tracker = |k, t| Config::of(Some((k, t, Poses::Planned)), None, None);
+    let ballbar = Config::of(None, Some((30, Poses::Planned)), None);
     let mut out = vec![
         tracker(12, Target::Tip),
         tracker(30, Target::Tip),
-        tracker(12, Target::Offset),
-        tracker(30, Target::Offset),
-        tracker(30, Target::Free),
+        tracker(12, Target::Offset(ALONG)),
+        tracker(30, Target::Offset(ALONG)),
+        tracker(30, Target::Free(ALONG)),
         ballbar,
     ];
     let with_touch: Vec<Config> = out
@@ -189,31 +324,52 @@ fn planned(instrument: Instrument, k: usize, dir: &Path) -> Vec<Planned> {
     rows
 }
 
-/// The plans every configuration draws from, made once.
+/// The plans the configurations draw from, each made once, when first
+/// needed.
 struct Plans {
-    tracker12: Vec<Planned>,
-    tracker30: Vec<Planned>,
-    ballbar30: Vec<Planned>,
-    touch24: Vec<Planned>,
+    dir: PathBuf,
+    made: RefCell<BTreeMap<(String, usize), Vec<Planned>>>,
 }
 
 impl Plans {
     fn new(dir: &Path) -> Plans {
         Plans {
-            tracker12: planned(Instrument::Tracker, 12, dir),
-            tracker30: planned(Instrument::Tracker, 30, dir),
-            ballbar30: planned(Instrument::Ballbar, 30, dir),
-            touch24: planned(Instrument::Touch, 24, dir),
+            dir: dir.to_path_buf(),
+            made: RefCell::new(BTreeMap::new()),
         }
     }
 
-    /// The first `k` of the 12 planned points, or of the 30.
-    fn tracker(&self, k: usize) -> &[Planned] {
-        if k <= 12 {
-            &self.tracker12[..k]
+    /// The plan of `instrument` with `k` records (fewer touch-offs than
+    /// 24: the first `k` of the plan of 24; fewer tracker points or ballbar
+    /// readings than 12: the first `k` of the plan of 12).
+    fn of(&self, instrument: Instrument, k: usize) -> Vec<Planned> {
+        let planned_k = k.max(if instrument == Instrument::Touch {
+            24
         } else {
-            &self.tracker30[..k.min(30)]
-        }
+            12
+        });
+        let key = (format!("{instrument:?}"), planned_k);
+        let mut made = self.made.borrow_mut();
+        let plan = made
+            .entry(key)
+            .or_insert_with(|| planned(instrument, planned_k, &self.dir));
+        plan[..k].to_vec()
+    }
+}
+
+/// The poses of an instrument with `k` records chosen as `poses` for
+/// machine `seed`.
+fn poses_of(
+    plans: &Plans,
+    instrument: Instrument,
+    k: usize,
+    poses: Poses,
+    seed: u64,
+) -> Vec<Planned> {
+    match (poses, instrument) {
+        (Poses::Planned, _) => plans.of(instrument, k),
+        (Poses::Random, Instrument::Tracker) => tails::random_tracker_poses(k, seed),
+        (Poses::Random, _) => tails::random_ballbar_poses(k, seed),
     }
 }
 
@@ -266,10 +422,9 @@ fn campaign(
     let joints = |truth: &TrueMachine, q: &[f64; 3]| {
         truth.forward_lengths(&truth.delivered_lengths(q, &effects))
     };
-    // Head errors of the head table's sizes, twice and three times them.
-    let truth = TrueMachine::random(1.0 + (seed % 3) as f64, seed);
+    let truth = config.machines.truth(seed);
     let mut rng = Pcg64Mcg::seed_from_u64(seed.wrapping_mul(0x9e37_79b9) ^ 0xf05e);
-    let poses = 60 + (rng.random::<f64>() * 61.0) as usize;
+    let poses = config.machines.internal_poses(&mut rng);
     let rows: Vec<Row> = nominal
         .workspace
         .random_poses(poses, seed ^ 0x5eed)
@@ -289,14 +444,11 @@ fn campaign(
     let internal = dir.join(format!("internal-{seed}.csv"));
     std::fs::write(&internal, to_csv(&rows)).unwrap();
     let mut x = FusedSources::default();
-    if let Some((k, target)) = config.tracker {
+    if let Some((k, target, chosen)) = config.tracker {
         let station = TrueTracker::random(seed);
-        let offset = match target {
-            Target::Tip => Vector3::zeros(),
-            Target::Offset | Target::Free => Vector3::new(0.0, 0.0, 20.0),
-        };
+        let offset = target.offset_mm();
         let mut text = String::from("q1,q2,q3,h1,h2,x,y,z,extension_mm\n");
-        for p in plans.tracker(k) {
+        for p in poses_of(plans, Instrument::Tracker, k, chosen, seed) {
             let at = truth.spindle_point_at(&joints(&truth, &p.q), p.h, p.extension_mm, &offset);
             let y = station.measure(&at, &mut rng);
             text.push_str(&csv_line(&[
@@ -314,28 +466,28 @@ fn campaign(
         let path = dir.join(format!("tracker-{seed}.csv"));
         std::fs::write(&path, text).unwrap();
         x.tracker = vec![path];
-        x.tracker_target = Some(match target {
-            Target::Tip => TrackerTargetSpec::Tip,
-            Target::Offset => TrackerTargetSpec::Offset([0.0, 0.0, 20.0]),
-            Target::Free => TrackerTargetSpec::Free,
-        });
+        x.tracker_target = Some(target.spec());
     }
-    if config.ballbar.is_some() {
+    if let Some((k, chosen)) = config.ballbar {
         let bar = TrueBallbar {
             pivot_mm: Vector3::from(PIVOT_MM)
                 + Vector3::from_fn(|_, _| 0.5 * normal(&mut rng).clamp(-3.0, 3.0)),
             sigma_um: 1.0,
         };
         let mut text = String::from("q1,q2,q3,h1,h2,length\n");
-        for p in &plans.ballbar30 {
-            let length = bar.read(&truth, &p.q, p.h, &Vector3::zeros(), &effects, &mut rng);
+        for p in poses_of(plans, Instrument::Ballbar, k, chosen, seed) {
+            let ball = Vector3::from(config.ball_mm);
+            let length = bar.read(&truth, &p.q, p.h, &ball, &effects, &mut rng);
             text.push_str(&csv_line(&[p.q[0], p.q[1], p.q[2], p.h[0], p.h[1], length]));
         }
         let path = dir.join(format!("ballbar-{seed}.csv"));
         std::fs::write(&path, text).unwrap();
         x.ballbar = vec![path];
+        if config.ball_mm != [0.0; 3] {
+            x.ballbar_ball_mm = Some(Triple(config.ball_mm));
+        }
     }
-    if config.touch.is_some() {
+    if let Some(k) = config.touch {
         let sphere = TrueSphere {
             centre_mm: Vector3::from(SPHERE_MM)
                 + Vector3::from_fn(|_, _| 0.5 * normal(&mut rng).clamp(-3.0, 3.0)),
@@ -345,7 +497,7 @@ fn campaign(
             beyond_tip_mm: config.touch_beyond_mm,
         };
         let mut text = String::from("q1,q2,q3,h1,h2,feature\n");
-        for p in &plans.touch24[..config.touch.unwrap_or(0).min(plans.touch24.len())] {
+        for p in plans.of(Instrument::Touch, k) {
             let q = sphere.touch(&truth, &p.q, p.h, &effects, &mut rng).unwrap();
             text.push_str(&csv_line(&[q[0], q[1], q[2], p.h[0], p.h[1], 1.0]));
         }
@@ -363,6 +515,7 @@ fn campaign(
         x.features = Some(features);
     }
     let mut request = CalibrateRequest::new(DataInput::File(internal));
+    request.robust = config.robust;
     request.fused = Some(x);
     request.for_machine_file = true;
     (truth, request, effects)
@@ -440,6 +593,15 @@ fn run(config: &Config, plans: &Plans, seed: u64, dir: &Path, force: bool) -> Ou
     let (truth, request, effects) = campaign(config, plans, seed, dir);
     let mut c = calibrate(request).unwrap();
     let json = c.to_json();
+    // TRICEPT_FUSED_DUMP=SEED prints the true machine and the calibration's
+    // JSON of machine SEED (how a file beyond its promise is looked into).
+    if std::env::var("TRICEPT_FUSED_DUMP").ok() == Some(seed.to_string()) {
+        eprintln!(
+            "DUMP {}\n{truth:#?}\n{}",
+            config.name(),
+            serde_json::to_string_pretty(&json).unwrap()
+        );
+    }
     let a = &json["accuracy"];
     assert_eq!(a["point"], "tool tip", "{a}");
     let mut outcome = Outcome {
@@ -483,16 +645,28 @@ fn scratch(name: &str) -> PathBuf {
 /// The tally of `seeds` per configuration: prints one TALLY line each and
 /// returns (files written at exit 0, within the promise, beyond 2x).
 fn tally(seeds: std::ops::Range<u64>, leg_effects: bool, dir: &Path) -> (usize, usize, usize) {
+    let configs: Vec<(u64, Config)> = (0..)
+        .zip(configurations())
+        .map(|(i, c)| (i, Config { leg_effects, ..c }))
+        .collect();
+    tally_of(&configs, seeds, "", dir)
+}
+
+/// The tally of `seeds` for each of `configs` (`(i, config)`: machine
+/// `100 i + seed`), the TALLY lines named with `label`: (files written at
+/// exit 0, within the promise, beyond 2x).
+fn tally_of(
+    configs: &[(u64, Config)],
+    seeds: std::ops::Range<u64>,
+    label: &str,
+    dir: &Path,
+) -> (usize, usize, usize) {
     let plans = Plans::new(dir);
     let (mut written, mut within, mut beyond, mut typical) = (0, 0, 0, 0);
-    for (i, config) in configurations().iter().enumerate() {
-        let config = &Config {
-            leg_effects,
-            ..*config
-        };
+    for (i, config) in configs {
         let outcomes: Vec<Outcome> = seeds
             .clone()
-            .map(|s| run(config, &plans, 100 * i as u64 + s, dir, false))
+            .map(|s| run(config, &plans, 100 * i + s, dir, false))
             .collect();
         for o in &outcomes {
             eprintln!(
@@ -527,7 +701,11 @@ fn tally(seeds: std::ops::Range<u64>, leg_effects: bool, dir: &Path) -> (usize, 
         println!(
             "TALLY {}{}: machines {}, written (exit 0) {}, within upper_mm {w}, beyond 2x {b}, worst delivered/upper {worst:.2}; head at its typical size: within {typical_within}",
             config.name(),
-            if leg_effects { " + leg effect" } else { "" },
+            if config.leg_effects {
+                " + leg effect"
+            } else {
+                ""
+            },
             outcomes.len(),
             ok.len()
         );
@@ -537,7 +715,7 @@ fn tally(seeds: std::ops::Range<u64>, leg_effects: bool, dir: &Path) -> (usize, 
         typical += typical_within;
     }
     println!(
-        "TALLY fused: written (exit 0) {written}, within upper_mm {within}, beyond 2x {beyond}; head at its typical size: within {typical}"
+        "TALLY fused{label}: written (exit 0) {written}, within upper_mm {within}, beyond 2x {beyond}; head at its typical size: within {typical}"
     );
     (written, within, beyond)
 }
@@ -580,11 +758,8 @@ fn one_fused_file_per_configuration_keeps_its_promise() {
 /// beyond the tip.
 fn twelve_points_and_touches(touches: usize, beyond_mm: f64) -> Config {
     Config {
-        tracker: Some((12, Target::Tip)),
-        ballbar: None,
-        touch: Some(touches),
         touch_beyond_mm: beyond_mm,
-        leg_effects: false,
+        ..Config::of(Some((12, Target::Tip, Poses::Planned)), None, Some(touches))
     }
 }
 
@@ -676,13 +851,7 @@ fn touches_that_disagree_with_the_tracker_are_still_refused() {
     assert!(!file.exists());
     // A tracker that cannot be checked beside the internal data alone (which
     // do not see the head): nothing outside the machine checks it, refused.
-    let config = Config {
-        tracker: Some((6, Target::Tip)),
-        ballbar: None,
-        touch: None,
-        touch_beyond_mm: 0.0,
-        leg_effects: false,
-    };
+    let config = Config::of(Some((6, Target::Tip, Poses::Planned)), None, None);
     let (_, request, _) = campaign(&config, &plans, 8, &dir);
     let c = calibrate(request).unwrap();
     let json = c.to_json();
