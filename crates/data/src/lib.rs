@@ -47,15 +47,19 @@ mod atomic;
 mod bounded;
 mod error;
 mod external;
+mod message;
 mod pose;
 mod read;
 mod records;
 mod targets;
 mod write;
 
-pub use atomic::write_atomic;
+pub use atomic::{check_output_file, write_atomic};
 pub use bounded::{MAX_JSON_BYTES, read_json_text};
 pub use error::DataError;
+pub use message::{
+    MAX_MESSAGE_CHARS, MAX_QUOTED_CHARS, SHOWN_CHARS, SHOWN_PATH_CHARS, one_line, shown, shown_path,
+};
 pub use external::{
     BallbarData, BallbarReading, ExternalData, ExternalPose, ExternalRecord, Feature, Features,
     PlannedPose, PlannedPoses, Stylus, TouchData, TouchReading, TrackerData, TrackerPoint,
