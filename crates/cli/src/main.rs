@@ -191,15 +191,15 @@ fn file_roles(command: &Command) -> files::FileRoles {
     match command {
         Command::Ik(a) => {
             machine(&mut r, &a.machine);
-            r.inputs("--input", &a.input.input);
+            stdin_or_input(&mut r, &a.input.input);
         }
         Command::Fk(a) => {
             machine(&mut r, &a.machine);
-            r.inputs("--input", &a.input.input);
+            stdin_or_input(&mut r, &a.input.input);
         }
         Command::ToolIk(a) => {
             machine(&mut r, &a.machine);
-            r.inputs("--input", &a.input.input);
+            stdin_or_input(&mut r, &a.input.input);
         }
         Command::Machine(a) => machine(&mut r, &a.machine),
         Command::Docs(_) | Command::Effects(_) => {}
@@ -230,7 +230,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
             r.inputs("--ballbar-poses", &a.ballbar_poses);
             r.inputs("--touch-poses", &a.touch_poses);
             for (flag, p) in [
-                ("--out", &a.out),
+                ("--out", &simulate_cmd::out_file(a)),
                 ("--tracker-out", &a.tracker_out),
                 ("--ballbar-out", &a.ballbar_out),
                 ("--touch-out", &a.touch_out),
@@ -247,6 +247,9 @@ fn file_roles(command: &Command) -> files::FileRoles {
             r.inputs("--plausibility", &a.plausibility);
             if let Some(p) = &a.write_machine {
                 r.output("--write-machine", p);
+            }
+            if let Some(d) = &a.plots {
+                r.output_dir("--plots", d, "residual-", ".svg");
             }
         }
         Command::Detectability(a) => {
@@ -272,6 +275,9 @@ fn file_roles(command: &Command) -> files::FileRoles {
             if let Some(h) = &a.history {
                 r.output("--history", h);
             }
+            if let Some(d) = &a.plot {
+                r.output_dir("--plot", d, "check-", ".svg");
+            }
         }
         Command::Export(a) => {
             r.input("--machine", &a.machine);
@@ -287,6 +293,13 @@ fn file_roles(command: &Command) -> files::FileRoles {
         }
     }
     r
+}
+
+/// The `--input` of a kinematics verb: a file, or stdin (`-`).
+fn stdin_or_input(r: &mut files::FileRoles, input: &Option<std::path::PathBuf>) {
+    if let Some(p) = input.as_ref().filter(|p| p.as_os_str() != files::STDIO) {
+        r.input("--input", p);
+    }
 }
 
 /// Runs the verb; `Ok` carries the exit code of a result (0, or the

@@ -154,7 +154,9 @@ fn resolve(path: &Path) -> io::Result<PathBuf> {
 /// ```
 pub fn check_output_file(path: &Path) -> io::Result<()> {
     let text = path.as_os_str().to_string_lossy();
-    if text.ends_with('/') || text.ends_with(std::path::MAIN_SEPARATOR) || path.file_name().is_none()
+    if text.ends_with('/')
+        || text.ends_with(std::path::MAIN_SEPARATOR)
+        || path.file_name().is_none()
     {
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
@@ -435,8 +437,18 @@ mod tests {
             assert!(e.to_string().contains(kind), "{e}");
         }
         assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
-        assert!(std::fs::metadata("/dev/null").unwrap().file_type().is_char_device());
-        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        assert!(
+            std::fs::metadata("/dev/null")
+                .unwrap()
+                .file_type()
+                .is_char_device()
+        );
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
         // Nothing but the pipe and the link in the directory: no temporary.
         assert_eq!(entries(&d), ["null.json", "pipe"]);
         let e = write_atomic(&d.join("sub/"), |w| w.write_all(b"x")).unwrap_err();

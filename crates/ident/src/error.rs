@@ -117,54 +117,49 @@ pub struct Error {
 }
 
 impl Error {
-    /// An error of the given kind.
+    /// An error of the given kind. The message is made one bounded line
+    /// ([`tricept_data::one_line`]): what it repeats of the input (a key,
+    /// a value, a path) is cut and its control characters escaped.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{Error, ErrorKind};
+    /// let e = Error::new(ErrorKind::Input, format!("unknown key `{}`", "k".repeat(1 << 20)));
+    /// assert!(e.message().len() < 1000);
+    /// assert_eq!(Error::input("a\nb\u{1b}[2J").message(), "a\\nb\\u{1b}[2J");
+    /// ```
     pub fn new(kind: ErrorKind, message: impl Into<String>) -> Error {
         Error {
             kind,
-            message: message.into(),
+            message: tricept_data::one_line(&message.into()),
         }
     }
 
     /// An error of the user's input (exit code 2).
     pub fn input(message: impl Into<String>) -> Error {
-        Error {
-            kind: ErrorKind::Input,
-            message: message.into(),
-        }
+        Error::new(ErrorKind::Input, message)
     }
 
     /// Any other error (exit code 1).
     pub fn other(message: impl Into<String>) -> Error {
-        Error {
-            kind: ErrorKind::Other,
-            message: message.into(),
-        }
+        Error::new(ErrorKind::Other, message)
     }
 
     /// A library error with its kind and its message.
     pub fn from_library(e: &(impl Classify + fmt::Display)) -> Error {
-        Error {
-            kind: e.kind(),
-            message: e.to_string(),
-        }
+        Error::new(e.kind(), e.to_string())
     }
 
     /// A library error with `context: ` before its message, keeping its
     /// kind.
     pub fn with_context(context: impl fmt::Display, e: &(impl Classify + fmt::Display)) -> Error {
-        Error {
-            kind: e.kind(),
-            message: format!("{context}: {e}"),
-        }
+        Error::new(e.kind(), format!("{context}: {e}"))
     }
 
     /// The same error with `context: ` before its message (a file, a flag).
     #[must_use]
     pub fn in_file(self, context: impl fmt::Display) -> Error {
-        Error {
-            kind: self.kind,
-            message: format!("{context}: {}", self.message),
-        }
+        Error::new(self.kind, format!("{context}: {}", self.message))
     }
 
     /// Whose fault it is.

@@ -173,9 +173,12 @@ pub fn load_machine(path: Option<&Path>, noise: &SensorNoise) -> Result<LoadedMa
             w.radius_mm, w.z_min_mm, w.z_max_mm, r.x, r.y, r.z
         )));
     }
-    tricept_engine::check_calibration_record(&description)
+    let notes = tricept_engine::check_calibration_record(&description)
         .map_err(|e| Error::input(format!("{source}: {e}")))?;
     let mut warnings = Vec::new();
+    if let Some(w) = notes.warning() {
+        warnings.push(format!("{source}: {w}"));
+    }
     if let Some(c) = &description.calibration {
         if c.forced {
             warnings.push(format!(
