@@ -44,17 +44,17 @@ pub enum RecordError {
     #[error(
         "{} edited after the calibration (the record's seal does not match){}: every verb that loads the file commands, checks or exports by {}; restore the file, or calibrate again",
         named(.fields),
-        if .mismatch.is_empty() { String::new() } else { format!("; the machine no longer matches its record: {}", .mismatch.join("; ")) },
+        .detail.as_ref().map(|d| format!("; {d}")).unwrap_or_default(),
         if .fields.len() == 1 { "it" } else { "them" }
     )]
     Edited {
         /// The edited fields, as named in the file (`leg_offsets_mm`,
         /// `calibration.estimates_mm.dq2`).
         fields: Vec<String>,
-        /// Where the file's geometry and the one rebuilt from its record
-        /// differ (empty when they agree, or when the record cannot be
-        /// rebuilt), each with both values.
-        mismatch: Vec<String>,
+        /// What the rebuild from the record says besides (`None` when the
+        /// file's geometry agrees with its record): where they differ,
+        /// with both values, or why the record cannot be read.
+        detail: Option<String>,
     },
     /// The record has no seal: written before records were sealed, or the
     /// seal was removed.
@@ -165,11 +165,15 @@ pub fn check_calibration_record(d: &MachineDescription) -> Result<RecordNotes, R
         SealCheck::NoRecord => return Ok(RecordNotes::default()),
         SealCheck::Unsealed => return Err(RecordError::Unsealed),
         SealCheck::Edited(fields) => {
-            let mismatch = match rebuilt_differences(d) {
-                Err(RecordError::Mismatch { fields, .. }) => fields,
-                _ => Vec::new(),
+            let detail = match rebuilt_differences(d) {
+                Err(RecordError::Mismatch { fields, .. }) => Some(format!(
+                    "the machine does not match its calibration record: {}",
+                    fields.join("; ")
+                )),
+                Err(e) => Some(e.to_string()),
+                Ok(()) => None,
             };
-            return Err(RecordError::Edited { fields, mismatch });
+            return Err(RecordError::Edited { fields, detail });
         }
         SealCheck::Intact { partial } => partial,
     };

@@ -324,8 +324,7 @@ impl DiagnoseResult {
     pub fn write_machine(&self, path: &Path, force: bool) -> Result<Option<String>, Error> {
         let what = format!("--write-machine {}", path.display());
         let (description, forced) = self.extended_description(&what, force)?;
-        crate::machine_file::write(path, &description)
-            .map_err(|e| Error::other(format!("{}: not written: {e}", path.display())))?;
+        crate::machine_file::write(path, &description).map_err(|e| Error::not_written(path, &e))?;
         Ok(forced.map(|why| format!("{what}: written with --force although {why}")))
     }
 }

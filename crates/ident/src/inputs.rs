@@ -23,7 +23,7 @@ use tricept_kinematics::{
 use tricept_model::ParameterSet;
 use tricept_plant::Effect;
 
-use crate::error::Error;
+use crate::error::{Classify, Error};
 use crate::limits;
 
 /// Sensor-noise overrides of a machine (default: the description's).
@@ -126,7 +126,10 @@ pub fn description_error(path: &str, e: &DescriptionError) -> Error {
         DescriptionError::Io { .. } => e.to_string(),
         _ => format!("{path}: {e}"),
     };
-    Error::input(message)
+    match e.file_failure() {
+        Some(f) => Error::input(message).with_file_failure(f),
+        None => Error::input(message),
+    }
 }
 
 /// serde_json appends " at line L column C"; the message states it up front.

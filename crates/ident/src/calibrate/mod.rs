@@ -343,8 +343,7 @@ impl Calibration {
             }
         };
         let d = self.description(forced.clone())?;
-        machine_file::write(path, &d)
-            .map_err(|e| Error::other(format!("{}: not written: {e}", path.display())))?;
+        machine_file::write(path, &d).map_err(|e| Error::not_written(path, &e))?;
         if let Fit::Fused(f) = &mut self.fit {
             f.record_write(path, true);
         }
@@ -359,7 +358,7 @@ impl Calibration {
 /// intact and the error (exit code 1) names the file.
 pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), Error> {
     tricept_data::write_atomic(path, |w| w.write_all(text.as_bytes()))
-        .map_err(|e| Error::other(format!("{}: not written: {e}", path.display())))
+        .map_err(|e| Error::not_written(path, &e))
 }
 
 /// The one-line summary of a non-zero verdict (`VERB: exit CODE: WHY (see
