@@ -335,23 +335,52 @@ mod tests {
     }
 
     #[test]
-    fn concurrent_appends_keep_every_record() {
+    fn concurrent_appends_through_any_name_keep_every_record() {
         let dir = std::env::temp_dir().join(format!("tricept-history-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
         let path = dir.join("h.jsonl");
-        let _ = std::fs::remove_file(&path);
+        // One writer by the file's name, one through a symbolic link to it
+        // (and one more through a path with `..` in it): one file, one
+        // lock.
+        #[cfg(unix)]
+        let other = {
+            let link = dir.join("link.jsonl");
+            std::os::unix::fs::symlink("h.jsonl", &link).unwrap();
+            link
+        };
+        #[cfg(not(unix))]
+        let other = dir.join("sub").join("..").join("h.jsonl");
+        let names = [
+            path.clone(),
+            other,
+            dir.join("sub").join("..").join("h.jsonl"),
+        ];
         std::thread::scope(|s| {
-            for writer in 0..2 {
-                let path = &path;
+            for (writer, name) in names.iter().take(2).enumerate() {
                 s.spawn(move || {
                     for i in 0..50 {
-                        append(path, &entry(writer, i)).unwrap();
+                        append(name, &entry(writer, i)).unwrap();
                     }
                 });
             }
+            let name = &names[2];
+            s.spawn(move || {
+                for i in 0..10 {
+                    append(name, &entry(2, i)).unwrap();
+                }
+            });
         });
+        // Nothing beside the history (no lock file), the link still a link.
+        let mut left: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        #[cfg(unix)]
+        assert_eq!(left, ["h.jsonl", "link.jsonl", "sub"]);
+        assert_eq!(read(&path).unwrap().len(), 110);
         let kept = read(&path).unwrap();
-        assert_eq!(kept.len(), 100);
         for writer in 0..2 {
             let name = format!("writer{writer}");
             let days: Vec<String> = kept
@@ -362,6 +391,31 @@ mod tests {
             let expected: Vec<String> = (0..50).map(|i| format!("day{i}.csv")).collect();
             assert_eq!(days, expected, "{name}: every append, in its order");
         }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_history_that_is_not_a_regular_file_is_refused_without_waiting() {
+        // A named pipe opened to read or write would wait for its other end.
+        let dir = std::env::temp_dir().join(format!("tricept-history-fifo-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let fifo = dir.join("h.jsonl");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        assert!(made.is_ok_and(|s| s.success()));
+        assert!(
+            read(&fifo)
+                .unwrap_err()
+                .to_string()
+                .contains("not a regular file")
+        );
+        assert!(
+            append(&fifo, &entry(0, 0))
+                .unwrap_err()
+                .to_string()
+                .contains("not a regular file")
+        );
         std::fs::remove_dir_all(&dir).ok();
     }
 }
