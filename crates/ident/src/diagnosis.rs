@@ -317,6 +317,23 @@ impl DiagnoseResult {
         Ok((description, forced))
     }
 
+    /// The machine file of the final model, kept apart from the result
+    /// ([`crate::advanced::MachineFile`]): the description (forced when
+    /// the data are not explained) and the verdict the write rule applies.
+    pub fn machine_file(&self) -> Result<crate::advanced::MachineFile, Error> {
+        let (description, forced) = self.extended_description("--write-machine", true)?;
+        let code = if forced.is_some() {
+            EXIT_INADEQUATE
+        } else {
+            EXIT_OK
+        };
+        Ok(crate::advanced::MachineFile::new(
+            description,
+            code,
+            forced.unwrap_or_default(),
+        ))
+    }
+
     /// Writes the calibrated machine of the final model to `path`
     /// atomically ([`DiagnoseResult::extended_description`]); returns the
     /// warning of a forced write (`--write-machine PATH: written with

@@ -23,7 +23,7 @@ use tricept_kinematics::{
 use tricept_model::ParameterSet;
 use tricept_plant::Effect;
 
-use crate::error::{Classify, Error};
+use crate::error::{Classify, Error, FileFailure};
 use crate::limits;
 
 /// Sensor-noise overrides of a machine (default: the description's).
@@ -166,47 +166,85 @@ pub fn load_machine(path: Option<&Path>, noise: &SensorNoise) -> Result<LoadedMa
             )
         }
     };
-    let mut machine = description
-        .build()
-        .map_err(|e| description_error(&source, &e))?;
-    if let Some((r, why)) = machine.unreachable_workspace_point() {
-        let w = &machine.workspace;
-        return Err(Error::input(format!(
-            "{source}: the workspace (radius {} mm, z from {} to {} mm) is not within the machine's reach: at ({:.1}, {:.1}, {:.1}) mm: {why}; shrink `workspace` or correct `limits`",
-            w.radius_mm, w.z_min_mm, w.z_max_mm, r.x, r.y, r.z
-        )));
-    }
-    let notes = tricept_engine::check_calibration_record(&description)
-        .map_err(|e| Error::input(format!("{source}: {e}")))?;
-    let mut warnings = Vec::new();
-    if let Some(w) = notes.warning() {
-        warnings.push(format!("{source}: {w}"));
-    }
-    if let Some(c) = &description.calibration {
-        if c.forced {
-            warnings.push(format!(
-                "{source} holds a calibration written with --force although it is not to be trusted (converged: {}, adequate: {})",
-                c.converged, c.adequate
-            ));
-        } else if !c.converged {
-            warnings.push(format!(
-                "{source} holds a calibration whose fit did not converge: its estimates are not a calibration"
-            ));
-        } else if !c.adequate {
-            warnings.push(format!(
-                "{source} holds a calibration whose model did not explain its data (chi2/dof {:.2})",
-                c.chi2_per_dof
-            ));
+    let mut loaded = LoadedMachine::from_description(description, source, noise)?;
+    loaded.path = path.map(Path::to_path_buf);
+    Ok(loaded)
+}
+
+impl LoadedMachine {
+    /// A machine from a description in memory (one a program built, or a
+    /// file's text read back), checked as a file is ([`load_machine`]): it
+    /// must be valid, its workspace reachable and its calibration record,
+    /// if it has one, intact. `source` names it in messages.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::advanced::{LoadedMachine, SensorNoise};
+    /// use tricept_ident::kinematics::MachineDescription;
+    /// let mut d = MachineDescription::paper();
+    /// let m = LoadedMachine::from_description(d.clone(), "mine", &SensorNoise::default()).unwrap();
+    /// assert_eq!(m.source(), "mine");
+    /// d.workspace.radius_mm = -1.0;
+    /// assert!(LoadedMachine::from_description(d, "mine", &SensorNoise::default()).is_err());
+    /// ```
+    pub fn from_description(
+        description: MachineDescription,
+        source: impl Into<String>,
+        noise: &SensorNoise,
+    ) -> Result<LoadedMachine, Error> {
+        let source = source.into();
+        description
+            .validate()
+            .map_err(|e| description_error(&source, &e))?;
+        let mut machine = description
+            .build()
+            .map_err(|e| description_error(&source, &e))?;
+        if let Some((r, why)) = machine.unreachable_workspace_point() {
+            let w = &machine.workspace;
+            return Err(Error::input(format!(
+                "{source}: the workspace (radius {} mm, z from {} to {} mm) is not within the machine's reach: at ({:.1}, {:.1}, {:.1}) mm: {why}; shrink `workspace` or correct `limits`",
+                w.radius_mm, w.z_min_mm, w.z_max_mm, r.x, r.y, r.z
+            )));
         }
+        let notes = tricept_engine::check_calibration_record(&description)
+            .map_err(|e| Error::input(format!("{source}: {e}")))?;
+        let mut warnings = Vec::new();
+        if let Some(w) = notes.warning() {
+            warnings.push(format!("{source}: {w}"));
+        }
+        if let Some(c) = &description.calibration {
+            if c.forced {
+                warnings.push(format!(
+                    "{source} holds a calibration written with --force although it is not to be trusted (converged: {}, adequate: {})",
+                    c.converged, c.adequate
+                ));
+            } else if !c.converged {
+                warnings.push(format!(
+                    "{source} holds a calibration whose fit did not converge: its estimates are not a calibration"
+                ));
+            } else if !c.adequate {
+                warnings.push(format!(
+                    "{source} holds a calibration whose model did not explain its data (chi2/dof {:.2})",
+                    c.chi2_per_dof
+                ));
+            }
+        }
+        apply_noise(&mut machine, noise)?;
+        Ok(LoadedMachine {
+            description,
+            machine,
+            source,
+            path: None,
+            warnings,
+        })
     }
-    apply_noise(&mut machine, noise)?;
-    Ok(LoadedMachine {
-        description,
-        machine,
-        source,
-        path: path.map(Path::to_path_buf),
-        warnings,
-    })
+
+    /// The same machine with the sensor-noise overrides `noise` applied
+    /// (each must be positive), as a file loaded with them would be.
+    pub fn with_noise(mut self, noise: &SensorNoise) -> Result<LoadedMachine, Error> {
+        apply_noise(&mut self.machine, noise)?;
+        Ok(self)
+    }
 }
 
 /// Applies sensor-noise overrides to a machine (each must be positive).
@@ -241,7 +279,9 @@ pub fn positive(flag: &str, v: f64) -> Result<f64, Error> {
 /// stroke; every problem is an input error naming file, line and column.
 pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, Error> {
     let file = path.display().to_string();
-    let f = std::fs::File::open(path).map_err(|e| Error::input(format!("{file}: {e}")))?;
+    let f = std::fs::File::open(path).map_err(|e| {
+        Error::input(format!("{file}: {e}")).with_file_failure(FileFailure::new(file.clone(), &e))
+    })?;
     read_data_from(std::io::BufReader::new(f), &file, machine)
 }
 
@@ -498,8 +538,19 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
             ),
             None => (spec.clone(), "--truth-effect".to_string()),
         };
-        let value: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| Error::input(format!("{origin}: {e}")))?;
+        let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+            // A bare effect name is the usual slip: say what to give.
+            let typical = tricept_plant::effects::typical_effects()
+                .into_iter()
+                .find(|t| t.tag() == text.trim());
+            match typical.and_then(|t| serde_json::to_string(&t).ok()) {
+                Some(example) => Error::input(format!(
+                    "{origin}: `{}` names an effect; give it with its magnitudes as a JSON object, e.g. '{example}' (`tricept effects` lists every effect's keys)",
+                    text.trim()
+                )),
+                None => Error::input(format!("{origin}: {e}")),
+            }
+        })?;
         let items = match value {
             serde_json::Value::Array(a) => a,
             v => vec![v],

@@ -327,6 +327,19 @@ impl Calibration {
         }
     }
 
+    /// The machine file this calibration may write, kept apart from it
+    /// ([`crate::advanced::MachineFile`]): the description (forced when
+    /// the exit code is not 0) and the verdict the write rule applies. An
+    /// input error for data given in memory (the record holds the data
+    /// file's hash).
+    pub fn machine_file(&self) -> Result<crate::advanced::MachineFile, Error> {
+        let code = self.exit_code();
+        let why = self.reason();
+        let forced = (code != 0).then(|| why.clone());
+        let d = self.description(forced)?;
+        Ok(crate::advanced::MachineFile::new(d, code, why))
+    }
+
     /// Writes the calibrated machine file at `path` atomically, by the one
     /// write rule: a fit whose exit code is not 0 is refused (an error of
     /// that code) unless `force`, and the file then says it was forced.
