@@ -286,6 +286,7 @@ fn check_output_file(flag: &str, out: &Path) -> Result<(), CliError> {
             "{flag} -: {flag} does not write stdout (stdout carries the report); give a file name (`./-` for a file named `-`)"
         )));
     }
+    check_names(flag, out)?;
     tricept_data::check_output_file(out).map_err(|e| {
         let why = match e.kind() {
             std::io::ErrorKind::IsADirectory => "is a directory; give a file name".to_string(),
@@ -295,20 +296,77 @@ fn check_output_file(flag: &str, out: &Path) -> Result<(), CliError> {
     })
 }
 
-/// Refuses an output directory that is `-` or exists as something other
-/// than a directory (following symbolic links).
+/// Refuses an output directory that is `-`, has a name too long for a
+/// file system, exists as something other than a directory (following
+/// symbolic links), or cannot be created: an ancestor that is a file, a
+/// link that loops.
 fn check_output_dir(flag: &str, dir: &Path) -> Result<(), CliError> {
     if dir.as_os_str() == STDIO {
         return Err(CliError::input(format!(
             "{flag} -: {flag} names a directory, not stdout; give a directory name"
         )));
     }
+    check_names(flag, dir)?;
+    let refused = |why: String| CliError::input(format!("{flag} {}: {why}", shown(dir)));
     match std::fs::metadata(dir) {
-        Ok(m) if !m.is_dir() => Err(CliError::input(format!(
-            "{flag} {}: is a file, not a directory",
-            shown(dir)
+        Ok(m) if m.is_dir() => return Ok(()),
+        Ok(_) => return Err(refused("is a file, not a directory".into())),
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            return Err(refused(format!("cannot be a directory: {e}")));
+        }
+        Err(_) => {}
+    }
+    // Created with its parents: its own name a name (`new/.` is none), and
+    // the nearest that exists a directory.
+    let text = dir.as_os_str().to_string_lossy();
+    let last = text
+        .trim_end_matches(['/', std::path::MAIN_SEPARATOR])
+        .rsplit(['/', std::path::MAIN_SEPARATOR])
+        .next()
+        .unwrap_or_default();
+    if last.is_empty() || last == "." || last == ".." {
+        return Err(refused(
+            "does not exist and ends in `.` or `..`: name the directory to create".into(),
+        ));
+    }
+    for ancestor in dir.ancestors().skip(1) {
+        let a = if ancestor.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            ancestor
+        };
+        match std::fs::metadata(a) {
+            Ok(m) if m.is_dir() => return Ok(()),
+            Ok(_) => {
+                return Err(refused(format!(
+                    "cannot be created: {} is not a directory",
+                    shown(a)
+                )));
+            }
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(refused(format!("cannot be created: {e}")));
+            }
+            Err(_) => {}
+        }
+    }
+    Ok(())
+}
+
+/// The longest name of one file or directory most file systems take, in
+/// bytes (`NAME_MAX`).
+const NAME_MAX: usize = 255;
+
+/// Refuses a path with a name longer than [`NAME_MAX`] bytes: no file
+/// system here would take it, and finding that out only when writing
+/// would come after the work.
+fn check_names(flag: &str, path: &Path) -> Result<(), CliError> {
+    match path.components().find(|c| c.as_os_str().len() > NAME_MAX) {
+        Some(c) => Err(CliError::input(format!(
+            "{flag} {}: a name of {} bytes (a file system takes at most {NAME_MAX})",
+            shown(path),
+            c.as_os_str().len()
         ))),
-        _ => Ok(()),
+        None => Ok(()),
     }
 }
 

@@ -36,6 +36,7 @@ mod output;
 mod plan_cmd;
 mod simulate_cmd;
 
+use std::path::Path;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -182,7 +183,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
     // The true errors' file, and the effects' `@FILE`s.
     let truth_inputs = |r: &mut files::FileRoles, t: &args::TruthArgs| {
         if let Some(tricept_ident::advanced::TrueErrors::File(p)) = &t.truth {
-            r.input_if_file("--truth", &p.to_string_lossy());
+            r.input("--truth", p);
         }
         for e in &t.truth_effects {
             r.input_if_file("--truth-effect", &e.to_string());
@@ -205,7 +206,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         Command::Docs(_) | Command::Effects(_) => {}
         Command::Identifiability(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses.to_string());
+            r.inputs("--poses", a.poses.file().map(Path::to_path_buf).as_ref());
             r.inputs("--data", &a.data);
         }
         Command::Identify(a) => {
@@ -223,9 +224,11 @@ fn file_roles(command: &Command) -> files::FileRoles {
         }
         Command::Simulate(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses.to_string());
+            r.inputs("--poses", a.poses.file().map(Path::to_path_buf).as_ref());
             truth_inputs(&mut r, &a.truth);
-            r.input_if_file("--head-errors", &a.head_errors.to_string());
+            if let tricept_ident::simulate::HeadErrors::File(p) = &a.head_errors {
+                r.input("--head-errors", p);
+            }
             r.inputs("--tracker-poses", &a.tracker_poses);
             r.inputs("--ballbar-poses", &a.ballbar_poses);
             r.inputs("--touch-poses", &a.touch_poses);
@@ -254,7 +257,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
         }
         Command::Detectability(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses.to_string());
+            r.inputs("--poses", a.poses.file().map(Path::to_path_buf).as_ref());
             r.inputs("--data", &a.data);
         }
         Command::Compensate(a) => {
@@ -285,8 +288,11 @@ fn file_roles(command: &Command) -> files::FileRoles {
         Command::Plan(a) => {
             machine(&mut r, &a.machine);
             r.inputs("--data", &a.data);
-            r.input_if_file("--poses", &a.poses.to_string());
-            r.input_if_file("--candidates", &a.candidates.to_string());
+            r.inputs("--poses", a.poses.file().map(Path::to_path_buf).as_ref());
+            r.inputs(
+                "--candidates",
+                a.candidates.file().map(Path::to_path_buf).as_ref(),
+            );
             if let Some(p) = &a.out {
                 r.output("--out", p);
             }
@@ -357,10 +363,14 @@ fn main() -> ExitCode {
                 errln!("error: {line}");
                 return ExitCode::from(tricept_ident::EXIT_INPUT);
             }
-            // Usage errors go to stderr (exit 2); help and version are
-            // output like any other (a full disk is a failure, exit 1).
+            // Usage errors go to stderr (exit 2), what they repeat of the
+            // command line inert (a control character escaped); help and
+            // version are output like any other (a full disk is a
+            // failure, exit 1).
             if e.use_stderr() {
-                let _ = e.print();
+                for line in e.render().to_string().trim_end().lines() {
+                    errln!("{line}");
+                }
                 return ExitCode::from(2);
             }
             output::write_text(&e.render().to_string());

@@ -154,10 +154,12 @@ fn resolve(path: &Path) -> io::Result<PathBuf> {
 /// ```
 pub fn check_output_file(path: &Path) -> io::Result<()> {
     let text = path.as_os_str().to_string_lossy();
-    if text.ends_with('/')
-        || text.ends_with(std::path::MAIN_SEPARATOR)
-        || path.file_name().is_none()
-    {
+    // `a/.` has the file name `a` once normalised: the text says what it names.
+    let last = text
+        .rsplit(['/', std::path::MAIN_SEPARATOR])
+        .next()
+        .unwrap_or_default();
+    if last.is_empty() || last == "." || last == ".." || path.file_name().is_none() {
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
             "names a directory (it ends with a separator or is `.` or `..`), not a file: give a file name",
@@ -451,8 +453,10 @@ mod tests {
         );
         // Nothing but the pipe and the link in the directory: no temporary.
         assert_eq!(entries(&d), ["null.json", "pipe"]);
-        let e = write_atomic(&d.join("sub/"), |w| w.write_all(b"x")).unwrap_err();
-        assert!(e.to_string().contains("names a directory"), "{e}");
+        for name in ["sub/", "sub/.", "sub/..", ".", ".."] {
+            let e = write_atomic(&d.join(name), |w| w.write_all(b"x")).unwrap_err();
+            assert!(e.to_string().contains("names a directory"), "{name}: {e}");
+        }
         std::fs::remove_dir_all(&d).ok();
     }
 }

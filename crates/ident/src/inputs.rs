@@ -250,10 +250,18 @@ impl LoadedMachine {
 /// Applies sensor-noise overrides to a machine (each must be positive).
 fn apply_noise(m: &mut Machine, noise: &SensorNoise) -> Result<(), Error> {
     if let Some(a) = noise.angle_noise_arcsec {
-        m.sensors.angle_rad = positive("--angle-noise-arcsec", a)? * RAD_PER_ARCSEC;
+        m.sensors.angle_rad = at_most(
+            "--angle-noise-arcsec",
+            positive("--angle-noise-arcsec", a)?,
+            MAX_NOISE,
+        )? * RAD_PER_ARCSEC;
     }
     if let Some(l) = noise.length_noise_um {
-        m.sensors.length_mm = positive("--length-noise-um", l)? * 1e-3;
+        m.sensors.length_mm = at_most(
+            "--length-noise-um",
+            positive("--length-noise-um", l)?,
+            MAX_NOISE,
+        )? * 1e-3;
     }
     if let Some(k) = noise.readings_per_pose {
         if k == 0 {
@@ -262,6 +270,22 @@ fn apply_noise(m: &mut Machine, noise: &SensorNoise) -> Result<(), Error> {
         m.sensors.readings_per_pose = k;
     }
     Ok(())
+}
+
+/// The largest sensor noise an override may state (arcsec or um): an
+/// encoder 10 000 arcsec (2.8 degrees) or a scale 10 mm off in one
+/// reading is no sensor of this machine, and its weights would underflow.
+pub const MAX_NOISE: f64 = 1e4;
+
+/// `v` if it is at most `max`, else an input error naming `flag`.
+fn at_most(flag: &str, v: f64, max: f64) -> Result<f64, Error> {
+    if v <= max {
+        Ok(v)
+    } else {
+        Err(Error::input(format!(
+            "{flag}: must be at most {max}, got {v}"
+        )))
+    }
 }
 
 /// `v` if it is a positive finite number, else an input error naming `flag`.
@@ -401,6 +425,22 @@ impl Poses {
                 per_ring: 8,
                 levels: 3,
             }),
+        }
+    }
+
+    /// The CSV file of the poses, when the spec names one (neither a
+    /// grid, a random set, a disc nor `optimal:N`).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::advanced::Poses;
+    /// assert!("random:20,1".parse::<Poses>().unwrap().file().is_none());
+    /// assert_eq!("p.csv".parse::<Poses>().unwrap().file().unwrap().to_str(), Some("p.csv"));
+    /// ```
+    pub fn file(&self) -> Option<&Path> {
+        match &self.kind {
+            PosesKind::File(p) => Some(p),
+            _ => None,
         }
     }
 

@@ -13,6 +13,7 @@ mod edges;
 mod exit_codes;
 mod export;
 mod fusion;
+mod fuzz;
 mod one_exit_code;
 mod outputs;
 mod relied_on;
