@@ -520,8 +520,12 @@ fn paths_at_random() {
     // Run one level down, so that a `..` stays inside the scratch.
     let dir = root.join("in");
     std::fs::create_dir_all(dir.join("sub")).unwrap();
-    for f in ["cal.csv", "cal.json", "day.csv", "out.json"] {
-        std::fs::copy(root.join(f), dir.join(f)).unwrap();
+    let pristine: Vec<(&str, Vec<u8>)> = ["cal.csv", "cal.json", "day.csv", "out.json"]
+        .into_iter()
+        .map(|f| (f, std::fs::read(root.join(f)).unwrap()))
+        .collect();
+    for (f, bytes) in &pristine {
+        std::fs::write(dir.join(f), bytes).unwrap();
     }
     let made = std::process::Command::new("mkfifo")
         .arg(dir.join("pipe"))
@@ -629,11 +633,13 @@ fn paths_at_random() {
         codes[usize::from(out.status.code().unwrap_or(1) as u8).min(4)] += 1;
         // The inputs as they were, for the next case (a run may have
         // written over one, as it may).
-        for f in ["cal.csv", "cal.json", "day.csv", "out.json"] {
-            if std::fs::symlink_metadata(dir.join(f)).is_ok_and(|m| m.is_dir()) {
-                std::fs::remove_dir_all(dir.join(f)).unwrap();
+        for (f, bytes) in &pristine {
+            for d in [&root, &dir] {
+                if std::fs::symlink_metadata(d.join(f)).is_ok_and(|m| m.is_dir()) {
+                    std::fs::remove_dir_all(d.join(f)).unwrap();
+                }
+                std::fs::write(d.join(f), bytes).unwrap();
             }
-            std::fs::copy(root.join(f), dir.join(f)).unwrap();
         }
     }
     println!(
