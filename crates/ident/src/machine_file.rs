@@ -366,7 +366,7 @@ pub fn calibrated_description(
 
 /// A calibrated machine file not yet written: its description (with its
 /// record) and the verdict of the fit it came from, written by the one
-/// write rule ([`write_rule`]). A result gives it
+/// write rule (`identify --write-machine`'s). A result gives it
 /// ([`crate::calibrate::Calibration::machine_file`],
 /// [`crate::diagnosis::DiagnoseResult::machine_file`]) to be kept apart
 /// from the result (as JSON: a Python binding pickles it) and written
