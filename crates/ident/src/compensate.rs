@@ -624,7 +624,7 @@ impl Compensation {
                     "{}: cannot create the directory: {e}",
                     dir.display()
                 ))
-                .with_file_failure(crate::advanced::FileFailure::new(
+                .with_file_failure(crate::error::FileFailure::new(
                     dir.display().to_string(),
                     &e,
                 ))

@@ -320,14 +320,14 @@ impl DiagnoseResult {
     /// The machine file of the final model, kept apart from the result
     /// ([`crate::advanced::MachineFile`]): the description (forced when
     /// the data are not explained) and the verdict the write rule applies.
-    pub fn machine_file(&self) -> Result<crate::advanced::MachineFile, Error> {
+    pub fn machine_file(&self) -> Result<crate::machine_file::MachineFile, Error> {
         let (description, forced) = self.extended_description("--write-machine", true)?;
         let code = if forced.is_some() {
             EXIT_INADEQUATE
         } else {
             EXIT_OK
         };
-        Ok(crate::advanced::MachineFile::new(
+        Ok(crate::machine_file::MachineFile::new(
             description,
             code,
             forced.unwrap_or_default(),

@@ -332,12 +332,12 @@ impl Calibration {
     /// the exit code is not 0) and the verdict the write rule applies. An
     /// input error for data given in memory (the record holds the data
     /// file's hash).
-    pub fn machine_file(&self) -> Result<crate::advanced::MachineFile, Error> {
+    pub fn machine_file(&self) -> Result<crate::machine_file::MachineFile, Error> {
         let code = self.exit_code();
         let why = self.reason();
         let forced = (code != 0).then(|| why.clone());
         let d = self.description(forced)?;
-        Ok(crate::advanced::MachineFile::new(d, code, why))
+        Ok(crate::machine_file::MachineFile::new(d, code, why))
     }
 
     /// Writes the calibrated machine file at `path` atomically, by the one
