@@ -154,12 +154,14 @@ fn resolve(path: &Path) -> io::Result<PathBuf> {
 /// ```
 pub fn check_output_file(path: &Path) -> io::Result<()> {
     let text = path.as_os_str().to_string_lossy();
-    // `a/.` has the file name `a` once normalised: the text says what it names.
+    // The text's last name, not `Path::file_name` (which reads `a/.` as
+    // `a`): every path without a file name (`/`, `..`, ``) ends in one of
+    // these.
     let last = text
         .rsplit(['/', std::path::MAIN_SEPARATOR])
         .next()
         .unwrap_or_default();
-    if last.is_empty() || last == "." || last == ".." || path.file_name().is_none() {
+    if last.is_empty() || last == "." || last == ".." {
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
             "names a directory (it ends with a separator or is `.` or `..`), not a file: give a file name",
@@ -453,7 +455,7 @@ mod tests {
         );
         // Nothing but the pipe and the link in the directory: no temporary.
         assert_eq!(entries(&d), ["null.json", "pipe"]);
-        for name in ["sub/", "sub/.", "sub/..", ".", ".."] {
+        for name in ["sub/", "sub/.", "sub/..", ".", "..", ""] {
             let e = write_atomic(&d.join(name), |w| w.write_all(b"x")).unwrap_err();
             assert!(e.to_string().contains("names a directory"), "{name}: {e}");
         }
