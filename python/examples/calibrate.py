@@ -2,8 +2,8 @@
 
 1. Simulate two campaigns of the Table 1 machine with the paper's Table 2
    errors (`tricept.simulate`): one to calibrate from, one held out.
-2. Calibrate from the first (`tricept.identify`, from column arrays) and
-   write the calibrated machine file.
+2. Calibrate from the first (`tricept.identify`, from column arrays); its
+   calibrated machine (`Calibration.machine`) is used in memory.
 3. Error maps over the workspace's mid plane, before and after: the
    platform error of commanding the machine with nominal commands (before)
    and with the calibration's commands (after), both measured on a second,
@@ -20,7 +20,6 @@ backend needs no display). Prints the rms errors before and after, mm.
 import json
 import os
 import sys
-import tempfile
 
 import matplotlib
 
@@ -29,15 +28,6 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import tricept  # noqa: E402
-
-
-def write_csv(columns, path):
-    names = list(columns)
-    rows = zip(*(columns[n] for n in names))
-    with open(path, "w") as f:
-        f.write(",".join(names) + "\n")
-        for r in rows:
-            f.write(",".join(repr(float(v)) for v in r) + "\n")
 
 
 def platform_error_mm(true_machine, commanding_machine, targets):
@@ -57,14 +47,9 @@ def main(out_dir):
     if c.exit_code != 0:
         print(c.report())
         return 1
-    tmp = tempfile.mkdtemp()
-    paths = {}
-    for name, data in (("cal", calibration_data), ("ref", held_out)):
-        write_csv(data, os.path.join(tmp, f"{name}.csv"))
-        paths[name] = os.path.join(out_dir, f"{name}.json")
-        tricept.identify(os.path.join(tmp, f"{name}.csv")).write_machine(paths[name])
-    calibrated = tricept.Machine.load(paths["cal"])
-    reference = tricept.Machine.load(paths["ref"])
+    # The calibrated machines in memory: no file needed.
+    calibrated = c.machine
+    reference = tricept.identify(held_out).machine
     nominal = tricept.Machine.paper()
 
     # Error maps on the mid plane.

@@ -3,89 +3,106 @@
 //! is read in place when it is C-contiguous (else copied once), the output
 //! is one array built in Rust and handed to numpy without a copy; the
 //! points are solved in parallel (rayon) with the GIL released, each point
-//! independently, so the result is the same at any thread count.
+//! independently, so the result is the same at any thread count. An output
+//! sized by the input is allocated fallibly: an allocation the memory
+//! cannot hold raises `MemoryError` instead of aborting the interpreter.
 //!
 //! The workflows (identify, diagnose, check, simulate) are the door's, the
-//! same calls the CLI's verbs make: their JSON is the CLI's `--json`, their
-//! exit codes the CLI's. Data come as a CSV file or as CSV text the Python
-//! half writes from column arrays (shortest round-trip numbers: the same
-//! bits as the arrays), read by the same strict reader.
+//! same calls the CLI's verbs make (`workflows.rs`): their JSON is the
+//! CLI's `--json`, their exit codes the CLI's. Data come as a CSV file or
+//! as CSV text the Python half writes from column arrays (shortest
+//! round-trip numbers: the same bits as the arrays), read by the same
+//! strict reader.
 //!
-//! Errors the input causes raise `tricept.InputError` (a `ValueError`)
-//! with the one-line message the CLI prints; a machine file refused by the
-//! write rule raises `tricept.UntrustedError` with the exit code.
+//! Errors (`errors.rs`): the input's fault raises `tricept.InputError` (a
+//! `ValueError`) with the one-line message the CLI prints; a file-system
+//! failure the operating system's `OSError` subclass (`FileNotFoundError`,
+//! `PermissionError`, ...); a machine file refused by the write rule
+//! `tricept.UntrustedError` with the exit code. The exception classes live
+//! in the Python package (`tricept._errors`), so that they pickle.
+
+mod errors;
+mod workflows;
 
 use std::borrow::Cow;
 use std::path::PathBuf;
 
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::create_exception;
 use pyo3::prelude::*;
 use rayon::prelude::*;
-use tricept_ident::advanced::{LoadedMachine, ParameterSet, Poses, SensorNoise, TrueErrors};
-use tricept_ident::calibrate::CalibrateRequest;
-use tricept_ident::check::CheckRequest;
-use tricept_ident::diagnosis::DiagnoseRequest;
+use tricept_ident::MachineInput;
+use tricept_ident::advanced::{LoadedMachine, SensorNoise};
 use tricept_ident::kinematics::{ExtendedMachine, HeadBranch, KinematicsError, Vector3};
-use tricept_ident::simulate::SimulateRequest;
-use tricept_ident::{DataInput, MachineInput};
 
-create_exception!(
-    _tricept,
-    InputError,
-    pyo3::exceptions::PyValueError,
-    "Bad input: a file, an array or an option; the message names the file, line and column, or the row."
-);
+use crate::errors::{door_error, input_error, memory_error};
 
-create_exception!(
-    _tricept,
-    UntrustedError,
-    pyo3::exceptions::PyRuntimeError,
-    "A result that is not to be trusted was asked to be written (the CLI's refusal: exit code 3 or 4); `force=True` writes it, marked as forced."
-);
-
-/// The input error of a door error, or of any message.
-fn input_error(message: impl Into<String>) -> PyErr {
-    InputError::new_err(message.into())
+/// A machine: the embedded Table 1 machine, a description file, a
+/// description's JSON text, or a calibration's result; a calibrated one
+/// with its leg effects and compensation tables applied.
+#[pyclass(module = "tricept._tricept", frozen)]
+pub(crate) struct Machine {
+    loaded: LoadedMachine,
+    machine: ExtendedMachine,
 }
 
-/// A door error as a Python exception: input errors raise `InputError`,
-/// anything else `RuntimeError`.
-fn door_error(e: tricept_ident::Error) -> PyErr {
-    match e.kind() {
-        tricept_ident::ErrorKind::Input => input_error(e.message()),
-        tricept_ident::ErrorKind::Inadequate | tricept_ident::ErrorKind::NotConverged => {
-            UntrustedError::new_err((e.message().to_string(), e.exit_code()))
+impl Machine {
+    /// The Python machine of a loaded one.
+    pub(crate) fn of(loaded: LoadedMachine) -> Machine {
+        Machine {
+            machine: ExtendedMachine::new(loaded.machine().clone()),
+            loaded,
         }
-        _ => pyo3::exceptions::PyRuntimeError::new_err(e.message().to_string()),
+    }
+
+    /// The machine as a workflow takes it, with the noise overrides.
+    pub(crate) fn input(&self, noise: &SensorNoise) -> Result<MachineInput, tricept_ident::Error> {
+        Ok(MachineInput::from(self.loaded.clone().with_noise(noise)?))
     }
 }
 
-/// A machine: the embedded Table 1 machine or a description file, a
-/// calibrated one with its leg effects and compensation tables applied.
-#[pyclass(module = "tricept._tricept", frozen)]
-struct Machine {
-    machine: ExtendedMachine,
-    source: String,
+/// A vector of `n` zeros allocated fallibly: `MemoryError` when the
+/// memory cannot hold it (or `n` overflows).
+fn zeros(n: Option<usize>, what: &str) -> PyResult<Vec<f64>> {
+    let n = n.ok_or_else(|| memory_error(format!("{what}: too many values")))?;
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).map_err(|e| {
+        memory_error(format!(
+            "{what}: cannot allocate {n} values ({} bytes): {e}",
+            n.saturating_mul(8)
+        ))
+    })?;
+    v.resize(n, 0.0);
+    Ok(v)
 }
 
-/// The rows of an `(n, width)` float array, in place when C-contiguous.
+/// The rows of an `(n, width)` float array, in place when C-contiguous
+/// (else copied into a fallibly allocated vector).
 fn rows<'a>(
+    py: Python<'_>,
     array: &'a PyReadonlyArray2<'_, f64>,
     width: usize,
     what: &str,
 ) -> PyResult<Cow<'a, [f64]>> {
     let shape = array.shape();
     if shape[1] != width {
-        return Err(input_error(format!(
-            "{what}: expected an (n, {width}) array, got shape ({}, {})",
-            shape[0], shape[1]
-        )));
+        return Err(input_error(
+            py,
+            format!(
+                "{what}: expected an (n, {width}) array, got shape ({}, {})",
+                shape[0], shape[1]
+            ),
+        ));
     }
     Ok(match array.as_slice() {
         Ok(s) => Cow::Borrowed(s),
-        Err(_) => Cow::Owned(array.as_array().iter().copied().collect()),
+        Err(_) => {
+            let mut v = zeros(shape[0].checked_mul(width), what)?;
+            for (o, x) in v.iter_mut().zip(array.as_array().iter()) {
+                *o = *x;
+            }
+            Cow::Owned(v)
+        }
     })
 }
 
@@ -104,24 +121,19 @@ where
     F: Fn(&[f64], &mut [f64]) -> Result<(), KinematicsError> + Sync,
 {
     let n = input.len() / width;
-    let result = py.detach(|| {
-        let mut out = vec![0.0; n * out_width];
-        let failures: Vec<(usize, KinematicsError)> = out
-            .par_chunks_mut(out_width)
+    let mut out = zeros(n.checked_mul(out_width), what)?;
+    let failure = py.detach(|| {
+        out.par_chunks_mut(out_width)
             .zip(input.par_chunks(width))
             .enumerate()
             .filter_map(|(i, (o, x))| solve(x, o).err().map(|e| (i, e)))
-            .collect();
-        match failures.into_iter().min_by_key(|(i, _)| *i) {
-            Some(first) => Err(first),
-            None => Ok(out),
-        }
+            .min_by_key(|(i, _)| *i)
     });
-    match result {
-        Ok(out) => Array2::from_shape_vec((n, out_width), out)
+    match failure {
+        None => Array2::from_shape_vec((n, out_width), out)
             .map(|a| a.into_pyarray(py))
             .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string())),
-        Err((i, e)) => Err(input_error(format!("{what}: row {i}: {e}"))),
+        Some((i, e)) => Err(input_error(py, format!("{what}: row {i}: {e}"))),
     }
 }
 
@@ -129,29 +141,71 @@ where
 impl Machine {
     /// The paper's Table 1 machine (the CLI's default machine).
     #[staticmethod]
-    fn paper() -> Machine {
-        Machine {
-            machine: ExtendedMachine::new(tricept_ident::kinematics::Machine::paper()),
-            source: "the built-in Table 1 machine".into(),
-        }
+    fn paper(py: Python<'_>) -> PyResult<Machine> {
+        let loaded = MachineInput::default()
+            .load()
+            .map_err(|e| door_error(py, e))?;
+        Ok(Machine::of(loaded))
     }
 
     /// A machine description file, as every `--machine` of the CLI loads
     /// it: a calibrated file whose record does not match it (edited) is
-    /// refused with `InputError`.
+    /// refused with `InputError`, a missing file with `FileNotFoundError`.
     #[staticmethod]
-    fn load(path: PathBuf) -> PyResult<Machine> {
-        let loaded = MachineInput::from(path).load().map_err(door_error)?;
-        Ok(Machine {
-            machine: ExtendedMachine::new(loaded.machine().clone()),
-            source: loaded.source().to_string(),
-        })
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Machine> {
+        let loaded = MachineInput::from(path)
+            .load()
+            .map_err(|e| door_error(py, e))?;
+        Ok(Machine::of(loaded))
+    }
+
+    /// A machine from a description's JSON text (what `to_json` gives),
+    /// checked as a file is; `source` names it in messages.
+    #[staticmethod]
+    #[pyo3(signature = (text, source="<json>".to_string()))]
+    fn from_json(py: Python<'_>, text: &str, source: String) -> PyResult<Machine> {
+        let d = tricept_ident::kinematics::MachineDescription::from_json(text)
+            .map_err(|e| door_error(py, tricept_ident::Error::from(e).in_file(&source)))?;
+        let loaded = LoadedMachine::from_description(d, source, &SensorNoise::default())
+            .map_err(|e| door_error(py, e))?;
+        Ok(Machine::of(loaded))
+    }
+
+    /// The machine's description as JSON text (with the calibration
+    /// record of a calibrated machine): what `tricept machine --json`
+    /// prints, and what `from_json` reads back.
+    fn to_json(&self) -> String {
+        self.loaded.description().to_json()
     }
 
     /// Where the machine came from: the file name, or the built-in machine.
     #[getter]
     fn source(&self) -> &str {
-        &self.source
+        self.loaded.source()
+    }
+
+    /// The machine's name (its description's `name`).
+    #[getter]
+    fn name(&self) -> &str {
+        &self.loaded.description().name
+    }
+
+    /// The method of the calibration the machine holds (`identify`,
+    /// `diagnose`, ...), `None` for a machine without a calibration record.
+    #[getter]
+    fn calibration(&self) -> Option<String> {
+        self.loaded
+            .description()
+            .calibration
+            .as_ref()
+            .map(|c| c.method.clone())
+    }
+
+    /// What loading it warned of (a forced or inadequate calibration), one
+    /// line each.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.loaded.warnings().to_vec()
     }
 
     /// Inverse kinematics of platform points: `points` is an `(n, 3)`
@@ -162,7 +216,7 @@ impl Machine {
         py: Python<'py>,
         points: PyReadonlyArray2<'py, f64>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let input = rows(&points, 3, "ik: points")?;
+        let input = rows(py, &points, 3, "ik: points")?;
         let m = &self.machine;
         solve_rows(py, &input, 3, 6, "ik: points", |x, o| {
             let sol = m.inverse(&Vector3::new(x[0], x[1], x[2]))?;
@@ -181,7 +235,7 @@ impl Machine {
         py: Python<'py>,
         q: PyReadonlyArray2<'py, f64>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let input = rows(&q, 3, "fk: q")?;
+        let input = rows(py, &q, 3, "fk: q")?;
         let m = &self.machine;
         solve_rows(py, &input, 3, 8, "fk: q", |x, o| {
             let sol = m.forward(&[x[0], x[1], x[2]])?;
@@ -210,20 +264,23 @@ impl Machine {
         points: PyReadonlyArray2<'py, f64>,
         axes: PyReadonlyArray2<'py, f64>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let tips = rows(&points, 3, "tool_ik: points")?;
-        let dirs = rows(&axes, 3, "tool_ik: axes")?;
+        let tips = rows(py, &points, 3, "tool_ik: points")?;
+        let dirs = rows(py, &axes, 3, "tool_ik: axes")?;
         if tips.len() != dirs.len() {
-            return Err(input_error(format!(
-                "tool_ik: points has {} rows and axes {}",
-                tips.len() / 3,
-                dirs.len() / 3
-            )));
+            return Err(input_error(
+                py,
+                format!(
+                    "tool_ik: points has {} rows and axes {}",
+                    tips.len() / 3,
+                    dirs.len() / 3
+                ),
+            ));
         }
-        let input: Vec<f64> = tips
-            .chunks(3)
-            .zip(dirs.chunks(3))
-            .flat_map(|(t, a)| t.iter().chain(a).copied())
-            .collect();
+        let mut input = zeros(tips.len().checked_mul(2), "tool_ik: points")?;
+        for ((o, t), a) in input.chunks_mut(6).zip(tips.chunks(3)).zip(dirs.chunks(3)) {
+            o[..3].copy_from_slice(t);
+            o[3..].copy_from_slice(a);
+        }
         let m = &self.machine;
         solve_rows(py, &input, 6, 9, "tool_ik: points", |x, o| {
             let sol = m.tool_inverse(
@@ -245,324 +302,24 @@ impl Machine {
     }
 
     fn __repr__(&self) -> String {
-        format!("Machine({:?})", self.source)
-    }
-}
-
-/// The machine of a workflow: a file, or the embedded Table 1 machine,
-/// with sensor-noise overrides.
-fn machine_of(path: Option<PathBuf>, noise: SensorNoise) -> PyResult<LoadedMachine> {
-    MachineInput::new(path, noise).load().map_err(door_error)
-}
-
-/// Data given as a file path or as CSV text (named `name` in messages),
-/// checked against `machine`'s stroke.
-fn data_of(
-    path: Option<PathBuf>,
-    csv_text: Option<&str>,
-    name: &str,
-    machine: &tricept_ident::kinematics::Machine,
-) -> PyResult<DataInput> {
-    match (path, csv_text) {
-        (Some(path), None) => Ok(DataInput::File(path)),
-        (None, Some(text)) => Ok(DataInput::Memory(
-            tricept_ident::advanced::read_data_from(text.as_bytes(), name, machine)
-                .map_err(door_error)?,
-        )),
-        _ => Err(input_error(
-            "data: give a CSV path or a mapping of column arrays",
-        )),
-    }
-}
-
-/// A calibration (`tricept identify`): its verdict, estimates, covariance,
-/// JSON and report, and the machine file it may write.
-#[pyclass(module = "tricept._tricept")]
-struct Calibration {
-    inner: tricept_ident::calibrate::Calibration,
-}
-
-#[pymethods]
-impl Calibration {
-    /// 0 trusted, 3 the model does not explain the data or the campaign
-    /// is too small, 4 not converged: the CLI's exit code.
-    #[getter]
-    fn exit_code(&self) -> u8 {
-        self.inner.exit_code()
-    }
-
-    /// The parameter names, in the order of the covariance.
-    #[getter]
-    fn names(&self) -> Vec<String> {
-        self.inner
-            .estimates()
-            .into_iter()
-            .map(|(n, _, _)| n)
-            .collect()
-    }
-
-    /// The estimates by name (mm, rad).
-    #[getter]
-    fn estimates(&self) -> Vec<(String, f64)> {
-        self.inner
-            .estimates()
-            .into_iter()
-            .map(|(n, v, _)| (n, v))
-            .collect()
-    }
-
-    /// Their standard deviations by name (mm, rad; `None`: held).
-    #[getter]
-    fn sd(&self) -> Vec<(String, Option<f64>)> {
-        self.inner
-            .estimates()
-            .into_iter()
-            .map(|(n, _, s)| (n, s))
-            .collect()
-    }
-
-    /// The estimates' covariance (mm^2, rad^2), in the order of `names`.
-    #[getter]
-    fn covariance<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let c = self.inner.covariance();
-        Array2::from_shape_fn((c.nrows(), c.ncols()), |(i, j)| c[(i, j)]).into_pyarray(py)
-    }
-
-    /// The warnings of the fit, one line each.
-    #[getter]
-    fn warnings(&self) -> Vec<String> {
-        self.inner.warnings().to_vec()
-    }
-
-    /// The JSON `tricept identify --json` prints.
-    fn to_json(&self) -> String {
-        self.inner.to_json().to_string()
-    }
-
-    /// The text report `tricept identify` prints.
-    fn report(&self) -> String {
-        self.inner.report()
-    }
-
-    /// Writes the calibrated machine file by the CLI's rule: a fit whose
-    /// exit code is not 0 raises `UntrustedError` unless `force`; data
-    /// given as arrays cannot be recorded and raise `InputError`.
-    #[pyo3(signature = (path, force=false))]
-    fn write_machine(&mut self, path: PathBuf, force: bool) -> PyResult<String> {
-        let written = self.inner.write_machine(&path, force).map_err(door_error)?;
-        Ok(written.path().display().to_string())
-    }
-}
-
-/// Identifies the machine from measured data (`tricept identify`).
-#[pyfunction]
-#[pyo3(signature = (path=None, csv_text=None, name="<arrays>".to_string(), machine=None, params="paper15".to_string(), robust=true, tolerance_mm=None, angle_noise_arcsec=None, length_noise_um=None, readings_per_pose=None))]
-#[allow(clippy::too_many_arguments)]
-fn identify(
-    py: Python<'_>,
-    path: Option<PathBuf>,
-    csv_text: Option<String>,
-    name: String,
-    machine: Option<PathBuf>,
-    params: String,
-    robust: bool,
-    tolerance_mm: Option<f64>,
-    angle_noise_arcsec: Option<f64>,
-    length_noise_um: Option<f64>,
-    readings_per_pose: Option<u32>,
-) -> PyResult<Calibration> {
-    let noise = SensorNoise {
-        angle_noise_arcsec,
-        length_noise_um,
-        readings_per_pose,
-    };
-    let data = match (path, csv_text) {
-        (Some(path), None) => DataInput::File(path),
-        (None, Some(text)) => {
-            let loaded = machine_of(machine.clone(), noise)?;
-            DataInput::Memory(
-                tricept_ident::advanced::read_data_from(text.as_bytes(), &name, loaded.machine())
-                    .map_err(door_error)?,
-            )
+        let d = self.loaded.description();
+        match &d.calibration {
+            Some(c) => format!(
+                "Machine({:?}, name={:?}, calibrated by {}{})",
+                self.loaded.source(),
+                d.name,
+                c.method,
+                if c.forced { ", forced" } else { "" }
+            ),
+            None => format!("Machine({:?}, name={:?})", self.loaded.source(), d.name),
         }
-        _ => {
-            return Err(input_error(
-                "data: give a CSV path or a mapping of column arrays",
-            ));
-        }
-    };
-    let mut request = CalibrateRequest::new(data);
-    request.machine = MachineInput::new(machine, noise);
-    request.parameter_set =
-        ParameterSet::by_label(&params).map_err(|e| input_error(format!("params: {e}")))?;
-    request.robust = robust;
-    if let Some(t) = tolerance_mm {
-        request.tolerance_mm = t;
     }
-    let inner = py
-        .detach(|| tricept_ident::calibrate::calibrate(request))
-        .map_err(door_error)?;
-    Ok(Calibration { inner })
-}
-
-/// A diagnosis (`tricept diagnose`): its exit code, JSON, report, and the
-/// extended machine file it may write.
-#[pyclass(module = "tricept._tricept")]
-struct Diagnosis {
-    inner: tricept_ident::diagnosis::DiagnoseResult,
-}
-
-#[pymethods]
-impl Diagnosis {
-    /// 0 the final model explains the data, 3 it does not.
-    #[getter]
-    fn exit_code(&self) -> u8 {
-        self.inner.exit_code()
-    }
-
-    /// The JSON `tricept diagnose --json` prints.
-    fn to_json(&self) -> String {
-        self.inner.to_json()
-    }
-
-    /// The text report `tricept diagnose` prints.
-    fn report(&self) -> String {
-        self.inner.to_text()
-    }
-
-    /// Writes the deployed machine file by the CLI's rule (`UntrustedError`
-    /// unless the final model explains the data, or `force`).
-    #[pyo3(signature = (path, force=false))]
-    fn write_machine(&self, path: PathBuf, force: bool) -> PyResult<Option<String>> {
-        self.inner.write_machine(&path, force).map_err(door_error)
-    }
-}
-
-/// Diagnoses measured data (`tricept diagnose`).
-#[pyfunction]
-#[pyo3(signature = (path=None, csv_text=None, name="<arrays>".to_string(), machine=None, noise_from_data=false, dictionary=true, deploy_rule="expected-error".to_string()))]
-#[allow(clippy::too_many_arguments)]
-fn diagnose(
-    py: Python<'_>,
-    path: Option<PathBuf>,
-    csv_text: Option<String>,
-    name: String,
-    machine: Option<PathBuf>,
-    noise_from_data: bool,
-    dictionary: bool,
-    deploy_rule: String,
-) -> PyResult<Diagnosis> {
-    let deploy_rule = deploy_rule.parse().map_err(input_error)?;
-    let loaded = machine_of(machine, SensorNoise::default())?;
-    let data = data_of(path, csv_text.as_deref(), &name, loaded.machine())?;
-    let mut request = DiagnoseRequest::new(loaded, data);
-    request.noise_from_data = noise_from_data;
-    request.dictionary = dictionary;
-    request.deploy_rule = deploy_rule;
-    let inner = py
-        .detach(|| tricept_ident::diagnosis::diagnose(request))
-        .map_err(door_error)?;
-    Ok(Diagnosis { inner })
-}
-
-/// A check against a calibration (`tricept check`).
-#[pyclass(module = "tricept._tricept", frozen)]
-struct CheckResult {
-    inner: tricept_ident::check::CheckResult,
-}
-
-#[pymethods]
-impl CheckResult {
-    /// 0 unchanged, 3 changed: the CLI's exit code.
-    #[getter]
-    fn exit_code(&self) -> u8 {
-        self.inner.exit_code()
-    }
-
-    /// The JSON `tricept check --json` prints.
-    fn to_json(&self) -> String {
-        self.inner.to_json()
-    }
-
-    /// The text report `tricept check` prints.
-    fn report(&self) -> String {
-        self.inner.to_text()
-    }
-}
-
-/// Checks measured data against a calibrated machine file (`tricept check`).
-#[pyfunction]
-#[pyo3(signature = (machine, path=None, csv_text=None, name="<arrays>".to_string(), alpha=None, history=None))]
-fn check(
-    py: Python<'_>,
-    machine: PathBuf,
-    path: Option<PathBuf>,
-    csv_text: Option<String>,
-    name: String,
-    alpha: Option<f64>,
-    history: Option<PathBuf>,
-) -> PyResult<CheckResult> {
-    let loaded = machine_of(Some(machine), SensorNoise::default())?;
-    let data = data_of(path, csv_text.as_deref(), &name, loaded.machine())?;
-    let mut request = CheckRequest::new(loaded, data);
-    if let Some(a) = alpha {
-        request.alpha = a;
-    }
-    request.history = history;
-    let inner = py
-        .detach(|| tricept_ident::check::check(request))
-        .map_err(door_error)?;
-    Ok(CheckResult { inner })
-}
-
-/// Simulates a campaign (`tricept simulate`); returns the CSV text the CLI
-/// writes (the Python half turns it into column arrays).
-#[pyfunction]
-#[pyo3(signature = (machine=None, truth="table2".to_string(), effects=Vec::new(), poses="grid".to_string(), seed=1, params="paper15".to_string(), both_directions=false, noise_factor=1.0))]
-#[allow(clippy::too_many_arguments)]
-fn simulate_csv(
-    py: Python<'_>,
-    machine: Option<PathBuf>,
-    truth: String,
-    effects: Vec<String>,
-    poses: String,
-    seed: u64,
-    params: String,
-    both_directions: bool,
-    noise_factor: f64,
-) -> PyResult<String> {
-    let mut request = SimulateRequest::new(machine_of(machine, SensorNoise::default())?);
-    request.truth = truth
-        .parse::<TrueErrors>()
-        .map_err(|e| input_error(format!("truth: {e}")))?;
-    request.truth_effects = tricept_ident::advanced::parse_effects(&effects).map_err(door_error)?;
-    request.poses = poses.parse::<Poses>().map_err(door_error)?;
-    request.seed = seed;
-    request.parameter_set =
-        ParameterSet::by_label(&params).map_err(|e| input_error(format!("params: {e}")))?;
-    request.both_directions = both_directions;
-    request.noise_factor = noise_factor;
-    let sim = py
-        .detach(|| tricept_ident::simulate::simulate(request))
-        .map_err(door_error)?;
-    let mut text = Vec::new();
-    tricept_data::write_to(&mut text, sim.data(), sim.comments())
-        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
-    String::from_utf8(text).map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))
 }
 
 /// The compiled half of the `tricept` package.
 #[pymodule]
 fn _tricept(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<Machine>()?;
-    m.add_class::<Calibration>()?;
-    m.add_class::<Diagnosis>()?;
-    m.add_class::<CheckResult>()?;
-    m.add_function(wrap_pyfunction!(identify, m)?)?;
-    m.add_function(wrap_pyfunction!(diagnose, m)?)?;
-    m.add_function(wrap_pyfunction!(check, m)?)?;
-    m.add_function(wrap_pyfunction!(simulate_csv, m)?)?;
-    m.add("InputError", m.py().get_type::<InputError>())?;
-    m.add("UntrustedError", m.py().get_type::<UntrustedError>())?;
-    Ok(())
+    workflows::register(m)
 }

@@ -83,7 +83,7 @@ def test_bad_input_raises_input_error_naming_the_row():
         m.ik([["a", "b", "c"]])
 
 
-def test_a_machine_file_loads_and_a_missing_one_is_an_input_error(cli, tmp_path):
+def test_a_machine_file_loads_and_a_missing_one_is_file_not_found(cli, tmp_path):
     out = cli("machine", "--json")
     assert out.returncode == 0
     (tmp_path / "m.json").write_text(out.stdout)
@@ -92,7 +92,7 @@ def test_a_machine_file_loads_and_a_missing_one_is_an_input_error(cli, tmp_path)
     np.testing.assert_allclose(
         m.ik([[0.0, 0.0, 750.0]]), tricept.Machine.paper().ik([[0.0, 0.0, 750.0]]), atol=1e-12
     )
-    with pytest.raises(tricept.InputError, match="nothing.json"):
+    with pytest.raises(FileNotFoundError, match="nothing.json"):
         tricept.Machine.load(tmp_path / "nothing.json")
 
 

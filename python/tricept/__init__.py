@@ -9,25 +9,32 @@ library as the ``tricept`` command line (lengths in mm, angles in rad)::
 
 Arrays are read in place when they are C-contiguous float64 (anything else
 is converted once); the points are solved in parallel with the GIL released.
-Bad input raises :class:`InputError`, a :class:`ValueError`.
+Bad input raises :class:`InputError`, a :class:`ValueError`; a file that
+cannot be read or written the operating system's :class:`OSError`
+subclass; memory that cannot hold a result :class:`MemoryError`.
 
 The workflows are the CLI's, through the same library calls:
 :func:`identify` (``tricept identify``), :func:`diagnose`, :func:`check` and
 :func:`simulate`. Data are a CSV path or a mapping of the CSV's column names
-to 1-D arrays (a pandas DataFrame is one); results carry the CLI's exit
-code and ``to_json()`` is the CLI's ``--json``.
+to 1-D arrays (a pandas DataFrame is one); ``machine`` is a machine file's
+path or a :class:`Machine`. Results carry the CLI's exit code,
+``to_json()`` is the CLI's ``--json``, and results and machines pickle.
 """
 
 import json
+import numbers
 import os
-from typing import Mapping, Optional, Sequence, Union
+from typing import Any, Dict, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
 from . import _tricept
-from ._tricept import InputError, UntrustedError
+from ._errors import InputError, UntrustedError
+
+__version__: str = _tricept.__version__
 
 __all__ = [
+    "__version__",
     "InputError",
     "UntrustedError",
     "Machine",
@@ -40,16 +47,52 @@ __all__ = [
     "simulate",
 ]
 
-Diagnosis = _tricept.Diagnosis
-CheckResult = _tricept.CheckResult
-
 PathLike = Union[str, os.PathLike]
+
+# Integer options and their ranges (what the compiled half can hold).
+_INT_RANGES = {
+    "readings_per_pose": (1, 2**32 - 1),
+    "seed": (0, 2**64 - 1),
+    "revisit": (0, 1_000_000),
+}
+
+
+def _int_options(options: Dict[str, Any]) -> Dict[str, Any]:
+    """``options`` with each integer option checked: a value out of its
+    range is an :class:`InputError` (a negative seed, a count of -1), a
+    value that is not an integer a :class:`TypeError`."""
+    for name, (low, high) in _INT_RANGES.items():
+        if name not in options or options[name] is None:
+            continue
+        value = options[name]
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+            raise TypeError(f"{name}: expected an integer, got {type(value).__name__}")
+        value = int(value)
+        if not low <= value <= high:
+            raise InputError(f"{name}: must be an integer from {low} to {high}, got {value}")
+        options[name] = value
+    return options
+
+
+def _machine_arg(machine) -> Any:
+    """The machine argument as the compiled half takes it: ``None`` (the
+    built-in Table 1 machine), a path, or a compiled machine."""
+    if machine is None:
+        return None
+    if isinstance(machine, Machine):
+        return machine._machine
+    if isinstance(machine, (str, os.PathLike)):
+        return os.fspath(machine)
+    raise InputError(
+        f"machine: expected a machine file (a path) or a tricept.Machine, got {type(machine).__name__}"
+    )
 
 
 def _data(data) -> dict:
     """The data argument as keyword arguments of the compiled workflows:
     a path, or CSV text written from a mapping of column arrays with
-    shortest round-trip numbers (the same float64 bits)."""
+    shortest round-trip numbers (the same float64 bits). Array row ``i`` is
+    the CSV's line ``i + 2``; messages name it as ``row i``."""
     if isinstance(data, (str, os.PathLike)):
         return {"path": os.fspath(data)}
     try:
@@ -58,6 +101,8 @@ def _data(data) -> dict:
         raise InputError("data: expected a CSV path or a mapping of column names to arrays") from None
     columns = []
     for k in names:
+        if any(c in k for c in ",\n\r") or not k.strip():
+            raise InputError(f"data: column name {k!r} is not one a CSV header can hold")
         c = np.asarray(data[k])
         if c.ndim != 1:
             raise InputError(f"data: column `{k}` is not one-dimensional (shape {c.shape})")
@@ -66,8 +111,12 @@ def _data(data) -> dict:
     if len(n) > 1:
         raise InputError(f"data: the columns have different lengths {sorted(n)}")
     lines = [",".join(names)]
-    for row in zip(*columns):
-        lines.append(",".join(_cell(v) for v in row))
+    for i, row in enumerate(zip(*columns)):
+        cells = [_cell(v) for v in row]
+        for k, cell in zip(names, cells):
+            if any(c in cell for c in ",\n\r"):
+                raise InputError(f"data: row {i}, column `{k}`: not a number (got {cell!r})")
+        lines.append(",".join(cells))
     return {"csv_text": "\n".join(lines) + "\n"}
 
 
@@ -79,17 +128,44 @@ def _cell(v) -> str:
     return str(v)
 
 
+class _Frozen:
+    """A result read back from a pickle: what the live result gave, kept
+    as data (its JSON, report, numbers, the machine file it may write)."""
+
+    def __init__(self, state: Dict[str, Any]):
+        self.__dict__.update(state)
+
+
+def _machine_file_state(compiled) -> Dict[str, Any]:
+    """The machine file a live result may write (``machine_file``), or why
+    there is none (``machine_file_error``), for its pickled state."""
+    try:
+        return {"machine_file": compiled.machine_file_json(), "machine_file_error": None}
+    except InputError as e:
+        return {"machine_file": None, "machine_file_error": str(e)}
+
+
+def _write_frozen(state, path: PathLike, force: bool):
+    """Writes the machine file a result read back from a pickle kept, by
+    the same rule (and with the same refusals) as the live result."""
+    if state.machine_file is None:
+        raise InputError(state.machine_file_error)
+    return _tricept.write_machine_file(state.machine_file, os.fspath(path), force)
+
+
 class Calibration:
     """A calibration (``tricept identify``): ``exit_code`` (0 trusted, 3
     the model does not explain the data or the campaign is too small, 4 not
     converged), ``estimates`` and ``sd`` by parameter name (mm, rad; an sd
     of ``None`` is a held parameter), ``covariance`` (in the order of
-    ``names``), ``warnings``, ``to_json()``, ``report()`` and
-    ``write_machine(path, force=False)``."""
+    ``names``), ``warnings``, ``to_json()``, ``report()``,
+    ``write_machine(path, force=False)`` and ``machine`` (the calibrated
+    :class:`Machine`, in memory). Pickles (the numbers, the JSON, the
+    report, the machine and the file it may write)."""
 
     __slots__ = ("_c",)
 
-    def __init__(self, compiled: "_tricept.Calibration"):
+    def __init__(self, compiled):
         self._c = compiled
 
     @property
@@ -98,7 +174,7 @@ class Calibration:
 
     @property
     def names(self) -> "list[str]":
-        return self._c.names
+        return list(self._c.names)
 
     @property
     def estimates(self) -> "dict[str, float]":
@@ -110,38 +186,204 @@ class Calibration:
 
     @property
     def covariance(self) -> np.ndarray:
-        return self._c.covariance
+        return np.array(self._c.covariance, dtype=np.float64)
 
     @property
     def warnings(self) -> "list[str]":
-        return self._c.warnings
+        return list(self._c.warnings)
 
     def to_json(self) -> str:
         """The JSON ``tricept identify --json`` prints."""
-        return self._c.to_json()
+        c = self._c
+        return c.json if isinstance(c, _Frozen) else c.to_json()
 
     def report(self) -> str:
         """The report ``tricept identify`` prints."""
-        return self._c.report()
+        c = self._c
+        return c.report_text if isinstance(c, _Frozen) else c.report()
 
     def write_machine(self, path: PathLike, force: bool = False) -> str:
         """Writes the calibrated machine file by the CLI's rule: a result
         that is not to be trusted raises :class:`UntrustedError` unless
         ``force``; a calibration from arrays cannot record its data file
-        and raises :class:`InputError`."""
+        and raises :class:`InputError`; a folder that does not exist raises
+        :class:`FileNotFoundError`."""
+        if isinstance(self._c, _Frozen):
+            _write_frozen(self._c, path, force)
+            return os.fspath(path)
         return self._c.write_machine(os.fspath(path), force)
 
+    @property
+    def machine(self) -> "Machine":
+        """The calibrated machine, in memory (no file needed): with its
+        calibration record when the data came from a file (so that
+        :func:`check` can use it), the identified geometry alone when they
+        came as arrays."""
+        c = self._c
+        if isinstance(c, _Frozen):
+            return Machine(_tricept.Machine.from_json(c.machine_json, c.machine_source))
+        return Machine(c.machine())
+
+    def __reduce__(self):
+        c = self._c
+        if isinstance(c, _Frozen):
+            return (_calibration_from_state, (dict(c.__dict__),))
+        machine = Machine(c.machine())
+        files = _machine_file_state(c)
+        state = {
+            "exit_code": c.exit_code,
+            "names": list(c.names),
+            "estimates": list(c.estimates),
+            "sd": list(c.sd),
+            "covariance": np.array(c.covariance),
+            "warnings": list(c.warnings),
+            "json": c.to_json(),
+            "report_text": c.report(),
+            "machine_json": machine.to_json(),
+            "machine_source": machine.source,
+            **files,
+        }
+        return (_calibration_from_state, (state,))
+
     def __repr__(self) -> str:
-        return f"Calibration(exit_code={self.exit_code}, parameters={len(self.names)})"
+        j = json.loads(self.to_json())
+        accuracy = (j.get("accuracy") or {}).get("rms_mm")
+        return (
+            f"Calibration(exit_code={self.exit_code}, data={j.get('data_file')!r}, "
+            f"parameters={len(self.names)}, converged={j.get('converged')}, "
+            f"adequate={j.get('adequate')}, rms_mm={accuracy})"
+        )
 
 
-def identify(data, machine: Optional[PathLike] = None, **options) -> "Calibration":
+def _calibration_from_state(state: Dict[str, Any]) -> Calibration:
+    return Calibration(_Frozen(state))
+
+
+class Diagnosis:
+    """A diagnosis (``tricept diagnose``): ``exit_code`` (0 the final model
+    explains the data, 3 it does not), ``verdict``, ``causes`` (the named
+    effects), ``to_json()``, ``report()`` and ``write_machine(path,
+    force=False)``. Pickles."""
+
+    __slots__ = ("_d",)
+
+    def __init__(self, compiled):
+        self._d = compiled
+
+    @property
+    def exit_code(self) -> int:
+        return self._d.exit_code
+
+    def to_json(self) -> str:
+        """The JSON ``tricept diagnose --json`` prints."""
+        d = self._d
+        return d.json if isinstance(d, _Frozen) else d.to_json()
+
+    def report(self) -> str:
+        """The report ``tricept diagnose`` prints."""
+        d = self._d
+        return d.report_text if isinstance(d, _Frozen) else d.report()
+
+    @property
+    def verdict(self) -> str:
+        """``adequate``, ``explained``, ``partially-explained`` or ``unexplained``."""
+        return json.loads(self.to_json())["verdict"]
+
+    @property
+    def causes(self) -> "list[str]":
+        """The effects the diagnosis names, in its order."""
+        return [c["effect"] for c in json.loads(self.to_json()).get("causes", [])]
+
+    def write_machine(self, path: PathLike, force: bool = False) -> Optional[str]:
+        """Writes the deployed machine file by the CLI's rule
+        (:class:`UntrustedError` unless the final model explains the data,
+        or ``force``); returns the warning of a forced write."""
+        if isinstance(self._d, _Frozen):
+            return _write_frozen(self._d, path, force)
+        return self._d.write_machine(os.fspath(path), force)
+
+    def __reduce__(self):
+        d = self._d
+        if isinstance(d, _Frozen):
+            return (_diagnosis_from_state, (dict(d.__dict__),))
+        # The machine file first: building it states the accuracy it
+        # promises, which the JSON then carries (as `diagnose --json
+        # --write-machine` prints it).
+        state = _machine_file_state(d)
+        state.update(exit_code=d.exit_code, json=d.to_json(), report_text=d.report())
+        return (_diagnosis_from_state, (state,))
+
+    def __repr__(self) -> str:
+        return f"Diagnosis(exit_code={self.exit_code}, verdict={self.verdict!r}, causes={self.causes!r})"
+
+
+def _diagnosis_from_state(state: Dict[str, Any]) -> Diagnosis:
+    return Diagnosis(_Frozen(state))
+
+
+class CheckResult:
+    """A check against a calibration (``tricept check``): ``exit_code`` (0
+    unchanged, 3 changed), ``verdict``, ``most_likely`` (the change, when
+    changed), ``to_json()`` and ``report()``. Pickles."""
+
+    __slots__ = ("_r",)
+
+    def __init__(self, compiled):
+        self._r = compiled
+
+    @property
+    def exit_code(self) -> int:
+        return self._r.exit_code
+
+    def to_json(self) -> str:
+        """The JSON ``tricept check --json`` prints."""
+        r = self._r
+        return r.json if isinstance(r, _Frozen) else r.to_json()
+
+    def report(self) -> str:
+        """The report ``tricept check`` prints."""
+        r = self._r
+        return r.report_text if isinstance(r, _Frozen) else r.report()
+
+    @property
+    def verdict(self) -> str:
+        """``unchanged``, ``noisier-than-stated``, ``changed``, ..."""
+        return json.loads(self.to_json())["verdict"]
+
+    @property
+    def most_likely(self) -> Optional[str]:
+        """The most likely change (``leg 2``, ...), ``None`` when unchanged."""
+        j = json.loads(self.to_json())
+        i = j.get("most_likely")
+        return None if i is None else j["candidates"][i]["name"]
+
+    def __reduce__(self):
+        r = self._r
+        if isinstance(r, _Frozen):
+            return (_check_from_state, (dict(r.__dict__),))
+        state = {"exit_code": r.exit_code, "json": r.to_json(), "report_text": r.report()}
+        return (_check_from_state, (state,))
+
+    def __repr__(self) -> str:
+        return (
+            f"CheckResult(exit_code={self.exit_code}, verdict={self.verdict!r}, "
+            f"most_likely={self.most_likely!r})"
+        )
+
+
+def _check_from_state(state: Dict[str, Any]) -> CheckResult:
+    return CheckResult(_Frozen(state))
+
+
+def identify(data, machine=None, **options) -> Calibration:
     """Identifies the machine's geometric errors from measured data, as
     ``tricept identify`` does.
 
     ``data``: a CSV path, or a mapping of the CSV's column names
-    (``q1, q2, q3, phi, theta, s`` and the optional ones) to 1-D arrays.
-    ``machine``: a machine file (default: the built-in Table 1 machine).
+    (``q1, q2, q3, phi, theta, s`` and the optional ones) to 1-D arrays (a
+    pandas DataFrame is one).
+    ``machine``: a machine file or a :class:`Machine` (default: the
+    built-in Table 1 machine).
     Options: ``params`` (``"paper15"`` or ``"full21"``), ``robust`` (reject
     gross readings, default True), ``tolerance_mm``, ``angle_noise_arcsec``,
     ``length_noise_um``, ``readings_per_pose``.
@@ -149,54 +391,61 @@ def identify(data, machine: Optional[PathLike] = None, **options) -> "Calibratio
     Returns a :class:`Calibration`: ``exit_code`` (0, 3 or 4 as the CLI),
     ``estimates`` and ``sd`` (dicts, mm and rad), ``covariance`` (ndarray,
     in the order of ``names``), ``to_json()`` (the CLI's ``--json``),
-    ``report()`` and ``write_machine(path, force=False)``.
+    ``report()``, ``write_machine(path, force=False)`` and ``machine``.
     """
     return Calibration(
-        _tricept.identify(
-            machine=None if machine is None else os.fspath(machine), **_data(data), **options
-        )
+        _tricept.identify(machine=_machine_arg(machine), **_data(data), **_int_options(options))
     )
 
 
-def diagnose(data, machine: Optional[PathLike] = None, **options) -> "Diagnosis":
+def diagnose(data, machine=None, **options) -> Diagnosis:
     """Does the geometric model explain the data, and if not, which effect
-    does (``tricept diagnose``)? Options: ``noise_from_data``,
-    ``dictionary``, ``deploy_rule`` (``"expected-error"``, the default, or
+    does (``tricept diagnose``)? ``machine``: a machine file or a
+    :class:`Machine`. Options: ``noise_from_data``, ``dictionary``,
+    ``deploy_rule`` (``"expected-error"``, the default, or
     ``"confident"``, as ``--deploy-rule``). Returns a :class:`Diagnosis` with ``exit_code``,
     ``to_json()``, ``report()`` and ``write_machine(path, force=False)``."""
-    return _tricept.diagnose(
-        machine=None if machine is None else os.fspath(machine), **_data(data), **options
-    )
+    return Diagnosis(_tricept.diagnose(machine=_machine_arg(machine), **_data(data), **options))
 
 
-def check(machine: PathLike, data, **options) -> "CheckResult":
+def check(machine, data, **options) -> CheckResult:
     """Has the machine changed since its calibration (``tricept check``)?
-    ``machine`` is the calibrated machine file. Options: ``alpha``,
+    ``machine`` is the calibrated machine file or :class:`Machine` (a
+    calibration's ``machine`` from a data file). Options: ``alpha``,
     ``history``. Returns a :class:`CheckResult` with ``exit_code``,
     ``to_json()`` and ``report()``."""
-    return _tricept.check(os.fspath(machine), **_data(data), **options)
+    if machine is None:
+        raise InputError("machine: check needs the calibrated machine (a file or a tricept.Machine)")
+    if "history" in options and options["history"] is not None:
+        options["history"] = os.fspath(options["history"])
+    return CheckResult(_tricept.check(_machine_arg(machine), **_data(data), **options))
 
 
 def simulate(
-    machine: Optional[PathLike] = None,
+    machine=None,
     truth: str = "table2",
-    effects: Sequence[Union[str, Mapping]] = (),
+    effects: Union[str, Mapping, Sequence[Union[str, Mapping]]] = (),
     poses: str = "grid",
     seed: int = 1,
     **options,
 ) -> "dict[str, np.ndarray]":
     """Simulates a campaign on a machine with true errors (``tricept
-    simulate``): ``truth`` (``table2``, ``zero``, ``random:MAG_MM[,SEED]`` or
-    a JSON file), ``effects`` (JSON objects or dicts, as ``--truth-effect``),
-    ``poses`` (a ``--poses`` spec), ``seed``; options ``params``,
-    ``both_directions``, ``noise_factor``. Returns the CSV's columns as
-    arrays (the file ``tricept simulate --out`` writes, read back)."""
+    simulate``): ``machine`` (a file or a :class:`Machine`), ``truth``
+    (``table2``, ``zero``, ``random:MAG_MM[,SEED]`` or a JSON file),
+    ``effects`` (one effect or a list of them: JSON objects, dicts, or
+    ``@FILE``, as ``--truth-effect``), ``poses`` (a ``--poses`` spec),
+    ``seed``; options ``params``, ``both_directions``, ``noise_factor``,
+    ``revisit`` (revisit the first N poses at the end, as ``--revisit``).
+    Returns the CSV's columns as arrays (the file ``tricept simulate
+    --out`` writes, read back)."""
+    if isinstance(effects, (str, Mapping)):
+        effects = [effects]
+    options = _int_options({"seed": seed, **options})
     text = _tricept.simulate_csv(
-        machine=None if machine is None else os.fspath(machine),
-        truth=truth,
+        machine=_machine_arg(machine),
+        truth=os.fspath(truth) if isinstance(truth, os.PathLike) else truth,
         effects=[e if isinstance(e, str) else json.dumps(e) for e in effects],
         poses=poses,
-        seed=seed,
         **options,
     )
     lines = [l for l in text.splitlines() if l and not l.startswith("#")]
@@ -219,12 +468,14 @@ def _points(values, name: str) -> np.ndarray:
 
 
 class Machine:
-    """A machine: the built-in Table 1 machine or a description file (a
-    calibrated one with its leg effects and compensation tables applied)."""
+    """A machine: the built-in Table 1 machine, a description file, a
+    description's JSON text, or a calibration's result (a calibrated one
+    with its leg effects and compensation tables applied). Pickles (as its
+    description's JSON, checked again when read back)."""
 
     __slots__ = ("_machine",)
 
-    def __init__(self, machine: "_tricept.Machine"):
+    def __init__(self, machine):
         self._machine = machine
 
     @staticmethod
@@ -233,15 +484,41 @@ class Machine:
         return Machine(_tricept.Machine.paper())
 
     @staticmethod
-    def load(path: Union[str, os.PathLike]) -> "Machine":
+    def load(path: PathLike) -> "Machine":
         """A machine description file, loaded as every ``--machine`` of the
-        CLI loads it: an edited calibrated file raises :class:`InputError`."""
+        CLI loads it: an edited calibrated file raises :class:`InputError`,
+        a missing file :class:`FileNotFoundError`."""
         return Machine(_tricept.Machine.load(os.fspath(path)))
+
+    @staticmethod
+    def from_json(text: str, source: str = "<json>") -> "Machine":
+        """A machine from a description's JSON text (what :meth:`to_json`
+        gives), checked as a file is; ``source`` names it in messages."""
+        return Machine(_tricept.Machine.from_json(text, source))
+
+    def to_json(self) -> str:
+        """The description as JSON text (with its calibration record)."""
+        return self._machine.to_json()
 
     @property
     def source(self) -> str:
         """The file name, or ``the built-in Table 1 machine``."""
         return self._machine.source
+
+    @property
+    def name(self) -> str:
+        """The description's ``name``."""
+        return self._machine.name
+
+    @property
+    def calibration(self) -> Optional[str]:
+        """The method of the calibration it holds (``identify``, ...), or ``None``."""
+        return self._machine.calibration
+
+    @property
+    def warnings(self) -> "list[str]":
+        """What loading it warned of, one line each."""
+        return list(self._machine.warnings)
 
     def ik(self, points) -> np.ndarray:
         """Platform points ``(n, 3)`` (mm) to an ``(n, 6)`` array of
@@ -261,5 +538,12 @@ class Machine:
             _points(points, "tool_ik: points"), _points(axes, "tool_ik: axes")
         )
 
+    def __reduce__(self):
+        return (_machine_from_json, (self.to_json(), self.source))
+
     def __repr__(self) -> str:
-        return f"Machine({self.source!r})"
+        return repr(self._machine)
+
+
+def _machine_from_json(text: str, source: str) -> Machine:
+    return Machine(_tricept.Machine.from_json(text, source))

@@ -1,32 +1,65 @@
 """Type stubs of the tricept package (lengths in mm, angles in rad)."""
 
 import os
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
+from typing import Any, Dict, Iterable, List, Mapping, Optional, Protocol, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
 
+from ._errors import InputError as InputError
+from ._errors import UntrustedError as UntrustedError
+
+__version__: str
+
+__all__ = [
+    "__version__",
+    "InputError",
+    "UntrustedError",
+    "Machine",
+    "Calibration",
+    "Diagnosis",
+    "CheckResult",
+    "identify",
+    "diagnose",
+    "check",
+    "simulate",
+]
+
 PathLike = Union[str, os.PathLike[str]]
-Data = Union[PathLike, Mapping[str, npt.ArrayLike]]
 
-class InputError(ValueError):
-    """Bad input: the CLI's one-line message naming the file, line and column, or the row."""
+class _Columns(Protocol):
+    """Anything with named columns: a mapping, or a pandas DataFrame."""
 
-class UntrustedError(RuntimeError):
-    """A write refused by the CLI's rule (exit code 3 or 4); args: (message, exit_code)."""
+    def keys(self) -> Iterable[Any]: ...
+    def __getitem__(self, key: Any, /) -> Any: ...
+
+_Data = Union[PathLike, Mapping[str, npt.ArrayLike], _Columns]
+_MachineArg = Union[PathLike, "Machine"]
 
 class Machine:
-    """A machine: the built-in Table 1 machine or a description file."""
+    """A machine: the built-in Table 1 machine, a description file, a description's JSON, or a calibration's."""
 
+    def __init__(self, machine: Any) -> None: ...
     @staticmethod
     def paper() -> "Machine":
         """The paper's Table 1 machine (the CLI's default)."""
     @staticmethod
-    def load(path: Union[str, os.PathLike[str]]) -> "Machine":
-        """A machine file; an edited calibrated file raises InputError."""
+    def load(path: PathLike) -> "Machine":
+        """A machine file; an edited calibrated file raises InputError, a missing one FileNotFoundError."""
+    @staticmethod
+    def from_json(text: str, source: str = "<json>") -> "Machine":
+        """A machine from a description's JSON text, checked as a file is."""
+    def to_json(self) -> str:
+        """The description as JSON text."""
     @property
     def source(self) -> str:
         """The file name, or the built-in machine."""
+    @property
+    def name(self) -> str: ...
+    @property
+    def calibration(self) -> Optional[str]: ...
+    @property
+    def warnings(self) -> List[str]: ...
     def ik(self, points: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """(n, 3) platform points -> (n, 6): q1, q2, q3, phi, theta, q4."""
     def fk(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
@@ -37,6 +70,7 @@ class Machine:
 class Calibration:
     """A calibration (tricept identify)."""
 
+    def __init__(self, compiled: Any) -> None: ...
     @property
     def exit_code(self) -> int: ...
     @property
@@ -49,6 +83,8 @@ class Calibration:
     def covariance(self) -> npt.NDArray[np.float64]: ...
     @property
     def warnings(self) -> List[str]: ...
+    @property
+    def machine(self) -> Machine: ...
     def to_json(self) -> str: ...
     def report(self) -> str: ...
     def write_machine(self, path: PathLike, force: bool = False) -> str: ...
@@ -56,8 +92,13 @@ class Calibration:
 class Diagnosis:
     """A diagnosis (tricept diagnose)."""
 
+    def __init__(self, compiled: Any) -> None: ...
     @property
     def exit_code(self) -> int: ...
+    @property
+    def verdict(self) -> str: ...
+    @property
+    def causes(self) -> List[str]: ...
     def to_json(self) -> str: ...
     def report(self) -> str: ...
     def write_machine(self, path: PathLike, force: bool = False) -> Optional[str]: ...
@@ -65,14 +106,19 @@ class Diagnosis:
 class CheckResult:
     """A check against a calibration (tricept check)."""
 
+    def __init__(self, compiled: Any) -> None: ...
     @property
     def exit_code(self) -> int: ...
+    @property
+    def verdict(self) -> str: ...
+    @property
+    def most_likely(self) -> Optional[str]: ...
     def to_json(self) -> str: ...
     def report(self) -> str: ...
 
 def identify(
-    data: Data,
-    machine: Optional[PathLike] = None,
+    data: _Data,
+    machine: Optional[_MachineArg] = None,
     *,
     params: str = "paper15",
     robust: bool = True,
@@ -84,21 +130,21 @@ def identify(
     """Identifies the geometric errors (tricept identify)."""
 
 def diagnose(
-    data: Data,
-    machine: Optional[PathLike] = None,
+    data: _Data,
+    machine: Optional[_MachineArg] = None,
     *,
     noise_from_data: bool = False,
     dictionary: bool = True,
-    deploy_rule: str = "confident",
+    deploy_rule: str = "expected-error",
 ) -> Diagnosis:
     """Does the geometric model explain the data (tricept diagnose)?
 
-    ``deploy_rule``: ``"confident"`` or ``"expected-error"`` (``--deploy-rule``).
+    ``deploy_rule``: ``"expected-error"`` (the default) or ``"confident"`` (``--deploy-rule``).
     """
 
 def check(
-    machine: PathLike,
-    data: Data,
+    machine: _MachineArg,
+    data: _Data,
     *,
     alpha: Optional[float] = None,
     history: Optional[PathLike] = None,
@@ -106,14 +152,15 @@ def check(
     """Has the machine changed since its calibration (tricept check)?"""
 
 def simulate(
-    machine: Optional[PathLike] = None,
-    truth: str = "table2",
-    effects: Sequence[Union[str, Mapping[str, Any]]] = (),
+    machine: Optional[_MachineArg] = None,
+    truth: Union[str, os.PathLike[str]] = "table2",
+    effects: Union[str, Mapping[str, Any], Sequence[Union[str, Mapping[str, Any]]]] = (),
     poses: str = "grid",
     seed: int = 1,
     *,
     params: str = "paper15",
     both_directions: bool = False,
     noise_factor: float = 1.0,
+    revisit: int = 0,
 ) -> Dict[str, npt.NDArray[np.float64]]:
     """Simulates a campaign (tricept simulate --out), as column arrays."""

@@ -16,9 +16,10 @@
 //! The file is rewritten whole at every append through
 //! [`tricept_data::write_atomic`], so that a crash never leaves half a
 //! line; a line that does not parse is an error naming it. Appends hold an
-//! exclusive lock on a lock file beside the history (`FILE.jsonl.lock`,
-//! left in place) from the read to the rename, so that checks appending to
-//! the same history at once keep every record.
+//! exclusive lock on the history file itself (no lock file is left beside
+//! it) from the read to the rename, so that checks appending to the same
+//! history at once keep every record, whatever name each gives it (a
+//! symbolic link, another relative path).
 
 use serde::{Deserialize, Serialize};
 
@@ -119,6 +120,13 @@ impl Entry {
 /// The entries of a history file (none when it does not exist).
 pub fn read(path: &std::path::Path) -> Result<Vec<Entry>, CheckError> {
     let file = path.display();
+    if let Ok(m) = std::fs::metadata(path)
+        && !m.is_file()
+    {
+        return Err(CheckError::HistoryLine(format!(
+            "{file}: not a regular file (a history is one, appended and replaced whole)"
+        )));
+    }
     let text = match tricept_data::read_json_text(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
@@ -139,19 +147,12 @@ pub fn read(path: &std::path::Path) -> Result<Vec<Entry>, CheckError> {
 }
 
 /// Appends `entry` to the history file `path` (rewritten atomically,
-/// under an exclusive lock on `PATH.lock`: concurrent appends all land).
+/// under an exclusive lock on the history file itself: concurrent appends
+/// all land, whatever name, link or relative path each gives it).
 pub fn append(path: &std::path::Path, entry: &Entry) -> Result<Vec<Entry>, CheckError> {
     let failed = |e: std::io::Error| CheckError::History(format!("{}: {e}", path.display()));
-    let mut lock_name = path.as_os_str().to_owned();
-    lock_name.push(".lock");
-    let lock = std::fs::OpenOptions::new()
-        .create(true)
-        .truncate(false)
-        .write(true)
-        .open(std::path::PathBuf::from(lock_name))
-        .map_err(failed)?;
-    lock.lock().map_err(failed)?;
-    // The lock is released when `lock` is dropped, after the rename.
+    // Held until the rename below has replaced the file.
+    let _lock = lock(path).map_err(failed)?;
     let mut entries = read(path)?;
     entries.push(entry.clone());
     let mut text = String::new();
@@ -164,6 +165,55 @@ pub fn append(path: &std::path::Path, entry: &Entry) -> Result<Vec<Entry>, Check
     tricept_data::write_atomic(path, |w| w.write_all(text.as_bytes()))
         .map_err(|e| CheckError::History(format!("{}: not written: {e}", path.display())))?;
     Ok(entries)
+}
+
+/// An exclusive lock on the history file `path` itself (created empty when
+/// it does not exist): the lock belongs to the file, not to the name, so
+/// two names of one file (a symbolic link, `./h.jsonl` and `h.jsonl`) take
+/// the same lock. An append replaces the file (a rename), so a lock taken
+/// on the file just replaced is dropped and taken again on the new one:
+/// the lock held is always that of the file the path names now.
+fn lock(path: &std::path::Path) -> std::io::Result<std::fs::File> {
+    let not_regular = || {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file: a history is one",
+        )
+    };
+    for _ in 0..10_000 {
+        // Opening a named pipe to write would wait for a reader.
+        if std::fs::metadata(path).is_ok_and(|m| !m.is_file()) {
+            return Err(not_regular());
+        }
+        let file = std::fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .append(true)
+            .open(path)?;
+        if !file.metadata()?.is_file() {
+            return Err(not_regular());
+        }
+        file.lock()?;
+        if same_file(&file.metadata()?, &std::fs::metadata(path)?) {
+            return Ok(file);
+        }
+    }
+    Err(std::io::Error::other(
+        "the history was replaced 10000 times while waiting for its lock",
+    ))
+}
+
+/// Whether two metadata are of the same file (device and inode).
+#[cfg(unix)]
+fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    a.dev() == b.dev() && a.ino() == b.ino()
+}
+
+/// Whether two metadata are of the same file (size and time: no inode).
+#[cfg(not(unix))]
+fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata) -> bool {
+    a.len() == b.len() && a.modified().ok() == b.modified().ok()
 }
 
 /// The trend of one key quantity over a history.
@@ -285,23 +335,52 @@ mod tests {
     }
 
     #[test]
-    fn concurrent_appends_keep_every_record() {
+    fn concurrent_appends_through_any_name_keep_every_record() {
         let dir = std::env::temp_dir().join(format!("tricept-history-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
         let path = dir.join("h.jsonl");
-        let _ = std::fs::remove_file(&path);
+        // One writer by the file's name, one through a symbolic link to it
+        // (and one more through a path with `..` in it): one file, one
+        // lock.
+        #[cfg(unix)]
+        let other = {
+            let link = dir.join("link.jsonl");
+            std::os::unix::fs::symlink("h.jsonl", &link).unwrap();
+            link
+        };
+        #[cfg(not(unix))]
+        let other = dir.join("sub").join("..").join("h.jsonl");
+        let names = [
+            path.clone(),
+            other,
+            dir.join("sub").join("..").join("h.jsonl"),
+        ];
         std::thread::scope(|s| {
-            for writer in 0..2 {
-                let path = &path;
+            for (writer, name) in names.iter().take(2).enumerate() {
                 s.spawn(move || {
                     for i in 0..50 {
-                        append(path, &entry(writer, i)).unwrap();
+                        append(name, &entry(writer, i)).unwrap();
                     }
                 });
             }
+            let name = &names[2];
+            s.spawn(move || {
+                for i in 0..10 {
+                    append(name, &entry(2, i)).unwrap();
+                }
+            });
         });
+        // Nothing beside the history (no lock file), the link still a link.
+        let mut left: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        #[cfg(unix)]
+        assert_eq!(left, ["h.jsonl", "link.jsonl", "sub"]);
+        assert_eq!(read(&path).unwrap().len(), 110);
         let kept = read(&path).unwrap();
-        assert_eq!(kept.len(), 100);
         for writer in 0..2 {
             let name = format!("writer{writer}");
             let days: Vec<String> = kept
@@ -312,6 +391,31 @@ mod tests {
             let expected: Vec<String> = (0..50).map(|i| format!("day{i}.csv")).collect();
             assert_eq!(days, expected, "{name}: every append, in its order");
         }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_history_that_is_not_a_regular_file_is_refused_without_waiting() {
+        // A named pipe opened to read or write would wait for its other end.
+        let dir = std::env::temp_dir().join(format!("tricept-history-fifo-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let fifo = dir.join("h.jsonl");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        assert!(made.is_ok_and(|s| s.success()));
+        assert!(
+            read(&fifo)
+                .unwrap_err()
+                .to_string()
+                .contains("not a regular file")
+        );
+        assert!(
+            append(&fifo, &entry(0, 0))
+                .unwrap_err()
+                .to_string()
+                .contains("not a regular file")
+        );
         std::fs::remove_dir_all(&dir).ok();
     }
 }

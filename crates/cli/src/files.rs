@@ -71,7 +71,13 @@ pub struct FileRoles {
     outputs: Vec<(String, PathBuf)>,
     /// Output directories the verb creates when they do not exist.
     created_dirs: Vec<PathBuf>,
+    /// Output directories whose file names the results decide: flag,
+    /// directory, and the names' prefix and suffix (`residual-`, `.svg`).
+    named_later: Vec<(String, PathBuf, &'static str, &'static str)>,
 }
+
+/// How a command line names stdin and stdout.
+pub const STDIO: &str = "-";
 
 impl FileRoles {
     /// A file the verb reads.
@@ -110,10 +116,31 @@ impl FileRoles {
         }
     }
 
-    /// Refuses (exit 2) an output that is one of the inputs or another
-    /// output, by name, through a symbolic link or as a hard link, an output
-    /// that is a directory, and one whose directory does not exist (unless
-    /// the verb creates it).
+    /// A directory the verb creates if need be and writes files into whose
+    /// names the results decide, each `PREFIX*SUFFIX` (a plot per effect).
+    pub fn output_dir(
+        &mut self,
+        flag: &str,
+        dir: &Path,
+        prefix: &'static str,
+        suffix: &'static str,
+    ) {
+        self.created_dirs.push(dir.to_path_buf());
+        self.named_later
+            .push((flag.to_string(), dir.to_path_buf(), prefix, suffix));
+    }
+
+    /// Refuses (exit 2), before anything is computed or appended: an input
+    /// that does not exist, is a directory or is `-` (stdin is read only
+    /// where a flag says so); an output named `-` (only a flag that says so
+    /// writes stdout, and the verb takes it out before), whose name ends in
+    /// a separator, that is a directory, a device, a named pipe or a
+    /// socket (also at the end of its symbolic links), whose directory
+    /// does not exist (unless the verb creates it), or that is one of the
+    /// inputs or another output, by name, through a symbolic link or as a
+    /// hard link; an output directory that is not a directory, or that
+    /// holds something other than a regular file under a name the verb
+    /// may write.
     pub fn check(&self) -> Result<(), CliError> {
         // Kept for the files whose names only the results decide (plots).
         let known = self
@@ -127,40 +154,34 @@ impl FileRoles {
         );
         let _ = KNOWN_FILES.set(known.collect());
         for (i, (flag, input)) in self.inputs.iter().enumerate() {
+            check_input(flag, input)?;
             if let Some((_, first)) = self.inputs[..i]
                 .iter()
                 .find(|(f, p)| f == flag && same_file(p, input))
             {
                 return Err(CliError::input(format!(
                     "{flag} {}: the same file as {flag} {} given before; each file counts once (a repeated tracker file would pass for a second station)",
-                    input.display(),
-                    first.display()
+                    shown(input),
+                    shown(first)
                 )));
             }
         }
+        for dir in &self.created_dirs {
+            let flag = self.flag_of_dir(dir);
+            check_output_dir(flag, dir)?;
+        }
         for (i, (out_flag, out)) in self.outputs.iter().enumerate() {
-            if out.is_dir() {
-                return Err(CliError::input(format!(
-                    "{out_flag} {}: is a directory; give a file name",
-                    out.display()
-                )));
-            }
+            check_output_file(out_flag, out)?;
             let dir = match out.parent() {
                 Some(d) if !d.as_os_str().is_empty() => d,
                 _ => Path::new("."),
             };
             let created = self.created_dirs.iter().any(|d| d == dir);
-            if created && dir.exists() && !dir.is_dir() {
-                return Err(CliError::input(format!(
-                    "{out_flag} {}: is a file, not a directory",
-                    dir.display()
-                )));
-            }
             if !created && !dir.is_dir() {
                 return Err(CliError::input(format!(
                     "{out_flag} {}: the directory {} does not exist",
-                    out.display(),
-                    dir.display()
+                    shown(out),
+                    shown(dir)
                 )));
             }
             let clash = self
@@ -172,12 +193,180 @@ impl FileRoles {
             if let Some((flag, path, role)) = clash {
                 return Err(CliError::input(format!(
                     "{out_flag} {}: is also {role} {flag} {}; writing it would destroy that file: choose another name",
-                    out.display(),
-                    path.display()
+                    shown(out),
+                    shown(path)
+                )));
+            }
+        }
+        for (flag, dir, prefix, suffix) in &self.named_later {
+            self.check_named_later(flag, dir, prefix, suffix)?;
+        }
+        Ok(())
+    }
+
+    /// The flag of an output directory, for its messages.
+    fn flag_of_dir(&self, dir: &Path) -> &str {
+        let named = self.named_later.iter().find(|(_, d, _, _)| d == dir);
+        let fixed = self.outputs.iter().find(|(_, p)| p.parent() == Some(dir));
+        named
+            .map(|(f, ..)| f.as_str())
+            .or(fixed.map(|(f, _)| f.as_str()))
+            .unwrap_or("output directory")
+    }
+
+    /// Refuses a file the verb may write into `dir` (a name `PREFIX*SUFFIX`
+    /// there) that is not a regular file, or that is one of the inputs or
+    /// outputs.
+    fn check_named_later(
+        &self,
+        flag: &str,
+        dir: &Path,
+        prefix: &str,
+        suffix: &str,
+    ) -> Result<(), CliError> {
+        let ours = |name: &std::ffi::OsStr| {
+            let n = name.to_string_lossy();
+            n.starts_with(prefix) && n.ends_with(suffix)
+        };
+        if let Ok(entries) = std::fs::read_dir(dir) {
+            for entry in entries.flatten() {
+                if ours(&entry.file_name()) {
+                    check_output_file(flag, &entry.path())?;
+                }
+            }
+        }
+        let canonical_dir = canonical(dir);
+        let known = self
+            .inputs
+            .iter()
+            .map(|(f, p)| (f, p, "the input"))
+            .chain(self.outputs.iter().map(|(f, p)| (f, p, "the output")));
+        for (other, path, role) in known {
+            let inside = canonical(path).parent().is_some_and(|d| d == canonical_dir);
+            if inside && path.file_name().is_some_and(ours) {
+                return Err(CliError::input(format!(
+                    "{flag} {}: may write {role} {other} {} (the names {prefix}*{suffix} are its own); choose another directory",
+                    shown(dir),
+                    shown(path)
                 )));
             }
         }
         Ok(())
+    }
+}
+
+/// A path as messages show it (`tricept_data::shown_path`).
+fn shown(p: &Path) -> String {
+    tricept_data::shown_path(p)
+}
+
+/// Refuses an input that is `-`, does not exist or is a directory (a
+/// named pipe or a device is read: `--data <(zcat d.csv.gz)`).
+fn check_input(flag: &str, input: &Path) -> Result<(), CliError> {
+    if input.as_os_str() == STDIO {
+        return Err(CliError::input(format!(
+            "{flag} -: {flag} does not read stdin; give a file name (`./-` for a file named `-`)"
+        )));
+    }
+    match std::fs::metadata(input) {
+        Ok(m) if m.is_dir() => Err(CliError::input(format!(
+            "{flag} {}: is a directory, not a file",
+            shown(input)
+        ))),
+        Ok(_) => Ok(()),
+        Err(e) => Err(CliError::input(format!("{flag} {}: {e}", shown(input)))),
+    }
+}
+
+/// Refuses an output file the verb must not write (see
+/// [`FileRoles::check`]; `tricept_data::check_output_file`).
+fn check_output_file(flag: &str, out: &Path) -> Result<(), CliError> {
+    if out.as_os_str() == STDIO {
+        return Err(CliError::input(format!(
+            "{flag} -: {flag} does not write stdout (stdout carries the report); give a file name (`./-` for a file named `-`)"
+        )));
+    }
+    check_names(flag, out)?;
+    tricept_data::check_output_file(out).map_err(|e| {
+        let why = match e.kind() {
+            std::io::ErrorKind::IsADirectory => "is a directory; give a file name".to_string(),
+            _ => e.to_string(),
+        };
+        CliError::input(format!("{flag} {}: {why}", shown(out)))
+    })
+}
+
+/// Refuses an output directory that is `-`, has a name too long for a
+/// file system, exists as something other than a directory (following
+/// symbolic links), or cannot be created: an ancestor that is a file, a
+/// link that loops.
+fn check_output_dir(flag: &str, dir: &Path) -> Result<(), CliError> {
+    if dir.as_os_str() == STDIO {
+        return Err(CliError::input(format!(
+            "{flag} -: {flag} names a directory, not stdout; give a directory name"
+        )));
+    }
+    check_names(flag, dir)?;
+    let refused = |why: String| CliError::input(format!("{flag} {}: {why}", shown(dir)));
+    match std::fs::metadata(dir) {
+        Ok(m) if m.is_dir() => return Ok(()),
+        Ok(_) => return Err(refused("is a file, not a directory".into())),
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            return Err(refused(format!("cannot be a directory: {e}")));
+        }
+        Err(_) => {}
+    }
+    // Created with its parents: its own name a name (`new/.` is none), and
+    // the nearest that exists a directory.
+    let text = dir.as_os_str().to_string_lossy();
+    let last = text
+        .trim_end_matches(['/', std::path::MAIN_SEPARATOR])
+        .rsplit(['/', std::path::MAIN_SEPARATOR])
+        .next()
+        .unwrap_or_default();
+    if last.is_empty() || last == "." || last == ".." {
+        return Err(refused(
+            "does not exist and ends in `.` or `..`: name the directory to create".into(),
+        ));
+    }
+    for ancestor in dir.ancestors().skip(1) {
+        let a = if ancestor.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            ancestor
+        };
+        match std::fs::metadata(a) {
+            Ok(m) if m.is_dir() => return Ok(()),
+            Ok(_) => {
+                return Err(refused(format!(
+                    "cannot be created: {} is not a directory",
+                    shown(a)
+                )));
+            }
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(refused(format!("cannot be created: {e}")));
+            }
+            Err(_) => {}
+        }
+    }
+    Ok(())
+}
+
+/// The longest name of one file or directory most file systems take, in
+/// bytes (`NAME_MAX`).
+const NAME_MAX: usize = 255;
+
+/// Refuses a path with a name longer than [`NAME_MAX`] bytes: no file
+/// system here would take it, and finding that out only when writing
+/// would come after the work.
+fn check_names(flag: &str, path: &Path) -> Result<(), CliError> {
+    match path.components().find(|c| c.as_os_str().len() > NAME_MAX) {
+        Some(c) => Err(CliError::input(format!(
+            "{flag} {}: a name of {} bytes (a file system takes at most {NAME_MAX})",
+            shown(path),
+            c.as_os_str().len()
+        ))),
+        None => Ok(()),
     }
 }
 
@@ -196,10 +385,13 @@ pub fn output_in(flag: &str, dir: &Path, name: &str) -> Result<PathBuf, CliError
     match known.iter().find(|(_, p, _)| same_file(&out, p)) {
         Some((other, p, role)) => Err(CliError::input(format!(
             "{flag} {}: is also the {role} {other} {}; writing it would destroy that file: choose another directory",
-            out.display(),
-            p.display()
+            shown(&out),
+            shown(p)
         ))),
-        None => Ok(out),
+        None => {
+            check_output_file(flag, &out)?;
+            Ok(out)
+        }
     }
 }
 

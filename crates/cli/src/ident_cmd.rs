@@ -60,6 +60,11 @@ pub fn calibrate_request(a: &IdentifyArgs) -> CalibrateRequest {
 
 /// `tricept identify`.
 pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
+    if a.external.plausibility.is_some() && !a.external.any() {
+        return Err(CliError::input(
+            "--plausibility: the plausible ranges of the head, tool and instruments apply to the fused identification only (with --tracker, --ballbar, --touch, --head or --effects); without them it would be ignored",
+        ));
+    }
     let spin = crate::args::spinner(
         "identify: reading, screening and fitting (Gauss-Newton on the exact model)",
         &a.data,

@@ -36,6 +36,7 @@ mod output;
 mod plan_cmd;
 mod simulate_cmd;
 
+use std::path::Path;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -182,7 +183,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
     // The true errors' file, and the effects' `@FILE`s.
     let truth_inputs = |r: &mut files::FileRoles, t: &args::TruthArgs| {
         if let Some(tricept_ident::advanced::TrueErrors::File(p)) = &t.truth {
-            r.input_if_file("--truth", &p.to_string_lossy());
+            r.input("--truth", p);
         }
         for e in &t.truth_effects {
             r.input_if_file("--truth-effect", &e.to_string());
@@ -191,21 +192,21 @@ fn file_roles(command: &Command) -> files::FileRoles {
     match command {
         Command::Ik(a) => {
             machine(&mut r, &a.machine);
-            r.inputs("--input", &a.input.input);
+            stdin_or_input(&mut r, &a.input.input);
         }
         Command::Fk(a) => {
             machine(&mut r, &a.machine);
-            r.inputs("--input", &a.input.input);
+            stdin_or_input(&mut r, &a.input.input);
         }
         Command::ToolIk(a) => {
             machine(&mut r, &a.machine);
-            r.inputs("--input", &a.input.input);
+            stdin_or_input(&mut r, &a.input.input);
         }
         Command::Machine(a) => machine(&mut r, &a.machine),
         Command::Docs(_) | Command::Effects(_) => {}
         Command::Identifiability(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses.to_string());
+            r.inputs("--poses", a.poses.file().map(Path::to_path_buf).as_ref());
             r.inputs("--data", &a.data);
         }
         Command::Identify(a) => {
@@ -223,14 +224,16 @@ fn file_roles(command: &Command) -> files::FileRoles {
         }
         Command::Simulate(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses.to_string());
+            r.inputs("--poses", a.poses.file().map(Path::to_path_buf).as_ref());
             truth_inputs(&mut r, &a.truth);
-            r.input_if_file("--head-errors", &a.head_errors.to_string());
+            if let tricept_ident::simulate::HeadErrors::File(p) = &a.head_errors {
+                r.input("--head-errors", p);
+            }
             r.inputs("--tracker-poses", &a.tracker_poses);
             r.inputs("--ballbar-poses", &a.ballbar_poses);
             r.inputs("--touch-poses", &a.touch_poses);
             for (flag, p) in [
-                ("--out", &a.out),
+                ("--out", &simulate_cmd::out_file(a)),
                 ("--tracker-out", &a.tracker_out),
                 ("--ballbar-out", &a.ballbar_out),
                 ("--touch-out", &a.touch_out),
@@ -248,10 +251,13 @@ fn file_roles(command: &Command) -> files::FileRoles {
             if let Some(p) = &a.write_machine {
                 r.output("--write-machine", p);
             }
+            if let Some(d) = &a.plots {
+                r.output_dir("--plots", d, "residual-", ".svg");
+            }
         }
         Command::Detectability(a) => {
             machine(&mut r, &a.machine);
-            r.input_if_file("--poses", &a.poses.to_string());
+            r.inputs("--poses", a.poses.file().map(Path::to_path_buf).as_ref());
             r.inputs("--data", &a.data);
         }
         Command::Compensate(a) => {
@@ -272,6 +278,9 @@ fn file_roles(command: &Command) -> files::FileRoles {
             if let Some(h) = &a.history {
                 r.output("--history", h);
             }
+            if let Some(d) = &a.plot {
+                r.output_dir("--plot", d, "check-", ".svg");
+            }
         }
         Command::Export(a) => {
             r.input("--machine", &a.machine);
@@ -279,14 +288,24 @@ fn file_roles(command: &Command) -> files::FileRoles {
         Command::Plan(a) => {
             machine(&mut r, &a.machine);
             r.inputs("--data", &a.data);
-            r.input_if_file("--poses", &a.poses.to_string());
-            r.input_if_file("--candidates", &a.candidates.to_string());
+            r.inputs("--poses", a.poses.file().map(Path::to_path_buf).as_ref());
+            r.inputs(
+                "--candidates",
+                a.candidates.file().map(Path::to_path_buf).as_ref(),
+            );
             if let Some(p) = &a.out {
                 r.output("--out", p);
             }
         }
     }
     r
+}
+
+/// The `--input` of a kinematics verb: a file, or stdin (`-`).
+fn stdin_or_input(r: &mut files::FileRoles, input: &Option<std::path::PathBuf>) {
+    if let Some(p) = input.as_ref().filter(|p| p.as_os_str() != files::STDIO) {
+        r.input("--input", p);
+    }
 }
 
 /// Runs the verb; `Ok` carries the exit code of a result (0, or the
@@ -344,10 +363,14 @@ fn main() -> ExitCode {
                 errln!("error: {line}");
                 return ExitCode::from(tricept_ident::EXIT_INPUT);
             }
-            // Usage errors go to stderr (exit 2); help and version are
-            // output like any other (a full disk is a failure, exit 1).
+            // Usage errors go to stderr (exit 2), what they repeat of the
+            // command line inert (a control character escaped); help and
+            // version are output like any other (a full disk is a
+            // failure, exit 1).
             if e.use_stderr() {
-                let _ = e.print();
+                for line in e.render().to_string().trim_end().lines() {
+                    errln!("{line}");
+                }
                 return ExitCode::from(2);
             }
             output::write_text(&e.render().to_string());

@@ -51,32 +51,51 @@ pub fn finish() -> Option<String> {
     STDOUT_ERROR.lock().ok().and_then(|slot| slot.clone())
 }
 
-/// Writes `args` and a newline to stdout unless it is closed.
+/// Writes `args` and a newline to stdout unless it is closed (control
+/// characters other than line ends and tabs escaped: [`inert`]).
 pub fn write_line(args: std::fmt::Arguments<'_>) {
-    if stdout_closed() {
-        return;
-    }
-    let mut out = std::io::stdout().lock();
-    if let Err(e) = out.write_fmt(args).and_then(|_| out.write_all(b"\n")) {
-        failed(&e);
-    }
+    write_text(&format!("{args}\n"));
 }
 
-/// Writes `text` as it is (a report that ends its own lines).
+/// Writes `text` (a report that ends its own lines) with every control
+/// character but `\n` and `\t` escaped ([`inert`]): a path or a name
+/// the report repeats cannot move the cursor or recolour the terminal.
 pub fn write_text(text: &str) {
     if stdout_closed() {
         return;
     }
-    if let Err(e) = std::io::stdout().lock().write_all(text.as_bytes()) {
+    if let Err(e) = std::io::stdout().lock().write_all(inert(text).as_bytes()) {
         failed(&e);
     }
 }
 
-/// A line on stderr; a failed write is ignored (there is nowhere left to
-/// report it).
+/// `text` with every control character but `\n` and `\t` escaped (as
+/// `\u{1b}`); borrowed when there is none (the usual case).
+fn inert(text: &str) -> std::borrow::Cow<'_, str> {
+    let active = |c: char| c.is_control() && c != '\n' && c != '\t';
+    if !text.chars().any(active) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 16);
+    for c in text.chars() {
+        if active(c) {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
+}
+
+/// A line on stderr, made one bounded line ([`tricept_data::one_line`]:
+/// repeated input cut, every control character, a newline too, escaped);
+/// a failed write is ignored (there is nowhere left to report it).
 pub fn write_err_line(args: std::fmt::Arguments<'_>) {
+    let line = tricept_data::one_line(&args.to_string());
     let mut err = std::io::stderr().lock();
-    let _ = err.write_fmt(args).and_then(|_| err.write_all(b"\n"));
+    let _ = err
+        .write_all(line.as_bytes())
+        .and_then(|_| err.write_all(b"\n"));
 }
 
 /// Each of `warnings` on stderr as `warning: ...`.

@@ -35,7 +35,8 @@ pub struct SimulateArgs {
     /// (vibration, a sensor worse than its data sheet).
     #[arg(long, value_name = "F", default_value_t = 1.0)]
     pub noise_factor: f64,
-    /// Output file (default: stdout; with --json, a summary goes to stdout).
+    /// Output file (default, or `-`: stdout; with --json, a summary goes
+    /// to stdout).
     #[arg(long, value_name = "FILE.csv")]
     pub out: Option<PathBuf>,
     /// Head errors of the simulated machine: `zero`, `random:SCALE[,SEED]`
@@ -132,9 +133,17 @@ pub struct SimulateArgs {
     pub machine: MachineArgs,
 }
 
+/// The file of `--out`: `None` for stdout (no `--out`, or `-`).
+pub fn out_file(a: &SimulateArgs) -> Option<PathBuf> {
+    a.out
+        .clone()
+        .filter(|p| p.as_os_str() != crate::files::STDIO)
+}
+
 /// `tricept simulate`.
 pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
-    if a.machine.json && a.out.is_none() {
+    let out = out_file(a);
+    if a.machine.json && out.is_none() {
         return Err(CliError::input(
             "--json: needs --out FILE.csv (without it the CSV itself goes to stdout)",
         ));
@@ -168,7 +177,7 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
         written(out, tricept_data::write_external_path(out, data, c))?;
         crate::files::write_text(features_out, features)?;
     }
-    match &a.out {
+    match &out {
         Some(path) => {
             written(
                 path,

@@ -17,7 +17,10 @@
 //! On any failure before the rename the temporary file is removed and the
 //! target is untouched, byte for byte. A target that is a symbolic link is
 //! resolved first: the file it points to is replaced, the link stays. The
-//! permissions of a replaced file are kept.
+//! permissions of a replaced file are kept. Only a regular file is ever
+//! replaced: a device node, a named pipe or a socket at the target (or at
+//! the end of its links) is refused before anything is written
+//! ([`check_output_file`]).
 
 use std::fs::{File, OpenOptions};
 use std::io::{self, BufWriter, Write};
@@ -57,6 +60,7 @@ where
     G: FnOnce(File) -> W,
     F: FnOnce(&mut dyn Write) -> io::Result<()>,
 {
+    check_output_file(path)?;
     let target = resolve(path)?;
     let dir = directory_of(&target);
     let (tmp_path, file) = create_temporary(&dir, &target)?;
@@ -118,10 +122,75 @@ fn resolve(path: &Path) -> io::Result<PathBuf> {
                     "is a directory, not a file",
                 ));
             }
+            Ok(m) if !m.is_file() => {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidInput,
+                    format!(
+                        "is {}, not a regular file: only a regular file is replaced",
+                        special_kind(&m.file_type())
+                    ),
+                ));
+            }
             _ => return Ok(p),
         }
     }
     Err(io::Error::other("too many levels of symbolic links"))
+}
+
+/// Refuses an output path that [`write_atomic`] would not write: a name
+/// ending in a separator (`out/`: a directory's name, not a file's), an
+/// existing directory, or anything but a regular file at its end
+/// (following symbolic links): a device node, a named pipe or a socket is
+/// never replaced by a file. The errors are `InvalidInput` (or
+/// `IsADirectory`) and say why.
+///
+/// # Example
+/// ```
+/// use std::path::Path;
+/// let e = tricept_data::check_output_file(Path::new("/dev/null")).unwrap_err();
+/// assert!(e.to_string().contains("character device"), "{e}");
+/// assert!(tricept_data::check_output_file(Path::new("out/")).is_err());
+/// assert!(tricept_data::check_output_file(Path::new("new-file.json")).is_ok());
+/// ```
+pub fn check_output_file(path: &Path) -> io::Result<()> {
+    let text = path.as_os_str().to_string_lossy();
+    // The text's last name, not `Path::file_name` (which reads `a/.` as
+    // `a`): every path without a file name (`/`, `..`, ``) ends in one of
+    // these.
+    let last = text
+        .rsplit(['/', std::path::MAIN_SEPARATOR])
+        .next()
+        .unwrap_or_default();
+    if last.is_empty() || last == "." || last == ".." {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "names a directory (it ends with a separator or is `.` or `..`), not a file: give a file name",
+        ));
+    }
+    resolve(path).map(|_| ())
+}
+
+/// What a file that is neither regular nor a directory is, as a message
+/// says it.
+fn special_kind(t: &std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+        if t.is_fifo() {
+            return "a named pipe";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    let _ = t;
+    "a special file"
 }
 
 /// The number of the next temporary file of this process.
@@ -349,6 +418,47 @@ mod tests {
         assert_eq!(e.kind(), io::ErrorKind::IsADirectory);
         assert_eq!(e.to_string(), "is a directory, not a file");
         assert!(d.is_dir());
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_device_a_named_pipe_or_a_link_to_one_is_never_replaced() {
+        use std::os::unix::fs::FileTypeExt;
+        let d = dir("special");
+        let fifo = d.join("pipe");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+        let link = d.join("null.json");
+        std::os::unix::fs::symlink("/dev/null", &link).unwrap();
+        for (target, kind) in [
+            (fifo.as_path(), "a named pipe"),
+            (link.as_path(), "a character device"),
+            (Path::new("/dev/null"), "a character device"),
+        ] {
+            let e = write_atomic(target, |w| w.write_all(b"x")).unwrap_err();
+            assert_eq!(e.kind(), io::ErrorKind::InvalidInput, "{e}");
+            assert!(e.to_string().contains(kind), "{e}");
+        }
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+        assert!(
+            std::fs::metadata("/dev/null")
+                .unwrap()
+                .file_type()
+                .is_char_device()
+        );
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        // Nothing but the pipe and the link in the directory: no temporary.
+        assert_eq!(entries(&d), ["null.json", "pipe"]);
+        for name in ["sub/", "sub/.", "sub/..", ".", "..", ""] {
+            let e = write_atomic(&d.join(name), |w| w.write_all(b"x")).unwrap_err();
+            assert!(e.to_string().contains("names a directory"), "{name}: {e}");
+        }
         std::fs::remove_dir_all(&d).ok();
     }
 }

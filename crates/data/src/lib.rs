@@ -47,19 +47,23 @@ mod atomic;
 mod bounded;
 mod error;
 mod external;
+mod message;
 mod pose;
 mod read;
 mod records;
 mod targets;
 mod write;
 
-pub use atomic::write_atomic;
+pub use atomic::{check_output_file, write_atomic};
 pub use bounded::{MAX_JSON_BYTES, read_json_text};
 pub use error::DataError;
 pub use external::{
     BallbarData, BallbarReading, ExternalData, ExternalPose, ExternalRecord, Feature, Features,
     PlannedPose, PlannedPoses, Stylus, TouchData, TouchReading, TrackerData, TrackerPoint,
     read_external_from, read_external_path, write_external_path, write_external_to,
+};
+pub use message::{
+    MAX_MESSAGE_CHARS, MAX_QUOTED_CHARS, SHOWN_CHARS, SHOWN_PATH_CHARS, one_line, shown, shown_path,
 };
 pub use pose::{Dataset, MeasuredPose, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Readings};
 pub use read::{MAX_ANGLE_SPAN_RAD, MAX_LENGTH_MM, read_from, read_path, read_with_progress};

@@ -20,6 +20,7 @@ use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
 use crate::DataError;
+use crate::message::shown;
 
 /// The longest line a reader accepts, in bytes: far longer than any row of
 /// numbers, short enough that `/dev/zero` or a binary file is refused
@@ -30,27 +31,6 @@ pub const MAX_LINE_BYTES: usize = 1 << 20;
 /// value is not a reading in any unit of the format, and its square would
 /// lose all precision in a fit.
 pub const MAX_MAGNITUDE: f64 = 1e12;
-
-/// The longest field a message repeats, in characters.
-const SHOWN_CHARS: usize = 80;
-
-/// A field as messages show it: control characters escaped, cut to
-/// [`SHOWN_CHARS`] characters with the length of the rest.
-pub(crate) fn shown(field: &str) -> String {
-    let mut out = String::new();
-    for (count, (i, c)) in field.char_indices().enumerate() {
-        if count == SHOWN_CHARS {
-            out.push_str(&format!("… ({} more bytes)", field.len() - i));
-            return out;
-        }
-        if c.is_control() {
-            out.extend(c.escape_default());
-        } else {
-            out.push(c);
-        }
-    }
-    out
-}
 
 /// The UTF-8 encoding of U+FEFF, which some editors and spreadsheets write at
 /// the start of a "UTF-8" file.

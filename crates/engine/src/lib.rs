@@ -84,7 +84,7 @@ pub use identify::{
 pub use model::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
 pub use options::IdentifyOptions;
 pub use promise::{CrossValidation, cross_validate};
-pub use record::{RECORD_METHODS, RecordError, check_calibration_record};
+pub use record::{RECORD_METHODS, RecordError, RecordNotes, check_calibration_record};
 pub use report::{Combination, CorrelatedPair, IdentifiabilityReport, NamedValues, Observability};
 pub use robust::{
     Rejection, identify_robust, residuals_at, screen_gross_errors, screen_gross_errors_with_fit,

@@ -18,7 +18,7 @@
 //! by its `effect.parameter` names in `calibration.effects`; the base
 //! machine's values for those the record does not name).
 
-use tricept_kinematics::description::CalibrationRecord;
+use tricept_kinematics::description::{CalibrationRecord, SealCheck};
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::effects::{Deployment, EffectName};
 use tricept_model::{HeadParameterSet, ParameterSet, actual_machine};
@@ -37,17 +37,24 @@ pub enum RecordError {
     /// The record cannot be read as one this version writes.
     #[error("calibration record: {0}")]
     Unreadable(String),
-    /// Fields a later verb judges by (standard deviations, correlations,
-    /// sensor offsets and noise, temperature, fit quality) differ from the
-    /// values the record was sealed with.
+    /// Fields of the file differ from the values the record was sealed
+    /// with (every field is sealed: the geometry, the estimates, the
+    /// nominal machine, the UP limb, the workspace, the standard
+    /// deviations, noise and temperature).
     #[error(
-        "{} edited after the calibration (the record's seal does not match): a later check judges the machine by {}; restore the file, or calibrate again",
-        .fields.iter().map(|f| format!("`{f}`")).collect::<Vec<_>>().join(", "),
+        "{} edited after the calibration (the record's seal does not match){}: every verb that loads the file commands, checks or exports by {}; restore the file, or calibrate again",
+        named(.fields),
+        .detail.as_ref().map(|d| format!("; {d}")).unwrap_or_default(),
         if .fields.len() == 1 { "it" } else { "them" }
     )]
     Edited {
-        /// The edited fields, as named in the file.
-        fields: Vec<&'static str>,
+        /// The edited fields, as named in the file (`leg_offsets_mm`,
+        /// `calibration.estimates_mm.dq2`).
+        fields: Vec<String>,
+        /// What the rebuild from the record says besides (`None` when the
+        /// file's geometry agrees with its record): where they differ,
+        /// with both values, or why the record cannot be read.
+        detail: Option<String>,
     },
     /// The record has no seal: written before records were sealed, or the
     /// seal was removed.
@@ -69,8 +76,45 @@ pub enum RecordError {
     },
 }
 
+/// The edited fields as a message names them: at most 12, then how many
+/// more.
+fn named(fields: &[String]) -> String {
+    const SHOWN: usize = 12;
+    let mut s = fields
+        .iter()
+        .take(SHOWN)
+        .map(|f| format!("`{f}`"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if fields.len() > SHOWN {
+        s.push_str(&format!(" and {} more fields", fields.len() - SHOWN));
+    }
+    s
+}
+
+/// What loading a calibrated file has to say beside refusing it: a seal
+/// written before the seal covered every field.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub struct RecordNotes {
+    /// The record's seal covers a chosen list of fields only (a file
+    /// written before every field was sealed): an edit of the geometry
+    /// with its estimates cannot be seen.
+    pub partial_seal: bool,
+}
+
+impl RecordNotes {
+    /// The warning a loader prints, if any.
+    pub fn warning(&self) -> Option<&'static str> {
+        self.partial_seal.then_some(
+            "its calibration record was sealed by an earlier tricept, whose seal did not cover the geometry, the estimates, the nominal machine, the UP limb or the workspace: an edit of those that agree with each other cannot be seen; write it again with this version (`tricept identify --write-machine`) to seal every field",
+        )
+    }
+}
+
 /// Checks a calibrated machine description against its `calibration`
-/// record (see the module docs); `Ok` for a description without one.
+/// record (see the module docs); `Ok` for a description without one, with
+/// what a loader should say of an intact record ([`RecordNotes`]).
 ///
 /// # Example
 /// ```
@@ -104,26 +148,47 @@ pub enum RecordError {
 /// assert!(check_calibration_record(&d).is_err());
 /// d.seal();
 /// assert!(check_calibration_record(&d).is_ok());
-/// // An edit of a judged field is caught and named.
+/// // An edit of any field is caught and named.
 /// let mut edited = d.clone();
 /// edited.sensors.length_noise_um *= 2.0;
 /// let e = check_calibration_record(&edited).unwrap_err().to_string();
-/// assert!(e.contains("`sensors` edited"), "{e}");
-/// // An edit of the geometry without the record is caught and named.
+/// assert!(e.contains("`sensors.length_noise_um` edited"), "{e}");
+/// // An edit of the geometry without the record is caught and named,
+/// // with both values.
 /// d.leg_offsets_mm[0] += 5.0;
 /// let e = check_calibration_record(&d).unwrap_err().to_string();
-/// assert!(e.contains("leg_offsets_mm[0]"), "{e}");
+/// assert!(e.contains("`leg_offsets_mm` edited"), "{e}");
+/// assert!(e.contains("leg_offsets_mm[0] is 5.450000 in the file but 0.450000 from the record"), "{e}");
 /// ```
-pub fn check_calibration_record(d: &MachineDescription) -> Result<(), RecordError> {
+pub fn check_calibration_record(d: &MachineDescription) -> Result<RecordNotes, RecordError> {
+    let partial_seal = match d.seal_check() {
+        SealCheck::NoRecord => return Ok(RecordNotes::default()),
+        SealCheck::Unsealed => return Err(RecordError::Unsealed),
+        SealCheck::Edited(fields) => {
+            let detail = match rebuilt_differences(d) {
+                Err(RecordError::Mismatch { fields, .. }) => Some(format!(
+                    "the machine does not match its calibration record: {}",
+                    fields.join("; ")
+                )),
+                Err(e) => Some(e.to_string()),
+                Ok(()) => None,
+            };
+            return Err(RecordError::Edited { fields, detail });
+        }
+        SealCheck::Intact { partial } => partial,
+    };
+    rebuilt_differences(d)?;
+    Ok(RecordNotes { partial_seal })
+}
+
+/// The record's geometry rebuilt and compared with the file's: `Ok` when
+/// they agree, else the differences ([`RecordError::Mismatch`]) or why the
+/// record cannot be rebuilt.
+fn rebuilt_differences(d: &MachineDescription) -> Result<(), RecordError> {
     let Some(c) = &d.calibration else {
         return Ok(());
     };
     let unreadable = |why: String| RecordError::Unreadable(why);
-    match d.edited_sealed_fields() {
-        Err(()) => return Err(RecordError::Unsealed),
-        Ok(fields) if !fields.is_empty() => return Err(RecordError::Edited { fields }),
-        Ok(_) => {}
-    }
     if !RECORD_METHODS.contains(&c.method.as_str()) {
         return Err(unreadable(format!(
             "unknown method `{}` (this version writes {})",

@@ -16,9 +16,10 @@
 //!   [`LoadedMachine`] (its description, its warnings), which converts into
 //!   the [`crate::MachineInput`] every request takes.
 //! - **Result parts** several workflows share: the [`Accuracy`] a written
-//!   file promises.
+//!   file promises, the [`MachineFile`] a result may write (kept apart
+//!   from it, to write later by the same rule).
 //! - **Low level**: the error mapping of the internal crates' errors
-//!   ([`Classify`]), the data set in memory ([`Dataset`]) and its reader,
+//!   ([`Classify`], and the file-system failure under one, [`FileFailure`]), the data set in memory ([`Dataset`]) and its reader,
 //!   and the foreign crates whose types results hold (`nalgebra`,
 //!   `serde_json`).
 
@@ -26,11 +27,12 @@ pub use crate::accuracy::Accuracy;
 pub use crate::calibrate::values::{
     EffectNames, EvalGrid, HeadModel, LengthSigma, TrackerTargetSpec,
 };
-pub use crate::error::Classify;
+pub use crate::error::{Classify, FileFailure};
 pub use crate::inputs::{
     FrameMmRad, HeadAngles, LoadedMachine, Poses, SensorNoise, Triple, TrueErrors, load_machine,
     parse_effects, parse_numbers, read_data_from,
 };
+pub use crate::machine_file::MachineFile;
 pub use nalgebra;
 pub use serde_json;
 pub use tricept_data::Dataset;

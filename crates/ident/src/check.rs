@@ -96,7 +96,9 @@ pub fn check(request: CheckRequest) -> Result<CheckResult, Error> {
         )));
     }
     if let Some(h) = &request.history {
-        // A history that cannot be read is refused before the check runs.
+        // A history that cannot be read or replaced is refused before the
+        // check runs.
+        crate::error::check_output_path("--history", h)?;
         tricept_check::history::read(h)?;
     }
     let mut options = CheckOptions::for_machine(loaded.machine());

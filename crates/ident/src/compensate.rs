@@ -624,6 +624,10 @@ impl Compensation {
                     "{}: cannot create the directory: {e}",
                     dir.display()
                 ))
+                .with_file_failure(crate::error::FileFailure::new(
+                    dir.display().to_string(),
+                    &e,
+                ))
             })?;
         }
         write_text(&t.path, &self.table_csv(t))?;

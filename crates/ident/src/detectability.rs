@@ -85,6 +85,11 @@ pub fn detectability(request: DetectabilityRequest) -> Result<DetectabilityRepor
             // machine.
             let mut plant = Plant::geometric(m.clone(), GeometricErrors::default());
             let drift_k = request.temperature_drift_k;
+            if !(drift_k.is_finite() && drift_k.abs() <= 1000.0) {
+                return Err(Error::input(format!(
+                    "--temperature-drift: the temperature change over the campaign must be a number of K within +-1000, got {drift_k}"
+                )));
+            }
             if drift_k != 0.0 {
                 plant.effects = vec![Effect::from(tricept_plant::effects::Thermal {
                     drift_k,

@@ -318,6 +318,23 @@ impl DiagnoseResult {
         Ok((description, forced))
     }
 
+    /// The machine file of the final model, kept apart from the result
+    /// ([`crate::advanced::MachineFile`]): the description (forced when
+    /// the data are not explained) and the verdict the write rule applies.
+    pub fn machine_file(&self) -> Result<crate::machine_file::MachineFile, Error> {
+        let (description, forced) = self.extended_description("--write-machine", true)?;
+        let code = if forced.is_some() {
+            EXIT_INADEQUATE
+        } else {
+            EXIT_OK
+        };
+        Ok(crate::machine_file::MachineFile::new(
+            description,
+            code,
+            forced.unwrap_or_default(),
+        ))
+    }
+
     /// Writes the calibrated machine of the final model to `path`
     /// atomically ([`DiagnoseResult::extended_description`]); returns the
     /// warning of a forced write (`--write-machine PATH: written with
@@ -325,8 +342,7 @@ impl DiagnoseResult {
     pub fn write_machine(&self, path: &Path, force: bool) -> Result<Option<String>, Error> {
         let what = format!("--write-machine {}", path.display());
         let (description, forced) = self.extended_description(&what, force)?;
-        crate::machine_file::write(path, &description)
-            .map_err(|e| Error::other(format!("{}: not written: {e}", path.display())))?;
+        crate::machine_file::write(path, &description).map_err(|e| Error::not_written(path, &e))?;
         Ok(forced.map(|why| format!("{what}: written with --force although {why}")))
     }
 }

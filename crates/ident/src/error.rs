@@ -98,6 +98,11 @@ impl ErrorKind {
 pub trait Classify {
     /// Whose fault this error is.
     fn kind(&self) -> ErrorKind;
+
+    /// The file-system failure under it, if there is one.
+    fn file_failure(&self) -> Option<FileFailure> {
+        None
+    }
 }
 
 /// A failure of a workflow: a one-line message (naming the file, line and
@@ -114,38 +119,128 @@ pub trait Classify {
 pub struct Error {
     kind: ErrorKind,
     message: String,
+    file: Option<FileFailure>,
+}
+
+/// The file-system failure under an [`Error`] (a file that cannot be
+/// opened, read or written): the file and the operating system's error,
+/// for a caller that raises the platform's own error (Python's `OSError`
+/// subclasses: `FileNotFoundError`, `PermissionError`, ...).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::load_machine;
+/// use tricept_ident::advanced::SensorNoise;
+/// let e = load_machine(Some("no/such.json".as_ref()), &SensorNoise::default()).unwrap_err();
+/// let f = e.file_failure().unwrap();
+/// assert_eq!(f.path(), "no/such.json");
+/// assert_eq!(f.io_kind(), std::io::ErrorKind::NotFound);
+/// assert_eq!(f.os_error(), Some(2)); // ENOENT
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FileFailure {
+    path: String,
+    os_error: Option<i32>,
+    io_kind: std::io::ErrorKind,
+}
+
+impl FileFailure {
+    /// The failure of `path` with the I/O error `e`.
+    pub fn new(path: impl Into<String>, e: &std::io::Error) -> FileFailure {
+        FileFailure {
+            path: path.into(),
+            os_error: e.raw_os_error(),
+            io_kind: e.kind(),
+        }
+    }
+
+    /// The file, as given.
+    pub fn path(&self) -> &str {
+        &self.path
+    }
+
+    /// The operating system's error number (`errno`), when the failure
+    /// came from the operating system.
+    pub fn os_error(&self) -> Option<i32> {
+        self.os_error
+    }
+
+    /// The kind of the I/O error.
+    pub fn io_kind(&self) -> std::io::ErrorKind {
+        self.io_kind
+    }
 }
 
 impl Error {
-    /// An error of the given kind.
+    /// An error of the given kind. The message is made one bounded line
+    /// ([`tricept_data::one_line`]): what it repeats of the input (a key,
+    /// a value, a path) is cut and its control characters escaped.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{Error, ErrorKind};
+    /// let e = Error::new(ErrorKind::Input, format!("unknown key `{}`", "k".repeat(1 << 20)));
+    /// assert!(e.message().len() < 1000);
+    /// assert_eq!(Error::input("a\nb\u{1b}[2J").message(), "a\\nb\\u{1b}[2J");
+    /// ```
     pub fn new(kind: ErrorKind, message: impl Into<String>) -> Error {
         Error {
             kind,
-            message: message.into(),
+            message: tricept_data::one_line(&message.into()),
+            file: None,
         }
+    }
+
+    /// The same error, caused by the file-system failure `file`.
+    #[must_use]
+    pub fn with_file_failure(mut self, file: FileFailure) -> Error {
+        self.file = Some(file);
+        self
+    }
+
+    /// A file that could not be written: `PATH: not written: WHY`. Our own
+    /// refusals of the path (a device, a named pipe, a directory, a name
+    /// ending in a separator) are the input's fault (exit code 2); a
+    /// failure of the file system (a full disk, a missing directory, no
+    /// permission) is not (exit code 1) and carries its [`FileFailure`].
+    pub fn not_written(path: &std::path::Path, e: &std::io::Error) -> Error {
+        let refused = matches!(
+            e.kind(),
+            std::io::ErrorKind::InvalidInput | std::io::ErrorKind::IsADirectory
+        ) && e.raw_os_error().is_none();
+        let kind = if refused {
+            ErrorKind::Input
+        } else {
+            ErrorKind::Other
+        };
+        let error = Error::new(kind, format!("{}: not written: {e}", path.display()));
+        if refused {
+            error
+        } else {
+            error.with_file_failure(FileFailure::new(path.display().to_string(), e))
+        }
+    }
+
+    /// The file-system failure that caused this error, if one did.
+    pub fn file_failure(&self) -> Option<&FileFailure> {
+        self.file.as_ref()
     }
 
     /// An error of the user's input (exit code 2).
     pub fn input(message: impl Into<String>) -> Error {
-        Error {
-            kind: ErrorKind::Input,
-            message: message.into(),
-        }
+        Error::new(ErrorKind::Input, message)
     }
 
     /// Any other error (exit code 1).
     pub fn other(message: impl Into<String>) -> Error {
-        Error {
-            kind: ErrorKind::Other,
-            message: message.into(),
-        }
+        Error::new(ErrorKind::Other, message)
     }
 
     /// A library error with its kind and its message.
     pub fn from_library(e: &(impl Classify + fmt::Display)) -> Error {
         Error {
-            kind: e.kind(),
-            message: e.to_string(),
+            file: e.file_failure(),
+            ..Error::new(e.kind(), e.to_string())
         }
     }
 
@@ -153,8 +248,8 @@ impl Error {
     /// kind.
     pub fn with_context(context: impl fmt::Display, e: &(impl Classify + fmt::Display)) -> Error {
         Error {
-            kind: e.kind(),
-            message: format!("{context}: {e}"),
+            file: e.file_failure(),
+            ..Error::new(e.kind(), format!("{context}: {e}"))
         }
     }
 
@@ -162,8 +257,8 @@ impl Error {
     #[must_use]
     pub fn in_file(self, context: impl fmt::Display) -> Error {
         Error {
-            kind: self.kind,
-            message: format!("{context}: {}", self.message),
+            file: self.file,
+            ..Error::new(self.kind, format!("{context}: {}", self.message))
         }
     }
 
@@ -184,6 +279,28 @@ impl Error {
     }
 }
 
+/// Refuses an output file before any work (exit code 2): a path
+/// [`tricept_data::check_output_file`] refuses (a device, a named pipe, a
+/// directory, a name ending in a separator), or one whose directory does
+/// not exist (with the file-system failure `NotFound`).
+pub(crate) fn check_output_path(flag: &str, path: &std::path::Path) -> Result<(), Error> {
+    let shown = path.display();
+    tricept_data::check_output_file(path)
+        .map_err(|e| Error::input(format!("{flag} {shown}: {e}")))?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => std::path::Path::new("."),
+    };
+    if let Err(e) = std::fs::metadata(dir) {
+        return Err(Error::input(format!(
+            "{flag} {shown}: the directory {} does not exist",
+            dir.display()
+        ))
+        .with_file_failure(FileFailure::new(shown.to_string(), &e)));
+    }
+    Ok(())
+}
+
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.message)
@@ -202,11 +319,25 @@ impl Classify for DataError {
     fn kind(&self) -> ErrorKind {
         ErrorKind::Input
     }
+
+    fn file_failure(&self) -> Option<FileFailure> {
+        match self {
+            DataError::Io { file, source } => Some(FileFailure::new(file.clone(), source)),
+            _ => None,
+        }
+    }
 }
 
 impl Classify for DescriptionError {
     fn kind(&self) -> ErrorKind {
         ErrorKind::Input
+    }
+
+    fn file_failure(&self) -> Option<FileFailure> {
+        match self {
+            DescriptionError::Io { path, source } => Some(FileFailure::new(path.clone(), source)),
+            _ => None,
+        }
     }
 }
 

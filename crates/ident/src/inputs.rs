@@ -23,7 +23,7 @@ use tricept_kinematics::{
 use tricept_model::ParameterSet;
 use tricept_plant::Effect;
 
-use crate::error::Error;
+use crate::error::{Classify, Error, FileFailure};
 use crate::limits;
 
 /// Sensor-noise overrides of a machine (default: the description's).
@@ -126,7 +126,10 @@ pub fn description_error(path: &str, e: &DescriptionError) -> Error {
         DescriptionError::Io { .. } => e.to_string(),
         _ => format!("{path}: {e}"),
     };
-    Error::input(message)
+    match e.file_failure() {
+        Some(f) => Error::input(message).with_file_failure(f),
+        None => Error::input(message),
+    }
 }
 
 /// serde_json appends " at line L column C"; the message states it up front.
@@ -163,53 +166,102 @@ pub fn load_machine(path: Option<&Path>, noise: &SensorNoise) -> Result<LoadedMa
             )
         }
     };
-    let mut machine = description
-        .build()
-        .map_err(|e| description_error(&source, &e))?;
-    if let Some((r, why)) = machine.unreachable_workspace_point() {
-        let w = &machine.workspace;
-        return Err(Error::input(format!(
-            "{source}: the workspace (radius {} mm, z from {} to {} mm) is not within the machine's reach: at ({:.1}, {:.1}, {:.1}) mm: {why}; shrink `workspace` or correct `limits`",
-            w.radius_mm, w.z_min_mm, w.z_max_mm, r.x, r.y, r.z
-        )));
-    }
-    tricept_engine::check_calibration_record(&description)
-        .map_err(|e| Error::input(format!("{source}: {e}")))?;
-    let mut warnings = Vec::new();
-    if let Some(c) = &description.calibration {
-        if c.forced {
-            warnings.push(format!(
-                "{source} holds a calibration written with --force although it is not to be trusted (converged: {}, adequate: {})",
-                c.converged, c.adequate
-            ));
-        } else if !c.converged {
-            warnings.push(format!(
-                "{source} holds a calibration whose fit did not converge: its estimates are not a calibration"
-            ));
-        } else if !c.adequate {
-            warnings.push(format!(
-                "{source} holds a calibration whose model did not explain its data (chi2/dof {:.2})",
-                c.chi2_per_dof
-            ));
+    let mut loaded = LoadedMachine::from_description(description, source, noise)?;
+    loaded.path = path.map(Path::to_path_buf);
+    Ok(loaded)
+}
+
+impl LoadedMachine {
+    /// A machine from a description in memory (one a program built, or a
+    /// file's text read back), checked as a file is ([`load_machine`]): it
+    /// must be valid, its workspace reachable and its calibration record,
+    /// if it has one, intact. `source` names it in messages.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::advanced::{LoadedMachine, SensorNoise};
+    /// use tricept_ident::kinematics::MachineDescription;
+    /// let mut d = MachineDescription::paper();
+    /// let m = LoadedMachine::from_description(d.clone(), "mine", &SensorNoise::default()).unwrap();
+    /// assert_eq!(m.source(), "mine");
+    /// d.workspace.radius_mm = -1.0;
+    /// assert!(LoadedMachine::from_description(d, "mine", &SensorNoise::default()).is_err());
+    /// ```
+    pub fn from_description(
+        description: MachineDescription,
+        source: impl Into<String>,
+        noise: &SensorNoise,
+    ) -> Result<LoadedMachine, Error> {
+        let source = source.into();
+        description
+            .validate()
+            .map_err(|e| description_error(&source, &e))?;
+        let mut machine = description
+            .build()
+            .map_err(|e| description_error(&source, &e))?;
+        if let Some((r, why)) = machine.unreachable_workspace_point() {
+            let w = &machine.workspace;
+            return Err(Error::input(format!(
+                "{source}: the workspace (radius {} mm, z from {} to {} mm) is not within the machine's reach: at ({:.1}, {:.1}, {:.1}) mm: {why}; shrink `workspace` or correct `limits`",
+                w.radius_mm, w.z_min_mm, w.z_max_mm, r.x, r.y, r.z
+            )));
         }
+        let notes = tricept_engine::check_calibration_record(&description)
+            .map_err(|e| Error::input(format!("{source}: {e}")))?;
+        let mut warnings = Vec::new();
+        if let Some(w) = notes.warning() {
+            warnings.push(format!("{source}: {w}"));
+        }
+        if let Some(c) = &description.calibration {
+            if c.forced {
+                warnings.push(format!(
+                    "{source} holds a calibration written with --force although it is not to be trusted (converged: {}, adequate: {})",
+                    c.converged, c.adequate
+                ));
+            } else if !c.converged {
+                warnings.push(format!(
+                    "{source} holds a calibration whose fit did not converge: its estimates are not a calibration"
+                ));
+            } else if !c.adequate {
+                warnings.push(format!(
+                    "{source} holds a calibration whose model did not explain its data (chi2/dof {:.2})",
+                    c.chi2_per_dof
+                ));
+            }
+        }
+        apply_noise(&mut machine, noise)?;
+        Ok(LoadedMachine {
+            description,
+            machine,
+            source,
+            path: None,
+            warnings,
+        })
     }
-    apply_noise(&mut machine, noise)?;
-    Ok(LoadedMachine {
-        description,
-        machine,
-        source,
-        path: path.map(Path::to_path_buf),
-        warnings,
-    })
+
+    /// The same machine with the sensor-noise overrides `noise` applied
+    /// (each must be positive), as a file loaded with them would be.
+    pub fn with_noise(mut self, noise: &SensorNoise) -> Result<LoadedMachine, Error> {
+        apply_noise(&mut self.machine, noise)?;
+        Ok(self)
+    }
 }
 
 /// Applies sensor-noise overrides to a machine (each must be positive).
 fn apply_noise(m: &mut Machine, noise: &SensorNoise) -> Result<(), Error> {
     if let Some(a) = noise.angle_noise_arcsec {
-        m.sensors.angle_rad = positive("--angle-noise-arcsec", a)? * RAD_PER_ARCSEC;
+        m.sensors.angle_rad = at_most(
+            "--angle-noise-arcsec",
+            positive("--angle-noise-arcsec", a)?,
+            MAX_NOISE,
+        )? * RAD_PER_ARCSEC;
     }
     if let Some(l) = noise.length_noise_um {
-        m.sensors.length_mm = positive("--length-noise-um", l)? * 1e-3;
+        m.sensors.length_mm = at_most(
+            "--length-noise-um",
+            positive("--length-noise-um", l)?,
+            MAX_NOISE,
+        )? * 1e-3;
     }
     if let Some(k) = noise.readings_per_pose {
         if k == 0 {
@@ -218,6 +270,22 @@ fn apply_noise(m: &mut Machine, noise: &SensorNoise) -> Result<(), Error> {
         m.sensors.readings_per_pose = k;
     }
     Ok(())
+}
+
+/// The largest sensor noise an override may state (arcsec or um): an
+/// encoder 10 000 arcsec (2.8 degrees) or a scale 10 mm off in one
+/// reading is no sensor of this machine, and its weights would underflow.
+pub const MAX_NOISE: f64 = 1e4;
+
+/// `v` if it is at most `max`, else an input error naming `flag`.
+fn at_most(flag: &str, v: f64, max: f64) -> Result<f64, Error> {
+    if v <= max {
+        Ok(v)
+    } else {
+        Err(Error::input(format!(
+            "{flag}: must be at most {max}, got {v}"
+        )))
+    }
 }
 
 /// `v` if it is a positive finite number, else an input error naming `flag`.
@@ -235,7 +303,9 @@ pub fn positive(flag: &str, v: f64) -> Result<f64, Error> {
 /// stroke; every problem is an input error naming file, line and column.
 pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, Error> {
     let file = path.display().to_string();
-    let f = std::fs::File::open(path).map_err(|e| Error::input(format!("{file}: {e}")))?;
+    let f = std::fs::File::open(path).map_err(|e| {
+        Error::input(format!("{file}: {e}")).with_file_failure(FileFailure::new(file.clone(), &e))
+    })?;
     read_data_from(std::io::BufReader::new(f), &file, machine)
 }
 
@@ -355,6 +425,22 @@ impl Poses {
                 per_ring: 8,
                 levels: 3,
             }),
+        }
+    }
+
+    /// The CSV file of the poses, when the spec names one (neither a
+    /// grid, a random set, a disc nor `optimal:N`).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::advanced::Poses;
+    /// assert!("random:20,1".parse::<Poses>().unwrap().file().is_none());
+    /// assert_eq!("p.csv".parse::<Poses>().unwrap().file().unwrap().to_str(), Some("p.csv"));
+    /// ```
+    pub fn file(&self) -> Option<&Path> {
+        match &self.kind {
+            PosesKind::File(p) => Some(p),
+            _ => None,
         }
     }
 
@@ -492,8 +578,19 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
             ),
             None => (spec.clone(), "--truth-effect".to_string()),
         };
-        let value: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| Error::input(format!("{origin}: {e}")))?;
+        let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+            // A bare effect name is the usual slip: say what to give.
+            let typical = tricept_plant::effects::typical_effects()
+                .into_iter()
+                .find(|t| t.tag() == text.trim());
+            match typical.and_then(|t| serde_json::to_string(&t).ok()) {
+                Some(example) => Error::input(format!(
+                    "{origin}: `{}` names an effect; give it with its magnitudes as a JSON object, e.g. '{example}' (`tricept effects` lists every effect's keys)",
+                    text.trim()
+                )),
+                None => Error::input(format!("{origin}: {e}")),
+            }
+        })?;
         let items = match value {
             serde_json::Value::Array(a) => a,
             v => vec![v],

@@ -364,6 +364,86 @@ pub fn calibrated_description(
     Ok(d)
 }
 
+/// A calibrated machine file not yet written: its description (with its
+/// record) and the verdict of the fit it came from, written by the one
+/// write rule (`identify --write-machine`'s). A result gives it
+/// ([`crate::calibrate::Calibration::machine_file`],
+/// [`crate::diagnosis::DiagnoseResult::machine_file`]) to be kept apart
+/// from the result (as JSON: a Python binding pickles it) and written
+/// later, with the same refusal as the result's own `write_machine`.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::MachineFile;
+/// let f = MachineFile::from_json("{}");
+/// assert!(f.is_err());
+/// ```
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MachineFile {
+    /// The calibrated machine with its record (forced when `code` is not
+    /// 0: the only way it may be written).
+    description: MachineDescription,
+    /// The fit's exit code for the write rule: 0 may be written, 3 and 4
+    /// only with `force`.
+    code: u8,
+    /// Why a non-zero code is not to be trusted.
+    why: String,
+}
+
+impl MachineFile {
+    /// The file of a fit whose exit code is `code` (`why`: the reason of a
+    /// non-zero one) and whose description is `description` (built forced
+    /// when `code` is not 0).
+    pub(crate) fn new(description: MachineDescription, code: u8, why: String) -> MachineFile {
+        MachineFile {
+            description,
+            code,
+            why,
+        }
+    }
+
+    /// The calibrated machine's description, with its record (not sealed:
+    /// writing seals it).
+    pub fn description(&self) -> &MachineDescription {
+        &self.description
+    }
+
+    /// The description sealed, as [`MachineFile::write`] would write it
+    /// now: what loads as a machine in memory.
+    pub fn sealed(&self) -> MachineDescription {
+        let mut d = self.description.clone();
+        d.seal();
+        d
+    }
+
+    /// Writes the file at `path` atomically by the write rule: a fit whose
+    /// exit code is not 0 is refused (an error of that code) unless
+    /// `force`; the record's `date` is the time of writing. Returns the
+    /// warning of a forced write.
+    pub fn write(&self, path: &Path, force: bool) -> Result<Option<String>, Error> {
+        let what = format!("--write-machine {}", path.display());
+        let forced = write_rule(&what, self.code, &self.why, force)?;
+        let mut d = self.description.clone();
+        if let Some(c) = d.calibration.as_mut() {
+            c.date = utc_now();
+        }
+        write(path, &d).map_err(|e| Error::not_written(path, &e))?;
+        Ok(forced.map(|why| format!("{what}: written with --force although {why}")))
+    }
+
+    /// The JSON text it is kept as.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).unwrap_or_default()
+    }
+
+    /// Reads it back from [`MachineFile::to_json`]'s text (an input error
+    /// for any other text).
+    pub fn from_json(text: &str) -> Result<MachineFile, Error> {
+        serde_json::from_str(text)
+            .map_err(|e| Error::input(format!("not a machine file kept by tricept: {e}")))
+    }
+}
+
 /// Writes a machine description to `path` atomically (a crash or a full
 /// disk leaves the previous file), its calibration record sealed last
 /// ([`MachineDescription::seal`]), so that a file loads back only as it

@@ -242,7 +242,7 @@ impl Plan {
                 comments,
             )
             .map(|()| true)
-            .map_err(|e| Error::other(format!("{}: not written: {e}", path.display()))),
+            .map_err(|e| Error::not_written(path, &e)),
         }
     }
 }

@@ -1,17 +1,22 @@
 //! The `tricept` binary end to end, one test binary: bad inputs, the check,
-//! a closed stdout, the embedded docs, the exit-code table, the fused
-//! identification, what writing survives, and a calibration a user can
+//! a closed stdout, the embedded docs, the edges (special files, `-`,
+//! refusals before work, the history lock, bounded messages), the
+//! exit-code table, the fused identification, the seal, seeded fuzzing of
+//! every input kind, what writing survives, and a calibration a user can
 //! trust (one module per subject; what they share in `support`).
 
 mod bad_inputs;
 mod check;
 mod closed_stdout;
 mod docs;
+mod edges;
 mod exit_codes;
 mod export;
 mod fusion;
+mod fuzz;
 mod one_exit_code;
 mod outputs;
 mod relied_on;
+mod seal;
 mod support;
 mod trust;

@@ -327,6 +327,19 @@ impl Calibration {
         }
     }
 
+    /// The machine file this calibration may write, kept apart from it
+    /// ([`crate::advanced::MachineFile`]): the description (forced when
+    /// the exit code is not 0) and the verdict the write rule applies. An
+    /// input error for data given in memory (the record holds the data
+    /// file's hash).
+    pub fn machine_file(&self) -> Result<crate::machine_file::MachineFile, Error> {
+        let code = self.exit_code();
+        let why = self.reason();
+        let forced = (code != 0).then(|| why.clone());
+        let d = self.description(forced)?;
+        Ok(crate::machine_file::MachineFile::new(d, code, why))
+    }
+
     /// Writes the calibrated machine file at `path` atomically, by the one
     /// write rule: a fit whose exit code is not 0 is refused (an error of
     /// that code) unless `force`, and the file then says it was forced.
@@ -343,8 +356,7 @@ impl Calibration {
             }
         };
         let d = self.description(forced.clone())?;
-        machine_file::write(path, &d)
-            .map_err(|e| Error::other(format!("{}: not written: {e}", path.display())))?;
+        machine_file::write(path, &d).map_err(|e| Error::not_written(path, &e))?;
         if let Fit::Fused(f) = &mut self.fit {
             f.record_write(path, true);
         }
@@ -359,7 +371,7 @@ impl Calibration {
 /// intact and the error (exit code 1) names the file.
 pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), Error> {
     tricept_data::write_atomic(path, |w| w.write_all(text.as_bytes()))
-        .map_err(|e| Error::other(format!("{}: not written: {e}", path.display())))
+        .map_err(|e| Error::not_written(path, &e))
 }
 
 /// The one-line summary of a non-zero verdict (`VERB: exit CODE: WHY (see

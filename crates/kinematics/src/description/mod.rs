@@ -42,6 +42,7 @@ pub use record::{
     HeldParameter, Interpolation, LegEffectsDescription, LegTableDescription,
     SensorOffsetsDescription,
 };
+pub use seal::SealCheck;
 pub use validate::{MAX_TABLE_EXTRA_UM, MAX_TABLE_POINTS, MAX_TABLE_SLOPE_UM_PER_MM};
 
 /// The JSON text of the paper's Table 1 machine, embedded at compile time.
@@ -179,12 +180,12 @@ pub struct CalibrationRecord {
     /// before tables existed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub leg_tables_digest: Option<String>,
-    /// Digests of every field a later verb judges by (the standard
-    /// deviations, correlations, sensor offsets, temperature, effects, fit
-    /// quality, and the machine's sensor noise and controller parameters),
-    /// by field name: [`MachineDescription::seal`] writes it,
-    /// [`MachineDescription::edited_sealed_fields`] names a field edited
-    /// since. Absent only on a record not yet written.
+    /// Digests of every field of the file (the geometry, the estimates,
+    /// the nominal machine, the UP limb, the workspace, the standard
+    /// deviations, noise and temperature a check judges by: every leaf but
+    /// the seal), by field name: [`MachineDescription::seal`] writes it,
+    /// [`MachineDescription::seal_check`] names a field edited since.
+    /// Absent only on a record not yet written.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seal: Option<std::collections::BTreeMap<String, String>>,
     /// External measurements fused with the UP limb's data (tracker,

@@ -1,22 +1,155 @@
-//! The seal of a calibration record: a digest of every field a later verb
-//! judges by, so that a hand edit of one (a larger `std_dev_mm` that would
-//! hide a real change from `tricept check`, a quieter `sensors` noise, a
-//! `temperature_c` moved to the campaign's) is refused when the file is
-//! loaded, naming the field.
+//! The seal of a calibration record: a digest of every field of the file,
+//! so that a hand edit of any of them is refused when the file is loaded,
+//! naming the field. A calibrated file is rebuilt from itself: the
+//! geometry every `--machine` commands with, the estimates and the nominal
+//! (or `relative_to_machine`) machine it is checked against, the UP limb
+//! and the workspace the check and the export work over, the standard
+//! deviations, noise and temperature a later check judges by. An edit of
+//! one of them alone is caught by the rebuild
+//! (`tricept_engine::check_calibration_record`); an edit of two that agree
+//! (a leg offset and its estimate moved together) only by the seal, which
+//! is why it covers every field, not a chosen list.
 //!
-//! Each field is digested (64-bit FNV-1a) over its compact JSON text as
-//! serde_json writes it: the shortest text that reads back to the same
-//! number, and, with serde_json's `float_roundtrip` parser (a workspace
-//! feature), read back to exactly the same bits. A file that was loaded
-//! and written again keeps its seal; any edited value breaks it.
+//! The fields are the file's leaves: every member of a JSON object whose
+//! value is not an object (a number, a string, an array), named by its
+//! path (`leg_offsets_mm`, `calibration.estimates_mm.dq2`,
+//! `calibration.nominal.up_limb.axis_skew_rad`; a key that is not a plain
+//! word is quoted: `calibration.effects["leg-lead.ppm1"].value`); only the
+//! seal itself is left out. Each is digested (64-bit FNV-1a) over a
+//! canonical text: compact JSON, object keys sorted, every number as the
+//! shortest text of its float64 value (so `0`, `0.0` and `0e0` are one
+//! value, as they are one number: a tool that rewrites the file without
+//! changing a value, as `jq .` does, keeps the seal; with serde_json's
+//! `float_roundtrip` parser, a workspace feature, the value is exactly the
+//! written one). A field added or removed is named as such.
+//!
+//! Files sealed before the seal covered every field (issue 45) carry the
+//! digests of a chosen list (the standard deviations, correlations, sensor
+//! offsets, temperature, effects, fit quality, noise, controller and
+//! promise); they are still checked against that list and loaded, and
+//! [`MachineDescription::seal_is_partial`] says so, for a warning.
 
 use std::collections::BTreeMap;
 
+use serde_json::Value;
+
 use super::MachineDescription;
 
-/// The fields a seal covers, as named in a machine file, and their values
-/// in a description (`None` when the description has no calibration).
-fn sealed_fields(d: &MachineDescription) -> Option<Vec<(&'static str, String)>> {
+/// The seal's entry that says it covers every field (its value names the
+/// scheme); absent in partial seals.
+const SCHEME: &str = "sealed";
+
+/// The value of [`SCHEME`].
+const EVERY_FIELD: &str = "every field";
+
+/// What a seal says of a description: [`MachineDescription::seal_check`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum SealCheck {
+    /// No calibration record: nothing to seal.
+    NoRecord,
+    /// A record without a seal.
+    Unsealed,
+    /// Every sealed field as it was written; `partial` for a seal written
+    /// before it covered every field.
+    Intact {
+        /// The seal covers a chosen list of fields, not every field.
+        partial: bool,
+    },
+    /// The fields whose value differs from the sealed one, by name (`
+    /// (added)` or ` (removed)` after a field the seal does not or no
+    /// longer finds).
+    Edited(Vec<String>),
+}
+
+/// Every leaf of the description as it is written, the seal left out:
+/// (name, canonical text).
+fn leaves(d: &MachineDescription) -> Vec<(String, String)> {
+    let mut value = serde_json::to_value(d).unwrap_or(Value::Null);
+    if let Some(c) = value.get_mut("calibration").and_then(Value::as_object_mut) {
+        c.remove("seal");
+    }
+    let mut out = Vec::new();
+    walk(&value, String::new(), &mut out);
+    out
+}
+
+/// The leaves under `value`, named from `path`.
+fn walk(value: &Value, path: String, out: &mut Vec<(String, String)>) {
+    match value {
+        Value::Object(map) => {
+            for (key, v) in map {
+                walk(v, child(&path, key), out);
+            }
+        }
+        leaf => {
+            let mut text = String::new();
+            canonical(leaf, &mut text);
+            out.push((path, text));
+        }
+    }
+}
+
+/// The path of member `key` under `path`: `path.key` for a plain word,
+/// `path["key"]` (JSON-quoted) for any other key.
+fn child(path: &str, key: &str) -> String {
+    let plain = !key.is_empty()
+        && key
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-');
+    match (plain, path.is_empty()) {
+        (true, true) => key.to_string(),
+        (true, false) => format!("{path}.{key}"),
+        (false, _) => format!("{path}[{}]", serde_json::to_string(key).unwrap_or_default()),
+    }
+}
+
+/// The canonical text of a value: compact, keys sorted, numbers by value.
+fn canonical(value: &Value, out: &mut String) {
+    match value {
+        Value::Number(n) => out.push_str(&number(n)),
+        Value::Array(items) => {
+            out.push('[');
+            for (i, v) in items.iter().enumerate() {
+                if i > 0 {
+                    out.push(',');
+                }
+                canonical(v, out);
+            }
+            out.push(']');
+        }
+        Value::Object(map) => {
+            let mut keys: Vec<&String> = map.keys().collect();
+            keys.sort();
+            out.push('{');
+            for (i, k) in keys.into_iter().enumerate() {
+                if i > 0 {
+                    out.push(',');
+                }
+                out.push_str(&serde_json::to_string(k).unwrap_or_default());
+                out.push(':');
+                canonical(&map[k], out);
+            }
+            out.push('}');
+        }
+        other => out.push_str(&serde_json::to_string(other).unwrap_or_default()),
+    }
+}
+
+/// A number's canonical text: the shortest text of its float64 value when
+/// that value is exact, the integer itself when it is not (beyond 2^53).
+fn number(n: &serde_json::Number) -> String {
+    let exact_integer = |f: f64| {
+        n.as_u64().is_none_or(|u| f as u64 == u) && n.as_i64().is_none_or(|i| f as i64 == i)
+    };
+    match n.as_f64() {
+        Some(f) if exact_integer(f) => format!("{f:?}"),
+        _ => n.to_string(),
+    }
+}
+
+/// The fields a partial seal (written before every field was sealed)
+/// covers, with their values' compact JSON text as it digested them.
+fn partial_fields(d: &MachineDescription) -> Option<Vec<(&'static str, String)>> {
     let c = d.calibration.as_deref()?;
     let mut fields = vec![
         ("calibration.std_dev_mm", text(&c.std_dev_mm)),
@@ -34,9 +167,6 @@ fn sealed_fields(d: &MachineDescription) -> Option<Vec<(&'static str, String)>> 
         ("sensors", text(&d.sensors)),
         ("controller", text(&d.controller)),
     ];
-    // The promise, in every record that has one or whose seal covers one
-    // (a file written before records carried it keeps its seal; one whose
-    // promise was removed by hand is refused).
     let sealed = |seal: &BTreeMap<String, String>| seal.contains_key(ACCURACY);
     if c.accuracy.is_some() || c.seal.as_ref().is_some_and(sealed) {
         fields.push((ACCURACY, text(&c.accuracy)));
@@ -44,7 +174,7 @@ fn sealed_fields(d: &MachineDescription) -> Option<Vec<(&'static str, String)>> 
     Some(fields)
 }
 
-/// The sealed name of the promise.
+/// The sealed name of the promise in a partial seal.
 const ACCURACY: &str = "calibration.accuracy";
 
 /// A value's compact JSON text (plain data cannot fail to serialise).
@@ -63,10 +193,10 @@ fn fnv1a(text: &str) -> String {
 }
 
 impl MachineDescription {
-    /// Seals the calibration record: digests of the fields a later verb
-    /// judges by ([`CalibrationRecord::seal`](super::CalibrationRecord::seal)).
-    /// Call it last, on the description as it is written; nothing happens
-    /// without a calibration.
+    /// Seals the calibration record: the digest of every field of the
+    /// file ([`CalibrationRecord::seal`](super::CalibrationRecord::seal),
+    /// the module docs). Call it last, on the description as it is
+    /// written; nothing happens without a calibration.
     ///
     /// # Example
     /// ```
@@ -76,35 +206,68 @@ impl MachineDescription {
     /// assert!(d.calibration.is_none());
     /// ```
     pub fn seal(&mut self) {
-        let Some(fields) = sealed_fields(self) else {
+        if self.calibration.is_none() {
             return;
-        };
-        let seal: BTreeMap<String, String> = fields
+        }
+        let mut seal: BTreeMap<String, String> = leaves(self)
             .into_iter()
-            .map(|(name, text)| (name.to_string(), fnv1a(&text)))
+            .map(|(name, text)| (name, fnv1a(&text)))
             .collect();
+        seal.insert(SCHEME.to_string(), EVERY_FIELD.to_string());
         if let Some(c) = self.calibration.as_mut() {
             c.seal = Some(seal);
         }
     }
 
-    /// The sealed fields whose value differs from the one the seal was
-    /// written with, by name (`calibration.std_dev_mm`, `sensors`, ...);
-    /// `Err(())` when the record has no seal. Empty for a description
-    /// without calibration.
-    #[allow(clippy::result_unit_err)]
-    pub fn edited_sealed_fields(&self) -> Result<Vec<&'static str>, ()> {
-        let Some(fields) = sealed_fields(self) else {
-            return Ok(Vec::new());
+    /// What the seal says of this description: no record, no seal, intact
+    /// (whole or partial), or the fields edited since it was written.
+    pub fn seal_check(&self) -> SealCheck {
+        let Some(c) = self.calibration.as_deref() else {
+            return SealCheck::NoRecord;
         };
-        let Some(seal) = self.calibration.as_ref().and_then(|c| c.seal.as_ref()) else {
-            return Err(());
+        let Some(seal) = c.seal.as_ref() else {
+            return SealCheck::Unsealed;
         };
-        Ok(fields
-            .into_iter()
-            .filter(|(name, text)| seal.get(*name) != Some(&fnv1a(text)))
-            .map(|(name, _)| name)
-            .collect())
+        let edited: Vec<String> = if seal.get(SCHEME).map(String::as_str) == Some(EVERY_FIELD) {
+            let now = leaves(self);
+            let mut edited: Vec<String> = now
+                .iter()
+                .filter_map(|(name, text)| match seal.get(name) {
+                    None => Some(format!("{name} (added)")),
+                    Some(d) if *d != fnv1a(text) => Some(name.clone()),
+                    Some(_) => None,
+                })
+                .collect();
+            edited.extend(
+                seal.keys()
+                    .filter(|k| *k != SCHEME && !now.iter().any(|(n, _)| n == *k))
+                    .map(|k| format!("{k} (removed)")),
+            );
+            edited
+        } else {
+            let fields = partial_fields(self).unwrap_or_default();
+            let edited: Vec<String> = fields
+                .into_iter()
+                .filter(|(name, text)| seal.get(*name) != Some(&fnv1a(text)))
+                .map(|(name, _)| name.to_string())
+                .collect();
+            if edited.is_empty() {
+                return SealCheck::Intact { partial: true };
+            }
+            edited
+        };
+        if edited.is_empty() {
+            SealCheck::Intact { partial: false }
+        } else {
+            SealCheck::Edited(edited)
+        }
+    }
+
+    /// Whether the record's seal covers a chosen list of fields only
+    /// (written before every field was sealed): an edit of the geometry
+    /// together with its estimates cannot be seen in such a file.
+    pub fn seal_is_partial(&self) -> bool {
+        self.seal_check() == SealCheck::Intact { partial: true }
     }
 }
 
@@ -120,10 +283,12 @@ mod tests {
         let nominal = MachineDescription::paper();
         let mut std_dev_mm = serde_json::Map::new();
         std_dev_mm.insert("dq1".into(), 0.0012345678901234567.into());
+        let mut estimates_mm = serde_json::Map::new();
+        estimates_mm.insert("dq1".into(), 0.0.into());
         d.calibration = Some(Box::new(CalibrationRecord {
             method: "identify".into(),
             parameter_set: "paper15".into(),
-            estimates_mm: serde_json::Map::new(),
+            estimates_mm,
             std_dev_mm,
             correlations: CorrelationsDescription::default(),
             effects: serde_json::Map::new(),
@@ -155,62 +320,128 @@ mod tests {
         d
     }
 
+    /// `d` with the JSON value at `pointer` replaced by `edit` of it, read
+    /// back as a file would be.
+    fn edited(
+        d: &MachineDescription,
+        pointer: &str,
+        edit: impl Fn(&Value) -> Value,
+    ) -> MachineDescription {
+        let mut v = serde_json::to_value(d).unwrap();
+        let target = v.pointer_mut(pointer).unwrap();
+        *target = edit(target);
+        serde_json::from_value(v).unwrap()
+    }
+
     #[test]
     fn a_sealed_record_read_back_from_its_text_keeps_its_seal() {
         let mut d = calibrated();
-        assert_eq!(d.edited_sealed_fields(), Err(()));
+        assert_eq!(d.seal_check(), SealCheck::Unsealed);
         d.seal();
-        assert_eq!(d.edited_sealed_fields(), Ok(vec![]));
+        assert_eq!(d.seal_check(), SealCheck::Intact { partial: false });
         // Awkward numbers, written and read back: the same bits.
         for x in [0.1 + 0.2, 1e-7 / 3.0, 796.5 / 7.0, 2.0f64.sqrt() * 1e5] {
             d.sensors.angle_noise_arcsec = x;
             d.seal();
             let back: MachineDescription = serde_json::from_str(&d.to_json()).unwrap();
             assert_eq!(back.sensors.angle_noise_arcsec.to_bits(), x.to_bits());
-            assert_eq!(back.edited_sealed_fields(), Ok(vec![]));
+            assert_eq!(back.seal_check(), SealCheck::Intact { partial: false });
         }
+        // A number rewritten without changing its value (`0.0` as `0`, as
+        // `jq .` writes it) keeps the seal.
+        let text = d.to_json().replace("\"dq1\": 0.0\n", "\"dq1\": 0\n");
+        assert!(text.contains("\"dq1\": 0\n"));
+        let back: MachineDescription = serde_json::from_str(&text).unwrap();
+        assert_eq!(back.seal_check(), SealCheck::Intact { partial: false });
     }
 
     #[test]
-    fn each_edited_field_is_named() {
+    fn each_edited_field_is_named_and_edits_that_agree_are_caught() {
         let mut d = calibrated();
         d.seal();
-        type Edit = fn(&mut MachineDescription);
-        let edits: [(&str, Edit); 5] = [
-            ("calibration.std_dev_mm", |d| {
-                let c = d.calibration.as_mut().unwrap();
-                c.std_dev_mm.insert("dq1".into(), 0.01.into());
-            }),
-            ("calibration.temperature_c", |d| {
-                d.calibration.as_mut().unwrap().temperature_c = Some(24.0)
-            }),
-            ("calibration.sensor_offsets", |d| {
-                d.calibration.as_mut().unwrap().sensor_offsets.s_mm += 1e-6
-            }),
-            ("sensors", |d| d.sensors.length_noise_um *= 1.5),
-            ("calibration.correlations", |d| {
-                d.calibration
-                    .as_mut()
-                    .unwrap()
-                    .correlations
-                    .names
-                    .push("x".into())
-            }),
+        let nudge = |v: &Value| Value::from(v.as_f64().unwrap() + 1e-6);
+        let cases: [(&str, &str); 7] = [
+            ("/calibration/std_dev_mm/dq1", "calibration.std_dev_mm.dq1"),
+            ("/calibration/temperature_c", "calibration.temperature_c"),
+            (
+                "/calibration/sensor_offsets/s_mm",
+                "calibration.sensor_offsets.s_mm",
+            ),
+            ("/sensors/length_noise_um", "sensors.length_noise_um"),
+            ("/workspace/radius_mm", "workspace.radius_mm"),
+            ("/up_limb/axis_skew_rad", "up_limb.axis_skew_rad"),
+            (
+                "/calibration/nominal/placement/circular/base_radius_mm",
+                "calibration.nominal.placement.circular.base_radius_mm",
+            ),
         ];
-        for (name, edit) in edits {
-            let mut e = d.clone();
-            edit(&mut e);
-            assert_eq!(e.edited_sealed_fields(), Ok(vec![name]), "{name}");
+        for (pointer, name) in cases {
+            let e = edited(&d, pointer, nudge);
+            assert_eq!(
+                e.seal_check(),
+                SealCheck::Edited(vec![name.into()]),
+                "{name}"
+            );
         }
+        // A leg offset and its estimate moved together: both named.
+        let mut e = edited(&d, "/calibration/estimates_mm/dq1", nudge);
+        e.leg_offsets_mm[0] += 1e-6;
+        assert_eq!(
+            e.seal_check(),
+            SealCheck::Edited(vec![
+                "leg_offsets_mm (added)".into(),
+                "calibration.estimates_mm.dq1".into()
+            ])
+        );
+        // Added and removed keys of a free-form map.
+        e = edited(
+            &d,
+            "/calibration/estimates_mm",
+            |_| serde_json::json!({"dq9": 0.0}),
+        );
+        assert_eq!(
+            e.seal_check(),
+            SealCheck::Edited(vec![
+                "calibration.estimates_mm.dq9 (added)".into(),
+                "calibration.estimates_mm.dq1 (removed)".into()
+            ])
+        );
+        // A key that is not a plain word is quoted.
+        e = edited(
+            &d,
+            "/calibration/std_dev_mm",
+            |_| serde_json::json!({"dq1": 0.0012345678901234567, "a.b": 1.0}),
+        );
+        assert_eq!(
+            e.seal_check(),
+            SealCheck::Edited(vec!["calibration.std_dev_mm[\"a.b\"] (added)".into()])
+        );
     }
 
     #[test]
-    fn the_promise_is_sealed_once_a_record_has_one() {
-        // A record without a promise (written before it existed) keeps its
-        // seal; one with a promise names it when it is edited or removed.
+    fn a_partial_seal_is_still_checked_and_said_to_be_partial() {
         let mut d = calibrated();
-        d.seal();
-        assert_eq!(d.edited_sealed_fields(), Ok(vec![]));
+        let legacy: BTreeMap<String, String> = partial_fields(&d)
+            .unwrap()
+            .into_iter()
+            .map(|(n, t)| (n.to_string(), fnv1a(&t)))
+            .collect();
+        d.calibration.as_mut().unwrap().seal = Some(legacy);
+        assert_eq!(d.seal_check(), SealCheck::Intact { partial: true });
+        assert!(d.seal_is_partial());
+        let e = edited(&d, "/sensors/length_noise_um", |v| {
+            Value::from(v.as_f64().unwrap() * 2.0)
+        });
+        assert_eq!(e.seal_check(), SealCheck::Edited(vec!["sensors".into()]));
+        // What the partial seal does not cover passes: the reason for the
+        // warning.
+        let e = edited(&d, "/workspace/radius_mm", |_| Value::from(300.0));
+        assert!(e.seal_is_partial());
+    }
+
+    #[test]
+    fn the_promise_is_sealed_and_its_removal_named() {
+        let mut d = calibrated();
         let c = d.calibration.as_mut().unwrap();
         c.accuracy = Some(crate::description::AccuracyRecord {
             rms_mm: 0.05,
@@ -219,25 +450,17 @@ mod tests {
             parts: serde_json::Map::new(),
         });
         d.seal();
-        assert_eq!(d.edited_sealed_fields(), Ok(vec![]));
-        let mut better = d.clone();
-        better
-            .calibration
-            .as_mut()
-            .unwrap()
-            .accuracy
-            .as_mut()
-            .unwrap()
-            .upper_mm = 0.05;
+        assert_eq!(d.seal_check(), SealCheck::Intact { partial: false });
+        let better = edited(&d, "/calibration/accuracy/upper_mm", |_| Value::from(0.05));
         assert_eq!(
-            better.edited_sealed_fields(),
-            Ok(vec!["calibration.accuracy"])
+            better.seal_check(),
+            SealCheck::Edited(vec!["calibration.accuracy.upper_mm".into()])
         );
         let mut removed = d.clone();
         removed.calibration.as_mut().unwrap().accuracy = None;
-        assert_eq!(
-            removed.edited_sealed_fields(),
-            Ok(vec!["calibration.accuracy"])
-        );
+        let SealCheck::Edited(fields) = removed.seal_check() else {
+            panic!("not refused");
+        };
+        assert!(fields.contains(&"calibration.accuracy.rms_mm (removed)".to_string()));
     }
 }
