@@ -61,6 +61,16 @@ pub struct ExportPlan {
 }
 
 impl ExportPlan {
+    /// Adds a warning to the summary (and to its file): what the caller
+    /// knows of the machine file (an old seal, say).
+    pub fn warn(&mut self, warning: String) {
+        self.summary.warnings.push(warning);
+        let json = summary_json(&self.summary);
+        if let Some((_, text)) = self.files.iter_mut().find(|(n, _)| n == SUMMARY_FILE) {
+            *text = json;
+        }
+    }
+
     /// Writes the files into `dir` as one set: into a new folder beside
     /// it, then put in its place in one step, so that `dir` holds the
     /// previous export or this one, whole, never a mixture (a folder
@@ -138,9 +148,13 @@ pub fn plan(
         limits,
         warnings,
     };
-    let json = serde_json::to_string_pretty(&summary).unwrap_or_default();
-    files.push((SUMMARY_FILE.to_string(), json + "\n"));
+    files.push((SUMMARY_FILE.to_string(), summary_json(&summary)));
     Ok(ExportPlan { summary, files })
+}
+
+/// The summary file's text.
+fn summary_json(summary: &ExportSummary) -> String {
+    serde_json::to_string_pretty(summary).unwrap_or_default() + "\n"
 }
 
 /// The three axes' names: `--axis-names` or the control's defaults, each

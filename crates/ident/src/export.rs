@@ -4,8 +4,6 @@
 
 use std::path::PathBuf;
 
-use tricept_kinematics::MachineDescription;
-
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::machine_input::MachineInput;
 
@@ -101,25 +99,29 @@ impl Export {
 /// when every axis is within the tolerance and the control's ranges,
 /// writes the files as one set (the previous export or this one, whole).
 pub fn export(request: ExportRequest) -> Result<Export, Error> {
-    let request = &request;
-    let Some(path) = request.machine.path() else {
+    let ExportRequest {
+        machine,
+        options,
+        out,
+    } = request;
+    let Some(path) = machine.path().map(std::path::Path::to_path_buf) else {
         return Err(Error::input(
             "export: a calibrated machine file is needed (a machine file written by `tricept identify --write-machine`)",
         ));
     };
     let source = path.display().to_string();
-    tricept_export::check_out(&request.out, path)?;
-    let description =
-        MachineDescription::from_file(path).map_err(|e| Error::from(e).in_file(&source))?;
-    tricept_engine::check_calibration_record(&description)
-        .map_err(|e| Error::from(e).in_file(&source))?;
-    let plan = tricept_export::plan(&description, &request.options).map_err(|e| match e {
+    tricept_export::check_out(&out, &path)?;
+    let loaded = machine.load()?;
+    let mut plan = tricept_export::plan(loaded.description(), &options).map_err(|e| match e {
         ExportError::NoCalibration => Error::from(e).in_file(&source),
         e => Error::from(e),
     })?;
+    for w in loaded.warnings() {
+        plan.warn(format!("{source}: {w}"));
+    }
     let written = plan.summary.within_tolerance;
     if written {
-        plan.write(&request.out)?;
+        plan.write(&out)?;
     }
     Ok(Export {
         summary: plan.summary,
