@@ -137,6 +137,7 @@ pub fn plan(
         within_tolerance: limits.is_empty(),
         limits,
         warnings,
+        calibration_digest: description.calibration_digest(),
     };
     let json = serde_json::to_string_pretty(&summary).unwrap_or_default();
     files.push((SUMMARY_FILE.to_string(), json + "\n"));
