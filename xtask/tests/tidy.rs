@@ -899,6 +899,7 @@ const DOOR_ROOT: &[&str] = &[
     "identifiability",
     "kinematics",
     "plan",
+    "report",
     "simulate",
     // The error and the exit codes.
     "EXIT_INADEQUATE",
