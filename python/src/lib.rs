@@ -515,6 +515,30 @@ fn check(
     Ok(CheckResult { inner })
 }
 
+/// Writes the page of a calibrated machine (`tricept report`); returns the
+/// verdict's JSON (`tricept report --json`) with the exit code.
+#[pyfunction]
+#[pyo3(signature = (machine, out, data=None, history=None, export=None))]
+fn report(
+    py: Python<'_>,
+    machine: PathBuf,
+    out: PathBuf,
+    data: Option<PathBuf>,
+    history: Option<PathBuf>,
+    export: Option<PathBuf>,
+) -> PyResult<String> {
+    let mut request = tricept_ident::report::ReportRequest::new(machine.as_path(), out);
+    request.data = data;
+    request.history = history;
+    request.export = export;
+    let r = py
+        .detach(|| tricept_ident::report::report(request))
+        .map_err(door_error)?;
+    let mut v = r.to_json();
+    v["exit_code"] = r.exit_code().into();
+    Ok(v.to_string())
+}
+
 /// Simulates a campaign (`tricept simulate`); returns the CSV text the CLI
 /// writes (the Python half turns it into column arrays).
 #[pyfunction]
@@ -562,6 +586,7 @@ fn _tricept(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(report, m)?)?;
     m.add("InputError", m.py().get_type::<InputError>())?;
     m.add("UntrustedError", m.py().get_type::<UntrustedError>())?;
     Ok(())

@@ -12,8 +12,8 @@ is converted once); the points are solved in parallel with the GIL released.
 Bad input raises :class:`InputError`, a :class:`ValueError`.
 
 The workflows are the CLI's, through the same library calls:
-:func:`identify` (``tricept identify``), :func:`diagnose`, :func:`check` and
-:func:`simulate`. Data are a CSV path or a mapping of the CSV's column names
+:func:`identify` (``tricept identify``), :func:`diagnose`, :func:`check`,
+:func:`simulate` and :func:`report`. Data are a CSV path or a mapping of the CSV's column names
 to 1-D arrays (a pandas DataFrame is one); results carry the CLI's exit
 code and ``to_json()`` is the CLI's ``--json``.
 """
@@ -38,6 +38,7 @@ __all__ = [
     "diagnose",
     "check",
     "simulate",
+    "report",
 ]
 
 Diagnosis = _tricept.Diagnosis
@@ -263,3 +264,31 @@ class Machine:
 
     def __repr__(self) -> str:
         return f"Machine({self.source!r})"
+
+
+def report(
+    machine: PathLike,
+    out: PathLike,
+    data: Optional[PathLike] = None,
+    history: Optional[PathLike] = None,
+    export: Optional[PathLike] = None,
+) -> dict:
+    """Writes the page of a calibrated machine file (``tricept report``):
+    one self-contained HTML file at ``out``, with the calibration's
+    campaign (``data``), its check history and its export folder when
+    given. Returns the verdict as ``tricept report --json`` prints it
+    (``out``, ``verdict``) with the CLI's ``exit_code`` (3 when the page
+    says not to trust the machine). Inputs of another calibration raise
+    :class:`InputError`."""
+    def path(p):
+        return None if p is None else os.fspath(p)
+
+    return json.loads(
+        _tricept.report(
+            os.fspath(machine),
+            os.fspath(out),
+            data=path(data),
+            history=path(history),
+            export=path(export),
+        )
+    )

@@ -132,9 +132,8 @@ fn slipped(path: &str, slip_mm: f64) -> Result<TrueErrors, Failure> {
         .position(|n| n == "dq2")
         .ok_or("no dq2 in paper15")?;
     values[k] += slip_mm;
-    let text = serde_json::to_string_pretty(&serde_json::Value::Object(
-        set.values_to_map(&values),
-    ))?;
+    let text =
+        serde_json::to_string_pretty(&serde_json::Value::Object(set.values_to_map(&values)))?;
     tricept_data::write_atomic(Path::new(path), |w| w.write_all(text.as_bytes()))?;
     Ok(TrueErrors::File(path.into()))
 }

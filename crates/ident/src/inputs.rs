@@ -110,7 +110,11 @@ impl LoadedMachine {
         let Some(c) = &self.description.calibration else {
             return Ok(None);
         };
-        let mut description = c.relative_to_machine.as_deref().unwrap_or(&c.nominal).clone();
+        let mut description = c
+            .relative_to_machine
+            .as_deref()
+            .unwrap_or(&c.nominal)
+            .clone();
         description.sensors = self.description.sensors.clone();
         let mut machine = description
             .build()

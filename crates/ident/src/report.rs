@@ -148,7 +148,12 @@ fn sources(request: &ReportRequest, loaded: &LoadedMachine) -> Result<Sources, E
         serde_json::to_value(description).unwrap_or(Value::Null),
     );
     let diagnosis = match &request.data {
-        Some(path) => Some(diagnosis(path, &record.data_sha256, &record.data_file, loaded)?),
+        Some(path) => Some(diagnosis(
+            path,
+            &record.data_sha256,
+            &record.data_file,
+            loaded,
+        )?),
         None => None,
     };
     let (history, trends) = match &request.history {

@@ -66,11 +66,9 @@ pub fn page(sources: &Sources) -> Result<Page, ReportError> {
         None => Vec::new(),
     };
     let export_named = match &sources.export {
-        Some(e) => identity::check_export(
-            digest,
-            e.file.as_deref().unwrap_or("the export"),
-            &e.json,
-        )?,
+        Some(e) => {
+            identity::check_export(digest, e.file.as_deref().unwrap_or("the export"), &e.json)?
+        }
         None => false,
     };
     let verdict = verdict::verdict(sources, &unnamed, export_named);

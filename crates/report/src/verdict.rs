@@ -20,8 +20,8 @@
 use serde::Serialize;
 use serde_json::Value;
 
-use crate::sources::Sources;
 use crate::json::{Lookup, token};
+use crate::sources::Sources;
 
 /// How far the machine can be trusted, worst last.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
@@ -60,7 +60,9 @@ impl Level {
         match self {
             Level::Trusted => "nothing on record speaks against this calibration",
             Level::Caution => "usable; read the notes below first",
-            Level::DoNotTrust => "do not rely on this calibration: find why (below) or calibrate again",
+            Level::DoNotTrust => {
+                "do not rely on this calibration: find why (below) or calibrate again"
+            }
         }
     }
 }
@@ -155,8 +157,7 @@ pub fn verdict(sources: &Sources, unnamed: &[usize], export_named: bool) -> Verd
             &["/calibration/adequate", "/calibration/chi2_per_dof"],
         );
     }
-    if flag("/calibration/converged") == Some(true) && flag("/calibration/adequate") == Some(true)
-    {
+    if flag("/calibration/converged") == Some(true) && flag("/calibration/adequate") == Some(true) {
         reason(
             Level::Trusted,
             "the calibration's fit converged and its model explains its data to the stated noise",
@@ -197,14 +198,16 @@ pub fn verdict(sources: &Sources, unnamed: &[usize], export_named: bool) -> Verd
                 Level::Caution,
                 "the last check found the readings noisier than stated (not a change of the machine): state the noise or service the sensors",
             ),
-            "unchanged" => (
-                Level::Trusted,
-                "the last check found the machine unchanged",
+            "unchanged" => (Level::Trusted, "the last check found the machine unchanged"),
+            _ => (
+                Level::Caution,
+                "the last check's verdict is not one tricept writes",
             ),
-            _ => (Level::Caution, "the last check's verdict is not one tricept writes"),
         };
         let mut paths = vec![p("verdict"), p("time")];
-        if l.get("history", &p("most_likely")).is_some_and(|v| !v.is_null()) {
+        if l.get("history", &p("most_likely"))
+            .is_some_and(|v| !v.is_null())
+        {
             paths.push(p("most_likely"));
         }
         let refs: Vec<&str> = paths.iter().map(String::as_str).collect();
@@ -229,7 +232,7 @@ pub fn verdict(sources: &Sources, unnamed: &[usize], export_named: bool) -> Verd
     if sources.diagnosis.is_some() {
         diagnosis_reasons(&l, &mut reason);
     }
-    reasons.sort_by(|a, b| b.level.cmp(&a.level));
+    reasons.sort_by_key(|r| std::cmp::Reverse(r.level));
     let level = reasons.first().map_or(Level::Trusted, |r| r.level);
     Verdict {
         level,
@@ -242,7 +245,10 @@ pub fn verdict(sources: &Sources, unnamed: &[usize], export_named: bool) -> Verd
 /// What the campaign's diagnosis adds: a remainder, or causes a geometric
 /// file does not deploy.
 fn diagnosis_reasons(l: &Lookup<'_>, reason: &mut impl FnMut(Level, &str, &str, &[&str])) {
-    if l.get("diagnosis", "/final_adequate").and_then(Value::as_bool) == Some(false) {
+    if l.get("diagnosis", "/final_adequate")
+        .and_then(Value::as_bool)
+        == Some(false)
+    {
         reason(
             Level::Caution,
             "the campaign's diagnosis leaves a misfit no named cause explains (its verdict and remainder below)",

@@ -1,7 +1,8 @@
 //! The `tricept` binary end to end, one test binary: bad inputs, the check,
 //! a closed stdout, the embedded docs, the exit-code table, the fused
-//! identification, what writing survives, and a calibration a user can
-//! trust (one module per subject; what they share in `support`).
+//! identification, what writing survives, the report page, and a
+//! calibration a user can trust (one module per subject; what they share
+//! in `support`).
 
 mod bad_inputs;
 mod check;
@@ -13,5 +14,6 @@ mod fusion;
 mod one_exit_code;
 mod outputs;
 mod relied_on;
+mod report;
 mod support;
 mod trust;

@@ -20,7 +20,9 @@ pub fn section(l: &Lookup<'_>, sources: &Sources) -> String {
         return wrap(
             "checks",
             TITLE,
-            &p("No check history given: <code>tricept check --machine CAL.json --data TODAY.csv --history CHECKS.jsonl</code> keeps one, and <code>--history CHECKS.jsonl</code> shows it here."),
+            &p(
+                "No check history given: <code>tricept check --machine CAL.json --data TODAY.csv --history CHECKS.jsonl</code> keeps one, and <code>--history CHECKS.jsonl</code> shows it here.",
+            ),
         );
     }
     let mut s = p(&format!(
@@ -101,7 +103,11 @@ pub fn section(l: &Lookup<'_>, sources: &Sources) -> String {
                 "-".into()
             };
             vec![
-                format!("{}<br>{}", l.text(h, &q("time")), l.text(h, &q("data_file"))),
+                format!(
+                    "{}<br>{}",
+                    l.text(h, &q("time")),
+                    l.text(h, &q("data_file"))
+                ),
                 l.text(h, &q("verdict")),
                 named,
                 format!(
@@ -209,7 +215,11 @@ fn trend_plot(l: &Lookup<'_>, k: usize) -> String {
     plot.segment((xlo, 0.0), (xhi, 0.0), "ref");
     for (j, ((d, v), s)) in days.iter().zip(&values).zip(&sd).enumerate() {
         let class = if outside.contains(&j) { "bad" } else { "s1" };
-        plot.segment((*d, v - 2.0 * s), (*d, v + 2.0 * s), &format!("{class} whisker"));
+        plot.segment(
+            (*d, v - 2.0 * s),
+            (*d, v + 2.0 * s),
+            &format!("{class} whisker"),
+        );
         plot.point(*d, *v, 3.2, class);
     }
     plot.finish()

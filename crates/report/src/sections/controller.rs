@@ -17,7 +17,9 @@ pub fn section(l: &Lookup<'_>, sources: &Sources) -> String {
         return wrap(
             "controller",
             TITLE,
-            &p("No export given: <code>tricept export --machine CAL.json --out DIR</code> writes the control's files, and <code>--export DIR</code> shows them here."),
+            &p(
+                "No export given: <code>tricept export --machine CAL.json --out DIR</code> writes the control's files, and <code>--export DIR</code> shows them here.",
+            ),
         );
     };
     let e = "export";
@@ -26,10 +28,10 @@ pub fn section(l: &Lookup<'_>, sources: &Sources) -> String {
         .collect();
     let mut s = p(&format!(
         "{}: the {} files for the {} control, written as one set: {}.",
-        export
-            .file
-            .as_deref()
-            .map_or(String::new(), |f| format!("<code>{}</code>", crate::json::escape(f))),
+        export.file.as_deref().map_or(String::new(), |f| format!(
+            "<code>{}</code>",
+            crate::json::escape(f)
+        )),
         l.text(e, "/controller"),
         l.text(e, "/control"),
         files.join(", ")
@@ -118,7 +120,10 @@ fn format_errors(l: &Lookup<'_>, n: usize) -> String {
         .map(|k| l.f64(e, &format!("/axes/{k}/format_error_um")))
         .collect();
     let tolerance = l.f64(e, "/tolerance_um");
-    let (_, hi) = range(errors.iter().flatten().copied(), &[0.0, tolerance.unwrap_or(0.0)]);
+    let (_, hi) = range(
+        errors.iter().flatten().copied(),
+        &[0.0, tolerance.unwrap_or(0.0)],
+    );
     let rows = n as f64;
     let mut plot = Plot::new(
         "fig-format-errors",

@@ -147,7 +147,9 @@ fn tables(l: &Lookup<'_>) -> String {
     let m = "machine";
     let n = l.array(m, "/leg_effects/tables").len();
     if n == 0 {
-        return p("Per-leg compensation tables: none (the file deploys no pitch, curvature or worn-segment term).");
+        return p(
+            "Per-leg compensation tables: none (the file deploys no pitch, curvature or worn-segment term).",
+        );
     }
     let mut lines = Vec::new();
     for k in 0..n {
@@ -177,7 +179,12 @@ fn tables(l: &Lookup<'_>) -> String {
     // The middle tenth of the stroke, where a pitch error's period shows.
     let (mid, half) = (0.5 * (xlo + xhi), 0.05 * (xhi - xlo));
     let plots = [
-        table_plot(&lines, "fig-leg-tables", "along the whole stroke", (xlo, xhi)),
+        table_plot(
+            &lines,
+            "fig-leg-tables",
+            "along the whole stroke",
+            (xlo, xhi),
+        ),
         table_plot(
             &lines,
             "fig-leg-tables-detail",
@@ -218,7 +225,9 @@ fn table_plot(
 ) -> String {
     let inside = |q: &&(f64, f64)| q.0 >= window.0 && q.0 <= window.1;
     let (ylo, yhi) = range(
-        lines.iter().flat_map(|(_, p)| p.iter().filter(inside).map(|q| q.1)),
+        lines
+            .iter()
+            .flat_map(|(_, p)| p.iter().filter(inside).map(|q| q.1)),
         &[0.0],
     );
     let mut plot = Plot::new(
@@ -356,7 +365,9 @@ fn controller(l: &Lookup<'_>) -> String {
         ));
     }
     if items.is_empty() {
-        return p("Controller parameters and static leg effects: none (no backlash, thermal growth, lead or compliance deployed).");
+        return p(
+            "Controller parameters and static leg effects: none (no backlash, thermal growth, lead or compliance deployed).",
+        );
     }
     let mut s = String::from("<h3>Controller parameters and static leg effects</h3>\n");
     s.push_str(&list(&items));
@@ -367,7 +378,9 @@ fn controller(l: &Lookup<'_>) -> String {
 fn gains(l: &Lookup<'_>, sources: &Sources) -> String {
     let d = "diagnosis";
     if sources.diagnosis.is_none() {
-        return p("The gain of each deployed term needs the campaign: give <code>--data CAMPAIGN.csv</code>.");
+        return p(
+            "The gain of each deployed term needs the campaign: give <code>--data CAMPAIGN.csv</code>.",
+        );
     }
     let n = l.array(d, "/model_terms").len();
     let mut s = String::from("<h3>The gain of each term</h3>\n");

@@ -25,7 +25,11 @@ pub fn header(l: &Lookup<'_>, sources: &Sources, verdict: &Verdict) -> String {
             .map(|v| {
                 let key = v.path.rsplit('/').next().unwrap_or_default();
                 let key = key.replace("~1", "/").replace("~0", "~");
-                format!("{} {}", escape(&key), l.show(&v.src, &v.path, Digits::Sig(4)))
+                format!(
+                    "{} {}",
+                    escape(&key),
+                    l.show(&v.src, &v.path, Digits::Sig(4))
+                )
             })
             .collect();
         let values = if values.is_empty() {

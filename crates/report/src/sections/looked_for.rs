@@ -62,7 +62,10 @@ pub fn section(l: &Lookup<'_>, sources: &Sources) -> String {
         s.push_str(&list(&causes));
     }
     for (key, what) in [
-        ("rejected", "Fits rejected (physically implausible, or no better on held-out poses):"),
+        (
+            "rejected",
+            "Fits rejected (physically implausible, or no better on held-out poses):",
+        ),
         ("aliases", "What this campaign cannot tell apart:"),
         ("limitations", "What this campaign could not show:"),
     ] {

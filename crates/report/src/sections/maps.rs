@@ -7,7 +7,7 @@
 use crate::html::{figure, p, section as wrap, table};
 use crate::json::{Digits, Lookup, number};
 use crate::sources::Sources;
-use crate::svg::{Plot, range};
+use crate::svg::{Plot, cividis, range};
 
 /// The section.
 pub fn section(l: &Lookup<'_>, sources: &Sources) -> String {
@@ -62,7 +62,14 @@ pub fn section(l: &Lookup<'_>, sources: &Sources) -> String {
         })
         .collect();
     s.push_str(&table(
-        &["plane z, mm", "points", "max, mm", "mean, mm", "rms, mm", "min, mm"],
+        &[
+            "plane z, mm",
+            "points",
+            "max, mm",
+            "mean, mm",
+            "rms, mm",
+            "min, mm",
+        ],
         &[true; 6],
         &rows,
     ));
@@ -81,7 +88,9 @@ fn heat_map(l: &Lookup<'_>, id: &str, scale_top: f64) -> String {
         .filter_map(serde_json::Value::as_f64)
         .fold(0.0, |a: f64, v| a.max(v.abs()))
         + 0.5 * spacing;
-    let z = l.f64(id, "/plane_z_mm").map_or("-".into(), |z| number(z, Digits::Sig(4)));
+    let z = l
+        .f64(id, "/plane_z_mm")
+        .map_or("-".into(), |z| number(z, Digits::Sig(4)));
     let mut plot = Plot::new(
         &format!("fig-{id}"),
         &format!("Platform error before calibration at z = {z} mm"),
@@ -95,18 +104,22 @@ fn heat_map(l: &Lookup<'_>, id: &str, scale_top: f64) -> String {
         let (Some(x), Some(y), Some(v)) = (x.as_f64(), y.as_f64(), v.as_f64()) else {
             continue;
         };
-        let c = tricept_plot::colour(v / scale_top);
         let h = 0.5 * spacing;
         plot.rect(
             (x - h, y - h),
             (x + h, y + h),
             "cell",
-            Some(&format!("#{:02x}{:02x}{:02x}", c.0, c.1, c.2)),
+            Some(&cividis(v / scale_top)),
         );
     }
     plot.axes("x, mm", "y, mm", (5, 5));
     let (x0, x1) = plot.x_edges();
-    plot.label_px((0.5 * (x0 + x1), 16.0), &format!("z = {z} mm"), "middle", "axis");
+    plot.label_px(
+        (0.5 * (x0 + x1), 16.0),
+        &format!("z = {z} mm"),
+        "middle",
+        "axis",
+    );
     plot.finish()
 }
 
@@ -124,12 +137,11 @@ fn colour_bar(l: &Lookup<'_>, top: f64) -> String {
     let n = 64;
     for k in 0..n {
         let (a, b) = (top * k as f64 / n as f64, top * (k + 1) as f64 / n as f64);
-        let c = tricept_plot::colour((k as f64 + 0.5) / n as f64);
         plot.rect(
             (a, 0.0),
             (b, 1.0),
             "cell",
-            Some(&format!("#{:02x}{:02x}{:02x}", c.0, c.1, c.2)),
+            Some(&cividis((k as f64 + 0.5) / n as f64)),
         );
     }
     plot.axes("platform error, mm", "", (6, 0));

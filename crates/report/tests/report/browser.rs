@@ -39,7 +39,14 @@ fn the_page_in_a_real_browser() {
             magnitude_mm: 0.25,
             seed: 4,
         };
-        let data = campaign(&dir, &format!("day{day}.csv"), truth, &[PITCH], 20 + day, 1.0);
+        let data = campaign(
+            &dir,
+            &format!("day{day}.csv"),
+            truth,
+            &[PITCH],
+            20 + day,
+            1.0,
+        );
         check_into(&machine, &data, &history);
     }
     let export = export_of(&machine, &dir, "cnc");
@@ -51,8 +58,15 @@ fn the_page_in_a_real_browser() {
     expected.insert("history".into(), history_lines(&history));
     expected.insert("trends".into(), trends(&history));
     expected.insert("export".into(), read_json(&export.join("export.json")));
-    let d = diagnose(DiagnoseRequest::new(MachineInput::default(), data.as_path())).unwrap();
-    expected.insert("diagnosis".into(), serde_json::from_str(&d.to_json()).unwrap());
+    let d = diagnose(DiagnoseRequest::new(
+        MachineInput::default(),
+        data.as_path(),
+    ))
+    .unwrap();
+    expected.insert(
+        "diagnosis".into(),
+        serde_json::from_str(&d.to_json()).unwrap(),
+    );
     expected.insert("verdict".into(), report.verdict().to_json());
     // The Table 2 fixture identified, alone.
     let table2 = table2_machine(&dir);
@@ -68,7 +82,12 @@ fn the_page_in_a_real_browser() {
     check_page(&session, &full, &machine, Some(&expected));
     check_page(&session, &alone, &table2, Some(&expected2));
     let sample = fixture("docs/report-sample.html");
-    check_page(&session, &sample, &fixture("fixtures/report/table2.json"), None);
+    check_page(
+        &session,
+        &sample,
+        &fixture("fixtures/report/table2.json"),
+        None,
+    );
     eprintln!(
         "browser checks of 3 pages: {:.1} s",
         started.elapsed().as_secs_f64()
@@ -111,7 +130,8 @@ fn check_page(
         .filter(|e| e["level"] == "SEVERE" || e["level"] == "WARNING")
         .collect();
     assert!(console.is_empty(), "{name}: console: {console:?}");
-    let fetched = session.script("return performance.getEntriesByType('resource').map(e => e.name)");
+    let fetched =
+        session.script("return performance.getEntriesByType('resource').map(e => e.name)");
     assert_eq!(fetched, Value::Array(vec![]), "{name}: fetched resources");
     for width in [1280, 390] {
         session.window(width, 900);
@@ -133,8 +153,16 @@ fn check_page(
                 "{name} at {width} px: an empty plot: {p}"
             );
         }
-        assert_eq!(layout["overflow"], Value::Array(vec![]), "{name} at {width} px");
-        assert_eq!(layout["svgText"], Value::Array(vec![]), "{name} at {width} px");
+        assert_eq!(
+            layout["overflow"],
+            Value::Array(vec![]),
+            "{name} at {width} px"
+        );
+        assert_eq!(
+            layout["svgText"],
+            Value::Array(vec![]),
+            "{name} at {width} px"
+        );
     }
     session.window(1280, 900);
     accessibility(session, &name);
@@ -152,7 +180,11 @@ fn check_page(
     }
     if let Some(expected) = expected {
         for (id, want) in expected {
-            assert_eq!(sources.get(id), Some(want), "{name}: the page's `{id}` block");
+            assert_eq!(
+                sources.get(id),
+                Some(want),
+                "{name}: the page's `{id}` block"
+            );
         }
         for (id, block) in &sources {
             if id.starts_with("map-") {
@@ -280,13 +312,23 @@ fn accessibility(session: &Session<'_>, name: &str) {
         .map(|v| v.as_u64().unwrap())
         .collect();
     assert_eq!(levels.first(), Some(&1), "{name}: the first heading");
-    assert_eq!(levels.iter().filter(|l| **l == 1).count(), 1, "{name}: one h1");
+    assert_eq!(
+        levels.iter().filter(|l| **l == 1).count(),
+        1,
+        "{name}: one h1"
+    );
     for w in levels.windows(2) {
-        assert!(w[1] <= w[0] + 1, "{name}: a heading skips a level: {levels:?}");
+        assert!(
+            w[1] <= w[0] + 1,
+            "{name}: a heading skips a level: {levels:?}"
+        );
     }
     let figures = session.script(FIGURES);
     for f in figures.as_array().unwrap() {
-        assert!(f["plots"].as_u64().unwrap() >= 1, "{name}: a figure without a plot: {f}");
+        assert!(
+            f["plots"].as_u64().unwrap() >= 1,
+            "{name}: a figure without a plot: {f}"
+        );
         assert!(
             f["caption"].as_str().unwrap().len() > 20,
             "{name}: a figure without a caption: {f}"
@@ -314,7 +356,10 @@ fn accessibility(session: &Session<'_>, name: &str) {
         seen.push(c["level"].as_str().unwrap().to_string());
     }
     for level in ["trusted", "caution", "do-not-trust"] {
-        assert!(seen.iter().any(|s| s == level), "{name}: no {level} colours shown");
+        assert!(
+            seen.iter().any(|s| s == level),
+            "{name}: no {level} colours shown"
+        );
     }
 }
 
@@ -346,9 +391,8 @@ fn contrast(a: [f64; 3], b: [f64; 3]) -> f64 {
             ((s + 0.055) / 1.055).powf(2.4)
         }
     };
-    let luminance = |c: [f64; 3]| {
-        0.2126 * channel(c[0]) + 0.7152 * channel(c[1]) + 0.0722 * channel(c[2])
-    };
+    let luminance =
+        |c: [f64; 3]| 0.2126 * channel(c[0]) + 0.7152 * channel(c[1]) + 0.0722 * channel(c[2]);
     let (la, lb) = (luminance(a), luminance(b));
     (la.max(lb) + 0.05) / (la.min(lb) + 0.05)
 }
@@ -372,7 +416,10 @@ fn pdf(bytes: &[u8], sections: usize, name: &str) {
         pages > sections,
         "{name}: {pages} pages for {sections} sections"
     );
-    let boxes: Vec<&str> = text.match_indices("/MediaBox [").map(|(i, _)| &text[i..]).collect();
+    let boxes: Vec<&str> = text
+        .match_indices("/MediaBox [")
+        .map(|(i, _)| &text[i..])
+        .collect();
     assert!(!boxes.is_empty(), "{name}: no page size");
     for b in boxes {
         let inner = &b["/MediaBox [".len()..b.find(']').unwrap()];

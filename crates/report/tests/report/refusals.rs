@@ -62,7 +62,14 @@ fn inputs_of_another_calibration_are_refused_naming_the_file() {
     );
     // ... and one whose later check is of another calibration.
     let mixed = dir.join("mixed.jsonl");
-    let day2 = campaign(&dir, "day2.csv", tricept_ident::advanced::TrueErrors::Table2, &[], 5, 1.0);
+    let day2 = campaign(
+        &dir,
+        "day2.csv",
+        tricept_ident::advanced::TrueErrors::Table2,
+        &[],
+        5,
+        1.0,
+    );
     check_into(&table2, &day2, &mixed);
     check_into(&pitch, &day, &mixed);
     refused(
@@ -87,7 +94,14 @@ fn inputs_of_another_calibration_are_refused_naming_the_file() {
     let table2_history = dir.join("t2.jsonl");
     check_into(&table2, &day2, &table2_history);
     let data = fixture("fixtures/data/table2-grid-seed1.csv");
-    page(&table2, Some(&data), Some(&table2_history), Some(&own), &out).unwrap();
+    page(
+        &table2,
+        Some(&data),
+        Some(&table2_history),
+        Some(&own),
+        &out,
+    )
+    .unwrap();
     assert!(out.is_file());
 }
 
@@ -96,23 +110,50 @@ fn lines_and_exports_written_before_they_named_a_calibration_are_read_with_a_cau
     let dir = Dir::new("unnamed");
     let table2 = table2_machine(&dir);
     let history = dir.join("checks.jsonl");
-    let day = campaign(&dir, "day.csv", tricept_ident::advanced::TrueErrors::Table2, &[], 7, 1.0);
+    let day = campaign(
+        &dir,
+        "day.csv",
+        tricept_ident::advanced::TrueErrors::Table2,
+        &[],
+        7,
+        1.0,
+    );
     check_into(&table2, &day, &history);
     // As a line of a history written before lines named their calibration.
-    let line: Value = serde_json::from_str(std::fs::read_to_string(&history).unwrap().trim()).unwrap();
+    let line: Value =
+        serde_json::from_str(std::fs::read_to_string(&history).unwrap().trim()).unwrap();
     let mut old = line.clone();
-    old.as_object_mut().unwrap().remove("calibration_digest").unwrap();
+    old.as_object_mut()
+        .unwrap()
+        .remove("calibration_digest")
+        .unwrap();
     std::fs::write(&history, format!("{old}\n{line}\n")).unwrap();
     let cnc = export_of(&table2, &dir, "cnc");
     let summary = cnc.join("export.json");
     let mut s = read_json(&summary);
-    s.as_object_mut().unwrap().remove("calibration_digest").unwrap();
+    s.as_object_mut()
+        .unwrap()
+        .remove("calibration_digest")
+        .unwrap();
     std::fs::write(&summary, s.to_string()).unwrap();
     let out = dir.join("page.html");
     let r = page(&table2, None, Some(&history), Some(&cnc), &out).unwrap();
-    let says: Vec<&str> = r.verdict().reasons.iter().map(|x| x.says.as_str()).collect();
-    assert!(says.iter().any(|s| s.contains("history's checks from this one on name no calibration")), "{says:?}");
-    assert!(says.iter().any(|s| s.contains("the export names no calibration")), "{says:?}");
+    let says: Vec<&str> = r
+        .verdict()
+        .reasons
+        .iter()
+        .map(|x| x.says.as_str())
+        .collect();
+    assert!(
+        says.iter()
+            .any(|s| s.contains("history's checks from this one on name no calibration")),
+        "{says:?}"
+    );
+    assert!(
+        says.iter()
+            .any(|s| s.contains("the export names no calibration")),
+        "{says:?}"
+    );
     assert!(r.verdict().level >= tricept_ident::report::Level::Caution);
     // The reason points at the first unnamed check.
     let html = std::fs::read_to_string(&out).unwrap();

@@ -97,8 +97,8 @@ pub fn campaign(
 ) -> PathBuf {
     let mut r = SimulateRequest::new(MachineInput::default());
     r.truth = truth;
-    r.truth_effects = parse_effects(&effects.iter().map(|e| e.to_string()).collect::<Vec<_>>())
-        .unwrap();
+    r.truth_effects =
+        parse_effects(&effects.iter().map(|e| e.to_string()).collect::<Vec<_>>()).unwrap();
     r.poses = format!("random:20,{seed}").parse::<Poses>().unwrap();
     r.seed = seed;
     r.noise_factor = noise_factor;

@@ -27,14 +27,20 @@ fn a_slipped_leg_found_by_the_last_check_turns_the_page_red() {
     assert_eq!(r.verdict().level, Level::DoNotTrust);
     assert_eq!(r.exit_code(), EXIT_INADEQUATE);
     let first = &r.verdict().reasons[0];
-    assert_eq!(first.says, "the last check found the machine changed since its calibration");
+    assert_eq!(
+        first.says,
+        "the last check found the machine changed since its calibration"
+    );
     let paths: Vec<&str> = first.shows.iter().map(|s| s.path.as_str()).collect();
     assert_eq!(paths, ["/1/verdict", "/1/time", "/1/most_likely"]);
     let html = std::fs::read_to_string(&out).unwrap();
     assert!(html.contains("<div class=\"verdict\" id=\"verdict\" data-level=\"do-not-trust\">"));
     assert!(html.contains(">DO NOT TRUST</span>"));
     // The change the check named is on the page, by its pointer.
-    assert!(html.contains("data-src=\"history\" data-path=\"/1/most_likely\">leg 2<"), "leg 2 is not named");
+    assert!(
+        html.contains("data-src=\"history\" data-path=\"/1/most_likely\">leg 2<"),
+        "leg 2 is not named"
+    );
 }
 
 #[test]
@@ -62,10 +68,18 @@ fn a_forced_calibration_is_not_trusted() {
     let r = page(&machine, Some(&data), None, None, &dir.join("page.html")).unwrap();
     assert_eq!(r.verdict().level, Level::DoNotTrust);
     assert_eq!(r.exit_code(), EXIT_INADEQUATE);
-    let says: Vec<&str> = r.verdict().reasons.iter().map(|x| x.says.as_str()).collect();
+    let says: Vec<&str> = r
+        .verdict()
+        .reasons
+        .iter()
+        .map(|x| x.says.as_str())
+        .collect();
     assert!(says.iter().any(|s| s.contains("--force")), "{says:?}");
     // The campaign's diagnosis names the pitch error the file lacks.
-    assert!(says.iter().any(|s| s.contains("does not deploy")), "{says:?}");
+    assert!(
+        says.iter().any(|s| s.contains("does not deploy")),
+        "{says:?}"
+    );
 }
 
 #[test]
@@ -74,12 +88,26 @@ fn a_clean_calibration_with_unchanged_checks_and_its_export_is_trusted() {
     let machine = table2_machine(&dir);
     let history = dir.join("checks.jsonl");
     for (k, seed) in [14u64, 15].into_iter().enumerate() {
-        let day = campaign(&dir, &format!("day{k}.csv"), TrueErrors::Table2, &[], seed, 1.0);
+        let day = campaign(
+            &dir,
+            &format!("day{k}.csv"),
+            TrueErrors::Table2,
+            &[],
+            seed,
+            1.0,
+        );
         assert_eq!(check_into(&machine, &day, &history), "unchanged");
     }
     let cnc = export_of(&machine, &dir, "cnc");
     let data = fixture("fixtures/data/table2-grid-seed1.csv");
-    let r = page(&machine, Some(&data), Some(&history), Some(&cnc), &dir.join("page.html")).unwrap();
+    let r = page(
+        &machine,
+        Some(&data),
+        Some(&history),
+        Some(&cnc),
+        &dir.join("page.html"),
+    )
+    .unwrap();
     assert_eq!(r.verdict().level, Level::Trusted, "{:?}", r.verdict());
     assert_eq!(r.exit_code(), EXIT_OK);
     assert!(r.text().starts_with("report written to "));

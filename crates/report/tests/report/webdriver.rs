@@ -76,7 +76,10 @@ fn exchange(port: u16, method: &str, path: &str, body: Option<&Value>) -> (u16, 
             break i;
         }
         let n = stream.read(&mut buf).unwrap();
-        assert!(n > 0, "{method} {path}: the connection closed before a response");
+        assert!(
+            n > 0,
+            "{method} {path}: the connection closed before a response"
+        );
         raw.extend_from_slice(&buf[..n]);
     };
     let head = String::from_utf8_lossy(&raw[..split]).to_ascii_lowercase();
@@ -340,5 +343,8 @@ fn base64_decodes_the_rfc_4648_test_vectors() {
 
 #[test]
 fn chunked_bodies_are_joined() {
-    assert_eq!(dechunk(b"4\r\nWiki\r\n5\r\npedia\r\n0\r\n\r\n"), b"Wikipedia");
+    assert_eq!(
+        dechunk(b"4\r\nWiki\r\n5\r\npedia\r\n0\r\n\r\n"),
+        b"Wikipedia"
+    );
 }
