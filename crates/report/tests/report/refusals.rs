@@ -138,12 +138,7 @@ fn lines_and_exports_written_before_they_named_a_calibration_are_read_with_a_cau
     std::fs::write(&summary, s.to_string()).unwrap();
     let out = dir.join("page.html");
     let r = page(&table2, None, Some(&history), Some(&cnc), &out).unwrap();
-    let says: Vec<&str> = r
-        .verdict()
-        .reasons
-        .iter()
-        .map(|x| x.says.as_str())
-        .collect();
+    let says = crate::support::reasons(&r);
     assert!(
         says.iter()
             .any(|s| s.contains("history's checks from this one on name no calibration")),

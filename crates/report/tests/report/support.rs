@@ -149,3 +149,8 @@ pub fn page(
 pub fn read_json(path: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
+
+/// What each reason of a page's verdict says.
+pub fn reasons(r: &Report) -> Vec<String> {
+    r.verdict().reasons.iter().map(|x| x.says.clone()).collect()
+}

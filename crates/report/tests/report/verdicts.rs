@@ -68,12 +68,7 @@ fn a_forced_calibration_is_not_trusted() {
     let r = page(&machine, Some(&data), None, None, &dir.join("page.html")).unwrap();
     assert_eq!(r.verdict().level, Level::DoNotTrust);
     assert_eq!(r.exit_code(), EXIT_INADEQUATE);
-    let says: Vec<&str> = r
-        .verdict()
-        .reasons
-        .iter()
-        .map(|x| x.says.as_str())
-        .collect();
+    let says = crate::support::reasons(&r);
     assert!(says.iter().any(|s| s.contains("--force")), "{says:?}");
     // The campaign's diagnosis names the pitch error the file lacks.
     assert!(
