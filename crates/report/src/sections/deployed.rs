@@ -283,7 +283,7 @@ fn effects(l: &Lookup<'_>) -> String {
             units.push(u);
         }
     }
-    let mut plots = Vec::new();
+    let mut s = String::new();
     for (k, unit) in units.iter().enumerate() {
         let rows: Vec<(String, Option<f64>, Option<f64>)> = names
             .iter()
@@ -295,28 +295,33 @@ fn effects(l: &Lookup<'_>) -> String {
                     l.f64(m, &format!("{path}/std_dev")),
                 )
             })
+            .filter(|r| r.2.is_some())
             .collect();
-        let rows: Vec<_> = rows.into_iter().filter(|r| r.2.is_some()).collect();
         if rows.is_empty() {
             continue;
         }
-        plots.push(whisker_plot(
+        let plot = whisker_plot(
             &format!("fig-effects-{}", k + 1),
             &format!("Fitted effect sizes, {unit}"),
             "Each effect parameter's fitted value (dot) with two standard deviations (line); the values are in the table below.",
             &format!("value, {unit}"),
             &rows,
+        );
+        s.push_str(&figure(
+            &[plot],
+            &format!(
+                "The effects in {unit} the calibration fitted beside the geometry (calibration.effects), each with two standard deviations."
+            ),
         ));
     }
-    let mut s: String = plots
+    if names
         .iter()
-        .map(|plot| {
-            figure(
-                std::slice::from_ref(plot),
-                "The effects the calibration fitted beside the geometry (calibration.effects), each with two standard deviations, grouped by unit (a parameter without a standard deviation, such as a scanned period, is in the table only).",
-            )
-        })
-        .collect();
+        .any(|(_, path)| l.f64(m, &format!("{path}/std_dev")).is_none())
+    {
+        s.push_str(&p(
+            "A parameter without a standard deviation (a scanned period) is in the table only.",
+        ));
+    }
     let cells: Vec<Vec<String>> = names
         .iter()
         .map(|(n, path)| {
