@@ -442,6 +442,30 @@ fn machine_of_file(py: Python<'_>, file_json: &str, source: String) -> PyResult<
         .map_err(|e| door_error(py, e))
 }
 
+/// Writes the page of a calibrated machine (`tricept report`); returns the
+/// verdict's JSON (`tricept report --json`) with the exit code.
+#[pyfunction]
+#[pyo3(signature = (machine, out, data=None, history=None, export=None))]
+fn report(
+    py: Python<'_>,
+    machine: PathBuf,
+    out: PathBuf,
+    data: Option<PathBuf>,
+    history: Option<PathBuf>,
+    export: Option<PathBuf>,
+) -> PyResult<String> {
+    let mut request = tricept_ident::report::ReportRequest::new(machine.as_path(), out);
+    request.data = data;
+    request.history = history;
+    request.export = export;
+    let r = py
+        .detach(|| tricept_ident::report::report(request))
+        .map_err(|e| door_error(py, e))?;
+    let mut v = r.to_json();
+    v["exit_code"] = r.exit_code().into();
+    Ok(v.to_string())
+}
+
 /// Adds the workflows and their results to the module.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Calibration>()?;
@@ -453,5 +477,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate_csv, m)?)?;
     m.add_function(wrap_pyfunction!(write_machine_file, m)?)?;
     m.add_function(wrap_pyfunction!(machine_of_file, m)?)?;
+    m.add_function(wrap_pyfunction!(report, m)?)?;
     Ok(())
 }

@@ -1,6 +1,7 @@
 """The workflows from Python equal the CLI's: identify from a path and from
 arrays gives the CLI's estimates (to 1e-12 mm) and exit code, diagnose and
 check give the CLI's exit codes and JSON, simulate gives the CLI's file,
+report the CLI's page and verdict,
 and a refused or bad request raises the documented exception."""
 
 import json
@@ -129,3 +130,16 @@ def test_bad_data_raise_input_error_with_the_cli_message(cli, tmp_path):
     assert str(e.value) == out.stderr.strip().removeprefix("error: ")
     with pytest.raises(tricept.InputError):
         tricept.identify({"q1": [1.0, 2.0], "q2": [1.0]})
+
+
+def test_report_writes_the_cli_page(cli, tmp_path):
+    machine = tmp_path / "t2.json"
+    assert cli("identify", "--data", GRID, "--write-machine", machine).returncode == 0
+    out = cli("report", "--machine", machine, "--data", GRID, "--out", tmp_path / "cli.html", "--json")
+    expected = json.loads(out.stdout)
+    got = tricept.report(machine, tmp_path / "py.html", data=GRID)
+    assert got.pop("exit_code") == out.returncode == 0
+    assert got["verdict"] == expected["verdict"]
+    assert (tmp_path / "py.html").read_bytes() == (tmp_path / "cli.html").read_bytes()
+    with pytest.raises(tricept.InputError, match="not the campaign of this calibration"):
+        tricept.report(machine, tmp_path / "x.html", data=HIDDEN)

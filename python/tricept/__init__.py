@@ -14,8 +14,8 @@ cannot be read or written the operating system's :class:`OSError`
 subclass; memory that cannot hold a result :class:`MemoryError`.
 
 The workflows are the CLI's, through the same library calls:
-:func:`identify` (``tricept identify``), :func:`diagnose`, :func:`check` and
-:func:`simulate`. Data are a CSV path or a mapping of the CSV's column names
+:func:`identify` (``tricept identify``), :func:`diagnose`, :func:`check`,
+:func:`simulate` and :func:`report`. Data are a CSV path or a mapping of the CSV's column names
 to 1-D arrays (a pandas DataFrame is one); ``machine`` is a machine file's
 path or a :class:`Machine`. Results carry the CLI's exit code,
 ``to_json()`` is the CLI's ``--json``, and results and machines pickle.
@@ -45,6 +45,7 @@ __all__ = [
     "diagnose",
     "check",
     "simulate",
+    "report",
 ]
 
 PathLike = Union[str, os.PathLike]
@@ -547,3 +548,32 @@ class Machine:
 
 def _machine_from_json(text: str, source: str) -> Machine:
     return Machine(_tricept.Machine.from_json(text, source))
+
+
+def report(
+    machine: PathLike,
+    out: PathLike,
+    data: Optional[PathLike] = None,
+    history: Optional[PathLike] = None,
+    export: Optional[PathLike] = None,
+) -> dict:
+    """Writes the page of a calibrated machine file (``tricept report``):
+    one self-contained HTML file at ``out``, with the calibration's
+    campaign (``data``), its check history and its export folder when
+    given. Returns the verdict as ``tricept report --json`` prints it
+    (``out``, ``verdict``) with the CLI's ``exit_code`` (3 when the page
+    says not to trust the machine). Inputs of another calibration raise
+    :class:`InputError`."""
+
+    def path(p):
+        return None if p is None else os.fspath(p)
+
+    return json.loads(
+        _tricept.report(
+            os.fspath(machine),
+            os.fspath(out),
+            data=path(data),
+            history=path(history),
+            export=path(export),
+        )
+    )

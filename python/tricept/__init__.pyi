@@ -164,3 +164,12 @@ def simulate(
     revisit: int = 0,
 ) -> Dict[str, npt.NDArray[np.float64]]:
     """Simulates a campaign (tricept simulate --out), as column arrays."""
+
+def report(
+    machine: PathLike,
+    out: PathLike,
+    data: Optional[PathLike] = None,
+    history: Optional[PathLike] = None,
+    export: Optional[PathLike] = None,
+) -> Dict[str, Any]:
+    """Writes the page of a calibrated machine (tricept report); its verdict."""

@@ -8,6 +8,7 @@ mod checks;
 mod fig3;
 mod hybrid;
 mod mutants;
+mod report_sample;
 mod reproduction;
 mod study;
 
@@ -73,6 +74,10 @@ enum Command {
     /// from the independent generator (tricept-truth), per scenario and
     /// pose count: the table of docs/check.md, "Measured rates".
     CheckRates(check_rates::CheckRatesArgs),
+    /// The sample page of `tricept report` for the Table 2 fixture,
+    /// docs/report-sample.html, from fixtures/report/ (`--inputs`: make
+    /// the calibration, its checks and its export first).
+    ReportSample(report_sample::ReportSampleArgs),
 }
 
 fn main() -> ExitCode {
@@ -91,6 +96,7 @@ fn main() -> ExitCode {
         Command::Msrv => checks::msrv(),
         Command::Mutants(args) => mutants::run(args),
         Command::CheckRates(args) => check_rates::run(args),
+        Command::ReportSample(args) => report_sample::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

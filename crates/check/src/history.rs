@@ -48,6 +48,11 @@ pub struct Entry {
     pub consistency: (f64, usize, f64),
     /// The key quantities.
     pub quantities: Vec<Quantity>,
+    /// The calibration checked against: its digest
+    /// (`MachineDescription::calibration_digest`); absent in lines written
+    /// before histories named it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub calibration_digest: Option<String>,
 }
 
 /// A key quantity of one check.
@@ -113,6 +118,7 @@ impl Entry {
                 report.consistency.p_value,
             ),
             quantities,
+            calibration_digest: None,
         }
     }
 }
@@ -247,6 +253,7 @@ pub struct Trend {
 ///     time: String::new(), unix_s: day * 86_400.0, machine: "m".into(), data_file: "d".into(),
 ///     verdict: "unchanged".into(), most_likely: None, shortlist: vec![], consistency: (50.0, 57, 0.7),
 ///     quantities: vec![Quantity { name: "dq1".into(), unit: "um".into(), value: v, std_dev: 1.0, band: 5.0 }],
+///     calibration_digest: None,
 /// };
 /// // A leg drifting 1 um a day: inside its band for four days, outside on the sixth.
 /// let t = &trends(&[entry(0.0, 0.0), entry(2.0, 2.0), entry(4.0, 4.0), entry(6.0, 6.0)])[0];
@@ -331,6 +338,7 @@ mod tests {
             shortlist: Vec::new(),
             consistency: (1.0, 3, 0.8),
             quantities: Vec::new(),
+            calibration_digest: None,
         }
     }
 

@@ -17,7 +17,7 @@ pub struct DocsArgs {
 }
 
 /// Every page: name, what it holds, text (Markdown).
-const PAGES: [(&str, &str, &str); 12] = [
+const PAGES: [(&str, &str, &str); 13] = [
     (
         "data-format",
         "the measured-data CSV, the external measurements, the machine JSON, every output file (columns, keys, units)",
@@ -47,6 +47,11 @@ const PAGES: [(&str, &str, &str); 12] = [
         "check",
         "`tricept check`: has the machine changed since its calibration? The test, the candidates, planning a check, measured rates",
         include_str!("../../../docs/check.md"),
+    ),
+    (
+        "report",
+        "`tricept report`: one page per machine: its sections and sources, the verdict's rule, how histories and exports name their calibration",
+        include_str!("../../../docs/report.md"),
     ),
     (
         "controllers",

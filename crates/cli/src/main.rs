@@ -34,6 +34,7 @@ mod ident_cmd;
 mod kinematics_cmd;
 mod output;
 mod plan_cmd;
+mod report_cmd;
 mod simulate_cmd;
 
 use std::path::Path;
@@ -169,6 +170,13 @@ enum Command {
         after_help = "Exit codes: 0 written; 3 a format error past --tolerance-um, or a range of the control the files would exceed (nothing written; the report names the limit); 2 bad input, checked before any work (an unknown control, an option past the model's documented limit, an axis name the control cannot accept, a machine file without a calibration or edited after it, an --out that is a file, holds files that are not an export, or holds the machine file).\n\nThe files are written as one set: a folder holding a previous export is replaced whole, never mixed.\n\nExamples:\n  tricept export --machine calibrated.json --out cnc/                 (a Tricept's SINUMERIK 840D sl)\n  tricept export --machine calibrated.json --control heidenhain-itnc530 --out cnc/\n  tricept export --machine calibrated.json --control fanuc-0i --axis-names U,V,W --detection-unit-um 0.1 --out cnc/ --json\nFormats, signs, units and each model's limits with their sources: `tricept docs controllers`"
     )]
     Export(export_cmd::ExportArgs),
+    /// One self-contained HTML page per calibrated machine: the verdict,
+    /// the promise, what was found, the daily checks and the controller
+    /// files, at a glance in a browser (prints to A4).
+    #[command(
+        after_help = "Exit codes: 0 written (verdict trusted, or use with caution); 3 written, and the page says not to trust the machine (a forced or inadequate calibration, or a last check that found it changed); 2 bad input: a machine file without a calibration or edited after it, a campaign whose SHA-256 is not the record's, a history or an export of another calibration (each names the file).\n\nExamples:\n  tricept report --machine calibrated.json --out page.html\n  tricept report --machine calibrated.json --data campaign.csv --history checks.jsonl --export cnc/ --out page.html\nThe page, its verdict rule and how to read its sources: `tricept docs report`"
+    )]
+    Report(report_cmd::ReportArgs),
 }
 
 /// The files a verb reads and writes, by flag (checked before it runs:
@@ -285,6 +293,15 @@ fn file_roles(command: &Command) -> files::FileRoles {
         Command::Export(a) => {
             r.input("--machine", &a.machine);
         }
+        Command::Report(a) => {
+            r.input("--machine", &a.machine);
+            r.inputs("--data", &a.data);
+            r.inputs("--history", &a.history);
+            if let Some(dir) = &a.export {
+                r.input("--export", &dir.join(tricept_ident::report::EXPORT_SUMMARY));
+            }
+            r.output("--out", &a.out);
+        }
         Command::Plan(a) => {
             machine(&mut r, &a.machine);
             r.inputs("--data", &a.data);
@@ -328,6 +345,7 @@ fn run(cli: Cli) -> Result<u8, CliError> {
         Command::Effects(a) => effects_cmd::run(&a),
         Command::Check(a) => check_cmd::run(&a),
         Command::Export(a) => export_cmd::run(&a),
+        Command::Report(a) => report_cmd::run(&a),
     }
 }
 

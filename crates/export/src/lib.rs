@@ -147,6 +147,7 @@ pub fn plan(
         within_tolerance: limits.is_empty(),
         limits,
         warnings,
+        calibration_digest: description.calibration_digest(),
     };
     files.push((SUMMARY_FILE.to_string(), summary_json(&summary)));
     Ok(ExportPlan { summary, files })

@@ -168,4 +168,9 @@ pub struct ExportSummary {
     /// Options past a limit the sources do not state as hard (the files
     /// are written: check the control's manual).
     pub warnings: Vec<String>,
+    /// The calibration exported: its digest
+    /// (`MachineDescription::calibration_digest`), by which a report tells
+    /// an export of another calibration.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub calibration_digest: Option<String>,
 }

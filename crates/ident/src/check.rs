@@ -114,7 +114,13 @@ pub fn check(request: CheckRequest) -> Result<CheckResult, Error> {
         )));
     }
     let history = match &request.history {
-        Some(path) => Some(append_to(path, &report, &machine, &data_name)?),
+        Some(path) => Some(append_to(
+            path,
+            &report,
+            &machine,
+            &data_name,
+            loaded.description().calibration_digest(),
+        )?),
         None => None,
     };
     Ok(CheckResult {
@@ -128,17 +134,24 @@ pub fn check(request: CheckRequest) -> Result<CheckResult, Error> {
 }
 
 /// Appends the check to the history at `path` and computes its trends.
+/// The entry names the calibration by its digest
+/// (`MachineDescription::calibration_digest`), so that a report can tell a
+/// history of another calibration.
 fn append_to(
     path: &Path,
     report: &CheckReport,
     machine: &str,
     data: &str,
+    calibration_digest: Option<String>,
 ) -> Result<History, Error> {
     let time = crate::machine_file::utc_now();
     let unix_s = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0.0, |d| d.as_secs_f64());
-    let entry = Entry::of(report, &time, unix_s, machine, data);
+    let entry = Entry {
+        calibration_digest,
+        ..Entry::of(report, &time, unix_s, machine, data)
+    };
     let entries = append(path, &entry)?;
     Ok(History {
         file: path.to_path_buf(),

@@ -99,6 +99,36 @@ impl LoadedMachine {
         }
     }
 
+    /// The machine a calibrated file's data were identified against (its
+    /// record's `relative_to_machine`, else its `nominal`) with this file's
+    /// sensors, named `source`: what a rerun of its calibration starts
+    /// from. `None` for a machine without a calibration record.
+    pub(crate) fn identified_against(
+        &self,
+        source: String,
+    ) -> Result<Option<LoadedMachine>, Error> {
+        let Some(c) = &self.description.calibration else {
+            return Ok(None);
+        };
+        let mut description = c
+            .relative_to_machine
+            .as_deref()
+            .unwrap_or(&c.nominal)
+            .clone();
+        description.sensors = self.description.sensors.clone();
+        let mut machine = description
+            .build()
+            .map_err(|e| description_error(&source, &e))?;
+        machine.sensors = self.machine.sensors;
+        Ok(Some(LoadedMachine {
+            description,
+            machine,
+            source,
+            path: None,
+            warnings: Vec::new(),
+        }))
+    }
+
     /// The nominal machine a calibrated file records, as a description
     /// without calibration of its own.
     pub fn nominal_description(&self) -> MachineDescription {

@@ -25,7 +25,7 @@
 //! The root is a curated handful: one module per workflow ([`calibrate`],
 //! [`check`], [`compensate`], [`detectability`], [`diagnosis`],
 //! [`effects`], [`export`], [`identifiability`], [`kinematics`], [`plan`],
-//! [`simulate`]), each with its function, its request, its result and the
+//! [`report`], [`simulate`]), each with its function, its request, its result and the
 //! parts they are made of; the error with its exit codes; and the two
 //! inputs. The typed values several requests share, the machine loaded
 //! ahead of a workflow and the few low-level items code beside the door
@@ -61,6 +61,7 @@ pub mod export;
 pub mod identifiability;
 pub mod kinematics;
 pub mod plan;
+pub mod report;
 pub mod simulate;
 
 // Layer 2: what a downstream crate may need besides the workflows.

@@ -2,8 +2,9 @@
 //! a closed stdout, the embedded docs, the edges (special files, `-`,
 //! refusals before work, the history lock, bounded messages), the
 //! exit-code table, the fused identification, the seal, seeded fuzzing of
-//! every input kind, what writing survives, and a calibration a user can
-//! trust (one module per subject; what they share in `support`).
+//! every input kind, what writing survives, the report page, and a
+//! calibration a user can trust (one module per subject; what they share
+//! in `support`).
 
 mod bad_inputs;
 mod check;
@@ -17,6 +18,7 @@ mod fuzz;
 mod one_exit_code;
 mod outputs;
 mod relied_on;
+mod report;
 mod seal;
 mod support;
 mod trust;

@@ -9,7 +9,9 @@
 //!   controller parameters, the record's held parameters, sensor offsets,
 //!   correlations and external sources);
 //! - `validate.rs`: [`MachineDescription::validate`], the checks that refuse
-//!   impossible geometry and implausible values.
+//!   impossible geometry and implausible values;
+//! - `identity.rs`: [`MachineDescription::calibration_digest`], the digest
+//!   a calibration's check history and export name it by.
 //!
 //! A description is what a user writes and what `--machine FILE` loads. It is
 //! deliberately verbose: every key carries its unit in its name (`_mm`,
@@ -26,6 +28,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::DescriptionError;
 
 mod geometry;
+mod identity;
 mod record;
 mod seal;
 mod validate;

@@ -1,0 +1,288 @@
+//! The report workflow (`tricept report`): one self-contained HTML page per
+//! calibrated machine (`tricept-report`): the verdict at the top, the
+//! platform error over the workspace before and after, the residuals, what
+//! the calibration deploys and what was looked for, the daily checks and
+//! the controller files; every value shown names the JSON it comes from,
+//! and that JSON is in the page.
+//!
+//! A [`ReportRequest`] gathers the page's sources from what the other
+//! workflows give: the machine file as loaded (an edited one is refused),
+//! the compensation map at three heights ([`crate::compensate`]), the
+//! campaign's diagnosis ([`crate::diagnosis`], from the machine the
+//! calibration started from, on `data`, which must be the campaign the
+//! record's SHA-256 names), the check history and its trends, and the
+//! export's summary; a history or an export of another calibration is
+//! refused (exit code 2) naming the file. The verdict's exit code: 3 when
+//! the page says not to trust the machine, else 0.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::{Value, json};
+use tricept_report::{Source, Sources};
+
+use crate::compensate::{Calibrated, CompensateRequest, compensate};
+use crate::diagnosis::{DiagnoseRequest, diagnose};
+use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
+use crate::inputs::LoadedMachine;
+use crate::machine_file::sha256_file;
+use crate::machine_input::MachineInput;
+
+pub use tricept_report::{Level, Verdict};
+
+/// The file of an export folder the page reads (`--export DIR`).
+pub const EXPORT_SUMMARY: &str = tricept_export::SUMMARY_FILE;
+
+/// The lattice spacing of the page's compensation maps, mm.
+pub const MAP_SPACING_MM: f64 = 25.0;
+
+/// What the page is made from, and where it goes.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::report::{ReportRequest, report};
+/// let mut request = ReportRequest::new("calibrated.json", "page.html");
+/// request.history = Some("checks.jsonl".into());
+/// let page = report(request)?;
+/// println!("{}", page.text());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct ReportRequest {
+    /// The calibrated machine file.
+    pub machine: MachineInput,
+    /// The campaign the calibration was made from (its residuals, what
+    /// its diagnosis looked for, each term's gain).
+    pub data: Option<PathBuf>,
+    /// The check history (`tricept check --history`).
+    pub history: Option<PathBuf>,
+    /// An export folder (`tricept export --out DIR`).
+    pub export: Option<PathBuf>,
+    /// The page written (HTML).
+    pub out: PathBuf,
+}
+
+impl ReportRequest {
+    /// The page of `machine` alone, written to `out`.
+    pub fn new(machine: impl Into<MachineInput>, out: impl Into<PathBuf>) -> ReportRequest {
+        ReportRequest {
+            machine: machine.into(),
+            data: None,
+            history: None,
+            export: None,
+            out: out.into(),
+        }
+    }
+}
+
+/// A page written, and its verdict.
+#[derive(Debug, Clone)]
+pub struct Report {
+    verdict: Verdict,
+    out: PathBuf,
+}
+
+impl Report {
+    /// The page's verdict.
+    pub fn verdict(&self) -> &Verdict {
+        &self.verdict
+    }
+
+    /// 3 when the page says not to trust the machine, else 0.
+    pub fn exit_code(&self) -> u8 {
+        match self.verdict.level {
+            Level::DoNotTrust => EXIT_INADEQUATE,
+            _ => EXIT_OK,
+        }
+    }
+
+    /// What the CLI prints: where the page went, the verdict and its
+    /// reasons, one line each.
+    pub fn text(&self) -> String {
+        let mut s = format!(
+            "report written to {}: {}: {}\n",
+            self.out.display(),
+            self.verdict.words,
+            self.verdict.level.meaning()
+        );
+        for r in &self.verdict.reasons {
+            s.push_str(&format!("  {}: {}\n", r.level.as_str(), r.says));
+        }
+        s
+    }
+
+    /// The verdict as JSON, with the page's path.
+    pub fn to_json(&self) -> Value {
+        json!({"out": self.out.display().to_string(), "verdict": self.verdict.to_json()})
+    }
+}
+
+/// Gathers the page's sources, renders the page and writes it atomically.
+pub fn report(request: ReportRequest) -> Result<Report, Error> {
+    let loaded = request.machine.clone().load()?;
+    let sources = sources(&request, &loaded)?;
+    let page = tricept_report::page(&sources).map_err(|e| Error::input(e.to_string()))?;
+    crate::calibrate::write_text(&request.out, &page.html)?;
+    Ok(Report {
+        verdict: page.verdict,
+        out: request.out,
+    })
+}
+
+/// The page's sources.
+fn sources(request: &ReportRequest, loaded: &LoadedMachine) -> Result<Sources, Error> {
+    let name = loaded.source().to_string();
+    let description = loaded.description();
+    let (Some(record), Some(digest)) = (
+        description.calibration.as_deref(),
+        description.calibration_digest(),
+    ) else {
+        return Err(Error::input(format!(
+            "{name}: holds no `calibration` record: a report is of a calibrated machine file (tricept identify or diagnose --write-machine)"
+        )));
+    };
+    let machine = Source::new(
+        "machine",
+        "the calibrated machine file, as loaded (its record checked against its seal)",
+        Some(name.clone()),
+        serde_json::to_value(description).unwrap_or(Value::Null),
+    );
+    let diagnosis = match &request.data {
+        Some(path) => Some(diagnosis(
+            path,
+            &record.data_sha256,
+            &record.data_file,
+            loaded,
+        )?),
+        None => None,
+    };
+    let (history, trends) = match &request.history {
+        Some(path) => {
+            let (h, t) = history(path)?;
+            (Some(h), Some(t))
+        }
+        None => (None, None),
+    };
+    Ok(Sources {
+        machine,
+        calibration_digest: digest,
+        maps: maps(loaded)?,
+        diagnosis,
+        history,
+        trends,
+        export: request.export.as_deref().map(export).transpose()?,
+    })
+}
+
+/// The compensation map at the workspace's bottom, middle and top planes.
+fn maps(loaded: &LoadedMachine) -> Result<Vec<Source>, Error> {
+    let w = &loaded.machine().workspace;
+    let heights = [w.z_min_mm, w.mid_plane_z_mm(), w.z_max_mm];
+    heights
+        .iter()
+        .enumerate()
+        .map(|(k, z)| {
+            let mut r = CompensateRequest::new(Calibrated::MachineFile(loaded.clone().into()));
+            r.force = true;
+            r.plane_z_mm = Some(*z);
+            r.spacing_mm = MAP_SPACING_MM;
+            let c = compensate(r)?;
+            let mut v = c.to_json();
+            let (map, _) = c.maps();
+            v["spacing_mm"] = c.spacing_mm().into();
+            v["points"] = json!({
+                "x": map.targets_mm.iter().map(|p| p.x).collect::<Vec<_>>(),
+                "y": map.targets_mm.iter().map(|p| p.y).collect::<Vec<_>>(),
+                "correction_mm": map.errors_mm.iter().map(|e| e.norm()).collect::<Vec<_>>(),
+            });
+            Ok(Source::new(
+                &format!("map-{}", k + 1),
+                &format!(
+                    "tricept compensate --machine CAL.json --plane-z {z} --spacing {MAP_SPACING_MM} --json, with the map's columns (map.csv) as points"
+                ),
+                None,
+                v,
+            ))
+        })
+        .collect()
+}
+
+/// The campaign's diagnosis, from the machine the calibration started
+/// from; the campaign must be the one the record names by its SHA-256.
+fn diagnosis(
+    path: &Path,
+    sha256: &str,
+    recorded: &str,
+    loaded: &LoadedMachine,
+) -> Result<Source, Error> {
+    let file = path.display().to_string();
+    let found = sha256_file(path)?;
+    if found != sha256 {
+        return Err(Error::input(format!(
+            "{file}: not the campaign of this calibration: its SHA-256 is {found}, the calibration record's (`calibration.data_sha256`, of {recorded}) is {sha256}"
+        )));
+    }
+    let base = loaded
+        .identified_against(format!(
+            "the machine {} was calibrated from",
+            loaded.source()
+        ))?
+        .ok_or_else(|| Error::input(format!("{}: no calibration record", loaded.source())))?;
+    let d = diagnose(DiagnoseRequest::new(base, path))?;
+    let json = serde_json::from_str(&d.to_json()).unwrap_or(Value::Null);
+    Ok(Source::new(
+        "diagnosis",
+        "tricept diagnose --data CAMPAIGN.csv --json, from the machine the calibration started from",
+        Some(file),
+        json,
+    ))
+}
+
+/// The history's lines and their trends.
+fn history(path: &Path) -> Result<(Source, Source), Error> {
+    let file = path.display().to_string();
+    if !path.is_file() {
+        return Err(Error::input(format!(
+            "{file}: no such check history (tricept check --history writes one)"
+        )));
+    }
+    let entries = tricept_check::history::read(path)?;
+    let lines: Vec<Value> = entries
+        .iter()
+        .map(|e| serde_json::to_value(e).unwrap_or(Value::Null))
+        .collect();
+    let trends = tricept_check::history::trends(&entries);
+    Ok((
+        Source::new(
+            "history",
+            "the check history's lines (tricept check --history)",
+            Some(file),
+            Value::Array(lines),
+        ),
+        Source::new(
+            "trends",
+            "the history's trends, as tricept check --json gives them (history.trends)",
+            None,
+            serde_json::to_value(trends).unwrap_or(Value::Null),
+        ),
+    ))
+}
+
+/// The export's summary.
+fn export(dir: &Path) -> Result<Source, Error> {
+    let path = dir.join(EXPORT_SUMMARY);
+    let file = path.display().to_string();
+    let text = tricept_data::read_json_text(&path).map_err(|e| {
+        Error::input(format!(
+            "{file}: {e}: --export names the folder tricept export --out wrote"
+        ))
+    })?;
+    let json: Value = serde_json::from_str(&text)
+        .map_err(|e| Error::input(format!("{file}: not an export summary: {e}")))?;
+    Ok(Source::new(
+        "export",
+        "the export's summary (tricept export --out DIR: DIR/export.json)",
+        Some(file),
+        json,
+    ))
+}
