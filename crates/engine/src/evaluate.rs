@@ -51,7 +51,15 @@ pub(crate) fn evaluate(
             k,
             campaigns: &campaigns,
         };
-        evaluate_block(&*predictor, &layout, first, poses, sigma, pose_weights, seeds)
+        evaluate_block(
+            &*predictor,
+            &layout,
+            first,
+            poses,
+            sigma,
+            pose_weights,
+            seeds,
+        )
     };
     let blocks: Vec<Result<Block, IdentError>> = if poses.len() <= EVALUATION_BLOCK {
         vec![block(0, poses, seeds)]

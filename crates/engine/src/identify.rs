@@ -650,8 +650,8 @@ fn finish(
         dof: prior.dimension(),
     });
     chi_square += prior_fit.map_or(0.0, |f| f.chi_square);
-    let dof = (3 * residuals.len() + prior_fit.map_or(0, |f| f.dof))
-        .saturating_sub(decision.rank + nn);
+    let dof =
+        (3 * residuals.len() + prior_fit.map_or(0, |f| f.dof)).saturating_sub(decision.rank + nn);
     let lines = poses.iter().map(|p| p.line).collect();
     Identification {
         names,

@@ -24,7 +24,7 @@ use crate::error::IdentError;
 /// use nalgebra::DMatrix;
 /// use tricept_engine::Prior;
 /// // Parameters 0 and 2 of three: N([0.1, 0.3], diag(0.01, 0.04)); parameter 1 free.
-/// let p = Prior::new(vec![0.1, 0.0, 0.3], &[0, 2], &DMatrix::from_diagonal(&[0.01, 0.04].into())).unwrap();
+/// let p = Prior::new(vec![0.1, 0.0, 0.3], &[0, 2], &DMatrix::from_row_slice(2, 2, &[0.01, 0.0, 0.0, 0.04])).unwrap();
 /// assert_eq!(p.dimension(), 2);
 /// // (0.2 - 0.1)^2 / 0.01 + (0.1 - 0.3)^2 / 0.04 = 1 + 1.
 /// assert!((p.chi_square(&[0.2, 5.0, 0.1]) - 2.0).abs() < 1e-12);
@@ -50,7 +50,11 @@ impl Prior {
     /// The prior with `mean` (all `k` parameters; those not covered are
     /// ignored) and `covariance` of the parameters `covers` (in that
     /// order); the covariance must be symmetric positive definite.
-    pub fn new(mean: Vec<f64>, covers: &[usize], covariance: &DMatrix<f64>) -> Result<Prior, IdentError> {
+    pub fn new(
+        mean: Vec<f64>,
+        covers: &[usize],
+        covariance: &DMatrix<f64>,
+    ) -> Result<Prior, IdentError> {
         let k = mean.len();
         let c = covers.len();
         if covariance.shape() != (c, c) || covers.iter().any(|&j| j >= k) {
@@ -68,7 +72,9 @@ impl Prior {
             )));
         }
         if mean.iter().chain(covariance.iter()).any(|v| !v.is_finite()) {
-            return Err(IdentError::Invalid("a prior with a non-finite value".into()));
+            return Err(IdentError::Invalid(
+                "a prior with a non-finite value".into(),
+            ));
         }
         let symmetric = (covariance - covariance.transpose()).amax()
             <= 1e-12 * covariance.amax().max(f64::MIN_POSITIVE);
@@ -77,12 +83,16 @@ impl Prior {
             .cholesky()
             .filter(|_| symmetric)
             .ok_or_else(|| {
-                IdentError::Invalid("the prior covariance is not symmetric positive definite".into())
+                IdentError::Invalid(
+                    "the prior covariance is not symmetric positive definite".into(),
+                )
             })?;
         let inverse_root = cholesky
             .l()
             .solve_lower_triangular(&DMatrix::identity(c, c))
-            .ok_or(IdentError::Numerical("the prior covariance's factor is singular"))?;
+            .ok_or(IdentError::Numerical(
+                "the prior covariance's factor is singular",
+            ))?;
         let mut rows = DMatrix::zeros(c, k);
         for (a, &j) in covers.iter().enumerate() {
             for r in 0..c {
