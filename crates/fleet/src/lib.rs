@@ -2,13 +2,30 @@
 //! machine ran, every machine of a batch (`docs/fleet.md`).
 //!
 //! - `reml.rs`: the batch's spread by REML and a machine's distance from
-//!   the rest.
+//!   the rest;
+//! - `own.rs`: each machine alone (its own calibration and exit code) and
+//!   the batch's rank decision;
+//! - `joint.rs`: the joint fit of every member's readings on the sparse
+//!   core ([`tricept_numerics::sparse`]);
+//! - `batch.rs`: the hierarchical model end to end ([`calibrate_batch`]).
 #![cfg_attr(
     not(test),
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
+// Layer 0: errors and the batch's statistics.
 mod error;
 pub mod reml;
 
+// Layer 1: machines alone, and all of them at once.
+mod joint;
+mod own;
+
+// Layer 2: the batch.
+mod batch;
+
+pub use batch::{Batch, BatchOptions, MIN_MACHINES, MachineOutcome, calibrate_batch};
 pub use error::FleetError;
+pub use joint::{JointFit, JointInput, fit as joint_fit};
+pub use own::{EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, OwnFit, batch_design};
+pub use tricept_numerics::sparse::{SolveStats, SolverKind};
