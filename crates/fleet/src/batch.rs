@@ -221,9 +221,9 @@ pub fn calibrate_batch(
         .iter()
         .map(|o| match &o.id {
             _ if !o.fits() => Some(o.reason.clone().unwrap_or_default()),
-            Some(id) if id.design().identifiable() != identifiable.as_slice() => Some(
-                "its campaign cannot determine every parameter the batch does".to_string(),
-            ),
+            Some(id) if id.design().identifiable() != identifiable.as_slice() => {
+                Some("its campaign cannot determine every parameter the batch does".to_string())
+            }
             _ => None,
         })
         .collect();
@@ -249,7 +249,11 @@ pub fn calibrate_batch(
         .collect();
     let mut scales: Vec<Vec<f64>> = members
         .iter()
-        .map(|&c| (0..r).map(|a| summaries[c].covariance[(a, a)].max(0.0).sqrt()).collect())
+        .map(|&c| {
+            (0..r)
+                .map(|a| summaries[c].covariance[(a, a)].max(0.0).sqrt())
+                .collect()
+        })
         .collect();
     scales.push(mean_sd);
     let input = JointInput {
@@ -257,7 +261,12 @@ pub fn calibrate_batch(
         data: members.iter().map(|&c| &own[candidates[c]].kept).collect(),
         start: members
             .iter()
-            .map(|&c| own[candidates[c]].id.as_ref().map_or_else(Vec::new, |id| id.estimate.clone()))
+            .map(|&c| {
+                own[candidates[c]]
+                    .id
+                    .as_ref()
+                    .map_or_else(Vec::new, |id| id.estimate.clone())
+            })
             .collect(),
         identifiable: &identifiable,
         spread_variance: &spread.variance,
@@ -368,7 +377,11 @@ fn summary(o: &OwnFit, identifiable: &[usize]) -> Summary {
 /// than `max_share` of them were set aside (then nobody is).
 type Screened = (Vec<bool>, Spread, Vec<Distance>, bool);
 
-fn screen_outliers(summaries: &[Summary], alpha: f64, max_share: f64) -> Result<Screened, FleetError> {
+fn screen_outliers(
+    summaries: &[Summary],
+    alpha: f64,
+    max_share: f64,
+) -> Result<Screened, FleetError> {
     let n = summaries.len();
     let r = summaries[0].estimate.len();
     let crit = chi2_isf(alpha / n as f64, r as f64);
@@ -396,7 +409,11 @@ fn screen_outliers(summaries: &[Summary], alpha: f64, max_share: f64) -> Result<
         let next = if back.is_empty() {
             let worst = (0..n)
                 .filter(|&m| member[m] && distances[m].chi_square > crit)
-                .max_by(|a, b| distances[*a].chi_square.total_cmp(&distances[*b].chi_square));
+                .max_by(|a, b| {
+                    distances[*a]
+                        .chi_square
+                        .total_cmp(&distances[*b].chi_square)
+                });
             match worst {
                 Some(w) if member.iter().filter(|x| !**x).count() < cap + 1 => {
                     let mut next = member.clone();

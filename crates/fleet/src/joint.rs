@@ -133,16 +133,17 @@ fn evaluate(
     let mut jac = vec![0.0; 3 * k];
     let mut residuals = Vec::with_capacity(n);
     for (j, (pose, seed)) in data.poses.iter().zip(seeds.iter_mut()).enumerate() {
-        let g = predictor
-            .predict(pose, seed, &mut jac)
-            .map_err(|e| FleetError::Identification {
-                source_name: data.source.clone(),
-                error: tricept_engine::IdentError::Kinematics {
-                    pose: j,
-                    line: pose.line,
-                    source: e,
-                },
-            })?;
+        let g =
+            predictor
+                .predict(pose, seed, &mut jac)
+                .map_err(|e| FleetError::Identification {
+                    source_name: data.source.clone(),
+                    error: tricept_engine::IdentError::Kinematics {
+                        pose: j,
+                        line: pose.line,
+                        source: e,
+                    },
+                })?;
         let y = pose.readings.to_array();
         let res: [f64; 3] = std::array::from_fn(|c| y[c] - g[c]);
         for c in 0..3 {
@@ -166,7 +167,11 @@ fn evaluate(
         std::array::from_fn(|c| residuals.iter().map(|x| x[c]).sum::<f64>() / nf);
     let chi_square_readings = residuals
         .iter()
-        .map(|x| (0..3).map(|c| ((x[c] - offsets[c]) / sigma[c]).powi(2)).sum::<f64>())
+        .map(|x| {
+            (0..3)
+                .map(|c| ((x[c] - offsets[c]) / sigma[c]).powi(2))
+                .sum::<f64>()
+        })
         .sum();
     let mut chi_square_prior = 0.0;
     for (t, &(a, pos)) in spread.iter().enumerate() {
@@ -229,7 +234,11 @@ fn evaluate_all(
 
 /// The step at a point: globals and every member's locals, and the
 /// solve's statistics.
-fn step(point: &Point, input: &JointInput<'_>, r: usize) -> Result<(Vec<f64>, Vec<Vec<f64>>, SolveStats), FleetError> {
+fn step(
+    point: &Point,
+    input: &JointInput<'_>,
+    r: usize,
+) -> Result<(Vec<f64>, Vec<Vec<f64>>, SolveStats), FleetError> {
     if input.kind != SolverKind::Schur {
         let problem = BlockProblem {
             n_global: r,
@@ -242,14 +251,22 @@ fn step(point: &Point, input: &JointInput<'_>, r: usize) -> Result<(Vec<f64>, Ve
     let reduced = reduce(point, r)?;
     let norms = global_norms(point, r);
     let (global, _, _) = solve_globals(&reduced, &norms)?;
-    let local = reduced.par_iter().map(|b| b.local_solution(&global)).collect();
+    let local = reduced
+        .par_iter()
+        .map(|b| b.local_solution(&global))
+        .collect();
     let seconds = start.elapsed().as_secs_f64();
     Ok((
         global,
         local,
         SolveStats {
             kind: SolverKind::Schur,
-            unknowns: point.evaluated.iter().map(|e| e.block.n_local).sum::<usize>() + r,
+            unknowns: point
+                .evaluated
+                .iter()
+                .map(|e| e.block.n_local)
+                .sum::<usize>()
+                + r,
             nonzeros: nonzeros(point),
             rows: point.evaluated.iter().map(|e| e.block.rows.nrows()).sum(),
             seconds,
@@ -304,7 +321,9 @@ pub fn fit(input: &JointInput<'_>) -> Result<JointFit, FleetError> {
     let r = input.identifiable.len();
     let members = input.data.len();
     if input.start.len() != members || input.scales.len() != members + 1 {
-        return Err(FleetError::Input("a joint fit's inputs of different lengths".into()));
+        return Err(FleetError::Input(
+            "a joint fit's inputs of different lengths".into(),
+        ));
     }
     let mut local = vec![None; r];
     let mut at = 3;
@@ -317,7 +336,11 @@ pub fn fit(input: &JointInput<'_>) -> Result<JointFit, FleetError> {
     let layout = Layout {
         identifiable: input.identifiable,
         local,
-        tau: input.spread_variance.iter().map(|v| v.max(0.0).sqrt()).collect(),
+        tau: input
+            .spread_variance
+            .iter()
+            .map(|v| v.max(0.0).sqrt())
+            .collect(),
     };
     // A parameter of no spread is the mean on every machine from the start.
     let mut parameters = input.start.clone();
@@ -328,8 +351,11 @@ pub fn fit(input: &JointInput<'_>) -> Result<JointFit, FleetError> {
             }
         }
     }
-    let seeds: Vec<Vec<Option<UpJoints>>> =
-        input.data.iter().map(|d| vec![None; d.poses.len()]).collect();
+    let seeds: Vec<Vec<Option<UpJoints>>> = input
+        .data
+        .iter()
+        .map(|d| vec![None; d.poses.len()])
+        .collect();
     let mut point = evaluate_all(input, &layout, parameters, input.mean_start.clone(), seeds)?;
     let mut solve_seconds = 0.0;
     let mut stats = None;
@@ -341,7 +367,12 @@ pub fn fit(input: &JointInput<'_>) -> Result<JointFit, FleetError> {
         solve_seconds += s.seconds;
         stats = Some(s);
         let moves = |t: f64| -> (Vec<Vec<f64>>, Vec<f64>) {
-            let mean: Vec<f64> = point.mean.iter().zip(&d_global).map(|(m, d)| m + t * d).collect();
+            let mean: Vec<f64> = point
+                .mean
+                .iter()
+                .zip(&d_global)
+                .map(|(m, d)| m + t * d)
+                .collect();
             let parameters = point
                 .parameters
                 .iter()
@@ -407,7 +438,11 @@ pub fn fit(input: &JointInput<'_>) -> Result<JointFit, FleetError> {
     };
     Ok(JointFit {
         offsets: point.evaluated.iter().map(|e| e.offsets).collect(),
-        chi_square_readings: point.evaluated.iter().map(|e| e.chi_square_readings).collect(),
+        chi_square_readings: point
+            .evaluated
+            .iter()
+            .map(|e| e.chi_square_readings)
+            .collect(),
         chi_square_prior: point.evaluated.iter().map(|e| e.chi_square_prior).sum(),
         readings: input.data.iter().map(|d| 3 * d.poses.len()).sum(),
         parameters: point.parameters,
@@ -423,7 +458,11 @@ pub fn fit(input: &JointInput<'_>) -> Result<JointFit, FleetError> {
 
 /// A member's covariance of its identifiable parameters: its local ones
 /// from the block, those of no spread from the mean's.
-fn member_covariance(b: &ReducedBlock, mean_cov: faer::MatRef<'_, f64>, layout: &Layout<'_>) -> DMatrix<f64> {
+fn member_covariance(
+    b: &ReducedBlock,
+    mean_cov: faer::MatRef<'_, f64>,
+    layout: &Layout<'_>,
+) -> DMatrix<f64> {
     let local = b.local_covariance(mean_cov);
     let cross = b.cross_covariance(mean_cov);
     let r = layout.identifiable.len();

@@ -73,7 +73,10 @@ impl OwnFit {
             .map(|a| a.worthwhile)
             .unwrap_or(false);
         let (exit_code, reason) = if !verdict.converged {
-            (EXIT_NOT_CONVERGED, Some("its own fit did not converge".to_string()))
+            (
+                EXIT_NOT_CONVERGED,
+                Some("its own fit did not converge".to_string()),
+            )
         } else if !verdict.adequate {
             (
                 EXIT_INADEQUATE,
@@ -148,7 +151,10 @@ pub fn batch_design(
     let mut row = vec![0.0; k + 1];
     for b in &blocks {
         for i in 0..k {
-            row[..k].iter_mut().enumerate().for_each(|(j, v)| *v = b[(i, j)]);
+            row[..k]
+                .iter_mut()
+                .enumerate()
+                .for_each(|(j, v)| *v = b[(i, j)]);
             acc.push_row(&row);
         }
     }
