@@ -72,8 +72,8 @@ pub struct Agreement {
 /// Which campaigns agree (module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Agreements {
-    /// Every campaign's test within the last set tested (`None`: a
-    /// campaign that left before, or a single campaign).
+    /// Every campaign's test: within the last set tested, or the test it
+    /// left on (`None`: a single campaign).
     pub tests: Vec<Option<Agreement>>,
     /// The campaigns that disagree with the rest, in the order they left.
     pub disagreeing: Vec<u32>,
@@ -98,16 +98,19 @@ pub fn agreements(
     while inside.len() >= 2 {
         let set = data.subset(|j| inside.contains(&data.poses[j].campaign));
         let all = identify(model, &set, options).map_err(fail)?;
-        tests = vec![None; count];
+        // A campaign that left keeps the test it left on.
         for &c in &inside {
             tests[c as usize] = Some(test(model, &set, &all, c, options)?);
         }
         let crit = alpha / inside.len() as f64;
+        // The worst by its statistic in standard deviations: p-values of
+        // gross disagreements all round to zero.
+        let z = |t: &Agreement| (t.chi_square - t.dof as f64) / (2.0 * t.dof.max(1) as f64).sqrt();
         let worst = inside
             .iter()
-            .filter_map(|&c| tests[c as usize].map(|t| (c, t.p_value)))
-            .filter(|(_, p)| *p < crit)
-            .min_by(|a, b| a.1.total_cmp(&b.1));
+            .filter_map(|&c| tests[c as usize].map(|t| (c, t)))
+            .filter(|(_, t)| t.p_value < crit)
+            .max_by(|a, b| z(&a.1).total_cmp(&z(&b.1)));
         match worst {
             None => break,
             Some(_) if inside.len() == 2 => {

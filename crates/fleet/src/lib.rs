@@ -11,7 +11,8 @@
 //!   core ([`tricept_numerics::sparse`]);
 //! - `batch.rs`: the hierarchical model end to end ([`calibrate_batch`]);
 //! - `prior_file.rs`: the batch's prior for a new machine, sealed, with its
-//!   provenance ([`PriorFile`]).
+//!   provenance ([`PriorFile`]);
+//! - `report.rs`: a batch as JSON and text.
 #![cfg_attr(
     not(test),
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
@@ -29,6 +30,7 @@ mod own;
 // Layer 2: the batch, and what it says of a new machine.
 mod batch;
 mod prior_file;
+mod report;
 
 pub use batch::{Batch, BatchOptions, MIN_MACHINES, MachineOutcome, calibrate_batch};
 pub use campaigns::{Agreement, Agreements, agreements, campaign_chi_squares, pool};

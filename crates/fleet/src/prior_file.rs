@@ -69,6 +69,10 @@ pub struct PriorProvenance {
     pub written_utc: String,
     /// The tricept version that wrote it.
     pub tricept_version: String,
+    /// Why it was written although the batch is not to be trusted
+    /// (`--force`), when it was.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub forced: Option<String>,
 }
 
 /// The prior file (module docs).
