@@ -34,7 +34,9 @@ __all__ = [
     "Calibration",
     "Diagnosis",
     "CheckResult",
+    "Fleet",
     "identify",
+    "fleet",
     "diagnose",
     "check",
     "simulate",
@@ -42,6 +44,7 @@ __all__ = [
 
 Diagnosis = _tricept.Diagnosis
 CheckResult = _tricept.CheckResult
+Fleet = _tricept.Fleet
 
 PathLike = Union[str, os.PathLike]
 
@@ -135,13 +138,22 @@ class Calibration:
         return f"Calibration(exit_code={self.exit_code}, parameters={len(self.names)})"
 
 
-def identify(data, machine: Optional[PathLike] = None, **options) -> "Calibration":
+def identify(
+    data, machine: Optional[PathLike] = None, prior: Optional[PathLike] = None, **options
+) -> "Calibration":
     """Identifies the machine's geometric errors from measured data, as
     ``tricept identify`` does.
 
-    ``data``: a CSV path, or a mapping of the CSV's column names
-    (``q1, q2, q3, phi, theta, s`` and the optional ones) to 1-D arrays.
+    ``data``: a CSV path, a mapping of the CSV's column names
+    (``q1, q2, q3, phi, theta, s`` and the optional ones) to 1-D arrays, or
+    a list of CSV paths: campaigns of the same machine, pooled (the
+    geometry shared, each campaign with its own sensor offsets; the
+    ``campaigns`` entry of ``to_json()`` lists each one's offsets,
+    chi-square and agreement), as ``--data`` given several times.
     ``machine``: a machine file (default: the built-in Table 1 machine).
+    ``prior``: a batch's prior file (:func:`fleet`'s ``write_prior``): the
+    calibration is then the maximum a posteriori estimate and its accuracy
+    promise carries the prior's uncertainty, as ``--prior``.
     Options: ``params`` (``"paper15"`` or ``"full21"``), ``robust`` (reject
     gross readings, default True), ``tolerance_mm``, ``angle_noise_arcsec``,
     ``length_noise_um``, ``readings_per_pose``.
@@ -151,10 +163,43 @@ def identify(data, machine: Optional[PathLike] = None, **options) -> "Calibratio
     in the order of ``names``), ``to_json()`` (the CLI's ``--json``),
     ``report()`` and ``write_machine(path, force=False)``.
     """
+    extra = {}
+    if isinstance(data, (list, tuple)):
+        if not data:
+            raise InputError("data: an empty list of campaigns")
+        extra["campaigns"] = [os.fspath(p) for p in data[1:]]
+        data = data[0]
+    if prior is not None:
+        extra["prior"] = os.fspath(prior)
     return Calibration(
         _tricept.identify(
-            machine=None if machine is None else os.fspath(machine), **_data(data), **options
+            machine=None if machine is None else os.fspath(machine),
+            **_data(data),
+            **extra,
+            **options,
         )
+    )
+
+
+def fleet(data: Sequence[PathLike], machine: Optional[PathLike] = None, **options) -> "Fleet":
+    """Calibrates the machines of a batch together, one CSV path each, as
+    ``tricept fleet`` does: the batch mean and its uncertainty, the
+    machine-to-machine spread (REML), each machine with the batch as its
+    prior, the machines that do not belong. ``machine``: the batch's
+    nominal machine file. Options: ``params``, ``tolerance_mm``, ``solver``
+    (``"schur"``, ``"sparse-cholesky"``, ``"sparse-qr"`` or ``"dense"``).
+
+    Returns a :class:`Fleet`: ``exit_code`` (0, 3 or 4 as the CLI),
+    ``to_json()`` (the CLI's ``--json``: ``batch_mean_mm``,
+    ``batch_spread_mm``, ``machines``, ``outliers``, ``solver``, ...),
+    ``report()`` and ``write_prior(path, force=False)``.
+    """
+    if isinstance(data, (str, os.PathLike)):
+        raise InputError("data: a batch is a list of CSV paths, one per machine")
+    return _tricept.fleet(
+        [os.fspath(p) for p in data],
+        machine=None if machine is None else os.fspath(machine),
+        **options,
     )
 
 
