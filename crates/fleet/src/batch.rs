@@ -178,6 +178,41 @@ impl Batch {
         out
     }
 
+    /// The block problem of the joint fit's first step (the members at
+    /// their own estimates, the mean at the spread's): the normal
+    /// equations every solver kind solves, for benchmarks and peers.
+    pub fn first_step_problem(
+        &self,
+        model: &dyn ReadingModel,
+        sigma: [f64; 3],
+    ) -> Result<tricept_numerics::sparse::BlockProblem, FleetError> {
+        let r = self.identifiable.len();
+        let members: Vec<&MachineOutcome> = self.machines.iter().filter(|m| m.in_batch).collect();
+        let mut scales: Vec<Vec<f64>> = vec![vec![1.0; r]; members.len()];
+        scales.push(vec![1.0; r]);
+        let input = JointInput {
+            model,
+            data: members.iter().map(|m| &m.own.kept).collect(),
+            start: members
+                .iter()
+                .map(|m| {
+                    m.own
+                        .id
+                        .as_ref()
+                        .map_or_else(Vec::new, |id| id.estimate.clone())
+                })
+                .collect(),
+            identifiable: &self.identifiable,
+            spread_variance: &self.spread.variance,
+            mean_start: self.spread.mean.iter().copied().collect(),
+            scales,
+            sigma,
+            kind: SolverKind::Schur,
+            max_iterations: 1,
+        };
+        crate::joint::first_step_problem(&input)
+    }
+
     /// What the batch says of a new machine of it, before its data: the
     /// mean (all `k`) and, over the identifiable parameters, the covariance
     /// of a machine's parameters: its spread at the 95 % upper bound (the

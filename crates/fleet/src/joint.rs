@@ -315,12 +315,26 @@ fn nonzeros(point: &Point) -> usize {
         .sum()
 }
 
-/// The joint fit (module docs).
-pub fn fit(input: &JointInput<'_>) -> Result<JointFit, FleetError> {
-    let started = Instant::now();
+/// The block problem of the joint fit's first step, at its start (for
+/// benchmarks and peers: the same normal equations every solver kind
+/// sees).
+pub fn first_step_problem(input: &JointInput<'_>) -> Result<BlockProblem, FleetError> {
+    let (_, point) = start(input)?;
+    let r = input.identifiable.len();
+    Ok(BlockProblem {
+        n_global: r,
+        blocks: point.evaluated.into_iter().map(|e| e.block).collect(),
+    })
+}
+
+/// The layout of `input`'s unknowns and its first point evaluated.
+fn start<'a>(input: &'a JointInput<'a>) -> Result<(Layout<'a>, Point), FleetError> {
     let r = input.identifiable.len();
     let members = input.data.len();
-    if input.start.len() != members || input.scales.len() != members + 1 {
+    if input.start.len() != members
+        || input.scales.len() != members + 1
+        || input.spread_variance.len() != r
+    {
         return Err(FleetError::Input(
             "a joint fit's inputs of different lengths".into(),
         ));
@@ -356,7 +370,16 @@ pub fn fit(input: &JointInput<'_>) -> Result<JointFit, FleetError> {
         .iter()
         .map(|d| vec![None; d.poses.len()])
         .collect();
-    let mut point = evaluate_all(input, &layout, parameters, input.mean_start.clone(), seeds)?;
+    let point = evaluate_all(input, &layout, parameters, input.mean_start.clone(), seeds)?;
+    Ok((layout, point))
+}
+
+/// The joint fit (module docs).
+pub fn fit(input: &JointInput<'_>) -> Result<JointFit, FleetError> {
+    let started = Instant::now();
+    let r = input.identifiable.len();
+    let members = input.data.len();
+    let (layout, mut point) = start(input)?;
     let mut solve_seconds = 0.0;
     let mut stats = None;
     let mut converged = false;
