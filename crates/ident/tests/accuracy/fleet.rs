@@ -20,9 +20,9 @@
 //!   than any alone; a campaign taken after a leg slipped is named.
 //!
 //! The tallies (`#[ignore]`, `cargo test -p tricept-ident --test accuracy
-//! fleet:: -- --ignored --nocapture`) run more batches and measure how
-//! many poses a new machine needs with the prior for the accuracy an
-//! 80-pose campaign gives alone.
+//! fleet:: -- --ignored --nocapture`; `FLEET_SEED=103` runs one batch of
+//! it) run more batches and measure how many poses a new machine needs
+//! with the prior for the accuracy an 80-pose campaign gives alone.
 
 use std::path::{Path, PathBuf};
 
@@ -32,7 +32,7 @@ use serde_json::Value;
 use tricept_ident::advanced::ParameterSet;
 use tricept_ident::calibrate::{CalibrateRequest, calibrate};
 use tricept_ident::fleet::{FleetRequest, fleet};
-use tricept_ident::kinematics::{Machine, Vector3};
+use tricept_ident::kinematics::Machine;
 use tricept_ident::{DataInput, EXIT_INADEQUATE, EXIT_OK};
 use tricept_truth::{Row, SensorNoise, TrueMachine, normal, to_csv};
 
@@ -389,7 +389,10 @@ fn tally_of_batches_and_new_machines() {
     let dir = scratch("fleet-tally");
     let (mut named_right, mut named_wrong, mut batches) = (0, 0, 0);
     let (mut mean_within, mut spread_within, mut params) = (0, 0, 0);
-    for seed in 100..130u64 {
+    let only: Option<u64> = std::env::var("FLEET_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok());
+    for seed in (100..130u64).filter(|s| only.is_none_or(|o| o == *s)) {
         let pop = Population::new(seed);
         let faulty = (seed % 15) as usize;
         let fault = if names()[faulty] == "dyA3" {
@@ -413,6 +416,35 @@ fn tally_of_batches_and_new_machines() {
             .iter()
             .filter(|o| **o != files[0].display().to_string())
             .count();
+        if fault.is_some() != (outliers == vec![files[0].display().to_string()])
+            || outliers.len() > 1
+        {
+            let m0 = &json["machines"][0];
+            eprintln!(
+                "seed {seed}: fault {:?} ({}), named {} machine(s): {:?}; machine 0 distance {} deviates {}",
+                fault.map(|f| (names()[f.0].clone(), f.1)),
+                fault.map_or(String::new(), |f| format!("{:.3} mm spread", pop.tau[f.0])),
+                outliers.len(),
+                outliers
+                    .iter()
+                    .map(|o| o.rsplit('/').next().unwrap_or(o))
+                    .collect::<Vec<_>>(),
+                m0["distance"],
+                m0["deviates"]
+            );
+            if let Some((k, _)) = fault {
+                let n = &names()[k];
+                eprintln!(
+                    "  {n}: machine 0 {} (sd {}), batch mean {} spread {}, truth batch {:.4} machine 0 {:.4}",
+                    m0["estimates_mm"][n],
+                    m0["std_dev_mm"][n],
+                    json["batch_mean_mm"][n],
+                    json["batch_spread_mm"][n],
+                    pop.batch[k],
+                    pop.batch[k]
+                );
+            }
+        }
         let b = r.batch();
         let (mean, sd) = b.mean();
         for (a, &k) in b.identifiable.iter().enumerate() {
