@@ -44,7 +44,7 @@ pub(crate) struct InternalFit {
     /// The accuracy the calibrated machine file will deliver.
     pub promise: Accuracy,
     /// Several campaigns or a batch's prior: what pooling adds.
-    pub pooled: Option<Box<super::pooled::Pooled>>,
+    pub pooled: Option<Box<super::pooling::Pooled>>,
 }
 
 /// Identifies `set` from `dataset` against `loaded` (robust unless told

@@ -1,6 +1,7 @@
 //! Calibrate: identify the machine from the UP limb's sensors alone
-//! (`internal.rs`) or fused with external measurements that also calibrate
-//! the head (`fused.rs`); the verdict and its exit code, the accuracy the
+//! (`internal.rs`), from several campaigns or with a batch's prior
+//! (`pooled.rs`, `pooling.rs`), or fused with external measurements that
+//! also calibrate the head (`fused.rs`); the verdict and its exit code, the accuracy the
 //! calibration predicts, the advice of a campaign too small to calibrate
 //! (`advice.rs`), and the calibrated machine file with its record, written
 //! by the one write rule of every machine file (`machine_file.rs`).
@@ -14,6 +15,7 @@ mod advice;
 mod fused;
 mod internal;
 mod pooled;
+mod pooling;
 pub(crate) mod values;
 
 use std::path::{Path, PathBuf};
