@@ -69,7 +69,7 @@ pub fn run(a: &FleetArgs) -> Result<u8, CliError> {
         crate::output::write_text(&result.report());
     }
     if let Some((_, Err(e))) = written {
-        return Err(e.into());
+        return Err(e);
     }
     let code = result.exit_code();
     if code != 0 {

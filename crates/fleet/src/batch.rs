@@ -459,7 +459,7 @@ fn robust_scores(summaries: &[Summary], member: &[bool]) -> Vec<f64> {
         let centre = median(&mut values);
         let mut deviations: Vec<f64> = values.iter().map(|v| (v - centre).abs()).collect();
         let scale = 1.4826 * median(&mut deviations);
-        if !(scale > 0.0) {
+        if scale.is_nan() || scale <= 0.0 {
             continue;
         }
         for (i, s) in summaries.iter().enumerate() {
