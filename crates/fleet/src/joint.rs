@@ -238,11 +238,7 @@ type Step = (Vec<f64>, Vec<Vec<f64>>, SolveStats);
 
 /// The step at a point: globals and every member's locals, and the
 /// solve's statistics.
-fn step(
-    point: &Point,
-    input: &JointInput<'_>,
-    r: usize,
-) -> Result<Step, FleetError> {
+fn step(point: &Point, input: &JointInput<'_>, r: usize) -> Result<Step, FleetError> {
     if input.kind != SolverKind::Schur {
         let problem = BlockProblem {
             n_global: r,
