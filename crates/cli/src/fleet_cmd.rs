@@ -30,7 +30,7 @@ pub struct FleetArgs {
     pub tolerance_mm: f64,
     /// The factorisation of the joint fit: schur (block elimination, the
     /// fast path), sparse-cholesky, sparse-qr or dense (small batches).
-    #[arg(long, default_value = "schur", value_name = "KIND")]
+    #[arg(long, default_value = "schur", value_name = "KIND", value_parser = solver_kind)]
     pub solver: SolverKind,
     /// Write the batch's prior for a new machine of it (`identify
     /// --prior`), sealed, with its provenance.
@@ -40,6 +40,11 @@ pub struct FleetArgs {
     /// says so).
     #[arg(long, requires = "write_prior")]
     pub force: bool,
+}
+
+/// `--solver` as a solver kind (one line, exit 2, when unknown).
+fn solver_kind(name: &str) -> Result<SolverKind, CliError> {
+    name.parse().map_err(CliError::input)
 }
 
 /// `tricept fleet`.

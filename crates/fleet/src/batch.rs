@@ -527,6 +527,11 @@ fn screen_outliers(
                 }
             }
             let mut worst: Option<(usize, f64)> = None;
+            // The spread of the others needs at least MIN_MACHINES of them:
+            // a batch of three is not screened.
+            if order.len() <= MIN_MACHINES {
+                tested.clear();
+            }
             for &m in &tested {
                 let mut without = member.clone();
                 without[m] = false;
