@@ -112,8 +112,16 @@ impl Population {
 }
 
 /// A campaign of `n` random poses of `truth` (seed `seed`), written at
-/// `path` with a logged temperature `temp_c`.
-fn campaign(truth: &TrueMachine, n: usize, seed: u64, temp_c: Option<f64>, path: &Path) {
+/// `path` with a logged temperature `temp_c`; its sensors `noise` times
+/// noisier than the documented noise the data format states.
+fn campaign_with(
+    truth: &TrueMachine,
+    n: usize,
+    seed: u64,
+    temp_c: Option<f64>,
+    path: &Path,
+    noise: f64,
+) {
     let nominal = Machine::paper();
     let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0xca4b);
     let rows: Vec<Row> = nominal
@@ -123,12 +131,21 @@ fn campaign(truth: &TrueMachine, n: usize, seed: u64, temp_c: Option<f64>, path:
         .filter_map(|r| nominal.inverse(r).ok().map(|s| s.legs_mm))
         .map(|q| Row {
             commands_mm: q,
-            readings: truth.sensed(&truth.forward(&q), &SensorNoise::DOCUMENTED, &mut rng),
+            readings: truth.sensed(
+                &truth.forward(&q),
+                &SensorNoise::DOCUMENTED.times(noise),
+                &mut rng,
+            ),
             temp_c: temp_c.map(|t| t + 0.02 * normal(&mut rng)),
             directions: None,
         })
         .collect();
     std::fs::write(path, to_csv(&rows)).unwrap();
+}
+
+/// [`campaign_with`] at the documented noise.
+fn campaign(truth: &TrueMachine, n: usize, seed: u64, temp_c: Option<f64>, path: &Path) {
+    campaign_with(truth, n, seed, temp_c, path, 1.0);
 }
 
 /// `{name: value}` of a JSON object as numbers (`null` -> None).
@@ -146,11 +163,26 @@ fn batch(
     fault: Option<(usize, f64)>,
     dir: &Path,
 ) -> (tricept_ident::fleet::FleetResult, Vec<PathBuf>) {
+    batch_with(pop, seed, machines, poses, fault, None, dir)
+}
+
+/// [`batch`] with machine `noisy`'s sensors three times noisier than
+/// stated (its own data then do not fit).
+fn batch_with(
+    pop: &Population,
+    seed: u64,
+    machines: u64,
+    poses: usize,
+    fault: Option<(usize, f64)>,
+    noisy: Option<u64>,
+    dir: &Path,
+) -> (tricept_ident::fleet::FleetResult, Vec<PathBuf>) {
     let files: Vec<PathBuf> = (0..machines)
         .map(|i| {
             let path = dir.join(format!("b{seed}-m{i}.csv"));
             let t = pop.machine(seed, i, if i == 0 { fault } else { None });
-            campaign(&t, poses, seed * 100 + i, None, &path);
+            let noise = if noisy == Some(i) { 3.0 } else { 1.0 };
+            campaign_with(&t, poses, seed * 100 + i, None, &path, noise);
             path
         })
         .collect();
@@ -168,7 +200,9 @@ fn a_batch_is_estimated_in_truth_and_its_faulty_machine_named() {
     let names = names();
     let faulty = names.iter().position(|n| n == "dxA2").unwrap();
     let fault = 12.0 * pop.tau[faulty];
-    let (r, files) = batch(&pop, 47, 20, 80, Some((faulty, fault)), &dir);
+    // Machine 1's sensors are three times noisier than stated: its own
+    // data do not fit, and it is kept out (not an outlier).
+    let (r, files) = batch_with(&pop, 47, 21, 80, Some((faulty, fault)), Some(1), &dir);
     let json = r.to_json();
     assert_eq!(
         json["outliers"],
@@ -190,7 +224,24 @@ fn a_batch_is_estimated_in_truth_and_its_faulty_machine_named() {
         "{}",
         machines[0]
     );
-    for m in &machines[1..] {
+    let noisy = &machines[1];
+    assert_eq!(
+        (
+            noisy["in_batch"].clone(),
+            noisy["outlier"].clone(),
+            noisy["exit_code"].clone()
+        ),
+        (false.into(), false.into(), 3.into()),
+        "{noisy}"
+    );
+    assert!(
+        noisy["kept_out"]
+            .as_str()
+            .unwrap()
+            .contains("does not explain its own data"),
+        "{noisy}"
+    );
+    for m in &machines[2..] {
         assert_eq!(m["in_batch"], true, "{m}");
         assert!(m["deviates"].as_array().unwrap().is_empty(), "{m}");
     }
