@@ -200,7 +200,7 @@ impl Calibration {
 
 /// Identifies the machine from measured data (`tricept identify`).
 #[pyfunction]
-#[pyo3(signature = (path=None, csv_text=None, name="<arrays>".to_string(), machine=None, params="paper15".to_string(), robust=true, tolerance_mm=None, angle_noise_arcsec=None, length_noise_um=None, readings_per_pose=None))]
+#[pyo3(signature = (path=None, csv_text=None, name="<arrays>".to_string(), machine=None, params="paper15".to_string(), robust=true, tolerance_mm=None, angle_noise_arcsec=None, length_noise_um=None, readings_per_pose=None, campaigns=Vec::new(), prior=None))]
 #[allow(clippy::too_many_arguments)]
 fn identify(
     py: Python<'_>,
@@ -214,6 +214,8 @@ fn identify(
     angle_noise_arcsec: Option<f64>,
     length_noise_um: Option<f64>,
     readings_per_pose: Option<u32>,
+    campaigns: Vec<PathBuf>,
+    prior: Option<PathBuf>,
 ) -> PyResult<Calibration> {
     let noise = SensorNoise {
         angle_noise_arcsec,
@@ -237,6 +239,8 @@ fn identify(
     if let Some(t) = tolerance_mm {
         request.tolerance_mm = t;
     }
+    request.campaigns = campaigns.into_iter().map(DataInput::File).collect();
+    request.prior = prior;
     let inner = py
         .detach(|| tricept_ident::calibrate::calibrate(request))
         .map_err(|e| door_error_in(py, e, rows))?;
@@ -442,6 +446,71 @@ fn machine_of_file(py: Python<'_>, file_json: &str, source: String) -> PyResult<
         .map_err(|e| door_error(py, e))
 }
 
+/// A batch calibrated together (`tricept fleet`).
+#[pyclass(module = "tricept._tricept", frozen)]
+struct Fleet {
+    inner: tricept_ident::fleet::FleetResult,
+}
+
+#[pymethods]
+impl Fleet {
+    /// 0 every machine fits and belongs, 3 a machine is kept out or the
+    /// batch is not one population, 4 not converged: the CLI's exit code.
+    #[getter]
+    fn exit_code(&self) -> u8 {
+        self.inner.exit_code()
+    }
+
+    /// The JSON `tricept fleet --json` prints.
+    fn to_json(&self) -> String {
+        self.inner.to_json().to_string()
+    }
+
+    /// The text report `tricept fleet` prints.
+    fn report(&self) -> String {
+        self.inner.report()
+    }
+
+    /// Writes the batch's prior (`--write-prior`) by the CLI's rule:
+    /// `UntrustedError` when the batch is not to be trusted, unless
+    /// `force`. Returns why it was forced, if it was.
+    #[pyo3(signature = (path, force=false))]
+    fn write_prior(&self, py: Python<'_>, path: PathBuf, force: bool) -> PyResult<Option<String>> {
+        self.inner
+            .write_prior(&path, force)
+            .map_err(|e| door_error(py, e))
+    }
+}
+
+/// Calibrates a batch of machines together, one data file each
+/// (`tricept fleet`).
+#[pyfunction]
+#[pyo3(signature = (paths, machine=None, params="paper15".to_string(), tolerance_mm=None, solver="schur".to_string()))]
+fn fleet(
+    py: Python<'_>,
+    paths: Vec<PathBuf>,
+    machine: Option<Bound<'_, PyAny>>,
+    params: String,
+    tolerance_mm: Option<f64>,
+    solver: String,
+) -> PyResult<Fleet> {
+    let mut request =
+        tricept_ident::fleet::FleetRequest::new(paths.into_iter().map(DataInput::File).collect());
+    request.machine = machine_input(py, machine.as_ref(), SensorNoise::default())?;
+    request.parameter_set =
+        ParameterSet::by_label(&params).map_err(|e| input_error(py, format!("params: {e}")))?;
+    if let Some(t) = tolerance_mm {
+        request.tolerance_mm = t;
+    }
+    request.solver = solver
+        .parse()
+        .map_err(|e: String| input_error(py, format!("solver: {e}")))?;
+    let inner = py
+        .detach(|| tricept_ident::fleet::fleet(request))
+        .map_err(|e| door_error(py, e))?;
+    Ok(Fleet { inner })
+}
+
 /// Writes the page of a calibrated machine (`tricept report`); returns the
 /// verdict's JSON (`tricept report --json`) with the exit code.
 #[pyfunction]
@@ -471,7 +540,9 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Calibration>()?;
     m.add_class::<Diagnosis>()?;
     m.add_class::<CheckResult>()?;
+    m.add_class::<Fleet>()?;
     m.add_function(wrap_pyfunction!(identify, m)?)?;
+    m.add_function(wrap_pyfunction!(fleet, m)?)?;
     m.add_function(wrap_pyfunction!(diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_csv, m)?)?;

@@ -143,3 +143,38 @@ def test_report_writes_the_cli_page(cli, tmp_path):
     assert (tmp_path / "py.html").read_bytes() == (tmp_path / "cli.html").read_bytes()
     with pytest.raises(tricept.InputError, match="not the campaign of this calibration"):
         tricept.report(machine, tmp_path / "x.html", data=HIDDEN)
+
+
+def test_fleet_and_a_new_machine_from_its_prior_equal_the_cli(cli, tmp_path):
+    # Four machines with their own errors, 40 poses each, simulated by the CLI.
+    paths = []
+    for i in range(1, 5):
+        p = tmp_path / f"m{i}.csv"
+        cli("simulate", "--truth", f"random:0.1,{i}", "--poses", f"random:40,{i}", "--seed", str(i), "--out", p)
+        paths.append(p)
+    code, expected = cli_json(cli, "fleet", "--data", *paths)
+    batch = tricept.fleet(paths)
+    assert batch.exit_code == code
+    got = json.loads(batch.to_json())
+    for key in ("batch_mean_mm", "batch_mean_sd_mm", "batch_spread_mm", "outliers", "held"):
+        assert got[key] == expected[key], key
+    assert [m["estimates_mm"] for m in got["machines"]] == [m["estimates_mm"] for m in expected["machines"]]
+    assert got["solver"]["kind"] == "schur" and got["solver"]["readings"] == 4 * 40 * 3
+    prior = tmp_path / "prior.json"
+    batch.write_prior(prior)
+    new = tmp_path / "new.csv"
+    cli("simulate", "--truth", "random:0.1,9", "--poses", "random:12,9", "--seed", "9", "--out", new)
+    code, expected = cli_json(cli, "identify", "--data", new, "--prior", prior)
+    c = tricept.identify(new, prior=prior)
+    assert c.exit_code == code
+    assert json.loads(c.to_json())["estimates_mm"] == expected["estimates_mm"]
+    assert json.loads(c.to_json())["prior"]["file"] == str(prior)
+    # Two campaigns of one machine, pooled as --data twice.
+    again = tmp_path / "again.csv"
+    cli("simulate", "--truth", "random:0.1,9", "--poses", "random:40,10", "--seed", "10", "--out", again)
+    code, expected = cli_json(cli, "identify", "--data", new, "--data", again)
+    pooled = tricept.identify([new, again])
+    assert pooled.exit_code == code
+    assert [x["data_file"] for x in json.loads(pooled.to_json())["campaigns"]] == [str(new), str(again)]
+    with pytest.raises(tricept.InputError):
+        tricept.fleet(paths[0])

@@ -41,7 +41,9 @@ __all__ = [
     "Calibration",
     "Diagnosis",
     "CheckResult",
+    "Fleet",
     "identify",
+    "fleet",
     "diagnose",
     "check",
     "simulate",
@@ -376,15 +378,21 @@ def _check_from_state(state: Dict[str, Any]) -> CheckResult:
     return CheckResult(_Frozen(state))
 
 
-def identify(data, machine=None, **options) -> Calibration:
+def identify(data, machine=None, prior: Optional[PathLike] = None, **options) -> Calibration:
     """Identifies the machine's geometric errors from measured data, as
     ``tricept identify`` does.
 
-    ``data``: a CSV path, or a mapping of the CSV's column names
+    ``data``: a CSV path, a mapping of the CSV's column names
     (``q1, q2, q3, phi, theta, s`` and the optional ones) to 1-D arrays (a
-    pandas DataFrame is one).
+    pandas DataFrame is one), or a list of CSV paths: campaigns of the same
+    machine, pooled (the geometry shared, each campaign with its own sensor
+    offsets; the ``campaigns`` entry of ``to_json()`` lists each one's
+    offsets, chi-square and agreement), as ``--data`` given several times.
     ``machine``: a machine file or a :class:`Machine` (default: the
     built-in Table 1 machine).
+    ``prior``: a batch's prior file (:func:`fleet`'s ``write_prior``): the
+    calibration is then the maximum a posteriori estimate and its accuracy
+    promise carries the prior's uncertainty, as ``--prior``.
     Options: ``params`` (``"paper15"`` or ``"full21"``), ``robust`` (reject
     gross readings, default True), ``tolerance_mm``, ``angle_noise_arcsec``,
     ``length_noise_um``, ``readings_per_pose``.
@@ -394,8 +402,77 @@ def identify(data, machine=None, **options) -> Calibration:
     in the order of ``names``), ``to_json()`` (the CLI's ``--json``),
     ``report()``, ``write_machine(path, force=False)`` and ``machine``.
     """
+    extra: Dict[str, Any] = {}
+    if isinstance(data, (list, tuple)):
+        if not data:
+            raise InputError("data: an empty list of campaigns")
+        extra["campaigns"] = [os.fspath(p) for p in data[1:]]
+        data = data[0]
+    if prior is not None:
+        extra["prior"] = os.fspath(prior)
     return Calibration(
-        _tricept.identify(machine=_machine_arg(machine), **_data(data), **_int_options(options))
+        _tricept.identify(
+            machine=_machine_arg(machine), **_data(data), **extra, **_int_options(options)
+        )
+    )
+
+
+class Fleet:
+    """A batch calibrated together (``tricept fleet``): ``exit_code`` (0,
+    3 or 4 as the CLI), ``to_json()`` (the CLI's ``--json``), ``report()``
+    and ``write_prior(path, force=False)``."""
+
+    __slots__ = ("_f",)
+
+    def __init__(self, compiled):
+        self._f = compiled
+
+    @property
+    def exit_code(self) -> int:
+        return self._f.exit_code
+
+    def to_json(self) -> str:
+        """The JSON ``tricept fleet --json`` prints."""
+        return self._f.to_json()
+
+    def report(self) -> str:
+        """The report ``tricept fleet`` prints."""
+        return self._f.report()
+
+    def write_prior(self, path: PathLike, force: bool = False) -> Optional[str]:
+        """Writes the batch's prior file (``--write-prior``) by the CLI's
+        rule (:class:`UntrustedError` when the batch is not to be trusted,
+        unless ``force``); returns why it was forced, if it was."""
+        return self._f.write_prior(os.fspath(path), force)
+
+    def __repr__(self) -> str:
+        j = json.loads(self.to_json())
+        return (
+            f"Fleet(exit_code={self.exit_code}, machines={len(j.get('machines', []))}, "
+            f"outliers={j.get('outliers')!r})"
+        )
+
+
+def fleet(data: Sequence[PathLike], machine=None, **options) -> Fleet:
+    """Calibrates the machines of a batch together, one CSV path each, as
+    ``tricept fleet`` does: the batch mean and its uncertainty, the
+    machine-to-machine spread (REML), each machine with the batch as its
+    prior, the machines that do not belong. ``machine``: the batch's
+    nominal machine file or :class:`Machine`. Options: ``params``,
+    ``tolerance_mm``, ``solver`` (``"schur"``, ``"sparse-cholesky"``,
+    ``"sparse-qr"`` or ``"dense"``).
+
+    Returns a :class:`Fleet`: ``exit_code`` (0, 3 or 4 as the CLI),
+    ``to_json()`` (the CLI's ``--json``: ``batch_mean_mm``,
+    ``batch_spread_mm``, ``machines``, ``outliers``, ``solver``, ...),
+    ``report()`` and ``write_prior(path, force=False)``.
+    """
+    if isinstance(data, (str, os.PathLike)):
+        raise InputError("data: a batch is a list of CSV paths, one per machine")
+    return Fleet(
+        _tricept.fleet(
+            [os.fspath(p) for p in data], machine=_machine_arg(machine), **options
+        )
     )
 
 

@@ -19,10 +19,13 @@ __all__ = [
     "Calibration",
     "Diagnosis",
     "CheckResult",
+    "Fleet",
     "identify",
+    "fleet",
     "diagnose",
     "check",
     "simulate",
+    "report",
 ]
 
 PathLike = Union[str, os.PathLike[str]]
@@ -116,9 +119,29 @@ class CheckResult:
     def to_json(self) -> str: ...
     def report(self) -> str: ...
 
-def identify(
-    data: _Data,
+class Fleet:
+    """A batch calibrated together (tricept fleet)."""
+
+    @property
+    def exit_code(self) -> int: ...
+    def to_json(self) -> str: ...
+    def report(self) -> str: ...
+    def write_prior(self, path: PathLike, force: bool = False) -> Optional[str]: ...
+
+def fleet(
+    data: Sequence[PathLike],
     machine: Optional[_MachineArg] = None,
+    *,
+    params: str = "paper15",
+    tolerance_mm: Optional[float] = None,
+    solver: str = "schur",
+) -> Fleet:
+    """The machines of a batch calibrated together (tricept fleet)."""
+
+def identify(
+    data: Union[_Data, Sequence[PathLike]],
+    machine: Optional[_MachineArg] = None,
+    prior: Optional[PathLike] = None,
     *,
     params: str = "paper15",
     robust: bool = True,

@@ -896,6 +896,7 @@ const DOOR_ROOT: &[&str] = &[
     "diagnosis",
     "effects",
     "export",
+    "fleet",
     "identifiability",
     "kinematics",
     "plan",

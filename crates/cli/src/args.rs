@@ -260,9 +260,16 @@ impl FitSettings {
 /// `tricept identify`.
 #[derive(Debug, Args)]
 pub struct IdentifyArgs {
-    /// Measured-data CSV (see docs/data-format.md).
-    #[arg(long, value_name = "FILE.csv")]
-    pub data: PathBuf,
+    /// Measured-data CSV (see docs/data-format.md); given again, more
+    /// campaigns of the same machine, pooled: the geometry shared, each
+    /// campaign with its own sensor offsets (docs/fleet.md).
+    #[arg(long, value_name = "FILE.csv", required = true, num_args = 1..)]
+    pub data: Vec<PathBuf>,
+    /// A batch's prior (`tricept fleet --write-prior`): a new machine of
+    /// the batch calibrates from few poses, the prior's uncertainty in its
+    /// accuracy promise (docs/fleet.md).
+    #[arg(long, value_name = "PRIOR.json")]
+    pub prior: Option<PathBuf>,
     #[command(flatten)]
     pub settings: FitSettings,
     /// Also write the calibrated machine as a description file (loadable

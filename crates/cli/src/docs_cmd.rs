@@ -17,7 +17,7 @@ pub struct DocsArgs {
 }
 
 /// Every page: name, what it holds, text (Markdown).
-const PAGES: [(&str, &str, &str); 13] = [
+const PAGES: [(&str, &str, &str); 14] = [
     (
         "data-format",
         "the measured-data CSV, the external measurements, the machine JSON, every output file (columns, keys, units)",
@@ -57,6 +57,11 @@ const PAGES: [(&str, &str, &str); 13] = [
         "controllers",
         "`tricept export`: the compensation files of Sinumerik, Fanuc and Heidenhain controls, signs, units, limits, format errors",
         include_str!("../../../docs/controllers.md"),
+    ),
+    (
+        "fleet",
+        "pooled calibration: several campaigns of a machine, a batch of machines (the hierarchical model, its tests), a new machine from the batch's prior, the sparse solvers",
+        include_str!("../../../docs/fleet.md"),
     ),
     (
         "reliability",

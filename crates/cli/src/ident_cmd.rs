@@ -52,7 +52,15 @@ pub fn run_identifiability(a: &IdentifiabilityArgs) -> Result<u8, CliError> {
 
 /// The door's request of `identify`'s flags.
 pub fn calibrate_request(a: &IdentifyArgs) -> CalibrateRequest {
-    let mut request = a.settings.request(&a.data);
+    let (first, more) = a
+        .data
+        .split_first()
+        .map_or((None, &[][..]), |(f, m)| (Some(f), m));
+    let mut request = a
+        .settings
+        .request(first.map_or(std::path::Path::new(""), |p| p.as_path()));
+    request.campaigns = more.iter().cloned().map(DataInput::File).collect();
+    request.prior = a.prior.clone();
     request.fused = a.external.any().then(|| a.external.sources());
     request.for_machine_file = a.write_machine.is_some();
     request
@@ -67,7 +75,9 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
     }
     let spin = crate::args::spinner(
         "identify: reading, screening and fitting (Gauss-Newton on the exact model)",
-        &a.data,
+        a.data
+            .first()
+            .map_or(std::path::Path::new(""), |p| p.as_path()),
     );
     let calibration = calibrate(calibrate_request(a));
     spin.finish_and_clear();

@@ -30,6 +30,7 @@ mod docs_cmd;
 mod effects_cmd;
 mod export_cmd;
 mod files;
+mod fleet_cmd;
 mod ident_cmd;
 mod kinematics_cmd;
 mod output;
@@ -163,6 +164,15 @@ enum Command {
         after_help = "The keys are the simulator's inputs, in the units a machine builder quotes; the diagnosis fits its own parameters (`tricept docs diagnosis`).\n\nExamples:\n  tricept effects\n  tricept effects compliance\n  tricept effects --json | head -1"
     )]
     Effects(effects_cmd::EffectsArgs),
+    /// A batch of machines calibrated together: the batch's systematic
+    /// error and its spread, each machine with the batch as its prior, the
+    /// machines that do not belong, and the prior a new machine calibrates
+    /// from (`identify --prior`).
+    #[command(
+        allow_negative_numbers = true,
+        after_help = "A hierarchical model: each machine's errors are the batch mean plus its own deviation (spread estimated by REML); every reading of every machine in one fit on a sparse solver. A machine whose own data do not fit, or whose estimate lies beyond the spread (a chi-square test against the others, docs/fleet.md), is named and kept out.\n\nExit codes: 0 every machine fits and belongs; 3 a machine is kept out (named), or the batch is not one population; 4 the joint fit did not converge; 2 bad input (fewer than three machines whose data fit).\n\nExamples:\n  tricept fleet --data m1.csv --data m2.csv --data m3.csv --data m4.csv\n  tricept fleet --data m*.csv --json --write-prior batch.json && tricept identify --data new.csv --prior batch.json --write-machine new.json"
+    )]
+    Fleet(fleet_cmd::FleetArgs),
     /// Compensation files a CNC control loads (Sinumerik, Fanuc,
     /// Heidenhain) from a calibrated machine file, with the format error.
     #[command(
@@ -219,7 +229,8 @@ fn file_roles(command: &Command) -> files::FileRoles {
         }
         Command::Identify(a) => {
             machine(&mut r, &a.settings.machine);
-            r.input("--data", &a.data);
+            r.inputs("--data", &a.data);
+            r.inputs("--prior", &a.prior);
             let x = &a.external;
             r.inputs("--tracker", &x.tracker);
             r.inputs("--ballbar", &x.ballbar);
@@ -302,6 +313,13 @@ fn file_roles(command: &Command) -> files::FileRoles {
             }
             r.output("--out", &a.out);
         }
+        Command::Fleet(a) => {
+            machine(&mut r, &a.machine);
+            r.inputs("--data", &a.data);
+            if let Some(p) = &a.write_prior {
+                r.output("--write-prior", p);
+            }
+        }
         Command::Plan(a) => {
             machine(&mut r, &a.machine);
             r.inputs("--data", &a.data);
@@ -346,6 +364,7 @@ fn run(cli: Cli) -> Result<u8, CliError> {
         Command::Check(a) => check_cmd::run(&a),
         Command::Export(a) => export_cmd::run(&a),
         Command::Report(a) => report_cmd::run(&a),
+        Command::Fleet(a) => fleet_cmd::run(&a),
     }
 }
 

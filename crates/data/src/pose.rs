@@ -50,6 +50,11 @@ pub struct MeasuredPose {
     pub approach: Option<[i8; 3]>,
     /// Line of the source file the pose came from (1-based; 0 if none).
     pub line: u64,
+    /// The campaign of a pooled data set the pose belongs to (0 for a
+    /// single file; no CSV column): the poses of one campaign share the
+    /// sensors' zero offsets, every campaign has its own (the encoders and
+    /// the scale are homed again between campaigns).
+    pub campaign: u32,
 }
 
 /// A set of logged poses and where they came from.

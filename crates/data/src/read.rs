@@ -348,6 +348,7 @@ fn parse_row(record: &Record, c: &Columns, header: &Header) -> Result<MeasuredPo
         time_s,
         approach,
         line: record.line,
+        campaign: 0,
     })
 }
 

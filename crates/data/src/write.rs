@@ -107,6 +107,7 @@ mod tests {
                     time_s: Some(10.0 * k as f64),
                     approach: Some([1, -1, if k % 2 == 0 { 1 } else { -1 }]),
                     line: 0,
+                    campaign: 0,
                 })
                 .collect(),
             source: "mem".into(),

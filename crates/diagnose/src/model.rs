@@ -237,6 +237,12 @@ impl ReadingModel for ExtendedModel {
             .as_deref()
             .map(|m| m as &dyn ReadingModel)
     }
+
+    /// The geometric model's prior (a batch's), the terms not covered.
+    fn prior(&self) -> Option<tricept_engine::Prior> {
+        let geometric = self.geometric.prior()?;
+        Some(geometric.padded(self.names.len() - geometric.parameters()))
+    }
 }
 
 /// Step of the central differences for class-2 parameters (arcsec, um).

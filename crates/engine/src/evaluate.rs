@@ -2,6 +2,8 @@
 //! Jacobians and the reduced weighted problem, in blocks of
 //! [`EVALUATION_BLOCK`] poses (in parallel beyond one block, the blocks'
 //! factors merged in block order: the same bits at any thread count).
+//! The nuisance columns are the sensor offsets, three per campaign
+//! ([`Campaigns`]); a model's prior adds its rows last ([`crate::Prior`]).
 
 use rayon::prelude::*;
 use tricept_data::MeasuredPose;
@@ -9,12 +11,14 @@ use tricept_kinematics::UpJoints;
 use tricept_numerics::linalg::TriangularAccumulator;
 use tricept_numerics::lsq::ReducedProblem;
 
+use crate::campaigns::Campaigns;
 use crate::error::IdentError;
 use crate::model::{PosePredictor, ReadingModel};
 
 /// One evaluation of the model at fixed parameters over all poses.
 pub(crate) struct Evaluation {
-    /// The reduced weighted problem `[offsets | parameters | y - g(p)]`.
+    /// The reduced weighted problem `[offsets | parameters | y - g(p)]`,
+    /// with the prior's rows when the model has one.
     pub problem: ReducedProblem,
     /// `y - g(p)` per pose (rad, rad, mm).
     pub residuals: Vec<[f64; 3]>,
@@ -39,9 +43,23 @@ pub(crate) fn evaluate(
     seeds: &mut [Option<UpJoints>],
 ) -> Result<Evaluation, IdentError> {
     let k = model.names().len();
+    let campaigns = Campaigns::of(poses);
+    let nn = campaigns.nuisance();
     let predictor = model.at(p);
     let block = |first: usize, poses: &[MeasuredPose], seeds: &mut [Option<UpJoints>]| {
-        evaluate_block(&*predictor, k, first, poses, sigma, pose_weights, seeds)
+        let layout = Layout {
+            k,
+            campaigns: &campaigns,
+        };
+        evaluate_block(
+            &*predictor,
+            &layout,
+            first,
+            poses,
+            sigma,
+            pose_weights,
+            seeds,
+        )
     };
     let blocks: Vec<Result<Block, IdentError>> = if poses.len() <= EVALUATION_BLOCK {
         vec![block(0, poses, seeds)]
@@ -62,11 +80,12 @@ pub(crate) fn evaluate(
         residuals.extend(b.residuals);
         factors.push(b.r);
     }
-    let r = match factors.pop() {
-        Some(r) if factors.is_empty() => r,
-        last => {
-            let n = 3 + k + 1;
-            let mut acc = TriangularAccumulator::with_rows_hint(n, n * (factors.len() + 1));
+    let prior = model.prior().map(|prior| prior.problem_rows(nn, p));
+    let r = match (factors.pop(), &prior) {
+        (Some(r), None) if factors.is_empty() => r,
+        (last, _) => {
+            let n = nn + k + 1;
+            let mut acc = TriangularAccumulator::with_rows_hint(n, n * (factors.len() + 2));
             let mut row = vec![0.0; n];
             for f in factors.iter().chain(&last) {
                 for i in 0..f.nrows() {
@@ -74,14 +93,17 @@ pub(crate) fn evaluate(
                     acc.push_row(&row);
                 }
             }
+            for extra in prior.iter().flatten() {
+                acc.push_row(extra);
+            }
             acc.finish()
         }
     };
     Ok(Evaluation {
         problem: ReducedProblem {
-            rows,
+            rows: rows + prior.map_or(0, |p| p.len()),
             r,
-            n_nuisance: 3,
+            n_nuisance: nn,
             k,
         },
         residuals,
@@ -117,22 +139,33 @@ struct Block {
     residuals: Vec<[f64; 3]>,
 }
 
+/// The columns of an evaluation's rows: `k` parameters after three
+/// offsets per campaign.
+struct Layout<'a> {
+    k: usize,
+    campaigns: &'a Campaigns,
+}
+
 /// The poses `first..first + poses.len()` of an evaluation.
 fn evaluate_block(
     predictor: &dyn PosePredictor,
-    k: usize,
+    layout: &Layout<'_>,
     first: usize,
     poses: &[MeasuredPose],
     sigma: &[f64; 3],
     pose_weights: Option<&[f64]>,
     seeds: &mut [Option<UpJoints>],
 ) -> Result<Block, IdentError> {
-    let mut acc = TriangularAccumulator::with_rows_hint(3 + k + 1, 3 * poses.len());
+    let k = layout.k;
+    let nn = layout.campaigns.nuisance();
+    let mut acc = TriangularAccumulator::with_rows_hint(nn + k + 1, 3 * poses.len());
     let mut jac = vec![0.0; 3 * k];
-    let mut row = vec![0.0; 3 + k + 1];
+    let mut row = vec![0.0; nn + k + 1];
     let mut residuals = Vec::with_capacity(poses.len());
     for ((i, pose), seed) in poses.iter().enumerate().zip(seeds.iter_mut()) {
         let j = first + i;
+        // Every pose's campaign is among the campaigns of the poses.
+        let offsets = 3 * layout.campaigns.index(pose).unwrap_or(0);
         let g =
             predictor
                 .predict(pose, seed, &mut jac)
@@ -148,11 +181,11 @@ fn evaluate_block(
             res[c] = y[c] - g[c];
             let w = w_pose / sigma[c];
             row.iter_mut().for_each(|v| *v = 0.0);
-            row[c] = w;
+            row[offsets + c] = w;
             for t in 0..k {
-                row[3 + t] = w * jac[c * k + t];
+                row[nn + t] = w * jac[c * k + t];
             }
-            row[3 + k] = w * res[c];
+            row[nn + k] = w * res[c];
             acc.push_row(&row);
         }
         residuals.push(res);

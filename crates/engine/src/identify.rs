@@ -28,11 +28,13 @@ use serde_json::{Map, Value};
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_kinematics::UpJoints;
 
+use crate::campaigns::Campaigns;
 use crate::error::IdentError;
 use crate::evaluate::{Evaluation, evaluate};
 use crate::gauss_newton::{Iteration, Run, iterate};
 use crate::model::ReadingModel;
 use crate::options::IdentifyOptions;
+use crate::prior::{Prior, PriorFit};
 use crate::report::{IdentifiabilityReport, NamedValues};
 use tricept_numerics::lsq::{RankDecision, ReducedProblem};
 
@@ -209,9 +211,11 @@ impl Design {
 pub struct ResidualStats {
     /// RMS of the residuals `[phi, theta, s]` (rad, rad, mm).
     pub rms: [f64; 3],
-    /// Weighted sum of squared residuals (chi-square).
+    /// Weighted sum of squared residuals (chi-square), the prior's share
+    /// included when the model has one ([`Identification::prior_fit`]).
     pub chi_square: f64,
-    /// Degrees of freedom: readings - identified parameters - 3 offsets.
+    /// Degrees of freedom: readings - identified parameters - 3 offsets
+    /// per campaign (+ the parameters a prior covers).
     pub dof: usize,
     /// `chi_square / dof`: about 1 when the model and noise levels are right.
     pub reduced_chi_square: f64,
@@ -249,10 +253,16 @@ pub struct Identification {
     /// Covariance of the parameters (`k x k`, zero rows and columns for
     /// fixed parameters), in the parameters' units squared.
     pub covariance: DMatrix<f64>,
-    /// Estimated sensor zero offsets `[phi, theta, s]` (rad, rad, mm).
+    /// Estimated sensor zero offsets `[phi, theta, s]` (rad, rad, mm) of
+    /// the first campaign (the only one of a single file).
     pub offsets: [f64; 3],
     /// Their standard deviations.
     pub offsets_std_dev: [f64; 3],
+    /// Every campaign's offsets, ascending campaign number (one entry for
+    /// a single file, equal to `offsets`).
+    pub campaign_offsets: Vec<CampaignOffsets>,
+    /// The prior's share of the chi-square, when the model has a prior.
+    pub prior_fit: Option<PriorFit>,
     /// Identifiability of the problem at the starting point.
     pub report: IdentifiabilityReport,
     /// Residuals `y - g(p) - c` of every pose (rad, rad, mm).
@@ -267,17 +277,30 @@ pub struct Identification {
     pub lines: Vec<u64>,
     /// The rank decision taken at the start and used throughout.
     design: Design,
-    /// Covariance of `[offsets | parameters]` (`3 + k` square), for the
-    /// gross-error screen's hat matrix.
+    /// Covariance of `[offsets | parameters]` (`3 c + k` square, three
+    /// offsets per campaign), for the gross-error screen's hat matrix.
     pub(crate) full_covariance: faer::Mat<f64>,
+    /// The campaigns fitted, whose offsets come first in `full_covariance`.
+    pub(crate) campaigns: Campaigns,
+}
+
+/// One campaign's sensor zero offsets in a fit.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct CampaignOffsets {
+    /// The campaign ([`tricept_data::MeasuredPose::campaign`]).
+    pub campaign: u32,
+    /// `[phi, theta, s]` (rad, rad, mm).
+    pub offsets: [f64; 3],
+    /// Their standard deviations.
+    pub std_dev: [f64; 3],
 }
 
 /// Checks that there are enough readings, and enough distinct poses, for
 /// the unknowns: repeated commands average the noise but add no geometry.
-fn check_size(poses: &[MeasuredPose], k: usize) -> Result<(), IdentError> {
+fn check_size(poses: &[MeasuredPose], k: usize, prior_rows: usize) -> Result<(), IdentError> {
     let n_poses = poses.len();
-    let unknowns = k + 3;
-    let needed = unknowns.div_ceil(3) + 1;
+    let unknowns = (k + Campaigns::of(poses).nuisance()).saturating_sub(prior_rows);
+    let needed = (unknowns.div_ceil(3) + 1).max(2);
     if 3 * n_poses < unknowns + 1 {
         return Err(IdentError::TooFewPoses {
             poses: n_poses,
@@ -416,7 +439,8 @@ pub(crate) fn fit(
     let names = model.names().to_vec();
     let k = names.len();
     let poses = &data.poses;
-    check_size(poses, k)?;
+    let prior = model.prior();
+    check_size(poses, k, prior.as_ref().map_or(0, Prior::dimension))?;
     let mismatch = |what: &str, found: usize, expected: usize| {
         IdentError::Invalid(format!("{found} {what} for {expected}"))
     };
@@ -495,12 +519,15 @@ pub(crate) fn fit(
     };
     iterate(&problem, &mut state, &decision, options.max_iterations);
 
-    let lines = poses.iter().map(|p| p.line).collect();
     let seeds = std::mem::take(&mut state.state);
-    Ok((
-        finish(names, state, decision, report, options, weights, lines),
-        seeds,
-    ))
+    let fitted = Fitted {
+        decision,
+        report,
+        weights,
+        poses,
+        prior,
+    };
+    Ok((finish(names, state, fitted, options), seeds))
 }
 
 /// The fixed parts of an identification problem.
@@ -531,14 +558,21 @@ impl Iteration for Problem<'_> {
     }
 }
 
+/// What a fit was made of besides its iteration: the rank decision and
+/// report, the pose weights, the poses and the model's prior.
+struct Fitted<'a> {
+    decision: RankDecision,
+    report: IdentifiabilityReport,
+    weights: Option<&'a [f64]>,
+    poses: &'a [MeasuredPose],
+    prior: Option<Prior>,
+}
+
 fn finish(
     names: Vec<String>,
     state: Run<Vec<Option<UpJoints>>, Evaluation>,
-    decision: RankDecision,
-    report: IdentifiabilityReport,
+    fitted: Fitted<'_>,
     options: &IdentifyOptions,
-    weights: Option<&[f64]>,
-    lines: Vec<u64>,
 ) -> Identification {
     let Run {
         p,
@@ -548,7 +582,16 @@ fn finish(
         converged,
         ..
     } = state;
+    let Fitted {
+        decision,
+        report,
+        weights,
+        poses,
+        prior,
+    } = fitted;
     let k = names.len();
+    let campaigns = Campaigns::of(poses);
+    let nn = campaigns.nuisance();
     // The iteration ends on an evaluated point: its step is zero (and the
     // offsets re-fitted at p), except for the linearised estimator
     // (`max_iterations` 0), whose one step from the start is its estimate.
@@ -557,26 +600,36 @@ fn finish(
         .zip(&solution.parameters)
         .map(|(a, b)| a + b)
         .collect();
-    let offsets = [
-        solution.nuisance[0],
-        solution.nuisance[1],
-        solution.nuisance[2],
-    ];
-    let offsets_std_dev = [0, 1, 2].map(|c| solution.covariance[(c, c)].max(0.0).sqrt());
+    let campaign_offsets: Vec<CampaignOffsets> = campaigns
+        .ids()
+        .iter()
+        .enumerate()
+        .map(|(i, &campaign)| CampaignOffsets {
+            campaign,
+            offsets: std::array::from_fn(|c| solution.nuisance[3 * i + c]),
+            std_dev: std::array::from_fn(|c| {
+                solution.covariance[(3 * i + c, 3 * i + c)].max(0.0).sqrt()
+            }),
+        })
+        .collect();
     let std_dev = (0..k)
         .map(|j| {
             if decision.fixed.contains(&j) {
                 None
             } else {
-                Some(solution.covariance[(3 + j, 3 + j)].max(0.0).sqrt())
+                Some(solution.covariance[(nn + j, nn + j)].max(0.0).sqrt())
             }
         })
         .collect();
-    let covariance = DMatrix::from_fn(k, k, |a, b| solution.covariance[(3 + a, 3 + b)]);
+    let covariance = DMatrix::from_fn(k, k, |a, b| solution.covariance[(nn + a, nn + b)]);
     let residuals: Vec<[f64; 3]> = eval
         .residuals
         .iter()
-        .map(|r| [0, 1, 2].map(|c| r[c] - offsets[c]))
+        .zip(poses)
+        .map(|(r, pose)| {
+            let o = &campaign_offsets[campaigns.index(pose).unwrap_or(0)].offsets;
+            [0, 1, 2].map(|c| r[c] - o[c])
+        })
         .collect();
     let n = residuals.len().max(1) as f64;
     let rms = [0, 1, 2].map(|c| (residuals.iter().map(|r| r[c] * r[c]).sum::<f64>() / n).sqrt());
@@ -592,14 +645,23 @@ fn finish(
             }
         }
     }
-    let dof = (3 * residuals.len()).saturating_sub(decision.rank + 3);
+    let prior_fit = prior.map(|prior| PriorFit {
+        chi_square: prior.chi_square(&estimate),
+        dof: prior.dimension(),
+    });
+    chi_square += prior_fit.map_or(0.0, |f| f.chi_square);
+    let dof =
+        (3 * residuals.len() + prior_fit.map_or(0, |f| f.dof)).saturating_sub(decision.rank + nn);
+    let lines = poses.iter().map(|p| p.line).collect();
     Identification {
         names,
         estimate,
         std_dev,
         covariance,
-        offsets,
-        offsets_std_dev,
+        offsets: campaign_offsets[0].offsets,
+        offsets_std_dev: campaign_offsets[0].std_dev,
+        campaign_offsets,
+        prior_fit,
         report: report.clone(),
         residuals,
         stats: ResidualStats {
@@ -618,6 +680,7 @@ fn finish(
         lines,
         design: Design { decision, report },
         full_covariance: solution.covariance,
+        campaigns,
     }
 }
 
@@ -637,7 +700,7 @@ fn decide_design(
         names,
         &decision,
         &solution,
-        3,
+        eval.problem.n_nuisance,
         eval.problem.rows,
         n_poses,
         options.weak_threshold,
@@ -671,7 +734,8 @@ pub fn design(
     poses: &[MeasuredPose],
     options: &IdentifyOptions,
 ) -> Result<Design, IdentError> {
-    check_size(poses, model.names().len())?;
+    let prior_rows = model.prior().map_or(0, |p| p.dimension());
+    check_size(poses, model.names().len(), prior_rows)?;
     let mut seeds = vec![None; poses.len()];
     if p.len() != model.names().len() {
         return Err(IdentError::Invalid(format!(
@@ -717,6 +781,35 @@ pub fn identifiability(
 }
 
 impl Identification {
+    /// Per campaign fitted, its offsets and the covariance of `[its
+    /// offsets | identifiable parameters]` (row-major, `q x q` with `q = 3 +
+    /// rank`): the columns the rows of its poses touch. Index them with
+    /// [`Identification::campaign_of`].
+    pub(crate) fn campaign_blocks(&self) -> Vec<([f64; 3], Vec<f64>)> {
+        let nn = self.campaigns.nuisance();
+        let c = &self.full_covariance;
+        self.campaign_offsets
+            .iter()
+            .enumerate()
+            .map(|(i, o)| {
+                let columns: Vec<usize> = (3 * i..3 * i + 3)
+                    .chain(self.design.identifiable().iter().map(|&j| nn + j))
+                    .collect();
+                let q = columns.len();
+                let cov = (0..q * q)
+                    .map(|t| c[(columns[t / q], columns[t % q])])
+                    .collect();
+                (o.offsets, cov)
+            })
+            .collect()
+    }
+
+    /// The position of `pose`'s campaign among the fit's campaigns
+    /// (`None`: a campaign the fit did not see).
+    pub(crate) fn campaign_of(&self, pose: &MeasuredPose) -> Option<usize> {
+        self.campaigns.index(pose)
+    }
+
     /// The rank decision taken at the start and kept throughout (rank,
     /// identifiable and fixed parameters, singular directions).
     pub fn design(&self) -> &Design {

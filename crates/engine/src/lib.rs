@@ -21,7 +21,10 @@
 //!   volumetric error before and after ([`compensation`]), and a table of
 //!   leg-command corrections for a controller ([`CompensationTable`]);
 //! - fuses the internal data with external measurements (laser tracker,
-//!   ballbar, touch-offs) and calibrates the head ([`fusion`]).
+//!   ballbar, touch-offs) and calibrates the head ([`fusion`]);
+//! - pools campaigns of one machine, each with its own sensor offsets
+//!   ([`tricept_data::MeasuredPose::campaign`]), and takes a batch's
+//!   Gaussian prior on the parameters ([`Prior`]): the same fit, more rows.
 //!
 //! Parameter names are those of [`tricept_model::ParameterSet`]; lengths in
 //! mm, angles in rad.
@@ -57,6 +60,7 @@
 )]
 
 mod accuracy;
+mod campaigns;
 mod compensate;
 mod error;
 mod evaluate;
@@ -65,6 +69,7 @@ mod gauss_newton;
 mod identify;
 mod model;
 mod options;
+mod prior;
 mod promise;
 mod record;
 mod report;
@@ -79,10 +84,12 @@ pub use accuracy::{
 pub use compensate::{Compensation, compensation, corrected_commands};
 pub use error::IdentError;
 pub use identify::{
-    Design, Identification, ResidualStats, Start, design, identifiability, identify, identify_from,
+    CampaignOffsets, Design, Identification, ResidualStats, Start, design, identifiability,
+    identify, identify_from,
 };
 pub use model::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
 pub use options::IdentifyOptions;
+pub use prior::{Prior, PriorFit};
 pub use promise::{CrossValidation, cross_validate};
 pub use record::{RECORD_METHODS, RecordError, RecordNotes, check_calibration_record};
 pub use report::{Combination, CorrelatedPair, IdentifiabilityReport, NamedValues, Observability};

@@ -16,6 +16,9 @@ use tricept_kinematics::{KinematicsError, LegGeometry, Machine, UpJoints};
 use tricept_model::effects::static_leg_extra_per_mm;
 use tricept_model::{N_FULL, ParameterSet, actual_machine, error_jacobian_at};
 
+use crate::error::IdentError;
+use crate::prior::Prior;
+
 /// A parametric model of the UP limb's readings.
 ///
 /// # Example
@@ -51,6 +54,13 @@ pub trait ReadingModel: Sync {
     /// machine it was calibrated from (see
     /// [`GeometricModel::with_rank_reference`]). Default: none.
     fn rank_reference(&self) -> Option<&dyn ReadingModel> {
+        None
+    }
+
+    /// A Gaussian prior on the parameters (a batch's, for a new machine of
+    /// it): every fit of the model is then the maximum a posteriori
+    /// estimate ([`Prior`]). Default: none.
+    fn prior(&self) -> Option<Prior> {
         None
     }
 }
@@ -99,6 +109,7 @@ pub struct GeometricModel {
     nominal: Machine,
     set: ParameterSet,
     rank_reference: Option<Box<GeometricModel>>,
+    prior: Option<Prior>,
 }
 
 impl GeometricModel {
@@ -117,7 +128,49 @@ impl GeometricModel {
             nominal,
             set,
             rank_reference: None,
+            prior: None,
         }
+    }
+
+    /// The same model with a Gaussian prior on its parameters (its rank
+    /// reference gets it too): every fit is then the maximum a posteriori
+    /// estimate. A prior of another number of parameters is an
+    /// [`IdentError::Invalid`].
+    ///
+    /// # Example
+    /// ```
+    /// use nalgebra::DMatrix;
+    /// use tricept_engine::{GeometricModel, IdentifyOptions, Prior, ReadingModel, identify};
+    /// use tricept_kinematics::Machine;
+    /// use tricept_model::ParameterSet;
+    /// use tricept_plant::{Campaign, Plant};
+    /// let m = Machine::paper();
+    /// let set = ParameterSet::paper15();
+    /// let data = Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+    ///     .simulate(&Campaign::random(&m, 8, 1))
+    ///     .unwrap();
+    /// // A batch that knows every parameter but dyA3 to 0.05 mm, centred on Table 2.
+    /// let covers: Vec<usize> = (0..15).filter(|&j| set.names()[j] != "dyA3").collect();
+    /// let prior = Prior::new(set.table2(), &covers, &DMatrix::from_diagonal_element(14, 14, 0.05f64.powi(2))).unwrap();
+    /// let model = GeometricModel::new(m.clone(), set.clone()).with_prior(prior).unwrap();
+    /// let id = identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+    /// // Eight poses and the prior: the weak direction is known, dyA3 held.
+    /// assert_eq!(id.report.fixed, vec!["dyA3".to_string()]);
+    /// assert_eq!(id.prior_fit.unwrap().dof, 14);
+    /// ```
+    pub fn with_prior(mut self, prior: Prior) -> Result<GeometricModel, IdentError> {
+        if prior.parameters() != self.set.len() {
+            return Err(IdentError::Invalid(format!(
+                "a prior on {} parameters for a model of {}",
+                prior.parameters(),
+                self.set.len()
+            )));
+        }
+        if let Some(r) = &mut self.rank_reference {
+            r.prior = Some(prior.clone());
+        }
+        self.prior = Some(prior);
+        Ok(self)
     }
 
     /// The same model, with the rank decision taken on `structural` (at
@@ -155,7 +208,9 @@ impl GeometricModel {
     /// assert_eq!(id2.report.fixed, vec!["dyA3".to_string()]);
     /// ```
     pub fn with_rank_reference(mut self, structural: Machine) -> GeometricModel {
-        self.rank_reference = Some(Box::new(GeometricModel::new(structural, self.set.clone())));
+        let mut reference = GeometricModel::new(structural, self.set.clone());
+        reference.prior = self.prior.clone();
+        self.rank_reference = Some(Box::new(reference));
         self
     }
 
@@ -300,6 +355,10 @@ impl ReadingModel for GeometricModel {
         self.rank_reference
             .as_deref()
             .map(|m| m as &dyn ReadingModel)
+    }
+
+    fn prior(&self) -> Option<Prior> {
+        self.prior.clone()
     }
 }
 

@@ -87,7 +87,7 @@ pub fn cross_validate(
     sigma: &[f64; 3],
 ) -> Result<CrossValidation, IdentError> {
     let k = model.names().len();
-    if id.estimate.len() != k || id.full_covariance.nrows() != 3 + k {
+    if id.estimate.len() != k || id.full_covariance.nrows() != 3 * id.campaign_offsets.len() + k {
         return Err(IdentError::Invalid(format!(
             "an identification of {} parameters for a model of {k}",
             id.estimate.len()
@@ -98,12 +98,15 @@ pub fn cross_validate(
             "the logged noise must be positive, got {sigma:?}"
         )));
     }
-    let columns: Vec<usize> = (0..3)
-        .chain(id.design().identifiable().iter().map(|&j| 3 + j))
+    // Per campaign: its offsets and the covariance of [its offsets |
+    // identifiable parameters], the columns its poses' rows touch.
+    let identifiable = id.design().identifiable();
+    let q = 3 + identifiable.len();
+    let blocks: Vec<([f64; 3], DMatrix<f64>)> = id
+        .campaign_blocks()
+        .into_iter()
+        .map(|(o, c)| (o, DMatrix::from_row_slice(q, q, &c)))
         .collect();
-    let q = columns.len();
-    let c = &id.full_covariance;
-    let cov = DMatrix::from_fn(q, q, |a, b| c[(columns[a], columns[b])]);
     let predictor = model.at(&id.estimate);
     let w = Matrix3::from_diagonal(&nalgebra::Vector3::from_fn(|i, _| 1.0 / sigma[i]));
     let w_inv = Matrix3::from_diagonal(&nalgebra::Vector3::from_fn(|i, _| sigma[i]));
@@ -116,17 +119,21 @@ pub fn cross_validate(
             .map(|p| {
                 let mut seed: Option<UpJoints> = None;
                 let g = predictor.predict(p, &mut seed, &mut jac).ok()?;
+                let (offsets, cov) = &blocks[id.campaign_of(p)?];
                 let y = p.readings.to_array();
-                let e = nalgebra::Vector3::from_fn(|r, _| y[r] - g[r] - id.offsets[r]);
-                // X_j: the pose's unweighted rows [offsets | identifiable].
-                let x = DMatrix::from_fn(3, q, |r, t| match columns[t] {
-                    col if col < 3 => f64::from(u8::from(col == r)),
-                    col => jac[r * k + col - 3],
+                let e = nalgebra::Vector3::from_fn(|r, _| y[r] - g[r] - offsets[r]);
+                // X_j: the pose's unweighted rows [its offsets | identifiable].
+                let x = DMatrix::from_fn(3, q, |r, t| {
+                    if t < 3 {
+                        f64::from(u8::from(t == r))
+                    } else {
+                        jac[r * k + identifiable[t - 3]]
+                    }
                 });
                 let xw =
                     DMatrix::from_diagonal(&nalgebra::DVector::from_fn(3, |r, _| 1.0 / sigma[r]))
                         * &x;
-                let h = &xw * &cov * xw.transpose();
+                let h = &xw * cov * xw.transpose();
                 let h = Matrix3::from_fn(|a, b| h[(a, b)]);
                 let inv = (Matrix3::identity() - h).try_inverse()?;
                 let limb = machine.up_limb.pose(&UpJoints::from_array(g));

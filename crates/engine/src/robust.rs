@@ -286,34 +286,39 @@ fn robust_start(
 ) -> Result<(Vec<bool>, Option<FirstEvaluation>), IdentError> {
     let k = model.names().len();
     let first = FirstEvaluation::new(model, &vec![0.0; k], &data.poses, &options.sigma)?;
-    let nominal: Vec<Option<[f64; 3]>> = first.residuals().iter().map(|r| Some(*r)).collect();
     let median = |mut v: Vec<f64>| -> f64 { tricept_numerics::stats::median(&mut v) };
-    let centre: [f64; 3] =
-        std::array::from_fn(|c| median(nominal.iter().flatten().map(|r| r[c]).collect()));
-    let scale: [f64; 3] = std::array::from_fn(|c| {
-        let mad = median(
-            nominal
-                .iter()
-                .flatten()
-                .map(|r| (r[c] - centre[c]).abs())
-                .collect(),
-        );
-        let s = 1.4826 * mad;
-        if s.is_finite() {
-            s.max(options.sigma[c])
-        } else {
-            options.sigma[c]
+    // Centre and scale per campaign: each campaign's offsets are its own.
+    let mut z = vec![0.0; data.poses.len()];
+    let mut campaigns: Vec<u32> = data.poses.iter().map(|p| p.campaign).collect();
+    campaigns.sort_unstable();
+    campaigns.dedup();
+    for campaign in campaigns {
+        let members: Vec<usize> = (0..data.poses.len())
+            .filter(|&j| data.poses[j].campaign == campaign)
+            .collect();
+        let residual = |j: usize, c: usize| first.residuals()[j][c];
+        let centre: [f64; 3] =
+            std::array::from_fn(|c| median(members.iter().map(|&j| residual(j, c)).collect()));
+        let scale: [f64; 3] = std::array::from_fn(|c| {
+            let mad = median(
+                members
+                    .iter()
+                    .map(|&j| (residual(j, c) - centre[c]).abs())
+                    .collect(),
+            );
+            let s = 1.4826 * mad;
+            if s.is_finite() {
+                s.max(options.sigma[c])
+            } else {
+                options.sigma[c]
+            }
+        });
+        for &j in &members {
+            z[j] = (0..3)
+                .map(|c| (residual(j, c) - centre[c]).abs() / scale[c])
+                .fold(0.0, f64::max);
         }
-    });
-    let z: Vec<f64> = nominal
-        .iter()
-        .map(|r| match r {
-            Some(r) => (0..3)
-                .map(|c| (r[c] - centre[c]).abs() / scale[c])
-                .fold(0.0, f64::max),
-            None => f64::INFINITY,
-        })
-        .collect();
+    }
     Ok((start_set(&z), Some(first)))
 }
 
@@ -348,14 +353,9 @@ fn deleted_residuals(
     options: &IdentifyOptions,
 ) -> Result<Vec<Option<f64>>, IdentError> {
     let k = model.names().len();
-    let columns: Vec<usize> = (0..3)
-        .chain(id.design().identifiable().iter().map(|&j| 3 + j))
-        .collect();
-    let q = columns.len();
-    let c = &id.full_covariance;
-    let cov: Vec<f64> = (0..q * q)
-        .map(|i| c[(columns[i / q], columns[i % q])])
-        .collect();
+    let q = 3 + id.design().rank();
+    let identifiable = id.design().identifiable();
+    let blocks = id.campaign_blocks();
     let predictor = model.at(&id.estimate);
     // (e^T (I -+ H)^-1 e, |e|^2, inside) of every pose that can be solved.
     let forms: Vec<Option<(f64, f64, bool)>> = map_blocks(&data.poses, |first, poses| {
@@ -370,17 +370,18 @@ fn deleted_residuals(
             .map(|((p, &inside), &seed)| {
                 let mut seed = seed;
                 let g = predictor.predict(p, &mut seed, &mut jac).ok()?;
+                let (offsets, cov) = &blocks[id.campaign_of(p)?];
                 let y = p.readings.to_array();
                 let e = nalgebra::Vector3::from_fn(|c, _| {
-                    (y[c] - g[c] - id.offsets[c]) / options.sigma[c]
+                    (y[c] - g[c] - offsets[c]) / options.sigma[c]
                 });
-                // X_j: the pose's weighted rows [offsets | identifiable].
+                // X_j: the pose's weighted rows [its offsets | identifiable].
                 x.iter_mut().for_each(|v| *v = 0.0);
                 for c in 0..3 {
                     let w = 1.0 / options.sigma[c];
                     x[c * q + c] = w;
-                    for (t, &col) in columns[3..].iter().enumerate() {
-                        x[c * q + 3 + t] = w * jac[c * k + col - 3];
+                    for (t, &col) in identifiable.iter().enumerate() {
+                        x[c * q + 3 + t] = w * jac[c * k + col];
                     }
                 }
                 // H_jj = X_j C X_j^T.
@@ -403,12 +404,16 @@ fn deleted_residuals(
             })
             .collect())
     })?;
-    let (mut chi2, mut m) = (0.0, 0usize);
+    // The fit's own chi-square and degrees of freedom (a prior's rows
+    // count as readings the fit explains).
+    let (mut chi2, mut m) = id
+        .prior_fit
+        .map_or((0.0, 0usize), |f| (f.chi_square, f.dof));
     for (_, e2, _) in forms.iter().flatten().filter(|f| f.2) {
         chi2 += e2;
         m += 3;
     }
-    let nu = m.saturating_sub(q);
+    let nu = m.saturating_sub(q + 3 * (id.campaign_offsets.len() - 1));
     Ok(forms
         .into_iter()
         .map(|f| {

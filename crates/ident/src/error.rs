@@ -14,6 +14,7 @@ use tricept_data::DataError;
 use tricept_diagnose::{DeployError, DiagnoseError};
 use tricept_engine::{IdentError, RecordError};
 use tricept_export::ExportError;
+use tricept_fleet::FleetError;
 use tricept_kinematics::{DescriptionError, KinematicsError};
 use tricept_model::ModelError;
 use tricept_plant::PlantError;
@@ -395,6 +396,18 @@ impl Classify for DeployError {
         match self {
             DeployError::Refit(e) => e.kind(),
             _ => ErrorKind::Input,
+        }
+    }
+}
+
+impl Classify for FleetError {
+    /// What cannot be pooled is the input's fault; an identification
+    /// error keeps its own kind; a solver's failure is not the input's.
+    fn kind(&self) -> ErrorKind {
+        match self {
+            FleetError::Input(_) => ErrorKind::Input,
+            FleetError::Identification { error, .. } => error.kind(),
+            _ => ErrorKind::Other,
         }
     }
 }

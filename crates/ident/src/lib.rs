@@ -24,8 +24,8 @@
 //!
 //! The root is a curated handful: one module per workflow ([`calibrate`],
 //! [`check`], [`compensate`], [`detectability`], [`diagnosis`],
-//! [`effects`], [`export`], [`identifiability`], [`kinematics`], [`plan`],
-//! [`report`], [`simulate`]), each with its function, its request, its result and the
+//! [`effects`], [`export`], [`fleet`], [`identifiability`], [`kinematics`],
+//! [`plan`], [`report`], [`simulate`]), each with its function, its request, its result and the
 //! parts they are made of; the error with its exit codes; and the two
 //! inputs. The typed values several requests share, the machine loaded
 //! ahead of a workflow and the few low-level items code beside the door
@@ -58,6 +58,7 @@ pub mod detectability;
 pub mod diagnosis;
 pub mod effects;
 pub mod export;
+pub mod fleet;
 pub mod identifiability;
 pub mod kinematics;
 pub mod plan;

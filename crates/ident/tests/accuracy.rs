@@ -10,12 +10,18 @@
 //! file's `upper_mm` in at least 95 % of the files written with exit 0,
 //! and never beyond twice it.
 //!
+//! The pooled calibrations (campaigns, batches, new machines from a
+//! batch's prior) are kept in truth in `accuracy/fleet.rs`.
+//!
 //! The CI tests run 24 campaigns through `identify` and 12 through
 //! `diagnose --write-machine`; the tallies of `docs/reliability.md` run 200
 //! each (`cargo test -p tricept-ident --test accuracy -- --ignored
 //! --nocapture`; `TRICEPT_TALLY_SEED_OFFSET=2000` runs them on another 200
 //! seeds each; `TRICEPT_TALLY_DEPLOY_RULE=expected-error` diagnoses with
 //! that deploy rule).
+
+#[path = "accuracy/fleet.rs"]
+mod fleet;
 
 use std::path::Path;
 

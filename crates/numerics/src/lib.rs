@@ -10,6 +10,9 @@
 //!   hold chosen by column-pivoted QR, covariance.
 //! - [`stats`]: chi-square tail probabilities and quantiles, test power,
 //!   sample quantiles.
+//! - [`sparse`]: least squares with a block-arrow structure (pooled
+//!   campaigns and batches) on faer's sparse Cholesky and QR, with a
+//!   block-elimination fast path.
 //! - [`roots`]: the one bracketing-and-bisection search every threshold in
 //!   the project (a quantile, a non-centrality, an encoder grade) uses.
 #![cfg_attr(
@@ -20,4 +23,5 @@
 pub mod linalg;
 pub mod lsq;
 pub mod roots;
+pub mod sparse;
 pub mod stats;

@@ -161,6 +161,7 @@ impl Plant {
                 time_s: Some(t.time_s),
                 approach: Some(t.approach),
                 line: 0,
+                campaign: 0,
             });
         }
         let logged = campaign.noise.logged_sigma();

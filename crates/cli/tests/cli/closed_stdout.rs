@@ -15,6 +15,14 @@ fn every_verb_survives_a_closed_stdout() {
     std::fs::write(&points, "x,y,z\n0,0,750\n10,0,760\n").unwrap();
     let written = dir.join("written.json");
     let (p, w) = (points.to_str().unwrap(), written.to_str().unwrap());
+    // A batch of three machines: the fixture's campaign under three names.
+    let batch: Vec<String> = (1..=3)
+        .map(|i| {
+            let copy = dir.join(format!("machine-{i}.csv"));
+            std::fs::copy(&good, &copy).unwrap();
+            copy.display().to_string()
+        })
+        .collect();
     let cases: Vec<(Vec<&str>, i32)> = vec![
         (vec!["ik", "0", "0", "750"], 0),
         (vec!["ik", "0", "0", "750", "--json"], 0),
@@ -42,6 +50,18 @@ fn every_verb_survives_a_closed_stdout() {
                 p,
                 "--spacing",
                 "50",
+            ],
+            0,
+        ),
+        (
+            vec![
+                "fleet", "--data", &batch[0], "--data", &batch[1], "--data", &batch[2],
+            ],
+            0,
+        ),
+        (
+            vec![
+                "identify", "--data", &batch[0], "--data", &batch[1], "--json",
             ],
             0,
         ),

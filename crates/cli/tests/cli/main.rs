@@ -1,10 +1,10 @@
 //! The `tricept` binary end to end, one test binary: bad inputs, the check,
 //! a closed stdout, the embedded docs, the edges (special files, `-`,
 //! refusals before work, the history lock, bounded messages), the
-//! exit-code table, the fused identification, the seal, seeded fuzzing of
-//! every input kind, what writing survives, the report page, and a
-//! calibration a user can trust (one module per subject; what they share
-//! in `support`).
+//! exit-code table, the fused identification, pooled campaigns and
+//! batches, the seal, seeded fuzzing of every input kind, what writing
+//! survives, the report page, and a calibration a user can trust (one
+//! module per subject; what they share in `support`).
 
 mod bad_inputs;
 mod check;
@@ -13,6 +13,7 @@ mod docs;
 mod edges;
 mod exit_codes;
 mod export;
+mod fleet;
 mod fusion;
 mod fuzz;
 mod one_exit_code;

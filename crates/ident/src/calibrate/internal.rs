@@ -11,7 +11,7 @@ use serde_json::{Map, Value, json};
 use tricept_data::Dataset;
 use tricept_engine::IdentError;
 use tricept_engine::{
-    GeometricModel, Identification, IdentifyOptions, PredictedAccuracy, Rejection, Verdict,
+    GeometricModel, Identification, IdentifyOptions, PredictedAccuracy, Prior, Rejection, Verdict,
     identify, identify_robust, likely_causes,
 };
 use tricept_kinematics::units::RAD_PER_ARCSEC;
@@ -43,22 +43,30 @@ pub(crate) struct InternalFit {
     pub temperature_c: Option<f64>,
     /// The accuracy the calibrated machine file will deliver.
     pub promise: Accuracy,
+    /// Several campaigns or a batch's prior: what pooling adds.
+    pub pooled: Option<Box<super::pooling::Pooled>>,
 }
 
 /// Identifies `set` from `dataset` against `loaded` (robust unless told
-/// not to); the rank rule of a calibrated machine is its nominal
-/// machine's.
+/// not to), with a batch's `prior` when given; the rank rule of a
+/// calibrated machine is its nominal machine's.
 pub(crate) fn fit(
     loaded: &LoadedMachine,
     set: &ParameterSet,
     dataset: &Dataset,
     robust: bool,
     tolerance_mm: f64,
+    prior: Option<Prior>,
 ) -> Result<InternalFit, Error> {
     let m = loaded.machine();
     let mut model = GeometricModel::new(m.clone(), set.clone());
     if let Some(reference) = loaded.rank_reference()? {
         model = model.with_rank_reference(reference);
+    }
+    if let Some(prior) = prior {
+        model = model
+            .with_prior(prior)
+            .map_err(|e| Error::with_context("--prior", &e))?;
     }
     let options = IdentifyOptions::for_machine(m);
     let source = dataset.source.as_str();
@@ -96,6 +104,7 @@ pub(crate) fn fit(
         tolerance_mm,
     )?;
     Ok(InternalFit {
+        pooled: None,
         promise,
         model,
         id,
@@ -112,7 +121,10 @@ impl InternalFit {
     pub fn exit_code(&self) -> u8 {
         if !self.verdict.converged {
             EXIT_NOT_CONVERGED
-        } else if !self.verdict.adequate || !self.accuracy.worthwhile {
+        } else if !self.verdict.adequate
+            || !self.accuracy.worthwhile
+            || self.pooled.as_ref().is_some_and(|p| p.refused().is_some())
+        {
             EXIT_INADEQUATE
         } else {
             EXIT_OK
@@ -130,7 +142,7 @@ impl InternalFit {
         } else if !self.accuracy.worthwhile {
             Some("the campaign is too small to calibrate the machine")
         } else {
-            None
+            self.pooled.as_ref().and_then(|p| p.refused())
         }
     }
 
@@ -161,7 +173,7 @@ impl InternalFit {
         data: &Path,
         forced: Option<String>,
     ) -> Result<MachineDescription, Error> {
-        machine_file::calibrated_description(
+        let mut d = machine_file::calibrated_description(
             loaded,
             &self.identified(),
             &machine_file::FitRecord::of_identification(&self.id),
@@ -169,7 +181,18 @@ impl InternalFit {
                 method: "identify",
                 data_file: data,
                 parameter_set: self.model.parameter_set().label(),
-                rejected_lines: self.rejected.iter().map(|r| r.line).collect(),
+                // The first campaign's lines; the others' are in their records.
+                rejected_lines: self
+                    .rejected
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| {
+                        self.pooled.as_ref().is_none_or(|p| {
+                            p.rejected_file(*i) == Some(data.display().to_string().as_str())
+                        })
+                    })
+                    .map(|(_, r)| r.line)
+                    .collect(),
                 adequate: self.verdict.adequate,
                 forced,
                 warnings: self.verdict.warnings.clone(),
@@ -180,7 +203,12 @@ impl InternalFit {
                 accuracy: Some(self.promise.record()),
             },
             None,
-        )
+        )?;
+        // The other campaigns and the prior are recorded with their hashes.
+        if let (Some(p), Some(c)) = (&self.pooled, d.calibration.as_mut()) {
+            c.external_sources.extend(p.sources()?);
+        }
+        Ok(d)
     }
 
     /// The JSON of `identify --json`.
@@ -211,6 +239,11 @@ impl InternalFit {
             o.insert("accuracy".into(), self.promise.to_json());
             o.insert("machine".into(), loaded.description().name.clone().into());
             o.insert("data_file".into(), data_name.into());
+            if let Some(p) = &self.pooled {
+                for (k, value) in p.json() {
+                    o.insert(k.into(), value);
+                }
+            }
         }
         v
     }
@@ -259,18 +292,34 @@ impl InternalFit {
             "predicted platform error after calibration: {:.4} mm rms (up to {:.4} mm at one of {} points), against {:.4} mm without calibration ({} mm per parameter)",
             a.after_rms_mm, a.after_max_mm, a.points, a.before_rms_mm, a.tolerance_mm
         );
-        for r in &self.rejected {
+        for (i, r) in self.rejected.iter().enumerate() {
             let why = match r.residual_sigma {
                 Some(z) => format!("a reading {z:.1} noise standard deviations off (gross error)"),
                 None => "the fitted machine cannot reach its commands".to_string(),
             };
+            let file = self
+                .pooled
+                .as_ref()
+                .and_then(|p| p.rejected_file(i))
+                .unwrap_or(data);
             let _ = writeln!(
                 s,
-                "rejected pose {} (line {} of {data}): {why}",
+                "rejected pose {} (line {} of {file}): {why}",
                 r.pose + 1,
                 r.line
             );
         }
+        if let Some(p) = &self.pooled {
+            s.push_str(&p.report());
+        }
+        let campaigns;
+        let data = match &self.pooled {
+            Some(p) if p.campaigns.len() > 1 => {
+                campaigns = format!("the {} campaigns", p.campaigns.len());
+                campaigns.as_str()
+            }
+            _ => data,
+        };
         let _ = writeln!(
             s,
             "{} poses of {data} against `{}`, parameter set {}: {} in {} Gauss-Newton iterations",

@@ -1,6 +1,7 @@
 //! Calibrate: identify the machine from the UP limb's sensors alone
-//! (`internal.rs`) or fused with external measurements that also calibrate
-//! the head (`fused.rs`); the verdict and its exit code, the accuracy the
+//! (`internal.rs`), from several campaigns or with a batch's prior
+//! (`pooled.rs`, `pooling.rs`), or fused with external measurements that
+//! also calibrate the head (`fused.rs`); the verdict and its exit code, the accuracy the
 //! calibration predicts, the advice of a campaign too small to calibrate
 //! (`advice.rs`), and the calibrated machine file with its record, written
 //! by the one write rule of every machine file (`machine_file.rs`).
@@ -13,6 +14,8 @@
 mod advice;
 mod fused;
 mod internal;
+mod pooled;
+mod pooling;
 pub(crate) mod values;
 
 use std::path::{Path, PathBuf};
@@ -59,6 +62,14 @@ pub struct CalibrateRequest {
     /// The calibration is meant to be written as a machine file: what the
     /// format cannot carry (fitted effects) is refused before fitting.
     pub for_machine_file: bool,
+    /// More campaigns of the same machine (`--data` given again): pooled
+    /// with `data`, the geometry shared, each campaign with its own sensor
+    /// offsets (`docs/fleet.md`).
+    pub campaigns: Vec<DataInput>,
+    /// A batch's prior (`tricept fleet --write-prior`): the calibration is
+    /// then the maximum a posteriori estimate, and its accuracy promise
+    /// carries the prior's uncertainty (`docs/fleet.md`).
+    pub prior: Option<PathBuf>,
 }
 
 impl CalibrateRequest {
@@ -73,6 +84,8 @@ impl CalibrateRequest {
             tolerance_mm: tricept_engine::DEFAULT_TOLERANCE_MM,
             fused: None,
             for_machine_file: false,
+            campaigns: Vec::new(),
+            prior: None,
         }
     }
 }
@@ -133,7 +146,26 @@ pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
     }
     let loaded = request.machine.load()?;
     let set = &request.parameter_set;
+    let pooled = !request.campaigns.is_empty() || request.prior.is_some();
+    if pooled && request.fused.is_some() {
+        return Err(Error::input(
+            "several --data or --prior with external measurements: not supported (pool the internal campaigns, or fuse one)",
+        ));
+    }
     let fit = match &request.fused {
+        None if pooled => {
+            let inputs: Vec<&DataInput> = std::iter::once(&request.data)
+                .chain(&request.campaigns)
+                .collect();
+            Fit::Internal(Box::new(pooled::fit(
+                &loaded,
+                set,
+                &inputs,
+                request.prior.as_deref(),
+                request.robust,
+                tolerance_mm,
+            )?))
+        }
         None => {
             let dataset = request.data.load(loaded.machine())?;
             Fit::Internal(Box::new(internal::fit(
@@ -142,6 +174,7 @@ pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
                 &dataset,
                 request.robust,
                 tolerance_mm,
+                None,
             )?))
         }
         Some(x) => {

@@ -45,7 +45,7 @@ pub use record::{
     HeldParameter, Interpolation, LegEffectsDescription, LegTableDescription,
     SensorOffsetsDescription,
 };
-pub use seal::SealCheck;
+pub use seal::{SealCheck, seal_digest};
 pub use validate::{MAX_TABLE_EXTRA_UM, MAX_TABLE_POINTS, MAX_TABLE_SLOPE_UM_PER_MM};
 
 /// The JSON text of the paper's Table 1 machine, embedded at compile time.

@@ -177,6 +177,19 @@ fn partial_fields(d: &MachineDescription) -> Option<Vec<(&'static str, String)>>
 /// The sealed name of the promise in a partial seal.
 const ACCURACY: &str = "calibration.accuracy";
 
+/// The seal's digest of a value: 64-bit FNV-1a of its compact JSON text,
+/// in hex. Other sealed files (a batch's prior) seal their fields with it.
+///
+/// # Example
+/// ```
+/// use tricept_kinematics::description::seal_digest;
+/// assert_eq!(seal_digest(&1.5), seal_digest(&1.5));
+/// assert_ne!(seal_digest(&1.5), seal_digest(&1.50001));
+/// ```
+pub fn seal_digest(value: &impl serde::Serialize) -> String {
+    fnv1a(&text(value))
+}
+
 /// A value's compact JSON text (plain data cannot fail to serialise).
 fn text(value: &impl serde::Serialize) -> String {
     serde_json::to_string(value).unwrap_or_default()

@@ -1,0 +1,206 @@
+//! Fleet: the machines of a batch calibrated together (`tricept fleet`,
+//! `docs/fleet.md`): the batch's systematic error with its uncertainty, the
+//! machine-to-machine spread, each machine with the batch as its prior, the
+//! machines that do not belong, and the prior a new machine of the batch
+//! calibrates from (`identify --prior`).
+//!
+//! [`fleet`] takes a [`FleetRequest`] (one data file per machine, the
+//! nominal machine) and returns a [`FleetResult`]: its JSON, report, exit
+//! code and the prior file it writes. The computation is `tricept-fleet`'s.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+use tricept_data::Dataset;
+use tricept_engine::{AccuracyModel, GeometricModel, IdentifyOptions, accuracy_points};
+use tricept_fleet::{
+    Batch, BatchOptions, DataFileRecord, PriorFile, PriorProvenance, calibrate_batch,
+};
+use tricept_model::ParameterSet;
+
+pub use tricept_fleet::SolverKind;
+
+use crate::data_input::DataInput;
+use crate::error::Error;
+use crate::inputs::LoadedMachine;
+use crate::machine_input::MachineInput;
+
+/// A batch to calibrate.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let result = fleet(FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into(), "m3.csv".into()]))?;
+/// println!("{}", result.to_json()["batch_spread_mm"]);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct FleetRequest {
+    /// One campaign per machine (at least three).
+    pub data: Vec<DataInput>,
+    /// The batch's nominal machine (default: the embedded Table 1 machine).
+    pub machine: MachineInput,
+    /// The geometric parameters (default `paper15`).
+    pub parameter_set: ParameterSet,
+    /// Manufacturing tolerance per parameter, mm: each machine's campaign
+    /// is judged worth deploying as `identify` judges it.
+    pub tolerance_mm: f64,
+    /// The factorisation of the joint fit (default the block elimination).
+    pub solver: SolverKind,
+}
+
+impl FleetRequest {
+    /// The batch of `data` (one file per machine) on the Table 1 machine.
+    pub fn new(data: Vec<DataInput>) -> FleetRequest {
+        FleetRequest {
+            data,
+            machine: MachineInput::default(),
+            parameter_set: ParameterSet::paper15(),
+            tolerance_mm: tricept_engine::DEFAULT_TOLERANCE_MM,
+            solver: SolverKind::Schur,
+        }
+    }
+}
+
+/// A batch calibrated.
+#[derive(Debug)]
+pub struct FleetResult {
+    loaded: LoadedMachine,
+    batch: Batch,
+    parameter_set: String,
+    files: Vec<Option<PathBuf>>,
+}
+
+/// Calibrates the batch of `request` (module docs). Errors: bad files and
+/// fewer than three machines whose data fit are input errors (exit 2).
+pub fn fleet(request: FleetRequest) -> Result<FleetResult, Error> {
+    let tolerance = request.tolerance_mm;
+    if !(tolerance.is_finite() && tolerance > 0.0 && tolerance <= 10.0) {
+        return Err(Error::input(format!(
+            "--tolerance-mm: the manufacturing tolerance must be a number of mm above 0 and at most 10, got {tolerance}"
+        )));
+    }
+    let loaded = request.machine.load()?;
+    let m = loaded.machine();
+    let set = &request.parameter_set;
+    let datasets = request
+        .data
+        .iter()
+        .map(|d| d.load(m))
+        .collect::<Result<Vec<Dataset>, Error>>()?;
+    let mut model = GeometricModel::new(m.clone(), set.clone());
+    if let Some(reference) = loaded.rank_reference()? {
+        model = model.with_rank_reference(reference);
+    }
+    let accuracy = AccuracyModel::new(m, set, &accuracy_points(m), tolerance)
+        .map_err(|e| Error::with_context("--tolerance-mm", &e))?;
+    let options = BatchOptions {
+        kind: request.solver,
+        ..BatchOptions::default()
+    };
+    let batch = calibrate_batch(
+        &model,
+        &datasets,
+        &IdentifyOptions::for_machine(m),
+        &accuracy,
+        &options,
+    )
+    .map_err(|e| Error::with_context("fleet", &e))?;
+    Ok(FleetResult {
+        loaded,
+        batch,
+        parameter_set: set.label().to_string(),
+        files: request
+            .data
+            .iter()
+            .map(|d| d.path().map(Path::to_path_buf))
+            .collect(),
+    })
+}
+
+impl FleetResult {
+    /// The batch (every machine's outcome, the spread, the joint fit).
+    pub fn batch(&self) -> &Batch {
+        &self.batch
+    }
+
+    /// 0 every machine fits and belongs; 3 a machine is kept out (its own
+    /// data, or an outlier: named), or the batch is not one population; 4
+    /// the joint fit or the spread did not converge.
+    pub fn exit_code(&self) -> u8 {
+        self.batch.exit_code()
+    }
+
+    /// The JSON of `tricept fleet --json` (the batch's keys, and `machine`).
+    pub fn to_json(&self) -> Value {
+        let mut v = self.batch.to_json();
+        if let Value::Object(o) = &mut v {
+            o.insert(
+                "machine".into(),
+                self.loaded.description().name.clone().into(),
+            );
+            o.insert("parameter_set".into(), self.parameter_set.clone().into());
+        }
+        v
+    }
+
+    /// The text report.
+    pub fn report(&self) -> String {
+        self.batch.to_text()
+    }
+
+    /// Writes the prior a new machine of the batch calibrates from
+    /// (`identify --prior`) at `path`, atomically. Refused (an error of
+    /// the batch's exit code) when the batch estimate itself is not to be
+    /// trusted (not converged, or not one population) unless `force`;
+    /// machines kept out do not enter it and do not stop it.
+    pub fn write_prior(&self, path: &Path, force: bool) -> Result<Option<String>, Error> {
+        let b = &self.batch;
+        let why = if !(b.joint.converged && b.spread.converged) {
+            Some("the batch's fit did not converge".to_string())
+        } else if b.not_one_population {
+            Some("the batch may not be one population".to_string())
+        } else {
+            None
+        };
+        let code = match &why {
+            None => 0,
+            Some(_) => b.exit_code().max(tricept_fleet::EXIT_INADEQUATE),
+        };
+        let what = format!("--write-prior {}", path.display());
+        let forced =
+            crate::machine_file::write_rule(&what, code, why.as_deref().unwrap_or(""), force)?;
+        let data_files = b
+            .machines
+            .iter()
+            .zip(&self.files)
+            .map(|(m, file)| {
+                Ok(DataFileRecord {
+                    file: m.own.source.clone(),
+                    sha256: match file {
+                        Some(p) => crate::machine_file::sha256_file(p)?,
+                        None => String::new(),
+                    },
+                    in_batch: m.in_batch,
+                })
+            })
+            .collect::<Result<Vec<_>, Error>>()?;
+        let provenance = PriorProvenance {
+            method: "fleet".into(),
+            machines: b.machines.len(),
+            members: b.members(),
+            data_files,
+            outliers: b.outliers().iter().map(|s| s.to_string()).collect(),
+            solver: b.joint.stats.kind.name().into(),
+            written_utc: crate::machine_file::utc_now(),
+            tricept_version: env!("CARGO_PKG_VERSION").into(),
+            forced: forced.clone(),
+        };
+        let machine =
+            serde_json::to_value(self.loaded.nominal_description()).unwrap_or(Value::Null);
+        let file = PriorFile::new(b, machine, &self.parameter_set, provenance);
+        crate::calibrate::write_text(path, &(file.to_json() + "\n"))?;
+        Ok(forced)
+    }
+}
