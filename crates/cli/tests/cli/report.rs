@@ -50,7 +50,7 @@ fn report_writes_the_page_and_refuses_what_is_not_this_calibration_s() {
     std::fs::write(dir.join("edited.json"), edited.to_string()).unwrap();
     refused(
         &["report", "--machine", "edited.json", "--out", "e.html"],
-        &["edited.json", "`sensors`"],
+        &["edited.json", "`sensors.length_noise_um`"],
     );
     refused(
         &[
