@@ -145,9 +145,7 @@ fn append_to(
     calibration_digest: Option<String>,
 ) -> Result<History, Error> {
     let time = crate::machine_file::utc_now();
-    let unix_s = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0.0, |d| d.as_secs_f64());
+    let unix_s = crate::machine_file::now_unix_s();
     let entry = Entry {
         calibration_digest,
         ..Entry::of(report, &time, unix_s, machine, data)

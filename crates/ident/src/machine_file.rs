@@ -152,11 +152,28 @@ pub fn sha256_file(path: &Path) -> Result<String, Error> {
     Ok(digest.iter().map(|b| format!("{b:02x}")).collect())
 }
 
-/// The current UTC time as ISO 8601 (`2026-11-23T09:38:00Z`).
-pub fn utc_now() -> String {
-    let secs = std::time::SystemTime::now()
+/// The time files and histories are stamped with, in seconds since
+/// 1970-01-01 00:00:00 UTC: the clock, or the environment variable
+/// `SOURCE_DATE_EPOCH` when it holds a whole number of seconds (the
+/// reproducible-builds convention: "The value MUST be an ASCII
+/// representation of an integer with no fractional component"), so that
+/// a rerun writes the same bytes.
+pub(crate) fn now_unix_s() -> f64 {
+    if let Some(secs) = std::env::var("SOURCE_DATE_EPOCH")
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+    {
+        return secs as f64;
+    }
+    std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs());
+        .map_or(0.0, |d| d.as_secs_f64())
+}
+
+/// The current UTC time as ISO 8601 (`2026-11-23T09:38:00Z`), of
+/// [`now_unix_s`].
+pub fn utc_now() -> String {
+    let secs = now_unix_s() as u64;
     let (days, rem) = (secs / 86_400, secs % 86_400);
     let (y, m, d) = civil_from_days(days as i64);
     format!(

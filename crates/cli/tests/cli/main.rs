@@ -16,6 +16,7 @@ mod export;
 mod fleet;
 mod fusion;
 mod fuzz;
+mod golden;
 mod one_exit_code;
 mod outputs;
 mod relied_on;
