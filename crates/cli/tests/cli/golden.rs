@@ -5,13 +5,14 @@
 //! one file per case. A refactoring that changes no behaviour leaves them
 //! all as they are; a change of an output shows as its diff.
 //!
-//! The cases run in order in one work directory holding a copy of
+//! The cases run twice, on 2 threads and on 1, each time in order in one work directory holding a copy of
 //! `fixtures/` (later cases read what earlier ones wrote: the calibrated
 //! machine, the planned points), with relative paths, so that the outputs
 //! name the same files on every machine. `SOURCE_DATE_EPOCH` fixes the
 //! date written into machine files, histories and priors; the one number
 //! that still changes between runs, a solver's wall-clock time (`tricept
-//! fleet`'s `seconds`), is replaced by `<seconds>`.
+//! fleet`'s `seconds`, and its text report's `... s solving, ... s in
+//! all`), is replaced by `<seconds>` and `<t>`.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -83,7 +84,11 @@ const CASES: &[Case] = &[
     ),
     case("ik-batch", &["ik", "--input", "points.csv"], &[]),
     case("fk-batch", &["fk", "--input", "commands.csv"], &[]),
-    case("tool-ik-batch", &["tool-ik", "--input", "tool-poses.csv"], &[]),
+    case(
+        "tool-ik-batch",
+        &["tool-ik", "--input", "tool-poses.csv"],
+        &[],
+    ),
     case("machine", &["machine"], &[]),
     case("machine-json", &["machine", "--json"], &[]),
     // Identifiability.
@@ -102,7 +107,11 @@ const CASES: &[Case] = &[
     ),
     // Calibration from the fixture.
     case("identify", &["identify", "--data", DATA], &[]),
-    case("identify-json", &["identify", "--data", DATA, "--json"], &[]),
+    case(
+        "identify-json",
+        &["identify", "--data", DATA, "--json"],
+        &[],
+    ),
     case(
         "identify-write",
         &["identify", "--data", DATA, "--write-machine", "cal.json"],
@@ -146,7 +155,11 @@ const CASES: &[Case] = &[
         &["ik", "0", "0", "750", "--machine", "cal.json", "--json"],
         &[],
     ),
-    case("machine-calibrated", &["machine", "--machine", "cal.json"], &[]),
+    case(
+        "machine-calibrated",
+        &["machine", "--machine", "cal.json"],
+        &[],
+    ),
     // Simulation.
     case(
         "simulate",
@@ -266,19 +279,20 @@ const CASES: &[Case] = &[
     ),
     case(
         "ik-deployed",
-        &["ik", "0", "0", "750", "--machine", "deployed.json", "--json"],
-        &[],
-    ),
-    case(
-        "ik-deployed-hidden",
         &[
             "ik",
             "0",
             "0",
             "750",
             "--machine",
-            "deployed-hidden.json",
+            "deployed.json",
+            "--json",
         ],
+        &[],
+    ),
+    case(
+        "ik-deployed-hidden",
+        &["ik", "0", "0", "750", "--machine", "deployed-hidden.json"],
         &[],
     ),
     case(
@@ -488,8 +502,30 @@ const CASES: &[Case] = &[
     ),
     case(
         "plan-check",
-        &["plan", "--instrument", "check", "--out", "check-poses.csv"],
+        &[
+            "plan",
+            "--instrument",
+            "check",
+            "--machine",
+            "fixtures/report/table2.json",
+            "--out",
+            "check-poses.csv",
+        ],
         &["check-poses.csv"],
+    ),
+    case(
+        "plan-check-json",
+        &[
+            "plan",
+            "--instrument",
+            "check",
+            "--machine",
+            "cal.json",
+            "--detect-um",
+            "30",
+            "--json",
+        ],
+        &[],
     ),
     case(
         "simulate-tracker",
@@ -660,15 +696,7 @@ const CASES: &[Case] = &[
     case(
         "fleet",
         &[
-            "fleet",
-            "--data",
-            "m1.csv",
-            "--data",
-            "m2.csv",
-            "--data",
-            "m3.csv",
-            "--data",
-            "m4.csv",
+            "fleet", "--data", "m1.csv", "--data", "m2.csv", "--data", "m3.csv", "--data", "m4.csv",
         ],
         &[],
     ),
@@ -841,10 +869,11 @@ const CASES: &[Case] = &[
         &[],
     ),
     case(
-        "error-bad-csv",
-        &["identify", "--data", "points.csv"],
+        "error-plan-check-uncalibrated",
+        &["plan", "--instrument", "check"],
         &[],
     ),
+    case("error-bad-csv", &["identify", "--data", "points.csv"], &[]),
 ];
 
 /// The golden directory.
@@ -881,9 +910,36 @@ fn files_of(dir: &Path, path: &str) -> Vec<String> {
     names
 }
 
-/// `"seconds": NUMBER` (and `"fit_seconds"`) with the number replaced:
-/// wall-clock times.
+/// Wall-clock times with their numbers replaced: `"seconds": NUMBER`
+/// (and `"fit_seconds"`) in JSON, `NUMBER s solving` and `NUMBER s in
+/// all` in the fleet's text report.
 fn without_times(text: &str) -> String {
+    let mut text = without_json_seconds(text);
+    for unit in [" s solving", " s in all"] {
+        text = without_number_before(&text, unit);
+    }
+    text
+}
+
+/// `text` with the number just before each `marker` replaced by `<t>`.
+fn without_number_before(text: &str, marker: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find(marker) {
+        let number = rest[..at]
+            .rfind(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .map_or(0, |i| i + 1);
+        out.push_str(&rest[..number]);
+        out.push_str("<t>");
+        out.push_str(marker);
+        rest = &rest[at + marker.len()..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// `"seconds": NUMBER` (and `"fit_seconds"`) with the number replaced.
+fn without_json_seconds(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     let mut rest = text;
     while let Some(at) = rest.find("seconds\":") {
@@ -902,13 +958,13 @@ fn without_times(text: &str) -> String {
     out
 }
 
-/// Runs a case in `dir`: its recording.
-fn record(dir: &Path, c: &Case) -> String {
+/// Runs a case in `dir` on `threads` threads: its recording.
+fn record(dir: &Path, c: &Case, threads: &str) -> String {
     let out = tricept()
         .args(c.args)
         .current_dir(dir)
         .env("SOURCE_DATE_EPOCH", EPOCH)
-        .env("RAYON_NUM_THREADS", "2")
+        .env("RAYON_NUM_THREADS", threads)
         .output()
         .unwrap();
     let mut s = String::new();
@@ -930,12 +986,10 @@ fn record(dir: &Path, c: &Case) -> String {
     without_times(&s)
 }
 
-/// Every case's outputs are the recorded ones (`TRICEPT_BLESS=1` records
-/// them anew; the diff of `crates/cli/tests/golden/` then shows what
-/// changed).
-#[test]
-fn every_verb_s_outputs_on_the_fixtures_are_the_recorded_ones() {
-    let dir = fresh_workdir("golden");
+/// Every case run in order in a fresh work directory on `threads`
+/// threads: each case's name and recording.
+fn run_all(threads: &str) -> Vec<(&'static str, String)> {
+    let dir = fresh_workdir(&format!("golden-{threads}"));
     copy_dir(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures"),
         &dir.join("fixtures"),
@@ -943,52 +997,74 @@ fn every_verb_s_outputs_on_the_fixtures_are_the_recorded_ones() {
     for (name, text) in INPUTS {
         std::fs::write(dir.join(name), text).unwrap();
     }
-    let bless = std::env::var_os("TRICEPT_BLESS").is_some();
-    let golden = golden_dir();
-    if bless {
-        std::fs::create_dir_all(&golden).unwrap();
-    }
-    let mut names = std::collections::BTreeSet::new();
-    let mut changed = Vec::new();
+    let mut recordings = Vec::with_capacity(CASES.len());
     for c in CASES {
-        assert!(names.insert(c.name), "{}: two cases of one name", c.name);
         if c.name == "error-edited" {
             // A calibrated file edited after it was written.
             let text = std::fs::read_to_string(dir.join("cal.json")).unwrap();
-            let edited = text.replacen("\"radius_mm\": 200.0", "\"radius_mm\": 190.0", 1);
-            assert_ne!(edited, text, "the edit did not apply");
+            let edited = text.replacen("\"max_tilt_deg\": 40.0", "\"max_tilt_deg\": 41.0", 1);
+            assert!(edited != text, "the edit did not apply");
             std::fs::write(dir.join("edited.json"), edited).unwrap();
         }
-        let got = record(&dir, c);
-        let path = golden.join(format!("{}.txt", c.name));
-        if bless {
-            std::fs::write(&path, &got).unwrap();
+        recordings.push((c.name, record(&dir, c, threads)));
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    recordings
+}
+
+/// Where `got` first differs from the recording at `path`, if it does.
+fn difference(name: &str, path: &Path, got: &str, threads: &str) -> Option<String> {
+    let want = std::fs::read_to_string(path).unwrap_or_default();
+    if got == want {
+        return None;
+    }
+    let line = got
+        .lines()
+        .zip(want.lines())
+        .position(|(a, b)| a != b)
+        .unwrap_or_else(|| got.lines().count().min(want.lines().count()));
+    Some(format!(
+        "{name} (on {threads} threads): differs from {} at line {}:\n  got:  {}\n  want: {}",
+        path.display(),
+        line + 1,
+        got.lines().nth(line).unwrap_or("<end>"),
+        want.lines().nth(line).unwrap_or("<end>")
+    ))
+}
+
+/// Every case's outputs are the recorded ones, on 2 threads and on 1
+/// (the same bits at any thread count). `TRICEPT_BLESS=1` records them
+/// anew from the run on 2 threads; the diff of `crates/cli/tests/golden/`
+/// then shows what changed.
+#[test]
+fn every_verb_s_outputs_on_the_fixtures_are_the_recorded_ones() {
+    let mut names = std::collections::BTreeSet::new();
+    for c in CASES {
+        assert!(names.insert(c.name), "{}: two cases of one name", c.name);
+    }
+    let bless = std::env::var_os("TRICEPT_BLESS").is_some();
+    let golden = golden_dir();
+    let mut changed = Vec::new();
+    for threads in ["2", "1"] {
+        let recordings = run_all(threads);
+        if bless && threads == "2" {
+            let _ = std::fs::remove_dir_all(&golden);
+            std::fs::create_dir_all(&golden).unwrap();
+            for (name, got) in &recordings {
+                std::fs::write(golden.join(format!("{name}.txt")), got).unwrap();
+            }
             continue;
         }
-        let want = std::fs::read_to_string(&path).unwrap_or_default();
-        if got != want {
-            let line = got
-                .lines()
-                .zip(want.lines())
-                .position(|(a, b)| a != b)
-                .unwrap_or_else(|| got.lines().count().min(want.lines().count()));
-            changed.push(format!(
-                "{}: differs from {} at line {}:\n  got:  {}\n  want: {}",
-                c.name,
-                path.display(),
-                line + 1,
-                got.lines().nth(line).unwrap_or("<end>"),
-                want.lines().nth(line).unwrap_or("<end>")
-            ));
+        for (name, got) in &recordings {
+            let path = golden.join(format!("{name}.txt"));
+            changed.extend(difference(name, &path, got, threads));
         }
     }
-    if !bless {
-        // A recording without its case is a case removed.
-        for e in std::fs::read_dir(&golden).unwrap().flatten() {
-            let name = e.file_name().to_string_lossy().into_owned();
-            if !names.contains(name.trim_end_matches(".txt")) {
-                changed.push(format!("{name}: recorded, but no case runs it"));
-            }
+    // A recording without its case is a case removed.
+    for e in std::fs::read_dir(&golden).unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if !names.contains(name.trim_end_matches(".txt")) {
+            changed.push(format!("{name}: recorded, but no case runs it"));
         }
     }
     assert!(
@@ -998,5 +1074,4 @@ fn every_verb_s_outputs_on_the_fixtures_are_the_recorded_ones() {
         CASES.len(),
         changed.join("\n")
     );
-    std::fs::remove_dir_all(&dir).ok();
 }
