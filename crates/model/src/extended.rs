@@ -336,3 +336,22 @@ mod tests {
         assert!((fk.position_mm - t.platform_mm).norm() < 1e-8);
     }
 }
+
+/// A batch of points solved with the leg effects applied
+/// (`tricept_kinematics::batch`).
+impl tricept_kinematics::batch::PointKinematics for ExtendedMachine {
+    fn inverse(&self, r: &Vector3<f64>) -> Result<IkSolution, KinematicsError> {
+        ExtendedMachine::inverse(self, r)
+    }
+    fn forward(&self, commands_mm: &[f64; 3]) -> Result<FkSolution, KinematicsError> {
+        ExtendedMachine::forward(self, commands_mm)
+    }
+    fn tool_inverse(
+        &self,
+        tip_mm: &Vector3<f64>,
+        axis: &Vector3<f64>,
+        branch: HeadBranch,
+    ) -> Result<ToolIkSolution, KinematicsError> {
+        ExtendedMachine::tool_inverse(self, tip_mm, axis, branch)
+    }
+}
