@@ -61,7 +61,7 @@
 
 mod accuracy;
 mod campaigns;
-mod compensate;
+pub mod compensate;
 mod error;
 mod evaluate;
 pub mod fusion;

@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::Vector3;
 use serde_json::{Map, Value, json};
-use tricept_engine::{CompensationTable, ExtendedMachine};
-use tricept_kinematics::description::LegTableDescription;
+use tricept_engine::ExtendedMachine;
+use tricept_engine::compensate::{MapError, TableError, WorkspaceTable};
 use tricept_model::{MapStats, ParameterSet};
 use tricept_plant::Effect;
 
@@ -99,13 +99,11 @@ impl CompensateRequest {
 /// A target (mm) and its corrected leg commands (mm).
 pub type CorrectedTarget = (Vector3<f64>, [f64; 3]);
 
-/// The compensation table and what it was built from.
+/// The compensation table and where it is written.
 #[derive(Debug, Clone)]
 struct Table {
-    table: CompensationTable,
-    error_um: f64,
+    built: WorkspaceTable,
     path: PathBuf,
-    leg_tables: Vec<LegTableDescription>,
     legs_path: PathBuf,
 }
 
@@ -255,21 +253,8 @@ pub fn compensate(request: CompensateRequest) -> Result<Compensation, Error> {
     let grid = w.disc_grid(z, spacing);
     // What compensation changes, as the calibrated model sees it: nominal
     // commands, positions by the calibrated machine.
-    let context = "compensation map";
-    let mut predicted = Vec::with_capacity(grid.len());
-    for r in &grid {
-        let ik = nominal
-            .inverse(r)
-            .map_err(|e| Error::with_context(context, &e))?;
-        let p = calibrated
-            .forward_from(&ik.legs_mm, &ik.up)
-            .map_err(|e| Error::with_context(context, &e))?;
-        predicted.push(p.position_mm - r);
-    }
-    let predicted = ErrorMap {
-        targets_mm: grid.clone(),
-        errors_mm: predicted,
-    };
+    let predicted = tricept_engine::compensate::correction_map(&nominal, &calibrated, &grid)
+        .map_err(|e| Error::with_context(MAP_CONTEXT, &e))?;
     out.insert("plane_z_mm".into(), z.into());
     out.insert("grid_points".into(), grid.len().into());
     out.insert(
@@ -298,11 +283,11 @@ pub fn compensate(request: CompensateRequest) -> Result<Compensation, Error> {
     if let Some(t) = &table {
         let mut entry = json!({
             "file": t.path.display().to_string(),
-            "spacing_mm": t.table.spacing_mm,
-            "counts": t.table.counts,
-            "interpolation_error_um": t.error_um,
+            "spacing_mm": t.built.table.spacing_mm,
+            "counts": t.built.table.counts,
+            "interpolation_error_um": t.built.error_um,
         });
-        if !t.leg_tables.is_empty() {
+        if !t.built.leg_tables.is_empty() {
             entry["leg_tables"] = t.legs_path.display().to_string().into();
         }
         out.insert("table".into(), entry);
@@ -329,9 +314,11 @@ pub fn compensate(request: CompensateRequest) -> Result<Compensation, Error> {
     })
 }
 
-/// The compensation table (the per-leg tables exported as they are: the
-/// controller's pitch-error compensation on each leg axis; the workspace
-/// table carries the rest, which is smooth).
+/// The errors of a map's solutions name the map.
+const MAP_CONTEXT: &str = "compensation map";
+
+/// The compensation table (`tricept_engine::compensate::workspace_table`)
+/// and where it goes.
 fn table(
     request: &CompensateRequest,
     dir: &Path,
@@ -340,38 +327,28 @@ fn table(
     warnings: &mut Vec<String>,
 ) -> Result<Table, Error> {
     let w = &nominal.machine().workspace;
-    let leg_tables = calibrated.machine().leg_effects.tables.clone();
-    let calibrated = if leg_tables.is_empty() {
-        calibrated.clone()
-    } else {
-        let mut m = calibrated.machine().clone();
-        m.leg_effects.tables.clear();
-        ExtendedMachine::new(m)
-    };
-    let context = "compensation map";
-    let (table, error_um) = match request.table_spacing_mm {
-        Some(h) => {
-            let t = CompensationTable::build(nominal, &calibrated, w, h)
-                .map_err(|e| Error::input(format!("--table-spacing {h}: {e}")))?;
-            let e = t
-                .interpolation_error_um(nominal, &calibrated, w)
-                .map_err(|e| Error::with_context(context, &e))?;
-            (t, e)
+    let built = tricept_engine::compensate::workspace_table(
+        nominal,
+        calibrated,
+        w,
+        request.table_spacing_mm,
+        TABLE_ERROR_LIMIT_UM,
+    )
+    .map_err(|e| match (e, request.table_spacing_mm) {
+        (TableError::Spacing(e), Some(h)) => Error::input(format!("--table-spacing {h}: {e}")),
+        (TableError::Spacing(e) | TableError::Kinematics(e), _) => {
+            Error::with_context(MAP_CONTEXT, &e)
         }
-        None => CompensationTable::with_error_below(nominal, &calibrated, w, TABLE_ERROR_LIMIT_UM)
-            .map_err(|e| Error::with_context(context, &e))?,
-    };
-    if error_um >= TABLE_ERROR_LIMIT_UM {
+    })?;
+    if built.error_um >= TABLE_ERROR_LIMIT_UM {
         warnings.push(format!(
-            "the compensation table's interpolation error is {error_um:.3} um at {} mm spacing, above {TABLE_ERROR_LIMIT_UM} um: a finer --table-spacing reduces it",
-            table.spacing_mm
+            "the compensation table's interpolation error is {:.3} um at {} mm spacing, above {TABLE_ERROR_LIMIT_UM} um: a finer --table-spacing reduces it",
+            built.error_um, built.table.spacing_mm
         ));
     }
     Ok(Table {
-        table,
-        error_um,
+        built,
         path: dir.join(TABLE_FILES[0]),
-        leg_tables,
         legs_path: dir.join(TABLE_FILES[1]),
     })
 }
@@ -399,24 +376,12 @@ fn truth_maps(
     plant.effects = request.truth_effects.clone();
     // Where the true machine goes when commanded by a machine's IK.
     let map = |commanding: &ExtendedMachine| -> Result<ErrorMap, Error> {
-        let context = "compensation map";
-        let mut errors = Vec::with_capacity(grid.len());
-        for r in grid {
-            let q = commanding
-                .inverse(r)
-                .map_err(|e| Error::with_context(context, &e))?
-                .legs_mm;
-            errors.push(
-                plant
-                    .reach(&q)
-                    .map_err(|e| Error::with_context(context, &e))?
-                    - r,
-            );
-        }
-        Ok(ErrorMap {
-            targets_mm: grid.to_vec(),
-            errors_mm: errors,
-        })
+        tricept_engine::compensate::commanded_map(commanding, grid, |q| plant.reach(q)).map_err(
+            |e| match e {
+                MapError::Commanding(e) => Error::with_context(MAP_CONTEXT, &e),
+                MapError::Reach(e) => Error::with_context(MAP_CONTEXT, &e),
+            },
+        )
     };
     Ok(Some((map(nominal)?, map(calibrated)?)))
 }
@@ -558,57 +523,7 @@ impl Compensation {
     /// The per-point map as CSV: the predicted correction and, against a
     /// true machine, the error before and after, mm.
     pub fn map_csv(&self) -> String {
-        let (predicted, truth) = (&self.predicted, self.truth.as_ref());
-        let mut csv = String::new();
-        let _ = writeln!(
-            csv,
-            "# tricept compensate: per-point map on a plane, mm; correction = where the calibrated model says the nominal commands put the platform, minus the target"
-        );
-        if truth.is_some() {
-            let _ = writeln!(
-                csv,
-                "# before/after = where the simulated true machine goes when commanded by the nominal / calibrated IK, minus the target"
-            );
-        }
-        let mut header =
-            "x,y,z,correction_dx,correction_dy,correction_dz,correction_mm".to_string();
-        if truth.is_some() {
-            header.push_str(
-                ",before_dx,before_dy,before_dz,before_mm,after_dx,after_dy,after_dz,after_mm",
-            );
-        }
-        let _ = writeln!(csv, "{header}");
-        for (i, r) in predicted.targets_mm.iter().enumerate() {
-            let c = predicted.errors_mm[i];
-            let _ = write!(
-                csv,
-                "{},{},{},{},{},{},{}",
-                r.x,
-                r.y,
-                r.z,
-                c.x,
-                c.y,
-                c.z,
-                c.norm()
-            );
-            if let Some((b, a)) = truth {
-                let (b, a) = (b.errors_mm[i], a.errors_mm[i]);
-                let _ = write!(
-                    csv,
-                    ",{},{},{},{},{},{},{},{}",
-                    b.x,
-                    b.y,
-                    b.z,
-                    b.norm(),
-                    a.x,
-                    a.y,
-                    a.z,
-                    a.norm()
-                );
-            }
-            csv.push('\n');
-        }
-        csv
+        tricept_engine::compensate::map_csv(&self.predicted, self.truth.as_ref())
     }
 
     /// Writes the compensation table (and the per-leg tables of a machine
@@ -630,102 +545,21 @@ impl Compensation {
                 ))
             })?;
         }
-        write_text(&t.path, &self.table_csv(t))?;
+        let csv = tricept_engine::compensate::table_csv(
+            &t.built,
+            &self.calibrated.machine().name,
+            &self.nominal.machine().name,
+        );
+        write_text(&t.path, &csv)?;
         let mut written = vec![t.path.clone()];
-        if !t.leg_tables.is_empty() {
-            write_text(
-                &t.legs_path,
-                &leg_tables_csv(&t.leg_tables, self.calibrated.machine()),
-            )?;
+        if !t.built.leg_tables.is_empty() {
+            let csv = tricept_engine::compensate::leg_tables_csv(
+                &t.built.leg_tables,
+                self.calibrated.machine(),
+            );
+            write_text(&t.legs_path, &csv)?;
             written.push(t.legs_path.clone());
         }
         Ok(written)
     }
-
-    fn table_csv(&self, t: &Table) -> String {
-        let (tb, error_um) = (&t.table, t.error_um);
-        let o = tb.origin_mm;
-        let mut s = String::new();
-        let _ = writeln!(
-            s,
-            "# tricept {} compensation table: leg-command corrections dq = q_calibrated - q_nominal (mm) on a regular grid",
-            env!("CARGO_PKG_VERSION")
-        );
-        let _ = writeln!(
-            s,
-            "# calibrated machine: {}",
-            self.calibrated.machine().name
-        );
-        let _ = writeln!(s, "# nominal machine: {}", self.nominal.machine().name);
-        let _ = writeln!(
-            s,
-            "# grid: origin_mm {} {} {}, spacing_mm {}, counts {} {} {}; node (i,j,k) at origin + spacing (i,j,k), i fastest",
-            o.x, o.y, o.z, tb.spacing_mm, tb.counts[0], tb.counts[1], tb.counts[2]
-        );
-        let _ = writeln!(
-            s,
-            "# lookup: command = nominal IK + trilinear interpolation of dq at the eight corners of the cell holding the target"
-        );
-        let _ = writeln!(
-            s,
-            "# interpolation_error_um {error_um:.6} (largest difference from the exact correction on the lattice of spacing {} mm inside the workspace)",
-            tb.spacing_mm / 4.0
-        );
-        let _ = writeln!(
-            s,
-            "# nodes the machine cannot reach are left out; every cell that meets the workspace has its eight corners"
-        );
-        let _ = writeln!(s, "i,j,k,x,y,z,dq1,dq2,dq3");
-        for k in 0..tb.counts[2] {
-            for j in 0..tb.counts[1] {
-                for i in 0..tb.counts[0] {
-                    let idx = i + tb.counts[0] * (j + tb.counts[1] * k);
-                    if let Some(dq) = tb.nodes[idx] {
-                        let r = o + Vector3::new(i as f64, j as f64, k as f64) * tb.spacing_mm;
-                        let _ = writeln!(
-                            s,
-                            "{i},{j},{k},{},{},{},{},{},{}",
-                            r.x, r.y, r.z, dq[0], dq[1], dq[2]
-                        );
-                    }
-                }
-            }
-        }
-        s
-    }
-}
-
-/// The per-leg compensation tables of `machine` as CSV: one row per point
-/// (`leg,command_mm,extra_length_um`), each table's range, spacing,
-/// interpolation and source in the header.
-fn leg_tables_csv(tables: &[LegTableDescription], machine: &tricept_kinematics::Machine) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "# tricept {} per-leg compensation tables of {}: the extra length of each leg (um) at equally spaced leg commands (mm)",
-        env!("CARGO_PKG_VERSION"),
-        machine.name
-    );
-    let _ = writeln!(
-        s,
-        "# interpolation: linear between the points, the end values beyond them; applied on each leg axis after table.csv: the command q with q + extra(q) = the table's command (to first order q = command - extra(command), the form of a CNC controller's pitch-error compensation)"
-    );
-    for t in tables {
-        let _ = writeln!(
-            s,
-            "# leg {}: from {} mm every {} mm, {} points; {}",
-            t.leg,
-            t.start_mm,
-            t.step_mm,
-            t.extra_length_um.len(),
-            t.source
-        );
-    }
-    let _ = writeln!(s, "leg,command_mm,extra_length_um");
-    for t in tables {
-        for (k, v) in t.extra_length_um.iter().enumerate() {
-            let _ = writeln!(s, "{},{},{v}", t.leg, t.start_mm + t.step_mm * k as f64);
-        }
-    }
-    s
 }
