@@ -11,18 +11,16 @@ use std::path::PathBuf;
 
 use nalgebra::{DMatrix, Vector3};
 use serde_json::{Value, json};
-use tricept_data::{ExternalData, ExternalPose, PlannedPose};
-use tricept_engine::fusion::{
-    FusedModel, Source, TrackerOptions, head_angle_poses, information_factor,
-};
+use tricept_data::{ExternalData, PlannedPose};
+use tricept_engine::fusion::{FusedModel, Source, TrackerOptions, information_factor};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_model::effects::EffectName;
 use tricept_study::plan::{
-    Plan as StudyPlan, PlanProblem, PlanRow, candidate_rows, internal_factor, nominal_ballbar_data,
-    nominal_touch_data, nominal_tracker_data, plan as study_plan, sphere_candidates,
-    with_extensions,
+    Plan as StudyPlan, PlanProblem, PlanRow, candidate_rows, internal_factor, plan as study_plan,
+    sphere_candidates,
 };
+use tricept_study::plan_sources::{Candidate, ballbar_source, touch_source, tracker_source};
 
 use crate::calibrate::values::{
     EvalGrid, HeadModel, TrackerTargetSpec, eval_options, fused_model, head_angles_text,
@@ -255,25 +253,6 @@ fn instrument_sigma(a: &PlanRequest, own: f64, flag: &str) -> Result<f64, Error>
     }
 }
 
-/// The features file of a touch plan: one sphere (id 1) and the stylus.
-fn touch_features(
-    sphere_radius_mm: f64,
-    stylus_radius_mm: f64,
-    stylus_sigma_um: f64,
-) -> tricept_data::Features {
-    tricept_data::Features {
-        stylus: tricept_data::Stylus {
-            radius_mm: stylus_radius_mm,
-            radius_sigma_um: stylus_sigma_um,
-        },
-        features: vec![tricept_data::Feature::Sphere {
-            id: 1,
-            radius_mm: sphere_radius_mm,
-            radius_sigma_um: 0.5,
-        }],
-    }
-}
-
 /// Plans as `request` says.
 pub fn plan(request: PlanRequest) -> Result<Plan, Error> {
     let a = &request;
@@ -373,9 +352,6 @@ fn internal_information(
     })
 }
 
-/// A candidate pose and its target's extension along the tool, mm.
-type Candidate = (ExternalPose, f64);
-
 /// The candidates of an instrument, its nominal source and the centre of a
 /// ballbar's pivot or a touched sphere, mm.
 type Candidates = (Vec<Candidate>, Source, Option<Vector3<f64>>);
@@ -409,13 +385,12 @@ fn candidates(a: &PlanRequest, m: &Machine, model: &FusedModel) -> Result<Candid
                     limits::MAX_CANDIDATES
                 )));
             }
-            let poses = with_extensions(&head_angle_poses(m, &points, h1, h2), &a.extensions);
-            let data = nominal_tracker_data(model, &poses)?;
             let options = TrackerOptions {
                 sigma_um: instrument_sigma(a, a.tracker_sigma_um, "--tracker-sigma-um")?,
                 target,
             };
-            let source = Source::tracker(&data, &options)?;
+            let (poses, source) =
+                tracker_source(model, m, &points, (h1, h2), &a.extensions, &options)?;
             (poses, source, None)
         }
         Instrument::Ballbar | Instrument::Touch => {
@@ -448,23 +423,20 @@ fn candidates(a: &PlanRequest, m: &Machine, model: &FusedModel) -> Result<Candid
                 )));
             }
             let source = if touch {
-                let data = nominal_touch_data(&poses, 1)?;
-                let features = touch_features(
-                    a.touch_sphere_radius_mm,
+                let stylus = (
                     a.touch_stylus_radius_mm,
                     positive("--touch-stylus-sigma-um", a.touch_stylus_sigma_um)?,
                 );
                 let options = tricept_engine::fusion::TouchOptions {
                     sigma_um: instrument_sigma(a, a.touch_sigma_um, "--touch-sigma-um")?,
                 };
-                Source::touch(&data, &features, &options)?
+                touch_source(&poses, a.touch_sphere_radius_mm, stylus, &options)?
             } else {
-                let data = nominal_ballbar_data(model, &poses, &centre)?;
                 let options = tricept_engine::fusion::BallbarOptions {
                     sigma_um: instrument_sigma(a, a.ballbar_sigma_um, "--ballbar-sigma-um")?,
                     ..Default::default()
                 };
-                Source::ballbar(&data, &options)?
+                ballbar_source(model, &poses, &centre, &options)?
             };
             let poses = poses.into_iter().map(|p| (p, 0.0)).collect();
             (poses, source, Some(centre))
@@ -480,30 +452,13 @@ fn planned_poses(
     centre: Option<Vector3<f64>>,
     last: &PlanRow,
 ) -> Result<OutFile, Error> {
-    let p = vec![0.0; model.len()];
-    let records = last
-        .selection
-        .iter()
-        .map(|&c| {
-            let (pose, extension_mm) = poses[c];
-            let effector = tricept_model::Effector {
-                extension_mm,
-                ..Default::default()
-            };
-            let (x, _) = model.spindle_point(&p, &pose, &effector)?;
-            Ok(PlannedPose {
-                pose,
-                extension_mm,
-                tip_mm: Some(x.into()),
-                length_mm: match a.instrument {
-                    Instrument::Ballbar => centre.map(|c| (x - c).norm()),
-                    _ => None,
-                },
-                feature: (a.instrument == Instrument::Touch).then_some(1),
-                line: 0,
-            })
-        })
-        .collect::<Result<Vec<_>, Error>>()?;
+    let records = tricept_study::plan_sources::planned_poses(
+        model,
+        poses,
+        &last.selection,
+        centre.filter(|_| a.instrument == Instrument::Ballbar),
+        (a.instrument == Instrument::Touch).then_some(1),
+    )?;
     let comments = vec![format!(
         "planned by tricept {} for a {:?}: {} measurements, RMS predicted tool-tip sd after touch-off {:.1} um, tool axis {:.1} arcsec, redundancy {:.1}",
         env!("CARGO_PKG_VERSION"),
@@ -671,24 +626,12 @@ fn check_plan(a: &PlanRequest, loaded: &LoadedMachine) -> Result<Plan, Error> {
     )?;
     let mut out = None;
     if a.out.is_some() {
-        let m = loaded.machine();
-        let mut records = Vec::with_capacity(p.targets_mm.len());
-        for r in &p.targets_mm {
-            let q = m
-                .inverse(r)
-                .map_err(|e| Error::with_context("plan", &e))?
-                .legs_mm;
-            records.push(format!(
-                "{},{},{},{},{},{}",
-                r.x, r.y, r.z, q[0], q[1], q[2]
-            ));
-        }
-        let text = format!(
-            "# tricept plan --instrument check: {} poses for `{}`; drive the machine to the commands q1,q2,q3 (mm) and log its readings\nx,y,z,q1,q2,q3\n{}\n",
-            p.poses,
-            loaded.description().name,
-            records.join("\n")
-        );
+        let text = tricept_study::plan_sources::check_poses_csv(
+            loaded.machine(),
+            &loaded.description().name,
+            &p.targets_mm,
+        )
+        .map_err(|e| Error::with_context("plan", &e))?;
         out = Some(OutFile::Check(text));
     }
     let json = json!({

@@ -38,6 +38,7 @@ mod kernel;
 pub mod optimise;
 pub mod paper;
 pub mod plan;
+pub mod plan_sources;
 mod results;
 mod rng;
 pub mod scenario;
