@@ -59,7 +59,7 @@
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
-mod accuracy;
+pub mod accuracy;
 mod campaigns;
 pub mod compensate;
 mod error;
@@ -70,7 +70,6 @@ mod identify;
 mod model;
 mod options;
 mod prior;
-mod promise;
 mod record;
 mod report;
 mod robust;
@@ -78,6 +77,7 @@ mod suspects;
 mod table;
 mod verdict;
 
+pub use accuracy::cross_validation::{CrossValidation, cross_validate};
 pub use accuracy::{
     AccuracyModel, DEFAULT_TOLERANCE_MM, PredictedAccuracy, WORTHWHILE_RATIO, accuracy_points,
 };
@@ -90,7 +90,6 @@ pub use identify::{
 pub use model::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
 pub use options::IdentifyOptions;
 pub use prior::{Prior, PriorFit};
-pub use promise::{CrossValidation, cross_validate};
 pub use record::{RECORD_METHODS, RecordError, RecordNotes, check_calibration_record};
 pub use report::{Combination, CorrelatedPair, IdentifiabilityReport, NamedValues, Observability};
 pub use robust::{

@@ -26,6 +26,17 @@
 //! that does not clearly beat the machine's tolerance is a coin flip at
 //! best, and at 8 poses it is far worse (`dq` +- 4 mm along the weak
 //! direction of all three legs).
+//!
+//! The accuracy a machine file promises is made here too, from the same
+//! evaluation points: [`promise`] (internal data: the estimate, what the
+//! fit leaves unexplained out of sample ([`cross_validation`]), the
+//! structure) and [`fused`] (the tool tip of a fused fit).
+
+pub mod cross_validation;
+pub mod fused;
+pub mod promise;
+
+pub use promise::{Accuracy, Fit, PromiseError, of_fit};
 
 use nalgebra::{DMatrix, Vector3};
 use serde::Serialize;
