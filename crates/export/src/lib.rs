@@ -82,6 +82,12 @@ impl ExportPlan {
 
 /// The export of the calibrated machine `description` for the control of
 /// `options`: the files' text and the summary. Nothing is written.
+///
+/// Its steps: the options checked (`check_options`, `axis_names`),
+/// what every control's writer starts from (`setup_of`), the control's
+/// files and the geometry table (`control_files`), what they leave of
+/// the platform's error (`platform_error_um`) and what they cannot carry
+/// (`not_exported`), and the summary (`summary_of`).
 pub fn plan(
     description: &MachineDescription,
     options: &ExportOptions,
@@ -92,10 +98,36 @@ pub fn plan(
     let names = axis_names(options)?;
     let warnings = check_options(options)?;
     let machine = description.build()?;
-    let legs = correction::leg_corrections(&machine, options.reference_mm)?;
+    let setup = setup_of(description, &machine, names, options)?;
+    let control = control_files(description, &machine, &setup);
+    let workspace_poses = machine.workspace.random_poses(200, 0x0e4b_0a7d);
+    let platform_error_um = platform_error_um(&machine, &control, &workspace_poses)?;
+    let not_exported = not_exported(&machine, &setup, &control, record, &workspace_poses)?;
+    let summary = summary_of(
+        description,
+        options,
+        &control,
+        platform_error_um,
+        not_exported,
+        warnings,
+    );
+    let mut files = control.files;
+    files.push((SUMMARY_FILE.to_string(), summary_json(&summary)));
+    Ok(ExportPlan { summary, files })
+}
+
+/// What every control's writer starts from: the legs' exact corrections
+/// (their references checked), the axis names, the controller parameters.
+fn setup_of<'a>(
+    description: &MachineDescription,
+    machine: &Machine,
+    names: [String; 3],
+    options: &'a ExportOptions,
+) -> Result<Setup<'a>, ExportError> {
+    let legs = correction::leg_corrections(machine, options.reference_mm)?;
     correction::check_references(&legs)?;
     let params = description.controller.unwrap_or_default();
-    let setup = Setup {
+    Ok(Setup {
         legs,
         names,
         leg_offsets_mm: machine.leg_offsets_mm,
@@ -105,52 +137,71 @@ pub fn plan(
         max_points: options
             .max_points
             .unwrap_or(options.control.default_max_points()),
-    };
-    let mut control = match options.control.family() {
-        Controller::Sinumerik => sinumerik::files(&setup),
-        Controller::Heidenhain => heidenhain::files(&setup),
-        Controller::Fanuc => fanuc::files(&setup),
+    })
+}
+
+/// The control's files, by its family's writer, and the geometry table.
+fn control_files(
+    description: &MachineDescription,
+    machine: &Machine,
+    setup: &Setup,
+) -> ControlFiles {
+    let mut control = match setup.options.control.family() {
+        Controller::Sinumerik => sinumerik::files(setup),
+        Controller::Heidenhain => heidenhain::files(setup),
+        Controller::Fanuc => fanuc::files(setup),
     };
     control.files.push((
         geometry::FILE.to_string(),
-        geometry::table(description, &machine, &control.axes),
+        geometry::table(description, machine, &control.axes),
     ));
-    let workspace_poses = machine.workspace.random_poses(200, 0x0e4b_0a7d);
-    let mut platform_error_um: f64 = 0.0;
+    control
+}
+
+/// The largest platform error the control's files leave at the workspace
+/// poses, um, over every reading the control may make of them.
+fn platform_error_um(
+    machine: &Machine,
+    control: &ControlFiles,
+    workspace_poses: &[nalgebra::Vector3<f64>],
+) -> Result<f64, ExportError> {
+    let mut worst: f64 = 0.0;
     for reading in &control.readings {
-        platform_error_um = platform_error_um.max(correction::platform_error_um(
-            &machine,
-            &workspace_poses,
+        worst = worst.max(correction::platform_error_um(
+            machine,
+            workspace_poses,
             reading,
         )?);
     }
-    let not_exported = not_exported(&machine, &setup, &control, record, &workspace_poses)?;
-    let ControlFiles {
-        mut files,
-        axes,
-        parameters,
-        limits,
-        ..
-    } = control;
-    let mut file_names: Vec<String> = files.iter().map(|(n, _)| n.clone()).collect();
+    Ok(worst)
+}
+
+/// The summary of an export (its file is [`SUMMARY_FILE`]).
+fn summary_of(
+    description: &MachineDescription,
+    options: &ExportOptions,
+    control: &ControlFiles,
+    platform_error_um: f64,
+    not_exported: Vec<NotExported>,
+    warnings: Vec<String>,
+) -> ExportSummary {
+    let mut file_names: Vec<String> = control.files.iter().map(|(n, _)| n.clone()).collect();
     file_names.push(SUMMARY_FILE.to_string());
-    let summary = ExportSummary {
+    ExportSummary {
         controller: options.control.family(),
         control: options.control,
         control_limits: options.control.limits(),
         files: file_names,
-        axes,
+        axes: control.axes.clone(),
         platform_error_um,
         not_exported,
-        parameters,
+        parameters: control.parameters.clone(),
         tolerance_um: options.tolerance_um,
-        within_tolerance: limits.is_empty(),
-        limits,
+        within_tolerance: control.limits.is_empty(),
+        limits: control.limits.clone(),
         warnings,
         calibration_digest: description.calibration_digest(),
-    };
-    files.push((SUMMARY_FILE.to_string(), summary_json(&summary)));
-    Ok(ExportPlan { summary, files })
+    }
 }
 
 /// The summary file's text.
