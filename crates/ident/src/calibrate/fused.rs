@@ -8,23 +8,18 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
-use tricept_data::{
-    BallbarReading, Dataset, ExternalData, ExternalRecord, Features, TouchReading, TrackerPoint,
-};
+use tricept_data::{BallbarReading, ExternalData, ExternalRecord, TouchReading, TrackerPoint};
 use tricept_engine::IdentError;
-use tricept_engine::fusion::{
-    BallbarOptions, FusedModel, Fusion, FusionPlausibility, Source, SourceKind, TouchOptions,
-    TrackerOptions, TrackerTarget, identify_fused,
-};
+use tricept_engine::fusion::{FusedModel, Fusion, Source, SourceKind, identify_fused};
 use tricept_kinematics::description::ExternalSourceRecord;
 use tricept_kinematics::{Machine, MachineDescription};
-use tricept_model::ParameterSet;
 use tricept_model::effects::EffectName;
 
-use super::values::{FusedSources, TrackerTargetSpec, eval_options, fused_model};
+use super::checked::{Checked, FusedWork};
+use super::values::fused_model;
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error};
-use crate::inputs::{LoadedMachine, check_commands, positive};
-use crate::{limits, machine_file};
+use crate::inputs::{LoadedMachine, check_commands};
+use crate::machine_file;
 
 /// A fused fit with its model and its sources.
 #[derive(Debug)]
@@ -133,67 +128,29 @@ impl Unchecked {
     }
 }
 
-/// Fits `x` with the internal `data` on `loaded`; `for_machine_file`
-/// refuses up front fitted effects, which the machine format cannot carry.
-pub(crate) fn fit(
-    loaded: &LoadedMachine,
-    set: &ParameterSet,
-    data: &Dataset,
-    x: &FusedSources,
-    robust: bool,
-    for_machine_file: bool,
-) -> Result<FusedFit, Error> {
-    let machine = loaded.machine();
-    if x.tracker.is_empty() && x.tracker_target.is_some() {
-        return Err(Error::input(
-            "--tracker-target: there is no --tracker file to state the target of",
-        ));
-    }
-    let mut model = fused_model(machine, set, &x.effects, x.head)?;
-    if for_machine_file && !model.effects().is_empty() {
-        let names: Vec<&str> = model.effects().iter().map(|e| e.as_str()).collect();
-        return Err(Error::input(format!(
-            "--write-machine: {} fitted, but the machine format cannot carry {}; write a geometric fit (without --effects) or compensate with the fused model",
-            names.join(", "),
-            if names.len() == 1 { "it" } else { "them" }
-        )));
-    }
-    // A calibrated machine: the rank decision of its nominal machine, as in
-    // the internal calibration (docs/identifiability.md).
-    if let Some(reference) = loaded.rank_reference()? {
-        model = model.with_rank_reference(reference)?;
-    }
-    let mut options = eval_options(machine, x.eval_grid, &x.eval_head_angles)?;
-    if !robust {
-        options.screen = None;
-    }
-    if let Some(path) = &x.plausibility {
-        let text = tricept_data::read_json_text(path)
-            .map_err(|e| Error::input(format!("--plausibility {}: {e}", path.display())))?;
-        options.plausibility = FusionPlausibility::with_overrides(&text)
-            .map_err(|e| Error::input(format!("--plausibility {}: {e}", path.display())))?;
-    }
-    options.tool_axis_arcsec = positive("--tool-axis-warn-arcsec", x.tool_axis_warn_arcsec)?;
-    let all = sources(x, data, machine)?;
-    let fit = identify_fused(&model, &all, &options)?;
-    let unchecked = unchecked(&model, &fit, &options, || sources(x, data, machine))?;
+/// Fits the checked fused calibration `w` on `c`'s machine.
+pub(crate) fn fit(c: &Checked, w: &FusedWork) -> Result<FusedFit, Error> {
+    let (machine, model, options) = (c.loaded.machine(), &w.model, &w.options);
+    let all = sources(w, machine)?;
+    let fit = identify_fused(model, &all, options)?;
+    let unchecked = unchecked(model, &fit, options, || sources(w, machine))?;
     // The geometric estimate's shift when every leg may have a lead.
     let mut structure = (0.0, 0.0);
     if model.effects().is_empty() && fit.converged {
-        let mut rich = fused_model(machine, set, &[EffectName::LegLead], x.head)?;
-        if let Some(reference) = loaded.rank_reference()? {
+        let mut rich = fused_model(machine, &c.set, &[EffectName::LegLead], w.head)?;
+        if let Some(reference) = c.loaded.rank_reference()? {
             rich = rich.with_rank_reference(reference)?;
         }
-        if let Ok(r) = identify_fused(&rich, &all, &options) {
+        if let Ok(r) = identify_fused(&rich, &all, options) {
             structure =
-                crate::accuracy::fused_structure(&model, &fit, &rich, &r, &options.eval_poses);
+                crate::accuracy::fused_structure(model, &fit, &rich, &r, &options.eval_poses);
         }
     }
     Ok(FusedFit {
-        model,
+        model: model.clone(),
         fit,
         sources: all,
-        set_label: set.label().to_string(),
+        set_label: c.set.label().to_string(),
         deployed: None,
         unchecked,
         structure,
@@ -295,64 +252,31 @@ fn unchecked(
 }
 
 /// The sources: the internal data and every external file.
-fn sources(x: &FusedSources, data: &Dataset, machine: &Machine) -> Result<Vec<Source>, Error> {
-    let mut sources = vec![Source::internal(data, machine.sensors.logged_sigma())];
-    let target = if x.tracker.is_empty() {
-        TrackerTarget::Free
-    } else {
-        TrackerTargetSpec::required(x.tracker_target, x.tracker_target_sigma_um)?
-    };
-    let tracker = TrackerOptions {
-        sigma_um: positive("--tracker-sigma-um", x.tracker_sigma_um)?,
-        target,
-    };
+fn sources(w: &FusedWork, machine: &Machine) -> Result<Vec<Source>, Error> {
+    let mut sources = vec![Source::internal(&w.data, machine.sensors.logged_sigma())];
+    let (paths, tracker) = &w.tracker;
     sources.extend(external_sources(
-        &x.tracker,
+        paths,
         "tracker",
         machine,
         |r: &TrackerPoint| (r.line, r.pose.commands_mm),
-        |d| Source::tracker(d, &tracker),
+        |d| Source::tracker(d, tracker),
     )?);
-    let ball = match x.ballbar_ball_mm {
-        Some(t) => {
-            if let Some(v) = t.0.iter().find(|v| v.abs() > limits::MAX_TOOL_OFFSET_MM) {
-                return Err(Error::input(format!(
-                    "--ballbar-ball-mm: {v} mm is beyond ±{} mm from the tool tip",
-                    limits::MAX_TOOL_OFFSET_MM
-                )));
-            }
-            t.0
-        }
-        None => [0.0; 3],
-    };
-    let ballbar = BallbarOptions {
-        sigma_um: positive("--ballbar-sigma-um", x.ballbar_sigma_um)?,
-        length_sigma_um: x.ballbar_length_sigma.sigma_um(),
-        ball_offset_mm: ball,
-    };
+    let (paths, ballbar) = &w.ballbar;
     sources.extend(external_sources(
-        &x.ballbar,
+        paths,
         "ballbar",
         machine,
         |r: &BallbarReading| (r.line, r.pose.commands_mm),
-        |d| Source::ballbar(d, &ballbar),
+        |d| Source::ballbar(d, ballbar),
     )?);
-    if !x.touch.is_empty() {
-        let Some(features) = &x.features else {
-            return Err(Error::input(
-                "--touch needs --features FILE.json (the spheres and planes touched)",
-            ));
-        };
-        let features = Features::from_path(features)?;
-        let touch = TouchOptions {
-            sigma_um: positive("--touch-sigma-um", x.touch_sigma_um)?,
-        };
+    if let Some((paths, features, touch)) = &w.touch {
         sources.extend(external_sources(
-            &x.touch,
+            paths,
             "touch",
             machine,
             |r: &TouchReading| (r.line, r.pose.commands_mm),
-            |d| Source::touch(d, &features, &touch),
+            |d| Source::touch(d, features, touch),
         )?);
     }
     Ok(sources)

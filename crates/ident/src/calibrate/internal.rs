@@ -16,9 +16,9 @@ use tricept_engine::{
 };
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{Machine, MachineDescription};
-use tricept_model::ParameterSet;
 
 use super::advice::{campaign_advice, predicted_accuracy};
+use super::checked::Checked;
 use crate::accuracy::Accuracy;
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error};
 use crate::inputs::LoadedMachine;
@@ -47,17 +47,15 @@ pub(crate) struct InternalFit {
     pub pooled: Option<Box<super::pooling::Pooled>>,
 }
 
-/// Identifies `set` from `dataset` against `loaded` (robust unless told
-/// not to), with a batch's `prior` when given; the rank rule of a
+/// Identifies `c`'s set from `dataset` against its machine (robust unless
+/// told not to), with a batch's `prior` when given; the rank rule of a
 /// calibrated machine is its nominal machine's.
 pub(crate) fn fit(
-    loaded: &LoadedMachine,
-    set: &ParameterSet,
+    c: &Checked,
     dataset: &Dataset,
-    robust: bool,
-    tolerance_mm: f64,
     prior: Option<Prior>,
 ) -> Result<InternalFit, Error> {
+    let (loaded, set, robust, tolerance_mm) = (&c.loaded, &c.set, c.robust, c.tolerance_mm);
     let m = loaded.machine();
     let mut model = GeometricModel::new(m.clone(), set.clone());
     if let Some(reference) = loaded.rank_reference()? {

@@ -12,6 +12,7 @@
 //! report, its JSON) and writes.
 
 mod advice;
+mod checked;
 mod fused;
 mod internal;
 mod pooled;
@@ -29,6 +30,7 @@ use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, Error};
 use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
+use checked::Work;
 pub(crate) use internal::fit_error;
 pub use values::FusedSources;
 
@@ -138,60 +140,17 @@ impl Written {
 /// small to fit; a fit that completes returns its verdict in
 /// [`Calibration::exit_code`].
 pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
-    let tolerance_mm = request.tolerance_mm;
-    if !(tolerance_mm.is_finite() && tolerance_mm > 0.0 && tolerance_mm <= 10.0) {
-        return Err(Error::input(format!(
-            "--tolerance-mm: the manufacturing tolerance must be a number of mm above 0 and at most 10, got {tolerance_mm}"
-        )));
-    }
-    let loaded = request.machine.load()?;
-    let set = &request.parameter_set;
-    let pooled = !request.campaigns.is_empty() || request.prior.is_some();
-    if pooled && request.fused.is_some() {
-        return Err(Error::input(
-            "several --data or --prior with external measurements: not supported (pool the internal campaigns, or fuse one)",
-        ));
-    }
-    let fit = match &request.fused {
-        None if pooled => {
-            let inputs: Vec<&DataInput> = std::iter::once(&request.data)
-                .chain(&request.campaigns)
-                .collect();
-            Fit::Internal(Box::new(pooled::fit(
-                &loaded,
-                set,
-                &inputs,
-                request.prior.as_deref(),
-                request.robust,
-                tolerance_mm,
-            )?))
+    let (checked, data, work) = checked::check(request)?;
+    let fit = match &work {
+        Work::Pooled { datasets, prior } => {
+            Fit::Internal(Box::new(pooled::fit(&checked, datasets, prior.as_deref())?))
         }
-        None => {
-            let dataset = request.data.load(loaded.machine())?;
-            Fit::Internal(Box::new(internal::fit(
-                &loaded,
-                set,
-                &dataset,
-                request.robust,
-                tolerance_mm,
-                None,
-            )?))
-        }
-        Some(x) => {
-            let dataset = request.data.load(loaded.machine())?;
-            Fit::Fused(Box::new(fused::fit(
-                &loaded,
-                set,
-                &dataset,
-                x,
-                request.robust,
-                request.for_machine_file,
-            )?))
-        }
+        Work::Internal(dataset) => Fit::Internal(Box::new(internal::fit(&checked, dataset, None)?)),
+        Work::Fused(w) => Fit::Fused(Box::new(fused::fit(&checked, w)?)),
     };
     Ok(Calibration {
-        loaded,
-        data: request.data,
+        loaded: checked.loaded,
+        data,
         fit,
     })
 }

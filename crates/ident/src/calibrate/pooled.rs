@@ -13,9 +13,9 @@ use tricept_fleet::{PriorFile, agreements, campaign_chi_squares, pool};
 use tricept_model::ParameterSet;
 use tricept_numerics::stats::chi2_sf;
 
+use super::checked::Checked;
 use super::internal::{InternalFit, fit as internal_fit};
 use super::pooling::{CampaignRow, Pooled, PriorUsed};
-use crate::data_input::DataInput;
 use crate::error::Error;
 use crate::inputs::LoadedMachine;
 
@@ -53,21 +53,15 @@ fn read_prior(
     Ok((prior, file))
 }
 
-/// Calibrates from the campaigns `inputs` (at least one) and the prior at
+/// Calibrates from the campaigns `datasets` (at least one) and the prior at
 /// `prior` (module docs).
 pub(crate) fn fit(
-    loaded: &LoadedMachine,
-    set: &ParameterSet,
-    inputs: &[&DataInput],
+    c: &Checked,
+    datasets: &[Dataset],
     prior: Option<&Path>,
-    robust: bool,
-    tolerance_mm: f64,
 ) -> Result<InternalFit, Error> {
+    let (loaded, set) = (&c.loaded, &c.set);
     let m = loaded.machine();
-    let datasets = inputs
-        .iter()
-        .map(|d| d.load(m))
-        .collect::<Result<Vec<Dataset>, Error>>()?;
     let (prior, prior_file) = match prior {
         Some(path) => {
             let (p, f) = read_prior(path, loaded, set)?;
@@ -78,7 +72,7 @@ pub(crate) fn fit(
     let all = pool(&datasets);
     let options = IdentifyOptions::for_machine(m);
     let mut used = all.clone();
-    let mut fit = internal_fit(loaded, set, &used, robust, tolerance_mm, prior.clone())?;
+    let mut fit = internal_fit(c, &used, prior.clone())?;
     let count = datasets.len();
     let mut tests = vec![None; count];
     let mut disagreeing = Vec::new();
@@ -91,7 +85,7 @@ pub(crate) fn fit(
         // Three or more campaigns: the ones that disagree leave the fit.
         if !disagreeing.is_empty() && disagreeing.len() < count {
             used = all.subset(|j| !disagreeing.contains(&all.poses[j].campaign));
-            fit = internal_fit(loaded, set, &used, robust, tolerance_mm, prior)?;
+            fit = internal_fit(c, &used, prior)?;
         }
     }
     let kept = used.subset(|j| !fit.rejected.iter().any(|r| r.pose == j));

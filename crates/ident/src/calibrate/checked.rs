@@ -1,0 +1,251 @@
+//! A calibration request checked once, before any fit: the tolerance, the
+//! machine, the data, and for a fused calibration its model, its options
+//! and every instrument's noise and files' companions. The internal,
+//! pooled and fused fits take the one [`Checked`] type and the work it
+//! holds ([`Work`]), and check nothing of the request again.
+
+use std::path::PathBuf;
+
+use tricept_data::{Dataset, Features};
+use tricept_engine::fusion::{
+    BallbarOptions, FusedModel, FusionOptions, FusionPlausibility, TouchOptions, TrackerOptions,
+    TrackerTarget,
+};
+use tricept_model::ParameterSet;
+
+use super::CalibrateRequest;
+use super::values::{FusedSources, HeadModel, TrackerTargetSpec, eval_options, fused_model};
+use crate::data_input::DataInput;
+use crate::error::Error;
+use crate::inputs::{LoadedMachine, positive};
+use crate::limits;
+
+/// What every fit of a checked request shares.
+#[derive(Debug)]
+pub(crate) struct Checked {
+    /// The machine, loaded.
+    pub loaded: LoadedMachine,
+    /// The geometric parameters to identify.
+    pub set: ParameterSet,
+    /// Reject poses with a gross reading error.
+    pub robust: bool,
+    /// Manufacturing tolerance of each geometric parameter, mm (checked:
+    /// above 0, at most 10).
+    pub tolerance_mm: f64,
+}
+
+/// The fit a checked request asks for.
+#[derive(Debug)]
+pub(crate) enum Work {
+    /// One campaign of internal data.
+    Internal(Dataset),
+    /// Several campaigns, a batch's prior, or both.
+    Pooled {
+        /// The campaigns, loaded.
+        datasets: Vec<Dataset>,
+        /// The batch's prior file.
+        prior: Option<PathBuf>,
+    },
+    /// Internal data fused with external measurements.
+    Fused(Box<FusedWork>),
+}
+
+/// A fused calibration, checked: the internal data, the model, the
+/// options and the external sources' settings.
+#[derive(Debug)]
+pub(crate) struct FusedWork {
+    /// The internal data.
+    pub data: Dataset,
+    /// The fused model (with the rank rule of a calibrated machine).
+    pub model: FusedModel,
+    /// The head's parameters (of the richer model that checks the fit).
+    pub head: HeadModel,
+    /// The fusion options.
+    pub options: FusionOptions,
+    /// Tracker files and their settings.
+    pub tracker: (Vec<PathBuf>, TrackerOptions),
+    /// Ballbar files and their settings.
+    pub ballbar: (Vec<PathBuf>, BallbarOptions),
+    /// Touch-off files, the features touched and their settings.
+    pub touch: Option<(Vec<PathBuf>, Features, TouchOptions)>,
+}
+
+/// Checks `request` once: the tolerance, the machine, which fit, the data
+/// (and a fused calibration's settings, [`fused`]).
+pub(crate) fn check(request: CalibrateRequest) -> Result<(Checked, DataInput, Work), Error> {
+    let tolerance_mm = request.tolerance_mm;
+    if !(tolerance_mm.is_finite() && tolerance_mm > 0.0 && tolerance_mm <= 10.0) {
+        return Err(Error::input(format!(
+            "--tolerance-mm: the manufacturing tolerance must be a number of mm above 0 and at most 10, got {tolerance_mm}"
+        )));
+    }
+    let loaded = request.machine.load()?;
+    let pooled = !request.campaigns.is_empty() || request.prior.is_some();
+    if pooled && request.fused.is_some() {
+        return Err(Error::input(
+            "several --data or --prior with external measurements: not supported (pool the internal campaigns, or fuse one)",
+        ));
+    }
+    let checked = Checked {
+        set: request.parameter_set,
+        robust: request.robust,
+        tolerance_mm,
+        loaded,
+    };
+    let m = checked.loaded.machine();
+    let work = match &request.fused {
+        None if pooled => Work::Pooled {
+            datasets: std::iter::once(&request.data)
+                .chain(&request.campaigns)
+                .map(|d| d.load(m))
+                .collect::<Result<_, Error>>()?,
+            prior: request.prior,
+        },
+        None => Work::Internal(request.data.load(m)?),
+        Some(x) => {
+            let data = request.data.load(m)?;
+            Work::Fused(Box::new(fused(
+                &checked,
+                data,
+                x,
+                request.for_machine_file,
+            )?))
+        }
+    };
+    Ok((checked, request.data, work))
+}
+
+/// Checks a fused calibration's settings `x`; `for_machine_file` refuses
+/// up front fitted effects, which the machine format cannot carry.
+fn fused(
+    c: &Checked,
+    data: Dataset,
+    x: &FusedSources,
+    for_machine_file: bool,
+) -> Result<FusedWork, Error> {
+    let machine = c.loaded.machine();
+    if x.tracker.is_empty() && x.tracker_target.is_some() {
+        return Err(Error::input(
+            "--tracker-target: there is no --tracker file to state the target of",
+        ));
+    }
+    let mut model = fused_model(machine, &c.set, &x.effects, x.head)?;
+    if for_machine_file && !model.effects().is_empty() {
+        let names: Vec<&str> = model.effects().iter().map(|e| e.as_str()).collect();
+        return Err(Error::input(format!(
+            "--write-machine: {} fitted, but the machine format cannot carry {}; write a geometric fit (without --effects) or compensate with the fused model",
+            names.join(", "),
+            if names.len() == 1 { "it" } else { "them" }
+        )));
+    }
+    // A calibrated machine: the rank decision of its nominal machine, as in
+    // the internal calibration (docs/identifiability.md).
+    if let Some(reference) = c.loaded.rank_reference()? {
+        model = model.with_rank_reference(reference)?;
+    }
+    let mut options = eval_options(machine, x.eval_grid, &x.eval_head_angles)?;
+    if !c.robust {
+        options.screen = None;
+    }
+    if let Some(path) = &x.plausibility {
+        let text = tricept_data::read_json_text(path)
+            .map_err(|e| Error::input(format!("--plausibility {}: {e}", path.display())))?;
+        options.plausibility = FusionPlausibility::with_overrides(&text)
+            .map_err(|e| Error::input(format!("--plausibility {}: {e}", path.display())))?;
+    }
+    options.tool_axis_arcsec = positive("--tool-axis-warn-arcsec", x.tool_axis_warn_arcsec)?;
+    let target = if x.tracker.is_empty() {
+        TrackerTarget::Free
+    } else {
+        TrackerTargetSpec::required(x.tracker_target, x.tracker_target_sigma_um)?
+    };
+    let tracker = TrackerOptions {
+        sigma_um: positive("--tracker-sigma-um", x.tracker_sigma_um)?,
+        target,
+    };
+    let ball = match x.ballbar_ball_mm {
+        Some(t) => {
+            if let Some(v) = t.0.iter().find(|v| v.abs() > limits::MAX_TOOL_OFFSET_MM) {
+                return Err(Error::input(format!(
+                    "--ballbar-ball-mm: {v} mm is beyond ±{} mm from the tool tip",
+                    limits::MAX_TOOL_OFFSET_MM
+                )));
+            }
+            t.0
+        }
+        None => [0.0; 3],
+    };
+    let ballbar = BallbarOptions {
+        sigma_um: positive("--ballbar-sigma-um", x.ballbar_sigma_um)?,
+        length_sigma_um: x.ballbar_length_sigma.sigma_um(),
+        ball_offset_mm: ball,
+    };
+    let touch = if x.touch.is_empty() {
+        None
+    } else {
+        let Some(features) = &x.features else {
+            return Err(Error::input(
+                "--touch needs --features FILE.json (the spheres and planes touched)",
+            ));
+        };
+        let features = Features::from_path(features)?;
+        let options = TouchOptions {
+            sigma_um: positive("--touch-sigma-um", x.touch_sigma_um)?,
+        };
+        Some((x.touch.clone(), features, options))
+    };
+    Ok(FusedWork {
+        data,
+        model,
+        head: x.head,
+        options,
+        tracker: (x.tracker.clone(), tracker),
+        ballbar: (x.ballbar.clone(), ballbar),
+        touch,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fixture() -> PathBuf {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/data/table2-grid-seed1.csv")
+    }
+
+    #[test]
+    fn every_instrument_setting_is_checked_before_any_external_file_is_read() {
+        // Both the tracker's and the ballbar's noise are wrong and their
+        // files do not exist: the first setting is named, no file is.
+        let mut request = CalibrateRequest::new(fixture());
+        request.fused = Some(FusedSources {
+            tracker: vec!["no-such-tracker.csv".into()],
+            tracker_target: Some("tip".parse().unwrap()),
+            tracker_sigma_um: -1.0,
+            ballbar: vec!["no-such-ballbar.csv".into()],
+            ballbar_sigma_um: 0.0,
+            ..FusedSources::default()
+        });
+        let e = check(request).unwrap_err();
+        assert_eq!(e.exit_code(), crate::EXIT_INPUT);
+        assert!(e.message().starts_with("--tracker-sigma-um"), "{e}");
+        // Settings right, files missing: the fit is checked, the files are
+        // read by the fit.
+        let mut request = CalibrateRequest::new(fixture());
+        request.fused = Some(FusedSources {
+            tracker: vec!["no-such-tracker.csv".into()],
+            tracker_target: Some("tip".parse().unwrap()),
+            ..FusedSources::default()
+        });
+        let (checked, _, work) = check(request).unwrap();
+        let Work::Fused(w) = work else {
+            panic!("a fused request is fused work")
+        };
+        assert_eq!(w.tracker.1.sigma_um, 10.0);
+        assert!(w.touch.is_none());
+        assert_eq!(
+            checked.tolerance_mm,
+            CalibrateRequest::new("x").tolerance_mm
+        );
+    }
+}
