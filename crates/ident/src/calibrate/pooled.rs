@@ -69,7 +69,7 @@ pub(crate) fn fit(
         }
         None => (None, None),
     };
-    let all = pool(&datasets);
+    let all = pool(datasets);
     let options = IdentifyOptions::for_machine(m);
     let mut used = all.clone();
     let mut fit = internal_fit(c, &used, prior.clone())?;
