@@ -242,6 +242,25 @@ const MAX_TABLE_PASSES: usize = 40;
 /// Change of the commands (mm) at which the table passes stop.
 const TABLE_TOLERANCE_MM: f64 = 1e-12;
 
+/// A batch of points solved with the leg effects applied
+/// (`tricept_kinematics::batch`).
+impl tricept_kinematics::batch::PointKinematics for ExtendedMachine {
+    fn inverse(&self, r: &Vector3<f64>) -> Result<IkSolution, KinematicsError> {
+        ExtendedMachine::inverse(self, r)
+    }
+    fn forward(&self, commands_mm: &[f64; 3]) -> Result<FkSolution, KinematicsError> {
+        ExtendedMachine::forward(self, commands_mm)
+    }
+    fn tool_inverse(
+        &self,
+        tip_mm: &Vector3<f64>,
+        axis: &Vector3<f64>,
+        branch: HeadBranch,
+    ) -> Result<ToolIkSolution, KinematicsError> {
+        ExtendedMachine::tool_inverse(self, tip_mm, axis, branch)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -334,24 +353,5 @@ mod tests {
         let t = x.tool_inverse(&tip, &axis, HeadBranch::default()).unwrap();
         let fk = x.forward(&t.legs_mm).unwrap();
         assert!((fk.position_mm - t.platform_mm).norm() < 1e-8);
-    }
-}
-
-/// A batch of points solved with the leg effects applied
-/// (`tricept_kinematics::batch`).
-impl tricept_kinematics::batch::PointKinematics for ExtendedMachine {
-    fn inverse(&self, r: &Vector3<f64>) -> Result<IkSolution, KinematicsError> {
-        ExtendedMachine::inverse(self, r)
-    }
-    fn forward(&self, commands_mm: &[f64; 3]) -> Result<FkSolution, KinematicsError> {
-        ExtendedMachine::forward(self, commands_mm)
-    }
-    fn tool_inverse(
-        &self,
-        tip_mm: &Vector3<f64>,
-        axis: &Vector3<f64>,
-        branch: HeadBranch,
-    ) -> Result<ToolIkSolution, KinematicsError> {
-        ExtendedMachine::tool_inverse(self, tip_mm, axis, branch)
     }
 }
