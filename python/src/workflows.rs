@@ -417,7 +417,7 @@ fn simulate_csv(
         .detach(|| tricept_ident::simulate::simulate(request))
         .map_err(|e| door_error(py, e))?;
     let mut text = Vec::new();
-    tricept_data::write_to(&mut text, sim.data(), sim.comments())
+    tricept_ident::advanced::files::write_to(&mut text, sim.data(), sim.comments())
         .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
     String::from_utf8(text).map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))
 }

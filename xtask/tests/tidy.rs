@@ -11,6 +11,8 @@
 //!   or through others, except the pairs listed in [`ALLOWED_CIRCLES`].
 //! - **The map.** ARCHITECTURE.md names every crate directory, and every
 //!   repository path it names exists.
+//! - **Dependencies** (`tidy/deps.rs`): the binary, the Python package and
+//!   the examples depend on the door alone; no dependency goes unused.
 //!
 //! An edge is a path in a file's code outside its tests (`#[cfg(test)]`
 //! items) that resolves to another file's module; a path to an item that a
@@ -20,6 +22,9 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
+
+#[path = "tidy/deps.rs"]
+mod deps;
 
 /// Circles that may stay: `(crate directory, files)`, with why.
 const ALLOWED_CIRCLES: &[(&str, &[&str])] = &[

@@ -165,7 +165,7 @@ pub struct FitArgs {
     /// machine has without calibration. A campaign whose predicted platform
     /// accuracy is not at most half of what this tolerance gives is
     /// refused (exit 3; docs/reliability.md).
-    #[arg(long, default_value_t = tricept_engine::DEFAULT_TOLERANCE_MM, value_name = "MM")]
+    #[arg(long, default_value_t = tricept_ident::advanced::DEFAULT_TOLERANCE_MM, value_name = "MM")]
     pub tolerance_mm: f64,
 }
 
@@ -357,7 +357,7 @@ pub struct ExternalArgs {
 /// The help of `--effects`: the effects the fused model can carry, from
 /// the registry.
 fn effects_help() -> String {
-    let names: Vec<&str> = tricept_engine::fusion::fusable_effects()
+    let names: Vec<&str> = tricept_ident::advanced::fusable_effects()
         .map(|e| e.as_str())
         .collect();
     format!(

@@ -72,9 +72,9 @@ fn plot_trends(dir: &Path, trends: &[Trend]) -> Result<(), CliError> {
         let x: Vec<f64> = (1..=t.values.len()).map(|i| i as f64).collect();
         let title = format!("{} over the checks ({})", t.name, t.unit);
         let y_label = format!("{} ({})", t.name, t.unit);
-        let drawn = tricept_plot::curves(
+        let drawn = tricept_ident::advanced::plot::curves(
             &path,
-            &tricept_plot::Axes {
+            &tricept_ident::advanced::plot::Axes {
                 title: &title,
                 x_label: "check",
                 y_label: &y_label,
@@ -82,7 +82,7 @@ fn plot_trends(dir: &Path, trends: &[Trend]) -> Result<(), CliError> {
                 log_y: false,
             },
             &[
-                tricept_plot::Curve {
+                tricept_ident::advanced::plot::Curve {
                     name: "estimate +- 2 sd".into(),
                     x: x.clone(),
                     y: t.values.clone(),
@@ -94,7 +94,7 @@ fn plot_trends(dir: &Path, trends: &[Trend]) -> Result<(), CliError> {
                             .collect(),
                     ),
                 },
-                tricept_plot::Curve {
+                tricept_ident::advanced::plot::Curve {
                     name: "a check flags beyond".into(),
                     x,
                     y: vec![0.0; t.days.len()],

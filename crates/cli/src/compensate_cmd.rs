@@ -119,11 +119,11 @@ fn write_map(dir: &Path, c: &Compensation) -> Result<(), CliError> {
     crate::files::create_dir(dir)?;
     crate::files::write_text(&dir.join(MAP_FILES[0]), &c.map_csv())?;
     let (predicted, truth) = c.maps();
-    let cells = |m: &ErrorMap| -> Vec<tricept_plot::Cell> {
+    let cells = |m: &ErrorMap| -> Vec<tricept_ident::advanced::plot::Cell> {
         m.targets_mm
             .iter()
             .zip(&m.errors_mm)
-            .map(|(r, e)| tricept_plot::Cell {
+            .map(|(r, e)| tricept_ident::advanced::plot::Cell {
                 x: r.x,
                 y: r.y,
                 value: e.norm(),
@@ -133,11 +133,17 @@ fn write_map(dir: &Path, c: &Compensation) -> Result<(), CliError> {
     // Each map on its own colour scale (its min..max): an after map is often
     // ten times smaller than the before map and flat on the before's scale.
     let plot = |name: &str, what: &str, m: &ErrorMap| {
-        let z = tricept_plot::plane_z(m.targets_mm.iter().map(|r| r.z));
+        let z = tricept_ident::advanced::plot::plane_z(m.targets_mm.iter().map(|r| r.z));
         let title = format!("{what} |dr| (mm), {z}");
         let path = dir.join(name);
-        let drawn =
-            tricept_plot::heat_map(&path, &title, &cells(m), c.spacing_mm(), "|dr| (mm)", None);
+        let drawn = tricept_ident::advanced::plot::heat_map(
+            &path,
+            &title,
+            &cells(m),
+            c.spacing_mm(),
+            "|dr| (mm)",
+            None,
+        );
         crate::files::plotted(&path, drawn)
     };
     plot("correction.svg", "Predicted correction", predicted)?;

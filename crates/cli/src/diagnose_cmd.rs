@@ -159,9 +159,9 @@ fn plot_residuals(dir: &Path, plots: &[ResidualPlot]) -> Result<(), CliError> {
     crate::files::create_dir(dir)?;
     for p in plots {
         let path = crate::files::output_in("--plots", dir, &format!("residual-{}.svg", p.effect))?;
-        let drawn = tricept_plot::scatter(
+        let drawn = tricept_ident::advanced::plot::scatter(
             &path,
-            &tricept_plot::Axes {
+            &tricept_ident::advanced::plot::Axes {
                 title: &format!("{}: {}, before and after", p.effect, p.y_label),
                 x_label: &p.x_label,
                 y_label: &p.y_label,

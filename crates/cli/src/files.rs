@@ -1,6 +1,6 @@
 //! The files a verb writes: each one atomically (a temporary file in the
 //! same directory, synced, renamed over the target:
-//! [`tricept_data::write_atomic`]), and never one of the verb's inputs.
+//! [`tricept_ident::advanced::files::write_atomic`]), and never one of the verb's inputs.
 //!
 //! [`FileRoles`] lists a verb's input and output files; [`FileRoles::check`]
 //! runs before any computation and refuses (exit 2) an output that is an
@@ -20,7 +20,10 @@ pub fn write_with<F>(path: &Path, content: F) -> Result<(), CliError>
 where
     F: FnOnce(&mut dyn Write) -> std::io::Result<()>,
 {
-    written(path, tricept_data::write_atomic(path, content))
+    written(
+        path,
+        tricept_ident::advanced::files::write_atomic(path, content),
+    )
 }
 
 /// The outcome of an atomic write of `path` by a library writer
@@ -42,7 +45,10 @@ pub fn written(path: &Path, result: std::io::Result<()>) -> Result<(), CliError>
 
 /// The outcome of a figure drawn into `path` (`tricept_plot`, atomic
 /// too): `wrote PATH` on stderr, or exit 1 with the plotter's message.
-pub fn plotted(path: &Path, result: Result<(), tricept_plot::PlotError>) -> Result<(), CliError> {
+pub fn plotted(
+    path: &Path,
+    result: Result<(), tricept_ident::advanced::plot::PlotError>,
+) -> Result<(), CliError> {
     result.map_err(|e| CliError::other(e.to_string()))?;
     errln!("wrote {}", path.display());
     Ok(())
@@ -257,7 +263,7 @@ impl FileRoles {
 
 /// A path as messages show it (`tricept_data::shown_path`).
 fn shown(p: &Path) -> String {
-    tricept_data::shown_path(p)
+    tricept_ident::advanced::files::shown_path(p)
 }
 
 /// Refuses an input that is `-`, does not exist or is a directory (a
@@ -287,7 +293,7 @@ fn check_output_file(flag: &str, out: &Path) -> Result<(), CliError> {
         )));
     }
     check_names(flag, out)?;
-    tricept_data::check_output_file(out).map_err(|e| {
+    tricept_ident::advanced::files::check_output_file(out).map_err(|e| {
         let why = match e.kind() {
             std::io::ErrorKind::IsADirectory => "is a directory; give a file name".to_string(),
             _ => e.to_string(),

@@ -26,7 +26,7 @@ pub struct FleetArgs {
     pub machine: MachineArgs,
     /// Manufacturing tolerance of each parameter, mm: each machine's
     /// campaign is judged worth deploying as `identify` judges it.
-    #[arg(long, default_value_t = tricept_engine::DEFAULT_TOLERANCE_MM, value_name = "MM")]
+    #[arg(long, default_value_t = tricept_ident::advanced::DEFAULT_TOLERANCE_MM, value_name = "MM")]
     pub tolerance_mm: f64,
     /// The factorisation of the joint fit: schur (block elimination, the
     /// fast path), sparse-cholesky, sparse-qr or dense (small batches).

@@ -87,11 +87,11 @@ fn inert(text: &str) -> std::borrow::Cow<'_, str> {
     std::borrow::Cow::Owned(out)
 }
 
-/// A line on stderr, made one bounded line ([`tricept_data::one_line`]:
+/// A line on stderr, made one bounded line ([`tricept_ident::advanced::files::one_line`]:
 /// repeated input cut, every control character, a newline too, escaped);
 /// a failed write is ignored (there is nowhere left to report it).
 pub fn write_err_line(args: std::fmt::Arguments<'_>) {
-    let line = tricept_data::one_line(&args.to_string());
+    let line = tricept_ident::advanced::files::one_line(&args.to_string());
     let mut err = std::io::stderr().lock();
     let _ = err
         .write_all(line.as_bytes())

@@ -43,7 +43,7 @@ pub struct PlanArgs {
     #[arg(long, default_value_t = 20.0, value_name = "UM")]
     pub detect_um: f64,
     /// For a check: the power with which it is detected.
-    #[arg(long, default_value_t = tricept_check::DEFAULT_POWER, value_name = "P")]
+    #[arg(long, default_value_t = tricept_ident::advanced::DEFAULT_POWER, value_name = "P")]
     pub power: f64,
     /// The internal campaign's measured-data file (only its commands are
     /// used); default: the pose set of --poses.

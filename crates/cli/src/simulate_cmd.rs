@@ -166,22 +166,31 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
     let sim = simulate(request)?;
     let written = |path: &std::path::Path, r| crate::files::written(path, r);
     if let (Some(out), Some((data, c))) = (&a.tracker_out, sim.tracker()) {
-        written(out, tricept_data::write_external_path(out, data, c))?;
+        written(
+            out,
+            tricept_ident::advanced::files::write_external_path(out, data, c),
+        )?;
     }
     if let (Some(out), Some((data, c))) = (&a.ballbar_out, sim.ballbar()) {
-        written(out, tricept_data::write_external_path(out, data, c))?;
+        written(
+            out,
+            tricept_ident::advanced::files::write_external_path(out, data, c),
+        )?;
     }
     if let (Some(out), Some(features_out), Some((data, c, features))) =
         (&a.touch_out, &a.features_out, sim.touch())
     {
-        written(out, tricept_data::write_external_path(out, data, c))?;
+        written(
+            out,
+            tricept_ident::advanced::files::write_external_path(out, data, c),
+        )?;
         crate::files::write_text(features_out, features)?;
     }
     match &out {
         Some(path) => {
             written(
                 path,
-                tricept_data::write_path(path, sim.data(), sim.comments()),
+                tricept_ident::advanced::files::write_path(path, sim.data(), sim.comments()),
             )?;
             if a.machine.json {
                 outln!("{}", sim.to_json(path));
@@ -190,7 +199,7 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
             }
         }
         // A closed stdout (`| head`) is not an error: the writer swallows it.
-        None => tricept_data::write_to(
+        None => tricept_ident::advanced::files::write_to(
             std::io::BufWriter::new(crate::output::Stdout),
             sim.data(),
             sim.comments(),

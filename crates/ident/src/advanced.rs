@@ -22,6 +22,10 @@
 //!   ([`Classify`], and the file-system failure under one, [`FileFailure`]), the data set in memory ([`Dataset`]) and its reader,
 //!   and the foreign crates whose types results hold (`nalgebra`,
 //!   `serde_json`).
+//! - **Beside the door**: files written as every verb writes them
+//!   ([`files`]), the figures ([`plot`]), and the defaults the binary's
+//!   flags show ([`DEFAULT_TOLERANCE_MM`], [`DEFAULT_POWER`],
+//!   [`fusable_effects`]).
 
 pub use crate::accuracy::Accuracy;
 pub use crate::calibrate::values::{
@@ -35,5 +39,20 @@ pub use crate::inputs::{
 pub use crate::machine_file::MachineFile;
 pub use nalgebra;
 pub use serde_json;
+pub use tricept_check::DEFAULT_POWER;
 pub use tricept_data::Dataset;
+pub use tricept_engine::DEFAULT_TOLERANCE_MM;
+pub use tricept_engine::fusion::fusable_effects;
 pub use tricept_model::ParameterSet;
+/// The figures of the verbs that draw (SVG, atomic): `tricept_plot`.
+pub use tricept_plot as plot;
+
+/// Files written as every verb writes them (atomic: temporary file and
+/// rename; `-` for stdout) and messages made one bounded line, from
+/// `tricept_data`.
+pub mod files {
+    pub use tricept_data::{
+        check_output_file, one_line, shown_path, write_atomic, write_external_path, write_path,
+        write_to,
+    };
+}
