@@ -1,3 +1,5 @@
+//! internal: use tricept-ident (the door; this crate's items change with it).
+//!
 //! Has the machine changed? A quick check of a calibrated Tricept from its
 //! own sensors.
 //!

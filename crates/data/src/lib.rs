@@ -1,3 +1,5 @@
+//! internal: use tricept-ident (the door; this crate's items change with it).
+//!
 //! The measured-data contract of the Tricept self-calibration: one CSV row
 //! per pose, written by logging tools and the plant simulator, read by
 //! identification and diagnosis.

@@ -1,3 +1,5 @@
+//! internal: use tricept-ident (the door; this crate's items change with it).
+//!
 //! Measured data against the model: does the paper's geometric model
 //! explain the data; if not, which effects of the vocabulary explain it,
 //! what lies outside the vocabulary (described by a generic dictionary),

@@ -1,3 +1,5 @@
+//! internal: use tricept-ident (the door; this crate's items change with it).
+//!
 //! The identification engine of tricept: self-calibration of the Tricept from the UP limb's own sensors
 //! (Hong 2009, sections 2-3), done as a numerical-software engineer would.
 //!

@@ -1,4 +1,6 @@
-//! `tricept-export` (internal): a calibrated machine file translated into
+//! internal: use tricept-ident.
+//!
+//! `tricept-export`: a calibrated machine file translated into
 //! the files a CNC control loads: Sinumerik, Fanuc or Heidenhain.
 //!
 //! Each Tricept leg is a CNC axis driven by a ball screw. What depends on a

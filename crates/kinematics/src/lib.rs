@@ -1,3 +1,5 @@
+//! internal: use tricept-ident (the door; this crate's items change with it).
+//!
 //! Exact kinematics of the Tricept: the 3-UPS + UP parallel module and its
 //! 2-DOF head.
 //!

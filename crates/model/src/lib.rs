@@ -1,3 +1,5 @@
+//! internal: use tricept-ident (the door; this crate's items change with it).
+//!
 //! The geometric error model of the Tricept module (Hong 2009, section 1).
 //!
 //! - [`GeometricErrors`] and [`ParameterSet`]: the full 21-parameter vector

@@ -1,3 +1,5 @@
+//! internal: use tricept-ident (the door; this crate's items change with it).
+//!
 //! The generic numerical kernels the tricept crates share, in the spirit of
 //! rust-analyzer's `stdx`: nothing here knows about a Tricept, and nothing
 //! here is a stable API (the crate is internal: `publish = false`; the

@@ -1,3 +1,5 @@
+//! internal: use tricept-ident (the door; this crate's items change with it).
+//!
 //! The plant simulator: measured-data files ([`tricept_data::Dataset`])
 //! produced the way a real campaign would produce them, from an exact
 //! Tricept with geometric errors, optional unmodelled effects, sensor zero

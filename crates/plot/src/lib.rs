@@ -1,3 +1,5 @@
+//! internal: use tricept-ident (the door; this crate's items change with it).
+//!
 //! SVG figures for the docs, drawn with `plotters` (SVG backend only, so no
 //! system font or image library is needed).
 //!

@@ -1,3 +1,5 @@
+//! internal: use tricept-ident (the door; this crate's items change with it).
+//!
 //! The encoder-grade study (the paper's Fig. 4, and beyond): how accurate is
 //! a self-calibrated Tricept as a function of the U-joint encoders' grade?
 //!

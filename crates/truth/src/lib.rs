@@ -1,3 +1,5 @@
+//! internal: use tricept-ident (the door; this crate's items change with it).
+//!
 //! The truth the tests measure against: a Tricept, its sensors and its
 //! instruments written from the documented conventions alone
 //! (`docs/conventions.md`, `docs/data-format.md`, the Table 1 machine of

@@ -1,3 +1,5 @@
+//! internal: use tricept-ident (the door; this crate's items change with it).
+//!
 //! Feature unification, so that every target of the workspace compiles each
 //! third-party crate once.
 //!

@@ -229,3 +229,28 @@ fn the_use_finder_reads_paths_and_uses_only() {
     assert!(!uses("use other::rayon::X;", "rayon"));
     assert!(!uses("my_serde_json::x()", "serde_json"));
 }
+
+#[test]
+fn internal_crates_say_so_in_their_first_doc_line() {
+    let crates = workspace().join("crates");
+    let mut silent = Vec::new();
+    let mut seen = 0;
+    for e in std::fs::read_dir(&crates).unwrap().flatten() {
+        let lib = e.path().join("src/lib.rs");
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name == "ident" || !lib.exists() {
+            continue;
+        }
+        seen += 1;
+        let text = std::fs::read_to_string(&lib).unwrap_or_default();
+        if !text.starts_with("//! internal: use tricept-ident") {
+            silent.push(format!("crates/{name}/src/lib.rs"));
+        }
+    }
+    assert!(seen >= 10, "{seen} internal crates");
+    assert!(
+        silent.is_empty(),
+        "first doc line is not `//! internal: use tricept-ident`:\n{}",
+        silent.join("\n")
+    );
+}

@@ -1,8 +1,9 @@
 //! A calibration request checked once, before any fit: the tolerance, the
 //! machine, the data, and for a fused calibration its model, its options
-//! and every instrument's noise and files' companions. The internal,
-//! pooled and fused fits take the one [`Checked`] type and the work it
-//! holds ([`Work`]), and check nothing of the request again.
+//! and every instrument's noise and files' companions (`calibrate`'s
+//! `check` makes them). The internal, pooled and fused fits take the one
+//! [`Checked`] type and the work it holds ([`Work`]), and check nothing of
+//! the request again.
 
 use std::path::PathBuf;
 
@@ -13,9 +14,7 @@ use tricept_engine::fusion::{
 };
 use tricept_model::ParameterSet;
 
-use super::CalibrateRequest;
 use super::values::{FusedSources, HeadModel, TrackerTargetSpec, eval_options, fused_model};
-use crate::data_input::DataInput;
 use crate::error::Error;
 use crate::inputs::{LoadedMachine, positive};
 use crate::limits;
@@ -70,54 +69,9 @@ pub(crate) struct FusedWork {
     pub touch: Option<(Vec<PathBuf>, Features, TouchOptions)>,
 }
 
-/// Checks `request` once: the tolerance, the machine, which fit, the data
-/// (and a fused calibration's settings, [`fused`]).
-pub(crate) fn check(request: CalibrateRequest) -> Result<(Checked, DataInput, Work), Error> {
-    let tolerance_mm = request.tolerance_mm;
-    if !(tolerance_mm.is_finite() && tolerance_mm > 0.0 && tolerance_mm <= 10.0) {
-        return Err(Error::input(format!(
-            "--tolerance-mm: the manufacturing tolerance must be a number of mm above 0 and at most 10, got {tolerance_mm}"
-        )));
-    }
-    let loaded = request.machine.load()?;
-    let pooled = !request.campaigns.is_empty() || request.prior.is_some();
-    if pooled && request.fused.is_some() {
-        return Err(Error::input(
-            "several --data or --prior with external measurements: not supported (pool the internal campaigns, or fuse one)",
-        ));
-    }
-    let checked = Checked {
-        set: request.parameter_set,
-        robust: request.robust,
-        tolerance_mm,
-        loaded,
-    };
-    let m = checked.loaded.machine();
-    let work = match &request.fused {
-        None if pooled => Work::Pooled {
-            datasets: std::iter::once(&request.data)
-                .chain(&request.campaigns)
-                .map(|d| d.load(m))
-                .collect::<Result<_, Error>>()?,
-            prior: request.prior,
-        },
-        None => Work::Internal(request.data.load(m)?),
-        Some(x) => {
-            let data = request.data.load(m)?;
-            Work::Fused(Box::new(fused(
-                &checked,
-                data,
-                x,
-                request.for_machine_file,
-            )?))
-        }
-    };
-    Ok((checked, request.data, work))
-}
-
 /// Checks a fused calibration's settings `x`; `for_machine_file` refuses
 /// up front fitted effects, which the machine format cannot carry.
-fn fused(
+pub(crate) fn fused(
     c: &Checked,
     data: Dataset,
     x: &FusedSources,
@@ -203,49 +157,4 @@ fn fused(
         ballbar: (x.ballbar.clone(), ballbar),
         touch,
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn fixture() -> PathBuf {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/data/table2-grid-seed1.csv")
-    }
-
-    #[test]
-    fn every_instrument_setting_is_checked_before_any_external_file_is_read() {
-        // Both the tracker's and the ballbar's noise are wrong and their
-        // files do not exist: the first setting is named, no file is.
-        let mut request = CalibrateRequest::new(fixture());
-        request.fused = Some(FusedSources {
-            tracker: vec!["no-such-tracker.csv".into()],
-            tracker_target: Some("tip".parse().unwrap()),
-            tracker_sigma_um: -1.0,
-            ballbar: vec!["no-such-ballbar.csv".into()],
-            ballbar_sigma_um: 0.0,
-            ..FusedSources::default()
-        });
-        let e = check(request).unwrap_err();
-        assert_eq!(e.exit_code(), crate::EXIT_INPUT);
-        assert!(e.message().starts_with("--tracker-sigma-um"), "{e}");
-        // Settings right, files missing: the fit is checked, the files are
-        // read by the fit.
-        let mut request = CalibrateRequest::new(fixture());
-        request.fused = Some(FusedSources {
-            tracker: vec!["no-such-tracker.csv".into()],
-            tracker_target: Some("tip".parse().unwrap()),
-            ..FusedSources::default()
-        });
-        let (checked, _, work) = check(request).unwrap();
-        let Work::Fused(w) = work else {
-            panic!("a fused request is fused work")
-        };
-        assert_eq!(w.tracker.1.sigma_um, 10.0);
-        assert!(w.touch.is_none());
-        assert_eq!(
-            checked.tolerance_mm,
-            CalibrateRequest::new("x").tolerance_mm
-        );
-    }
 }

@@ -30,7 +30,7 @@ use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, Error};
 use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
-use checked::Work;
+use checked::{Checked, Work};
 pub(crate) use internal::fit_error;
 pub use values::FusedSources;
 
@@ -140,7 +140,7 @@ impl Written {
 /// small to fit; a fit that completes returns its verdict in
 /// [`Calibration::exit_code`].
 pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
-    let (checked, data, work) = checked::check(request)?;
+    let (checked, data, work) = check(request)?;
     let fit = match &work {
         Work::Pooled { datasets, prior } => {
             Fit::Internal(Box::new(pooled::fit(&checked, datasets, prior.as_deref())?))
@@ -153,6 +153,51 @@ pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
         data,
         fit,
     })
+}
+
+/// Checks `request` once: the tolerance, the machine, which fit, the data
+/// (and a fused calibration's settings, [`fused`]).
+fn check(request: CalibrateRequest) -> Result<(Checked, DataInput, Work), Error> {
+    let tolerance_mm = request.tolerance_mm;
+    if !(tolerance_mm.is_finite() && tolerance_mm > 0.0 && tolerance_mm <= 10.0) {
+        return Err(Error::input(format!(
+            "--tolerance-mm: the manufacturing tolerance must be a number of mm above 0 and at most 10, got {tolerance_mm}"
+        )));
+    }
+    let loaded = request.machine.load()?;
+    let pooled = !request.campaigns.is_empty() || request.prior.is_some();
+    if pooled && request.fused.is_some() {
+        return Err(Error::input(
+            "several --data or --prior with external measurements: not supported (pool the internal campaigns, or fuse one)",
+        ));
+    }
+    let checked = Checked {
+        set: request.parameter_set,
+        robust: request.robust,
+        tolerance_mm,
+        loaded,
+    };
+    let m = checked.loaded.machine();
+    let work = match &request.fused {
+        None if pooled => Work::Pooled {
+            datasets: std::iter::once(&request.data)
+                .chain(&request.campaigns)
+                .map(|d| d.load(m))
+                .collect::<Result<_, Error>>()?,
+            prior: request.prior,
+        },
+        None => Work::Internal(request.data.load(m)?),
+        Some(x) => {
+            let data = request.data.load(m)?;
+            Work::Fused(Box::new(checked::fused(
+                &checked,
+                data,
+                x,
+                request.for_machine_file,
+            )?))
+        }
+    };
+    Ok((checked, request.data, work))
 }
 
 impl Calibration {
@@ -411,5 +456,41 @@ mod tests {
         let e = calibrate(request).unwrap_err();
         assert_eq!(e.exit_code(), crate::EXIT_INPUT);
         assert!(e.message().starts_with("--tolerance-mm"), "{e}");
+    }
+
+    #[test]
+    fn every_instrument_setting_is_checked_before_any_external_file_is_read() {
+        // Both the tracker's and the ballbar's noise are wrong and their
+        // files do not exist: the first setting is named, no file is.
+        let mut request = CalibrateRequest::new(fixture());
+        request.fused = Some(FusedSources {
+            tracker: vec!["no-such-tracker.csv".into()],
+            tracker_target: Some("tip".parse().unwrap()),
+            tracker_sigma_um: -1.0,
+            ballbar: vec!["no-such-ballbar.csv".into()],
+            ballbar_sigma_um: 0.0,
+            ..FusedSources::default()
+        });
+        let e = check(request).unwrap_err();
+        assert_eq!(e.exit_code(), crate::EXIT_INPUT);
+        assert!(e.message().starts_with("--tracker-sigma-um"), "{e}");
+        // Settings right, files missing: the fit is checked, the files are
+        // read by the fit.
+        let mut request = CalibrateRequest::new(fixture());
+        request.fused = Some(FusedSources {
+            tracker: vec!["no-such-tracker.csv".into()],
+            tracker_target: Some("tip".parse().unwrap()),
+            ..FusedSources::default()
+        });
+        let (checked, _, work) = check(request).unwrap();
+        let Work::Fused(w) = work else {
+            panic!("a fused request is fused work")
+        };
+        assert_eq!(w.tracker.1.sigma_um, 10.0);
+        assert!(w.touch.is_none());
+        assert_eq!(
+            checked.tolerance_mm,
+            CalibrateRequest::new("x").tolerance_mm
+        );
     }
 }
