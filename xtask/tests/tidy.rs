@@ -662,8 +662,12 @@ fn no_import_circles_between_files() {
 /// that grows is split by job into a module directory.
 const MAX_FILE_LINES: usize = 900;
 
+/// The headroom kept under [`MAX_FILE_LINES`]: a file at the cap breaks at
+/// its next edit, so none may come within this many lines of it.
+const HEADROOM_LINES: usize = 50;
+
 #[test]
-fn no_crate_source_file_is_over_900_lines() {
+fn no_crate_source_file_comes_within_50_lines_of_the_900_line_cap() {
     let root = workspace();
     let mut problems = Vec::new();
     let mut files = 0;
@@ -674,9 +678,9 @@ fn no_crate_source_file_is_over_900_lines() {
         for path in modules(src).values() {
             files += 1;
             let lines = std::fs::read_to_string(path).map_or(0, |t| t.lines().count());
-            if lines > MAX_FILE_LINES {
+            if lines > MAX_FILE_LINES - HEADROOM_LINES {
                 problems.push(format!(
-                    "{}: {lines} lines, over {MAX_FILE_LINES}: split it by job into a module directory",
+                    "{}: {lines} lines, within {HEADROOM_LINES} of the cap {MAX_FILE_LINES}: split it by job into a module directory",
                     relative(&root, path)
                 ));
             }
