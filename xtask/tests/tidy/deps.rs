@@ -12,6 +12,10 @@
 //!   (`crate_name::` or `use crate_name`), like `cargo machete`. The
 //!   workspace hack is exempt: its dependencies are there to unify
 //!   features, not to be used.
+//! - **The map's graph.** ARCHITECTURE.md's crate graph is `cargo
+//!   metadata`'s: every arrow a dependency, every dependency an arrow
+//!   pointing down; the map at most 250 lines.
+//! - **Internal crates say so** in their first doc line.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -253,4 +257,99 @@ fn internal_crates_say_so_in_their_first_doc_line() {
         "first doc line is not `//! internal: use tricept-ident`:\n{}",
         silent.join("\n")
     );
+}
+
+/// The crate graph drawn in ARCHITECTURE.md (the fenced block after `##
+/// Crate graph`): its arrows as `(from, to)` with full package names, and
+/// each crate's row (the leaves' row last).
+fn drawn_graph(map: &str) -> (BTreeSet<(String, String)>, Vec<(String, usize)>) {
+    let full = |short: &str| match short.trim() {
+        "xtask" => "xtask".to_string(),
+        s => format!("tricept-{s}"),
+    };
+    let after = map.split("## Crate graph").nth(1).unwrap_or("");
+    let block = after.split("```").nth(1).unwrap_or("");
+    let mut edges = BTreeSet::new();
+    let mut rows = Vec::new();
+    for (row, line) in block.lines().skip(1).enumerate() {
+        if let Some(leaves) = line.strip_prefix("leaves:") {
+            rows.extend(leaves.split(',').map(|c| (full(c), usize::MAX)));
+        } else if let Some((from, to)) = line.split_once("->") {
+            for f in from.split(',') {
+                rows.push((full(f), row));
+                for t in to.split(',') {
+                    edges.insert((full(f), full(t)));
+                }
+            }
+        }
+    }
+    (edges, rows)
+}
+
+#[test]
+fn the_architecture_graph_is_cargo_metadata_s() {
+    let map = std::fs::read_to_string(workspace().join("ARCHITECTURE.md")).unwrap();
+    let (drawn, rows) = drawn_graph(&map);
+    let packages = packages();
+    let names: BTreeSet<String> = packages
+        .iter()
+        .filter_map(|p| p["name"].as_str().map(String::from))
+        .collect();
+    let hack = "tricept-workspace-hack";
+    let mut real = BTreeSet::new();
+    for p in &packages {
+        for (_, dep) in normal_dependencies(p) {
+            if names.contains(&dep) && dep != hack {
+                real.insert((name(p).to_string(), dep));
+            }
+        }
+    }
+    let row_of = |c: &str| rows.iter().find(|(n, _)| n == c).map(|(_, r)| *r);
+    let mut wrong = Vec::new();
+    for (a, b) in drawn.difference(&real) {
+        wrong.push(format!("drawn but not a dependency: {a} -> {b}"));
+    }
+    for (a, b) in real.difference(&drawn) {
+        wrong.push(format!("a dependency not drawn: {a} -> {b}"));
+    }
+    for (a, b) in &real {
+        if !(row_of(a) < row_of(b)) {
+            wrong.push(format!("{b} is not drawn below {a}, which depends on it"));
+        }
+    }
+    for n in &names {
+        if row_of(n).is_none() {
+            wrong.push(format!("{n} is not in the graph"));
+        }
+    }
+    assert!(real.len() > 30, "only {} dependencies read", real.len());
+    assert!(
+        wrong.is_empty(),
+        "ARCHITECTURE.md's crate graph against cargo metadata:\n{}",
+        wrong.join("\n")
+    );
+}
+
+#[test]
+fn the_graph_reader_expands_rows() {
+    let map = "## Crate graph\n\n```text\na, b -> c, d\nc -> d\nleaves: d\n```\n";
+    let (edges, rows) = drawn_graph(map);
+    assert_eq!(edges.len(), 5);
+    assert!(edges.contains(&("tricept-b".into(), "tricept-d".into())));
+    assert_eq!(
+        rows,
+        vec![
+            ("tricept-a".to_string(), 0),
+            ("tricept-b".to_string(), 0),
+            ("tricept-c".to_string(), 1),
+            ("tricept-d".to_string(), usize::MAX)
+        ]
+    );
+}
+
+#[test]
+fn the_architecture_map_is_at_most_250_lines() {
+    let map = std::fs::read_to_string(workspace().join("ARCHITECTURE.md")).unwrap();
+    let lines = map.lines().count();
+    assert!(lines <= 250, "ARCHITECTURE.md: {lines} lines, over 250");
 }
