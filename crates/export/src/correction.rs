@@ -253,6 +253,39 @@ pub fn platform_error_um(
     Ok(worst * 1e3)
 }
 
+/// A leg's length as the control leaves it at a command, minus the exact
+/// one, mm.
+pub type LegDeviation = Box<dyn Fn(f64) -> f64>;
+
+/// The three legs' corrections over their strokes
+/// ([`leg_corrections`]), each reference point checked inside its stroke
+/// ([`check_references`]).
+pub fn checked_leg_corrections(
+    machine: &Machine,
+    reference_mm: Option<[f64; 3]>,
+) -> Result<[LegCorrection; 3], ExportError> {
+    let legs = leg_corrections(machine, reference_mm)?;
+    check_references(&legs)?;
+    Ok(legs)
+}
+
+/// What a control's files leave of the machine's error, um: the largest
+/// platform error over `poses` and over every reading the control may
+/// make of the files (`readings`, each leg's deviation;
+/// [`platform_error_um`]), and the gravity compliance no per-axis table
+/// can carry ([`compliance_size_um`]).
+pub fn left_by_files(
+    machine: &Machine,
+    poses: &[Vector3<f64>],
+    readings: &[[LegDeviation; 3]],
+) -> Result<(f64, f64), ExportError> {
+    let mut platform_um: f64 = 0.0;
+    for reading in readings {
+        platform_um = platform_um.max(platform_error_um(machine, poses, reading)?);
+    }
+    Ok((platform_um, compliance_size_um(machine, poses)?))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

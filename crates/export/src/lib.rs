@@ -88,8 +88,8 @@ impl ExportPlan {
 /// Its steps: the options checked (`check_options`, `axis_names`),
 /// what every control's writer starts from (`setup_of`), the control's
 /// files and the geometry table (`control_files`), what they leave of
-/// the platform's error (`platform_error_um`) and what they cannot carry
-/// (`not_exported`), and the summary (`summary_of`).
+/// the machine's error ([`correction::left_by_files`]) and what they
+/// cannot carry (`not_exported`), and the summary (`summary_of`).
 pub fn plan(
     description: &MachineDescription,
     options: &ExportOptions,
@@ -103,8 +103,9 @@ pub fn plan(
     let setup = setup_of(description, &machine, names, options)?;
     let control = control_files(description, &machine, &setup);
     let workspace_poses = machine.workspace.random_poses(200, 0x0e4b_0a7d);
-    let platform_error_um = platform_error_um(&machine, &control, &workspace_poses)?;
-    let not_exported = not_exported(&machine, &setup, &control, record, &workspace_poses)?;
+    let (platform_error_um, compliance_um) =
+        correction::left_by_files(&machine, &workspace_poses, &control.readings)?;
+    let not_exported = not_exported(&setup, &control, record, compliance_um);
     let summary = summary_of(
         description,
         options,
@@ -126,8 +127,7 @@ fn setup_of<'a>(
     names: [String; 3],
     options: &'a ExportOptions,
 ) -> Result<Setup<'a>, ExportError> {
-    let legs = correction::leg_corrections(machine, options.reference_mm)?;
-    correction::check_references(&legs)?;
+    let legs = correction::checked_leg_corrections(machine, options.reference_mm)?;
     let params = description.controller.unwrap_or_default();
     Ok(Setup {
         legs,
@@ -158,24 +158,6 @@ fn control_files(
         geometry::table(description, machine, &control.axes),
     ));
     control
-}
-
-/// The largest platform error the control's files leave at the workspace
-/// poses, um, over every reading the control may make of them.
-fn platform_error_um(
-    machine: &Machine,
-    control: &ControlFiles,
-    workspace_poses: &[nalgebra::Vector3<f64>],
-) -> Result<f64, ExportError> {
-    let mut worst: f64 = 0.0;
-    for reading in &control.readings {
-        worst = worst.max(correction::platform_error_um(
-            machine,
-            workspace_poses,
-            reading,
-        )?);
-    }
-    Ok(worst)
 }
 
 /// The summary of an export (its file is [`SUMMARY_FILE`]).
@@ -235,17 +217,16 @@ fn axis_names(options: &ExportOptions) -> Result<[String; 3], ExportError> {
 }
 
 /// What the control's files cannot carry, with its size: the legs'
-/// gravity compliance, thermal growth where the control has no place for
-/// it, and the diagnosis' sensor-side corrections.
+/// gravity compliance (`compliance_um`), thermal growth where the control
+/// has no place for it, and the diagnosis' sensor-side corrections.
 fn not_exported(
-    machine: &Machine,
     setup: &Setup,
     control: &ControlFiles,
     record: &tricept_kinematics::description::CalibrationRecord,
-    workspace_poses: &[nalgebra::Vector3<f64>],
-) -> Result<Vec<NotExported>, ExportError> {
+    compliance_um: f64,
+) -> Vec<NotExported> {
     let mut not_exported = Vec::new();
-    let compliance = correction::compliance_size_um(machine, workspace_poses)?;
+    let compliance = compliance_um;
     if compliance > 0.0 {
         not_exported.push(NotExported {
             what: "leg_effects.compliance_um_per_kn_at_1m".into(),
@@ -277,7 +258,7 @@ fn not_exported(
             why: "a correction of the UP limb's readings: it changes no position the control commands".into(),
         });
     }
-    Ok(not_exported)
+    not_exported
 }
 
 /// Checks the options' ranges, that the Fanuc-only ones are given to

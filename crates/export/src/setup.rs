@@ -30,7 +30,7 @@ pub(crate) struct Setup<'a> {
 
 /// A leg's length as the control leaves it at a command, minus the exact
 /// one, mm.
-pub(crate) type Deviation = Box<dyn Fn(f64) -> f64>;
+pub(crate) type Deviation = crate::correction::LegDeviation;
 
 /// What a control's writer hands back.
 pub(crate) struct ControlFiles {
