@@ -61,8 +61,9 @@ pub use bounded::{MAX_JSON_BYTES, read_json_text};
 pub use error::DataError;
 pub use external::{
     BallbarData, BallbarReading, ExternalData, ExternalPose, ExternalRecord, Feature, Features,
-    PlannedPose, PlannedPoses, Stylus, TouchData, TouchReading, TrackerData, TrackerPoint,
-    read_external_from, read_external_path, write_external_path, write_external_to,
+    InstrumentRecord, PlannedPose, PlannedPoses, Reading, Stylus, TouchData, TouchReading,
+    TrackerData, TrackerPoint, read_external_from, read_external_path, write_external_path,
+    write_external_to,
 };
 pub use message::{
     MAX_MESSAGE_CHARS, MAX_QUOTED_CHARS, SHOWN_CHARS, SHOWN_PATH_CHARS, one_line, shown, shown_path,

@@ -1,6 +1,6 @@
 //! Ballbar lengths (`q1,q2,q3,h1,h2,length`).
 
-use super::{ExternalData, ExternalPose, ExternalRow, Row};
+use super::{ExternalData, ExternalPose, ExternalRow, InstrumentRecord, Reading, Row};
 use crate::DataError;
 
 /// One reading of a ballbar between the tool-tip ball and a pivot on the table.
@@ -38,13 +38,14 @@ impl ExternalRow for BallbarReading {
                 "a ballbar length must be 10-2000 mm (um or m?)",
             ));
         }
+        let common = row.reading(pose)?;
         Ok(BallbarReading {
             pose,
             length_mm,
-            sigma_um: row.sigma_um()?,
-            setup: row.whole_from_one("setup")?.unwrap_or(1),
-            temp_c: row.temp_c()?,
-            line: row.record.line,
+            sigma_um: common.sigma_um,
+            setup: common.setup.unwrap_or(1),
+            temp_c: common.temp_c,
+            line: common.line,
         })
     }
 
@@ -55,10 +56,19 @@ impl ExternalRow for BallbarReading {
     fn value(&self, column: &str) -> Option<f64> {
         match column {
             "length" => Some(self.length_mm),
-            "sigma_um" => self.sigma_um,
-            "setup" => (self.setup != 1).then_some(f64::from(self.setup)),
-            "temp_c" => self.temp_c,
-            _ => None,
+            _ => self.reading().value(column),
+        }
+    }
+}
+
+impl InstrumentRecord for BallbarReading {
+    fn reading(&self) -> Reading {
+        Reading {
+            pose: self.pose,
+            sigma_um: self.sigma_um,
+            setup: Some(self.setup),
+            temp_c: self.temp_c,
+            line: self.line,
         }
     }
 }

@@ -26,6 +26,14 @@
 //! ballbar `length` of 10-2000 mm (a value outside is um or m), whole
 //! `setup` and `feature` numbers from 1, plausible temperatures, and no row
 //! repeated exactly.
+//!
+//! Adding an instrument: one file here with its record (the measured fields
+//! and the [`Reading`] fields every instrument's row carries), its
+//! `ExternalRow` impl (the measured columns, read with [`Row`]'s checks; the
+//! common columns through `Row::reading` and [`Reading::value`]) and its
+//! [`InstrumentRecord`] impl; then `tricept-plant`'s `instruments/` (the
+//! simulated reading) and `tricept-engine`'s `fusion/` (the model term), one
+//! file each.
 
 use std::io::{Read, Write};
 use std::path::Path;
@@ -50,6 +58,51 @@ pub struct ExternalPose {
     pub commands_mm: [f64; 3],
     /// Commanded head angles `[h1, h2]`, rad.
     pub head_rad: [f64; 2],
+}
+
+/// What every instrument's row carries beside its measurement: where the
+/// machine stood, the row's standard deviation, the instrument's setup, the
+/// structure temperature and the line in the file.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Reading {
+    /// Where the machine stood.
+    pub pose: ExternalPose,
+    /// Standard deviation of the measurement, um (`None`: the default).
+    pub sigma_um: Option<f64>,
+    /// Setup (station, mounting), from 1 (`None`: the kind has no setups).
+    pub setup: Option<u32>,
+    /// Structure temperature, °C.
+    pub temp_c: Option<f64>,
+    /// Line in the file (0 if none).
+    pub line: u64,
+}
+
+impl Reading {
+    /// Value of a common optional column (`sigma_um`, `setup`, `temp_c`) as
+    /// written; `None` for a column not set (a setup of 1 is the default).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_data::Reading;
+    /// let r = Reading { sigma_um: Some(2.0), setup: Some(1), ..Reading::default() };
+    /// assert_eq!((r.value("sigma_um"), r.value("setup"), r.value("x")), (Some(2.0), None, None));
+    /// ```
+    pub fn value(&self, column: &str) -> Option<f64> {
+        match column {
+            "sigma_um" => self.sigma_um,
+            "setup" => self.setup.filter(|s| *s != 1).map(f64::from),
+            "temp_c" => self.temp_c,
+            _ => None,
+        }
+    }
+}
+
+/// A record an instrument measured: its [`Reading`] fields read the same
+/// way for every instrument (what the fusion's sources and the simulated
+/// instruments share).
+pub trait InstrumentRecord: ExternalRecord + Clone {
+    /// The fields every instrument's row carries.
+    fn reading(&self) -> Reading;
 }
 
 /// The records of one external-measurement file and where they came from.
@@ -178,6 +231,18 @@ impl Row<'_> {
                     .then_some("must be a whole number from 1")
             })?
             .map(|v| v as u32))
+    }
+
+    /// The common columns of an instrument's row (`setup` where the kind
+    /// has that column).
+    fn reading(&self, pose: ExternalPose) -> Result<Reading, DataError> {
+        Ok(Reading {
+            pose,
+            sigma_um: self.sigma_um()?,
+            setup: self.whole_from_one("setup")?,
+            temp_c: self.temp_c()?,
+            line: self.record.line,
+        })
     }
 
     fn bad(&self, idx: usize, reason: &str) -> DataError {

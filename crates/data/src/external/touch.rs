@@ -5,7 +5,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::{ExternalData, ExternalPose, ExternalRow, Row};
+use super::{ExternalData, ExternalPose, ExternalRow, InstrumentRecord, Reading, Row};
 use crate::DataError;
 
 /// One touch of a probe in the spindle on a feature of the features file.
@@ -39,12 +39,13 @@ impl ExternalRow for TouchReading {
                 "a feature id must be a whole number from 1",
             ));
         }
+        let common = row.reading(pose)?;
         Ok(TouchReading {
             pose,
             feature: f as u32,
-            sigma_um: row.sigma_um()?,
-            temp_c: row.temp_c()?,
-            line: row.record.line,
+            sigma_um: common.sigma_um,
+            temp_c: common.temp_c,
+            line: common.line,
         })
     }
 
@@ -55,9 +56,19 @@ impl ExternalRow for TouchReading {
     fn value(&self, column: &str) -> Option<f64> {
         match column {
             "feature" => Some(f64::from(self.feature)),
-            "sigma_um" => self.sigma_um,
-            "temp_c" => self.temp_c,
-            _ => None,
+            _ => self.reading().value(column),
+        }
+    }
+}
+
+impl InstrumentRecord for TouchReading {
+    fn reading(&self) -> Reading {
+        Reading {
+            pose: self.pose,
+            sigma_um: self.sigma_um,
+            setup: None,
+            temp_c: self.temp_c,
+            line: self.line,
         }
     }
 }

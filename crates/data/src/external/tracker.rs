@@ -1,6 +1,8 @@
 //! Laser-tracker and CMM points (`q1,q2,q3,h1,h2,x,y,z`).
 
-use super::{ExternalData, ExternalPose, ExternalRow, MAX_EXTENSION_MM, Row};
+use super::{
+    ExternalData, ExternalPose, ExternalRow, InstrumentRecord, MAX_EXTENSION_MM, Reading, Row,
+};
 use crate::DataError;
 
 /// One point measured by a laser tracker or a CMM.
@@ -31,22 +33,24 @@ impl ExternalRow for TrackerPoint {
     const OPTIONAL: &'static [&'static str] = &["sigma_um", "extension_mm", "setup", "temp_c"];
 
     fn from_row(pose: ExternalPose, row: &Row<'_>) -> Result<Self, DataError> {
+        let position_mm = [
+            row.measured_mm(0)?,
+            row.measured_mm(1)?,
+            row.measured_mm(2)?,
+        ];
+        let common = row.reading(pose)?;
         Ok(TrackerPoint {
             pose,
-            position_mm: [
-                row.measured_mm(0)?,
-                row.measured_mm(1)?,
-                row.measured_mm(2)?,
-            ],
-            sigma_um: row.sigma_um()?,
+            position_mm,
+            sigma_um: common.sigma_um,
             extension_mm: row
                 .optional("extension_mm", |v| {
                     (v.abs() > MAX_EXTENSION_MM).then_some("an extension beyond ±1000 mm (mm?)")
                 })?
                 .unwrap_or(0.0),
-            setup: row.whole_from_one("setup")?.unwrap_or(1),
-            temp_c: row.temp_c()?,
-            line: row.record.line,
+            setup: common.setup.unwrap_or(1),
+            temp_c: common.temp_c,
+            line: common.line,
         })
     }
 
@@ -59,11 +63,20 @@ impl ExternalRow for TrackerPoint {
             "x" => Some(self.position_mm[0]),
             "y" => Some(self.position_mm[1]),
             "z" => Some(self.position_mm[2]),
-            "sigma_um" => self.sigma_um,
             "extension_mm" => (self.extension_mm != 0.0).then_some(self.extension_mm),
-            "setup" => (self.setup != 1).then_some(f64::from(self.setup)),
-            "temp_c" => self.temp_c,
-            _ => None,
+            _ => self.reading().value(column),
+        }
+    }
+}
+
+impl InstrumentRecord for TrackerPoint {
+    fn reading(&self) -> Reading {
+        Reading {
+            pose: self.pose,
+            sigma_um: self.sigma_um,
+            setup: Some(self.setup),
+            temp_c: self.temp_c,
+            line: self.line,
         }
     }
 }

@@ -17,7 +17,7 @@ use tricept_model::Effector;
 use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Sink, Source, SourceKind, SourceRows, for_each_point, groups, lines_text,
+    Nuisance, Readings, RecordList, Sink, Source, SourceKind, SourceRows, for_each_point,
     project_rows, sphere_centre,
 };
 
@@ -46,13 +46,11 @@ impl Default for BallbarOptions {
 
 #[derive(Debug, Clone)]
 struct Ballbar {
-    readings: Vec<BallbarReading>,
-    sigma_mm: Vec<f64>,
+    readings: Readings<BallbarReading>,
     length_sigma_mm: Option<f64>,
     effector: Effector,
     setups: Vec<u32>,
     setup_of: Vec<usize>,
-    file: String,
 }
 
 impl Source {
@@ -67,23 +65,14 @@ impl Source {
     /// assert!(e.to_string().starts_with("b.csv: setup 1 has 2 readings"), "{e}");
     /// ```
     pub fn ballbar(data: &BallbarData, options: &BallbarOptions) -> Result<Source, IdentError> {
-        let (setups, setup_of) = groups(
-            &data.source,
-            data.records.iter().map(|r| (r.setup, r.line)),
-            4,
-            |id, n| {
-                format!(
-                    "setup {id} has {n} readings; its pivot needs at least 4 with the ball not in one plane"
-                )
-            },
-        )?;
+        let readings = Readings::new(data, options.sigma_um);
+        let (setups, setup_of) = readings.setups(4, |id, n| {
+            format!(
+                "setup {id} has {n} readings; its pivot needs at least 4 with the ball not in one plane"
+            )
+        })?;
         Ok(Source::new(Box::new(Ballbar {
-            sigma_mm: data
-                .records
-                .iter()
-                .map(|r| 1e-3 * r.sigma_um.unwrap_or(options.sigma_um))
-                .collect(),
-            readings: data.records.clone(),
+            readings,
             length_sigma_mm: options.length_sigma_um.map(|s| 1e-3 * s),
             effector: Effector {
                 extension_mm: 0.0,
@@ -91,7 +80,6 @@ impl Source {
             },
             setups,
             setup_of,
-            file: data.source.clone(),
         })))
     }
 }
@@ -99,9 +87,7 @@ impl Source {
 impl Ballbar {
     /// Every reading's pose, line and effector (the ball).
     fn records(&self) -> impl Iterator<Item = (ExternalPose, u64, Effector)> + '_ {
-        self.readings
-            .iter()
-            .map(|r| (r.pose, r.line, self.effector))
+        self.readings.points(|_| self.effector)
     }
 }
 
@@ -114,8 +100,8 @@ impl SourceRows for Ballbar {
         Some(self.effector.offset_mm).filter(|o| o.norm() > 0.0)
     }
 
-    fn file(&self) -> &str {
-        &self.file
+    fn record_list(&self) -> &dyn RecordList {
+        &self.readings
     }
 
     fn nuisance_names(&self) -> Vec<String> {
@@ -128,12 +114,8 @@ impl SourceRows for Ballbar {
         names
     }
 
-    fn records(&self) -> usize {
-        self.readings.len()
-    }
-
-    fn data_rows(&self) -> usize {
-        self.readings.len()
+    fn rows_each(&self) -> usize {
+        1
     }
 
     fn prior_rows(&self) -> usize {
@@ -154,14 +136,6 @@ impl SourceRows for Ballbar {
             .collect()
     }
 
-    fn pose(&self, record: usize) -> ExternalPose {
-        self.readings[record].pose
-    }
-
-    fn line(&self, record: usize) -> u64 {
-        self.readings[record].line
-    }
-
     fn initial(
         &self,
         at: &FusedAt<'_>,
@@ -169,27 +143,22 @@ impl SourceRows for Ballbar {
         seeds: &mut [Option<UpJoints>],
         active: &[bool],
     ) -> Result<Nuisance, IdentError> {
-        let mut tips = Vec::with_capacity(self.readings.len());
+        let readings = &self.readings.records;
+        let mut tips = Vec::with_capacity(readings.len());
         for_each_point(at, contexts, seeds, self.records(), |_, x, _| {
             tips.push(x.position_mm)
         })?;
         let mut values = vec![0.0; 4 * self.setups.len()];
         for (s, id) in self.setups.iter().enumerate() {
-            let (x, radii): (Vec<Vector3<f64>>, Vec<f64>) = (0..self.readings.len())
-                .filter(|&j| self.setup_of[j] == s && active[j])
-                .map(|j| (tips[j], self.readings[j].length_mm))
+            let in_setup = |j: usize| self.setup_of[j] == s && active[j];
+            let (x, radii): (Vec<Vector3<f64>>, Vec<f64>) = (0..readings.len())
+                .filter(|&j| in_setup(j))
+                .map(|j| (tips[j], readings[j].length_mm))
                 .unzip();
-            let c = sphere_centre(&x, &radii).ok_or_else(|| IdentError::Source {
-                file: self.file.clone(),
-                line: None,
-                message: format!(
-                    "the ball positions of setup {id} ({}) lie in one plane: the pivot cannot be found",
-                    lines_text(
-                        (0..self.readings.len())
-                            .filter(|&j| self.setup_of[j] == s && active[j])
-                            .map(|j| self.readings[j].line)
-                    )
-                ),
+            let c = sphere_centre(&x, &radii).ok_or_else(|| {
+                self.readings.degenerate(in_setup, |lines| {
+                    format!("the ball positions of setup {id} ({lines}) lie in one plane: the pivot cannot be found")
+                })
             })?;
             values[4 * s..4 * s + 3].copy_from_slice(c.as_slice());
         }
@@ -224,10 +193,10 @@ impl SourceRows for Ballbar {
             project_rows(&u, jac, k, &mut theta);
             sink.data(
                 j,
-                1.0 / self.sigma_mm[j],
+                1.0 / self.readings.sigma_mm[j],
                 &dnu,
                 &theta,
-                self.readings[j].length_mm - (rho + nu.values[base + 3]),
+                self.readings.records[j].length_mm - (rho + nu.values[base + 3]),
             );
         })?;
         if let Some(sigma) = self.length_sigma_mm {
@@ -238,17 +207,7 @@ impl SourceRows for Ballbar {
         Ok(())
     }
 
-    fn retract(&self, nu: &mut Nuisance, step: &[f64]) {
-        for (v, s) in nu.values.iter_mut().zip(step) {
-            *v += s;
-        }
-    }
-
     fn nuisance_hint(&self) -> &'static str {
         "spread the ball over the sphere around the pivot (different directions, not one plane)"
-    }
-
-    fn boxed_clone(&self) -> Box<dyn SourceRows> {
-        Box::new(self.clone())
     }
 }

@@ -7,7 +7,7 @@ use tricept_kinematics::UpJoints;
 
 use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
-use crate::fusion::source::{Nuisance, Sink, Source, SourceKind, SourceRows};
+use crate::fusion::source::{Nuisance, RecordList, Sink, Source, SourceKind, SourceRows};
 
 impl Source {
     /// The UP limb's readings, with the standard deviation of one logged
@@ -29,33 +29,13 @@ struct Internal {
     file: String,
 }
 
-impl SourceRows for Internal {
-    fn kind(&self) -> SourceKind {
-        SourceKind::Internal
-    }
-
+impl RecordList for Internal {
     fn file(&self) -> &str {
         &self.file
     }
 
-    fn nuisance_names(&self) -> Vec<String> {
-        vec![
-            "phi_offset_rad".into(),
-            "theta_offset_rad".into(),
-            "s_offset_mm".into(),
-        ]
-    }
-
-    fn records(&self) -> usize {
+    fn len(&self) -> usize {
         self.poses.len()
-    }
-
-    fn data_rows(&self) -> usize {
-        3 * self.poses.len()
-    }
-
-    fn min_redundancy(&self) -> f64 {
-        6.0
     }
 
     fn pose(&self, record: usize) -> ExternalPose {
@@ -67,6 +47,32 @@ impl SourceRows for Internal {
 
     fn line(&self, record: usize) -> u64 {
         self.poses[record].line
+    }
+}
+
+impl SourceRows for Internal {
+    fn kind(&self) -> SourceKind {
+        SourceKind::Internal
+    }
+
+    fn record_list(&self) -> &dyn RecordList {
+        self
+    }
+
+    fn nuisance_names(&self) -> Vec<String> {
+        vec![
+            "phi_offset_rad".into(),
+            "theta_offset_rad".into(),
+            "s_offset_mm".into(),
+        ]
+    }
+
+    fn rows_each(&self) -> usize {
+        3
+    }
+
+    fn min_redundancy(&self) -> f64 {
+        6.0
     }
 
     fn residual_unit_um(&self) -> Option<f64> {
@@ -137,9 +143,5 @@ impl SourceRows for Internal {
 
     fn nuisance_hint(&self) -> &'static str {
         "the poses do not move the UP limb's joints"
-    }
-
-    fn boxed_clone(&self) -> Box<dyn SourceRows> {
-        Box::new(self.clone())
     }
 }

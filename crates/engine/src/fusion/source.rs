@@ -16,9 +16,21 @@
 //! estimate) and the Jacobian is exact. The internal source's offsets are
 //! linear and re-solved at every evaluation, exactly as
 //! [`crate::identify`] does.
+//!
+//! What every external instrument's source shares is written here once:
+//! its records with their standard deviations and file ([`Readings`]:
+//! built from the data layer's [`InstrumentRecord`]s, grouped by setup,
+//! each record's pose, line and effector, the lines of a group for a
+//! message), and the [`SourceRows`] methods that only read them (file,
+//! record count, pose, line, row count, the copy). Adding an instrument is
+//! one file in this folder: a struct holding a `Readings` and what is new
+//! (options, nuisance layout, `initial`, `evaluate`, `retract`), its
+//! `Source::` constructor, and a [`SourceKind`]; its record and reader are
+//! one file in `tricept-data`'s `external/`, its simulated reading one in
+//! `tricept-plant`'s `instruments/`.
 
 use nalgebra::{Matrix3, Vector3};
-use tricept_data::ExternalPose;
+use tricept_data::{ExternalData, ExternalPose, InstrumentRecord};
 use tricept_kinematics::UpJoints;
 use tricept_numerics::linalg::TriangularAccumulator;
 use tricept_numerics::lsq::ReducedProblem;
@@ -64,6 +76,15 @@ pub(crate) struct Nuisance {
     pub rotations: Vec<Matrix3<f64>>,
     /// Plane normals (touch features; zero for spheres).
     pub normals: Vec<Vector3<f64>>,
+}
+
+impl Nuisance {
+    /// Moves every value by its step.
+    pub fn add(&mut self, step: &[f64]) {
+        for (v, s) in self.values.iter_mut().zip(step) {
+            *v += s;
+        }
+    }
 }
 
 /// The rows of one source being accumulated: `[nuisance | parameters |
@@ -188,25 +209,149 @@ impl Sink {
     }
 }
 
-/// What every kind of source provides to the fused identification.
-pub(crate) trait SourceRows: Send + Sync + std::fmt::Debug {
-    /// The kind of instrument.
-    fn kind(&self) -> SourceKind;
+/// The records of a source as the fused identification reads them: the
+/// file, how many, and each one's pose and line.
+pub(crate) trait RecordList {
     /// The file (or label) the records came from.
     fn file(&self) -> &str;
+    /// Number of records.
+    fn len(&self) -> usize;
+    /// Where the machine stood at a record.
+    fn pose(&self, record: usize) -> ExternalPose;
+    /// The record's line in its file.
+    fn line(&self, record: usize) -> u64;
+}
+
+/// The records of an external instrument's file with each one's standard
+/// deviation (mm): what every external source holds.
+#[derive(Debug, Clone)]
+pub(crate) struct Readings<R> {
+    /// Records in file order.
+    pub records: Vec<R>,
+    /// Standard deviation of each record's rows, mm.
+    pub sigma_mm: Vec<f64>,
+    /// The file the records came from.
+    pub file: String,
+}
+
+impl<R: InstrumentRecord> Readings<R> {
+    /// The records of `data`, a row without `sigma_um` at `default_sigma_um`.
+    pub fn new(data: &ExternalData<R>, default_sigma_um: f64) -> Readings<R> {
+        Readings {
+            sigma_mm: data
+                .records
+                .iter()
+                .map(|r| 1e-3 * r.reading().sigma_um.unwrap_or(default_sigma_um))
+                .collect(),
+            records: data.records.clone(),
+            file: data.source.clone(),
+        }
+    }
+
+    /// The records' setups (sorted) and each record's index into them; a
+    /// setup with fewer than `min` records is refused with
+    /// `message(setup, count)` ([`groups`]).
+    pub fn setups(
+        &self,
+        min: usize,
+        message: impl Fn(u32, usize) -> String,
+    ) -> Result<(Vec<u32>, Vec<usize>), IdentError> {
+        let keyed = self.records.iter().map(|r| {
+            let common = r.reading();
+            (common.setup.unwrap_or(1), common.line)
+        });
+        groups(&self.file, keyed, min, message)
+    }
+
+    /// Every record's pose, line and the effector `effector` gives it, for
+    /// [`for_each_point`].
+    pub fn points<'a>(
+        &'a self,
+        effector: impl Fn(&R) -> tricept_model::Effector + 'a,
+    ) -> impl Iterator<Item = (ExternalPose, u64, tricept_model::Effector)> + 'a {
+        self.records.iter().map(move |r| {
+            let common = r.reading();
+            (common.pose, common.line, effector(r))
+        })
+    }
+
+    /// The refusal of a group of records (those `in_group`) whose geometry
+    /// cannot be fitted: `message` given the group's lines (`lines 3, 7`).
+    pub fn degenerate(
+        &self,
+        in_group: impl Fn(usize) -> bool,
+        message: impl FnOnce(String) -> String,
+    ) -> IdentError {
+        let lines = (0..self.records.len())
+            .filter(|&j| in_group(j))
+            .map(|j| self.records[j].reading().line);
+        IdentError::Source {
+            file: self.file.clone(),
+            line: None,
+            message: message(lines_text(lines)),
+        }
+    }
+}
+
+impl<R: InstrumentRecord> RecordList for Readings<R> {
+    fn file(&self) -> &str {
+        &self.file
+    }
+
+    fn len(&self) -> usize {
+        self.records.len()
+    }
+
+    fn pose(&self, record: usize) -> ExternalPose {
+        self.records[record].reading().pose
+    }
+
+    fn line(&self, record: usize) -> u64 {
+        self.records[record].reading().line
+    }
+}
+
+/// A boxed copy of a source's rows (written once for every `Clone` source).
+pub(crate) trait BoxedClone {
+    /// A copy.
+    fn boxed_clone(&self) -> Box<dyn SourceRows>;
+}
+
+impl<T: SourceRows + Clone + 'static> BoxedClone for T {
+    fn boxed_clone(&self) -> Box<dyn SourceRows> {
+        Box::new(self.clone())
+    }
+}
+
+/// What every kind of source provides to the fused identification.
+pub(crate) trait SourceRows: BoxedClone + Send + Sync + std::fmt::Debug {
+    /// The kind of instrument.
+    fn kind(&self) -> SourceKind;
+    /// The source's records.
+    fn record_list(&self) -> &dyn RecordList;
+    /// The file (or label) the records came from.
+    fn file(&self) -> &str {
+        self.record_list().file()
+    }
     /// Nuisance parameter names (the source's label is prefixed by the caller).
     fn nuisance_names(&self) -> Vec<String>;
     /// Number of records.
-    fn records(&self) -> usize;
+    fn records(&self) -> usize {
+        self.record_list().len()
+    }
+    /// Data rows each record gives (3 for a point or the UP limb's
+    /// readings, 1 for a length or a touch).
+    fn rows_each(&self) -> usize;
     /// Number of data rows (records times rows per record).
-    fn data_rows(&self) -> usize;
+    fn data_rows(&self) -> usize {
+        self.rows_each() * self.records()
+    }
     /// Number of prior rows (a known target offset, a certified bar
     /// length, a stylus radius).
     fn prior_rows(&self) -> usize {
         0
     }
-    /// Data rows per record (3 for a point or the UP limb's readings, 1
-    /// for a length or a touch).
+    /// Data rows per record: [`SourceRows::rows_each`], 0 without records.
     fn rows_per_record(&self) -> usize {
         self.data_rows() / self.records().max(1)
     }
@@ -238,9 +383,13 @@ pub(crate) trait SourceRows: Send + Sync + std::fmt::Debug {
         None
     }
     /// Where the machine stood at a record.
-    fn pose(&self, record: usize) -> ExternalPose;
+    fn pose(&self, record: usize) -> ExternalPose {
+        self.record_list().pose(record)
+    }
     /// The record's line in its file.
-    fn line(&self, record: usize) -> u64;
+    fn line(&self, record: usize) -> u64 {
+        self.record_list().line(record)
+    }
     /// Unit of the residuals in um for reports (`None`: mixed units).
     fn residual_unit_um(&self) -> Option<f64> {
         Some(1e3)
@@ -272,7 +421,10 @@ pub(crate) trait SourceRows: Send + Sync + std::fmt::Debug {
     /// rows (which are computed without it). Default: nothing to take off.
     fn take_off_linear_nuisance(&self, _rows: &mut [(usize, f64, f64)], _nuisance: &[f64]) {}
     /// Moves the nuisance by `step` (re-basing rotations and normals).
-    fn retract(&self, nu: &mut Nuisance, step: &[f64]);
+    /// Default: every value moved by its step.
+    fn retract(&self, nu: &mut Nuisance, step: &[f64]) {
+        nu.add(step);
+    }
     /// The nuisance values to report (rotations as rotation vectors).
     fn report_values(&self, nu: &Nuisance) -> Vec<f64> {
         nu.values.clone()
@@ -283,8 +435,6 @@ pub(crate) trait SourceRows: Send + Sync + std::fmt::Debug {
     }
     /// What the nuisance looks like when it cannot be determined.
     fn nuisance_hint(&self) -> &'static str;
-    /// A copy.
-    fn boxed_clone(&self) -> Box<dyn SourceRows>;
 }
 
 /// What is known about the tracker target's offset from the tool tip (a

@@ -27,8 +27,8 @@ use tricept_model::Effector;
 use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Sink, Source, SourceKind, SourceRows, for_each_point, lines_text, project_rows,
-    sphere_centre,
+    Nuisance, Readings, RecordList, Sink, Source, SourceKind, SourceRows, for_each_point,
+    project_rows, sphere_centre,
 };
 
 /// How to read a touch-off file.
@@ -55,13 +55,11 @@ struct Used {
 
 #[derive(Debug, Clone)]
 struct Touch {
-    touches: Vec<TouchReading>,
-    sigma_mm: Vec<f64>,
+    touches: Readings<TouchReading>,
     stylus_mm: f64,
     stylus_sigma_mm: f64,
     used: Vec<Used>,
     feature_of: Vec<usize>,
-    file: String,
 }
 
 impl Source {
@@ -90,6 +88,7 @@ impl Source {
         features: &Features,
         options: &TouchOptions,
     ) -> Result<Source, IdentError> {
+        let touches = Readings::new(data, options.sigma_um);
         let mut used: Vec<Used> = Vec::new();
         let mut feature_of = Vec::with_capacity(data.records.len());
         let mut column = 1;
@@ -119,35 +118,23 @@ impl Source {
                 Feature::Plane { .. } => (3, "plane"),
             };
             if n < needed {
-                return Err(IdentError::Source {
-                    file: data.source.clone(),
-                    line: None,
-                    message: format!(
-                        "{what} {} has {n} touches ({}); it needs at least {needed}",
-                        u.feature.id(),
-                        lines_text(
-                            data.records
-                                .iter()
-                                .zip(&feature_of)
-                                .filter(|(_, f)| **f == k)
-                                .map(|(t, _)| t.line)
+                return Err(touches.degenerate(
+                    |j| feature_of[j] == k,
+                    |lines| {
+                        format!(
+                            "{what} {} has {n} touches ({lines}); it needs at least {needed}",
+                            u.feature.id()
                         )
-                    ),
-                });
+                    },
+                ));
             }
         }
         Ok(Source::new(Box::new(Touch {
-            sigma_mm: data
-                .records
-                .iter()
-                .map(|t| 1e-3 * t.sigma_um.unwrap_or(options.sigma_um))
-                .collect(),
-            touches: data.records.clone(),
+            touches,
             stylus_mm: features.stylus.radius_mm,
             stylus_sigma_mm: 1e-3 * features.stylus.radius_sigma_um,
             used,
             feature_of,
-            file: data.source.clone(),
         })))
     }
 }
@@ -166,9 +153,7 @@ fn plane_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
 impl Touch {
     /// Every touch's pose, line and effector (the stylus centre: the tip).
     fn records(&self) -> impl Iterator<Item = (ExternalPose, u64, Effector)> + '_ {
-        self.touches
-            .iter()
-            .map(|t| (t.pose, t.line, Effector::default()))
+        self.touches.points(|_| Effector::default())
     }
 }
 
@@ -177,8 +162,8 @@ impl SourceRows for Touch {
         SourceKind::Touch
     }
 
-    fn file(&self) -> &str {
-        &self.file
+    fn record_list(&self) -> &dyn RecordList {
+        &self.touches
     }
 
     fn nuisance_names(&self) -> Vec<String> {
@@ -194,12 +179,8 @@ impl SourceRows for Touch {
         names
     }
 
-    fn records(&self) -> usize {
-        self.touches.len()
-    }
-
-    fn data_rows(&self) -> usize {
-        self.touches.len()
+    fn rows_each(&self) -> usize {
+        1
     }
 
     fn prior_rows(&self) -> usize {
@@ -218,14 +199,6 @@ impl SourceRows for Touch {
         )]
     }
 
-    fn pose(&self, record: usize) -> ExternalPose {
-        self.touches[record].pose
-    }
-
-    fn line(&self, record: usize) -> u64 {
-        self.touches[record].line
-    }
-
     fn initial(
         &self,
         at: &FusedAt<'_>,
@@ -233,8 +206,9 @@ impl SourceRows for Touch {
         seeds: &mut [Option<UpJoints>],
         active: &[bool],
     ) -> Result<Nuisance, IdentError> {
-        let mut tips = Vec::with_capacity(self.touches.len());
-        let mut axes = Vec::with_capacity(self.touches.len());
+        let n_touches = self.touches.records.len();
+        let mut tips = Vec::with_capacity(n_touches);
+        let mut axes = Vec::with_capacity(n_touches);
         let direction = at.tool_direction();
         for_each_point(at, contexts, seeds, self.records(), |_, x, _| {
             tips.push(x.position_mm);
@@ -247,22 +221,18 @@ impl SourceRows for Touch {
         };
         nu.values[0] = self.stylus_mm;
         for (k, u) in self.used.iter().enumerate() {
-            let x: Vec<Vector3<f64>> = (0..self.touches.len())
-                .filter(|&j| self.feature_of[j] == k && active[j])
+            let on_feature = |j: usize| self.feature_of[j] == k && active[j];
+            let x: Vec<Vector3<f64>> = (0..n_touches)
+                .filter(|&j| on_feature(j))
                 .map(|j| tips[j])
                 .collect();
-            let degenerate = |shape: &str| IdentError::Source {
-                file: self.file.clone(),
-                line: None,
-                message: format!(
-                    "the touches of feature {} ({}) lie {shape}: it cannot be located",
-                    u.feature.id(),
-                    lines_text(
-                        (0..self.touches.len())
-                            .filter(|&j| self.feature_of[j] == k && active[j])
-                            .map(|j| self.touches[j].line)
+            let degenerate = |shape: &str| {
+                self.touches.degenerate(on_feature, |lines| {
+                    format!(
+                        "the touches of feature {} ({lines}) lie {shape}: it cannot be located",
+                        u.feature.id()
                     )
-                ),
+                })
             };
             match u.feature {
                 Feature::Sphere { radius_mm, .. } => {
@@ -287,8 +257,8 @@ impl SourceRows for Touch {
                     // The normal points out of the material, towards the
                     // probe: against the tool axes that touched it.
                     let mut n: Vector3<f64> = eig.eigenvectors.column(order[0]).into();
-                    let mean_axis: Vector3<f64> = (0..self.touches.len())
-                        .filter(|&j| self.feature_of[j] == k && active[j])
+                    let mean_axis: Vector3<f64> = (0..n_touches)
+                        .filter(|&j| on_feature(j))
                         .map(|j| axes[j])
                         .sum();
                     if n.dot(&mean_axis) > 0.0 {
@@ -342,16 +312,14 @@ impl SourceRows for Touch {
                     -(n.dot(&x) - nu.values[col + 2])
                 }
             };
-            sink.data(j, 1.0 / self.sigma_mm[j], &dnu, &theta, residual);
+            sink.data(j, 1.0 / self.touches.sigma_mm[j], &dnu, &theta, residual);
         })?;
         sink.prior(0, self.stylus_sigma_mm, self.stylus_mm - nu.values[0]);
         Ok(())
     }
 
     fn retract(&self, nu: &mut Nuisance, step: &[f64]) {
-        for (v, s) in nu.values.iter_mut().zip(step) {
-            *v += s;
-        }
+        nu.add(step);
         for (k, u) in self.used.iter().enumerate() {
             if let Feature::Plane { .. } = u.feature {
                 let n = nu.normals[k];
@@ -382,9 +350,5 @@ impl SourceRows for Touch {
 
     fn nuisance_hint(&self) -> &'static str {
         "touch each sphere from directions spread over its surface, and each plane at points spread over it"
-    }
-
-    fn boxed_clone(&self) -> Box<dyn SourceRows> {
-        Box::new(self.clone())
     }
 }

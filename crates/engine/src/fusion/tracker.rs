@@ -22,8 +22,8 @@ use tricept_model::Effector;
 use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Sink, Source, SourceKind, SourceRows, TrackerTarget, cross_matrix, for_each_point,
-    groups, lines_text, rotate_row,
+    Nuisance, Readings, RecordList, Sink, Source, SourceKind, SourceRows, TrackerTarget,
+    cross_matrix, for_each_point, rotate_row,
 };
 
 /// How to read a tracker file.
@@ -47,12 +47,10 @@ impl Default for TrackerOptions {
 
 #[derive(Debug, Clone)]
 struct Tracker {
-    points: Vec<TrackerPoint>,
-    sigma_mm: Vec<f64>,
+    points: Readings<TrackerPoint>,
     target: TrackerTarget,
     setups: Vec<u32>,
     setup_of: Vec<usize>,
-    file: String,
 }
 
 impl Source {
@@ -68,25 +66,15 @@ impl Source {
     /// assert!(e.to_string().ends_with("(lines 2, 3)"), "{e}");
     /// ```
     pub fn tracker(data: &TrackerData, options: &TrackerOptions) -> Result<Source, IdentError> {
-        let (setups, setup_of) = groups(
-            &data.source,
-            data.records.iter().map(|p| (p.setup, p.line)),
-            3,
-            |id, n| {
-                format!("station {id} has {n} points; its frame needs at least 3 not on one line")
-            },
-        )?;
+        let points = Readings::new(data, options.sigma_um);
+        let (setups, setup_of) = points.setups(3, |id, n| {
+            format!("station {id} has {n} points; its frame needs at least 3 not on one line")
+        })?;
         Ok(Source::new(Box::new(Tracker {
-            sigma_mm: data
-                .records
-                .iter()
-                .map(|p| 1e-3 * p.sigma_um.unwrap_or(options.sigma_um))
-                .collect(),
-            points: data.records.clone(),
+            points,
             target: options.target,
             setups,
             setup_of,
-            file: data.source.clone(),
         })))
     }
 }
@@ -101,12 +89,9 @@ impl Tracker {
         &'a self,
         nu: &'a Nuisance,
     ) -> impl Iterator<Item = (ExternalPose, u64, Effector)> + 'a {
-        self.points.iter().map(|p| {
-            let effector = Effector {
-                extension_mm: p.extension_mm,
-                offset_mm: Tracker::offset(nu),
-            };
-            (p.pose, p.line, effector)
+        self.points.points(|p| Effector {
+            extension_mm: p.extension_mm,
+            offset_mm: Tracker::offset(nu),
         })
     }
 }
@@ -145,8 +130,8 @@ impl SourceRows for Tracker {
         SourceKind::Tracker
     }
 
-    fn file(&self) -> &str {
-        &self.file
+    fn record_list(&self) -> &dyn RecordList {
+        &self.points
     }
 
     fn nuisance_names(&self) -> Vec<String> {
@@ -162,12 +147,8 @@ impl SourceRows for Tracker {
         names
     }
 
-    fn records(&self) -> usize {
-        self.points.len()
-    }
-
-    fn data_rows(&self) -> usize {
-        3 * self.points.len()
+    fn rows_each(&self) -> usize {
+        3
     }
 
     fn prior_rows(&self) -> usize {
@@ -212,14 +193,6 @@ impl SourceRows for Tracker {
         }))
     }
 
-    fn pose(&self, record: usize) -> ExternalPose {
-        self.points[record].pose
-    }
-
-    fn line(&self, record: usize) -> u64 {
-        self.points[record].line
-    }
-
     fn initial(
         &self,
         at: &FusedAt<'_>,
@@ -235,26 +208,21 @@ impl SourceRows for Tracker {
         if let TrackerTarget::Known { offset_mm, .. } = self.target {
             nu.values[..3].copy_from_slice(&offset_mm);
         }
-        let mut predicted = Vec::with_capacity(self.points.len());
+        let points = &self.points.records;
+        let mut predicted = Vec::with_capacity(points.len());
         for_each_point(at, contexts, seeds, self.records(&nu), |_, x, _| {
             predicted.push(x.position_mm)
         })?;
         for (s, id) in self.setups.iter().enumerate() {
-            let (x, y): (Vec<Vector3<f64>>, Vec<Vector3<f64>>) = (0..self.points.len())
-                .filter(|&j| self.setup_of[j] == s && active[j])
-                .map(|j| (predicted[j], Vector3::from(self.points[j].position_mm)))
+            let in_station = |j: usize| self.setup_of[j] == s && active[j];
+            let (x, y): (Vec<Vector3<f64>>, Vec<Vector3<f64>>) = (0..points.len())
+                .filter(|&j| in_station(j))
+                .map(|j| (predicted[j], Vector3::from(points[j].position_mm)))
                 .unzip();
-            let (r, t) = horn(&x, &y).ok_or_else(|| IdentError::Source {
-                file: self.file.clone(),
-                line: None,
-                message: format!(
-                    "the points of station {id} ({}) lie on one line: the tracker's frame cannot be found",
-                    lines_text(
-                        (0..self.points.len())
-                            .filter(|&j| self.setup_of[j] == s && active[j])
-                            .map(|j| self.points[j].line)
-                    )
-                ),
+            let (r, t) = horn(&x, &y).ok_or_else(|| {
+                self.points.degenerate(in_station, |lines| {
+                    format!("the points of station {id} ({lines}) lie on one line: the tracker's frame cannot be found")
+                })
             })?;
             nu.rotations[s] = r;
             nu.values[3 + 6 * s + 3..3 + 6 * s + 6].copy_from_slice(t.as_slice());
@@ -275,7 +243,7 @@ impl SourceRows for Tracker {
         let mut theta = vec![0.0; k];
         let mut dnu = vec![0.0; nn];
         for_each_point(at, contexts, seeds, self.records(nu), |j, x, jac| {
-            let p = &self.points[j];
+            let p = &self.points.records[j];
             let s = self.setup_of[j];
             let r = nu.rotations[s];
             let base = 3 + 6 * s;
@@ -297,7 +265,7 @@ impl SourceRows for Tracker {
                 rotate_row(&r, jac, k, c, &mut theta);
                 sink.data(
                     j,
-                    1.0 / self.sigma_mm[j],
+                    1.0 / self.points.sigma_mm[j],
                     &dnu,
                     &theta,
                     p.position_mm[c] - predicted[c],
@@ -346,9 +314,5 @@ impl SourceRows for Tracker {
 
     fn nuisance_hint(&self) -> &'static str {
         "the target offset and the tracker frame cannot be separated: vary the spindle's orientation (h1, h2 and the platform tilt) between the points"
-    }
-
-    fn boxed_clone(&self) -> Box<dyn SourceRows> {
-        Box::new(self.clone())
     }
 }
