@@ -9,7 +9,6 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use tricept_ident::MachineInput;
 use tricept_ident::advanced::{
     Dataset, EffectNames, EvalGrid, HeadAngles, HeadModel, LengthSigma, LoadedMachine,
     ParameterSet, SensorNoise, TrackerTargetSpec, Triple, TrueErrors,
@@ -18,6 +17,7 @@ use tricept_ident::calibrate::{CalibrateRequest, FusedSources};
 use tricept_ident::effects::{Effect, EffectName};
 use tricept_ident::kinematics::Machine;
 use tricept_ident::simulate::TruthEffects;
+use tricept_ident::{DataInput, MachineInput};
 
 use crate::cli_error::CliError;
 
@@ -285,6 +285,33 @@ pub struct IdentifyArgs {
     /// External measurements and the head (the fused identification).
     #[command(flatten)]
     pub external: ExternalArgs,
+}
+
+impl IdentifyArgs {
+    /// `identify`'s flags read in one pass: checked together, turned into
+    /// the door's request, with the spinner shown while it runs.
+    pub fn prepare(&self) -> Result<(CalibrateRequest, indicatif::ProgressBar), CliError> {
+        if self.external.plausibility.is_some() && !self.external.any() {
+            return Err(CliError::input(
+                "--plausibility: the plausible ranges of the head, tool and instruments apply to the fused identification only (with --tracker, --ballbar, --touch, --head or --effects); without them it would be ignored",
+            ));
+        }
+        let (first, more) = self
+            .data
+            .split_first()
+            .map_or((None, &[][..]), |(f, m)| (Some(f), m));
+        let first = first.map_or(Path::new(""), |p| p.as_path());
+        let mut request = self.settings.request(first);
+        request.campaigns = more.iter().cloned().map(DataInput::File).collect();
+        request.prior = self.prior.clone();
+        request.fused = self.external.any().then(|| self.external.sources());
+        request.for_machine_file = self.write_machine.is_some();
+        let spin = spinner(
+            "identify: reading, screening and fitting (Gauss-Newton on the exact model)",
+            first,
+        );
+        Ok((request, spin))
+    }
 }
 
 /// External measurements and the head (options of `tricept identify`).

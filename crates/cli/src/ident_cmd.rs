@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use clap::Args;
 use tricept_ident::DataInput;
 use tricept_ident::advanced::Poses;
-use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+use tricept_ident::calibrate::calibrate;
 use tricept_ident::identifiability::{Campaign, IdentifiabilityRequest, assess_identifiability};
 
 use crate::args::{IdentifyArgs, MachineArgs, NoiseArgs, ParamArgs};
@@ -50,36 +50,10 @@ pub fn run_identifiability(a: &IdentifiabilityArgs) -> Result<u8, CliError> {
     Ok(0)
 }
 
-/// The door's request of `identify`'s flags.
-pub fn calibrate_request(a: &IdentifyArgs) -> CalibrateRequest {
-    let (first, more) = a
-        .data
-        .split_first()
-        .map_or((None, &[][..]), |(f, m)| (Some(f), m));
-    let mut request = a
-        .settings
-        .request(first.map_or(std::path::Path::new(""), |p| p.as_path()));
-    request.campaigns = more.iter().cloned().map(DataInput::File).collect();
-    request.prior = a.prior.clone();
-    request.fused = a.external.any().then(|| a.external.sources());
-    request.for_machine_file = a.write_machine.is_some();
-    request
-}
-
 /// `tricept identify`.
 pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
-    if a.external.plausibility.is_some() && !a.external.any() {
-        return Err(CliError::input(
-            "--plausibility: the plausible ranges of the head, tool and instruments apply to the fused identification only (with --tracker, --ballbar, --touch, --head or --effects); without them it would be ignored",
-        ));
-    }
-    let spin = crate::args::spinner(
-        "identify: reading, screening and fitting (Gauss-Newton on the exact model)",
-        a.data
-            .first()
-            .map_or(std::path::Path::new(""), |p| p.as_path()),
-    );
-    let calibration = calibrate(calibrate_request(a));
+    let (request, spin) = a.prepare()?;
+    let calibration = calibrate(request);
     spin.finish_and_clear();
     let mut calibration = calibration?;
     crate::output::warn_all(calibration.machine_warnings());

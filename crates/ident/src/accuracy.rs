@@ -23,7 +23,8 @@ pub(crate) use tricept_engine::accuracy::fused::{fused_structure, head_scale, of
 /// The promise of `id`, fitted with `model` on `data` (logged noise in
 /// `options`) on machine `m`: its first `set.len()` parameters are the
 /// geometry of `set`, the rest deployed terms; the same model with every
-/// leg also a polynomial in its command checks its geometric estimate.
+/// leg also a polynomial in its command checks its geometric estimate;
+/// with the report's line ([`Accuracy::line`]).
 pub(crate) fn of_fit(
     m: &Machine,
     set: &ParameterSet,
@@ -32,7 +33,7 @@ pub(crate) fn of_fit(
     data: &Dataset,
     options: &IdentifyOptions,
     tolerance_mm: f64,
-) -> Result<Accuracy, Error> {
+) -> Result<(Accuracy, String), Error> {
     let legs = Term::Generic(GenericTerm::new(
         GenericFamily::LegPolynomial,
         Scope::AllLegs,
@@ -47,7 +48,7 @@ pub(crate) fn of_fit(
         data,
         options,
     };
-    tricept_engine::accuracy::of_fit(&fit, tolerance_mm).map_err(|e| match e {
+    tricept_engine::accuracy::of_fit_stated(&fit, tolerance_mm).map_err(|e| match e {
         PromiseError::Ident(e) => Error::with_context("accuracy", &e),
         e => Error::other(e.to_string()),
     })

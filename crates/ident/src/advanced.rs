@@ -31,10 +31,11 @@ pub use crate::accuracy::Accuracy;
 pub use crate::calibrate::values::{
     EffectNames, EvalGrid, HeadModel, LengthSigma, TrackerTargetSpec,
 };
+pub use crate::data_input::read_data_from;
 pub use crate::error::{Classify, FileFailure};
 pub use crate::inputs::{
     FrameMmRad, HeadAngles, LoadedMachine, Poses, SensorNoise, Triple, TrueErrors, load_machine,
-    parse_effects, parse_numbers, read_data_from,
+    parse_effects, parse_numbers,
 };
 pub use crate::machine_file::MachineFile;
 pub use nalgebra;

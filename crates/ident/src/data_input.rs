@@ -2,15 +2,17 @@
 //! whose bytes a written machine file's record hashes), or a [`Dataset`]
 //! already in memory (built by a program, or numpy columns from a Python
 //! binding). Either way the commands are checked against the machine's
-//! stroke before any computation.
+//! stroke before any computation. Reading the file and checking the
+//! commands live here, so that loading the data is one room of the
+//! identify walk.
 
+use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
 use tricept_data::Dataset;
-use tricept_kinematics::Machine;
+use tricept_kinematics::{KinematicsError, Machine};
 
-use crate::error::Error;
-use crate::inputs::{check_commands, read_data};
+use crate::error::{Error, FileFailure};
 
 /// Measured data: a file to read, a file already read, or a data set in
 /// memory.
@@ -97,6 +99,60 @@ impl DataInput {
             }
         }
     }
+}
+
+/// Reads a measured-data file and refuses commands outside the machine's
+/// stroke; every problem is an input error naming file, line and column.
+pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, Error> {
+    let file = path.display().to_string();
+    let f = std::fs::File::open(path).map_err(|e| {
+        Error::input(format!("{file}: {e}")).with_file_failure(FileFailure::new(file.clone(), &e))
+    })?;
+    read_data_from(std::io::BufReader::new(f), &file, machine)
+}
+
+/// The measured data (docs/data-format.md) read from a reader (a file
+/// wrapped in a progress display, say); `file` names it in messages.
+pub fn read_data_from(
+    reader: impl BufRead,
+    file: &str,
+    machine: &Machine,
+) -> Result<Dataset, Error> {
+    let data = tricept_data::read_from(reader, file)?;
+    // Commands the machine cannot take are input errors too, found here
+    // with their line rather than deep inside the solver.
+    check_commands(
+        &data.source,
+        data.poses.iter().map(|p| (p.line, p.commands_mm)),
+        machine,
+    )?;
+    Ok(data)
+}
+
+/// Refuses leg commands outside the machine's stroke: an input error naming
+/// the file, the line and the column (`records` give line and commands).
+pub fn check_commands(
+    file: &str,
+    records: impl Iterator<Item = (u64, [f64; 3])>,
+    machine: &Machine,
+) -> Result<(), Error> {
+    for (line, q) in records {
+        if let Err(e) = machine.check_commands(&q) {
+            let message = match e {
+                KinematicsError::OutOfStroke {
+                    leg,
+                    length_mm,
+                    min_mm,
+                    max_mm,
+                } => format!(
+                    "{file}: line {line}, column `q{leg}`: command {length_mm} mm is outside the leg stroke [{min_mm}, {max_mm}] mm"
+                ),
+                e => format!("{file}: line {line}: {e}"),
+            };
+            return Err(Error::input(message));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

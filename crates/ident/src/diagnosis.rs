@@ -281,7 +281,7 @@ impl DiagnoseResult {
         let deployed = self.deploy()?;
         let g = ParameterSet::paper15().len();
         let nominal = self.machine.machine();
-        let promise = crate::accuracy::of_fit(
+        let (promise, _) = crate::accuracy::of_fit(
             nominal,
             &ParameterSet::paper15(),
             &deployed.model,

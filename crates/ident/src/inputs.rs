@@ -9,21 +9,18 @@
 //! file, the line and the column, or the value at fault.
 
 use std::fmt;
-use std::io::BufRead;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 use nalgebra::Vector3;
-use tricept_data::Dataset;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{
-    DescriptionError, KinematicsError, MAX_POSES, Machine, MachineDescription, PoseSet,
-    PoseSetError,
+    DescriptionError, MAX_POSES, Machine, MachineDescription, PoseSet, PoseSetError,
 };
 use tricept_model::ParameterSet;
 use tricept_plant::Effect;
 
-use crate::error::{Classify, Error, FileFailure};
+use crate::error::{Classify, Error};
 use crate::limits;
 
 /// Sensor-noise overrides of a machine (default: the description's).
@@ -51,11 +48,11 @@ pub struct SensorNoise {
 /// record calls for (a forced or inadequate calibration).
 #[derive(Debug, Clone)]
 pub struct LoadedMachine {
-    description: MachineDescription,
-    machine: Machine,
+    pub(crate) description: MachineDescription,
+    pub(crate) machine: Machine,
     source: String,
     path: Option<PathBuf>,
-    warnings: Vec<String>,
+    pub(crate) warnings: Vec<String>,
 }
 
 impl LoadedMachine {
@@ -327,60 +324,6 @@ pub fn positive(flag: &str, v: f64) -> Result<f64, Error> {
             "{flag}: must be a positive number, got {v}"
         )))
     }
-}
-
-/// Reads a measured-data file and refuses commands outside the machine's
-/// stroke; every problem is an input error naming file, line and column.
-pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, Error> {
-    let file = path.display().to_string();
-    let f = std::fs::File::open(path).map_err(|e| {
-        Error::input(format!("{file}: {e}")).with_file_failure(FileFailure::new(file.clone(), &e))
-    })?;
-    read_data_from(std::io::BufReader::new(f), &file, machine)
-}
-
-/// The measured data (docs/data-format.md) read from a reader (a file
-/// wrapped in a progress display, say); `file` names it in messages.
-pub fn read_data_from(
-    reader: impl BufRead,
-    file: &str,
-    machine: &Machine,
-) -> Result<Dataset, Error> {
-    let data = tricept_data::read_from(reader, file)?;
-    // Commands the machine cannot take are input errors too, found here
-    // with their line rather than deep inside the solver.
-    check_commands(
-        &data.source,
-        data.poses.iter().map(|p| (p.line, p.commands_mm)),
-        machine,
-    )?;
-    Ok(data)
-}
-
-/// Refuses leg commands outside the machine's stroke: an input error naming
-/// the file, the line and the column (`records` give line and commands).
-pub fn check_commands(
-    file: &str,
-    records: impl Iterator<Item = (u64, [f64; 3])>,
-    machine: &Machine,
-) -> Result<(), Error> {
-    for (line, q) in records {
-        if let Err(e) = machine.check_commands(&q) {
-            let message = match e {
-                KinematicsError::OutOfStroke {
-                    leg,
-                    length_mm,
-                    min_mm,
-                    max_mm,
-                } => format!(
-                    "{file}: line {line}, column `q{leg}`: command {length_mm} mm is outside the leg stroke [{min_mm}, {max_mm}] mm"
-                ),
-                e => format!("{file}: line {line}: {e}"),
-            };
-            return Err(Error::input(message));
-        }
-    }
-    Ok(())
 }
 
 /// A set of target points (`--poses`): a generated [`PoseSet`]

@@ -36,7 +36,7 @@ pub mod cross_validation;
 pub mod fused;
 pub mod promise;
 
-pub use promise::{Accuracy, Fit, PromiseError, of_fit};
+pub use promise::{Accuracy, Fit, PromiseError, of_fit, of_fit_stated};
 
 use nalgebra::{DMatrix, Vector3};
 use serde::Serialize;

@@ -234,6 +234,15 @@ pub struct Fit<'a> {
     pub options: &'a IdentifyOptions,
 }
 
+/// The promise of a fit ([`of_fit`]) with its report line
+/// ([`Accuracy::line`]), made in one pass: the identify walk states it where
+/// it makes it.
+pub fn of_fit_stated(fit: &Fit<'_>, tolerance_mm: f64) -> Result<(Accuracy, String), PromiseError> {
+    let promise = of_fit(fit, tolerance_mm)?;
+    let line = promise.line();
+    Ok((promise, line))
+}
+
 /// The promise of a fit ([`Fit`]), held parameters at `tolerance_mm`.
 pub fn of_fit(fit: &Fit<'_>, tolerance_mm: f64) -> Result<Accuracy, PromiseError> {
     let &Fit {

@@ -17,8 +17,9 @@ use tricept_model::effects::EffectName;
 
 use super::checked::{Checked, FusedWork};
 use super::values::fused_model;
+use crate::data_input::check_commands;
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error};
-use crate::inputs::{LoadedMachine, check_commands};
+use crate::inputs::LoadedMachine;
 use crate::machine_file;
 
 /// A fused fit with its model and its sources.

@@ -20,7 +20,7 @@ use tricept_kinematics::{Machine, MachineDescription};
 use super::advice::{campaign_advice, predicted_accuracy};
 use super::checked::Checked;
 use crate::accuracy::Accuracy;
-use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error};
+use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error, exit_line};
 use crate::inputs::LoadedMachine;
 use crate::machine_file;
 
@@ -43,8 +43,57 @@ pub(crate) struct InternalFit {
     pub temperature_c: Option<f64>,
     /// The accuracy the calibrated machine file will deliver.
     pub promise: Accuracy,
+    /// Its report line, made with it.
+    pub promise_line: String,
     /// Several campaigns or a batch's prior: what pooling adds.
     pub pooled: Option<Box<super::pooling::Pooled>>,
+}
+
+/// What a calibration says, made once where the calibration is made: its
+/// exit code and reasons, the exit line, the text report and the notices
+/// for the error stream.
+#[derive(Debug, Clone)]
+pub(crate) struct Said {
+    /// The exit code of the verdict.
+    pub exit_code: u8,
+    /// Why it is not to be trusted (empty when it is).
+    pub reason: String,
+    /// Why it must not be deployed (`None` when it may).
+    pub refusal: Option<String>,
+    /// The one-line summary of a non-zero exit code.
+    pub exit_line: Option<String>,
+    /// The text report.
+    pub report: String,
+    /// Lines for the error stream after the report.
+    pub notices: Vec<String>,
+}
+
+impl Said {
+    /// What the internal (or pooled) fit `f` of the data `name` says.
+    pub fn of_internal(f: &InternalFit, loaded: &LoadedMachine, name: &str) -> Said {
+        let exit_code = f.exit_code();
+        let reason = f.reason();
+        Said {
+            exit_code,
+            exit_line: exit_line("identify", exit_code, &reason),
+            reason,
+            refusal: f.refusal().map(String::from),
+            report: f.report(loaded, name),
+            notices: Vec::new(),
+        }
+    }
+}
+
+/// The internal calibration of `dataset` (named `name`) and what it says,
+/// made in one pass ([`fit`], [`Said::of_internal`]).
+pub(crate) fn calibrated(
+    c: &Checked,
+    dataset: &Dataset,
+    name: &str,
+) -> Result<(InternalFit, Said), Error> {
+    let f = fit(c, dataset, None)?;
+    let said = Said::of_internal(&f, &c.loaded, name);
+    Ok((f, said))
 }
 
 /// Identifies `c`'s set from `dataset` against its machine (robust unless
@@ -56,7 +105,7 @@ pub(crate) fn fit(
     prior: Option<Prior>,
 ) -> Result<InternalFit, Error> {
     let (loaded, set, robust, tolerance_mm) = (&c.loaded, &c.set, c.robust, c.tolerance_mm);
-    let m = loaded.machine();
+    let m = &loaded.machine;
     let mut model = GeometricModel::new(m.clone(), set.clone());
     if let Some(reference) = loaded.rank_reference()? {
         model = model.with_rank_reference(reference);
@@ -92,7 +141,7 @@ pub(crate) fn fit(
             .push(campaign_advice(m, set, &accuracy, id.residuals.len())?);
     }
     let kept = dataset.subset(|j| !rejected.iter().any(|r| r.pose == j));
-    let promise = crate::accuracy::of_fit(
+    let (promise, promise_line) = crate::accuracy::of_fit(
         m,
         set,
         &crate::accuracy::geometric_base(&model, m, &kept),
@@ -104,6 +153,7 @@ pub(crate) fn fit(
     Ok(InternalFit {
         pooled: None,
         promise,
+        promise_line,
         model,
         id,
         rejected,
@@ -276,7 +326,7 @@ impl InternalFit {
                 "NOT worthwhile (the campaign is too small to calibrate)"
             }
         );
-        let _ = writeln!(s, "{}", self.promise.line());
+        let _ = writeln!(s, "{}", self.promise_line);
         let (causes, others): (Vec<&String>, Vec<&String>) = self
             .verdict
             .warnings

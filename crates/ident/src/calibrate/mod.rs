@@ -26,11 +26,13 @@ use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
 use crate::data_input::DataInput;
-use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, Error};
+use crate::error::Error;
+pub(crate) use crate::error::exit_line;
 use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
 use checked::{Checked, Work};
+use internal::Said;
 pub(crate) use internal::fit_error;
 pub use values::FusedSources;
 
@@ -105,6 +107,7 @@ pub struct Calibration {
     loaded: LoadedMachine,
     data: DataInput,
     fit: Fit,
+    said: Said,
 }
 
 /// A machine file written: where, and why it was written although its fit
@@ -141,17 +144,42 @@ impl Written {
 /// [`Calibration::exit_code`].
 pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
     let (checked, data, work) = check(request)?;
-    let fit = match &work {
+    let name = data.name();
+    let (fit, said) = match &work {
         Work::Pooled { datasets, prior } => {
-            Fit::Internal(Box::new(pooled::fit(&checked, datasets, prior.as_deref())?))
+            let f = pooled::fit(&checked, datasets, prior.as_deref())?;
+            let said = Said::of_internal(&f, &checked.loaded, &name);
+            (Fit::Internal(Box::new(f)), said)
         }
-        Work::Internal(dataset) => Fit::Internal(Box::new(internal::fit(&checked, dataset, None)?)),
-        Work::Fused(w) => Fit::Fused(Box::new(fused::fit(&checked, w)?)),
+        Work::Internal(dataset) => {
+            let (f, said) = internal::calibrated(&checked, dataset, &name)?;
+            (Fit::Internal(Box::new(f)), said)
+        }
+        Work::Fused(w) => {
+            let f = fused::fit(&checked, w)?;
+            let code = f.exit_code();
+            let refusal = (code != 0).then(|| f.refusal_reason());
+            let said = Said {
+                exit_code: code,
+                reason: refusal.clone().unwrap_or_default(),
+                refusal,
+                exit_line: f.exit_line(),
+                report: f.report(),
+                notices: f
+                    .fit
+                    .warnings
+                    .iter()
+                    .map(|w| format!("warning: {w}"))
+                    .collect(),
+            };
+            (Fit::Fused(Box::new(f)), said)
+        }
     };
     Ok(Calibration {
         loaded: checked.loaded,
         data,
         fit,
+        said,
     })
 }
 
@@ -177,7 +205,7 @@ fn check(request: CalibrateRequest) -> Result<(Checked, DataInput, Work), Error>
         tolerance_mm,
         loaded,
     };
-    let m = checked.loaded.machine();
+    let m = &checked.loaded.machine;
     let work = match &request.fused {
         None if pooled => Work::Pooled {
             datasets: std::iter::once(&request.data)
@@ -206,10 +234,7 @@ impl Calibration {
     /// calibrate, or (fused) a source cannot be checked or an estimate is
     /// implausible; 4 not converged.
     pub fn exit_code(&self) -> u8 {
-        match &self.fit {
-            Fit::Internal(f) => f.exit_code(),
-            Fit::Fused(f) => f.exit_code(),
-        }
+        self.said.exit_code
     }
 
     /// Whether the fit converged.
@@ -232,21 +257,14 @@ impl Calibration {
     /// Why the calibration is not to be trusted, in one phrase (empty when
     /// it is).
     pub fn reason(&self) -> String {
-        match &self.fit {
-            Fit::Internal(f) => f.reason(),
-            Fit::Fused(f) if f.exit_code() != 0 => f.refusal_reason(),
-            Fit::Fused(_) => String::new(),
-        }
+        self.said.reason.clone()
     }
 
     /// Why the calibration must not be deployed, in one phrase (`None` when
     /// it may): the internal fit's verdict; for a fused fit as
     /// [`Calibration::reason`].
     pub fn refusal(&self) -> Option<String> {
-        match &self.fit {
-            Fit::Internal(f) => f.refusal().map(String::from),
-            Fit::Fused(f) => (f.exit_code() != 0).then(|| f.refusal_reason()),
-        }
+        self.said.refusal.clone()
     }
 
     /// The fit's warnings (likely causes, the campaign advice, unexplained
@@ -261,30 +279,19 @@ impl Calibration {
     /// The warnings the machine file loaded calls for (a forced or
     /// inadequate calibration it holds).
     pub fn machine_warnings(&self) -> &[String] {
-        self.loaded.warnings()
+        &self.loaded.warnings
     }
 
     /// Lines for the error stream after the report: a fused fit's
     /// warnings (`warning: ...`).
     pub fn notices(&self) -> Vec<String> {
-        match &self.fit {
-            Fit::Internal(_) => Vec::new(),
-            Fit::Fused(f) => f
-                .fit
-                .warnings
-                .iter()
-                .map(|w| format!("warning: {w}"))
-                .collect(),
-        }
+        self.said.notices.clone()
     }
 
     /// The one-line summary of a non-zero exit code (`identify: exit 3:
     /// ...`), `None` for 0.
     pub fn exit_line(&self) -> Option<String> {
-        match &self.fit {
-            Fit::Internal(f) => exit_line("identify", f.exit_code(), &f.reason()),
-            Fit::Fused(f) => f.exit_line(),
-        }
+        self.said.exit_line.clone()
     }
 
     /// The machine calibrated against, as loaded.
@@ -344,10 +351,7 @@ impl Calibration {
 
     /// The text report `tricept identify` prints.
     pub fn report(&self) -> String {
-        match &self.fit {
-            Fit::Internal(f) => f.report(&self.loaded, &self.data.name()),
-            Fit::Fused(f) => f.report(),
-        }
+        self.said.report.clone()
     }
 
     /// The calibrated machine's description with its `calibration` record
@@ -409,13 +413,6 @@ impl Calibration {
 pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), Error> {
     tricept_data::write_atomic(path, |w| w.write_all(text.as_bytes()))
         .map_err(|e| Error::not_written(path, &e))
-}
-
-/// The one-line summary of a non-zero verdict (`VERB: exit CODE: WHY (see
-/// the warnings)`) for 3 and 4, else `None`.
-pub(crate) fn exit_line(verb: &str, code: u8, why: &str) -> Option<String> {
-    (code == EXIT_INADEQUATE || code == EXIT_NOT_CONVERGED)
-        .then(|| format!("{verb}: exit {code}: {why} (see the warnings)"))
 }
 
 #[cfg(test)]
