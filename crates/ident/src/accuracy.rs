@@ -54,6 +54,28 @@ pub(crate) fn of_fit(
     })
 }
 
+/// The promise of an internal calibration: [`of_fit`] on the model of
+/// `geometric`'s set on `m` alone ([`geometric_base`]), made in one call.
+pub(crate) fn of_geometric_fit(
+    geometric: &GeometricModel,
+    m: &Machine,
+    id: &Identification,
+    data: &Dataset,
+    options: &IdentifyOptions,
+    tolerance_mm: f64,
+) -> Result<(Accuracy, String), Error> {
+    let base = geometric_base(geometric, m, data);
+    of_fit(
+        m,
+        geometric.parameter_set(),
+        &base,
+        id,
+        data,
+        options,
+        tolerance_mm,
+    )
+}
+
 /// The model of `set` on `m` alone, in `data`'s frame: the base of an
 /// internal calibration's structure part.
 pub(crate) fn geometric_base(

@@ -141,15 +141,8 @@ pub(crate) fn fit(
             .push(campaign_advice(m, set, &accuracy, id.residuals.len())?);
     }
     let kept = dataset.subset(|j| !rejected.iter().any(|r| r.pose == j));
-    let (promise, promise_line) = crate::accuracy::of_fit(
-        m,
-        set,
-        &crate::accuracy::geometric_base(&model, m, &kept),
-        &id,
-        &kept,
-        &options,
-        tolerance_mm,
-    )?;
+    let (promise, promise_line) =
+        crate::accuracy::of_geometric_fit(&model, m, &id, &kept, &options, tolerance_mm)?;
     Ok(InternalFit {
         pooled: None,
         promise,

@@ -10,6 +10,54 @@
 //! memory, the machine, the parameter set, the external sources) and
 //! returns a [`Calibration`]: what `tricept identify` prints (its text
 //! report, its JSON) and writes.
+//!
+//! # The identify walk
+//!
+//! `tricept identify --data D` (text report, no machine file written),
+//! file by file in execution order. A stay is an arrival by a call made
+//! from the CLI or the door; an internal crate's file counts where the door
+//! calls it (its own calls are not followed); a run of calls from one
+//! place into one file (a loop, a builder) is one stay; constructors of the
+//! request's values and accessors that return a stored field are not
+//! stays. A *return* is a stay in a file the walk had already left
+//! (marked R).
+//!
+//! 1. `cli/src/main.rs`: parse, `run`
+//! 2. `cli/src/files.rs`: the paths' roles checked
+//! 3. `cli/src/ident_cmd.rs`: `run_identify`
+//! 4. `cli/src/args.rs`: `IdentifyArgs::prepare` (the flags in one pass:
+//!    their checks, the request, the spinner)
+//! 5. `ident/src/calibrate/mod.rs`: `calibrate`, `check`
+//! 6. `ident/src/machine_input.rs`: `MachineInput::load`
+//! 7. `ident/src/inputs.rs`: `load_machine`, `LoadedMachine::from_description`
+//! 8. `kinematics/src/description/`, `kinematics/src/machine.rs`: validate,
+//!    build, the workspace's reach
+//! 9. `ident/src/data_input.rs`: the data's name, `load`, `read_data`,
+//!    `check_commands`
+//! 10. `data/src/read.rs`: the CSV
+//! 11. `kinematics/src/machine.rs`: each pose's commands in the stroke (R)
+//! 12. `ident/src/calibrate/internal.rs`: `calibrated` (`fit`, then what it
+//!     says: [`Calibration`] keeps the exit code, reasons, exit line,
+//!     report and notices made here)
+//! 13. `ident/src/inputs.rs`: `rank_reference` (R)
+//! 14. `engine/src/model.rs`, `options.rs`, `robust.rs`, `verdict.rs`: the
+//!     robust fit and its verdict
+//! 15. `ident/src/calibrate/advice.rs` and `engine/src/accuracy/mod.rs`:
+//!     the predicted accuracy
+//! 16. `data/src/pose.rs`: the kept poses
+//! 17. `ident/src/accuracy.rs`: `of_geometric_fit`, through `diagnose`'s
+//!     model to `engine/src/accuracy/promise.rs` (`of_fit_stated`: the
+//!     promise with its report line)
+//! 18. `ident/src/machine_file.rs`: the mean temperature
+//! 19. `ident/src/error.rs`: the exit line; `engine/src/report.rs`: the
+//!     identification's table
+//! 20. `cli/src/output.rs`: the machine file's warnings
+//! 21. `cli/src/output.rs`: the report (R; between 20 and 21 the CLI reads
+//!     the stored report)
+//! 22. `cli/src/output.rs`: stdout flushed by `main` (R)
+//!
+//! 4 returns. Keep it so: a value the CLI prints is made where the
+//! calibration is made and stored, not recomputed by a getter.
 
 mod advice;
 mod checked;
@@ -143,8 +191,7 @@ impl Written {
 /// small to fit; a fit that completes returns its verdict in
 /// [`Calibration::exit_code`].
 pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
-    let (checked, data, work) = check(request)?;
-    let name = data.name();
+    let (checked, data, name, work) = check(request)?;
     let (fit, said) = match &work {
         Work::Pooled { datasets, prior } => {
             let f = pooled::fit(&checked, datasets, prior.as_deref())?;
@@ -185,7 +232,7 @@ pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
 
 /// Checks `request` once: the tolerance, the machine, which fit, the data
 /// (and a fused calibration's settings, [`fused`]).
-fn check(request: CalibrateRequest) -> Result<(Checked, DataInput, Work), Error> {
+fn check(request: CalibrateRequest) -> Result<(Checked, DataInput, String, Work), Error> {
     let tolerance_mm = request.tolerance_mm;
     if !(tolerance_mm.is_finite() && tolerance_mm > 0.0 && tolerance_mm <= 10.0) {
         return Err(Error::input(format!(
@@ -206,6 +253,8 @@ fn check(request: CalibrateRequest) -> Result<(Checked, DataInput, Work), Error>
         loaded,
     };
     let m = &checked.loaded.machine;
+    // The data's name and the data, read in one visit to `data_input.rs`.
+    let name = request.data.name();
     let work = match &request.fused {
         None if pooled => Work::Pooled {
             datasets: std::iter::once(&request.data)
@@ -225,7 +274,7 @@ fn check(request: CalibrateRequest) -> Result<(Checked, DataInput, Work), Error>
             )?))
         }
     };
-    Ok((checked, request.data, work))
+    Ok((checked, request.data, name, work))
 }
 
 impl Calibration {
@@ -479,7 +528,7 @@ mod tests {
             tracker_target: Some("tip".parse().unwrap()),
             ..FusedSources::default()
         });
-        let (checked, _, work) = check(request).unwrap();
+        let (checked, _, _, work) = check(request).unwrap();
         let Work::Fused(w) = work else {
             panic!("a fused request is fused work")
         };
