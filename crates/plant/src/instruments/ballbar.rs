@@ -1,13 +1,11 @@
 //! A ballbar from the tool-tip ball to a pivot on the table.
 
 use nalgebra::Vector3;
-use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
-use rand_pcg::Pcg64Mcg;
-use tricept_data::{BallbarData, BallbarReading, ExternalData, ExternalPose};
+use tricept_data::{BallbarData, BallbarReading, ExternalPose};
 use tricept_model::Effector;
 
-use super::kinematics_error;
+use super::{measure_each, spindle_point};
 use crate::{Plant, PlantError};
 
 /// Tag mixed into the seed, so that instruments measuring with the same
@@ -56,19 +54,14 @@ impl Ballbar {
         poses: &[ExternalPose],
         seed: u64,
     ) -> Result<BallbarData, PlantError> {
-        let actual = plant.actual_machine();
-        let mut rng = Pcg64Mcg::seed_from_u64(seed ^ BALLBAR_TAG);
         let effector = Effector {
             extension_mm: 0.0,
             offset_mm: self.ball_offset_mm,
         };
-        let mut records = Vec::with_capacity(poses.len());
-        for (j, pose) in poses.iter().enumerate() {
-            let x = plant
-                .spindle_point_on(&actual, &pose.commands_mm, pose.head_rad, &effector)
-                .map_err(kinematics_error(j, Vector3::from(pose.commands_mm)))?;
-            let z: f64 = StandardNormal.sample(&mut rng);
-            records.push(BallbarReading {
+        let reading = |actual: &_, j, pose: &ExternalPose, rng: &mut _| {
+            let x = spindle_point(plant, actual, j, pose, &effector)?;
+            let z: f64 = StandardNormal.sample(rng);
+            Ok(BallbarReading {
                 pose: *pose,
                 length_mm: (x - self.pivot_mm).norm()
                     + 1e-3 * (self.length_error_um + self.sigma_um * z),
@@ -76,11 +69,15 @@ impl Ballbar {
                 setup: self.setup,
                 temp_c: None,
                 line: 0,
-            });
-        }
-        Ok(ExternalData {
-            records,
-            source: "simulated ballbar".into(),
-        })
+            })
+        };
+        measure_each(
+            plant,
+            poses,
+            seed,
+            BALLBAR_TAG,
+            "simulated ballbar",
+            reading,
+        )
     }
 }

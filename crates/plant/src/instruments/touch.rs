@@ -1,16 +1,14 @@
 //! A touch probe on reference spheres and planes.
 
 use nalgebra::Vector3;
-use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 use rand_pcg::Pcg64Mcg;
-use tricept_data::{
-    ExternalData, ExternalPose, Feature, Features, Stylus, TouchData, TouchReading,
-};
+use tricept_data::{ExternalPose, Feature, Features, Stylus, TouchData, TouchReading};
 use tricept_model::Effector;
 
-use super::{commanded, kinematics_error};
+use super::{commanded, kinematics_error, measure_each};
 use crate::{Plant, PlantError};
+use tricept_kinematics::Machine;
 
 /// Tag mixed into the seed, so that instruments measuring with the same
 /// seed draw independent noise.
@@ -130,11 +128,8 @@ impl TouchProbe {
         targets: &[TouchTarget],
         seed: u64,
     ) -> Result<TouchData, PlantError> {
-        let actual = plant.actual_machine();
-        let mut rng = Pcg64Mcg::seed_from_u64(seed ^ TOUCH_TAG);
         let r = self.stylus_radius_mm + 1e-3 * self.stylus_radius_error_um;
-        let mut records = Vec::with_capacity(targets.len());
-        for (j, t) in targets.iter().enumerate() {
+        let touch = |actual: &Machine, j: usize, t: &TouchTarget, rng: &mut Pcg64Mcg| {
             let feature = self
                 .features
                 .iter()
@@ -148,7 +143,7 @@ impl TouchProbe {
                     .map_err(&err)?;
                 let x = plant
                     .spindle_point_on(
-                        &actual,
+                        actual,
                         &pose.commands_mm,
                         pose.head_rad,
                         &Effector::default(),
@@ -171,19 +166,23 @@ impl TouchProbe {
                     hi = mid;
                 }
             }
-            let z: f64 = StandardNormal.sample(&mut rng);
+            let z: f64 = StandardNormal.sample(rng);
             let (pose, _) = at(0.5 * (lo + hi) + 1e-3 * self.sigma_um * z)?;
-            records.push(TouchReading {
+            Ok(TouchReading {
                 pose,
                 feature: t.feature,
                 sigma_um: Some(self.sigma_um),
                 temp_c: None,
                 line: 0,
-            });
-        }
-        Ok(ExternalData {
-            records,
-            source: "simulated touch probe".into(),
-        })
+            })
+        };
+        measure_each(
+            plant,
+            targets,
+            seed,
+            TOUCH_TAG,
+            "simulated touch probe",
+            touch,
+        )
     }
 }

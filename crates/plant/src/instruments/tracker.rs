@@ -1,13 +1,11 @@
 //! A laser tracker (or a CMM) on a target in the spindle.
 
 use nalgebra::{Isometry3, Vector3};
-use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
-use rand_pcg::Pcg64Mcg;
-use tricept_data::{ExternalData, ExternalPose, TrackerData, TrackerPoint};
+use tricept_data::{ExternalPose, TrackerData, TrackerPoint};
 use tricept_model::Effector;
 
-use super::kinematics_error;
+use super::{measure_each, spindle_point};
 use crate::{Plant, PlantError};
 
 /// Tag mixed into the seed, so that instruments measuring with the same
@@ -61,24 +59,19 @@ impl Tracker {
         poses: &[(ExternalPose, f64)],
         seed: u64,
     ) -> Result<TrackerData, PlantError> {
-        let actual = plant.actual_machine();
-        let mut rng = Pcg64Mcg::seed_from_u64(seed ^ TRACKER_TAG);
         let sigma_mm = self.sigma_um * 1e-3;
-        let mut records = Vec::with_capacity(poses.len());
-        for (j, (pose, extension_mm)) in poses.iter().enumerate() {
+        let point = |actual: &_, j, (pose, extension_mm): &(ExternalPose, f64), rng: &mut _| {
             let effector = Effector {
                 extension_mm: *extension_mm,
                 offset_mm: self.target_offset_mm,
             };
-            let x = plant
-                .spindle_point_on(&actual, &pose.commands_mm, pose.head_rad, &effector)
-                .map_err(kinematics_error(j, Vector3::from(pose.commands_mm)))?;
+            let x = spindle_point(plant, actual, j, pose, &effector)?;
             let y = self.frame * nalgebra::Point3::from(x);
             let position_mm: [f64; 3] = std::array::from_fn(|c| {
-                let z: f64 = StandardNormal.sample(&mut rng);
+                let z: f64 = StandardNormal.sample(rng);
                 y[c] + sigma_mm * z
             });
-            records.push(TrackerPoint {
+            Ok(TrackerPoint {
                 pose: *pose,
                 position_mm,
                 sigma_um: Some(self.sigma_um),
@@ -86,11 +79,8 @@ impl Tracker {
                 setup: self.setup,
                 temp_c: None,
                 line: 0,
-            });
-        }
-        Ok(ExternalData {
-            records,
-            source: "simulated tracker".into(),
-        })
+            })
+        };
+        measure_each(plant, poses, seed, TRACKER_TAG, "simulated tracker", point)
     }
 }
