@@ -10,14 +10,12 @@
 //! absorbed by `b` and no ballbar sees it.
 
 use nalgebra::Vector3;
-use tricept_data::{BallbarData, BallbarReading, ExternalPose};
-use tricept_kinematics::UpJoints;
+use tricept_data::{BallbarData, BallbarReading};
 use tricept_model::Effector;
 
 use crate::error::IdentError;
-use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Readings, RecordList, Sink, Source, SourceKind, SourceRows, for_each_point,
+    Nuisance, PointRows, Readings, RecordList, Sink, Source, SourceKind, SourceRows, Start,
     project_rows, sphere_centre,
 };
 
@@ -84,13 +82,6 @@ impl Source {
     }
 }
 
-impl Ballbar {
-    /// Every reading's pose, line and effector (the ball).
-    fn records(&self) -> impl Iterator<Item = (ExternalPose, u64, Effector)> + '_ {
-        self.readings.points(|_| self.effector)
-    }
-}
-
 impl SourceRows for Ballbar {
     fn kind(&self) -> SourceKind {
         SourceKind::Ballbar
@@ -136,19 +127,21 @@ impl SourceRows for Ballbar {
             .collect()
     }
 
-    fn initial(
-        &self,
-        at: &FusedAt<'_>,
-        contexts: &[LegContext],
-        seeds: &mut [Option<UpJoints>],
-        active: &[bool],
-    ) -> Result<Nuisance, IdentError> {
+    fn effector(&self, _record: usize, _nu: &Nuisance) -> Effector {
+        self.effector
+    }
+
+    fn start(&self) -> Nuisance {
+        Nuisance {
+            values: vec![0.0; 4 * self.setups.len()],
+            ..Nuisance::default()
+        }
+    }
+
+    fn fit_start(&self, start: Start<'_>) -> Result<Nuisance, IdentError> {
+        let (mut nu, active) = (start.nu, start.active);
         let readings = &self.readings.records;
-        let mut tips = Vec::with_capacity(readings.len());
-        for_each_point(at, contexts, seeds, self.records(), |_, x, _| {
-            tips.push(x.position_mm)
-        })?;
-        let mut values = vec![0.0; 4 * self.setups.len()];
+        let tips: Vec<Vector3<f64>> = start.points.iter().map(|x| x.position_mm).collect();
         for (s, id) in self.setups.iter().enumerate() {
             let in_setup = |j: usize| self.setup_of[j] == s && active[j];
             let (x, radii): (Vec<Vector3<f64>>, Vec<f64>) = (0..readings.len())
@@ -160,51 +153,46 @@ impl SourceRows for Ballbar {
                     format!("the ball positions of setup {id} ({lines}) lie in one plane: the pivot cannot be found")
                 })
             })?;
-            values[4 * s..4 * s + 3].copy_from_slice(c.as_slice());
+            nu.values[4 * s..4 * s + 3].copy_from_slice(c.as_slice());
         }
-        Ok(Nuisance {
-            values,
-            ..Nuisance::default()
-        })
+        Ok(nu)
     }
 
-    fn evaluate(
-        &self,
-        at: &FusedAt<'_>,
-        contexts: &[LegContext],
-        nu: &Nuisance,
-        seeds: &mut [Option<UpJoints>],
-        sink: &mut Sink,
-    ) -> Result<(), IdentError> {
-        let k = at.len();
-        let mut theta = vec![0.0; k];
-        let mut dnu = vec![0.0; nu.values.len()];
-        for_each_point(at, contexts, seeds, self.records(), |j, x, jac| {
-            let base = 4 * self.setup_of[j];
-            let c = Vector3::new(nu.values[base], nu.values[base + 1], nu.values[base + 2]);
-            let d = x.position_mm - c;
-            let rho = d.norm();
-            let u = d / rho;
-            dnu.iter_mut().for_each(|v| *v = 0.0);
-            for m in 0..3 {
-                dnu[base + m] = -u[m];
-            }
-            dnu[base + 3] = 1.0;
-            project_rows(&u, jac, k, &mut theta);
-            sink.data(
-                j,
-                1.0 / self.readings.sigma_mm[j],
-                &dnu,
-                &theta,
-                self.readings.records[j].length_mm - (rho + nu.values[base + 3]),
-            );
-        })?;
+    fn point_rows(&self, rows: PointRows<'_>, sink: &mut Sink) {
+        let PointRows {
+            record: j,
+            point: x,
+            jac,
+            k,
+            nu,
+            dnu,
+            theta,
+        } = rows;
+        let base = 4 * self.setup_of[j];
+        let c = Vector3::new(nu.values[base], nu.values[base + 1], nu.values[base + 2]);
+        let d = x.position_mm - c;
+        let rho = d.norm();
+        let u = d / rho;
+        for m in 0..3 {
+            dnu[base + m] = -u[m];
+        }
+        dnu[base + 3] = 1.0;
+        project_rows(&u, jac, k, theta);
+        sink.data(
+            j,
+            1.0 / self.readings.sigma_mm[j],
+            dnu,
+            theta,
+            self.readings.records[j].length_mm - (rho + nu.values[base + 3]),
+        );
+    }
+
+    fn priors(&self, nu: &Nuisance, sink: &mut Sink) {
         if let Some(sigma) = self.length_sigma_mm {
             for s in 0..self.setups.len() {
                 sink.prior(4 * s + 3, sigma, -nu.values[4 * s + 3]);
             }
         }
-        Ok(())
     }
 
     fn nuisance_hint(&self) -> &'static str {

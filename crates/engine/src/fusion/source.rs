@@ -20,18 +20,23 @@
 //! What every external instrument's source shares is written here once:
 //! its records with their standard deviations and file ([`Readings`]:
 //! built from the data layer's [`InstrumentRecord`]s, grouped by setup,
-//! each record's pose, line and effector, the lines of a group for a
-//! message), and the [`SourceRows`] methods that only read them (file,
-//! record count, pose, line, row count, the copy). Adding an instrument is
-//! one file in this folder: a struct holding a `Readings` and what is new
-//! (options, nuisance layout, `initial`, `evaluate`, `retract`), its
-//! `Source::` constructor, and a [`SourceKind`]; its record and reader are
+//! the lines of a group for a message), the [`SourceRows`] methods that
+//! only read them (file, record count, pose, line, row count, the copy),
+//! and the loops over the records' spindle points: `initial` (every
+//! point at the start, handed to `fit_start`) and `evaluate` (every point
+//! with its Jacobian, handed to `point_rows`, then `priors`). Adding an
+//! instrument is one file in this folder: a struct holding a `Readings`
+//! and what is new (options, the nuisance's layout in `start`, its
+//! closed-form `fit_start`, the rows of one point, the priors, `retract`
+//! when not additive), its `Source::` constructor, and a [`SourceKind`];
+//! its record and reader are
 //! one file in `tricept-data`'s `external/`, its simulated reading one in
 //! `tricept-plant`'s `instruments/`.
 
 use nalgebra::{Matrix3, Vector3};
 use tricept_data::{ExternalData, ExternalPose, InstrumentRecord};
 use tricept_kinematics::UpJoints;
+use tricept_model::Effector;
 use tricept_numerics::linalg::TriangularAccumulator;
 use tricept_numerics::lsq::ReducedProblem;
 
@@ -263,18 +268,6 @@ impl<R: InstrumentRecord> Readings<R> {
         groups(&self.file, keyed, min, message)
     }
 
-    /// Every record's pose, line and the effector `effector` gives it, for
-    /// [`for_each_point`].
-    pub fn points<'a>(
-        &'a self,
-        effector: impl Fn(&R) -> tricept_model::Effector + 'a,
-    ) -> impl Iterator<Item = (ExternalPose, u64, tricept_model::Effector)> + 'a {
-        self.records.iter().map(move |r| {
-            let common = r.reading();
-            (common.pose, common.line, effector(r))
-        })
-    }
-
     /// The refusal of a group of records (those `in_group`) whose geometry
     /// cannot be fitted: `message` given the group's lines (`lines 3, 7`).
     pub fn degenerate(
@@ -399,16 +392,52 @@ pub(crate) trait SourceRows: BoxedClone + Send + Sync + std::fmt::Debug {
     fn linear_nuisance(&self) -> bool {
         false
     }
+    /// The effector whose point the instrument measures at a record under
+    /// the nuisance `nu` (default: the tool tip).
+    fn effector(&self, _record: usize, _nu: &Nuisance) -> Effector {
+        Effector::default()
+    }
+    /// The nuisance before its closed-form start: sizes, and the values
+    /// stated (a known target offset, a stylus radius).
+    fn start(&self) -> Nuisance {
+        Nuisance::default()
+    }
+    /// The starting nuisance fitted to the spindle points of [`Start`]
+    /// (default: [`SourceRows::start`] as it is).
+    fn fit_start(&self, start: Start<'_>) -> Result<Nuisance, IdentError> {
+        Ok(start.nu)
+    }
     /// Starting values of the nuisance, by closed-form fits of the records
     /// marked `active` to the model's predictions at the starting point.
+    /// Default: every record's spindle point under [`SourceRows::start`],
+    /// handed to [`SourceRows::fit_start`].
     fn initial(
         &self,
         at: &FusedAt<'_>,
         contexts: &[LegContext],
         seeds: &mut [Option<UpJoints>],
         active: &[bool],
-    ) -> Result<Nuisance, IdentError>;
-    /// The rows at the model `at` and nuisance `nu`.
+    ) -> Result<Nuisance, IdentError> {
+        let nu = self.start();
+        let mut points = Vec::with_capacity(self.records());
+        for_each_point(at, contexts, seeds, self.points(&nu), |_, x, _| {
+            points.push(*x)
+        })?;
+        self.fit_start(Start {
+            nu,
+            points,
+            tool_direction: at.tool_direction(),
+            active,
+        })
+    }
+    /// The data rows of one record's spindle point ([`PointRows`]).
+    /// Default: none (a source that writes its own [`SourceRows::evaluate`]).
+    fn point_rows(&self, _rows: PointRows<'_>, _sink: &mut Sink) {}
+    /// The prior rows at the nuisance `nu` (default: none).
+    fn priors(&self, _nu: &Nuisance, _sink: &mut Sink) {}
+    /// The rows at the model `at` and nuisance `nu`. Default: every
+    /// record's spindle point and Jacobian handed to
+    /// [`SourceRows::point_rows`], then [`SourceRows::priors`].
     fn evaluate(
         &self,
         at: &FusedAt<'_>,
@@ -416,7 +445,41 @@ pub(crate) trait SourceRows: BoxedClone + Send + Sync + std::fmt::Debug {
         nu: &Nuisance,
         seeds: &mut [Option<UpJoints>],
         sink: &mut Sink,
-    ) -> Result<(), IdentError>;
+    ) -> Result<(), IdentError> {
+        let k = at.len();
+        let mut theta = vec![0.0; k];
+        let mut dnu = vec![0.0; nu.values.len()];
+        for_each_point(
+            at,
+            contexts,
+            seeds,
+            self.points(nu),
+            |record, point, jac| {
+                dnu.iter_mut().for_each(|v| *v = 0.0);
+                let rows = PointRows {
+                    record,
+                    point,
+                    jac,
+                    k,
+                    nu,
+                    dnu: &mut dnu,
+                    theta: &mut theta,
+                };
+                self.point_rows(rows, sink);
+            },
+        )?;
+        self.priors(nu, sink);
+        Ok(())
+    }
+    /// Every record's pose, line and effector under `nu`.
+    fn points<'a>(
+        &'a self,
+        nu: &'a Nuisance,
+    ) -> Box<dyn Iterator<Item = (ExternalPose, u64, Effector)> + 'a> {
+        Box::new(
+            (0..self.records()).map(move |j| (self.pose(j), self.line(j), self.effector(j, nu))),
+        )
+    }
     /// Takes the values of a linear nuisance off the residuals of the data
     /// rows (which are computed without it). Default: nothing to take off.
     fn take_off_linear_nuisance(&self, _rows: &mut [(usize, f64, f64)], _nuisance: &[f64]) {}
@@ -435,6 +498,38 @@ pub(crate) trait SourceRows: BoxedClone + Send + Sync + std::fmt::Debug {
     }
     /// What the nuisance looks like when it cannot be determined.
     fn nuisance_hint(&self) -> &'static str;
+}
+
+/// The spindle points a source's nuisance starts from
+/// ([`SourceRows::fit_start`]).
+pub(crate) struct Start<'a> {
+    /// The nuisance before the fit ([`SourceRows::start`]).
+    pub nu: Nuisance,
+    /// Every record's spindle point at the starting model.
+    pub points: Vec<SpindlePoint>,
+    /// The tool direction at zero head angles.
+    pub tool_direction: Vector3<f64>,
+    /// Which records the fit uses.
+    pub active: &'a [bool],
+}
+
+/// One record's spindle point at the model and the buffers of its rows
+/// ([`SourceRows::point_rows`]).
+pub(crate) struct PointRows<'a> {
+    /// The record.
+    pub record: usize,
+    /// Its spindle point.
+    pub point: &'a SpindlePoint,
+    /// The point's Jacobian, row-major `3 x k`.
+    pub jac: &'a [f64],
+    /// The number of global parameters.
+    pub k: usize,
+    /// The nuisance.
+    pub nu: &'a Nuisance,
+    /// A row's derivatives with respect to the nuisance (zeroed).
+    pub dnu: &'a mut [f64],
+    /// A row's derivatives with respect to the global parameters.
+    pub theta: &'a mut [f64],
 }
 
 /// What is known about the tracker target's offset from the tool tip (a

@@ -20,14 +20,11 @@
 //! what makes a rigid translation of the machine irrelevant to the part.
 
 use nalgebra::Vector3;
-use tricept_data::{ExternalPose, Feature, Features, TouchData, TouchReading};
-use tricept_kinematics::UpJoints;
-use tricept_model::Effector;
+use tricept_data::{Feature, Features, TouchData, TouchReading};
 
 use crate::error::IdentError;
-use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Readings, RecordList, Sink, Source, SourceKind, SourceRows, for_each_point,
+    Nuisance, PointRows, Readings, RecordList, Sink, Source, SourceKind, SourceRows, Start,
     project_rows, sphere_centre,
 };
 
@@ -150,13 +147,6 @@ fn plane_basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     (a, n.cross(&a))
 }
 
-impl Touch {
-    /// Every touch's pose, line and effector (the stylus centre: the tip).
-    fn records(&self) -> impl Iterator<Item = (ExternalPose, u64, Effector)> + '_ {
-        self.touches.points(|_| Effector::default())
-    }
-}
-
 impl SourceRows for Touch {
     fn kind(&self) -> SourceKind {
         SourceKind::Touch
@@ -199,27 +189,26 @@ impl SourceRows for Touch {
         )]
     }
 
-    fn initial(
-        &self,
-        at: &FusedAt<'_>,
-        contexts: &[LegContext],
-        seeds: &mut [Option<UpJoints>],
-        active: &[bool],
-    ) -> Result<Nuisance, IdentError> {
-        let n_touches = self.touches.records.len();
-        let mut tips = Vec::with_capacity(n_touches);
-        let mut axes = Vec::with_capacity(n_touches);
-        let direction = at.tool_direction();
-        for_each_point(at, contexts, seeds, self.records(), |_, x, _| {
-            tips.push(x.position_mm);
-            axes.push(x.rotation * direction);
-        })?;
+    fn start(&self) -> Nuisance {
         let mut nu = Nuisance {
             values: vec![0.0; 1 + 3 * self.used.len()],
             rotations: Vec::new(),
             normals: vec![Vector3::zeros(); self.used.len()],
         };
         nu.values[0] = self.stylus_mm;
+        nu
+    }
+
+    // The stylus centre is the tool tip: the default effector.
+    fn fit_start(&self, start: Start<'_>) -> Result<Nuisance, IdentError> {
+        let (mut nu, active, direction) = (start.nu, start.active, start.tool_direction);
+        let n_touches = self.touches.records.len();
+        let tips: Vec<Vector3<f64>> = start.points.iter().map(|x| x.position_mm).collect();
+        let axes: Vec<Vector3<f64>> = start
+            .points
+            .iter()
+            .map(|x| x.rotation * direction)
+            .collect();
         for (k, u) in self.used.iter().enumerate() {
             let on_feature = |j: usize| self.feature_of[j] == k && active[j];
             let x: Vec<Vector3<f64>> = (0..n_touches)
@@ -272,50 +261,48 @@ impl SourceRows for Touch {
         Ok(nu)
     }
 
-    fn evaluate(
-        &self,
-        at: &FusedAt<'_>,
-        contexts: &[LegContext],
-        nu: &Nuisance,
-        seeds: &mut [Option<UpJoints>],
-        sink: &mut Sink,
-    ) -> Result<(), IdentError> {
-        let k = at.len();
-        let mut theta = vec![0.0; k];
-        let mut dnu = vec![0.0; nu.values.len()];
-        for_each_point(at, contexts, seeds, self.records(), |j, x, jac| {
-            let x = x.position_mm;
-            let f = self.feature_of[j];
-            let u = &self.used[f];
-            let col = u.column;
-            dnu.iter_mut().for_each(|v| *v = 0.0);
-            let residual = match u.feature {
-                Feature::Sphere { radius_mm, .. } => {
-                    let c = Vector3::new(nu.values[col], nu.values[col + 1], nu.values[col + 2]);
-                    let d = x - c;
-                    let rho = d.norm();
-                    let dir = d / rho;
-                    for m in 0..3 {
-                        dnu[col + m] = -dir[m];
-                    }
-                    dnu[0] = -1.0;
-                    project_rows(&dir, jac, k, &mut theta);
-                    radius_mm - (rho - nu.values[0])
+    fn point_rows(&self, rows: PointRows<'_>, sink: &mut Sink) {
+        let PointRows {
+            record: j,
+            point: x,
+            jac,
+            k,
+            nu,
+            dnu,
+            theta,
+        } = rows;
+        let x = x.position_mm;
+        let f = self.feature_of[j];
+        let u = &self.used[f];
+        let col = u.column;
+        let residual = match u.feature {
+            Feature::Sphere { radius_mm, .. } => {
+                let c = Vector3::new(nu.values[col], nu.values[col + 1], nu.values[col + 2]);
+                let d = x - c;
+                let rho = d.norm();
+                let dir = d / rho;
+                for m in 0..3 {
+                    dnu[col + m] = -dir[m];
                 }
-                Feature::Plane { .. } => {
-                    let n = nu.normals[f];
-                    let (a, b) = plane_basis(&n);
-                    dnu[col] = a.dot(&x);
-                    dnu[col + 1] = b.dot(&x);
-                    dnu[col + 2] = -1.0;
-                    project_rows(&n, jac, k, &mut theta);
-                    -(n.dot(&x) - nu.values[col + 2])
-                }
-            };
-            sink.data(j, 1.0 / self.touches.sigma_mm[j], &dnu, &theta, residual);
-        })?;
+                dnu[0] = -1.0;
+                project_rows(&dir, jac, k, theta);
+                radius_mm - (rho - nu.values[0])
+            }
+            Feature::Plane { .. } => {
+                let n = nu.normals[f];
+                let (a, b) = plane_basis(&n);
+                dnu[col] = a.dot(&x);
+                dnu[col + 1] = b.dot(&x);
+                dnu[col + 2] = -1.0;
+                project_rows(&n, jac, k, theta);
+                -(n.dot(&x) - nu.values[col + 2])
+            }
+        };
+        sink.data(j, 1.0 / self.touches.sigma_mm[j], dnu, theta, residual);
+    }
+
+    fn priors(&self, nu: &Nuisance, sink: &mut Sink) {
         sink.prior(0, self.stylus_sigma_mm, self.stylus_mm - nu.values[0]);
-        Ok(())
     }
 
     fn retract(&self, nu: &mut Nuisance, step: &[f64]) {

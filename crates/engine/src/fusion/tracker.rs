@@ -15,15 +15,13 @@
 //! rank rule and named.
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
-use tricept_data::{ExternalPose, TrackerData, TrackerPoint};
-use tricept_kinematics::UpJoints;
+use tricept_data::{TrackerData, TrackerPoint};
 use tricept_model::Effector;
 
 use crate::error::IdentError;
-use crate::fusion::model::{FusedAt, LegContext};
 use crate::fusion::source::{
-    Nuisance, Readings, RecordList, Sink, Source, SourceKind, SourceRows, TrackerTarget,
-    cross_matrix, for_each_point, rotate_row,
+    Nuisance, PointRows, Readings, RecordList, Sink, Source, SourceKind, SourceRows, Start,
+    TrackerTarget, cross_matrix, rotate_row,
 };
 
 /// How to read a tracker file.
@@ -76,23 +74,6 @@ impl Source {
             setups,
             setup_of,
         })))
-    }
-}
-
-impl Tracker {
-    fn offset(nu: &Nuisance) -> Vector3<f64> {
-        Vector3::new(nu.values[0], nu.values[1], nu.values[2])
-    }
-
-    /// Every point's pose, line and effector under the nuisance `nu`.
-    fn records<'a>(
-        &'a self,
-        nu: &'a Nuisance,
-    ) -> impl Iterator<Item = (ExternalPose, u64, Effector)> + 'a {
-        self.points.points(|p| Effector {
-            extension_mm: p.extension_mm,
-            offset_mm: Tracker::offset(nu),
-        })
     }
 }
 
@@ -193,13 +174,14 @@ impl SourceRows for Tracker {
         }))
     }
 
-    fn initial(
-        &self,
-        at: &FusedAt<'_>,
-        contexts: &[LegContext],
-        seeds: &mut [Option<UpJoints>],
-        active: &[bool],
-    ) -> Result<Nuisance, IdentError> {
+    fn effector(&self, record: usize, nu: &Nuisance) -> Effector {
+        Effector {
+            extension_mm: self.points.records[record].extension_mm,
+            offset_mm: Vector3::new(nu.values[0], nu.values[1], nu.values[2]),
+        }
+    }
+
+    fn start(&self) -> Nuisance {
         let mut nu = Nuisance {
             values: vec![0.0; 3 + 6 * self.setups.len()],
             rotations: vec![Matrix3::identity(); self.setups.len()],
@@ -208,11 +190,13 @@ impl SourceRows for Tracker {
         if let TrackerTarget::Known { offset_mm, .. } = self.target {
             nu.values[..3].copy_from_slice(&offset_mm);
         }
+        nu
+    }
+
+    fn fit_start(&self, start: Start<'_>) -> Result<Nuisance, IdentError> {
+        let (mut nu, active) = (start.nu, start.active);
         let points = &self.points.records;
-        let mut predicted = Vec::with_capacity(points.len());
-        for_each_point(at, contexts, seeds, self.records(&nu), |_, x, _| {
-            predicted.push(x.position_mm)
-        })?;
+        let predicted: Vec<Vector3<f64>> = start.points.iter().map(|x| x.position_mm).collect();
         for (s, id) in self.setups.iter().enumerate() {
             let in_station = |j: usize| self.setup_of[j] == s && active[j];
             let (x, y): (Vec<Vector3<f64>>, Vec<Vector3<f64>>) = (0..points.len())
@@ -230,48 +214,47 @@ impl SourceRows for Tracker {
         Ok(nu)
     }
 
-    fn evaluate(
-        &self,
-        at: &FusedAt<'_>,
-        contexts: &[LegContext],
-        nu: &Nuisance,
-        seeds: &mut [Option<UpJoints>],
-        sink: &mut Sink,
-    ) -> Result<(), IdentError> {
-        let k = at.len();
-        let nn = nu.values.len();
-        let mut theta = vec![0.0; k];
-        let mut dnu = vec![0.0; nn];
-        for_each_point(at, contexts, seeds, self.records(nu), |j, x, jac| {
-            let p = &self.points.records[j];
-            let s = self.setup_of[j];
-            let r = nu.rotations[s];
-            let base = 3 + 6 * s;
-            let t = Vector3::new(
-                nu.values[base + 3],
-                nu.values[base + 4],
-                nu.values[base + 5],
-            );
-            let predicted = r * x.position_mm + t;
-            let d_offset = r * x.rotation;
-            let d_rotation = -cross_matrix(&predicted);
-            for c in 0..3 {
-                dnu.iter_mut().for_each(|v| *v = 0.0);
-                for m in 0..3 {
-                    dnu[m] = d_offset[(c, m)];
-                    dnu[base + m] = d_rotation[(c, m)];
-                }
-                dnu[base + 3 + c] = 1.0;
-                rotate_row(&r, jac, k, c, &mut theta);
-                sink.data(
-                    j,
-                    1.0 / self.points.sigma_mm[j],
-                    &dnu,
-                    &theta,
-                    p.position_mm[c] - predicted[c],
-                );
+    fn point_rows(&self, rows: PointRows<'_>, sink: &mut Sink) {
+        let PointRows {
+            record: j,
+            point: x,
+            jac,
+            k,
+            nu,
+            dnu,
+            theta,
+        } = rows;
+        let p = &self.points.records[j];
+        let s = self.setup_of[j];
+        let r = nu.rotations[s];
+        let base = 3 + 6 * s;
+        let t = Vector3::new(
+            nu.values[base + 3],
+            nu.values[base + 4],
+            nu.values[base + 5],
+        );
+        let predicted = r * x.position_mm + t;
+        let d_offset = r * x.rotation;
+        let d_rotation = -cross_matrix(&predicted);
+        for c in 0..3 {
+            dnu.iter_mut().for_each(|v| *v = 0.0);
+            for m in 0..3 {
+                dnu[m] = d_offset[(c, m)];
+                dnu[base + m] = d_rotation[(c, m)];
             }
-        })?;
+            dnu[base + 3 + c] = 1.0;
+            rotate_row(&r, jac, k, c, theta);
+            sink.data(
+                j,
+                1.0 / self.points.sigma_mm[j],
+                dnu,
+                theta,
+                p.position_mm[c] - predicted[c],
+            );
+        }
+    }
+
+    fn priors(&self, nu: &Nuisance, sink: &mut Sink) {
         if let TrackerTarget::Known {
             offset_mm,
             sigma_um,
@@ -281,7 +264,6 @@ impl SourceRows for Tracker {
                 sink.prior(c, 1e-3 * sigma_um, offset_mm[c] - nu.values[c]);
             }
         }
-        Ok(())
     }
 
     fn retract(&self, nu: &mut Nuisance, step: &[f64]) {
