@@ -159,15 +159,8 @@ impl SourceRows for Ballbar {
     }
 
     fn point_rows(&self, rows: PointRows<'_>, sink: &mut Sink) {
-        let PointRows {
-            record: j,
-            point: x,
-            jac,
-            k,
-            nu,
-            dnu,
-            theta,
-        } = rows;
+        let (j, x, k, nu) = (rows.record, rows.point, rows.k, rows.nu);
+        let (jac, dnu, theta) = (rows.jac, rows.dnu, rows.theta);
         let base = 4 * self.setup_of[j];
         let c = Vector3::new(nu.values[base], nu.values[base + 1], nu.values[base + 2]);
         let d = x.position_mm - c;

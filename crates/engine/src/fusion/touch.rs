@@ -262,15 +262,8 @@ impl SourceRows for Touch {
     }
 
     fn point_rows(&self, rows: PointRows<'_>, sink: &mut Sink) {
-        let PointRows {
-            record: j,
-            point: x,
-            jac,
-            k,
-            nu,
-            dnu,
-            theta,
-        } = rows;
+        let (j, x, k, nu) = (rows.record, rows.point, rows.k, rows.nu);
+        let (jac, dnu, theta) = (rows.jac, rows.dnu, rows.theta);
         let x = x.position_mm;
         let f = self.feature_of[j];
         let u = &self.used[f];

@@ -215,15 +215,8 @@ impl SourceRows for Tracker {
     }
 
     fn point_rows(&self, rows: PointRows<'_>, sink: &mut Sink) {
-        let PointRows {
-            record: j,
-            point: x,
-            jac,
-            k,
-            nu,
-            dnu,
-            theta,
-        } = rows;
+        let (j, x, k, nu) = (rows.record, rows.point, rows.k, rows.nu);
+        let (jac, dnu, theta) = (rows.jac, rows.dnu, rows.theta);
         let p = &self.points.records[j];
         let s = self.setup_of[j];
         let r = nu.rotations[s];
