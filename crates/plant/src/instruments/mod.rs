@@ -9,9 +9,9 @@
 //! `touch.rs`), as in `tricept-data`'s `external/` and `tricept-engine`'s
 //! `fusion/`.
 //!
-//! What every instrument repeats is written here once: [`measure_each`]
+//! What every instrument repeats is written here once: `measure_each`
 //! (the actual machine, the seeded generator of the instrument's tag, one
-//! record per item, the records' data set) and [`spindle_point`] (the
+//! record per item, the records' data set) and `spindle_point` (the
 //! actual spindle point at a pose, an error naming the item). Adding an
 //! instrument is one file here: its settings and a `measure` that calls
 //! `measure_each` with what is new (where the spindle goes, what the
