@@ -38,16 +38,20 @@ impl ExternalRow for TrackerPoint {
             row.measured_mm(1)?,
             row.measured_mm(2)?,
         ];
+        // A row's first bad column is named: `sigma_um` comes before
+        // `extension_mm`, which comes before `setup` and `temp_c`.
+        row.sigma_um()?;
+        let extension_mm = row
+            .optional("extension_mm", |v| {
+                (v.abs() > MAX_EXTENSION_MM).then_some("an extension beyond ±1000 mm (mm?)")
+            })?
+            .unwrap_or(0.0);
         let common = row.reading(pose)?;
         Ok(TrackerPoint {
             pose,
             position_mm,
             sigma_um: common.sigma_um,
-            extension_mm: row
-                .optional("extension_mm", |v| {
-                    (v.abs() > MAX_EXTENSION_MM).then_some("an extension beyond ±1000 mm (mm?)")
-                })?
-                .unwrap_or(0.0),
+            extension_mm,
             setup: common.setup.unwrap_or(1),
             temp_c: common.temp_c,
             line: common.line,
