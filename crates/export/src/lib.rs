@@ -47,7 +47,9 @@ mod types;
 
 pub use control::{ControlLimits, ControlModel, Controller, Limit};
 pub use folder::{SUMMARY_FILE, check_out};
-pub use types::{AxisSummary, ExportError, ExportOptions, ExportSummary, NotExported};
+pub use types::{
+    AxisSummary, ExportError, ExportOptions, ExportSummary, NotExported, SUMMARY_FORMAT_VERSION,
+};
 
 use setup::{ControlFiles, Setup};
 
@@ -135,6 +137,7 @@ pub fn plan(
     let mut file_names: Vec<String> = files.iter().map(|(n, _)| n.clone()).collect();
     file_names.push(SUMMARY_FILE.to_string());
     let summary = ExportSummary {
+        format_version: types::SUMMARY_FORMAT_VERSION,
         controller: options.control.family(),
         control: options.control,
         control_limits: options.control.limits(),
