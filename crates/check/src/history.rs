@@ -181,14 +181,61 @@ pub fn read(path: &std::path::Path) -> Result<Vec<Entry>, CheckError> {
         .collect()
 }
 
+/// Refuses a history of another calibration: every check of `entries`
+/// that names its calibration (`calibration_digest`; lines written before
+/// histories named it do not) must name `digest`. A history follows one
+/// calibration: after a recalibration, start a new one.
+///
+/// # Example
+/// ```
+/// use tricept_check::history::{Entry, belongs_to};
+/// let mut e: Entry = serde_json::from_str(r#"{"time": "2026-12-03T06:30:00Z", "unix_s": 0.0,
+///     "machine": "m.json", "data_file": "d.csv", "verdict": "unchanged", "most_likely": null,
+///     "shortlist": [], "consistency": [1.0, 3, 0.8], "quantities": []}"#).unwrap();
+/// let path = std::path::Path::new("h.jsonl");
+/// // A line without a digest belongs to any calibration.
+/// assert!(belongs_to(path, &[e.clone()], Some("abc")).is_ok());
+/// e.calibration_digest = Some("def".into());
+/// assert!(belongs_to(path, &[e], Some("abc")).is_err());
+/// ```
+pub fn belongs_to(
+    path: &std::path::Path,
+    entries: &[Entry],
+    digest: Option<&str>,
+) -> Result<(), CheckError> {
+    let Some(digest) = digest else {
+        return Ok(());
+    };
+    let other = entries.iter().enumerate().find_map(|(i, e)| {
+        e.calibration_digest
+            .as_deref()
+            .filter(|d| *d != digest)
+            .map(|d| (i, d))
+    });
+    match other {
+        None => Ok(()),
+        Some((i, d)) => Err(CheckError::HistoryLine(format!(
+            "{}: check {} of the history ({}) is of another calibration (digest {}, the machine file's {}): a history follows one calibration; start a new one after a recalibration",
+            path.display(),
+            i + 1,
+            entries[i].time,
+            d.get(..12).unwrap_or(d),
+            digest.get(..12).unwrap_or(digest)
+        ))),
+    }
+}
+
 /// Appends `entry` to the history file `path` (rewritten atomically,
 /// under an exclusive lock on the history file itself: concurrent appends
-/// all land, whatever name, link or relative path each gives it).
+/// all land, whatever name, link or relative path each gives it). A
+/// history of another calibration than the entry's is refused
+/// ([`belongs_to`]).
 pub fn append(path: &std::path::Path, entry: &Entry) -> Result<Vec<Entry>, CheckError> {
     let failed = |e: std::io::Error| CheckError::History(format!("{}: {e}", path.display()));
     // Held until the rename below has replaced the file.
     let _lock = lock(path).map_err(failed)?;
     let mut entries = read(path)?;
+    belongs_to(path, &entries, entry.calibration_digest.as_deref())?;
     entries.push(entry.clone());
     let mut text = String::new();
     for e in &entries {
@@ -390,6 +437,36 @@ mod tests {
         let e = read(&path).unwrap_err().to_string();
         assert!(e.contains("line 2: format_version 2"), "{e}");
         assert!(append(&path, &entry(1, 3)).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_history_of_another_calibration_is_refused_and_kept() {
+        let dir =
+            std::env::temp_dir().join(format!("tricept-history-other-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("h.jsonl");
+        let of = |digest: Option<&str>, i: usize| Entry {
+            calibration_digest: digest.map(String::from),
+            ..entry(0, i)
+        };
+        // A line written before histories named their calibration, then
+        // two checks of calibration A.
+        append(&path, &of(None, 0)).unwrap();
+        append(&path, &of(Some("aaaaaaaaaaaaaaaa"), 1)).unwrap();
+        append(&path, &of(Some("aaaaaaaaaaaaaaaa"), 2)).unwrap();
+        let before = std::fs::read(&path).unwrap();
+        // A check of calibration B: refused, naming the first check of A,
+        // the history as it was.
+        let e = append(&path, &of(Some("bbbbbbbbbbbbbbbb"), 3))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("check 2 of the history"), "{e}");
+        assert!(e.contains("another calibration"), "{e}");
+        assert_eq!(std::fs::read(&path).unwrap(), before);
+        // A check that names no calibration is taken.
+        assert_eq!(append(&path, &of(None, 4)).unwrap().len(), 4);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -99,7 +99,12 @@ pub fn check(request: CheckRequest) -> Result<CheckResult, Error> {
         // A history that cannot be read or replaced is refused before the
         // check runs.
         crate::error::check_output_path("--history", h)?;
-        tricept_check::history::read(h)?;
+        let entries = tricept_check::history::read(h)?;
+        tricept_check::history::belongs_to(
+            h,
+            &entries,
+            loaded.description().calibration_digest().as_deref(),
+        )?;
     }
     let mut options = CheckOptions::for_machine(loaded.machine());
     options.alpha = alpha;

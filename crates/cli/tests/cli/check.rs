@@ -1,7 +1,8 @@
 //! `tricept check` end to end: a machine calibrated from simulated data,
 //! checked unchanged (exit 0), with a slipped leg hidden in the truth
 //! (exit 3, named), against a file without a record or with a campaign that
-//! sees nothing (exit 2), and its history and trend plots.
+//! sees nothing (exit 2), and its history (one calibration's: a
+//! recalibration's check is refused) and trend plots.
 
 use crate::support::{calibrated_machine, fresh_workdir, moved_truth, run_in as tricept, stderr};
 
@@ -44,6 +45,47 @@ fn a_calibrated_machine_is_checked_from_its_own_sensors() {
             .starts_with("verdict: UNCHANGED"),
         "{text}"
     );
+    // A recalibration from another campaign is another calibration: its
+    // checks do not go into this history (refused before the check, the
+    // history as it was).
+    ok(&[
+        "simulate",
+        "--truth",
+        "random:0.25,5",
+        "--poses",
+        "random:80,4",
+        "--out",
+        "recal.csv",
+    ]);
+    ok(&[
+        "identify",
+        "--data",
+        "recal.csv",
+        "--write-machine",
+        "recal.json",
+    ]);
+    let before = std::fs::read(dir.join("h.jsonl")).unwrap();
+    let out = tricept(
+        d,
+        &[
+            "check",
+            "--machine",
+            "recal.json",
+            "--data",
+            "day1.csv",
+            "--history",
+            "h.jsonl",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("h.jsonl: check 1 of the history")
+            && stderr(&out).contains("is of another calibration"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(out.stdout.is_empty());
+    assert_eq!(std::fs::read(dir.join("h.jsonl")).unwrap(), before);
     // Leg 2 slipped by 25 um: the truth of the calibration plus the slip.
     moved_truth(d, &[("dq2", 0.025)], "slipped.json");
     ok(&[

@@ -71,7 +71,14 @@ fn inputs_of_another_calibration_are_refused_naming_the_file() {
         1.0,
     );
     check_into(&table2, &day2, &mixed);
-    check_into(&pitch, &day, &mixed);
+    // `check` itself refuses to append a check of another calibration, so
+    // the mixed file is made as a careless concatenation would make it.
+    let joined = [
+        std::fs::read_to_string(&mixed).unwrap(),
+        std::fs::read_to_string(&history).unwrap(),
+    ]
+    .concat();
+    std::fs::write(&mixed, joined).unwrap();
     refused(
         page(&table2, None, Some(&mixed), None, &out).unwrap_err(),
         &["mixed.jsonl", "check 2"],
