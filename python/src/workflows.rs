@@ -62,7 +62,7 @@ fn data_input(
     match (path, csv_text) {
         (Some(path), None) => Ok(DataInput::File(path)),
         (None, Some(text)) => Ok(DataInput::Memory(
-            tricept_ident::advanced::read_data_from(text.as_bytes(), name, machine.machine())
+            tricept_ident::advanced::read_data_from(text.as_bytes(), name, machine.geometry())
                 .map_err(|e| door_error_in(py, e, Some(name)))?,
         )),
         _ => Err(input_error(

@@ -140,7 +140,7 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
 fn read_with_progress(path: &Path, loaded: &LoadedMachine) -> Result<DataInput, CliError> {
     Ok(DataInput::Read {
         file: path.to_path_buf(),
-        data: read_data(path, loaded.machine())?,
+        data: read_data(path, loaded.geometry())?,
     })
 }
 

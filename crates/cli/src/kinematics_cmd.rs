@@ -116,7 +116,7 @@ fn kinematics(
                 verb.name()
             )));
         }
-        return run_batch(verb, &ExtendedMachine::new(loaded.machine().clone()), path);
+        return run_batch(verb, loaded.commanding().extended(), path);
     }
     let values: Vec<f64> = point.iter().map(|v| v.unwrap_or(f64::NAN)).collect();
     let solution = solve_point(verb, &loaded, &values)?;

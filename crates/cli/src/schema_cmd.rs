@@ -128,7 +128,9 @@ pub fn run(a: &SchemaArgs) -> Result<u8, CliError> {
         }
         return Ok(0);
     };
-    let name = name.trim_start_matches("docs/schema/").trim_end_matches(".json");
+    let name = name
+        .trim_start_matches("docs/schema/")
+        .trim_end_matches(".json");
     match SCHEMAS.iter().find(|(n, _, _)| *n == name) {
         Some((_, _, text)) => {
             crate::output::write_text(text);

@@ -292,7 +292,7 @@ impl DiagnoseResult {
         )?;
         let mut description = machine_file::calibrated_description(
             &self.machine,
-            &deployed.machine,
+            &deployed.geometry,
             &machine_file::FitRecord::of_identification(&deployed.id),
             machine_file::Provenance {
                 method: "diagnose",

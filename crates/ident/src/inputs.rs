@@ -33,7 +33,7 @@ use crate::limits;
 /// use tricept_ident::advanced::{SensorNoise, load_machine};
 /// let noise = SensorNoise { angle_noise_arcsec: Some(2.0), ..SensorNoise::default() };
 /// let loaded = load_machine(None, &noise).unwrap();
-/// assert!((loaded.machine().sensors.angle_rad - 2.0 / 206_264.806).abs() < 1e-9);
+/// assert!((loaded.geometry().sensors.angle_rad - 2.0 / 206_264.806).abs() < 1e-9);
 /// ```
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SensorNoise {
@@ -64,8 +64,16 @@ impl LoadedMachine {
         &self.description
     }
 
-    /// The validated machine, noise overrides applied.
-    pub fn machine(&self) -> &Machine {
+    /// The validated machine, noise overrides applied (crate-internal:
+    /// the fits and readers take the geometric machine).
+    pub(crate) fn machine(&self) -> &Machine {
+        &self.machine
+    }
+
+    /// The geometric machine, noise overrides applied: what a data reader
+    /// and a fit take. Its own kinematics ignore the leg effects of the
+    /// file; command the machine through [`LoadedMachine::commanding`].
+    pub fn geometry(&self) -> &Machine {
         &self.machine
     }
 
@@ -390,9 +398,9 @@ pub fn check_commands(
 /// # Example
 /// ```
 /// use tricept_ident::advanced::Poses;
-/// use tricept_ident::kinematics::Machine;
+/// use tricept_ident::kinematics::GeometricMachine;
 /// let poses: Poses = "random:10,1".parse().unwrap();
-/// assert_eq!(poses.targets(&Machine::paper()).unwrap().len(), 10);
+/// assert_eq!(poses.targets(&GeometricMachine::paper()).unwrap().len(), 10);
 /// assert!("optimal:0".parse::<Poses>().is_err());
 /// ```
 #[derive(Debug, Clone, PartialEq)]

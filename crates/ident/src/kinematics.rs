@@ -25,8 +25,11 @@ use tricept_data::NumericRows;
 use crate::error::{EXIT_OK, Error};
 use crate::inputs::LoadedMachine;
 
-pub use nalgebra::Vector3;
-pub use tricept_kinematics::{HeadBranch, KinematicsError, Machine, MachineDescription};
+pub use crate::commanding::{GeometricMachine, Machine, Vector3};
+pub use tricept_kinematics::{
+    FkSolution, HeadBranch, IkSolution, KinematicsError, MachineDescription, ToolIkSolution,
+    UpJoints,
+};
 pub use tricept_model::ExtendedMachine;
 
 /// Rows solved per block.
@@ -244,8 +247,9 @@ fn write_cell(out: &mut Vec<u8>, c: Cell) {
 ///
 /// # Example
 /// ```
-/// use tricept_ident::kinematics::{ExtendedMachine, Machine, Verb, run};
-/// let m = ExtendedMachine::new(Machine::paper());
+/// use tricept_ident::kinematics::{Machine, Verb, run};
+/// let m = Machine::paper();
+/// let m = m.extended();
 /// let mut out = Vec::new();
 /// let n = run(Verb::Ik, &m, "x,y,z\n0,0,750\n".as_bytes(), "points.csv", &mut out, || false).unwrap();
 /// assert_eq!(n, 1);
@@ -478,7 +482,7 @@ impl PointSolution {
 /// effects, the controller parameters and the calibration record.
 pub fn machine_summary(loaded: &LoadedMachine) -> String {
     let (d, m, source) = (loaded.description(), loaded.machine(), loaded.source());
-    let v = |p: &Vector3<f64>| format!("({:.3}, {:.3}, {:.3})", p.x, p.y, p.z);
+    let v = |p: &Vector3| format!("({:.3}, {:.3}, {:.3})", p.x, p.y, p.z);
     let mut lines = vec![format!("{} (from {source})", d.name)];
     if let Some(n) = &d.notes {
         lines.push(format!("  notes: {n}"));

@@ -42,6 +42,7 @@
 
 // Layer 0: errors, limits and inputs.
 mod accuracy;
+mod commanding;
 mod data_input;
 mod error;
 mod inputs;

@@ -25,7 +25,7 @@ use crate::inputs::{LoadedMachine, SensorNoise, load_machine};
 /// assert!(input.path().is_none());
 /// let loaded = input.load().unwrap();
 /// assert_eq!(loaded.source(), "the built-in Table 1 machine");
-/// assert!((loaded.machine().sensors.angle_rad - 2.0 / 206_264.806).abs() < 1e-9);
+/// assert!((loaded.geometry().sensors.angle_rad - 2.0 / 206_264.806).abs() < 1e-9);
 /// // A loaded machine is an input too, and keeps where it came from.
 /// assert!(MachineInput::from(loaded).path().is_none());
 /// ```

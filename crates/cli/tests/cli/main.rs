@@ -10,6 +10,7 @@ mod bad_inputs;
 mod check;
 mod closed_stdout;
 mod docs;
+mod door;
 mod edges;
 mod exit_codes;
 mod export;

@@ -83,11 +83,7 @@ pub fn newer_format(text: &str, what: &'static str, supported: u32) -> Option<Ne
 }
 
 /// [`NewerFormat`] when an already parsed `version` is above `supported`.
-pub fn check_version(
-    version: u32,
-    what: &'static str,
-    supported: u32,
-) -> Result<(), NewerFormat> {
+pub fn check_version(version: u32, what: &'static str, supported: u32) -> Result<(), NewerFormat> {
     if version <= supported {
         return Ok(());
     }
@@ -117,7 +113,10 @@ mod tests {
     fn only_a_declared_integer_above_the_supported_version_is_newer() {
         for (text, newer) in [
             (r#"{"format_version": 2}"#, Some(2)),
-            ("\u{feff}{\"format_version\": 9, \"x\": [1, {\"y\": 2}]}", Some(9)),
+            (
+                "\u{feff}{\"format_version\": 9, \"x\": [1, {\"y\": 2}]}",
+                Some(9),
+            ),
             (r#"{"format_version": 1}"#, None),
             (r#"{"format_version": 0}"#, None),
             (r#"{"format_version": "2"}"#, None),
@@ -134,13 +133,19 @@ mod tests {
         }
         assert!(check_version(1, "machine file", 1).is_ok());
         let e = check_version(2, "prior file", 1).unwrap_err();
-        assert!(e.to_string().contains("prior files up to format version 1"), "{e}");
+        assert!(
+            e.to_string().contains("prior files up to format version 1"),
+            "{e}"
+        );
     }
 
     #[test]
     fn the_unversioned_leaf_is_version_1_at_any_depth_and_nothing_else() {
         assert!(is_unversioned_leaf("format_version", "1.0"));
-        assert!(is_unversioned_leaf("calibration.nominal.format_version", "1.0"));
+        assert!(is_unversioned_leaf(
+            "calibration.nominal.format_version",
+            "1.0"
+        ));
         assert!(!is_unversioned_leaf("format_version", "2.0"));
         assert!(!is_unversioned_leaf("calibration.format_versions", "1.0"));
         assert!(!is_unversioned_leaf("leg_offsets_mm", "1.0"));
