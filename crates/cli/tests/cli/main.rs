@@ -9,6 +9,7 @@
 mod bad_inputs;
 mod check;
 mod closed_stdout;
+mod compat;
 mod docs;
 mod door;
 mod edges;
@@ -21,6 +22,7 @@ mod one_exit_code;
 mod outputs;
 mod relied_on;
 mod report;
+mod schema;
 mod seal;
 mod support;
 mod trust;
