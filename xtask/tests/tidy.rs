@@ -909,6 +909,7 @@ const DOOR_ROOT: &[&str] = &[
     "EXIT_OK",
     "EXIT_OTHER",
     "Error",
+    "ErrorCause",
     "ErrorKind",
     // The two inputs every request is made of.
     "DataInput",

@@ -164,9 +164,13 @@ pub fn description_error(path: &str, e: &DescriptionError) -> Error {
         DescriptionError::Io { .. } => e.to_string(),
         _ => format!("{path}: {e}"),
     };
-    match e.file_failure() {
+    let error = match e.file_failure() {
         Some(f) => Error::input(message).with_file_failure(f),
         None => Error::input(message),
+    };
+    match e.cause() {
+        Some(cause) => error.with_cause(cause),
+        None => error,
     }
 }
 
@@ -245,7 +249,7 @@ impl LoadedMachine {
             )));
         }
         let notes = tricept_engine::check_calibration_record(&description)
-            .map_err(|e| Error::input(format!("{source}: {e}")))?;
+            .map_err(|e| Error::with_context(&source, &e))?;
         let mut warnings = Vec::new();
         if let Some(w) = notes.warning() {
             warnings.push(format!("{source}: {w}"));

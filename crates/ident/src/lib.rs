@@ -75,7 +75,8 @@ pub mod advanced;
 
 // The error and the exit codes.
 pub use error::{
-    EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error, ErrorKind,
+    EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error, ErrorCause,
+    ErrorKind,
 };
 
 // The two inputs every workflow is fed: the machine and the measured data.

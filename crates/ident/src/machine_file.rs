@@ -140,7 +140,8 @@ pub fn write_rule(what: &str, code: u8, why: &str, force: bool) -> Result<Option
         (_, false) => Err(Error::new(
             crate::ErrorKind::of_exit_code(code),
             format!("{what}: not written: {why}; --force writes it anyway, marked as forced"),
-        )),
+        )
+        .with_cause(crate::ErrorCause::RefusedWrite)),
     }
 }
 

@@ -19,8 +19,10 @@ fn batch_kinematics_write_the_json_keys_as_csv_columns() {
     let csv = String::from_utf8(out.stdout).unwrap();
     let (_, header, rows) = parts(&csv);
     let single = json(&run(&["ik", "-120.5", "80", "700", "--json"]));
+    // The CSV's columns are the JSON's keys after its `format_version`.
     let keys: Vec<String> = single.as_object().unwrap().keys().cloned().collect();
-    assert_eq!(header, keys);
+    assert_eq!(keys[0], "format_version");
+    assert_eq!(header, keys[1..]);
     // (serde_json reads floats to within an ulp, hence the tolerance.)
     let same = |a: f64, b: f64| (a - b).abs() <= 1e-15 * a.abs().max(b.abs());
     for (k, v) in header.iter().zip(&rows[1]) {
