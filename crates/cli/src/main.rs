@@ -429,8 +429,22 @@ fn main() -> ExitCode {
             };
         }
     };
+    // A write the library refused (an untrusted result): the flag that
+    // named the file, and the one that writes it anyway.
+    let write_flag = match &cli.command {
+        Command::Identify(_) | Command::Diagnose(_) => "--write-machine ",
+        Command::Fleet(_) => "--write-prior ",
+        _ => "",
+    };
     let code = match run(cli) {
         Ok(code) => code,
+        Err(e) if e.cause() == tricept_ident::ErrorCause::RefusedWrite => {
+            errln!(
+                "error: {write_flag}{}; --force writes it anyway, marked as forced",
+                e.message()
+            );
+            e.exit_code()
+        }
         Err(e) => {
             errln!("error: {}", e.message());
             e.exit_code()

@@ -35,6 +35,7 @@
 //! process exit code, one mapping for every verb ([`Error::exit_code`]).
 //!
 #![doc = include_str!("first_example.md")]
+#![deny(missing_docs)]
 #![cfg_attr(
     not(test),
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)

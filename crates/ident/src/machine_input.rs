@@ -107,6 +107,42 @@ impl From<&str> for MachineInput {
     }
 }
 
+impl From<String> for MachineInput {
+    fn from(path: String) -> MachineInput {
+        MachineInput::from(PathBuf::from(path))
+    }
+}
+
+impl From<&String> for MachineInput {
+    fn from(path: &String) -> MachineInput {
+        MachineInput::from(PathBuf::from(path))
+    }
+}
+
+/// A machine file by any name a program holds: `&str`, `String`, `&Path`,
+/// `PathBuf` or `&PathBuf`.
+///
+/// # Example
+/// ```
+/// use std::path::PathBuf;
+/// use tricept_ident::MachineInput;
+/// let file = PathBuf::from("calibrated.json");
+/// for input in [
+///     MachineInput::from(&file),
+///     MachineInput::from(file.clone()),
+///     MachineInput::from(file.as_path()),
+///     MachineInput::from("calibrated.json"),
+///     MachineInput::from(String::from("calibrated.json")),
+/// ] {
+///     assert_eq!(input.path(), Some(file.as_path()));
+/// }
+/// ```
+impl From<&PathBuf> for MachineInput {
+    fn from(path: &PathBuf) -> MachineInput {
+        MachineInput::from(path.clone())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

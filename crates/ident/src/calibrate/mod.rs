@@ -397,7 +397,7 @@ impl Calibration {
     /// write rule: a fit whose exit code is not 0 is refused (an error of
     /// that code) unless `force`, and the file then says it was forced.
     pub fn write_machine(&mut self, path: &Path, force: bool) -> Result<Written, Error> {
-        let what = format!("--write-machine {}", path.display());
+        let what = path.display().to_string();
         let code = self.exit_code();
         let forced = match machine_file::write_rule(&what, code, &self.reason(), force) {
             Ok(forced) => forced,
