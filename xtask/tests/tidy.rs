@@ -987,7 +987,9 @@ fn the_door_s_root_is_its_curated_list() {
         missing.is_empty(),
         "DOOR_ROOT names what tricept-ident's root no longer has: {missing:?}"
     );
-    assert!(root.len() <= 23, "{} names at the root", root.len());
+    // 24: `ErrorCause` (issue 49), which every program that handles an
+    // error matches on, beside `Error` and `ErrorKind`.
+    assert!(root.len() <= 24, "{} names at the root", root.len());
 }
 
 /// One machine input (issue 27): every request field that holds a machine
