@@ -147,7 +147,7 @@ impl Calibration {
 
     /// The JSON `tricept identify --json` prints.
     fn to_json(&self) -> String {
-        self.inner.to_json().to_string()
+        versioned(&self.inner.to_json().to_string())
     }
 
     /// The text report `tricept identify` prints.
@@ -270,7 +270,7 @@ impl Diagnosis {
 
     /// The JSON `tricept diagnose --json` prints.
     fn to_json(&self) -> String {
-        self.inner.to_json()
+        versioned(&self.inner.to_json())
     }
 
     /// The text report `tricept diagnose` prints.
@@ -344,7 +344,7 @@ impl CheckResult {
 
     /// The JSON `tricept check --json` prints.
     fn to_json(&self) -> String {
-        self.inner.to_json()
+        versioned(&self.inner.to_json())
     }
 
     /// The text report `tricept check` prints.
@@ -463,7 +463,7 @@ impl Fleet {
 
     /// The JSON `tricept fleet --json` prints.
     fn to_json(&self) -> String {
-        self.inner.to_json().to_string()
+        versioned(&self.inner.to_json().to_string())
     }
 
     /// The text report `tricept fleet` prints.
@@ -550,4 +550,12 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(machine_of_file, m)?)?;
     m.add_function(wrap_pyfunction!(report, m)?)?;
     Ok(())
+}
+
+/// A workflow's JSON as `--json` prints it: `format_version` first
+/// (`tricept_ident::advanced::versioned_json`), one line.
+fn versioned(json: &str) -> String {
+    tricept_ident::advanced::versioned_json(json)
+        .map(|t| t.trim_end().to_string())
+        .unwrap_or_else(|| json.to_string())
 }

@@ -325,7 +325,9 @@ pub struct Trend {
 /// # Example
 /// ```
 /// use tricept_check::history::{Entry, Quantity, trends};
+/// use tricept_check::history::HISTORY_FORMAT_VERSION;
 /// let entry = |day: f64, v: f64| Entry {
+///     format_version: HISTORY_FORMAT_VERSION,
 ///     time: String::new(), unix_s: day * 86_400.0, machine: "m".into(), data_file: "d".into(),
 ///     verdict: "unchanged".into(), most_likely: None, shortlist: vec![], consistency: (50.0, 57, 0.7),
 ///     quantities: vec![Quantity { name: "dq1".into(), unit: "um".into(), value: v, std_dev: 1.0, band: 5.0 }],

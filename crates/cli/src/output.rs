@@ -69,44 +69,16 @@ pub fn write_text(text: &str) {
     }
 }
 
-/// The format version of every `--json` output this tricept prints (the
-/// `format_version` key each object starts with; `tricept schema NAME`
-/// prints its JSON Schema; CHANGELOG.md "Versions" says what bumps it).
-pub const JSON_FORMAT_VERSION: u32 = 1;
-
-/// Writes a verb's `--json` output (one JSON object, or one per line):
-/// each object with `format_version` ([`JSON_FORMAT_VERSION`]) as its
-/// first key unless it carries its own (a machine file's), one object per
-/// line, compact. A text that is not JSON objects is written as it is.
+/// Writes a verb's `--json` output (one JSON object, or one per line)
+/// with its `format_version` first
+/// (`tricept_ident::advanced::versioned_json`, as the Python binding's
+/// `to_json`); a text that is not JSON objects is written as it is.
 pub fn write_json(text: impl std::fmt::Display) {
     let text = text.to_string();
-    let whole = serde_json::from_str::<serde_json::Value>(&text)
-        .map(|v| vec![v])
-        .or_else(|_| {
-            text.lines()
-                .filter(|l| !l.trim().is_empty())
-                .map(serde_json::from_str::<serde_json::Value>)
-                .collect::<Result<Vec<_>, _>>()
-        });
-    let Ok(objects) = whole else {
-        write_line(format_args!("{text}"));
-        return;
-    };
-    let mut out = String::with_capacity(text.len() + 32 * objects.len());
-    for v in objects {
-        let v = match v {
-            serde_json::Value::Object(map) if !map.contains_key("format_version") => {
-                let mut versioned = serde_json::Map::with_capacity(map.len() + 1);
-                versioned.insert("format_version".into(), JSON_FORMAT_VERSION.into());
-                versioned.extend(map);
-                serde_json::Value::Object(versioned)
-            }
-            other => other,
-        };
-        out.push_str(&v.to_string());
-        out.push('\n');
+    match tricept_ident::advanced::versioned_json(&text) {
+        Some(versioned) => write_text(&versioned),
+        None => write_line(format_args!("{text}")),
     }
-    write_text(&out);
 }
 
 /// `text` with every control character but `\n` and `\t` escaped (as

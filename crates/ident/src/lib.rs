@@ -47,6 +47,7 @@ mod commanding;
 mod data_input;
 mod error;
 mod inputs;
+mod json_version;
 mod limits;
 mod machine_file;
 mod machine_input;
