@@ -50,7 +50,7 @@ impl Machine {
     /// The Python machine of a loaded one.
     pub(crate) fn of(loaded: LoadedMachine) -> Machine {
         Machine {
-            machine: ExtendedMachine::new(loaded.machine().clone()),
+            machine: loaded.commanding().extended().clone(),
             loaded,
         }
     }

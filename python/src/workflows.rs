@@ -62,7 +62,7 @@ fn data_input(
     match (path, csv_text) {
         (Some(path), None) => Ok(DataInput::File(path)),
         (None, Some(text)) => Ok(DataInput::Memory(
-            tricept_ident::advanced::read_data_from(text.as_bytes(), name, machine.machine())
+            tricept_ident::advanced::read_data_from(text.as_bytes(), name, machine.geometry())
                 .map_err(|e| door_error_in(py, e, Some(name)))?,
         )),
         _ => Err(input_error(
@@ -147,7 +147,7 @@ impl Calibration {
 
     /// The JSON `tricept identify --json` prints.
     fn to_json(&self) -> String {
-        self.inner.to_json().to_string()
+        versioned(&self.inner.to_json().to_string())
     }
 
     /// The text report `tricept identify` prints.
@@ -270,7 +270,7 @@ impl Diagnosis {
 
     /// The JSON `tricept diagnose --json` prints.
     fn to_json(&self) -> String {
-        self.inner.to_json()
+        versioned(&self.inner.to_json())
     }
 
     /// The text report `tricept diagnose` prints.
@@ -344,7 +344,7 @@ impl CheckResult {
 
     /// The JSON `tricept check --json` prints.
     fn to_json(&self) -> String {
-        self.inner.to_json()
+        versioned(&self.inner.to_json())
     }
 
     /// The text report `tricept check` prints.
@@ -463,7 +463,7 @@ impl Fleet {
 
     /// The JSON `tricept fleet --json` prints.
     fn to_json(&self) -> String {
-        self.inner.to_json().to_string()
+        versioned(&self.inner.to_json().to_string())
     }
 
     /// The text report `tricept fleet` prints.
@@ -550,4 +550,12 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(machine_of_file, m)?)?;
     m.add_function(wrap_pyfunction!(report, m)?)?;
     Ok(())
+}
+
+/// A workflow's JSON as `--json` prints it: `format_version` first
+/// (`tricept_ident::advanced::versioned_json`), one line.
+fn versioned(json: &str) -> String {
+    tricept_ident::advanced::versioned_json(json)
+        .map(|t| t.trim_end().to_string())
+        .unwrap_or_else(|| json.to_string())
 }

@@ -918,6 +918,7 @@ const DOOR_ROOT: &[&str] = &[
     "EXIT_OK",
     "EXIT_OTHER",
     "Error",
+    "ErrorCause",
     "ErrorKind",
     // The two inputs every request is made of.
     "DataInput",
@@ -995,7 +996,9 @@ fn the_door_s_root_is_its_curated_list() {
         missing.is_empty(),
         "DOOR_ROOT names what tricept-ident's root no longer has: {missing:?}"
     );
-    assert!(root.len() <= 23, "{} names at the root", root.len());
+    // 24: `ErrorCause` (issue 49), which every program that handles an
+    // error matches on, beside `Error` and `ErrorKind`.
+    assert!(root.len() <= 24, "{} names at the root", root.len());
 }
 
 /// One machine input (issue 27): every request field that holds a machine
@@ -1046,5 +1049,97 @@ fn the_root_reader_finds_public_names() {
             .iter()
             .map(|s| s.to_string())
             .collect::<BTreeSet<_>>()
+    );
+}
+
+/// tricept-ident's public API, as text: every public item of its sources
+/// (`pub fn`, `struct`, `enum`, `trait`, `type`, `const`, `mod`, `use`
+/// and public fields, each with its signature up to its body and the item
+/// it belongs to), sorted. A stand-in for `cargo semver-checks`, which
+/// needs a published baseline: the listing is kept in
+/// `crates/ident/public-api.txt`, and a change of the door's API fails
+/// until the listing is updated with it (`BLESS=1 cargo test -p xtask
+/// --test tidy public_api`), so that every change is declared in review
+/// (and in CHANGELOG.md).
+fn public_api(root: &Path) -> Vec<String> {
+    let mut files = Vec::new();
+    let mut stack = vec![root.join("crates/ident/src")];
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                files.push(p);
+            }
+        }
+    }
+    let mut items = BTreeSet::new();
+    for file in files {
+        let text = std::fs::read_to_string(&file).unwrap_or_default();
+        // Unit tests are not API.
+        let text = text.split("#[cfg(test)]\nmod tests").next().unwrap_or("");
+        let mut owner = String::new();
+        let mut lines = text.lines().peekable();
+        while let Some(line) = lines.next() {
+            let trimmed = line.trim_start();
+            let top = trimmed.len() == line.len();
+            let declares = |k: &&str| trimmed.starts_with(k) || trimmed.contains(&format!(" {k}"));
+            if top && ["struct ", "enum ", "trait ", "impl"].iter().any(declares) {
+                owner = trimmed.trim_end_matches(['{', ' ']).to_string();
+            }
+            // Items of a private type, and private items, are not API.
+            let private_owner = !top && !owner.starts_with("pub ") && !owner.starts_with("impl");
+            if !trimmed.starts_with("pub ") || private_owner {
+                continue;
+            }
+            let mut item = trimmed.to_string();
+            let signature = item.starts_with("pub fn ") || item.starts_with("pub const fn ");
+            let ends =
+                |s: &str| s.ends_with('{') || s.ends_with(';') || (!signature && s.ends_with(','));
+            while !ends(item.trim_end()) {
+                match lines.next() {
+                    Some(next) => {
+                        item.push(' ');
+                        item.push_str(next.trim());
+                    }
+                    None => break,
+                }
+            }
+            let item = item
+                .trim_end_matches(['{', ' '])
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" ");
+            items.insert(if top {
+                item
+            } else {
+                format!("{owner} :: {item}")
+            });
+        }
+    }
+    items.into_iter().collect()
+}
+
+#[test]
+fn public_api_of_the_door_changes_only_with_its_listing() {
+    let root = workspace();
+    let listing = root.join("crates/ident/public-api.txt");
+    let now = public_api(&root).join("\n") + "\n";
+    assert!(now.lines().count() > 100, "too few items found: {now}");
+    if std::env::var_os("BLESS").is_some() {
+        std::fs::write(&listing, &now).unwrap();
+        return;
+    }
+    let kept = std::fs::read_to_string(&listing).unwrap_or_default();
+    let kept_set: BTreeSet<&str> = kept.lines().collect();
+    let now_set: BTreeSet<&str> = now.lines().collect();
+    let added: Vec<&&str> = now_set.difference(&kept_set).collect();
+    let removed: Vec<&&str> = kept_set.difference(&now_set).collect();
+    assert!(
+        added.is_empty() && removed.is_empty(),
+        "tricept-ident's public API changed without its listing (crates/ident/public-api.txt): \
+         added {added:#?}, removed {removed:#?}; declare it with \
+         `BLESS=1 cargo test -p xtask --test tidy public_api` and a line in CHANGELOG.md"
     );
 }

@@ -13,6 +13,10 @@
 //! reported once it leaves the band, and its slope (weighted least squares
 //! over the entries, per day) is given with its uncertainty.
 //!
+//! Each line carries its `format_version` ([`HISTORY_FORMAT_VERSION`]); a
+//! line without it is version 1, and a line of a newer version is refused,
+//! naming it, before the history is appended to.
+//!
 //! The file is rewritten whole at every append through
 //! [`tricept_data::write_atomic`], so that a crash never leaves half a
 //! line; a line that does not parse is an error naming it. Appends hold an
@@ -26,10 +30,23 @@ use serde::{Deserialize, Serialize};
 use crate::check::CheckReport;
 use crate::error::CheckError;
 
+/// The format version of a history line this tricept writes, and the
+/// newest it reads (`format_version` key).
+pub const HISTORY_FORMAT_VERSION: u32 = 1;
+
+/// serde's default of `format_version`: a line without it is version 1.
+fn unversioned() -> u32 {
+    tricept_kinematics::description::UNVERSIONED
+}
+
 /// One check in the history.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Entry {
+    /// The line's format version ([`HISTORY_FORMAT_VERSION`] as written;
+    /// absent: 1).
+    #[serde(default = "unversioned")]
+    pub format_version: u32,
     /// When the check ran, UTC (ISO 8601).
     pub time: String,
     /// The same, seconds since 1970-01-01.
@@ -103,6 +120,7 @@ impl Entry {
             })
             .collect();
         Entry {
+            format_version: HISTORY_FORMAT_VERSION,
             time: time.to_string(),
             unix_s,
             machine: machine.to_string(),
@@ -142,6 +160,17 @@ pub fn read(path: &std::path::Path) -> Result<Vec<Entry>, CheckError> {
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty())
         .map(|(i, l)| {
+            let newer = tricept_kinematics::description::newer_format(
+                l,
+                "check history line",
+                HISTORY_FORMAT_VERSION,
+            );
+            if let Some(newer) = newer {
+                return Err(CheckError::HistoryLine(format!(
+                    "{file}: line {}: {newer}",
+                    i + 1
+                )));
+            }
             serde_json::from_str(l).map_err(|e| {
                 CheckError::HistoryLine(format!(
                     "{file}: line {}: not a check of this history: {e}",
@@ -296,7 +325,9 @@ pub struct Trend {
 /// # Example
 /// ```
 /// use tricept_check::history::{Entry, Quantity, trends};
+/// use tricept_check::history::HISTORY_FORMAT_VERSION;
 /// let entry = |day: f64, v: f64| Entry {
+///     format_version: HISTORY_FORMAT_VERSION,
 ///     time: String::new(), unix_s: day * 86_400.0, machine: "m".into(), data_file: "d".into(),
 ///     verdict: "unchanged".into(), most_likely: None, shortlist: vec![], consistency: (50.0, 57, 0.7),
 ///     quantities: vec![Quantity { name: "dq1".into(), unit: "um".into(), value: v, std_dev: 1.0, band: 5.0 }],
@@ -376,6 +407,7 @@ mod tests {
 
     fn entry(writer: usize, i: usize) -> Entry {
         Entry {
+            format_version: HISTORY_FORMAT_VERSION,
             time: format!("2026-12-03T00:00:{i:02}Z"),
             unix_s: i as f64,
             machine: format!("writer{writer}"),
@@ -387,6 +419,27 @@ mod tests {
             quantities: Vec::new(),
             calibration_digest: None,
         }
+    }
+
+    #[test]
+    fn a_line_without_a_version_is_version_1_and_a_newer_line_is_refused_by_number() {
+        let dir = std::env::temp_dir().join(format!("tricept-history-v-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("h.jsonl");
+        let mut old = serde_json::to_value(entry(1, 1)).unwrap();
+        old.as_object_mut().unwrap().remove("format_version");
+        std::fs::write(&path, format!("{old}\n")).unwrap();
+        let read_back = read(&path).unwrap();
+        assert_eq!(read_back, [entry(1, 1)]);
+        let mut newer = serde_json::to_value(entry(1, 2)).unwrap();
+        newer["format_version"] = 2.into();
+        newer["a_key_of_version_2"] = true.into();
+        std::fs::write(&path, format!("{old}\n{newer}\n")).unwrap();
+        let e = read(&path).unwrap_err().to_string();
+        assert!(e.contains("line 2: format_version 2"), "{e}");
+        assert!(append(&path, &entry(1, 3)).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -15,7 +15,7 @@ use tricept_ident::advanced::{
 };
 use tricept_ident::calibrate::{CalibrateRequest, FusedSources};
 use tricept_ident::effects::{Effect, EffectName};
-use tricept_ident::kinematics::Machine;
+use tricept_ident::kinematics::GeometricMachine as Machine;
 use tricept_ident::simulate::TruthEffects;
 use tricept_ident::{DataInput, MachineInput};
 

@@ -50,7 +50,7 @@ pub fn run(a: &CheckArgs) -> Result<u8, CliError> {
         plot_trends(dir, result.trends())?;
     }
     if a.machine.json {
-        outln!("{}", result.to_json());
+        crate::output::write_json(result.to_json());
     } else {
         crate::output::write_text(&result.to_text());
     }

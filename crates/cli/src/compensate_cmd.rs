@@ -89,7 +89,7 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
         errln!("wrote {}", path.display());
     }
     if a.settings.machine.json {
-        outln!("{}", c.to_json());
+        crate::output::write_json(c.to_json());
     } else {
         let report = c.report();
         match c.corrected_targets() {

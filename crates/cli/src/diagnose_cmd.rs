@@ -123,7 +123,7 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
         .as_ref()
         .map(|path| write_machine(&result, path, a.force));
     if a.machine.json {
-        outln!("{}", result.to_json());
+        crate::output::write_json(result.to_json());
     } else {
         crate::output::write_text(&result.to_text());
     }
@@ -140,7 +140,7 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
 fn read_with_progress(path: &Path, loaded: &LoadedMachine) -> Result<DataInput, CliError> {
     Ok(DataInput::Read {
         file: path.to_path_buf(),
-        data: read_data(path, loaded.machine())?,
+        data: read_data(path, loaded.geometry())?,
     })
 }
 
@@ -191,7 +191,7 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<u8, CliError> {
     request.temperature_drift_k = a.temperature_drift;
     let report = detectability(request)?;
     if a.machine.json {
-        outln!("{}", report.to_json());
+        crate::output::write_json(report.to_json());
     } else {
         crate::output::write_text(&report.to_text());
     }

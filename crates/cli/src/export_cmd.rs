@@ -118,7 +118,7 @@ pub fn run(a: &ExportArgs) -> Result<u8, CliError> {
     };
     let e = tricept_ident::export::export(request)?;
     if a.json {
-        outln!("{}", e.json(&a.out));
+        crate::output::write_json(e.json(&a.out));
     } else {
         crate::output::write_text(&e.text(&a.out));
     }

@@ -69,7 +69,7 @@ pub fn run(a: &FleetArgs) -> Result<u8, CliError> {
         errln!("wrote {}", path.display());
     }
     if a.machine.json {
-        outln!("{}", result.to_json());
+        crate::output::write_json(result.to_json());
     } else {
         crate::output::write_text(&result.report());
     }

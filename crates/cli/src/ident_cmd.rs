@@ -43,7 +43,7 @@ pub fn run_identifiability(a: &IdentifiabilityArgs) -> Result<u8, CliError> {
     let result = assess_identifiability(request)?;
     crate::output::warn_all(result.machine_warnings());
     if a.machine.json {
-        outln!("{}", result.to_json());
+        crate::output::write_json(result.to_json());
     } else {
         crate::output::write_text(&result.to_text());
     }
@@ -68,7 +68,7 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
         errln!("wrote {}", w.path().display());
     }
     if a.settings.machine.json {
-        outln!("{}", calibration.to_json());
+        crate::output::write_json(calibration.to_json());
     } else {
         crate::output::write_text(&calibration.report());
     }

@@ -116,12 +116,12 @@ fn kinematics(
                 verb.name()
             )));
         }
-        return run_batch(verb, &ExtendedMachine::new(loaded.machine().clone()), path);
+        return run_batch(verb, loaded.commanding().extended(), path);
     }
     let values: Vec<f64> = point.iter().map(|v| v.unwrap_or(f64::NAN)).collect();
     let solution = solve_point(verb, &loaded, &values)?;
     if machine.json {
-        outln!("{}", solution.to_json());
+        crate::output::write_json(solution.to_json());
     } else {
         crate::output::write_text(&solution.to_text());
     }

@@ -36,6 +36,7 @@ mod kinematics_cmd;
 mod output;
 mod plan_cmd;
 mod report_cmd;
+mod schema_cmd;
 mod simulate_cmd;
 
 use std::path::Path;
@@ -187,6 +188,13 @@ enum Command {
         after_help = "Exit codes: 0 written (verdict trusted, or use with caution); 3 written, and the page says not to trust the machine (a forced or inadequate calibration, or a last check that found it changed); 2 bad input: a machine file without a calibration or edited after it, a campaign whose SHA-256 is not the record's, a history or an export of another calibration (each names the file).\n\nExamples:\n  tricept report --machine calibrated.json --out page.html\n  tricept report --machine calibrated.json --data campaign.csv --history checks.jsonl --export cnc/ --out page.html\nThe page, its verdict rule and how to read its sources: `tricept docs report`"
     )]
     Report(report_cmd::ReportArgs),
+    /// The JSON Schema of a file tricept writes (a machine file, a prior,
+    /// a check history line, an export summary) or of a verb's --json
+    /// output; without a name, the list.
+    #[command(
+        after_help = "Every file tricept writes carries `format_version` (an integer; a file without it is version 1, one newer than this tricept is refused with exit code 2): `tricept docs data-format`, \"Format versions and schemas\".\n\nExamples:\n  tricept schema\n  tricept schema machine > machine.schema.json\n  tricept schema identify"
+    )]
+    Schema(schema_cmd::SchemaArgs),
 }
 
 /// The files a verb reads and writes, by flag (checked before it runs:
@@ -221,7 +229,7 @@ fn file_roles(command: &Command) -> files::FileRoles {
             stdin_or_input(&mut r, &a.input.input);
         }
         Command::Machine(a) => machine(&mut r, &a.machine),
-        Command::Docs(_) | Command::Effects(_) => {}
+        Command::Docs(_) | Command::Effects(_) | Command::Schema(_) => {}
         Command::Identifiability(a) => {
             machine(&mut r, &a.machine);
             r.inputs("--poses", a.poses.file().map(Path::to_path_buf).as_ref());
@@ -365,6 +373,7 @@ fn run(cli: Cli) -> Result<u8, CliError> {
         Command::Export(a) => export_cmd::run(&a),
         Command::Report(a) => report_cmd::run(&a),
         Command::Fleet(a) => fleet_cmd::run(&a),
+        Command::Schema(a) => schema_cmd::run(&a),
     }
 }
 
@@ -420,8 +429,22 @@ fn main() -> ExitCode {
             };
         }
     };
+    // A write the library refused (an untrusted result): the flag that
+    // named the file, and the one that writes it anyway.
+    let write_flag = match &cli.command {
+        Command::Identify(_) | Command::Diagnose(_) => "--write-machine ",
+        Command::Fleet(_) => "--write-prior ",
+        _ => "",
+    };
     let code = match run(cli) {
         Ok(code) => code,
+        Err(e) if e.cause() == tricept_ident::ErrorCause::RefusedWrite => {
+            errln!(
+                "error: {write_flag}{}; --force writes it anyway, marked as forced",
+                e.message()
+            );
+            e.exit_code()
+        }
         Err(e) => {
             errln!("error: {}", e.message());
             e.exit_code()

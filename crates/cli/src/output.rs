@@ -69,6 +69,18 @@ pub fn write_text(text: &str) {
     }
 }
 
+/// Writes a verb's `--json` output (one JSON object, or one per line)
+/// with its `format_version` first
+/// (`tricept_ident::advanced::versioned_json`, as the Python binding's
+/// `to_json`); a text that is not JSON objects is written as it is.
+pub fn write_json(text: impl std::fmt::Display) {
+    let text = text.to_string();
+    match tricept_ident::advanced::versioned_json(&text) {
+        Some(versioned) => write_text(&versioned),
+        None => write_line(format_args!("{text}")),
+    }
+}
+
 /// `text` with every control character but `\n` and `\t` escaped (as
 /// `\u{1b}`); borrowed when there is none (the usual case).
 fn inert(text: &str) -> std::borrow::Cow<'_, str> {

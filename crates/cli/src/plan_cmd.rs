@@ -201,7 +201,7 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
         errln!("wrote {}", path.display());
     }
     if a.machine.json {
-        outln!("{}", plan.to_json());
+        crate::output::write_json(plan.to_json());
     } else {
         crate::output::write_text(plan.report());
     }

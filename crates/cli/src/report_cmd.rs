@@ -42,7 +42,7 @@ pub fn run(a: &ReportArgs) -> Result<u8, CliError> {
     request.export = a.export.clone();
     let r = report(request)?;
     if a.json {
-        outln!("{}", r.to_json());
+        crate::output::write_json(r.to_json());
     } else {
         crate::output::write_text(&r.text());
     }

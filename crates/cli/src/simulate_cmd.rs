@@ -193,7 +193,7 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
                 tricept_ident::advanced::files::write_path(path, sim.data(), sim.comments()),
             )?;
             if a.machine.json {
-                outln!("{}", sim.to_json(path));
+                crate::output::write_json(sim.to_json(path));
             } else {
                 errln!("{}", sim.to_text(path));
             }

@@ -34,8 +34,11 @@ pub struct Deployed {
     /// parameters, then each term's `effect.parameter`).
     pub id: Identification,
     /// The calibrated machine: geometry, class-2 effects, leg effects and
-    /// compensation tables.
-    pub machine: Machine,
+    /// compensation tables. Its own kinematics ignore the leg effects it
+    /// carries: command it through
+    /// [`ExtendedMachine`](tricept_model::ExtendedMachine), which applies
+    /// them (the door's `kinematics::Machine`).
+    pub geometry: Machine,
     /// The controller parameters of the dynamic effects, when any is named.
     pub controller: Option<ControllerDescription>,
     /// What the machine file applies, one line per term (where it goes).
@@ -71,10 +74,10 @@ pub struct Deployed {
 /// let deployed = deploy(&nominal, None, &data, &d).unwrap();
 /// // The compliance the diagnosis named is in the machine's leg effects
 /// // (the file was simulated with 33.6 N/um at 1 m: 29.8 um/kN).
-/// let c = deployed.machine.leg_effects.compliance_um_per_kn_at_1m;
+/// let c = deployed.geometry.leg_effects.compliance_um_per_kn_at_1m;
 /// assert!((c - 1000.0 / 33.6).abs() < 2.0, "{c}");
 /// // The calibrated machine with its leg effects, ready for IK.
-/// let machine = ExtendedMachine::new(deployed.machine);
+/// let machine = ExtendedMachine::new(deployed.geometry);
 /// let q = machine.inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0)).unwrap().legs_mm;
 /// assert!(q.iter().all(|q| (q - 773.4).abs() < 1.0));
 /// ```
@@ -161,7 +164,7 @@ pub fn deploy(
     machine.leg_effects.tables.sort_by_key(|t| t.leg);
     Ok(Deployed {
         id,
-        machine,
+        geometry: machine,
         controller,
         applied,
         recorded,

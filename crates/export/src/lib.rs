@@ -49,7 +49,9 @@ mod types;
 
 pub use control::{ControlLimits, ControlModel, Controller, Limit};
 pub use folder::{SUMMARY_FILE, check_out};
-pub use types::{AxisSummary, ExportError, ExportOptions, ExportSummary, NotExported};
+pub use types::{
+    AxisSummary, ExportError, ExportOptions, ExportSummary, NotExported, SUMMARY_FORMAT_VERSION,
+};
 
 use setup::{ControlFiles, Setup};
 
@@ -172,6 +174,7 @@ fn summary_of(
     let mut file_names: Vec<String> = control.files.iter().map(|(n, _)| n.clone()).collect();
     file_names.push(SUMMARY_FILE.to_string());
     ExportSummary {
+        format_version: types::SUMMARY_FORMAT_VERSION,
         controller: options.control.family(),
         control: options.control,
         control_limits: options.control.limits(),

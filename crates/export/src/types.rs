@@ -137,9 +137,16 @@ pub struct NotExported {
     pub why: String,
 }
 
+/// The format version of the export's summary file this tricept writes
+/// (`format_version` key), and the newest a report reads.
+pub const SUMMARY_FORMAT_VERSION: u32 = 1;
+
 /// The summary of an export (the JSON the verb prints).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ExportSummary {
+    /// The summary file's format version: [`SUMMARY_FORMAT_VERSION`] (a
+    /// summary without it, written before it, is version 1).
+    pub format_version: u32,
     /// The control's family (which files).
     pub controller: Controller,
     /// The control model.

@@ -37,5 +37,7 @@ pub use campaigns::{Agreement, Agreements, agreements, campaign_chi_squares, poo
 pub use error::FleetError;
 pub use joint::{JointFit, JointInput, first_step_problem, fit as joint_fit};
 pub use own::{EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, OwnFit, batch_design};
-pub use prior_file::{DataFileRecord, NamedCovariance, PRIOR_FORMAT, PriorFile, PriorProvenance};
+pub use prior_file::{
+    DataFileRecord, NamedCovariance, PRIOR_FORMAT, PRIOR_FORMAT_VERSION, PriorFile, PriorProvenance,
+};
 pub use tricept_numerics::sparse::{SolveStats, SolverKind};

@@ -11,6 +11,9 @@
 //! which machines were in the batch, the outliers). It is sealed as a
 //! machine file's record is ([`seal_digest`] of each field's compact
 //! JSON): a hand edit of any sealed field is refused on load, by name.
+//! Its `format_version` ([`PRIOR_FORMAT_VERSION`]) is sealed too; a file
+//! without it is version 1 (as its seal, which then does not name it), and
+//! a newer one is refused before anything else is read of it.
 
 use std::collections::BTreeMap;
 
@@ -18,14 +21,23 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 use tricept_engine::Prior;
-use tricept_kinematics::description::seal_digest;
+use tricept_kinematics::description::{UNVERSIONED, newer_format, seal_digest};
 use tricept_model::ParameterSet;
 
 use crate::batch::Batch;
 use crate::error::FleetError;
 
-/// The format's name and version (`format` key).
+/// The format's name (`format` key).
 pub const PRIOR_FORMAT: &str = "tricept-prior/1";
+
+/// The prior file's format version this tricept writes and the newest it
+/// reads (`format_version` key).
+pub const PRIOR_FORMAT_VERSION: u32 = 1;
+
+/// serde's default of `format_version`: a file without it is version 1.
+fn unversioned() -> u32 {
+    UNVERSIONED
+}
 
 /// A covariance by parameter name.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -79,6 +91,9 @@ pub struct PriorProvenance {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PriorFile {
+    /// [`PRIOR_FORMAT_VERSION`] as written (absent: 1).
+    #[serde(default = "unversioned")]
+    pub format_version: u32,
     /// [`PRIOR_FORMAT`].
     pub format: String,
     /// What it is, for people.
@@ -134,6 +149,7 @@ impl PriorFile {
             .map(|&j| names[j].clone())
             .collect();
         let mut file = PriorFile {
+            format_version: PRIOR_FORMAT_VERSION,
             format: PRIOR_FORMAT.to_string(),
             name: format!(
                 "prior of a batch of {} machines ({} in the batch estimates)",
@@ -163,8 +179,13 @@ impl PriorFile {
         file
     }
 
-    /// The digests of the sealed fields.
+    /// The digests of the sealed fields (`format_version` unless a seal
+    /// without it is checked and it is 1: a file written before it).
     fn digests(&self) -> BTreeMap<String, String> {
+        let unversioned = self.format_version == UNVERSIONED
+            && !self.seal.is_empty()
+            && !self.seal.contains_key("format_version");
+        let version = (!unversioned).then(|| ("format_version", seal_digest(&self.format_version)));
         [
             ("format", seal_digest(&self.format)),
             ("machine", seal_digest(&self.machine)),
@@ -178,6 +199,7 @@ impl PriorFile {
             ("provenance", seal_digest(&self.provenance)),
         ]
         .into_iter()
+        .chain(version)
         .map(|(k, v)| (k.to_string(), v))
         .collect()
     }
@@ -197,6 +219,9 @@ impl PriorFile {
     /// assert!(e.to_string().starts_with("p.json: not a prior file"), "{e}");
     /// ```
     pub fn from_json(text: &str, source: &str) -> Result<PriorFile, FleetError> {
+        if let Some(newer) = newer_format(text, "prior file", PRIOR_FORMAT_VERSION) {
+            return Err(FleetError::Input(format!("{source}: {newer}")));
+        }
         let file: PriorFile =
             serde_json::from_str(text.trim_start_matches('\u{feff}')).map_err(|e| {
                 FleetError::Input(format!("{source}: not a prior file ({PRIOR_FORMAT}): {e}"))

@@ -15,6 +15,9 @@
 //! - **The machine loaded ahead**: [`load_machine`] gives a
 //!   [`LoadedMachine`] (its description, its warnings), which converts into
 //!   the [`crate::MachineInput`] every request takes.
+//! - **Output format**: the `format_version` of the JSON outputs
+//!   ([`OUTPUT_FORMAT_VERSION`]) and the one way it is put into one
+//!   ([`versioned_json`]: what `--json` prints).
 //! - **Result parts** several workflows share: the [`Accuracy`] a written
 //!   file promises, the [`MachineFile`] a result may write (kept apart
 //!   from it, to write later by the same rule).
@@ -37,6 +40,7 @@ pub use crate::inputs::{
     FrameMmRad, HeadAngles, LoadedMachine, Poses, SensorNoise, Triple, TrueErrors, load_machine,
     parse_effects, parse_numbers,
 };
+pub use crate::json_version::{OUTPUT_FORMAT_VERSION, versioned_json};
 pub use crate::machine_file::MachineFile;
 pub use nalgebra;
 pub use serde_json;

@@ -154,7 +154,7 @@ fn machines(r: &CompensateRequest) -> Result<Pair, Error> {
             out.insert("rejected".into(), fit.rejected_json());
             Ok(Pair {
                 nominal: ExtendedMachine::new(fit.loaded().machine().clone()),
-                calibrated: ExtendedMachine::new(fit.identified()),
+                calibrated: ExtendedMachine::new(fit.identified_geometry()),
                 out,
                 warnings: fit.warnings().to_vec(),
                 machine_warnings: fit.machine_warnings().to_vec(),

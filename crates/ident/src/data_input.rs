@@ -59,6 +59,42 @@ impl From<&Path> for DataInput {
     }
 }
 
+impl From<String> for DataInput {
+    fn from(path: String) -> DataInput {
+        DataInput::File(PathBuf::from(path))
+    }
+}
+
+impl From<&String> for DataInput {
+    fn from(path: &String) -> DataInput {
+        DataInput::File(PathBuf::from(path))
+    }
+}
+
+/// A data file by any name a program holds: `&str`, `String`, `&Path`,
+/// `PathBuf` or `&PathBuf`.
+///
+/// # Example
+/// ```
+/// use std::path::PathBuf;
+/// use tricept_ident::DataInput;
+/// let file = PathBuf::from("campaign.csv");
+/// for input in [
+///     DataInput::from(&file),
+///     DataInput::from(file.clone()),
+///     DataInput::from(file.as_path()),
+///     DataInput::from("campaign.csv"),
+///     DataInput::from(String::from("campaign.csv")),
+/// ] {
+///     assert_eq!(input.name(), "campaign.csv");
+/// }
+/// ```
+impl From<&PathBuf> for DataInput {
+    fn from(path: &PathBuf) -> DataInput {
+        DataInput::File(path.clone())
+    }
+}
+
 impl From<Dataset> for DataInput {
     fn from(data: Dataset) -> DataInput {
         DataInput::Memory(data)

@@ -292,7 +292,7 @@ impl DiagnoseResult {
         )?;
         let mut description = machine_file::calibrated_description(
             &self.machine,
-            &deployed.machine,
+            &deployed.geometry,
             &machine_file::FitRecord::of_identification(&deployed.id),
             machine_file::Provenance {
                 method: "diagnose",
@@ -340,7 +340,7 @@ impl DiagnoseResult {
     /// warning of a forced write (`--write-machine PATH: written with
     /// --force although ...`).
     pub fn write_machine(&self, path: &Path, force: bool) -> Result<Option<String>, Error> {
-        let what = format!("--write-machine {}", path.display());
+        let what = path.display().to_string();
         let (description, forced) = self.extended_description(&what, force)?;
         crate::machine_file::write(path, &description).map_err(|e| Error::not_written(path, &e))?;
         Ok(forced.map(|why| format!("{what}: written with --force although {why}")))

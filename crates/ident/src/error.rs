@@ -8,6 +8,7 @@
 //! every verb that can meet it.
 
 use std::fmt;
+use std::sync::Arc;
 
 use tricept_check::CheckError;
 use tricept_data::DataError;
@@ -86,6 +87,82 @@ impl ErrorKind {
     }
 }
 
+/// What failed, for a program to match on (the message says it for
+/// people): a file not found or unreadable, a parse error at a line and
+/// column, a file of a newer format, a sealed file edited, a write
+/// refused by the rule that only a trusted result is written, a fit that
+/// did not converge or does not explain its data, another invalid input,
+/// or anything else. [`Error::cause`] gives it.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{ErrorCause, MachineInput};
+/// use tricept_ident::kinematics::Machine;
+/// let e = Machine::load("no/such/machine.json").unwrap_err();
+/// assert!(matches!(e.cause(), ErrorCause::NotFound { path } if path == "no/such/machine.json"));
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ErrorCause {
+    /// A file that does not exist.
+    NotFound {
+        /// The file, as given.
+        path: String,
+    },
+    /// A file that exists but cannot be read or written (permissions, a
+    /// directory, an I/O error).
+    Unreadable {
+        /// The file, as given.
+        path: String,
+    },
+    /// A file that does not parse: where (1-based; `None` when the reader
+    /// cannot say).
+    Parse {
+        /// The line.
+        line: Option<u64>,
+        /// The column (a 1-based character column of a JSON file; `None`
+        /// for a CSV row, whose column is named in the message).
+        column: Option<u64>,
+    },
+    /// A file whose `format_version` is newer than this tricept reads.
+    NewerFormat {
+        /// The version the file declares.
+        found: u64,
+        /// The newest this tricept reads.
+        supported: u32,
+    },
+    /// A sealed file (a calibrated machine file) edited after it was
+    /// written: the fields that differ.
+    SealBroken {
+        /// The edited fields, as named in the file.
+        fields: Vec<String>,
+    },
+    /// A write refused: the result is not to be trusted (its exit code
+    /// says why) and writing was not forced.
+    RefusedWrite,
+    /// A fit that did not converge (exit code 4).
+    NotConverged,
+    /// A model that does not explain the data, or a campaign too small to
+    /// calibrate (exit code 3).
+    Inadequate,
+    /// Another input that cannot be used (exit code 2).
+    Invalid,
+    /// Anything else (exit code 1).
+    Other,
+}
+
+impl ErrorCause {
+    /// The cause a failure of `kind` has when nothing more is known.
+    fn of_kind(kind: ErrorKind) -> ErrorCause {
+        match kind {
+            ErrorKind::Input => ErrorCause::Invalid,
+            ErrorKind::Other => ErrorCause::Other,
+            ErrorKind::Inadequate => ErrorCause::Inadequate,
+            ErrorKind::NotConverged => ErrorCause::NotConverged,
+        }
+    }
+}
+
 /// A library error that knows whose fault it is.
 ///
 /// # Example
@@ -104,6 +181,11 @@ pub trait Classify {
     fn file_failure(&self) -> Option<FileFailure> {
         None
     }
+
+    /// What failed, when it says more than its kind.
+    fn cause(&self) -> Option<ErrorCause> {
+        None
+    }
 }
 
 /// A failure of a workflow: a one-line message (naming the file, line and
@@ -116,12 +198,27 @@ pub trait Classify {
 /// assert_eq!(e.exit_code(), EXIT_INPUT);
 /// assert_eq!(e.to_string(), "check: --alpha: must lie between 0 and 0.5, got 2");
 /// ```
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone)]
 pub struct Error {
     kind: ErrorKind,
     message: String,
     file: Option<FileFailure>,
+    cause: Option<ErrorCause>,
+    source: Option<Arc<dyn std::error::Error + Send + Sync + 'static>>,
 }
+
+/// Two errors are equal when their kind, message, file failure and cause
+/// are (the underlying error is not compared).
+impl PartialEq for Error {
+    fn eq(&self, other: &Error) -> bool {
+        self.kind == other.kind
+            && self.message == other.message
+            && self.file == other.file
+            && self.cause == other.cause
+    }
+}
+
+impl Eq for Error {}
 
 /// The file-system failure under an [`Error`] (a file that cannot be
 /// opened, read or written): the file and the operating system's error,
@@ -189,7 +286,49 @@ impl Error {
             kind,
             message: tricept_data::one_line(&message.into()),
             file: None,
+            cause: None,
+            source: None,
         }
+    }
+
+    /// What failed ([`ErrorCause`]): a file not found, a parse error at a
+    /// line and column, a broken seal, a refused write, ...; else what
+    /// the kind says ([`ErrorCause::Invalid`] for bad input).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{Error, ErrorCause};
+    /// assert_eq!(Error::input("x").cause(), ErrorCause::Invalid);
+    /// assert_eq!(Error::other("x").cause(), ErrorCause::Other);
+    /// ```
+    pub fn cause(&self) -> ErrorCause {
+        if let Some(c) = &self.cause {
+            return c.clone();
+        }
+        match &self.file {
+            Some(f) if f.io_kind() == std::io::ErrorKind::NotFound => ErrorCause::NotFound {
+                path: f.path().to_string(),
+            },
+            Some(f) => ErrorCause::Unreadable {
+                path: f.path().to_string(),
+            },
+            None => ErrorCause::of_kind(self.kind),
+        }
+    }
+
+    /// The same error, of cause `cause`.
+    #[must_use]
+    pub fn with_cause(mut self, cause: ErrorCause) -> Error {
+        self.cause = Some(cause);
+        self
+    }
+
+    /// The same error, caused by the library error `source`
+    /// ([`std::error::Error::source`] returns it).
+    #[must_use]
+    pub fn with_source(mut self, source: impl std::error::Error + Send + Sync + 'static) -> Error {
+        self.source = Some(Arc::new(source));
+        self
     }
 
     /// The same error, caused by the file-system failure `file`.
@@ -241,6 +380,7 @@ impl Error {
     pub fn from_library(e: &(impl Classify + fmt::Display)) -> Error {
         Error {
             file: e.file_failure(),
+            cause: e.cause(),
             ..Error::new(e.kind(), e.to_string())
         }
     }
@@ -250,6 +390,7 @@ impl Error {
     pub fn with_context(context: impl fmt::Display, e: &(impl Classify + fmt::Display)) -> Error {
         Error {
             file: e.file_failure(),
+            cause: e.cause(),
             ..Error::new(e.kind(), format!("{context}: {e}"))
         }
     }
@@ -259,6 +400,8 @@ impl Error {
     pub fn in_file(self, context: impl fmt::Display) -> Error {
         Error {
             file: self.file,
+            cause: self.cause,
+            source: self.source,
             ..Error::new(self.kind, format!("{context}: {}", self.message))
         }
     }
@@ -315,17 +458,38 @@ impl fmt::Display for Error {
     }
 }
 
-impl std::error::Error for Error {}
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.source
+            .as_deref()
+            .map(|e| e as &(dyn std::error::Error + 'static))
+    }
+}
 
-impl<E: Classify + fmt::Display> From<E> for Error {
+impl<E: Classify + std::error::Error + Send + Sync + 'static> From<E> for Error {
     fn from(e: E) -> Error {
-        Error::from_library(&e)
+        Error::from_library(&e).with_source(e)
     }
 }
 
 impl Classify for DataError {
     fn kind(&self) -> ErrorKind {
         ErrorKind::Input
+    }
+
+    fn cause(&self) -> Option<ErrorCause> {
+        let at = |line: u64, column: Option<u64>| ErrorCause::Parse {
+            line: Some(line),
+            column,
+        };
+        match self {
+            DataError::Json { line, column, .. } => Some(at(*line, Some(*column))),
+            DataError::MissingColumn { line, .. }
+            | DataError::DuplicateColumn { line, .. }
+            | DataError::FieldCount { line, .. }
+            | DataError::BadValue { line, .. } => Some(at(*line, None)),
+            _ => None,
+        }
     }
 
     fn file_failure(&self) -> Option<FileFailure> {
@@ -341,6 +505,20 @@ impl Classify for DescriptionError {
         ErrorKind::Input
     }
 
+    fn cause(&self) -> Option<ErrorCause> {
+        match self {
+            DescriptionError::Json { source } => Some(ErrorCause::Parse {
+                line: Some(source.line() as u64),
+                column: Some(source.column() as u64),
+            }),
+            DescriptionError::NewerFormat(n) => Some(ErrorCause::NewerFormat {
+                found: n.found,
+                supported: n.supported,
+            }),
+            _ => None,
+        }
+    }
+
     fn file_failure(&self) -> Option<FileFailure> {
         match self {
             DescriptionError::Io { path, source } => Some(FileFailure::new(path.clone(), source)),
@@ -352,6 +530,15 @@ impl Classify for DescriptionError {
 impl Classify for RecordError {
     fn kind(&self) -> ErrorKind {
         ErrorKind::Input
+    }
+
+    fn cause(&self) -> Option<ErrorCause> {
+        match self {
+            RecordError::Edited { fields, .. } => Some(ErrorCause::SealBroken {
+                fields: fields.clone(),
+            }),
+            _ => None,
+        }
     }
 }
 

@@ -168,7 +168,7 @@ impl FleetResult {
             None => 0,
             Some(_) => b.exit_code().max(tricept_fleet::EXIT_INADEQUATE),
         };
-        let what = format!("--write-prior {}", path.display());
+        let what = path.display().to_string();
         let forced =
             crate::machine_file::write_rule(&what, code, why.as_deref().unwrap_or(""), force)?;
         let data_files = b

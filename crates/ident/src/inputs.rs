@@ -30,7 +30,7 @@ use crate::limits;
 /// use tricept_ident::advanced::{SensorNoise, load_machine};
 /// let noise = SensorNoise { angle_noise_arcsec: Some(2.0), ..SensorNoise::default() };
 /// let loaded = load_machine(None, &noise).unwrap();
-/// assert!((loaded.machine().sensors.angle_rad - 2.0 / 206_264.806).abs() < 1e-9);
+/// assert!((loaded.geometry().sensors.angle_rad - 2.0 / 206_264.806).abs() < 1e-9);
 /// ```
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SensorNoise {
@@ -61,8 +61,16 @@ impl LoadedMachine {
         &self.description
     }
 
-    /// The validated machine, noise overrides applied.
-    pub fn machine(&self) -> &Machine {
+    /// The validated machine, noise overrides applied (crate-internal:
+    /// the fits and readers take the geometric machine).
+    pub(crate) fn machine(&self) -> &Machine {
+        &self.machine
+    }
+
+    /// The geometric machine, noise overrides applied: what a data reader
+    /// and a fit take. Its own kinematics ignore the leg effects of the
+    /// file; command the machine through [`LoadedMachine::commanding`].
+    pub fn geometry(&self) -> &Machine {
         &self.machine
     }
 
@@ -153,9 +161,13 @@ pub fn description_error(path: &str, e: &DescriptionError) -> Error {
         DescriptionError::Io { .. } => e.to_string(),
         _ => format!("{path}: {e}"),
     };
-    match e.file_failure() {
+    let error = match e.file_failure() {
         Some(f) => Error::input(message).with_file_failure(f),
         None => Error::input(message),
+    };
+    match e.cause() {
+        Some(cause) => error.with_cause(cause),
+        None => error,
     }
 }
 
@@ -234,7 +246,7 @@ impl LoadedMachine {
             )));
         }
         let notes = tricept_engine::check_calibration_record(&description)
-            .map_err(|e| Error::input(format!("{source}: {e}")))?;
+            .map_err(|e| Error::with_context(&source, &e))?;
         let mut warnings = Vec::new();
         if let Some(w) = notes.warning() {
             warnings.push(format!("{source}: {w}"));
@@ -333,9 +345,9 @@ pub fn positive(flag: &str, v: f64) -> Result<f64, Error> {
 /// # Example
 /// ```
 /// use tricept_ident::advanced::Poses;
-/// use tricept_ident::kinematics::Machine;
+/// use tricept_ident::kinematics::GeometricMachine;
 /// let poses: Poses = "random:10,1".parse().unwrap();
-/// assert_eq!(poses.targets(&Machine::paper()).unwrap().len(), 10);
+/// assert_eq!(poses.targets(&GeometricMachine::paper()).unwrap().len(), 10);
 /// assert!("optimal:0".parse::<Poses>().is_err());
 /// ```
 #[derive(Debug, Clone, PartialEq)]

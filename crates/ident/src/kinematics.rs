@@ -11,9 +11,12 @@ use serde_json::{Map, Value};
 use crate::error::{EXIT_OK, Error};
 use crate::inputs::LoadedMachine;
 
-pub use nalgebra::Vector3;
+pub use crate::commanding::{GeometricMachine, Machine, Vector3};
 pub use tricept_kinematics::batch::{BLOCK_ROWS, BatchError, Cell, Verb, run};
-pub use tricept_kinematics::{HeadBranch, KinematicsError, Machine, MachineDescription};
+pub use tricept_kinematics::{
+    FkSolution, HeadBranch, IkSolution, KinematicsError, MachineDescription, ToolIkSolution,
+    UpJoints,
+};
 pub use tricept_model::ExtendedMachine;
 
 /// Runs `verb` on every row of `input` ([`run`]) as the CLI does:
@@ -129,7 +132,7 @@ impl PointSolution {
 /// effects, the controller parameters and the calibration record.
 pub fn machine_summary(loaded: &LoadedMachine) -> String {
     let (d, m, source) = (loaded.description(), loaded.machine(), loaded.source());
-    let v = |p: &Vector3<f64>| format!("({:.3}, {:.3}, {:.3})", p.x, p.y, p.z);
+    let v = |p: &Vector3| format!("({:.3}, {:.3}, {:.3})", p.x, p.y, p.z);
     let mut lines = vec![format!("{} (from {source})", d.name)];
     if let Some(n) = &d.notes {
         lines.push(format!("  notes: {n}"));

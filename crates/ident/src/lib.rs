@@ -35,6 +35,7 @@
 //! process exit code, one mapping for every verb ([`Error::exit_code`]).
 //!
 #![doc = include_str!("first_example.md")]
+#![deny(missing_docs)]
 #![cfg_attr(
     not(test),
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
@@ -42,9 +43,11 @@
 
 // Layer 0: errors, limits and inputs.
 mod accuracy;
+mod commanding;
 mod data_input;
 mod error;
 mod inputs;
+mod json_version;
 mod limits;
 mod machine_file;
 mod machine_input;
@@ -74,7 +77,8 @@ pub mod advanced;
 
 // The error and the exit codes.
 pub use error::{
-    EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error, ErrorKind,
+    EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error, ErrorCause,
+    ErrorKind,
 };
 
 // The two inputs every workflow is fed: the machine and the measured data.

@@ -139,8 +139,9 @@ pub fn write_rule(what: &str, code: u8, why: &str, force: bool) -> Result<Option
         (_, true) => Ok(Some(why.to_string())),
         (_, false) => Err(Error::new(
             crate::ErrorKind::of_exit_code(code),
-            format!("{what}: not written: {why}; --force writes it anyway, marked as forced"),
-        )),
+            format!("{what}: not written: {why}"),
+        )
+        .with_cause(crate::ErrorCause::RefusedWrite)),
     }
 }
 
@@ -438,7 +439,7 @@ impl MachineFile {
     /// `force`; the record's `date` is the time of writing. Returns the
     /// warning of a forced write.
     pub fn write(&self, path: &Path, force: bool) -> Result<Option<String>, Error> {
-        let what = format!("--write-machine {}", path.display());
+        let what = path.display().to_string();
         let forced = write_rule(&what, self.code, &self.why, force)?;
         let mut d = self.description.clone();
         if let Some(c) = d.calibration.as_mut() {

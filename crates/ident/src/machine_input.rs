@@ -25,7 +25,7 @@ use crate::inputs::{LoadedMachine, SensorNoise, load_machine};
 /// assert!(input.path().is_none());
 /// let loaded = input.load().unwrap();
 /// assert_eq!(loaded.source(), "the built-in Table 1 machine");
-/// assert!((loaded.machine().sensors.angle_rad - 2.0 / 206_264.806).abs() < 1e-9);
+/// assert!((loaded.geometry().sensors.angle_rad - 2.0 / 206_264.806).abs() < 1e-9);
 /// // A loaded machine is an input too, and keeps where it came from.
 /// assert!(MachineInput::from(loaded).path().is_none());
 /// ```
@@ -104,6 +104,42 @@ impl From<PathBuf> for MachineInput {
 impl From<&str> for MachineInput {
     fn from(path: &str) -> MachineInput {
         MachineInput::from(PathBuf::from(path))
+    }
+}
+
+impl From<String> for MachineInput {
+    fn from(path: String) -> MachineInput {
+        MachineInput::from(PathBuf::from(path))
+    }
+}
+
+impl From<&String> for MachineInput {
+    fn from(path: &String) -> MachineInput {
+        MachineInput::from(PathBuf::from(path))
+    }
+}
+
+/// A machine file by any name a program holds: `&str`, `String`, `&Path`,
+/// `PathBuf` or `&PathBuf`.
+///
+/// # Example
+/// ```
+/// use std::path::PathBuf;
+/// use tricept_ident::MachineInput;
+/// let file = PathBuf::from("calibrated.json");
+/// for input in [
+///     MachineInput::from(&file),
+///     MachineInput::from(file.clone()),
+///     MachineInput::from(file.as_path()),
+///     MachineInput::from("calibrated.json"),
+///     MachineInput::from(String::from("calibrated.json")),
+/// ] {
+///     assert_eq!(input.path(), Some(file.as_path()));
+/// }
+/// ```
+impl From<&PathBuf> for MachineInput {
+    fn from(path: &PathBuf) -> MachineInput {
+        MachineInput::from(path.clone())
     }
 }
 

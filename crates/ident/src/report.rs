@@ -277,6 +277,14 @@ fn export(dir: &Path) -> Result<Source, Error> {
             "{file}: {e}: --export names the folder tricept export --out wrote"
         ))
     })?;
+    let newer = tricept_kinematics::description::newer_format(
+        &text,
+        "export summary",
+        tricept_export::SUMMARY_FORMAT_VERSION,
+    );
+    if let Some(newer) = newer {
+        return Err(Error::input(format!("{file}: {newer}")));
+    }
     let json: Value = serde_json::from_str(&text)
         .map_err(|e| Error::input(format!("{file}: not an export summary: {e}")))?;
     Ok(Source::new(

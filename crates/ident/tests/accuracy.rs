@@ -27,11 +27,12 @@ use std::path::Path;
 
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
+use tricept_ident::advanced::nalgebra::Vector3;
 use tricept_ident::advanced::{SensorNoise, load_machine};
 use tricept_ident::calibrate::{CalibrateRequest, calibrate};
 use tricept_ident::compensate::{Calibrated, CompensateRequest, compensate};
 use tricept_ident::diagnosis::{DeployRule, DiagnoseRequest, diagnose};
-use tricept_ident::kinematics::{Machine, Vector3};
+use tricept_ident::kinematics::GeometricMachine as Machine;
 use tricept_ident::{DataInput, MachineInput};
 use tricept_truth::{LegContext, LegEffect, Row, TrueMachine, to_csv};
 

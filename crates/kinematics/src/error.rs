@@ -92,6 +92,10 @@ pub enum DescriptionError {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// The file declares a `format_version` newer than this tricept reads
+    /// (refused before its other keys are read).
+    #[error("{0}")]
+    NewerFormat(#[from] crate::description::NewerFormat),
     /// The description parsed but describes an impossible machine.
     #[error("invalid machine description: {key}: {reason}")]
     Invalid {

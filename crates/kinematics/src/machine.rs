@@ -228,6 +228,7 @@ impl Machine {
         let v3 = |v: &Vector3<f64>| [v.x, v.y, v.z];
         let w = &self.workspace;
         MachineDescription {
+            format_version: crate::description::FORMAT_VERSION,
             name: self.name.clone(),
             notes: None,
             placement: Placement::Explicit(crate::description::ExplicitPlacement {

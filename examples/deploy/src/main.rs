@@ -13,7 +13,7 @@
 
 use tricept_ident::MachineInput;
 use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
-use tricept_ident::kinematics::{ExtendedMachine, Vector3};
+use tricept_ident::kinematics::{Machine, Vector3};
 
 /// The data file when none is given: a campaign with a hidden compliance.
 const DEFAULT_DATA: &str = concat!(
@@ -26,7 +26,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::env::args().nth(1);
     let path = path.as_deref().unwrap_or(DEFAULT_DATA);
     let loaded = MachineInput::default().load()?;
-    let nominal = loaded.machine().clone();
+    let nominal = loaded.commanding();
     let result = diagnose(DiagnoseRequest::new(loaded, path))?;
     for c in &result.diagnosis().causes {
         println!("{}: {}", c.effect, c.description);
@@ -44,14 +44,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(c) = &deployed.controller {
         println!("controller: {c:?}");
     }
-    let e = &deployed.machine.leg_effects;
+    let e = &deployed.geometry.leg_effects;
     println!(
         "leg effects: lead {:?} ppm, compliance {} um/kN at 1 m, {} compensation tables",
         e.lead_ppm,
         e.compliance_um_per_kn_at_1m,
         e.tables.len()
     );
-    let calibrated = ExtendedMachine::new(deployed.machine);
+    let calibrated = Machine::from(&deployed);
     let target = Vector3::new(0.0, 0.0, 750.0);
     let q = calibrated.inverse(&target)?.legs_mm;
     let q_nominal = nominal.inverse(&target)?.legs_mm;

@@ -19,7 +19,7 @@ use std::process::ExitCode;
 use tricept_ident::calibrate::{CalibrateRequest, Calibration, calibrate};
 use tricept_ident::check::{CheckRequest, check};
 use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
-use tricept_ident::kinematics::{ExtendedMachine, Vector3};
+use tricept_ident::kinematics::{Machine, Vector3};
 use tricept_ident::{EXIT_OK, Error, MachineInput};
 
 fn main() -> ExitCode {
@@ -90,7 +90,7 @@ fn write_machine(calibration: &mut Calibration, out: &Path) -> Result<(), Error>
 
 /// Step 3: command the calibrated machine.
 fn command(calibration: &Calibration) -> Result<(), Error> {
-    let calibrated = ExtendedMachine::new(calibration.identified());
+    let calibrated = calibration.identified();
     println!("x,y,z,q1,q2,q3");
     for r in [
         Vector3::new(0.0, 0.0, 750.0),
@@ -114,7 +114,7 @@ fn diagnose_and_deploy(path: &Path, out: &Path) -> Result<(), Box<dyn std::error
         return Err(why.into());
     }
     let deployed = result.deploy()?;
-    let q = ExtendedMachine::new(deployed.machine)
+    let q = Machine::from(&deployed)
         .inverse(&Vector3::new(0.0, 0.0, 750.0))?
         .legs_mm;
     println!("deployed: leg commands at the centre {q:?} mm");

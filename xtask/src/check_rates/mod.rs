@@ -296,7 +296,7 @@ pub fn outcomes(
             let mut rng = Pcg64Mcg::seed_from_u64(campaign_seed(seed, s, k, c));
             let (rows, hidden) = machine.campaign(scenario, commands, c, &mut rng);
             let name = format!("check-{s}-{k}-{c}.csv");
-            let data = read_data_from(Cursor::new(to_csv(&rows)), &name, machine.loaded.machine())
+            let data = read_data_from(Cursor::new(to_csv(&rows)), &name, machine.loaded.geometry())
                 .map_err(|e| e.to_string())?;
             let bad_line = hidden
                 .bad_row

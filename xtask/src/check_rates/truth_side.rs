@@ -150,7 +150,7 @@ impl Calibrated {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         let truth = TrueMachine::random(0.0, seed);
         let nominal = load_machine(None, &SensorNoise::default()).map_err(|e| e.to_string())?;
-        let m = nominal.machine();
+        let m = nominal.geometry();
         let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0xca11_b4a7);
         let rows = m
             .workspace

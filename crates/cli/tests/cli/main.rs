@@ -9,7 +9,9 @@
 mod bad_inputs;
 mod check;
 mod closed_stdout;
+mod compat;
 mod docs;
+mod door;
 mod edges;
 mod exit_codes;
 mod export;
@@ -21,6 +23,7 @@ mod one_exit_code;
 mod outputs;
 mod relied_on;
 mod report;
+mod schema;
 mod seal;
 mod support;
 mod trust;

@@ -116,7 +116,7 @@ fn run(label: &str, seed: u64, n: usize, effect: Effect) -> Outcome {
     // file.
     let written = d.final_adequate;
     let deployed = deploy(&nominal, None, &data, &d).expect("deploy");
-    let json = serde_json::to_string(&deployed.machine.to_description()).expect("json");
+    let json = serde_json::to_string(&deployed.geometry.to_description()).expect("json");
     let machine = MachineDescription::from_json(&json)
         .and_then(|m| m.build())
         .expect("the written file loads");

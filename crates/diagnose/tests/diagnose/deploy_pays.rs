@@ -253,7 +253,7 @@ fn run(case: usize, seed: u64, n: usize, rule: DeployRule) -> Outcome {
     let id = identify(&model, &data, &IdentifyOptions::for_machine(&nominal)).expect("identify");
     let geometric = ExtendedMachine::new(model.machine_at(&id.estimate));
     let deployed = deploy(&nominal, None, &data, &d).expect("deploy");
-    let json = serde_json::to_string(&deployed.machine.to_description()).expect("json");
+    let json = serde_json::to_string(&deployed.geometry.to_description()).expect("json");
     let file = MachineDescription::from_json(&json)
         .and_then(|m| m.build())
         .map(ExtendedMachine::new)
@@ -286,7 +286,7 @@ fn run(case: usize, seed: u64, n: usize, rule: DeployRule) -> Outcome {
         let mut all = d.clone();
         all.model_terms.iter_mut().for_each(|t| t.deployed = true);
         let every = deploy(&nominal, None, &data, &all).expect("deploy all");
-        let f = ExtendedMachine::new(every.machine.clone());
+        let f = ExtendedMachine::new(every.geometry.clone());
         println!(
             "ALL {} n={n} seed {seed}: every term deployed {:.1} um",
             CASES[case],

@@ -77,7 +77,7 @@ fn stroke(data: &Dataset, leg: usize) -> (f64, f64) {
 
 /// The table of leg `leg` (1-3).
 fn table(d: &Deployed, leg: u8) -> &LegTableDescription {
-    d.machine
+    d.geometry
         .leg_effects
         .tables
         .iter()
@@ -202,7 +202,7 @@ fn records_sensor_and_time_terms_and_the_terms_not_worth_deploying() {
     // And why each was kept back.
     assert!(seen.contains("; kept back because a reason;"), "{seen}");
     // Neither applies a table; nothing else is applied but the scale gain's absence.
-    assert!(d.machine.leg_effects.tables.is_empty(), "{:?}", d.applied);
+    assert!(d.geometry.leg_effects.tables.is_empty(), "{:?}", d.applied);
 }
 
 #[test]
@@ -394,7 +394,7 @@ fn an_effect_with_a_parameter_per_leg_deploys_each_to_its_leg() {
             true,
         )],
     );
-    let lead = d.machine.leg_effects.lead_ppm;
+    let lead = d.geometry.leg_effects.lead_ppm;
     for leg in 0..3 {
         assert!((lead[leg] - truth[leg]).abs() < 10.0, "{lead:?}");
     }

@@ -70,7 +70,7 @@ pub(crate) struct Said {
 
 impl Said {
     /// What the internal (or pooled) fit `f` of the data `name` says.
-    pub fn of_internal(f: &InternalFit, loaded: &LoadedMachine, name: &str) -> Said {
+    pub(crate) fn of_internal(f: &InternalFit, loaded: &LoadedMachine, name: &str) -> Said {
         let exit_code = f.exit_code();
         let reason = f.reason();
         Said {

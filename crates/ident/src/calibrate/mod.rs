@@ -348,8 +348,28 @@ impl Calibration {
         &self.loaded
     }
 
-    /// The identified machine.
-    pub fn identified(&self) -> Machine {
+    /// The identified machine, to command: its kinematics apply every
+    /// effect it carries (the leg effects of the machine calibrated
+    /// against, kept), as a machine file written from this calibration
+    /// and loaded again does.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+    /// use tricept_ident::kinematics::Vector3;
+    /// let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/table2-grid-seed1.csv");
+    /// let calibration = calibrate(CalibrateRequest::new(file))?;
+    /// let ik = calibration.identified().inverse(&Vector3::new(0.0, 0.0, 750.0))?;
+    /// assert!(ik.legs_mm.iter().all(|q| q.is_finite()));
+    /// # Ok::<(), tricept_ident::Error>(())
+    /// ```
+    pub fn identified(&self) -> crate::kinematics::Machine {
+        crate::kinematics::Machine::from_geometry(self.identified_geometry())
+    }
+
+    /// The identified geometric machine (the fits' and the machine file's
+    /// writer's view).
+    pub(crate) fn identified_geometry(&self) -> Machine {
         match &self.fit {
             Fit::Internal(f) => f.identified(),
             Fit::Fused(f) => f.model.machine_at(&f.fit.estimate),
@@ -434,7 +454,7 @@ impl Calibration {
     /// write rule: a fit whose exit code is not 0 is refused (an error of
     /// that code) unless `force`, and the file then says it was forced.
     pub fn write_machine(&mut self, path: &Path, force: bool) -> Result<Written, Error> {
-        let what = format!("--write-machine {}", path.display());
+        let what = path.display().to_string();
         let code = self.exit_code();
         let forced = match machine_file::write_rule(&what, code, &self.reason(), force) {
             Ok(forced) => forced,

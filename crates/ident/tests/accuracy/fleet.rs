@@ -32,7 +32,7 @@ use serde_json::Value;
 use tricept_ident::advanced::ParameterSet;
 use tricept_ident::calibrate::{CalibrateRequest, calibrate};
 use tricept_ident::fleet::{FleetRequest, fleet};
-use tricept_ident::kinematics::Machine;
+use tricept_ident::kinematics::GeometricMachine as Machine;
 use tricept_ident::{DataInput, EXIT_INADEQUATE, EXIT_OK};
 use tricept_truth::{Row, SensorNoise, TrueMachine, normal, to_csv};
 

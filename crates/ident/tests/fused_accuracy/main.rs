@@ -36,9 +36,10 @@ use std::path::{Path, PathBuf};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use tricept_ident::DataInput;
+use tricept_ident::advanced::nalgebra::Vector3;
 use tricept_ident::advanced::{SensorNoise, TrackerTargetSpec, Triple, load_machine};
 use tricept_ident::calibrate::{CalibrateRequest, FusedSources, calibrate};
-use tricept_ident::kinematics::{Machine, Vector3, Verb as KinematicsVerb, solve_point};
+use tricept_ident::kinematics::{GeometricMachine as Machine, Verb as KinematicsVerb, solve_point};
 use tricept_ident::plan::{Instrument, PlanRequest, plan};
 use tricept_truth::{
     HeadSizes, LegEffect, Row, TrueBallbar, TrueMachine, TrueSphere, TrueTracker, normal, to_csv,

@@ -11,7 +11,9 @@
 //! - `validate.rs`: [`MachineDescription::validate`], the checks that refuse
 //!   impossible geometry and implausible values;
 //! - `identity.rs`: [`MachineDescription::calibration_digest`], the digest
-//!   a calibration's check history and export name it by.
+//!   a calibration's check history and export name it by;
+//! - `version.rs`: the file's `format_version` ([`FORMAT_VERSION`]) and
+//!   the refusal of a file newer than this reader ([`NewerFormat`]).
 //!
 //! A description is what a user writes and what `--machine FILE` loads. It is
 //! deliberately verbose: every key carries its unit in its name (`_mm`,
@@ -32,6 +34,7 @@ mod identity;
 mod record;
 mod seal;
 mod validate;
+mod version;
 
 use geometry::is_zero3;
 
@@ -47,6 +50,9 @@ pub use record::{
 };
 pub use seal::{SealCheck, seal_digest};
 pub use validate::{MAX_TABLE_EXTRA_UM, MAX_TABLE_POINTS, MAX_TABLE_SLOPE_UM_PER_MM};
+pub use version::{
+    FORMAT_VERSION, FORMAT_VERSION_KEY, NewerFormat, UNVERSIONED, check_version, newer_format,
+};
 
 /// The JSON text of the paper's Table 1 machine, embedded at compile time.
 pub const PAPER_MACHINE_JSON: &str = include_str!(concat!(
@@ -70,6 +76,11 @@ pub const MAX_LENGTH_MM: f64 = 1e5;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MachineDescription {
+    /// The file's format version: [`FORMAT_VERSION`] as this tricept
+    /// writes it; a file without the key is version 1 ([`UNVERSIONED`]),
+    /// and one newer than [`FORMAT_VERSION`] is refused on load.
+    #[serde(default = "version::unversioned")]
+    pub format_version: u32,
     /// Free-form name shown in reports.
     pub name: String,
     /// Free-form notes (provenance, assumptions); ignored by the solvers.
@@ -225,10 +236,26 @@ impl MachineDescription {
         }
     }
 
-    /// Parses and validates a description from JSON text.
+    /// Parses and validates a description from JSON text. A text whose
+    /// `format_version` is newer than [`FORMAT_VERSION`] is refused first
+    /// ([`DescriptionError::NewerFormat`]), whatever else it holds.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_kinematics::{DescriptionError, MachineDescription};
+    /// let text = MachineDescription::paper().to_json().replace(
+    ///     "\"format_version\": 1,",
+    ///     "\"format_version\": 2, \"a_key_of_version_2\": true,",
+    /// );
+    /// let e = MachineDescription::from_json(&text).unwrap_err();
+    /// assert!(matches!(e, DescriptionError::NewerFormat(_)), "{e}");
+    /// ```
     pub fn from_json(text: &str) -> Result<MachineDescription, DescriptionError> {
         // A byte-order mark, as some editors write, is not part of the JSON.
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        if let Some(newer) = version::newer_format(text, "machine file", FORMAT_VERSION) {
+            return Err(newer.into());
+        }
         let d: MachineDescription = serde_json::from_str(text)?;
         d.validate()?;
         Ok(d)

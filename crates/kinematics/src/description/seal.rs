@@ -23,6 +23,12 @@
 //! `float_roundtrip` parser, a workspace feature, the value is exactly the
 //! written one). A field added or removed is named as such.
 //!
+//! The file's `format_version` is a field like any other, sealed. A seal
+//! written before files had versions does not name it; a file without the
+//! key is version 1, so the key read back as 1 (at any depth: the nominal
+//! machine inside the record has one too) is not an addition, and every
+//! other value of it is.
+//!
 //! Files sealed before the seal covered every field (issue 45) carry the
 //! digests of a chosen list (the standard deviations, correlations, sensor
 //! offsets, temperature, effects, fit quality, noise, controller and
@@ -208,8 +214,10 @@ fn fnv1a(text: &str) -> String {
 impl MachineDescription {
     /// Seals the calibration record: the digest of every field of the
     /// file ([`CalibrationRecord::seal`](super::CalibrationRecord::seal),
-    /// the module docs). Call it last, on the description as it is
-    /// written; nothing happens without a calibration.
+    /// the module docs), the file's `format_version` set to this
+    /// tricept's ([`FORMAT_VERSION`](super::FORMAT_VERSION)) first. Call
+    /// it last, on the description as it is written; nothing happens
+    /// without a calibration.
     ///
     /// # Example
     /// ```
@@ -222,6 +230,8 @@ impl MachineDescription {
         if self.calibration.is_none() {
             return;
         }
+        // What this tricept writes is its own format.
+        self.format_version = super::FORMAT_VERSION;
         let mut seal: BTreeMap<String, String> = leaves(self)
             .into_iter()
             .map(|(name, text)| (name, fnv1a(&text)))
@@ -246,6 +256,7 @@ impl MachineDescription {
             let mut edited: Vec<String> = now
                 .iter()
                 .filter_map(|(name, text)| match seal.get(name) {
+                    None if super::version::is_unversioned_leaf(name, text) => None,
                     None => Some(format!("{name} (added)")),
                     Some(d) if *d != fnv1a(text) => Some(name.clone()),
                     Some(_) => None,
@@ -450,6 +461,46 @@ mod tests {
         // warning.
         let e = edited(&d, "/workspace/radius_mm", |_| Value::from(300.0));
         assert!(e.seal_is_partial());
+    }
+
+    #[test]
+    fn the_format_version_is_sealed_and_a_seal_older_than_it_still_holds() {
+        let mut d = calibrated();
+        d.format_version = 0;
+        d.seal();
+        assert_eq!(d.format_version, crate::description::FORMAT_VERSION);
+        let seal = d.calibration.as_ref().unwrap().seal.clone().unwrap();
+        assert!(seal.contains_key("format_version"));
+        assert!(seal.contains_key("calibration.nominal.format_version"));
+        let e = edited(&d, "/format_version", |_| Value::from(2));
+        assert_eq!(
+            e.seal_check(),
+            SealCheck::Edited(vec!["format_version".into()])
+        );
+        // A file sealed before files had versions: neither the key nor its
+        // digest. Read back, the key is version 1 and no edit.
+        let mut old = serde_json::to_value(&d).unwrap();
+        old.as_object_mut().unwrap().remove("format_version");
+        old["calibration"]["nominal"]
+            .as_object_mut()
+            .unwrap()
+            .remove("format_version");
+        let seal = old["calibration"]["seal"].as_object_mut().unwrap();
+        seal.remove("format_version");
+        seal.remove("calibration.nominal.format_version");
+        let back: MachineDescription = serde_json::from_value(old.clone()).unwrap();
+        assert_eq!(back.format_version, 1);
+        assert_eq!(back.seal_check(), SealCheck::Intact { partial: false });
+        // Written back by this reader (the key as 1): still intact; any
+        // other version is an addition the old seal names.
+        let again: MachineDescription = serde_json::from_str(&back.to_json()).unwrap();
+        assert_eq!(again.seal_check(), SealCheck::Intact { partial: false });
+        old["format_version"] = 2.into();
+        let two: MachineDescription = serde_json::from_value(old).unwrap();
+        assert_eq!(
+            two.seal_check(),
+            SealCheck::Edited(vec!["format_version (added)".into()])
+        );
     }
 
     #[test]

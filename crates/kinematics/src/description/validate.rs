@@ -6,8 +6,11 @@ use super::{MAX_HEAD_ANGLE_OFFSET_RAD, MAX_LENGTH_MM, MachineDescription, Placem
 use crate::error::DescriptionError;
 
 impl MachineDescription {
-    /// Checks that the description is a possible machine.
+    /// Checks that the description is a possible machine, of a format
+    /// version this tricept reads (its own and the machines inside its
+    /// calibration record).
     pub fn validate(&self) -> Result<(), DescriptionError> {
+        super::check_version(self.format_version, "machine file", super::FORMAT_VERSION)?;
         let invalid = |key: &str, reason: String| DescriptionError::Invalid {
             key: key.to_string(),
             reason,
@@ -135,6 +138,9 @@ impl MachineDescription {
             }
         }
         if let Some(c) = &self.calibration {
+            if let Some(r) = &c.relative_to_machine {
+                super::check_version(r.format_version, "machine file", super::FORMAT_VERSION)?;
+            }
             c.nominal.validate().map_err(|e| match e {
                 DescriptionError::Invalid { key, reason } => DescriptionError::Invalid {
                     key: format!("calibration.nominal.{key}"),

@@ -19,8 +19,10 @@ fn batch_kinematics_write_the_json_keys_as_csv_columns() {
     let csv = String::from_utf8(out.stdout).unwrap();
     let (_, header, rows) = parts(&csv);
     let single = json(&run(&["ik", "-120.5", "80", "700", "--json"]));
+    // The CSV's columns are the JSON's keys after its `format_version`.
     let keys: Vec<String> = single.as_object().unwrap().keys().cloned().collect();
-    assert_eq!(header, keys);
+    assert_eq!(keys[0], "format_version");
+    assert_eq!(header, keys[1..]);
     // (serde_json reads floats to within an ulp, hence the tolerance.)
     let same = |a: f64, b: f64| (a - b).abs() <= 1e-15 * a.abs().max(b.abs());
     for (k, v) in header.iter().zip(&rows[1]) {
@@ -50,7 +52,7 @@ fn batch_kinematics_write_the_json_keys_as_csv_columns() {
     let (_, h, back) = parts(std::str::from_utf8(&out.stdout).unwrap());
     let single_fk = json(&run(&["fk", "773", "773", "773", "--json"]));
     let keys: Vec<String> = single_fk.as_object().unwrap().keys().cloned().collect();
-    assert_eq!(h, keys);
+    assert_eq!(h, keys[1..]);
     let x = col(&h, "x");
     assert!((back[1][x].parse::<f64>().unwrap() + 120.5).abs() < 1e-9);
     // tool-ik too.
@@ -61,7 +63,7 @@ fn batch_kinematics_write_the_json_keys_as_csv_columns() {
         "tool-ik", "150", "100", "1080", "0.2", "-0.1", "1", "--json",
     ]));
     let (_, h, r) = parts(std::str::from_utf8(&out.stdout).unwrap());
-    assert_eq!(h.len(), single.as_object().unwrap().len());
+    assert_eq!(h.len() + 1, single.as_object().unwrap().len());
     assert!(same(
         r[0][col(&h, "h2")].parse::<f64>().unwrap(),
         single["h2"].as_f64().unwrap()
