@@ -32,7 +32,15 @@
 //! needs are in [`advanced`].
 //!
 //! Errors: every failure is an [`Error`] whose [`ErrorKind`] decides the
-//! process exit code, one mapping for every verb ([`Error::exit_code`]).
+//! process exit code, one mapping for every verb ([`Error::exit_code`]),
+//! and whose [`ErrorCause`] ([`Error::cause`]) says what failed for a
+//! program to match on (a file not found, a parse error at a line and
+//! column, a sealed file edited, a refused write, ...).
+//!
+//! Commanding a machine: [`kinematics::Machine`] applies everything a
+//! machine file carries (the geometry and the leg effects a diagnosis
+//! deploys), as `tricept ik --machine` does; the geometric machine alone
+//! is only [`kinematics::Machine::geometry`].
 //!
 #![doc = include_str!("first_example.md")]
 #![deny(missing_docs)]
