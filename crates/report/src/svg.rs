@@ -65,6 +65,30 @@ pub fn range(values: impl IntoIterator<Item = f64>, include: &[f64]) -> (f64, f6
     (lo - pad, hi + pad)
 }
 
+/// A time axis in days for `days`: [`range`] of them, but at least one day
+/// wide, so that checks made seconds apart (a script, a test) are drawn at
+/// the left of a day rather than on an axis of millionths of a day whose
+/// labels would not fit.
+///
+/// # Example
+/// ```
+/// let (lo, hi) = tricept_report::svg::days_range([0.0, 2e-7]);
+/// assert!(hi - lo >= 1.0 && lo < 0.0 && hi > 1.0);
+/// let (_, decimals) = tricept_report::svg::ticks(lo, hi, 6);
+/// assert!(decimals <= 1);
+/// // Checks weeks apart keep their own range.
+/// assert_eq!(tricept_report::svg::days_range([0.0, 30.0]), tricept_report::svg::range([0.0, 30.0], &[]));
+/// ```
+pub fn days_range(days: impl IntoIterator<Item = f64>) -> (f64, f64) {
+    let days: Vec<f64> = days.into_iter().filter(|d| d.is_finite()).collect();
+    let first = days.iter().copied().fold(f64::INFINITY, f64::min);
+    let last = days.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if days.is_empty() || last - first >= 1.0 {
+        return range(days, &[]);
+    }
+    (first - 0.05, first + 1.05)
+}
+
 /// Tick positions for `lo..hi`: steps of 1, 2 or 5 times a power of ten,
 /// about `n` of them, with the decimals their labels need.
 ///

@@ -8,7 +8,7 @@ use serde_json::Value;
 use crate::html::{figure, legend, list, p, section as wrap, table};
 use crate::json::{Digits, Lookup, escape};
 use crate::sources::Sources;
-use crate::svg::{Plot, range};
+use crate::svg::{Plot, days_range, range};
 
 const TITLE: &str = "5. Daily checks";
 
@@ -135,7 +135,7 @@ pub fn section(l: &Lookup<'_>, sources: &Sources) -> String {
 /// The checks' verdicts on a time line, the named change beside a change.
 fn timeline(l: &Lookup<'_>, days: &[f64]) -> String {
     let h = "history";
-    let (lo, hi) = range(days.iter().copied(), &[]);
+    let (lo, hi) = days_range(days.iter().copied());
     let mut plot = Plot::new(
         "fig-check-verdicts",
         "The checks' verdicts over time",
@@ -199,7 +199,7 @@ fn trend_plot(l: &Lookup<'_>, k: usize) -> String {
         .flat_map(|(v, s)| [v - 2.0 * s, v + 2.0 * s])
         .chain(band.iter().flat_map(|b| [-b, *b]));
     let (ylo, yhi) = range(spread, &[0.0]);
-    let (xlo, xhi) = range(days.iter().copied(), &[]);
+    let (xlo, xhi) = days_range(days.iter().copied());
     let mut plot = Plot::new(
         &format!("fig-trend-{}", k + 1),
         &format!("{name} at each check against its band, {unit}"),
