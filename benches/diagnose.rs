@@ -11,7 +11,7 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use tricept_diagnose::{DiagnoseOptions, diagnose};
-use tricept_engine::{GeometricModel, IdentifyOptions, identify_robust};
+use tricept_engine::{IdentifyOptions, model::GeometricModel, robust::identify_robust};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_plant::effects::{Effect, Waveform};

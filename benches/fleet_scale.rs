@@ -21,8 +21,10 @@ use std::io::Write;
 use std::time::Instant;
 
 use tricept_benches::fleet_batch;
-use tricept_engine::{AccuracyModel, GeometricModel, IdentifyOptions, accuracy_points};
-use tricept_fleet::{BatchOptions, SolverKind, calibrate_batch};
+use tricept_engine::{
+    IdentifyOptions, accuracy::AccuracyModel, accuracy::accuracy_points, model::GeometricModel,
+};
+use tricept_fleet::{BatchOptions, batch::SolverKind, calibrate_batch};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_numerics::sparse::{BlockProblem, BlockSolution};

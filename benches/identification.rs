@@ -10,7 +10,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use tricept_engine::{GeometricModel, IdentifyOptions, identify};
+use tricept_engine::{IdentifyOptions, identify, model::GeometricModel};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_plant::{Campaign, Plant};
@@ -49,7 +49,8 @@ fn large(c: &mut Criterion) {
         group.bench_function(format!("{n}_poses_robust"), |b| {
             b.iter(|| {
                 black_box(
-                    tricept_engine::identify_robust(&model, black_box(&data), &options).unwrap(),
+                    tricept_engine::robust::identify_robust(&model, black_box(&data), &options)
+                        .unwrap(),
                 )
             })
         });
@@ -80,14 +81,14 @@ fn fused(c: &mut Criterion) {
         .iter()
         .enumerate()
         .map(|(j, r)| {
-            let pose = tricept_data::ExternalPose {
+            let pose = tricept_data::external::ExternalPose {
                 commands_mm: m.inverse(r).unwrap().legs_mm,
                 head_rad: [(j % 6) as f64 * 1.047, [-0.7, -0.4, 0.4, 0.7][j % 4]],
             };
             (pose, 0.0)
         })
         .collect();
-    let tracker = tricept_plant::Tracker {
+    let tracker = tricept_plant::instruments::Tracker {
         frame: nalgebra::Isometry3::translation(1500.0, -800.0, 200.0),
         target_offset_mm: nalgebra::Vector3::zeros(),
         sigma_um: 10.0,

@@ -7,7 +7,7 @@ use std::hint::black_box;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use tricept_kinematics::Machine;
 use tricept_study::exact::run_exact;
-use tricept_study::{GradeModel, Scenario};
+use tricept_study::{Scenario, fast::GradeModel};
 
 fn study(c: &mut Criterion) {
     let m = Machine::paper();

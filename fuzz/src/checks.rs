@@ -7,7 +7,7 @@
 //! `fuzz/regressions/<target>/` once the bug is fixed.
 
 use nalgebra::Vector3;
-use tricept_engine::{GeometricModel, IdentifyOptions, identify_robust};
+use tricept_engine::{IdentifyOptions, model::GeometricModel, robust::identify_robust};
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
@@ -40,7 +40,7 @@ pub fn machine_description(text: &str) {
     let centre = Vector3::new(0.0, 0.0, machine.workspace.mid_plane_z_mm());
     if let Ok(ik) = machine.inverse(&centre) {
         let _ = machine.forward(&ik.legs_mm);
-        let _ = tricept_model::error_jacobian(&machine, &ik.up);
+        let _ = tricept_model::jacobian::error_jacobian(&machine, &ik.up);
     }
     let _ = machine.forward(&[700.0, 800.0, 900.0]);
 }

@@ -8,8 +8,12 @@
 //! which, if any, reproduces the paper's 1.179 / 0.573 / 0.693 mm.
 
 use nalgebra::Vector3;
-use tricept_kinematics::{AxisOrder, Machine, MachineDescription, Placement};
-use tricept_model::{MapStats, ParameterSet, actual_machine, volumetric_errors};
+use tricept_kinematics::{
+    Machine, MachineDescription, description::AxisOrder, description::Placement,
+};
+use tricept_model::{
+    ParameterSet, actual::actual_machine, volumetric::MapStats, volumetric::volumetric_errors,
+};
 use tricept_numerics::stats::quantile;
 
 /// The paper's before-compensation figures (max, min, mean), mm.
@@ -250,10 +254,11 @@ fn one_seed(
     targets: &[Vector3<f64>],
     plane: &[Vector3<f64>],
     seed: u64,
-) -> Result<(SeedResult, tricept_engine::Compensation), String> {
+) -> Result<(SeedResult, tricept_engine::compensate::Compensation), String> {
     let campaign = tricept_plant::Campaign::from_targets(nominal, targets.to_vec(), seed);
     let data = plant.simulate(&campaign).map_err(|e| e.to_string())?;
-    let model = tricept_engine::GeometricModel::new(nominal.clone(), ParameterSet::paper15());
+    let model =
+        tricept_engine::model::GeometricModel::new(nominal.clone(), ParameterSet::paper15());
     let id = tricept_engine::identify(
         &model,
         &data,
@@ -261,8 +266,13 @@ fn one_seed(
     )
     .map_err(|e| e.to_string())?;
     let identified = model.machine_at(&id.estimate);
-    let c = tricept_engine::compensation(nominal, &identified, &plant.actual_machine(), plane)
-        .map_err(|e| e.to_string())?;
+    let c = tricept_engine::compensate::compensation(
+        nominal,
+        &identified,
+        &plant.actual_machine(),
+        plane,
+    )
+    .map_err(|e| e.to_string())?;
     let residual = c.after.without_mean_translation().stats();
     Ok((
         SeedResult {
@@ -396,7 +406,7 @@ fn predicted_translation_sd(
     let k = set.len();
     let campaign = tricept_plant::Campaign::from_targets(nominal, targets.to_vec(), 1);
     let data = plant.simulate(&campaign).map_err(|e| e.to_string())?;
-    let model = tricept_engine::GeometricModel::new(nominal.clone(), set.clone());
+    let model = tricept_engine::model::GeometricModel::new(nominal.clone(), set.clone());
     let id = tricept_engine::identify(
         &model,
         &data,
@@ -407,7 +417,7 @@ fn predicted_translation_sd(
     let mut z_row = vec![0.0; k];
     for r in plane {
         let up = nominal.inverse(r).map_err(|e| e.to_string())?.up;
-        let jp = tricept_model::position_error_jacobian(&nominal.legs_at(&up))
+        let jp = tricept_model::jacobian::position_error_jacobian(&nominal.legs_at(&up))
             .map_err(|e| e.to_string())?;
         set.project(1, |_, f| jp[(2, f)], &mut z_row);
         for (cj, zj) in c.iter_mut().zip(&z_row) {

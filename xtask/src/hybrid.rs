@@ -38,19 +38,19 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 use serde_json::{Value, json};
-use tricept_data::{ExternalData, ExternalPose};
+use tricept_data::{external::ExternalData, external::ExternalPose};
 use tricept_diagnose::{DiagnoseOptions, diagnose};
 use tricept_engine::fusion::{
     BallbarOptions, FusedModel, FusionOptions, Source, TouchOptions, TrackerOptions, TrackerTarget,
     head_angle_poses, identify_fused,
 };
-use tricept_kinematics::{HeadBranch, Machine};
+use tricept_kinematics::{Machine, head::HeadBranch};
 use tricept_model::effects::{EffectName, stiffness_for_platform_deflection};
-use tricept_model::{Effector, ParameterSet};
+use tricept_model::{ParameterSet, head_errors::Effector};
 use tricept_numerics::stats::quantile;
 use tricept_plant::{
-    Ballbar, Campaign, Effect, Plant, TouchFeature, TouchProbe, TouchTarget, Tracker,
-    random_head_errors,
+    Campaign, Effect, Plant, instruments::Ballbar, instruments::TouchFeature,
+    instruments::TouchProbe, instruments::TouchTarget, instruments::Tracker, random_head_errors,
 };
 use tricept_plot::{Axes, Curve, Reference, curves};
 use tricept_study::plan::{
@@ -152,13 +152,13 @@ const SPHERE_RADIUS_MM: f64 = 12.7;
 const STYLUS_RADIUS_MM: f64 = 1.0;
 
 /// The features file of the touch-offs.
-fn touch_features() -> tricept_data::Features {
-    tricept_data::Features {
-        stylus: tricept_data::Stylus {
+fn touch_features() -> tricept_data::external::Features {
+    tricept_data::external::Features {
+        stylus: tricept_data::external::Stylus {
             radius_mm: STYLUS_RADIUS_MM,
             radius_sigma_um: 2.0,
         },
-        features: vec![tricept_data::Feature::Sphere {
+        features: vec![tricept_data::external::Feature::Sphere {
             id: 1,
             radius_mm: SPHERE_RADIUS_MM,
             radius_sigma_um: 0.5,

@@ -29,14 +29,18 @@ use std::path::PathBuf;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde_json::{Value, json};
-use tricept_engine::{GeometricModel, IdentifyOptions, design};
-use tricept_kinematics::{AxisOrder, Machine, MachineDescription, Placement};
-use tricept_model::{MapStats, ParameterSet, residual_mu};
+use tricept_engine::{IdentifyOptions, identify::design, model::GeometricModel};
+use tricept_kinematics::{
+    Machine, MachineDescription, description::AxisOrder, description::Placement,
+};
+use tricept_model::{ParameterSet, params::residual_mu, volumetric::MapStats};
 use tricept_numerics::stats::quantile;
 use tricept_study::grades::mu_at_grade;
 use tricept_study::invisible::invisible_platform_errors;
 use tricept_study::paper::{Differenced, DifferencedSolve, NominalLinearisation, RowWeights};
-use tricept_study::{GradeModel, LinearEstimator, Scenario, StudyError, Summary};
+use tricept_study::{
+    Scenario, StudyError, fast::GradeModel, fast::LinearEstimator, results::Summary,
+};
 
 /// The paper's Fig. 3b figures (max, min, mean after compensation), mm.
 const PAPER_AFTER_MM: [f64; 3] = [0.278, 0.171, 0.203];
@@ -220,7 +224,7 @@ fn placed_machine(angles_deg: [f64; 3], order: AxisOrder) -> Result<Machine, Str
 
 /// Whether a combination is one parameter alone (every other coefficient
 /// below 1e-6 of the largest, which is 1).
-fn single_term(c: &tricept_engine::Combination) -> Option<String> {
+fn single_term(c: &tricept_engine::report::Combination) -> Option<String> {
     let others = c.terms.iter().skip(1).all(|(_, v)| v.abs() < 1e-6);
     (others && !c.terms.is_empty()).then(|| c.terms[0].0.clone())
 }
@@ -264,7 +268,7 @@ fn invisible() -> Result<Value, String> {
                 .map_err(|e| e.to_string())?;
             for set in [ParameterSet::paper15(), ParameterSet::full21()] {
                 let model = GeometricModel::new(m.clone(), set.clone());
-                let report = tricept_engine::identifiability(
+                let report = tricept_engine::identify::identifiability(
                     &model,
                     &vec![0.0; set.len()],
                     &poses,
@@ -528,9 +532,12 @@ fn fig3b(a: &ReproductionArgs) -> Result<Value, String> {
                                 .estimate
                         }
                     };
-                    let map =
-                        tricept_model::volumetric_errors(&model.machine_at(&p), &actual, &plane)
-                            .map_err(|e| e.to_string())?;
+                    let map = tricept_model::volumetric::volumetric_errors(
+                        &model.machine_at(&p),
+                        &actual,
+                        &plane,
+                    )
+                    .map_err(|e| e.to_string())?;
                     Ok(MapResult {
                         after: map.stats(),
                         touched: map.without_mean_translation().stats(),
@@ -769,7 +776,7 @@ fn mahalanobis2(
 /// identifiable parameters: 14 on average for an unbiased fit, `14 +
 /// b^T C^-1 b` with the bias `b`.
 fn held(a: &ReproductionArgs) -> Result<Value, String> {
-    use tricept_engine::{Start, identify, identify_from};
+    use tricept_engine::{identify, identify::Start, identify::identify_from};
     use tricept_plant::{Campaign, Plant};
     println!(
         "## What holding dyA3 at zero biases (`cargo xtask reproduction --only held`)\n\nTable 2 on the x-first machine (dyA3 = 0.2 mm), paper noise. Bias: noise-free exact readings fitted with dyA3 held at zero, minus the truth, in standard deviations of that campaign; `check`: the largest |error| / sd with dyA3 held at its true value. d^2: mean Mahalanobis distance from the truth of {} noisy campaigns per size (14 identifiable parameters), with dyA3 at zero and at the truth, the bias's own b^T C^-1 b, and the fits' mean chi-square per degree of freedom.\n",

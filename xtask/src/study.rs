@@ -9,12 +9,13 @@ use std::path::PathBuf;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nalgebra::Vector3;
 use serde_json::{Value, json};
-use tricept_kinematics::{Machine, MachineDescription, PoseSetError};
+use tricept_kinematics::{Machine, MachineDescription, workspace::PoseSetError};
 use tricept_study::grades::mu_at_grade;
 use tricept_study::optimise::{Candidates, Criterion, candidate_grid, exchange};
 use tricept_study::paper::{PaperSolve, paper_solve};
 use tricept_study::{
-    GradeModel, GradeResult, LinearEstimator, Scenario, StudyError, equivalent_grade, recommend,
+    Scenario, StudyError, fast::GradeModel, fast::LinearEstimator, grades::equivalent_grade,
+    grades::recommend, results::GradeResult,
 };
 
 /// The paper's Fig. 4 anchors.
@@ -155,11 +156,11 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
             .map_err(|e| format!("{}: {e}", p.display()))?,
         None => Machine::paper(),
     };
-    let pose_set: tricept_kinematics::PoseSet =
+    let pose_set: tricept_kinematics::workspace::PoseSet =
         a.poses.parse().map_err(|e: PoseSetError| e.to_string())?;
     let targets = match pose_set.generate(&machine.workspace) {
         Some(points) => points,
-        None => tricept_data::read_targets(std::path::Path::new(&a.poses))
+        None => tricept_data::targets::read_targets(std::path::Path::new(&a.poses))
             .map_err(|e| e.to_string())?
             .into_iter()
             .map(Vector3::from)
@@ -203,7 +204,7 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
     table("Default pose set", &scenario, &results);
 
     let max_grade = a.grades.iter().copied().fold(0.0, f64::max);
-    let crossing = tricept_study::crossing_grade(
+    let crossing = tricept_study::grades::crossing_grade(
         &scenario,
         max_grade,
         1e5,
@@ -212,7 +213,7 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
         &our_estimator(&scenario),
     )
     .map_err(s)?;
-    let paper_crossing = tricept_study::crossing_grade(
+    let paper_crossing = tricept_study::grades::crossing_grade(
         &scenario,
         a.grades.iter().copied().fold(f64::INFINITY, f64::min),
         1e5,
@@ -349,9 +350,15 @@ pub fn run(a: StudyArgs) -> Result<(), String> {
             Ok(mu_at_grade(&sc, g, 20_000, a.seed).map_err(s)?.median)
         };
         let (m2, m4) = (mu_at(2.0)?, mu_at(4.0)?);
-        let cross =
-            tricept_study::crossing_grade(&sc, 0.25, 1e5, 10_000, a.seed, &our_estimator(&sc))
-                .map_err(s)?;
+        let cross = tricept_study::grades::crossing_grade(
+            &sc,
+            0.25,
+            1e5,
+            10_000,
+            a.seed,
+            &our_estimator(&sc),
+        )
+        .map_err(s)?;
         println!(
             "| {n} | {m2:.3} | {m4:.3} | {} |",
             cross.map_or("none below 1e5".to_string(), |g| format!("{g:.1}"))

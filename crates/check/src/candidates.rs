@@ -18,19 +18,19 @@
 //! and columns, when its condition on the logged temperatures holds.
 //!
 //! `J21` is the reading Jacobian of the 21 joint and length errors
-//! (eq. 9), `P21` the platform point's ([`tricept_model::position_error_jacobian`]),
+//! (eq. 9), `P21` the platform point's ([`tricept_model::jacobian::position_error_jacobian`]),
 //! both at the pose. A zero jump of a sensor is not a candidate: the
 //! offsets are re-estimated at every check (a power cycle re-references
 //! them), and their change is reported as such.
 
 use nalgebra::Vector3;
 use serde::Serialize;
-use tricept_kinematics::UpJoints;
-use tricept_model::ErrorJacobian;
+use tricept_kinematics::up_limb::UpJoints;
 use tricept_model::effects::{
     Basis, CheckColumns, CheckRole, CheckWhen, EffectName, GenericFamily, legendre_p2, legendre_p3,
     normalised_coordinate,
 };
+use tricept_model::jacobian::ErrorJacobian;
 
 /// The name of the whole structure's thermal growth.
 pub(crate) const STRUCTURE: &str = "thermal growth of the structure";
@@ -250,7 +250,7 @@ impl Candidate {
     ///
     /// # Example
     /// ```
-    /// use tricept_check::Candidate;
+    /// use tricept_check::candidates::Candidate;
     /// let ranges = [(700.0, 900.0); 3];
     /// let warm = Candidate::for_check(ranges, Some(20.0), Some(24.0));
     /// assert_eq!(warm.len(), Candidate::all(ranges, Some(20.0), true).len() + 1);

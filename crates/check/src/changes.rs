@@ -16,7 +16,7 @@
 //! 1. **Enter.** The candidate with the smallest conditional p-value enters
 //!    when its statistic exceeds the family-wise critical value of the
 //!    check (Bonferroni over every test of every candidate,
-//!    [`crate::family_level`]). Of the significant candidates of its kind
+//!    [`crate::check::family_level`]). Of the significant candidates of its kind
 //!    whose p-value is within a factor 20 of it (they explain the step
 //!    alike), the one whose joint fit is the smallest change enters: the
 //!    sum of each estimate squared over its unseen limit squared (0.25 mm

@@ -41,14 +41,14 @@
 //! explained by any single candidate. A candidate must also stand out
 //! beyond the scatter the readings leave after it ([`crate::noise`]): tests
 //! that fire with none standing out are `noisier-than-stated`, not a change.
-//! [`check`] screens gross readings first ([`crate::screen`]).
+//! [`check`](fn@crate::check) screens gross readings first ([`crate::screen`]).
 
 use nalgebra::{DMatrix, DVector, Vector3};
 use serde::Serialize;
 use tricept_data::Dataset;
-use tricept_engine::ReadingModel;
-use tricept_kinematics::{Machine, UpJoints};
-use tricept_model::error_jacobian_at;
+use tricept_engine::model::ReadingModel;
+use tricept_kinematics::{Machine, up_limb::UpJoints};
+use tricept_model::jacobian::error_jacobian_at;
 use tricept_numerics::linalg::{TriangularAccumulator, invert_upper, solve_upper};
 use tricept_numerics::stats::{chi2_isf, required_noncentrality};
 
@@ -95,7 +95,7 @@ impl CheckOptions {
             alpha: DEFAULT_ALPHA,
             power: DEFAULT_POWER,
             sigma: machine.sensors.logged_sigma(),
-            points_mm: tricept_engine::accuracy_points(machine),
+            points_mm: tricept_engine::accuracy::accuracy_points(machine),
         }
     }
 }
@@ -454,7 +454,7 @@ pub(crate) fn evaluate(
 ///
 /// # Example
 /// ```
-/// use tricept_check::{Candidate, family_level};
+/// use tricept_check::{candidates::Candidate, check::family_level};
 /// let c = Candidate::all([(700.0, 900.0); 3], None, false);
 /// // 3 legs x 4 nested tests, 6 joints, a common lead, two sensor tests.
 /// assert!((family_level(0.01, &c) - 0.005 / 21.0).abs() < 1e-15);

@@ -151,7 +151,7 @@ pub fn read(path: &std::path::Path) -> Result<Vec<Entry>, CheckError> {
             "{file}: not a regular file (a history is one, appended and replaced whole)"
         )));
     }
-    let text = match tricept_data::read_json_text(path) {
+    let text = match tricept_data::bounded::read_json_text(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
         Err(e) => return Err(CheckError::HistoryLine(format!("{file}: {e}"))),

@@ -15,11 +15,11 @@
 //! - [`Reference`] (`reference.rs`): the calibrated machine with its
 //!   covariance, offsets and temperature, from a machine file's
 //!   `calibration` record;
-//! - [`check`] (`check.rs`): the test, the verdict, the most likely change
+//! - [`check`](fn@check) (`check.rs`): the test, the verdict, the most likely change
 //!   with its size, uncertainty and effect on the platform, the shortlist
 //!   of changes the campaign cannot tell apart;
-//! - [`Candidate`] (`candidates.rs`): what can have changed;
-//! - [`Change`] (`changes.rs`): the smallest set of changes that explains
+//! - [`Candidate`](crate::candidates::Candidate) (`candidates.rs`): what can have changed;
+//! - [`Change`](crate::changes::Change) (`changes.rs`): the smallest set of changes that explains
 //!   the readings, by a forward search;
 //! - [`history`] (`history.rs`): checks appended to a JSON-lines file, and
 //!   the trend of the key quantities against their bands;
@@ -56,25 +56,19 @@
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
-mod candidates;
-mod changes;
-mod check;
+pub mod candidates;
+pub mod changes;
+pub mod check;
 mod design;
 mod error;
 pub mod history;
-mod noise;
-mod parts;
+pub mod noise;
+pub mod parts;
 mod reference;
 mod report;
-mod screen;
+pub mod screen;
 
-pub use candidates::{Candidate, CandidateKind};
-pub use changes::Change;
-pub use check::{
-    CheckOptions, CheckReport, CheckVerdict, DEFAULT_ALPHA, DEFAULT_POWER, family_level, leg_ranges,
-};
+pub use check::{CheckOptions, CheckReport, CheckVerdict};
 pub use error::CheckError;
-pub use noise::{ChannelNoise, NoiseSeen};
-pub use parts::{CandidateResult, ChiSquare, Rejected};
 pub use reference::Reference;
-pub use screen::{MAX_SET_ASIDE_SHARE, SCREEN_ALPHA, check};
+pub use screen::check;

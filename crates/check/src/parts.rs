@@ -8,7 +8,7 @@
 use nalgebra::{DMatrix, DVector, Vector3};
 use serde::Serialize;
 use tricept_kinematics::Machine;
-use tricept_model::position_error_jacobian;
+use tricept_model::jacobian::position_error_jacobian;
 use tricept_numerics::stats::{chi2_isf, chi2_ln_sf, chi2_sf};
 
 use crate::candidates::{Candidate, CandidateKind};
@@ -189,7 +189,11 @@ pub(crate) fn unseen_limit(parameter: &str) -> f64 {
 /// The platform point's Jacobian at each evaluation target of the
 /// calibrated machine, with the commands that reach it.
 pub(crate) struct Impact {
-    at: Vec<(tricept_model::ErrorJacobian, Vector3<f64>, [f64; 3])>,
+    at: Vec<(
+        tricept_model::jacobian::ErrorJacobian,
+        Vector3<f64>,
+        [f64; 3],
+    )>,
 }
 
 impl Impact {

@@ -3,7 +3,7 @@
 //! calibrated at, from a calibrated machine file's `calibration` record.
 
 use nalgebra::DMatrix;
-use tricept_engine::GeometricModel;
+use tricept_engine::model::GeometricModel;
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 

@@ -3,7 +3,7 @@
 //!
 //! A gross reading (a misread scale, an encoder glitch) shows only in the
 //! residuals of a fit, so the screen works after the check, as `identify`'s
-//! does after its fit (`tricept_engine::screen_gross_errors`): at the fit
+//! does after its fit (`tricept_engine::robust::screen_gross_errors`): at the fit
 //! the verdict rests on (the offsets and the calibration's uncertainty,
 //! with the most likely change when there is one), every pose gets the
 //! statistic of its deleted (leave-one-pose-out) residual,

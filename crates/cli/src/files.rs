@@ -261,7 +261,7 @@ impl FileRoles {
     }
 }
 
-/// A path as messages show it (`tricept_data::shown_path`).
+/// A path as messages show it (`tricept_data::message::shown_path`).
 fn shown(p: &Path) -> String {
     tricept_ident::advanced::files::shown_path(p)
 }
@@ -285,7 +285,7 @@ fn check_input(flag: &str, input: &Path) -> Result<(), CliError> {
 }
 
 /// Refuses an output file the verb must not write (see
-/// [`FileRoles::check`]; `tricept_data::check_output_file`).
+/// [`FileRoles::check`]; `tricept_data::atomic::check_output_file`).
 fn check_output_file(flag: &str, out: &Path) -> Result<(), CliError> {
     if out.as_os_str() == STDIO {
         return Err(CliError::input(format!(

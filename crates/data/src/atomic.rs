@@ -147,10 +147,10 @@ fn resolve(path: &Path) -> io::Result<PathBuf> {
 /// # Example
 /// ```
 /// use std::path::Path;
-/// let e = tricept_data::check_output_file(Path::new("/dev/null")).unwrap_err();
+/// let e = tricept_data::atomic::check_output_file(Path::new("/dev/null")).unwrap_err();
 /// assert!(e.to_string().contains("character device"), "{e}");
-/// assert!(tricept_data::check_output_file(Path::new("out/")).is_err());
-/// assert!(tricept_data::check_output_file(Path::new("new-file.json")).is_ok());
+/// assert!(tricept_data::atomic::check_output_file(Path::new("out/")).is_err());
+/// assert!(tricept_data::atomic::check_output_file(Path::new("new-file.json")).is_ok());
 /// ```
 pub fn check_output_file(path: &Path) -> io::Result<()> {
     let text = path.as_os_str().to_string_lossy();

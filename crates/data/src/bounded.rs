@@ -19,7 +19,7 @@ pub const MAX_JSON_BYTES: u64 = 64 << 20;
 ///
 /// # Example
 /// ```
-/// let e = tricept_data::read_json_text(std::path::Path::new("/dev/zero")).unwrap_err();
+/// let e = tricept_data::bounded::read_json_text(std::path::Path::new("/dev/zero")).unwrap_err();
 /// assert!(e.to_string().contains("64 MiB"), "{e}");
 /// ```
 pub fn read_json_text(path: &Path) -> std::io::Result<String> {

@@ -18,12 +18,12 @@
 //! Other columns are ignored. The reader is strict: every problem is a
 //! [`DataError`] that names the file, the line and the column, never a
 //! panic and never a silently skipped row. Target lists (columns `x,y,z`,
-//! [`read_targets`]) follow the same rules and get the same messages.
+//! [`read_targets`](crate::targets::read_targets)) follow the same rules and get the same messages.
 //!
 //! External measurements (laser tracker or CMM points, ballbar lengths,
 //! touch-offs on spheres and planes, with the leg commands and head angles
 //! they were taken at) have their own CSV contracts, read by the same
-//! machinery with the same messages ([`read_external_path`], [`Features`]).
+//! machinery with the same messages ([`read_external_path`](crate::external::read_external_path), [`Features`](crate::external::Features)).
 //!
 //! Modules: `pose` (the types: [`Readings`], [`MeasuredPose`], [`Dataset`]),
 //! `error` ([`DataError`]), `records` (the line and record machinery every
@@ -45,31 +45,19 @@
     deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)
 )]
 
-mod atomic;
-mod bounded;
+pub mod atomic;
+pub mod bounded;
 mod error;
-mod external;
-mod message;
-mod pose;
-mod read;
+pub mod external;
+pub mod message;
+pub mod pose;
+pub mod read;
 mod records;
-mod targets;
+pub mod targets;
 mod write;
 
-pub use atomic::{check_output_file, write_atomic};
-pub use bounded::{MAX_JSON_BYTES, read_json_text};
+pub use atomic::write_atomic;
 pub use error::DataError;
-pub use external::{
-    BallbarData, BallbarReading, ExternalData, ExternalPose, ExternalRecord, Feature, Features,
-    InstrumentRecord, PlannedPose, PlannedPoses, Reading, Stylus, TouchData, TouchReading,
-    TrackerData, TrackerPoint, read_external_from, read_external_path, write_external_path,
-    write_external_to,
-};
-pub use message::{
-    MAX_MESSAGE_CHARS, MAX_QUOTED_CHARS, SHOWN_CHARS, SHOWN_PATH_CHARS, one_line, shown, shown_path,
-};
-pub use pose::{Dataset, MeasuredPose, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Readings};
-pub use read::{MAX_ANGLE_SPAN_RAD, MAX_LENGTH_MM, read_from, read_path, read_with_progress};
-pub use records::{MAX_LINE_BYTES, MAX_MAGNITUDE};
-pub use targets::{NumericRows, read_targets, read_targets_from};
+pub use pose::{Dataset, MeasuredPose, Readings};
+pub use read::{read_from, read_path};
 pub use write::{write_path, write_to};

@@ -39,8 +39,8 @@ pub const MAX_MESSAGE_CHARS: usize = 2000;
 /// # Example
 /// ```
 /// let long = "x".repeat(100);
-/// assert_eq!(tricept_data::shown(&long), format!("{}… (20 more bytes)", "x".repeat(80)));
-/// assert_eq!(tricept_data::shown("a\nb\u{1b}[31m"), "a\\nb\\u{1b}[31m");
+/// assert_eq!(tricept_data::message::shown(&long), format!("{}… (20 more bytes)", "x".repeat(80)));
+/// assert_eq!(tricept_data::message::shown("a\nb\u{1b}[31m"), "a\\nb\\u{1b}[31m");
 /// ```
 pub fn shown(field: &str) -> String {
     cut(field, SHOWN_CHARS)
@@ -53,7 +53,7 @@ pub fn shown(field: &str) -> String {
 /// # Example
 /// ```
 /// use std::path::Path;
-/// assert_eq!(tricept_data::shown_path(Path::new("a\nb.csv")), "a\\nb.csv");
+/// assert_eq!(tricept_data::message::shown_path(Path::new("a\nb.csv")), "a\\nb.csv");
 /// ```
 pub fn shown_path(path: &Path) -> String {
     cut(&path.to_string_lossy(), SHOWN_PATH_CHARS)
@@ -92,12 +92,12 @@ fn push_inert(out: &mut String, c: char) {
 /// # Example
 /// ```
 /// let key = "k".repeat(1_000_000);
-/// let m = tricept_data::one_line(&format!("unknown field `{key}` at line 1 column 1000014\nnext"));
+/// let m = tricept_data::message::one_line(&format!("unknown field `{key}` at line 1 column 1000014\nnext"));
 /// assert!(m.len() < 1000, "{}", m.len());
 /// assert!(m.starts_with("unknown field `kkk"));
 /// assert!(m.contains("(999800 more bytes)`"), "{m}");
 /// assert!(m.ends_with("at line 1 column 1000014\\nnext"), "{m}");
-/// assert_eq!(tricept_data::one_line(&m), m);
+/// assert_eq!(tricept_data::message::one_line(&m), m);
 /// ```
 pub fn one_line(message: &str) -> String {
     let mut out = String::with_capacity(message.len().min(2 * MAX_MESSAGE_CHARS));

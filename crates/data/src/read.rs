@@ -11,7 +11,10 @@ use std::path::Path;
 use rayon::prelude::*;
 
 use crate::records::{Header, LineBatch, Record, Records, open, record_of};
-use crate::{DataError, Dataset, MeasuredPose, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Readings};
+pub use crate::records::{MAX_LINE_BYTES, MAX_MAGNITUDE};
+use crate::{
+    DataError, Dataset, MeasuredPose, Readings, pose::OPTIONAL_COLUMNS, pose::REQUIRED_COLUMNS,
+};
 
 /// Largest span of an encoder column accepted as radians: a U joint of a
 /// Tricept turns well under 100 degrees in all.
@@ -94,7 +97,7 @@ pub fn read_from<R: Read>(reader: R, file: &str) -> Result<Dataset, DataError> {
 ///     csv.push_str(&format!("{},800,800,0.01,0.02,5\n", 700.0 + k as f64 * 1e-3));
 /// }
 /// let mut reports = Vec::new();
-/// let data = tricept_data::read_with_progress(csv.as_bytes(), "big.csv", |n| reports.push(n)).unwrap();
+/// let data = tricept_data::read::read_with_progress(csv.as_bytes(), "big.csv", |n| reports.push(n)).unwrap();
 /// assert_eq!(data.poses.len(), 70_000);
 /// assert_eq!(reports, [65_536]);
 /// ```
@@ -446,7 +449,7 @@ mod tests {
         );
         assert!(error(&two).starts_with(&format!("t.csv: line {}, column `q3`", BATCH_LINES + 3)));
         // A bad row before an overlong line in the same batch.
-        let long = "9".repeat(crate::MAX_LINE_BYTES + 10);
+        let long = "9".repeat(crate::records::MAX_LINE_BYTES + 10);
         let both = spoil(
             &spoil(&clean, &[BATCH_LINES + 100], &long),
             &[BATCH_LINES + 50],

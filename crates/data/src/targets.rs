@@ -22,7 +22,7 @@ const TARGET_COLUMNS: [&str; 3] = ["x", "y", "z"];
 /// std::fs::create_dir_all(&dir).unwrap();
 /// let path = dir.join("targets.csv");
 /// std::fs::write(&path, "x,y,z\n0,0,1000\n50,-25,1010.5\n").unwrap();
-/// let points = tricept_data::read_targets(&path).unwrap();
+/// let points = tricept_data::targets::read_targets(&path).unwrap();
 /// assert_eq!(points, vec![[0.0, 0.0, 1000.0], [50.0, -25.0, 1010.5]]);
 /// # std::fs::remove_dir_all(&dir).unwrap();
 /// ```
@@ -41,10 +41,10 @@ pub fn read_targets(path: &Path) -> Result<Vec<[f64; 3]>, DataError> {
 /// # Example
 /// ```
 /// let csv = "# targets\nid,z,y,x\n1,1000,0,0\n2,1010.5,-25,50\n";
-/// let points = tricept_data::read_targets_from(csv.as_bytes(), "targets.csv").unwrap();
+/// let points = tricept_data::targets::read_targets_from(csv.as_bytes(), "targets.csv").unwrap();
 /// assert_eq!(points, vec![[0.0, 0.0, 1000.0], [50.0, -25.0, 1010.5]]);
 ///
-/// let err = tricept_data::read_targets_from("x,y,z\n0,0,abc\n".as_bytes(), "t.csv").unwrap_err();
+/// let err = tricept_data::targets::read_targets_from("x,y,z\n0,0,abc\n".as_bytes(), "t.csv").unwrap_err();
 /// assert_eq!(err.to_string(), "t.csv: line 2, column `z`: not a number (got `abc`)");
 /// ```
 pub fn read_targets_from<R: Read>(reader: R, file: &str) -> Result<Vec<[f64; 3]>, DataError> {
@@ -65,7 +65,7 @@ pub fn read_targets_from<R: Read>(reader: R, file: &str) -> Result<Vec<[f64; 3]>
 ///
 /// # Example
 /// ```
-/// use tricept_data::NumericRows;
+/// use tricept_data::targets::NumericRows;
 /// let csv = "\u{feff}q2,q1,q3\n# a comment\n700,701,702.5\n";
 /// let rows: Vec<_> = NumericRows::new(csv.as_bytes(), "legs.csv", ["q1", "q2", "q3"])
 ///     .unwrap()

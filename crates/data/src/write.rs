@@ -5,7 +5,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use crate::{Dataset, REQUIRED_COLUMNS};
+use crate::{Dataset, pose::REQUIRED_COLUMNS};
 
 /// Writes `data` as CSV: the required columns, then the context columns
 /// that every pose carries. Values are written with full precision

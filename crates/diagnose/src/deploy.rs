@@ -1,5 +1,5 @@
 //! The diagnosis' model deployed into a machine file: the terms of the
-//! final model worth deploying ([`crate::ModelTerm::deployed`]) refitted on
+//! final model worth deploying ([`crate::report::ModelTerm::deployed`]) refitted on
 //! the poses the diagnosis kept, so that the geometry is de-biased by
 //! every one of them, generic terms included, and every fitted parameter
 //! put where the registry says it goes
@@ -13,7 +13,7 @@
 use std::sync::Arc;
 
 use tricept_data::{Dataset, MeasuredPose};
-use tricept_engine::{GeometricModel, Identification, IdentifyOptions, identify};
+use tricept_engine::{Identification, IdentifyOptions, identify, model::GeometricModel};
 use tricept_kinematics::Machine;
 use tricept_kinematics::description::{
     ControllerDescription, LegTableDescription, MAX_TABLE_POINTS, MAX_TABLE_SLOPE_UM_PER_MM,

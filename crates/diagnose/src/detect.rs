@@ -19,8 +19,10 @@
 use faer::Mat;
 use serde::Serialize;
 use tricept_data::MeasuredPose;
-use tricept_engine::{GeometricModel, IdentifyOptions, ReadingModel, design};
-use tricept_kinematics::UpJoints;
+use tricept_engine::{
+    IdentifyOptions, identify::design, model::GeometricModel, model::ReadingModel,
+};
+use tricept_kinematics::up_limb::UpJoints;
 use tricept_numerics::linalg::{TriangularAccumulator, invert_upper};
 
 use std::sync::Arc;
@@ -76,10 +78,10 @@ pub fn detectability(
 /// # Example
 /// ```
 /// use tricept_diagnose::detect::term_detectability;
-/// use tricept_diagnose::{GenericFamily, GenericTerm, Scope, Term};
+/// use tricept_diagnose::{terms::GenericFamily, terms::GenericTerm, terms::Scope, terms::Term};
 /// let m = tricept_kinematics::Machine::paper();
 /// let data = tricept_data::read_path("../../fixtures/data/diagnose-pitch.csv".as_ref()).unwrap();
-/// let g = tricept_engine::GeometricModel::new(m.clone(), tricept_model::ParameterSet::paper15());
+/// let g = tricept_engine::model::GeometricModel::new(m.clone(), tricept_model::ParameterSet::paper15());
 /// let drift = Term::Generic(GenericTerm::new(GenericFamily::ReadingDrift, Scope::Channel(2)));
 /// // A 3 um drift of the scale over these 80 poses is seen with 95 % power.
 /// let d = term_detectability(&g, &drift, &[3.0], &data.poses, m.sensors.logged_sigma(), 1e-3).unwrap();

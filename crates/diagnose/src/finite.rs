@@ -13,7 +13,7 @@ use serde::ser::{self, Impossible};
 /// ```
 /// #[derive(serde::Serialize)]
 /// struct R { a: f64, b: Vec<Option<f64>> }
-/// use tricept_diagnose::first_non_finite;
+/// use tricept_diagnose::finite::first_non_finite;
 /// assert_eq!(first_non_finite(&R { a: 1.0, b: vec![None, Some(2.0)] }), None);
 /// assert_eq!(first_non_finite(&R { a: 1.0, b: vec![Some(f64::NAN)] }).as_deref(), Some("b[0]"));
 /// ```

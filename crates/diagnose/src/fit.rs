@@ -10,8 +10,9 @@ use nalgebra::DMatrix;
 use rayon::prelude::*;
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_engine::{
-    GeometricModel, IdentError, Identification, IdentifyOptions, ReadingModel, identify,
-    residuals_at, screen_gross_errors, screen_gross_errors_with_fit,
+    IdentError, Identification, IdentifyOptions, identify, model::GeometricModel,
+    model::ReadingModel, robust::residuals_at, robust::screen_gross_errors,
+    robust::screen_gross_errors_with_fit,
 };
 
 use tricept_model::effects::Needs;

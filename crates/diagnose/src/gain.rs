@@ -6,8 +6,8 @@
 
 use nalgebra::{DMatrix, Vector3};
 use tricept_data::MeasuredPose;
-use tricept_engine::ReadingModel;
-use tricept_kinematics::{Machine, UpJoints};
+use tricept_engine::model::ReadingModel;
+use tricept_kinematics::{Machine, up_limb::UpJoints};
 
 use crate::fit::Fit;
 use crate::options::DiagnoseOptions;
@@ -31,7 +31,7 @@ pub(crate) fn volumetric_difference(
     let predictor = fin.model.at(&fin.id.estimate);
     let k = fin.model.names().len();
     let mut jac = vec![0.0; 3 * k];
-    let mut map = tricept_model::ErrorMap {
+    let mut map = tricept_model::volumetric::ErrorMap {
         targets_mm: Vec::new(),
         errors_mm: Vec::new(),
     };

@@ -44,8 +44,8 @@
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use tricept_data::{Dataset, MeasuredPose};
-use tricept_engine::ReadingModel;
-use tricept_kinematics::{Machine, UpJoints};
+use tricept_engine::model::ReadingModel;
+use tricept_kinematics::{Machine, up_limb::UpJoints};
 
 use crate::fit::Fit;
 use crate::gain::{Improvement, improvement};

@@ -10,15 +10,15 @@
 //! The crate is layered; a file imports only from its own layer or those
 //! below (checked by `xtask/tests/tidy.rs`), bottom to top:
 //!
-//! 1. **Options and errors**: [`DiagnoseOptions`] and [`DictionaryOptions`]
+//! 1. **Options and errors**: [`DiagnoseOptions`] and [`DictionaryOptions`](crate::options::DictionaryOptions)
 //!    (`options.rs`), [`DiagnoseError`] and [`DeployError`] (`error.rs`),
-//!    the plausibility table ([`Plausibility`], `plausibility.rs`), the
+//!    the plausibility table ([`Plausibility`](crate::plausibility::Plausibility), `plausibility.rs`), the
 //!    report's types, JSON and text ([`Diagnosis`], `report.rs`; `finite.rs`:
 //!    no non-finite number leaves it), the tests' reference distributions
 //!    (`evidence.rs`).
-//! 2. **The model**: the terms ([`Term`]: an effect of the vocabulary,
-//!    whose spec is in [`tricept_model::effects`], or a [`GenericTerm`]) and
-//!    the campaign [`Frame`] (`terms.rs`); [`ExtendedModel`] (`model.rs`),
+//! 2. **The model**: the terms ([`Term`](crate::terms::Term): an effect of the vocabulary,
+//!    whose spec is in [`tricept_model::effects`], or a [`GenericTerm`](crate::terms::GenericTerm)) and
+//!    the campaign [`Frame`](crate::terms::Frame) (`terms.rs`); [`ExtendedModel`] (`model.rs`),
 //!    the geometric model plus any terms.
 //! 3. **The fit core** (`fit.rs`): a fitted model, the settings every fit
 //!    shares, cross-validation, residuals, the outlier screen.
@@ -32,7 +32,7 @@
 //!    (`describe.rs`), the report from what the pipeline found
 //!    (`assemble.rs`).
 //! 6. **Orchestration**: [`diagnose`] (`run.rs`: checks, noise, outlier
-//!    screen, selection, report), [`deploy`] (`deploy.rs`: the final model
+//!    screen, selection, report), [`deploy`](fn@deploy) (`deploy.rs`: the final model
 //!    into a machine file), [`detect`] (what a campaign can detect, before it
 //!    is run).
 //!
@@ -55,15 +55,15 @@
 // Layer 1: options and errors
 mod error;
 mod evidence;
-mod finite;
-mod options;
-mod plausibility;
-mod report;
+pub mod finite;
+pub mod options;
+pub mod plausibility;
+pub mod report;
 #[cfg(test)]
 mod testing;
 // Layer 2: the model
 mod model;
-mod terms;
+pub mod terms;
 // Layer 3: the fit core
 mod fit;
 // Layer 4: dictionary, noise, selection, aliases, gain and residual plots
@@ -72,32 +72,20 @@ mod dictionary;
 mod gain;
 mod holdout;
 mod linear;
-mod noise;
+pub mod noise;
 mod residuals;
 mod select;
 // Layer 5: description and report assembly
 mod assemble;
 mod describe;
 // Layer 6: orchestration: the diagnosis, its deployment, detectability
-mod deploy;
+pub mod deploy;
 pub mod detect;
 mod run;
 
 pub use deploy::{Deployed, deploy};
 pub use error::{DeployError, DiagnoseError};
-pub use finite::first_non_finite;
 pub use model::ExtendedModel;
-pub use noise::NOISE_CHECK_LEVEL;
-pub use options::{DeployRule, DiagnoseOptions, DictionaryOptions, MIN_PURE_ERROR_DOF};
-pub use plausibility::{Plausibility, PlausibilityError, Range};
-pub use report::{
-    Alias, Cause, CauseKind, ChannelRms, DEPLOY_BENEFIT_SD, DEPLOY_IMPROVEMENT_SD, Diagnosis,
-    Estimate, Evidence, FinalFit, Gain, ModelTerm, NoiseCheck, NoiseSource, PureError, RejectStage,
-    Rejected, Remainder, ResidualPlot, SIGNIFICANT_IMPROVEMENT_SD, Structure, TermScore, Tested,
-    Verdict,
-};
+pub use options::DiagnoseOptions;
+pub use report::Diagnosis;
 pub use run::diagnose;
-pub use terms::{
-    Frame, GenericTerm, MIN_TEMPERATURE_RANGE_K, OrderAxis, Scope, TEMPERATURE_FOLLOWS_TIME, Term,
-};
-pub use tricept_model::effects::{CauseName, GenericFamily, REFERENCE_TEMPERATURE_C};

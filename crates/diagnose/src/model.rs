@@ -18,8 +18,11 @@ use std::sync::Arc;
 
 use crate::terms::{Frame, Term, TermKind};
 use tricept_data::MeasuredPose;
-use tricept_engine::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel, solve_pose};
-use tricept_kinematics::{KinematicsError, Machine, UpJoints};
+use tricept_engine::{
+    model::GeometricModel, model::GeometricPredictor, model::PosePredictor, model::ReadingModel,
+    model::solve_pose,
+};
+use tricept_kinematics::{KinematicsError, Machine, up_limb::UpJoints};
 use tricept_model::effects::{Basis, CauseName, EffectName, Entries, Kind};
 
 /// The geometric model plus the parameters of some terms: effects of the
@@ -42,7 +45,7 @@ impl ExtendedModel {
     /// # Example
     /// ```
     /// use tricept_diagnose::ExtendedModel;
-    /// use tricept_engine::{GeometricModel, ReadingModel};
+    /// use tricept_engine::{model::GeometricModel, model::ReadingModel};
     /// use tricept_model::effects::EffectName;
     /// let g = GeometricModel::new(tricept_kinematics::Machine::paper(), tricept_model::ParameterSet::paper15());
     /// let m = ExtendedModel::new(g, &[EffectName::Thermal]);
@@ -58,8 +61,8 @@ impl ExtendedModel {
     /// # Example
     /// ```
     /// use std::sync::Arc;
-    /// use tricept_diagnose::{ExtendedModel, Frame, GenericFamily, GenericTerm, Scope, Term};
-    /// use tricept_engine::{GeometricModel, ReadingModel};
+    /// use tricept_diagnose::{ExtendedModel, terms::Frame, terms::GenericFamily, terms::GenericTerm, terms::Scope, terms::Term};
+    /// use tricept_engine::{model::GeometricModel, model::ReadingModel};
     /// let m = tricept_kinematics::Machine::paper();
     /// let data = tricept_data::read_path("../../fixtures/data/diagnose-pitch.csv".as_ref()).unwrap();
     /// let pitch = Term::Generic(GenericTerm {
@@ -239,7 +242,7 @@ impl ReadingModel for ExtendedModel {
     }
 
     /// The geometric model's prior (a batch's), the terms not covered.
-    fn prior(&self) -> Option<tricept_engine::Prior> {
+    fn prior(&self) -> Option<tricept_engine::prior::Prior> {
         let geometric = self.geometric.prior()?;
         Some(geometric.padded(self.names.len() - geometric.parameters()))
     }
@@ -343,7 +346,7 @@ impl PosePredictor for ExtendedPredictor<'_> {
                 .try_inverse()
                 .ok_or(KinematicsError::Singular {
                     condition: f64::INFINITY,
-                    limit: tricept_kinematics::SINGULARITY_CONDITION_LIMIT,
+                    limit: tricept_kinematics::error::SINGULARITY_CONDITION_LIMIT,
                 })?;
             for (j, d) in &leg_derivs {
                 let v = j1_inv * nalgebra::Vector3::from(*d);

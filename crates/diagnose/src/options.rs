@@ -43,13 +43,13 @@ pub struct DiagnoseOptions {
 
 /// How a term of the final model is judged worth deploying. Both deploy a
 /// term only when its out-of-sample benefit exceeds
-/// [`crate::DEPLOY_BENEFIT_SD`] standard deviations; they differ where the
+/// [`crate::report::DEPLOY_BENEFIT_SD`] standard deviations; they differ where the
 /// readings cannot see (the weak leg-length direction,
 /// `docs/diagnosis.md`, "Deploy by what the file will deliver").
 ///
 /// # Example
 /// ```
-/// use tricept_diagnose::{DeployRule, DiagnoseOptions};
+/// use tricept_diagnose::{options::DeployRule, DiagnoseOptions};
 /// use tricept_kinematics::Machine;
 /// let mut options = DiagnoseOptions::for_machine(&Machine::paper());
 /// assert_eq!(options.deploy_rule, DeployRule::ExpectedError);
@@ -59,7 +59,7 @@ pub struct DiagnoseOptions {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum DeployRule {
     /// The term's predicted improvement exceeds
-    /// [`crate::DEPLOY_IMPROVEMENT_SD`] standard deviations of what the file
+    /// [`crate::report::DEPLOY_IMPROVEMENT_SD`] standard deviations of what the file
     /// does not know, or the term moves the platform where the readings
     /// cannot see by no more than they see it gain: the rule before the
     /// expected error (`--deploy-rule confident`). It keeps back terms whose
@@ -68,7 +68,7 @@ pub enum DeployRule {
     Confident,
     /// The default: what [`DeployRule::Confident`] deploys, and also a term
     /// whose file has the smaller expected error
-    /// ([`crate::ModelTerm::expected_rms_with_mm`]) by a predicted
+    /// ([`crate::report::ModelTerm::expected_rms_with_mm`]) by a predicted
     /// improvement of at least one standard deviation: the file the report
     /// expects to be best. Measured in truth (`docs/reliability.md`, "Deployed
     /// terms that pay in truth"): the sum of delivered errors lower on every

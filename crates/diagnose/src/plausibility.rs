@@ -39,7 +39,7 @@ impl Default for Plausibility {
     ///
     /// # Example
     /// ```
-    /// let p = tricept_diagnose::Plausibility::default();
+    /// let p = tricept_diagnose::plausibility::Plausibility::default();
     /// assert_eq!(p.ranges["thermal.expansion_ppm_per_k"].max, 16.0);
     /// assert_eq!(p.ranges["reading-drift.s_um"].unit, "um");
     /// ```
@@ -65,7 +65,7 @@ impl Plausibility {
     ///
     /// # Example
     /// ```
-    /// use tricept_diagnose::Plausibility;
+    /// use tricept_diagnose::plausibility::Plausibility;
     /// let p = Plausibility::with_overrides(r#"{"thermal.expansion_ppm_per_k": [20, 26]}"#).unwrap();
     /// assert_eq!(p.ranges["thermal.expansion_ppm_per_k"].min, 20.0);
     /// assert!(Plausibility::with_overrides(r#"{"thermal.alpha": [1, 2]}"#).is_err());

@@ -7,7 +7,7 @@ use serde::Serialize;
 use serde::ser::{SerializeMap, Serializer};
 use serde_json::Value;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
-use tricept_model::effects::CauseName;
+pub use tricept_model::effects::CauseName;
 
 /// The statistical evidence for one candidate.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -328,7 +328,7 @@ pub struct ModelTerm {
     /// standard deviations) and where the readings cannot see (its
     /// improvement above [`DEPLOY_IMPROVEMENT_SD`] standard deviations, or,
     /// under the default rule, the smaller expected error by an improvement
-    /// of at least one standard deviation: [`crate::DeployRule`]), both
+    /// of at least one standard deviation: [`crate::options::DeployRule`]), both
     /// against the deployed model without it; no term is exempt. Or the
     /// model without it cannot be fitted.
     pub deployed: bool,

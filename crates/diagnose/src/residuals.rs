@@ -5,7 +5,7 @@
 
 use tricept_data::Dataset;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
-use tricept_kinematics::{Machine, UpJoints};
+use tricept_kinematics::{Machine, up_limb::UpJoints};
 use tricept_model::effects::{CauseName, PlotAxes, XAxis, YAxis};
 use tricept_numerics::stats::chi2_sf;
 

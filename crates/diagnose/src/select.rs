@@ -41,7 +41,7 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 use tricept_data::Dataset;
-use tricept_engine::GeometricModel;
+use tricept_engine::model::GeometricModel;
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_model::effects::EffectName;

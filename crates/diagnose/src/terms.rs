@@ -17,10 +17,11 @@ use std::collections::BTreeMap;
 
 use tricept_data::{Dataset, MeasuredPose};
 use tricept_kinematics::units::RAD_PER_ARCSEC;
-use tricept_kinematics::{KinematicsError, Machine, UpJoints};
+use tricept_kinematics::{KinematicsError, Machine, up_limb::UpJoints};
+pub use tricept_model::effects::GenericFamily;
 use tricept_model::effects::{
-    Basis, CHANNELS, CauseName, EffectName, Entries, GenericFamily, Judgement, Kind, LegContext,
-    Needs, encoder_gain_error_rad, legendre_p2, legendre_p3, legendre_p4, linear_drift,
+    Basis, CHANNELS, CauseName, EffectName, Entries, Judgement, Kind, LegContext, Needs,
+    encoder_gain_error_rad, legendre_p2, legendre_p3, legendre_p4, linear_drift,
     normalised_coordinate, periodic_extra_mm,
 };
 
@@ -71,7 +72,7 @@ impl Term {
     ///
     /// # Example
     /// ```
-    /// use tricept_diagnose::{GenericFamily, GenericTerm, Scope, Term};
+    /// use tricept_diagnose::{terms::GenericFamily, terms::GenericTerm, terms::Scope, terms::Term};
     /// use tricept_model::effects::EffectName;
     /// let lead = Term::Catalogue(EffectName::LegLead);
     /// let drift = Term::Generic(GenericTerm::new(GenericFamily::ReadingDrift, Scope::Channel(2)));
@@ -516,7 +517,7 @@ impl Frame {
     ///
     /// # Example
     /// ```
-    /// use tricept_diagnose::{Frame, GenericFamily, Scope};
+    /// use tricept_diagnose::{terms::Frame, terms::GenericFamily, terms::Scope};
     /// let m = tricept_kinematics::Machine::paper();
     /// let data = tricept_data::read_path("../../fixtures/data/diagnose-pitch.csv".as_ref()).unwrap();
     /// let frame = Frame::of(&m, &data);

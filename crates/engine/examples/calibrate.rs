@@ -9,9 +9,11 @@
 use std::path::PathBuf;
 
 use nalgebra::Vector3;
-use tricept_engine::{GeometricModel, IdentifyOptions, corrected_commands, identify};
+use tricept_engine::{
+    IdentifyOptions, compensate::corrected_commands, identify, model::GeometricModel,
+};
 use tricept_kinematics::{Machine, MachineDescription};
-use tricept_model::{ParameterSet, volumetric_errors};
+use tricept_model::{ParameterSet, volumetric::volumetric_errors};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();

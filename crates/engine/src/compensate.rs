@@ -18,15 +18,17 @@ use std::fmt::Write as _;
 use nalgebra::Vector3;
 use tricept_kinematics::description::LegTableDescription;
 use tricept_kinematics::{KinematicsError, Machine, Workspace};
-use tricept_model::{ErrorMap, ExtendedMachine, ModelError, volumetric_errors};
+use tricept_model::{
+    ExtendedMachine, ModelError, volumetric::ErrorMap, volumetric::volumetric_errors,
+};
 
-use crate::CompensationTable;
+use crate::table::CompensationTable;
 
 /// Before/after error maps of a compensation.
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
@@ -36,9 +38,9 @@ use crate::CompensationTable;
 ///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
 ///     .unwrap();
 /// let id = tricept_engine::identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
-/// let actual = tricept_model::actual_machine(&m, &set.to_errors(&set.table2()));
+/// let actual = tricept_model::actual::actual_machine(&m, &set.to_errors(&set.table2()));
 /// let plane = m.workspace.disc_grid(750.0, 100.0);
-/// let c = tricept_engine::compensation(&m, &model.machine_at(&id.estimate), &actual, &plane).unwrap();
+/// let c = tricept_engine::compensate::compensation(&m, &model.machine_at(&id.estimate), &actual, &plane).unwrap();
 /// assert!(c.after.stats().mean_mm < 0.2 * c.before.stats().mean_mm);
 /// ```
 #[derive(Debug, Clone)]
@@ -60,7 +62,7 @@ pub struct Compensation {
 /// actual.leg_offsets_mm = [0.3, -0.2, 0.1];
 /// let targets = nominal.workspace.disc_grid(nominal.workspace.mid_plane_z_mm(), 100.0);
 /// // A perfect identification removes the error entirely.
-/// let c = tricept_engine::compensation(&nominal, &actual, &actual, &targets).unwrap();
+/// let c = tricept_engine::compensate::compensation(&nominal, &actual, &actual, &targets).unwrap();
 /// assert!(c.before.stats().max_mm > 0.1 && c.after.stats().max_mm < 1e-9);
 /// ```
 pub fn compensation(
@@ -86,7 +88,7 @@ pub fn compensation(
 /// let mut identified = m.clone();
 /// identified.leg_offsets_mm[0] = 0.1;
 /// let r = Vector3::new(0.0, 0.0, 750.0);
-/// let q = tricept_engine::corrected_commands(&identified, &[r]).unwrap();
+/// let q = tricept_engine::compensate::corrected_commands(&identified, &[r]).unwrap();
 /// assert!((m.inverse(&r).unwrap().legs_mm[0] - q[0][0] - 0.1).abs() < 1e-12);
 /// ```
 pub fn corrected_commands(

@@ -7,7 +7,7 @@ use tricept_kinematics::KinematicsError;
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();

@@ -3,11 +3,11 @@
 //! [`EVALUATION_BLOCK`] poses (in parallel beyond one block, the blocks'
 //! factors merged in block order: the same bits at any thread count).
 //! The nuisance columns are the sensor offsets, three per campaign
-//! ([`Campaigns`]); a model's prior adds its rows last ([`crate::Prior`]).
+//! ([`Campaigns`]); a model's prior adds its rows last ([`crate::prior::Prior`]).
 
 use rayon::prelude::*;
 use tricept_data::MeasuredPose;
-use tricept_kinematics::UpJoints;
+use tricept_kinematics::up_limb::UpJoints;
 use tricept_numerics::linalg::TriangularAccumulator;
 use tricept_numerics::lsq::ReducedProblem;
 

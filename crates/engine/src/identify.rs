@@ -14,7 +14,7 @@
 //!
 //! The solver is Gauss-Newton with step halving on the exact model, on the
 //! rows weighted by `1/sigma` of each logged reading. The rank decision
-//! (which parameters the data can see; [`crate::lsq`]) is taken once, at the
+//! (which parameters the data can see; [`tricept_numerics::lsq`]) is taken once, at the
 //! starting point, and kept: a parameter that is unidentifiable to first
 //! order is held at its prior rather than fitted to second-order effects.
 //! (On the x-first machine `dyA3` is such a parameter: its second-order
@@ -26,7 +26,7 @@
 use nalgebra::DMatrix;
 use serde_json::{Map, Value};
 use tricept_data::{Dataset, MeasuredPose};
-use tricept_kinematics::UpJoints;
+use tricept_kinematics::up_limb::UpJoints;
 
 use crate::campaigns::Campaigns;
 use crate::error::IdentError;
@@ -51,7 +51,7 @@ pub(crate) use design::{check_size, decide_design};
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions, Start, identify_from};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions, identify::Start, identify::identify_from};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// use tricept_plant::{Campaign, Plant};
@@ -90,7 +90,7 @@ impl Start {
     ///
     /// # Example
     /// ```
-    /// use tricept_engine::Start;
+    /// use tricept_engine::identify::Start;
     /// let s = Start { pose_weights: Some(vec![1.0, 2.0, 3.0]), ..Start::default() };
     /// assert_eq!(s.subset(|j| j != 1).pose_weights, Some(vec![1.0, 3.0]));
     /// ```
@@ -118,7 +118,7 @@ impl Start {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
@@ -153,7 +153,7 @@ pub struct ResidualStats {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
@@ -224,7 +224,7 @@ pub struct CampaignOffsets {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions, identify};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions, identify};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// use tricept_plant::{Campaign, Plant};
@@ -256,7 +256,7 @@ pub fn identify(
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions, Start, design, identify_from};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions, identify::Start, identify::design, identify::identify_from};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// use tricept_plant::{Campaign, Plant};
@@ -607,12 +607,12 @@ impl Identification {
     /// (mm), `std_dev`, `rank`, `n_params`, `unidentifiable`,
     /// `singular_values`, `condition_number`, `observability`, residual
     /// statistics (poses numbered from 1, with their file line), the
-    /// [`Verdict`](crate::Verdict) (`converged`, `adequate`, `warnings`),
+    /// [`Verdict`](crate::verdict::Verdict) (`converged`, `adequate`, `warnings`),
     /// and more.
     ///
     /// # Example
     /// ```
-    /// use tricept_engine::{GeometricModel, IdentifyOptions, identify};
+    /// use tricept_engine::{model::GeometricModel, IdentifyOptions, identify};
     /// use tricept_kinematics::Machine;
     /// use tricept_model::ParameterSet;
     /// let m = Machine::paper();

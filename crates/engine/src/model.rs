@@ -12,9 +12,11 @@
 //! identification adds three offset unknowns of its own.
 
 use tricept_data::MeasuredPose;
-use tricept_kinematics::{KinematicsError, LegGeometry, Machine, UpJoints};
+use tricept_kinematics::{KinematicsError, Machine, machine::LegGeometry, up_limb::UpJoints};
 use tricept_model::effects::static_leg_extra_per_mm;
-use tricept_model::{N_FULL, ParameterSet, actual_machine, error_jacobian_at};
+use tricept_model::{
+    ParameterSet, actual::actual_machine, jacobian::error_jacobian_at, params::N_FULL,
+};
 
 use crate::error::IdentError;
 use crate::prior::Prior;
@@ -23,7 +25,7 @@ use crate::prior::Prior;
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
@@ -32,7 +34,7 @@ use crate::prior::Prior;
 /// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
 ///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
 ///     .unwrap();
-/// use tricept_engine::ReadingModel;
+/// use tricept_engine::model::ReadingModel;
 /// let predictor = model.at(&set.table2());
 /// let mut jac = vec![0.0; 3 * 15];
 /// let mut seed = None;
@@ -69,12 +71,12 @@ pub trait ReadingModel: Sync {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
 /// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-/// use tricept_engine::ReadingModel;
+/// use tricept_engine::model::ReadingModel;
 /// let pose = tricept_data::MeasuredPose { commands_mm: [800.0; 3], ..Default::default() };
 /// let mut jac = vec![0.0; 45];
 /// let mut seed = None;
@@ -98,7 +100,7 @@ pub trait PosePredictor: Sync {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, ReadingModel};
+/// use tricept_engine::{model::GeometricModel, model::ReadingModel};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let model = GeometricModel::new(Machine::paper(), ParameterSet::paper15());
@@ -117,7 +119,7 @@ impl GeometricModel {
     ///
     /// # Example
     /// ```
-    /// use tricept_engine::GeometricModel;
+    /// use tricept_engine::model::GeometricModel;
     /// use tricept_kinematics::Machine;
     /// use tricept_model::ParameterSet;
     /// let model = GeometricModel::new(Machine::paper(), ParameterSet::paper15());
@@ -140,7 +142,7 @@ impl GeometricModel {
     /// # Example
     /// ```
     /// use nalgebra::DMatrix;
-    /// use tricept_engine::{GeometricModel, IdentifyOptions, Prior, ReadingModel, identify};
+    /// use tricept_engine::{model::GeometricModel, IdentifyOptions, prior::Prior, model::ReadingModel, identify};
     /// use tricept_kinematics::Machine;
     /// use tricept_model::ParameterSet;
     /// use tricept_plant::{Campaign, Plant};
@@ -189,7 +191,7 @@ impl GeometricModel {
     ///
     /// # Example
     /// ```
-    /// use tricept_engine::{GeometricModel, IdentifyOptions, identify};
+    /// use tricept_engine::{model::GeometricModel, IdentifyOptions, identify};
     /// use tricept_kinematics::Machine;
     /// use tricept_model::ParameterSet;
     /// use tricept_plant::{Campaign, Plant};
@@ -219,7 +221,7 @@ impl GeometricModel {
     ///
     /// # Example
     /// ```
-    /// use tricept_engine::GeometricModel;
+    /// use tricept_engine::model::GeometricModel;
     /// use tricept_kinematics::Machine;
     /// let model = GeometricModel::new(Machine::paper(), tricept_model::ParameterSet::paper15());
     /// assert!(model.rank_reference_machine().is_none());
@@ -234,7 +236,7 @@ impl GeometricModel {
     ///
     /// # Example
     /// ```
-    /// use tricept_engine::GeometricModel;
+    /// use tricept_engine::model::GeometricModel;
     /// use tricept_kinematics::Machine;
     /// let model = GeometricModel::new(Machine::paper(), tricept_model::ParameterSet::paper15());
     /// assert_eq!(model.nominal().leg_offsets_mm, [0.0; 3]);
@@ -247,7 +249,7 @@ impl GeometricModel {
     ///
     /// # Example
     /// ```
-    /// use tricept_engine::GeometricModel;
+    /// use tricept_engine::model::GeometricModel;
     /// use tricept_model::ParameterSet;
     /// let model = GeometricModel::new(tricept_kinematics::Machine::paper(), ParameterSet::full21());
     /// assert_eq!(model.parameter_set().names()[0], "dxB1");
@@ -260,7 +262,7 @@ impl GeometricModel {
     ///
     /// # Example
     /// ```
-    /// use tricept_engine::GeometricModel;
+    /// use tricept_engine::model::GeometricModel;
     /// use tricept_model::ParameterSet;
     /// let set = ParameterSet::paper15();
     /// let model = GeometricModel::new(tricept_kinematics::Machine::paper(), set.clone());
@@ -282,7 +284,7 @@ impl GeometricModel {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::GeometricPredictor;
+/// use tricept_engine::model::GeometricPredictor;
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let set = ParameterSet::paper15();
@@ -309,7 +311,7 @@ impl<'a> GeometricPredictor<'a> {
     ///
     /// # Example
     /// ```
-    /// use tricept_engine::GeometricPredictor;
+    /// use tricept_engine::model::GeometricPredictor;
     /// let set = tricept_model::ParameterSet::paper15();
     /// let g = GeometricPredictor::new(tricept_kinematics::Machine::paper(), &set);
     /// assert_eq!(g.machine().leg_offsets_mm, [0.0; 3]);
@@ -370,7 +372,7 @@ impl ReadingModel for GeometricModel {
 /// use tricept_kinematics::Machine;
 /// let m = Machine::paper();
 /// let mut seed = None;
-/// let up = tricept_engine::solve_pose(&m, &[800.0; 3], &mut seed).unwrap();
+/// let up = tricept_engine::model::solve_pose(&m, &[800.0; 3], &mut seed).unwrap();
 /// assert_eq!(seed, Some(up));
 /// assert!(up.phi_rad.abs() < 1e-12);
 /// ```

@@ -22,7 +22,7 @@ use crate::error::IdentError;
 /// # Example
 /// ```
 /// use nalgebra::DMatrix;
-/// use tricept_engine::Prior;
+/// use tricept_engine::prior::Prior;
 /// // Parameters 0 and 2 of three: N([0.1, 0.3], diag(0.01, 0.04)); parameter 1 free.
 /// let p = Prior::new(vec![0.1, 0.0, 0.3], &[0, 2], &DMatrix::from_row_slice(2, 2, &[0.01, 0.0, 0.0, 0.04])).unwrap();
 /// assert_eq!(p.dimension(), 2);
@@ -131,7 +131,7 @@ impl Prior {
     /// # Example
     /// ```
     /// use nalgebra::DMatrix;
-    /// let p = tricept_engine::Prior::new(vec![1.0], &[0], &DMatrix::from_element(1, 1, 4.0)).unwrap();
+    /// let p = tricept_engine::prior::Prior::new(vec![1.0], &[0], &DMatrix::from_element(1, 1, 4.0)).unwrap();
     /// let wider = p.padded(2);
     /// assert_eq!((wider.parameters(), wider.dimension()), (3, 1));
     /// assert!((wider.chi_square(&[3.0, 7.0, 8.0]) - 1.0).abs() < 1e-12);

@@ -21,7 +21,7 @@
 use tricept_kinematics::description::{CalibrationRecord, SealCheck};
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::effects::{Deployment, EffectName};
-use tricept_model::{HeadParameterSet, ParameterSet, actual_machine};
+use tricept_model::{ParameterSet, actual::actual_machine, head_errors::HeadParameterSet};
 
 /// The methods that write calibration records.
 pub const RECORD_METHODS: [&str; 3] = ["identify", "diagnose", "identify (fused)"];
@@ -118,7 +118,7 @@ impl RecordNotes {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions, check_calibration_record, identify};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions, record::check_calibration_record, identify};
 /// use tricept_kinematics::Machine;
 /// use tricept_kinematics::description::*;
 /// use tricept_model::ParameterSet;

@@ -26,7 +26,7 @@ use tricept_numerics::lsq::{RankDecision, Solution};
 ///
 /// # Example
 /// ```
-/// let o = tricept_engine::Observability::from_singular_values(&[4.0, 1.0], 16);
+/// let o = tricept_engine::report::Observability::from_singular_values(&[4.0, 1.0], 16);
 /// assert_eq!(o.o1, 0.5); // sqrt(4 * 1) / sqrt(16)
 /// assert_eq!(o.o2, 0.25);
 /// assert_eq!(o.o3, 1.0);
@@ -59,7 +59,7 @@ impl Observability {
     ///
     /// # Example
     /// ```
-    /// use tricept_engine::Observability;
+    /// use tricept_engine::report::Observability;
     /// // Condition number 100: O2 = 0.01 whatever the scale.
     /// let a = Observability::from_singular_values(&[10.0, 0.1], 10);
     /// let b = Observability::from_singular_values(&[1.0, 0.01], 10);
@@ -87,7 +87,7 @@ impl Observability {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
@@ -101,7 +101,7 @@ impl Observability {
 ///         ..Default::default()
 ///     })
 ///     .collect();
-/// let report = tricept_engine::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
+/// let report = tricept_engine::identify::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
 /// let weak = &report.weak[0];
 /// assert!(weak.to_text().contains("dq1"));
 /// assert!(weak.std_dev_mm.unwrap() > 0.1);
@@ -128,7 +128,7 @@ impl Combination {
     ///
     /// # Example
     /// ```
-    /// let c = tricept_engine::Combination {
+    /// let c = tricept_engine::report::Combination {
     ///     terms: vec![("dq1".into(), 1.0), ("dq2".into(), -0.5)],
     ///     singular_value: 0.0,
     ///     std_dev_mm: None,
@@ -146,7 +146,7 @@ impl Combination {
     ///
     /// # Example
     /// ```
-    /// let c = tricept_engine::Combination {
+    /// let c = tricept_engine::report::Combination {
     ///     terms: vec![("dyA3".into(), 1.0), ("dq1".into(), -0.25)],
     ///     singular_value: 0.0,
     ///     std_dev_mm: None,
@@ -175,7 +175,7 @@ impl Combination {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
@@ -189,7 +189,7 @@ impl Combination {
 ///         ..Default::default()
 ///     })
 ///     .collect();
-/// let report = tricept_engine::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
+/// let report = tricept_engine::identify::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
 /// let json = report.to_json();
 /// assert_eq!(json["n_params"], 15);
 /// assert_eq!(json["unidentifiable"][0]["dyA3"], 1.0);
@@ -251,7 +251,7 @@ pub struct CorrelatedPair {
 ///
 /// # Example
 /// ```
-/// let v = tricept_engine::NamedValues(vec![("dq1".into(), Some(0.5)), ("dyA3".into(), None)]);
+/// let v = tricept_engine::report::NamedValues(vec![("dq1".into(), Some(0.5)), ("dyA3".into(), None)]);
 /// assert_eq!(serde_json::to_string(&v).unwrap(), r#"{"dq1":0.5,"dyA3":null}"#);
 /// assert_eq!(v.get("dq1"), Some(0.5));
 /// ```
@@ -417,7 +417,7 @@ impl IdentifiabilityReport {
     ///
     /// # Example
     /// ```
-    /// use tricept_engine::{GeometricModel, IdentifyOptions};
+    /// use tricept_engine::{model::GeometricModel, IdentifyOptions};
     /// use tricept_kinematics::Machine;
     /// use tricept_model::ParameterSet;
     /// let m = Machine::paper();
@@ -428,7 +428,7 @@ impl IdentifiabilityReport {
     ///     .iter()
     ///     .map(|r| tricept_data::MeasuredPose { commands_mm: m.inverse(r).unwrap().legs_mm, ..Default::default() })
     ///     .collect();
-    /// let r = tricept_engine::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
+    /// let r = tricept_engine::identify::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
     /// let j = r.to_json();
     /// assert_eq!(j["rank"], 14);
     /// assert_eq!(j["unidentifiable"][0]["dyA3"], 1.0);
@@ -441,7 +441,7 @@ impl IdentifiabilityReport {
     ///
     /// # Example
     /// ```
-    /// use tricept_engine::{GeometricModel, IdentifyOptions};
+    /// use tricept_engine::{model::GeometricModel, IdentifyOptions};
     /// use tricept_kinematics::Machine;
     /// use tricept_model::ParameterSet;
     /// let m = Machine::paper();
@@ -452,7 +452,7 @@ impl IdentifiabilityReport {
     ///     .iter()
     ///     .map(|r| tricept_data::MeasuredPose { commands_mm: m.inverse(r).unwrap().legs_mm, ..Default::default() })
     ///     .collect();
-    /// let r = tricept_engine::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
+    /// let r = tricept_engine::identify::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
     /// assert!(r.to_text().starts_with("rank 14 of 15 parameters (75 poses"));
     /// ```
     pub fn to_text(&self) -> String {

@@ -35,7 +35,7 @@
 use nalgebra::Matrix3;
 use serde::Serialize;
 use tricept_data::{Dataset, MeasuredPose};
-use tricept_kinematics::UpJoints;
+use tricept_kinematics::up_limb::UpJoints;
 use tricept_numerics::stats::chi2_isf;
 
 use crate::error::IdentError;
@@ -53,7 +53,7 @@ pub const START_Z: f64 = 10.0;
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
@@ -65,7 +65,7 @@ pub const START_Z: f64 = 10.0;
 /// let mut data = data;
 /// data.poses[3].readings.phi_rad += 1e-3; // a 206 arcsec glitch
 /// data.poses[3].line = 42;
-/// let (_, rejected) = tricept_engine::identify_robust(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+/// let (_, rejected) = tricept_engine::robust::identify_robust(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
 /// assert_eq!(rejected[0].line, 42);
 /// ```
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -86,7 +86,7 @@ pub struct Rejection {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
@@ -96,7 +96,7 @@ pub struct Rejection {
 ///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
 ///     .unwrap();
 /// let id = tricept_engine::identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
-/// let r = tricept_engine::residuals_at(&model, &id.estimate, &id.offsets, &data.poses, &m.sensors.logged_sigma()).unwrap();
+/// let r = tricept_engine::robust::residuals_at(&model, &id.estimate, &id.offsets, &data.poses, &m.sensors.logged_sigma()).unwrap();
 /// // In noise units: of order one.
 /// assert!(r.iter().flatten().all(|v| v.iter().all(|x| x.abs() < 5.0)));
 /// ```
@@ -139,7 +139,7 @@ fn kept(data: &Dataset, rejected: &[Rejection]) -> Dataset {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
@@ -149,10 +149,10 @@ fn kept(data: &Dataset, rejected: &[Rejection]) -> Dataset {
 ///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
 ///     .unwrap();
 /// let options = IdentifyOptions::for_machine(&m);
-/// let rejected = tricept_engine::screen_gross_errors(&model, &data, &options, 1e-3, 0.1).unwrap();
+/// let rejected = tricept_engine::robust::screen_gross_errors(&model, &data, &options, 1e-3, 0.1).unwrap();
 /// assert!(rejected.is_empty()); // clean data lose nothing
 /// data.poses[6].readings.s_mm += 10.0; // a 10 mm misread of the scale
-/// let rejected = tricept_engine::screen_gross_errors(&model, &data, &options, 1e-3, 0.1).unwrap();
+/// let rejected = tricept_engine::robust::screen_gross_errors(&model, &data, &options, 1e-3, 0.1).unwrap();
 /// assert_eq!(rejected.iter().map(|r| r.pose).collect::<Vec<_>>(), vec![6]);
 /// ```
 pub fn screen_gross_errors(
@@ -172,7 +172,7 @@ pub fn screen_gross_errors(
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions, identify, screen_gross_errors_with_fit};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions, identify, robust::screen_gross_errors_with_fit};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
@@ -436,7 +436,7 @@ fn deleted_residuals(
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{identify_robust, GeometricModel, IdentifyOptions};
+/// use tricept_engine::{robust::identify_robust, model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// use tricept_plant::{Campaign, Plant};

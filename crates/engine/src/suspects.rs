@@ -12,7 +12,7 @@
 
 use serde::Serialize;
 use tricept_data::{Dataset, Readings};
-use tricept_kinematics::{AxisOrder, Machine};
+use tricept_kinematics::{Machine, description::AxisOrder};
 use tricept_model::ParameterSet;
 
 use crate::identify::identify;
@@ -112,7 +112,7 @@ fn trials(machine: &Machine) -> Vec<Trial> {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions, identify, likely_causes};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions, identify, suspects::likely_causes};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// use tricept_plant::{Campaign, Plant};

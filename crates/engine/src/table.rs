@@ -33,7 +33,7 @@ pub const SPACING_LADDER_MM: [f64; 6] = [100.0, 50.0, 40.0, 25.0, 20.0, 10.0];
 ///
 /// # Example
 /// ```
-/// use tricept_engine::CompensationTable;
+/// use tricept_engine::table::CompensationTable;
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ExtendedMachine;
 /// let nominal = Machine::paper();

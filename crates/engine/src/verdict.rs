@@ -13,7 +13,7 @@
 //!   [`INCONSISTENT_CHI2_PER_DOF`] (residuals of about 30 noise standard
 //!   deviations on average). That is a wrong machine file, swapped
 //!   columns or readings in the wrong units, not a calibration problem;
-//!   [`crate::likely_causes`] tests which.
+//!   [`crate::suspects::likely_causes`] tests which.
 
 use serde::Serialize;
 use tricept_numerics::stats::chi2_sf;
@@ -40,7 +40,7 @@ pub const BARELY_SEEN_STD_DEV_MM: f64 = 1.0;
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions, identify};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions, identify};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// use tricept_plant::{Campaign, Plant};

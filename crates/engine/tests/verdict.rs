@@ -11,8 +11,9 @@
 use std::sync::OnceLock;
 
 use tricept_engine::{
-    ADEQUACY_ALPHA, BARELY_SEEN_STD_DEV_MM, GeometricModel, INCONSISTENT_CHI2_PER_DOF,
-    Identification, IdentifyOptions, LARGE_ESTIMATE_MM, identify,
+    Identification, IdentifyOptions, identify, model::GeometricModel, verdict::ADEQUACY_ALPHA,
+    verdict::BARELY_SEEN_STD_DEV_MM, verdict::INCONSISTENT_CHI2_PER_DOF,
+    verdict::LARGE_ESTIMATE_MM,
 };
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;

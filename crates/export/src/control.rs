@@ -130,7 +130,7 @@ pub struct ControlLimits {
 ///
 /// # Example
 /// ```
-/// use tricept_export::{ControlModel, Controller};
+/// use tricept_export::{control::ControlModel, control::Controller};
 /// let m: ControlModel = "fanuc-0i".parse().unwrap();
 /// assert_eq!(m.family(), Controller::Fanuc);
 /// assert_eq!(m.limits().value_range.unwrap().value, 7);

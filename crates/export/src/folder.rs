@@ -156,7 +156,7 @@ fn check_contents(target: &Path) -> Result<(), String> {
 /// The files a previous export in `dir` lists in its summary (none when
 /// there is no readable summary).
 fn previous_export_files(dir: &Path) -> Vec<String> {
-    let Ok(text) = tricept_data::read_json_text(&dir.join(SUMMARY_FILE)) else {
+    let Ok(text) = tricept_data::bounded::read_json_text(&dir.join(SUMMARY_FILE)) else {
         return Vec::new();
     };
     let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else {

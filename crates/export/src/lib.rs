@@ -47,7 +47,7 @@ mod setup;
 pub mod sinumerik;
 mod types;
 
-pub use control::{ControlLimits, ControlModel, Controller, Limit};
+use control::{Controller, Limit};
 pub use folder::{SUMMARY_FILE, check_out};
 pub use types::{
     AxisSummary, ExportError, ExportOptions, ExportSummary, NotExported, SUMMARY_FORMAT_VERSION,

@@ -3,7 +3,7 @@
 //! writer; the root only re-exports it.
 
 use serde::Serialize;
-use tricept_kinematics::{DescriptionError, KinematicsError};
+use tricept_kinematics::{KinematicsError, error::DescriptionError};
 
 use crate::control::{ControlLimits, ControlModel, Controller};
 

@@ -23,9 +23,9 @@ use std::path::Path;
 
 use nalgebra::Vector3;
 use tricept_export::fanuc::StepAt;
-use tricept_export::{ControlModel, Controller, ExportOptions, ExportPlan, plan};
+use tricept_export::{ExportOptions, ExportPlan, control::ControlModel, control::Controller, plan};
 use tricept_kinematics::description::{ExplicitPlacement, Placement};
-use tricept_kinematics::{AxisOrder, MachineDescription};
+use tricept_kinematics::{MachineDescription, description::AxisOrder};
 use tricept_model::effects::{backlash_extra_mm, thermal_extra_mm};
 use tricept_model::{ExtendedMachine, ParameterSet};
 use tricept_plant::Plant;

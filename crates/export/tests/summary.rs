@@ -8,7 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
-use tricept_export::{Controller, ExportError, ExportOptions, ExportPlan, plan};
+use tricept_export::{ExportError, ExportOptions, ExportPlan, control::Controller, plan};
 use tricept_kinematics::MachineDescription;
 
 fn fixture(name: &str) -> MachineDescription {

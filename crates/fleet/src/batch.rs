@@ -33,8 +33,8 @@
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use tricept_data::Dataset;
-use tricept_engine::{AccuracyModel, IdentifyOptions, ReadingModel};
-use tricept_numerics::sparse::SolverKind;
+use tricept_engine::{IdentifyOptions, accuracy::AccuracyModel, model::ReadingModel};
+pub use tricept_numerics::sparse::{SolveStats, SolverKind};
 use tricept_numerics::stats::{chi2_sf, median};
 
 use crate::error::FleetError;

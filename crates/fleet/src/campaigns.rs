@@ -19,7 +19,7 @@
 //! campaigns that disagree neither can be preferred: both are named.
 
 use tricept_data::Dataset;
-use tricept_engine::{Identification, IdentifyOptions, ReadingModel, identify};
+use tricept_engine::{Identification, IdentifyOptions, identify, model::ReadingModel};
 use tricept_numerics::stats::chi2_sf;
 
 use crate::error::FleetError;
@@ -32,7 +32,7 @@ use crate::error::FleetError;
 /// use tricept_data::{Dataset, MeasuredPose};
 /// let a = Dataset { poses: vec![MeasuredPose::default(); 2], source: "a.csv".into() };
 /// let b = Dataset { poses: vec![MeasuredPose::default(); 3], source: "b.csv".into() };
-/// let pooled = tricept_fleet::pool(&[a, b]);
+/// let pooled = tricept_fleet::campaigns::pool(&[a, b]);
 /// assert_eq!(pooled.poses.iter().map(|p| p.campaign).collect::<Vec<_>>(), vec![0, 0, 1, 1, 1]);
 /// assert_eq!(pooled.source, "a.csv + b.csv");
 /// ```

@@ -19,8 +19,8 @@ use std::time::Instant;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use tricept_data::Dataset;
-use tricept_engine::ReadingModel;
-use tricept_kinematics::UpJoints;
+use tricept_engine::model::ReadingModel;
+use tricept_kinematics::up_limb::UpJoints;
 use tricept_numerics::sparse::{
     BlockProblem, ReducedBlock, RowBlock, SolveStats, SolverKind, solve_globals,
 };

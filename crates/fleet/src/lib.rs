@@ -4,7 +4,7 @@
 //! - `reml.rs`: the batch's spread by REML and a machine's distance from
 //!   the rest;
 //! - `campaigns.rs`: the campaigns of one machine pooled, each campaign's
-//!   share and whether it agrees with the rest ([`agreements`]);
+//!   share and whether it agrees with the rest ([`agreements`](crate::campaigns::agreements));
 //! - `own.rs`: each machine alone (its own calibration and exit code) and
 //!   the batch's rank decision;
 //! - `joint.rs`: the joint fit of every member's readings on the sparse
@@ -23,21 +23,15 @@ mod error;
 pub mod reml;
 
 // Layer 1: campaigns pooled, machines alone, and all of them at once.
-mod campaigns;
-mod joint;
-mod own;
+pub mod campaigns;
+pub mod joint;
+pub mod own;
 
 // Layer 2: the batch, and what it says of a new machine.
-mod batch;
-mod prior_file;
+pub mod batch;
+pub mod prior_file;
 mod report;
 
-pub use batch::{Batch, BatchOptions, MIN_MACHINES, MachineOutcome, calibrate_batch};
-pub use campaigns::{Agreement, Agreements, agreements, campaign_chi_squares, pool};
+pub use batch::{Batch, BatchOptions, calibrate_batch};
 pub use error::FleetError;
-pub use joint::{JointFit, JointInput, first_step_problem, fit as joint_fit};
-pub use own::{EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, OwnFit, batch_design};
-pub use prior_file::{
-    DataFileRecord, NamedCovariance, PRIOR_FORMAT, PRIOR_FORMAT_VERSION, PriorFile, PriorProvenance,
-};
-pub use tricept_numerics::sparse::{SolveStats, SolverKind};
+pub use prior_file::PriorFile;

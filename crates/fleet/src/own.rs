@@ -11,7 +11,8 @@
 use rayon::prelude::*;
 use tricept_data::Dataset;
 use tricept_engine::{
-    AccuracyModel, Identification, IdentifyOptions, ReadingModel, Rejection, identify_robust,
+    Identification, IdentifyOptions, accuracy::AccuracyModel, model::ReadingModel,
+    robust::Rejection, robust::identify_robust,
 };
 use tricept_numerics::linalg::TriangularAccumulator;
 use tricept_numerics::lsq::{RankDecision, ReducedProblem};
@@ -122,7 +123,7 @@ impl OwnFit {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// use tricept_plant::{Campaign, Plant};
@@ -132,7 +133,7 @@ impl OwnFit {
 ///     .map(|s| Plant::geometric(m.clone(), set.to_errors(&[0.0; 15])).simulate(&Campaign::random(&m, 20, s)).unwrap())
 ///     .collect();
 /// let model = GeometricModel::new(m.clone(), set.clone());
-/// let d = tricept_fleet::batch_design(&model, &data.iter().collect::<Vec<_>>(), &IdentifyOptions::for_machine(&m)).unwrap();
+/// let d = tricept_fleet::own::batch_design(&model, &data.iter().collect::<Vec<_>>(), &IdentifyOptions::for_machine(&m)).unwrap();
 /// // x-first U joint: no machine sees dyA3, so neither does the batch.
 /// assert_eq!(d.fixed, vec![set.index_of("dyA3").unwrap()]);
 /// ```

@@ -20,7 +20,7 @@ use std::collections::BTreeMap;
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
-use tricept_engine::Prior;
+use tricept_engine::prior::Prior;
 use tricept_kinematics::description::{UNVERSIONED, newer_format, seal_digest};
 use tricept_model::ParameterSet;
 

@@ -8,8 +8,12 @@
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 use tricept_data::Dataset;
-use tricept_engine::{AccuracyModel, GeometricModel, IdentifyOptions, accuracy_points};
-use tricept_fleet::{BatchOptions, JointInput, SolverKind, calibrate_batch, first_step_problem};
+use tricept_engine::{
+    IdentifyOptions, accuracy::AccuracyModel, accuracy::accuracy_points, model::GeometricModel,
+};
+use tricept_fleet::{
+    BatchOptions, batch::SolverKind, calibrate_batch, joint::JointInput, joint::first_step_problem,
+};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_numerics::sparse::{BlockError, BlockSolution, ReducedBlock};
@@ -179,5 +183,5 @@ fn a_direction_no_machine_sees_is_held_for_the_batch_never_filled() {
             "{kind:?}"
         );
     }
-    assert!(tricept_fleet::joint_fit(&input).is_err());
+    assert!(tricept_fleet::joint::fit(&input).is_err());
 }

@@ -9,9 +9,12 @@
 use std::sync::Arc;
 
 use tricept_data::Dataset;
-use tricept_diagnose::{ExtendedModel, Frame, GenericFamily, GenericTerm, Scope, Term};
+use tricept_diagnose::{
+    ExtendedModel, terms::Frame, terms::GenericFamily, terms::GenericTerm, terms::Scope,
+    terms::Term,
+};
 use tricept_engine::accuracy::{Fit, PromiseError};
-use tricept_engine::{GeometricModel, Identification, IdentifyOptions};
+use tricept_engine::{Identification, IdentifyOptions, model::GeometricModel};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 

@@ -44,9 +44,9 @@ pub use crate::json_version::{OUTPUT_FORMAT_VERSION, versioned_json};
 pub use crate::machine_file::MachineFile;
 pub use nalgebra;
 pub use serde_json;
-pub use tricept_check::DEFAULT_POWER;
+pub use tricept_check::check::DEFAULT_POWER;
 pub use tricept_data::Dataset;
-pub use tricept_engine::DEFAULT_TOLERANCE_MM;
+pub use tricept_engine::accuracy::DEFAULT_TOLERANCE_MM;
 pub use tricept_engine::fusion::fusable_effects;
 pub use tricept_model::ParameterSet;
 /// The figures of the verbs that draw (SVG, atomic): `tricept_plot`.
@@ -57,7 +57,7 @@ pub use tricept_plot as plot;
 /// `tricept_data`.
 pub mod files {
     pub use tricept_data::{
-        check_output_file, one_line, shown_path, write_atomic, write_external_path, write_path,
-        write_to,
+        atomic::check_output_file, external::write_external_path, message::one_line,
+        message::shown_path, write_atomic, write_path, write_to,
     };
 }

@@ -21,7 +21,7 @@ use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::machine_input::MachineInput;
 
 pub use tricept_check::history::Trend;
-pub use tricept_check::{CheckReport, DEFAULT_ALPHA};
+pub use tricept_check::{CheckReport, check::DEFAULT_ALPHA};
 
 /// A check campaign against a calibrated machine.
 ///
@@ -54,7 +54,7 @@ impl CheckRequest {
         CheckRequest {
             machine: machine.into(),
             data: data.into(),
-            alpha: tricept_check::DEFAULT_ALPHA,
+            alpha: tricept_check::check::DEFAULT_ALPHA,
             history: None,
         }
     }

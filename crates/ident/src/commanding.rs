@@ -15,7 +15,9 @@ use std::path::Path;
 
 use tricept_kinematics::MachineDescription;
 use tricept_kinematics::description::LegEffectsDescription;
-use tricept_kinematics::{FkSolution, HeadBranch, IkSolution, ToolIkSolution};
+use tricept_kinematics::{
+    fk::FkSolution, head::HeadBranch, head::ToolIkSolution, machine::IkSolution,
+};
 use tricept_model::ExtendedMachine;
 
 use crate::error::Error;

@@ -14,9 +14,9 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::Vector3;
 use serde_json::{Map, Value, json};
-use tricept_engine::ExtendedMachine;
 use tricept_engine::compensate::{MapError, TableError, WorkspaceTable};
-use tricept_model::{MapStats, ParameterSet};
+use tricept_model::ExtendedMachine;
+use tricept_model::{ParameterSet, volumetric::MapStats};
 use tricept_plant::Effect;
 
 use crate::calibrate::{CalibrateRequest, calibrate, exit_line, write_text};
@@ -25,7 +25,7 @@ use crate::inputs::TrueErrors;
 use crate::machine_file::write_rule;
 use crate::machine_input::MachineInput;
 
-pub use tricept_model::ErrorMap;
+pub use tricept_model::volumetric::ErrorMap;
 
 /// The largest interpolation error (um) the default table spacing allows.
 pub const TABLE_ERROR_LIMIT_UM: f64 = 1.0;
@@ -390,7 +390,7 @@ fn corrected_targets(
     path: &Path,
     calibrated: &ExtendedMachine,
 ) -> Result<Vec<CorrectedTarget>, Error> {
-    let points = tricept_data::read_targets(path)?;
+    let points = tricept_data::targets::read_targets(path)?;
     let mut rows = Vec::with_capacity(points.len());
     for (k, p) in points.iter().enumerate() {
         let r = Vector3::from(*p);

@@ -6,9 +6,9 @@
 
 use serde_json::{Value, json};
 use tricept_diagnose::detect::{advise, realistic, term_detectability};
-use tricept_engine::GeometricModel;
+use tricept_engine::model::GeometricModel;
 use tricept_model::{GeometricErrors, ParameterSet};
-use tricept_plant::{Campaign, Effect, Plant, PoseOrder};
+use tricept_plant::{Campaign, Effect, Plant, campaign::PoseOrder};
 
 use crate::data_input::DataInput;
 use crate::error::{EXIT_OK, Error};
@@ -180,7 +180,7 @@ impl DetectabilityReport {
         }
         out.push_str(&format!(
             "the stated sensor noise can be checked only against repeated poses: revisit at least {} poses on separate visits (`simulate --revisit`) to use `diagnose --noise-from-data`\n",
-            tricept_diagnose::MIN_PURE_ERROR_DOF
+            tricept_diagnose::options::MIN_PURE_ERROR_DOF
         ));
         out
     }

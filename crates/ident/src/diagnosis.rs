@@ -17,7 +17,7 @@ use std::sync::OnceLock;
 
 use serde_json::{Map, json};
 use tricept_data::Dataset;
-use tricept_diagnose::{DiagnoseError, DiagnoseOptions, Plausibility};
+use tricept_diagnose::{DiagnoseError, DiagnoseOptions, plausibility::Plausibility};
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
@@ -28,7 +28,7 @@ use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
 
-pub use tricept_diagnose::{DeployRule, Deployed, Diagnosis, ResidualPlot};
+pub use tricept_diagnose::{Deployed, Diagnosis, options::DeployRule, report::ResidualPlot};
 
 /// What to diagnose and how.
 ///
@@ -127,8 +127,8 @@ pub fn diagnose(request: DiagnoseRequest) -> Result<DiagnoseResult, Error> {
     }
     if let Some(path) = &plausibility {
         let file = path.display().to_string();
-        let text =
-            tricept_data::read_json_text(path).map_err(|e| Error::input(format!("{file}: {e}")))?;
+        let text = tricept_data::bounded::read_json_text(path)
+            .map_err(|e| Error::input(format!("{file}: {e}")))?;
         options.plausibility = Plausibility::with_overrides(&text)
             .map_err(|e| Error::input(format!("{file}: {e}")))?;
     }
@@ -288,7 +288,7 @@ impl DiagnoseResult {
             &deployed.id,
             &deployed.clean,
             &tricept_engine::IdentifyOptions::for_machine(nominal),
-            tricept_engine::DEFAULT_TOLERANCE_MM,
+            tricept_engine::accuracy::DEFAULT_TOLERANCE_MM,
         )?;
         let mut description = machine_file::calibrated_description(
             &self.machine,

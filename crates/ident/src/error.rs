@@ -13,10 +13,10 @@ use std::sync::Arc;
 use tricept_check::CheckError;
 use tricept_data::DataError;
 use tricept_diagnose::{DeployError, DiagnoseError};
-use tricept_engine::{IdentError, RecordError};
+use tricept_engine::{IdentError, record::RecordError};
 use tricept_export::ExportError;
 use tricept_fleet::FleetError;
-use tricept_kinematics::{DescriptionError, KinematicsError};
+use tricept_kinematics::{KinematicsError, error::DescriptionError};
 use tricept_model::ModelError;
 use tricept_plant::PlantError;
 use tricept_study::StudyError;
@@ -271,7 +271,7 @@ impl FileFailure {
 
 impl Error {
     /// An error of the given kind. The message is made one bounded line
-    /// ([`tricept_data::one_line`]): what it repeats of the input (a key,
+    /// ([`tricept_data::message::one_line`]): what it repeats of the input (a key,
     /// a value, a path) is cut and its control characters escaped.
     ///
     /// # Example
@@ -284,7 +284,7 @@ impl Error {
     pub fn new(kind: ErrorKind, message: impl Into<String>) -> Error {
         Error {
             kind,
-            message: tricept_data::one_line(&message.into()),
+            message: tricept_data::message::one_line(&message.into()),
             file: None,
             cause: None,
             source: None,
@@ -424,7 +424,7 @@ impl Error {
 }
 
 /// Refuses an output file before any work (exit code 2): a path
-/// [`tricept_data::check_output_file`] refuses (a device, a named pipe, a
+/// [`tricept_data::atomic::check_output_file`] refuses (a device, a named pipe, a
 /// directory, a name ending in a separator), or one whose directory does
 /// not exist (with the file-system failure `NotFound`).
 /// The one-line summary of a non-zero verdict (`VERB: exit CODE: WHY (see
@@ -436,7 +436,7 @@ pub(crate) fn exit_line(verb: &str, code: u8, why: &str) -> Option<String> {
 
 pub(crate) fn check_output_path(flag: &str, path: &std::path::Path) -> Result<(), Error> {
     let shown = path.display();
-    tricept_data::check_output_file(path)
+    tricept_data::atomic::check_output_file(path)
         .map_err(|e| Error::input(format!("{flag} {shown}: {e}")))?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,

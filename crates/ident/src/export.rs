@@ -8,8 +8,8 @@ use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::machine_input::MachineInput;
 
 pub use tricept_export::{
-    AxisSummary, ControlLimits, ControlModel, Controller, ExportError, ExportOptions,
-    ExportSummary, Limit, NotExported,
+    AxisSummary, ExportError, ExportOptions, ExportSummary, NotExported, control::ControlLimits,
+    control::ControlModel, control::Controller, control::Limit,
 };
 
 /// What to export, and where.

@@ -12,13 +12,16 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 use tricept_data::Dataset;
-use tricept_engine::{AccuracyModel, GeometricModel, IdentifyOptions, accuracy_points};
+use tricept_engine::{
+    IdentifyOptions, accuracy::AccuracyModel, accuracy::accuracy_points, model::GeometricModel,
+};
 use tricept_fleet::{
-    Batch, BatchOptions, DataFileRecord, PriorFile, PriorProvenance, calibrate_batch,
+    Batch, BatchOptions, PriorFile, calibrate_batch, prior_file::DataFileRecord,
+    prior_file::PriorProvenance,
 };
 use tricept_model::ParameterSet;
 
-pub use tricept_fleet::SolverKind;
+pub use tricept_fleet::batch::SolverKind;
 
 use crate::data_input::DataInput;
 use crate::error::Error;
@@ -57,7 +60,7 @@ impl FleetRequest {
             data,
             machine: MachineInput::default(),
             parameter_set: ParameterSet::paper15(),
-            tolerance_mm: tricept_engine::DEFAULT_TOLERANCE_MM,
+            tolerance_mm: tricept_engine::accuracy::DEFAULT_TOLERANCE_MM,
             solver: SolverKind::Schur,
         }
     }
@@ -166,7 +169,7 @@ impl FleetResult {
         };
         let code = match &why {
             None => 0,
-            Some(_) => b.exit_code().max(tricept_fleet::EXIT_INADEQUATE),
+            Some(_) => b.exit_code().max(tricept_fleet::own::EXIT_INADEQUATE),
         };
         let what = path.display().to_string();
         let forced =

@@ -5,7 +5,7 @@
 
 use serde_json::Value;
 use tricept_data::MeasuredPose;
-use tricept_engine::{GeometricModel, IdentifyOptions};
+use tricept_engine::{IdentifyOptions, model::GeometricModel};
 use tricept_model::ParameterSet;
 
 use crate::calibrate::fit_error;
@@ -14,7 +14,7 @@ use crate::error::Error;
 use crate::inputs::Poses;
 use crate::machine_input::MachineInput;
 
-pub use tricept_engine::IdentifiabilityReport;
+pub use tricept_engine::report::IdentifiabilityReport;
 
 /// The poses to assess.
 #[derive(Debug, Clone)]
@@ -98,7 +98,7 @@ pub fn assess_identifiability(request: IdentifiabilityRequest) -> Result<Identif
         }
     };
     let model = GeometricModel::new(m.clone(), set.clone());
-    let report = tricept_engine::identifiability(
+    let report = tricept_engine::identify::identifiability(
         &model,
         &vec![0.0; set.len()],
         &commands,

@@ -15,7 +15,8 @@ use std::str::FromStr;
 use nalgebra::Vector3;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{
-    DescriptionError, MAX_POSES, Machine, MachineDescription, PoseSet, PoseSetError,
+    Machine, MachineDescription, error::DescriptionError, workspace::MAX_POSES, workspace::PoseSet,
+    workspace::PoseSetError,
 };
 use tricept_model::ParameterSet;
 use tricept_plant::Effect;
@@ -245,7 +246,7 @@ impl LoadedMachine {
                 w.radius_mm, w.z_min_mm, w.z_max_mm, r.x, r.y, r.z
             )));
         }
-        let notes = tricept_engine::check_calibration_record(&description)
+        let notes = tricept_engine::record::check_calibration_record(&description)
             .map_err(|e| Error::with_context(&source, &e))?;
         let mut warnings = Vec::new();
         if let Some(w) = notes.warning() {
@@ -437,7 +438,7 @@ impl Poses {
                     .map_err(|e| Error::other(format!("--poses `{}`: {e}", self.spec)))
             }
             PosesKind::Set(set) => Ok(set.generate(&machine.workspace).unwrap_or_default()),
-            PosesKind::File(path) => Ok(tricept_data::read_targets(path)?
+            PosesKind::File(path) => Ok(tricept_data::targets::read_targets(path)?
                 .into_iter()
                 .map(Vector3::from)
                 .collect()),
@@ -482,7 +483,7 @@ impl FromStr for TrueErrors {
             "table2" => TrueErrors::Table2,
             "zero" => TrueErrors::Zero,
             s if s.starts_with("random:") => {
-                let max = tricept_model::MAX_PARAMETER_ERROR.0;
+                let max = tricept_model::params::MAX_PARAMETER_ERROR.0;
                 let (magnitude_mm, seed) = random_spec(
                     "errors",
                     s,
@@ -534,7 +535,7 @@ impl TrueErrors {
             )),
             TrueErrors::File(path) => {
                 let name = path.display();
-                let text = tricept_data::read_json_text(path)
+                let text = tricept_data::bounded::read_json_text(path)
                     .map_err(|e| Error::input(format!("{name}: {e}")))?;
                 set.parse_values(&text)
                     .map_err(|e| Error::input(format!("{name}: {e}")))
@@ -557,7 +558,7 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
     for spec in specs {
         let (text, origin) = match spec.strip_prefix('@') {
             Some(path) => (
-                tricept_data::read_json_text(Path::new(path))
+                tricept_data::bounded::read_json_text(Path::new(path))
                     .map_err(|e| Error::input(format!("{path}: {e}")))?,
                 path.to_string(),
             ),

@@ -14,8 +14,8 @@ use crate::inputs::LoadedMachine;
 pub use crate::commanding::{GeometricMachine, Machine, Vector3};
 pub use tricept_kinematics::batch::{BLOCK_ROWS, BatchError, Cell, Verb, run};
 pub use tricept_kinematics::{
-    FkSolution, HeadBranch, IkSolution, KinematicsError, MachineDescription, ToolIkSolution,
-    UpJoints,
+    KinematicsError, MachineDescription, fk::FkSolution, head::HeadBranch, head::ToolIkSolution,
+    machine::IkSolution, up_limb::UpJoints,
 };
 pub use tricept_model::ExtendedMachine;
 

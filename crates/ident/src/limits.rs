@@ -2,8 +2,8 @@
 //! is allocated or computed (exit 2 beyond them), so that no input value
 //! makes a verb exhaust the memory or run without end. Listed in
 //! docs/reliability.md; generated pose sets are bounded by
-//! [`tricept_kinematics::MAX_POSES`] and the readers' lines by
-//! [`tricept_data::MAX_LINE_BYTES`].
+//! [`tricept_kinematics::workspace::MAX_POSES`] and the readers' lines by
+//! [`tricept_data::read::MAX_LINE_BYTES`].
 
 /// Evaluation tool poses of the fused predictions and of `plan`
 /// (`--eval-grid` times the head angles).

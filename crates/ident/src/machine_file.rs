@@ -13,7 +13,7 @@ use nalgebra::DMatrix;
 use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
 use tricept_engine::fusion::{Fusion, SourceKind};
-use tricept_engine::{IdentifiabilityReport, Identification};
+use tricept_engine::{Identification, report::IdentifiabilityReport};
 use tricept_kinematics::description::{
     CalibrationRecord, CorrelationsDescription, ExternalSourceRecord, HeldParameter,
     SensorOffsetsDescription,

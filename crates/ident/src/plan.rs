@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use nalgebra::{DMatrix, Vector3};
 use serde_json::{Value, json};
-use tricept_data::{ExternalData, PlannedPose};
+use tricept_data::{external::ExternalData, external::PlannedPose};
 use tricept_engine::fusion::{FusedModel, Source, TrackerOptions, information_factor};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
@@ -134,7 +134,7 @@ impl PlanRequest {
             instrument,
             k: Vec::new(),
             detect_um: 20.0,
-            power: tricept_check::DEFAULT_POWER,
+            power: tricept_check::check::DEFAULT_POWER,
             data: None,
             poses: None,
             candidates: None,
@@ -231,16 +231,18 @@ impl Plan {
         match &self.out {
             None => Ok(false),
             Some(OutFile::Check(text)) => write_text(path, text).map(|()| true),
-            Some(OutFile::Planned { records, comments }) => tricept_data::write_external_path(
-                path,
-                &ExternalData {
-                    records: records.clone(),
-                    source: String::new(),
-                },
-                comments,
-            )
-            .map(|()| true)
-            .map_err(|e| Error::not_written(path, &e)),
+            Some(OutFile::Planned { records, comments }) => {
+                tricept_data::external::write_external_path(
+                    path,
+                    &ExternalData {
+                        records: records.clone(),
+                        source: String::new(),
+                    },
+                    comments,
+                )
+                .map(|()| true)
+                .map_err(|e| Error::not_written(path, &e))
+            }
         }
     }
 }
@@ -621,7 +623,7 @@ fn check_plan(a: &PlanRequest, loaded: &LoadedMachine) -> Result<Plan, Error> {
         &reference,
         a.detect_um,
         a.power,
-        tricept_check::DEFAULT_ALPHA,
+        tricept_check::check::DEFAULT_ALPHA,
         budget,
     )?;
     let mut out = None;

@@ -272,7 +272,7 @@ fn history(path: &Path) -> Result<(Source, Source), Error> {
 fn export(dir: &Path) -> Result<Source, Error> {
     let path = dir.join(EXPORT_SUMMARY);
     let file = path.display().to_string();
-    let text = tricept_data::read_json_text(&path).map_err(|e| {
+    let text = tricept_data::bounded::read_json_text(&path).map_err(|e| {
         Error::input(format!(
             "{file}: {e}: --export names the folder tricept export --out wrote"
         ))

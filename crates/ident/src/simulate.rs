@@ -4,7 +4,7 @@
 //! instruments (laser tracker, ballbar, touch probe) would measure on it.
 //! Everything is returned in memory with the comment lines its file
 //! carries; the caller writes the files
-//! (`tricept_data::write_path`, `tricept_data::write_external_path`).
+//! (`tricept_data::write_path`, `tricept_data::external::write_external_path`).
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -13,15 +13,17 @@ use std::str::FromStr;
 use nalgebra::{Isometry3, Vector3};
 use serde_json::{Value, json};
 use tricept_data::{
-    BallbarData, Dataset, ExternalPose, PlannedPose, TouchData, TrackerData, read_external_path,
+    Dataset, external::BallbarData, external::ExternalPose, external::PlannedPose,
+    external::TouchData, external::TrackerData, external::read_external_path,
 };
-use tricept_engine::GeometricModel;
+use tricept_engine::model::GeometricModel;
 use tricept_kinematics::Machine;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
-use tricept_model::{HeadParameterSet, ParameterSet};
+use tricept_model::{ParameterSet, head_errors::HeadParameterSet};
 use tricept_plant::{
-    Ballbar, Campaign, Effect, Plant, PlantError, PoseOrder, TouchFeature, TouchProbe, TouchTarget,
-    Tracker,
+    Campaign, Effect, Plant, PlantError, campaign::PoseOrder, instruments::Ballbar,
+    instruments::TouchFeature, instruments::TouchProbe, instruments::TouchTarget,
+    instruments::Tracker,
 };
 
 use crate::error::{EXIT_OK, Error};
@@ -95,7 +97,7 @@ impl HeadErrors {
             HeadErrors::File(path) => {
                 let flag = "--head-errors";
                 let name = path.display();
-                let text = tricept_data::read_json_text(path)
+                let text = tricept_data::bounded::read_json_text(path)
                     .map_err(|e| Error::input(format!("{flag}: {name}: {e}")))?;
                 HeadParameterSet::head13(&machine.head)
                     .parse_values(&text)

@@ -7,7 +7,7 @@
 //! ```
 
 use nalgebra::Vector3;
-use tricept_kinematics::{AxisOrder, FkSeed, Machine, box_lattice};
+use tricept_kinematics::{Machine, description::AxisOrder, fk::FkSeed, workspace::box_lattice};
 
 fn main() {
     for machine in [

@@ -17,9 +17,12 @@ use std::io::{Read, Write};
 
 use nalgebra::Vector3;
 use rayon::prelude::*;
-use tricept_data::NumericRows;
+use tricept_data::targets::NumericRows;
 
-use crate::{FkSolution, HeadBranch, IkSolution, KinematicsError, Machine, ToolIkSolution};
+use crate::{
+    KinematicsError, Machine, fk::FkSolution, head::HeadBranch, head::ToolIkSolution,
+    machine::IkSolution,
+};
 
 /// The three solutions a batch asks a machine for.
 pub trait PointKinematics: Sync {

@@ -8,7 +8,7 @@
 use thiserror::Error;
 
 /// Largest condition number (of the unit-free `J1`, see
-/// [`crate::FkSolution::condition`]) accepted before a configuration is
+/// [`crate::fk::FkSolution::condition`]) accepted before a configuration is
 /// declared singular. In the Table 1 workspace it stays below 20.
 pub const SINGULARITY_CONDITION_LIMIT: f64 = 1e6;
 
@@ -66,7 +66,7 @@ pub enum KinematicsError {
     /// number exceeds the limit, so the answer would not be trustworthy.
     #[error("singular configuration: condition number {condition:.3e} exceeds {limit:.1e}")]
     Singular {
-        /// Estimated condition number (dimensionless, see [`crate::FkSolution::condition`]).
+        /// Estimated condition number (dimensionless, see [`crate::fk::FkSolution::condition`]).
         condition: f64,
         /// The limit it exceeded.
         limit: f64,

@@ -3,7 +3,7 @@
 //!
 //! The unknowns are the UP joints `x = (phi, theta, q4)`; the equations are
 //! the three leg closures `f_i(x) = |A_i(x) - B_i| - (q_i + dq_i) = 0`. Their
-//! Jacobian is the paper's `J1` (see [`crate::LegGeometry::j1`]), so Newton's
+//! Jacobian is the paper's `J1` (see [`crate::machine::LegGeometry::j1`]), so Newton's
 //! method costs one 3x3 solve per iteration. The iteration is safeguarded by
 //! a backtracking line search on `|f|^2`; it starts from a closed-form seed
 //! (three-sphere trilateration with the platform level; if that fails, two
@@ -12,7 +12,7 @@
 //! Every solution carries the condition number of `J1` made unit-free by
 //! scaling its angle columns by `1/q4`, and the solver refuses (with an
 //! error, never a wrong number) configurations where that number exceeds
-//! [`crate::SINGULARITY_CONDITION_LIMIT`].
+//! [`crate::error::SINGULARITY_CONDITION_LIMIT`].
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -82,7 +82,7 @@ impl Machine {
     ///
     /// # Example
     /// ```
-    /// use tricept_kinematics::{FkSeed, Machine};
+    /// use tricept_kinematics::{fk::FkSeed, Machine};
     /// let m = Machine::paper();
     /// let legs = m.inverse(&nalgebra::Vector3::new(300.0, -200.0, 700.0)).unwrap().legs_mm;
     /// let a = m.forward_seeded(&legs, FkSeed::Level).unwrap();
@@ -404,7 +404,7 @@ mod tests {
     fn the_extrapolated_seed_is_many_times_closer_than_a_level_platform() {
         for m in [
             Machine::paper(),
-            Machine::paper().with_axis_order(crate::AxisOrder::YFirst),
+            Machine::paper().with_axis_order(crate::description::AxisOrder::YFirst),
         ] {
             let (mut worst_level, mut worst_seed) = (0.0f64, 0.0f64);
             let (mut sum_level, mut sum_seed) = (0.0, 0.0);

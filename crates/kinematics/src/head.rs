@@ -2,7 +2,7 @@
 //! and the 5-DOF tool-pose inverse kinematics of the whole Tricept.
 //!
 //! The head is written in product-of-exponentials form in the platform frame
-//! (see [`crate::HeadDescription`]). Head angles in every public function
+//! (see [`crate::description::HeadDescription`]). Head angles in every public function
 //! are *commanded* angles, what a controller sends and `tricept tool-ik`
 //! prints; the kinematic angle about each axis is the command plus the
 //! head's `angle_offsets_rad` (zero on a nominal head). Because the platform orientation `R`
@@ -266,7 +266,7 @@ impl Machine {
     /// # Example
     /// ```
     /// use nalgebra::Vector3;
-    /// use tricept_kinematics::{HeadBranch, Machine};
+    /// use tricept_kinematics::{head::HeadBranch, Machine};
     /// let m = Machine::paper();
     /// let tip = Vector3::new(150.0, 100.0, 1080.0);
     /// let axis = Vector3::new(0.2, -0.1, 1.0);

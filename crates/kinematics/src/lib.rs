@@ -32,17 +32,14 @@
 pub mod batch;
 pub mod description;
 pub mod error;
-mod fk;
+pub mod fk;
 pub mod head;
-mod machine;
+pub mod machine;
 pub mod units;
-mod up_limb;
-mod workspace;
+pub mod up_limb;
+pub mod workspace;
 
-pub use description::{AxisOrder, HeadDescription, MachineDescription, Placement};
-pub use error::{DescriptionError, KinematicsError, SINGULARITY_CONDITION_LIMIT};
-pub use fk::{FkSeed, FkSolution};
-pub use head::{Head, HeadBranch, ToolIkSolution, ToolPose};
-pub use machine::{IkSolution, LegGeometry, Limits, Machine, SensorNoise};
-pub use up_limb::{UpJoints, UpLimb, UpLimbPose};
-pub use workspace::{MAX_POSES, PoseSet, PoseSetError, Workspace, box_lattice};
+pub use description::MachineDescription;
+pub use error::KinematicsError;
+pub use machine::Machine;
+pub use workspace::Workspace;

@@ -269,7 +269,7 @@ impl Machine {
     }
 
     /// The same machine with a different ideal U-joint axis order.
-    pub fn with_axis_order(mut self, order: crate::AxisOrder) -> Machine {
+    pub fn with_axis_order(mut self, order: crate::description::AxisOrder) -> Machine {
         self.up_limb.axis_order = order;
         self
     }

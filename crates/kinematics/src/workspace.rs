@@ -153,7 +153,7 @@ impl Workspace {
 ///
 /// # Example
 /// ```
-/// use tricept_kinematics::{Machine, PoseSet};
+/// use tricept_kinematics::{Machine, workspace::PoseSet};
 /// let ws = Machine::paper().workspace;
 /// let grid: PoseSet = "grid".parse().unwrap();
 /// assert_eq!(grid.generate(&ws).unwrap().len(), 75);
@@ -304,7 +304,7 @@ impl std::str::FromStr for PoseSet {
 impl PoseSet {
     /// The points of a generated set in `workspace`, mm; `None` for
     /// [`PoseSet::File`], whose points the caller reads
-    /// (`tricept_data::read_targets`).
+    /// (`tricept_data::targets::read_targets`).
     pub fn generate(&self, workspace: &Workspace) -> Option<Vec<Vector3<f64>>> {
         match self {
             PoseSet::Grid {
@@ -329,7 +329,7 @@ impl PoseSet {
 /// # Example
 /// ```
 /// use nalgebra::Vector3;
-/// let l = tricept_kinematics::box_lattice(
+/// let l = tricept_kinematics::workspace::box_lattice(
 ///     Vector3::new(-100.0, -100.0, 600.0),
 ///     Vector3::new(100.0, 100.0, 700.0),
 ///     50.0,

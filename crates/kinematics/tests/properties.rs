@@ -3,7 +3,9 @@
 
 use nalgebra::Vector3;
 use proptest::prelude::*;
-use tricept_kinematics::{AxisOrder, HeadBranch, Machine, UpLimb, box_lattice};
+use tricept_kinematics::{
+    Machine, description::AxisOrder, head::HeadBranch, up_limb::UpLimb, workspace::box_lattice,
+};
 
 fn machines() -> Vec<Machine> {
     let paper = Machine::paper();

@@ -15,7 +15,7 @@ use crate::params::GeometricErrors;
 /// ```
 /// use nalgebra::Vector3;
 /// use tricept_kinematics::Machine;
-/// use tricept_model::{actual_machine, ParameterSet};
+/// use tricept_model::{actual::actual_machine, ParameterSet};
 /// let nominal = Machine::paper();
 /// let set = ParameterSet::paper15();
 /// let actual = actual_machine(&nominal, &set.to_errors(&set.table2()));

@@ -27,7 +27,8 @@
 
 use nalgebra::Vector3;
 use tricept_kinematics::{
-    FkSolution, HeadBranch, IkSolution, KinematicsError, Machine, ToolIkSolution, UpJoints,
+    KinematicsError, Machine, fk::FkSolution, head::HeadBranch, head::ToolIkSolution,
+    machine::IkSolution, up_limb::UpJoints,
 };
 
 #[cfg(test)]
@@ -84,7 +85,7 @@ impl ExtendedMachine {
     ///
     /// # Example
     /// ```
-    /// use tricept_kinematics::{Machine, UpJoints};
+    /// use tricept_kinematics::{Machine, up_limb::UpJoints};
     /// use tricept_model::ExtendedMachine;
     /// let mut m = Machine::paper();
     /// m.leg_effects.lead_ppm = [50.0, -30.0, 0.0];

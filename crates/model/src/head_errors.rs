@@ -1,5 +1,5 @@
 //! The error parameters of the 2-DOF head: a minimal set of 13 that moves a
-//! nominal head ([`tricept_kinematics::Head`]) into any nearby actual one,
+//! nominal head ([`tricept_kinematics::head::Head`]) into any nearby actual one,
 //! with an exact map (parameters to head) and the analytic Jacobian of any
 //! point fixed to the spindle.
 //!
@@ -54,7 +54,7 @@
 
 use nalgebra::{Matrix3, Rotation3, SMatrix, Unit, Vector3};
 use serde_json::{Map, Value};
-use tricept_kinematics::Head;
+use tricept_kinematics::head::Head;
 
 use crate::error::ModelError;
 use crate::params::{values_from_named_map, values_to_named_map};
@@ -151,7 +151,7 @@ impl Frames {
 /// # Example
 /// ```
 /// use tricept_kinematics::Machine;
-/// use tricept_model::HeadParameterSet;
+/// use tricept_model::head_errors::HeadParameterSet;
 /// let nominal = Machine::paper().head;
 /// let set = HeadParameterSet::head13(&nominal);
 /// let mut p = vec![0.0; 13];
@@ -269,7 +269,7 @@ impl HeadParameterSet {
     ///
     /// # Example
     /// ```
-    /// use tricept_model::HeadParameterSet;
+    /// use tricept_model::head_errors::HeadParameterSet;
     /// let set = HeadParameterSet::head13(&tricept_kinematics::Machine::paper().head);
     /// let v = set.scale_direction();
     /// // Default head: A axis 150 mm out along z' (= -a2), tool tip 350 mm along z'.
@@ -296,7 +296,7 @@ impl HeadParameterSet {
     ///
     /// # Example
     /// ```
-    /// use tricept_model::HeadParameterSet;
+    /// use tricept_model::head_errors::HeadParameterSet;
     /// let set = HeadParameterSet::head13(&tricept_kinematics::Machine::paper().head);
     /// let p = set.parse_values(r#"{"h1_zero_rad": 5e-4}"#).unwrap();
     /// assert_eq!(p[7], 5e-4);
@@ -344,7 +344,7 @@ impl HeadAt {
     ///
     /// # Example
     /// ```
-    /// use tricept_model::{Effector, HeadParameterSet};
+    /// use tricept_model::{head_errors::Effector, head_errors::HeadParameterSet};
     /// let nominal = tricept_kinematics::Machine::paper().head;
     /// let set = HeadParameterSet::head13(&nominal);
     /// let (p, jac) = set.at(&[0.0; 13]).point_jacobian([0.4, 0.3], &Effector::default());

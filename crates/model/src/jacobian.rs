@@ -22,7 +22,8 @@
 
 use nalgebra::{Matrix3, SMatrix};
 use tricept_kinematics::{
-    KinematicsError, LegGeometry, Machine, SINGULARITY_CONDITION_LIMIT, UpJoints,
+    KinematicsError, Machine, error::SINGULARITY_CONDITION_LIMIT, machine::LegGeometry,
+    up_limb::UpJoints,
 };
 
 use crate::params::N_FULL;
@@ -59,7 +60,7 @@ pub fn error_jacobian_at(geometry: &LegGeometry) -> Result<ErrorJacobian, Kinema
 /// ```
 /// use nalgebra::Vector3;
 /// use tricept_kinematics::Machine;
-/// use tricept_model::{error_jacobian, ParameterSet};
+/// use tricept_model::{jacobian::error_jacobian, ParameterSet};
 /// let m = Machine::paper();
 /// let up = m.inverse(&Vector3::new(100.0, 50.0, 700.0)).unwrap().up;
 /// let j = error_jacobian(&m, &up).unwrap();
@@ -88,7 +89,7 @@ pub fn position_error_jacobian(geometry: &LegGeometry) -> Result<ErrorJacobian, 
 /// ```
 /// use nalgebra::Vector3;
 /// use tricept_kinematics::Machine;
-/// use tricept_model::{point_error_jacobian, position_error_jacobian};
+/// use tricept_model::{jacobian::point_error_jacobian, jacobian::position_error_jacobian};
 /// let m = Machine::paper();
 /// let up = m.inverse(&Vector3::new(100.0, 50.0, 700.0)).unwrap().up;
 /// let g = m.legs_at(&up);

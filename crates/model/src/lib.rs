@@ -4,17 +4,17 @@
 //!
 //! - [`GeometricErrors`] and [`ParameterSet`]: the full 21-parameter vector
 //!   `deps = [db_i; da_0i; dq_i]`, the paper's 15-parameter set
-//!   ([`PAPER15_NAMES`]) and the linear map between them; Table 2 as a fixture.
-//! - [`actual_machine`]: nominal + errors, an exact [`tricept_kinematics::Machine`]
+//!   ([`PAPER15_NAMES`](crate::params::PAPER15_NAMES)) and the linear map between them; Table 2 as a fixture.
+//! - [`actual_machine`](crate::actual::actual_machine): nominal + errors, an exact [`tricept_kinematics::Machine`]
 //!   from which simulated readings are computed.
-//! - [`error_jacobian`]: the analytic `J = J1^{-1} J2` of eq. 9 for both
+//! - [`error_jacobian`](crate::jacobian::error_jacobian): the analytic `J = J1^{-1} J2` of eq. 9 for both
 //!   U-joint conventions.
-//! - [`point_error_jacobian`]: the same for any platform-fixed point (a
+//! - [`point_error_jacobian`](crate::jacobian::point_error_jacobian): the same for any platform-fixed point (a
 //!   tool tip, a tracker target).
-//! - [`HeadParameterSet`]: the 13 error parameters of the 2-DOF head, exact
+//! - [`HeadParameterSet`](crate::head_errors::HeadParameterSet): the 13 error parameters of the 2-DOF head, exact
 //!   and with the analytic Jacobian of any spindle point.
-//! - [`volumetric_errors`]: platform error maps (the paper's Fig. 3).
-//! - [`residual_mu`]: the paper's residual error `mu` (Fig. 4).
+//! - [`volumetric_errors`](crate::volumetric::volumetric_errors): platform error maps (the paper's Fig. 3).
+//! - [`residual_mu`](crate::params::residual_mu): the paper's residual error `mu` (Fig. 4).
 //! - [`effects`]: the registry of the effects the geometric model leaves
 //!   out (leg lead, backlash, thermal growth, sensor errors, class-2
 //!   errors, compliance; one file and one spec each) and of the generic
@@ -36,30 +36,18 @@
 // below (`xtask/tests/tidy.rs` checks it).
 // Layer 1: errors, parameters, plausible ranges
 mod error;
-mod params;
+pub mod params;
 pub mod plausibility;
 // Layer 2: the actual machine and the linearisations
-mod actual;
-mod head_errors;
-mod jacobian;
-mod volumetric;
+pub mod actual;
+pub mod head_errors;
+pub mod jacobian;
+pub mod volumetric;
 // Layer 3: the effect registry
 pub mod effects;
 // Layer 4: a calibrated machine's kinematics with its effects
 mod extended;
 
-pub use actual::{actual_machine, errors_between};
 pub use error::ModelError;
 pub use extended::ExtendedMachine;
-pub use head_errors::{
-    Effector, HEAD13_NAMES, HeadAt, HeadJacobian, HeadParameterSet, N_HEAD, TYPICAL_HEAD_ERRORS,
-};
-pub use jacobian::{
-    ErrorJacobian, error_jacobian, error_jacobian_at, j2, point_error_jacobian,
-    position_error_jacobian,
-};
-pub use params::{
-    FULL21_NAMES, GeometricErrors, MAX_PARAMETER_ERROR, N_FULL, PAPER15_NAMES, ParameterSet,
-    TABLE2_JSON, residual_mu,
-};
-pub use volumetric::{ErrorMap, MapStats, volumetric_errors};
+pub use params::{GeometricErrors, ParameterSet};

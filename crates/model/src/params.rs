@@ -214,7 +214,7 @@ impl ParameterSet {
     /// # Example
     /// ```
     /// use tricept_kinematics::Machine;
-    /// use tricept_model::{error_jacobian, ParameterSet};
+    /// use tricept_model::{jacobian::error_jacobian, ParameterSet};
     /// let m = Machine::paper();
     /// let up = m.inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0)).unwrap().up;
     /// let j21 = error_jacobian(&m, &up).unwrap();
@@ -398,7 +398,7 @@ pub(crate) fn values_to_named_map(names: &[String], p: &[f64]) -> Map<String, Va
 ///
 /// # Example
 /// ```
-/// use tricept_model::{residual_mu, ParameterSet};
+/// use tricept_model::{params::residual_mu, ParameterSet};
 /// let t2 = ParameterSet::paper15().table2();
 /// // No calibration (deps_e = 0): the paper's mu_0 = 0.285 mm.
 /// let mu0 = residual_mu(&t2, &vec![0.0; 15]);

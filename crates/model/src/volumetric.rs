@@ -74,7 +74,7 @@ impl ErrorMap {
 /// # Example
 /// ```
 /// use tricept_kinematics::Machine;
-/// use tricept_model::volumetric_errors;
+/// use tricept_model::volumetric::volumetric_errors;
 /// let m = Machine::paper();
 /// let targets = m.workspace.disc_grid(m.workspace.mid_plane_z_mm(), 100.0);
 /// // A machine commanded by its own model has no error.

@@ -4,9 +4,10 @@
 
 use nalgebra::{SVector, Vector3};
 use proptest::prelude::*;
-use tricept_kinematics::{AxisOrder, Machine, UpJoints, UpLimb};
+use tricept_kinematics::{Machine, description::AxisOrder, up_limb::UpJoints, up_limb::UpLimb};
 use tricept_model::{
-    GeometricErrors, N_FULL, ParameterSet, actual_machine, error_jacobian, position_error_jacobian,
+    GeometricErrors, ParameterSet, actual::actual_machine, jacobian::error_jacobian,
+    jacobian::position_error_jacobian, params::N_FULL,
 };
 
 fn machines() -> Vec<Machine> {

@@ -5,10 +5,11 @@
 //! leaves out.
 
 use nalgebra::Vector3;
-use tricept_kinematics::{AxisOrder, Head, Machine};
+use tricept_kinematics::{Machine, description::AxisOrder, head::Head};
 use tricept_model::{
-    Effector, GeometricErrors, HeadParameterSet, N_FULL, N_HEAD, TYPICAL_HEAD_ERRORS,
-    actual_machine, point_error_jacobian,
+    GeometricErrors, actual::actual_machine, head_errors::Effector, head_errors::HeadParameterSet,
+    head_errors::N_HEAD, head_errors::TYPICAL_HEAD_ERRORS, jacobian::point_error_jacobian,
+    params::N_FULL,
 };
 
 /// A small deterministic generator (xorshift64*), uniform in [-1, 1).

@@ -10,7 +10,7 @@
 //! data), and its sensors can be noisier than their data sheet says.
 
 use nalgebra::Vector3;
-use tricept_kinematics::{Machine, SensorNoise, UpJoints};
+use tricept_kinematics::{Machine, machine::SensorNoise, up_limb::UpJoints};
 
 use crate::PlantError;
 

@@ -16,7 +16,7 @@
 //! 5. the logger writes time, temperature and approach directions.
 //!
 //! The actual machine also carries head errors ([`Plant::head_errors`], the
-//! 13 parameters of [`tricept_model::HeadParameterSet`]), which no internal
+//! 13 parameters of [`tricept_model::head_errors::HeadParameterSet`]), which no internal
 //! sensor sees, and external instruments ([`instruments`]: a laser tracker,
 //! a ballbar, a touch probe on reference spheres and planes) measure the
 //! exact spindle point of the actual machine ([`Plant::spindle_point`]).
@@ -37,16 +37,15 @@ use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 use rand_pcg::Pcg64Mcg;
 use tricept_data::{Dataset, MeasuredPose, Readings};
-use tricept_kinematics::{KinematicsError, Machine, UpJoints};
+use tricept_kinematics::{KinematicsError, Machine, up_limb::UpJoints};
 use tricept_model::{
-    Effector, GeometricErrors, HeadParameterSet, N_HEAD, TYPICAL_HEAD_ERRORS, actual_machine,
+    GeometricErrors, actual::actual_machine, head_errors::Effector, head_errors::HeadParameterSet,
+    head_errors::N_HEAD, head_errors::TYPICAL_HEAD_ERRORS,
 };
 
-pub use campaign::{Campaign, PoseOrder};
+pub use campaign::Campaign;
 pub use effects::Effect;
 pub use error::PlantError;
-pub use instruments::{Ballbar, TouchFeature, TouchProbe, TouchTarget, Tracker};
-pub use tricept_model::effects::EffectName;
 
 /// The simulated machine: nominal model, geometric errors and effects.
 #[derive(Debug, Clone)]
@@ -252,7 +251,7 @@ impl Plant {
         &self,
         actual: &Machine,
         commands_mm: &[f64; 3],
-    ) -> Result<tricept_kinematics::FkSolution, KinematicsError> {
+    ) -> Result<tricept_kinematics::fk::FkSolution, KinematicsError> {
         let nominal_up = self.nominal.forward(commands_mm)?.up;
         let state = effects::PoseState {
             commands_mm: *commands_mm,
@@ -278,8 +277,8 @@ impl Plant {
     ///
     /// # Example
     /// ```
-    /// use tricept_kinematics::{HeadBranch, Machine};
-    /// use tricept_model::Effector;
+    /// use tricept_kinematics::{head::HeadBranch, Machine};
+    /// use tricept_model::head_errors::Effector;
     /// use tricept_plant::Plant;
     /// let m = Machine::paper();
     /// let mut plant = Plant::geometric(m.clone(), Default::default());
@@ -328,7 +327,7 @@ impl Plant {
 /// ```
 /// let e = tricept_plant::random_head_errors(1.0, 7);
 /// assert_eq!(e.len(), 13);
-/// assert!(e.iter().zip(tricept_model::TYPICAL_HEAD_ERRORS).all(|(v, s)| v.abs() >= 0.5 * s && v.abs() <= s));
+/// assert!(e.iter().zip(tricept_model::head_errors::TYPICAL_HEAD_ERRORS).all(|(v, s)| v.abs() >= 0.5 * s && v.abs() <= s));
 /// assert_eq!(e, tricept_plant::random_head_errors(1.0, 7));
 /// ```
 pub fn random_head_errors(scale: f64, seed: u64) -> Vec<f64> {

@@ -15,7 +15,7 @@
 use nalgebra::Vector3;
 use serde_json::{Value, json};
 use tricept_kinematics::Machine;
-use tricept_model::{Effector, ParameterSet};
+use tricept_model::{ParameterSet, head_errors::Effector};
 use tricept_plant::effects::typical_effects;
 use tricept_plant::{Campaign, Effect, Plant, random_errors, random_head_errors};
 

@@ -5,13 +5,15 @@
 //! campaign, and a seed always gives the same bits.
 
 use nalgebra::Vector3;
-use tricept_kinematics::{Machine, SensorNoise};
+use tricept_kinematics::{Machine, machine::SensorNoise};
 use tricept_model::ParameterSet;
 use tricept_model::effects::{
     GenericFamily, compliance_extra_mm, gravity_leg_tension_n, scale_gain_error_mm,
 };
 use tricept_plant::effects::Waveform;
-use tricept_plant::{Campaign, DEFAULT_SENSOR_OFFSETS, Effect, Plant, PoseOrder, random_errors};
+use tricept_plant::{
+    Campaign, DEFAULT_SENSOR_OFFSETS, Effect, Plant, campaign::PoseOrder, random_errors,
+};
 
 fn plant(seed: u64) -> Plant {
     let m = Machine::paper();
@@ -364,12 +366,12 @@ fn plant_with_head(seed: u64) -> Plant {
 }
 
 /// Tracker poses spread over the workspace and the head's angles.
-fn external_poses(m: &Machine, n: usize) -> Vec<tricept_data::ExternalPose> {
+fn external_poses(m: &Machine, n: usize) -> Vec<tricept_data::external::ExternalPose> {
     m.workspace
         .random_poses(n, 9)
         .iter()
         .enumerate()
-        .map(|(j, r)| tricept_data::ExternalPose {
+        .map(|(j, r)| tricept_data::external::ExternalPose {
             commands_mm: m.inverse(r).unwrap().legs_mm,
             head_rad: [0.9 * j as f64, 0.6 * ((j % 5) as f64 - 2.0) / 2.0],
         })
@@ -384,7 +386,7 @@ fn a_tracker_measures_the_exact_target_in_its_frame_with_the_stated_noise() {
         .enumerate()
         .map(|(j, pose)| (pose, if j % 2 == 0 { 0.0 } else { 80.0 }))
         .collect();
-    let mut tracker = tricept_plant::Tracker {
+    let mut tracker = tricept_plant::instruments::Tracker {
         frame: nalgebra::Isometry3::new(
             Vector3::new(900.0, -300.0, 50.0),
             Vector3::new(0.3, -0.2, 0.1),
@@ -428,7 +430,7 @@ fn a_tracker_measures_the_exact_target_in_its_frame_with_the_stated_noise() {
 fn a_ballbar_reads_the_exact_distance_plus_its_length_error() {
     let p = plant_with_head(5);
     let pivot = Vector3::new(30.0, -20.0, 1250.0);
-    let bar = tricept_plant::Ballbar {
+    let bar = tricept_plant::instruments::Ballbar {
         pivot_mm: pivot,
         length_error_um: 2.5,
         ball_offset_mm: Vector3::new(0.0, 0.0, 5.0),
@@ -438,7 +440,7 @@ fn a_ballbar_reads_the_exact_distance_plus_its_length_error() {
     let poses = external_poses(&p.nominal, 20);
     let data = bar.measure(&p, &poses, 3).unwrap();
     for (r, pose) in data.records.iter().zip(&poses) {
-        let effector = tricept_model::Effector {
+        let effector = tricept_model::head_errors::Effector {
             extension_mm: 0.0,
             offset_mm: bar.ball_offset_mm,
         };
@@ -453,12 +455,12 @@ fn a_ballbar_reads_the_exact_distance_plus_its_length_error() {
 fn a_touch_latches_the_commands_where_the_actual_stylus_meets_the_true_feature() {
     let p = plant_with_head(6);
     let (centre, radius, r) = (Vector3::new(100.0, 50.0, 1150.0), 12.7, 1.0);
-    let probe = tricept_plant::TouchProbe {
+    let probe = tricept_plant::instruments::TouchProbe {
         stylus_radius_mm: r,
         stylus_radius_error_um: 4.0,
         stylus_radius_sigma_um: 5.0,
         sigma_um: 0.0,
-        features: vec![tricept_plant::TouchFeature::Sphere {
+        features: vec![tricept_plant::instruments::TouchFeature::Sphere {
             id: 1,
             centre_mm: centre,
             radius_mm: radius,
@@ -468,7 +470,7 @@ fn a_touch_latches_the_commands_where_the_actual_stylus_meets_the_true_feature()
         .map(|j| {
             let a = j as f64 * 0.8;
             let u = Vector3::new(0.5 * a.cos(), 0.5 * a.sin(), -0.8).normalize();
-            tricept_plant::TouchTarget {
+            tricept_plant::instruments::TouchTarget {
                 feature: 1,
                 tip_mm: centre + u * (radius + r),
                 axis: Vector3::new(0.2 * a.sin(), 0.2 * a.cos(), 1.0),

@@ -9,7 +9,7 @@
 //! ```
 
 use tricept_kinematics::Machine;
-use tricept_study::{GradeModel, Scenario, TrialResult};
+use tricept_study::{Scenario, fast::GradeModel, results::TrialResult};
 
 /// One field of a trial's result.
 type Field = fn(&TrialResult) -> f64;

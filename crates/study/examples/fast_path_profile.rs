@@ -11,7 +11,7 @@
 use std::time::Instant;
 
 use tricept_kinematics::Machine;
-use tricept_study::{GradeModel, Scenario};
+use tricept_study::{Scenario, fast::GradeModel};
 
 /// CPU time of this thread, s (10 ms resolution).
 fn cpu_s() -> Result<f64, String> {

@@ -1,6 +1,6 @@
 //! How many self-calibration poses, and which, make a campaign worth
 //! deploying: the advice of a refused campaign
-//! ([`tricept_engine::PredictedAccuracy`]), and the poses of
+//! ([`tricept_engine::accuracy::PredictedAccuracy`]), and the poses of
 //! `--poses optimal:N`.
 //!
 //! For a pose count `n` on a ladder of sizes, the `n` poses are chosen from
@@ -15,8 +15,10 @@
 
 use nalgebra::{DMatrix, Vector3};
 use serde::Serialize;
-use tricept_engine::{AccuracyModel, GeometricModel, IdentifyOptions, PredictedAccuracy};
-use tricept_kinematics::{Machine, PoseSet};
+use tricept_engine::{
+    IdentifyOptions, accuracy::AccuracyModel, accuracy::PredictedAccuracy, model::GeometricModel,
+};
+use tricept_kinematics::{Machine, workspace::PoseSet};
 use tricept_model::ParameterSet;
 
 use crate::StudyError;
@@ -54,7 +56,7 @@ fn columns(machine: &Machine, set: &ParameterSet) -> Result<(Vec<usize>, Vec<usi
         })
         .collect::<Result<_, StudyError>>()?;
     let model = GeometricModel::new(machine.clone(), set.clone());
-    let d = tricept_engine::design(
+    let d = tricept_engine::identify::design(
         &model,
         &vec![0.0; set.len()],
         &poses,
@@ -172,7 +174,7 @@ mod tests {
     fn a_few_optimal_poses_suffice_where_eight_grid_poses_do_not() {
         let m = Machine::paper();
         let set = ParameterSet::paper15();
-        let points = tricept_engine::accuracy_points(&m);
+        let points = tricept_engine::accuracy::accuracy_points(&m);
         let accuracy = AccuracyModel::new(&m, &set, &points, 0.25).unwrap();
         let (optimal, random) = worthwhile_campaigns(&m, &set, &accuracy).unwrap();
         let (optimal, random) = (optimal.unwrap(), random.unwrap());

@@ -9,7 +9,7 @@
 //! 20 um). The check's test of that parameter alone has the non-centrality
 //! `lambda_t = D_t^2 G_tt`, where `G` is the information of the check's
 //! poses with the sensor offsets and the calibration's own uncertainty
-//! projected out (as in [`tricept_check::check`]): the campaign detects
+//! projected out (as in [`tricept_check::check`](fn@tricept_check::check)): the campaign detects
 //! the change with power `chi2_power(lambda_t, 1, level)` at the check's
 //! family-wise level. The poses are chosen from the workspace's candidate
 //! grid ([`crate::optimise::candidate_grid`]) to maximise the smallest
@@ -19,9 +19,12 @@
 
 use nalgebra::{DMatrix, DVector, Vector3};
 use serde::Serialize;
-use tricept_check::{Candidate, Reference, family_level, leg_ranges};
+use tricept_check::{Reference, candidates::Candidate, check::family_level, check::leg_ranges};
 use tricept_kinematics::Machine;
-use tricept_model::{FULL21_NAMES, N_FULL, error_jacobian, position_error_jacobian};
+use tricept_model::{
+    jacobian::error_jacobian, jacobian::position_error_jacobian, params::FULL21_NAMES,
+    params::N_FULL,
+};
 use tricept_numerics::stats::chi2_power;
 
 use crate::StudyError;
@@ -280,7 +283,7 @@ pub fn plan_check(
 
 /// `mean_r |P21(r)[:, t]|` over the workspace's evaluation grid (mm/mm).
 fn platform_columns(machine: &Machine) -> Result<[f64; N_FULL], StudyError> {
-    let points = tricept_engine::accuracy_points(machine);
+    let points = tricept_engine::accuracy::accuracy_points(machine);
     let mut sum = [0.0; N_FULL];
     for r in &points {
         let up = machine.inverse(r)?.up;

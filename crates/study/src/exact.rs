@@ -12,13 +12,13 @@
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use tricept_data::Dataset;
-use tricept_engine::{Identification, Start, identify_from};
-use tricept_model::{residual_mu, volumetric_errors};
+use tricept_engine::{Identification, identify::Start, identify::identify_from};
+use tricept_model::{params::residual_mu, volumetric::volumetric_errors};
 
 use crate::fast::{GradeModel, model_of, options_for, start_for};
 use crate::rng::trial_rng;
 use crate::scenario::Scenario;
-use crate::{StudyError, TrialResult};
+use crate::{StudyError, results::TrialResult};
 
 /// The data of exact trial `trial`: noise-free readings plus the mean of
 /// `readings_per_pose` draws per reading.

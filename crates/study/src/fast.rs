@@ -22,15 +22,16 @@
 use faer::Mat;
 use rayon::prelude::*;
 use tricept_engine::{
-    Design, GeometricModel, IdentifyOptions, ReadingModel, Start, design, identify_from,
+    IdentifyOptions, identify::Design, identify::Start, identify::design, identify::identify_from,
+    model::GeometricModel, model::ReadingModel,
 };
-use tricept_kinematics::UpJoints;
-use tricept_model::{position_error_jacobian, volumetric_errors};
+use tricept_kinematics::up_limb::UpJoints;
+use tricept_model::{jacobian::position_error_jacobian, volumetric::volumetric_errors};
 
 use crate::kernel::Kernel;
 use crate::rng::block_rng;
 use crate::scenario::Scenario;
-use crate::{StudyError, TrialResult};
+use crate::{StudyError, results::TrialResult};
 
 /// Trials per block (the unit of parallel work and of seeding).
 pub const BLOCK: usize = 512;
@@ -265,7 +266,7 @@ impl LinearEstimator {
     /// # Example
     /// ```
     /// use tricept_kinematics::Machine;
-    /// use tricept_study::{GradeModel, Scenario};
+    /// use tricept_study::{fast::GradeModel, Scenario};
     /// let m = Machine::paper();
     /// let s = Scenario::paper(m.clone(), m.workspace.polar_grid(2, 8, 3)).unwrap();
     /// let g = GradeModel::new(&s, 2.0).unwrap();
@@ -273,7 +274,7 @@ impl LinearEstimator {
     /// let full = g.estimator.run(&s, 1000, 1, 0, &|_| {});
     /// // mu = |truth - p* - dp|_1 / 15 and noise part = |dp|_1 / 15:
     /// // they differ by at most mu(p*).
-    /// let bias = tricept_model::residual_mu(&s.truth, &g.estimator.p_star);
+    /// let bias = tricept_model::params::residual_mu(&s.truth, &g.estimator.p_star);
     /// for (a, t) in noise.iter().zip(&full) {
     ///     assert!((a - t.mu_mm).abs() <= bias + 1e-12);
     /// }

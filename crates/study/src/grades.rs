@@ -12,7 +12,7 @@ use tricept_numerics::roots::{Spacing, Threshold, threshold};
 
 use crate::fast::{GradeModel, LinearEstimator};
 use crate::scenario::Scenario;
-use crate::{GradeResult, StudyError, Summary};
+use crate::{StudyError, results::GradeResult, results::Summary};
 
 /// A condition of the grade search that cannot be evaluated (the paper's
 /// estimator is singular at this grade).

@@ -25,7 +25,7 @@
 //! offset) the limb no longer stays in one plane and the argument does not
 //! apply (the error is then expected to be weakly visible; not measured).
 
-use tricept_kinematics::{AxisOrder, Machine};
+use tricept_kinematics::{Machine, description::AxisOrder};
 
 /// Relative tolerance of "lies on the axis" (rounding of the placement).
 const ON_AXIS: f64 = 1e-9;
@@ -44,7 +44,7 @@ pub struct InvisibleError {
 ///
 /// # Example
 /// ```
-/// use tricept_kinematics::{AxisOrder, Machine};
+/// use tricept_kinematics::{description::AxisOrder, Machine};
 /// use tricept_study::invisible::invisible_platform_errors;
 /// // The paper's machine: B3 at 0 degrees, on the x-first joint's fixed axis.
 /// let m = Machine::paper();

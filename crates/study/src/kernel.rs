@@ -23,7 +23,7 @@ use pulp::{Simd, WithSimd};
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-use crate::TrialResult;
+use crate::results::TrialResult;
 
 /// Vectors of trials per step.
 const W: usize = 2;

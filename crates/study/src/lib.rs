@@ -41,15 +41,15 @@ pub mod optimise;
 pub mod paper;
 pub mod plan;
 pub mod plan_sources;
-mod results;
+pub mod results;
 mod rng;
 pub mod scenario;
 
 pub use error::StudyError;
-pub use fast::{GradeModel, LinearEstimator};
-pub use grades::{EquivalentGrade, crossing_grade, equivalent_grade, grade_for_mu, recommend};
-pub use results::{GradeResult, PathResult, Summary, TrialResult};
 pub use scenario::Scenario;
+
+use fast::GradeModel;
+use results::{GradeResult, PathResult};
 
 /// Runs the fast path at every grade; `exact_trials` exact trials and the
 /// paper's solve alongside when asked.

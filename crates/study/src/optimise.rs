@@ -31,7 +31,7 @@
 use nalgebra::{DMatrix, Vector3};
 use rayon::prelude::*;
 use tricept_kinematics::Machine;
-use tricept_model::{ParameterSet, error_jacobian};
+use tricept_model::{ParameterSet, jacobian::error_jacobian};
 
 use crate::StudyError;
 
@@ -378,7 +378,8 @@ mod tests {
 
     #[test]
     fn exchange_never_lowers_the_criterion_and_beats_a_poor_start() {
-        let m = Machine::paper().with_axis_order(tricept_kinematics::AxisOrder::YFirst);
+        let m =
+            Machine::paper().with_axis_order(tricept_kinematics::description::AxisOrder::YFirst);
         let set = ParameterSet::paper15();
         let columns: Vec<usize> = (0..15).collect();
         let c = Candidates::new(

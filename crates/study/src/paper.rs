@@ -22,7 +22,7 @@
 
 use faer::Mat;
 use nalgebra::DMatrix;
-use tricept_model::error_jacobian;
+use tricept_model::jacobian::error_jacobian;
 
 use crate::StudyError;
 use crate::fast::{LinearEstimator, plane_jacobian};
@@ -156,7 +156,7 @@ impl DifferencedSolve {
     ///
     /// # Example
     /// ```
-    /// use tricept_kinematics::{AxisOrder, Machine};
+    /// use tricept_kinematics::{description::AxisOrder, Machine};
     /// use tricept_study::Scenario;
     /// use tricept_study::paper::{Differenced, DifferencedSolve, NominalLinearisation, RowWeights};
     /// let m = Machine::paper().with_axis_order(AxisOrder::YFirst);

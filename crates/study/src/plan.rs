@@ -54,13 +54,14 @@ use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 use tricept_data::MeasuredPose;
 use tricept_data::{
-    BallbarData, BallbarReading, ExternalData, ExternalPose, TouchData, TouchReading, TrackerData,
-    TrackerPoint,
+    external::BallbarData, external::BallbarReading, external::ExternalData,
+    external::ExternalPose, external::TouchData, external::TouchReading, external::TrackerData,
+    external::TrackerPoint,
 };
 use tricept_engine::fusion::{DesignRows, FusedModel, Source, design_rows, information_factor};
 use tricept_kinematics::units::RAD_PER_ARCSEC;
-use tricept_kinematics::{HeadBranch, Machine};
-use tricept_model::Effector;
+use tricept_kinematics::{Machine, head::HeadBranch};
+use tricept_model::head_errors::Effector;
 use tricept_numerics::linalg::TriangularAccumulator;
 use tricept_numerics::lsq::{DEFAULT_RANK_TOLERANCE, ReducedProblem};
 
@@ -582,7 +583,7 @@ fn nominal_tips(
 ///
 /// # Example
 /// ```
-/// use tricept_data::ExternalPose;
+/// use tricept_data::external::ExternalPose;
 /// let c = tricept_study::plan::with_extensions(&[ExternalPose::default(); 2], &[0.0, 100.0]);
 /// assert_eq!(c.iter().map(|x| x.1).collect::<Vec<_>>(), vec![0.0, 100.0, 0.0, 100.0]);
 /// ```

@@ -6,7 +6,10 @@
 //! ([`check_poses_csv`]).
 
 use nalgebra::Vector3;
-use tricept_data::{ExternalPose, Feature, Features, PlannedPose, Stylus};
+use tricept_data::{
+    external::ExternalPose, external::Feature, external::Features, external::PlannedPose,
+    external::Stylus,
+};
 use tricept_engine::fusion::{
     BallbarOptions, FusedModel, Source, TouchOptions, TrackerOptions, head_angle_poses,
 };
@@ -95,7 +98,7 @@ pub fn planned_poses(
         .iter()
         .map(|&c| {
             let (pose, extension_mm) = poses[c];
-            let effector = tricept_model::Effector {
+            let effector = tricept_model::head_errors::Effector {
                 extension_mm,
                 ..Default::default()
             };

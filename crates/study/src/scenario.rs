@@ -4,8 +4,8 @@
 
 use nalgebra::Vector3;
 use tricept_data::{MeasuredPose, Readings};
-use tricept_kinematics::{Machine, UpJoints};
-use tricept_model::{ParameterSet, residual_mu, volumetric_errors};
+use tricept_kinematics::{Machine, up_limb::UpJoints};
+use tricept_model::{ParameterSet, params::residual_mu, volumetric::volumetric_errors};
 use tricept_plant::{Campaign, Plant};
 
 use crate::StudyError;

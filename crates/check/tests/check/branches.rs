@@ -14,8 +14,8 @@
 
 use nalgebra::DMatrix;
 use tricept_check::{
-    Candidate, CheckError, CheckOptions, CheckReport, CheckVerdict, ChiSquare, Reference, check,
-    family_level, leg_ranges,
+    CheckError, CheckOptions, CheckReport, CheckVerdict, Reference, candidates::Candidate, check,
+    check::family_level, check::leg_ranges, parts::ChiSquare,
 };
 use tricept_data::Dataset;
 use tricept_kinematics::Machine;

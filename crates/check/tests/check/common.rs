@@ -8,7 +8,7 @@ use rand_distr::{Distribution, Normal};
 use rand_pcg::Pcg64Mcg;
 use tricept_check::{CheckOptions, CheckReport, Reference, check};
 use tricept_data::Dataset;
-use tricept_engine::{GeometricModel, IdentifyOptions, identify};
+use tricept_engine::{IdentifyOptions, identify, model::GeometricModel};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_plant::{Campaign, DEFAULT_SENSOR_OFFSETS, Plant};

@@ -15,7 +15,7 @@ use crate::common::{CALIBRATION_C, calibrated, check_campaign, run};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use rand_pcg::Pcg64Mcg;
-use tricept_check::{CandidateKind, Change, CheckReport, Reference};
+use tricept_check::{CheckReport, Reference, candidates::CandidateKind, changes::Change};
 use tricept_data::Dataset;
 use tricept_plant::effects::{LegLead, ScaleGain};
 use tricept_plant::{Effect, Plant};
@@ -39,7 +39,7 @@ fn change<'a>(r: &'a CheckReport, name: &str) -> Option<&'a Change> {
 /// calibrated machine's commands.
 fn platform_truth_um(before: &Plant, changed: &Plant, reference: &Reference) -> f64 {
     let m = reference.machine();
-    let points = tricept_engine::accuracy_points(m);
+    let points = tricept_engine::accuracy::accuracy_points(m);
     let total: f64 = points
         .iter()
         .map(|r| {

@@ -873,7 +873,7 @@ fn poses_csv(tips: &[[f64; 3]], axes: &[[f64; 3]], extension: Option<&[f64]>) ->
             .tool_inverse(
                 &nalgebra::Vector3::from(*t),
                 &nalgebra::Vector3::from(*a),
-                tricept_kinematics::HeadBranch::default(),
+                tricept_kinematics::head::HeadBranch::default(),
             )
             .unwrap();
         let [q1, q2, q3] = ik.legs_mm;

@@ -7,10 +7,10 @@
 use std::path::Path;
 
 use nalgebra::Vector3;
-use tricept_data::ExternalPose;
+use tricept_data::external::ExternalPose;
 use tricept_engine::fusion::FusedModel;
 use tricept_kinematics::Machine;
-use tricept_model::{Effector, ParameterSet};
+use tricept_model::{ParameterSet, head_errors::Effector};
 
 use crate::support::{ok, run_in as tricept, workdir};
 

@@ -8,7 +8,7 @@
 //!   signal);
 //! - exit 2 is one line on stderr that names the file (and its line, and
 //!   column, where the problem has one) or the flag, at most
-//!   [`tricept_data::MAX_MESSAGE_CHARS`] characters, no control character;
+//!   [`tricept_data::message::MAX_MESSAGE_CHARS`] characters, no control character;
 //! - no file changed by a refusal; by a run that succeeds, none but its
 //!   own output.
 //!
@@ -158,7 +158,7 @@ fn holds(
                 return fail("not one line");
             }
             if line.chars().any(|c| c.is_control() && c != '\n')
-                || first.chars().count() > tricept_data::MAX_MESSAGE_CHARS + 100
+                || first.chars().count() > tricept_data::message::MAX_MESSAGE_CHARS + 100
             {
                 return fail("control characters or an unbounded message");
             }
@@ -626,7 +626,7 @@ fn paths_at_random() {
         let target = resolved(&dir.join(&path));
         let history = dir.join("h.jsonl");
         let outputs = [target.as_path(), history.as_path()];
-        let shown = tricept_data::shown_path(Path::new(&path));
+        let shown = tricept_data::message::shown_path(Path::new(&path));
         let shown: String = shown.chars().take(40).collect();
         let names = [flag, shown.as_str()];
         let case = format!("paths case {case} {args:?}");

@@ -1,6 +1,6 @@
 //! Ballbar lengths (`q1,q2,q3,h1,h2,length`).
 
-use super::{ExternalData, ExternalPose, ExternalRow, InstrumentRecord, Reading, Row};
+use super::{ExternalData, ExternalPose, ExternalRow, Row, instrument_record};
 use crate::DataError;
 
 /// One reading of a ballbar between the tool-tip ball and a pivot on the table.
@@ -38,37 +38,15 @@ impl ExternalRow for BallbarReading {
                 "a ballbar length must be 10-2000 mm (um or m?)",
             ));
         }
-        let common = row.reading(pose)?;
         Ok(BallbarReading {
-            pose,
             length_mm,
-            sigma_um: common.sigma_um,
-            setup: common.setup.unwrap_or(1),
-            temp_c: common.temp_c,
-            line: common.line,
+            ..BallbarReading::with_reading(row.reading(pose)?)
         })
     }
 
-    fn pose(&self) -> &ExternalPose {
-        &self.pose
-    }
-
-    fn value(&self, column: &str) -> Option<f64> {
-        match column {
-            "length" => Some(self.length_mm),
-            _ => self.reading().value(column),
-        }
+    fn own_value(&self, column: &str) -> Option<f64> {
+        (column == "length").then_some(self.length_mm)
     }
 }
 
-impl InstrumentRecord for BallbarReading {
-    fn reading(&self) -> Reading {
-        Reading {
-            pose: self.pose,
-            sigma_um: self.sigma_um,
-            setup: Some(self.setup),
-            temp_c: self.temp_c,
-            line: self.line,
-        }
-    }
-}
+instrument_record!(BallbarReading, setup);

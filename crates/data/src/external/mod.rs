@@ -29,17 +29,18 @@
 //!
 //! Adding an instrument: one file here with its record (the measured fields
 //! and the [`Reading`] fields every instrument's row carries), its
-//! `ExternalRow` impl (the measured columns, read with [`Row`]'s checks; the
-//! common columns through `Row::reading` and [`Reading::value`]) and its
-//! [`InstrumentRecord`] impl; then `tricept-plant`'s `instruments/` (the
-//! simulated reading) and `tricept-engine`'s `fusion/` (the model term), one
-//! file each.
+//! `ExternalRow` impl (the measured columns, read with [`Row`]'s checks, and
+//! their values; the common columns come through `Row::reading` and
+//! [`Reading::value`]) and one line `instrument_record!(Record, setup)`,
+//! which writes the common part (its [`InstrumentRecord`] impl and
+//! `with_reading`); then `tricept-plant`'s `instruments/` (the simulated
+//! reading) and `tricept-engine`'s `fusion/` (the model term), one file each.
 
 use std::io::{Read, Write};
 use std::path::Path;
 
 use crate::records::{Header, Record, Records, open};
-use crate::{DataError, MAX_LENGTH_MM};
+use crate::{DataError, read::MAX_LENGTH_MM};
 
 mod ballbar;
 mod planned;
@@ -83,7 +84,7 @@ impl Reading {
     ///
     /// # Example
     /// ```
-    /// use tricept_data::Reading;
+    /// use tricept_data::external::Reading;
     /// let r = Reading { sigma_um: Some(2.0), setup: Some(1), ..Reading::default() };
     /// assert_eq!((r.value("sigma_um"), r.value("setup"), r.value("x")), (Some(2.0), None, None));
     /// ```
@@ -102,8 +103,59 @@ impl Reading {
 /// instruments share).
 pub trait InstrumentRecord: ExternalRecord + Clone {
     /// The fields every instrument's row carries.
-    fn reading(&self) -> Reading;
+    fn reading(&self) -> Reading {
+        self.common()
+    }
 }
+
+/// The [`Reading`] fields of a record (a planned pose has only its pose
+/// and line).
+pub trait CommonFields {
+    /// The record's common fields.
+    fn common(&self) -> Reading;
+}
+
+/// Writes the part every instrument's record shares once: its
+/// [`CommonFields`] (the record's `pose`, `sigma_um`, `temp_c`, `line` and,
+/// for a kind with setups, `setup: u32`), its [`InstrumentRecord`] impl,
+/// and `with_reading`, the record with a row's common fields and the
+/// measured ones at their defaults. `instrument_record!(TrackerPoint,
+/// setup)`; `instrument_record!(TouchReading)` for a kind without setups.
+macro_rules! instrument_record {
+    ($record:ident $(, $setup:ident)?) => {
+        impl $crate::external::CommonFields for $record {
+            fn common(&self) -> $crate::external::Reading {
+                $crate::external::Reading {
+                    pose: self.pose,
+                    sigma_um: self.sigma_um,
+                    setup: instrument_record!(@some $(self.$setup)?),
+                    temp_c: self.temp_c,
+                    line: self.line,
+                }
+            }
+        }
+
+        impl $crate::external::InstrumentRecord for $record {}
+
+        impl $record {
+            /// The record with `common`'s fields, the measured ones at
+            /// their defaults.
+            fn with_reading(common: $crate::external::Reading) -> Self {
+                $record {
+                    pose: common.pose,
+                    sigma_um: common.sigma_um,
+                    $($setup: common.$setup.unwrap_or(1),)?
+                    temp_c: common.temp_c,
+                    line: common.line,
+                    ..$record::default()
+                }
+            }
+        }
+    };
+    (@some) => { None };
+    (@some $value:expr) => { Some($value) };
+}
+use instrument_record;
 
 /// The records of one external-measurement file and where they came from.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -138,17 +190,25 @@ mod sealed {
 
 /// A record type of an external file: its columns and how a row reads
 /// and writes.
-pub trait ExternalRow: Sized {
+pub trait ExternalRow: CommonFields + Sized {
     /// Required columns after the pose columns.
     const MEASURED: &'static [&'static str];
     /// Optional columns.
     const OPTIONAL: &'static [&'static str];
     /// Builds the record from its pose and a reader of the other columns.
     fn from_row(pose: ExternalPose, row: &Row<'_>) -> Result<Self, DataError>;
+    /// Value of a column of this kind's own (`None`: not set, or a common
+    /// column).
+    fn own_value(&self, column: &str) -> Option<f64>;
     /// The pose.
-    fn pose(&self) -> &ExternalPose;
+    fn pose(&self) -> ExternalPose {
+        self.common().pose
+    }
     /// Value of a measured or optional column (`None`: not set).
-    fn value(&self, column: &str) -> Option<f64>;
+    fn value(&self, column: &str) -> Option<f64> {
+        self.own_value(column)
+            .or_else(|| self.common().value(column))
+    }
     /// The value written for an optional column a record does not set
     /// (`None`: the column is written only when every record sets it).
     fn default_of(column: &str) -> Option<f64> {
@@ -384,7 +444,7 @@ fn write_rows<W: Write, T: ExternalRow>(
 ///
 /// # Example
 /// ```
-/// use tricept_data::{BallbarReading, TouchReading, TrackerPoint, read_external_from};
+/// use tricept_data::{external::BallbarReading, external::TouchReading, external::TrackerPoint, external::read_external_from};
 /// let csv = "q1,q2,q3,h1,h2,x,y,z,sigma_um\n800,810,790,0.5,-0.3,1500.1,-20.2,300.3,12\n";
 /// let t = read_external_from::<TrackerPoint, _>(csv.as_bytes(), "t.csv").unwrap();
 /// assert_eq!(t.records[0].position_mm, [1500.1, -20.2, 300.3]);
@@ -422,7 +482,7 @@ pub fn read_external_path<T: ExternalRecord>(path: &Path) -> Result<ExternalData
 ///
 /// # Example
 /// ```
-/// use tricept_data::{ExternalData, ExternalPose, PlannedPose, TrackerPoint};
+/// use tricept_data::{external::ExternalData, external::ExternalPose, external::PlannedPose, external::TrackerPoint};
 /// let data = ExternalData {
 ///     records: vec![TrackerPoint {
 ///         pose: ExternalPose { commands_mm: [800.0; 3], head_rad: [0.1, 0.2] },
@@ -434,15 +494,15 @@ pub fn read_external_path<T: ExternalRecord>(path: &Path) -> Result<ExternalData
 ///     source: "mem".into(),
 /// };
 /// let mut out = Vec::new();
-/// tricept_data::write_external_to(&mut out, &data, &[]).unwrap();
+/// tricept_data::external::write_external_to(&mut out, &data, &[]).unwrap();
 /// let text = String::from_utf8(out).unwrap();
 /// assert_eq!(text, "q1,q2,q3,h1,h2,x,y,z,extension_mm\n800,800,800,0.1,0.2,1,2,3,100\n");
-/// let back = tricept_data::read_external_from::<TrackerPoint, _>(text.as_bytes(), "mem").unwrap();
+/// let back = tricept_data::external::read_external_from::<TrackerPoint, _>(text.as_bytes(), "mem").unwrap();
 /// assert_eq!(back.records[0].position_mm, data.records[0].position_mm);
 ///
 /// // Poses to measure at carry the nominal tool tip for information.
 /// let csv = "q1,q2,q3,h1,h2,x,y,z\n800,810,790,0.5,-0.3,10,20,1100\n";
-/// let p = tricept_data::read_external_from::<PlannedPose, _>(csv.as_bytes(), "plan.csv").unwrap();
+/// let p = tricept_data::external::read_external_from::<PlannedPose, _>(csv.as_bytes(), "plan.csv").unwrap();
 /// assert_eq!(p.records[0].tip_mm, Some([10.0, 20.0, 1100.0]));
 /// ```
 pub fn write_external_to<T: ExternalRecord, W: Write>(

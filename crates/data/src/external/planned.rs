@@ -1,7 +1,9 @@
 //! Poses to measure at (what `tricept plan` writes and `tricept simulate`
 //! reads).
 
-use super::{ExternalData, ExternalPose, ExternalRow, MAX_EXTENSION_MM, Row};
+use super::{
+    CommonFields, ExternalData, ExternalPose, ExternalRow, MAX_EXTENSION_MM, Reading, Row,
+};
 use crate::DataError;
 
 /// A pose to measure at (what `tricept plan` writes and `tricept simulate`
@@ -54,11 +56,7 @@ impl ExternalRow for PlannedPose {
         })
     }
 
-    fn pose(&self) -> &ExternalPose {
-        &self.pose
-    }
-
-    fn value(&self, column: &str) -> Option<f64> {
+    fn own_value(&self, column: &str) -> Option<f64> {
         match column {
             "extension_mm" => (self.extension_mm != 0.0).then_some(self.extension_mm),
             "x" => self.tip_mm.map(|t| t[0]),
@@ -67,6 +65,16 @@ impl ExternalRow for PlannedPose {
             "length" => self.length_mm,
             "feature" => self.feature.map(f64::from),
             _ => None,
+        }
+    }
+}
+
+impl CommonFields for PlannedPose {
+    fn common(&self) -> Reading {
+        Reading {
+            pose: self.pose,
+            line: self.line,
+            ..Reading::default()
         }
     }
 }

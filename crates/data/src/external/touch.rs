@@ -5,7 +5,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::{ExternalData, ExternalPose, ExternalRow, InstrumentRecord, Reading, Row};
+use super::{ExternalData, ExternalPose, ExternalRow, Row, instrument_record};
 use crate::DataError;
 
 /// One touch of a probe in the spindle on a feature of the features file.
@@ -39,39 +39,18 @@ impl ExternalRow for TouchReading {
                 "a feature id must be a whole number from 1",
             ));
         }
-        let common = row.reading(pose)?;
         Ok(TouchReading {
-            pose,
             feature: f as u32,
-            sigma_um: common.sigma_um,
-            temp_c: common.temp_c,
-            line: common.line,
+            ..TouchReading::with_reading(row.reading(pose)?)
         })
     }
 
-    fn pose(&self) -> &ExternalPose {
-        &self.pose
-    }
-
-    fn value(&self, column: &str) -> Option<f64> {
-        match column {
-            "feature" => Some(f64::from(self.feature)),
-            _ => self.reading().value(column),
-        }
+    fn own_value(&self, column: &str) -> Option<f64> {
+        (column == "feature").then_some(f64::from(self.feature))
     }
 }
 
-impl InstrumentRecord for TouchReading {
-    fn reading(&self) -> Reading {
-        Reading {
-            pose: self.pose,
-            sigma_um: self.sigma_um,
-            setup: None,
-            temp_c: self.temp_c,
-            line: self.line,
-        }
-    }
-}
+instrument_record!(TouchReading);
 
 /// The probe's stylus.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -120,9 +99,9 @@ impl Feature {
 /// let json = r#"{"stylus": {"radius_mm": 1.0, "radius_sigma_um": 2.0},
 ///   "features": [{"id": 1, "kind": "sphere", "radius_mm": 12.7, "radius_sigma_um": 0.5},
 ///                {"id": 2, "kind": "plane"}]}"#;
-/// let f = tricept_data::Features::from_json(json, "features.json").unwrap();
+/// let f = tricept_data::external::Features::from_json(json, "features.json").unwrap();
 /// assert_eq!(f.features.len(), 2);
-/// let e = tricept_data::Features::from_json(r#"{"stylus": {"radius_mm": 1.0, "radius_sigma_um": 2.0},
+/// let e = tricept_data::external::Features::from_json(r#"{"stylus": {"radius_mm": 1.0, "radius_sigma_um": 2.0},
 ///   "features": [{"id": 1, "kind": "cube"}]}"#, "f.json").unwrap_err();
 /// assert!(e.to_string().starts_with("f.json: line 2, column"), "{e}");
 /// ```
@@ -204,7 +183,7 @@ impl Features {
     /// Reads and checks a features file.
     pub fn from_path(path: &Path) -> Result<Features, DataError> {
         let file = path.display().to_string();
-        let text = crate::read_json_text(path).map_err(|source| DataError::Io {
+        let text = crate::bounded::read_json_text(path).map_err(|source| DataError::Io {
             file: file.clone(),
             source,
         })?;

@@ -1,8 +1,6 @@
 //! Laser-tracker and CMM points (`q1,q2,q3,h1,h2,x,y,z`).
 
-use super::{
-    ExternalData, ExternalPose, ExternalRow, InstrumentRecord, MAX_EXTENSION_MM, Reading, Row,
-};
+use super::{ExternalData, ExternalPose, ExternalRow, MAX_EXTENSION_MM, Row, instrument_record};
 use crate::DataError;
 
 /// One point measured by a laser tracker or a CMM.
@@ -46,41 +44,22 @@ impl ExternalRow for TrackerPoint {
                 (v.abs() > MAX_EXTENSION_MM).then_some("an extension beyond ±1000 mm (mm?)")
             })?
             .unwrap_or(0.0);
-        let common = row.reading(pose)?;
         Ok(TrackerPoint {
-            pose,
             position_mm,
-            sigma_um: common.sigma_um,
             extension_mm,
-            setup: common.setup.unwrap_or(1),
-            temp_c: common.temp_c,
-            line: common.line,
+            ..TrackerPoint::with_reading(row.reading(pose)?)
         })
     }
 
-    fn pose(&self) -> &ExternalPose {
-        &self.pose
-    }
-
-    fn value(&self, column: &str) -> Option<f64> {
+    fn own_value(&self, column: &str) -> Option<f64> {
         match column {
             "x" => Some(self.position_mm[0]),
             "y" => Some(self.position_mm[1]),
             "z" => Some(self.position_mm[2]),
             "extension_mm" => (self.extension_mm != 0.0).then_some(self.extension_mm),
-            _ => self.reading().value(column),
+            _ => None,
         }
     }
 }
 
-impl InstrumentRecord for TrackerPoint {
-    fn reading(&self) -> Reading {
-        Reading {
-            pose: self.pose,
-            sigma_um: self.sigma_um,
-            setup: Some(self.setup),
-            temp_c: self.temp_c,
-            line: self.line,
-        }
-    }
-}
+instrument_record!(TrackerPoint, setup);

@@ -8,8 +8,8 @@ use std::ops::Range;
 use nalgebra::{DMatrix, DVector, Matrix3};
 use rayon::prelude::*;
 use tricept_data::Dataset;
-use tricept_engine::ReadingModel;
-use tricept_kinematics::UpJoints;
+use tricept_engine::model::ReadingModel;
+use tricept_kinematics::up_limb::UpJoints;
 use tricept_numerics::linalg::TriangularAccumulator;
 
 use super::kernels::{axpy, dot3};

@@ -14,7 +14,7 @@ use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 use tricept_data::Dataset;
 use tricept_diagnose::{Diagnosis, deploy, diagnose};
-use tricept_engine::{GeometricModel, IdentifyOptions, identify};
+use tricept_engine::{IdentifyOptions, identify, model::GeometricModel};
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::effects::{CauseName, EffectName};
 use tricept_model::{ExtendedMachine, ParameterSet};
@@ -294,7 +294,7 @@ fn generic_leg_errors_are_deployed_and_pay_in_truth() {
             t.deployed
                 && t.effect.is_generic()
                 && matches!((t.improvement_mm, t.improvement_sd_mm), (Some(i), Some(sd))
-                    if i <= tricept_diagnose::DEPLOY_IMPROVEMENT_SD * sd)
+                    if i <= tricept_diagnose::report::DEPLOY_IMPROVEMENT_SD * sd)
         });
         let floor = if by_expected_error { 1.0 / 1.1 } else { 2.0 };
         if deployed_generic && ratio < floor {

@@ -27,8 +27,10 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 use tricept_data::Dataset;
-use tricept_diagnose::{CauseKind, DeployRule, DiagnoseOptions, Diagnosis, deploy, diagnose};
-use tricept_engine::{GeometricModel, IdentifyOptions, identify};
+use tricept_diagnose::{
+    DiagnoseOptions, Diagnosis, deploy, diagnose, options::DeployRule, report::CauseKind,
+};
+use tricept_engine::{IdentifyOptions, identify, model::GeometricModel};
 use tricept_kinematics::description::ControllerDescription;
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::{ExtendedMachine, ParameterSet};
@@ -475,13 +477,13 @@ fn worse_allowed(written: usize) -> usize {
 }
 
 /// The deployed terms of `d` whose predicted improvement is below
-/// [`tricept_diagnose::DEPLOY_IMPROVEMENT_SD`] standard deviations: what
+/// [`tricept_diagnose::report::DEPLOY_IMPROVEMENT_SD`] standard deviations: what
 /// the expected-error rule deploys and the confident one keeps back.
 fn deployed_by_expected_error_alone(d: &Diagnosis) -> Vec<String> {
     d.model_terms
         .iter()
         .filter(|t| {
-            let two = tricept_diagnose::DEPLOY_IMPROVEMENT_SD;
+            let two = tricept_diagnose::report::DEPLOY_IMPROVEMENT_SD;
             t.deployed
                 && matches!(
                     (t.improvement_mm, t.improvement_sd_mm, t.holdout_benefit_mm, t.holdout_benefit_sd_mm),

@@ -11,7 +11,8 @@ use std::sync::OnceLock;
 
 use tricept_data::Dataset;
 use tricept_diagnose::{
-    CauseName, Deployed, Diagnosis, GenericFamily, ModelTerm, deploy, diagnose,
+    Deployed, Diagnosis, deploy, diagnose, report::CauseName, report::ModelTerm,
+    terms::GenericFamily,
 };
 use tricept_kinematics::Machine;
 use tricept_kinematics::description::{LegTableDescription, MAX_TABLE_SLOPE_UM_PER_MM};

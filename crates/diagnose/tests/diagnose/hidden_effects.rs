@@ -27,7 +27,7 @@ use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_model::ParameterSet;
 use tricept_model::effects::{EffectName as E, stiffness_for_platform_deflection};
 use tricept_plant::effects::Effect;
-use tricept_plant::{Campaign, Plant, PoseOrder, random_errors};
+use tricept_plant::{Campaign, Plant, campaign::PoseOrder, random_errors};
 
 /// An effect of random magnitude from the stated range.
 pub(crate) fn hidden(e: E, rng: &mut Pcg64Mcg, m: &Machine) -> Effect {
@@ -162,7 +162,7 @@ fn found(d: &Diagnosis, effect: E) -> bool {
 }
 
 /// The estimates of `effect`'s parameters in the final model.
-fn fitted(d: &Diagnosis, effect: E) -> Vec<tricept_diagnose::Estimate> {
+fn fitted(d: &Diagnosis, effect: E) -> Vec<tricept_diagnose::report::Estimate> {
     let prefix = format!("{effect}.");
     d.extended
         .iter()

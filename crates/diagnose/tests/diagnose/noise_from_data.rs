@@ -9,7 +9,7 @@
 //! prints the tallies.
 
 use crate::common::*;
-use tricept_diagnose::{NoiseSource, diagnose};
+use tricept_diagnose::{diagnose, report::NoiseSource};
 use tricept_kinematics::Machine;
 
 const SETS: u64 = 20;

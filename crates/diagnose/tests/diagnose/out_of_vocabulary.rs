@@ -15,8 +15,8 @@
 
 use crate::common::*;
 use tricept_diagnose::detect::detectability;
-use tricept_diagnose::{Diagnosis, Verdict};
-use tricept_engine::GeometricModel;
+use tricept_diagnose::{Diagnosis, report::Verdict};
+use tricept_engine::model::GeometricModel;
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_model::effects::{CauseName, EffectName as E, GenericFamily as G};

@@ -11,7 +11,7 @@
 
 use crate::common::*;
 use rand_pcg::Pcg64Mcg;
-use tricept_diagnose::{Diagnosis, Plausibility, RejectStage};
+use tricept_diagnose::{Diagnosis, plausibility::Plausibility, report::RejectStage};
 use tricept_kinematics::Machine;
 use tricept_model::effects::{CauseName, EffectName as E, stiffness_for_platform_deflection};
 use tricept_plant::effects::Effect;

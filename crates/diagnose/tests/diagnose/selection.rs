@@ -11,10 +11,10 @@
 //! testing of the selection runs (docs/testing.md).
 
 use crate::common::*;
-use tricept_diagnose::{DiagnoseOptions, Diagnosis, Evidence, RejectStage};
+use tricept_diagnose::{DiagnoseOptions, Diagnosis, report::Evidence, report::RejectStage};
 use tricept_kinematics::Machine;
 use tricept_model::effects::{CauseName, EffectName as E, GenericFamily as G};
-use tricept_plant::PoseOrder;
+use tricept_plant::campaign::PoseOrder;
 use tricept_plant::effects::{Effect, Waveform};
 
 fn lead(seed: u64) -> Effect {

@@ -6,7 +6,7 @@
 //! prints the tallies.
 
 use crate::common::*;
-use tricept_diagnose::first_non_finite;
+use tricept_diagnose::finite::first_non_finite;
 use tricept_model::effects::EffectName as E;
 
 const SETS: u64 = 20;

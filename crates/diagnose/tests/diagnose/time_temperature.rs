@@ -1,6 +1,6 @@
 //! Time and temperature confounded: in a campaign whose logged temperature
 //! follows its time (the plant's linear 2 K ramp: |r| = 1, beyond
-//! `tricept_diagnose::TEMPERATURE_FOLLOWS_TIME`), a thermal
+//! `tricept_diagnose::terms::TEMPERATURE_FOLLOWS_TIME`), a thermal
 //! growth and a drift with time read alike. The model's temperature terms
 //! and time terms then form one alias set, no time term is named as a
 //! cause beside a temperature term, and the report says which campaign

@@ -5,7 +5,7 @@
 //! The UP limb's readings `(phi, theta, s)` measure the platform's position
 //! at the commanded leg lengths, so a reading residual `d` is a platform
 //! error `J d`, with `J` the limb's point Jacobian at the pose
-//! ([`tricept_kinematics::UpLimbPose::point_jacobian`]). The residual of a
+//! ([`tricept_kinematics::up_limb::UpLimbPose::point_jacobian`]). The residual of a
 //! pose the fit has seen is too small; its **deleted** (leave-one-pose-out)
 //! residual, `d_j = W^-1 (I - H_jj)^-1 W (y_j - g_j - c)` with `H_jj` the
 //! pose's 3 x 3 block of the weighted hat matrix and `W = diag(1/sigma)`, is
@@ -27,7 +27,7 @@
 use nalgebra::{DMatrix, Matrix3};
 use serde::Serialize;
 use tricept_data::MeasuredPose;
-use tricept_kinematics::{Machine, UpJoints};
+use tricept_kinematics::{Machine, up_limb::UpJoints};
 
 use crate::error::IdentError;
 use crate::evaluate::map_blocks;
@@ -39,7 +39,7 @@ use crate::model::ReadingModel;
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions, cross_validate, identify};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions, accuracy::cross_validation::cross_validate, identify};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();

@@ -7,7 +7,7 @@
 
 use serde_json::Map;
 
-use tricept_model::Effector;
+use tricept_model::head_errors::Effector;
 
 use super::promise::{Accuracy, TOOL_TIP, Z95, posterior_upper};
 use crate::fusion::{FusedModel, Fusion, SourceKind};
@@ -102,7 +102,7 @@ pub fn fused_structure(
     fit: &Fusion,
     rich_model: &FusedModel,
     rich: &Fusion,
-    eval: &[tricept_data::ExternalPose],
+    eval: &[tricept_data::external::ExternalPose],
 ) -> (f64, f64) {
     let (k, kr) = (model.len(), rich_model.len());
     // The geometric parameters' places among the rich model's.

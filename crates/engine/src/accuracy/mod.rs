@@ -5,7 +5,7 @@
 //! A machine commanded by a model whose parameters are off by `e` (in the
 //! parameter set's coordinates, mm) misses a target `r` by
 //! `dr = P(r) e` to first order, where `P(r)` is the platform point's error
-//! Jacobian projected on the set ([`tricept_model::position_error_jacobian`]).
+//! Jacobian projected on the set ([`tricept_model::jacobian::position_error_jacobian`]).
 //! For `e` with covariance `S`, `E|dr|^2 = trace(P S P^T)`, so the **rms
 //! platform error** over evaluation points `r_j` is
 //!
@@ -41,7 +41,7 @@ pub use promise::{Accuracy, Fit, PromiseError, of_fit, of_fit_stated};
 use nalgebra::{DMatrix, Vector3};
 use serde::Serialize;
 use tricept_kinematics::Machine;
-use tricept_model::{ParameterSet, position_error_jacobian};
+use tricept_model::{ParameterSet, jacobian::position_error_jacobian};
 
 use crate::IdentError;
 
@@ -61,7 +61,7 @@ pub const WORTHWHILE_RATIO: f64 = 0.5;
 /// # Example
 /// ```
 /// let m = tricept_kinematics::Machine::paper();
-/// assert_eq!(tricept_engine::accuracy_points(&m).len(), 51);
+/// assert_eq!(tricept_engine::accuracy::accuracy_points(&m).len(), 51);
 /// ```
 pub fn accuracy_points(m: &Machine) -> Vec<Vector3<f64>> {
     m.workspace.polar_grid(2, 8, 3)
@@ -91,7 +91,7 @@ pub struct PredictedAccuracy {
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{AccuracyModel, GeometricModel, IdentifyOptions, identify};
+/// use tricept_engine::{accuracy::AccuracyModel, model::GeometricModel, IdentifyOptions, identify};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// use tricept_plant::{Campaign, Plant};

@@ -55,7 +55,7 @@ use tricept_model::ParameterSet;
 
 use super::cross_validation::{CrossValidation, cross_validate};
 use super::{AccuracyModel, accuracy_points};
-use crate::{IdentError, Identification, IdentifyOptions, ReadingModel};
+use crate::{IdentError, Identification, IdentifyOptions, model::ReadingModel};
 
 /// Why a promise could not be made.
 #[derive(Debug, thiserror::Error)]

@@ -10,8 +10,8 @@
 //! absorbed by `b` and no ballbar sees it.
 
 use nalgebra::Vector3;
-use tricept_data::{BallbarData, BallbarReading};
-use tricept_model::Effector;
+use tricept_data::{external::BallbarData, external::BallbarReading};
+use tricept_model::head_errors::Effector;
 
 use crate::error::IdentError;
 use crate::fusion::source::{
@@ -58,7 +58,7 @@ impl Source {
     /// ```
     /// use tricept_engine::fusion::{BallbarOptions, Source};
     /// let csv = "q1,q2,q3,h1,h2,length\n800,800,800,0,0.3,150\n810,800,800,0,0.3,150\n";
-    /// let data = tricept_data::read_external_from(csv.as_bytes(), "b.csv").unwrap();
+    /// let data = tricept_data::external::read_external_from(csv.as_bytes(), "b.csv").unwrap();
     /// let e = Source::ballbar(&data, &BallbarOptions::default()).unwrap_err();
     /// assert!(e.to_string().starts_with("b.csv: setup 1 has 2 readings"), "{e}");
     /// ```

@@ -1,6 +1,6 @@
 //! Why a fused fit is implausible, or does not explain an external source:
 //! each usual mistake is undone in turn and the data fitted again, as
-//! [`crate::likely_causes`] does for the UP limb's data; a mistake whose
+//! [`crate::suspects::likely_causes`] does for the UP limb's data; a mistake whose
 //! undoing makes the fit converge, explain the source and leave every
 //! estimate plausible is named, with the fit it gives.
 //!

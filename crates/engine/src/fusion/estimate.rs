@@ -24,7 +24,7 @@
 use faer::Mat;
 use nalgebra::{DMatrix, DVector};
 use serde_json::Value;
-use tricept_kinematics::UpJoints;
+use tricept_kinematics::up_limb::UpJoints;
 use tricept_numerics::linalg::svd_values_and_vectors;
 use tricept_numerics::lsq::{HatFactor, RankDecision, ReducedProblem, Solution};
 

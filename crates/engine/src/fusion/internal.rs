@@ -2,8 +2,8 @@
 //! with the three sensor zero offsets as a linear nuisance, re-solved at
 //! every evaluation exactly as [`crate::identify`] does.
 
-use tricept_data::{Dataset, ExternalPose, MeasuredPose};
-use tricept_kinematics::UpJoints;
+use tricept_data::{Dataset, MeasuredPose, external::ExternalPose};
+use tricept_kinematics::up_limb::UpJoints;
 
 use crate::error::IdentError;
 use crate::fusion::model::{FusedAt, LegContext};

@@ -7,7 +7,7 @@
 //! tracker, a ballbar or touch-offs on reference features measure the tool
 //! (or a point in the spindle) from outside. [`identify_fused`] fits the
 //! module's parameters, the effects a diagnosis named, the head's 13
-//! parameters ([`tricept_model::HeadParameterSet`]) and every instrument's
+//! parameters ([`tricept_model::head_errors::HeadParameterSet`]) and every instrument's
 //! nuisance parameters in one weighted least-squares problem on the exact
 //! model, each source with its own noise, and reports what each source and
 //! their union can see ([`FusionReport`]) and how uncertain the tool tip
@@ -27,7 +27,7 @@
 //! The fusion lives in the engine rather than a crate of its own because
 //! it *is* the identification with more row blocks: it shares the solver
 //! core, the rank rule, the report type and the iteration, and with the
-//! internal data alone it reproduces [`crate::identify`] bit for bit
+//! internal data alone it reproduces [`crate::identify`](fn@crate::identify) bit for bit
 //! (tested; up to one evaluation block of 4096 poses, beyond which
 //! `identify`'s parallel blocks merge the same rows in another order, equal
 //! to rounding). A separate crate would have had to make those internals

@@ -20,11 +20,12 @@
 use std::ops::Range;
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
-use tricept_data::ExternalPose;
-use tricept_kinematics::{HeadBranch, KinematicsError, Machine, UpJoints};
+use tricept_data::external::ExternalPose;
+use tricept_kinematics::{KinematicsError, Machine, head::HeadBranch, up_limb::UpJoints};
 use tricept_model::effects::{Basis, EffectName, Kind, LegContext as EffectContext};
 use tricept_model::{
-    Effector, HeadAt, HeadParameterSet, N_FULL, ParameterSet, actual_machine, point_error_jacobian,
+    ParameterSet, actual::actual_machine, head_errors::Effector, head_errors::HeadAt,
+    head_errors::HeadParameterSet, jacobian::point_error_jacobian, params::N_FULL,
 };
 
 use crate::error::IdentError;
@@ -301,7 +302,7 @@ impl FusedModel {
     /// tenths of a mm), each effect parameter's typical size in the
     /// registry (100 ppm for a lead or a scale gain, 30 um/kN at 1 m for the
     /// compliance: a 12 um sag on the default machine), and
-    /// [`tricept_model::TYPICAL_HEAD_ERRORS`] for the head. They size the
+    /// [`tricept_model::head_errors::TYPICAL_HEAD_ERRORS`] for the head. They size the
     /// report's invisible combinations and the priors of planning.
     ///
     /// # Example
@@ -317,7 +318,7 @@ impl FusedModel {
             t.extend(e.spec().parameters.iter().map(|p| p.typical));
         }
         if self.head.is_some() {
-            t.extend_from_slice(&tricept_model::TYPICAL_HEAD_ERRORS);
+            t.extend_from_slice(&tricept_model::head_errors::TYPICAL_HEAD_ERRORS);
         }
         t
     }
@@ -392,10 +393,10 @@ impl FusedModel {
     ///
     /// # Example
     /// ```
-    /// use tricept_data::ExternalPose;
+    /// use tricept_data::external::ExternalPose;
     /// use tricept_engine::fusion::FusedModel;
     /// use tricept_kinematics::Machine;
-    /// use tricept_model::Effector;
+    /// use tricept_model::head_errors::Effector;
     /// let model = FusedModel::new(Machine::paper(), tricept_model::ParameterSet::paper15(), &[], true).unwrap();
     /// let q = Machine::paper().inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0)).unwrap().legs_mm;
     /// let pose = ExternalPose { commands_mm: q, head_rad: [0.0, 0.0] };
@@ -430,10 +431,10 @@ impl FusedModel {
     ///
     /// # Example
     /// ```
-    /// use tricept_data::ExternalPose;
+    /// use tricept_data::external::ExternalPose;
     /// use tricept_engine::fusion::FusedModel;
     /// use tricept_kinematics::Machine;
-    /// use tricept_model::Effector;
+    /// use tricept_model::head_errors::Effector;
     /// let model = FusedModel::new(Machine::paper(), tricept_model::ParameterSet::paper15(), &[], true).unwrap();
     /// let q = Machine::paper().inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0)).unwrap().legs_mm;
     /// let pose = ExternalPose { commands_mm: q, head_rad: [0.3, 0.2] };
@@ -481,7 +482,7 @@ impl FusedModel {
     /// # Example
     /// ```
     /// use tricept_engine::fusion::FusedModel;
-    /// use tricept_kinematics::{HeadBranch, Machine};
+    /// use tricept_kinematics::{head::HeadBranch, Machine};
     /// use tricept_model::{ParameterSet, effects::EffectName};
     /// let model = FusedModel::new(Machine::paper(), ParameterSet::paper15(), &[EffectName::LegLead], true).unwrap();
     /// let mut p = vec![0.0; model.len()];
@@ -697,6 +698,6 @@ impl FusedAt<'_> {
 fn invert(j1: &Matrix3<f64>) -> Result<Matrix3<f64>, KinematicsError> {
     j1.try_inverse().ok_or(KinematicsError::Singular {
         condition: f64::INFINITY,
-        limit: tricept_kinematics::SINGULARITY_CONDITION_LIMIT,
+        limit: tricept_kinematics::error::SINGULARITY_CONDITION_LIMIT,
     })
 }

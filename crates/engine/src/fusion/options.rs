@@ -2,7 +2,7 @@
 //! gross-error screen's [`ScreenOptions`]) and the tool poses it evaluates
 //! its predictions over.
 
-use tricept_data::ExternalPose;
+use tricept_data::external::ExternalPose;
 use tricept_kinematics::Machine;
 use tricept_numerics::lsq::DEFAULT_RANK_TOLERANCE;
 

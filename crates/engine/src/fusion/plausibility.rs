@@ -4,7 +4,7 @@
 //! stylus' radius change) against one table of plausible ranges.
 //!
 //! The head's and the tool's ranges are ten times their typical sizes
-//! ([`tricept_model::TYPICAL_HEAD_ERRORS`]): a head built to a drawing is
+//! ([`tricept_model::head_errors::TYPICAL_HEAD_ERRORS`]): a head built to a drawing is
 //! off by its typical size, a 5-sigma outlier of a machine twice as bad
 //! stays inside, and a tool length change of millimetres (a target that
 //! is not where `--tracker-target` says, a tracker file of another tool)
@@ -22,7 +22,7 @@ use tricept_model::effects::Measure;
 use tricept_model::plausibility::{
     PlausibilityError, Range, insert_range, override_ranges, round3,
 };
-use tricept_model::{HEAD13_NAMES, TYPICAL_HEAD_ERRORS};
+use tricept_model::{head_errors::HEAD13_NAMES, head_errors::TYPICAL_HEAD_ERRORS};
 
 use crate::fusion::model::{FusedModel, fusable_effects};
 

@@ -3,7 +3,7 @@
 //!
 //! Everything is computed on the weighted problems at the starting point
 //! (each source's nuisance projected out, columns scaled to unit norm),
-//! like [`crate::IdentifiabilityReport`]:
+//! like [`crate::report::IdentifiabilityReport`]:
 //!
 //! - **each source alone and the union**: rank, unidentifiable and weak
 //!   combinations (one `IdentifiabilityReport` each);
@@ -32,7 +32,7 @@ use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use serde_json::Value;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
-use tricept_model::Effector;
+use tricept_model::head_errors::Effector;
 use tricept_numerics::lsq::{RankDecision, ReducedProblem};
 
 use crate::error::IdentError;
@@ -748,7 +748,7 @@ mod tests {
     /// Three tracker points whose target is stated at `offset_mm`.
     fn tracker(offset_mm: [f64; 3]) -> Source {
         let csv = "q1,q2,q3,h1,h2,x,y,z\n800,800,800,0,0,1,2,3\n810,800,800,0,0,1,5,3\n800,820,800,0,0,4,2,3\n";
-        let data = tricept_data::read_external_from(csv.as_bytes(), "t.csv").unwrap();
+        let data = tricept_data::external::read_external_from(csv.as_bytes(), "t.csv").unwrap();
         let options = TrackerOptions {
             sigma_um: 10.0,
             target: TrackerTarget::Known {

@@ -1,7 +1,7 @@
 //! The gross-error screen of a fused identification: a wild tracker point,
 //! a misread ballbar or a touch on the wrong feature must not wreck the fit,
 //! and must be named by its file and line. It is the screen of the UP
-//! limb's data (`tricept_engine::screen_gross_errors`, `robust.rs`) applied to
+//! limb's data (`tricept_engine::robust::screen_gross_errors`, `robust.rs`) applied to
 //! every source's records, each record a block of rows (3 coordinates of a
 //! point, 1 length, 1 touch, 3 readings of a pose):
 //!

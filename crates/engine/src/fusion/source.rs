@@ -34,9 +34,9 @@
 //! `tricept-plant`'s `instruments/`.
 
 use nalgebra::{Matrix3, Vector3};
-use tricept_data::{ExternalData, ExternalPose, InstrumentRecord};
-use tricept_kinematics::UpJoints;
-use tricept_model::Effector;
+use tricept_data::{external::ExternalData, external::ExternalPose, external::InstrumentRecord};
+use tricept_kinematics::up_limb::UpJoints;
+use tricept_model::head_errors::Effector;
 use tricept_numerics::linalg::TriangularAccumulator;
 use tricept_numerics::lsq::ReducedProblem;
 
@@ -557,7 +557,7 @@ pub enum TrackerTarget {
 /// use tricept_engine::fusion::{Source, SourceKind};
 /// use tricept_kinematics::Machine;
 /// let m = Machine::paper();
-/// let data = tricept_engine::read_path(std::path::Path::new(concat!(
+/// let data = tricept_data::read_path(std::path::Path::new(concat!(
 ///     env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/table2-grid-seed1.csv"))).unwrap();
 /// let s = Source::internal(&data, m.sensors.logged_sigma());
 /// assert_eq!((s.label(), s.kind(), s.records()), ("internal", SourceKind::Internal, 75));
@@ -650,7 +650,7 @@ impl Source {
     /// ```
     /// use tricept_engine::fusion::{Source, TrackerOptions, TrackerTarget};
     /// let csv = "q1,q2,q3,h1,h2,x,y,z\n800,800,800,0,0,1,2,3\n810,800,800,0,0,1,5,3\n800,820,800,0,0,4,2,3\n";
-    /// let data = tricept_data::read_external_from(csv.as_bytes(), "t.csv").unwrap();
+    /// let data = tricept_data::external::read_external_from(csv.as_bytes(), "t.csv").unwrap();
     /// let s = Source::tracker(&data, &TrackerOptions::default()).unwrap();
     /// let t = s.with_tracker_target(TrackerTarget::Known { offset_mm: [0.0; 3], sigma_um: 5.0 }).unwrap();
     /// assert_eq!((t.label(), t.records()), ("tracker", 3));
@@ -675,7 +675,7 @@ impl Source {
     /// ```
     /// use tricept_engine::fusion::{Source, TrackerOptions, TrackerTarget};
     /// let csv = "q1,q2,q3,h1,h2,x,y,z\n800,800,800,0,0,1,2,3\n810,800,800,0,0,1,5,3\n800,820,800,0,0,4,2,3\n";
-    /// let data = tricept_data::read_external_from(csv.as_bytes(), "t.csv").unwrap();
+    /// let data = tricept_data::external::read_external_from(csv.as_bytes(), "t.csv").unwrap();
     /// let s = Source::tracker(&data, &TrackerOptions::default()).unwrap();
     /// assert_eq!(s.stated_offset_mm(), None);
     /// let t = s.with_tracker_target(TrackerTarget::Known { offset_mm: [0.0, 0.0, 20.0], sigma_um: 5.0 }).unwrap();
@@ -765,7 +765,7 @@ pub(crate) fn for_each_point(
     at: &FusedAt<'_>,
     contexts: &[LegContext],
     seeds: &mut [Option<UpJoints>],
-    records: impl Iterator<Item = (ExternalPose, u64, tricept_model::Effector)>,
+    records: impl Iterator<Item = (ExternalPose, u64, tricept_model::head_errors::Effector)>,
     mut f: impl FnMut(usize, &SpindlePoint, &[f64]),
 ) -> Result<(), IdentError> {
     let mut jac = vec![0.0; 3 * at.len()];

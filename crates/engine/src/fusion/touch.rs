@@ -20,7 +20,9 @@
 //! what makes a rigid translation of the machine irrelevant to the part.
 
 use nalgebra::Vector3;
-use tricept_data::{Feature, Features, TouchData, TouchReading};
+use tricept_data::{
+    external::Feature, external::Features, external::TouchData, external::TouchReading,
+};
 
 use crate::error::IdentError;
 use crate::fusion::source::{
@@ -67,13 +69,13 @@ impl Source {
     /// # Example
     /// ```
     /// use tricept_engine::fusion::{Source, TouchOptions};
-    /// let features = tricept_data::Features::from_json(
+    /// let features = tricept_data::external::Features::from_json(
     ///     r#"{"stylus": {"radius_mm": 1, "radius_sigma_um": 2}, "features": [{"id": 1, "kind": "plane"}]}"#,
     ///     "f.json",
     /// )
     /// .unwrap();
     /// let csv = "q1,q2,q3,h1,h2,feature\n800,800,800,0,0.3,4\n";
-    /// let data = tricept_data::read_external_from(csv.as_bytes(), "t.csv").unwrap();
+    /// let data = tricept_data::external::read_external_from(csv.as_bytes(), "t.csv").unwrap();
     /// let e = Source::touch(&data, &features, &TouchOptions::default()).unwrap_err();
     /// assert_eq!(
     ///     e.to_string(),

@@ -15,8 +15,8 @@
 //! rank rule and named.
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
-use tricept_data::{TrackerData, TrackerPoint};
-use tricept_model::Effector;
+use tricept_data::{external::TrackerData, external::TrackerPoint};
+use tricept_model::head_errors::Effector;
 
 use crate::error::IdentError;
 use crate::fusion::source::{
@@ -58,7 +58,7 @@ impl Source {
     /// ```
     /// use tricept_engine::fusion::{Source, TrackerOptions};
     /// let csv = "q1,q2,q3,h1,h2,x,y,z,setup\n800,800,800,0,0,1,2,3,1\n810,800,800,0,0,1,2,3,1\n";
-    /// let data = tricept_data::read_external_from::<tricept_data::TrackerPoint, _>(csv.as_bytes(), "t.csv").unwrap();
+    /// let data = tricept_data::external::read_external_from::<tricept_data::external::TrackerPoint, _>(csv.as_bytes(), "t.csv").unwrap();
     /// let e = Source::tracker(&data, &TrackerOptions::default()).unwrap_err();
     /// assert!(e.to_string().starts_with("t.csv: station 1 has 2 points"), "{e}");
     /// assert!(e.to_string().ends_with("(lines 2, 3)"), "{e}");

@@ -16,11 +16,11 @@ use crate::report::IdentifiabilityReport;
 
 /// The rank decision and identifiability report of a pose set under a
 /// noise model, computed once ([`design`]) and reused by many
-/// identifications ([`crate::Start::design`]).
+/// identifications ([`crate::identify::Start::design`]).
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
@@ -34,7 +34,7 @@ use crate::report::IdentifiabilityReport;
 ///         ..Default::default()
 ///     })
 ///     .collect();
-/// let d = tricept_engine::design(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
+/// let d = tricept_engine::identify::design(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
 /// assert_eq!(d.rank(), 14);
 /// assert_eq!(d.report().fixed, vec!["dyA3".to_string()]);
 /// assert_eq!(d.fixed(), &[11]); // dyA3's index in paper15
@@ -73,7 +73,7 @@ impl Design {
     ///
     /// # Example
     /// ```
-    /// use tricept_engine::{GeometricModel, IdentifyOptions, identify};
+    /// use tricept_engine::{model::GeometricModel, IdentifyOptions, identify};
     /// use tricept_kinematics::Machine;
     /// use tricept_model::ParameterSet;
     /// let m = Machine::paper();
@@ -164,11 +164,11 @@ pub(crate) fn decide_design(
 }
 
 /// The rank decision and report of a pose set (see [`identifiability`]),
-/// for reuse through [`crate::Start::design`].
+/// for reuse through [`crate::identify::Start::design`].
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
@@ -180,7 +180,7 @@ pub(crate) fn decide_design(
 ///     .map(|r| tricept_data::MeasuredPose { commands_mm: m.inverse(r).unwrap().legs_mm, ..Default::default() })
 ///     .collect();
 /// let opts = IdentifyOptions::for_machine(&m);
-/// let d = tricept_engine::design(&model, &[0.0; 15], &poses, &opts).unwrap();
+/// let d = tricept_engine::identify::design(&model, &[0.0; 15], &poses, &opts).unwrap();
 /// assert_eq!(d.report().fixed, vec!["dyA3".to_string()]);
 /// ```
 pub fn design(
@@ -209,7 +209,7 @@ pub fn design(
 ///
 /// # Example
 /// ```
-/// use tricept_engine::{GeometricModel, IdentifyOptions};
+/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
 /// use tricept_kinematics::Machine;
 /// use tricept_model::ParameterSet;
 /// let m = Machine::paper();
@@ -223,7 +223,7 @@ pub fn design(
 ///         ..Default::default()
 ///     })
 ///     .collect();
-/// let report = tricept_engine::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
+/// let report = tricept_engine::identify::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
 /// assert_eq!(report.unidentifiable[0].to_text(), "1.000 dyA3");
 /// ```
 pub fn identifiability(

@@ -15,18 +15,21 @@ use crate::common::{
 };
 use nalgebra::{Rotation3, Vector3};
 use rayon::prelude::*;
-use tricept_data::ExternalPose;
+use tricept_data::external::ExternalPose;
 use tricept_engine::fusion::{
     BallbarOptions, FusedModel, Fusion, FusionOptions, Source, TouchOptions, TrackerOptions,
     TrackerTarget, identify_fused,
 };
-use tricept_engine::{GeometricModel, IdentError, IdentifyOptions, identify};
+use tricept_engine::{IdentError, IdentifyOptions, identify, model::GeometricModel};
 use tricept_kinematics::Machine;
 use tricept_model::effects::EffectName;
-use tricept_model::{HeadParameterSet, ParameterSet};
+use tricept_model::{ParameterSet, head_errors::HeadParameterSet};
 use tricept_numerics::stats::chi2_isf;
 use tricept_plant::instruments::commanded;
-use tricept_plant::{Ballbar, Effect, Plant, TouchFeature, TouchProbe, TouchTarget};
+use tricept_plant::{
+    Effect, Plant, instruments::Ballbar, instruments::TouchFeature, instruments::TouchProbe,
+    instruments::TouchTarget,
+};
 
 /// The truth in the fused model's parameters `[paper15 | effects | head13]`.
 fn truth_of(model: &FusedModel, module: &[f64], effects: &[f64], head: &[f64]) -> Vec<f64> {
@@ -118,7 +121,7 @@ fn assert_nuisance(fit: &Fusion, name: &str, expected: f64) {
 fn internal_only_fused_identification_is_bit_identical_to_identify() {
     let m = Machine::paper();
     let set = ParameterSet::paper15();
-    let data = tricept_engine::read_path(std::path::Path::new(concat!(
+    let data = tricept_data::read_path(std::path::Path::new(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../fixtures/data/table2-grid-seed1.csv"
     )))
@@ -612,7 +615,7 @@ fn with_the_head_free_the_weak_leg_length_combination_becomes_nearly_harmless_no
         Source::tracker(&data, &known_target()).unwrap(),
     ];
     let fit = identify_fused(&model, &sources, &FusionOptions::for_machine(m)).unwrap();
-    let coefficient = |c: &tricept_engine::Combination, name: &str| {
+    let coefficient = |c: &tricept_engine::report::Combination, name: &str| {
         c.terms
             .iter()
             .find(|(n, _)| n == name)
@@ -761,7 +764,7 @@ fn touch_offs_on_spheres_and_a_plane_locate_them_and_the_stylus() {
     let data = probe.measure(&plant, &targets, 25).unwrap();
     let features = probe.features_file(0.0);
     let model = FusedModel::new(m.clone(), ParameterSet::paper15(), &[], true).unwrap();
-    let planes_only = tricept_data::ExternalData {
+    let planes_only = tricept_data::external::ExternalData {
         records: data
             .records
             .iter()

@@ -11,7 +11,7 @@
 use crate::common::{internal, known_target, spread_poses, table2_plant, tracker, tracker_points};
 use nalgebra::Vector3;
 use rayon::prelude::*;
-use tricept_data::{ExternalPose, TrackerData};
+use tricept_data::{external::ExternalPose, external::TrackerData};
 use tricept_engine::fusion::{
     FusedModel, Fusion, FusionOptions, FusionPlausibility, Source, SourceKind, TrackerOptions,
     TrackerTarget, identify_fused,

@@ -7,9 +7,11 @@ use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use tricept_data::{Dataset, MeasuredPose, Readings};
-use tricept_engine::{GeometricModel, IdentError, IdentifyOptions, identifiability, identify};
-use tricept_kinematics::{AxisOrder, Machine};
-use tricept_model::{ParameterSet, error_jacobian};
+use tricept_engine::{
+    IdentError, IdentifyOptions, identify, identify::identifiability, model::GeometricModel,
+};
+use tricept_kinematics::{Machine, description::AxisOrder};
+use tricept_model::{ParameterSet, jacobian::error_jacobian};
 use tricept_plant::{Campaign, Plant};
 
 fn machine(order: AxisOrder) -> Machine {
@@ -229,7 +231,7 @@ fn report_at(
     m: &Machine,
     set: &ParameterSet,
     poses: &[MeasuredPose],
-) -> tricept_engine::IdentifiabilityReport {
+) -> tricept_engine::report::IdentifiabilityReport {
     let model = GeometricModel::new(m.clone(), set.clone());
     identifiability(
         &model,
@@ -241,7 +243,7 @@ fn report_at(
 }
 
 /// The report on the 3 x 8 x 3 polar grid used by the identifiability tests.
-fn grid_report(m: &Machine, set: &ParameterSet) -> tricept_engine::IdentifiabilityReport {
+fn grid_report(m: &Machine, set: &ParameterSet) -> tricept_engine::report::IdentifiabilityReport {
     report_at(m, set, &poses_at(m, &m.workspace.polar_grid(3, 8, 3)))
 }
 
@@ -305,7 +307,7 @@ fn poses_on_the_axis_only_leave_named_combinations_that_are_truly_invisible() {
         for (name, c) in &combo.terms {
             p[set.index_of(name).unwrap()] = 0.05 * c;
         }
-        let actual = tricept_model::actual_machine(&m, &set.to_errors(&p));
+        let actual = tricept_model::actual::actual_machine(&m, &set.to_errors(&p));
         let changes: Vec<[f64; 3]> = poses
             .iter()
             .map(|pose| {
@@ -353,7 +355,7 @@ fn the_full_21_set_names_the_two_rigid_body_gauges() {
 
 #[test]
 fn gross_reading_errors_are_rejected_by_row_and_do_not_wreck_the_estimate() {
-    use tricept_engine::identify_robust;
+    use tricept_engine::robust::identify_robust;
     let m = machine(AxisOrder::YFirst);
     let set = ParameterSet::paper15();
     let truth = set.table2();
@@ -416,7 +418,7 @@ fn gross_reading_errors_are_rejected_by_row_and_do_not_wreck_the_estimate() {
 #[test]
 fn one_gross_reading_of_any_size_is_rejected_in_a_40_pose_campaign() {
     use rayon::prelude::*;
-    use tricept_engine::identify_robust;
+    use tricept_engine::robust::identify_robust;
     let m = machine(AxisOrder::XFirst);
     let set = ParameterSet::paper15();
     let model = GeometricModel::new(m.clone(), set.clone());
@@ -506,9 +508,14 @@ fn a_non_converged_fit_reports_one_consistent_point() {
         let mut options = IdentifyOptions::for_machine(&m);
         options.max_iterations = max_iterations;
         let id = identify(&model, &data, &options).unwrap();
-        let again =
-            tricept_engine::residuals_at(&model, &id.estimate, &id.offsets, &data.poses, &sigma)
-                .unwrap();
+        let again = tricept_engine::robust::residuals_at(
+            &model,
+            &id.estimate,
+            &id.offsets,
+            &data.poses,
+            &sigma,
+        )
+        .unwrap();
         for (j, (r, a)) in id.residuals.iter().zip(&again).enumerate() {
             let a = a.unwrap();
             for c in 0..3 {
@@ -541,12 +548,17 @@ fn the_reported_statistics_are_those_of_the_reported_estimate() {
         let data = plant.simulate(&Campaign::random(&m, poses, seed)).unwrap();
         let id = identify(&model, &data, &options).unwrap();
         assert!(id.converged);
-        let z: Vec<[f64; 3]> =
-            tricept_engine::residuals_at(&model, &id.estimate, &id.offsets, &data.poses, &sigma)
-                .unwrap()
-                .into_iter()
-                .map(|r| r.unwrap())
-                .collect();
+        let z: Vec<[f64; 3]> = tricept_engine::robust::residuals_at(
+            &model,
+            &id.estimate,
+            &id.offsets,
+            &data.poses,
+            &sigma,
+        )
+        .unwrap()
+        .into_iter()
+        .map(|r| r.unwrap())
+        .collect();
         let chi_square: f64 = z.iter().flatten().map(|v| v * v).sum();
         let max = z.iter().flatten().fold(0.0f64, |a, v| a.max(v.abs()));
         let rms = [0, 1, 2].map(|c| {
@@ -591,7 +603,7 @@ fn a_fit_of_several_blocks_is_bit_identical_on_one_and_two_threads() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| tricept_engine::identify_robust(&model, &data, &options).unwrap())
+            .install(|| tricept_engine::robust::identify_robust(&model, &data, &options).unwrap())
     };
     let ((one, rejected_one), (two, rejected_two)) = (run(1), run(2));
     assert_eq!(rejected_one, rejected_two);

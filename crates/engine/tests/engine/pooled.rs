@@ -15,7 +15,9 @@
 
 use nalgebra::DMatrix;
 use tricept_data::Dataset;
-use tricept_engine::{GeometricModel, IdentifyOptions, Prior, identify, identify_robust};
+use tricept_engine::{
+    IdentifyOptions, identify, model::GeometricModel, prior::Prior, robust::identify_robust,
+};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_plant::{Campaign, Plant};

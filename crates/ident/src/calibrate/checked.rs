@@ -7,7 +7,7 @@
 
 use std::path::PathBuf;
 
-use tricept_data::{Dataset, Features};
+use tricept_data::{Dataset, external::Features};
 use tricept_engine::fusion::{
     BallbarOptions, FusedModel, FusionOptions, FusionPlausibility, TouchOptions, TrackerOptions,
     TrackerTarget,
@@ -102,7 +102,7 @@ pub(crate) fn fused(
         options.screen = None;
     }
     if let Some(path) = &x.plausibility {
-        let text = tricept_data::read_json_text(path)
+        let text = tricept_data::bounded::read_json_text(path)
             .map_err(|e| Error::input(format!("--plausibility {}: {e}", path.display())))?;
         options.plausibility = FusionPlausibility::with_overrides(&text)
             .map_err(|e| Error::input(format!("--plausibility {}: {e}", path.display())))?;

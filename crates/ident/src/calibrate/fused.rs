@@ -8,7 +8,10 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
-use tricept_data::{BallbarReading, ExternalData, ExternalRecord, TouchReading, TrackerPoint};
+use tricept_data::{
+    external::BallbarReading, external::ExternalData, external::ExternalRecord,
+    external::TouchReading, external::TrackerPoint,
+};
 use tricept_engine::IdentError;
 use tricept_engine::fusion::{FusedModel, Fusion, Source, SourceKind, identify_fused};
 use tricept_kinematics::description::ExternalSourceRecord;
@@ -71,7 +74,7 @@ impl Unchecked {
     /// test at the adequacy level, and the fit with them may otherwise be
     /// trusted.
     pub fn agrees(&self) -> bool {
-        self.others_fine && self.p_value > tricept_engine::ADEQUACY_ALPHA
+        self.others_fine && self.p_value > tricept_engine::verdict::ADEQUACY_ALPHA
     }
 
     /// The promise's part `(rms_mm, upper_mm)`: the tip's shift beyond
@@ -297,7 +300,7 @@ fn external_sources<T: ExternalRecord>(
         .iter()
         .enumerate()
         .map(|(k, path)| {
-            let d = tricept_data::read_external_path::<T>(path)?;
+            let d = tricept_data::external::read_external_path::<T>(path)?;
             check_commands(&d.source, d.records.iter().map(&at), machine)?;
             let label = if k == 0 {
                 kind.to_string()

@@ -11,8 +11,9 @@ use serde_json::{Map, Value, json};
 use tricept_data::Dataset;
 use tricept_engine::IdentError;
 use tricept_engine::{
-    GeometricModel, Identification, IdentifyOptions, PredictedAccuracy, Prior, Rejection, Verdict,
-    identify, identify_robust, likely_causes,
+    Identification, IdentifyOptions, accuracy::PredictedAccuracy, identify, model::GeometricModel,
+    prior::Prior, robust::Rejection, robust::identify_robust, suspects::likely_causes,
+    verdict::Verdict,
 };
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{Machine, MachineDescription};

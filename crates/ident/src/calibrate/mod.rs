@@ -133,7 +133,7 @@ impl CalibrateRequest {
             machine: MachineInput::default(),
             parameter_set: ParameterSet::paper15(),
             robust: true,
-            tolerance_mm: tricept_engine::DEFAULT_TOLERANCE_MM,
+            tolerance_mm: tricept_engine::accuracy::DEFAULT_TOLERANCE_MM,
             fused: None,
             for_machine_file: false,
             campaigns: Vec::new(),

@@ -8,8 +8,10 @@ use std::path::Path;
 
 use serde_json::Value;
 use tricept_data::Dataset;
-use tricept_engine::{ADEQUACY_ALPHA, IdentifyOptions, Prior};
-use tricept_fleet::{PriorFile, agreements, campaign_chi_squares, pool};
+use tricept_engine::{IdentifyOptions, prior::Prior, verdict::ADEQUACY_ALPHA};
+use tricept_fleet::{
+    PriorFile, campaigns::agreements, campaigns::campaign_chi_squares, campaigns::pool,
+};
 use tricept_model::ParameterSet;
 use tricept_numerics::stats::chi2_sf;
 
@@ -27,8 +29,8 @@ fn read_prior(
     set: &ParameterSet,
 ) -> Result<(Prior, PriorFile), Error> {
     let name = path.display().to_string();
-    let text =
-        tricept_data::read_json_text(path).map_err(|e| Error::input(format!("{name}: {e}")))?;
+    let text = tricept_data::bounded::read_json_text(path)
+        .map_err(|e| Error::input(format!("{name}: {e}")))?;
     let file =
         PriorFile::from_json(&text, &name).map_err(|e| Error::with_context("--prior", &e))?;
     let geometry = |v: Value| match v {

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use serde_json::{Value, json};
-use tricept_fleet::Agreement;
+use tricept_fleet::campaigns::Agreement;
 use tricept_kinematics::description::ExternalSourceRecord;
 use tricept_numerics::stats::chi2_sf;
 

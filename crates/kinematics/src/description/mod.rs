@@ -242,7 +242,7 @@ impl MachineDescription {
     ///
     /// # Example
     /// ```
-    /// use tricept_kinematics::{DescriptionError, MachineDescription};
+    /// use tricept_kinematics::{error::DescriptionError, MachineDescription};
     /// let text = MachineDescription::paper().to_json().replace(
     ///     "\"format_version\": 1,",
     ///     "\"format_version\": 2, \"a_key_of_version_2\": true,",
@@ -263,10 +263,11 @@ impl MachineDescription {
 
     /// Reads, parses and validates a description file.
     pub fn from_file(path: &std::path::Path) -> Result<MachineDescription, DescriptionError> {
-        let text = tricept_data::read_json_text(path).map_err(|source| DescriptionError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text =
+            tricept_data::bounded::read_json_text(path).map_err(|source| DescriptionError::Io {
+                path: path.display().to_string(),
+                source,
+            })?;
         Self::from_json(&text)
     }
 

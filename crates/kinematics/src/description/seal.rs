@@ -6,7 +6,7 @@
 //! and the workspace the check and the export work over, the standard
 //! deviations, noise and temperature a later check judges by. An edit of
 //! one of them alone is caught by the rebuild
-//! (`tricept_engine::check_calibration_record`); an edit of two that agree
+//! (`tricept_engine::record::check_calibration_record`); an edit of two that agree
 //! (a leg offset and its estimate moved together) only by the seal, which
 //! is why it covers every field, not a chosen list.
 //!

@@ -4,7 +4,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 use tricept_kinematics::description::LegEffectsDescription;
-use tricept_kinematics::{KinematicsError, Machine, UpJoints};
+use tricept_kinematics::{KinematicsError, Machine, up_limb::UpJoints};
 
 use super::spec::{
     Basis, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, LegDeployment, Magnitude,

@@ -4,7 +4,7 @@
 //! ([`static_leg_extra_per_mm`], [`pose_free_leg_extra_per_mm`]).
 
 use tricept_kinematics::description::ControllerDescription;
-use tricept_kinematics::{Machine, UpJoints};
+use tricept_kinematics::{Machine, up_limb::UpJoints};
 
 use super::{Deployment, EffectName};
 

@@ -1,7 +1,7 @@
 //! `encoder-eccentricity`: a once-per-revolution error `A sin(angle + psi)`
 //! of each U-joint encoder, fitted as its sine and cosine parts (arcsec).
 
-use tricept_kinematics::UpJoints;
+use tricept_kinematics::up_limb::UpJoints;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 
 use super::spec::{

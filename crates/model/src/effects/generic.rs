@@ -24,7 +24,7 @@
 //! drift over time recorded with the campaign's middle, not applied.
 
 use serde::{Deserialize, Serialize};
-use tricept_kinematics::UpJoints;
+use tricept_kinematics::up_limb::UpJoints;
 
 use super::forms::{
     encoder_gain_error_rad, legendre_p2, legendre_p3, normalised_coordinate, periodic_extra_mm,

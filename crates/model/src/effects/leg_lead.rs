@@ -2,7 +2,7 @@
 //! length `k_i q_i` (`k_i` in ppm of the command).
 
 use tricept_kinematics::description::LegEffectsDescription;
-use tricept_kinematics::{KinematicsError, Machine, UpJoints};
+use tricept_kinematics::{KinematicsError, Machine, up_limb::UpJoints};
 
 use super::spec::{
     CheckColumns, CheckRole, CheckWhen,    Basis, CommonPart, Deployment, EffectSpec, Entries, Judged, Kind, LegContext, LegDeployment, Magnitude,

@@ -1,7 +1,7 @@
 //! `scale-gain`: the UP limb's linear scale reads `(1 + g) q4` (`g` in
 //! ppm).
 
-use tricept_kinematics::UpJoints;
+use tricept_kinematics::up_limb::UpJoints;
 
 use super::spec::{
     CheckColumns, CheckRole, CheckWhen,    Basis, Deployment, EffectSpec, Entries, Judged, Kind, KnownAlias, Magnitude, Measure, Needs,

@@ -13,7 +13,7 @@
 
 use serde::Serialize;
 use serde::de::DeserializeOwned;
-use tricept_kinematics::{Machine, UpJoints};
+use tricept_kinematics::{Machine, up_limb::UpJoints};
 
 /// One input key of a simulated effect.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -12,7 +12,7 @@
 
 use nalgebra::DMatrix;
 use tricept_kinematics::description::{ControllerDescription, LegEffectsDescription};
-use tricept_kinematics::{KinematicsError, Machine, UpJoints};
+use tricept_kinematics::{KinematicsError, Machine, up_limb::UpJoints};
 
 use super::forms::{legendre_p2, legendre_p3};
 use super::simulation::Simulation;

@@ -3,7 +3,7 @@
 //! `encoder-gain`.
 
 use serde::{Deserialize, Serialize};
-use tricept_kinematics::UpJoints;
+use tricept_kinematics::up_limb::UpJoints;
 use tricept_model::effects::{
     EffectKey, PoseState, Simulate, Simulation, encoder_gain_error_rad, parse_input,
 };

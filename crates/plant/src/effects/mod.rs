@@ -32,7 +32,7 @@
 use serde::de::Error as _;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use tricept_data::MeasuredPose;
-use tricept_kinematics::{Machine, UpJoints};
+use tricept_kinematics::{Machine, up_limb::UpJoints};
 use tricept_model::effects::{CauseName, EffectName, Simulate, Simulation};
 
 pub use tricept_model::effects::simulated::*;

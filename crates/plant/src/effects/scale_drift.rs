@@ -3,7 +3,7 @@
 //! temperature; described by the generic family `reading-drift`.
 
 use serde::{Deserialize, Serialize};
-use tricept_kinematics::UpJoints;
+use tricept_kinematics::up_limb::UpJoints;
 use tricept_model::effects::{
     EffectKey, PoseState, Simulate, Simulation, linear_drift, parse_input,
 };

@@ -2,8 +2,8 @@
 
 use nalgebra::Vector3;
 use rand_distr::{Distribution, StandardNormal};
-use tricept_data::{BallbarData, BallbarReading, ExternalPose};
-use tricept_model::Effector;
+use tricept_data::{external::BallbarData, external::BallbarReading, external::ExternalPose};
+use tricept_model::head_errors::Effector;
 
 use super::{measure_each, spindle_point};
 use crate::{Plant, PlantError};
@@ -35,9 +35,9 @@ impl Ballbar {
     /// # Example
     /// ```
     /// use nalgebra::Vector3;
-    /// use tricept_data::ExternalPose;
-    /// use tricept_kinematics::{HeadBranch, Machine};
-    /// use tricept_plant::{Ballbar, Plant};
+    /// use tricept_data::external::ExternalPose;
+    /// use tricept_kinematics::{head::HeadBranch, Machine};
+    /// use tricept_plant::{instruments::Ballbar, Plant};
     /// let m = Machine::paper();
     /// let plant = Plant::geometric(m.clone(), Default::default());
     /// let bar = Ballbar { pivot_mm: Vector3::new(0.0, 0.0, 1250.0), length_error_um: 0.0,

@@ -20,9 +20,9 @@
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
-use tricept_data::{ExternalData, ExternalPose};
-use tricept_kinematics::{HeadBranch, Machine};
-use tricept_model::Effector;
+use tricept_data::{external::ExternalData, external::ExternalPose};
+use tricept_kinematics::{Machine, head::HeadBranch};
+use tricept_model::head_errors::Effector;
 
 use crate::{Plant, PlantError};
 

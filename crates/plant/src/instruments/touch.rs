@@ -3,8 +3,11 @@
 use nalgebra::Vector3;
 use rand_distr::{Distribution, StandardNormal};
 use rand_pcg::Pcg64Mcg;
-use tricept_data::{ExternalPose, Feature, Features, Stylus, TouchData, TouchReading};
-use tricept_model::Effector;
+use tricept_data::{
+    external::ExternalPose, external::Feature, external::Features, external::Stylus,
+    external::TouchData, external::TouchReading,
+};
+use tricept_model::head_errors::Effector;
 
 use super::{commanded, kinematics_error, measure_each};
 use crate::{Plant, PlantError};

@@ -2,8 +2,8 @@
 
 use nalgebra::{Isometry3, Vector3};
 use rand_distr::{Distribution, StandardNormal};
-use tricept_data::{ExternalPose, TrackerData, TrackerPoint};
-use tricept_model::Effector;
+use tricept_data::{external::ExternalPose, external::TrackerData, external::TrackerPoint};
+use tricept_model::head_errors::Effector;
 
 use super::{measure_each, spindle_point};
 use crate::{Plant, PlantError};
@@ -35,9 +35,9 @@ impl Tracker {
     /// # Example
     /// ```
     /// use nalgebra::{Isometry3, Vector3};
-    /// use tricept_data::ExternalPose;
+    /// use tricept_data::external::ExternalPose;
     /// use tricept_kinematics::Machine;
-    /// use tricept_plant::{Plant, Tracker};
+    /// use tricept_plant::{Plant, instruments::Tracker};
     /// let m = Machine::paper();
     /// let plant = Plant::geometric(m.clone(), Default::default());
     /// let tracker = Tracker {

@@ -3,7 +3,7 @@
 //! about the planned power, and a smaller one is missed more often.
 
 use tricept_check::{CheckOptions, Reference, check};
-use tricept_engine::{GeometricModel, IdentifyOptions, identify};
+use tricept_engine::{IdentifyOptions, identify, model::GeometricModel};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_plant::{Campaign, Plant, random_errors};

@@ -5,7 +5,7 @@
 //! estimate is noisier, as Gauss-Markov says it must be.
 
 use nalgebra::DMatrix;
-use tricept_kinematics::{AxisOrder, Machine};
+use tricept_kinematics::{Machine, description::AxisOrder};
 use tricept_study::Scenario;
 use tricept_study::paper::{Differenced, DifferencedSolve, NominalLinearisation, RowWeights};
 

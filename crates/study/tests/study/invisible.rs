@@ -3,8 +3,10 @@
 //! the identifiability report's rank and unidentifiable combinations, and
 //! the exact model's readings.
 
-use tricept_engine::{GeometricModel, IdentifyOptions, identifiability};
-use tricept_kinematics::{AxisOrder, Machine, MachineDescription, Placement};
+use tricept_engine::{IdentifyOptions, identify::identifiability, model::GeometricModel};
+use tricept_kinematics::{
+    Machine, MachineDescription, description::AxisOrder, description::Placement,
+};
 use tricept_model::ParameterSet;
 use tricept_plant::{Campaign, Plant};
 use tricept_study::invisible::invisible_platform_errors;

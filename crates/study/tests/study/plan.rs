@@ -10,7 +10,7 @@ use tricept_engine::fusion::{
 };
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
-use tricept_plant::{Campaign, Plant, Tracker, random_head_errors};
+use tricept_plant::{Campaign, Plant, instruments::Tracker, random_head_errors};
 use tricept_study::plan::{
     PlanProblem, candidate_rows, internal_factor, nominal_tracker_data, plan, with_extensions,
 };

@@ -14,13 +14,14 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 use tricept_data::{
-    BallbarReading, Dataset, ExternalData, ExternalPose, MeasuredPose, Readings, TrackerPoint,
+    Dataset, MeasuredPose, Readings, external::BallbarReading, external::ExternalData,
+    external::ExternalPose, external::TrackerPoint,
 };
 use tricept_engine::fusion::{
     BallbarOptions, FusedModel, Fusion, FusionOptions, Source, TrackerOptions, TrackerTarget,
     head_angle_poses, identify_fused,
 };
-use tricept_kinematics::{HeadBranch, Machine, MachineDescription};
+use tricept_kinematics::{Machine, MachineDescription, head::HeadBranch};
 use tricept_model::ParameterSet;
 use tricept_study::plan::{
     PlanProblem, candidate_rows, internal_factor, nominal_ballbar_data, nominal_tracker_data, plan,

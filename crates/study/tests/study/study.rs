@@ -2,9 +2,9 @@
 //! same seed gives the same bits at any thread count, and `mu` at zero noise
 //! is exactly the bias of the unidentifiable parameters.
 
-use tricept_kinematics::{AxisOrder, Machine};
+use tricept_kinematics::{Machine, description::AxisOrder};
 use tricept_study::exact::{exact_trial, identify_trial, run_exact, trial_data};
-use tricept_study::{GradeModel, PathResult, Scenario, TrialResult};
+use tricept_study::{Scenario, fast::GradeModel, results::PathResult, results::TrialResult};
 
 fn scenario(order: AxisOrder) -> Scenario {
     let m = Machine::paper().with_axis_order(order);
@@ -123,7 +123,7 @@ fn mu_at_zero_noise_is_the_bias_of_the_unidentifiable_parameters_only() {
         // The exact identification of the noise-free readings. The held
         // dyA3 also acts at second order (e^2 / 2 q3 on leg 3, aliased into
         // dyB3 and the weak leg-length direction): about 1 % on top.
-        let mu_star = tricept_model::residual_mu(&s.truth, &g.estimator.p_star);
+        let mu_star = tricept_model::params::residual_mu(&s.truth, &g.estimator.p_star);
         if expected > 0.0 {
             assert!(
                 (mu_star / expected - 1.0).abs() < 0.02,
@@ -154,7 +154,7 @@ fn mu_at_zero_noise_is_the_bias_of_the_unidentifiable_parameters_only() {
         // And the fast path with vanishing noise converges to mu(p*).
         let q = quiet(&s, s.truth.clone());
         let gq = GradeModel::new(&q, 1e-6).unwrap();
-        let mu_q = tricept_model::residual_mu(&q.truth, &gq.estimator.p_star);
+        let mu_q = tricept_model::params::residual_mu(&q.truth, &gq.estimator.p_star);
         for t in gq.estimator.run(&q, 200, 1, 0, &|_| {}) {
             assert!(
                 (t.mu_mm - mu_q).abs() < 1e-6,
@@ -230,8 +230,8 @@ mod grades {
     use tricept_kinematics::Machine;
     use tricept_study::grades::mu_at_grade;
     use tricept_study::{
-        GradeModel, GradeResult, PathResult, Scenario, crossing_grade, equivalent_grade,
-        grade_for_mu, recommend,
+        Scenario, fast::GradeModel, grades::crossing_grade, grades::equivalent_grade,
+        grades::grade_for_mu, grades::recommend, results::GradeResult, results::PathResult,
     };
 
     fn default_scenario() -> Scenario {
@@ -278,7 +278,8 @@ mod grades {
         let median = |grade: f64| {
             let e = GradeModel::new(&s, grade).unwrap().estimator;
             let r = e.run(&s, 4000, 9, 1000 + grade.to_bits() % 1000, &|_| {});
-            tricept_study::Summary::of(&r.iter().map(|t| t.mu_mm).collect::<Vec<_>>()).median
+            tricept_study::results::Summary::of(&r.iter().map(|t| t.mu_mm).collect::<Vec<_>>())
+                .median
         };
         assert!(
             median(0.8 * g) < s.mu0_mm && median(1.25 * g) > s.mu0_mm,

@@ -5,11 +5,11 @@
 #![allow(dead_code)]
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
-use tricept_data::ExternalPose;
+use tricept_data::external::ExternalPose;
 use tricept_engine::fusion::{Source, TrackerOptions, TrackerTarget};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
-use tricept_plant::{Campaign, Plant, Tracker, random_head_errors};
+use tricept_plant::{Campaign, Plant, instruments::Tracker, random_head_errors};
 
 /// The documented head errors of these tests: `random_head_errors(1.0, 11)`.
 pub fn head_truth() -> Vec<f64> {
@@ -48,7 +48,7 @@ pub fn tracker_points(
     target: Vector3<f64>,
     poses: &[ExternalPose],
     seed: u64,
-) -> tricept_data::TrackerData {
+) -> tricept_data::external::TrackerData {
     let records: Vec<(ExternalPose, f64)> = poses.iter().map(|p| (*p, 0.0)).collect();
     tracker(target).measure(plant, &records, seed).unwrap()
 }
