@@ -7,9 +7,9 @@ use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use tricept_benches::workspace_points;
+use tricept_ident::kinematics::ExtendedMachine;
 use tricept_ident::kinematics::{Verb, run};
 use tricept_kinematics::Machine;
-use tricept_model::ExtendedMachine;
 
 /// Points per iteration.
 const POINTS: usize = 100_000;

@@ -12,12 +12,12 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use tricept_diagnose::{DiagnoseOptions, diagnose};
 use tricept_engine::{IdentifyOptions, model::GeometricModel, robust::identify_robust};
+use tricept_ident::advanced::ParameterSet;
 use tricept_kinematics::Machine;
-use tricept_model::ParameterSet;
 use tricept_plant::effects::{Effect, Waveform};
 use tricept_plant::{Campaign, Plant, random_errors};
 
-fn data(n: usize, seed: u64, effects: Vec<Effect>) -> tricept_data::Dataset {
+fn data(n: usize, seed: u64, effects: Vec<Effect>) -> tricept_ident::advanced::Dataset {
     let m = Machine::paper();
     let set = ParameterSet::paper15();
     let mut plant = Plant::geometric(m.clone(), set.to_errors(&random_errors(15, 0.25, seed)));

@@ -13,9 +13,10 @@ use tricept_benches::fleet_batch;
 use tricept_engine::{
     IdentifyOptions, accuracy::AccuracyModel, accuracy::accuracy_points, model::GeometricModel,
 };
-use tricept_fleet::{BatchOptions, batch::SolverKind, calibrate_batch};
+use tricept_fleet::{BatchOptions, calibrate_batch};
+use tricept_ident::advanced::ParameterSet;
+use tricept_ident::fleet::SolverKind;
 use tricept_kinematics::Machine;
-use tricept_model::ParameterSet;
 
 /// Whether the bench solves `machines` machines with `kind`: the dense
 /// solve only where it fits (10 machines: 195 unknowns; 100 machines take

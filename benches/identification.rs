@@ -11,8 +11,8 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use tricept_engine::{IdentifyOptions, identify, model::GeometricModel};
+use tricept_ident::advanced::ParameterSet;
 use tricept_kinematics::Machine;
-use tricept_model::ParameterSet;
 use tricept_plant::{Campaign, Plant};
 
 fn identification(c: &mut Criterion) {
@@ -57,7 +57,7 @@ fn large(c: &mut Criterion) {
         // The other part of `tricept identify` on a log: reading and
         // checking the CSV (parsed in parallel batches).
         let mut csv = Vec::new();
-        tricept_data::write_to(&mut csv, &data, &[]).unwrap();
+        tricept_ident::advanced::files::write_to(&mut csv, &data, &[]).unwrap();
         group.throughput(criterion::Throughput::Bytes(csv.len() as u64));
         group.bench_function(format!("{n}_rows_read"), |b| {
             b.iter(|| black_box(tricept_data::read_from(black_box(&csv[..]), "bench.csv").unwrap()))

@@ -370,21 +370,28 @@ pub fn run_compensation(
             "After compensation, rigid shift removed",
         ),
     ] {
-        let z = tricept_plot::plane_z(map.targets_mm.iter().map(|p| p.z));
+        let z = tricept_ident::advanced::plot::plane_z(map.targets_mm.iter().map(|p| p.z));
         let title = format!("{what} |dr| (mm), {z}");
-        let cells: Vec<tricept_plot::Cell> = map
+        let cells: Vec<tricept_ident::advanced::plot::Cell> = map
             .targets_mm
             .iter()
             .zip(map.magnitudes_mm())
-            .map(|(p, v)| tricept_plot::Cell {
+            .map(|(p, v)| tricept_ident::advanced::plot::Cell {
                 x: p.x,
                 y: p.y,
                 value: v,
             })
             .collect();
         let path = out_dir.join(file);
-        tricept_plot::heat_map(&path, &title, &cells, spacing_mm, "|dr| (mm)", None)
-            .map_err(|e| e.to_string())?;
+        tricept_ident::advanced::plot::heat_map(
+            &path,
+            &title,
+            &cells,
+            spacing_mm,
+            "|dr| (mm)",
+            None,
+        )
+        .map_err(|e| e.to_string())?;
         println!("wrote {}", path.display());
     }
     Ok(())

@@ -44,15 +44,17 @@ use tricept_engine::fusion::{
     BallbarOptions, FusedModel, FusionOptions, Source, TouchOptions, TrackerOptions, TrackerTarget,
     head_angle_poses, identify_fused,
 };
+use tricept_ident::advanced::ParameterSet;
+use tricept_ident::advanced::plot::{Axes, Curve, Reference, curves};
+use tricept_ident::effects::EffectName;
 use tricept_kinematics::{Machine, head::HeadBranch};
-use tricept_model::effects::{EffectName, stiffness_for_platform_deflection};
-use tricept_model::{ParameterSet, head_errors::Effector};
+use tricept_model::effects::stiffness_for_platform_deflection;
+use tricept_model::head_errors::Effector;
 use tricept_numerics::stats::quantile;
 use tricept_plant::{
     Campaign, Effect, Plant, instruments::Ballbar, instruments::TouchFeature,
     instruments::TouchProbe, instruments::TouchTarget, instruments::Tracker, random_head_errors,
 };
-use tricept_plot::{Axes, Curve, Reference, curves};
 use tricept_study::plan::{
     PlanProblem, candidate_rows, internal_factor, nominal_ballbar_data, nominal_touch_data,
     nominal_tracker_data, plan, sphere_candidates,

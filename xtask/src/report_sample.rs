@@ -94,7 +94,7 @@ fn inputs() -> Result<(), Failure> {
         r.poses = format!("random:20,{}", 40 + day).parse::<Poses>()?;
         r.seed = 40 + day as u64;
         let s = simulate(r)?;
-        tricept_data::write_path(&data, s.data(), s.comments())?;
+        tricept_ident::advanced::files::write_path(&data, s.data(), s.comments())?;
         let c = check(CheckRequest::new(MACHINE, data.as_path()))?;
         let unix_s = ((day0 + day) * 86_400 + 6 * 3600 + 30 * 60) as f64;
         let entry = tricept_check::history::Entry {
@@ -134,7 +134,9 @@ fn slipped(path: &str, slip_mm: f64) -> Result<TrueErrors, Failure> {
     values[k] += slip_mm;
     let text =
         serde_json::to_string_pretty(&serde_json::Value::Object(set.values_to_map(&values)))?;
-    tricept_data::write_atomic(Path::new(path), |w| w.write_all(text.as_bytes()))?;
+    tricept_ident::advanced::files::write_atomic(Path::new(path), |w| {
+        w.write_all(text.as_bytes())
+    })?;
     Ok(TrueErrors::File(path.into()))
 }
 

@@ -30,10 +30,11 @@ use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde_json::{Value, json};
 use tricept_engine::{IdentifyOptions, identify::design, model::GeometricModel};
+use tricept_ident::advanced::ParameterSet;
 use tricept_kinematics::{
     Machine, MachineDescription, description::AxisOrder, description::Placement,
 };
-use tricept_model::{ParameterSet, params::residual_mu, volumetric::MapStats};
+use tricept_model::{params::residual_mu, volumetric::MapStats};
 use tricept_numerics::stats::quantile;
 use tricept_study::grades::mu_at_grade;
 use tricept_study::invisible::invisible_platform_errors;

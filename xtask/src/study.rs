@@ -443,7 +443,7 @@ fn plot(
     optimised: &[Optimised],
     few_poses: Option<&(usize, Vec<GradeResult>)>,
 ) -> Result<(), String> {
-    use tricept_plot::{Axes, Curve, Marker, Reference, curves};
+    use tricept_ident::advanced::plot::{Axes, Curve, Marker, Reference, curves};
     let x: Vec<f64> = results.iter().map(|r| r.grade_arcsec).collect();
     let mut cs = vec![Curve {
         name: "ours, default poses: median mu, 5-95 %".into(),

@@ -236,11 +236,34 @@ mod tests {
         }
     }
 
-    fn dir(name: &str) -> PathBuf {
+    /// A test's own scratch folder, removed when the test ends (passed or
+    /// failed).
+    struct Scratch(PathBuf);
+
+    impl std::ops::Deref for Scratch {
+        type Target = Path;
+        fn deref(&self) -> &Path {
+            &self.0
+        }
+    }
+
+    impl AsRef<Path> for Scratch {
+        fn as_ref(&self) -> &Path {
+            &self.0
+        }
+    }
+
+    impl Drop for Scratch {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
+    fn dir(name: &str) -> Scratch {
         let d = std::env::temp_dir().join(format!("tricept-atomic-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&d);
         std::fs::create_dir_all(&d).unwrap();
-        d
+        Scratch(d)
     }
 
     fn entries(d: &Path) -> Vec<String> {
@@ -250,6 +273,15 @@ mod tests {
             .collect();
         v.sort();
         v
+    }
+
+    #[test]
+    fn a_directory_is_not_replaced() {
+        let d = dir("isdir");
+        let e = write_atomic(&d, |w| w.write_all(b"x")).unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::IsADirectory);
+        assert_eq!(e.to_string(), "is a directory, not a file");
+        assert!(d.is_dir());
     }
 
     #[test]
@@ -283,7 +315,6 @@ mod tests {
         .unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), new);
         assert_eq!(entries(&d), vec!["machine.json".to_string()]);
-        std::fs::remove_dir_all(&d).ok();
     }
 
     #[test]
@@ -296,7 +327,26 @@ mod tests {
         });
         assert!(r.is_err());
         assert!(entries(&d).is_empty(), "{:?}", entries(&d));
-        std::fs::remove_dir_all(&d).ok();
+    }
+
+    /// Runs `f` on its own thread and returns its result, failing the test
+    /// when it takes more than 10 s (a writer that retries forever).
+    fn promptly<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let _ = tx.send(f());
+        });
+        rx.recv_timeout(std::time::Duration::from_secs(10))
+            .expect("the write did not return within 10 s")
+    }
+
+    #[test]
+    fn a_missing_directory_is_an_error_at_once() {
+        let d = dir("missing");
+        let target = d.join("no").join("such").join("machine.json");
+        let e = promptly(move || write_atomic(&target, |w| w.write_all(b"x")).unwrap_err());
+        assert_eq!(e.kind(), io::ErrorKind::NotFound, "{e}");
+        assert!(entries(&d).is_empty(), "{:?}", entries(&d));
     }
 
     #[cfg(unix)]
@@ -319,28 +369,6 @@ mod tests {
         assert_eq!(std::fs::read_to_string(&real).unwrap(), "new");
         let mode = std::fs::metadata(&real).unwrap().permissions().mode() & 0o777;
         assert_eq!(mode, 0o640);
-        std::fs::remove_dir_all(&d).ok();
-    }
-
-    /// Runs `f` on its own thread and returns its result, failing the test
-    /// when it takes more than 10 s (a writer that retries forever).
-    fn promptly<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
-        let (tx, rx) = std::sync::mpsc::channel();
-        std::thread::spawn(move || {
-            let _ = tx.send(f());
-        });
-        rx.recv_timeout(std::time::Duration::from_secs(10))
-            .expect("the write did not return within 10 s")
-    }
-
-    #[test]
-    fn a_missing_directory_is_an_error_at_once() {
-        let d = dir("missing");
-        let target = d.join("no").join("such").join("machine.json");
-        let e = promptly(move || write_atomic(&target, |w| w.write_all(b"x")).unwrap_err());
-        assert_eq!(e.kind(), io::ErrorKind::NotFound, "{e}");
-        assert!(entries(&d).is_empty(), "{:?}", entries(&d));
-        std::fs::remove_dir_all(&d).ok();
     }
 
     #[cfg(unix)]
@@ -355,7 +383,7 @@ mod tests {
         let read_only = if privileged {
             PathBuf::from("/sys")
         } else {
-            d.clone()
+            d.to_path_buf()
         };
         if read_only.is_dir() {
             let target = read_only.join(format!("tricept-atomic-{}.json", std::process::id()));
@@ -365,7 +393,6 @@ mod tests {
             assert!(!target.exists());
         }
         std::fs::set_permissions(&d, std::fs::Permissions::from_mode(0o755)).unwrap();
-        std::fs::remove_dir_all(&d).ok();
     }
 
     #[test]
@@ -384,7 +411,6 @@ mod tests {
         assert!(seen[0].starts_with(".machine.json.tmp-"), "{seen:?}");
         assert_eq!(entries(&d), vec!["machine.json".to_string()]);
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
-        std::fs::remove_dir_all(&d).ok();
     }
 
     #[test]
@@ -408,17 +434,6 @@ mod tests {
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
         // The other files are left alone.
         assert_eq!(entries(&d).len(), 201);
-        std::fs::remove_dir_all(&d).ok();
-    }
-
-    #[test]
-    fn a_directory_is_not_replaced() {
-        let d = dir("isdir");
-        let e = write_atomic(&d, |w| w.write_all(b"x")).unwrap_err();
-        assert_eq!(e.kind(), io::ErrorKind::IsADirectory);
-        assert_eq!(e.to_string(), "is a directory, not a file");
-        assert!(d.is_dir());
-        std::fs::remove_dir_all(&d).ok();
     }
 
     #[cfg(unix)]
@@ -459,6 +474,5 @@ mod tests {
             let e = write_atomic(&d.join(name), |w| w.write_all(b"x")).unwrap_err();
             assert!(e.to_string().contains("names a directory"), "{name}: {e}");
         }
-        std::fs::remove_dir_all(&d).ok();
     }
 }

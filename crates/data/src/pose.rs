@@ -100,21 +100,27 @@ impl Dataset {
 }
 
 #[cfg(test)]
+impl Dataset {
+    /// The dataset of `poses` held in memory (source `mem`), for tests.
+    pub(crate) fn in_memory(poses: impl IntoIterator<Item = MeasuredPose>) -> Dataset {
+        Dataset {
+            poses: poses.into_iter().collect(),
+            source: "mem".into(),
+        }
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn subset_keeps_order_lines_and_source() {
-        let data = Dataset {
-            poses: (0..5)
-                .map(|k| MeasuredPose {
-                    commands_mm: [700.0 + k as f64; 3],
-                    line: 10 + k,
-                    ..Default::default()
-                })
-                .collect(),
-            source: "mem".into(),
-        };
+        let data = Dataset::in_memory((0..5).map(|k| MeasuredPose {
+            commands_mm: [700.0 + k as f64; 3],
+            line: 10 + k,
+            ..Default::default()
+        }));
         let odd = data.subset(|i| i % 2 == 1);
         assert_eq!(odd.source, "mem");
         assert_eq!(odd.poses, vec![data.poses[1], data.poses[3]]);
