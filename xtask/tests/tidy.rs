@@ -920,6 +920,7 @@ const DOOR_ROOT: &[&str] = &[
     "Error",
     "ErrorCause",
     "ErrorKind",
+    "Setting",
     // The two inputs every request is made of.
     "DataInput",
     "MachineInput",

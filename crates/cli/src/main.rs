@@ -434,6 +434,7 @@ fn main() -> ExitCode {
     let write_flag = match &cli.command {
         Command::Identify(_) | Command::Diagnose(_) => "--write-machine ",
         Command::Fleet(_) => "--write-prior ",
+        Command::Compensate(_) => "compensate --machine ",
         _ => "",
     };
     let code = match run(cli) {

@@ -21,6 +21,8 @@ use tricept_model::ModelError;
 use tricept_plant::PlantError;
 use tricept_study::StudyError;
 
+use crate::Setting;
+
 /// Exit code of a result that can be trusted.
 pub const EXIT_OK: u8 = 0;
 /// Exit code of anything that is not the input's fault.
@@ -170,7 +172,7 @@ impl ErrorCause {
 /// use tricept_ident::ErrorKind;
 /// use tricept_ident::advanced::Classify;
 /// use tricept_ident::export::ExportError;
-/// let e = ExportError::Options("--max-points: must be at least 2".into());
+/// let e = ExportError::Options("max_points: must be at least 2".into());
 /// assert_eq!(e.kind(), ErrorKind::Input);
 /// ```
 pub trait Classify {
@@ -189,14 +191,17 @@ pub trait Classify {
 }
 
 /// A failure of a workflow: a one-line message (naming the file, line and
-/// column where there is one) and its [`ErrorKind`].
+/// column where there is one), its [`ErrorKind`], what failed
+/// ([`Error::cause`]), the request setting it is about
+/// ([`Error::setting`]) and the library error under it
+/// ([`source`](std::error::Error::source)).
 ///
 /// # Example
 /// ```
 /// use tricept_ident::{Error, EXIT_INPUT};
-/// let e = Error::input("--alpha: must lie between 0 and 0.5, got 2").in_file("check");
+/// let e = Error::input("the false-alarm probability must lie between 0 and 0.5, got 2").in_file("check");
 /// assert_eq!(e.exit_code(), EXIT_INPUT);
-/// assert_eq!(e.to_string(), "check: --alpha: must lie between 0 and 0.5, got 2");
+/// assert_eq!(e.to_string(), "check: the false-alarm probability must lie between 0 and 0.5, got 2");
 /// ```
 #[derive(Debug, Clone)]
 pub struct Error {
@@ -204,7 +209,23 @@ pub struct Error {
     message: String,
     file: Option<FileFailure>,
     cause: Option<ErrorCause>,
+    setting: Option<Named>,
     source: Option<Arc<dyn std::error::Error + Send + Sync + 'static>>,
+}
+
+/// Where an [`Error`]'s message names its setting: the message is
+/// `before`, the setting's name, `after`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct Named {
+    setting: Setting,
+    before: String,
+    after: String,
+}
+
+impl Named {
+    fn render(&self, name: &str) -> String {
+        tricept_data::one_line(&format!("{}{name}{}", self.before, self.after))
+    }
 }
 
 /// Two errors are equal when their kind, message, file failure and cause
@@ -215,6 +236,7 @@ impl PartialEq for Error {
             && self.message == other.message
             && self.file == other.file
             && self.cause == other.cause
+            && self.setting == other.setting
     }
 }
 
@@ -287,7 +309,106 @@ impl Error {
             message: tricept_data::one_line(&message.into()),
             file: None,
             cause: None,
+            setting: None,
             source: None,
+        }
+    }
+
+    /// An error of the user's input about one setting of a request:
+    /// `NAME: WHY`, with NAME the setting's [`Setting::name`] (a program
+    /// names it its own way with [`Error::message_naming`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{Error, Setting, EXIT_INPUT};
+    /// let e = Error::invalid(Setting::ToleranceMm, "must be above 0, got -1");
+    /// assert_eq!(e.to_string(), "tolerance_mm: must be above 0, got -1");
+    /// assert_eq!(e.exit_code(), EXIT_INPUT);
+    /// ```
+    pub fn invalid(setting: Setting, why: impl fmt::Display) -> Error {
+        Error::naming(ErrorKind::Input, setting, format!(": {why}"))
+    }
+
+    /// An error of the user's input about one value of a setting:
+    /// `NAME VALUE: WHY`.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{Error, Setting};
+    /// let e = Error::invalid_value(Setting::Poses, "`grid:x`", "not a number");
+    /// assert_eq!(e.to_string(), "poses `grid:x`: not a number");
+    /// assert_eq!(e.message_naming(|_| "--poses"), "--poses `grid:x`: not a number");
+    /// ```
+    pub fn invalid_value(setting: Setting, value: impl fmt::Display, why: impl fmt::Display) -> Error {
+        Error::naming(ErrorKind::Input, setting, format!(" {value}: {why}"))
+    }
+
+    /// An error of `kind` whose message is the setting's name, then
+    /// `after`.
+    pub(crate) fn naming(kind: ErrorKind, setting: Setting, after: String) -> Error {
+        let named = Named {
+            setting,
+            before: String::new(),
+            after,
+        };
+        Error {
+            setting: None,
+            ..Error::new(kind, named.render(setting.name()))
+        }
+        .with_named(named)
+    }
+
+    fn with_named(mut self, named: Named) -> Error {
+        self.setting = Some(named);
+        self
+    }
+
+    /// The request setting this error is about, if it is about one.
+    pub fn setting(&self) -> Option<Setting> {
+        self.setting.as_ref().map(|n| n.setting)
+    }
+
+    /// The message with the setting it is about named by `name` (a
+    /// program's own name for it: a command-line flag, a keyword
+    /// argument); the message itself when it is about no setting.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{Error, Setting};
+    /// let e = Error::invalid(Setting::Alpha, "must lie between 0 and 0.5, got 2").in_file("check");
+    /// assert_eq!(e.message_naming(|_| "--alpha"), "check: --alpha: must lie between 0 and 0.5, got 2");
+    /// assert_eq!(Error::input("x").message_naming(|_| "--alpha"), "x");
+    /// ```
+    pub fn message_naming<'a>(&self, name: impl FnOnce(Setting) -> &'a str) -> String {
+        match &self.setting {
+            Some(n) => n.render(name(n.setting)),
+            None => self.message.clone(),
+        }
+    }
+
+    /// The same error, about `setting`: `NAME: ` before its message.
+    #[must_use]
+    pub fn in_setting(self, setting: Setting) -> Error {
+        self.about(setting, String::new())
+    }
+
+    /// The same error, about the value `value` of `setting`: `NAME VALUE: `
+    /// before its message.
+    #[must_use]
+    pub fn in_setting_value(self, setting: Setting, value: impl fmt::Display) -> Error {
+        self.about(setting, format!(" {value}"))
+    }
+
+    fn about(self, setting: Setting, value: String) -> Error {
+        let named = Named {
+            setting,
+            before: String::new(),
+            after: format!("{value}: {}", self.message),
+        };
+        Error {
+            message: named.render(setting.name()),
+            setting: Some(named),
+            ..self
         }
     }
 
@@ -376,32 +497,50 @@ impl Error {
         Error::new(ErrorKind::Other, message)
     }
 
-    /// A library error with its kind and its message.
-    pub fn from_library(e: &(impl Classify + fmt::Display)) -> Error {
+    /// A library error with its kind, its message and its cause, the
+    /// library error its [`source`](std::error::Error::source).
+    pub fn from_library(e: impl Classify + std::error::Error + Send + Sync + 'static) -> Error {
         Error {
-            file: e.file_failure(),
-            cause: e.cause(),
-            ..Error::new(e.kind(), e.to_string())
+            file: Classify::file_failure(&e),
+            cause: Classify::cause(&e),
+            ..Error::new(Classify::kind(&e), e.to_string())
         }
+        .with_source(e)
     }
 
     /// A library error with `context: ` before its message, keeping its
-    /// kind.
-    pub fn with_context(context: impl fmt::Display, e: &(impl Classify + fmt::Display)) -> Error {
-        Error {
-            file: e.file_failure(),
-            cause: e.cause(),
-            ..Error::new(e.kind(), format!("{context}: {e}"))
-        }
+    /// kind and its cause, the library error its
+    /// [`source`](std::error::Error::source).
+    ///
+    /// # Example
+    /// ```
+    /// use std::error::Error as _;
+    /// use tricept_ident::{Error, ErrorCause};
+    /// use tricept_ident::export::ExportError;
+    /// let e = Error::with_context("export", ExportError::Options("too many points".into()));
+    /// assert_eq!(e.to_string(), "export: too many points");
+    /// assert_eq!(e.source().unwrap().to_string(), "too many points");
+    /// assert_eq!(e.cause(), ErrorCause::Invalid);
+    /// ```
+    pub fn with_context(
+        context: impl fmt::Display,
+        e: impl Classify + std::error::Error + Send + Sync + 'static,
+    ) -> Error {
+        Error::from_library(e).in_file(context)
     }
 
     /// The same error with `context: ` before its message (a file, a flag).
     #[must_use]
     pub fn in_file(self, context: impl fmt::Display) -> Error {
+        let setting = self.setting.map(|n| Named {
+            before: format!("{context}: {}", n.before),
+            ..n
+        });
         Error {
             file: self.file,
             cause: self.cause,
             source: self.source,
+            setting,
             ..Error::new(self.kind, format!("{context}: {}", self.message))
         }
     }
@@ -434,19 +573,19 @@ pub(crate) fn exit_line(verb: &str, code: u8, why: &str) -> Option<String> {
         .then(|| format!("{verb}: exit {code}: {why} (see the warnings)"))
 }
 
-pub(crate) fn check_output_path(flag: &str, path: &std::path::Path) -> Result<(), Error> {
+pub(crate) fn check_output_path(setting: Setting, path: &std::path::Path) -> Result<(), Error> {
     let shown = path.display();
-    tricept_data::check_output_file(path)
-        .map_err(|e| Error::input(format!("{flag} {shown}: {e}")))?;
+    tricept_data::check_output_file(path).map_err(|e| Error::invalid_value(setting, &shown, e))?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => std::path::Path::new("."),
     };
     if let Err(e) = std::fs::metadata(dir) {
-        return Err(Error::input(format!(
-            "{flag} {shown}: the directory {} does not exist",
-            dir.display()
-        ))
+        return Err(Error::invalid_value(
+            setting,
+            &shown,
+            format!("the directory {} does not exist", dir.display()),
+        )
         .with_file_failure(FileFailure::new(shown.to_string(), &e)));
     }
     Ok(())
@@ -468,7 +607,7 @@ impl std::error::Error for Error {
 
 impl<E: Classify + std::error::Error + Send + Sync + 'static> From<E> for Error {
     fn from(e: E) -> Error {
-        Error::from_library(&e).with_source(e)
+        Error::from_library(e)
     }
 }
 

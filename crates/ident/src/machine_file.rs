@@ -346,7 +346,7 @@ pub fn calibrated_description(
         warnings: p
             .forced
             .iter()
-            .map(|why| format!("written with --force although {why}"))
+            .map(|why| format!("written although {why} (forced)"))
             .chain(p.warnings)
             .collect(),
         poses_used: id.poses_used,
@@ -446,7 +446,7 @@ impl MachineFile {
             c.date = utc_now();
         }
         write(path, &d).map_err(|e| Error::not_written(path, &e))?;
-        Ok(forced.map(|why| format!("{what}: written with --force although {why}")))
+        Ok(forced.map(|why| format!("{what}: written although {why} (forced)")))
     }
 
     /// The JSON text it is kept as.
