@@ -188,6 +188,13 @@ pub trait Classify {
     fn cause(&self) -> Option<ErrorCause> {
         None
     }
+
+    /// The request setting the error is about, by its name
+    /// ([`Setting::name`]), and why it is refused: the message is then
+    /// `NAME: WHY`.
+    fn setting(&self) -> Option<(&'static str, String)> {
+        None
+    }
 }
 
 /// A failure of a workflow: a one-line message (naming the file, line and
@@ -500,9 +507,17 @@ impl Error {
     /// A library error with its kind, its message and its cause, the
     /// library error its [`source`](std::error::Error::source).
     pub fn from_library(e: impl Classify + std::error::Error + Send + Sync + 'static) -> Error {
+        let named = Classify::setting(&e).and_then(|(name, why)| {
+            Some(Named {
+                setting: Setting::from_name(name)?,
+                before: String::new(),
+                after: format!(": {why}"),
+            })
+        });
         Error {
             file: Classify::file_failure(&e),
             cause: Classify::cause(&e),
+            setting: named,
             ..Error::new(Classify::kind(&e), e.to_string())
         }
         .with_source(e)
@@ -793,6 +808,21 @@ impl Classify for ExportError {
             ExportError::Io { .. } => ErrorKind::Other,
             ExportError::Kinematics(e) => e.kind(),
             _ => ErrorKind::Input,
+        }
+    }
+
+    fn setting(&self) -> Option<(&'static str, String)> {
+        match self {
+            ExportError::Setting { setting, why } => Some((setting, why.clone())),
+            ExportError::AxisName {
+                name,
+                controller,
+                rule,
+            } => Some((
+                "axis_names",
+                format!("`{name}` is not a {controller} axis name ({rule})"),
+            )),
+            _ => None,
         }
     }
 }

@@ -38,6 +38,21 @@ macro_rules! settings {
                     $(Setting::$variant => $name,)*
                 }
             }
+
+            /// The setting named `name` ([`Setting::name`]), if there is one.
+            ///
+            /// # Example
+            /// ```
+            /// use tricept_ident::Setting;
+            /// assert_eq!(Setting::from_name("max_points"), Some(Setting::MaxPoints));
+            /// assert_eq!(Setting::from_name("--max-points"), None);
+            /// ```
+            pub fn from_name(name: &str) -> Option<Setting> {
+                match name {
+                    $($name => Some(Setting::$variant),)*
+                    _ => None,
+                }
+            }
         }
     };
 }
@@ -161,6 +176,22 @@ settings! {
     Revisit => "revisit",
     /// The instrument a plan is for.
     Instrument => "instrument",
+    /// The control an export writes for.
+    Controller => "controller",
+    /// The names of an export's three axes.
+    AxisNames => "axis_names",
+    /// The compensation points per axis of an export.
+    MaxPoints => "max_points",
+    /// The detection unit of a FANUC control (um).
+    DetectionUnitUm => "detection_unit_um",
+    /// The largest increment between two FANUC points.
+    MaxIncrement => "max_increment",
+    /// The format error an export accepts (um).
+    ToleranceUm => "tolerance_um",
+    /// The legs' reference points of an export (mm).
+    ReferenceMm => "reference_mm",
+    /// The folder an export writes.
+    Out => "out",
 }
 
 impl fmt::Display for Setting {
