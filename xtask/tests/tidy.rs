@@ -13,6 +13,8 @@
 //!   repository path it names exists.
 //! - **Dependencies** (`tidy/deps.rs`): the binary, the Python package and
 //!   the examples depend on the door alone; no dependency goes unused.
+//! - **No flags in the libraries** (`tidy/flags.rs`): no string literal of
+//!   a library crate or the Python package names a command-line flag.
 //!
 //! An edge is a path in a file's code outside its tests (`#[cfg(test)]`
 //! items) that resolves to another file's module; a path to an item that a
@@ -25,6 +27,8 @@ use std::path::{Path, PathBuf};
 
 #[path = "tidy/deps.rs"]
 mod deps;
+#[path = "tidy/flags.rs"]
+mod flags;
 
 /// Circles that may stay: `(crate directory, files)`, with why.
 const ALLOWED_CIRCLES: &[(&str, &[&str])] = &[

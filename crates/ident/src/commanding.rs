@@ -106,7 +106,7 @@ impl Machine {
         description
             .build()
             .map(Machine::from_geometry)
-            .map_err(|e| description_error(source, &e))
+            .map_err(|e| description_error(source, e))
     }
 
     /// The machine whose geometry and leg effects are `geometry`'s.

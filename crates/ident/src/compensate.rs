@@ -174,7 +174,7 @@ fn machines(r: &CompensateRequest) -> Result<Pair, Error> {
             let nominal = c
                 .nominal
                 .build()
-                .map_err(|e| crate::inputs::description_error(loaded.source(), &e))?;
+                .map_err(|e| crate::inputs::description_error(loaded.source(), e))?;
             let (code, why) = if !c.converged {
                 (EXIT_NOT_CONVERGED, "its calibration did not converge")
             } else if c.forced || !c.adequate {

@@ -129,8 +129,7 @@ pub fn diagnose(request: DiagnoseRequest) -> Result<DiagnoseResult, Error> {
     }
     if let Some(path) = &plausibility {
         let file = path.display().to_string();
-        let text =
-            tricept_data::read_json_text(path).map_err(|e| Error::input(format!("{file}: {e}")))?;
+        let text = tricept_data::read_json_text(path).map_err(|e| Error::unreadable(&file, e))?;
         options.plausibility = Plausibility::with_overrides(&text)
             .map_err(|e| Error::input(format!("{file}: {e}")))?;
     }

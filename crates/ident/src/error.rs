@@ -489,6 +489,15 @@ impl Error {
         }
     }
 
+    /// A file that cannot be read: `PATH: WHY`, an input error (exit code
+    /// 2) with its file-system failure and the I/O error as its source.
+    pub(crate) fn unreadable(path: impl fmt::Display, e: std::io::Error) -> Error {
+        let path = path.to_string();
+        Error::input(format!("{path}: {e}"))
+            .with_file_failure(FileFailure::new(path, &e))
+            .with_source(e)
+    }
+
     /// The file-system failure that caused this error, if one did.
     pub fn file_failure(&self) -> Option<&FileFailure> {
         self.file.as_ref()

@@ -101,7 +101,7 @@ impl LoadedMachine {
                 .nominal
                 .build()
                 .map(Some)
-                .map_err(|e| description_error(&self.source, &e)),
+                .map_err(|e| description_error(&self.source, e)),
         }
     }
 
@@ -124,7 +124,7 @@ impl LoadedMachine {
         description.sensors = self.description.sensors.clone();
         let mut machine = description
             .build()
-            .map_err(|e| description_error(&source, &e))?;
+            .map_err(|e| description_error(&source, e))?;
         machine.sensors = self.machine.sensors;
         Ok(Some(LoadedMachine {
             description,
@@ -150,9 +150,10 @@ impl LoadedMachine {
 }
 
 /// The input error of a description that cannot be loaded, naming the
-/// file (and the line and column of a JSON error).
-pub fn description_error(path: &str, e: &DescriptionError) -> Error {
-    let message = match e {
+/// file (and the line and column of a JSON error), the description's
+/// error its [`source`](std::error::Error::source).
+pub fn description_error(path: &str, e: DescriptionError) -> Error {
+    let message = match &e {
         DescriptionError::Json { source } => format!(
             "{path}: line {}, column {}: {}",
             source.line(),
@@ -166,10 +167,11 @@ pub fn description_error(path: &str, e: &DescriptionError) -> Error {
         Some(f) => Error::input(message).with_file_failure(f),
         None => Error::input(message),
     };
-    match e.cause() {
+    let error = match e.cause() {
         Some(cause) => error.with_cause(cause),
         None => error,
-    }
+    };
+    error.with_source(e)
 }
 
 /// serde_json appends " at line L column C"; the message states it up front.
@@ -201,7 +203,7 @@ pub fn load_machine(path: Option<&Path>, noise: &SensorNoise) -> Result<LoadedMa
         Some(path) => {
             let source = path.display().to_string();
             (
-                MachineDescription::from_file(path).map_err(|e| description_error(&source, &e))?,
+                MachineDescription::from_file(path).map_err(|e| description_error(&source, e))?,
                 source,
             )
         }
@@ -235,10 +237,10 @@ impl LoadedMachine {
         let source = source.into();
         description
             .validate()
-            .map_err(|e| description_error(&source, &e))?;
+            .map_err(|e| description_error(&source, e))?;
         let mut machine = description
             .build()
-            .map_err(|e| description_error(&source, &e))?;
+            .map_err(|e| description_error(&source, e))?;
         if let Some((r, why)) = machine.unreachable_workspace_point() {
             let w = &machine.workspace;
             return Err(Error::input(format!(
@@ -553,10 +555,10 @@ impl TrueErrors {
             )),
             TrueErrors::File(path) => {
                 let name = path.display();
-                let text = tricept_data::read_json_text(path)
-                    .map_err(|e| Error::input(format!("{name}: {e}")))?;
+                let text =
+                    tricept_data::read_json_text(path).map_err(|e| Error::unreadable(&name, e))?;
                 set.parse_values(&text)
-                    .map_err(|e| Error::input(format!("{name}: {e}")))
+                    .map_err(|e| Error::input(format!("{name}: {e}")).with_source(e))
             }
         }
     }
@@ -577,7 +579,7 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
         let (text, origin) = match spec.strip_prefix('@') {
             Some(path) => (
                 tricept_data::read_json_text(Path::new(path))
-                    .map_err(|e| Error::input(format!("{path}: {e}")))?,
+                    .map_err(|e| Error::unreadable(path, e))?,
                 path.to_string(),
             ),
             None => (spec.clone(), Setting::TruthEffect.name().to_string()),
@@ -601,7 +603,8 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
         };
         for item in items {
             let effect: Effect =
-                serde_json::from_value(item).map_err(|e| Error::input(format!("{origin}: {e}")))?;
+                serde_json::from_value(item)
+                    .map_err(|e| Error::input(format!("{origin}: {e}")).with_source(e))?;
             effect
                 .validate()
                 .map_err(|why| Error::input(format!("{origin}: {why}")))?;

@@ -147,8 +147,7 @@ pub fn write_rule(what: &str, code: u8, why: &str, force: bool) -> Result<Option
 
 /// SHA-256 of a file's bytes, lower-case hex.
 pub fn sha256_file(path: &Path) -> Result<String, Error> {
-    let bytes =
-        std::fs::read(path).map_err(|e| Error::input(format!("{}: {e}", path.display())))?;
+    let bytes = std::fs::read(path).map_err(|e| Error::unreadable(path.display(), e))?;
     let digest = Sha256::digest(&bytes);
     Ok(digest.iter().map(|b| format!("{b:02x}")).collect())
 }
@@ -458,7 +457,7 @@ impl MachineFile {
     /// for any other text).
     pub fn from_json(text: &str) -> Result<MachineFile, Error> {
         serde_json::from_str(text)
-            .map_err(|e| Error::input(format!("not a machine file kept by tricept: {e}")))
+            .map_err(|e| Error::input(format!("not a machine file kept by tricept: {e}")).with_source(e))
     }
 }
 

@@ -279,6 +279,8 @@ fn export(dir: &Path) -> Result<Source, Error> {
             Setting::Export,
             format!("{file}: {e}: not the folder an export wrote"),
         )
+        .with_file_failure(crate::error::FileFailure::new(&file, &e))
+        .with_source(e)
     })?;
     let newer = tricept_kinematics::description::newer_format(
         &text,

@@ -95,7 +95,7 @@ impl HeadErrors {
             HeadErrors::File(path) => {
                 let name = path.display();
                 let text = tricept_data::read_json_text(path)
-                    .map_err(|e| Error::invalid(Setting::HeadErrors, format!("{name}: {e}")))?;
+                    .map_err(|e| Error::unreadable(&name, e).in_setting(Setting::HeadErrors))?;
                 HeadParameterSet::head13(&machine.head)
                     .parse_values(&text)
                     .map_err(|e| Error::invalid(Setting::HeadErrors, format!("{name}: {e}")))

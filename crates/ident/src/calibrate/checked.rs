@@ -108,7 +108,7 @@ pub(crate) fn fused(
     }
     if let Some(path) = &x.plausibility {
         let text = tricept_data::read_json_text(path)
-            .map_err(|e| Error::invalid_value(Setting::Plausibility, path.display(), e))?;
+            .map_err(|e| Error::unreadable(path.display(), e).in_setting(Setting::Plausibility))?;
         options.plausibility = FusionPlausibility::with_overrides(&text)
             .map_err(|e| Error::invalid_value(Setting::Plausibility, path.display(), e))?;
     }
