@@ -219,7 +219,9 @@ fn locate_columns(header: &Header) -> Result<Columns, DataError> {
     let has = |c: &str| header.find(c).is_some();
     if !has("phi") && has("h1") && has("h2") {
         let kind = if has("x") && has("y") && has("z") {
-            Some("a laser-tracker file (columns h1, h2, x, y, z): give it as a tracker file (tracker)")
+            Some(
+                "a laser-tracker file (columns h1, h2, x, y, z): give it as a tracker file (tracker)",
+            )
         } else if has("length") {
             Some("a ballbar file (columns h1, h2, length): give it as a ballbar file (ballbar)")
         } else if has("feature") {

@@ -128,7 +128,9 @@ fn check_contents(target: &Path) -> Result<(), String> {
         Ok(m) => m,
     };
     if !meta.is_dir() {
-        return Err("is not a folder: the output names the folder the control's files go into".into());
+        return Err(
+            "is not a folder: the output names the folder the control's files go into".into(),
+        );
     }
     let entries: Vec<String> = fs::read_dir(target)
         .map_err(|e| e.to_string())?

@@ -283,7 +283,10 @@ fn check_options(o: &ExportOptions) -> Result<Vec<String>, ExportError> {
     }
     if o.control.family() != Controller::Fanuc {
         if o.detection_unit_um.is_some() {
-            return bad("detection_unit_um", "applies to a fanuc control only".into());
+            return bad(
+                "detection_unit_um",
+                "applies to a fanuc control only".into(),
+            );
         }
         if o.max_increment.is_some() {
             return bad("max_increment", "applies to a fanuc control only".into());

@@ -185,12 +185,7 @@ fn machines(r: &CompensateRequest) -> Result<Pair, Error> {
             } else {
                 (0, "")
             };
-            write_rule(
-                loaded.source(),
-                code,
-                why,
-                r.force,
-            )?;
+            write_rule(loaded.source(), code, why, r.force)?;
             out.insert("machine".into(), loaded.description().name.clone().into());
             out.insert("converged".into(), c.converged.into());
             out.insert("adequate".into(), c.adequate.into());

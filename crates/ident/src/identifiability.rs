@@ -85,7 +85,13 @@ pub fn assess_identifiability(request: IdentifiabilityRequest) -> Result<Identif
                     Error::invalid_value(
                         Setting::Poses,
                         poses,
-                        format!("pose {} ({:.3}, {:.3}, {:.3} mm): {e}", i + 1, r.x, r.y, r.z),
+                        format!(
+                            "pose {} ({:.3}, {:.3}, {:.3} mm): {e}",
+                            i + 1,
+                            r.x,
+                            r.y,
+                            r.z
+                        ),
                     )
                 })?;
                 commands.push(MeasuredPose {

@@ -20,8 +20,8 @@ use tricept_kinematics::{
 use tricept_model::ParameterSet;
 use tricept_plant::Effect;
 
-use crate::error::{Classify, Error};
 use crate::Setting;
+use crate::error::{Classify, Error};
 use crate::limits;
 
 /// Sensor-noise overrides of a machine (default: the description's).
@@ -532,11 +532,9 @@ pub(crate) fn random_spec(
             Error::invalid_value(setting, format!("`{spec}`"), format!("expected {expected}"))
         })?;
     let seed: u64 = match parts.next() {
-        Some(t) => t
-            .parse()
-            .map_err(|_| {
-                Error::invalid_value(setting, format!("`{spec}`"), "SEED must be a whole number")
-            })?,
+        Some(t) => t.parse().map_err(|_| {
+            Error::invalid_value(setting, format!("`{spec}`"), "SEED must be a whole number")
+        })?,
         None => 0,
     };
     Ok((size, seed))
@@ -602,9 +600,8 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
             v => vec![v],
         };
         for item in items {
-            let effect: Effect =
-                serde_json::from_value(item)
-                    .map_err(|e| Error::input(format!("{origin}: {e}")).with_source(e))?;
+            let effect: Effect = serde_json::from_value(item)
+                .map_err(|e| Error::input(format!("{origin}: {e}")).with_source(e))?;
             effect
                 .validate()
                 .map_err(|why| Error::input(format!("{origin}: {why}")))?;

@@ -247,7 +247,8 @@ mod tests {
         assert_eq!(e.exit_code(), crate::EXIT_INPUT);
         assert!(
             e.message().starts_with("ik: input -: line 3: ")
-                && e.message_naming(|_| "--input").starts_with("ik: --input -: line 3: "),
+                && e.message_naming(|_| "--input")
+                    .starts_with("ik: --input -: line 3: "),
             "{}",
             e.message()
         );

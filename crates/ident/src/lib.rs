@@ -51,6 +51,7 @@
 
 // Layer 0: errors, limits and inputs.
 mod accuracy;
+mod classify;
 mod commanding;
 mod data_input;
 mod error;

@@ -456,8 +456,9 @@ impl MachineFile {
     /// Reads it back from [`MachineFile::to_json`]'s text (an input error
     /// for any other text).
     pub fn from_json(text: &str) -> Result<MachineFile, Error> {
-        serde_json::from_str(text)
-            .map_err(|e| Error::input(format!("not a machine file kept by tricept: {e}")).with_source(e))
+        serde_json::from_str(text).map_err(|e| {
+            Error::input(format!("not a machine file kept by tricept: {e}")).with_source(e)
+        })
     }
 }
 

@@ -305,7 +305,10 @@ pub fn plan(request: PlanRequest) -> Result<Plan, Error> {
 /// Refuses sizes no plan can use.
 fn check_sizes(a: &PlanRequest, k: &[usize]) -> Result<(), Error> {
     if k.contains(&0) {
-        return Err(Error::invalid(Setting::K, "expected positive whole numbers"));
+        return Err(Error::invalid(
+            Setting::K,
+            "expected positive whole numbers",
+        ));
     }
     if let Some(t) = a.target_um
         && !(t.is_finite() && t > 0.0)
@@ -417,7 +420,11 @@ fn candidates(a: &PlanRequest, m: &Machine, model: &FusedModel) -> Result<Candid
             if a.ballbar_candidates > limits::MAX_CANDIDATES {
                 return Err(Error::invalid(
                     Setting::BallbarCandidates,
-                    format!("{}; at most {}", a.ballbar_candidates, limits::MAX_CANDIDATES),
+                    format!(
+                        "{}; at most {}",
+                        a.ballbar_candidates,
+                        limits::MAX_CANDIDATES
+                    ),
                 ));
             }
             let poses = sphere_candidates(m, &centre, radius, a.ballbar_candidates);
@@ -603,7 +610,10 @@ fn check_plan(a: &PlanRequest, loaded: &LoadedMachine) -> Result<Plan, Error> {
     let budget = match a.k.as_slice() {
         [] => 20,
         k if k.contains(&0) => {
-            return Err(Error::invalid(Setting::K, "expected positive whole numbers"));
+            return Err(Error::invalid(
+                Setting::K,
+                "expected positive whole numbers",
+            ));
         }
         k => k.iter().copied().max().unwrap_or(20),
     };
@@ -670,7 +680,9 @@ fn check_plan(a: &PlanRequest, loaded: &LoadedMachine) -> Result<Plan, Error> {
             if p.reached {
                 String::new()
             } else {
-                format!(" (the budget of {budget} poses (k) is spent; more poses or a larger change to detect (detect_um))")
+                format!(
+                    " (the budget of {budget} poses (k) is spent; more poses or a larger change to detect (detect_um))"
+                )
             }
         );
         wln!(

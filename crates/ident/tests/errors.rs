@@ -115,7 +115,9 @@ fn a_write_of_an_untrusted_calibration_is_refused_as_such_with_its_source() {
 }
 
 /// The chain of `source()`s under `e`, outermost first.
-fn chain<'a>(e: &'a (dyn std::error::Error + 'static)) -> Vec<&'a (dyn std::error::Error + 'static)> {
+fn chain<'a>(
+    e: &'a (dyn std::error::Error + 'static),
+) -> Vec<&'a (dyn std::error::Error + 'static)> {
     let mut out = Vec::new();
     let mut next = e.source();
     while let Some(s) = next {
@@ -196,10 +198,7 @@ fn a_campaign_that_is_missing_or_does_not_parse_is_told_apart() {
     // One bad reading: the fixture with `phi` of its third pose unreadable.
     let text = std::fs::read_to_string(fixture("data/diagnose-hidden-effect.csv")).unwrap();
     let lines: Vec<&str> = text.lines().collect();
-    let header = lines
-        .iter()
-        .position(|l| l.starts_with("q1,"))
-        .unwrap();
+    let header = lines.iter().position(|l| l.starts_with("q1,")).unwrap();
     let bad_line = header + 3; // 0-based: the third pose after the header
     let mut edited: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
     let mut fields: Vec<&str> = lines[bad_line].split(',').collect();
@@ -231,7 +230,11 @@ fn an_error_about_a_setting_names_the_request_field_and_carries_it() {
     assert!(e.message().starts_with("tolerance_mm: "), "{e}");
     assert!(e.message().ends_with("got 20"), "{e}");
     assert_eq!(
-        e.message_naming(|s| if s == Setting::ToleranceMm { "TOL" } else { "?" }),
+        e.message_naming(|s| if s == Setting::ToleranceMm {
+            "TOL"
+        } else {
+            "?"
+        }),
         e.message().replacen("tolerance_mm", "TOL", 1)
     );
     // A setting of a lower crate's options (the export's points per axis)

@@ -142,10 +142,17 @@ fn flags_in(text: &str) -> Vec<String> {
             && !before.is_some_and(|b| b.is_alphanumeric() || b == '_' || b == '-');
         if starts {
             let mut j = i + 2;
-            while j < c.len() && (c[j].is_ascii_lowercase() || c[j].is_ascii_digit() || c[j] == '-') {
+            while j < c.len() && (c[j].is_ascii_lowercase() || c[j].is_ascii_digit() || c[j] == '-')
+            {
                 j += 1;
             }
-            out.push(c[i..j].iter().collect::<String>().trim_end_matches('-').to_string());
+            out.push(
+                c[i..j]
+                    .iter()
+                    .collect::<String>()
+                    .trim_end_matches('-')
+                    .to_string(),
+            );
             i = j;
         } else {
             i += 1;
@@ -303,7 +310,11 @@ fn test_modules_in_their_own_files_are_found() {
     let dir = std::env::temp_dir().join(format!("tricept-tidy-flags-{}", std::process::id()));
     let src = dir.join("src");
     std::fs::create_dir_all(src.join("holdout")).unwrap();
-    std::fs::write(src.join("lib.rs"), "mod holdout;\n#[cfg(test)]\nmod testing;\n").unwrap();
+    std::fs::write(
+        src.join("lib.rs"),
+        "mod holdout;\n#[cfg(test)]\nmod testing;\n",
+    )
+    .unwrap();
     std::fs::write(src.join("holdout.rs"), "#[cfg(test)]\nmod tests;\n").unwrap();
     let files = vec![src.join("lib.rs"), src.join("holdout.rs")];
     let tests = test_module_paths(&files);

@@ -176,12 +176,9 @@ impl Written {
 
     /// The warning of a forced write (`None` for a trusted fit).
     pub fn forced_warning(&self) -> Option<String> {
-        self.forced.as_ref().map(|why| {
-            format!(
-                "{}: written although {why} (forced)",
-                self.path.display()
-            )
-        })
+        self.forced
+            .as_ref()
+            .map(|why| format!("{}: written although {why} (forced)", self.path.display()))
     }
 }
 
