@@ -146,10 +146,9 @@ pub(crate) fn fused(
         None
     } else {
         let Some(features) = &x.features else {
-            return Err(Error::naming(
-                crate::ErrorKind::Input,
-                Setting::Touch,
-                " needs the features touched (a JSON file of the spheres and planes)".to_string(),
+            return Err(Error::invalid(
+                Setting::Features,
+                "needed with touch-off files: the spheres and planes touched (a JSON file)",
             ));
         };
         let features = Features::from_path(features)?;
