@@ -203,9 +203,9 @@ pub trait Classify {
 pub struct Error {
     kind: ErrorKind,
     message: String,
-    file: Option<FileFailure>,
+    file: Option<Box<FileFailure>>,
     cause: Option<ErrorCause>,
-    setting: Option<Named>,
+    setting: Option<Box<Named>>,
     source: Option<Arc<dyn std::error::Error + Send + Sync + 'static>>,
 }
 
@@ -352,15 +352,10 @@ impl Error {
             after,
         };
         Error {
-            setting: None,
-            ..Error::new(kind, named.render(setting.name()))
+            message: named.render(setting.name()),
+            setting: Some(Box::new(named)),
+            ..Error::new(kind, "")
         }
-        .with_named(named)
-    }
-
-    fn with_named(mut self, named: Named) -> Error {
-        self.setting = Some(named);
-        self
     }
 
     /// The request setting this error is about, if it is about one.
@@ -386,7 +381,8 @@ impl Error {
         }
     }
 
-    /// The same error, about `setting`: `NAME: ` before its message.
+    /// The same error, about `setting`: `NAME: ` before its message (a
+    /// setting it was about already is then named by its request field).
     #[must_use]
     pub fn in_setting(self, setting: Setting) -> Error {
         self.about(setting, String::new())
@@ -407,7 +403,7 @@ impl Error {
         };
         Error {
             message: named.render(setting.name()),
-            setting: Some(named),
+            setting: Some(Box::new(named)),
             ..self
         }
     }
@@ -455,7 +451,7 @@ impl Error {
     /// The same error, caused by the file-system failure `file`.
     #[must_use]
     pub fn with_file_failure(mut self, file: FileFailure) -> Error {
-        self.file = Some(file);
+        self.file = Some(Box::new(file));
         self
     }
 
@@ -493,7 +489,7 @@ impl Error {
 
     /// The file-system failure that caused this error, if one did.
     pub fn file_failure(&self) -> Option<&FileFailure> {
-        self.file.as_ref()
+        self.file.as_deref()
     }
 
     /// An error of the user's input (exit code 2).
@@ -510,14 +506,14 @@ impl Error {
     /// library error its [`source`](std::error::Error::source).
     pub fn from_library(e: impl Classify + std::error::Error + Send + Sync + 'static) -> Error {
         let named = Classify::setting(&e).and_then(|(name, why)| {
-            Some(Named {
+            Some(Box::new(Named {
                 setting: Setting::from_name(name)?,
                 before: String::new(),
                 after: format!(": {why}"),
-            })
+            }))
         });
         Error {
-            file: Classify::file_failure(&e),
+            file: Classify::file_failure(&e).map(Box::new),
             cause: Classify::cause(&e),
             setting: named,
             ..Error::new(Classify::kind(&e), e.to_string())
@@ -549,9 +545,11 @@ impl Error {
     /// The same error with `context: ` before its message (a file, a flag).
     #[must_use]
     pub fn in_file(self, context: impl fmt::Display) -> Error {
-        let setting = self.setting.map(|n| Named {
-            before: format!("{context}: {}", n.before),
-            ..n
+        let setting = self.setting.map(|n| {
+            Box::new(Named {
+                before: format!("{context}: {}", n.before),
+                ..*n
+            })
         });
         Error {
             file: self.file,

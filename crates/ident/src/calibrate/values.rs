@@ -87,7 +87,7 @@ impl TrackerTargetSpec {
         spec: Option<TrackerTargetSpec>,
         sigma_um: f64,
     ) -> Result<TrackerTarget, Error> {
-        spec.ok_or_else(|| target_required())?.target(sigma_um)
+        spec.ok_or_else(target_required)?.target(sigma_um)
     }
 }
 
