@@ -59,8 +59,8 @@ def test_options_out_of_range_and_machines_of_the_wrong_kind_are_input_errors():
         ({"readings_per_pose": -1}, "readings_per_pose"),
         ({"readings_per_pose": 2**40}, "readings_per_pose"),
         ({"readings_per_pose": 0}, "readings_per_pose"),
-        ({"tolerance_mm": -1.0}, "tolerance"),
-        ({"angle_noise_arcsec": -2.0}, "angle-noise"),
+        ({"tolerance_mm": -1.0}, "^tolerance_mm: the manufacturing tolerance"),
+        ({"angle_noise_arcsec": -2.0}, "^angle_noise_arcsec: must be a positive number"),
     ):
         with pytest.raises(tricept.InputError, match=needle):
             tricept.identify(GRID, **options)

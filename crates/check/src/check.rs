@@ -609,7 +609,7 @@ fn validate(data: &Dataset, options: &CheckOptions) -> Result<(), CheckError> {
     }
     if distinct.len() < 4 {
         return Err(CheckError::Blind(format!(
-            "{} rows at {} distinct poses: the sensor offsets take three readings' worth, and a change of a leg or joint shows only as readings that vary over at least four spread poses (`tricept plan --instrument check` plans them)",
+            "{} rows at {} distinct poses: the sensor offsets take three readings' worth, and a change of a leg or joint shows only as readings that vary over at least four spread poses (a plan for a check, instrument `check`, plans them)",
             data.poses.len(),
             distinct.len()
         )));

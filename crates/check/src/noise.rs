@@ -112,7 +112,7 @@ impl NoiseSeen {
     pub(crate) fn warning(&self) -> String {
         let (s, t) = (&self.seen, &self.stated);
         format!(
-            "the readings scatter {:.2} times the stated noise (per logged reading: phi {:.2} arcsec, theta {:.2} arcsec, s {:.2} um, against the stated {:.2}, {:.2}, {:.2}) and no change stands out beyond that noise: state the sensors' noise (`--angle-noise-arcsec`, `--length-noise-um`, the noise of one reading) or service the sensors",
+            "the readings scatter {:.2} times the stated noise (per logged reading: phi {:.2} arcsec, theta {:.2} arcsec, s {:.2} um, against the stated {:.2}, {:.2}, {:.2}) and no change stands out beyond that noise: state the sensors' noise (`angle_noise_arcsec`, `length_noise_um`, the noise of one reading) or service the sensors",
             self.factor, s.phi_arcsec, s.theta_arcsec, s.s_um, t.phi_arcsec, t.theta_arcsec, t.s_um
         )
     }

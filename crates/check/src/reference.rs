@@ -71,7 +71,7 @@ impl Reference {
     pub fn from_description(d: &MachineDescription) -> Result<Reference, CheckError> {
         let Some(c) = &d.calibration else {
             return Err(CheckError::Record(format!(
-                "`{}` holds no `calibration` record: a check needs the calibration's estimates, their uncertainty and its sensor offsets (write the machine with `tricept identify --write-machine`)",
+                "`{}` holds no `calibration` record: a check needs the calibration's estimates, their uncertainty and its sensor offsets (the machine file a calibration writes: identify's `write_machine`)",
                 d.name
             )));
         };

@@ -87,7 +87,7 @@ impl CheckReport {
                 if self.shortlist.len() > 1 {
                     let _ = writeln!(
                         s,
-                        "  the check cannot tell apart: {} (each explains the readings as well; a campaign planned with `tricept plan --instrument check` or a diagnosis separates them)",
+                        "  the check cannot tell apart: {} (each explains the readings as well; a campaign planned for a check (instrument `check`) or a diagnosis separates them)",
                         self.shortlist.join(", ")
                     );
                 }

@@ -148,7 +148,7 @@ fn read_with_progress(path: &Path, loaded: &LoadedMachine) -> Result<DataInput, 
 /// warning) on stderr.
 fn write_machine(result: &DiagnoseResult, path: &Path, force: bool) -> Result<(), CliError> {
     if let Some(warning) = result.write_machine(path, force)? {
-        errln!("warning: {warning}");
+        errln!("warning: --write-machine {warning}");
     }
     errln!("wrote {}", path.display());
     Ok(())

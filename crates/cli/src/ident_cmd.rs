@@ -63,7 +63,7 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
         .map(|path| calibration.write_machine(path, a.force));
     if let Some(Ok(w)) = &written {
         if let Some(warning) = w.forced_warning() {
-            errln!("warning: {warning}");
+            errln!("warning: --write-machine {warning}");
         }
         errln!("wrote {}", w.path().display());
     }

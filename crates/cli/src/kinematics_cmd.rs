@@ -170,6 +170,7 @@ pub fn print_machine(a: &MachineVerbArgs) -> Result<u8, CliError> {
         outln!("{}", loaded.description().to_json());
     } else {
         crate::output::write_text(&machine_summary(&loaded));
+        outln!("  (tricept machine --json prints the description file)");
     }
     Ok(0)
 }

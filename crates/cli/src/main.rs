@@ -30,6 +30,7 @@ mod docs_cmd;
 mod effects_cmd;
 mod export_cmd;
 mod files;
+mod flags;
 mod fleet_cmd;
 mod ident_cmd;
 mod kinematics_cmd;
@@ -392,10 +393,13 @@ fn value_error(e: &clap::Error) -> Option<String> {
         Some(ContextValue::String(arg)) => arg.split_whitespace().next().unwrap_or_default(),
         _ => "",
     };
-    Some(if flag.is_empty() || ours.message().starts_with(flag) {
-        ours.message().to_string()
+    let message = flags::message(ours);
+    Some(if flag.is_empty() || message.starts_with(flag) {
+        message
+    } else if ours.setting().is_some() {
+        ours.message_naming(|_| flag)
     } else {
-        format!("{flag}: {ours}")
+        format!("{flag}: {message}")
     })
 }
 
@@ -434,6 +438,7 @@ fn main() -> ExitCode {
     let write_flag = match &cli.command {
         Command::Identify(_) | Command::Diagnose(_) => "--write-machine ",
         Command::Fleet(_) => "--write-prior ",
+        Command::Compensate(_) => "compensate --machine ",
         _ => "",
     };
     let code = match run(cli) {
@@ -441,12 +446,12 @@ fn main() -> ExitCode {
         Err(e) if e.cause() == tricept_ident::ErrorCause::RefusedWrite => {
             errln!(
                 "error: {write_flag}{}; --force writes it anyway, marked as forced",
-                e.message()
+                flags::message(&e)
             );
             e.exit_code()
         }
         Err(e) => {
-            errln!("error: {}", e.message());
+            errln!("error: {}", flags::message(&e));
             e.exit_code()
         }
     };

@@ -222,11 +222,13 @@ fn locate_columns(header: &Header) -> Result<Columns, DataError> {
     let has = |c: &str| header.find(c).is_some();
     if !has("phi") && has("h1") && has("h2") {
         let kind = if has("x") && has("y") && has("z") {
-            Some("a laser-tracker file (columns h1, h2, x, y, z): give it as --tracker")
+            Some(
+                "a laser-tracker file (columns h1, h2, x, y, z): give it as a tracker file (tracker)",
+            )
         } else if has("length") {
-            Some("a ballbar file (columns h1, h2, length): give it as --ballbar")
+            Some("a ballbar file (columns h1, h2, length): give it as a ballbar file (ballbar)")
         } else if has("feature") {
-            Some("a touch-off file (columns h1, h2, feature): give it as --touch")
+            Some("a touch-off file (columns h1, h2, feature): give it as a touch-off file (touch)")
         } else {
             None
         };

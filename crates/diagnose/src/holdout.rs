@@ -445,7 +445,7 @@ fn kept_back_because(
     }
     match policy {
         DeployRule::Confident => Some(format!(
-            "the confident rule (--deploy-rule confident): its improvement is {z:.1} sd, not above {DEPLOY_IMPROVEMENT_SD} sd, and larger than the benefit the readings see"
+            "the confident rule (deploy_rule `confident`): its improvement is {z:.1} sd, not above {DEPLOY_IMPROVEMENT_SD} sd, and larger than the benefit the readings see"
         )),
         DeployRule::ExpectedError => match expected {
             None => Some(format!(

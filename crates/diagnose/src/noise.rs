@@ -183,7 +183,7 @@ pub(crate) fn noise_check(
             if used == NoiseSource::Data {
                 ""
             } else {
-                "; rerun with --noise-from-data"
+                "; rerun with the noise estimated from the data (noise_from_data)"
             }
         )
     };

@@ -107,7 +107,7 @@ impl RecordNotes {
     /// The warning a loader prints, if any.
     pub fn warning(&self) -> Option<&'static str> {
         self.partial_seal.then_some(
-            "its calibration record was sealed by an earlier tricept, whose seal did not cover the geometry, the estimates, the nominal machine, the UP limb or the workspace: an edit of those that agree with each other cannot be seen; write it again with this version (`tricept identify --write-machine`) to seal every field",
+            "its calibration record was sealed by an earlier tricept, whose seal did not cover the geometry, the estimates, the nominal machine, the UP limb or the workspace: an edit of those that agree with each other cannot be seen; write it again with this version (identify's `write_machine`) to seal every field",
         )
     }
 }

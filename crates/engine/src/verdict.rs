@@ -96,7 +96,7 @@ impl Identification {
         let a = tricept_kinematics::units::RAD_PER_ARCSEC;
         if inconsistent {
             warnings.push(format!(
-                "the data cannot come from the described machine: chi2/dof {chi2_per_dof:.3e} (residual rms phi {:.1} arcsec, theta {:.1} arcsec, s {:.1} um){}; likely causes: a wrong machine file (--machine, its U-joint axis order), swapped columns (phi/theta, q1/q2/q3) or readings in the wrong units (s in m instead of mm, angles not in rad)",
+                "the data cannot come from the described machine: chi2/dof {chi2_per_dof:.3e} (residual rms phi {:.1} arcsec, theta {:.1} arcsec, s {:.1} um){}; likely causes: a wrong machine file (the machine, its U-joint axis order), swapped columns (phi/theta, q1/q2/q3) or readings in the wrong units (s in m instead of mm, angles not in rad)",
                 s.rms[0] / a,
                 s.rms[1] / a,
                 s.rms[2] * 1e3,

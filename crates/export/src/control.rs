@@ -197,7 +197,7 @@ const FANUC_MAGNIFICATION: Limit = Limit {
 const FANUC_POINT_NUMBERS: Limit = Limit {
     value: 1024,
     hard: false,
-    source: "the range of parameters 3620-3622 is not in the sources found; 0 to 1023 (the numbers of the Series 0i and 16i/18i, the smallest FANUC range commonly stated) is taken; raise --max-points only as far as the control's parameter manual allows",
+    source: "the range of parameters 3620-3622 is not in the sources found; 0 to 1023 (the numbers of the Series 0i and 16i/18i, the smallest FANUC range commonly stated) is taken; raise max_points only as far as the control's parameter manual allows",
 };
 
 impl ControlModel {

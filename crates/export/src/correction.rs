@@ -196,13 +196,16 @@ pub fn leg_corrections(
 pub fn check_references(legs: &[LegCorrection; 3]) -> Result<(), ExportError> {
     for l in legs {
         if !(l.reference_mm.is_finite() && (l.lo_mm..=l.hi_mm).contains(&l.reference_mm)) {
-            return Err(ExportError::Options(format!(
-                "--reference-mm: leg {}'s reference point {} mm is outside the stroke the workspace uses ({} to {} mm)",
-                l.leg + 1,
-                l.reference_mm,
-                l.lo_mm,
-                l.hi_mm
-            )));
+            return Err(ExportError::Setting {
+                setting: "reference_mm",
+                why: format!(
+                    "leg {}'s reference point {} mm is outside the stroke the workspace uses ({} to {} mm)",
+                    l.leg + 1,
+                    l.reference_mm,
+                    l.lo_mm,
+                    l.hi_mm
+                ),
+            });
         }
     }
     Ok(())

@@ -383,7 +383,7 @@ pub(crate) fn files(setup: &Setup) -> ControlFiles {
         ));
         if a.clipped {
             out.limits.push(format!(
-                "axis {}: a point's value exceeds {cap} (the range of a point on the {model}, or --max-increment) even at magnification {max_magnification} (parameter 3623): raise --max-points or --detection-unit-um",
+                "axis {}: a point's value exceeds {cap} (the range of a point on the {model}, or max_increment) even at magnification {max_magnification} (parameter 3623): raise max_points or detection_unit_um",
                 names[i],
             ));
         } else if a.format_error_um > options.tolerance_um {
@@ -395,7 +395,7 @@ pub(crate) fn files(setup: &Setup) -> ControlFiles {
         && next as u64 > numbers.value
     {
         out.limits.push(format!(
-            "the three axes need compensation point numbers 0 to {}: the {model} has 0 to {} ({}): lower --max-points to {}",
+            "the three axes need compensation point numbers 0 to {}: the {model} has 0 to {} ({}): lower max_points to {}",
             next - 1,
             numbers.value - 1,
             numbers.source,
@@ -430,7 +430,7 @@ pub(crate) fn files(setup: &Setup) -> ControlFiles {
 fn remedy(a: &FanucAxis, name: &str, du: f64, tolerance_um: f64) -> String {
     let rounding_um = 0.5 * du * f64::from(a.magnification);
     let lower = format!(
-        "lower --detection-unit-um ({du} um, magnification {}: half a unit is {rounding_um:.3} um)",
+        "lower detection_unit_um ({du} um, magnification {}: half a unit is {rounding_um:.3} um)",
         a.magnification
     );
     let remedy = if rounding_um >= tolerance_um {
@@ -439,12 +439,12 @@ fn remedy(a: &FanucAxis, name: &str, du: f64, tolerance_um: f64) -> String {
         let points = a.increments.len() as f64 * (a.format_error_um - rounding_um)
             / (tolerance_um - rounding_um);
         format!(
-            "raise --max-points (the points of the axis) to more than {}, or {lower}",
+            "raise max_points (the points of the axis) to more than {}, or {lower}",
             points.ceil()
         )
     };
     format!(
-        "axis {name}: format error {:.3} um past --tolerance-um {tolerance_um}: {remedy}",
+        "axis {name}: format error {:.3} um past tolerance_um {tolerance_um}: {remedy}",
         a.format_error_um
     )
 }

@@ -69,7 +69,7 @@ pub fn check_out(out: &Path, machine: &Path) -> Result<(), ExportError> {
         && m.starts_with(t)
     {
         return Err(refuse(format!(
-            "holds the machine file being exported ({}): the export replaces the folder; choose another --out",
+            "holds the machine file being exported ({}): the export replaces the folder; choose another output folder",
             machine.display()
         )));
     }
@@ -79,7 +79,7 @@ pub fn check_out(out: &Path, machine: &Path) -> Result<(), ExportError> {
                 && same_file(&meta, &m)
             {
                 return Err(refuse(format!(
-                    "{} is the machine file being exported (a hard link): the export replaces the folder; choose another --out",
+                    "{} is the machine file being exported (a hard link): the export replaces the folder; choose another output folder",
                     e.file_name().to_string_lossy()
                 )));
             }
@@ -128,7 +128,9 @@ fn check_contents(target: &Path) -> Result<(), String> {
         Ok(m) => m,
     };
     if !meta.is_dir() {
-        return Err("is not a folder: --out names the folder the control's files go into".into());
+        return Err(
+            "is not a folder: the output names the folder the control's files go into".into(),
+        );
     }
     let entries: Vec<String> = fs::read_dir(target)
         .map_err(|e| e.to_string())?

@@ -196,7 +196,7 @@ fn summary_json(summary: &ExportSummary) -> String {
     serde_json::to_string_pretty(summary).unwrap_or_default() + "\n"
 }
 
-/// The three axes' names: `--axis-names` or the control's defaults, each
+/// The three axes' names: `axis_names` or the control's defaults, each
 /// one the control accepts, none twice.
 fn axis_names(options: &ExportOptions) -> Result<[String; 3], ExportError> {
     let c = options.control.family();
@@ -211,9 +211,10 @@ fn axis_names(options: &ExportOptions) -> Result<[String; 3], ExportError> {
             rule,
         })?;
         if names[..i].contains(n) {
-            return Err(ExportError::Options(format!(
-                "--axis-names: `{n}` is given twice"
-            )));
+            return Err(ExportError::Setting {
+                setting: "axis_names",
+                why: format!("`{n}` is given twice"),
+            });
         }
     }
     Ok(names)
@@ -234,7 +235,7 @@ fn not_exported(
         not_exported.push(NotExported {
             what: "leg_effects.compliance_um_per_kn_at_1m".into(),
             size_um: compliance,
-            why: "the legs' gravity compliance depends on the pose, not on one axis' position: it stays in tricept's own kinematics (ik, compensate --table)".into(),
+            why: "the legs' gravity compliance depends on the pose, not on one axis' position: it stays in tricept's own kinematics (ik, compensate's table)".into(),
         });
     }
     let alpha = setup.params.thermal_expansion_ppm_per_k;
@@ -268,62 +269,66 @@ fn not_exported(
 /// Fanuc only, and each against the model's limits: past a hard limit
 /// refused, past a stand-in a warning (returned).
 fn check_options(o: &ExportOptions) -> Result<Vec<String>, ExportError> {
-    let bad = |m: String| Err(ExportError::Options(m));
+    let bad = |setting: &'static str, why: String| Err(ExportError::Setting { setting, why });
     if !(o.tolerance_um.is_finite() && o.tolerance_um > 0.0) {
-        return bad(format!(
-            "--tolerance-um: must be a positive number, got {}",
-            o.tolerance_um
-        ));
+        return bad(
+            "tolerance_um",
+            format!("must be a positive number, got {}", o.tolerance_um),
+        );
     }
     if let Some(n) = o.max_points
         && !(3..=100_000).contains(&n)
     {
-        return bad(format!("--max-points: must lie from 3 to 100000, got {n}"));
+        return bad("max_points", format!("must lie from 3 to 100000, got {n}"));
     }
     if o.control.family() != Controller::Fanuc {
         if o.detection_unit_um.is_some() {
-            return bad("--detection-unit-um: applies to --controller fanuc only".into());
+            return bad(
+                "detection_unit_um",
+                "applies to a fanuc control only".into(),
+            );
         }
         if o.max_increment.is_some() {
-            return bad("--max-increment: applies to --controller fanuc only".into());
+            return bad("max_increment", "applies to a fanuc control only".into());
         }
     }
     if let Some(du) = o.detection_unit_um
         && !(du.is_finite() && du > 0.0 && du <= 100.0)
     {
-        return bad(format!(
-            "--detection-unit-um: must lie in (0, 100] um, got {du}"
-        ));
+        return bad(
+            "detection_unit_um",
+            format!("must lie in (0, 100] um, got {du}"),
+        );
     }
     if o.max_increment == Some(0) {
-        return bad("--max-increment: must be at least 1".into());
+        return bad("max_increment", "must be at least 1".into());
     }
     let limits = o.control.limits();
     let mut warnings = Vec::new();
-    let mut against = |flag: &str, asked: Option<u64>, limit: Option<Limit>| {
+    let mut against = |setting: &'static str, asked: Option<u64>, limit: Option<Limit>| {
         let (Some(asked), Some(limit)) = (asked, limit) else {
             return Ok(());
         };
         if asked <= limit.value {
             return Ok(());
         }
-        let said = format!(
-            "{flag} {asked}: past the {}'s {} ({})",
+        let why = format!(
+            "{asked} is past the {}'s {} ({})",
             o.control, limit.value, limit.source
         );
         if limit.hard {
-            return Err(ExportError::Options(said));
+            return Err(ExportError::Setting { setting, why });
         }
-        warnings.push(format!("{said}: check the control's manual"));
+        warnings.push(format!("{setting}: {why}: check the control's manual"));
         Ok(())
     };
     against(
-        "--max-points",
+        "max_points",
         o.max_points.map(|n| n as u64),
         Some(limits.points_per_axis),
     )?;
     against(
-        "--max-increment",
+        "max_increment",
         o.max_increment.map(u64::from),
         limits.value_range,
     )?;

@@ -198,7 +198,7 @@ pub(crate) fn plan_axes(
         ));
         if t.format_error_um > setup.options.tolerance_um {
             out.limits.push(format!(
-                "axis {}: format error {:.3} um past --tolerance-um {}: raise --max-points ({points_limit}) to {} (the deployed table's own spacing)",
+                "axis {}: format error {:.3} um past tolerance_um {}: raise max_points ({points_limit}) to {} (the deployed table's own spacing)",
                 setup.names[i], t.format_error_um, setup.options.tolerance_um, t.points_needed
             ));
         }

@@ -12,11 +12,11 @@ use crate::control::{ControlLimits, ControlModel, Controller};
 pub enum ExportError {
     /// The machine file has no calibration record.
     #[error(
-        "the machine file holds no calibration: there is nothing to compensate beyond the nominal machine (export a file written by `tricept diagnose --write-machine` or `tricept identify --write-machine`)"
+        "the machine file holds no calibration: there is nothing to compensate beyond the nominal machine (export a machine file a calibration wrote: identify's or diagnose's `write_machine`)"
     )]
     NoCalibration,
     /// An axis name the control cannot accept.
-    #[error("--axis-names: `{name}` is not a {controller} axis name ({rule})")]
+    #[error("axis_names: `{name}` is not a {controller} axis name ({rule})")]
     AxisName {
         /// The name as given.
         name: String,
@@ -28,6 +28,15 @@ pub enum ExportError {
     /// An option out of range or not for this control.
     #[error("{0}")]
     Options(String),
+    /// One option out of range or not for this control: the option (its
+    /// field of [`ExportOptions`], e.g. `max_points`) and why.
+    #[error("{setting}: {why}")]
+    Setting {
+        /// The option's field name.
+        setting: &'static str,
+        /// Why it is refused.
+        why: String,
+    },
     /// The machine description cannot be built.
     #[error("the machine file: {0}")]
     Description(#[from] DescriptionError),

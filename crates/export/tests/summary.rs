@@ -127,10 +127,10 @@ fn a_fanuc_format_error_past_the_tolerance_names_its_remedy() {
     let coarse = plan(&d, &fanuc(128, 10.0, 1.0)).unwrap();
     for limit in &coarse.summary.limits {
         assert!(
-            limit.contains(": lower --detection-unit-um (10 um"),
+            limit.contains(": lower detection_unit_um (10 um"),
             "{limit}"
         );
-        assert!(!limit.contains("--max-points"), "{limit}");
+        assert!(!limit.contains("max_points"), "{limit}");
     }
     assert!(!coarse.summary.limits.is_empty());
 }
@@ -151,7 +151,7 @@ fn assert_remedies(p: &ExportPlan) -> bool {
         assert!(axis.format_error_um > 1.0, "{axis:?}");
         assert!(
             limit.contains(&format!(
-                "format error {:.3} um past --tolerance-um 1:",
+                "format error {:.3} um past tolerance_um 1:",
                 axis.format_error_um
             )),
             "{limit}"
@@ -215,34 +215,34 @@ fn a_thermal_growth_a_control_cannot_carry_is_listed_with_its_size() {
 #[test]
 fn options_no_control_can_use_are_refused() {
     let d = fixture("lead");
-    let refused = |o: ExportOptions, flag: &str| match plan(&d, &o) {
-        Err(ExportError::Options(m)) => assert!(m.starts_with(flag), "{m}"),
-        other => panic!("{flag}: {other:?}"),
+    let refused = |o: ExportOptions, name: &str| match plan(&d, &o) {
+        Err(ExportError::Setting { setting, why }) => assert_eq!(setting, name, "{why}"),
+        other => panic!("{name}: {other:?}"),
     };
     for tolerance in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         let mut o = ExportOptions::new(Controller::Sinumerik);
         o.tolerance_um = tolerance;
-        refused(o, "--tolerance-um");
+        refused(o, "tolerance_um");
     }
     for points in [2, 100_001] {
         let mut o = ExportOptions::new(Controller::Heidenhain);
         o.max_points = Some(points);
-        refused(o, "--max-points");
+        refused(o, "max_points");
     }
     for c in [Controller::Sinumerik, Controller::Heidenhain] {
         let mut o = ExportOptions::new(c);
         o.detection_unit_um = Some(1.0);
-        refused(o, "--detection-unit-um");
+        refused(o, "detection_unit_um");
         let mut o = ExportOptions::new(c);
         o.max_increment = Some(7);
-        refused(o, "--max-increment");
+        refused(o, "max_increment");
     }
     for du in [0.0, -0.1, 100.5, f64::NAN] {
-        refused(fanuc(128, du, 5.0), "--detection-unit-um");
+        refused(fanuc(128, du, 5.0), "detection_unit_um");
     }
     let mut o = fanuc(128, 1.0, 5.0);
     o.max_increment = Some(0);
-    refused(o, "--max-increment");
+    refused(o, "max_increment");
     // At the ends of their ranges the options are taken.
     let mut o = fanuc(3, 100.0, 5.0);
     o.max_increment = Some(1);
@@ -297,7 +297,7 @@ fn a_linear_table_past_the_tolerance_names_the_points_its_own_spacing_needs() {
             assert!(axis.format_error_um > 1.0, "{axis:?}");
             assert!(
                 limit.starts_with(&format!(
-                    "axis {}: format error {:.3} um past --tolerance-um 1: raise --max-points ({limit_name}) to ",
+                    "axis {}: format error {:.3} um past tolerance_um 1: raise max_points ({limit_name}) to ",
                     axis.axis, axis.format_error_um
                 )),
                 "{limit}"
@@ -396,13 +396,13 @@ fn a_fanuc_tape_keeps_the_range_of_a_point_and_of_the_point_numbers() {
         .find(|l| l.starts_with("the three axes need compensation point numbers 0 to "))
         .unwrap();
     assert!(limit.contains("the fanuc-0i has 0 to 1023"), "{limit}");
-    assert!(limit.ends_with("lower --max-points to 341"), "{limit}");
+    assert!(limit.ends_with("lower max_points to 341"), "{limit}");
     // --max-points' largest value: past the axis' stand-in limit (a
     // warning) and past the numbers (a limit).
     let huge = plan(&d, &fanuc(100_000, 0.1, 1.0)).unwrap();
     assert!(!huge.summary.within_tolerance);
     assert!(
-        huge.summary.warnings[0].starts_with("--max-points 100000: past the fanuc-0i's 1018"),
+        huge.summary.warnings[0].starts_with("max_points: 100000 is past the fanuc-0i's 1018"),
         "{:?}",
         huge.summary.warnings
     );
@@ -419,10 +419,12 @@ fn a_fanuc_tape_keeps_the_range_of_a_point_and_of_the_point_numbers() {
     let mut wide = fanuc(128, 1.0, 1.0);
     wide.max_increment = Some(127);
     match plan(&d, &wide) {
-        Err(ExportError::Options(m)) => {
+        Err(e @ ExportError::Setting { setting, .. }) => {
+            assert_eq!(setting, "max_increment");
             assert!(
-                m.starts_with("--max-increment 127: past the fanuc-0i's 7"),
-                "{m}"
+                e.to_string()
+                    .starts_with("max_increment: 127 is past the fanuc-0i's 7"),
+                "{e}"
             )
         }
         other => panic!("{other:?}"),

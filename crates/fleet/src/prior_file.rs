@@ -240,7 +240,7 @@ impl PriorFile {
             .collect();
         if !edited.is_empty() {
             return Err(FleetError::Input(format!(
-                "{source}: the prior was edited after it was written (sealed fields changed: {}); write it again with `tricept fleet --write-prior`",
+                "{source}: the prior was edited after it was written (sealed fields changed: {}); write it again (a fleet's `write_prior`)",
                 edited.join(", ")
             )));
         }

@@ -52,7 +52,7 @@ pub(crate) fn of_fit(
         options,
     };
     tricept_engine::accuracy::of_fit_stated(&fit, tolerance_mm).map_err(|e| match e {
-        PromiseError::Ident(e) => Error::with_context("accuracy", &e),
+        PromiseError::Ident(e) => Error::with_context("accuracy", e),
         e => Error::other(e.to_string()),
     })
 }

@@ -91,14 +91,15 @@ pub fn check(request: CheckRequest) -> Result<CheckResult, Error> {
     let data = request.data.load(loaded.machine())?;
     let alpha = request.alpha;
     if !(alpha > 0.0 && alpha < 0.5) {
-        return Err(Error::input(format!(
-            "--alpha: the false-alarm probability must lie between 0 and 0.5, got {alpha}"
-        )));
+        return Err(Error::invalid(
+            crate::Setting::Alpha,
+            format!("the false-alarm probability must lie between 0 and 0.5, got {alpha}"),
+        ));
     }
     if let Some(h) = &request.history {
         // A history that cannot be read or replaced is refused before the
         // check runs.
-        crate::error::check_output_path("--history", h)?;
+        crate::error::check_output_path(crate::Setting::History, h)?;
         let entries = tricept_check::history::read(h)?;
         tricept_check::history::belongs_to(
             h,
@@ -109,12 +110,12 @@ pub fn check(request: CheckRequest) -> Result<CheckResult, Error> {
     let mut options = CheckOptions::for_machine(loaded.machine());
     options.alpha = alpha;
     let report = tricept_check::check(&reference, &data, &options).map_err(|e| match e {
-        CheckError::Blind(_) => Error::with_context(&data_name, &e),
+        CheckError::Blind(_) => Error::with_context(&data_name, e),
         e => Error::from(e),
     })?;
     if report.is_blind() {
         return Err(Error::input(format!(
-            "{data_name}: the check's poses cannot see a change: no leg or joint change of less than 1 mm would be detected ({} poses); plan them with `tricept plan --instrument check`",
+            "{data_name}: the check's poses cannot see a change: no leg or joint change of less than 1 mm would be detected ({} poses); plan them for a check (a plan's instrument `check`)",
             report.poses
         )));
     }
@@ -225,7 +226,7 @@ impl CheckResult {
             let per_reading = f64::from(self.readings_per_pose).sqrt();
             let n = &r.noise.seen;
             out.push(format!(
-                "{}: the readings are noisier than stated ({:.2} times; per logged reading phi {:.2} arcsec, theta {:.2} arcsec, s {:.2} um) and no change stands out beyond that noise: not a change of the machine; state the noise (--angle-noise-arcsec {:.2} --length-noise-um {:.2}) or service the sensors",
+                "{}: the readings are noisier than stated ({:.2} times; per logged reading phi {:.2} arcsec, theta {:.2} arcsec, s {:.2} um) and no change stands out beyond that noise: not a change of the machine; state the noise (angle_noise_arcsec {:.2}, length_noise_um {:.2}) or service the sensors",
                 self.data,
                 r.noise.factor,
                 n.phi_arcsec,
@@ -381,7 +382,9 @@ mod tests {
             data,
         );
         r.alpha = 0.7;
-        assert!(check(r).unwrap_err().message().starts_with("--alpha"));
+        let e = check(r).unwrap_err();
+        assert_eq!(e.setting(), Some(crate::Setting::Alpha), "{e}");
+        assert!(e.message().starts_with("alpha: "), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }
 }

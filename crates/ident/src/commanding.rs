@@ -108,7 +108,7 @@ impl Machine {
         description
             .build()
             .map(Machine::from_geometry)
-            .map_err(|e| description_error(source, &e))
+            .map_err(|e| description_error(source, e))
     }
 
     /// The machine whose geometry and leg effects are `geometry`'s.
@@ -140,7 +140,7 @@ impl Machine {
     pub fn inverse(&self, point_mm: &Vector3) -> Result<IkSolution, Error> {
         self.extended
             .inverse(point_mm)
-            .map_err(|e| Error::with_context("ik", &e))
+            .map_err(|e| Error::with_context("ik", e))
     }
 
     /// Forward kinematics: the platform point and UP joints reached with
@@ -156,7 +156,7 @@ impl Machine {
     pub fn forward(&self, legs_mm: &[f64; 3]) -> Result<FkSolution, Error> {
         self.extended
             .forward(legs_mm)
-            .map_err(|e| Error::with_context("fk", &e))
+            .map_err(|e| Error::with_context("fk", e))
     }
 
     /// Tool inverse kinematics: the leg commands and head angles that put
@@ -173,7 +173,7 @@ impl Machine {
     pub fn tool_inverse(&self, tip_mm: &Vector3, axis: &Vector3) -> Result<ToolIkSolution, Error> {
         self.extended
             .tool_inverse(tip_mm, axis, HeadBranch::default())
-            .map_err(|e| Error::with_context("tool-ik", &e))
+            .map_err(|e| Error::with_context("tool-ik", e))
     }
 
     /// Whether the machine carries any static leg effect (a lead, a

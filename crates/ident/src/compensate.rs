@@ -19,6 +19,7 @@ use tricept_model::ExtendedMachine;
 use tricept_model::{ParameterSet, volumetric::MapStats};
 use tricept_plant::Effect;
 
+use crate::Setting;
 use crate::calibrate::{CalibrateRequest, calibrate, exit_line, write_text};
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, Error};
 use crate::inputs::TrueErrors;
@@ -166,30 +167,25 @@ fn machines(r: &CompensateRequest) -> Result<Pair, Error> {
             let loaded = machine.clone().load()?;
             let Some(c) = &loaded.description().calibration else {
                 return Err(Error::input(format!(
-                    "compensate: give --data FILE.csv to identify from, or a calibrated machine file as --machine ({} holds no `calibration` record)",
+                    "compensate: give data (a CSV file) to identify from, or a calibrated machine file as the machine ({} holds no `calibration` record)",
                     loaded.source()
                 )));
             };
             let nominal = c
                 .nominal
                 .build()
-                .map_err(|e| crate::inputs::description_error(loaded.source(), &e))?;
+                .map_err(|e| crate::inputs::description_error(loaded.source(), e))?;
             let (code, why) = if !c.converged {
                 (EXIT_NOT_CONVERGED, "its calibration did not converge")
             } else if c.forced || !c.adequate {
                 (
                     EXIT_INADEQUATE,
-                    "its calibration is not to be trusted (written with --force, or its model did not explain its data)",
+                    "its calibration is not to be trusted (written forced, or its model did not explain its data)",
                 )
             } else {
                 (0, "")
             };
-            write_rule(
-                &format!("compensate --machine {}", loaded.source()),
-                code,
-                why,
-                r.force,
-            )?;
+            write_rule(loaded.source(), code, why, r.force)?;
             out.insert("machine".into(), loaded.description().name.clone().into());
             out.insert("converged".into(), c.converged.into());
             out.insert("adequate".into(), c.adequate.into());
@@ -215,16 +211,18 @@ pub fn compensate(request: CompensateRequest) -> Result<Compensation, Error> {
     let request = &request;
     let spacing = request.spacing_mm;
     if !(spacing.is_finite() && spacing >= 1.0) {
-        return Err(Error::input(format!(
-            "--spacing: the map's lattice spacing must be at least 1 mm, got {spacing} mm"
-        )));
+        return Err(Error::invalid(
+            Setting::Spacing,
+            format!("the map's lattice spacing must be at least 1 mm, got {spacing} mm"),
+        ));
     }
     if let Some(h) = request.table_spacing_mm
         && !(h.is_finite() && h >= 1.0)
     {
-        return Err(Error::input(format!(
-            "--table-spacing: the table's grid spacing must be at least 1 mm, got {h} mm"
-        )));
+        return Err(Error::invalid(
+            Setting::TableSpacing,
+            format!("the table's grid spacing must be at least 1 mm, got {h} mm"),
+        ));
     }
     let Pair {
         nominal,
@@ -238,23 +236,30 @@ pub fn compensate(request: CompensateRequest) -> Result<Compensation, Error> {
     let w = nominal.machine().workspace;
     let z = request.plane_z_mm.unwrap_or_else(|| w.mid_plane_z_mm());
     if !(z.is_finite() && z >= w.z_min_mm && z <= w.z_max_mm) {
-        return Err(Error::input(format!(
-            "--plane-z: {z} mm is outside the workspace, whose z runs from {} to {} mm",
-            w.z_min_mm, w.z_max_mm
-        )));
+        return Err(Error::invalid(
+            Setting::PlaneZ,
+            format!(
+                "{z} mm is outside the workspace, whose z runs from {} to {} mm",
+                w.z_min_mm, w.z_max_mm
+            ),
+        ));
     }
     let points = std::f64::consts::PI * (w.radius_mm / spacing + 1.0).powi(2);
     if points > crate::limits::MAX_MAP_POINTS as f64 {
-        return Err(Error::input(format!(
-            "--spacing {spacing} mm: about {points:.0} map points, more than {}; a coarser spacing is needed",
-            crate::limits::MAX_MAP_POINTS
-        )));
+        return Err(Error::invalid_value(
+            Setting::Spacing,
+            format!("{spacing} mm"),
+            format!(
+                "about {points:.0} map points, more than {}; a coarser spacing is needed",
+                crate::limits::MAX_MAP_POINTS
+            ),
+        ));
     }
     let grid = w.disc_grid(z, spacing);
     // What compensation changes, as the calibrated model sees it: nominal
     // commands, positions by the calibrated machine.
     let predicted = tricept_engine::compensate::correction_map(&nominal, &calibrated, &grid)
-        .map_err(|e| Error::with_context(MAP_CONTEXT, &e))?;
+        .map_err(|e| Error::with_context(MAP_CONTEXT, e))?;
     out.insert("plane_z_mm".into(), z.into());
     out.insert("grid_points".into(), grid.len().into());
     out.insert(
@@ -335,14 +340,16 @@ fn table(
         TABLE_ERROR_LIMIT_UM,
     )
     .map_err(|e| match (e, request.table_spacing_mm) {
-        (TableError::Spacing(e), Some(h)) => Error::input(format!("--table-spacing {h}: {e}")),
+        (TableError::Spacing(e), Some(h)) => {
+            Error::from_library(e).in_setting_value(Setting::TableSpacing, h)
+        }
         (TableError::Spacing(e) | TableError::Kinematics(e), _) => {
-            Error::with_context(MAP_CONTEXT, &e)
+            Error::with_context(MAP_CONTEXT, e)
         }
     })?;
     if built.error_um >= TABLE_ERROR_LIMIT_UM {
         warnings.push(format!(
-            "the compensation table's interpolation error is {:.3} um at {} mm spacing, above {TABLE_ERROR_LIMIT_UM} um: a finer --table-spacing reduces it",
+            "the compensation table's interpolation error is {:.3} um at {} mm spacing, above {TABLE_ERROR_LIMIT_UM} um: a finer table spacing (table_spacing) reduces it",
             built.error_um, built.table.spacing_mm
         ));
     }
@@ -362,8 +369,9 @@ fn truth_maps(
 ) -> Result<Option<(ErrorMap, ErrorMap)>, Error> {
     let Some(truth) = &request.truth else {
         if !request.truth_effects.is_empty() {
-            return Err(Error::input(
-                "--truth-effect: needs --truth (the true errors of the simulated machine)",
+            return Err(Error::invalid(
+                Setting::TruthEffect,
+                "needs the truth (the true errors of the simulated machine)",
             ));
         }
         return Ok(None);
@@ -378,8 +386,8 @@ fn truth_maps(
     let map = |commanding: &ExtendedMachine| -> Result<ErrorMap, Error> {
         tricept_engine::compensate::commanded_map(commanding, grid, |q| plant.reach(q)).map_err(
             |e| match e {
-                MapError::Commanding(e) => Error::with_context(MAP_CONTEXT, &e),
-                MapError::Reach(e) => Error::with_context(MAP_CONTEXT, &e),
+                MapError::Commanding(e) => Error::with_context(MAP_CONTEXT, e),
+                MapError::Reach(e) => Error::with_context(MAP_CONTEXT, e),
             },
         )
     };

@@ -10,6 +10,7 @@ use tricept_engine::model::GeometricModel;
 use tricept_model::{GeometricErrors, ParameterSet};
 use tricept_plant::{Campaign, Effect, Plant, campaign::PoseOrder};
 
+use crate::Setting;
 use crate::data_input::DataInput;
 use crate::error::{EXIT_OK, Error};
 use crate::inputs::Poses;
@@ -86,9 +87,12 @@ pub fn detectability(request: DetectabilityRequest) -> Result<DetectabilityRepor
             let mut plant = Plant::geometric(m.clone(), GeometricErrors::default());
             let drift_k = request.temperature_drift_k;
             if !(drift_k.is_finite() && drift_k.abs() <= 1000.0) {
-                return Err(Error::input(format!(
-                    "--temperature-drift: the temperature change over the campaign must be a number of K within +-1000, got {drift_k}"
-                )));
+                return Err(Error::invalid(
+                    Setting::TemperatureDrift,
+                    format!(
+                        "the temperature change over the campaign must be a number of K within +-1000, got {drift_k}"
+                    ),
+                ));
             }
             if drift_k != 0.0 {
                 plant.effects = vec![Effect::from(tricept_plant::effects::Thermal {
@@ -98,7 +102,7 @@ pub fn detectability(request: DetectabilityRequest) -> Result<DetectabilityRepor
             }
             let data = plant
                 .simulate(&campaign)
-                .map_err(|e| Error::input(format!("--poses {}: {e}", request.poses)))?;
+                .map_err(|e| Error::invalid_value(Setting::Poses, &request.poses, e))?;
             let described = format!(
                 "{} logged poses ({}{}), mean of {} readings, temperature drift {} K",
                 data.poses.len(),
@@ -179,7 +183,7 @@ impl DetectabilityReport {
             ));
         }
         out.push_str(&format!(
-            "the stated sensor noise can be checked only against repeated poses: revisit at least {} poses on separate visits (`simulate --revisit`) to use `diagnose --noise-from-data`\n",
+            "the stated sensor noise can be checked only against repeated poses: revisit at least {} poses on separate visits (a simulation's `revisit`) to estimate the noise from the data (a diagnosis' `noise_from_data`)\n",
             tricept_diagnose::options::MIN_PURE_ERROR_DOF
         ));
         out

@@ -21,6 +21,7 @@ use tricept_diagnose::{DiagnoseError, DiagnoseOptions, plausibility::Plausibilit
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
+use crate::Setting;
 use crate::accuracy::Accuracy;
 use crate::data_input::DataInput;
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
@@ -119,16 +120,16 @@ pub fn diagnose(request: DiagnoseRequest) -> Result<DiagnoseResult, Error> {
     options.deploy_rule = deploy_rule;
     if let Some(k) = temperature_noise_k {
         if !(k.is_finite() && k >= 0.0) {
-            return Err(Error::input(format!(
-                "--temperature-noise: must be a non-negative number of kelvin, got {k}"
-            )));
+            return Err(Error::invalid(
+                Setting::TemperatureNoise,
+                format!("must be a non-negative number of kelvin, got {k}"),
+            ));
         }
         options.temperature_sigma_k = k;
     }
     if let Some(path) = &plausibility {
         let file = path.display().to_string();
-        let text = tricept_data::bounded::read_json_text(path)
-            .map_err(|e| Error::input(format!("{file}: {e}")))?;
+        let text = tricept_data::bounded::read_json_text(path).map_err(|e| Error::unreadable(&file, e))?;
         options.plausibility = Plausibility::with_overrides(&text)
             .map_err(|e| Error::input(format!("{file}: {e}")))?;
     }
@@ -153,8 +154,9 @@ fn diagnose_error(source: &str, e: DiagnoseError) -> Error {
             line, source: k, ..
         }) => Error::input(format!(
             "{source}: line {line}: the commands of this pose cannot be reached: {k}"
-        )),
-        _ => Error::with_context(source, &e),
+        ))
+        .with_source(e),
+        _ => Error::with_context(source, e),
     }
 }
 
@@ -322,7 +324,7 @@ impl DiagnoseResult {
     /// ([`crate::advanced::MachineFile`]): the description (forced when
     /// the data are not explained) and the verdict the write rule applies.
     pub fn machine_file(&self) -> Result<crate::machine_file::MachineFile, Error> {
-        let (description, forced) = self.extended_description("--write-machine", true)?;
+        let (description, forced) = self.extended_description("the machine file", true)?;
         let code = if forced.is_some() {
             EXIT_INADEQUATE
         } else {
@@ -343,7 +345,7 @@ impl DiagnoseResult {
         let what = path.display().to_string();
         let (description, forced) = self.extended_description(&what, force)?;
         crate::machine_file::write(path, &description).map_err(|e| Error::not_written(path, &e))?;
-        Ok(forced.map(|why| format!("{what}: written with --force although {why}")))
+        Ok(forced.map(|why| format!("{what}: written although {why} (forced)")))
     }
 }
 
@@ -422,7 +424,7 @@ pub fn vocabulary_help() -> String {
             let s = e.spec();
             let params = e.parameter_names();
             format!(
-                "  {}: {}{}; --write-machine: {}",
+                "  {}: {}{}; in a written machine file: {}",
                 s.name,
                 s.physics.replace('`', ""),
                 if params.is_empty() {
@@ -477,6 +479,7 @@ mod tests {
         r.temperature_noise_k = Some(-1.0);
         let e = diagnose(r).unwrap_err();
         assert_eq!(e.exit_code(), EXIT_INPUT);
-        assert!(e.message().starts_with("--temperature-noise"));
+        assert_eq!(e.setting(), Some(Setting::TemperatureNoise));
+        assert!(e.message().starts_with("temperature_noise: "));
     }
 }

@@ -96,7 +96,7 @@ impl EffectList {
                     k.key, k.unit, k.meaning
                 ));
             }
-            out.push_str(&format!("  typical: --truth-effect '{example}'\n\n"));
+            out.push_str(&format!("  typical: '{example}'\n\n"));
         }
         out
     }

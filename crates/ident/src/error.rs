@@ -10,16 +10,7 @@
 use std::fmt;
 use std::sync::Arc;
 
-use tricept_check::CheckError;
-use tricept_data::DataError;
-use tricept_diagnose::{DeployError, DiagnoseError};
-use tricept_engine::{IdentError, record::RecordError};
-use tricept_export::ExportError;
-use tricept_fleet::FleetError;
-use tricept_kinematics::{KinematicsError, error::DescriptionError};
-use tricept_model::ModelError;
-use tricept_plant::PlantError;
-use tricept_study::StudyError;
+use crate::Setting;
 
 /// Exit code of a result that can be trusted.
 pub const EXIT_OK: u8 = 0;
@@ -170,7 +161,7 @@ impl ErrorCause {
 /// use tricept_ident::ErrorKind;
 /// use tricept_ident::advanced::Classify;
 /// use tricept_ident::export::ExportError;
-/// let e = ExportError::Options("--max-points: must be at least 2".into());
+/// let e = ExportError::Options("max_points: must be at least 2".into());
 /// assert_eq!(e.kind(), ErrorKind::Input);
 /// ```
 pub trait Classify {
@@ -186,25 +177,51 @@ pub trait Classify {
     fn cause(&self) -> Option<ErrorCause> {
         None
     }
+
+    /// The request setting the error is about, by its name
+    /// ([`Setting::name`]), and why it is refused: the message is then
+    /// `NAME: WHY`.
+    fn setting(&self) -> Option<(&'static str, String)> {
+        None
+    }
 }
 
 /// A failure of a workflow: a one-line message (naming the file, line and
-/// column where there is one) and its [`ErrorKind`].
+/// column where there is one), its [`ErrorKind`], what failed
+/// ([`Error::cause`]), the request setting it is about
+/// ([`Error::setting`]) and the library error under it
+/// ([`source`](std::error::Error::source)).
 ///
 /// # Example
 /// ```
 /// use tricept_ident::{Error, EXIT_INPUT};
-/// let e = Error::input("--alpha: must lie between 0 and 0.5, got 2").in_file("check");
+/// let e = Error::input("the false-alarm probability must lie between 0 and 0.5, got 2").in_file("check");
 /// assert_eq!(e.exit_code(), EXIT_INPUT);
-/// assert_eq!(e.to_string(), "check: --alpha: must lie between 0 and 0.5, got 2");
+/// assert_eq!(e.to_string(), "check: the false-alarm probability must lie between 0 and 0.5, got 2");
 /// ```
 #[derive(Debug, Clone)]
 pub struct Error {
     kind: ErrorKind,
     message: String,
-    file: Option<FileFailure>,
+    file: Option<Box<FileFailure>>,
     cause: Option<ErrorCause>,
+    setting: Option<Box<Named>>,
     source: Option<Arc<dyn std::error::Error + Send + Sync + 'static>>,
+}
+
+/// Where an [`Error`]'s message names its setting: the message is
+/// `before`, the setting's name, `after`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct Named {
+    setting: Setting,
+    before: String,
+    after: String,
+}
+
+impl Named {
+    fn render(&self, name: &str) -> String {
+        tricept_data::message::one_line(&format!("{}{name}{}", self.before, self.after))
+    }
 }
 
 /// Two errors are equal when their kind, message, file failure and cause
@@ -215,6 +232,7 @@ impl PartialEq for Error {
             && self.message == other.message
             && self.file == other.file
             && self.cause == other.cause
+            && self.setting == other.setting
     }
 }
 
@@ -287,7 +305,106 @@ impl Error {
             message: tricept_data::message::one_line(&message.into()),
             file: None,
             cause: None,
+            setting: None,
             source: None,
+        }
+    }
+
+    /// An error of the user's input about one setting of a request:
+    /// `NAME: WHY`, with NAME the setting's [`Setting::name`] (a program
+    /// names it its own way with [`Error::message_naming`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{Error, Setting, EXIT_INPUT};
+    /// let e = Error::invalid(Setting::ToleranceMm, "must be above 0, got -1");
+    /// assert_eq!(e.to_string(), "tolerance_mm: must be above 0, got -1");
+    /// assert_eq!(e.exit_code(), EXIT_INPUT);
+    /// ```
+    pub fn invalid(setting: Setting, why: impl fmt::Display) -> Error {
+        Error::naming(ErrorKind::Input, setting, format!(": {why}"))
+    }
+
+    /// An error of the user's input about one value of a setting:
+    /// `NAME VALUE: WHY`.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{Error, Setting};
+    /// let e = Error::invalid_value(Setting::Poses, "`grid:x`", "not a number");
+    /// assert_eq!(e.to_string(), "poses `grid:x`: not a number");
+    /// assert_eq!(e.message_naming(|_| "--poses"), "--poses `grid:x`: not a number");
+    /// ```
+    pub fn invalid_value(
+        setting: Setting,
+        value: impl fmt::Display,
+        why: impl fmt::Display,
+    ) -> Error {
+        Error::naming(ErrorKind::Input, setting, format!(" {value}: {why}"))
+    }
+
+    /// An error of `kind` whose message is the setting's name, then
+    /// `after`.
+    pub(crate) fn naming(kind: ErrorKind, setting: Setting, after: String) -> Error {
+        let named = Named {
+            setting,
+            before: String::new(),
+            after,
+        };
+        Error {
+            message: named.render(setting.name()),
+            setting: Some(Box::new(named)),
+            ..Error::new(kind, "")
+        }
+    }
+
+    /// The request setting this error is about, if it is about one.
+    pub fn setting(&self) -> Option<Setting> {
+        self.setting.as_ref().map(|n| n.setting)
+    }
+
+    /// The message with the setting it is about named by `name` (a
+    /// program's own name for it: a command-line flag, a keyword
+    /// argument); the message itself when it is about no setting.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::{Error, Setting};
+    /// let e = Error::invalid(Setting::Alpha, "must lie between 0 and 0.5, got 2").in_file("check");
+    /// assert_eq!(e.message_naming(|_| "--alpha"), "check: --alpha: must lie between 0 and 0.5, got 2");
+    /// assert_eq!(Error::input("x").message_naming(|_| "--alpha"), "x");
+    /// ```
+    pub fn message_naming<'a>(&self, name: impl FnOnce(Setting) -> &'a str) -> String {
+        match &self.setting {
+            Some(n) => n.render(name(n.setting)),
+            None => self.message.clone(),
+        }
+    }
+
+    /// The same error, about `setting`: `NAME: ` before its message (a
+    /// setting it was about already is then named by its request field).
+    #[must_use]
+    pub fn in_setting(self, setting: Setting) -> Error {
+        self.about(setting, String::new())
+    }
+
+    /// The same error, about the value `value` of `setting`: `NAME VALUE: `
+    /// before its message.
+    #[must_use]
+    pub fn in_setting_value(self, setting: Setting, value: impl fmt::Display) -> Error {
+        self.about(setting, format!(" {value}"))
+    }
+
+    fn about(self, setting: Setting, value: String) -> Error {
+        let named = Named {
+            setting,
+            before: String::new(),
+            after: format!("{value}: {}", self.message),
+        };
+        Error {
+            message: named.render(setting.name()),
+            setting: Some(Box::new(named)),
+            ..self
         }
     }
 
@@ -334,7 +451,7 @@ impl Error {
     /// The same error, caused by the file-system failure `file`.
     #[must_use]
     pub fn with_file_failure(mut self, file: FileFailure) -> Error {
-        self.file = Some(file);
+        self.file = Some(Box::new(file));
         self
     }
 
@@ -361,9 +478,18 @@ impl Error {
         }
     }
 
+    /// A file that cannot be read: `PATH: WHY`, an input error (exit code
+    /// 2) with its file-system failure and the I/O error as its source.
+    pub(crate) fn unreadable(path: impl fmt::Display, e: std::io::Error) -> Error {
+        let path = path.to_string();
+        Error::input(format!("{path}: {e}"))
+            .with_file_failure(FileFailure::new(path, &e))
+            .with_source(e)
+    }
+
     /// The file-system failure that caused this error, if one did.
     pub fn file_failure(&self) -> Option<&FileFailure> {
-        self.file.as_ref()
+        self.file.as_deref()
     }
 
     /// An error of the user's input (exit code 2).
@@ -376,32 +502,60 @@ impl Error {
         Error::new(ErrorKind::Other, message)
     }
 
-    /// A library error with its kind and its message.
-    pub fn from_library(e: &(impl Classify + fmt::Display)) -> Error {
+    /// A library error with its kind, its message and its cause, the
+    /// library error its [`source`](std::error::Error::source).
+    pub fn from_library(e: impl Classify + std::error::Error + Send + Sync + 'static) -> Error {
+        let named = Classify::setting(&e).and_then(|(name, why)| {
+            Some(Box::new(Named {
+                setting: Setting::from_name(name)?,
+                before: String::new(),
+                after: format!(": {why}"),
+            }))
+        });
         Error {
-            file: e.file_failure(),
-            cause: e.cause(),
-            ..Error::new(e.kind(), e.to_string())
+            file: Classify::file_failure(&e).map(Box::new),
+            cause: Classify::cause(&e),
+            setting: named,
+            ..Error::new(Classify::kind(&e), e.to_string())
         }
+        .with_source(e)
     }
 
     /// A library error with `context: ` before its message, keeping its
-    /// kind.
-    pub fn with_context(context: impl fmt::Display, e: &(impl Classify + fmt::Display)) -> Error {
-        Error {
-            file: e.file_failure(),
-            cause: e.cause(),
-            ..Error::new(e.kind(), format!("{context}: {e}"))
-        }
+    /// kind and its cause, the library error its
+    /// [`source`](std::error::Error::source).
+    ///
+    /// # Example
+    /// ```
+    /// use std::error::Error as _;
+    /// use tricept_ident::{Error, ErrorCause};
+    /// use tricept_ident::export::ExportError;
+    /// let e = Error::with_context("export", ExportError::Options("too many points".into()));
+    /// assert_eq!(e.to_string(), "export: too many points");
+    /// assert_eq!(e.source().unwrap().to_string(), "too many points");
+    /// assert_eq!(e.cause(), ErrorCause::Invalid);
+    /// ```
+    pub fn with_context(
+        context: impl fmt::Display,
+        e: impl Classify + std::error::Error + Send + Sync + 'static,
+    ) -> Error {
+        Error::from_library(e).in_file(context)
     }
 
     /// The same error with `context: ` before its message (a file, a flag).
     #[must_use]
     pub fn in_file(self, context: impl fmt::Display) -> Error {
+        let setting = self.setting.map(|n| {
+            Box::new(Named {
+                before: format!("{context}: {}", n.before),
+                ..*n
+            })
+        });
         Error {
             file: self.file,
             cause: self.cause,
             source: self.source,
+            setting,
             ..Error::new(self.kind, format!("{context}: {}", self.message))
         }
     }
@@ -434,19 +588,19 @@ pub(crate) fn exit_line(verb: &str, code: u8, why: &str) -> Option<String> {
         .then(|| format!("{verb}: exit {code}: {why} (see the warnings)"))
 }
 
-pub(crate) fn check_output_path(flag: &str, path: &std::path::Path) -> Result<(), Error> {
+pub(crate) fn check_output_path(setting: Setting, path: &std::path::Path) -> Result<(), Error> {
     let shown = path.display();
-    tricept_data::atomic::check_output_file(path)
-        .map_err(|e| Error::input(format!("{flag} {shown}: {e}")))?;
+    tricept_data::atomic::check_output_file(path).map_err(|e| Error::invalid_value(setting, &shown, e))?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => std::path::Path::new("."),
     };
     if let Err(e) = std::fs::metadata(dir) {
-        return Err(Error::input(format!(
-            "{flag} {shown}: the directory {} does not exist",
-            dir.display()
-        ))
+        return Err(Error::invalid_value(
+            setting,
+            &shown,
+            format!("the directory {} does not exist", dir.display()),
+        )
         .with_file_failure(FileFailure::new(shown.to_string(), &e)));
     }
     Ok(())
@@ -468,199 +622,16 @@ impl std::error::Error for Error {
 
 impl<E: Classify + std::error::Error + Send + Sync + 'static> From<E> for Error {
     fn from(e: E) -> Error {
-        Error::from_library(&e).with_source(e)
-    }
-}
-
-impl Classify for DataError {
-    fn kind(&self) -> ErrorKind {
-        ErrorKind::Input
-    }
-
-    fn cause(&self) -> Option<ErrorCause> {
-        let at = |line: u64, column: Option<u64>| ErrorCause::Parse {
-            line: Some(line),
-            column,
-        };
-        match self {
-            DataError::Json { line, column, .. } => Some(at(*line, Some(*column))),
-            DataError::MissingColumn { line, .. }
-            | DataError::DuplicateColumn { line, .. }
-            | DataError::FieldCount { line, .. }
-            | DataError::BadValue { line, .. } => Some(at(*line, None)),
-            _ => None,
-        }
-    }
-
-    fn file_failure(&self) -> Option<FileFailure> {
-        match self {
-            DataError::Io { file, source } => Some(FileFailure::new(file.clone(), source)),
-            _ => None,
-        }
-    }
-}
-
-impl Classify for DescriptionError {
-    fn kind(&self) -> ErrorKind {
-        ErrorKind::Input
-    }
-
-    fn cause(&self) -> Option<ErrorCause> {
-        match self {
-            DescriptionError::Json { source } => Some(ErrorCause::Parse {
-                line: Some(source.line() as u64),
-                column: Some(source.column() as u64),
-            }),
-            DescriptionError::NewerFormat(n) => Some(ErrorCause::NewerFormat {
-                found: n.found,
-                supported: n.supported,
-            }),
-            _ => None,
-        }
-    }
-
-    fn file_failure(&self) -> Option<FileFailure> {
-        match self {
-            DescriptionError::Io { path, source } => Some(FileFailure::new(path.clone(), source)),
-            _ => None,
-        }
-    }
-}
-
-impl Classify for RecordError {
-    fn kind(&self) -> ErrorKind {
-        ErrorKind::Input
-    }
-
-    fn cause(&self) -> Option<ErrorCause> {
-        match self {
-            RecordError::Edited { fields, .. } => Some(ErrorCause::SealBroken {
-                fields: fields.clone(),
-            }),
-            _ => None,
-        }
-    }
-}
-
-impl Classify for KinematicsError {
-    /// Unreachable or non-finite inputs are the user's; solver failures
-    /// are not.
-    fn kind(&self) -> ErrorKind {
-        match self {
-            KinematicsError::NotFinite { .. }
-            | KinematicsError::OutOfReach { .. }
-            | KinematicsError::OutOfStroke { .. }
-            | KinematicsError::NoAssembly { .. }
-            | KinematicsError::Singular { .. } => ErrorKind::Input,
-            _ => ErrorKind::Other,
-        }
-    }
-}
-
-impl Classify for IdentError {
-    /// Data too small to calibrate, unreachable poses, inconsistent
-    /// options and unusable external sources are the input's fault; a
-    /// numerical failure is not.
-    fn kind(&self) -> ErrorKind {
-        match self {
-            IdentError::TooFewPoses { .. }
-            | IdentError::TooFewDistinctPoses { .. }
-            | IdentError::Kinematics { .. }
-            | IdentError::Invalid(_)
-            | IdentError::Source { .. }
-            | IdentError::NuisanceUnidentifiable { .. } => ErrorKind::Input,
-            _ => ErrorKind::Other,
-        }
-    }
-}
-
-impl Classify for DiagnoseError {
-    /// What the data cause is the input's fault; an identification error
-    /// keeps its own kind.
-    fn kind(&self) -> ErrorKind {
-        match self {
-            DiagnoseError::Ident(e) => e.kind(),
-            _ => ErrorKind::Input,
-        }
-    }
-}
-
-impl Classify for DeployError {
-    fn kind(&self) -> ErrorKind {
-        match self {
-            DeployError::Refit(e) => e.kind(),
-            _ => ErrorKind::Input,
-        }
-    }
-}
-
-impl Classify for FleetError {
-    /// What cannot be pooled is the input's fault; an identification
-    /// error keeps its own kind; a solver's failure is not the input's.
-    fn kind(&self) -> ErrorKind {
-        match self {
-            FleetError::Input(_) => ErrorKind::Input,
-            FleetError::Identification { error, .. } => error.kind(),
-            _ => ErrorKind::Other,
-        }
-    }
-}
-
-impl Classify for CheckError {
-    fn kind(&self) -> ErrorKind {
-        match self {
-            CheckError::Record(_)
-            | CheckError::Blind(_)
-            | CheckError::Invalid(_)
-            | CheckError::HistoryLine(_)
-            | CheckError::Kinematics { .. } => ErrorKind::Input,
-            _ => ErrorKind::Other,
-        }
-    }
-}
-
-impl Classify for ModelError {
-    fn kind(&self) -> ErrorKind {
-        match self {
-            ModelError::Kinematics(e) => e.kind(),
-            _ => ErrorKind::Input,
-        }
-    }
-}
-
-impl Classify for PlantError {
-    fn kind(&self) -> ErrorKind {
-        ErrorKind::Input
-    }
-}
-
-impl Classify for StudyError {
-    fn kind(&self) -> ErrorKind {
-        match self {
-            StudyError::Ident(e) => e.kind(),
-            StudyError::Kinematics(e) => e.kind(),
-            StudyError::Model(e) => e.kind(),
-            StudyError::Check(e) => e.kind(),
-            StudyError::Invalid(_) => ErrorKind::Input,
-            _ => ErrorKind::Other,
-        }
-    }
-}
-
-impl Classify for ExportError {
-    /// A failed write is not the input's fault; everything else is.
-    fn kind(&self) -> ErrorKind {
-        match self {
-            ExportError::Io { .. } => ErrorKind::Other,
-            ExportError::Kinematics(e) => e.kind(),
-            _ => ErrorKind::Input,
-        }
+        Error::from_library(e)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use tricept_diagnose::DiagnoseError;
+    use tricept_engine::IdentError;
+    use tricept_study::StudyError;
 
     #[test]
     fn the_same_library_error_has_one_exit_code_wherever_it_is_wrapped() {

@@ -106,7 +106,7 @@ pub fn export(request: ExportRequest) -> Result<Export, Error> {
     } = request;
     let Some(path) = machine.path().map(std::path::Path::to_path_buf) else {
         return Err(Error::input(
-            "export: a calibrated machine file is needed (a machine file written by `tricept identify --write-machine`)",
+            "export: a calibrated machine file is needed (a machine file written by a calibration: identify's or diagnose's `write_machine`)",
         ));
     };
     let source = path.display().to_string();

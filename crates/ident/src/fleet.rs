@@ -23,6 +23,7 @@ use tricept_model::ParameterSet;
 
 pub use tricept_fleet::batch::SolverKind;
 
+use crate::Setting;
 use crate::data_input::DataInput;
 use crate::error::Error;
 use crate::inputs::LoadedMachine;
@@ -80,9 +81,12 @@ pub struct FleetResult {
 pub fn fleet(request: FleetRequest) -> Result<FleetResult, Error> {
     let tolerance = request.tolerance_mm;
     if !(tolerance.is_finite() && tolerance > 0.0 && tolerance <= 10.0) {
-        return Err(Error::input(format!(
-            "--tolerance-mm: the manufacturing tolerance must be a number of mm above 0 and at most 10, got {tolerance}"
-        )));
+        return Err(Error::invalid(
+            Setting::ToleranceMm,
+            format!(
+                "the manufacturing tolerance must be a number of mm above 0 and at most 10, got {tolerance}"
+            ),
+        ));
     }
     let loaded = request.machine.load()?;
     let m = loaded.machine();
@@ -97,7 +101,7 @@ pub fn fleet(request: FleetRequest) -> Result<FleetResult, Error> {
         model = model.with_rank_reference(reference);
     }
     let accuracy = AccuracyModel::new(m, set, &accuracy_points(m), tolerance)
-        .map_err(|e| Error::with_context("--tolerance-mm", &e))?;
+        .map_err(|e| Error::from_library(e).in_setting(Setting::ToleranceMm))?;
     let options = BatchOptions {
         kind: request.solver,
         ..BatchOptions::default()
@@ -109,7 +113,7 @@ pub fn fleet(request: FleetRequest) -> Result<FleetResult, Error> {
         &accuracy,
         &options,
     )
-    .map_err(|e| Error::with_context("fleet", &e))?;
+    .map_err(|e| Error::with_context("fleet", e))?;
     Ok(FleetResult {
         loaded,
         batch,

@@ -8,6 +8,7 @@ use tricept_data::MeasuredPose;
 use tricept_engine::{IdentifyOptions, model::GeometricModel};
 use tricept_model::ParameterSet;
 
+use crate::Setting;
 use crate::calibrate::fit_error;
 use crate::data_input::DataInput;
 use crate::error::Error;
@@ -81,20 +82,24 @@ pub fn assess_identifiability(request: IdentifiabilityRequest) -> Result<Identif
             let mut commands = Vec::with_capacity(targets.len());
             for (i, r) in targets.iter().enumerate() {
                 let ik = m.inverse(r).map_err(|e| {
-                    Error::input(format!(
-                        "--poses {poses}: pose {} ({:.3}, {:.3}, {:.3} mm): {e}",
-                        i + 1,
-                        r.x,
-                        r.y,
-                        r.z
-                    ))
+                    Error::invalid_value(
+                        Setting::Poses,
+                        poses,
+                        format!(
+                            "pose {} ({:.3}, {:.3}, {:.3} mm): {e}",
+                            i + 1,
+                            r.x,
+                            r.y,
+                            r.z
+                        ),
+                    )
                 })?;
                 commands.push(MeasuredPose {
                     commands_mm: ik.legs_mm,
                     ..Default::default()
                 });
             }
-            (commands, poses.to_string(), format!("--poses {poses}"))
+            (commands, poses.to_string(), format!("poses {poses}"))
         }
     };
     let model = GeometricModel::new(m.clone(), set.clone());
@@ -104,7 +109,7 @@ pub fn assess_identifiability(request: IdentifiabilityRequest) -> Result<Identif
         &commands,
         &IdentifyOptions::for_machine(m),
     )
-    .map_err(|e| fit_error(&source, &e))?;
+    .map_err(|e| fit_error(&source, e))?;
     Ok(Identifiability {
         report,
         machine_name: m.name.clone(),

@@ -21,6 +21,7 @@ use tricept_kinematics::{
 use tricept_model::ParameterSet;
 use tricept_plant::Effect;
 
+use crate::Setting;
 use crate::error::{Classify, Error};
 use crate::limits;
 
@@ -101,7 +102,7 @@ impl LoadedMachine {
                 .nominal
                 .build()
                 .map(Some)
-                .map_err(|e| description_error(&self.source, &e)),
+                .map_err(|e| description_error(&self.source, e)),
         }
     }
 
@@ -124,7 +125,7 @@ impl LoadedMachine {
         description.sensors = self.description.sensors.clone();
         let mut machine = description
             .build()
-            .map_err(|e| description_error(&source, &e))?;
+            .map_err(|e| description_error(&source, e))?;
         machine.sensors = self.machine.sensors;
         Ok(Some(LoadedMachine {
             description,
@@ -150,9 +151,10 @@ impl LoadedMachine {
 }
 
 /// The input error of a description that cannot be loaded, naming the
-/// file (and the line and column of a JSON error).
-pub fn description_error(path: &str, e: &DescriptionError) -> Error {
-    let message = match e {
+/// file (and the line and column of a JSON error), the description's
+/// error its [`source`](std::error::Error::source).
+pub fn description_error(path: &str, e: DescriptionError) -> Error {
+    let message = match &e {
         DescriptionError::Json { source } => format!(
             "{path}: line {}, column {}: {}",
             source.line(),
@@ -166,10 +168,11 @@ pub fn description_error(path: &str, e: &DescriptionError) -> Error {
         Some(f) => Error::input(message).with_file_failure(f),
         None => Error::input(message),
     };
-    match e.cause() {
+    let error = match e.cause() {
         Some(cause) => error.with_cause(cause),
         None => error,
-    }
+    };
+    error.with_source(e)
 }
 
 /// serde_json appends " at line L column C"; the message states it up front.
@@ -201,7 +204,7 @@ pub fn load_machine(path: Option<&Path>, noise: &SensorNoise) -> Result<LoadedMa
         Some(path) => {
             let source = path.display().to_string();
             (
-                MachineDescription::from_file(path).map_err(|e| description_error(&source, &e))?,
+                MachineDescription::from_file(path).map_err(|e| description_error(&source, e))?,
                 source,
             )
         }
@@ -235,10 +238,10 @@ impl LoadedMachine {
         let source = source.into();
         description
             .validate()
-            .map_err(|e| description_error(&source, &e))?;
+            .map_err(|e| description_error(&source, e))?;
         let mut machine = description
             .build()
-            .map_err(|e| description_error(&source, &e))?;
+            .map_err(|e| description_error(&source, e))?;
         if let Some((r, why)) = machine.unreachable_workspace_point() {
             let w = &machine.workspace;
             return Err(Error::input(format!(
@@ -247,7 +250,7 @@ impl LoadedMachine {
             )));
         }
         let notes = tricept_engine::record::check_calibration_record(&description)
-            .map_err(|e| Error::with_context(&source, &e))?;
+            .map_err(|e| Error::with_context(&source, e))?;
         let mut warnings = Vec::new();
         if let Some(w) = notes.warning() {
             warnings.push(format!("{source}: {w}"));
@@ -255,7 +258,7 @@ impl LoadedMachine {
         if let Some(c) = &description.calibration {
             if c.forced {
                 warnings.push(format!(
-                    "{source} holds a calibration written with --force although it is not to be trusted (converged: {}, adequate: {})",
+                    "{source} holds a calibration written although it is not to be trusted (forced) (converged: {}, adequate: {})",
                     c.converged, c.adequate
                 ));
             } else if !c.converged {
@@ -291,21 +294,24 @@ impl LoadedMachine {
 fn apply_noise(m: &mut Machine, noise: &SensorNoise) -> Result<(), Error> {
     if let Some(a) = noise.angle_noise_arcsec {
         m.sensors.angle_rad = at_most(
-            "--angle-noise-arcsec",
-            positive("--angle-noise-arcsec", a)?,
+            Setting::AngleNoiseArcsec,
+            positive(Setting::AngleNoiseArcsec, a)?,
             MAX_NOISE,
         )? * RAD_PER_ARCSEC;
     }
     if let Some(l) = noise.length_noise_um {
         m.sensors.length_mm = at_most(
-            "--length-noise-um",
-            positive("--length-noise-um", l)?,
+            Setting::LengthNoiseUm,
+            positive(Setting::LengthNoiseUm, l)?,
             MAX_NOISE,
         )? * 1e-3;
     }
     if let Some(k) = noise.readings_per_pose {
         if k == 0 {
-            return Err(Error::input("--readings-per-pose: must be at least 1"));
+            return Err(Error::invalid(
+                Setting::ReadingsPerPose,
+                "must be at least 1",
+            ));
         }
         m.sensors.readings_per_pose = k;
     }
@@ -317,25 +323,28 @@ fn apply_noise(m: &mut Machine, noise: &SensorNoise) -> Result<(), Error> {
 /// reading is no sensor of this machine, and its weights would underflow.
 pub const MAX_NOISE: f64 = 1e4;
 
-/// `v` if it is at most `max`, else an input error naming `flag`.
-fn at_most(flag: &str, v: f64, max: f64) -> Result<f64, Error> {
+/// `v` if it is at most `max`, else an input error naming `setting`.
+fn at_most(setting: Setting, v: f64, max: f64) -> Result<f64, Error> {
     if v <= max {
         Ok(v)
     } else {
-        Err(Error::input(format!(
-            "{flag}: must be at most {max}, got {v}"
-        )))
+        Err(Error::invalid(
+            setting,
+            format!("must be at most {max}, got {v}"),
+        ))
     }
 }
 
-/// `v` if it is a positive finite number, else an input error naming `flag`.
-pub fn positive(flag: &str, v: f64) -> Result<f64, Error> {
+/// `v` if it is a positive finite number, else an input error naming
+/// `setting`.
+pub fn positive(setting: Setting, v: f64) -> Result<f64, Error> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(Error::input(format!(
-            "{flag}: must be a positive number, got {v}"
-        )))
+        Err(Error::invalid(
+            setting,
+            format!("must be a positive number, got {v}"),
+        ))
     }
 }
 
@@ -374,9 +383,11 @@ impl FromStr for Poses {
                 .ok()
                 .filter(|n| (1..=MAX_POSES).contains(n))
                 .ok_or_else(|| {
-                    Error::input(format!(
-                        "--poses `{spec}`: expected optimal:N with N a whole number from 1 to {MAX_POSES}"
-                    ))
+                    Error::invalid_value(
+                        Setting::Poses,
+                        format!("`{spec}`"),
+                        format!("expected optimal:N with N a whole number from 1 to {MAX_POSES}"),
+                    )
                 })?;
             PosesKind::Optimal(n)
         } else {
@@ -435,7 +446,13 @@ impl Poses {
         match &self.kind {
             PosesKind::Optimal(n) => {
                 tricept_study::campaign::d_optimal_targets(machine, &ParameterSet::paper15(), *n)
-                    .map_err(|e| Error::other(format!("--poses `{}`: {e}", self.spec)))
+                    .map_err(|e| {
+                        Error::naming(
+                            crate::ErrorKind::Other,
+                            Setting::Poses,
+                            format!(" `{}`: {e}", self.spec),
+                        )
+                    })
             }
             PosesKind::Set(set) => Ok(set.generate(&machine.workspace).unwrap_or_default()),
             PosesKind::File(path) => Ok(tricept_data::targets::read_targets(path)?
@@ -485,7 +502,7 @@ impl FromStr for TrueErrors {
             s if s.starts_with("random:") => {
                 let max = tricept_model::params::MAX_PARAMETER_ERROR.0;
                 let (magnitude_mm, seed) = random_spec(
-                    "errors",
+                    Setting::Truth,
                     s,
                     max,
                     &format!("random:MAG_MM[,SEED] with MAG_MM from 0 to {max} mm"),
@@ -501,7 +518,7 @@ impl FromStr for TrueErrors {
 /// `random:SIZE[,SEED]` spec, or an input error naming `flag` and saying
 /// what was `expected`.
 pub(crate) fn random_spec(
-    flag: &str,
+    setting: Setting,
     spec: &str,
     max: f64,
     expected: &str,
@@ -512,11 +529,13 @@ pub(crate) fn random_spec(
         .next()
         .and_then(|t| t.parse().ok())
         .filter(|v: &f64| v.is_finite() && (0.0..=max).contains(v))
-        .ok_or_else(|| Error::input(format!("{flag} `{spec}`: expected {expected}")))?;
+        .ok_or_else(|| {
+            Error::invalid_value(setting, format!("`{spec}`"), format!("expected {expected}"))
+        })?;
     let seed: u64 = match parts.next() {
-        Some(t) => t
-            .parse()
-            .map_err(|_| Error::input(format!("{flag} `{spec}`: SEED must be a whole number")))?,
+        Some(t) => t.parse().map_err(|_| {
+            Error::invalid_value(setting, format!("`{spec}`"), "SEED must be a whole number")
+        })?,
         None => 0,
     };
     Ok((size, seed))
@@ -535,10 +554,10 @@ impl TrueErrors {
             )),
             TrueErrors::File(path) => {
                 let name = path.display();
-                let text = tricept_data::bounded::read_json_text(path)
-                    .map_err(|e| Error::input(format!("{name}: {e}")))?;
+                let text =
+                    tricept_data::bounded::read_json_text(path).map_err(|e| Error::unreadable(&name, e))?;
                 set.parse_values(&text)
-                    .map_err(|e| Error::input(format!("{name}: {e}")))
+                    .map_err(|e| Error::input(format!("{name}: {e}")).with_source(e))
             }
         }
     }
@@ -559,10 +578,10 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
         let (text, origin) = match spec.strip_prefix('@') {
             Some(path) => (
                 tricept_data::bounded::read_json_text(Path::new(path))
-                    .map_err(|e| Error::input(format!("{path}: {e}")))?,
+                    .map_err(|e| Error::unreadable(path, e))?,
                 path.to_string(),
             ),
-            None => (spec.clone(), "--truth-effect".to_string()),
+            None => (spec.clone(), Setting::TruthEffect.name().to_string()),
         };
         let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
             // A bare effect name is the usual slip: say what to give.
@@ -582,8 +601,8 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
             v => vec![v],
         };
         for item in items {
-            let effect: Effect =
-                serde_json::from_value(item).map_err(|e| Error::input(format!("{origin}: {e}")))?;
+            let effect: Effect = serde_json::from_value(item)
+                .map_err(|e| Error::input(format!("{origin}: {e}")).with_source(e))?;
             effect
                 .validate()
                 .map_err(|why| Error::input(format!("{origin}: {why}")))?;
@@ -594,27 +613,28 @@ pub fn parse_effects(specs: &[String]) -> Result<Vec<Effect>, Error> {
 }
 
 /// `count` comma-separated finite numbers within ±1e5
-/// (mm, deg or rad), or an input error naming `flag`.
+/// (mm, deg or rad), or an input error naming `label` (what the numbers
+/// are).
 ///
 /// # Example
 /// ```
-/// assert_eq!(tricept_ident::advanced::parse_numbers("--at", "1,2.5,-3", 3).unwrap(), vec![1.0, 2.5, -3.0]);
-/// assert!(tricept_ident::advanced::parse_numbers("--at", "1,2", 3).is_err());
+/// assert_eq!(tricept_ident::advanced::parse_numbers("at", "1,2.5,-3", 3).unwrap(), vec![1.0, 2.5, -3.0]);
+/// assert!(tricept_ident::advanced::parse_numbers("at", "1,2", 3).is_err());
 /// ```
-pub fn parse_numbers(flag: &str, text: &str, count: usize) -> Result<Vec<f64>, Error> {
+pub fn parse_numbers(label: &str, text: &str, count: usize) -> Result<Vec<f64>, Error> {
     let values: Result<Vec<f64>, _> = text.split(',').map(|t| t.trim().parse::<f64>()).collect();
     match values {
         Ok(v) if v.len() == count && v.iter().all(|x| x.is_finite()) => {
             if let Some(x) = v.iter().find(|x| x.abs() > limits::MAX_COORDINATE) {
                 return Err(Error::input(format!(
-                    "{flag}: {x} is beyond ±{} (mm, deg or rad): not a value for this machine",
+                    "{label}: {x} is beyond ±{} (mm, deg or rad): not a value for this machine",
                     limits::MAX_COORDINATE
                 )));
             }
             Ok(v)
         }
         _ => Err(Error::input(format!(
-            "{flag}: expected {count} comma-separated numbers, got `{text}`"
+            "{label}: expected {count} comma-separated numbers, got `{text}`"
         ))),
     }
 }
@@ -733,12 +753,12 @@ mod tests {
 
     #[test]
     fn positive_takes_positive_finite_numbers_only() {
-        assert!(positive("--sigma-um", 0.0).is_err());
-        assert!(positive("--sigma-um", f64::NAN).is_err());
-        assert_eq!(positive("--sigma-um", 2.5).unwrap(), 2.5);
+        assert!(positive(Setting::SigmaUm, 0.0).is_err());
+        assert!(positive(Setting::SigmaUm, f64::NAN).is_err());
+        assert_eq!(positive(Setting::SigmaUm, 2.5).unwrap(), 2.5);
         assert_eq!(
-            positive("--sigma-um", -1.0).unwrap_err().message(),
-            "--sigma-um: must be a positive number, got -1"
+            positive(Setting::SigmaUm, -1.0).unwrap_err().message(),
+            "sigma_um: must be a positive number, got -1"
         );
     }
 }

@@ -34,10 +34,10 @@ pub fn solve_batch<R: Read, W: Write>(
 ) -> Result<usize, Error> {
     run(verb, machine, input, file, out, stop).map_err(|e| match e {
         BatchError::Input(message) => Error::input(message),
-        BatchError::Point { line, source } => Error::with_context(
-            format!("{} --input {label}: line {line}", verb.name()),
-            &source,
-        ),
+        BatchError::Point { line, source } => Error::from_library(source)
+            .in_file(format!("line {line}"))
+            .in_setting_value(crate::Setting::Input, label)
+            .in_file(verb.name()),
         BatchError::Output(message) => Error::other(format!("stdout: {message}")),
     })
 }
@@ -79,7 +79,7 @@ pub fn solve_point(
     let m = ExtendedMachine::new(machine.machine().clone());
     let cells = verb
         .solve(&m, point)
-        .map_err(|e| Error::with_context(verb.name(), &e))?;
+        .map_err(|e| Error::with_context(verb.name(), e))?;
     Ok(PointSolution { verb, cells })
 }
 
@@ -201,7 +201,6 @@ pub fn machine_summary(loaded: &LoadedMachine) -> String {
             if c.forced { ", FORCED" } else { "" }
         ));
     }
-    lines.push("  (tricept machine --json prints the description file)".to_string());
     lines.join("\n") + "\n"
 }
 
@@ -247,7 +246,9 @@ mod tests {
         .unwrap_err();
         assert_eq!(e.exit_code(), crate::EXIT_INPUT);
         assert!(
-            e.message().starts_with("ik --input -: line 3: "),
+            e.message().starts_with("ik: input -: line 3: ")
+                && e.message_naming(|_| "--input")
+                    .starts_with("ik: --input -: line 3: "),
             "{}",
             e.message()
         );

@@ -51,6 +51,7 @@
 
 // Layer 0: errors, limits and inputs.
 mod accuracy;
+mod classify;
 mod commanding;
 mod data_input;
 mod error;
@@ -59,6 +60,7 @@ mod json_version;
 mod limits;
 mod machine_file;
 mod machine_input;
+mod setting;
 
 // Layer 1: the workflows, one public module each (its function, its
 // request, its result and the parts they are made of).
@@ -88,6 +90,7 @@ pub use error::{
     EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error, ErrorCause,
     ErrorKind,
 };
+pub use setting::Setting;
 
 // The two inputs every workflow is fed: the machine and the measured data.
 pub use data_input::DataInput;

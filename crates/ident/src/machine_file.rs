@@ -147,8 +147,7 @@ pub fn write_rule(what: &str, code: u8, why: &str, force: bool) -> Result<Option
 
 /// SHA-256 of a file's bytes, lower-case hex.
 pub fn sha256_file(path: &Path) -> Result<String, Error> {
-    let bytes =
-        std::fs::read(path).map_err(|e| Error::input(format!("{}: {e}", path.display())))?;
+    let bytes = std::fs::read(path).map_err(|e| Error::unreadable(path.display(), e))?;
     let digest = Sha256::digest(&bytes);
     Ok(digest.iter().map(|b| format!("{b:02x}")).collect())
 }
@@ -346,7 +345,7 @@ pub fn calibrated_description(
         warnings: p
             .forced
             .iter()
-            .map(|why| format!("written with --force although {why}"))
+            .map(|why| format!("written although {why} (forced)"))
             .chain(p.warnings)
             .collect(),
         poses_used: id.poses_used,
@@ -446,7 +445,7 @@ impl MachineFile {
             c.date = utc_now();
         }
         write(path, &d).map_err(|e| Error::not_written(path, &e))?;
-        Ok(forced.map(|why| format!("{what}: written with --force although {why}")))
+        Ok(forced.map(|why| format!("{what}: written although {why} (forced)")))
     }
 
     /// The JSON text it is kept as.
@@ -457,8 +456,9 @@ impl MachineFile {
     /// Reads it back from [`MachineFile::to_json`]'s text (an input error
     /// for any other text).
     pub fn from_json(text: &str) -> Result<MachineFile, Error> {
-        serde_json::from_str(text)
-            .map_err(|e| Error::input(format!("not a machine file kept by tricept: {e}")))
+        serde_json::from_str(text).map_err(|e| {
+            Error::input(format!("not a machine file kept by tricept: {e}")).with_source(e)
+        })
     }
 }
 

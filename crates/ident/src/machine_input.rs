@@ -234,6 +234,10 @@ mod tests {
         let input = MachineInput::new(None, noise);
         let e = input.load().unwrap_err();
         assert_eq!(e.exit_code(), crate::EXIT_INPUT);
-        assert!(e.message().contains("--readings-per-pose"), "{e}");
+        assert!(
+            e.setting() == Some(crate::Setting::ReadingsPerPose)
+                && e.message().contains("readings_per_pose"),
+            "{e}"
+        );
     }
 }

@@ -22,6 +22,7 @@ use tricept_study::plan::{
 };
 use tricept_study::plan_sources::{Candidate, ballbar_source, touch_source, tracker_source};
 
+use crate::Setting;
 use crate::calibrate::values::{
     EvalGrid, HeadModel, TrackerTargetSpec, eval_options, fused_model, head_angles_text,
 };
@@ -247,11 +248,11 @@ impl Plan {
     }
 }
 
-/// The instrument's noise: its own flag, or the old `--sigma-um`.
-fn instrument_sigma(a: &PlanRequest, own: f64, flag: &str) -> Result<f64, Error> {
+/// The instrument's noise: its own setting, or the old `sigma_um`.
+fn instrument_sigma(a: &PlanRequest, own: f64, setting: Setting) -> Result<f64, Error> {
     match a.sigma_um {
-        Some(v) => positive("--sigma-um", v),
-        None => positive(flag, own),
+        Some(v) => positive(Setting::SigmaUm, v),
+        None => positive(setting, own),
     }
 }
 
@@ -306,25 +307,29 @@ pub fn plan(request: PlanRequest) -> Result<Plan, Error> {
 /// Refuses sizes no plan can use.
 fn check_sizes(a: &PlanRequest, k: &[usize]) -> Result<(), Error> {
     if k.contains(&0) {
-        return Err(Error::input("--k: expected positive whole numbers"));
+        return Err(Error::invalid(
+            Setting::K,
+            "expected positive whole numbers",
+        ));
     }
     if let Some(t) = a.target_um
         && !(t.is_finite() && t > 0.0)
     {
-        return Err(Error::input(format!(
-            "--target-um: the accuracy to reach must be a positive number of um, got {t}"
-        )));
+        return Err(Error::invalid(
+            Setting::TargetUm,
+            format!("the accuracy to reach must be a positive number of um, got {t}"),
+        ));
     }
-    for (flag, n, max) in [
-        ("--passes", a.passes, limits::MAX_PASSES),
+    for (setting, n, max) in [
+        (Setting::Passes, a.passes, limits::MAX_PASSES),
         (
-            "--random-baseline",
+            Setting::RandomBaseline,
             a.random_baseline,
             limits::MAX_RANDOM_BASELINE,
         ),
     ] {
         if n > max {
-            return Err(Error::input(format!("{flag}: {n}; at most {max}")));
+            return Err(Error::invalid(setting, format!("{n}; at most {max}")));
         }
     }
     Ok(())
@@ -348,7 +353,7 @@ fn internal_information(
             let poses = a.poses()?;
             let targets = poses.targets(m)?;
             let f = internal_factor(model, &targets)
-                .map_err(|e| Error::input(format!("--poses {poses}: {e}")))?;
+                .map_err(|e| Error::invalid_value(Setting::Poses, &poses, e))?;
             (f, targets.len())
         }
     })
@@ -372,23 +377,27 @@ fn candidates(a: &PlanRequest, m: &Machine, model: &FusedModel) -> Result<Candid
                 .iter()
                 .any(|e| !e.is_finite() || e.abs() > 1000.0)
             {
-                return Err(Error::input(
-                    "--extensions: expected extensions along the tool in mm, within ±1000",
+                return Err(Error::invalid(
+                    Setting::Extensions,
+                    "expected extensions along the tool in mm, within ±1000",
                 ));
             }
             let candidates = a.candidates()?;
             let points = candidates.targets(m)?;
             let count = points.len() * h1.len() * h2.len() * a.extensions.len().max(1);
             if count > limits::MAX_CANDIDATES {
-                return Err(Error::input(format!(
-                    "--candidates {} with --head-angles-deg {}: {count} candidate poses; at most {}",
-                    candidates,
-                    head_angles_text(&a.head_angles_deg),
-                    limits::MAX_CANDIDATES
-                )));
+                return Err(Error::invalid_value(
+                    Setting::Candidates,
+                    &candidates,
+                    format!(
+                        "with the head angles {} deg: {count} candidate poses; at most {}",
+                        head_angles_text(&a.head_angles_deg),
+                        limits::MAX_CANDIDATES
+                    ),
+                ));
             }
             let options = TrackerOptions {
-                sigma_um: instrument_sigma(a, a.tracker_sigma_um, "--tracker-sigma-um")?,
+                sigma_um: instrument_sigma(a, a.tracker_sigma_um, Setting::TrackerSigmaUm)?,
                 target,
             };
             let (poses, source) =
@@ -397,45 +406,52 @@ fn candidates(a: &PlanRequest, m: &Machine, model: &FusedModel) -> Result<Candid
         }
         Instrument::Ballbar | Instrument::Touch => {
             let touch = a.instrument == Instrument::Touch;
-            let (flag, Triple(p)) = if touch {
-                ("--touch-sphere-mm", a.touch_sphere_mm)
+            let (setting, Triple(p)) = if touch {
+                (Setting::TouchSphereMm, a.touch_sphere_mm)
             } else {
-                ("--ballbar-pivot-mm", a.ballbar_pivot_mm)
+                (Setting::BallbarPivotMm, a.ballbar_pivot_mm)
             };
             let centre = Vector3::new(p[0], p[1], p[2]);
             let text = format!("{},{},{}", p[0], p[1], p[2]);
             let radius = if touch {
-                positive("--touch-sphere-radius-mm", a.touch_sphere_radius_mm)?
-                    + positive("--touch-stylus-radius-mm", a.touch_stylus_radius_mm)?
+                positive(Setting::TouchSphereRadiusMm, a.touch_sphere_radius_mm)?
+                    + positive(Setting::TouchStylusRadiusMm, a.touch_stylus_radius_mm)?
             } else {
-                positive("--ballbar-length-mm", a.ballbar_length_mm)?
+                positive(Setting::BallbarLengthMm, a.ballbar_length_mm)?
             };
             if a.ballbar_candidates > limits::MAX_CANDIDATES {
-                return Err(Error::input(format!(
-                    "--ballbar-candidates: {}; at most {}",
-                    a.ballbar_candidates,
-                    limits::MAX_CANDIDATES
-                )));
+                return Err(Error::invalid(
+                    Setting::BallbarCandidates,
+                    format!(
+                        "{}; at most {}",
+                        a.ballbar_candidates,
+                        limits::MAX_CANDIDATES
+                    ),
+                ));
             }
             let poses = sphere_candidates(m, &centre, radius, a.ballbar_candidates);
             if poses.len() < 4 {
-                return Err(Error::input(format!(
-                    "{flag} {text}: the machine reaches only {} positions around this point",
-                    poses.len()
-                )));
+                return Err(Error::invalid_value(
+                    setting,
+                    text,
+                    format!(
+                        "the machine reaches only {} positions around this point",
+                        poses.len()
+                    ),
+                ));
             }
             let source = if touch {
                 let stylus = (
                     a.touch_stylus_radius_mm,
-                    positive("--touch-stylus-sigma-um", a.touch_stylus_sigma_um)?,
+                    positive(Setting::TouchStylusSigmaUm, a.touch_stylus_sigma_um)?,
                 );
                 let options = tricept_engine::fusion::TouchOptions {
-                    sigma_um: instrument_sigma(a, a.touch_sigma_um, "--touch-sigma-um")?,
+                    sigma_um: instrument_sigma(a, a.touch_sigma_um, Setting::TouchSigmaUm)?,
                 };
                 touch_source(&poses, a.touch_sphere_radius_mm, stylus, &options)?
             } else {
                 let options = tricept_engine::fusion::BallbarOptions {
-                    sigma_um: instrument_sigma(a, a.ballbar_sigma_um, "--ballbar-sigma-um")?,
+                    sigma_um: instrument_sigma(a, a.ballbar_sigma_um, Setting::BallbarSigmaUm)?,
                     ..Default::default()
                 };
                 ballbar_source(model, &poses, &centre, &options)?
@@ -570,7 +586,7 @@ fn report(
             }
             (None, Some(k)) => wln!(
                 s,
-                "recommended: at least {k} measurements (the smallest k asked for that leaves {:.0} redundant rows; --target-um adds an accuracy target)",
+                "recommended: at least {k} measurements (the smallest k asked for that leaves {:.0} redundant rows; an accuracy target (target_um) adds one)",
                 result.min_redundancy
             ),
             (None, None) => wln!(s, "no k asked for leaves enough redundant rows"),
@@ -588,34 +604,41 @@ fn report(
 /// any single parameter with `--power` (`tricept_study::check_plan`).
 fn check_plan(a: &PlanRequest, loaded: &LoadedMachine) -> Result<Plan, Error> {
     let Some(path) = loaded.path() else {
-        return Err(Error::input(
-            "plan --instrument check: --machine CALIBRATED.json is needed (a check is planned for a calibrated machine and its record)",
+        return Err(Error::invalid(
+            Setting::Machine,
+            "a check's plan needs a calibrated machine file (a check is planned for a calibrated machine and its record)",
         ));
     };
     let budget = match a.k.as_slice() {
         [] => 20,
         k if k.contains(&0) => {
-            return Err(Error::input("--k: expected positive whole numbers"));
+            return Err(Error::invalid(
+                Setting::K,
+                "expected positive whole numbers",
+            ));
         }
         k => k.iter().copied().max().unwrap_or(20),
     };
     if budget > limits::MAX_CANDIDATES {
-        return Err(Error::input(format!(
-            "--k: {budget} poses; at most {}",
-            limits::MAX_CANDIDATES
-        )));
+        return Err(Error::invalid(
+            Setting::K,
+            format!("{budget} poses; at most {}", limits::MAX_CANDIDATES),
+        ));
     }
     if !(a.detect_um.is_finite() && a.detect_um > 0.0) {
-        return Err(Error::input(format!(
-            "--detect-um: the change to detect must be a positive number of um, got {}",
-            a.detect_um
-        )));
+        return Err(Error::invalid(
+            Setting::DetectUm,
+            format!(
+                "the change to detect must be a positive number of um, got {}",
+                a.detect_um
+            ),
+        ));
     }
     if !(a.power > 0.0 && a.power < 1.0) {
-        return Err(Error::input(format!(
-            "--power: must lie between 0 and 1, got {}",
-            a.power
-        )));
+        return Err(Error::invalid(
+            Setting::Power,
+            format!("must lie between 0 and 1, got {}", a.power),
+        ));
     }
     let reference = tricept_check::Reference::from_description(loaded.description())
         .map_err(|e| Error::input(format!("{}: {e}", path.display())))?;
@@ -633,7 +656,7 @@ fn check_plan(a: &PlanRequest, loaded: &LoadedMachine) -> Result<Plan, Error> {
             &loaded.description().name,
             &p.targets_mm,
         )
-        .map_err(|e| Error::with_context("plan", &e))?;
+        .map_err(|e| Error::with_context("plan", e))?;
         out = Some(OutFile::Check(text));
     }
     let json = json!({
@@ -659,7 +682,9 @@ fn check_plan(a: &PlanRequest, loaded: &LoadedMachine) -> Result<Plan, Error> {
             if p.reached {
                 String::new()
             } else {
-                format!(" (the budget --k {budget} is spent; more poses or a larger --detect-um)")
+                format!(
+                    " (the budget of {budget} poses (k) is spent; more poses or a larger change to detect (detect_um))"
+                )
             }
         );
         wln!(

@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 use serde_json::{Value, json};
 use tricept_report::{Source, Sources};
 
+use crate::Setting;
 use crate::compensate::{Calibrated, CompensateRequest, compensate};
 use crate::diagnosis::{DiagnoseRequest, diagnose};
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
@@ -138,7 +139,7 @@ fn sources(request: &ReportRequest, loaded: &LoadedMachine) -> Result<Sources, E
         description.calibration_digest(),
     ) else {
         return Err(Error::input(format!(
-            "{name}: holds no `calibration` record: a report is of a calibrated machine file (tricept identify or diagnose --write-machine)"
+            "{name}: holds no `calibration` record: a report is of a calibrated machine file (written by identify's or diagnose's `write_machine`)"
         )));
     };
     let machine = Source::new(
@@ -198,7 +199,7 @@ fn maps(loaded: &LoadedMachine) -> Result<Vec<Source>, Error> {
             Ok(Source::new(
                 &format!("map-{}", k + 1),
                 &format!(
-                    "tricept compensate --machine CAL.json --plane-z {z} --spacing {MAP_SPACING_MM} --json, with the map's columns (map.csv) as points"
+                    "the compensation of the calibrated machine at plane_z {z} mm, spacing {MAP_SPACING_MM} mm (compensate's JSON), with the map's columns (map.csv) as points"
                 ),
                 None,
                 v,
@@ -232,7 +233,7 @@ fn diagnosis(
     let json = serde_json::from_str(&d.to_json()).unwrap_or(Value::Null);
     Ok(Source::new(
         "diagnosis",
-        "tricept diagnose --data CAMPAIGN.csv --json, from the machine the calibration started from",
+        "the diagnosis of the campaign (diagnose's JSON), from the machine the calibration started from",
         Some(file),
         json,
     ))
@@ -242,9 +243,10 @@ fn diagnosis(
 fn history(path: &Path) -> Result<(Source, Source), Error> {
     let file = path.display().to_string();
     if !path.is_file() {
-        return Err(Error::input(format!(
-            "{file}: no such check history (tricept check --history writes one)"
-        )));
+        return Err(Error::invalid(
+            Setting::History,
+            format!("{file}: no such check history (a check with a history writes one)"),
+        ));
     }
     let entries = tricept_check::history::read(path)?;
     let lines: Vec<Value> = entries
@@ -255,13 +257,13 @@ fn history(path: &Path) -> Result<(Source, Source), Error> {
     Ok((
         Source::new(
             "history",
-            "the check history's lines (tricept check --history)",
+            "the check history's lines (a check's history)",
             Some(file),
             Value::Array(lines),
         ),
         Source::new(
             "trends",
-            "the history's trends, as tricept check --json gives them (history.trends)",
+            "the history's trends, as a check's JSON gives them (history.trends)",
             None,
             serde_json::to_value(trends).unwrap_or(Value::Null),
         ),
@@ -273,9 +275,12 @@ fn export(dir: &Path) -> Result<Source, Error> {
     let path = dir.join(EXPORT_SUMMARY);
     let file = path.display().to_string();
     let text = tricept_data::bounded::read_json_text(&path).map_err(|e| {
-        Error::input(format!(
-            "{file}: {e}: --export names the folder tricept export --out wrote"
-        ))
+        Error::invalid(
+            Setting::Export,
+            format!("{file}: {e}: not the folder an export wrote"),
+        )
+        .with_file_failure(crate::error::FileFailure::new(&file, &e))
+        .with_source(e)
     })?;
     let newer = tricept_kinematics::description::newer_format(
         &text,
@@ -289,7 +294,7 @@ fn export(dir: &Path) -> Result<Source, Error> {
         .map_err(|e| Error::input(format!("{file}: not an export summary: {e}")))?;
     Ok(Source::new(
         "export",
-        "the export's summary (tricept export --out DIR: DIR/export.json)",
+        "the export's summary (DIR/export.json in the folder an export wrote)",
         Some(file),
         json,
     ))

@@ -26,6 +26,7 @@ use tricept_plant::{
     instruments::Tracker,
 };
 
+use crate::Setting;
 use crate::error::{EXIT_OK, Error};
 use crate::inputs::{Poses, TrueErrors, positive, random_spec};
 use crate::machine_input::MachineInput;
@@ -59,12 +60,11 @@ impl FromStr for HeadErrors {
     type Err = Error;
 
     fn from_str(s: &str) -> Result<HeadErrors, Error> {
-        let flag = "--head-errors";
         Ok(match s {
             "zero" => HeadErrors::Zero,
             s if s.starts_with("random:") => {
                 let (scale, seed) = random_spec(
-                    flag,
+                    Setting::HeadErrors,
                     s,
                     100.0,
                     "random:SCALE[,SEED] with SCALE (times the typical sizes) from 0 to 100",
@@ -95,13 +95,12 @@ impl HeadErrors {
                 Ok(tricept_plant::random_head_errors(*scale, *seed))
             }
             HeadErrors::File(path) => {
-                let flag = "--head-errors";
                 let name = path.display();
                 let text = tricept_data::bounded::read_json_text(path)
-                    .map_err(|e| Error::input(format!("{flag}: {name}: {e}")))?;
+                    .map_err(|e| Error::unreadable(&name, e).in_setting(Setting::HeadErrors))?;
                 HeadParameterSet::head13(&machine.head)
                     .parse_values(&text)
-                    .map_err(|e| Error::input(format!("{flag}: {name}: {e}")))
+                    .map_err(|e| Error::invalid(Setting::HeadErrors, format!("{name}: {e}")))
             }
         }
     }
@@ -286,9 +285,10 @@ pub fn simulate(request: SimulateRequest) -> Result<Simulation, Error> {
     }
     let factor = request.noise_factor;
     if !(factor.is_finite() && factor > 0.0) {
-        return Err(Error::input(format!(
-            "--noise-factor: must be a positive number, got {factor}"
-        )));
+        return Err(Error::invalid(
+            Setting::NoiseFactor,
+            format!("must be a positive number, got {factor}"),
+        ));
     }
     campaign.revisits = request.revisit;
     campaign.noise_factor = factor;
@@ -442,7 +442,7 @@ fn simulate_tracker(
             Vector3::new(f[3], f[4], f[5]),
         ),
         target_offset_mm: Vector3::from(t.target_mm),
-        sigma_um: positive("--tracker-sigma-um", t.sigma_um)?,
+        sigma_um: positive(Setting::TrackerSigmaUm, t.sigma_um)?,
         setup: 1,
     };
     let data = tracker
@@ -469,7 +469,7 @@ fn simulate_ballbar(
         pivot_mm: Vector3::from(b.pivot_mm),
         length_error_um: b.length_error_um,
         ball_offset_mm: Vector3::zeros(),
-        sigma_um: positive("--ballbar-sigma-um", b.sigma_um)?,
+        sigma_um: positive(Setting::BallbarSigmaUm, b.sigma_um)?,
         setup: 1,
     };
     let poses: Vec<_> = read_poses(&b.poses)?.into_iter().map(|(p, _)| p).collect();
@@ -494,14 +494,14 @@ fn simulate_touches(
 ) -> Result<(TouchData, Vec<String>, String), Error> {
     let centre = Vector3::from(t.sphere_mm);
     let probe = TouchProbe {
-        stylus_radius_mm: positive("--touch-stylus-radius-mm", t.stylus_radius_mm)?,
+        stylus_radius_mm: positive(Setting::TouchStylusRadiusMm, t.stylus_radius_mm)?,
         stylus_radius_error_um: t.stylus_error_um,
-        stylus_radius_sigma_um: positive("--touch-stylus-sigma-um", t.stylus_sigma_um)?,
-        sigma_um: positive("--touch-sigma-um", t.sigma_um)?,
+        stylus_radius_sigma_um: positive(Setting::TouchStylusSigmaUm, t.stylus_sigma_um)?,
+        sigma_um: positive(Setting::TouchSigmaUm, t.sigma_um)?,
         features: vec![TouchFeature::Sphere {
             id: 1,
             centre_mm: centre,
-            radius_mm: positive("--touch-sphere-radius-mm", t.sphere_radius_mm)?,
+            radius_mm: positive(Setting::TouchSphereRadiusMm, t.sphere_radius_mm)?,
         }],
     };
     let planned =
@@ -623,7 +623,8 @@ mod tests {
         for bad in ["random:x", "random:101", "random:1,y"] {
             let e = bad.parse::<HeadErrors>().unwrap_err();
             assert!(
-                e.message().starts_with("--head-errors `"),
+                e.message().starts_with("head_errors `")
+                    && e.setting() == Some(Setting::HeadErrors),
                 "{}",
                 e.message()
             );
@@ -655,6 +656,6 @@ mod tests {
         r.noise_factor = 0.0;
         let e = simulate(r).unwrap_err();
         assert_eq!(e.exit_code(), crate::EXIT_INPUT);
-        assert!(e.message().starts_with("--noise-factor"));
+        assert_eq!(e.setting(), Some(Setting::NoiseFactor));
     }
 }

@@ -21,7 +21,7 @@ pub enum ReportError {
     },
     /// An export summary names another calibration.
     #[error(
-        "{file}: an export of another calibration (calibration_digest {found}; the machine file's calibration is {expected}): export this machine file (tricept export --machine ...)"
+        "{file}: an export of another calibration (calibration_digest {found}; the machine file's calibration is {expected}): export this machine file"
     )]
     ExportOfAnotherCalibration {
         /// The export's summary file.

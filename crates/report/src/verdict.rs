@@ -144,7 +144,7 @@ pub fn verdict(sources: &Sources, unnamed: &[usize], export_named: bool) -> Verd
     if flag("/calibration/forced") == Some(true) {
         reason(
             Level::DoNotTrust,
-            "the file was written with --force although its fit is not to be trusted",
+            "the file was written although its fit is not to be trusted (forced)",
             "machine",
             &["/calibration/forced", "/calibration/warnings/0"],
         );
@@ -181,7 +181,7 @@ pub fn verdict(sources: &Sources, unnamed: &[usize], export_named: bool) -> Verd
     if checks == 0 {
         reason(
             Level::Trusted,
-            "no daily check on record (give --history CHECKS.jsonl, written by tricept check --history)",
+            "no daily check on record (give the check history, CHECKS.jsonl, that a check with a history writes)",
             "machine",
             &[],
         );
@@ -265,7 +265,7 @@ fn diagnosis_reasons(l: &Lookup<'_>, reason: &mut impl FnMut(Level, &str, &str, 
         let refs: Vec<&str> = paths.iter().map(String::as_str).collect();
         reason(
             Level::Caution,
-            "the campaign's diagnosis names causes this geometric-only file does not deploy (tricept diagnose --write-machine deploys them)",
+            "the campaign's diagnosis names causes this geometric-only file does not deploy (a machine file a diagnosis writes deploys them)",
             "diagnosis",
             &refs,
         );

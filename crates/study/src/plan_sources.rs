@@ -131,7 +131,7 @@ pub fn check_poses_csv(
         ));
     }
     Ok(format!(
-        "# tricept plan --instrument check: {} poses for `{name}`; drive the machine to the commands q1,q2,q3 (mm) and log its readings\nx,y,z,q1,q2,q3\n{}\n",
+        "# tricept plan, instrument check: {} poses for `{name}`; drive the machine to the commands q1,q2,q3 (mm) and log its readings\nx,y,z,q1,q2,q3\n{}\n",
         targets_mm.len(),
         records.join("\n")
     ))

@@ -268,7 +268,7 @@ fn more_noise_than_stated_is_noisier_than_stated_not_a_change() {
         assert_eq!(r.warnings.len(), 1, "{:?}", r.warnings);
         assert!(
             r.warnings[0]
-                .contains("state the sensors' noise (`--angle-noise-arcsec`, `--length-noise-um`"),
+                .contains("state the sensors' noise (`angle_noise_arcsec`, `length_noise_um`"),
             "{:?}",
             r.warnings
         );

@@ -302,7 +302,7 @@ fn noisier_sensors_are_not_a_change() {
             assert!(
                 r.warnings
                     .iter()
-                    .any(|w| w.contains("--angle-noise-arcsec")),
+                    .any(|w| w.contains("`angle_noise_arcsec`")),
                 "{:?}",
                 r.warnings
             );

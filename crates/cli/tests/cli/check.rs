@@ -353,7 +353,7 @@ fn noisier_sensors_and_a_bad_reading_exit_0_with_a_warning() {
         .find(|l| l.starts_with("check: warning: noisy.csv: the readings are noisier than stated"))
         .unwrap_or_else(|| panic!("{err}"));
     assert!(
-        line.contains("state the noise (--angle-noise-arcsec "),
+        line.contains("state the noise (angle_noise_arcsec "),
         "{line}"
     );
     assert!(line.ends_with("or service the sensors"), "{line}");

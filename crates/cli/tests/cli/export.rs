@@ -143,7 +143,7 @@ fn the_control_model_is_named_by_control_and_must_match_the_family() {
     let o = run(&["--control", "sinumerik-808d", "--max-points", "2000"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(
-        stderr(&o).contains("--max-points 2000: past the sinumerik-808d's 200"),
+        stderr(&o).contains("--max-points: 2000 is past the sinumerik-808d's 200"),
         "{}",
         stderr(&o)
     );
@@ -359,6 +359,6 @@ fn bad_inputs_are_exit_2_and_say_why() {
         &lead,
         "heidenhain",
         &["--detection-unit-um", "0.1"],
-        "fanuc only",
+        "--detection-unit-um: applies to a fanuc control only",
     );
 }

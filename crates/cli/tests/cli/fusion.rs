@@ -393,7 +393,7 @@ fn a_target_beyond_the_tip_stated_as_tip_is_implausible_and_the_cause_is_named()
     );
     assert!(
         stderr.contains("likely cause (tested)")
-            && stderr.contains("not where --tracker-target says")
+            && stderr.contains("not where tracker_target says")
     );
     assert!(stderr.contains("not written") && !dir.join("m.json").exists());
     // The sign wrong: named as such.

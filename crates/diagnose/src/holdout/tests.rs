@@ -383,7 +383,7 @@ fn a_term_kept_back_says_why() {
     // names itself.
     let w = why(DeployRule::Confident, seen, g(1.6, 1.0), Some((0.01, 0.04)));
     assert!(
-        w.starts_with("the confident rule (--deploy-rule confident): its improvement is 1.6 sd, not above 2 sd"),
+        w.starts_with("the confident rule (deploy_rule `confident`): its improvement is 1.6 sd, not above 2 sd"),
         "{w}"
     );
     // Not expected better: the two expected errors.

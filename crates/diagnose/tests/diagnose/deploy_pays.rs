@@ -650,7 +650,7 @@ fn the_default_rule_deploys_the_pitch_terms_the_confident_rule_keeps_back() {
         assert!(!kept.deployed, "{}", confident.label);
         let why = kept.kept_back_because.expect("a reason");
         assert!(
-            why.starts_with("the confident rule (--deploy-rule confident): "),
+            why.starts_with("the confident rule (deploy_rule `confident`): "),
             "{why}"
         );
         assert!(

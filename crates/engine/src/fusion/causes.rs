@@ -87,7 +87,7 @@ pub(crate) fn likely_causes(
                         source: source.label().to_string(),
                         mistake: "target-sign",
                         description: format!(
-                            "{file}: the target offset's sign is wrong: stated {}, the data fit with --tracker-target {} (chi2/dof {:.2}, every estimate plausible)",
+                            "{file}: the target offset's sign is wrong: stated {}, the data fit with the tracker target (tracker_target) {} (chi2/dof {:.2}, every estimate plausible)",
                             triple(&offset_mm),
                             triple(&flipped),
                             f.sources[s].reduced_chi_square
@@ -104,7 +104,7 @@ pub(crate) fn likely_causes(
                     source: source.label().to_string(),
                     mistake: "target-mode",
                     description: format!(
-                        "{file}: the tracker target is not where --tracker-target says (stated {}), or the tool is not the internal data's: with the target free the data put it at ({:.3}, {:.3}, {:.3}) mm from the nominal tool tip ({size:.3} mm; spindle frame at zero head angles) and every estimate is plausible (chi2/dof {:.2}); measure the target's offset from the tip and state it with --tracker-target X,Y,Z",
+                        "{file}: the tracker target is not where tracker_target says (stated {}), or the tool is not the internal data's: with the target free the data put it at ({:.3}, {:.3}, {:.3}) mm from the nominal tool tip ({size:.3} mm; spindle frame at zero head angles) and every estimate is plausible (chi2/dof {:.2}); measure the target's offset from the tip and state it as tracker_target X,Y,Z",
                         triple(&offset_mm),
                         offset[0],
                         offset[1],

@@ -95,7 +95,7 @@ impl Default for FusionPlausibility {
             -0.5,
             0.5,
             "mm",
-            "a target stated with --tracker-target sits where it is stated to a few um".into(),
+            "a target stated with tracker_target sits where it is stated to a few um".into(),
         );
         add(
             "tracker.target_free_mm",

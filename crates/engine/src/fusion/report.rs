@@ -617,7 +617,7 @@ impl FusionReport {
                 )
             };
             out.push(format!(
-                "the tool axis is predicted to {:.0} arcsec rms (max {:.0}), above {axis_arcsec} arcsec{held}: tool-tip data do not calibrate the tool's direction; measure a tracker target at two known extensions along the tool (column `extension_mm`, e.g. 0 and 100 mm: `tricept plan --instrument tracker --extensions 0,100`)",
+                "the tool axis is predicted to {:.0} arcsec rms (max {:.0}), above {axis_arcsec} arcsec{held}: tool-tip data do not calibrate the tool's direction; measure a tracker target at two known extensions along the tool (column `extension_mm`, e.g. 0 and 100 mm: a tracker plan with extensions 0,100)",
                 a.rms_arcsec, a.max_arcsec
             ));
         }

@@ -373,7 +373,7 @@ impl Fusion {
                 ));
             } else if !s.explained() {
                 let advice = if s.kind == SourceKind::Internal {
-                    "run `tricept diagnose` on the internal data and add the effects it names (--effects), or check the sensor noise".to_string()
+                    "run `tricept diagnose` on the internal data and add the effects it names (effects), or check the sensor noise".to_string()
                 } else {
                     format!(
                         "its largest residual is {:.1} sigma at line {}: check that row; if the misfit is spread over the rows, check the instrument's stated noise and that each station or setup has its own `setup` number",

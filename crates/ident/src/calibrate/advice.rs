@@ -19,19 +19,14 @@ pub(crate) fn predicted_accuracy(
     id: &Identification,
     tolerance_mm: f64,
 ) -> Result<PredictedAccuracy, Error> {
-    let model = AccuracyModel::new(
-        m,
-        set,
-        &tricept_engine::accuracy::accuracy_points(m),
-        tolerance_mm,
-    )
-    .map_err(|e| match e {
-        IdentError::Invalid(why) => Error::input(format!("--tolerance-mm: {why}")),
-        e => Error::with_context("predicted accuracy", &e),
-    })?;
+    let model = AccuracyModel::new(m, set, &tricept_engine::accuracy::accuracy_points(m), tolerance_mm)
+        .map_err(|e| match e {
+            IdentError::Invalid(why) => Error::invalid(crate::Setting::ToleranceMm, why),
+            e => Error::with_context("predicted accuracy", e),
+        })?;
     model
         .assess(&id.covariance, id.design().fixed())
-        .map_err(|e| Error::with_context("predicted accuracy", &e))
+        .map_err(|e| Error::with_context("predicted accuracy", e))
 }
 
 /// Why a campaign of `poses` poses cannot calibrate (its predicted accuracy
@@ -42,22 +37,17 @@ pub(crate) fn campaign_advice(
     a: &PredictedAccuracy,
     poses: usize,
 ) -> Result<String, Error> {
-    let model = AccuracyModel::new(
-        m,
-        set,
-        &tricept_engine::accuracy::accuracy_points(m),
-        a.tolerance_mm,
-    )
-    .map_err(|e| Error::with_context("campaign advice", &e))?;
+    let model = AccuracyModel::new(m, set, &tricept_engine::accuracy::accuracy_points(m), a.tolerance_mm)
+        .map_err(|e| Error::with_context("campaign advice", e))?;
     let (optimal, random) = tricept_study::campaign::worthwhile_campaigns(m, set, &model)
-        .map_err(|e| Error::with_context("campaign advice", &e))?;
+        .map_err(|e| Error::with_context("campaign advice", e))?;
     let fix = match (optimal, random) {
         (Some(o), Some(r)) => format!(
-            "{} D-optimal poses (`--poses optimal:{}`, predicted {:.3} mm) or {} random poses over the workspace (`--poses random:{},1`, predicted {:.3} mm) would be worthwhile",
+            "{} D-optimal poses (poses `optimal:{}`, predicted {:.3} mm) or {} random poses over the workspace (poses `random:{},1`, predicted {:.3} mm) would be worthwhile",
             o.poses, o.poses, o.predicted.after_rms_mm, r.poses, r.poses, r.predicted.after_rms_mm
         ),
         (Some(o), None) => format!(
-            "{} D-optimal poses (`--poses optimal:{}`, predicted {:.3} mm) would be worthwhile",
+            "{} D-optimal poses (poses `optimal:{}`, predicted {:.3} mm) would be worthwhile",
             o.poses, o.poses, o.predicted.after_rms_mm
         ),
         _ => "no campaign of up to 200 poses of these sensors would be: better sensors or external measurements are needed (docs/hybrid.md)".to_string(),

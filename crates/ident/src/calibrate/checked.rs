@@ -15,6 +15,7 @@ use tricept_engine::fusion::{
 use tricept_model::ParameterSet;
 
 use super::values::{FusedSources, HeadModel, TrackerTargetSpec, eval_options, fused_model};
+use crate::Setting;
 use crate::error::Error;
 use crate::inputs::{LoadedMachine, positive};
 use crate::limits;
@@ -79,18 +80,22 @@ pub(crate) fn fused(
 ) -> Result<FusedWork, Error> {
     let machine = c.loaded.machine();
     if x.tracker.is_empty() && x.tracker_target.is_some() {
-        return Err(Error::input(
-            "--tracker-target: there is no --tracker file to state the target of",
+        return Err(Error::invalid(
+            Setting::TrackerTarget,
+            "there is no tracker file to state the target of",
         ));
     }
     let mut model = fused_model(machine, &c.set, &x.effects, x.head)?;
     if for_machine_file && !model.effects().is_empty() {
         let names: Vec<&str> = model.effects().iter().map(|e| e.as_str()).collect();
-        return Err(Error::input(format!(
-            "--write-machine: {} fitted, but the machine format cannot carry {}; write a geometric fit (without --effects) or compensate with the fused model",
-            names.join(", "),
-            if names.len() == 1 { "it" } else { "them" }
-        )));
+        return Err(Error::invalid(
+            Setting::WriteMachine,
+            format!(
+                "{} fitted, but the machine format cannot carry {}; write a geometric fit (without effects) or compensate with the fused model",
+                names.join(", "),
+                if names.len() == 1 { "it" } else { "them" }
+            ),
+        ));
     }
     // A calibrated machine: the rank decision of its nominal machine, as in
     // the internal calibration (docs/identifiability.md).
@@ -103,34 +108,37 @@ pub(crate) fn fused(
     }
     if let Some(path) = &x.plausibility {
         let text = tricept_data::bounded::read_json_text(path)
-            .map_err(|e| Error::input(format!("--plausibility {}: {e}", path.display())))?;
+            .map_err(|e| Error::unreadable(path.display(), e).in_setting(Setting::Plausibility))?;
         options.plausibility = FusionPlausibility::with_overrides(&text)
-            .map_err(|e| Error::input(format!("--plausibility {}: {e}", path.display())))?;
+            .map_err(|e| Error::invalid_value(Setting::Plausibility, path.display(), e))?;
     }
-    options.tool_axis_arcsec = positive("--tool-axis-warn-arcsec", x.tool_axis_warn_arcsec)?;
+    options.tool_axis_arcsec = positive(Setting::ToolAxisWarnArcsec, x.tool_axis_warn_arcsec)?;
     let target = if x.tracker.is_empty() {
         TrackerTarget::Free
     } else {
         TrackerTargetSpec::required(x.tracker_target, x.tracker_target_sigma_um)?
     };
     let tracker = TrackerOptions {
-        sigma_um: positive("--tracker-sigma-um", x.tracker_sigma_um)?,
+        sigma_um: positive(Setting::TrackerSigmaUm, x.tracker_sigma_um)?,
         target,
     };
     let ball = match x.ballbar_ball_mm {
         Some(t) => {
             if let Some(v) = t.0.iter().find(|v| v.abs() > limits::MAX_TOOL_OFFSET_MM) {
-                return Err(Error::input(format!(
-                    "--ballbar-ball-mm: {v} mm is beyond ±{} mm from the tool tip",
-                    limits::MAX_TOOL_OFFSET_MM
-                )));
+                return Err(Error::invalid(
+                    Setting::BallbarBallMm,
+                    format!(
+                        "{v} mm is beyond ±{} mm from the tool tip",
+                        limits::MAX_TOOL_OFFSET_MM
+                    ),
+                ));
             }
             t.0
         }
         None => [0.0; 3],
     };
     let ballbar = BallbarOptions {
-        sigma_um: positive("--ballbar-sigma-um", x.ballbar_sigma_um)?,
+        sigma_um: positive(Setting::BallbarSigmaUm, x.ballbar_sigma_um)?,
         length_sigma_um: x.ballbar_length_sigma.sigma_um(),
         ball_offset_mm: ball,
     };
@@ -138,13 +146,14 @@ pub(crate) fn fused(
         None
     } else {
         let Some(features) = &x.features else {
-            return Err(Error::input(
-                "--touch needs --features FILE.json (the spheres and planes touched)",
+            return Err(Error::invalid(
+                Setting::Features,
+                "needed with touch-off files: the spheres and planes touched (a JSON file)",
             ));
         };
         let features = Features::from_path(features)?;
         let options = TouchOptions {
-            sigma_um: positive("--touch-sigma-um", x.touch_sigma_um)?,
+            sigma_um: positive(Setting::TouchSigmaUm, x.touch_sigma_um)?,
         };
         Some((x.touch.clone(), features, options))
     };

@@ -20,6 +20,7 @@ use tricept_kinematics::{Machine, MachineDescription};
 
 use super::advice::{campaign_advice, predicted_accuracy};
 use super::checked::Checked;
+use crate::Setting;
 use crate::accuracy::Accuracy;
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error, exit_line};
 use crate::inputs::LoadedMachine;
@@ -114,15 +115,15 @@ pub(crate) fn fit(
     if let Some(prior) = prior {
         model = model
             .with_prior(prior)
-            .map_err(|e| Error::with_context("--prior", &e))?;
+            .map_err(|e| Error::from_library(e).in_setting(Setting::Prior))?;
     }
     let options = IdentifyOptions::for_machine(m);
     let source = dataset.source.as_str();
     let (id, rejected) = if robust {
-        identify_robust(&model, dataset, &options).map_err(|e| fit_error(source, &e))?
+        identify_robust(&model, dataset, &options).map_err(|e| fit_error(source, e))?
     } else {
         (
-            identify(&model, dataset, &options).map_err(|e| fit_error(source, &e))?,
+            identify(&model, dataset, &options).map_err(|e| fit_error(source, e))?,
             Vec::new(),
         )
     };
@@ -425,14 +426,15 @@ pub(crate) fn rejected_json(rejected: &[Rejection]) -> Value {
 
 /// An identification error of the data `source`, with the line of a pose
 /// that cannot be reached.
-pub(crate) fn fit_error(source: &str, e: &IdentError) -> Error {
-    match e {
+pub(crate) fn fit_error(source: &str, e: IdentError) -> Error {
+    match &e {
         IdentError::Kinematics {
             line, source: k, ..
         } => Error::new(
-            crate::Classify::kind(e),
+            crate::Classify::kind(&e),
             format!("{source}: line {line}: the commands of this pose cannot be reached: {k}"),
-        ),
-        e => Error::with_context(source, e),
+        )
+        .with_source(e),
+        _ => Error::with_context(source, e),
     }
 }

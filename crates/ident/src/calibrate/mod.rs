@@ -73,6 +73,7 @@ use serde_json::Value;
 use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
+use crate::Setting;
 use crate::data_input::DataInput;
 use crate::error::Error;
 pub(crate) use crate::error::exit_line;
@@ -175,12 +176,9 @@ impl Written {
 
     /// The warning of a forced write (`None` for a trusted fit).
     pub fn forced_warning(&self) -> Option<String> {
-        self.forced.as_ref().map(|why| {
-            format!(
-                "--write-machine {}: written with --force although {why}",
-                self.path.display()
-            )
-        })
+        self.forced
+            .as_ref()
+            .map(|why| format!("{}: written although {why} (forced)", self.path.display()))
     }
 }
 
@@ -235,15 +233,18 @@ pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
 fn check(request: CalibrateRequest) -> Result<(Checked, DataInput, String, Work), Error> {
     let tolerance_mm = request.tolerance_mm;
     if !(tolerance_mm.is_finite() && tolerance_mm > 0.0 && tolerance_mm <= 10.0) {
-        return Err(Error::input(format!(
-            "--tolerance-mm: the manufacturing tolerance must be a number of mm above 0 and at most 10, got {tolerance_mm}"
-        )));
+        return Err(Error::invalid(
+            Setting::ToleranceMm,
+            format!(
+                "the manufacturing tolerance must be a number of mm above 0 and at most 10, got {tolerance_mm}"
+            ),
+        ));
     }
     let loaded = request.machine.load()?;
     let pooled = !request.campaigns.is_empty() || request.prior.is_some();
     if pooled && request.fused.is_some() {
         return Err(Error::input(
-            "several --data or --prior with external measurements: not supported (pool the internal campaigns, or fuse one)",
+            "several campaigns or a prior with external measurements: not supported (pool the internal campaigns, or fuse one)",
         ));
     }
     let checked = Checked {
@@ -427,8 +428,9 @@ impl Calibration {
     /// (`forced`: why it is written although not to be trusted).
     pub fn description(&self, forced: Option<String>) -> Result<MachineDescription, Error> {
         let Some(data) = self.data.path() else {
-            return Err(Error::input(
-                "--write-machine: the calibration record holds the data file's hash: give the data as a file",
+            return Err(Error::invalid(
+                Setting::WriteMachine,
+                "the calibration record holds the data file's hash: give the data as a file",
             ));
         };
         match &self.fit {
@@ -521,7 +523,8 @@ mod tests {
         request.tolerance_mm = 0.0;
         let e = calibrate(request).unwrap_err();
         assert_eq!(e.exit_code(), crate::EXIT_INPUT);
-        assert!(e.message().starts_with("--tolerance-mm"), "{e}");
+        assert_eq!(e.setting(), Some(Setting::ToleranceMm), "{e}");
+        assert!(e.message().starts_with("tolerance_mm: "), "{e}");
     }
 
     #[test]
@@ -539,7 +542,7 @@ mod tests {
         });
         let e = check(request).unwrap_err();
         assert_eq!(e.exit_code(), crate::EXIT_INPUT);
-        assert!(e.message().starts_with("--tracker-sigma-um"), "{e}");
+        assert_eq!(e.setting(), Some(Setting::TrackerSigmaUm), "{e}");
         // Settings right, files missing: the fit is checked, the files are
         // read by the fit.
         let mut request = CalibrateRequest::new(fixture());

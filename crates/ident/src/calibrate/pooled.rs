@@ -18,6 +18,7 @@ use tricept_numerics::stats::chi2_sf;
 use super::checked::Checked;
 use super::internal::{InternalFit, fit as internal_fit};
 use super::pooling::{CampaignRow, Pooled, PriorUsed};
+use crate::Setting;
 use crate::error::Error;
 use crate::inputs::LoadedMachine;
 
@@ -29,10 +30,9 @@ fn read_prior(
     set: &ParameterSet,
 ) -> Result<(Prior, PriorFile), Error> {
     let name = path.display().to_string();
-    let text = tricept_data::bounded::read_json_text(path)
-        .map_err(|e| Error::input(format!("{name}: {e}")))?;
-    let file =
-        PriorFile::from_json(&text, &name).map_err(|e| Error::with_context("--prior", &e))?;
+    let text = tricept_data::bounded::read_json_text(path).map_err(|e| Error::unreadable(&name, e))?;
+    let file = PriorFile::from_json(&text, &name)
+        .map_err(|e| Error::from_library(e).in_setting(Setting::Prior))?;
     let geometry = |v: Value| match v {
         Value::Object(mut o) => {
             for k in ["name", "notes", "sensors", "calibration"] {
@@ -44,14 +44,18 @@ fn read_prior(
     };
     let ours = serde_json::to_value(loaded.nominal_description()).unwrap_or(Value::Null);
     if geometry(ours) != geometry(file.machine.clone()) {
-        return Err(Error::input(format!(
-            "--prior {name}: the batch's machine is not `{}` (give the batch's nominal machine with --machine)",
-            loaded.description().name
-        )));
+        return Err(Error::invalid_value(
+            Setting::Prior,
+            &name,
+            format!(
+                "the batch's machine is not `{}` (give the batch's nominal machine as the machine)",
+                loaded.description().name
+            ),
+        ));
     }
     let prior = file
         .prior(set)
-        .map_err(|e| Error::with_context(format!("--prior {name}"), &e))?;
+        .map_err(|e| Error::from_library(e).in_setting_value(Setting::Prior, &name))?;
     Ok((prior, file))
 }
 
@@ -81,7 +85,7 @@ pub(crate) fn fit(
     if count >= 2 {
         let kept = used.subset(|j| !fit.rejected.iter().any(|r| r.pose == j));
         let a = agreements(&fit.model, &kept, count, &options, ADEQUACY_ALPHA)
-            .map_err(|e| Error::with_context("the campaigns' agreement", &e))?;
+            .map_err(|e| Error::with_context("the campaigns' agreement", e))?;
         tests = a.tests;
         disagreeing = a.disagreeing;
         // Three or more campaigns: the ones that disagree leave the fit.

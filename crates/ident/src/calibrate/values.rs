@@ -14,6 +14,7 @@ use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 use tricept_model::effects::EffectName;
 
+use crate::Setting;
 use crate::error::Error;
 use crate::inputs::{HeadAngles, Triple, parse_numbers, positive};
 use crate::limits;
@@ -46,7 +47,7 @@ impl FromStr for TrackerTargetSpec {
             "free" => TrackerTargetSpec::Free,
             "tip" => TrackerTargetSpec::Tip,
             text => {
-                let v = parse_numbers("--tracker-target", text, 3).map_err(|_| {
+                let v = parse_numbers(Setting::TrackerTarget.name(), text, 3).map_err(|_| {
                     Error::input(format!(
                         "expected `tip`, `free` or X,Y,Z in mm, got `{text}`"
                     ))
@@ -57,8 +58,14 @@ impl FromStr for TrackerTargetSpec {
     }
 }
 
-/// The message of a tracker given without a target statement.
-pub(crate) const TARGET_REQUIRED: &str = "--tracker-target is required with a tracker: state where its target sits: `tip` (in a nest at the tool tip), `X,Y,Z` (a known offset from the tip, mm, spindle frame at zero head angles) or `free` (unknown: the tool tip is then not calibrated)";
+/// The error of a tracker given without a target statement.
+fn target_required() -> Error {
+    Error::naming(
+        crate::ErrorKind::Input,
+        Setting::TrackerTarget,
+        " is required with a tracker: state where its target sits: `tip` (in a nest at the tool tip), `X,Y,Z` (a known offset from the tip, mm, spindle frame at zero head angles) or `free` (unknown: the tool tip is then not calibrated)".to_string(),
+    )
+}
 
 impl TrackerTargetSpec {
     /// The engine's target statement, a known offset known to `sigma_um`.
@@ -70,7 +77,7 @@ impl TrackerTargetSpec {
         };
         Ok(TrackerTarget::Known {
             offset_mm,
-            sigma_um: positive("--tracker-target-sigma-um", sigma_um)?,
+            sigma_um: positive(Setting::TrackerTargetSigmaUm, sigma_um)?,
         })
     }
 
@@ -80,8 +87,7 @@ impl TrackerTargetSpec {
         spec: Option<TrackerTargetSpec>,
         sigma_um: f64,
     ) -> Result<TrackerTarget, Error> {
-        spec.ok_or_else(|| Error::input(TARGET_REQUIRED))?
-            .target(sigma_um)
+        spec.ok_or_else(target_required)?.target(sigma_um)
     }
 }
 
@@ -227,7 +233,7 @@ impl FromStr for EvalGrid {
                 "expected whole numbers RINGS,PER_RING,LEVELS, got `{text}`"
             ))
         };
-        let g = parse_numbers("--eval-grid", text, 3).map_err(|_| bad())?;
+        let g = parse_numbers(Setting::EvalGrid.name(), text, 3).map_err(|_| bad())?;
         if g.iter().any(|v| *v < 0.0 || v.fract() != 0.0) || g[2] < 1.0 {
             return Err(bad());
         }
@@ -272,11 +278,15 @@ pub fn eval_options(
         * grid.levels as f64
         * (angles.h1_deg.len() * angles.h2_deg.len()) as f64;
     if poses > limits::MAX_EVAL_POSES as f64 {
-        return Err(Error::input(format!(
-            "--eval-grid {grid} with --eval-head-angles-deg {}: {poses} evaluation poses; at most {}",
-            head_angles_text(angles),
-            limits::MAX_EVAL_POSES
-        )));
+        return Err(Error::invalid_value(
+            Setting::EvalGrid,
+            grid,
+            format!(
+                "with the evaluation head angles {} deg: {poses} evaluation poses; at most {}",
+                head_angles_text(angles),
+                limits::MAX_EVAL_POSES
+            ),
+        ));
     }
     let mut options = FusionOptions::for_machine(machine);
     options.eval_poses = evaluation_poses(
@@ -286,7 +296,10 @@ pub fn eval_options(
         &angles.h2_deg,
     );
     if options.eval_poses.is_empty() {
-        return Err(Error::input("--eval-grid: no reachable evaluation pose"));
+        return Err(Error::invalid(
+            Setting::EvalGrid,
+            "no reachable evaluation pose",
+        ));
     }
     Ok(options)
 }

@@ -100,7 +100,7 @@ const SIMULATION: Simulation = Simulation {
         keys: &[EffectKey::new(
         "um",
         "um",
-        "lost motion of each leg [3]; with --both-directions the data show it",
+        "lost motion of each leg [3]; with poses from both directions (both_directions) the data show it",
     )],
     parse: parse_input::<Backlash>,
     typical: || {

@@ -225,7 +225,7 @@ impl Needs {
     pub fn advice(self) -> Option<&'static str> {
         match self {
             Needs::ApproachDirections => {
-                Some("visit poses from both approach directions (--both-directions)")
+                Some("visit poses from both approach directions (both_directions)")
             }
             Needs::Temperature => Some("log the structure temperature while it changes"),
             Needs::PoseOrder => Some("log the time of every pose"),

@@ -21,7 +21,7 @@ pub fn section(l: &Lookup<'_>, sources: &Sources) -> String {
             "checks",
             TITLE,
             &p(
-                "No check history given: <code>tricept check --machine CAL.json --data TODAY.csv --history CHECKS.jsonl</code> keeps one, and <code>--history CHECKS.jsonl</code> shows it here.",
+                "No check history given: a daily check with a history (<code>history</code>, CHECKS.jsonl) keeps one, and giving it to the report (<code>history</code>) shows it here.",
             ),
         );
     }

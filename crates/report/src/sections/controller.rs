@@ -18,7 +18,7 @@ pub fn section(l: &Lookup<'_>, sources: &Sources) -> String {
             "controller",
             TITLE,
             &p(
-                "No export given: <code>tricept export --machine CAL.json --out DIR</code> writes the control's files, and <code>--export DIR</code> shows them here.",
+                "No export given: an export of this machine file writes the control's files into a folder, and giving that folder to the report (<code>export</code>) shows them here.",
             ),
         );
     };

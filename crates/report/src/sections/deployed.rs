@@ -384,13 +384,13 @@ fn gains(l: &Lookup<'_>, sources: &Sources) -> String {
     let d = "diagnosis";
     if sources.diagnosis.is_none() {
         return p(
-            "The gain of each deployed term needs the campaign: give <code>--data CAMPAIGN.csv</code>.",
+            "The gain of each deployed term needs the campaign: give it to the report (<code>data</code>, CAMPAIGN.csv).",
         );
     }
     let n = l.array(d, "/model_terms").len();
     let mut s = String::from("<h3>The gain of each term</h3>\n");
     s.push_str(&p(&format!(
-        "From <code>tricept diagnose --data CAMPAIGN.csv</code> (deploy rule {}): the deployed model against the geometric-only fit improves the mean platform error on the middle plane by {} mm (standard deviation {} mm).",
+        "From the campaign's diagnosis (deploy rule {}): the deployed model against the geometric-only fit improves the mean platform error on the middle plane by {} mm (standard deviation {} mm).",
         l.text(d, "/deploy_rule"),
         l.num(d, "/gain/improvement_mm"),
         l.num(d, "/gain/improvement_sd_mm"),

@@ -86,7 +86,7 @@ pub fn header(l: &Lookup<'_>, sources: &Sources, verdict: &Verdict) -> String {
             l.text("export", "/within_tolerance")
         )
     } else {
-        "none given (--export DIR)".into()
+        "none given (export)".into()
     };
     fact(&mut s, "Controller files", &export);
     fact(
@@ -119,7 +119,7 @@ fn last_check(l: &Lookup<'_>, sources: &Sources) -> String {
         .and_then(|h| h.json.as_array())
         .map_or(0, Vec::len);
     if n == 0 {
-        return "none on record (--history CHECKS.jsonl)".into();
+        return "none on record (history)".into();
     }
     let p = |k: &str| format!("/{}/{k}", n - 1);
     let mut s = format!(

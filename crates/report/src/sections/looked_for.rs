@@ -34,7 +34,7 @@ pub fn section(l: &Lookup<'_>, sources: &Sources) -> String {
     }
     if sources.diagnosis.is_none() {
         s.push_str(&p(
-            "What the campaign's diagnosis looked for needs the campaign: give <code>--data CAMPAIGN.csv</code>.",
+            "What the campaign's diagnosis looked for needs the campaign: give it to the report (<code>data</code>, CAMPAIGN.csv).",
         ));
         return wrap("looked-for", TITLE, &s);
     }

@@ -12,7 +12,7 @@ use crate::svg::{Plot, cividis, range};
 /// The section.
 pub fn section(l: &Lookup<'_>, sources: &Sources) -> String {
     let mut s = p(&format!(
-        "<strong>Before calibration</strong>: where the nominal machine's commands put the platform, by the calibrated model: the correction the calibration makes (<code>tricept compensate --machine CAL.json --plane-z Z --spacing S --map DIR</code>, its map.csv), at {} heights of the workspace. <strong>After calibration</strong>: the file's commands put the platform where it should be up to the accuracy the file promises, rms {} mm with a 95 % upper bound of {} mm at the {}, marked on the colour bar.",
+        "<strong>Before calibration</strong>: where the nominal machine's commands put the platform, by the calibrated model: the correction the calibration makes (the compensation map of the calibrated machine at a plane and a spacing, its map.csv), at {} heights of the workspace. <strong>After calibration</strong>: the file's commands put the platform where it should be up to the accuracy the file promises, rms {} mm with a 95 % upper bound of {} mm at the {}, marked on the colour bar.",
         sources.maps.len(),
         l.num("machine", "/calibration/accuracy/rms_mm"),
         l.num("machine", "/calibration/accuracy/upper_mm"),

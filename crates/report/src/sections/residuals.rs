@@ -22,7 +22,7 @@ pub fn section(l: &Lookup<'_>, sources: &Sources) -> String {
     ));
     if sources.diagnosis.is_none() {
         s.push_str(&p(
-            "The residuals of each channel need the campaign: give <code>--data CAMPAIGN.csv</code> (the file the calibration was made from).",
+            "The residuals of each channel need the campaign: give it to the report (<code>data</code>, CAMPAIGN.csv: the file the calibration was made from).",
         ));
         return wrap("residuals", TITLE, &s);
     }

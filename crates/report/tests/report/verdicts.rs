@@ -69,7 +69,7 @@ fn a_forced_calibration_is_not_trusted() {
     assert_eq!(r.verdict().level, Level::DoNotTrust);
     assert_eq!(r.exit_code(), EXIT_INADEQUATE);
     let says = crate::support::reasons(&r);
-    assert!(says.iter().any(|s| s.contains("--force")), "{says:?}");
+    assert!(says.iter().any(|s| s.contains("(forced)")), "{says:?}");
     // The campaign's diagnosis names the pitch error the file lacks.
     assert!(
         says.iter().any(|s| s.contains("does not deploy")),

@@ -26,7 +26,11 @@ fn a_forced_machine_is_marked_and_warned_about_when_loaded() {
     assert!(d["name"].as_str().unwrap().contains("FORCED"));
     let out = run(&["machine", "--machine", m.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--force"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("written although it is not to be trusted (forced)"),
+        "{stderr}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -266,7 +266,7 @@ fn a_campaign_too_small_to_calibrate_is_refused_and_told_what_would_do() {
     );
     let w = v["warnings"].to_string();
     assert!(
-        w.contains("`--poses optimal:") && w.contains("`--poses random:"),
+        w.contains("poses `optimal:") && w.contains("poses `random:"),
         "{w}"
     );
     // Forced, the file makes the true machine worse than no calibration.
@@ -280,7 +280,7 @@ fn a_campaign_too_small_to_calibrate_is_refused_and_told_what_would_do() {
     // The advised campaign is worthwhile, and in truth it is: on three
     // noise seeds it beats the uncalibrated machine by half.
     let advice = w
-        .split("`--poses optimal:")
+        .split("poses `optimal:")
         .nth(1)
         .and_then(|s| s.split('`').next())
         .unwrap()
