@@ -19,7 +19,7 @@ use tricept_engine::compensate::{MapError, TableError, WorkspaceTable};
 use tricept_model::{MapStats, ParameterSet};
 use tricept_plant::Effect;
 
-use crate::calibrate::{CalibrateRequest, calibrate, exit_line, write_text};
+use crate::calibrate::{CalibrateRequest, calibrate, exit_reason, write_text};
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, Error};
 use crate::inputs::TrueErrors;
 use crate::machine_file::write_rule;
@@ -96,6 +96,19 @@ impl CompensateRequest {
     }
 }
 
+crate::request::setters!(CompensateRequest {
+    force: bool,
+    truth: some TrueErrors,
+    truth_effects: Vec<Effect>,
+    parameter_set: ParameterSet,
+    plane_z_mm: some f64,
+    spacing_mm: f64,
+    targets: some into PathBuf,
+    map_dir: some into PathBuf,
+    table_dir: some into PathBuf,
+    table_spacing_mm: some f64,
+});
+
 /// A target (mm) and its corrected leg commands (mm).
 pub type CorrectedTarget = (Vector3<f64>, [f64; 3]);
 
@@ -120,10 +133,12 @@ pub struct Compensation {
     warnings: Vec<String>,
     machine_warnings: Vec<String>,
     code: u8,
-    why: String,
+    reason: Option<String>,
     z_mm: f64,
     spacing_mm: f64,
 }
+
+crate::outcome::outcome!(Compensation);
 
 /// The two machines of a compensation and where they came from.
 struct Pair {
@@ -159,7 +174,7 @@ fn machines(r: &CompensateRequest) -> Result<Pair, Error> {
                 warnings: fit.warnings().to_vec(),
                 machine_warnings: fit.machine_warnings().to_vec(),
                 code,
-                why: fit.reason(),
+                why: fit.why(),
             })
         }
         Calibrated::MachineFile(machine) => {
@@ -308,7 +323,7 @@ pub fn compensate(request: CompensateRequest) -> Result<Compensation, Error> {
         warnings,
         machine_warnings,
         code,
-        why,
+        reason: exit_reason(code, &why),
         z_mm: z,
         spacing_mm: spacing,
     })
@@ -416,9 +431,10 @@ impl Compensation {
         self.code
     }
 
-    /// The one-line summary of a non-zero exit code.
-    pub fn exit_line(&self) -> Option<String> {
-        exit_line("compensate", self.code, &self.why)
+    /// Why the exit code is not 0, in one phrase (`None` when it is 0):
+    /// why the calibration compensated from is not to be trusted.
+    pub fn reason(&self) -> Option<&str> {
+        self.reason.as_deref()
     }
 
     /// The warnings of the compensation (the calibration's, the table's).
@@ -447,7 +463,8 @@ impl Compensation {
         self.spacing_mm
     }
 
-    /// The JSON `tricept compensate --json` prints.
+    /// The JSON `tricept compensate --json` prints (`format_version`
+    /// first).
     pub fn to_json(&self) -> Value {
         let mut out = self.out.clone();
         if let Some(rows) = &self.targets {
@@ -460,7 +477,7 @@ impl Compensation {
                 ),
             );
         }
-        Value::Object(out)
+        crate::outcome::versioned(Value::Object(out))
     }
 
     /// The text report.

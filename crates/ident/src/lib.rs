@@ -59,6 +59,8 @@ mod json_version;
 mod limits;
 mod machine_file;
 mod machine_input;
+mod outcome;
+mod request;
 
 // Layer 1: the workflows, one public module each (its function, its
 // request, its result and the parts they are made of).
@@ -89,9 +91,14 @@ pub use error::{
     ErrorKind,
 };
 
-// The two inputs every workflow is fed: the machine and the measured data.
+// The two inputs every workflow is fed: the machine and the measured data,
+// and the machine as `MachineInput::load` returns it.
 pub use data_input::DataInput;
+pub use inputs::LoadedMachine;
 pub use machine_input::MachineInput;
+
+// The one shape of every workflow's result, and how one writes its file.
+pub use outcome::{Outcome, WriteOptions, WritesMachine, Written};
 
 // Crate-internal shorthands (the workflows' files use `crate::NAME`).
 pub(crate) use error::Classify;

@@ -87,13 +87,16 @@ fn a_newer_format_and_an_edited_calibrated_file_are_named() {
 fn a_write_of_an_untrusted_calibration_is_refused_as_such_with_its_source() {
     let dir = scratch("refused");
     // A hidden compliance the geometric model cannot explain: exit 3.
-    let mut calibration = calibrate(CalibrateRequest::new(
+    let calibration = calibrate(CalibrateRequest::new(
         fixture("data/diagnose-hidden-effect.csv").as_str(),
     ))
     .unwrap();
     assert_eq!(calibration.exit_code(), EXIT_INADEQUATE);
     let e = calibration
-        .write_machine(&dir.join("cal.json"), false)
+        .write_machine(
+            &dir.join("cal.json"),
+            tricept_ident::WriteOptions::default(),
+        )
         .unwrap_err();
     assert_eq!(e.cause(), ErrorCause::RefusedWrite, "{e}");
     assert_eq!(e.exit_code(), EXIT_INADEQUATE);

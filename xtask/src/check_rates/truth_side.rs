@@ -171,9 +171,9 @@ impl Calibrated {
         std::fs::write(&data, to_csv(&rows)).map_err(|e| format!("{}: {e}", data.display()))?;
         let mut request = CalibrateRequest::new(DataInput::File(data.clone()));
         request.for_machine_file = true;
-        let mut calibration = calibrate(request).map_err(|e| format!("machine {seed}: {e}"))?;
+        let calibration = calibrate(request).map_err(|e| format!("machine {seed}: {e}"))?;
         calibration
-            .write_machine(&machine_file, false)
+            .write_machine(&machine_file, tricept_ident::WriteOptions::default())
             .map_err(|e| format!("machine {seed}: identify: {e}"))?;
         let loaded = load_machine(Some(&machine_file), &SensorNoise::default())
             .map_err(|e| e.to_string())?;
