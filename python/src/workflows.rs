@@ -11,13 +11,13 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use tricept_ident::advanced::{
-    LoadedMachine, MachineFile, ParameterSet, Poses, SensorNoise, TrueErrors,
+    MachineFile, ParameterSet, Poses, SensorNoise, TrueErrors,
 };
 use tricept_ident::calibrate::CalibrateRequest;
 use tricept_ident::check::CheckRequest;
 use tricept_ident::diagnosis::DiagnoseRequest;
 use tricept_ident::simulate::SimulateRequest;
-use tricept_ident::{DataInput, MachineInput, WriteOptions};
+use tricept_ident::{DataInput, LoadedMachine, MachineInput, WriteOptions};
 
 use crate::Machine;
 use crate::errors::{door_error, door_error_in, input_error};

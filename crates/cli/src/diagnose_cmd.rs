@@ -5,7 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use tricept_ident::advanced::{LoadedMachine, Poses};
+use tricept_ident::LoadedMachine;
+use tricept_ident::advanced::Poses;
 use tricept_ident::detectability::{DetectabilityRequest, detectability};
 use tricept_ident::diagnosis::{
     DeployRule, DiagnoseRequest, DiagnoseResult, ResidualPlot, diagnose,

@@ -218,7 +218,8 @@ impl LoadedMachine {
     ///
     /// # Example
     /// ```
-    /// use tricept_ident::advanced::{LoadedMachine, SensorNoise};
+    /// use tricept_ident::LoadedMachine;
+    /// use tricept_ident::advanced::SensorNoise;
     /// use tricept_ident::kinematics::MachineDescription;
     /// let mut d = MachineDescription::paper();
     /// let m = LoadedMachine::from_description(d.clone(), "mine", &SensorNoise::default()).unwrap();
