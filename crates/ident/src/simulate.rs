@@ -266,6 +266,13 @@ impl SimulateRequest {
     }
 }
 
+impl Default for SimulateRequest {
+    /// [`SimulateRequest::new`].
+    fn default() -> SimulateRequest {
+        SimulateRequest::new()
+    }
+}
+
 crate::request::setters!(SimulateRequest {
     machine: into MachineInput,
     parameter_set: ParameterSet,
