@@ -359,7 +359,7 @@ impl DiagnoseResult {
                 temperature_c: machine_file::mean_temperature_c(&self.data),
                 accuracy: Some(promise.record()),
             },
-            deployed.controller.clone(),
+            deployed.controller,
         )?;
         if let Some(c) = description.calibration.as_mut() {
             c.applies = deployed.applied.clone();
