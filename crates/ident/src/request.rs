@@ -10,52 +10,34 @@
 macro_rules! setters {
     ($request:ident {}) => {};
     ($request:ident { $field:ident: some into $ty:ty, $($rest:tt)* }) => {
-        impl $request {
-            #[doc = concat!("Sets [`", stringify!($request), "::", stringify!($field),
-                "`] to `Some(value)`: a chainable setter.")]
-            #[must_use]
-            pub fn $field(mut self, value: impl Into<$ty>) -> $request {
-                self.$field = Some(value.into());
-                self
-            }
-        }
+        $crate::request::setters!(@one $request $field "`Some(value)`",
+            (value: impl Into<$ty>) Some(value.into()));
         $crate::request::setters!($request { $($rest)* });
     };
     ($request:ident { $field:ident: some $ty:ty, $($rest:tt)* }) => {
-        impl $request {
-            #[doc = concat!("Sets [`", stringify!($request), "::", stringify!($field),
-                "`] to `Some(value)`: a chainable setter.")]
-            #[must_use]
-            pub fn $field(mut self, value: $ty) -> $request {
-                self.$field = Some(value);
-                self
-            }
-        }
+        $crate::request::setters!(@one $request $field "`Some(value)`", (value: $ty) Some(value));
         $crate::request::setters!($request { $($rest)* });
     };
     ($request:ident { $field:ident: into $ty:ty, $($rest:tt)* }) => {
-        impl $request {
-            #[doc = concat!("Sets [`", stringify!($request), "::", stringify!($field),
-                "`]: a chainable setter.")]
-            #[must_use]
-            pub fn $field(mut self, value: impl Into<$ty>) -> $request {
-                self.$field = value.into();
-                self
-            }
-        }
+        $crate::request::setters!(@one $request $field "`value`",
+            (value: impl Into<$ty>) value.into());
         $crate::request::setters!($request { $($rest)* });
     };
     ($request:ident { $field:ident: $ty:ty, $($rest:tt)* }) => {
+        $crate::request::setters!(@one $request $field "`value`", (value: $ty) value);
+        $crate::request::setters!($request { $($rest)* });
+    };
+    // One setter: `$value: $param` in, `$set` stored.
+    (@one $request:ident $field:ident $what:literal, ($value:ident: $($param:tt)+) $set:expr) => {
         impl $request {
             #[doc = concat!("Sets [`", stringify!($request), "::", stringify!($field),
-                "`]: a chainable setter.")]
+                "`] to ", $what, ": a chainable setter.")]
             #[must_use]
-            pub fn $field(mut self, value: $ty) -> $request {
-                self.$field = value;
+            pub fn $field(mut self, $value: $($param)+) -> $request {
+                self.$field = $set;
                 self
             }
         }
-        $crate::request::setters!($request { $($rest)* });
     };
 }
 pub(crate) use setters;

@@ -260,26 +260,23 @@ fn inputs_convert_from_every_path_like_type() {
     let owned = String::from(text);
     let buf = PathBuf::from(text);
     let want = Some(Path::new(text));
-    let data = [
-        DataInput::from(text),
-        DataInput::from(owned.clone()),
-        DataInput::from(&owned),
-        DataInput::from(buf.clone()),
-        DataInput::from(&buf),
-        DataInput::from(buf.as_path()),
-    ];
-    for d in &data {
+    // `&str`, `String`, `&String`, `PathBuf`, `&PathBuf`, `&Path`.
+    macro_rules! every_path_like {
+        ($input:ty) => {
+            [
+                <$input>::from(text),
+                <$input>::from(owned.clone()),
+                <$input>::from(&owned),
+                <$input>::from(buf.clone()),
+                <$input>::from(&buf),
+                <$input>::from(buf.as_path()),
+            ]
+        };
+    }
+    for d in every_path_like!(DataInput) {
         assert_eq!(d.path(), want, "{d:?}");
     }
-    let machines = [
-        MachineInput::from(text),
-        MachineInput::from(owned.clone()),
-        MachineInput::from(&owned),
-        MachineInput::from(buf.clone()),
-        MachineInput::from(&buf),
-        MachineInput::from(buf.as_path()),
-    ];
-    for m in &machines {
+    for m in every_path_like!(MachineInput) {
         assert_eq!(m.path(), want, "{m:?}");
     }
 }
