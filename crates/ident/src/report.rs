@@ -40,10 +40,9 @@ pub const MAP_SPACING_MM: f64 = 25.0;
 /// # Example
 /// ```no_run
 /// use tricept_ident::report::{ReportRequest, report};
-/// let mut request = ReportRequest::new("calibrated.json", "page.html");
-/// request.history = Some("checks.jsonl".into());
+/// let request = ReportRequest::new("calibrated.json", "page.html").history("checks.jsonl");
 /// let page = report(request)?;
-/// println!("{}", page.text());
+/// println!("{}", page.report());
 /// # Ok::<(), tricept_ident::Error>(())
 /// ```
 #[derive(Debug, Clone)]
