@@ -32,7 +32,8 @@ use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use tricept_ident::MachineInput;
-use tricept_ident::advanced::{LoadedMachine, SensorNoise};
+use tricept_ident::LoadedMachine;
+use tricept_ident::advanced::SensorNoise;
 use tricept_ident::kinematics::{ExtendedMachine, HeadBranch, KinematicsError, Vector3};
 
 use crate::errors::{door_error, input_error, memory_error};

@@ -11,13 +11,13 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
 use tricept_ident::advanced::{
-    LoadedMachine, MachineFile, ParameterSet, Poses, SensorNoise, TrueErrors,
+    MachineFile, ParameterSet, Poses, SensorNoise, TrueErrors,
 };
 use tricept_ident::calibrate::CalibrateRequest;
 use tricept_ident::check::CheckRequest;
 use tricept_ident::diagnosis::DiagnoseRequest;
 use tricept_ident::simulate::SimulateRequest;
-use tricept_ident::{DataInput, MachineInput};
+use tricept_ident::{DataInput, LoadedMachine, MachineInput, WriteOptions};
 
 use crate::Machine;
 use crate::errors::{door_error, door_error_in, input_error};
@@ -162,7 +162,7 @@ impl Calibration {
     fn write_machine(&mut self, py: Python<'_>, path: PathBuf, force: bool) -> PyResult<String> {
         let written = self
             .inner
-            .write_machine(&path, force)
+            .write_machine(&path, WriteOptions::default().force(force))
             .map_err(|e| door_error(py, e))?;
         Ok(written.path().display().to_string())
     }
@@ -270,12 +270,12 @@ impl Diagnosis {
 
     /// The JSON `tricept diagnose --json` prints.
     fn to_json(&self) -> String {
-        versioned(&self.inner.to_json())
+        versioned(&self.inner.to_json().to_string())
     }
 
     /// The text report `tricept diagnose` prints.
     fn report(&self) -> String {
-        self.inner.to_text()
+        self.inner.report()
     }
 
     /// Writes the deployed machine file by the CLI's rule (`UntrustedError`
@@ -287,9 +287,16 @@ impl Diagnosis {
         path: PathBuf,
         force: bool,
     ) -> PyResult<Option<String>> {
-        self.inner
-            .write_machine(&path, force)
-            .map_err(|e| door_error(py, e))
+        let written = self
+            .inner
+            .write_machine(&path, WriteOptions::default().force(force))
+            .map_err(|e| door_error(py, e))?;
+        Ok(written.forced().map(|why| {
+            format!(
+                "{}: written although {why} (forced)",
+                written.path().display()
+            )
+        }))
     }
 
     /// The machine file it may write, as JSON (the door's `MachineFile`);
@@ -318,7 +325,7 @@ fn diagnose(
         .load()
         .map_err(|e| door_error(py, e))?;
     let data = data_input(py, path, csv_text.as_deref(), &name, &loaded)?;
-    let mut request = DiagnoseRequest::new(loaded, data);
+    let mut request = DiagnoseRequest::new(data).machine(loaded);
     request.noise_from_data = noise_from_data;
     request.dictionary = dictionary;
     request.deploy_rule = deploy_rule;
@@ -344,12 +351,12 @@ impl CheckResult {
 
     /// The JSON `tricept check --json` prints.
     fn to_json(&self) -> String {
-        versioned(&self.inner.to_json())
+        versioned(&self.inner.to_json().to_string())
     }
 
     /// The text report `tricept check` prints.
     fn report(&self) -> String {
-        self.inner.to_text()
+        self.inner.report()
     }
 }
 
@@ -400,7 +407,7 @@ fn simulate_csv(
     let loaded = machine_input(py, machine.as_ref(), SensorNoise::default())?
         .load()
         .map_err(|e| door_error(py, e))?;
-    let mut request = SimulateRequest::new(loaded);
+    let mut request = SimulateRequest::new().machine(loaded);
     request.truth = truth
         .parse::<TrueErrors>()
         .map_err(|e| input_error(py, format!("truth: {e}")))?;
@@ -477,7 +484,8 @@ impl Fleet {
     #[pyo3(signature = (path, force=false))]
     fn write_prior(&self, py: Python<'_>, path: PathBuf, force: bool) -> PyResult<Option<String>> {
         self.inner
-            .write_prior(&path, force)
+            .write_prior(&path, WriteOptions::default().force(force))
+            .map(|written| written.forced().map(str::to_string))
             .map_err(|e| door_error(py, e))
     }
 }
@@ -531,6 +539,10 @@ fn report(
         .detach(|| tricept_ident::report::report(request))
         .map_err(|e| door_error(py, e))?;
     let mut v = r.to_json();
+    if let Some(o) = v.as_object_mut() {
+        // As it was: the verdict's keys without the output's version.
+        o.shift_remove("format_version");
+    }
     v["exit_code"] = r.exit_code().into();
     Ok(v.to_string())
 }

@@ -64,15 +64,15 @@ fn sample(args: ReportSampleArgs) -> Result<(), Failure> {
     request.history = Some(HISTORY.into());
     request.export = Some(EXPORT.into());
     let r = report(request)?;
-    print!("{}", r.text());
+    print!("{}", r.report());
     Ok(())
 }
 
 /// The calibration, five daily checks and the export.
 fn inputs() -> Result<(), Failure> {
     std::fs::create_dir_all("fixtures/report/checks")?;
-    let mut fit = calibrate(CalibrateRequest::new(DATA))?;
-    fit.write_machine(Path::new(MACHINE), false)?;
+    let fit = calibrate(CalibrateRequest::new(DATA))?;
+    fit.write_machine(Path::new(MACHINE), tricept_ident::WriteOptions::default())?;
     let description = MachineDescription::from_file(Path::new(MACHINE))?;
     let digest = description.calibration_digest();
     let date = description
@@ -89,7 +89,7 @@ fn inputs() -> Result<(), Failure> {
             slipped("fixtures/report/checks/leg2-slipped.json", 0.025)?
         };
         let data = PathBuf::from(format!("fixtures/report/checks/day{day}.csv"));
-        let mut r = SimulateRequest::new(tricept_ident::MachineInput::default());
+        let mut r = SimulateRequest::new().machine(tricept_ident::MachineInput::default());
         r.truth = truth;
         r.poses = format!("random:20,{}", 40 + day).parse::<Poses>()?;
         r.seed = 40 + day as u64;
@@ -100,7 +100,7 @@ fn inputs() -> Result<(), Failure> {
         let entry = tricept_check::history::Entry {
             calibration_digest: digest.clone(),
             ..tricept_check::history::Entry::of(
-                c.report(),
+                c.check_report(),
                 &iso(day0 + day, 6 * 3600 + 30 * 60),
                 unix_s,
                 MACHINE,
@@ -108,16 +108,16 @@ fn inputs() -> Result<(), Failure> {
             )
         };
         tricept_check::history::append(Path::new(HISTORY), &entry)?;
-        println!("day {day}: {}", c.report().verdict.as_str());
+        println!("day {day}: {}", c.check_report().verdict.as_str());
     }
     // The history's lock file (left in place by design) is no input.
     let _ = std::fs::remove_file(format!("{HISTORY}.lock"));
-    let e = export(ExportRequest {
-        machine: MACHINE.into(),
-        options: ExportOptions::for_model(ControlModel::default()),
-        out: EXPORT.into(),
-    })?;
-    println!("export written: {}", e.written);
+    let e = export(ExportRequest::new(
+        MACHINE,
+        ExportOptions::for_model(ControlModel::default()),
+        EXPORT,
+    ))?;
+    println!("export written: {}", e.written());
     Ok(())
 }
 

@@ -29,10 +29,10 @@ use std::path::{Path, PathBuf};
 
 #[path = "tidy/deps.rs"]
 mod deps;
-#[path = "tidy/roots.rs"]
-mod roots;
 #[path = "tidy/flags.rs"]
 mod flags;
+#[path = "tidy/roots.rs"]
+mod roots;
 
 /// Circles that may stay: `(crate directory, files)`, with why.
 const ALLOWED_CIRCLES: &[(&str, &[&str])] = &[
@@ -929,9 +929,18 @@ const DOOR_ROOT: &[&str] = &[
     "ErrorCause",
     "ErrorKind",
     "Setting",
-    // The two inputs every request is made of.
+    // The two inputs every request is made of, and the machine
+    // `MachineInput::load` returns (a door signature's type is the door's,
+    // not `advanced`'s).
     "DataInput",
+    "LoadedMachine",
     "MachineInput",
+    // The one shape of every workflow's result (issue 49): a program that
+    // handles any result names these, whichever workflow it calls.
+    "Outcome",
+    "WriteOptions",
+    "WritesMachine",
+    "Written",
     // Everything else, behind one module.
     "advanced",
 ];
@@ -1008,8 +1017,77 @@ fn the_door_s_root_is_its_curated_list() {
     // 24: `ErrorCause` (issue 49), which every program that handles an
     // error matches on, beside `Error` and `ErrorKind`; 25: `Setting`,
     // which `Error::setting` returns (the request setting an error is
-    // about, named by each program its own way).
-    assert!(root.len() <= 25, "{} names at the root", root.len());
+    // about, named by each program its own way); 30: the result's
+    // shape (`Outcome`, `WritesMachine`), how a result writes its file
+    // (`WriteOptions`, `Written`), shared by calibrate, diagnosis and fleet,
+    // and `LoadedMachine`, which the root's `MachineInput::load` returns.
+    assert!(root.len() <= 30, "{} names at the root", root.len());
+}
+
+/// One result shape (issue 49): every workflow function of the door (a
+/// top-level `pub fn` whose `Ok` type is a `pub struct` of its own file)
+/// returns a result that implements `tricept_ident::Outcome`, through the
+/// door's `outcome!` macro, which implements the trait from the result's
+/// own methods (so the compiler checks their signatures).
+#[test]
+fn every_workflow_result_has_the_one_shape() {
+    let src = workspace().join("crates/ident/src");
+    let mut results = Vec::new();
+    let mut missing = Vec::new();
+    // The workflows' modules: the lower-case names of the root's list.
+    let workflow = |m: &Module| {
+        m.first().is_some_and(|name| {
+            name != "advanced"
+                && DOOR_ROOT.contains(&name.as_str())
+                && name.starts_with(char::is_lowercase)
+        })
+    };
+    let files = modules(&src);
+    for path in files.iter().filter(|(m, _)| workflow(m)).map(|(_, p)| p) {
+        let code = without_tests(&strip(&std::fs::read_to_string(path).unwrap_or_default()));
+        let flat = code.split_whitespace().collect::<Vec<_>>().join(" ");
+        // Top-level functions only: methods are indented.
+        let mut lines = code.lines();
+        while let Some(line) = lines.next() {
+            if !line.starts_with("pub fn ") {
+                continue;
+            }
+            let mut signature = line.to_string();
+            while !signature.contains('{') {
+                match lines.next() {
+                    Some(next) => signature.push_str(next.trim()),
+                    None => break,
+                }
+            }
+            let Some(ok) = signature
+                .split("-> Result<")
+                .nth(1)
+                .and_then(|r| r.split(',').next())
+                .map(str::trim)
+            else {
+                continue;
+            };
+            let declared = flat.contains(&format!("pub struct {ok} {{"));
+            if !declared {
+                continue;
+            }
+            results.push(ok.to_string());
+            let shaped = flat.contains(&format!("outcome!({ok})"))
+                || flat.contains(&format!("outcome!(writes {ok})"));
+            if !shaped {
+                missing.push(format!("{}: {ok}", path.display()));
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "workflow results without the one shape (`crate::outcome::outcome!(RESULT);`): {missing:?}"
+    );
+    // calibrate, check, compensate, detectability, diagnose, effects,
+    // export, fleet, identifiability, plan, report, simulate, solve_point.
+    results.sort();
+    results.dedup();
+    assert!(results.len() >= 13, "only {results:?} found");
 }
 
 /// One machine input (issue 27): every request field that holds a machine

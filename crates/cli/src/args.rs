@@ -10,14 +10,14 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use tricept_ident::advanced::{
-    Dataset, EffectNames, EvalGrid, HeadAngles, HeadModel, LengthSigma, LoadedMachine,
-    ParameterSet, SensorNoise, TrackerTargetSpec, Triple, TrueErrors,
+    Dataset, EffectNames, EvalGrid, HeadAngles, HeadModel, LengthSigma, ParameterSet, SensorNoise,
+    TrackerTargetSpec, Triple, TrueErrors,
 };
 use tricept_ident::calibrate::{CalibrateRequest, FusedSources};
 use tricept_ident::effects::{Effect, EffectName};
 use tricept_ident::kinematics::GeometricMachine as Machine;
 use tricept_ident::simulate::TruthEffects;
-use tricept_ident::{DataInput, MachineInput};
+use tricept_ident::{DataInput, LoadedMachine, MachineInput};
 
 use crate::cli_error::CliError;
 

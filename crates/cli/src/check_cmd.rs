@@ -52,13 +52,13 @@ pub fn run(a: &CheckArgs) -> Result<u8, CliError> {
     if a.machine.json {
         crate::output::write_json(result.to_json());
     } else {
-        crate::output::write_text(&result.to_text());
+        crate::output::write_text(&result.report());
     }
     for w in result.warnings() {
         errln!("check: warning: {w}");
     }
-    if let Some(why) = result.exit_reason() {
-        errln!("{why}");
+    if let Some(why) = result.reason() {
+        errln!("check: exit {}: {why}", result.exit_code());
     }
     Ok(result.exit_code())
 }

@@ -108,8 +108,8 @@ pub fn run_compensate(a: &CompensateArgs) -> Result<u8, CliError> {
             None => crate::output::write_text(&report),
         }
     }
-    if let Some(line) = c.exit_line() {
-        errln!("{line}");
+    if let Some(why) = c.reason() {
+        errln!("compensate: exit {}: {why}", c.exit_code());
     }
     Ok(c.exit_code())
 }

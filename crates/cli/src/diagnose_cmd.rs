@@ -5,12 +5,13 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use tricept_ident::DataInput;
-use tricept_ident::advanced::{LoadedMachine, Poses};
+use tricept_ident::LoadedMachine;
+use tricept_ident::advanced::Poses;
 use tricept_ident::detectability::{DetectabilityRequest, detectability};
 use tricept_ident::diagnosis::{
     DeployRule, DiagnoseRequest, DiagnoseResult, ResidualPlot, diagnose,
 };
+use tricept_ident::{DataInput, WriteOptions};
 
 use crate::args::{MachineArgs, NoiseArgs, load_with_noise, read_data};
 use crate::cli_error::CliError;
@@ -108,7 +109,7 @@ fn deploy_rule(name: &str) -> Result<DeployRule, CliError> {
 pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
     let loaded = load_with_noise(&a.machine, &a.noise)?;
     let data = read_with_progress(&a.data, &loaded)?;
-    let mut request = DiagnoseRequest::new(loaded, data);
+    let mut request = DiagnoseRequest::new(data).machine(loaded);
     request.noise_from_data = a.noise_from_data;
     request.temperature_noise_k = a.temperature_noise;
     request.plausibility = a.plausibility.clone();
@@ -125,13 +126,13 @@ pub fn run_diagnose(a: &DiagnoseArgs) -> Result<u8, CliError> {
     if a.machine.json {
         crate::output::write_json(result.to_json());
     } else {
-        crate::output::write_text(&result.to_text());
+        crate::output::write_text(&result.report());
     }
     if let Some(Err(e)) = written {
         return Err(e);
     }
-    if let Some(why) = result.exit_reason() {
-        errln!("{why}");
+    if let Some(why) = result.reason() {
+        errln!("diagnose: exit {}: {why}", result.exit_code());
     }
     Ok(result.exit_code())
 }
@@ -147,8 +148,12 @@ fn read_with_progress(path: &Path, loaded: &LoadedMachine) -> Result<DataInput, 
 /// Writes the extended machine, naming the file (and a forced write's
 /// warning) on stderr.
 fn write_machine(result: &DiagnoseResult, path: &Path, force: bool) -> Result<(), CliError> {
-    if let Some(warning) = result.write_machine(path, force)? {
-        errln!("warning: --write-machine {warning}");
+    let written = result.write_machine(path, WriteOptions::default().force(force))?;
+    if let Some(why) = written.forced() {
+        errln!(
+            "warning: {}: written with --force although {why}",
+            path.display()
+        );
     }
     errln!("wrote {}", path.display());
     Ok(())
@@ -185,7 +190,7 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<u8, CliError> {
         Some(path) => Some(read_with_progress(path, &loaded)?),
         None => None,
     };
-    let mut request = DetectabilityRequest::new(loaded, a.poses.clone());
+    let mut request = DetectabilityRequest::new(a.poses.clone()).machine(loaded);
     request.data = data;
     request.both_directions = a.both_directions;
     request.temperature_drift_k = a.temperature_drift;
@@ -193,7 +198,7 @@ pub fn run_detectability(a: &DetectabilityArgs) -> Result<u8, CliError> {
     if a.machine.json {
         crate::output::write_json(report.to_json());
     } else {
-        crate::output::write_text(&report.to_text());
+        crate::output::write_text(&report.report());
     }
     Ok(report.exit_code())
 }

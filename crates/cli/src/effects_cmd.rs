@@ -24,9 +24,9 @@ pub struct EffectsArgs {
 pub fn run(a: &EffectsArgs) -> Result<u8, CliError> {
     let list = tricept_ident::effects::effects(a.effect.as_deref())?;
     if a.json {
-        crate::output::write_json(list.to_json()?);
+        crate::output::write_json_lines(&list.to_json());
     } else {
-        crate::output::write_text(&list.to_text());
+        crate::output::write_text(&list.report());
     }
     Ok(list.exit_code())
 }

@@ -103,9 +103,9 @@ fn parse_three_mm(s: &str) -> Result<[f64; 3], String> {
 
 /// `tricept export`.
 pub fn run(a: &ExportArgs) -> Result<u8, CliError> {
-    let request = ExportRequest {
-        machine: a.machine.as_path().into(),
-        options: ExportOptions {
+    let request = ExportRequest::new(
+        a.machine.as_path(),
+        ExportOptions {
             axis_names: a.axis_names.clone(),
             max_points: a.max_points,
             detection_unit_um: a.detection_unit_um,
@@ -114,13 +114,13 @@ pub fn run(a: &ExportArgs) -> Result<u8, CliError> {
             reference_mm: a.reference_mm,
             ..ExportOptions::for_model(model(a)?)
         },
-        out: a.out.clone(),
-    };
+        a.out.clone(),
+    );
     let e = tricept_ident::export::export(request)?;
     if a.json {
-        crate::output::write_json(e.json(&a.out));
+        crate::output::write_json(e.to_json());
     } else {
-        crate::output::write_text(&e.text(&a.out));
+        crate::output::write_text(&e.report());
     }
-    Ok(e.exit_code)
+    Ok(e.exit_code())
 }

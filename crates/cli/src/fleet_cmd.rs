@@ -55,12 +55,12 @@ pub fn run(a: &FleetArgs) -> Result<u8, CliError> {
     request.tolerance_mm = a.tolerance_mm;
     request.solver = a.solver;
     let result = fleet(request)?;
-    let written = a
-        .write_prior
-        .as_ref()
-        .map(|path| (path, result.write_prior(path, a.force)));
-    if let Some((path, Ok(forced))) = &written {
-        if let Some(why) = forced {
+    let written = a.write_prior.as_ref().map(|path| {
+        let options = tricept_ident::WriteOptions::default().force(a.force);
+        (path, result.write_prior(path, options))
+    });
+    if let Some((path, Ok(w))) = &written {
+        if let Some(why) = w.forced() {
             errln!(
                 "warning: --write-prior {}: written with --force although {why}",
                 path.display()
@@ -77,15 +77,8 @@ pub fn run(a: &FleetArgs) -> Result<u8, CliError> {
         return Err(e);
     }
     let code = result.exit_code();
-    if code != 0 {
-        errln!(
-            "fleet: exit {code}: {} (see the warnings)",
-            result
-                .batch()
-                .warnings
-                .first()
-                .map_or("the batch's fit did not converge", String::as_str)
-        );
+    if let Some(why) = result.reason() {
+        errln!("fleet: exit {code}: {why}");
     }
     Ok(code)
 }

@@ -5,10 +5,10 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use tricept_ident::DataInput;
 use tricept_ident::advanced::Poses;
 use tricept_ident::calibrate::calibrate;
 use tricept_ident::identifiability::{Campaign, IdentifiabilityRequest, assess_identifiability};
+use tricept_ident::{DataInput, WriteOptions};
 
 use crate::args::{IdentifyArgs, MachineArgs, NoiseArgs, ParamArgs};
 use crate::cli_error::CliError;
@@ -45,7 +45,7 @@ pub fn run_identifiability(a: &IdentifiabilityArgs) -> Result<u8, CliError> {
     if a.machine.json {
         crate::output::write_json(result.to_json());
     } else {
-        crate::output::write_text(&result.to_text());
+        crate::output::write_text(&result.report());
     }
     Ok(0)
 }
@@ -55,15 +55,18 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
     let (request, spin) = a.prepare()?;
     let calibration = calibrate(request);
     spin.finish_and_clear();
-    let mut calibration = calibration?;
+    let calibration = calibration?;
     crate::output::warn_all(calibration.machine_warnings());
     let written = a
         .write_machine
         .as_ref()
-        .map(|path| calibration.write_machine(path, a.force));
+        .map(|path| calibration.write_machine(path, WriteOptions::default().force(a.force)));
     if let Some(Ok(w)) = &written {
-        if let Some(warning) = w.forced_warning() {
-            errln!("warning: --write-machine {warning}");
+        if let Some(why) = w.forced() {
+            errln!(
+                "warning: --write-machine {}: written with --force although {why}",
+                w.path().display()
+            );
         }
         errln!("wrote {}", w.path().display());
     }
@@ -78,8 +81,8 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<u8, CliError> {
     if let Some(Err(e)) = written {
         return Err(e);
     }
-    if let Some(line) = calibration.exit_line() {
-        errln!("{line}");
+    if let Some(why) = calibration.reason() {
+        errln!("identify: exit {}: {why}", calibration.exit_code());
     }
     Ok(calibration.exit_code())
 }

@@ -123,7 +123,7 @@ fn kinematics(
     if machine.json {
         crate::output::write_json(solution.to_json());
     } else {
-        crate::output::write_text(&solution.to_text());
+        crate::output::write_text(&solution.report());
     }
     Ok(solution.exit_code())
 }

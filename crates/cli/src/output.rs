@@ -81,6 +81,15 @@ pub fn write_json(text: impl std::fmt::Display) {
     }
 }
 
+/// Writes a `--json` output that is an array as one object per line (as
+/// `tricept effects --json`), anything else as [`write_json`] does.
+pub fn write_json_lines(v: &tricept_ident::advanced::serde_json::Value) {
+    match v.as_array() {
+        Some(items) => write_json(items.iter().map(|o| format!("{o}\n")).collect::<String>()),
+        None => write_json(v),
+    }
+}
+
 /// `text` with every control character but `\n` and `\t` escaped (as
 /// `\u{1b}`); borrowed when there is none (the usual case).
 fn inert(text: &str) -> std::borrow::Cow<'_, str> {

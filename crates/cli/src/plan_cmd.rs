@@ -203,7 +203,7 @@ pub fn run(a: &PlanArgs) -> Result<u8, CliError> {
     if a.machine.json {
         crate::output::write_json(plan.to_json());
     } else {
-        crate::output::write_text(plan.report());
+        crate::output::write_text(&plan.report());
     }
     Ok(0)
 }

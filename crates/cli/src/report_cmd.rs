@@ -44,7 +44,7 @@ pub fn run(a: &ReportArgs) -> Result<u8, CliError> {
     if a.json {
         crate::output::write_json(r.to_json());
     } else {
-        crate::output::write_text(&r.text());
+        crate::output::write_text(&r.report());
     }
     Ok(r.exit_code())
 }

@@ -148,7 +148,7 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
             "--json: needs --out FILE.csv (without it the CSV itself goes to stdout)",
         ));
     }
-    let mut request = SimulateRequest::new(load_with_noise(&a.machine, &a.noise)?);
+    let mut request = SimulateRequest::new().machine(load_with_noise(&a.machine, &a.noise)?);
     request.parameter_set = a.params.set()?;
     if let Some(truth) = &a.truth.truth {
         request.truth = truth.clone();
@@ -163,6 +163,7 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
     request.tracker = tracker(a)?;
     request.ballbar = ballbar(a)?;
     request.touch = touch(a)?;
+    request.out = out.clone();
     let sim = simulate(request)?;
     let written = |path: &std::path::Path, r| crate::files::written(path, r);
     if let (Some(out), Some((data, c))) = (&a.tracker_out, sim.tracker()) {
@@ -193,9 +194,9 @@ pub fn run(a: &SimulateArgs) -> Result<u8, CliError> {
                 tricept_ident::advanced::files::write_path(path, sim.data(), sim.comments()),
             )?;
             if a.machine.json {
-                crate::output::write_json(sim.to_json(path));
+                crate::output::write_json(sim.to_json());
             } else {
-                errln!("{}", sim.to_text(path));
+                errln!("{}", sim.report());
             }
         }
         // A closed stdout (`| head`) is not an error: the writer swallows it.

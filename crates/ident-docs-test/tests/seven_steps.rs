@@ -15,7 +15,7 @@ use tricept_ident::calibrate::{CalibrateRequest, calibrate};
 use tricept_ident::check::{CheckRequest, check};
 use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
 use tricept_ident::kinematics::{Machine, Vector3};
-use tricept_ident::{EXIT_INADEQUATE, EXIT_INPUT, EXIT_OK, ErrorCause, MachineInput};
+use tricept_ident::{EXIT_INADEQUATE, EXIT_INPUT, EXIT_OK, ErrorCause, MachineInput, WriteOptions};
 
 /// The simulated leads of `fixtures/compat/lead.csv`, ppm.
 const LEAD_PPM: [f64; 3] = [60.0, -40.0, 60.0];
@@ -46,7 +46,7 @@ fn the_seven_steps_of_a_downstream_program() -> Result<(), Box<dyn std::error::E
     );
 
     // 2. Identify: trusted only with exit code 0.
-    let mut calibration = calibrate(CalibrateRequest::new(&grid))?;
+    let calibration = calibrate(CalibrateRequest::new(&grid))?;
     assert_eq!(
         calibration.exit_code(),
         EXIT_OK,
@@ -57,7 +57,7 @@ fn the_seven_steps_of_a_downstream_program() -> Result<(), Box<dyn std::error::E
     // 3. Write the calibrated machine file, and read it back: the same
     // machine to command.
     let calibrated = dir.join("calibrated.json");
-    calibration.write_machine(&calibrated, false)?;
+    calibration.write_machine(&calibrated, WriteOptions::default())?;
     let target = Vector3::new(0.0, 0.0, 750.0);
     let from_file = Machine::load(&calibrated)?.inverse(&target)?.legs_mm;
     assert_eq!(
@@ -68,10 +68,10 @@ fn the_seven_steps_of_a_downstream_program() -> Result<(), Box<dyn std::error::E
     // 4. Diagnose a campaign with a hidden effect, and deploy what it
     // finds into a machine file.
     let lead = fixture("compat/lead.csv");
-    let result = diagnose(DiagnoseRequest::new(MachineInput::default(), &lead))?;
+    let result = diagnose(DiagnoseRequest::new(&lead).machine(MachineInput::default()))?;
     assert_eq!(result.exit_code(), EXIT_OK);
     let deployed_file = dir.join("deployed.json");
-    result.write_machine(&deployed_file, false)?;
+    result.write_machine(&deployed_file, WriteOptions::default())?;
     let deployed = Machine::load(&deployed_file)?;
     for (found, simulated) in deployed.leg_effects().lead_ppm.iter().zip(LEAD_PPM) {
         assert!(
@@ -120,12 +120,12 @@ fn the_seven_steps_of_a_downstream_program() -> Result<(), Box<dyn std::error::E
         matches!(e.cause(), ErrorCause::SealBroken { fields } if fields == ["name"]),
         "{e}"
     );
-    let mut untrusted = calibrate(CalibrateRequest::new(fixture(
+    let untrusted = calibrate(CalibrateRequest::new(fixture(
         "data/diagnose-hidden-effect.csv",
     )))?;
     assert_eq!(untrusted.exit_code(), EXIT_INADEQUATE);
     let e = untrusted
-        .write_machine(&dir.join("untrusted.json"), false)
+        .write_machine(&dir.join("untrusted.json"), WriteOptions::default())
         .unwrap_err();
     assert_eq!(e.cause(), ErrorCause::RefusedWrite);
     std::fs::remove_dir_all(&dir).ok();

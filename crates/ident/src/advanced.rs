@@ -13,14 +13,18 @@
 //!   [`EffectNames`], [`EvalGrid`]; the sensor-noise overrides
 //!   ([`SensorNoise`]) and the parameter set ([`ParameterSet`]).
 //! - **The machine loaded ahead**: [`load_machine`] gives a
-//!   [`LoadedMachine`] (its description, its warnings), which converts into
-//!   the [`crate::MachineInput`] every request takes.
+//!   [`crate::LoadedMachine`] (its description, its warnings), which
+//!   converts into the [`crate::MachineInput`] every request takes (as
+//!   [`crate::MachineInput::load`] does).
 //! - **Output format**: the `format_version` of the JSON outputs
 //!   ([`OUTPUT_FORMAT_VERSION`]) and the one way it is put into one
 //!   ([`versioned_json`]: what `--json` prints).
-//! - **Result parts** several workflows share: the [`Accuracy`] a written
-//!   file promises, the [`MachineFile`] a result may write (kept apart
-//!   from it, to write later by the same rule).
+//! - **Result parts**: the [`MachineFile`] a result may write (kept apart
+//!   from it, to write later by the same rule). The result's shape
+//!   ([`crate::Outcome`], [`crate::WritesMachine`]), how it writes
+//!   ([`crate::WriteOptions`], [`crate::Written`]) and the accuracy a
+//!   written file promises ([`crate::calibrate::Accuracy`]) are at the root
+//!   and in the workflows' modules.
 //! - **Low level**: the error mapping of the internal crates' errors
 //!   ([`Classify`], and the file-system failure under one, [`FileFailure`]), the data set in memory ([`Dataset`]) and its reader,
 //!   and the foreign crates whose types results hold (`nalgebra`,
@@ -30,15 +34,14 @@
 //!   flags show ([`DEFAULT_TOLERANCE_MM`], [`DEFAULT_POWER`],
 //!   [`fusable_effects`]).
 
-pub use crate::accuracy::Accuracy;
 pub use crate::calibrate::values::{
     EffectNames, EvalGrid, HeadModel, LengthSigma, TrackerTargetSpec,
 };
 pub use crate::data_input::read_data_from;
 pub use crate::error::{Classify, FileFailure};
 pub use crate::inputs::{
-    FrameMmRad, HeadAngles, LoadedMachine, Poses, SensorNoise, Triple, TrueErrors, load_machine,
-    parse_effects, parse_numbers,
+    FrameMmRad, HeadAngles, Poses, SensorNoise, Triple, TrueErrors, load_machine, parse_effects,
+    parse_numbers,
 };
 pub use crate::json_version::{OUTPUT_FORMAT_VERSION, versioned_json};
 pub use crate::machine_file::MachineFile;

@@ -29,7 +29,7 @@ pub use tricept_check::{CheckReport, check::DEFAULT_ALPHA};
 /// ```no_run
 /// use tricept_ident::check::{CheckRequest, check};
 /// let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
-/// print!("{}", result.to_text());
+/// print!("{}", result.report());
 /// # Ok::<(), tricept_ident::Error>(())
 /// ```
 #[derive(Debug, Clone)]
@@ -60,6 +60,11 @@ impl CheckRequest {
     }
 }
 
+crate::request::setters!(CheckRequest {
+    alpha: f64,
+    history: some into PathBuf,
+});
+
 /// The history a check was appended to.
 #[derive(Debug, Clone)]
 struct History {
@@ -77,7 +82,10 @@ pub struct CheckResult {
     data: String,
     history: Option<History>,
     readings_per_pose: u32,
+    reason: Option<String>,
 }
+
+crate::outcome::outcome!(CheckResult);
 
 /// Runs the check: the reference from the machine's calibration record,
 /// the data read, the history read (refused before the check when it
@@ -129,14 +137,42 @@ pub fn check(request: CheckRequest) -> Result<CheckResult, Error> {
         )?),
         None => None,
     };
+    let reason = changed_reason(&report, &data_name);
     Ok(CheckResult {
         report,
+        reason,
         reference: reference.name().to_string(),
         machine,
         data: data_name,
         history,
         readings_per_pose: loaded.machine().sensors.readings_per_pose.max(1),
     })
+}
+
+/// What changed, one phrase, when the machine changed (`data`: the data
+/// checked).
+fn changed_reason(r: &CheckReport, data: &str) -> Option<String> {
+    if !r.changed {
+        return None;
+    }
+    let what = match r.most_likely {
+        Some(i) if r.shortlist.len() > 1 => format!(
+            "most likely {} (cannot be told apart from {})",
+            r.candidates[i].name,
+            r.shortlist[1..].join(", ")
+        ),
+        Some(i) => format!("most likely {}", r.candidates[i].name),
+        None => "cause unknown".to_string(),
+    };
+    let what = if r.changes.len() > 1 {
+        let names: Vec<&str> = r.changes.iter().map(|c| c.name.as_str()).collect();
+        format!("{what}; the changes: {}", names.join(", "))
+    } else {
+        what
+    };
+    Some(format!(
+        "the machine changed since its calibration ({data}): {what}"
+    ))
 }
 
 /// Appends the check to the history at `path` and computes its trends.
@@ -166,8 +202,9 @@ fn append_to(
 
 impl CheckResult {
     /// The check's report: the verdict, the candidates, the most likely
-    /// change.
-    pub fn report(&self) -> &CheckReport {
+    /// change (the text of [`CheckResult::report`] and the JSON of
+    /// [`CheckResult::to_json`] are made from it).
+    pub fn check_report(&self) -> &CheckReport {
         &self.report
     }
 
@@ -186,31 +223,12 @@ impl CheckResult {
         }
     }
 
-    /// What changed, one line, when the exit code is not 0.
-    pub fn exit_reason(&self) -> Option<String> {
-        let r = &self.report;
-        if !r.changed {
-            return None;
-        }
-        let what = match r.most_likely {
-            Some(i) if r.shortlist.len() > 1 => format!(
-                "most likely {} (cannot be told apart from {})",
-                r.candidates[i].name,
-                r.shortlist[1..].join(", ")
-            ),
-            Some(i) => format!("most likely {}", r.candidates[i].name),
-            None => "cause unknown".to_string(),
-        };
-        let what = if r.changes.len() > 1 {
-            let names: Vec<&str> = r.changes.iter().map(|c| c.name.as_str()).collect();
-            format!("{what}; the changes: {}", names.join(", "))
-        } else {
-            what
-        };
-        Some(format!(
-            "check: exit {EXIT_INADEQUATE}: the machine changed since its calibration ({}): {what}",
-            self.data
-        ))
+    /// Why the exit code is not 0, in one phrase (`None` when it is 0):
+    /// the machine changed, its most likely change and those it cannot be
+    /// told apart from. The `tricept` binary prints it after `check: exit
+    /// 3: `.
+    pub fn reason(&self) -> Option<&str> {
+        self.reason.as_deref()
     }
 
     /// What a person should know although the exit code is 0 or 3, one
@@ -250,9 +268,10 @@ impl CheckResult {
         self.history.as_ref().map_or(&[], |h| &h.trends)
     }
 
-    /// The report as JSON (one line, as `tricept check --json` prints it):
-    /// the report's fields, the machine and data files, the history.
-    pub fn to_json(&self) -> String {
+    /// The report as JSON (what `tricept check --json` prints,
+    /// `format_version` first): the report's fields, the machine and data
+    /// files, the history.
+    pub fn to_json(&self) -> Value {
         let mut v = serde_json::to_value(&self.report).unwrap_or(Value::Null);
         if let Value::Object(o) = &mut v {
             o.insert("machine".into(), self.machine.clone().into());
@@ -264,11 +283,12 @@ impl CheckResult {
                 );
             }
         }
-        v.to_string()
+        crate::outcome::versioned(v)
     }
 
-    /// The report as text, with one line per trend of the history.
-    pub fn to_text(&self) -> String {
+    /// The report as text (what `tricept check` prints), with one line per
+    /// trend of the history.
+    pub fn report(&self) -> String {
         let mut out = format!(
             "check of {} against `{}` ({})\n",
             self.data, self.reference, self.machine
@@ -340,8 +360,9 @@ mod tests {
     #[test]
     fn missing_data_exit_with_the_same_code_from_every_workflow() {
         let missing = "no-such-dir/today.csv";
-        let d = crate::diagnosis::diagnose(DiagnoseRequest::new(paper(), missing)).unwrap_err();
-        let mut r = DetectabilityRequest::new(paper(), crate::inputs::Poses::grid());
+        let d =
+            crate::diagnosis::diagnose(DiagnoseRequest::new(missing).machine(paper())).unwrap_err();
+        let mut r = DetectabilityRequest::new(crate::inputs::Poses::grid()).machine(paper());
         r.data = Some(missing.into());
         let t = crate::detectability::detectability(r).unwrap_err();
         for e in [d, t] {
@@ -361,8 +382,9 @@ mod tests {
         let machine = dir.join("calibrated.json");
         let history = dir.join("checks.jsonl");
         std::fs::remove_file(&history).ok();
-        let d = crate::diagnosis::diagnose(DiagnoseRequest::new(paper(), data)).unwrap();
-        d.write_machine(&machine, false).unwrap();
+        let d = crate::diagnosis::diagnose(DiagnoseRequest::new(data).machine(paper())).unwrap();
+        d.write_machine(&machine, crate::WriteOptions::default())
+            .unwrap();
         for n in 1..=2 {
             let loaded = load_machine(Some(&machine), &SensorNoise::default()).unwrap();
             let mut r = CheckRequest::new(loaded, data);
@@ -370,12 +392,12 @@ mod tests {
             let result = check(r).unwrap();
             assert!(!result.changed());
             assert_eq!(result.exit_code(), EXIT_OK);
-            assert!(result.exit_reason().is_none());
-            let v: Value = serde_json::from_str(&result.to_json()).unwrap();
+            assert!(result.reason().is_none());
+            let v = result.to_json();
             assert_eq!(v["history"]["checks"], n);
             assert_eq!(v["data_file"], data);
             assert!(!result.trends().is_empty());
-            assert!(result.to_text().contains(&format!("({n} checks):")));
+            assert!(result.report().contains(&format!("({n} checks):")));
         }
         let mut r = CheckRequest::new(
             load_machine(Some(&machine), &SensorNoise::default()).unwrap(),

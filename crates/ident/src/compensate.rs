@@ -20,7 +20,7 @@ use tricept_model::{ParameterSet, volumetric::MapStats};
 use tricept_plant::Effect;
 
 use crate::Setting;
-use crate::calibrate::{CalibrateRequest, calibrate, exit_line, write_text};
+use crate::calibrate::{CalibrateRequest, calibrate, exit_reason, write_text};
 use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, Error};
 use crate::inputs::TrueErrors;
 use crate::machine_file::write_rule;
@@ -97,6 +97,19 @@ impl CompensateRequest {
     }
 }
 
+crate::request::setters!(CompensateRequest {
+    force: bool,
+    truth: some TrueErrors,
+    truth_effects: Vec<Effect>,
+    parameter_set: ParameterSet,
+    plane_z_mm: some f64,
+    spacing_mm: f64,
+    targets: some into PathBuf,
+    map_dir: some into PathBuf,
+    table_dir: some into PathBuf,
+    table_spacing_mm: some f64,
+});
+
 /// A target (mm) and its corrected leg commands (mm).
 pub type CorrectedTarget = (Vector3<f64>, [f64; 3]);
 
@@ -121,10 +134,12 @@ pub struct Compensation {
     warnings: Vec<String>,
     machine_warnings: Vec<String>,
     code: u8,
-    why: String,
+    reason: Option<String>,
     z_mm: f64,
     spacing_mm: f64,
 }
+
+crate::outcome::outcome!(Compensation);
 
 /// The two machines of a compensation and where they came from.
 struct Pair {
@@ -160,7 +175,7 @@ fn machines(r: &CompensateRequest) -> Result<Pair, Error> {
                 warnings: fit.warnings().to_vec(),
                 machine_warnings: fit.machine_warnings().to_vec(),
                 code,
-                why: fit.reason(),
+                why: fit.why(),
             })
         }
         Calibrated::MachineFile(machine) => {
@@ -313,7 +328,7 @@ pub fn compensate(request: CompensateRequest) -> Result<Compensation, Error> {
         warnings,
         machine_warnings,
         code,
-        why,
+        reason: exit_reason(code, &why),
         z_mm: z,
         spacing_mm: spacing,
     })
@@ -424,9 +439,10 @@ impl Compensation {
         self.code
     }
 
-    /// The one-line summary of a non-zero exit code.
-    pub fn exit_line(&self) -> Option<String> {
-        exit_line("compensate", self.code, &self.why)
+    /// Why the exit code is not 0, in one phrase (`None` when it is 0):
+    /// why the calibration compensated from is not to be trusted.
+    pub fn reason(&self) -> Option<&str> {
+        self.reason.as_deref()
     }
 
     /// The warnings of the compensation (the calibration's, the table's).
@@ -455,7 +471,8 @@ impl Compensation {
         self.spacing_mm
     }
 
-    /// The JSON `tricept compensate --json` prints.
+    /// The JSON `tricept compensate --json` prints (`format_version`
+    /// first).
     pub fn to_json(&self) -> Value {
         let mut out = self.out.clone();
         if let Some(rows) = &self.targets {
@@ -468,7 +485,7 @@ impl Compensation {
                 ),
             );
         }
-        Value::Object(out)
+        crate::outcome::versioned(Value::Object(out))
     }
 
     /// The text report.

@@ -37,11 +37,11 @@ pub struct DetectabilityRequest {
 }
 
 impl DetectabilityRequest {
-    /// The planned campaign `poses` on `machine`, one direction, a drift of
-    /// 2 K.
-    pub fn new(machine: impl Into<MachineInput>, poses: Poses) -> DetectabilityRequest {
+    /// The planned campaign `poses` on the Table 1 machine, one
+    /// direction, a drift of 2 K.
+    pub fn new(poses: Poses) -> DetectabilityRequest {
         DetectabilityRequest {
-            machine: machine.into(),
+            machine: MachineInput::default(),
             poses,
             data: None,
             both_directions: false,
@@ -49,6 +49,14 @@ impl DetectabilityRequest {
         }
     }
 }
+
+crate::request::setters!(DetectabilityRequest {
+    machine: into MachineInput,
+    poses: Poses,
+    data: some into DataInput,
+    both_directions: bool,
+    temperature_drift_k: f64,
+});
 
 /// Each effect's detectability on the campaign, with advice.
 #[derive(Debug, Clone)]
@@ -58,6 +66,8 @@ pub struct DetectabilityReport {
     readings_per_pose: u32,
     campaign: String,
 }
+
+crate::outcome::outcome!(DetectabilityReport);
 
 /// Assesses the request's campaign.
 pub fn detectability(request: DetectabilityRequest) -> Result<DetectabilityReport, Error> {
@@ -149,20 +159,27 @@ impl DetectabilityReport {
         EXIT_OK
     }
 
-    /// The report as JSON (one line, as `tricept detectability --json`
-    /// prints it).
-    pub fn to_json(&self) -> String {
+    /// Always `None`: an assessment has no verdict.
+    pub fn reason(&self) -> Option<&str> {
+        None
+    }
+
+    /// The report as JSON (what `tricept detectability --json` prints,
+    /// `format_version` first).
+    pub fn to_json(&self) -> Value {
         let v: Vec<Value> = self
             .rows
             .iter()
             .map(|(label, d, advice)| json!({"magnitude": label, "analysis": d, "advice": advice}))
             .collect();
-        json!({"poses": self.poses, "readings_per_pose": self.readings_per_pose, "effects": v})
-            .to_string()
+        crate::outcome::versioned(
+            json!({"poses": self.poses, "readings_per_pose": self.readings_per_pose, "effects": v}),
+        )
     }
 
-    /// The report as text: the campaign, a Markdown table, the noise note.
-    pub fn to_text(&self) -> String {
+    /// The report as text (what `tricept detectability` prints): the
+    /// campaign, a Markdown table, the noise note.
+    pub fn report(&self) -> String {
         let mut out = format!("{}\n", self.campaign);
         out.push_str(
             "| effect | magnitude | power | detectable from | geometric held-out rms | halved from | largest bias (mm) | advice |\n",

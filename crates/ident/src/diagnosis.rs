@@ -22,13 +22,14 @@ use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
 use crate::Setting;
-use crate::accuracy::Accuracy;
 use crate::data_input::DataInput;
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
 
+pub use crate::accuracy::Accuracy;
+pub use crate::outcome::{WriteOptions, Written};
 pub use tricept_diagnose::{Deployed, Diagnosis, options::DeployRule, report::ResidualPlot};
 
 /// What to diagnose and how.
@@ -37,8 +38,8 @@ pub use tricept_diagnose::{Deployed, Diagnosis, options::DeployRule, report::Res
 /// ```no_run
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
-/// let result = diagnose(DiagnoseRequest::new(MachineInput::default(), "data.csv"))?;
-/// println!("{}", result.to_text());
+/// let result = diagnose(DiagnoseRequest::new("data.csv").machine(MachineInput::default()))?;
+/// println!("{}", result.report());
 /// std::process::exit(i32::from(result.exit_code()));
 /// # Ok::<(), tricept_ident::Error>(())
 /// ```
@@ -67,11 +68,11 @@ pub struct DiagnoseRequest {
 }
 
 impl DiagnoseRequest {
-    /// A diagnosis of `data` measured on `machine`, with the default
-    /// options.
-    pub fn new(machine: impl Into<MachineInput>, data: impl Into<DataInput>) -> DiagnoseRequest {
+    /// A diagnosis of `data` measured on the Table 1 machine, with the
+    /// default options.
+    pub fn new(data: impl Into<DataInput>) -> DiagnoseRequest {
         DiagnoseRequest {
-            machine: machine.into(),
+            machine: MachineInput::default(),
             data: data.into(),
             noise_from_data: false,
             temperature_noise_k: None,
@@ -81,6 +82,15 @@ impl DiagnoseRequest {
         }
     }
 }
+
+crate::request::setters!(DiagnoseRequest {
+    machine: into MachineInput,
+    noise_from_data: bool,
+    temperature_noise_k: some f64,
+    plausibility: some into PathBuf,
+    dictionary: bool,
+    deploy_rule: DeployRule,
+});
 
 /// A diagnosis with what it needs to deploy its final model.
 #[derive(Debug, Clone)]
@@ -92,8 +102,20 @@ pub struct DiagnoseResult {
     machine: LoadedMachine,
     rank_reference: Option<Machine>,
     deploy_rule: DeployRule,
-    /// The accuracy of the machine file written, once written.
-    promise: OnceLock<Accuracy>,
+    /// Why the exit code is not 0.
+    reason: Option<String>,
+    /// The final model deployed and the accuracy of its machine file,
+    /// made once when first needed.
+    deployment: OnceLock<Result<Deployment, Error>>,
+}
+
+crate::outcome::outcome!(writes DiagnoseResult);
+
+/// The final model deployed, with the accuracy its machine file promises.
+#[derive(Debug, Clone)]
+struct Deployment {
+    deployed: Deployed,
+    promise: Accuracy,
 }
 
 /// Diagnoses the request's data: every problem of the input is an error of
@@ -129,12 +151,22 @@ pub fn diagnose(request: DiagnoseRequest) -> Result<DiagnoseResult, Error> {
     }
     if let Some(path) = &plausibility {
         let file = path.display().to_string();
-        let text = tricept_data::bounded::read_json_text(path).map_err(|e| Error::unreadable(&file, e))?;
+        let text =
+            tricept_data::bounded::read_json_text(path).map_err(|e| Error::unreadable(&file, e))?;
         options.plausibility = Plausibility::with_overrides(&text)
             .map_err(|e| Error::input(format!("{file}: {e}")))?;
     }
     let diagnosis = tricept_diagnose::diagnose(m, &dataset, &options)
         .map_err(|e| diagnose_error(&source, e))?;
+    let reason = (!diagnosis.final_adequate).then(|| {
+        format!(
+            "the final model does not explain the data: {}",
+            diagnosis
+                .unexplained
+                .as_deref()
+                .unwrap_or("a remainder is reported (see the report)")
+        )
+    });
     Ok(DiagnoseResult {
         diagnosis,
         source,
@@ -143,7 +175,8 @@ pub fn diagnose(request: DiagnoseRequest) -> Result<DiagnoseResult, Error> {
         rank_reference: options.rank_reference,
         deploy_rule,
         machine: loaded,
-        promise: OnceLock::new(),
+        reason,
+        deployment: OnceLock::new(),
     })
 }
 
@@ -181,17 +214,11 @@ impl DiagnoseResult {
         }
     }
 
-    /// Why the exit code is not 0, one line (`None` when it is).
-    pub fn exit_reason(&self) -> Option<String> {
-        (!self.explained()).then(|| {
-            format!(
-                "diagnose: exit {EXIT_INADEQUATE}: the final model does not explain the data: {}",
-                self.diagnosis
-                    .unexplained
-                    .as_deref()
-                    .unwrap_or("a remainder is reported (see the report)")
-            )
-        })
+    /// Why the exit code is not 0, in one phrase (`None` when it is 0):
+    /// what the final model leaves unexplained. The `tricept` binary
+    /// prints it after `diagnose: exit 3: `.
+    pub fn reason(&self) -> Option<&str> {
+        self.reason.as_deref()
     }
 
     /// The residual plots of the named causes (before and after).
@@ -199,24 +226,26 @@ impl DiagnoseResult {
         &self.diagnosis.plots
     }
 
-    /// The report as JSON (one line, as `tricept diagnose --json` prints
-    /// it), with the `accuracy` of the machine file once one is written.
-    pub fn to_json(&self) -> String {
+    /// The report as JSON (what `tricept diagnose --json` prints,
+    /// `format_version` first), with the `accuracy` of the machine file
+    /// once it is made ([`DiagnoseResult::accuracy`],
+    /// [`DiagnoseResult::write_machine`]).
+    pub fn to_json(&self) -> serde_json::Value {
         let mut v = self.diagnosis.to_json();
         if let serde_json::Value::Object(o) = &mut v {
             o.insert("deploy_rule".into(), self.deploy_rule.name().into());
-            if let Some(a) = self.accuracy() {
+            if let Some(a) = self.made_accuracy() {
                 o.insert("accuracy".into(), a.to_json());
             }
         }
-        v.to_string()
+        crate::outcome::versioned(v)
     }
 
-    /// The report as text, the accuracy of the machine file first once
-    /// one is written.
-    pub fn to_text(&self) -> String {
+    /// The report as text (what `tricept diagnose` prints), the accuracy
+    /// of the machine file first once it is made.
+    pub fn report(&self) -> String {
         let text = self.diagnosis.to_text(&self.source);
-        match self.accuracy() {
+        match self.made_accuracy() {
             // After the verdict's line.
             Some(a) => match text.split_once('\n') {
                 Some((first, rest)) => format!("{first}\n{}\n{rest}", a.line()),
@@ -226,22 +255,55 @@ impl DiagnoseResult {
         }
     }
 
-    /// The accuracy the machine file written will deliver (`None` until
-    /// one is written, [`DiagnoseResult::write_machine`]).
+    /// The accuracy the machine file of the final model promises: the
+    /// final model is deployed once, when first needed (here, by
+    /// [`DiagnoseResult::write_machine`] or
+    /// [`DiagnoseResult::machine_file`]), and kept. `None` when it cannot
+    /// be deployed ([`DiagnoseResult::deploy`] says why).
     pub fn accuracy(&self) -> Option<&Accuracy> {
-        self.promise.get()
+        self.deployment().ok().map(|d| &d.promise)
     }
 
-    /// Deploys the final model: each term worth deploying where the
+    /// The accuracy, once the final model has been deployed (the report
+    /// and the JSON state it then).
+    fn made_accuracy(&self) -> Option<&Accuracy> {
+        match self.deployment.get() {
+            Some(Ok(d)) => Some(&d.promise),
+            _ => None,
+        }
+    }
+
+    /// The final model deployed: each term worth deploying where the
     /// registry says it goes, generic leg errors as compensation tables,
-    /// the controller parameters of dynamic effects.
-    pub fn deploy(&self) -> Result<Deployed, Error> {
-        Ok(tricept_diagnose::deploy(
-            self.machine.machine(),
-            self.rank_reference.as_ref(),
-            &self.data,
-            &self.diagnosis,
-        )?)
+    /// the controller parameters of dynamic effects. Deployed once, when
+    /// first needed, and kept.
+    pub fn deploy(&self) -> Result<&Deployed, Error> {
+        self.deployment().map(|d| &d.deployed)
+    }
+
+    fn deployment(&self) -> Result<&Deployment, Error> {
+        self.deployment
+            .get_or_init(|| {
+                let nominal = self.machine.machine();
+                let deployed = tricept_diagnose::deploy(
+                    nominal,
+                    self.rank_reference.as_ref(),
+                    &self.data,
+                    &self.diagnosis,
+                )?;
+                let (promise, _) = crate::accuracy::of_fit(
+                    nominal,
+                    &ParameterSet::paper15(),
+                    &deployed.model,
+                    &deployed.id,
+                    &deployed.clean,
+                    &tricept_engine::IdentifyOptions::for_machine(nominal),
+                    tricept_engine::accuracy::DEFAULT_TOLERANCE_MM,
+                )?;
+                Ok(Deployment { deployed, promise })
+            })
+            .as_ref()
+            .map_err(Error::clone)
     }
 
     /// Why the final model cannot be written as a calibration: the misfit
@@ -262,7 +324,7 @@ impl DiagnoseResult {
     /// (exit 3) when the data are not explained, unless `force`. Returns
     /// the description and, for a forced one, why it is not to be trusted.
     /// `what` names the output in messages.
-    pub fn extended_description(
+    fn extended_description(
         &self,
         what: &str,
         force: bool,
@@ -280,18 +342,8 @@ impl DiagnoseResult {
                 "{what}: the record hashes the data file: diagnose a data file to write a machine"
             )));
         };
-        let deployed = self.deploy()?;
+        let Deployment { deployed, promise } = self.deployment()?;
         let g = ParameterSet::paper15().len();
-        let nominal = self.machine.machine();
-        let (promise, _) = crate::accuracy::of_fit(
-            nominal,
-            &ParameterSet::paper15(),
-            &deployed.model,
-            &deployed.id,
-            &deployed.clean,
-            &tricept_engine::IdentifyOptions::for_machine(nominal),
-            tricept_engine::accuracy::DEFAULT_TOLERANCE_MM,
-        )?;
         let mut description = machine_file::calibrated_description(
             &self.machine,
             &deployed.geometry,
@@ -304,7 +356,7 @@ impl DiagnoseResult {
                 adequate: forced.is_none(),
                 forced: forced.clone(),
                 warnings: problems.into_iter().chain(alias_notes(d)).collect(),
-                effects: effect_records(d, &deployed, g),
+                effects: effect_records(d, deployed, g),
                 n_geometric: g,
                 external: Vec::new(),
                 temperature_c: machine_file::mean_temperature_c(&self.data),
@@ -313,10 +365,9 @@ impl DiagnoseResult {
             deployed.controller,
         )?;
         if let Some(c) = description.calibration.as_mut() {
-            c.applies = deployed.applied;
-            c.records = deployed.recorded;
+            c.applies = deployed.applied.clone();
+            c.records = deployed.recorded.clone();
         }
-        let _ = self.promise.set(promise);
         Ok((description, forced))
     }
 
@@ -338,14 +389,29 @@ impl DiagnoseResult {
     }
 
     /// Writes the calibrated machine of the final model to `path`
-    /// atomically ([`DiagnoseResult::extended_description`]); returns the
-    /// warning of a forced write (`--write-machine PATH: written with
-    /// --force although ...`).
-    pub fn write_machine(&self, path: &Path, force: bool) -> Result<Option<String>, Error> {
+    /// atomically, by the one write rule: refused (exit code 3) when the
+    /// final model does not explain the data, unless
+    /// [`WriteOptions::force`], and the file then says it was forced; an
+    /// input error for data given in memory (the record hashes the data
+    /// file). The final model is deployed once ([`DiagnoseResult::deploy`])
+    /// however many files are written.
+    ///
+    /// # Example
+    /// ```no_run
+    /// use tricept_ident::{MachineInput, WriteOptions};
+    /// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+    /// let result = diagnose(DiagnoseRequest::new("data.csv").machine("calibrated.json"))?;
+    /// let written = result.write_machine("deployed.json".as_ref(), WriteOptions::default().force(true))?;
+    /// if let Some(why) = written.forced() {
+    ///     eprintln!("{} written although {why}", written.path().display());
+    /// }
+    /// # Ok::<(), tricept_ident::Error>(())
+    /// ```
+    pub fn write_machine(&self, path: &Path, options: WriteOptions) -> Result<Written, Error> {
         let what = path.display().to_string();
-        let (description, forced) = self.extended_description(&what, force)?;
+        let (description, forced) = self.extended_description(&what, options.is_forced())?;
         crate::machine_file::write(path, &description).map_err(|e| Error::not_written(path, &e))?;
-        Ok(forced.map(|why| format!("{what}: written although {why} (forced)")))
+        Ok(Written::new("machine file", path, forced))
     }
 }
 
@@ -453,18 +519,23 @@ mod tests {
     #[test]
     fn data_in_memory_diagnose_as_their_file_and_only_a_file_is_recorded() {
         let m = load_machine(None, &SensorNoise::default()).unwrap();
-        let from_file = diagnose(DiagnoseRequest::new(m.clone(), DATA)).unwrap();
+        let from_file = diagnose(DiagnoseRequest::new(DATA).machine(m.clone())).unwrap();
         let data = tricept_data::read_path(Path::new(DATA)).unwrap();
-        let from_memory = diagnose(DiagnoseRequest::new(m, data)).unwrap();
+        let from_memory = diagnose(DiagnoseRequest::new(data).machine(m)).unwrap();
         assert_eq!(from_file.to_json(), from_memory.to_json());
         assert_eq!(from_file.exit_code(), EXIT_OK);
-        assert!(from_file.exit_reason().is_none());
+        assert!(from_file.reason().is_none());
         let out =
             std::env::temp_dir().join(format!("tricept-door-diagnose-{}.json", std::process::id()));
-        let e = from_memory.write_machine(&out, false).unwrap_err();
+        let e = from_memory
+            .write_machine(&out, WriteOptions::default())
+            .unwrap_err();
         assert_eq!(e.exit_code(), EXIT_INPUT);
         assert!(!out.exists());
-        assert_eq!(from_file.write_machine(&out, false).unwrap(), None);
+        let written = from_file
+            .write_machine(&out, WriteOptions::default())
+            .unwrap();
+        assert_eq!((written.path(), written.forced()), (out.as_path(), None));
         let written = load_machine(Some(&out), &SensorNoise::default()).unwrap();
         let record = written.description().calibration.as_ref().unwrap();
         assert_eq!(record.method, "diagnose");
@@ -475,7 +546,7 @@ mod tests {
     #[test]
     fn a_bad_temperature_noise_is_an_input_error() {
         let m = load_machine(None, &SensorNoise::default()).unwrap();
-        let mut r = DiagnoseRequest::new(m, DATA);
+        let mut r = DiagnoseRequest::new(DATA).machine(m);
         r.temperature_noise_k = Some(-1.0);
         let e = diagnose(r).unwrap_err();
         assert_eq!(e.exit_code(), EXIT_INPUT);

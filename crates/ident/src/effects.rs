@@ -17,6 +17,8 @@ pub struct EffectList {
     effects: Vec<Effect>,
 }
 
+crate::outcome::outcome!(EffectList);
+
 /// The simulator's effects, or the one named `name` (`leg-lead`,
 /// `compliance`, ...): an input error naming the effects when there is no
 /// such effect.
@@ -24,7 +26,7 @@ pub struct EffectList {
 /// # Example
 /// ```
 /// let all = tricept_ident::effects::effects(None).unwrap();
-/// assert!(all.to_text().contains("leg-lead"));
+/// assert!(all.report().contains("leg-lead"));
 /// assert!(tricept_ident::effects::effects(Some("nothing")).is_err());
 /// ```
 pub fn effects(name: Option<&str>) -> Result<EffectList, Error> {
@@ -54,11 +56,17 @@ impl EffectList {
         EXIT_OK
     }
 
-    /// One JSON object per line (as `tricept effects --json` prints them):
-    /// `effect`, `in_vocabulary`, `diagnosed_as`, `keys` (`key`, `unit`,
-    /// `meaning`) and `example`.
-    pub fn to_json(&self) -> Result<String, Error> {
-        let mut out = String::new();
+    /// Always `None`: a listing has no verdict.
+    pub fn reason(&self) -> Option<&str> {
+        None
+    }
+
+    /// An array of one JSON object per effect (`tricept effects --json`
+    /// prints one per line), each with `format_version` first: `effect`,
+    /// `in_vocabulary`, `diagnosed_as`, `keys` (`key`, `unit`, `meaning`)
+    /// and `example`.
+    pub fn to_json(&self) -> Value {
+        let mut out = Vec::new();
         for e in &self.effects {
             let keys: Vec<Value> = e
                 .keys()
@@ -70,16 +78,16 @@ impl EffectList {
                 "in_vocabulary": e.in_vocabulary(),
                 "diagnosed_as": e.name().to_string(),
                 "keys": keys,
-                "example": serde_json::to_value(e).map_err(|x| Error::other(x.to_string()))?,
+                "example": serde_json::to_value(e).unwrap_or(Value::Null),
             });
-            out.push_str(&format!("{line}\n"));
+            out.push(crate::outcome::versioned(line));
         }
-        Ok(out)
+        Value::Array(out)
     }
 
-    /// The listing as text: each effect, its keys with units and meanings,
-    /// and its typical `--truth-effect`.
-    pub fn to_text(&self) -> String {
+    /// The listing as text (what `tricept effects` prints): each effect,
+    /// its keys with units and meanings, and its typical `--truth-effect`.
+    pub fn report(&self) -> String {
         let mut out = String::new();
         for e in &self.effects {
             let example = serde_json::to_string(e).unwrap_or_default();
@@ -109,14 +117,18 @@ mod tests {
     #[test]
     fn one_effect_is_one_json_line_and_an_unknown_one_is_an_input_error() {
         let one = effects(Some("leg-lead")).unwrap();
-        let json = one.to_json().unwrap();
-        assert_eq!(json.lines().count(), 1);
-        let v: Value = serde_json::from_str(json.trim()).unwrap();
+        let json = one.to_json();
+        assert_eq!(json.as_array().map(Vec::len), Some(1));
+        let v = &json[0];
         assert_eq!(v["effect"], "leg-lead");
-        assert!(one.to_text().starts_with("leg-lead ("));
+        assert_eq!(v["format_version"], 1);
+        assert!(one.report().starts_with("leg-lead ("));
         let all = effects(None).unwrap();
         assert!(all.effects().len() > 1);
-        assert_eq!(all.to_json().unwrap().lines().count(), all.effects().len());
+        assert_eq!(
+            all.to_json().as_array().map(Vec::len),
+            Some(all.effects().len())
+        );
         let e = effects(Some("nothing")).unwrap_err();
         assert_eq!(e.exit_code(), crate::EXIT_INPUT);
         assert!(e.message().contains("leg-lead"), "{}", e.message());

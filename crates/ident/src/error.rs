@@ -583,14 +583,15 @@ impl Error {
 /// not exist (with the file-system failure `NotFound`).
 /// The one-line summary of a non-zero verdict (`VERB: exit CODE: WHY (see
 /// the warnings)`) for 3 and 4, else `None`.
-pub(crate) fn exit_line(verb: &str, code: u8, why: &str) -> Option<String> {
+pub(crate) fn exit_reason(code: u8, why: &str) -> Option<String> {
     (code == EXIT_INADEQUATE || code == EXIT_NOT_CONVERGED)
-        .then(|| format!("{verb}: exit {code}: {why} (see the warnings)"))
+        .then(|| format!("{why} (see the warnings)"))
 }
 
 pub(crate) fn check_output_path(setting: Setting, path: &std::path::Path) -> Result<(), Error> {
     let shown = path.display();
-    tricept_data::atomic::check_output_file(path).map_err(|e| Error::invalid_value(setting, &shown, e))?;
+    tricept_data::atomic::check_output_file(path)
+        .map_err(|e| Error::invalid_value(setting, &shown, e))?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => std::path::Path::new("."),

@@ -14,6 +14,7 @@ pub use tricept_export::{
 
 /// What to export, and where.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct ExportRequest {
     /// The calibrated machine file (read as written: an input without a
     /// file is refused).
@@ -25,31 +26,82 @@ pub struct ExportRequest {
     pub out: PathBuf,
 }
 
+impl ExportRequest {
+    /// The export of the calibrated machine file `machine` for the control
+    /// and limits of `options` into the folder `out`.
+    pub fn new(
+        machine: impl Into<MachineInput>,
+        options: ExportOptions,
+        out: impl Into<PathBuf>,
+    ) -> ExportRequest {
+        ExportRequest {
+            machine: machine.into(),
+            options,
+            out: out.into(),
+        }
+    }
+}
+
 /// The outcome of an export.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Export {
-    /// The summary (the JSON of `--json`).
-    pub summary: ExportSummary,
-    /// Whether the files were written (not when a format error is past
-    /// the tolerance).
-    pub written: bool,
-    /// 0 written; 3 a format error past the tolerance (nothing written).
-    pub exit_code: u8,
+    summary: ExportSummary,
+    written: bool,
+    out: PathBuf,
 }
 
+crate::outcome::outcome!(Export);
+
+/// Why an export writes nothing.
+const NOT_WRITTEN: &str =
+    "a format error is past the tolerance or a control's range: nothing written (see the report)";
+
 impl Export {
-    /// The summary as JSON, with `written` and the output directory.
-    pub fn json(&self, out: &std::path::Path) -> serde_json::Value {
-        let mut v = serde_json::to_value(&self.summary).unwrap_or_default();
-        if let serde_json::Value::Object(o) = &mut v {
-            o.insert("out".into(), out.display().to_string().into());
-            o.insert("written".into(), self.written.into());
-        }
-        v
+    /// The summary (the JSON of `--json` without `out` and `written`).
+    pub fn summary(&self) -> &ExportSummary {
+        &self.summary
     }
 
-    /// The text report.
-    pub fn text(&self, out: &std::path::Path) -> String {
+    /// Whether the files were written (not when a format error is past
+    /// the tolerance).
+    pub fn written(&self) -> bool {
+        self.written
+    }
+
+    /// The folder the files go into.
+    pub fn out(&self) -> &std::path::Path {
+        &self.out
+    }
+
+    /// 0 written; 3 a format error past the tolerance (nothing written).
+    pub fn exit_code(&self) -> u8 {
+        if self.written {
+            EXIT_OK
+        } else {
+            EXIT_INADEQUATE
+        }
+    }
+
+    /// Why the exit code is not 0 (`None` when it is 0): nothing was
+    /// written.
+    pub fn reason(&self) -> Option<&str> {
+        (!self.written).then_some(NOT_WRITTEN)
+    }
+
+    /// The summary as JSON (what `tricept export --json` prints,
+    /// `format_version` first), with `written` and the output folder.
+    pub fn to_json(&self) -> serde_json::Value {
+        let mut v = serde_json::to_value(&self.summary).unwrap_or_default();
+        if let serde_json::Value::Object(o) = &mut v {
+            o.insert("out".into(), self.out.display().to_string().into());
+            o.insert("written".into(), self.written.into());
+        }
+        crate::outcome::versioned(v)
+    }
+
+    /// The text report (what `tricept export` prints).
+    pub fn report(&self) -> String {
+        let out = &self.out;
         let s = &self.summary;
         let mut t = format!(
             "{} export {} {}\n",
@@ -126,6 +178,6 @@ pub fn export(request: ExportRequest) -> Result<Export, Error> {
     Ok(Export {
         summary: plan.summary,
         written,
-        exit_code: if written { EXIT_OK } else { EXIT_INADEQUATE },
+        out,
     })
 }

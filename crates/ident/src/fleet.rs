@@ -21,6 +21,7 @@ use tricept_fleet::{
 };
 use tricept_model::ParameterSet;
 
+pub use crate::outcome::{WriteOptions, Written};
 pub use tricept_fleet::batch::SolverKind;
 
 use crate::Setting;
@@ -67,6 +68,13 @@ impl FleetRequest {
     }
 }
 
+crate::request::setters!(FleetRequest {
+    machine: into MachineInput,
+    parameter_set: ParameterSet,
+    tolerance_mm: f64,
+    solver: SolverKind,
+});
+
 /// A batch calibrated.
 #[derive(Debug)]
 pub struct FleetResult {
@@ -74,7 +82,10 @@ pub struct FleetResult {
     batch: Batch,
     parameter_set: String,
     files: Vec<Option<PathBuf>>,
+    reason: Option<String>,
 }
+
+crate::outcome::outcome!(FleetResult);
 
 /// Calibrates the batch of `request` (module docs). Errors: bad files and
 /// fewer than three machines whose data fit are input errors (exit 2).
@@ -114,7 +125,17 @@ pub fn fleet(request: FleetRequest) -> Result<FleetResult, Error> {
         &options,
     )
     .map_err(|e| Error::with_context("fleet", e))?;
+    let reason = (batch.exit_code() != 0).then(|| {
+        format!(
+            "{} (see the warnings)",
+            batch
+                .warnings
+                .first()
+                .map_or("the batch's fit did not converge", String::as_str)
+        )
+    });
     Ok(FleetResult {
+        reason,
         loaded,
         batch,
         parameter_set: set.label().to_string(),
@@ -139,7 +160,15 @@ impl FleetResult {
         self.batch.exit_code()
     }
 
-    /// The JSON of `tricept fleet --json` (the batch's keys, and `machine`).
+    /// Why the exit code is not 0, in one phrase (`None` when it is 0):
+    /// the batch's first warning. The `tricept` binary prints it after
+    /// `fleet: exit CODE: `.
+    pub fn reason(&self) -> Option<&str> {
+        self.reason.as_deref()
+    }
+
+    /// The JSON of `tricept fleet --json` (`format_version` first, the
+    /// batch's keys, and `machine`).
     pub fn to_json(&self) -> Value {
         let mut v = self.batch.to_json();
         if let Value::Object(o) = &mut v {
@@ -149,10 +178,10 @@ impl FleetResult {
             );
             o.insert("parameter_set".into(), self.parameter_set.clone().into());
         }
-        v
+        crate::outcome::versioned(v)
     }
 
-    /// The text report.
+    /// The text report (what `tricept fleet` prints).
     pub fn report(&self) -> String {
         self.batch.to_text()
     }
@@ -161,8 +190,9 @@ impl FleetResult {
     /// (`identify --prior`) at `path`, atomically. Refused (an error of
     /// the batch's exit code) when the batch estimate itself is not to be
     /// trusted (not converged, or not one population) unless `force`;
-    /// machines kept out do not enter it and do not stop it.
-    pub fn write_prior(&self, path: &Path, force: bool) -> Result<Option<String>, Error> {
+    /// machines kept out do not enter it and do not stop it
+    /// ([`WriteOptions::force`] writes it anyway, saying so).
+    pub fn write_prior(&self, path: &Path, options: WriteOptions) -> Result<Written, Error> {
         let b = &self.batch;
         let why = if !(b.joint.converged && b.spread.converged) {
             Some("the batch's fit did not converge".to_string())
@@ -176,8 +206,12 @@ impl FleetResult {
             Some(_) => b.exit_code().max(tricept_fleet::own::EXIT_INADEQUATE),
         };
         let what = path.display().to_string();
-        let forced =
-            crate::machine_file::write_rule(&what, code, why.as_deref().unwrap_or(""), force)?;
+        let forced = crate::machine_file::write_rule(
+            &what,
+            code,
+            why.as_deref().unwrap_or(""),
+            options.is_forced(),
+        )?;
         let data_files = b
             .machines
             .iter()
@@ -208,6 +242,6 @@ impl FleetResult {
             serde_json::to_value(self.loaded.nominal_description()).unwrap_or(Value::Null);
         let file = PriorFile::new(b, machine, &self.parameter_set, provenance);
         crate::calibrate::write_text(path, &(file.to_json() + "\n"))?;
-        Ok(forced)
+        Ok(Written::new("prior", path, forced))
     }
 }

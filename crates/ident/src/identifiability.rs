@@ -51,6 +51,11 @@ impl IdentifiabilityRequest {
     }
 }
 
+crate::request::setters!(IdentifiabilityRequest {
+    machine: into MachineInput,
+    parameter_set: ParameterSet,
+});
+
 /// The identifiability of a campaign.
 #[derive(Debug, Clone)]
 pub struct Identifiability {
@@ -61,6 +66,8 @@ pub struct Identifiability {
     campaign: String,
     warnings: Vec<String>,
 }
+
+crate::outcome::outcome!(Identifiability);
 
 /// Assesses what `request`'s campaign can identify.
 ///
@@ -121,8 +128,9 @@ pub fn assess_identifiability(request: IdentifiabilityRequest) -> Result<Identif
 }
 
 impl Identifiability {
-    /// The engine's report.
-    pub fn report(&self) -> &IdentifiabilityReport {
+    /// The engine's report (the text of [`Identifiability::report`] and
+    /// the JSON of [`Identifiability::to_json`] are made from it).
+    pub fn identifiability_report(&self) -> &IdentifiabilityReport {
         &self.report
     }
 
@@ -131,18 +139,29 @@ impl Identifiability {
         &self.warnings
     }
 
-    /// The JSON `tricept identifiability --json` prints.
+    /// Always 0: an assessment has no verdict.
+    pub fn exit_code(&self) -> u8 {
+        crate::error::EXIT_OK
+    }
+
+    /// Always `None`: an assessment has no verdict.
+    pub fn reason(&self) -> Option<&str> {
+        None
+    }
+
+    /// The JSON `tricept identifiability --json` prints (`format_version`
+    /// first).
     pub fn to_json(&self) -> Value {
         let mut v = self.report.to_json();
         if let Value::Object(o) = &mut v {
             o.insert("parameter_set".into(), self.parameter_set.clone().into());
             o.insert("axis_order".into(), self.axis_order.clone().into());
         }
-        v
+        crate::outcome::versioned(v)
     }
 
-    /// The text report.
-    pub fn to_text(&self) -> String {
+    /// The text report (what `tricept identifiability` prints).
+    pub fn report(&self) -> String {
         format!(
             "{} ({} U joint), parameter set {}, pose set `{}`\n{}",
             self.machine_name,

@@ -222,7 +222,8 @@ impl LoadedMachine {
     ///
     /// # Example
     /// ```
-    /// use tricept_ident::advanced::{LoadedMachine, SensorNoise};
+    /// use tricept_ident::LoadedMachine;
+    /// use tricept_ident::advanced::SensorNoise;
     /// use tricept_ident::kinematics::MachineDescription;
     /// let mut d = MachineDescription::paper();
     /// let m = LoadedMachine::from_description(d.clone(), "mine", &SensorNoise::default()).unwrap();
@@ -554,8 +555,8 @@ impl TrueErrors {
             )),
             TrueErrors::File(path) => {
                 let name = path.display();
-                let text =
-                    tricept_data::bounded::read_json_text(path).map_err(|e| Error::unreadable(&name, e))?;
+                let text = tricept_data::bounded::read_json_text(path)
+                    .map_err(|e| Error::unreadable(&name, e))?;
                 set.parse_values(&text)
                     .map_err(|e| Error::input(format!("{name}: {e}")).with_source(e))
             }

@@ -49,6 +49,8 @@ pub struct PointSolution {
     cells: Vec<Cell>,
 }
 
+crate::outcome::outcome!(PointSolution);
+
 /// Solves one point (`point` in the order of [`Verb::inputs`]) on
 /// `machine` with its static leg effects applied; an unreachable point is
 /// an input error naming the verb.
@@ -59,7 +61,7 @@ pub struct PointSolution {
 /// use tricept_ident::kinematics::{Verb, solve_point};
 /// let m = MachineInput::default().load().unwrap();
 /// let s = solve_point(Verb::Ik, &m, &[0.0, 0.0, 750.0]).unwrap();
-/// assert!(s.to_json().starts_with(r#"{"x":0.0,"y":0.0,"z":750.0,"q1":773.3"#));
+/// assert!(s.to_json().to_string().starts_with(r#"{"format_version":1,"x":0.0,"y":0.0,"z":750.0,"q1":773.3"#));
 /// assert!(solve_point(Verb::Ik, &m, &[0.0, 0.0, 5000.0]).is_err());
 /// ```
 pub fn solve_point(
@@ -94,8 +96,14 @@ impl PointSolution {
         EXIT_OK
     }
 
-    /// The solution as one JSON object, the verb's keys in order.
-    pub fn to_json(&self) -> String {
+    /// Always `None`: a solved point has no verdict.
+    pub fn reason(&self) -> Option<&str> {
+        None
+    }
+
+    /// The solution as one JSON object (what the verb's `--json` prints),
+    /// `format_version` first, then the verb's keys in order.
+    pub fn to_json(&self) -> Value {
         let map: Map<String, Value> = self
             .verb
             .keys()
@@ -103,11 +111,12 @@ impl PointSolution {
             .zip(&self.cells)
             .map(|(k, c)| (k.to_string(), c.to_json()))
             .collect();
-        Value::Object(map).to_string()
+        crate::outcome::versioned(Value::Object(map))
     }
 
-    /// The solution as aligned `key = value unit` lines.
-    pub fn to_text(&self) -> String {
+    /// The solution as aligned `key = value unit` lines (what the verb
+    /// prints).
+    pub fn report(&self) -> String {
         let keys = self.verb.keys();
         let width = keys.iter().map(|k| k.len()).max().unwrap_or(0);
         let mut out = String::new();
@@ -221,11 +230,11 @@ mod tests {
             })
             .collect();
         let fk = solve_point(Verb::Fk, &m, &q).unwrap();
-        let v: Value = serde_json::from_str(&fk.to_json()).unwrap();
+        let v = fk.to_json();
         for (k, want) in [("x", 100.0), ("y", -50.0), ("z", 760.0)] {
             assert!((v[k].as_f64().unwrap() - want).abs() < 1e-6, "{k}");
         }
-        let text = ik.to_text();
+        let text = ik.report();
         assert!(
             text.lines().nth(3).unwrap().starts_with("   q1 = "),
             "{text}"

@@ -18,18 +18,56 @@
 //! request describes one run and is spent by it: by value, the workflow
 //! keeps the data it was given (a calibration holds its data without
 //! copying them), and a caller can move a request to another thread (the
-//! Python binding runs every workflow with the GIL released). The
-//! constructor takes the few values a request cannot do without; the rest
-//! are public fields with the CLI's defaults.
+//! Python binding runs every workflow with the GIL released).
+//!
+//! Requests: `new` takes exactly what the workflow cannot do without, in
+//! this order: what it works on (the measured data of calibrate, diagnose,
+//! check and fleet; the calibrated machine that check, compensate, export
+//! and report read; the campaign that identifiability and detectability
+//! assess; the instrument plan plans for), then what the output is for and
+//! where it goes (export's control, export's and report's folder or page).
+//! Everything else has a default (the machine is the embedded Table 1
+//! machine unless the workflow reads a calibration from it) and is a
+//! public field with a chainable setter of the same name, so
+//! `CalibrateRequest::new("d.csv").tolerance_mm(0.01)` and
+//! `DiagnoseRequest::new("d.csv").machine("calibrated.json")` read alike
+//! (requests are `#[non_exhaustive]`: a field added later gets its setter,
+//! and no caller breaks). Paths convert from `&str`, `String`, `&String`,
+//! `&Path`, `PathBuf` and `&PathBuf` wherever a request takes a
+//! [`MachineInput`], a [`DataInput`] or a path.
+//!
+//! Results: every workflow's result has one shape, the [`Outcome`] trait
+//! (also each result's own methods): `exit_code()`, `reason()` (why the
+//! exit code is not 0; `None` when it is), `report()` (the text the verb
+//! prints) and `to_json()` (what `--json` prints, `format_version`
+//! first). A result that writes a machine file also has the shape of
+//! [`WritesMachine`]: `accuracy()` (what the file promises) and
+//! `write_machine(&self, path, WriteOptions)`, which returns the
+//! [`Written`] file or the refusal as an [`Error`].
+//!
+//! ```
+//! use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+//! use tricept_ident::{Outcome, WriteOptions};
+//! let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/table2-grid-seed1.csv");
+//! let calibration = calibrate(CalibrateRequest::new(data).tolerance_mm(0.05))?;
+//! assert_eq!(calibration.reason(), None);
+//! assert_eq!(calibration.to_json()["format_version"], 1);
+//! let out = std::env::temp_dir().join(format!("tricept-lib-doc-{}.json", std::process::id()));
+//! let written = calibration.write_machine(&out, WriteOptions::default())?;
+//! assert!(written.forced().is_none());
+//! # std::fs::remove_file(&out).ok();
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 //!
 //! The root is a curated handful: one module per workflow ([`calibrate`],
 //! [`check`], [`compensate`], [`detectability`], [`diagnosis`],
 //! [`effects`], [`export`], [`fleet`], [`identifiability`], [`kinematics`],
 //! [`plan`], [`report`], [`simulate`]), each with its function, its request, its result and the
-//! parts they are made of; the error with its exit codes; and the two
-//! inputs. The typed values several requests share, the machine loaded
-//! ahead of a workflow and the few low-level items code beside the door
-//! needs are in [`advanced`].
+//! parts they are made of; the error with its exit codes; the two inputs
+//! and the machine loaded from one ([`LoadedMachine`]); the result's shape
+//! and how a result writes its file. The typed values several requests
+//! share and the few low-level items code beside the door needs are in
+//! [`advanced`].
 //!
 //! Errors: every failure is an [`Error`] whose [`ErrorKind`] decides the
 //! process exit code, one mapping for every verb ([`Error::exit_code`]),
@@ -60,6 +98,8 @@ mod json_version;
 mod limits;
 mod machine_file;
 mod machine_input;
+mod outcome;
+mod request;
 mod setting;
 
 // Layer 1: the workflows, one public module each (its function, its
@@ -92,9 +132,14 @@ pub use error::{
 };
 pub use setting::Setting;
 
-// The two inputs every workflow is fed: the machine and the measured data.
+// The two inputs every workflow is fed: the machine and the measured data,
+// and the machine as `MachineInput::load` returns it.
 pub use data_input::DataInput;
+pub use inputs::LoadedMachine;
 pub use machine_input::MachineInput;
+
+// The one shape of every workflow's result, and how one writes its file.
+pub use outcome::{Outcome, WriteOptions, WritesMachine, Written};
 
 // Crate-internal shorthands (the workflows' files use `crate::NAME`).
 pub(crate) use error::Classify;

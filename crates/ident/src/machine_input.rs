@@ -188,19 +188,19 @@ mod tests {
             ),
             (
                 "diagnose",
-                diagnosis::diagnose(diagnosis::DiagnoseRequest::new(machine(), "data.csv")).err(),
+                diagnosis::diagnose(diagnosis::DiagnoseRequest::new("data.csv").machine(machine()))
+                    .err(),
             ),
             (
                 "detectability",
-                detectability::detectability(detectability::DetectabilityRequest::new(
-                    machine(),
-                    Poses::grid(),
-                ))
+                detectability::detectability(
+                    detectability::DetectabilityRequest::new(Poses::grid()).machine(machine()),
+                )
                 .err(),
             ),
             (
                 "simulate",
-                simulate::simulate(simulate::SimulateRequest::new(machine())).err(),
+                simulate::simulate(simulate::SimulateRequest::new().machine(machine())).err(),
             ),
             (
                 "compensate",

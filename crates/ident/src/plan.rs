@@ -174,7 +174,7 @@ impl PlanRequest {
     }
 
     /// The internal campaign's pose set.
-    fn poses(&self) -> Result<Poses, Error> {
+    fn poses_or_grid(&self) -> Result<Poses, Error> {
         match &self.poses {
             Some(p) => Ok(p.clone()),
             None => "grid".parse(),
@@ -182,13 +182,47 @@ impl PlanRequest {
     }
 
     /// The tracker's candidate points.
-    fn candidates(&self) -> Result<Poses, Error> {
+    fn candidates_or_grid(&self) -> Result<Poses, Error> {
         match &self.candidates {
             Some(p) => Ok(p.clone()),
             None => "grid:2,8,3".parse(),
         }
     }
 }
+
+crate::request::setters!(PlanRequest {
+    k: Vec<usize>,
+    detect_um: f64,
+    power: f64,
+    data: some into DataInput,
+    poses: some Poses,
+    candidates: some Poses,
+    head_angles_deg: HeadAngles,
+    extensions: Vec<f64>,
+    tracker_sigma_um: f64,
+    ballbar_sigma_um: f64,
+    sigma_um: some f64,
+    tracker_target: some TrackerTargetSpec,
+    tracker_target_sigma_um: f64,
+    ballbar_pivot_mm: Triple,
+    ballbar_length_mm: f64,
+    ballbar_candidates: usize,
+    touch_sphere_mm: Triple,
+    touch_sphere_radius_mm: f64,
+    touch_stylus_radius_mm: f64,
+    touch_stylus_sigma_um: f64,
+    touch_sigma_um: f64,
+    effects: Vec<EffectName>,
+    target_um: some f64,
+    random_baseline: usize,
+    seed: u64,
+    passes: usize,
+    eval_grid: EvalGrid,
+    eval_head_angles_deg: HeadAngles,
+    out: some into PathBuf,
+    machine: into MachineInput,
+    parameter_set: ParameterSet,
+});
 
 /// The poses to write: planned external measurements, or a check's
 /// commands.
@@ -210,10 +244,22 @@ pub struct Plan {
     warnings: Vec<String>,
 }
 
+crate::outcome::outcome!(Plan);
+
 impl Plan {
-    /// The JSON `tricept plan --json` prints.
-    pub fn to_json(&self) -> &Value {
-        &self.json
+    /// Always 0: a plan has no verdict.
+    pub fn exit_code(&self) -> u8 {
+        crate::error::EXIT_OK
+    }
+
+    /// Always `None`: a plan has no verdict.
+    pub fn reason(&self) -> Option<&str> {
+        None
+    }
+
+    /// The JSON `tricept plan --json` prints (`format_version` first).
+    pub fn to_json(&self) -> Value {
+        crate::outcome::versioned(self.json.clone())
     }
 
     /// The warnings of the machine file loaded.
@@ -221,9 +267,9 @@ impl Plan {
         &self.warnings
     }
 
-    /// The text report.
-    pub fn report(&self) -> &str {
-        &self.text
+    /// The text report (what `tricept plan` prints).
+    pub fn report(&self) -> String {
+        self.text.clone()
     }
 
     /// Writes the planned poses (of the largest k) atomically to `path`;
@@ -350,7 +396,7 @@ fn internal_information(
             (f, data.poses.len())
         }
         None => {
-            let poses = a.poses()?;
+            let poses = a.poses_or_grid()?;
             let targets = poses.targets(m)?;
             let f = internal_factor(model, &targets)
                 .map_err(|e| Error::invalid_value(Setting::Poses, &poses, e))?;
@@ -382,7 +428,7 @@ fn candidates(a: &PlanRequest, m: &Machine, model: &FusedModel) -> Result<Candid
                     "expected extensions along the tool in mm, within ±1000",
                 ));
             }
-            let candidates = a.candidates()?;
+            let candidates = a.candidates_or_grid()?;
             let points = candidates.targets(m)?;
             let count = points.len() * h1.len() * h2.len() * a.extensions.len().max(1);
             if count > limits::MAX_CANDIDATES {

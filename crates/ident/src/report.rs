@@ -41,10 +41,9 @@ pub const MAP_SPACING_MM: f64 = 25.0;
 /// # Example
 /// ```no_run
 /// use tricept_ident::report::{ReportRequest, report};
-/// let mut request = ReportRequest::new("calibrated.json", "page.html");
-/// request.history = Some("checks.jsonl".into());
+/// let request = ReportRequest::new("calibrated.json", "page.html").history("checks.jsonl");
 /// let page = report(request)?;
-/// println!("{}", page.text());
+/// println!("{}", page.report());
 /// # Ok::<(), tricept_ident::Error>(())
 /// ```
 #[derive(Debug, Clone)]
@@ -76,12 +75,21 @@ impl ReportRequest {
     }
 }
 
+crate::request::setters!(ReportRequest {
+    data: some into PathBuf,
+    history: some into PathBuf,
+    export: some into PathBuf,
+});
+
 /// A page written, and its verdict.
 #[derive(Debug, Clone)]
 pub struct Report {
     verdict: Verdict,
     out: PathBuf,
+    reason: Option<String>,
 }
+
+crate::outcome::outcome!(Report);
 
 impl Report {
     /// The page's verdict.
@@ -97,9 +105,15 @@ impl Report {
         }
     }
 
-    /// What the CLI prints: where the page went, the verdict and its
-    /// reasons, one line each.
-    pub fn text(&self) -> String {
+    /// Why the exit code is not 0 (`None` when it is 0): the page's
+    /// verdict not to trust the machine.
+    pub fn reason(&self) -> Option<&str> {
+        self.reason.as_deref()
+    }
+
+    /// The text report (what `tricept report` prints): where the page
+    /// went, the verdict and its reasons, one line each.
+    pub fn report(&self) -> String {
         let mut s = format!(
             "report written to {}: {}: {}\n",
             self.out.display(),
@@ -112,9 +126,12 @@ impl Report {
         s
     }
 
-    /// The verdict as JSON, with the page's path.
+    /// The verdict as JSON (what `tricept report --json` prints,
+    /// `format_version` first), with the page's path.
     pub fn to_json(&self) -> Value {
-        json!({"out": self.out.display().to_string(), "verdict": self.verdict.to_json()})
+        crate::outcome::versioned(
+            json!({"out": self.out.display().to_string(), "verdict": self.verdict.to_json()}),
+        )
     }
 }
 
@@ -124,9 +141,16 @@ pub fn report(request: ReportRequest) -> Result<Report, Error> {
     let sources = sources(&request, &loaded)?;
     let page = tricept_report::page(&sources).map_err(|e| Error::input(e.to_string()))?;
     crate::calibrate::write_text(&request.out, &page.html)?;
+    let reason = matches!(page.verdict.level, Level::DoNotTrust).then(|| {
+        format!(
+            "the page says not to trust the machine: {}",
+            page.verdict.words
+        )
+    });
     Ok(Report {
         verdict: page.verdict,
         out: request.out,
+        reason,
     })
 }
 
@@ -188,7 +212,8 @@ fn maps(loaded: &LoadedMachine) -> Result<Vec<Source>, Error> {
             r.plane_z_mm = Some(*z);
             r.spacing_mm = MAP_SPACING_MM;
             let c = compensate(r)?;
-            let mut v = c.to_json();
+            // The page keeps the map's keys without the output's version.
+            let mut v = crate::outcome::unversioned(c.to_json());
             let (map, _) = c.maps();
             v["spacing_mm"] = c.spacing_mm().into();
             v["points"] = json!({
@@ -229,8 +254,9 @@ fn diagnosis(
             loaded.source()
         ))?
         .ok_or_else(|| Error::input(format!("{}: no calibration record", loaded.source())))?;
-    let d = diagnose(DiagnoseRequest::new(base, path))?;
-    let json = serde_json::from_str(&d.to_json()).unwrap_or(Value::Null);
+    let d = diagnose(DiagnoseRequest::new(path).machine(base))?;
+    // The page keeps the diagnosis' keys without the output's version.
+    let json = crate::outcome::unversioned(d.to_json());
     Ok(Source::new(
         "diagnosis",
         "the diagnosis of the campaign (diagnose's JSON), from the machine the calibration started from",

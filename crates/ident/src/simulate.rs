@@ -201,10 +201,13 @@ pub struct TouchSimulation {
 /// ```
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::simulate::{SimulateRequest, simulate};
-/// let mut request = SimulateRequest::new(MachineInput::default());
-/// request.poses = "random:25,1".parse().unwrap();
-/// let sim = simulate(request).unwrap();
+/// let request = SimulateRequest::new()
+///     .machine(MachineInput::default())
+///     .poses("random:25,1".parse()?)
+///     .seed(2);
+/// let sim = simulate(request)?;
 /// assert_eq!(sim.data().poses.len(), 25);
+/// # Ok::<(), tricept_ident::Error>(())
 /// ```
 #[derive(Debug, Clone)]
 #[non_exhaustive]
@@ -235,14 +238,18 @@ pub struct SimulateRequest {
     pub ballbar: Option<BallbarSimulation>,
     /// Touch-offs too.
     pub touch: Option<TouchSimulation>,
+    /// The file the caller writes the data to
+    /// ([`crate::advanced::files::write_path`]), named by the report and
+    /// the JSON (default: none, the data stay in memory).
+    pub out: Option<PathBuf>,
 }
 
 impl SimulateRequest {
-    /// Table 2 errors on `machine`, the `grid` pose set, seed 1, the stated
-    /// noise, no effect and no external instrument.
-    pub fn new(machine: impl Into<MachineInput>) -> SimulateRequest {
+    /// Table 2 errors on the Table 1 machine, the `grid` pose set, seed 1,
+    /// the stated noise, no effect and no external instrument.
+    pub fn new() -> SimulateRequest {
         SimulateRequest {
-            machine: machine.into(),
+            machine: MachineInput::default(),
             parameter_set: ParameterSet::paper15(),
             truth: TrueErrors::Table2,
             truth_effects: Vec::new(),
@@ -255,9 +262,34 @@ impl SimulateRequest {
             tracker: None,
             ballbar: None,
             touch: None,
+            out: None,
         }
     }
 }
+
+impl Default for SimulateRequest {
+    /// [`SimulateRequest::new`].
+    fn default() -> SimulateRequest {
+        SimulateRequest::new()
+    }
+}
+
+crate::request::setters!(SimulateRequest {
+    machine: into MachineInput,
+    parameter_set: ParameterSet,
+    truth: TrueErrors,
+    truth_effects: Vec<Effect>,
+    head_errors: HeadErrors,
+    poses: Poses,
+    seed: u64,
+    both_directions: bool,
+    revisit: usize,
+    noise_factor: f64,
+    tracker: some TrackerSimulation,
+    ballbar: some BallbarSimulation,
+    touch: some TouchSimulation,
+    out: some into PathBuf,
+});
 
 /// Simulated data in memory, each with the comment lines its file carries.
 #[derive(Debug, Clone)]
@@ -269,7 +301,10 @@ pub struct Simulation {
     touch: Option<(TouchData, Vec<String>, String)>,
     summary: Value,
     truth: String,
+    out: Option<PathBuf>,
 }
+
+crate::outcome::outcome!(Simulation);
 
 /// Simulates the request's campaign (and instruments); every problem of
 /// the request is an input error (exit code 2).
@@ -327,6 +362,7 @@ pub fn simulate(request: SimulateRequest) -> Result<Simulation, Error> {
         touch,
         summary,
         truth: truth_label(&request.truth),
+        out: request.out.clone(),
     })
 }
 
@@ -581,22 +617,33 @@ impl Simulation {
         EXIT_OK
     }
 
-    /// The summary as JSON (one line, as `tricept simulate --json --out
-    /// FILE` prints it), naming the data file `out`.
-    pub fn to_json(&self, out: &Path) -> String {
-        let mut v = json!({"out": out.display().to_string()});
+    /// Always `None`: a simulation has no verdict.
+    pub fn reason(&self) -> Option<&str> {
+        None
+    }
+
+    /// The summary as JSON (what `tricept simulate --json --out FILE`
+    /// prints, `format_version` first), naming the data file of the
+    /// request's `out` (`null` without one).
+    pub fn to_json(&self) -> Value {
+        let out = self.out.as_ref().map(|p| p.display().to_string());
+        let mut v = json!({"out": out});
         if let (Value::Object(o), Value::Object(s)) = (&mut v, &self.summary) {
             o.extend(s.clone());
         }
-        v.to_string()
+        crate::outcome::versioned(v)
     }
 
-    /// The summary as text, naming the data file `out`.
-    pub fn to_text(&self, out: &Path) -> String {
+    /// The summary as text (what `tricept simulate --out FILE` prints on
+    /// stderr), naming the data file of the request's `out`.
+    pub fn report(&self) -> String {
+        let to = match &self.out {
+            Some(out) => format!("to {}", out.display()),
+            None => "in memory".to_string(),
+        };
         format!(
-            "{} poses to {} (machine `{}`, true errors `{}`, {} effect(s), seed {})",
+            "{} poses {to} (machine `{}`, true errors `{}`, {} effect(s), seed {})",
             self.data.poses.len(),
-            out.display(),
             self.summary["machine"].as_str().unwrap_or_default(),
             self.truth,
             self.summary["truth_effects"].as_array().map_or(0, Vec::len),
@@ -611,7 +658,7 @@ mod tests {
     use crate::inputs::{SensorNoise, load_machine};
 
     fn request() -> SimulateRequest {
-        SimulateRequest::new(load_machine(None, &SensorNoise::default()).unwrap())
+        SimulateRequest::new().machine(load_machine(None, &SensorNoise::default()).unwrap())
     }
 
     #[test]
@@ -641,13 +688,16 @@ mod tests {
         let mut other = request();
         other.seed = 2;
         assert_ne!(a.data(), simulate(other).unwrap().data());
-        let v: Value = serde_json::from_str(&a.to_json(Path::new("d.csv"))).unwrap();
+        assert_eq!(a.to_json()["out"], Value::Null);
+        assert!(a.report().starts_with("75 poses in memory"));
+        let mut named = request();
+        named.out = Some("d.csv".into());
+        let named = simulate(named).unwrap();
+        let v = named.to_json();
         assert_eq!(v["out"], "d.csv");
         assert_eq!(v["poses"], 75);
-        assert!(
-            a.to_text(Path::new("d.csv"))
-                .contains("true errors `table2`")
-        );
+        assert!(named.report().contains("poses to d.csv"));
+        assert!(named.report().contains("true errors `table2`"));
     }
 
     #[test]

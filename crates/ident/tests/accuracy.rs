@@ -167,7 +167,7 @@ fn campaign(seed: u64, dir: &Path, verb: Verb) -> Outcome {
     let data = dir.join(format!("campaign-{seed}.csv"));
     std::fs::write(&data, to_csv(&rows)).unwrap();
     let targets = nominal.workspace.random_poses(TARGETS, seed ^ 0x07a2_6e75);
-    let mut c = calibrate(CalibrateRequest::new(DataInput::File(data.clone()))).unwrap();
+    let c = calibrate(CalibrateRequest::new(DataInput::File(data.clone()))).unwrap();
     let identify_file = dir.join(format!("identify-{seed}.json"));
     let mut outcome = Outcome {
         seed,
@@ -193,23 +193,29 @@ fn campaign(seed: u64, dir: &Path, verb: Verb) -> Outcome {
             if outcome.exit != 0 {
                 return outcome;
             }
-            c.write_machine(&identify_file, false).unwrap();
+            c.write_machine(&identify_file, tricept_ident::WriteOptions::default())
+                .unwrap();
             identify_file
         }
         Verb::Diagnose(rule) | Verb::DiagnoseCompared(rule) => {
-            c.write_machine(&identify_file, true).unwrap();
+            c.write_machine(
+                &identify_file,
+                tricept_ident::WriteOptions::default().force(true),
+            )
+            .unwrap();
             let (sum, count) = delivered(&identify_file, &truth, &effects, &targets, dir);
             outcome.geometric_mm = (sum / count as f64).sqrt();
             let diagnosed = |rule: DeployRule| {
                 let loaded = load_machine(None, &SensorNoise::default()).unwrap();
-                let mut request = DiagnoseRequest::new(loaded, DataInput::File(data.clone()));
+                let mut request =
+                    DiagnoseRequest::new(DataInput::File(data.clone())).machine(loaded);
                 request.deploy_rule = rule;
                 let r = diagnose(request).unwrap();
                 if std::env::var_os("TRICEPT_TALLY_TERMS").is_some() {
                     eprintln!(
                         "seed {seed} {} terms: {}",
                         rule.name(),
-                        terms_line(&r.to_json())
+                        terms_line(&r.to_json().to_string())
                     );
                 }
                 r
@@ -218,11 +224,13 @@ fn campaign(seed: u64, dir: &Path, verb: Verb) -> Outcome {
             outcome.exit = r.exit_code();
             if verb == Verb::DiagnoseCompared(rule) {
                 let o = diagnosed(other_rule(rule));
-                let changed = deployed_terms(&o.to_json()) != deployed_terms(&r.to_json());
+                let changed = deployed_terms(&o.to_json().to_string())
+                    != deployed_terms(&r.to_json().to_string());
                 let mut delivered_mm = f64::NAN;
                 if o.exit_code() == 0 {
                     let file = dir.join(format!("diagnose-other-{seed}.json"));
-                    o.write_machine(&file, false).unwrap();
+                    o.write_machine(&file, tricept_ident::WriteOptions::default())
+                        .unwrap();
                     let (sum, count) = delivered(&file, &truth, &effects, &targets, dir);
                     delivered_mm = (sum / count as f64).sqrt();
                 }
@@ -232,11 +240,12 @@ fn campaign(seed: u64, dir: &Path, verb: Verb) -> Outcome {
                 return outcome;
             }
             let file = dir.join(format!("diagnose-{seed}.json"));
-            r.write_machine(&file, false).unwrap();
+            r.write_machine(&file, tricept_ident::WriteOptions::default())
+                .unwrap();
             let a = r.accuracy().unwrap();
-            let json: serde_json::Value = serde_json::from_str(&r.to_json()).unwrap();
+            let json = r.to_json();
             assert_eq!(json["accuracy"]["upper_mm"].as_f64(), Some(a.upper_mm));
-            assert!(first_lines_state_it(&r.to_text()), "{}", r.to_text());
+            assert!(first_lines_state_it(&r.report()), "{}", r.report());
             outcome.rms_mm = a.rms_mm;
             outcome.upper_mm = a.upper_mm;
             outcome.parts = serde_json::Value::Object(a.parts.clone());

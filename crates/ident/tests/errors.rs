@@ -10,7 +10,7 @@ use std::error::Error as _;
 use tricept_ident::calibrate::{CalibrateRequest, calibrate};
 use tricept_ident::export::{Controller, ExportError, ExportOptions, ExportRequest, export};
 use tricept_ident::kinematics::Machine;
-use tricept_ident::{EXIT_INADEQUATE, EXIT_INPUT, ErrorCause, ErrorKind, Setting};
+use tricept_ident::{EXIT_INADEQUATE, EXIT_INPUT, ErrorCause, ErrorKind, Setting, WriteOptions};
 
 fn fixture(name: &str) -> String {
     format!("{}/../../fixtures/{name}", env!("CARGO_MANIFEST_DIR"))
@@ -89,13 +89,16 @@ fn a_newer_format_and_an_edited_calibrated_file_are_named() {
 fn a_write_of_an_untrusted_calibration_is_refused_as_such_with_its_source() {
     let dir = scratch("refused");
     // A hidden compliance the geometric model cannot explain: exit 3.
-    let mut calibration = calibrate(CalibrateRequest::new(
+    let calibration = calibrate(CalibrateRequest::new(
         fixture("data/diagnose-hidden-effect.csv").as_str(),
     ))
     .unwrap();
     assert_eq!(calibration.exit_code(), EXIT_INADEQUATE);
     let e = calibration
-        .write_machine(&dir.join("cal.json"), false)
+        .write_machine(
+            &dir.join("cal.json"),
+            tricept_ident::WriteOptions::default(),
+        )
         .unwrap_err();
     assert_eq!(e.cause(), ErrorCause::RefusedWrite, "{e}");
     assert_eq!(e.exit_code(), EXIT_INADEQUATE);
@@ -242,11 +245,11 @@ fn an_error_about_a_setting_names_the_request_field_and_carries_it() {
     let dir = scratch("export-setting");
     let mut options = ExportOptions::new(Controller::Heidenhain);
     options.max_points = Some(2);
-    let e = export(ExportRequest {
-        machine: fixture("compat/machine-calibrated.json").as_str().into(),
+    let e = export(ExportRequest::new(
+        fixture("compat/machine-calibrated.json").as_str(),
         options,
-        out: dir.join("out"),
-    })
+        dir.join("out"),
+    ))
     .unwrap_err();
     assert_eq!(e.setting(), Some(Setting::MaxPoints), "{e}");
     assert!(e.message().starts_with("max_points: "), "{e}");
@@ -263,12 +266,12 @@ fn an_error_about_a_setting_names_the_request_field_and_carries_it() {
 #[test]
 fn a_refused_write_says_whether_the_fit_was_inadequate_by_its_kind() {
     let dir = scratch("refused-kind");
-    let mut calibration = calibrate(CalibrateRequest::new(
+    let calibration = calibrate(CalibrateRequest::new(
         fixture("data/diagnose-hidden-effect.csv").as_str(),
     ))
     .unwrap();
     let e = calibration
-        .write_machine(&dir.join("cal.json"), false)
+        .write_machine(&dir.join("cal.json"), WriteOptions::default())
         .unwrap_err();
     assert_eq!(e.cause(), ErrorCause::RefusedWrite, "{e}");
     assert_eq!(e.kind(), ErrorKind::Inadequate, "{e}");

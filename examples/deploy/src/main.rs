@@ -27,11 +27,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = path.as_deref().unwrap_or(DEFAULT_DATA);
     let loaded = MachineInput::default().load()?;
     let nominal = loaded.commanding();
-    let result = diagnose(DiagnoseRequest::new(loaded, path))?;
+    let result = diagnose(DiagnoseRequest::new(path).machine(loaded))?;
     for c in &result.diagnosis().causes {
         println!("{}: {}", c.effect, c.description);
     }
-    if let Some(why) = result.exit_reason() {
+    if let Some(why) = result.reason() {
         return Err(why.into());
     }
     let deployed = result.deploy()?;
@@ -51,7 +51,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         e.compliance_um_per_kn_at_1m,
         e.tables.len()
     );
-    let calibrated = Machine::from(&deployed);
+    let calibrated = Machine::from(deployed);
     let target = Vector3::new(0.0, 0.0, 750.0);
     let q = calibrated.inverse(&target)?.legs_mm;
     let q_nominal = nominal.inverse(&target)?.legs_mm;

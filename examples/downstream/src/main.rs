@@ -20,7 +20,7 @@ use tricept_ident::calibrate::{CalibrateRequest, Calibration, calibrate};
 use tricept_ident::check::{CheckRequest, check};
 use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
 use tricept_ident::kinematics::{Machine, Vector3};
-use tricept_ident::{EXIT_OK, Error, MachineInput};
+use tricept_ident::{EXIT_OK, Error, MachineInput, WriteOptions};
 
 fn main() -> ExitCode {
     let mut args = std::env::args().skip(1);
@@ -51,8 +51,8 @@ fn main() -> ExitCode {
 }
 
 fn run(data: &Path, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
-    let mut calibration = identify(data)?;
-    write_machine(&mut calibration, out)?;
+    let calibration = identify(data)?;
+    write_machine(&calibration, out)?;
     Ok(command(&calibration)?)
 }
 
@@ -73,7 +73,7 @@ fn identify(data: &Path) -> Result<Calibration, Error> {
             tricept_ident::ErrorKind::of_exit_code(calibration.exit_code()),
             format!(
                 "the calibration cannot be trusted: {}",
-                calibration.reason()
+                calibration.reason().unwrap_or_default()
             ),
         ));
     }
@@ -82,8 +82,8 @@ fn identify(data: &Path) -> Result<Calibration, Error> {
 
 /// Step 2: write the calibrated machine file (refused for a fit that is
 /// not to be trusted).
-fn write_machine(calibration: &mut Calibration, out: &Path) -> Result<(), Error> {
-    let written = calibration.write_machine(out, false)?;
+fn write_machine(calibration: &Calibration, out: &Path) -> Result<(), Error> {
+    let written = calibration.write_machine(out, WriteOptions::default())?;
     println!("wrote {}", written.path().display());
     Ok(())
 }
@@ -108,20 +108,18 @@ fn command(calibration: &Calibration) -> Result<(), Error> {
 /// it to `out` as a calibrated machine file.
 fn diagnose_and_deploy(path: &Path, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let nominal = MachineInput::default();
-    let result = diagnose(DiagnoseRequest::new(nominal, path.to_path_buf()))?;
+    let result = diagnose(DiagnoseRequest::new(path.to_path_buf()).machine(nominal))?;
     println!("diagnosis: {:?}", result.diagnosis().verdict);
-    if let Some(why) = result.exit_reason() {
+    if let Some(why) = result.reason() {
         return Err(why.into());
     }
     let deployed = result.deploy()?;
-    let q = Machine::from(&deployed)
+    let q = Machine::from(deployed)
         .inverse(&Vector3::new(0.0, 0.0, 750.0))?
         .legs_mm;
     println!("deployed: leg commands at the centre {q:?} mm");
-    if let Some(warning) = result.write_machine(out, false)? {
-        eprintln!("warning: {warning}");
-    }
-    println!("wrote {}", out.display());
+    let written = result.write_machine(out, WriteOptions::default())?;
+    println!("wrote {}", written.path().display());
     Ok(())
 }
 
@@ -130,8 +128,8 @@ fn diagnose_and_deploy(path: &Path, out: &Path) -> Result<(), Box<dyn std::error
 fn check_against(calibrated: &Path, path: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let machine = MachineInput::from(calibrated);
     let result = check(CheckRequest::new(machine, path.to_path_buf()))?;
-    print!("{}", result.to_text());
-    match result.exit_reason() {
+    print!("{}", result.report());
+    match result.reason() {
         None if result.exit_code() == EXIT_OK => Ok(()),
         why => Err(why.unwrap_or_default().into()),
     }

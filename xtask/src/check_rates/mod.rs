@@ -305,7 +305,7 @@ pub fn outcomes(
             let request = CheckRequest::new(machine.loaded.clone(), DataInput::Memory(data));
             let (exit, verdict, named, shortlist, set_aside) = match check(request) {
                 Ok(r) => {
-                    let v: Value = serde_json::from_str(&r.to_json()).map_err(|e| e.to_string())?;
+                    let v: Value = r.to_json();
                     let verdict = v["verdict"].as_str().unwrap_or("?").to_string();
                     let shortlist = alike(&v);
                     (

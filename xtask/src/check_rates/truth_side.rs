@@ -18,7 +18,8 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64Mcg;
-use tricept_ident::advanced::{LoadedMachine, SensorNoise, load_machine};
+use tricept_ident::LoadedMachine;
+use tricept_ident::advanced::{SensorNoise, load_machine};
 use tricept_ident::calibrate::{CalibrateRequest, calibrate};
 use tricept_ident::plan::{Instrument, PlanRequest, plan};
 use tricept_ident::{DataInput, MachineInput};
@@ -171,9 +172,9 @@ impl Calibrated {
         std::fs::write(&data, to_csv(&rows)).map_err(|e| format!("{}: {e}", data.display()))?;
         let mut request = CalibrateRequest::new(DataInput::File(data.clone()));
         request.for_machine_file = true;
-        let mut calibration = calibrate(request).map_err(|e| format!("machine {seed}: {e}"))?;
+        let calibration = calibrate(request).map_err(|e| format!("machine {seed}: {e}"))?;
         calibration
-            .write_machine(&machine_file, false)
+            .write_machine(&machine_file, tricept_ident::WriteOptions::default())
             .map_err(|e| format!("machine {seed}: identify: {e}"))?;
         let loaded = load_machine(Some(&machine_file), &SensorNoise::default())
             .map_err(|e| e.to_string())?;

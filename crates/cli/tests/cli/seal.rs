@@ -18,7 +18,8 @@
 use std::path::Path;
 
 use serde_json::Value;
-use tricept_ident::advanced::{LoadedMachine, SensorNoise};
+use tricept_ident::LoadedMachine;
+use tricept_ident::advanced::SensorNoise;
 use tricept_ident::kinematics::MachineDescription;
 
 use crate::support::{calibrated_machine, fresh_workdir, moved_truth, ok, run_in, stderr};

@@ -19,11 +19,16 @@ pub(crate) fn predicted_accuracy(
     id: &Identification,
     tolerance_mm: f64,
 ) -> Result<PredictedAccuracy, Error> {
-    let model = AccuracyModel::new(m, set, &tricept_engine::accuracy::accuracy_points(m), tolerance_mm)
-        .map_err(|e| match e {
-            IdentError::Invalid(why) => Error::invalid(crate::Setting::ToleranceMm, why),
-            e => Error::with_context("predicted accuracy", e),
-        })?;
+    let model = AccuracyModel::new(
+        m,
+        set,
+        &tricept_engine::accuracy::accuracy_points(m),
+        tolerance_mm,
+    )
+    .map_err(|e| match e {
+        IdentError::Invalid(why) => Error::invalid(crate::Setting::ToleranceMm, why),
+        e => Error::with_context("predicted accuracy", e),
+    })?;
     model
         .assess(&id.covariance, id.design().fixed())
         .map_err(|e| Error::with_context("predicted accuracy", e))
@@ -37,8 +42,13 @@ pub(crate) fn campaign_advice(
     a: &PredictedAccuracy,
     poses: usize,
 ) -> Result<String, Error> {
-    let model = AccuracyModel::new(m, set, &tricept_engine::accuracy::accuracy_points(m), a.tolerance_mm)
-        .map_err(|e| Error::with_context("campaign advice", e))?;
+    let model = AccuracyModel::new(
+        m,
+        set,
+        &tricept_engine::accuracy::accuracy_points(m),
+        a.tolerance_mm,
+    )
+    .map_err(|e| Error::with_context("campaign advice", e))?;
     let (optimal, random) = tricept_study::campaign::worthwhile_campaigns(m, set, &model)
         .map_err(|e| Error::with_context("campaign advice", e))?;
     let fix = match (optimal, random) {

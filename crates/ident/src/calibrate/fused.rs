@@ -33,8 +33,10 @@ pub(crate) struct FusedFit {
     pub sources: Vec<Source>,
     /// The module's parameter set label.
     pub set_label: String,
-    /// The outcome of a write, for the JSON (`deployed`).
-    pub deployed: Option<Value>,
+    /// The outcome of the last write, for the JSON (`deployed`).
+    pub deployed: std::sync::Mutex<Option<Value>>,
+    /// The promise of the written file, made once when first asked.
+    pub promise: std::sync::OnceLock<crate::accuracy::Accuracy>,
     /// External sources that cannot be checked on their own, tested
     /// against the checkable fit of the others (`None`: nothing to test).
     pub unchecked: Option<Unchecked>,
@@ -155,7 +157,8 @@ pub(crate) fn fit(c: &Checked, w: &FusedWork) -> Result<FusedFit, Error> {
         fit,
         sources: all,
         set_label: c.set.label().to_string(),
-        deployed: None,
+        deployed: std::sync::Mutex::new(None),
+        promise: std::sync::OnceLock::new(),
         unchecked,
         structure,
     })
@@ -332,8 +335,12 @@ impl FusedFit {
         self.fit.is_trustworthy() || self.unchecked.as_ref().is_some_and(Unchecked::agrees)
     }
 
-    /// The promise of the written file (`accuracy`).
-    pub fn accuracy(&self) -> crate::accuracy::Accuracy {
+    /// The promise of the written file (`accuracy`), made once.
+    pub fn accuracy(&self) -> &crate::accuracy::Accuracy {
+        self.promise.get_or_init(|| self.promise())
+    }
+
+    fn promise(&self) -> crate::accuracy::Accuracy {
         crate::accuracy::of_fusion(
             &self.model,
             &self.fit,
@@ -391,14 +398,12 @@ impl FusedFit {
         }
     }
 
-    /// The one-line summary of a non-zero exit code.
-    pub fn exit_line(&self) -> Option<String> {
+    /// Why the exit code is not 0, one phrase (`None` for 0).
+    pub fn exit_reason(&self) -> Option<String> {
         match self.exit_code() {
-            EXIT_NOT_CONVERGED => Some(format!(
-                "identify: exit {EXIT_NOT_CONVERGED}: the fused fit did not converge"
-            )),
+            EXIT_NOT_CONVERGED => Some("the fused fit did not converge".to_string()),
             EXIT_INADEQUATE => Some(format!(
-                "identify: exit {EXIT_INADEQUATE}: the fit completed but must not be trusted as it stands: {}",
+                "the fit completed but must not be trusted as it stands: {}",
                 self.refusal_reason()
             )),
             _ => None,
@@ -501,12 +506,16 @@ impl FusedFit {
     }
 
     /// Records a written file (or a refused one) for the JSON.
-    pub fn record_write(&mut self, path: &Path, written: bool) {
-        self.deployed = Some(if written {
+    pub fn record_write(&self, path: &Path, written: bool) {
+        let record = if written {
             json!({"written": path.display().to_string(), "held_at_nominal": self.held()})
         } else {
             json!({"written": Value::Null, "refused": path.display().to_string()})
-        });
+        };
+        match self.deployed.lock() {
+            Ok(mut d) => *d = Some(record),
+            Err(poisoned) => *poisoned.into_inner() = Some(record),
+        }
     }
 
     /// The JSON of `identify --json` with external data.
@@ -519,8 +528,12 @@ impl FusedFit {
             if let Some(u) = &self.unchecked {
                 o.insert("unchecked".into(), u.to_json());
             }
-            if let Some(d) = &self.deployed {
-                o.insert("deployed".into(), d.clone());
+            let deployed = match self.deployed.lock() {
+                Ok(d) => d.clone(),
+                Err(poisoned) => poisoned.into_inner().clone(),
+            };
+            if let Some(d) = deployed {
+                o.insert("deployed".into(), d);
             }
         }
         v

@@ -22,7 +22,7 @@ use super::advice::{campaign_advice, predicted_accuracy};
 use super::checked::Checked;
 use crate::Setting;
 use crate::accuracy::Accuracy;
-use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error, exit_line};
+use crate::error::{EXIT_INADEQUATE, EXIT_NOT_CONVERGED, EXIT_OK, Error, exit_reason};
 use crate::inputs::LoadedMachine;
 use crate::machine_file;
 
@@ -62,8 +62,8 @@ pub(crate) struct Said {
     pub reason: String,
     /// Why it must not be deployed (`None` when it may).
     pub refusal: Option<String>,
-    /// The one-line summary of a non-zero exit code.
-    pub exit_line: Option<String>,
+    /// Why the exit code is not 0 (`None` for 0).
+    pub exit_reason: Option<String>,
     /// The text report.
     pub report: String,
     /// Lines for the error stream after the report.
@@ -77,7 +77,7 @@ impl Said {
         let reason = f.reason();
         Said {
             exit_code,
-            exit_line: exit_line("identify", exit_code, &reason),
+            exit_reason: exit_reason(exit_code, &reason),
             reason,
             refusal: f.refusal().map(String::from),
             report: f.report(loaded, name),

@@ -74,12 +74,14 @@ use tricept_kinematics::{Machine, MachineDescription};
 use tricept_model::ParameterSet;
 
 use crate::Setting;
+pub use crate::accuracy::Accuracy;
 use crate::data_input::DataInput;
 use crate::error::Error;
-pub(crate) use crate::error::exit_line;
+pub(crate) use crate::error::exit_reason;
 use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
+pub use crate::outcome::{WriteOptions, Written};
 use checked::{Checked, Work};
 use internal::Said;
 pub(crate) use internal::fit_error;
@@ -143,6 +145,17 @@ impl CalibrateRequest {
     }
 }
 
+crate::request::setters!(CalibrateRequest {
+    machine: into MachineInput,
+    parameter_set: ParameterSet,
+    robust: bool,
+    tolerance_mm: f64,
+    fused: some FusedSources,
+    for_machine_file: bool,
+    campaigns: Vec<DataInput>,
+    prior: some into PathBuf,
+});
+
 #[derive(Debug)]
 enum Fit {
     Internal(Box<internal::InternalFit>),
@@ -159,28 +172,7 @@ pub struct Calibration {
     said: Said,
 }
 
-/// A machine file written: where, and why it was written although its fit
-/// is not to be trusted (with `force`).
-#[derive(Debug, Clone, PartialEq, Eq)]
-#[non_exhaustive]
-pub struct Written {
-    path: PathBuf,
-    forced: Option<String>,
-}
-
-impl Written {
-    /// The file written.
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
-
-    /// The warning of a forced write (`None` for a trusted fit).
-    pub fn forced_warning(&self) -> Option<String> {
-        self.forced
-            .as_ref()
-            .map(|why| format!("{}: written although {why} (forced)", self.path.display()))
-    }
-}
+crate::outcome::outcome!(writes Calibration);
 
 /// Calibrates as `request` says: loads the machine, reads the data, fits
 /// (fused when external sources are given), and judges the fit.
@@ -208,7 +200,7 @@ pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
                 exit_code: code,
                 reason: refusal.clone().unwrap_or_default(),
                 refusal,
-                exit_line: f.exit_line(),
+                exit_reason: f.exit_reason(),
                 report: f.report(),
                 notices: f
                     .fit
@@ -304,17 +296,34 @@ impl Calibration {
         }
     }
 
-    /// Why the calibration is not to be trusted, in one phrase (empty when
-    /// it is).
-    pub fn reason(&self) -> String {
+    /// Why the exit code is not 0, in one phrase (`None` when it is 0):
+    /// the verdict with its first likely cause, or why a fused fit must
+    /// not be deployed. The `tricept` binary prints it after `identify:
+    /// exit CODE: `.
+    pub fn reason(&self) -> Option<&str> {
+        self.said.exit_reason.as_deref()
+    }
+
+    /// Why the calibration is not to be trusted, the phrase a forced
+    /// machine file records (empty when it is).
+    pub(crate) fn why(&self) -> String {
         self.said.reason.clone()
     }
 
-    /// Why the calibration must not be deployed, in one phrase (`None` when
-    /// it may): the internal fit's verdict; for a fused fit as
-    /// [`Calibration::reason`].
-    pub fn refusal(&self) -> Option<String> {
+    /// Why the calibration must not be deployed, in one phrase (`None`
+    /// when it may): the internal fit's verdict; for a fused fit its
+    /// reasons.
+    pub(crate) fn refusal(&self) -> Option<String> {
         self.said.refusal.clone()
+    }
+
+    /// The poses rejected as gross errors (internal fit) as JSON: 1-based
+    /// pose number, file line, size.
+    pub(crate) fn rejected_json(&self) -> Value {
+        match &self.fit {
+            Fit::Internal(f) => internal::rejected_json(&f.rejected),
+            Fit::Fused(_) => Value::Array(Vec::new()),
+        }
     }
 
     /// The fit's warnings (likely causes, the campaign advice, unexplained
@@ -336,12 +345,6 @@ impl Calibration {
     /// warnings (`warning: ...`).
     pub fn notices(&self) -> Vec<String> {
         self.said.notices.clone()
-    }
-
-    /// The one-line summary of a non-zero exit code (`identify: exit 3:
-    /// ...`), `None` for 0.
-    pub fn exit_line(&self) -> Option<String> {
-        self.said.exit_line.clone()
     }
 
     /// The machine calibrated against, as loaded.
@@ -401,22 +404,23 @@ impl Calibration {
         }
     }
 
-    /// The poses rejected as gross errors (internal fit) as JSON: 1-based
-    /// pose number, file line, size.
-    pub fn rejected_json(&self) -> Value {
-        match &self.fit {
-            Fit::Internal(f) => internal::rejected_json(&f.rejected),
-            Fit::Fused(_) => Value::Array(Vec::new()),
-        }
-    }
-
-    /// The JSON `tricept identify --json` prints.
+    /// The JSON `tricept identify --json` prints (`format_version`
+    /// first).
     pub fn to_json(&self) -> Value {
         let name = self.data.name();
-        match &self.fit {
+        crate::outcome::versioned(match &self.fit {
             Fit::Internal(f) => f.to_json(&self.loaded, &name),
             Fit::Fused(f) => f.to_json(&self.loaded, &name),
-        }
+        })
+    }
+
+    /// The accuracy the machine file this calibration writes promises (also
+    /// the JSON's `accuracy` and the report's first lines).
+    pub fn accuracy(&self) -> Option<&Accuracy> {
+        Some(match &self.fit {
+            Fit::Internal(f) => &f.promise,
+            Fit::Fused(f) => f.accuracy(),
+        })
     }
 
     /// The text report `tricept identify` prints.
@@ -446,7 +450,7 @@ impl Calibration {
     /// file's hash).
     pub fn machine_file(&self) -> Result<crate::machine_file::MachineFile, Error> {
         let code = self.exit_code();
-        let why = self.reason();
+        let why = self.why();
         let forced = (code != 0).then(|| why.clone());
         let d = self.description(forced)?;
         Ok(crate::machine_file::MachineFile::new(d, code, why))
@@ -454,28 +458,36 @@ impl Calibration {
 
     /// Writes the calibrated machine file at `path` atomically, by the one
     /// write rule: a fit whose exit code is not 0 is refused (an error of
-    /// that code) unless `force`, and the file then says it was forced.
-    pub fn write_machine(&mut self, path: &Path, force: bool) -> Result<Written, Error> {
+    /// that code) unless [`WriteOptions::force`], and the file then says it
+    /// was forced. Data given in memory are an input error (the record
+    /// holds the data file's hash).
+    ///
+    /// # Example
+    /// ```no_run
+    /// use tricept_ident::WriteOptions;
+    /// use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+    /// let calibration = calibrate(CalibrateRequest::new("data.csv"))?;
+    /// let written = calibration.write_machine("calibrated.json".as_ref(), WriteOptions::default())?;
+    /// assert!(written.forced().is_none());
+    /// # Ok::<(), tricept_ident::Error>(())
+    /// ```
+    pub fn write_machine(&self, path: &Path, options: WriteOptions) -> Result<Written, Error> {
         let what = path.display().to_string();
         let code = self.exit_code();
-        let forced = match machine_file::write_rule(&what, code, &self.reason(), force) {
-            Ok(forced) => forced,
-            Err(e) => {
-                if let Fit::Fused(f) = &mut self.fit {
-                    f.record_write(path, false);
-                }
-                return Err(e);
+        let refused = |e: Error| {
+            if let Fit::Fused(f) = &self.fit {
+                f.record_write(path, false);
             }
+            e
         };
+        let forced = machine_file::write_rule(&what, code, &self.why(), options.is_forced())
+            .map_err(refused)?;
         let d = self.description(forced.clone())?;
         machine_file::write(path, &d).map_err(|e| Error::not_written(path, &e))?;
-        if let Fit::Fused(f) = &mut self.fit {
+        if let Fit::Fused(f) = &self.fit {
             f.record_write(path, true);
         }
-        Ok(Written {
-            path: path.to_path_buf(),
-            forced,
-        })
+        Ok(Written::new("machine file", path, forced))
     }
 }
 
@@ -502,7 +514,7 @@ mod tests {
         let from_file = calibrate(CalibrateRequest::new(fixture())).unwrap();
         let mut dataset = tricept_data::read_path(&fixture()).unwrap();
         dataset.source = "numpy columns".into();
-        let mut in_memory = calibrate(CalibrateRequest::new(dataset)).unwrap();
+        let in_memory = calibrate(CalibrateRequest::new(dataset)).unwrap();
         assert_eq!(from_file.exit_code(), 0, "{}", from_file.report());
         assert_eq!(in_memory.exit_code(), from_file.exit_code());
         assert_eq!(in_memory.estimates(), from_file.estimates());
@@ -510,7 +522,7 @@ mod tests {
         let e = in_memory
             .write_machine(
                 &std::env::temp_dir().join("tricept-never-written.json"),
-                false,
+                WriteOptions::default(),
             )
             .unwrap_err();
         assert_eq!(e.exit_code(), crate::EXIT_INPUT, "{e}");

@@ -30,7 +30,8 @@ fn read_prior(
     set: &ParameterSet,
 ) -> Result<(Prior, PriorFile), Error> {
     let name = path.display().to_string();
-    let text = tricept_data::bounded::read_json_text(path).map_err(|e| Error::unreadable(&name, e))?;
+    let text =
+        tricept_data::bounded::read_json_text(path).map_err(|e| Error::unreadable(&name, e))?;
     let file = PriorFile::from_json(&text, &name)
         .map_err(|e| Error::from_library(e).in_setting(Setting::Prior))?;
     let geometry = |v: Value| match v {

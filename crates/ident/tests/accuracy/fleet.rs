@@ -315,7 +315,7 @@ fn new_machine(
     campaign(&truth, poses, seed ^ 0xfee1, None, &data);
     let mut request = CalibrateRequest::new(DataInput::File(data));
     request.prior = prior.map(Path::to_path_buf);
-    let mut c = calibrate(request).unwrap();
+    let c = calibrate(request).unwrap();
     let a = c.to_json()["accuracy"].clone();
     let (rms, upper) = (
         a["rms_mm"].as_f64().unwrap(),
@@ -325,7 +325,8 @@ fn new_machine(
         return (c.exit_code(), rms, upper, f64::NAN);
     }
     let file = dir.join(format!("new-{seed}-{poses}-{}.json", prior.is_some()));
-    c.write_machine(&file, false).unwrap();
+    c.write_machine(&file, tricept_ident::WriteOptions::default())
+        .unwrap();
     let targets = Machine::paper()
         .workspace
         .random_poses(TARGETS, seed ^ 0x07a2);
@@ -340,7 +341,12 @@ fn new_machines_calibrated_from_the_batch_keep_their_promise_in_truth() {
     let pop = Population::new(48);
     let (r, _) = batch(&pop, 48, 16, 80, None, &dir);
     let prior = dir.join("prior.json");
-    assert_eq!(r.write_prior(&prior, false).unwrap(), None);
+    assert_eq!(
+        r.write_prior(&prior, tricept_ident::WriteOptions::default())
+            .unwrap()
+            .forced(),
+        None
+    );
     for seed in 0..6u64 {
         let (exit, rms, upper, got) = new_machine(&pop, 480 + seed, 10, Some(&prior), &dir);
         assert_eq!(exit, EXIT_OK, "seed {seed}");
@@ -516,7 +522,8 @@ fn tally_of_batches_and_new_machines() {
     let pop = Population::new(200);
     let (r, _) = batch(&pop, 200, 20, 80, None, &dir);
     let prior = dir.join("tally-prior.json");
-    r.write_prior(&prior, false).unwrap();
+    r.write_prior(&prior, tricept_ident::WriteOptions::default())
+        .unwrap();
     let trials = 20u64;
     let alone: Vec<f64> = (0..trials)
         .map(|s| new_machine(&pop, 2000 + s, 80, None, &dir).3)

@@ -592,7 +592,7 @@ fn delivered(file: &Path, truth: &TrueMachine, effects: &[LegEffect], targets: &
 /// when refused) and measures it.
 fn run(config: &Config, plans: &Plans, seed: u64, dir: &Path, force: bool) -> Outcome {
     let (truth, request, effects) = campaign(config, plans, seed, dir);
-    let mut c = calibrate(request).unwrap();
+    let c = calibrate(request).unwrap();
     let json = c.to_json();
     // TRICEPT_FUSED_DUMP=SEED prints the true machine and the calibration's
     // JSON of machine SEED (how a file beyond its promise is looked into).
@@ -618,7 +618,8 @@ fn run(config: &Config, plans: &Plans, seed: u64, dir: &Path, force: bool) -> Ou
         return outcome;
     }
     let file: PathBuf = dir.join(format!("fused-{seed}.json"));
-    c.write_machine(&file, force).unwrap();
+    c.write_machine(&file, tricept_ident::WriteOptions::default().force(force))
+        .unwrap();
     let loaded = load_machine(Some(&file), &SensorNoise::default()).unwrap();
     let promise = loaded
         .description()
@@ -831,7 +832,7 @@ fn touches_that_disagree_with_the_tracker_are_still_refused() {
     let dir = scratch("disagree");
     let plans = Plans::new(&dir);
     let (_, request, _) = campaign(&twelve_points_and_touches(12, 0.3), &plans, 8, &dir);
-    let mut c = calibrate(request).unwrap();
+    let c = calibrate(request).unwrap();
     let json = c.to_json();
     assert_eq!(c.exit_code(), 3, "{}", c.report());
     assert_eq!(source(&json, "touch")["checkable"], false, "{json}");
@@ -839,16 +840,19 @@ fn touches_that_disagree_with_the_tracker_are_still_refused() {
         json["unchecked"]["agrees_with_checked_fit"],
         false,
         "{:?} {}",
-        c.refusal(),
+        c.reason(),
         json["warnings"]
     );
-    let why = c.refusal().unwrap();
+    let why = c.reason().unwrap();
     assert!(
         why.contains("touch cannot be checked") && why.contains("disagree with the checked fit"),
         "{why}"
     );
     let file = dir.join("m.json");
-    assert!(c.write_machine(&file, false).is_err());
+    assert!(
+        c.write_machine(&file, tricept_ident::WriteOptions::default())
+            .is_err()
+    );
     assert!(!file.exists());
     // A tracker that cannot be checked beside the internal data alone (which
     // do not see the head): nothing outside the machine checks it, refused.

@@ -51,11 +51,12 @@ impl Drop for Dir {
 /// The Table 2 fixture identified (`identify --write-machine`).
 pub fn table2_machine(dir: &Dir) -> PathBuf {
     let out = dir.join("table2.json");
-    let mut fit = calibrate(CalibrateRequest::new(
+    let fit = calibrate(CalibrateRequest::new(
         fixture("fixtures/data/table2-grid-seed1.csv").as_path(),
     ))
     .unwrap();
-    fit.write_machine(&out, false).unwrap();
+    fit.write_machine(&out, tricept_ident::WriteOptions::default())
+        .unwrap();
     out
 }
 
@@ -63,12 +64,13 @@ pub fn table2_machine(dir: &Dir) -> PathBuf {
 /// three per-leg compensation tables).
 pub fn pitch_machine(dir: &Dir) -> PathBuf {
     let out = dir.join("pitch.json");
-    let d = diagnose(DiagnoseRequest::new(
-        MachineInput::default(),
-        fixture("fixtures/data/diagnose-pitch.csv").as_path(),
-    ))
+    let d = diagnose(
+        DiagnoseRequest::new(fixture("fixtures/data/diagnose-pitch.csv").as_path())
+            .machine(MachineInput::default()),
+    )
     .unwrap();
-    d.write_machine(&out, false).unwrap();
+    d.write_machine(&out, tricept_ident::WriteOptions::default())
+        .unwrap();
     out
 }
 
@@ -95,7 +97,7 @@ pub fn campaign(
     seed: u64,
     noise_factor: f64,
 ) -> PathBuf {
-    let mut r = SimulateRequest::new(MachineInput::default());
+    let mut r = SimulateRequest::new().machine(MachineInput::default());
     r.truth = truth;
     r.truth_effects =
         parse_effects(&effects.iter().map(|e| e.to_string()).collect::<Vec<_>>()).unwrap();
@@ -114,19 +116,19 @@ pub fn check_into(machine: &Path, data: &Path, history: &Path) -> String {
     let mut r = CheckRequest::new(machine, data);
     r.history = Some(history.to_path_buf());
     let c = check(r).unwrap();
-    c.report().verdict.as_str().to_string()
+    c.check_report().verdict.as_str().to_string()
 }
 
 /// The export of `machine` for the SINUMERIK 840D sl into `dir/name`.
 pub fn export_of(machine: &Path, dir: &Dir, name: &str) -> PathBuf {
     let out = dir.join(name);
-    let e = export(ExportRequest {
-        machine: machine.into(),
-        options: ExportOptions::for_model(ControlModel::default()),
-        out: out.clone(),
-    })
+    let e = export(ExportRequest::new(
+        machine,
+        ExportOptions::for_model(ControlModel::default()),
+        out.clone(),
+    ))
     .unwrap();
-    assert!(e.written);
+    assert!(e.written());
     out
 }
 

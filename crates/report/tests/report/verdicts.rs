@@ -62,9 +62,10 @@ fn a_forced_calibration_is_not_trusted() {
     // written with --force.
     let data = fixture("fixtures/data/diagnose-pitch.csv");
     let machine = dir.join("forced.json");
-    let mut fit = calibrate(CalibrateRequest::new(data.as_path())).unwrap();
+    let fit = calibrate(CalibrateRequest::new(data.as_path())).unwrap();
     assert_ne!(fit.exit_code(), EXIT_OK);
-    fit.write_machine(&machine, true).unwrap();
+    fit.write_machine(&machine, tricept_ident::WriteOptions::default().force(true))
+        .unwrap();
     let r = page(&machine, Some(&data), None, None, &dir.join("page.html")).unwrap();
     assert_eq!(r.verdict().level, Level::DoNotTrust);
     assert_eq!(r.exit_code(), EXIT_INADEQUATE);
@@ -105,5 +106,5 @@ fn a_clean_calibration_with_unchanged_checks_and_its_export_is_trusted() {
     .unwrap();
     assert_eq!(r.verdict().level, Level::Trusted, "{:?}", r.verdict());
     assert_eq!(r.exit_code(), EXIT_OK);
-    assert!(r.text().starts_with("report written to "));
+    assert!(r.report().starts_with("report written to "));
 }
