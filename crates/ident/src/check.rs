@@ -1,6 +1,6 @@
 //! The check workflow (`tricept check`): has the machine changed since its
 //! calibration? A short check campaign from the machine's own sensors
-//! tested against the calibrated machine file (`tricept_check`), with an
+//! tested against the calibration record of the machine file, with an
 //! optional history (JSON lines, appended) and its trends.
 //!
 //! The verdict's exit code: 0 unchanged, 3 changed; 0 too for readings

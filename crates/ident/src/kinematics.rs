@@ -1,8 +1,11 @@
 //! The kinematics workflows (`tricept ik`, `fk`, `tool-ik` and `machine`):
 //! one point solved on a machine with its static leg effects applied
-//! ([`solve_point`]), many points streamed from CSV ([`run`],
-//! [`solve_batch`]: the streaming is `tricept_kinematics::batch`'s), and
-//! the summary of a machine description ([`machine_summary`]).
+//! ([`solve_point`]), many points streamed from CSV in blocks of
+//! [`BLOCK_ROWS`] rows ([`run`], and [`solve_batch`] with the door's
+//! errors), and the summary of a machine description
+//! ([`machine_summary`]); the machine a program commands ([`Machine`])
+//! and the solutions it returns ([`IkSolution`], [`FkSolution`],
+//! [`ToolIkSolution`]).
 
 use std::io::{Read, Write};
 

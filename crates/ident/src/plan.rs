@@ -2,9 +2,10 @@
 //! touch-offs to take, given the internal campaign, so that the tool tip
 //! (and with known extensions the tool axis) is best known after touch-off;
 //! the predicted accuracy against their number, the redundancy each leaves
-//! to check the fit, and the recommended number (`tricept_study::plan`);
-//! or the fewest poses of a check of a calibrated machine that detect a
-//! stated change (`tricept_study::check_plan`).
+//! to check the fit, and the recommended number ([`Instrument::Tracker`],
+//! [`Instrument::Ballbar`], [`Instrument::Touch`]); or the fewest poses of
+//! a check of a calibrated machine that detect a stated change
+//! ([`Instrument::Check`]).
 
 use std::fmt::Write as _;
 use std::path::PathBuf;

@@ -3,8 +3,9 @@
 //! errors, sensor noise and offsets), and optionally what external
 //! instruments (laser tracker, ballbar, touch probe) would measure on it.
 //! Everything is returned in memory with the comment lines its file
-//! carries; the caller writes the files
-//! (`tricept_data::write_path`, `tricept_data::write_external_path`).
+//! carries; the caller writes the files as every verb writes them
+//! ([`crate::advanced::files::write_path`],
+//! [`crate::advanced::files::write_external_path`]).
 
 use std::fmt;
 use std::path::{Path, PathBuf};
