@@ -45,12 +45,23 @@ pub use crate::machine_file::MachineFile;
 pub use nalgebra;
 pub use serde_json;
 pub use tricept_check::DEFAULT_POWER;
-pub use tricept_data::Dataset;
+// The internal crates' errors the door's [`Error`](crate::Error) is made
+// from ([`Classify`]).
+pub use tricept_check::CheckError;
+pub use tricept_data::DataError;
+pub use tricept_data::{Dataset, MeasuredPose, Readings};
+pub use tricept_diagnose::{DeployError, DiagnoseError};
 pub use tricept_engine::DEFAULT_TOLERANCE_MM;
-pub use tricept_engine::fusion::fusable_effects;
-pub use tricept_model::ParameterSet;
+pub use tricept_engine::fusion::{TrackerTarget, fusable_effects};
+pub use tricept_engine::{IdentError, RecordError};
+pub use tricept_fleet::FleetError;
+pub use tricept_model::ModelError;
+pub use tricept_model::{GeometricErrors, ParameterSet};
+pub use tricept_numerics::sparse::BlockError;
+pub use tricept_plant::PlantError;
 /// The figures of the verbs that draw (SVG, atomic): `tricept_plot`.
 pub use tricept_plot as plot;
+pub use tricept_study::StudyError;
 
 /// Files written as every verb writes them (atomic: temporary file and
 /// rename; `-` for stdout) and messages made one bounded line, from

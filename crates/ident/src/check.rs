@@ -14,14 +14,18 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
 use tricept_check::history::{Entry, append, trends};
-use tricept_check::{CheckError, CheckOptions, CheckVerdict, Reference};
+use tricept_check::{CheckError, CheckOptions, Reference};
 
 use crate::data_input::DataInput;
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::machine_input::MachineInput;
 
 pub use tricept_check::history::Trend;
-pub use tricept_check::{CheckReport, DEFAULT_ALPHA};
+pub use tricept_check::{CandidateKind, ChannelNoise};
+pub use tricept_check::{
+    CandidateResult, Change, CheckReport, CheckVerdict, ChiSquare, DEFAULT_ALPHA, NoiseSeen,
+    Rejected,
+};
 
 /// A check campaign against a calibrated machine.
 ///

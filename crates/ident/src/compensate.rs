@@ -12,11 +12,11 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use nalgebra::Vector3;
+use crate::linalg::Vector3;
 use serde_json::{Map, Value, json};
 use tricept_engine::ExtendedMachine;
 use tricept_engine::compensate::{MapError, TableError, WorkspaceTable};
-use tricept_model::{MapStats, ParameterSet};
+use tricept_model::ParameterSet;
 use tricept_plant::Effect;
 
 use crate::calibrate::{CalibrateRequest, calibrate, exit_line, write_text};
@@ -25,7 +25,7 @@ use crate::inputs::TrueErrors;
 use crate::machine_file::write_rule;
 use crate::machine_input::MachineInput;
 
-pub use tricept_model::ErrorMap;
+pub use tricept_model::{ErrorMap, MapStats};
 
 /// The largest interpolation error (um) the default table spacing allows.
 pub const TABLE_ERROR_LIMIT_UM: f64 = 1.0;
@@ -97,7 +97,7 @@ impl CompensateRequest {
 }
 
 /// A target (mm) and its corrected leg commands (mm).
-pub type CorrectedTarget = (Vector3<f64>, [f64; 3]);
+pub type CorrectedTarget = (Vector3, [f64; 3]);
 
 /// The compensation table and where it is written.
 #[derive(Debug, Clone)]
@@ -358,7 +358,7 @@ fn truth_maps(
     request: &CompensateRequest,
     nominal: &ExtendedMachine,
     calibrated: &ExtendedMachine,
-    grid: &[Vector3<f64>],
+    grid: &[Vector3],
 ) -> Result<Option<(ErrorMap, ErrorMap)>, Error> {
     let Some(truth) = &request.truth else {
         if !request.truth_effects.is_empty() {

@@ -28,7 +28,17 @@ use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
 
-pub use tricept_diagnose::{DeployRule, Deployed, Diagnosis, ResidualPlot};
+pub use tricept_diagnose::Verdict as DiagnosisVerdict;
+pub use tricept_diagnose::{
+    Alias, Cause, CauseKind, ChannelRms, DeployRule, Deployed, Diagnosis, Estimate, Evidence,
+    ExtendedModel, FinalFit, Gain, ModelTerm, NoiseCheck, NoiseSource, PureError, RejectStage,
+    Rejected, Remainder, ResidualPlot, Structure, TermScore, Tested,
+};
+pub use tricept_diagnose::{Frame, GenericTerm, OrderAxis, Scope, Term};
+pub use tricept_engine::{
+    CampaignOffsets, Design, GeometricModel, GeometricPredictor, Identification, PosePredictor,
+    Prior, PriorFit, ReadingModel, ResidualStats,
+};
 
 /// What to diagnose and how.
 ///

@@ -8,7 +8,17 @@ use tricept_plant::effects::typical_effects;
 
 use crate::error::{EXIT_OK, Error};
 
-pub use tricept_model::effects::EffectName;
+pub use tricept_model::effects::Simulation as EffectSimulation;
+pub use tricept_model::effects::{
+    Basis, CheckColumns, CheckWhen, GenericSpec, LegContext, LegDeployment, PoseState,
+    SimulateObject, Structural, UnknownEffect, XAxis, YAxis,
+};
+pub use tricept_model::effects::{CauseName, EffectKey, EffectName, EffectSpec, Judgement};
+pub use tricept_model::effects::{
+    CheckRole, CommonPart, Deployment, GenericFamily, Judged, Kind, KnownAlias, Magnitude, Measure,
+    Needs, Parameter, PlausibleRange, PlotAxes, Simulate,
+};
+pub use tricept_model::plausibility::Range;
 pub use tricept_plant::Effect;
 
 /// The effects listed: all, or the one asked for.

@@ -13,12 +13,12 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 use tricept_data::Dataset;
 use tricept_engine::{AccuracyModel, GeometricModel, IdentifyOptions, accuracy_points};
-use tricept_fleet::{
-    Batch, BatchOptions, DataFileRecord, PriorFile, PriorProvenance, calibrate_batch,
-};
+use tricept_fleet::{BatchOptions, DataFileRecord, PriorFile, PriorProvenance, calibrate_batch};
 use tricept_model::ParameterSet;
 
-pub use tricept_fleet::SolverKind;
+pub use tricept_engine::Rejection;
+pub use tricept_fleet::reml::{Distance, Spread};
+pub use tricept_fleet::{Batch, JointFit, MachineOutcome, OwnFit, SolveStats, SolverKind};
 
 use crate::data_input::DataInput;
 use crate::error::Error;

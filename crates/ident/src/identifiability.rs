@@ -14,7 +14,9 @@ use crate::error::Error;
 use crate::inputs::Poses;
 use crate::machine_input::MachineInput;
 
-pub use tricept_engine::IdentifiabilityReport;
+pub use tricept_engine::{
+    Combination, CorrelatedPair, IdentifiabilityReport, NamedValues, Observability,
+};
 
 /// The poses to assess.
 #[derive(Debug, Clone)]

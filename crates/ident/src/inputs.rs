@@ -12,7 +12,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-use nalgebra::Vector3;
+use crate::linalg::Vector3;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{
     DescriptionError, MAX_POSES, Machine, MachineDescription, PoseSet, PoseSetError,
@@ -430,7 +430,7 @@ impl Poses {
     }
 
     /// The target points on `machine`, mm.
-    pub fn targets(&self, machine: &Machine) -> Result<Vec<Vector3<f64>>, Error> {
+    pub fn targets(&self, machine: &Machine) -> Result<Vec<Vector3>, Error> {
         match &self.kind {
             PosesKind::Optimal(n) => {
                 tricept_study::campaign::d_optimal_targets(machine, &ParameterSet::paper15(), *n)

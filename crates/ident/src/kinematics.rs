@@ -14,11 +14,21 @@ use serde_json::{Map, Value};
 use crate::error::{EXIT_OK, Error};
 use crate::inputs::LoadedMachine;
 
-pub use crate::commanding::{GeometricMachine, Machine, Vector3};
+pub use crate::commanding::{GeometricMachine, Machine};
+pub use crate::linalg::Vector3;
+pub use tricept_kinematics::SensorNoise as LoggedSensorNoise;
+pub use tricept_kinematics::batch::PointKinematics;
 pub use tricept_kinematics::batch::{BLOCK_ROWS, BatchError, Cell, Verb, run};
+pub use tricept_kinematics::description::{
+    AccuracyRecord, AxisOrder, CalibrationRecord, CircularPlacement, ControllerDescription,
+    CorrelationsDescription, ExplicitPlacement, ExternalSourceRecord, HeadDescription,
+    HeldParameter, Interpolation, LegEffectsDescription, LegTableDescription, LimitsDescription,
+    LoadsDescription, Placement, SealCheck, SensorDescription, SensorOffsetsDescription,
+    UpLimbDescription, WorkspaceDescription,
+};
 pub use tricept_kinematics::{
-    FkSolution, HeadBranch, IkSolution, KinematicsError, MachineDescription, ToolIkSolution,
-    UpJoints,
+    DescriptionError, FkSolution, Head, HeadBranch, IkSolution, KinematicsError, LegGeometry,
+    Limits, MachineDescription, ToolIkSolution, ToolPose, UpJoints, UpLimb, UpLimbPose, Workspace,
 };
 pub use tricept_model::ExtendedMachine;
 

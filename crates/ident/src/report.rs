@@ -27,6 +27,7 @@ use crate::inputs::LoadedMachine;
 use crate::machine_file::sha256_file;
 use crate::machine_input::MachineInput;
 
+pub use tricept_report::verdict::{Reason, Shown};
 pub use tricept_report::{Level, Verdict};
 
 /// The file of an export folder the page reads (`--export DIR`).

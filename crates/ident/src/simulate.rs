@@ -13,9 +13,11 @@ use std::str::FromStr;
 
 use nalgebra::{Isometry3, Vector3};
 use serde_json::{Value, json};
-use tricept_data::{
-    BallbarData, Dataset, ExternalPose, PlannedPose, TouchData, TrackerData, read_external_path,
+pub use tricept_data::{BallbarData, ExternalData, ExternalRecord, TouchData, TrackerData};
+pub use tricept_data::{
+    BallbarReading, ExternalPose, InstrumentRecord, TouchReading, TrackerPoint,
 };
+use tricept_data::{Dataset, PlannedPose, read_external_path};
 use tricept_engine::GeometricModel;
 use tricept_kinematics::Machine;
 use tricept_kinematics::units::RAD_PER_ARCSEC;

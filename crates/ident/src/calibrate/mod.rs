@@ -88,6 +88,7 @@ use crate::data_input::DataInput;
 use crate::error::Error;
 pub(crate) use crate::error::exit_line;
 use crate::inputs::LoadedMachine;
+pub use crate::linalg::DMatrix;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
 use checked::{Checked, Work};
@@ -404,7 +405,7 @@ impl Calibration {
 
     /// The covariance of the estimates (mm², rad², mm·rad), in the order
     /// of [`Calibration::estimates`]; held parameters have zero rows.
-    pub fn covariance(&self) -> &nalgebra::DMatrix<f64> {
+    pub fn covariance(&self) -> &DMatrix {
         match &self.fit {
             Fit::Internal(f) => &f.id.covariance,
             Fit::Fused(f) => &f.fit.covariance,
