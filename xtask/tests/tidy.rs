@@ -13,6 +13,9 @@
 //!   repository path it names exists.
 //! - **Dependencies** (`tidy/deps.rs`): the binary, the Python package and
 //!   the examples depend on the door alone; no dependency goes unused.
+//! - **The door's docs** (`tidy/docs.rs`): every public item of
+//!   tricept-ident has an example, in door paths only; its signatures name
+//!   types it exports.
 //!
 //! An edge is a path in a file's code outside its tests (`#[cfg(test)]`
 //! items) that resolves to another file's module; a path to an item that a
@@ -25,6 +28,10 @@ use std::path::{Path, PathBuf};
 
 #[path = "tidy/deps.rs"]
 mod deps;
+#[path = "tidy/docs.rs"]
+mod docs;
+#[path = "tidy/docs_reader.rs"]
+mod docs_reader;
 
 /// Circles that may stay: `(crate directory, files)`, with why.
 const ALLOWED_CIRCLES: &[(&str, &[&str])] = &[
