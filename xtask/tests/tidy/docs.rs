@@ -11,11 +11,17 @@
 //!   crate's paths is shown in that crate's docs only
 //!   (`#[cfg_attr(any(doc, doctest), doc = ...)]`: dependents read its
 //!   docs without `cfg(doc)`), and is not counted as the door's example.
+//! - **Signatures.** The types the door's own public signatures name
+//!   (`crates/ident/public-api.txt`, the items a user can reach) are the
+//!   door's, std's, `serde_json`'s or generic parameters: each has a page
+//!   under the door, and no signature spells an internal crate's path.
+//!   The signatures of the re-exported internal items are not read here
+//!   (their field and method types were checked on `cargo doc`'s pages).
 
 use std::collections::BTreeSet;
 
 use super::docs_reader::{
-    door, door_items, example_lines, internal_items, names_internal_crate, reexports,
+    KINDS, door, door_items, example_lines, ident, internal_items, names_internal_crate, reexports,
 };
 use super::workspace;
 
@@ -121,4 +127,65 @@ fn the_docs_reader_finds_examples_and_internal_paths() {
         )
     );
     assert_eq!(r[1].1, "Verb");
+}
+
+/// Names a door signature may use besides the door's own.
+const STD_NAMES: &[&str] = &[
+    "AsRef", "Box", "BufRead", "Display", "Fn", "Into", "Item", "Iterator", "Map", "Option",
+    "Path", "PathBuf", "Read", "Result", "Self", "Send", "String", "Sync", "Value", "Vec", "Write",
+];
+
+#[test]
+fn door_signatures_name_door_types_only() {
+    let items = door_items();
+    let (_, reexported) = door();
+    let mut names: BTreeSet<String> = reexported.into_iter().map(|(_, n, _)| n).collect();
+    names.extend(
+        items
+            .iter()
+            .filter_map(|(i, _)| i.rsplit(' ').next().map(str::to_string)),
+    );
+    let listing = std::fs::read_to_string(workspace().join("crates/ident/public-api.txt"));
+    let (mut read, mut wrong) = (0, Vec::new());
+    for line in listing.unwrap_or_default().lines() {
+        let (owner, item) = line.split_once(" :: ").unwrap_or(("", line));
+        let owner = owner.rsplit(' ').next().unwrap_or("");
+        let words: Vec<&str> = item.split(' ').collect();
+        let mut after = words.iter().skip_while(|w| ["pub", "const"].contains(w));
+        let first = after.next().unwrap_or(&"");
+        let name = ident(if KINDS.contains(first) {
+            after.next().unwrap_or(&"")
+        } else {
+            first
+        });
+        let reachable = if owner.is_empty() {
+            names.contains(name)
+        } else {
+            names.contains(ident(owner))
+        };
+        if words.get(1).is_some_and(|k| ["use", "mod"].contains(k)) || !reachable {
+            continue;
+        }
+        read += 1;
+        // A constant's value is not shown on its page.
+        let signature = item.split(" = ").next().unwrap_or("");
+        let signature = &signature[signature.find(name).unwrap_or(0) + name.len()..];
+        let mut rest = signature;
+        while let Some(k) = rest.find(|c: char| c.is_ascii_uppercase()) {
+            let word = ident(&rest[k..]);
+            let preceded = rest[..k].ends_with(|c: char| c.is_alphanumeric() || c == '_');
+            if !preceded && word.len() > 1 && !names.contains(word) && !STD_NAMES.contains(&word) {
+                wrong.push(format!("{word} in `{line}`"));
+            }
+            rest = &rest[k + word.len().max(1)..];
+        }
+        if names_internal_crate(signature) {
+            wrong.push(format!("an internal path in `{line}`"));
+        }
+    }
+    assert!(read > 250, "only {read} signatures read");
+    assert!(
+        wrong.is_empty(),
+        "door signatures naming what the door does not export: {wrong:#?}"
+    );
 }
