@@ -29,6 +29,15 @@
 //!   ([`files`]), the figures ([`plot`]), and the defaults the binary's
 //!   flags show ([`DEFAULT_TOLERANCE_MM`], [`DEFAULT_POWER`],
 //!   [`fusable_effects`]).
+//!
+//! # Example
+//! ```
+//! use tricept_ident::advanced::{LoadedMachine, SensorNoise, load_machine};
+//! let noise = SensorNoise { length_noise_um: Some(2.0), ..SensorNoise::default() };
+//! let loaded: LoadedMachine = load_machine(None, &noise)?;
+//! assert!(loaded.warnings().is_empty());
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 pub use crate::accuracy::Accuracy;
 pub use crate::calibrate::values::{
@@ -66,6 +75,13 @@ pub use tricept_study::StudyError;
 /// Files written as every verb writes them (atomic: temporary file and
 /// rename; `-` for stdout) and messages made one bounded line, from
 /// `tricept_data`.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::files::one_line;
+/// let message = one_line("a message\nover two lines");
+/// assert!(!message.contains('\n'));
+/// ```
 pub mod files {
     pub use tricept_data::{
         check_output_file, one_line, shown_path, write_atomic, write_external_path, write_path,

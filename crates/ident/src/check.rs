@@ -9,6 +9,16 @@
 //! are unchanged, each with a warning ([`CheckResult::warnings`]); a machine
 //! file without a calibration record and a campaign that cannot see a
 //! change are input errors (exit code 2).
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::check::{CheckRequest, check};
+//! let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
+//! if result.changed() {
+//!     println!("changed since its calibration: exit code {}", result.exit_code());
+//! }
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::path::{Path, PathBuf};
 
@@ -73,6 +83,19 @@ struct History {
 }
 
 /// A check's report, its verdict and the history's trends.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::check::{CheckRequest, check};
+/// let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
+/// for trend in result.trends() {
+///     println!("{trend:?}");
+/// }
+/// if result.changed() {
+///     println!("changed since its calibration: exit code {}", result.exit_code());
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct CheckResult {
     report: CheckReport,
@@ -86,6 +109,16 @@ pub struct CheckResult {
 /// Runs the check: the reference from the machine's calibration record,
 /// the data read, the history read (refused before the check when it
 /// cannot be), the test, and the entry appended to the history.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::check::{CheckRequest, check};
+/// let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
+/// if result.changed() {
+///     println!("changed since its calibration: exit code {}", result.exit_code());
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn check(request: CheckRequest) -> Result<CheckResult, Error> {
     let loaded = &request.machine.load()?;
     let machine = loaded.source().to_string();

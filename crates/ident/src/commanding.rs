@@ -30,7 +30,8 @@ use crate::linalg::Vector3;
 /// # Example
 /// ```
 /// use tricept_ident::kinematics::{GeometricMachine, Machine};
-/// let geometry: &GeometricMachine = Machine::paper().geometry();
+/// let machine = Machine::paper();
+/// let geometry: &GeometricMachine = machine.geometry();
 /// assert_eq!(geometry, &GeometricMachine::paper());
 /// ```
 #[doc(inline)]

@@ -11,6 +11,18 @@
 //! ([`DataInput`]); the result carries the
 //! verdict and its exit code (0 the final model explains the data, 3 it
 //! does not), the JSON and the text report the CLI prints.
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+//! let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+//! if !result.explained() {
+//!     for cause in &result.diagnosis().causes {
+//!         println!("{}: {}", cause.effect, cause.description);
+//!     }
+//! }
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -92,6 +104,18 @@ impl DiagnoseRequest {
 }
 
 /// A diagnosis with what it needs to deploy its final model.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// if !result.explained() {
+///     for cause in &result.diagnosis().causes {
+///         println!("{}: {}", cause.effect, cause.description);
+///     }
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct DiagnoseResult {
     diagnosis: Diagnosis,
@@ -107,6 +131,18 @@ pub struct DiagnoseResult {
 
 /// Diagnoses the request's data: every problem of the input is an error of
 /// kind input (exit code 2) naming the data.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// if !result.explained() {
+///     for cause in &result.diagnosis().causes {
+///         println!("{}: {}", cause.effect, cause.description);
+///     }
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn diagnose(request: DiagnoseRequest) -> Result<DiagnoseResult, Error> {
     let DiagnoseRequest {
         machine: loaded,
@@ -425,6 +461,12 @@ fn effect_records(d: &Diagnosis, deployed: &Deployed, g: usize) -> Map<String, s
 /// The vocabulary, from the registry: each effect, its physics, its
 /// parameters (units in the names) and where a written machine puts it
 /// (`tricept diagnose --help`).
+///
+/// # Example
+/// ```
+/// let help = tricept_ident::diagnosis::vocabulary_help();
+/// assert!(help.contains("leg-lead"));
+/// ```
 pub fn vocabulary_help() -> String {
     let lines: Vec<String> = tricept_model::effects::EffectName::ALL
         .iter()

@@ -2,6 +2,14 @@
 //! keys, their units and a typical example (what `simulate
 //! --truth-effect` takes), and whether the diagnosis names it (in its
 //! vocabulary) or describes it through a generic family.
+//!
+//! # Example
+//! ```
+//! use tricept_ident::effects::effects;
+//! let all = effects(None)?;
+//! assert!(all.effects().len() > 5);
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use serde_json::{Value, json};
 use tricept_plant::effects::typical_effects;
@@ -22,6 +30,15 @@ pub use tricept_model::plausibility::Range;
 pub use tricept_plant::Effect;
 
 /// The effects listed: all, or the one asked for.
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::effects;
+/// let lead = effects(Some("leg-lead"))?;
+/// assert_eq!(lead.effects().len(), 1);
+/// assert_eq!(lead.exit_code(), tricept_ident::EXIT_OK);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct EffectList {
     effects: Vec<Effect>,

@@ -1,6 +1,20 @@
 //! `export`: a calibrated machine file translated into the files a CNC
 //! control loads (`tricept-export`): a typed [`ExportRequest`] to an
 //! [`Export`] with its exit code, its JSON and its text report.
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::MachineInput;
+//! use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
+//! let request = ExportRequest {
+//!     machine: MachineInput::from("calibrated.json"),
+//!     options: ExportOptions::new(Controller::Heidenhain),
+//!     out: "export".into(),
+//! };
+//! let exported = export(request)?;
+//! assert!(exported.written || exported.exit_code != tricept_ident::EXIT_OK);
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::path::PathBuf;
 
@@ -13,6 +27,20 @@ pub use tricept_export::{
 };
 
 /// What to export, and where.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
+/// let request = ExportRequest {
+///     machine: MachineInput::from("calibrated.json"),
+///     options: ExportOptions::new(Controller::Heidenhain),
+///     out: "export".into(),
+/// };
+/// let exported = export(request)?;
+/// assert!(exported.written || exported.exit_code != tricept_ident::EXIT_OK);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct ExportRequest {
     /// The calibrated machine file (read as written: an input without a
@@ -26,6 +54,20 @@ pub struct ExportRequest {
 }
 
 /// The outcome of an export.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
+/// let request = ExportRequest {
+///     machine: MachineInput::from("calibrated.json"),
+///     options: ExportOptions::new(Controller::Heidenhain),
+///     out: "export".into(),
+/// };
+/// let exported = export(request)?;
+/// assert!(exported.written || exported.exit_code != tricept_ident::EXIT_OK);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Export {
     /// The summary (the JSON of `--json`).
@@ -98,6 +140,20 @@ impl Export {
 /// file (refusing one edited after its calibration), plans the export and,
 /// when every axis is within the tolerance and the control's ranges,
 /// writes the files as one set (the previous export or this one, whole).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
+/// let request = ExportRequest {
+///     machine: MachineInput::from("calibrated.json"),
+///     options: ExportOptions::new(Controller::Heidenhain),
+///     out: "export".into(),
+/// };
+/// let exported = export(request)?;
+/// assert!(exported.written || exported.exit_code != tricept_ident::EXIT_OK);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn export(request: ExportRequest) -> Result<Export, Error> {
     let ExportRequest {
         machine,

@@ -7,6 +7,18 @@
 //! [`fleet`] takes a [`FleetRequest`] (one data file per machine, the
 //! nominal machine) and returns a [`FleetResult`]: its JSON, report, exit
 //! code and the prior file it writes. The computation is `tricept-fleet`'s.
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::DataInput;
+//! use tricept_ident::fleet::{FleetRequest, fleet};
+//! let data: Vec<DataInput> = ["m1.csv", "m2.csv", "m3.csv"].into_iter().map(DataInput::from).collect();
+//! let result = fleet(FleetRequest::new(data))?;
+//! for machine in &result.batch().machines {
+//!     println!("{machine:?}");
+//! }
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::path::{Path, PathBuf};
 
@@ -64,6 +76,18 @@ impl FleetRequest {
 }
 
 /// A batch calibrated.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::DataInput;
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let data: Vec<DataInput> = ["m1.csv", "m2.csv", "m3.csv"].into_iter().map(DataInput::from).collect();
+/// let result = fleet(FleetRequest::new(data))?;
+/// for machine in &result.batch().machines {
+///     println!("{machine:?}");
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug)]
 pub struct FleetResult {
     loaded: LoadedMachine,
@@ -74,6 +98,18 @@ pub struct FleetResult {
 
 /// Calibrates the batch of `request` (module docs). Errors: bad files and
 /// fewer than three machines whose data fit are input errors (exit 2).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::DataInput;
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let data: Vec<DataInput> = ["m1.csv", "m2.csv", "m3.csv"].into_iter().map(DataInput::from).collect();
+/// let result = fleet(FleetRequest::new(data))?;
+/// for machine in &result.batch().machines {
+///     println!("{machine:?}");
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn fleet(request: FleetRequest) -> Result<FleetResult, Error> {
     let tolerance = request.tolerance_mm;
     if !(tolerance.is_finite() && tolerance > 0.0 && tolerance <= 10.0) {

@@ -46,6 +46,16 @@ pub struct SensorNoise {
 /// calibrated machine), the validated machine built from it (with the
 /// noise overrides applied), where it came from, and the warnings its
 /// record calls for (a forced or inadequate calibration).
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// let loaded = MachineInput::default().load()?;
+/// assert!(loaded.path().is_none() && loaded.warnings().is_empty());
+/// let m = loaded.commanding();
+/// assert!(!m.has_leg_effects());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct LoadedMachine {
     pub(crate) description: MachineDescription,

@@ -6,6 +6,14 @@
 //! ([`machine_summary`]); the machine a program commands ([`Machine`])
 //! and the solutions it returns ([`IkSolution`], [`FkSolution`],
 //! [`ToolIkSolution`]).
+//!
+//! # Example
+//! ```
+//! use tricept_ident::kinematics::{Machine, Vector3};
+//! let ik = Machine::paper().inverse(&Vector3::new(0.0, 0.0, 750.0))?;
+//! assert!((ik.legs_mm[0] - 773.3).abs() < 0.1);
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::io::{Read, Write};
 
@@ -36,6 +44,17 @@ pub use tricept_model::ExtendedMachine;
 /// `file` names the input in its messages, `label` in the message of a
 /// point that cannot be solved (`VERB --input LABEL: line N: ...`, of that
 /// error's kind); a failed write is an error of kind other naming stdout.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{ExtendedMachine, GeometricMachine, Verb, solve_batch};
+/// let machine = ExtendedMachine::new(GeometricMachine::paper());
+/// let mut out = Vec::new();
+/// let rows = solve_batch(Verb::Ik, &machine, "x,y,z\n0,0,750\n".as_bytes(), "points.csv", "points.csv", &mut out, || false)?;
+/// assert_eq!(rows, 1);
+/// assert!(String::from_utf8_lossy(&out).contains("773.3"));
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn solve_batch<R: Read, W: Write>(
     verb: Verb,
     machine: &ExtendedMachine,
@@ -56,6 +75,15 @@ pub fn solve_batch<R: Read, W: Write>(
 }
 
 /// One point solved by a kinematics verb.
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::kinematics::{Cell, Verb, solve_point};
+/// let s = solve_point(Verb::Ik, &MachineInput::default().load()?, &[0.0, 0.0, 750.0])?;
+/// assert!(matches!(s.cells()[3], Cell::Num(q1) if (q1 - 773.3).abs() < 0.1));
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointSolution {
     verb: Verb,
@@ -143,6 +171,15 @@ impl PointSolution {
 /// A summary of the machine in use with units (`tricept machine`): the
 /// joints, the UP limb, the workspace, the limits, the sensors, the leg
 /// effects, the controller parameters and the calibration record.
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::kinematics::machine_summary;
+/// let summary = machine_summary(&MachineInput::default().load()?);
+/// assert!(!summary.is_empty());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn machine_summary(loaded: &LoadedMachine) -> String {
     let (d, m, source) = (loaded.description(), loaded.machine(), loaded.source());
     let v = |p: &Vector3| format!("({:.3}, {:.3}, {:.3})", p.x, p.y, p.z);

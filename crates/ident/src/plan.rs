@@ -6,6 +6,14 @@
 //! [`Instrument::Ballbar`], [`Instrument::Touch`]); or the fewest poses of
 //! a check of a calibrated machine that detect a stated change
 //! ([`Instrument::Check`]).
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::plan::{Instrument, PlanRequest, plan};
+//! let planned = plan(PlanRequest::new(Instrument::Tracker))?;
+//! assert!(planned.machine_warnings().is_empty());
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -42,6 +50,13 @@ macro_rules! wln {
 }
 
 /// The instrument to plan for.
+///
+/// # Example
+/// ```
+/// use tricept_ident::plan::{Instrument, PlanRequest};
+/// let request = PlanRequest::new(Instrument::Ballbar);
+/// assert_eq!(request.instrument, Instrument::Ballbar);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum Instrument {
@@ -57,6 +72,13 @@ pub enum Instrument {
 }
 
 /// What to plan. The defaults are `tricept plan`'s.
+///
+/// # Example
+/// ```
+/// use tricept_ident::plan::{Instrument, PlanRequest};
+/// let request = PlanRequest::new(Instrument::Touch);
+/// assert!(request.k.is_empty()); // the default numbers of measurements
+/// ```
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct PlanRequest {
@@ -202,6 +224,14 @@ enum OutFile {
 }
 
 /// A plan: its JSON, its text report and the poses to take.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::plan::{Instrument, PlanRequest, plan};
+/// let planned = plan(PlanRequest::new(Instrument::Tracker))?;
+/// assert!(planned.machine_warnings().is_empty());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Plan {
     json: Value,
@@ -255,6 +285,14 @@ fn instrument_sigma(a: &PlanRequest, own: f64, flag: &str) -> Result<f64, Error>
 }
 
 /// Plans as `request` says.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::plan::{Instrument, PlanRequest, plan};
+/// let planned = plan(PlanRequest::new(Instrument::Tracker))?;
+/// assert!(planned.machine_warnings().is_empty());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn plan(request: PlanRequest) -> Result<Plan, Error> {
     let a = &request;
     let default_k = [3, 5, 8, 12, 20, 30, 50];

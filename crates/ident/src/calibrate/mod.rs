@@ -162,6 +162,18 @@ enum Fit {
 
 /// A calibration: the fit, its verdict and exit code, its report and JSON,
 /// and the machine file it may write.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+/// let calibration = calibrate(CalibrateRequest::new("campaign.csv"))?;
+/// let n = calibration.estimates().len();
+/// assert_eq!(calibration.covariance().nrows(), n);
+/// for warning in calibration.warnings() {
+///     eprintln!("{warning}");
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug)]
 pub struct Calibration {
     loaded: LoadedMachine,
@@ -202,6 +214,19 @@ impl Written {
 /// Errors are input errors (exit code 2) for bad files, flags and data too
 /// small to fit; a fit that completes returns its verdict in
 /// [`Calibration::exit_code`].
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+/// let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/table2-grid-seed1.csv");
+/// let calibration = calibrate(CalibrateRequest::new(file))?;
+/// assert!(calibration.converged() && calibration.adequate());
+/// // Every estimate, with its standard uncertainty where it has one.
+/// for (name, value, sigma) in calibration.estimates() {
+///     println!("{name} = {value} ({sigma:?})");
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
     let (checked, data, name, work) = check(request)?;
     let (fit, said) = match &work {
