@@ -60,6 +60,16 @@ pub use tricept_check::CheckError;
 pub use tricept_data::DataError;
 pub use tricept_data::{Dataset, MeasuredPose, Readings};
 pub use tricept_diagnose::{DeployError, DiagnoseError};
+
+/// The door: the manufacturing tolerance a calibration is judged against by default, mm.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::DEFAULT_TOLERANCE_MM;
+/// use tricept_ident::calibrate::CalibrateRequest;
+/// assert_eq!(CalibrateRequest::new("campaign.csv").tolerance_mm, DEFAULT_TOLERANCE_MM);
+/// ```
+#[doc(inline)]
 pub use tricept_engine::DEFAULT_TOLERANCE_MM;
 pub use tricept_engine::fusion::{TrackerTarget, fusable_effects};
 pub use tricept_engine::{IdentError, RecordError};

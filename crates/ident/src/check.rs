@@ -30,11 +30,38 @@ use crate::data_input::DataInput;
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::machine_input::MachineInput;
 
+/// The door: a check's report ([`CheckResult`]).
+///
+/// # Example
+/// ```
+/// use tricept_ident::check::{CheckReport, CheckVerdict};
+/// fn summary(report: &CheckReport) -> String {
+///     format!("{} poses, changed: {}", report.poses, report.changed)
+/// }
+/// # let _ = summary;
+/// # let _: Option<CheckVerdict> = None;
+/// ```
+#[doc(inline)]
+pub use tricept_check::CheckReport;
+/// The door: one quantity's trend over a check history ([`CheckResult::trends`]).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::check::{CheckRequest, Trend, check};
+/// let mut request = CheckRequest::new("calibrated.json", "today.csv");
+/// request.history = Some("checks.jsonl".into());
+/// let result = check(request)?;
+/// let trends: &[Trend] = result.trends();
+/// for t in trends {
+///     println!("{} ({}): {:?}", t.name, t.unit, t.values.last());
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
 pub use tricept_check::history::Trend;
 pub use tricept_check::{CandidateKind, ChannelNoise};
 pub use tricept_check::{
-    CandidateResult, Change, CheckReport, CheckVerdict, ChiSquare, DEFAULT_ALPHA, NoiseSeen,
-    Rejected,
+    CandidateResult, Change, CheckVerdict, ChiSquare, DEFAULT_ALPHA, NoiseSeen, Rejected,
 };
 
 /// A check campaign against a calibrated machine.

@@ -40,16 +40,93 @@ use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
 
+/// The door: a cause a diagnosis names ([`Diagnosis`]'s `causes`).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose, Cause};
+/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// let diagnosis = result.diagnosis();
+/// let causes: &[Cause] = &diagnosis.causes;
+/// for cause in causes.iter().filter(|c| c.plausible) {
+///     println!("{}: {}", cause.effect, cause.description);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_diagnose::Cause;
+/// The door: when a diagnosis deploys its final model.
+///
+/// # Example
+/// ```
+/// use tricept_ident::diagnosis::{DeployRule, DiagnoseRequest};
+/// let request = DiagnoseRequest::new("calibrated.json", "campaign.csv");
+/// assert_eq!(request.deploy_rule, DeployRule::ExpectedError);
+/// ```
+#[doc(inline)]
+pub use tricept_diagnose::DeployRule;
+/// The door: a diagnosis' final model deployed ([`DiagnoseResult::deploy`]).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+/// use tricept_ident::kinematics::{Machine, Vector3};
+/// let deployed = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?.deploy()?;
+/// let machine = Machine::from(&deployed);
+/// let legs_mm = machine.inverse(&Vector3::new(0.0, 0.0, 750.0))?.legs_mm;
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_diagnose::Deployed;
+/// The door: a diagnosis ([`DiagnoseResult::diagnosis`]).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// let diagnosis = result.diagnosis();
+/// println!("chi-square {} on {} dof", diagnosis.chi_square, diagnosis.dof);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_diagnose::Diagnosis;
+/// The door: what the final model gains on held-out poses ([`Diagnosis`]'s `gain`).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose, Gain};
+/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// let diagnosis = result.diagnosis();
+/// let gain: &Gain = &diagnosis.gain;
+/// println!("held-out rms {} -> {}", gain.holdout_rms_geometric, gain.holdout_rms_extended);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_diagnose::Gain;
 pub use tricept_diagnose::Verdict as DiagnosisVerdict;
 pub use tricept_diagnose::{
-    Alias, Cause, CauseKind, ChannelRms, DeployRule, Deployed, Diagnosis, Estimate, Evidence,
-    ExtendedModel, FinalFit, Gain, ModelTerm, NoiseCheck, NoiseSource, PureError, RejectStage,
-    Rejected, Remainder, ResidualPlot, Structure, TermScore, Tested,
+    Alias, CauseKind, ChannelRms, Estimate, Evidence, ExtendedModel, FinalFit, ModelTerm,
+    NoiseCheck, NoiseSource, PureError, RejectStage, Rejected, Remainder, ResidualPlot, Structure,
+    TermScore, Tested,
 };
 pub use tricept_diagnose::{Frame, GenericTerm, OrderAxis, Scope, Term};
+/// The door: an identification, the estimates of a fit and their covariance ([`Deployed`]'s `id`).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, Identification, diagnose};
+/// let deployed = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?.deploy()?;
+/// let id: &Identification = &deployed.id;
+/// for ((name, value), sigma) in id.names.iter().zip(&id.estimate).zip(&id.std_dev) {
+///     println!("{name} = {value} ({sigma:?})");
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_engine::Identification;
 pub use tricept_engine::{
-    CampaignOffsets, Design, GeometricModel, GeometricPredictor, Identification, PosePredictor,
-    Prior, PriorFit, ReadingModel, ResidualStats,
+    CampaignOffsets, Design, GeometricModel, GeometricPredictor, PosePredictor, Prior, PriorFit,
+    ReadingModel, ResidualStats,
 };
 
 /// What to diagnose and how.

@@ -16,12 +16,24 @@ use tricept_plant::effects::typical_effects;
 
 use crate::error::{EXIT_OK, Error};
 
+/// The door: the diagnosis' vocabulary of effects.
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::EffectName;
+/// let lead: EffectName = "leg-lead".parse()?;
+/// assert_eq!(lead.spec().name, "leg-lead");
+/// assert!(EffectName::ALL.contains(&lead));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_model::effects::EffectName;
 pub use tricept_model::effects::Simulation as EffectSimulation;
 pub use tricept_model::effects::{
     Basis, CheckColumns, CheckWhen, GenericSpec, LegContext, LegDeployment, PoseState,
     SimulateObject, Structural, UnknownEffect, XAxis, YAxis,
 };
-pub use tricept_model::effects::{CauseName, EffectKey, EffectName, EffectSpec, Judgement};
+pub use tricept_model::effects::{CauseName, EffectKey, EffectSpec, Judgement};
 pub use tricept_model::effects::{
     CheckRole, CommonPart, Deployment, GenericFamily, Judged, Kind, KnownAlias, Magnitude, Measure,
     Needs, Parameter, PlausibleRange, PlotAxes, Simulate,

@@ -29,8 +29,19 @@ use tricept_fleet::{BatchOptions, DataFileRecord, PriorFile, PriorProvenance, ca
 use tricept_model::ParameterSet;
 
 pub use tricept_engine::Rejection;
+/// The door: the sparse solver of a fleet's joint fit.
+///
+/// # Example
+/// ```
+/// use tricept_ident::fleet::{FleetRequest, SolverKind};
+/// let request = FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into()]);
+/// assert_eq!(request.solver, "schur".parse::<SolverKind>()?);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_fleet::SolverKind;
 pub use tricept_fleet::reml::{Distance, Spread};
-pub use tricept_fleet::{Batch, JointFit, MachineOutcome, OwnFit, SolveStats, SolverKind};
+pub use tricept_fleet::{Batch, JointFit, MachineOutcome, OwnFit, SolveStats};
 
 use crate::data_input::DataInput;
 use crate::error::Error;

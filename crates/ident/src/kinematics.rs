@@ -24,9 +24,68 @@ use crate::inputs::LoadedMachine;
 
 pub use crate::commanding::{GeometricMachine, Machine};
 pub use crate::linalg::Vector3;
+/// The door: a solution of [`Machine::forward`].
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{FkSolution, Machine, Vector3};
+/// let m = Machine::paper();
+/// let target = Vector3::new(50.0, -20.0, 760.0);
+/// let fk: FkSolution = m.forward(&m.inverse(&target)?.legs_mm)?;
+/// assert!((fk.position_mm - target).norm() < 1e-8);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::FkSolution;
+/// The door: a solution of [`Machine::inverse`].
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{IkSolution, Machine, Vector3};
+/// let ik: IkSolution = Machine::paper().inverse(&Vector3::new(0.0, 0.0, 750.0))?;
+/// assert!((ik.legs_mm[0] - 773.3).abs() < 0.1);
+/// assert!(ik.up.q4_mm > 0.0);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::IkSolution;
 pub use tricept_kinematics::SensorNoise as LoggedSensorNoise;
+/// The door: a solution of [`Machine::tool_inverse`].
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{Machine, ToolIkSolution, Vector3};
+/// let m = Machine::paper();
+/// let tip = Vector3::new(0.0, 0.0, 900.0);
+/// let s: ToolIkSolution = m.tool_inverse(&tip, &Vector3::new(0.0, 0.0, 1.0))?;
+/// assert!(s.legs_mm.iter().all(|q| q.is_finite()));
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::ToolIkSolution;
+/// The door: the UP limb's joints of a pose (an [`IkSolution`]'s `up`).
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{Machine, UpJoints, Vector3};
+/// let up: UpJoints = Machine::paper().inverse(&Vector3::new(0.0, 0.0, 750.0))?.up;
+/// assert!(up.phi_rad.abs() < 1e-9 && up.theta_rad.abs() < 1e-9);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::UpJoints;
 pub use tricept_kinematics::batch::PointKinematics;
-pub use tricept_kinematics::batch::{BLOCK_ROWS, BatchError, Cell, Verb, run};
+/// The door: the kinematics verbs [`solve_point`] and [`run`] solve.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::Verb;
+/// assert_eq!(Verb::Ik.inputs(), ["x", "y", "z"]);
+/// assert_eq!(Verb::Ik.keys()[3], "q1");
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::batch::Verb;
+pub use tricept_kinematics::batch::{BLOCK_ROWS, BatchError, Cell, run};
 pub use tricept_kinematics::description::{
     AccuracyRecord, AxisOrder, CalibrationRecord, CircularPlacement, ControllerDescription,
     CorrelationsDescription, ExplicitPlacement, ExternalSourceRecord, HeadDescription,
@@ -35,9 +94,19 @@ pub use tricept_kinematics::description::{
     UpLimbDescription, WorkspaceDescription,
 };
 pub use tricept_kinematics::{
-    DescriptionError, FkSolution, Head, HeadBranch, IkSolution, KinematicsError, LegGeometry,
-    Limits, MachineDescription, ToolIkSolution, ToolPose, UpJoints, UpLimb, UpLimbPose, Workspace,
+    DescriptionError, Head, HeadBranch, KinematicsError, LegGeometry, Limits, MachineDescription,
+    ToolPose, UpLimb, UpLimbPose, Workspace,
 };
+
+/// The door: the geometric machine with its static leg effects, as [`Machine::extended`] holds it.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{ExtendedMachine, GeometricMachine, Machine};
+/// let extended = ExtendedMachine::new(GeometricMachine::paper());
+/// assert_eq!(&extended, Machine::paper().extended());
+/// ```
+#[doc(inline)]
 pub use tricept_model::ExtendedMachine;
 
 /// Runs `verb` on every row of `input` ([`run`]) as the CLI does:

@@ -38,7 +38,33 @@ use crate::machine_file::sha256_file;
 use crate::machine_input::MachineInput;
 
 pub use tricept_report::verdict::{Reason, Shown};
-pub use tricept_report::{Level, Verdict};
+
+/// The door: how far a calibrated machine can be trusted.
+///
+/// # Example
+/// ```
+/// use tricept_ident::report::Level;
+/// let levels = [Level::Trusted, Level::Caution, Level::DoNotTrust];
+/// assert_eq!(levels.iter().filter(|l| **l == Level::Trusted).count(), 1);
+/// ```
+#[doc(inline)]
+pub use tricept_report::Level;
+/// The door: the verdict at the top of a machine's page ([`Report::verdict`]).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::report::{Level, ReportRequest, Verdict, report};
+/// let page = report(ReportRequest::new("calibrated.json", "machine.html"))?;
+/// let verdict: &Verdict = page.verdict();
+/// if verdict.level != Level::Trusted {
+///     for reason in &verdict.reasons {
+///         println!("{reason:?}");
+///     }
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_report::Verdict;
 
 /// The file of an export folder the page reads (`--export DIR`).
 ///

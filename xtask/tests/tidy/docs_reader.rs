@@ -206,25 +206,36 @@ pub(super) fn names_internal_crate(line: &str) -> bool {
         .any(|rest| !ident(rest).is_empty() && ident(rest) != "ident")
 }
 
-/// The door's re-exports of internal items, with their docs.
+/// The door's re-exports of internal items, with their docs: the docs
+/// on a one-line `pub use` (rustdoc shows them first) and the item's.
 pub(super) fn internal_items() -> Vec<(String, Option<(Vec<String>, Vec<String>)>)> {
     let mut crates = sources(&workspace().join("crates"));
     crates.retain(|p, _| p.components().any(|c| c.as_os_str() == "src"));
-    let (_, reexported) = door();
+    let (files, reexported) = door();
+    let mut door_docs = BTreeMap::new();
+    for (file, code) in &files {
+        let lines: Vec<&str> = code.lines().collect();
+        for (i, line) in lines.iter().enumerate() {
+            if line.starts_with("pub use ") && line.ends_with(';') {
+                for (_, name) in reexports(line) {
+                    door_docs.insert((file.clone(), name), doc_above(&lines, i));
+                }
+            }
+        }
+    }
     let internal = reexported
         .into_iter()
         .filter(|(p, _, _)| p[0].starts_with("tricept_") && p[0] != "tricept_ident");
     let items: Vec<_> = internal
         .map(|(path, name, file)| {
-            let at = file
-                .file_name()
-                .unwrap_or_default()
-                .to_string_lossy()
-                .to_string();
-            (
-                format!("{at}: {name} ({})", path.join("::")),
-                internal_docs(&path, &crates),
-            )
+            let at = file.file_name().unwrap_or_default().to_string_lossy();
+            let mut docs = internal_docs(&path, &crates);
+            if let (Some((own, _)), Some(door)) =
+                (&mut docs, door_docs.get(&(file.clone(), name.clone())))
+            {
+                own.splice(0..0, door.iter().cloned());
+            }
+            (format!("{at}: {name} ({})", path.join("::")), docs)
         })
         .collect();
     assert!(
