@@ -30,7 +30,7 @@ use crate::data_input::DataInput;
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::machine_input::MachineInput;
 
-/// The door: a check's report ([`CheckResult`]).
+/// A check's report ([`CheckResult`]).
 ///
 /// # Example
 /// ```
@@ -43,7 +43,31 @@ use crate::machine_input::MachineInput;
 /// ```
 #[doc(inline)]
 pub use tricept_check::CheckReport;
-/// The door: one quantity's trend over a check history ([`CheckResult::trends`]).
+/// A check's verdict ([`CheckReport`]'s `verdict`).
+///
+/// # Example
+/// ```
+/// use tricept_ident::check::{CheckReport, CheckVerdict};
+/// fn act_on(report: &CheckReport) -> &'static str {
+///     match report.verdict {
+///         CheckVerdict::Unchanged | CheckVerdict::NoisierThanStated => "keep the machine file",
+///         CheckVerdict::Changed | CheckVerdict::ChangedUnexplained => "recalibrate",
+///     }
+/// }
+/// # let _ = act_on;
+/// ```
+#[doc(inline)]
+pub use tricept_check::CheckVerdict;
+/// The significance level a check tests a change at by default.
+///
+/// # Example
+/// ```
+/// use tricept_ident::check::{CheckRequest, DEFAULT_ALPHA};
+/// assert_eq!(CheckRequest::new("calibrated.json", "today.csv").alpha, DEFAULT_ALPHA);
+/// ```
+#[doc(inline)]
+pub use tricept_check::DEFAULT_ALPHA;
+/// One quantity's trend over a check history ([`CheckResult::trends`]).
 ///
 /// # Example
 /// ```no_run
@@ -60,9 +84,7 @@ pub use tricept_check::CheckReport;
 #[doc(inline)]
 pub use tricept_check::history::Trend;
 pub use tricept_check::{CandidateKind, ChannelNoise};
-pub use tricept_check::{
-    CandidateResult, Change, CheckVerdict, ChiSquare, DEFAULT_ALPHA, NoiseSeen, Rejected,
-};
+pub use tricept_check::{CandidateResult, Change, ChiSquare, NoiseSeen, Rejected};
 
 /// A check campaign against a calibrated machine.
 ///

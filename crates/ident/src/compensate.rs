@@ -39,7 +39,22 @@ use crate::inputs::TrueErrors;
 use crate::machine_file::write_rule;
 use crate::machine_input::MachineInput;
 
-pub use tricept_model::{ErrorMap, MapStats};
+/// A volumetric error map on a plane ([`Compensation::maps`]).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::compensate::{Calibrated, CompensateRequest, ErrorMap, compensate};
+/// let calibrated = Calibrated::MachineFile(MachineInput::from("calibrated.json"));
+/// let compensation = compensate(CompensateRequest::new(calibrated))?;
+/// let (map, _before_after): (&ErrorMap, _) = compensation.maps();
+/// let worst_mm = map.errors_mm.iter().map(|e| e.norm()).fold(0.0, f64::max);
+/// println!("{} points, worst {worst_mm} mm", map.targets_mm.len());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_model::ErrorMap;
+pub use tricept_model::MapStats;
 
 /// The largest interpolation error (um) the default table spacing allows.
 ///

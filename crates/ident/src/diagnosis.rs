@@ -40,7 +40,7 @@ use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
 
-/// The door: a cause a diagnosis names ([`Diagnosis`]'s `causes`).
+/// A cause a diagnosis names ([`Diagnosis`]'s `causes`).
 ///
 /// # Example
 /// ```no_run
@@ -55,7 +55,7 @@ use crate::machine_input::MachineInput;
 /// ```
 #[doc(inline)]
 pub use tricept_diagnose::Cause;
-/// The door: when a diagnosis deploys its final model.
+/// When a diagnosis deploys its final model.
 ///
 /// # Example
 /// ```
@@ -65,7 +65,7 @@ pub use tricept_diagnose::Cause;
 /// ```
 #[doc(inline)]
 pub use tricept_diagnose::DeployRule;
-/// The door: a diagnosis' final model deployed ([`DiagnoseResult::deploy`]).
+/// A diagnosis' final model deployed ([`DiagnoseResult::deploy`]).
 ///
 /// # Example
 /// ```no_run
@@ -78,7 +78,7 @@ pub use tricept_diagnose::DeployRule;
 /// ```
 #[doc(inline)]
 pub use tricept_diagnose::Deployed;
-/// The door: a diagnosis ([`DiagnoseResult::diagnosis`]).
+/// A diagnosis ([`DiagnoseResult::diagnosis`]).
 ///
 /// # Example
 /// ```no_run
@@ -90,7 +90,7 @@ pub use tricept_diagnose::Deployed;
 /// ```
 #[doc(inline)]
 pub use tricept_diagnose::Diagnosis;
-/// The door: what the final model gains on held-out poses ([`Diagnosis`]'s `gain`).
+/// What the final model gains on held-out poses ([`Diagnosis`]'s `gain`).
 ///
 /// # Example
 /// ```no_run
@@ -110,7 +110,7 @@ pub use tricept_diagnose::{
     TermScore, Tested,
 };
 pub use tricept_diagnose::{Frame, GenericTerm, OrderAxis, Scope, Term};
-/// The door: an identification, the estimates of a fit and their covariance ([`Deployed`]'s `id`).
+/// An identification, the estimates of a fit and their covariance ([`Deployed`]'s `id`).
 ///
 /// # Example
 /// ```no_run

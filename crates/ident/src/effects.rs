@@ -16,7 +16,7 @@ use tricept_plant::effects::typical_effects;
 
 use crate::error::{EXIT_OK, Error};
 
-/// The door: the diagnosis' vocabulary of effects.
+/// The diagnosis' vocabulary of effects.
 ///
 /// # Example
 /// ```

@@ -21,9 +21,29 @@ use std::path::PathBuf;
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::machine_input::MachineInput;
 
+/// The CNC control an export writes for.
+///
+/// # Example
+/// ```
+/// use tricept_ident::export::{Controller, ExportOptions};
+/// let options = ExportOptions::new(Controller::Sinumerik);
+/// # let _ = options;
+/// ```
+#[doc(inline)]
+pub use tricept_export::Controller;
+/// The control and the limits of an export ([`ExportRequest`]'s `options`).
+///
+/// # Example
+/// ```
+/// use tricept_ident::export::{Controller, ExportOptions};
+/// let fanuc = ExportOptions::new(Controller::Fanuc);
+/// let heidenhain = ExportOptions::new(Controller::Heidenhain);
+/// assert_ne!(format!("{fanuc:?}"), format!("{heidenhain:?}"));
+/// ```
+#[doc(inline)]
+pub use tricept_export::ExportOptions;
 pub use tricept_export::{
-    AxisSummary, ControlLimits, ControlModel, Controller, ExportError, ExportOptions,
-    ExportSummary, Limit, NotExported,
+    AxisSummary, ControlLimits, ControlModel, ExportError, ExportSummary, Limit, NotExported,
 };
 
 /// What to export, and where.

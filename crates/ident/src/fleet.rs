@@ -29,7 +29,7 @@ use tricept_fleet::{BatchOptions, DataFileRecord, PriorFile, PriorProvenance, ca
 use tricept_model::ParameterSet;
 
 pub use tricept_engine::Rejection;
-/// The door: the sparse solver of a fleet's joint fit.
+/// The sparse solver of a fleet's joint fit.
 ///
 /// # Example
 /// ```

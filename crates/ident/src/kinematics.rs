@@ -24,7 +24,7 @@ use crate::inputs::LoadedMachine;
 
 pub use crate::commanding::{GeometricMachine, Machine};
 pub use crate::linalg::Vector3;
-/// The door: a solution of [`Machine::forward`].
+/// A solution of [`Machine::forward`].
 ///
 /// # Example
 /// ```
@@ -37,7 +37,7 @@ pub use crate::linalg::Vector3;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::FkSolution;
-/// The door: a solution of [`Machine::inverse`].
+/// A solution of [`Machine::inverse`].
 ///
 /// # Example
 /// ```
@@ -50,7 +50,7 @@ pub use tricept_kinematics::FkSolution;
 #[doc(inline)]
 pub use tricept_kinematics::IkSolution;
 pub use tricept_kinematics::SensorNoise as LoggedSensorNoise;
-/// The door: a solution of [`Machine::tool_inverse`].
+/// A solution of [`Machine::tool_inverse`].
 ///
 /// # Example
 /// ```
@@ -63,7 +63,7 @@ pub use tricept_kinematics::SensorNoise as LoggedSensorNoise;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::ToolIkSolution;
-/// The door: the UP limb's joints of a pose (an [`IkSolution`]'s `up`).
+/// The UP limb's joints of a pose (an [`IkSolution`]'s `up`).
 ///
 /// # Example
 /// ```
@@ -75,7 +75,7 @@ pub use tricept_kinematics::ToolIkSolution;
 #[doc(inline)]
 pub use tricept_kinematics::UpJoints;
 pub use tricept_kinematics::batch::PointKinematics;
-/// The door: the kinematics verbs [`solve_point`] and [`run`] solve.
+/// The kinematics verbs [`solve_point`] and [`run`] solve.
 ///
 /// # Example
 /// ```
@@ -98,7 +98,7 @@ pub use tricept_kinematics::{
     ToolPose, UpLimb, UpLimbPose, Workspace,
 };
 
-/// The door: the geometric machine with its static leg effects, as [`Machine::extended`] holds it.
+/// The geometric machine with its static leg effects, as [`Machine::extended`] holds it.
 ///
 /// # Example
 /// ```

@@ -39,7 +39,7 @@ use crate::machine_input::MachineInput;
 
 pub use tricept_report::verdict::{Reason, Shown};
 
-/// The door: how far a calibrated machine can be trusted.
+/// How far a calibrated machine can be trusted.
 ///
 /// # Example
 /// ```
@@ -49,7 +49,7 @@ pub use tricept_report::verdict::{Reason, Shown};
 /// ```
 #[doc(inline)]
 pub use tricept_report::Level;
-/// The door: the verdict at the top of a machine's page ([`Report::verdict`]).
+/// The verdict at the top of a machine's page ([`Report::verdict`]).
 ///
 /// # Example
 /// ```no_run

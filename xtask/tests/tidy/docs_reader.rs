@@ -1,11 +1,15 @@
-//! The reader of the door's docs for `tidy/docs.rs`: the door's items
-//! and re-exports from its sources, the docs of the internal items it
-//! re-exports, and the code blocks of docs.
+//! The reader of `tidy/docs.rs`: the door's items and re-exports, the
+//! docs of the internal items it re-exports, the code blocks of docs.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use super::{expand, workspace};
+
+/// A re-export: its path, the name it is public under, its file.
+type Reexport = (Vec<String>, String, PathBuf);
+/// An item's own docs, and those with its `impl` blocks' docs.
+pub(super) type Docs = (Vec<String>, Vec<String>);
 
 pub(super) const KINDS: [&str; 8] = [
     "fn", "struct", "enum", "trait", "type", "const", "static", "mod",
@@ -77,10 +81,7 @@ pub(super) fn reexports(code: &str) -> Vec<(Vec<String>, String)> {
 }
 
 /// The door's files, and its re-exports: `(path, name, file)`.
-pub(super) fn door() -> (
-    BTreeMap<PathBuf, String>,
-    Vec<(Vec<String>, String, PathBuf)>,
-) {
+pub(super) fn door() -> (BTreeMap<PathBuf, String>, Vec<Reexport>) {
     let files = sources(&workspace().join("crates/ident/src"));
     let reexports = files
         .iter()
@@ -133,19 +134,21 @@ pub(super) fn door_items() -> Vec<(String, Vec<String>)> {
     items
 }
 
-/// The docs of an internal item (`tricept_x::...::Name`), looked for in
-/// its crate, then in the crates it re-exports from: its own doc block,
-/// and with them every doc line of the `impl` blocks of it.
-pub(super) fn internal_docs(
-    path: &[String],
-    crates: &BTreeMap<PathBuf, String>,
-) -> Option<(Vec<String>, Vec<String>)> {
+/// The docs of an internal item (`tricept_x::...::Name`), in its crate or
+/// those it re-exports from: its own, and those with its `impl` blocks'.
+pub(super) fn internal_docs(path: &[String], crates: &BTreeMap<PathBuf, String>) -> Option<Docs> {
     let home = workspace()
         .join("crates")
         .join(path[0].trim_start_matches("tricept_").replace('_', "-"));
     if path.len() == 1 {
+        // A crate re-exported as a module: every item of it is a page.
         let doc = module_doc(crates.get(&home.join("src/lib.rs"))?);
-        return Some((doc.clone(), doc));
+        let all = crates
+            .iter()
+            .filter(|(f, _)| f.starts_with(&home))
+            .flat_map(|(_, c)| c.lines());
+        let all = all.filter_map(|l| l.trim().strip_prefix("///").or(l.strip_prefix("//!")));
+        return Some((doc, all.map(str::to_string).collect()));
     }
     let name = path.last()?.as_str();
     let order = crates
@@ -208,7 +211,7 @@ pub(super) fn names_internal_crate(line: &str) -> bool {
 
 /// The door's re-exports of internal items, with their docs: the docs
 /// on a one-line `pub use` (rustdoc shows them first) and the item's.
-pub(super) fn internal_items() -> Vec<(String, Option<(Vec<String>, Vec<String>)>)> {
+pub(super) fn internal_items() -> Vec<(String, Option<Docs>)> {
     let mut crates = sources(&workspace().join("crates"));
     crates.retain(|p, _| p.components().any(|c| c.as_os_str() == "src"));
     let (files, reexported) = door();
@@ -216,7 +219,7 @@ pub(super) fn internal_items() -> Vec<(String, Option<(Vec<String>, Vec<String>)
     for (file, code) in &files {
         let lines: Vec<&str> = code.lines().collect();
         for (i, line) in lines.iter().enumerate() {
-            if line.starts_with("pub use ") && line.ends_with(';') {
+            if line.trim_start().starts_with("pub use ") && line.ends_with(';') {
                 for (_, name) in reexports(line) {
                     door_docs.insert((file.clone(), name), doc_above(&lines, i));
                 }
