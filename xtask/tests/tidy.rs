@@ -17,6 +17,9 @@
 //!   most 20 public items; the rest is in modules named for what they hold.
 //! - **No flags in the libraries** (`tidy/flags.rs`): no string literal of
 //!   a library crate or the Python package names a command-line flag.
+//! - **The door's docs** (`tidy/docs.rs`): every public item of
+//!   tricept-ident has an example, in door paths only; its signatures name
+//!   types it exports.
 //!
 //! An edge is a path in a file's code outside its tests (`#[cfg(test)]`
 //! items) that resolves to another file's module; a path to an item that a
@@ -29,6 +32,10 @@ use std::path::{Path, PathBuf};
 
 #[path = "tidy/deps.rs"]
 mod deps;
+#[path = "tidy/docs.rs"]
+mod docs;
+#[path = "tidy/docs_reader.rs"]
+mod docs_reader;
 #[path = "tidy/flags.rs"]
 mod flags;
 #[path = "tidy/roots.rs"]

@@ -31,20 +31,25 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// writer it is given; the target is replaced only when that and the
 /// flush, sync and rename all succeed (see the module docs).
 ///
-/// # Example
-/// ```
-/// use std::io::Write;
-/// let path = std::env::temp_dir().join(format!("tricept-atomic-doc-{}.txt", std::process::id()));
-/// tricept_data::write_atomic(&path, |w| w.write_all(b"first\n")).unwrap();
-/// // A writer that fails half-way leaves the previous file as it was.
-/// let failed = tricept_data::write_atomic(&path, |w| {
-///     w.write_all(b"sec")?;
-///     Err(std::io::Error::other("disk full"))
-/// });
-/// assert!(failed.is_err());
-/// assert_eq!(std::fs::read_to_string(&path).unwrap(), "first\n");
-/// # std::fs::remove_file(&path).unwrap();
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use std::io::Write;
+let path = std::env::temp_dir().join(format!("tricept-atomic-doc-{}.txt", std::process::id()));
+tricept_data::write_atomic(&path, |w| w.write_all(b"first\n")).unwrap();
+// A writer that fails half-way leaves the previous file as it was.
+let failed = tricept_data::write_atomic(&path, |w| {
+    w.write_all(b"sec")?;
+    Err(std::io::Error::other("disk full"))
+});
+assert!(failed.is_err());
+assert_eq!(std::fs::read_to_string(&path).unwrap(), "first\n");
+# std::fs::remove_file(&path).unwrap();
+```
+"#
+)]
 pub fn write_atomic<F>(path: &Path, content: F) -> io::Result<()>
 where
     F: FnOnce(&mut dyn Write) -> io::Result<()>,
@@ -144,14 +149,19 @@ fn resolve(path: &Path) -> io::Result<PathBuf> {
 /// never replaced by a file. The errors are `InvalidInput` (or
 /// `IsADirectory`) and say why.
 ///
-/// # Example
-/// ```
-/// use std::path::Path;
-/// let e = tricept_data::atomic::check_output_file(Path::new("/dev/null")).unwrap_err();
-/// assert!(e.to_string().contains("character device"), "{e}");
-/// assert!(tricept_data::atomic::check_output_file(Path::new("out/")).is_err());
-/// assert!(tricept_data::atomic::check_output_file(Path::new("new-file.json")).is_ok());
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use std::path::Path;
+let e = tricept_data::atomic::check_output_file(Path::new("/dev/null")).unwrap_err();
+assert!(e.to_string().contains("character device"), "{e}");
+assert!(tricept_data::atomic::check_output_file(Path::new("out/")).is_err());
+assert!(tricept_data::atomic::check_output_file(Path::new("new-file.json")).is_ok());
+```
+"#
+)]
 pub fn check_output_file(path: &Path) -> io::Result<()> {
     let text = path.as_os_str().to_string_lossy();
     // The text's last name, not `Path::file_name` (which reads `a/.` as

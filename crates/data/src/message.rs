@@ -50,11 +50,16 @@ pub fn shown(field: &str) -> String {
 /// [`SHOWN_PATH_CHARS`] characters (a path that is not UTF-8 is shown
 /// with replacement characters).
 ///
-/// # Example
-/// ```
-/// use std::path::Path;
-/// assert_eq!(tricept_data::message::shown_path(Path::new("a\nb.csv")), "a\\nb.csv");
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use std::path::Path;
+assert_eq!(tricept_data::message::shown_path(Path::new("a\nb.csv")), "a\\nb.csv");
+```
+"#
+)]
 pub fn shown_path(path: &Path) -> String {
     cut(&path.to_string_lossy(), SHOWN_PATH_CHARS)
 }
@@ -89,16 +94,21 @@ fn push_inert(out: &mut String, c: char) {
 /// control characters escaped, the whole cut in the middle past
 /// [`MAX_MESSAGE_CHARS`].
 ///
-/// # Example
-/// ```
-/// let key = "k".repeat(1_000_000);
-/// let m = tricept_data::message::one_line(&format!("unknown field `{key}` at line 1 column 1000014\nnext"));
-/// assert!(m.len() < 1000, "{}", m.len());
-/// assert!(m.starts_with("unknown field `kkk"));
-/// assert!(m.contains("(999800 more bytes)`"), "{m}");
-/// assert!(m.ends_with("at line 1 column 1000014\\nnext"), "{m}");
-/// assert_eq!(tricept_data::message::one_line(&m), m);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+let key = "k".repeat(1_000_000);
+let m = tricept_data::message::one_line(&format!("unknown field `{key}` at line 1 column 1000014\nnext"));
+assert!(m.len() < 1000, "{}", m.len());
+assert!(m.starts_with("unknown field `kkk"));
+assert!(m.contains("(999800 more bytes)`"), "{m}");
+assert!(m.ends_with("at line 1 column 1000014\\nnext"), "{m}");
+assert_eq!(tricept_data::message::one_line(&m), m);
+```
+"#
+)]
 pub fn one_line(message: &str) -> String {
     let mut out = String::with_capacity(message.len().min(2 * MAX_MESSAGE_CHARS));
     let mut rest = message;

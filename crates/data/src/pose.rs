@@ -71,20 +71,25 @@ impl Dataset {
     /// in their order, with the same source. Each pose keeps its file line,
     /// so messages about the subset still point into the original file.
     ///
-    /// # Example
-    /// ```
-    /// let csv = "q1,q2,q3,phi,theta,s\n\
-    ///            700,700,700,0.01,0.02,5\n\
-    ///            701,700,700,0.01,0.02,5\n\
-    ///            702,700,700,0.01,0.02,5\n";
-    /// let data = tricept_data::read_from(csv.as_bytes(), "poses.csv").unwrap();
-    /// // Every other pose, e.g. for a two-fold cross-validation.
-    /// let even = data.subset(|i| i % 2 == 0);
-    /// assert_eq!(even.poses.len(), 2);
-    /// assert_eq!(even.poses[1].commands_mm[0], 702.0);
-    /// assert_eq!(even.poses[1].line, 4);
-    /// assert_eq!(even.source, "poses.csv");
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+let csv = "q1,q2,q3,phi,theta,s\n\
+           700,700,700,0.01,0.02,5\n\
+           701,700,700,0.01,0.02,5\n\
+           702,700,700,0.01,0.02,5\n";
+let data = tricept_data::read_from(csv.as_bytes(), "poses.csv").unwrap();
+// Every other pose, e.g. for a two-fold cross-validation.
+let even = data.subset(|i| i % 2 == 0);
+assert_eq!(even.poses.len(), 2);
+assert_eq!(even.poses[1].commands_mm[0], 702.0);
+assert_eq!(even.poses[1].line, 4);
+assert_eq!(even.source, "poses.csv");
+```
+"#
+    )]
     pub fn subset(&self, keep: impl Fn(usize) -> bool) -> Dataset {
         Dataset {
             poses: self

@@ -12,28 +12,33 @@ use crate::{Dataset, pose::REQUIRED_COLUMNS};
 /// (shortest representation that reads back to the same `f64`). Each line
 /// of each of `comments` becomes a `#` line before the header.
 ///
-/// # Example
-/// ```
-/// use tricept_data::{Dataset, MeasuredPose, Readings};
-/// let data = Dataset {
-///     poses: vec![MeasuredPose {
-///         commands_mm: [796.5; 3],
-///         readings: Readings { phi_rad: 1e-3, theta_rad: -2e-3, s_mm: 12.5 },
-///         temp_c: Some(20.1),
-///         ..Default::default()
-///     }],
-///     source: "memory".into(),
-/// };
-/// let mut csv = Vec::new();
-/// tricept_data::write_to(&mut csv, &data, &["simulated".into()]).unwrap();
-/// let text = String::from_utf8(csv).unwrap();
-/// assert_eq!(
-///     text,
-///     "# simulated\nq1,q2,q3,phi,theta,s,temp_c\n796.5,796.5,796.5,0.001,-0.002,12.5,20.1\n"
-/// );
-/// let back = tricept_data::read_from(text.as_bytes(), "memory").unwrap();
-/// assert_eq!(back.poses[0].commands_mm, data.poses[0].commands_mm);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r##"
+# Example
+```
+use tricept_data::{Dataset, MeasuredPose, Readings};
+let data = Dataset {
+    poses: vec![MeasuredPose {
+        commands_mm: [796.5; 3],
+        readings: Readings { phi_rad: 1e-3, theta_rad: -2e-3, s_mm: 12.5 },
+        temp_c: Some(20.1),
+        ..Default::default()
+    }],
+    source: "memory".into(),
+};
+let mut csv = Vec::new();
+tricept_data::write_to(&mut csv, &data, &["simulated".into()]).unwrap();
+let text = String::from_utf8(csv).unwrap();
+assert_eq!(
+    text,
+    "# simulated\nq1,q2,q3,phi,theta,s,temp_c\n796.5,796.5,796.5,0.001,-0.002,12.5,20.1\n"
+);
+let back = tricept_data::read_from(text.as_bytes(), "memory").unwrap();
+assert_eq!(back.poses[0].commands_mm, data.poses[0].commands_mm);
+```
+"##
+)]
 pub fn write_to<W: Write>(mut w: W, data: &Dataset, comments: &[String]) -> std::io::Result<()> {
     for c in comments {
         for line in c.lines() {
@@ -75,14 +80,19 @@ pub fn write_to<W: Write>(mut w: W, data: &Dataset, comments: &[String]) -> std:
 /// Writes `data` to a file (see [`write_to`]), atomically: on any failure
 /// the previous file is left as it was ([`crate::write_atomic`]).
 ///
-/// # Example
-/// ```
-/// let data = tricept_data::read_from("q1,q2,q3,phi,theta,s\n700,700,700,0,0,5\n".as_bytes(), "in").unwrap();
-/// let path = std::env::temp_dir().join(format!("tricept-write-doc-{}.csv", std::process::id()));
-/// tricept_data::write_path(&path, &data, &[]).unwrap();
-/// assert_eq!(tricept_data::read_path(&path).unwrap().poses, data.poses);
-/// # std::fs::remove_file(&path).unwrap();
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+let data = tricept_data::read_from("q1,q2,q3,phi,theta,s\n700,700,700,0,0,5\n".as_bytes(), "in").unwrap();
+let path = std::env::temp_dir().join(format!("tricept-write-doc-{}.csv", std::process::id()));
+tricept_data::write_path(&path, &data, &[]).unwrap();
+assert_eq!(tricept_data::read_path(&path).unwrap().poses, data.poses);
+# std::fs::remove_file(&path).unwrap();
+```
+"#
+)]
 pub fn write_path(path: &Path, data: &Dataset, comments: &[String]) -> std::io::Result<()> {
     crate::write_atomic(path, |w| write_to(w, data, comments))
 }

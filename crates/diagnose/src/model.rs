@@ -42,15 +42,20 @@ pub struct ExtendedModel {
 impl ExtendedModel {
     /// `geometric` extended by `effects` of the vocabulary.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_diagnose::ExtendedModel;
-    /// use tricept_engine::{model::GeometricModel, model::ReadingModel};
-    /// use tricept_model::effects::EffectName;
-    /// let g = GeometricModel::new(tricept_kinematics::Machine::paper(), tricept_model::ParameterSet::paper15());
-    /// let m = ExtendedModel::new(g, &[EffectName::Thermal]);
-    /// assert_eq!(m.names().last().unwrap(), "thermal.expansion_ppm_per_k");
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_diagnose::ExtendedModel;
+use tricept_engine::{model::GeometricModel, model::ReadingModel};
+use tricept_model::effects::EffectName;
+let g = GeometricModel::new(tricept_kinematics::Machine::paper(), tricept_model::ParameterSet::paper15());
+let m = ExtendedModel::new(g, &[EffectName::Thermal]);
+assert_eq!(m.names().last().unwrap(), "thermal.expansion_ppm_per_k");
+```
+"#
+    )]
     pub fn new(geometric: GeometricModel, effects: &[EffectName]) -> ExtendedModel {
         let terms: Vec<Term> = effects.iter().map(|e| Term::Catalogue(*e)).collect();
         ExtendedModel::with_terms(geometric, &terms, Arc::new(Frame::empty()))
@@ -58,30 +63,35 @@ impl ExtendedModel {
 
     /// `geometric` extended by `terms`, the generic ones measured in `frame`.
     ///
-    /// # Example
-    /// ```
-    /// use std::sync::Arc;
-    /// use tricept_diagnose::{ExtendedModel, terms::Frame, terms::GenericFamily, terms::GenericTerm, terms::Scope, terms::Term};
-    /// use tricept_engine::{model::GeometricModel, model::ReadingModel};
-    /// let m = tricept_kinematics::Machine::paper();
-    /// let data = tricept_data::read_path("../../fixtures/data/diagnose-pitch.csv".as_ref()).unwrap();
-    /// let pitch = Term::Generic(GenericTerm {
-    ///     family: GenericFamily::LegPeriodic,
-    ///     scope: Scope::AllLegs,
-    ///     period_mm: Some(10.0),
-    ///     edges_mm: None,
-    /// });
-    /// // A worn segment of leg 2's screw from 750 to 900 mm of command.
-    /// let step = Term::Generic(GenericTerm {
-    ///     edges_mm: Some([750.0, 900.0]),
-    ///     ..GenericTerm::new(GenericFamily::LegStep, Scope::Leg(1))
-    /// });
-    /// let g = GeometricModel::new(m.clone(), tricept_model::ParameterSet::paper15());
-    /// let model = ExtendedModel::with_terms(g, &[pitch, step], Arc::new(Frame::of(&m, &data)));
-    /// assert_eq!(model.names().len(), 15 + 6 + 1);
-    /// assert_eq!(model.names()[15], "leg-periodic.leg1_sin_um");
-    /// assert_eq!(model.names()[21], "leg-step.leg2_um");
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use std::sync::Arc;
+use tricept_diagnose::{ExtendedModel, terms::Frame, terms::GenericFamily, terms::GenericTerm, terms::Scope, terms::Term};
+use tricept_engine::{model::GeometricModel, model::ReadingModel};
+let m = tricept_kinematics::Machine::paper();
+let data = tricept_data::read_path("../../fixtures/data/diagnose-pitch.csv".as_ref()).unwrap();
+let pitch = Term::Generic(GenericTerm {
+    family: GenericFamily::LegPeriodic,
+    scope: Scope::AllLegs,
+    period_mm: Some(10.0),
+    edges_mm: None,
+});
+// A worn segment of leg 2's screw from 750 to 900 mm of command.
+let step = Term::Generic(GenericTerm {
+    edges_mm: Some([750.0, 900.0]),
+    ..GenericTerm::new(GenericFamily::LegStep, Scope::Leg(1))
+});
+let g = GeometricModel::new(m.clone(), tricept_model::ParameterSet::paper15());
+let model = ExtendedModel::with_terms(g, &[pitch, step], Arc::new(Frame::of(&m, &data)));
+assert_eq!(model.names().len(), 15 + 6 + 1);
+assert_eq!(model.names()[15], "leg-periodic.leg1_sin_um");
+assert_eq!(model.names()[21], "leg-step.leg2_um");
+```
+"#
+    )]
     pub fn with_terms(
         geometric: GeometricModel,
         terms: &[Term],

@@ -47,15 +47,20 @@ pub struct DiagnoseOptions {
 /// readings cannot see (the weak leg-length direction,
 /// `docs/diagnosis.md`, "Deploy by what the file will deliver").
 ///
-/// # Example
-/// ```
-/// use tricept_diagnose::{options::DeployRule, DiagnoseOptions};
-/// use tricept_kinematics::Machine;
-/// let mut options = DiagnoseOptions::for_machine(&Machine::paper());
-/// assert_eq!(options.deploy_rule, DeployRule::ExpectedError);
-/// options.deploy_rule = "confident".parse().unwrap();
-/// assert_eq!(options.deploy_rule, DeployRule::Confident);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_diagnose::{options::DeployRule, DiagnoseOptions};
+use tricept_kinematics::Machine;
+let mut options = DiagnoseOptions::for_machine(&Machine::paper());
+assert_eq!(options.deploy_rule, DeployRule::ExpectedError);
+options.deploy_rule = "confident".parse().unwrap();
+assert_eq!(options.deploy_rule, DeployRule::Confident);
+```
+"#
+)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum DeployRule {
     /// The term's predicted improvement exceeds

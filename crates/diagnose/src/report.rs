@@ -539,14 +539,19 @@ impl Diagnosis {
     /// `outliers` is not a named cause): the poses the final model was not
     /// fitted to.
     ///
-    /// # Example
-    /// ```no_run
-    /// use tricept_diagnose::{diagnose, DiagnoseOptions};
-    /// let m = tricept_kinematics::Machine::paper();
-    /// let data = tricept_data::read_path("fixtures/data/diagnose-hidden-effect.csv".as_ref()).unwrap();
-    /// let d = diagnose(&m, &data, &DiagnoseOptions::for_machine(&m)).unwrap();
-    /// let clean = data.subset(|j| !d.outlier_lines().contains(&data.poses[j].line));
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```no_run
+use tricept_diagnose::{diagnose, DiagnoseOptions};
+let m = tricept_kinematics::Machine::paper();
+let data = tricept_data::read_path("fixtures/data/diagnose-hidden-effect.csv".as_ref()).unwrap();
+let d = diagnose(&m, &data, &DiagnoseOptions::for_machine(&m)).unwrap();
+let clean = data.subset(|j| !d.outlier_lines().contains(&data.poses[j].line));
+```
+"#
+    )]
     pub fn outlier_lines(&self) -> Vec<u64> {
         use tricept_model::effects::{CauseName, EffectName};
         self.causes

@@ -70,15 +70,20 @@ pub enum Term {
 impl Term {
     /// The name under which the term is reported.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_diagnose::{terms::GenericFamily, terms::GenericTerm, terms::Scope, terms::Term};
-    /// use tricept_model::effects::EffectName;
-    /// let lead = Term::Catalogue(EffectName::LegLead);
-    /// let drift = Term::Generic(GenericTerm::new(GenericFamily::ReadingDrift, Scope::Channel(2)));
-    /// assert_eq!(lead.name().to_string(), "leg-lead");
-    /// assert_eq!(drift.params(), vec!["s_um".to_string()]);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_diagnose::{terms::GenericFamily, terms::GenericTerm, terms::Scope, terms::Term};
+use tricept_model::effects::EffectName;
+let lead = Term::Catalogue(EffectName::LegLead);
+let drift = Term::Generic(GenericTerm::new(GenericFamily::ReadingDrift, Scope::Channel(2)));
+assert_eq!(lead.name().to_string(), "leg-lead");
+assert_eq!(drift.params(), vec!["s_um".to_string()]);
+```
+"#
+    )]
     pub fn name(&self) -> CauseName {
         match self {
             Term::Catalogue(e) => CauseName::Catalogue(*e),
@@ -515,18 +520,23 @@ impl Frame {
 
     /// The frame of `data` on the nominal machine.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_diagnose::{terms::Frame, terms::GenericFamily, terms::Scope};
-    /// let m = tricept_kinematics::Machine::paper();
-    /// let data = tricept_data::read_path("../../fixtures/data/diagnose-pitch.csv".as_ref()).unwrap();
-    /// let frame = Frame::of(&m, &data);
-    /// // Time is logged: drifts can be searched; the temperature varies by 2 K.
-    /// assert!(frame.order.is_some_and(|o| o.uses_time));
-    /// let groups = frame.generic_groups();
-    /// assert!(groups.iter().any(|g| g.family == GenericFamily::ReadingDrift && g.scope == Scope::Channel(2)));
-    /// assert_eq!(groups[0].params()[0], "leg1_sin_um");
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_diagnose::{terms::Frame, terms::GenericFamily, terms::Scope};
+let m = tricept_kinematics::Machine::paper();
+let data = tricept_data::read_path("../../fixtures/data/diagnose-pitch.csv".as_ref()).unwrap();
+let frame = Frame::of(&m, &data);
+// Time is logged: drifts can be searched; the temperature varies by 2 K.
+assert!(frame.order.is_some_and(|o| o.uses_time));
+let groups = frame.generic_groups();
+assert!(groups.iter().any(|g| g.family == GenericFamily::ReadingDrift && g.scope == Scope::Channel(2)));
+assert_eq!(groups[0].params()[0], "leg1_sin_um");
+```
+"#
+    )]
     pub fn of(nominal: &Machine, data: &Dataset) -> Frame {
         let poses = &data.poses;
         let range = |v: &mut dyn Iterator<Item = f64>| {

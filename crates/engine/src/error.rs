@@ -5,17 +5,22 @@ use tricept_kinematics::KinematicsError;
 
 /// Why an identification could not produce a trustworthy answer.
 ///
-/// # Example
-/// ```
-/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let m = Machine::paper();
-/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-/// let e = tricept_engine::identify(&model, &tricept_data::Dataset::default(), &IdentifyOptions::for_machine(&m))
-///     .unwrap_err();
-/// assert!(matches!(e, tricept_engine::IdentError::TooFewPoses { poses: 0, .. }));
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let m = Machine::paper();
+let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+let e = tricept_engine::identify(&model, &tricept_data::Dataset::default(), &IdentifyOptions::for_machine(&m))
+    .unwrap_err();
+assert!(matches!(e, tricept_engine::IdentError::TooFewPoses { poses: 0, .. }));
+```
+"#
+)]
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum IdentError {

@@ -116,22 +116,27 @@ impl Start {
 
 /// Residual statistics of a fit.
 ///
-/// # Example
-/// ```
-/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let m = Machine::paper();
-/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-/// let set = ParameterSet::paper15();
-/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
-///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
-///     .unwrap();
-/// let id = tricept_engine::identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
-/// // The model explains the data to the noise: chi-square per degree of freedom near 1.
-/// assert!((id.stats.reduced_chi_square - 1.0).abs() < 0.3);
-/// assert_eq!(id.stats.dof, 3 * 75 - 14 - 3);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let m = Machine::paper();
+let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+let set = ParameterSet::paper15();
+let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+    .simulate(&tricept_plant::Campaign::grid(&m, 1))
+    .unwrap();
+let id = tricept_engine::identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+// The model explains the data to the noise: chi-square per degree of freedom near 1.
+assert!((id.stats.reduced_chi_square - 1.0).abs() < 0.3);
+assert_eq!(id.stats.dof, 3 * 75 - 14 - 3);
+```
+"#
+)]
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ResidualStats {
     /// RMS of the residuals `[phi, theta, s]` (rad, rad, mm).
@@ -151,22 +156,27 @@ pub struct ResidualStats {
 
 /// The result of [`identify`].
 ///
-/// # Example
-/// ```
-/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let m = Machine::paper();
-/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-/// let set = ParameterSet::paper15();
-/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
-///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
-///     .unwrap();
-/// let id = tricept_engine::identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
-/// let json = id.to_json();
-/// assert_eq!(json["rank"], 14);
-/// assert!(json["dq1"].is_number() && json["std_dev"]["dq1"].is_number());
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let m = Machine::paper();
+let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+let set = ParameterSet::paper15();
+let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+    .simulate(&tricept_plant::Campaign::grid(&m, 1))
+    .unwrap();
+let id = tricept_engine::identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+let json = id.to_json();
+assert_eq!(json["rank"], 14);
+assert!(json["dq1"].is_number() && json["std_dev"]["dq1"].is_number());
+```
+"#
+)]
 #[derive(Debug, Clone)]
 pub struct Identification {
     /// Parameter names.
@@ -610,23 +620,28 @@ impl Identification {
     /// [`Verdict`](crate::verdict::Verdict) (`converged`, `adequate`, `warnings`),
     /// and more.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_engine::{model::GeometricModel, IdentifyOptions, identify};
-    /// use tricept_kinematics::Machine;
-    /// use tricept_model::ParameterSet;
-    /// let m = Machine::paper();
-    /// let set = ParameterSet::paper15();
-    /// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
-    ///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
-    ///     .unwrap();
-    /// let id = identify(&GeometricModel::new(m.clone(), set), &data, &IdentifyOptions::for_machine(&m)).unwrap();
-    /// let j = id.to_json();
-    /// // dq1 lies along the weakest direction; judge it by its own uncertainty.
-    /// let (dq1, sd) = (j["dq1"].as_f64().unwrap(), j["std_dev"]["dq1"].as_f64().unwrap());
-    /// assert!((dq1 - 0.45).abs() < 4.0 * sd, "{dq1} ± {sd}");
-    /// assert_eq!(j["rank"], 14);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions, identify};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let m = Machine::paper();
+let set = ParameterSet::paper15();
+let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+    .simulate(&tricept_plant::Campaign::grid(&m, 1))
+    .unwrap();
+let id = identify(&GeometricModel::new(m.clone(), set), &data, &IdentifyOptions::for_machine(&m)).unwrap();
+let j = id.to_json();
+// dq1 lies along the weakest direction; judge it by its own uncertainty.
+let (dq1, sd) = (j["dq1"].as_f64().unwrap(), j["std_dev"]["dq1"].as_f64().unwrap());
+assert!((dq1 - 0.45).abs() < 4.0 * sd, "{dq1} ± {sd}");
+assert_eq!(j["rank"], 14);
+```
+"#
+    )]
     pub fn to_json(&self) -> Value {
         let mut m = Map::new();
         for (n, v) in self.names.iter().zip(&self.estimate) {

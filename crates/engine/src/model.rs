@@ -23,26 +23,31 @@ use crate::prior::Prior;
 
 /// A parametric model of the UP limb's readings.
 ///
-/// # Example
-/// ```
-/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let m = Machine::paper();
-/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-/// let set = ParameterSet::paper15();
-/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
-///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
-///     .unwrap();
-/// use tricept_engine::model::ReadingModel;
-/// let predictor = model.at(&set.table2());
-/// let mut jac = vec![0.0; 3 * 15];
-/// let mut seed = None;
-/// let g = predictor.predict(&data.poses[0], &mut seed, &mut jac).unwrap();
-/// // The readings are the joints plus the sensor offsets (and noise).
-/// let y = data.poses[0].readings.to_array();
-/// assert!((y[2] - g[2] - tricept_plant::DEFAULT_SENSOR_OFFSETS[2]).abs() < 1e-2);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let m = Machine::paper();
+let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+let set = ParameterSet::paper15();
+let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+    .simulate(&tricept_plant::Campaign::grid(&m, 1))
+    .unwrap();
+use tricept_engine::model::ReadingModel;
+let predictor = model.at(&set.table2());
+let mut jac = vec![0.0; 3 * 15];
+let mut seed = None;
+let g = predictor.predict(&data.poses[0], &mut seed, &mut jac).unwrap();
+// The readings are the joints plus the sensor offsets (and noise).
+let y = data.poses[0].readings.to_array();
+assert!((y[2] - g[2] - tricept_plant::DEFAULT_SENSOR_OFFSETS[2]).abs() < 1e-2);
+```
+"#
+)]
 pub trait ReadingModel: Sync {
     /// Parameter names, in order.
     fn names(&self) -> &[String];
@@ -69,20 +74,25 @@ pub trait ReadingModel: Sync {
 
 /// A reading model at fixed parameter values.
 ///
-/// # Example
-/// ```
-/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let m = Machine::paper();
-/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-/// use tricept_engine::model::ReadingModel;
-/// let pose = tricept_data::MeasuredPose { commands_mm: [800.0; 3], ..Default::default() };
-/// let mut jac = vec![0.0; 45];
-/// let mut seed = None;
-/// let g = model.at(&[0.0; 15]).predict(&pose, &mut seed, &mut jac).unwrap();
-/// assert_eq!(g, seed.unwrap().to_array());
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let m = Machine::paper();
+let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+use tricept_engine::model::ReadingModel;
+let pose = tricept_data::MeasuredPose { commands_mm: [800.0; 3], ..Default::default() };
+let mut jac = vec![0.0; 45];
+let mut seed = None;
+let g = model.at(&[0.0; 15]).predict(&pose, &mut seed, &mut jac).unwrap();
+assert_eq!(g, seed.unwrap().to_array());
+```
+"#
+)]
 pub trait PosePredictor: Sync {
     /// Readings `[phi, theta, s]` without offsets (rad, rad, mm) at `pose`,
     /// and their derivatives with respect to the parameters written
@@ -98,14 +108,19 @@ pub trait PosePredictor: Sync {
 
 /// The paper's geometric model over a parameter set.
 ///
-/// # Example
-/// ```
-/// use tricept_engine::{model::GeometricModel, model::ReadingModel};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let model = GeometricModel::new(Machine::paper(), ParameterSet::paper15());
-/// assert_eq!(model.names()[0], "dxB1");
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, model::ReadingModel};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let model = GeometricModel::new(Machine::paper(), ParameterSet::paper15());
+assert_eq!(model.names()[0], "dxB1");
+```
+"#
+)]
 #[derive(Debug, Clone)]
 pub struct GeometricModel {
     nominal: Machine,
@@ -117,14 +132,19 @@ pub struct GeometricModel {
 impl GeometricModel {
     /// The model of `nominal` with the errors of `set`.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_engine::model::GeometricModel;
-    /// use tricept_kinematics::Machine;
-    /// use tricept_model::ParameterSet;
-    /// let model = GeometricModel::new(Machine::paper(), ParameterSet::paper15());
-    /// assert_eq!(model.parameter_set().len(), 15);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_engine::model::GeometricModel;
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let model = GeometricModel::new(Machine::paper(), ParameterSet::paper15());
+assert_eq!(model.parameter_set().len(), 15);
+```
+"#
+    )]
     pub fn new(nominal: Machine, set: ParameterSet) -> GeometricModel {
         GeometricModel {
             nominal,
@@ -139,27 +159,32 @@ impl GeometricModel {
     /// estimate. A prior of another number of parameters is an
     /// [`IdentError::Invalid`].
     ///
-    /// # Example
-    /// ```
-    /// use nalgebra::DMatrix;
-    /// use tricept_engine::{model::GeometricModel, IdentifyOptions, prior::Prior, model::ReadingModel, identify};
-    /// use tricept_kinematics::Machine;
-    /// use tricept_model::ParameterSet;
-    /// use tricept_plant::{Campaign, Plant};
-    /// let m = Machine::paper();
-    /// let set = ParameterSet::paper15();
-    /// let data = Plant::geometric(m.clone(), set.to_errors(&set.table2()))
-    ///     .simulate(&Campaign::random(&m, 8, 1))
-    ///     .unwrap();
-    /// // A batch that knows every parameter but dyA3 to 0.05 mm, centred on Table 2.
-    /// let covers: Vec<usize> = (0..15).filter(|&j| set.names()[j] != "dyA3").collect();
-    /// let prior = Prior::new(set.table2(), &covers, &DMatrix::from_diagonal_element(14, 14, 0.05f64.powi(2))).unwrap();
-    /// let model = GeometricModel::new(m.clone(), set.clone()).with_prior(prior).unwrap();
-    /// let id = identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
-    /// // Eight poses and the prior: the weak direction is known, dyA3 held.
-    /// assert_eq!(id.report.fixed, vec!["dyA3".to_string()]);
-    /// assert_eq!(id.prior_fit.unwrap().dof, 14);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use nalgebra::DMatrix;
+use tricept_engine::{model::GeometricModel, IdentifyOptions, prior::Prior, model::ReadingModel, identify};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+use tricept_plant::{Campaign, Plant};
+let m = Machine::paper();
+let set = ParameterSet::paper15();
+let data = Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+    .simulate(&Campaign::random(&m, 8, 1))
+    .unwrap();
+// A batch that knows every parameter but dyA3 to 0.05 mm, centred on Table 2.
+let covers: Vec<usize> = (0..15).filter(|&j| set.names()[j] != "dyA3").collect();
+let prior = Prior::new(set.table2(), &covers, &DMatrix::from_diagonal_element(14, 14, 0.05f64.powi(2))).unwrap();
+let model = GeometricModel::new(m.clone(), set.clone()).with_prior(prior).unwrap();
+let id = identify(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+// Eight poses and the prior: the weak direction is known, dyA3 held.
+assert_eq!(id.report.fixed, vec!["dyA3".to_string()]);
+assert_eq!(id.prior_fit.unwrap().dof, 14);
+```
+"#
+    )]
     pub fn with_prior(mut self, prior: Prior) -> Result<GeometricModel, IdentError> {
         if prior.parameters() != self.set.len() {
             return Err(IdentError::Invalid(format!(
@@ -189,26 +214,31 @@ impl GeometricModel {
     /// first calibration did; the structure that decides it is the nominal
     /// machine's.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_engine::{model::GeometricModel, IdentifyOptions, identify};
-    /// use tricept_kinematics::Machine;
-    /// use tricept_model::ParameterSet;
-    /// use tricept_plant::{Campaign, Plant};
-    /// let m = Machine::paper();
-    /// let set = ParameterSet::paper15();
-    /// let data = Plant::geometric(m.clone(), set.to_errors(&set.table2()))
-    ///     .simulate(&Campaign::grid(&m, 1))
-    ///     .unwrap();
-    /// let options = IdentifyOptions::for_machine(&m);
-    /// let first = GeometricModel::new(m.clone(), set.clone());
-    /// let id = identify(&first, &data, &options).unwrap();
-    /// let calibrated = first.machine_at(&id.estimate);
-    /// // Against the calibrated machine, with the nominal one's rank rule:
-    /// let again = GeometricModel::new(calibrated, set.clone()).with_rank_reference(m.clone());
-    /// let id2 = identify(&again, &data, &options).unwrap();
-    /// assert_eq!(id2.report.fixed, vec!["dyA3".to_string()]);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions, identify};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+use tricept_plant::{Campaign, Plant};
+let m = Machine::paper();
+let set = ParameterSet::paper15();
+let data = Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+    .simulate(&Campaign::grid(&m, 1))
+    .unwrap();
+let options = IdentifyOptions::for_machine(&m);
+let first = GeometricModel::new(m.clone(), set.clone());
+let id = identify(&first, &data, &options).unwrap();
+let calibrated = first.machine_at(&id.estimate);
+// Against the calibrated machine, with the nominal one's rank rule:
+let again = GeometricModel::new(calibrated, set.clone()).with_rank_reference(m.clone());
+let id2 = identify(&again, &data, &options).unwrap();
+assert_eq!(id2.report.fixed, vec!["dyA3".to_string()]);
+```
+"#
+    )]
     pub fn with_rank_reference(mut self, structural: Machine) -> GeometricModel {
         let mut reference = GeometricModel::new(structural, self.set.clone());
         reference.prior = self.prior.clone();
@@ -219,57 +249,77 @@ impl GeometricModel {
     /// The machine whose rank decision this model uses, when set by
     /// [`GeometricModel::with_rank_reference`].
     ///
-    /// # Example
-    /// ```
-    /// use tricept_engine::model::GeometricModel;
-    /// use tricept_kinematics::Machine;
-    /// let model = GeometricModel::new(Machine::paper(), tricept_model::ParameterSet::paper15());
-    /// assert!(model.rank_reference_machine().is_none());
-    /// let model = model.with_rank_reference(Machine::paper());
-    /// assert!(model.rank_reference_machine().is_some());
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_engine::model::GeometricModel;
+use tricept_kinematics::Machine;
+let model = GeometricModel::new(Machine::paper(), tricept_model::ParameterSet::paper15());
+assert!(model.rank_reference_machine().is_none());
+let model = model.with_rank_reference(Machine::paper());
+assert!(model.rank_reference_machine().is_some());
+```
+"#
+    )]
     pub fn rank_reference_machine(&self) -> Option<&Machine> {
         self.rank_reference.as_deref().map(|m| &m.nominal)
     }
 
     /// The nominal machine.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_engine::model::GeometricModel;
-    /// use tricept_kinematics::Machine;
-    /// let model = GeometricModel::new(Machine::paper(), tricept_model::ParameterSet::paper15());
-    /// assert_eq!(model.nominal().leg_offsets_mm, [0.0; 3]);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_engine::model::GeometricModel;
+use tricept_kinematics::Machine;
+let model = GeometricModel::new(Machine::paper(), tricept_model::ParameterSet::paper15());
+assert_eq!(model.nominal().leg_offsets_mm, [0.0; 3]);
+```
+"#
+    )]
     pub fn nominal(&self) -> &Machine {
         &self.nominal
     }
 
     /// The parameter set.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_engine::model::GeometricModel;
-    /// use tricept_model::ParameterSet;
-    /// let model = GeometricModel::new(tricept_kinematics::Machine::paper(), ParameterSet::full21());
-    /// assert_eq!(model.parameter_set().names()[0], "dxB1");
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_engine::model::GeometricModel;
+use tricept_model::ParameterSet;
+let model = GeometricModel::new(tricept_kinematics::Machine::paper(), ParameterSet::full21());
+assert_eq!(model.parameter_set().names()[0], "dxB1");
+```
+"#
+    )]
     pub fn parameter_set(&self) -> &ParameterSet {
         &self.set
     }
 
     /// The machine described by parameter values `p`.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_engine::model::GeometricModel;
-    /// use tricept_model::ParameterSet;
-    /// let set = ParameterSet::paper15();
-    /// let model = GeometricModel::new(tricept_kinematics::Machine::paper(), set.clone());
-    /// let m = model.machine_at(&set.table2());
-    /// // Table 2: the leg-length offsets dq1..dq3 are 0.45, 0.7, 0.5 mm.
-    /// assert_eq!(m.leg_offsets_mm, [0.45, 0.7, 0.5]);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_engine::model::GeometricModel;
+use tricept_model::ParameterSet;
+let set = ParameterSet::paper15();
+let model = GeometricModel::new(tricept_kinematics::Machine::paper(), set.clone());
+let m = model.machine_at(&set.table2());
+// Table 2: the leg-length offsets dq1..dq3 are 0.45, 0.7, 0.5 mm.
+assert_eq!(m.leg_offsets_mm, [0.45, 0.7, 0.5]);
+```
+"#
+    )]
     pub fn machine_at(&self, p: &[f64]) -> Machine {
         actual_machine(&self.nominal, &self.set.to_errors(p))
     }
@@ -282,20 +332,25 @@ impl GeometricModel {
 /// *actual* leg lengths (commands plus whatever an effect adds) and writes
 /// the geometric columns into a wider Jacobian row.
 ///
-/// # Example
-/// ```
-/// use tricept_engine::model::GeometricPredictor;
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let set = ParameterSet::paper15();
-/// let g = GeometricPredictor::new(Machine::paper(), &set);
-/// // 15 geometric columns in a row of width 17 (two more for an effect).
-/// let mut jac = vec![0.0; 3 * 17];
-/// let mut seed = None;
-/// let (up, _) = g.solve(&[800.0; 3], &mut seed, &mut jac, 17).unwrap();
-/// assert!(up.phi_rad.abs() < 1e-12);
-/// assert_eq!(jac[15], 0.0); // the extra columns are left alone
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_engine::model::GeometricPredictor;
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let set = ParameterSet::paper15();
+let g = GeometricPredictor::new(Machine::paper(), &set);
+// 15 geometric columns in a row of width 17 (two more for an effect).
+let mut jac = vec![0.0; 3 * 17];
+let mut seed = None;
+let (up, _) = g.solve(&[800.0; 3], &mut seed, &mut jac, 17).unwrap();
+assert!(up.phi_rad.abs() < 1e-12);
+assert_eq!(jac[15], 0.0); // the extra columns are left alone
+```
+"#
+)]
 pub struct GeometricPredictor<'a> {
     machine: Machine,
     set: &'a ParameterSet,
@@ -309,13 +364,18 @@ impl<'a> GeometricPredictor<'a> {
 
     /// The exact machine it predicts with.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_engine::model::GeometricPredictor;
-    /// let set = tricept_model::ParameterSet::paper15();
-    /// let g = GeometricPredictor::new(tricept_kinematics::Machine::paper(), &set);
-    /// assert_eq!(g.machine().leg_offsets_mm, [0.0; 3]);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_engine::model::GeometricPredictor;
+let set = tricept_model::ParameterSet::paper15();
+let g = GeometricPredictor::new(tricept_kinematics::Machine::paper(), &set);
+assert_eq!(g.machine().leg_offsets_mm, [0.0; 3]);
+```
+"#
+    )]
     pub fn machine(&self) -> &Machine {
         &self.machine
     }

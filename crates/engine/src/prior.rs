@@ -19,16 +19,21 @@ use crate::error::IdentError;
 
 /// A Gaussian prior on some of a model's `k` parameters.
 ///
-/// # Example
-/// ```
-/// use nalgebra::DMatrix;
-/// use tricept_engine::prior::Prior;
-/// // Parameters 0 and 2 of three: N([0.1, 0.3], diag(0.01, 0.04)); parameter 1 free.
-/// let p = Prior::new(vec![0.1, 0.0, 0.3], &[0, 2], &DMatrix::from_row_slice(2, 2, &[0.01, 0.0, 0.0, 0.04])).unwrap();
-/// assert_eq!(p.dimension(), 2);
-/// // (0.2 - 0.1)^2 / 0.01 + (0.1 - 0.3)^2 / 0.04 = 1 + 1.
-/// assert!((p.chi_square(&[0.2, 5.0, 0.1]) - 2.0).abs() < 1e-12);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use nalgebra::DMatrix;
+use tricept_engine::prior::Prior;
+// Parameters 0 and 2 of three: N([0.1, 0.3], diag(0.01, 0.04)); parameter 1 free.
+let p = Prior::new(vec![0.1, 0.0, 0.3], &[0, 2], &DMatrix::from_row_slice(2, 2, &[0.01, 0.0, 0.0, 0.04])).unwrap();
+assert_eq!(p.dimension(), 2);
+// (0.2 - 0.1)^2 / 0.01 + (0.1 - 0.3)^2 / 0.04 = 1 + 1.
+assert!((p.chi_square(&[0.2, 5.0, 0.1]) - 2.0).abs() < 1e-12);
+```
+"#
+)]
 #[derive(Debug, Clone, PartialEq)]
 pub struct Prior {
     mean: Vec<f64>,
@@ -128,14 +133,19 @@ impl Prior {
     /// The same prior on a model with `extra` more parameters after these
     /// (a diagnosis' terms): they are not covered.
     ///
-    /// # Example
-    /// ```
-    /// use nalgebra::DMatrix;
-    /// let p = tricept_engine::prior::Prior::new(vec![1.0], &[0], &DMatrix::from_element(1, 1, 4.0)).unwrap();
-    /// let wider = p.padded(2);
-    /// assert_eq!((wider.parameters(), wider.dimension()), (3, 1));
-    /// assert!((wider.chi_square(&[3.0, 7.0, 8.0]) - 1.0).abs() < 1e-12);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use nalgebra::DMatrix;
+let p = tricept_engine::prior::Prior::new(vec![1.0], &[0], &DMatrix::from_element(1, 1, 4.0)).unwrap();
+let wider = p.padded(2);
+assert_eq!((wider.parameters(), wider.dimension()), (3, 1));
+assert!((wider.chi_square(&[3.0, 7.0, 8.0]) - 1.0).abs() < 1e-12);
+```
+"#
+    )]
     pub fn padded(&self, extra: usize) -> Prior {
         let k = self.mean.len();
         let mut mean = self.mean.clone();

@@ -24,15 +24,20 @@ use tricept_numerics::lsq::{RankDecision, Solution};
 
 /// Observability indices (see the module docs).
 ///
-/// # Example
-/// ```
-/// let o = tricept_engine::report::Observability::from_singular_values(&[4.0, 1.0], 16);
-/// assert_eq!(o.o1, 0.5); // sqrt(4 * 1) / sqrt(16)
-/// assert_eq!(o.o2, 0.25);
-/// assert_eq!(o.o3, 1.0);
-/// assert_eq!(o.o4, 0.25);
-/// assert_eq!(o.o5, 0.8);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+let o = tricept_engine::report::Observability::from_singular_values(&[4.0, 1.0], 16);
+assert_eq!(o.o1, 0.5); // sqrt(4 * 1) / sqrt(16)
+assert_eq!(o.o2, 0.25);
+assert_eq!(o.o3, 1.0);
+assert_eq!(o.o4, 0.25);
+assert_eq!(o.o5, 0.8);
+```
+"#
+)]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Observability {
     /// Borm-Menq: geometric mean of the singular values over sqrt(m).
@@ -57,14 +62,19 @@ pub struct Observability {
 impl Observability {
     /// Indices from singular values (any order) and the number of rows.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_engine::report::Observability;
-    /// // Condition number 100: O2 = 0.01 whatever the scale.
-    /// let a = Observability::from_singular_values(&[10.0, 0.1], 10);
-    /// let b = Observability::from_singular_values(&[1.0, 0.01], 10);
-    /// assert!((a.o2 - b.o2).abs() < 1e-15 && (a.o2 - 0.01).abs() < 1e-15);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_engine::report::Observability;
+// Condition number 100: O2 = 0.01 whatever the scale.
+let a = Observability::from_singular_values(&[10.0, 0.1], 10);
+let b = Observability::from_singular_values(&[1.0, 0.01], 10);
+assert!((a.o2 - b.o2).abs() < 1e-15 && (a.o2 - 0.01).abs() < 1e-15);
+```
+"#
+    )]
     pub fn from_singular_values(s: &[f64], rows: usize) -> Observability {
         let l = s.len().max(1) as f64;
         let max = s.iter().copied().fold(0.0, f64::max);
@@ -85,27 +95,32 @@ impl Observability {
 /// A linear combination of parameters, by name (coefficients scaled so the
 /// largest is 1).
 ///
-/// # Example
-/// ```
-/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let m = Machine::paper();
-/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-/// let poses: Vec<tricept_data::MeasuredPose> = m
-///     .workspace
-///     .polar_grid(3, 8, 3)
-///     .iter()
-///     .map(|r| tricept_data::MeasuredPose {
-///         commands_mm: m.inverse(r).unwrap().legs_mm,
-///         ..Default::default()
-///     })
-///     .collect();
-/// let report = tricept_engine::identify::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
-/// let weak = &report.weak[0];
-/// assert!(weak.to_text().contains("dq1"));
-/// assert!(weak.std_dev_mm.unwrap() > 0.1);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let m = Machine::paper();
+let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+let poses: Vec<tricept_data::MeasuredPose> = m
+    .workspace
+    .polar_grid(3, 8, 3)
+    .iter()
+    .map(|r| tricept_data::MeasuredPose {
+        commands_mm: m.inverse(r).unwrap().legs_mm,
+        ..Default::default()
+    })
+    .collect();
+let report = tricept_engine::identify::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
+let weak = &report.weak[0];
+assert!(weak.to_text().contains("dq1"));
+assert!(weak.std_dev_mm.unwrap() > 0.1);
+```
+"#
+)]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Combination {
     /// `(name, coefficient)` pairs, largest coefficient first (in JSON: the
@@ -126,15 +141,20 @@ fn terms_as_map<S: serde::Serializer>(terms: &[(String, f64)], s: S) -> Result<S
 impl Combination {
     /// The combination as a JSON map `name -> coefficient`.
     ///
-    /// # Example
-    /// ```
-    /// let c = tricept_engine::report::Combination {
-    ///     terms: vec![("dq1".into(), 1.0), ("dq2".into(), -0.5)],
-    ///     singular_value: 0.0,
-    ///     std_dev_mm: None,
-    /// };
-    /// assert_eq!(c.to_map()["dq2"], -0.5);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+let c = tricept_engine::report::Combination {
+    terms: vec![("dq1".into(), 1.0), ("dq2".into(), -0.5)],
+    singular_value: 0.0,
+    std_dev_mm: None,
+};
+assert_eq!(c.to_map()["dq2"], -0.5);
+```
+"#
+    )]
     pub fn to_map(&self) -> Map<String, Value> {
         self.terms
             .iter()
@@ -144,15 +164,20 @@ impl Combination {
 
     /// `1.000 dyA3 - 0.250 dq1 ...`
     ///
-    /// # Example
-    /// ```
-    /// let c = tricept_engine::report::Combination {
-    ///     terms: vec![("dyA3".into(), 1.0), ("dq1".into(), -0.25)],
-    ///     singular_value: 0.0,
-    ///     std_dev_mm: None,
-    /// };
-    /// assert_eq!(c.to_text(), "1.000 dyA3 - 0.250 dq1");
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+let c = tricept_engine::report::Combination {
+    terms: vec![("dyA3".into(), 1.0), ("dq1".into(), -0.25)],
+    singular_value: 0.0,
+    std_dev_mm: None,
+};
+assert_eq!(c.to_text(), "1.000 dyA3 - 0.250 dq1");
+```
+"#
+    )]
     pub fn to_text(&self) -> String {
         let mut s = String::new();
         for (i, (n, c)) in self.terms.iter().enumerate() {
@@ -173,28 +198,33 @@ impl Combination {
 
 /// What a pose set and the sensors can tell about the parameters.
 ///
-/// # Example
-/// ```
-/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let m = Machine::paper();
-/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-/// let poses: Vec<tricept_data::MeasuredPose> = m
-///     .workspace
-///     .polar_grid(3, 8, 3)
-///     .iter()
-///     .map(|r| tricept_data::MeasuredPose {
-///         commands_mm: m.inverse(r).unwrap().legs_mm,
-///         ..Default::default()
-///     })
-///     .collect();
-/// let report = tricept_engine::identify::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
-/// let json = report.to_json();
-/// assert_eq!(json["n_params"], 15);
-/// assert_eq!(json["unidentifiable"][0]["dyA3"], 1.0);
-/// assert!(report.condition_number > 100.0);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let m = Machine::paper();
+let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+let poses: Vec<tricept_data::MeasuredPose> = m
+    .workspace
+    .polar_grid(3, 8, 3)
+    .iter()
+    .map(|r| tricept_data::MeasuredPose {
+        commands_mm: m.inverse(r).unwrap().legs_mm,
+        ..Default::default()
+    })
+    .collect();
+let report = tricept_engine::identify::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
+let json = report.to_json();
+assert_eq!(json["n_params"], 15);
+assert_eq!(json["unidentifiable"][0]["dyA3"], 1.0);
+assert!(report.condition_number > 100.0);
+```
+"#
+)]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct IdentifiabilityReport {
     /// Parameter names.
@@ -249,12 +279,17 @@ pub struct CorrelatedPair {
 /// Optional values by parameter name, in parameter order; a JSON object
 /// `name -> value` (`null` where there is none).
 ///
-/// # Example
-/// ```
-/// let v = tricept_engine::report::NamedValues(vec![("dq1".into(), Some(0.5)), ("dyA3".into(), None)]);
-/// assert_eq!(serde_json::to_string(&v).unwrap(), r#"{"dq1":0.5,"dyA3":null}"#);
-/// assert_eq!(v.get("dq1"), Some(0.5));
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r##"
+# Example
+```
+let v = tricept_engine::report::NamedValues(vec![("dq1".into(), Some(0.5)), ("dyA3".into(), None)]);
+assert_eq!(serde_json::to_string(&v).unwrap(), r#"{"dq1":0.5,"dyA3":null}"#);
+assert_eq!(v.get("dq1"), Some(0.5));
+```
+"##
+)]
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct NamedValues(pub Vec<(String, Option<f64>)>);
 
@@ -415,46 +450,56 @@ impl IdentifiabilityReport {
     /// `unidentifiable` as a list of name -> coefficient maps,
     /// `singular_values`, `condition_number`, `observability`) and more.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_engine::{model::GeometricModel, IdentifyOptions};
-    /// use tricept_kinematics::Machine;
-    /// use tricept_model::ParameterSet;
-    /// let m = Machine::paper();
-    /// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-    /// let poses: Vec<tricept_data::MeasuredPose> = m
-    ///     .workspace
-    ///     .polar_grid(3, 8, 3)
-    ///     .iter()
-    ///     .map(|r| tricept_data::MeasuredPose { commands_mm: m.inverse(r).unwrap().legs_mm, ..Default::default() })
-    ///     .collect();
-    /// let r = tricept_engine::identify::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
-    /// let j = r.to_json();
-    /// assert_eq!(j["rank"], 14);
-    /// assert_eq!(j["unidentifiable"][0]["dyA3"], 1.0);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let m = Machine::paper();
+let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+let poses: Vec<tricept_data::MeasuredPose> = m
+    .workspace
+    .polar_grid(3, 8, 3)
+    .iter()
+    .map(|r| tricept_data::MeasuredPose { commands_mm: m.inverse(r).unwrap().legs_mm, ..Default::default() })
+    .collect();
+let r = tricept_engine::identify::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
+let j = r.to_json();
+assert_eq!(j["rank"], 14);
+assert_eq!(j["unidentifiable"][0]["dyA3"], 1.0);
+```
+"#
+    )]
     pub fn to_json(&self) -> Value {
         serde_json::to_value(self).unwrap_or(Value::Null)
     }
 
     /// A human-readable summary.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_engine::{model::GeometricModel, IdentifyOptions};
-    /// use tricept_kinematics::Machine;
-    /// use tricept_model::ParameterSet;
-    /// let m = Machine::paper();
-    /// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-    /// let poses: Vec<tricept_data::MeasuredPose> = m
-    ///     .workspace
-    ///     .polar_grid(3, 8, 3)
-    ///     .iter()
-    ///     .map(|r| tricept_data::MeasuredPose { commands_mm: m.inverse(r).unwrap().legs_mm, ..Default::default() })
-    ///     .collect();
-    /// let r = tricept_engine::identify::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
-    /// assert!(r.to_text().starts_with("rank 14 of 15 parameters (75 poses"));
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let m = Machine::paper();
+let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+let poses: Vec<tricept_data::MeasuredPose> = m
+    .workspace
+    .polar_grid(3, 8, 3)
+    .iter()
+    .map(|r| tricept_data::MeasuredPose { commands_mm: m.inverse(r).unwrap().legs_mm, ..Default::default() })
+    .collect();
+let r = tricept_engine::identify::identifiability(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
+assert!(r.to_text().starts_with("rank 14 of 15 parameters (75 poses"));
+```
+"#
+    )]
     pub fn to_text(&self) -> String {
         let mut s = String::new();
         s.push_str(&format!(

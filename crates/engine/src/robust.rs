@@ -51,23 +51,28 @@ pub const START_Z: f64 = 10.0;
 
 /// A rejected pose.
 ///
-/// # Example
-/// ```
-/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let m = Machine::paper();
-/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-/// let set = ParameterSet::paper15();
-/// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
-///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
-///     .unwrap();
-/// let mut data = data;
-/// data.poses[3].readings.phi_rad += 1e-3; // a 206 arcsec glitch
-/// data.poses[3].line = 42;
-/// let (_, rejected) = tricept_engine::robust::identify_robust(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
-/// assert_eq!(rejected[0].line, 42);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let m = Machine::paper();
+let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+let set = ParameterSet::paper15();
+let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+    .simulate(&tricept_plant::Campaign::grid(&m, 1))
+    .unwrap();
+let mut data = data;
+data.poses[3].readings.phi_rad += 1e-3; // a 206 arcsec glitch
+data.poses[3].line = 42;
+let (_, rejected) = tricept_engine::robust::identify_robust(&model, &data, &IdentifyOptions::for_machine(&m)).unwrap();
+assert_eq!(rejected[0].line, 42);
+```
+"#
+)]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Rejection {
     /// Index of the pose in the data.

@@ -128,14 +128,19 @@ pub struct ControlLimits {
 
 /// A CNC control model (`--control`).
 ///
-/// # Example
-/// ```
-/// use tricept_export::{control::ControlModel, control::Controller};
-/// let m: ControlModel = "fanuc-0i".parse().unwrap();
-/// assert_eq!(m.family(), Controller::Fanuc);
-/// assert_eq!(m.limits().value_range.unwrap().value, 7);
-/// assert_eq!(ControlModel::default().as_str(), "sinumerik-840d-sl");
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_export::{control::ControlModel, control::Controller};
+let m: ControlModel = "fanuc-0i".parse().unwrap();
+assert_eq!(m.family(), Controller::Fanuc);
+assert_eq!(m.limits().value_range.unwrap().value, 7);
+assert_eq!(ControlModel::default().as_str(), "sinumerik-840d-sl");
+```
+"#
+)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 pub enum ControlModel {
     /// Siemens SINUMERIK 840D sl: the Tricept's own control (the default).

@@ -33,6 +33,15 @@
 //!   ([`files`]), the figures ([`plot`]), and the defaults the binary's
 //!   flags show ([`DEFAULT_TOLERANCE_MM`], [`DEFAULT_POWER`],
 //!   [`fusable_effects`]).
+//!
+//! # Example
+//! ```
+//! use tricept_ident::advanced::{LoadedMachine, SensorNoise, load_machine};
+//! let noise = SensorNoise { length_noise_um: Some(2.0), ..SensorNoise::default() };
+//! let loaded: LoadedMachine = load_machine(None, &noise)?;
+//! assert!(loaded.warnings().is_empty());
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 pub use crate::calibrate::values::{
     EffectNames, EvalGrid, HeadModel, LengthSigma, TrackerTargetSpec,
@@ -47,20 +56,102 @@ pub use crate::json_version::{OUTPUT_FORMAT_VERSION, versioned_json};
 pub use crate::machine_file::MachineFile;
 pub use nalgebra;
 pub use serde_json;
+
+/// The power a planned check detects its stated change with by default.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::DEFAULT_POWER;
+/// use tricept_ident::plan::{Instrument, PlanRequest};
+/// assert_eq!(PlanRequest::new(Instrument::Check).power, DEFAULT_POWER);
+/// ```
+#[doc(inline)]
 pub use tricept_check::check::DEFAULT_POWER;
+// The internal crates' errors the door's [`Error`](crate::Error) is made
+// from ([`Classify`]).
+pub use tricept_check::CheckError;
+pub use tricept_data::DataError;
+/// Measured data in memory (what a [`DataInput`](crate::DataInput) loads).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{Dataset, read_data_from};
+/// use tricept_ident::kinematics::GeometricMachine;
+/// let csv = "q1,q2,q3,phi,theta,s\n700,700,700,0,0,5\n701,699,700,0.001,0,5\n";
+/// let data: Dataset = read_data_from(csv.as_bytes(), "memory", &GeometricMachine::paper())?;
+/// assert_eq!(data.poses.len(), 2);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
 pub use tricept_data::Dataset;
+pub use tricept_data::{MeasuredPose, Readings};
+pub use tricept_diagnose::{DeployError, DiagnoseError};
+
+/// The manufacturing tolerance a calibration is judged against by default, mm.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::DEFAULT_TOLERANCE_MM;
+/// use tricept_ident::calibrate::CalibrateRequest;
+/// assert_eq!(CalibrateRequest::new("campaign.csv").tolerance_mm, DEFAULT_TOLERANCE_MM);
+/// ```
+#[doc(inline)]
 pub use tricept_engine::accuracy::DEFAULT_TOLERANCE_MM;
-pub use tricept_engine::fusion::fusable_effects;
+pub use tricept_engine::fusion::{TrackerTarget, fusable_effects};
+pub use tricept_engine::{IdentError, record::RecordError};
+pub use tricept_fleet::FleetError;
+pub use tricept_model::GeometricErrors;
+pub use tricept_model::ModelError;
+/// Which geometric errors a calibration identifies.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::ParameterSet;
+/// use tricept_ident::calibrate::CalibrateRequest;
+/// let set = CalibrateRequest::new("campaign.csv").parameter_set;
+/// assert_eq!(set.len(), set.names().len());
+/// assert_eq!(ParameterSet::paper15().len(), 15);
+/// ```
+#[doc(inline)]
 pub use tricept_model::ParameterSet;
-/// The figures of the verbs that draw (SVG, atomic): `tricept_plot`.
+pub use tricept_numerics::sparse::BlockError;
+pub use tricept_plant::PlantError;
+/// The figures of the verbs that draw (SVG, written atomically).
+#[doc(inline)]
 pub use tricept_plot as plot;
+pub use tricept_study::StudyError;
 
 /// Files written as every verb writes them (atomic: temporary file and
-/// rename; `-` for stdout) and messages made one bounded line, from
-/// `tricept_data`.
+/// rename; `-` for stdout) and messages made one bounded line.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::files::one_line;
+/// let message = one_line("a message\nover two lines");
+/// assert!(!message.contains('\n'));
+/// ```
 pub mod files {
+    /// A message made one bounded line, as every error of the door is.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::advanced::files::one_line;
+    /// assert_eq!(one_line("two\nlines"), one_line(&one_line("two\nlines")));
+    /// assert!(!one_line("two\nlines").contains('\n'));
+    /// ```
+    #[doc(inline)]
+    pub use tricept_data::message::one_line;
+    /// A path as a message shows it (control characters escaped).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::advanced::files::shown_path;
+    /// assert_eq!(shown_path(std::path::Path::new("a\nb.csv")), "a\\nb.csv");
+    /// ```
+    #[doc(inline)]
+    pub use tricept_data::message::shown_path;
     pub use tricept_data::{
-        atomic::check_output_file, external::write_external_path, message::one_line,
-        message::shown_path, write_atomic, write_path, write_to,
+        atomic::check_output_file, external::write_external_path, write_atomic, write_path,
+        write_to,
     };
 }

@@ -1,6 +1,6 @@
 //! The check workflow (`tricept check`): has the machine changed since its
 //! calibration? A short check campaign from the machine's own sensors
-//! tested against the calibrated machine file (`tricept_check`), with an
+//! tested against the calibration record of the machine file, with an
 //! optional history (JSON lines, appended) and its trends.
 //!
 //! The verdict's exit code: 0 unchanged, 3 changed; 0 too for readings
@@ -9,19 +9,84 @@
 //! are unchanged, each with a warning ([`CheckResult::warnings`]); a machine
 //! file without a calibration record and a campaign that cannot see a
 //! change are input errors (exit code 2).
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::check::{CheckRequest, check};
+//! let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
+//! if result.changed() {
+//!     println!("changed since its calibration: exit code {}", result.exit_code());
+//! }
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
 use tricept_check::history::{Entry, append, trends};
-use tricept_check::{CheckError, CheckOptions, CheckVerdict, Reference};
+use tricept_check::{CheckError, CheckOptions, Reference};
 
 use crate::data_input::DataInput;
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::machine_input::MachineInput;
 
+/// A check's report ([`CheckResult`]).
+///
+/// # Example
+/// ```
+/// use tricept_ident::check::{CheckReport, CheckVerdict};
+/// fn summary(report: &CheckReport) -> String {
+///     format!("{} poses, changed: {}", report.poses, report.changed)
+/// }
+/// # let _ = summary;
+/// # let _: Option<CheckVerdict> = None;
+/// ```
+#[doc(inline)]
+pub use tricept_check::CheckReport;
+/// A check's verdict ([`CheckReport`]'s `verdict`).
+///
+/// # Example
+/// ```
+/// use tricept_ident::check::{CheckReport, CheckVerdict};
+/// fn act_on(report: &CheckReport) -> &'static str {
+///     match report.verdict {
+///         CheckVerdict::Unchanged | CheckVerdict::NoisierThanStated => "keep the machine file",
+///         CheckVerdict::Changed | CheckVerdict::ChangedUnexplained => "recalibrate",
+///     }
+/// }
+/// # let _ = act_on;
+/// ```
+#[doc(inline)]
+pub use tricept_check::CheckVerdict;
+/// The significance level a check tests a change at by default.
+///
+/// # Example
+/// ```
+/// use tricept_ident::check::{CheckRequest, DEFAULT_ALPHA};
+/// assert_eq!(CheckRequest::new("calibrated.json", "today.csv").alpha, DEFAULT_ALPHA);
+/// ```
+#[doc(inline)]
+pub use tricept_check::check::DEFAULT_ALPHA;
+/// One quantity's trend over a check history ([`CheckResult::trends`]).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::check::{CheckRequest, Trend, check};
+/// let mut request = CheckRequest::new("calibrated.json", "today.csv");
+/// request.history = Some("checks.jsonl".into());
+/// let result = check(request)?;
+/// let trends: &[Trend] = result.trends();
+/// for t in trends {
+///     println!("{} ({}): {:?}", t.name, t.unit, t.values.last());
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
 pub use tricept_check::history::Trend;
-pub use tricept_check::{CheckReport, check::DEFAULT_ALPHA};
+pub use tricept_check::{candidates::CandidateKind, noise::ChannelNoise};
+pub use tricept_check::{
+    changes::Change, noise::NoiseSeen, parts::CandidateResult, parts::ChiSquare, parts::Rejected,
+};
 
 /// A check campaign against a calibrated machine.
 ///
@@ -74,6 +139,19 @@ struct History {
 }
 
 /// A check's report, its verdict and the history's trends.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::check::{CheckRequest, check};
+/// let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
+/// for trend in result.trends() {
+///     println!("{trend:?}");
+/// }
+/// if result.changed() {
+///     println!("changed since its calibration: exit code {}", result.exit_code());
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct CheckResult {
     report: CheckReport,
@@ -90,6 +168,16 @@ crate::outcome::outcome!(CheckResult);
 /// Runs the check: the reference from the machine's calibration record,
 /// the data read, the history read (refused before the check when it
 /// cannot be), the test, and the entry appended to the history.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::check::{CheckRequest, check};
+/// let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
+/// if result.changed() {
+///     println!("changed since its calibration: exit code {}", result.exit_code());
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn check(request: CheckRequest) -> Result<CheckResult, Error> {
     let loaded = &request.machine.load()?;
     let machine = loaded.source().to_string();

@@ -22,16 +22,22 @@ use tricept_model::ExtendedMachine;
 
 use crate::error::Error;
 use crate::inputs::{LoadedMachine, SensorNoise, description_error, load_machine};
-
-/// A point or a direction in the machine's base frame (mm for a point):
-/// `nalgebra`'s 3-vector of `f64`.
-pub type Vector3 = nalgebra::Vector3<f64>;
+use crate::linalg::Vector3;
 
 /// The geometric machine: joints, leg offsets, UP limb, head, sensors and
 /// the leg effects it carries, whose **own** kinematics ignore those leg
 /// effects. Reached through [`Machine::geometry`]; command a machine
 /// through [`Machine`].
-pub type GeometricMachine = tricept_kinematics::Machine;
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{GeometricMachine, Machine};
+/// let machine = Machine::paper();
+/// let geometry: &GeometricMachine = machine.geometry();
+/// assert_eq!(geometry, &GeometricMachine::paper());
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::Machine as GeometricMachine;
 
 /// A machine to command: inverse and forward kinematics with every effect
 /// its file carries applied (the geometry and the static leg effects a

@@ -8,15 +8,29 @@
 //! [`compensate`] computes; the result writes its CSV files
 //! ([`Compensation::map_csv`], [`Compensation::write_tables`]) and gives
 //! the cells of its heat maps ([`Compensation::maps`]).
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::MachineInput;
+//! use tricept_ident::compensate::{Calibrated, CompensateRequest, compensate};
+//! let calibrated = Calibrated::MachineFile(MachineInput::from("calibrated.json"));
+//! let compensation = compensate(CompensateRequest::new(calibrated))?;
+//! if let Some(targets) = compensation.corrected_targets() {
+//!     for (target_mm, command) in targets {
+//!         println!("{target_mm:?} -> {command:?}");
+//!     }
+//! }
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use nalgebra::Vector3;
+use crate::linalg::Vector3;
 use serde_json::{Map, Value, json};
 use tricept_engine::compensate::{MapError, TableError, WorkspaceTable};
 use tricept_model::ExtendedMachine;
-use tricept_model::{ParameterSet, volumetric::MapStats};
+use tricept_model::ParameterSet;
 use tricept_plant::Effect;
 
 use crate::Setting;
@@ -26,18 +40,66 @@ use crate::inputs::TrueErrors;
 use crate::machine_file::write_rule;
 use crate::machine_input::MachineInput;
 
+/// A volumetric error map on a plane ([`Compensation::maps`]).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::compensate::{Calibrated, CompensateRequest, ErrorMap, compensate};
+/// let calibrated = Calibrated::MachineFile(MachineInput::from("calibrated.json"));
+/// let compensation = compensate(CompensateRequest::new(calibrated))?;
+/// let (map, _before_after): (&ErrorMap, _) = compensation.maps();
+/// let worst_mm = map.errors_mm.iter().map(|e| e.norm()).fold(0.0, f64::max);
+/// println!("{} points, worst {worst_mm} mm", map.targets_mm.len());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
 pub use tricept_model::volumetric::ErrorMap;
+pub use tricept_model::volumetric::MapStats;
 
 /// The largest interpolation error (um) the default table spacing allows.
+///
+/// # Example
+/// ```
+/// use tricept_ident::compensate::TABLE_ERROR_LIMIT_UM;
+/// // A table whose interpolation error exceeds it is refined, never used.
+/// assert!(TABLE_ERROR_LIMIT_UM <= 1.0);
+/// ```
 pub const TABLE_ERROR_LIMIT_UM: f64 = 1.0;
 
 /// The files of a map directory.
+///
+/// # Example
+/// ```
+/// use tricept_ident::compensate::MAP_FILES;
+/// let dir = std::path::Path::new("maps");
+/// let files: Vec<_> = MAP_FILES.iter().map(|f| dir.join(f)).collect();
+/// assert_eq!(files[0], dir.join("map.csv"));
+/// ```
 pub const MAP_FILES: &[&str] = &["map.csv", "correction.svg", "before.svg", "after.svg"];
 /// The files of a table directory (the second only for a machine with
 /// per-leg compensation tables).
+///
+/// # Example
+/// ```
+/// use tricept_ident::compensate::TABLE_FILES;
+/// assert!(TABLE_FILES.contains(&"table.csv"));
+/// ```
 pub const TABLE_FILES: &[&str] = &["table.csv", "leg-tables.csv"];
 
 /// Where the calibrated machine comes from.
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::calibrate::CalibrateRequest;
+/// use tricept_ident::compensate::Calibrated;
+/// // From a calibrated machine file, or calibrated here from data.
+/// let from_file = Calibrated::MachineFile(MachineInput::from("calibrated.json"));
+/// let from_data = Calibrated::Data(Box::new(CalibrateRequest::new("campaign.csv")));
+/// assert!(matches!(from_file, Calibrated::MachineFile(_)));
+/// assert!(matches!(from_data, Calibrated::Data(_)));
+/// ```
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub enum Calibrated {
@@ -49,6 +111,15 @@ pub enum Calibrated {
 }
 
 /// What to compensate, and what to produce.
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::compensate::{Calibrated, CompensateRequest};
+/// let request = CompensateRequest::new(Calibrated::MachineFile(MachineInput::from("calibrated.json")));
+/// assert_eq!(request.spacing_mm, 10.0);
+/// assert!(request.map_dir.is_none() && request.table_dir.is_none());
+/// ```
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct CompensateRequest {
@@ -111,7 +182,16 @@ crate::request::setters!(CompensateRequest {
 });
 
 /// A target (mm) and its corrected leg commands (mm).
-pub type CorrectedTarget = (Vector3<f64>, [f64; 3]);
+///
+/// # Example
+/// ```
+/// use tricept_ident::compensate::CorrectedTarget;
+/// use tricept_ident::kinematics::Vector3;
+/// let (target_mm, legs_mm): CorrectedTarget = (Vector3::new(0.0, 0.0, 750.0), [773.3, 773.3, 773.3]);
+/// assert_eq!(target_mm.z, 750.0);
+/// assert_eq!(legs_mm.len(), 3);
+/// ```
+pub type CorrectedTarget = (Vector3, [f64; 3]);
 
 /// The compensation table and where it is written.
 #[derive(Debug, Clone)]
@@ -122,6 +202,21 @@ struct Table {
 }
 
 /// A compensation: its JSON fields, maps, table and corrected targets.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::compensate::{Calibrated, CompensateRequest, compensate};
+/// let calibrated = Calibrated::MachineFile(MachineInput::from("calibrated.json"));
+/// let compensation = compensate(CompensateRequest::new(calibrated))?;
+/// println!("map spacing {} mm", compensation.spacing_mm());
+/// if let Some(targets) = compensation.corrected_targets() {
+///     for (target_mm, command) in targets {
+///         println!("{target_mm:?} -> {command:?}");
+///     }
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Compensation {
     out: Map<String, Value>,
@@ -222,6 +317,20 @@ fn stats_json(s: &MapStats) -> Value {
 }
 
 /// Compensates as `request` says.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::compensate::{Calibrated, CompensateRequest, compensate};
+/// let calibrated = Calibrated::MachineFile(MachineInput::from("calibrated.json"));
+/// let compensation = compensate(CompensateRequest::new(calibrated))?;
+/// if let Some(targets) = compensation.corrected_targets() {
+///     for (target_mm, command) in targets {
+///         println!("{target_mm:?} -> {command:?}");
+///     }
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn compensate(request: CompensateRequest) -> Result<Compensation, Error> {
     let request = &request;
     let spacing = request.spacing_mm;
@@ -380,7 +489,7 @@ fn truth_maps(
     request: &CompensateRequest,
     nominal: &ExtendedMachine,
     calibrated: &ExtendedMachine,
-    grid: &[Vector3<f64>],
+    grid: &[Vector3],
 ) -> Result<Option<(ErrorMap, ErrorMap)>, Error> {
     let Some(truth) = &request.truth else {
         if !request.truth_effects.is_empty() {

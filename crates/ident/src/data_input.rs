@@ -149,6 +149,16 @@ pub fn read_data(path: &Path, machine: &Machine) -> Result<Dataset, Error> {
 
 /// The measured data (docs/data-format.md) read from a reader (a file
 /// wrapped in a progress display, say); `file` names it in messages.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::read_data_from;
+/// use tricept_ident::kinematics::GeometricMachine;
+/// let csv = "q1,q2,q3,phi,theta,s\n700,700,700,0,0,5\n";
+/// let data = read_data_from(csv.as_bytes(), "memory", &GeometricMachine::paper())?;
+/// assert_eq!(data.poses.len(), 1);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn read_data_from(
     reader: impl BufRead,
     file: &str,

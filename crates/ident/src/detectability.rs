@@ -3,6 +3,18 @@
 //! context), how large each unmodelled effect must be before the diagnosis
 //! finds it, what it does to the geometric parameters below that, and
 //! advice on the campaign.
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::MachineInput;
+//! use tricept_ident::advanced::Poses;
+//! use tricept_ident::detectability::{DetectabilityRequest, detectability};
+//! let report = detectability(DetectabilityRequest::new(MachineInput::default(), Poses::grid()))?;
+//! for (effect, _detectability, advice) in report.rows() {
+//!     println!("{effect}: {advice}");
+//! }
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use serde_json::{Value, json};
 use tricept_diagnose::detect::{advise, realistic, term_detectability};
@@ -19,6 +31,15 @@ use crate::machine_input::MachineInput;
 pub use tricept_diagnose::detect::Detectability;
 
 /// The campaign to assess.
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::advanced::Poses;
+/// use tricept_ident::detectability::DetectabilityRequest;
+/// let request = DetectabilityRequest::new(MachineInput::default(), Poses::grid());
+/// assert!(request.data.is_none());
+/// ```
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct DetectabilityRequest {
@@ -59,6 +80,18 @@ crate::request::setters!(DetectabilityRequest {
 });
 
 /// Each effect's detectability on the campaign, with advice.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::advanced::Poses;
+/// use tricept_ident::detectability::{DetectabilityRequest, detectability};
+/// let report = detectability(DetectabilityRequest::new(MachineInput::default(), Poses::grid()))?;
+/// for (effect, _detectability, advice) in report.rows() {
+///     println!("{effect}: {advice}");
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct DetectabilityReport {
     rows: Vec<(&'static str, Detectability, String)>,
@@ -70,6 +103,18 @@ pub struct DetectabilityReport {
 crate::outcome::outcome!(DetectabilityReport);
 
 /// Assesses the request's campaign.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::advanced::Poses;
+/// use tricept_ident::detectability::{DetectabilityRequest, detectability};
+/// let report = detectability(DetectabilityRequest::new(MachineInput::default(), Poses::grid()))?;
+/// for (effect, _detectability, advice) in report.rows() {
+///     println!("{effect}: {advice}");
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn detectability(request: DetectabilityRequest) -> Result<DetectabilityReport, Error> {
     let loaded = request.machine.clone().load()?;
     let m = loaded.machine();

@@ -11,6 +11,18 @@
 //! ([`DataInput`]); the result carries the
 //! verdict and its exit code (0 the final model explains the data, 3 it
 //! does not), the JSON and the text report the CLI prints.
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+//! let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+//! if !result.explained() {
+//!     for cause in &result.diagnosis().causes {
+//!         println!("{}: {}", cause.effect, cause.description);
+//!     }
+//! }
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -30,7 +42,98 @@ use crate::machine_input::MachineInput;
 
 pub use crate::accuracy::Accuracy;
 pub use crate::outcome::{WriteOptions, Written};
-pub use tricept_diagnose::{Deployed, Diagnosis, options::DeployRule, report::ResidualPlot};
+/// A diagnosis' final model deployed ([`DiagnoseResult::deploy`]).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+/// use tricept_ident::kinematics::{Machine, Vector3};
+/// let deployed = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?.deploy()?;
+/// let machine = Machine::from(&deployed);
+/// let legs_mm = machine.inverse(&Vector3::new(0.0, 0.0, 750.0))?.legs_mm;
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_diagnose::Deployed;
+/// A diagnosis ([`DiagnoseResult::diagnosis`]).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// let diagnosis = result.diagnosis();
+/// println!("chi-square {} on {} dof", diagnosis.chi_square, diagnosis.dof);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_diagnose::Diagnosis;
+/// When a diagnosis deploys its final model.
+///
+/// # Example
+/// ```
+/// use tricept_ident::diagnosis::{DeployRule, DiagnoseRequest};
+/// let request = DiagnoseRequest::new("calibrated.json", "campaign.csv");
+/// assert_eq!(request.deploy_rule, DeployRule::ExpectedError);
+/// ```
+#[doc(inline)]
+pub use tricept_diagnose::options::DeployRule;
+/// A cause a diagnosis names ([`Diagnosis`]'s `causes`).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose, Cause};
+/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// let diagnosis = result.diagnosis();
+/// let causes: &[Cause] = &diagnosis.causes;
+/// for cause in causes.iter().filter(|c| c.plausible) {
+///     println!("{}: {}", cause.effect, cause.description);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_diagnose::report::Cause;
+/// What the final model gains on held-out poses ([`Diagnosis`]'s `gain`).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose, Gain};
+/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// let diagnosis = result.diagnosis();
+/// let gain: &Gain = &diagnosis.gain;
+/// println!("held-out rms {} -> {}", gain.holdout_rms_geometric, gain.holdout_rms_extended);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_diagnose::report::Gain;
+pub use tricept_diagnose::report::Verdict as DiagnosisVerdict;
+pub use tricept_diagnose::{
+    ExtendedModel, report::Alias, report::CauseKind, report::ChannelRms, report::Estimate,
+    report::Evidence, report::FinalFit, report::ModelTerm, report::NoiseCheck, report::NoiseSource,
+    report::PureError, report::RejectStage, report::Rejected, report::Remainder,
+    report::ResidualPlot, report::Structure, report::TermScore, report::Tested,
+};
+pub use tricept_diagnose::{
+    terms::Frame, terms::GenericTerm, terms::OrderAxis, terms::Scope, terms::Term,
+};
+/// An identification, the estimates of a fit and their covariance ([`Deployed`]'s `id`).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, Identification, diagnose};
+/// let deployed = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?.deploy()?;
+/// let id: &Identification = &deployed.id;
+/// for ((name, value), sigma) in id.names.iter().zip(&id.estimate).zip(&id.std_dev) {
+///     println!("{name} = {value} ({sigma:?})");
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_engine::Identification;
+pub use tricept_engine::{
+    identify::CampaignOffsets, identify::Design, identify::ResidualStats, model::GeometricModel,
+    model::GeometricPredictor, model::PosePredictor, model::ReadingModel, prior::Prior,
+    prior::PriorFit,
+};
 
 /// What to diagnose and how.
 ///
@@ -93,6 +196,18 @@ crate::request::setters!(DiagnoseRequest {
 });
 
 /// A diagnosis with what it needs to deploy its final model.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// if !result.explained() {
+///     for cause in &result.diagnosis().causes {
+///         println!("{}: {}", cause.effect, cause.description);
+///     }
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct DiagnoseResult {
     diagnosis: Diagnosis,
@@ -120,6 +235,18 @@ struct Deployment {
 
 /// Diagnoses the request's data: every problem of the input is an error of
 /// kind input (exit code 2) naming the data.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
+/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// if !result.explained() {
+///     for cause in &result.diagnosis().causes {
+///         println!("{}: {}", cause.effect, cause.description);
+///     }
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn diagnose(request: DiagnoseRequest) -> Result<DiagnoseResult, Error> {
     let DiagnoseRequest {
         machine: loaded,
@@ -483,6 +610,12 @@ fn effect_records(d: &Diagnosis, deployed: &Deployed, g: usize) -> Map<String, s
 /// The vocabulary, from the registry: each effect, its physics, its
 /// parameters (units in the names) and where a written machine puts it
 /// (`tricept diagnose --help`).
+///
+/// # Example
+/// ```
+/// let help = tricept_ident::diagnosis::vocabulary_help();
+/// assert!(help.contains("leg-lead"));
+/// ```
 pub fn vocabulary_help() -> String {
     let lines: Vec<String> = tricept_model::effects::EffectName::ALL
         .iter()

@@ -2,16 +2,55 @@
 //! keys, their units and a typical example (what `simulate
 //! --truth-effect` takes), and whether the diagnosis names it (in its
 //! vocabulary) or describes it through a generic family.
+//!
+//! # Example
+//! ```
+//! use tricept_ident::effects::effects;
+//! let all = effects(None)?;
+//! assert!(all.effects().len() > 5);
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use serde_json::{Value, json};
 use tricept_plant::effects::typical_effects;
 
 use crate::error::{EXIT_OK, Error};
 
+/// The diagnosis' vocabulary of effects.
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::EffectName;
+/// let lead: EffectName = "leg-lead".parse()?;
+/// assert_eq!(lead.spec().name, "leg-lead");
+/// assert!(EffectName::ALL.contains(&lead));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
 pub use tricept_model::effects::EffectName;
+pub use tricept_model::effects::Simulation as EffectSimulation;
+pub use tricept_model::effects::{
+    Basis, CheckColumns, CheckWhen, GenericSpec, LegContext, LegDeployment, PoseState,
+    SimulateObject, Structural, UnknownEffect, XAxis, YAxis,
+};
+pub use tricept_model::effects::{CauseName, EffectKey, EffectSpec, Judgement};
+pub use tricept_model::effects::{
+    CheckRole, CommonPart, Deployment, GenericFamily, Judged, Kind, KnownAlias, Magnitude, Measure,
+    Needs, Parameter, PlausibleRange, PlotAxes, Simulate,
+};
+pub use tricept_model::plausibility::Range;
 pub use tricept_plant::Effect;
 
 /// The effects listed: all, or the one asked for.
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::effects;
+/// let lead = effects(Some("leg-lead"))?;
+/// assert_eq!(lead.effects().len(), 1);
+/// assert_eq!(lead.exit_code(), tricept_ident::EXIT_OK);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct EffectList {
     effects: Vec<Effect>,

@@ -13,15 +13,53 @@ use std::sync::Arc;
 use crate::Setting;
 
 /// Exit code of a result that can be trusted.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{EXIT_OK, ErrorKind};
+/// use tricept_ident::kinematics::Machine;
+/// // Only a workflow that succeeded with a good verdict exits with it.
+/// assert!(Machine::load("no/such/machine.json").is_err_and(|e| e.exit_code() != EXIT_OK));
+/// assert_ne!(ErrorKind::Input.exit_code(), EXIT_OK);
+/// ```
 pub const EXIT_OK: u8 = 0;
 /// Exit code of anything that is not the input's fault.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{EXIT_OTHER, ErrorKind};
+/// assert_eq!(ErrorKind::Other.exit_code(), EXIT_OTHER);
+/// assert_eq!(ErrorKind::of_exit_code(EXIT_OTHER), ErrorKind::Other);
+/// ```
 pub const EXIT_OTHER: u8 = 1;
 /// Exit code of bad input: a file, a flag, a request.
+///
+/// # Example
+/// ```
+/// use tricept_ident::EXIT_INPUT;
+/// use tricept_ident::kinematics::Machine;
+/// // A file that is not there: the user's input is at fault.
+/// let e = Machine::load("no/such/machine.json").unwrap_err();
+/// assert_eq!(e.exit_code(), EXIT_INPUT);
+/// ```
 pub const EXIT_INPUT: u8 = 2;
 /// Exit code of a fit that converged but whose model does not explain the
 /// data, or of a campaign too small to calibrate.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{EXIT_INADEQUATE, ErrorKind};
+/// assert_eq!(ErrorKind::Inadequate.exit_code(), EXIT_INADEQUATE);
+/// assert_eq!(ErrorKind::of_exit_code(EXIT_INADEQUATE), ErrorKind::Inadequate);
+/// ```
 pub const EXIT_INADEQUATE: u8 = 3;
 /// Exit code of a fit that did not converge.
+///
+/// # Example
+/// ```
+/// use tricept_ident::{EXIT_NOT_CONVERGED, ErrorKind};
+/// assert_eq!(ErrorKind::NotConverged.exit_code(), EXIT_NOT_CONVERGED);
+/// ```
 pub const EXIT_NOT_CONVERGED: u8 = 4;
 
 /// Whose fault a failure is, which decides the exit code.

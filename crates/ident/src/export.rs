@@ -1,18 +1,67 @@
 //! `export`: a calibrated machine file translated into the files a CNC
 //! control loads (`tricept-export`): a typed [`ExportRequest`] to an
 //! [`Export`] with its exit code, its JSON and its text report.
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::MachineInput;
+//! use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
+//! let request = ExportRequest {
+//!     machine: MachineInput::from("calibrated.json"),
+//!     options: ExportOptions::new(Controller::Heidenhain),
+//!     out: "export".into(),
+//! };
+//! let exported = export(request)?;
+//! assert!(exported.written || exported.exit_code != tricept_ident::EXIT_OK);
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::path::PathBuf;
 
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::machine_input::MachineInput;
 
+/// The control and the limits of an export ([`ExportRequest`]'s `options`).
+///
+/// # Example
+/// ```
+/// use tricept_ident::export::{Controller, ExportOptions};
+/// let fanuc = ExportOptions::new(Controller::Fanuc);
+/// let heidenhain = ExportOptions::new(Controller::Heidenhain);
+/// assert_ne!(format!("{fanuc:?}"), format!("{heidenhain:?}"));
+/// ```
+#[doc(inline)]
+pub use tricept_export::ExportOptions;
+/// The CNC control an export writes for.
+///
+/// # Example
+/// ```
+/// use tricept_ident::export::{Controller, ExportOptions};
+/// let options = ExportOptions::new(Controller::Sinumerik);
+/// # let _ = options;
+/// ```
+#[doc(inline)]
+pub use tricept_export::control::Controller;
 pub use tricept_export::{
-    AxisSummary, ExportError, ExportOptions, ExportSummary, NotExported, control::ControlLimits,
-    control::ControlModel, control::Controller, control::Limit,
+    AxisSummary, ExportError, ExportSummary, NotExported, control::ControlLimits,
+    control::ControlModel, control::Limit,
 };
 
 /// What to export, and where.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
+/// let request = ExportRequest {
+///     machine: MachineInput::from("calibrated.json"),
+///     options: ExportOptions::new(Controller::Heidenhain),
+///     out: "export".into(),
+/// };
+/// let exported = export(request)?;
+/// assert!(exported.written || exported.exit_code != tricept_ident::EXIT_OK);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct ExportRequest {
@@ -43,6 +92,20 @@ impl ExportRequest {
 }
 
 /// The outcome of an export.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
+/// let request = ExportRequest {
+///     machine: MachineInput::from("calibrated.json"),
+///     options: ExportOptions::new(Controller::Heidenhain),
+///     out: "export".into(),
+/// };
+/// let exported = export(request)?;
+/// assert!(exported.written || exported.exit_code != tricept_ident::EXIT_OK);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Export {
     summary: ExportSummary,
@@ -150,6 +213,20 @@ impl Export {
 /// file (refusing one edited after its calibration), plans the export and,
 /// when every axis is within the tolerance and the control's ranges,
 /// writes the files as one set (the previous export or this one, whole).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
+/// let request = ExportRequest {
+///     machine: MachineInput::from("calibrated.json"),
+///     options: ExportOptions::new(Controller::Heidenhain),
+///     out: "export".into(),
+/// };
+/// let exported = export(request)?;
+/// assert!(exported.written || exported.exit_code != tricept_ident::EXIT_OK);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn export(request: ExportRequest) -> Result<Export, Error> {
     let ExportRequest {
         machine,

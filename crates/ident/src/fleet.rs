@@ -7,6 +7,18 @@
 //! [`fleet`] takes a [`FleetRequest`] (one data file per machine, the
 //! nominal machine) and returns a [`FleetResult`]: its JSON, report, exit
 //! code and the prior file it writes. The computation is `tricept-fleet`'s.
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::DataInput;
+//! use tricept_ident::fleet::{FleetRequest, fleet};
+//! let data: Vec<DataInput> = ["m1.csv", "m2.csv", "m3.csv"].into_iter().map(DataInput::from).collect();
+//! let result = fleet(FleetRequest::new(data))?;
+//! for machine in &result.batch().machines {
+//!     println!("{machine:?}");
+//! }
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::path::{Path, PathBuf};
 
@@ -16,13 +28,28 @@ use tricept_engine::{
     IdentifyOptions, accuracy::AccuracyModel, accuracy::accuracy_points, model::GeometricModel,
 };
 use tricept_fleet::{
-    Batch, BatchOptions, PriorFile, calibrate_batch, prior_file::DataFileRecord,
+    BatchOptions, PriorFile, calibrate_batch, prior_file::DataFileRecord,
     prior_file::PriorProvenance,
 };
 use tricept_model::ParameterSet;
 
 pub use crate::outcome::{WriteOptions, Written};
+pub use tricept_engine::robust::Rejection;
+/// The sparse solver of a fleet's joint fit.
+///
+/// # Example
+/// ```
+/// use tricept_ident::fleet::{FleetRequest, SolverKind};
+/// let request = FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into()]);
+/// assert_eq!(request.solver, "schur".parse::<SolverKind>()?);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
 pub use tricept_fleet::batch::SolverKind;
+pub use tricept_fleet::reml::{Distance, Spread};
+pub use tricept_fleet::{
+    Batch, batch::MachineOutcome, batch::SolveStats, joint::JointFit, own::OwnFit,
+};
 
 use crate::Setting;
 use crate::data_input::DataInput;
@@ -76,6 +103,18 @@ crate::request::setters!(FleetRequest {
 });
 
 /// A batch calibrated.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::DataInput;
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let data: Vec<DataInput> = ["m1.csv", "m2.csv", "m3.csv"].into_iter().map(DataInput::from).collect();
+/// let result = fleet(FleetRequest::new(data))?;
+/// for machine in &result.batch().machines {
+///     println!("{machine:?}");
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug)]
 pub struct FleetResult {
     loaded: LoadedMachine,
@@ -89,6 +128,18 @@ crate::outcome::outcome!(FleetResult);
 
 /// Calibrates the batch of `request` (module docs). Errors: bad files and
 /// fewer than three machines whose data fit are input errors (exit 2).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::DataInput;
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let data: Vec<DataInput> = ["m1.csv", "m2.csv", "m3.csv"].into_iter().map(DataInput::from).collect();
+/// let result = fleet(FleetRequest::new(data))?;
+/// for machine in &result.batch().machines {
+///     println!("{machine:?}");
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn fleet(request: FleetRequest) -> Result<FleetResult, Error> {
     let tolerance = request.tolerance_mm;
     if !(tolerance.is_finite() && tolerance > 0.0 && tolerance <= 10.0) {

@@ -2,6 +2,16 @@
 //! sensors can identify: rank, singular values, observability indices and
 //! the unidentifiable combinations, before any measurement
 //! (`tricept identifiability`).
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::advanced::Poses;
+//! use tricept_ident::identifiability::{Campaign, IdentifiabilityRequest, assess_identifiability};
+//! let request = IdentifiabilityRequest::new(Campaign::Poses(Poses::grid()));
+//! let assessed = assess_identifiability(request)?;
+//! assert!(assessed.machine_warnings().is_empty());
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use serde_json::Value;
 use tricept_data::MeasuredPose;
@@ -15,9 +25,21 @@ use crate::error::Error;
 use crate::inputs::Poses;
 use crate::machine_input::MachineInput;
 
-pub use tricept_engine::report::IdentifiabilityReport;
+pub use tricept_engine::{
+    report::Combination, report::CorrelatedPair, report::IdentifiabilityReport,
+    report::NamedValues, report::Observability,
+};
 
 /// The poses to assess.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::Poses;
+/// use tricept_ident::identifiability::Campaign;
+/// let planned = Campaign::Poses(Poses::grid());
+/// let logged = Campaign::Data("campaign.csv".into());
+/// assert!(matches!(planned, Campaign::Poses(_)) && matches!(logged, Campaign::Data(_)));
+/// ```
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub enum Campaign {
@@ -29,6 +51,16 @@ pub enum Campaign {
 }
 
 /// What to assess.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::advanced::Poses;
+/// use tricept_ident::identifiability::{Campaign, IdentifiabilityRequest, assess_identifiability};
+/// let request = IdentifiabilityRequest::new(Campaign::Poses(Poses::grid()));
+/// let assessed = assess_identifiability(request)?;
+/// assert!(assessed.machine_warnings().is_empty());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct IdentifiabilityRequest {
@@ -57,6 +89,16 @@ crate::request::setters!(IdentifiabilityRequest {
 });
 
 /// The identifiability of a campaign.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::advanced::Poses;
+/// use tricept_ident::identifiability::{Campaign, IdentifiabilityRequest, assess_identifiability};
+/// let request = IdentifiabilityRequest::new(Campaign::Poses(Poses::grid()));
+/// let assessed = assess_identifiability(request)?;
+/// assert!(assessed.machine_warnings().is_empty());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Identifiability {
     report: IdentifiabilityReport,

@@ -12,7 +12,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-use nalgebra::Vector3;
+use crate::linalg::Vector3;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
 use tricept_kinematics::{
     Machine, MachineDescription, error::DescriptionError, workspace::MAX_POSES, workspace::PoseSet,
@@ -48,6 +48,16 @@ pub struct SensorNoise {
 /// calibrated machine), the validated machine built from it (with the
 /// noise overrides applied), where it came from, and the warnings its
 /// record calls for (a forced or inadequate calibration).
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// let loaded = MachineInput::default().load()?;
+/// assert!(loaded.path().is_none() && loaded.warnings().is_empty());
+/// let m = loaded.commanding();
+/// assert!(!m.has_leg_effects());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct LoadedMachine {
     pub(crate) description: MachineDescription,
@@ -443,7 +453,7 @@ impl Poses {
     }
 
     /// The target points on `machine`, mm.
-    pub fn targets(&self, machine: &Machine) -> Result<Vec<Vector3<f64>>, Error> {
+    pub fn targets(&self, machine: &Machine) -> Result<Vec<Vector3>, Error> {
         match &self.kind {
             PosesKind::Optimal(n) => {
                 tricept_study::campaign::d_optimal_targets(machine, &ParameterSet::paper15(), *n)

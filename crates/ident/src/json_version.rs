@@ -8,6 +8,14 @@ use serde_json::{Map, Value};
 /// The format version of the JSON outputs of this tricept (the
 /// `format_version` key each output object starts with; `tricept schema
 /// NAME` prints the JSON Schema of each).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{OUTPUT_FORMAT_VERSION, serde_json, versioned_json};
+/// let text = versioned_json(r#"{"exit_code":0}"#).unwrap();
+/// let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+/// assert_eq!(json["format_version"], OUTPUT_FORMAT_VERSION);
+/// ```
 pub const OUTPUT_FORMAT_VERSION: u32 = 1;
 
 /// `text` (one JSON object, or one per line) with `format_version`

@@ -1,8 +1,19 @@
 //! The kinematics workflows (`tricept ik`, `fk`, `tool-ik` and `machine`):
 //! one point solved on a machine with its static leg effects applied
-//! ([`solve_point`]), many points streamed from CSV ([`run`],
-//! [`solve_batch`]: the streaming is `tricept_kinematics::batch`'s), and
-//! the summary of a machine description ([`machine_summary`]).
+//! ([`solve_point`]), many points streamed from CSV in blocks of
+//! [`BLOCK_ROWS`] rows ([`run`], and [`solve_batch`] with the door's
+//! errors), and the summary of a machine description
+//! ([`machine_summary`]); the machine a program commands ([`Machine`])
+//! and the solutions it returns ([`IkSolution`], [`FkSolution`],
+//! [`ToolIkSolution`]).
+//!
+//! # Example
+//! ```
+//! use tricept_ident::kinematics::{Machine, Vector3};
+//! let ik = Machine::paper().inverse(&Vector3::new(0.0, 0.0, 750.0))?;
+//! assert!((ik.legs_mm[0] - 773.3).abs() < 0.1);
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::io::{Read, Write};
 
@@ -11,18 +22,109 @@ use serde_json::{Map, Value};
 use crate::error::{EXIT_OK, Error};
 use crate::inputs::LoadedMachine;
 
-pub use crate::commanding::{GeometricMachine, Machine, Vector3};
-pub use tricept_kinematics::batch::{BLOCK_ROWS, BatchError, Cell, Verb, run};
-pub use tricept_kinematics::{
-    KinematicsError, MachineDescription, fk::FkSolution, head::HeadBranch, head::ToolIkSolution,
-    machine::IkSolution, up_limb::UpJoints,
+pub use crate::commanding::{GeometricMachine, Machine};
+pub use crate::linalg::Vector3;
+pub use tricept_kinematics::batch::PointKinematics;
+/// The kinematics verbs [`solve_point`] and [`run`] solve.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::Verb;
+/// assert_eq!(Verb::Ik.inputs(), ["x", "y", "z"]);
+/// assert_eq!(Verb::Ik.keys()[3], "q1");
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::batch::Verb;
+pub use tricept_kinematics::batch::{BLOCK_ROWS, BatchError, Cell, run};
+pub use tricept_kinematics::description::{
+    AccuracyRecord, AxisOrder, CalibrationRecord, CircularPlacement, ControllerDescription,
+    CorrelationsDescription, ExplicitPlacement, ExternalSourceRecord, HeadDescription,
+    HeldParameter, Interpolation, LegEffectsDescription, LegTableDescription, LimitsDescription,
+    LoadsDescription, Placement, SealCheck, SensorDescription, SensorOffsetsDescription,
+    UpLimbDescription, WorkspaceDescription,
 };
+/// A solution of [`Machine::forward`].
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{FkSolution, Machine, Vector3};
+/// let m = Machine::paper();
+/// let target = Vector3::new(50.0, -20.0, 760.0);
+/// let fk: FkSolution = m.forward(&m.inverse(&target)?.legs_mm)?;
+/// assert!((fk.position_mm - target).norm() < 1e-8);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::fk::FkSolution;
+/// A solution of [`Machine::tool_inverse`].
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{Machine, ToolIkSolution, Vector3};
+/// let m = Machine::paper();
+/// let tip = Vector3::new(0.0, 0.0, 900.0);
+/// let s: ToolIkSolution = m.tool_inverse(&tip, &Vector3::new(0.0, 0.0, 1.0))?;
+/// assert!(s.legs_mm.iter().all(|q| q.is_finite()));
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::head::ToolIkSolution;
+/// A solution of [`Machine::inverse`].
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{IkSolution, Machine, Vector3};
+/// let ik: IkSolution = Machine::paper().inverse(&Vector3::new(0.0, 0.0, 750.0))?;
+/// assert!((ik.legs_mm[0] - 773.3).abs() < 0.1);
+/// assert!(ik.up.q4_mm > 0.0);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::machine::IkSolution;
+pub use tricept_kinematics::machine::SensorNoise as LoggedSensorNoise;
+/// The UP limb's joints of a pose (an [`IkSolution`]'s `up`).
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{Machine, UpJoints, Vector3};
+/// let up: UpJoints = Machine::paper().inverse(&Vector3::new(0.0, 0.0, 750.0))?.up;
+/// assert!(up.phi_rad.abs() < 1e-9 && up.theta_rad.abs() < 1e-9);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::up_limb::UpJoints;
+pub use tricept_kinematics::{
+    KinematicsError, MachineDescription, Workspace, error::DescriptionError, head::Head,
+    head::HeadBranch, head::ToolPose, machine::LegGeometry, machine::Limits, up_limb::UpLimb,
+    up_limb::UpLimbPose,
+};
+
+/// The geometric machine with its static leg effects, as [`Machine::extended`] holds it.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{ExtendedMachine, GeometricMachine, Machine};
+/// let extended = ExtendedMachine::new(GeometricMachine::paper());
+/// assert_eq!(&extended, Machine::paper().extended());
+/// ```
+#[doc(inline)]
 pub use tricept_model::ExtendedMachine;
 
 /// Runs `verb` on every row of `input` ([`run`]) as the CLI does:
 /// `file` names the input in its messages, `label` in the message of a
 /// point that cannot be solved (`VERB --input LABEL: line N: ...`, of that
 /// error's kind); a failed write is an error of kind other naming stdout.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{ExtendedMachine, GeometricMachine, Verb, solve_batch};
+/// let machine = ExtendedMachine::new(GeometricMachine::paper());
+/// let mut out = Vec::new();
+/// let rows = solve_batch(Verb::Ik, &machine, "x,y,z\n0,0,750\n".as_bytes(), "points.csv", "points.csv", &mut out, || false)?;
+/// assert_eq!(rows, 1);
+/// assert!(String::from_utf8_lossy(&out).contains("773.3"));
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn solve_batch<R: Read, W: Write>(
     verb: Verb,
     machine: &ExtendedMachine,
@@ -43,6 +145,15 @@ pub fn solve_batch<R: Read, W: Write>(
 }
 
 /// One point solved by a kinematics verb.
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::kinematics::{Cell, Verb, solve_point};
+/// let s = solve_point(Verb::Ik, &MachineInput::default().load()?, &[0.0, 0.0, 750.0])?;
+/// assert!(matches!(s.cells()[3], Cell::Num(q1) if (q1 - 773.3).abs() < 0.1));
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointSolution {
     verb: Verb,
@@ -139,6 +250,15 @@ impl PointSolution {
 /// A summary of the machine in use with units (`tricept machine`): the
 /// joints, the UP limb, the workspace, the limits, the sensors, the leg
 /// effects, the controller parameters and the calibration record.
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::kinematics::machine_summary;
+/// let summary = machine_summary(&MachineInput::default().load()?);
+/// assert!(!summary.is_empty());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn machine_summary(loaded: &LoadedMachine) -> String {
     let (d, m, source) = (loaded.description(), loaded.machine(), loaded.source());
     let v = |p: &Vector3| format!("({:.3}, {:.3}, {:.3})", p.x, p.y, p.z);

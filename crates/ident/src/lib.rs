@@ -96,6 +96,7 @@ mod error;
 mod inputs;
 mod json_version;
 mod limits;
+mod linalg;
 mod machine_file;
 mod machine_input;
 mod outcome;

@@ -2,9 +2,18 @@
 //! touch-offs to take, given the internal campaign, so that the tool tip
 //! (and with known extensions the tool axis) is best known after touch-off;
 //! the predicted accuracy against their number, the redundancy each leaves
-//! to check the fit, and the recommended number (`tricept_study::plan`);
-//! or the fewest poses of a check of a calibrated machine that detect a
-//! stated change (`tricept_study::check_plan`).
+//! to check the fit, and the recommended number ([`Instrument::Tracker`],
+//! [`Instrument::Ballbar`], [`Instrument::Touch`]); or the fewest poses of
+//! a check of a calibrated machine that detect a stated change
+//! ([`Instrument::Check`]).
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::plan::{Instrument, PlanRequest, plan};
+//! let planned = plan(PlanRequest::new(Instrument::Tracker))?;
+//! assert!(planned.machine_warnings().is_empty());
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -42,6 +51,13 @@ macro_rules! wln {
 }
 
 /// The instrument to plan for.
+///
+/// # Example
+/// ```
+/// use tricept_ident::plan::{Instrument, PlanRequest};
+/// let request = PlanRequest::new(Instrument::Ballbar);
+/// assert_eq!(request.instrument, Instrument::Ballbar);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum Instrument {
@@ -57,6 +73,13 @@ pub enum Instrument {
 }
 
 /// What to plan. The defaults are `tricept plan`'s.
+///
+/// # Example
+/// ```
+/// use tricept_ident::plan::{Instrument, PlanRequest};
+/// let request = PlanRequest::new(Instrument::Touch);
+/// assert!(request.k.is_empty()); // the default numbers of measurements
+/// ```
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct PlanRequest {
@@ -236,6 +259,14 @@ enum OutFile {
 }
 
 /// A plan: its JSON, its text report and the poses to take.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::plan::{Instrument, PlanRequest, plan};
+/// let planned = plan(PlanRequest::new(Instrument::Tracker))?;
+/// assert!(planned.machine_warnings().is_empty());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Plan {
     json: Value,
@@ -303,6 +334,14 @@ fn instrument_sigma(a: &PlanRequest, own: f64, setting: Setting) -> Result<f64, 
 }
 
 /// Plans as `request` says.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::plan::{Instrument, PlanRequest, plan};
+/// let planned = plan(PlanRequest::new(Instrument::Tracker))?;
+/// assert!(planned.machine_warnings().is_empty());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn plan(request: PlanRequest) -> Result<Plan, Error> {
     let a = &request;
     let default_k = [3, 5, 8, 12, 20, 30, 50];

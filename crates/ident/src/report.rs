@@ -14,6 +14,16 @@
 //! export's summary; a history or an export of another calibration is
 //! refused (exit code 2) naming the file. The verdict's exit code: 3 when
 //! the page says not to trust the machine, else 0.
+//!
+//! # Example
+//! ```no_run
+//! use tricept_ident::report::{Level, ReportRequest, report};
+//! let page = report(ReportRequest::new("calibrated.json", "machine.html"))?;
+//! if page.verdict().level != Level::Trusted {
+//!     println!("{}", page.verdict().words);
+//! }
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::path::{Path, PathBuf};
 
@@ -28,12 +38,51 @@ use crate::inputs::LoadedMachine;
 use crate::machine_file::sha256_file;
 use crate::machine_input::MachineInput;
 
-pub use tricept_report::{Level, Verdict};
+pub use tricept_report::verdict::{Reason, Shown};
+
+/// How far a calibrated machine can be trusted.
+///
+/// # Example
+/// ```
+/// use tricept_ident::report::Level;
+/// let levels = [Level::Trusted, Level::Caution, Level::DoNotTrust];
+/// assert_eq!(levels.iter().filter(|l| **l == Level::Trusted).count(), 1);
+/// ```
+#[doc(inline)]
+pub use tricept_report::Level;
+/// The verdict at the top of a machine's page ([`Report::verdict`]).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::report::{Level, ReportRequest, Verdict, report};
+/// let page = report(ReportRequest::new("calibrated.json", "machine.html"))?;
+/// let verdict: &Verdict = page.verdict();
+/// if verdict.level != Level::Trusted {
+///     for reason in &verdict.reasons {
+///         println!("{reason:?}");
+///     }
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_report::Verdict;
 
 /// The file of an export folder the page reads (`--export DIR`).
+///
+/// # Example
+/// ```
+/// use tricept_ident::report::EXPORT_SUMMARY;
+/// let summary = std::path::Path::new("export").join(EXPORT_SUMMARY);
+/// assert!(summary.starts_with("export"));
+/// ```
 pub const EXPORT_SUMMARY: &str = tricept_export::SUMMARY_FILE;
 
 /// The lattice spacing of the page's compensation maps, mm.
+///
+/// # Example
+/// ```
+/// assert!(tricept_ident::report::MAP_SPACING_MM > 0.0);
+/// ```
 pub const MAP_SPACING_MM: f64 = 25.0;
 
 /// What the page is made from, and where it goes.
@@ -82,6 +131,16 @@ crate::request::setters!(ReportRequest {
 });
 
 /// A page written, and its verdict.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::report::{Level, ReportRequest, report};
+/// let page = report(ReportRequest::new("calibrated.json", "machine.html"))?;
+/// if page.verdict().level != Level::Trusted {
+///     println!("{}", page.verdict().words);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Report {
     verdict: Verdict,
@@ -136,6 +195,16 @@ impl Report {
 }
 
 /// Gathers the page's sources, renders the page and writes it atomically.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::report::{Level, ReportRequest, report};
+/// let page = report(ReportRequest::new("calibrated.json", "machine.html"))?;
+/// if page.verdict().level != Level::Trusted {
+///     println!("{}", page.verdict().words);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn report(request: ReportRequest) -> Result<Report, Error> {
     let loaded = request.machine.clone().load()?;
     let sources = sources(&request, &loaded)?;

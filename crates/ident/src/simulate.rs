@@ -3,8 +3,19 @@
 //! errors, sensor noise and offsets), and optionally what external
 //! instruments (laser tracker, ballbar, touch probe) would measure on it.
 //! Everything is returned in memory with the comment lines its file
-//! carries; the caller writes the files
-//! (`tricept_data::write_path`, `tricept_data::external::write_external_path`).
+//! carries; the caller writes the files as every verb writes them
+//! ([`crate::advanced::files::write_path`],
+//! [`crate::advanced::files::write_external_path`]).
+//!
+//! # Example
+//! ```
+//! use tricept_ident::MachineInput;
+//! use tricept_ident::simulate::{SimulateRequest, simulate};
+//! let sim = simulate(SimulateRequest::new(MachineInput::default()))?;
+//! assert!(!sim.data().poses.is_empty());
+//! assert_eq!(sim.exit_code(), tricept_ident::EXIT_OK);
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -12,9 +23,14 @@ use std::str::FromStr;
 
 use nalgebra::{Isometry3, Vector3};
 use serde_json::{Value, json};
-use tricept_data::{
-    Dataset, external::BallbarData, external::ExternalPose, external::PlannedPose,
-    external::TouchData, external::TrackerData, external::read_external_path,
+use tricept_data::{Dataset, external::PlannedPose, external::read_external_path};
+pub use tricept_data::{
+    external::BallbarData, external::ExternalData, external::ExternalRecord, external::TouchData,
+    external::TrackerData,
+};
+pub use tricept_data::{
+    external::BallbarReading, external::ExternalPose, external::InstrumentRecord,
+    external::TouchReading, external::TrackerPoint,
 };
 use tricept_engine::model::GeometricModel;
 use tricept_kinematics::Machine;
@@ -148,6 +164,20 @@ impl TruthEffects {
 }
 
 /// A laser tracker measuring the simulated machine at planned poses.
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::simulate::{SimulateRequest, TrackerSimulation};
+/// let mut request = SimulateRequest::new(MachineInput::default());
+/// request.tracker = Some(TrackerSimulation {
+///     poses: "tracker-poses.csv".into(),
+///     frame_mm_rad: [0.0; 6],
+///     target_mm: [0.0, 0.0, 120.0],
+///     sigma_um: 5.0,
+/// });
+/// assert!(request.tracker.is_some());
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrackerSimulation {
     /// Poses (CSV `q1,q2,q3,h1,h2[,extension_mm]`, as `tricept plan --out`
@@ -163,6 +193,20 @@ pub struct TrackerSimulation {
 }
 
 /// A ballbar read at planned poses.
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::simulate::{SimulateRequest, BallbarSimulation};
+/// let mut request = SimulateRequest::new(MachineInput::default());
+/// request.ballbar = Some(BallbarSimulation {
+///     poses: "ballbar-poses.csv".into(),
+///     pivot_mm: [0.0, 0.0, 600.0],
+///     length_error_um: 0.0,
+///     sigma_um: 1.0,
+/// });
+/// assert!(request.ballbar.is_some());
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct BallbarSimulation {
     /// Poses (CSV `q1,q2,q3,h1,h2`).
@@ -177,6 +221,23 @@ pub struct BallbarSimulation {
 
 /// A touch probe touching a reference sphere (feature 1) at planned
 /// touches.
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::simulate::{SimulateRequest, TouchSimulation};
+/// let mut request = SimulateRequest::new(MachineInput::default());
+/// request.touch = Some(TouchSimulation {
+///     poses: "touch-poses.csv".into(),
+///     sphere_mm: [0.0, 0.0, 700.0],
+///     sphere_radius_mm: 12.5,
+///     stylus_radius_mm: 1.5,
+///     stylus_sigma_um: 1.0,
+///     stylus_error_um: 0.0,
+///     sigma_um: 1.0,
+/// });
+/// assert!(request.touch.is_some());
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct TouchSimulation {
     /// Planned touches (CSV `q1,q2,q3,h1,h2,x,y,z,feature`).
@@ -292,6 +353,18 @@ crate::request::setters!(SimulateRequest {
 });
 
 /// Simulated data in memory, each with the comment lines its file carries.
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::simulate::{SimulateRequest, simulate};
+/// let mut request = SimulateRequest::new(MachineInput::default());
+/// request.poses = "random:12,7".parse()?;
+/// let sim = simulate(request)?;
+/// assert_eq!(sim.data().poses.len(), 12);
+/// assert!(sim.tracker().is_none() && sim.ballbar().is_none() && sim.touch().is_none());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Simulation {
     data: Dataset,
@@ -308,6 +381,16 @@ crate::outcome::outcome!(Simulation);
 
 /// Simulates the request's campaign (and instruments); every problem of
 /// the request is an input error (exit code 2).
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::simulate::{SimulateRequest, simulate};
+/// let sim = simulate(SimulateRequest::new(MachineInput::default()))?;
+/// assert!(!sim.data().poses.is_empty());
+/// assert_eq!(sim.exit_code(), tricept_ident::EXIT_OK);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn simulate(request: SimulateRequest) -> Result<Simulation, Error> {
     let loaded = request.machine.clone().load()?;
     let m = loaded.machine();

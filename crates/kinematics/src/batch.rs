@@ -269,17 +269,22 @@ fn write_cell(out: &mut Vec<u8>, c: Cell) {
 /// writes the CSV to `out`; `stop` is asked between blocks (a closed
 /// stdout). Returns the number of rows written.
 ///
-/// # Example
-/// ```
-/// use tricept_kinematics::Machine;
-/// use tricept_kinematics::batch::{Verb, run};
-/// let m = Machine::paper();
-/// let mut out = Vec::new();
-/// let n = run(Verb::Ik, &m, "x,y,z\n0,0,750\n".as_bytes(), "points.csv", &mut out, || false).unwrap();
-/// assert_eq!(n, 1);
-/// let text = String::from_utf8(out).unwrap();
-/// assert!(text.starts_with("x,y,z,q1,q2,q3,phi,theta,q4\n0,0,750,773.3"));
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_kinematics::Machine;
+use tricept_kinematics::batch::{Verb, run};
+let m = Machine::paper();
+let mut out = Vec::new();
+let n = run(Verb::Ik, &m, "x,y,z\n0,0,750\n".as_bytes(), "points.csv", &mut out, || false).unwrap();
+assert_eq!(n, 1);
+let text = String::from_utf8(out).unwrap();
+assert!(text.starts_with("x,y,z,q1,q2,q3,phi,theta,q4\n0,0,750,773.3"));
+```
+"#
+)]
 pub fn run<K: PointKinematics + ?Sized, R: Read, W: Write>(
     verb: Verb,
     machine: &K,

@@ -80,16 +80,21 @@ impl Machine {
     /// chosen by `seed`. Both strategies give the same solutions; they
     /// differ in cost (see [`FkSeed`]).
     ///
-    /// # Example
-    /// ```
-    /// use tricept_kinematics::{fk::FkSeed, Machine};
-    /// let m = Machine::paper();
-    /// let legs = m.inverse(&nalgebra::Vector3::new(300.0, -200.0, 700.0)).unwrap().legs_mm;
-    /// let a = m.forward_seeded(&legs, FkSeed::Level).unwrap();
-    /// let b = m.forward_seeded(&legs, FkSeed::Extrapolated).unwrap();
-    /// assert!((a.position_mm - b.position_mm).norm() < 1e-9);
-    /// assert!(b.iterations <= a.iterations);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_kinematics::{fk::FkSeed, Machine};
+let m = Machine::paper();
+let legs = m.inverse(&nalgebra::Vector3::new(300.0, -200.0, 700.0)).unwrap().legs_mm;
+let a = m.forward_seeded(&legs, FkSeed::Level).unwrap();
+let b = m.forward_seeded(&legs, FkSeed::Extrapolated).unwrap();
+assert!((a.position_mm - b.position_mm).norm() < 1e-9);
+assert!(b.iterations <= a.iterations);
+```
+"#
+    )]
     pub fn forward_seeded(
         &self,
         legs_mm: &[f64; 3],

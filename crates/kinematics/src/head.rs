@@ -120,16 +120,21 @@ impl Head {
     /// Tool tip and axis in the platform frame at commanded head angles `h`
     /// (rad).
     ///
-    /// # Example
-    /// ```
-    /// use tricept_kinematics::Machine;
-    /// let mut head = Machine::paper().head;
-    /// let a = head.tool_in_platform([0.3, 0.2]);
-    /// // An angle zero offset of 0.01 rad: the command 0.29 reaches the same pose.
-    /// head.angle_offsets_rad = [0.01, 0.0];
-    /// let b = head.tool_in_platform([0.29, 0.2]);
-    /// assert!((a.tip_mm - b.tip_mm).norm() < 1e-12);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_kinematics::Machine;
+let mut head = Machine::paper().head;
+let a = head.tool_in_platform([0.3, 0.2]);
+// An angle zero offset of 0.01 rad: the command 0.29 reaches the same pose.
+head.angle_offsets_rad = [0.01, 0.0];
+let b = head.tool_in_platform([0.29, 0.2]);
+assert!((a.tip_mm - b.tip_mm).norm() < 1e-12);
+```
+"#
+    )]
     pub fn tool_in_platform(&self, h: [f64; 2]) -> ToolPose {
         self.tool_at_kinematic(self.kinematic_angles(h))
     }
@@ -139,14 +144,19 @@ impl Head {
     /// kinematic head angles (a tracker target or a ballbar ball mounted in
     /// the spindle: the tool tip plus its offset), mm.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_kinematics::Machine;
-    /// let head = Machine::paper().head;
-    /// let h = [0.7, -0.4];
-    /// let p = head.spindle_point(h, &head.tool_tip_mm);
-    /// assert!((p - head.tool_in_platform(h).tip_mm).norm() < 1e-12);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_kinematics::Machine;
+let head = Machine::paper().head;
+let h = [0.7, -0.4];
+let p = head.spindle_point(h, &head.tool_tip_mm);
+assert!((p - head.tool_in_platform(h).tip_mm).norm() < 1e-12);
+```
+"#
+    )]
     pub fn spindle_point(&self, h: [f64; 2], point_mm: &Vector3<f64>) -> Vector3<f64> {
         let [h1, h2] = self.kinematic_angles(h);
         let r1 = rot(&self.axis1, h1);
@@ -263,18 +273,23 @@ impl Machine {
     /// (any non-zero length) to leg commands and commanded head angles
     /// (kinematic angles minus the head's angle offsets).
     ///
-    /// # Example
-    /// ```
-    /// use nalgebra::Vector3;
-    /// use tricept_kinematics::{head::HeadBranch, Machine};
-    /// let m = Machine::paper();
-    /// let tip = Vector3::new(150.0, 100.0, 1080.0);
-    /// let axis = Vector3::new(0.2, -0.1, 1.0);
-    /// let sol = m.tool_inverse(&tip, &axis, HeadBranch::default()).unwrap();
-    /// let back = m.tool_forward(&sol.up, sol.head_rad);
-    /// assert!((back.tip_mm - tip).norm() < 1e-9);
-    /// assert!((back.axis - axis.normalize()).norm() < 1e-12);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use nalgebra::Vector3;
+use tricept_kinematics::{head::HeadBranch, Machine};
+let m = Machine::paper();
+let tip = Vector3::new(150.0, 100.0, 1080.0);
+let axis = Vector3::new(0.2, -0.1, 1.0);
+let sol = m.tool_inverse(&tip, &axis, HeadBranch::default()).unwrap();
+let back = m.tool_forward(&sol.up, sol.head_rad);
+assert!((back.tip_mm - tip).norm() < 1e-9);
+assert!((back.axis - axis.normalize()).norm() < 1e-12);
+```
+"#
+    )]
     pub fn tool_inverse(
         &self,
         tip_mm: &Vector3<f64>,

@@ -131,16 +131,21 @@ impl LegGeometry {
 
 /// The Tricept module (3-UPS + UP) with its head: nominal or actual.
 ///
-/// # Example
-/// ```
-/// use nalgebra::Vector3;
-/// use tricept_kinematics::Machine;
-/// let m = Machine::paper();
-/// let r = Vector3::new(120.0, -80.0, 760.0);
-/// let ik = m.inverse(&r).unwrap();
-/// let fk = m.forward(&ik.legs_mm).unwrap();
-/// assert!((fk.position_mm - r).norm() < 1e-9);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use nalgebra::Vector3;
+use tricept_kinematics::Machine;
+let m = Machine::paper();
+let r = Vector3::new(120.0, -80.0, 760.0);
+let ik = m.inverse(&r).unwrap();
+let fk = m.forward(&ik.legs_mm).unwrap();
+assert!((fk.position_mm - r).norm() < 1e-9);
+```
+"#
+)]
 #[derive(Debug, Clone, PartialEq)]
 pub struct Machine {
     /// Name from the description.
@@ -207,14 +212,19 @@ impl Machine {
     /// whose workspace lies beyond its legs' stroke or its UP limb's tilt
     /// is wrong, and every verb would fail on it somewhere else.
     ///
-    /// # Example
-    /// ```
-    /// let mut m = tricept_kinematics::Machine::paper();
-    /// assert!(m.unreachable_workspace_point().is_none());
-    /// m.workspace.radius_mm = 900.0;
-    /// let (p, why) = m.unreachable_workspace_point().unwrap();
-    /// assert!(p.x.hypot(p.y) > 400.0, "{p} {why}");
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+let mut m = tricept_kinematics::Machine::paper();
+assert!(m.unreachable_workspace_point().is_none());
+m.workspace.radius_mm = 900.0;
+let (p, why) = m.unreachable_workspace_point().unwrap();
+assert!(p.x.hypot(p.y) > 400.0, "{p} {why}");
+```
+"#
+    )]
     pub fn unreachable_workspace_point(&self) -> Option<(Vector3<f64>, KinematicsError)> {
         self.workspace
             .polar_grid(2, 16, 3)
@@ -363,14 +373,19 @@ impl Machine {
     /// slack as every solver): the one check that the data reader, the
     /// identification and the kinematics share.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_kinematics::{KinematicsError, Machine};
-    /// let m = Machine::paper();
-    /// assert!(m.check_commands(&[800.0; 3]).is_ok());
-    /// let e = m.check_commands(&[800.0, 100.0, 800.0]).unwrap_err();
-    /// assert!(matches!(e, KinematicsError::OutOfStroke { leg: 2, .. }));
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_kinematics::{KinematicsError, Machine};
+let m = Machine::paper();
+assert!(m.check_commands(&[800.0; 3]).is_ok());
+let e = m.check_commands(&[800.0, 100.0, 800.0]).unwrap_err();
+assert!(matches!(e, KinematicsError::OutOfStroke { leg: 2, .. }));
+```
+"#
+    )]
     pub fn check_commands(&self, legs_mm: &[f64; 3]) -> Result<(), KinematicsError> {
         let [lo, hi] = self.limits.leg_stroke_mm;
         for (i, &q) in legs_mm.iter().enumerate() {
@@ -396,11 +411,16 @@ impl Machine {
 impl MachineDescription {
     /// The validated computational form.
     ///
-    /// # Example
-    /// ```
-    /// let m = tricept_kinematics::MachineDescription::paper().build().unwrap();
-    /// assert!((m.base_joints_mm[2].x - 288.7).abs() < 1e-12);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+let m = tricept_kinematics::MachineDescription::paper().build().unwrap();
+assert!((m.base_joints_mm[2].x - 288.7).abs() < 1e-12);
+```
+"#
+    )]
     pub fn build(&self) -> Result<Machine, crate::error::DescriptionError> {
         self.validate()?;
         Ok(Machine::from_validated(self))

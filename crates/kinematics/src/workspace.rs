@@ -51,13 +51,18 @@ impl Workspace {
     /// the middle plane), the axis point plus `rings` rings of `per_ring`
     /// points at radii `R k / rings`.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_kinematics::Machine;
-    /// // The project's default identification pose set: 3 x (1 + 3 x 8) = 75 poses.
-    /// let poses = Machine::paper().workspace.polar_grid(3, 8, 3);
-    /// assert_eq!(poses.len(), 75);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_kinematics::Machine;
+// The project's default identification pose set: 3 x (1 + 3 x 8) = 75 poses.
+let poses = Machine::paper().workspace.polar_grid(3, 8, 3);
+assert_eq!(poses.len(), 75);
+```
+"#
+    )]
     pub fn polar_grid(&self, rings: usize, per_ring: usize, levels: usize) -> Vec<Vector3<f64>> {
         let mut out = Vec::with_capacity(levels * (1 + rings * per_ring));
         for z in self.levels(levels) {

@@ -39,22 +39,27 @@ use crate::effects::{pose_free_leg_extra_per_mm, static_leg_extra_per_mm};
 /// ([`Machine::leg_effects`]). With no effects it is the machine itself,
 /// to the last bit.
 ///
-/// # Example
-/// ```
-/// use nalgebra::Vector3;
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ExtendedMachine;
-/// let mut m = Machine::paper();
-/// m.leg_effects.lead_ppm = [100.0, 0.0, 0.0];
-/// m.leg_effects.compliance_um_per_kn_at_1m = 30.0;
-/// let x = ExtendedMachine::new(m.clone());
-/// let r = Vector3::new(50.0, -20.0, 750.0);
-/// let ik = x.inverse(&r).unwrap();
-/// // A leg that grows 100 ppm with its command needs a shorter command.
-/// assert!(ik.legs_mm[0] < m.inverse(&r).unwrap().legs_mm[0] - 0.07);
-/// // FK undoes IK with the effects applied.
-/// assert!((x.forward(&ik.legs_mm).unwrap().position_mm - r).norm() < 1e-8);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use nalgebra::Vector3;
+use tricept_kinematics::Machine;
+use tricept_model::ExtendedMachine;
+let mut m = Machine::paper();
+m.leg_effects.lead_ppm = [100.0, 0.0, 0.0];
+m.leg_effects.compliance_um_per_kn_at_1m = 30.0;
+let x = ExtendedMachine::new(m.clone());
+let r = Vector3::new(50.0, -20.0, 750.0);
+let ik = x.inverse(&r).unwrap();
+// A leg that grows 100 ppm with its command needs a shorter command.
+assert!(ik.legs_mm[0] < m.inverse(&r).unwrap().legs_mm[0] - 0.07);
+// FK undoes IK with the effects applied.
+assert!((x.forward(&ik.legs_mm).unwrap().position_mm - r).norm() < 1e-8);
+```
+"#
+)]
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExtendedMachine {
     machine: Machine,
@@ -83,16 +88,21 @@ impl ExtendedMachine {
     /// Extra leg lengths (mm) of the static effects for `commands_mm` with
     /// the UP limb at `up` (the rates' part and the compensation tables').
     ///
-    /// # Example
-    /// ```
-    /// use tricept_kinematics::{Machine, up_limb::UpJoints};
-    /// use tricept_model::ExtendedMachine;
-    /// let mut m = Machine::paper();
-    /// m.leg_effects.lead_ppm = [50.0, -30.0, 0.0];
-    /// let up = m.forward(&[800.0; 3]).unwrap().up;
-    /// let extra = ExtendedMachine::new(m).leg_extra_mm(&[800.0; 3], &up);
-    /// assert!((extra[0] - 0.04).abs() < 1e-12 && (extra[1] + 0.024).abs() < 1e-12);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_kinematics::{Machine, up_limb::UpJoints};
+use tricept_model::ExtendedMachine;
+let mut m = Machine::paper();
+m.leg_effects.lead_ppm = [50.0, -30.0, 0.0];
+let up = m.forward(&[800.0; 3]).unwrap().up;
+let extra = ExtendedMachine::new(m).leg_extra_mm(&[800.0; 3], &up);
+assert!((extra[0] - 0.04).abs() < 1e-12 && (extra[1] + 0.024).abs() < 1e-12);
+```
+"#
+    )]
     pub fn leg_extra_mm(&self, commands_mm: &[f64; 3], up: &UpJoints) -> [f64; 3] {
         let rate = self.extra_per_mm(up);
         let table = self.machine.leg_effects.table_extra_mm(commands_mm);

@@ -43,16 +43,21 @@ pub const TABLE2_JSON: &str = include_str!(concat!(
 
 /// The full geometric error vector of the parallel module, mm.
 ///
-/// # Example
-/// ```
-/// use tricept_model::{GeometricErrors, ParameterSet};
-/// let set = ParameterSet::paper15();
-/// let e = set.to_errors(&set.table2());
-/// // dxB1 = 0.2 mm moves B1 and B2 alike (the paper's convention dxB1 = dxB2).
-/// assert_eq!(e.db_mm[0].x, 0.2);
-/// assert_eq!(e.db_mm[1].x, 0.2);
-/// assert_eq!(e.dq_mm, [0.45, 0.7, 0.5]);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_model::{GeometricErrors, ParameterSet};
+let set = ParameterSet::paper15();
+let e = set.to_errors(&set.table2());
+// dxB1 = 0.2 mm moves B1 and B2 alike (the paper's convention dxB1 = dxB2).
+assert_eq!(e.db_mm[0].x, 0.2);
+assert_eq!(e.db_mm[1].x, 0.2);
+assert_eq!(e.dq_mm, [0.45, 0.7, 0.5]);
+```
+"#
+)]
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct GeometricErrors {
     /// Errors of the base joints `B_1..B_3` in Oxyz, mm.
@@ -211,19 +216,24 @@ impl ParameterSet {
     /// product serves every Jacobian of the project: the readings' eq. 9
     /// `J` (3 x 21), the platform position's, any subset of rows.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_kinematics::Machine;
-    /// use tricept_model::{jacobian::error_jacobian, ParameterSet};
-    /// let m = Machine::paper();
-    /// let up = m.inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0)).unwrap().up;
-    /// let j21 = error_jacobian(&m, &up).unwrap();
-    /// let set = ParameterSet::paper15();
-    /// let mut out = vec![0.0; 3 * 15];
-    /// set.project(3, |row, f| j21[(row, f)], &mut out);
-    /// // dxB1 moves B1 and B2: its column is the sum of theirs.
-    /// assert!((out[0] - (j21[(0, 0)] + j21[(0, 7)])).abs() < 1e-15);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_kinematics::Machine;
+use tricept_model::{jacobian::error_jacobian, ParameterSet};
+let m = Machine::paper();
+let up = m.inverse(&nalgebra::Vector3::new(0.0, 0.0, 750.0)).unwrap().up;
+let j21 = error_jacobian(&m, &up).unwrap();
+let set = ParameterSet::paper15();
+let mut out = vec![0.0; 3 * 15];
+set.project(3, |row, f| j21[(row, f)], &mut out);
+// dxB1 moves B1 and B2: its column is the sum of theirs.
+assert!((out[0] - (j21[(0, 0)] + j21[(0, 7)])).abs() < 1e-15);
+```
+"#
+    )]
     pub fn project(&self, rows: usize, full: impl Fn(usize, usize) -> f64, out: &mut [f64]) {
         let k = self.sparse.len();
         for (c, col) in self.sparse.iter().enumerate() {

@@ -31,13 +31,18 @@ impl Range {
     /// compatible with the range: its 3-sigma interval meets it (a
     /// non-finite value never is).
     ///
-    /// # Example
-    /// ```
-    /// use tricept_model::plausibility::Range;
-    /// let r = Range { min: -3.0, max: 3.0, unit: "mm", why: "a tool length".into() };
-    /// assert!(r.admits(2.5, 0.0) && r.admits(3.5, 0.2));
-    /// assert!(!r.admits(20.0, 0.01) && !r.admits(f64::NAN, 0.0));
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_model::plausibility::Range;
+let r = Range { min: -3.0, max: 3.0, unit: "mm", why: "a tool length".into() };
+assert!(r.admits(2.5, 0.0) && r.admits(3.5, 0.2));
+assert!(!r.admits(20.0, 0.01) && !r.admits(f64::NAN, 0.0));
+```
+"#
+    )]
     pub fn admits(&self, value: f64, sd: f64) -> bool {
         let sd = if sd.is_finite() { sd.abs() } else { 0.0 };
         value.is_finite() && value + 3.0 * sd >= self.min && value - 3.0 * sd <= self.max

@@ -185,8 +185,9 @@ pub fn heat_map(
 /// when the points do not share one (`z = 700 to 800 mm`).
 ///
 /// ```
-/// assert_eq!(tricept_plot::plane_z([750.0, 750.0]), "z = 750 mm");
-/// assert_eq!(tricept_plot::plane_z([700.0, 812.5]), "z = 700 to 812.5 mm");
+/// # use tricept_plot::plane_z;
+/// assert_eq!(plane_z([750.0, 750.0]), "z = 750 mm");
+/// assert_eq!(plane_z([700.0, 812.5]), "z = 700 to 812.5 mm");
 /// ```
 pub fn plane_z(z_mm: impl IntoIterator<Item = f64>) -> String {
     let (lo, hi) = z_mm

@@ -82,13 +82,18 @@ pub const TOOL_TIP: &str = "tool tip";
 /// The accuracy a machine file will deliver: the top-level `accuracy`
 /// object of every verb that writes one.
 ///
-/// # Example
-/// ```
-/// use tricept_engine::accuracy::Accuracy;
-/// let a = Accuracy::combine("platform", &[(0.003, 0.004), (0.004, 0.006)], Default::default());
-/// assert!((a.rms_mm - 0.005).abs() < 1e-12);
-/// assert!(a.upper_mm >= a.rms_mm);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_engine::accuracy::Accuracy;
+let a = Accuracy::combine("platform", &[(0.003, 0.004), (0.004, 0.006)], Default::default());
+assert!((a.rms_mm - 0.005).abs() < 1e-12);
+assert!(a.upper_mm >= a.rms_mm);
+```
+"#
+)]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Accuracy {
     /// Predicted rms positioning error over the workspace, mm.

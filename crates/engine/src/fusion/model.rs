@@ -36,12 +36,17 @@ use crate::model::{GeometricPredictor, solve_pose};
 /// leg or reading terms linear in their parameters that need no context
 /// column.
 ///
-/// # Example
-/// ```
-/// use tricept_engine::fusion::fusable_effects;
-/// let names: Vec<&str> = fusable_effects().map(|e| e.as_str()).collect();
-/// assert_eq!(names, ["leg-lead", "scale-gain", "compliance"]);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_engine::fusion::fusable_effects;
+let names: Vec<&str> = fusable_effects().map(|e| e.as_str()).collect();
+assert_eq!(names, ["leg-lead", "scale-gain", "compliance"]);
+```
+"#
+)]
 pub fn fusable_effects() -> impl Iterator<Item = EffectName> {
     EffectName::ALL.into_iter().filter(|e| e.spec().fused)
 }

@@ -18,27 +18,32 @@ use crate::report::IdentifiabilityReport;
 /// noise model, computed once ([`design`]) and reused by many
 /// identifications ([`crate::identify::Start::design`]).
 ///
-/// # Example
-/// ```
-/// use tricept_engine::{model::GeometricModel, IdentifyOptions};
-/// use tricept_kinematics::Machine;
-/// use tricept_model::ParameterSet;
-/// let m = Machine::paper();
-/// let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
-/// let poses: Vec<tricept_data::MeasuredPose> = m
-///     .workspace
-///     .polar_grid(3, 8, 3)
-///     .iter()
-///     .map(|r| tricept_data::MeasuredPose {
-///         commands_mm: m.inverse(r).unwrap().legs_mm,
-///         ..Default::default()
-///     })
-///     .collect();
-/// let d = tricept_engine::identify::design(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
-/// assert_eq!(d.rank(), 14);
-/// assert_eq!(d.report().fixed, vec!["dyA3".to_string()]);
-/// assert_eq!(d.fixed(), &[11]); // dyA3's index in paper15
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let m = Machine::paper();
+let model = GeometricModel::new(m.clone(), ParameterSet::paper15());
+let poses: Vec<tricept_data::MeasuredPose> = m
+    .workspace
+    .polar_grid(3, 8, 3)
+    .iter()
+    .map(|r| tricept_data::MeasuredPose {
+        commands_mm: m.inverse(r).unwrap().legs_mm,
+        ..Default::default()
+    })
+    .collect();
+let d = tricept_engine::identify::design(&model, &[0.0; 15], &poses, &IdentifyOptions::for_machine(&m)).unwrap();
+assert_eq!(d.rank(), 14);
+assert_eq!(d.report().fixed, vec!["dyA3".to_string()]);
+assert_eq!(d.fixed(), &[11]); // dyA3's index in paper15
+```
+"#
+)]
 #[derive(Debug, Clone)]
 pub struct Design {
     pub(crate) decision: RankDecision,
@@ -71,23 +76,28 @@ impl Design {
     /// number of parameters. Directions `rank()..` span what the data
     /// cannot see; direction `rank() - 1` is the weakest one they can.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_engine::{model::GeometricModel, IdentifyOptions, identify};
-    /// use tricept_kinematics::Machine;
-    /// use tricept_model::ParameterSet;
-    /// let m = Machine::paper();
-    /// let set = ParameterSet::paper15();
-    /// let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
-    ///     .simulate(&tricept_plant::Campaign::grid(&m, 1))
-    ///     .unwrap();
-    /// let id = identify(&GeometricModel::new(m.clone(), set.clone()), &data, &IdentifyOptions::for_machine(&m)).unwrap();
-    /// // The weakest visible direction moves the three leg lengths together.
-    /// let d = id.design();
-    /// let v = d.direction(d.rank() - 1).unwrap();
-    /// let dq = ["dq1", "dq2", "dq3"].map(|n| v[set.index_of(n).unwrap()]);
-    /// assert!(dq.iter().all(|x| x.signum() == dq[0].signum()));
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_engine::{model::GeometricModel, IdentifyOptions, identify};
+use tricept_kinematics::Machine;
+use tricept_model::ParameterSet;
+let m = Machine::paper();
+let set = ParameterSet::paper15();
+let data = tricept_plant::Plant::geometric(m.clone(), set.to_errors(&set.table2()))
+    .simulate(&tricept_plant::Campaign::grid(&m, 1))
+    .unwrap();
+let id = identify(&GeometricModel::new(m.clone(), set.clone()), &data, &IdentifyOptions::for_machine(&m)).unwrap();
+// The weakest visible direction moves the three leg lengths together.
+let d = id.design();
+let v = d.direction(d.rank() - 1).unwrap();
+let dq = ["dq1", "dq2", "dq3"].map(|n| v[set.index_of(n).unwrap()]);
+assert!(dq.iter().all(|x| x.signum() == dq[0].signum()));
+```
+"#
+    )]
     pub fn direction(&self, i: usize) -> Option<Vec<f64>> {
         (i < self.decision.column_scale.len()).then(|| self.decision.direction(i))
     }

@@ -1,63 +1,74 @@
-//! Calibrate: identify the machine from the UP limb's sensors alone
-//! (`internal.rs`), from several campaigns or with a batch's prior
-//! (`pooled.rs`, `pooling.rs`), or fused with external measurements that
-//! also calibrate the head (`fused.rs`); the verdict and its exit code, the accuracy the
-//! calibration predicts, the advice of a campaign too small to calibrate
-//! (`advice.rs`), and the calibrated machine file with its record, written
-//! by the one write rule of every machine file (`machine_file.rs`).
+//! Calibrate: identify the machine's geometric errors from the UP limb's
+//! sensors alone, from several campaigns of one machine or with a batch's
+//! prior, or fused with external measurements (laser tracker, ballbar,
+//! touch-offs) that also calibrate the head. A calibration states its
+//! verdict and exit code, the accuracy it predicts on the platform, the
+//! advice for a campaign too small to calibrate, and the calibrated
+//! machine file it may write (under the one write rule of every machine
+//! file the door writes).
 //!
 //! [`calibrate`] takes a [`CalibrateRequest`] (the data as a file or in
 //! memory, the machine, the parameter set, the external sources) and
 //! returns a [`Calibration`]: what `tricept identify` prints (its text
 //! report, its JSON) and writes.
 //!
-//! # The identify walk
-//!
-//! `tricept identify --data D` (text report, no machine file written),
-//! file by file in execution order. A stay is an arrival by a call made
-//! from the CLI or the door; an internal crate's file counts where the door
-//! calls it (its own calls are not followed); a run of calls from one
-//! place into one file (a loop, a builder) is one stay; constructors of the
-//! request's values and accessors that return a stored field are not
-//! stays. A *return* is a stay in a file the walk had already left
-//! (marked R).
-//!
-//! 1. `cli/src/main.rs`: parse, `run`
-//! 2. `cli/src/files.rs`: the paths' roles checked
-//! 3. `cli/src/ident_cmd.rs`: `run_identify`
-//! 4. `cli/src/args.rs`: `IdentifyArgs::prepare` (the flags in one pass:
-//!    their checks, the request, the spinner)
-//! 5. `ident/src/calibrate/mod.rs`: `calibrate`, `check`
-//! 6. `ident/src/machine_input.rs`: `MachineInput::load`
-//! 7. `ident/src/inputs.rs`: `load_machine`, `LoadedMachine::from_description`
-//! 8. `kinematics/src/description/`, `kinematics/src/machine.rs`: validate,
-//!    build, the workspace's reach
-//! 9. `ident/src/data_input.rs`: the data's name, `load`, `read_data`,
-//!    `check_commands`
-//! 10. `data/src/read.rs`: the CSV
-//! 11. `kinematics/src/machine.rs`: each pose's commands in the stroke (R)
-//! 12. `ident/src/calibrate/internal.rs`: `calibrated` (`fit`, then what it
-//!     says: [`Calibration`] keeps the exit code, reasons, exit line,
-//!     report and notices made here)
-//! 13. `ident/src/inputs.rs`: `rank_reference` (R)
-//! 14. `engine/src/model.rs`, `options.rs`, `robust.rs`, `verdict.rs`: the
-//!     robust fit and its verdict
-//! 15. `ident/src/calibrate/advice.rs` and `engine/src/accuracy/mod.rs`:
-//!     the predicted accuracy
-//! 16. `data/src/pose.rs`: the kept poses
-//! 17. `ident/src/accuracy.rs`: `of_geometric_fit`, through `diagnose`'s
-//!     model to `engine/src/accuracy/promise.rs` (`of_fit_stated`: the
-//!     promise with its report line)
-//! 18. `ident/src/machine_file.rs`: the mean temperature
-//! 19. `ident/src/error.rs`: the exit line; `engine/src/report.rs`: the
-//!     identification's table
-//! 20. `cli/src/output.rs`: the machine file's warnings
-//! 21. `cli/src/output.rs`: the report (R; between 20 and 21 the CLI reads
-//!     the stored report)
-//! 22. `cli/src/output.rs`: stdout flushed by `main` (R)
-//!
-//! 4 returns. Keep it so: a value the CLI prints is made where the
-//! calibration is made and stored, not recomputed by a getter.
+//! # Example
+//! ```no_run
+//! use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+//! let calibration = calibrate(CalibrateRequest::new("campaign.csv"))?;
+//! for (name, value, sigma) in calibration.estimates() {
+//!     println!("{name} = {value} (+/- {sigma:?})");
+//! }
+//! # Ok::<(), tricept_ident::Error>(())
+//! ```
+
+// # The identify walk
+//
+// `tricept identify --data D` (text report, no machine file written),
+// file by file in execution order. A stay is an arrival by a call made
+// from the CLI or the door; an internal crate's file counts where the door
+// calls it (its own calls are not followed); a run of calls from one
+// place into one file (a loop, a builder) is one stay; constructors of the
+// request's values and accessors that return a stored field are not
+// stays. A *return* is a stay in a file the walk had already left
+// (marked R).
+//
+// 1. `cli/src/main.rs`: parse, `run`
+// 2. `cli/src/files.rs`: the paths' roles checked
+// 3. `cli/src/ident_cmd.rs`: `run_identify`
+// 4. `cli/src/args.rs`: `IdentifyArgs::prepare` (the flags in one pass:
+//    their checks, the request, the spinner)
+// 5. `ident/src/calibrate/mod.rs`: `calibrate`, `check`
+// 6. `ident/src/machine_input.rs`: `MachineInput::load`
+// 7. `ident/src/inputs.rs`: `load_machine`, `LoadedMachine::from_description`
+// 8. `kinematics/src/description/`, `kinematics/src/machine.rs`: validate,
+//    build, the workspace's reach
+// 9. `ident/src/data_input.rs`: the data's name, `load`, `read_data`,
+//    `check_commands`
+// 10. `data/src/read.rs`: the CSV
+// 11. `kinematics/src/machine.rs`: each pose's commands in the stroke (R)
+// 12. `ident/src/calibrate/internal.rs`: `calibrated` (`fit`, then what it
+//     says: [`Calibration`] keeps the exit code, reasons, exit line,
+//     report and notices made here)
+// 13. `ident/src/inputs.rs`: `rank_reference` (R)
+// 14. `engine/src/model.rs`, `options.rs`, `robust.rs`, `verdict.rs`: the
+//     robust fit and its verdict
+// 15. `ident/src/calibrate/advice.rs` and `engine/src/accuracy/mod.rs`:
+//     the predicted accuracy
+// 16. `data/src/pose.rs`: the kept poses
+// 17. `ident/src/accuracy.rs`: `of_geometric_fit`, through `diagnose`'s
+//     model to `engine/src/accuracy/promise.rs` (`of_fit_stated`: the
+//     promise with its report line)
+// 18. `ident/src/machine_file.rs`: the mean temperature
+// 19. `ident/src/error.rs`: the exit line; `engine/src/report.rs`: the
+//     identification's table
+// 20. `cli/src/output.rs`: the machine file's warnings
+// 21. `cli/src/output.rs`: the report (R; between 20 and 21 the CLI reads
+//     the stored report)
+// 22. `cli/src/output.rs`: stdout flushed by `main` (R)
+//
+// 4 returns. Keep it so: a value the CLI prints is made where the
+// calibration is made and stored, not recomputed by a getter.
 
 mod advice;
 mod checked;
@@ -79,6 +90,7 @@ use crate::data_input::DataInput;
 use crate::error::Error;
 pub(crate) use crate::error::exit_reason;
 use crate::inputs::LoadedMachine;
+pub use crate::linalg::DMatrix;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
 pub use crate::outcome::{WriteOptions, Written};
@@ -164,6 +176,18 @@ enum Fit {
 
 /// A calibration: the fit, its verdict and exit code, its report and JSON,
 /// and the machine file it may write.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+/// let calibration = calibrate(CalibrateRequest::new("campaign.csv"))?;
+/// let n = calibration.estimates().len();
+/// assert_eq!(calibration.covariance().nrows(), n);
+/// for warning in calibration.warnings() {
+///     eprintln!("{warning}");
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 #[derive(Debug)]
 pub struct Calibration {
     loaded: LoadedMachine,
@@ -180,6 +204,19 @@ crate::outcome::outcome!(writes Calibration);
 /// Errors are input errors (exit code 2) for bad files, flags and data too
 /// small to fit; a fit that completes returns its verdict in
 /// [`Calibration::exit_code`].
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+/// let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/table2-grid-seed1.csv");
+/// let calibration = calibrate(CalibrateRequest::new(file))?;
+/// assert!(calibration.converged() && calibration.adequate());
+/// // Every estimate, with its standard uncertainty where it has one.
+/// for (name, value, sigma) in calibration.estimates() {
+///     println!("{name} = {value} ({sigma:?})");
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
 pub fn calibrate(request: CalibrateRequest) -> Result<Calibration, Error> {
     let (checked, data, name, work) = check(request)?;
     let (fit, said) = match &work {
@@ -397,7 +434,7 @@ impl Calibration {
 
     /// The covariance of the estimates (mm², rad², mm·rad), in the order
     /// of [`Calibration::estimates`]; held parameters have zero rows.
-    pub fn covariance(&self) -> &nalgebra::DMatrix<f64> {
+    pub fn covariance(&self) -> &DMatrix {
         match &self.fit {
             Fit::Internal(f) => &f.id.covariance,
             Fit::Fused(f) => &f.fit.covariance,

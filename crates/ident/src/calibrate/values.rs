@@ -316,6 +316,16 @@ pub(crate) fn head_angles_text(angles: &HeadAngles) -> String {
 }
 
 /// External measurements and the head model of a fused calibration.
+///
+/// # Example
+/// ```
+/// use tricept_ident::calibrate::{CalibrateRequest, FusedSources};
+/// let mut fused = FusedSources::default();
+/// fused.tracker.push("tracker.csv".into());
+/// let mut request = CalibrateRequest::new("campaign.csv");
+/// request.fused = Some(fused);
+/// assert!(request.fused.is_some());
+/// ```
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct FusedSources {

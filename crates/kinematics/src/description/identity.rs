@@ -19,11 +19,16 @@ impl MachineDescription {
     /// The digest that identifies this file's calibration (see the module
     /// docs); `None` for a description without a `calibration` record.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_kinematics::MachineDescription;
-    /// assert_eq!(MachineDescription::paper().calibration_digest(), None);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_kinematics::MachineDescription;
+assert_eq!(MachineDescription::paper().calibration_digest(), None);
+```
+"#
+    )]
     pub fn calibration_digest(&self) -> Option<String> {
         let c = self.calibration.as_deref()?;
         let identity = serde_json::json!({

@@ -65,14 +65,19 @@ pub const MAX_LENGTH_MM: f64 = 1e5;
 
 /// A complete machine description, as stored in JSON.
 ///
-/// # Example
-/// ```
-/// use tricept_kinematics::MachineDescription;
-/// let d = MachineDescription::paper();
-/// assert_eq!(d.workspace.radius_mm, 400.0);
-/// let m = d.build().unwrap();
-/// assert!((m.base_joints_mm[2].x - 288.7).abs() < 1e-12);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_kinematics::MachineDescription;
+let d = MachineDescription::paper();
+assert_eq!(d.workspace.radius_mm, 400.0);
+let m = d.build().unwrap();
+assert!((m.base_joints_mm[2].x - 288.7).abs() < 1e-12);
+```
+"#
+)]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MachineDescription {
@@ -240,16 +245,21 @@ impl MachineDescription {
     /// `format_version` is newer than [`FORMAT_VERSION`] is refused first
     /// ([`DescriptionError::NewerFormat`]), whatever else it holds.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_kinematics::{error::DescriptionError, MachineDescription};
-    /// let text = MachineDescription::paper().to_json().replace(
-    ///     "\"format_version\": 1,",
-    ///     "\"format_version\": 2, \"a_key_of_version_2\": true,",
-    /// );
-    /// let e = MachineDescription::from_json(&text).unwrap_err();
-    /// assert!(matches!(e, DescriptionError::NewerFormat(_)), "{e}");
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_kinematics::{error::DescriptionError, MachineDescription};
+let text = MachineDescription::paper().to_json().replace(
+    "\"format_version\": 1,",
+    "\"format_version\": 2, \"a_key_of_version_2\": true,",
+);
+let e = MachineDescription::from_json(&text).unwrap_err();
+assert!(matches!(e, DescriptionError::NewerFormat(_)), "{e}");
+```
+"#
+    )]
     pub fn from_json(text: &str) -> Result<MachineDescription, DescriptionError> {
         // A byte-order mark, as some editors write, is not part of the JSON.
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);

@@ -14,13 +14,18 @@ use super::geometry::is_zero3;
 /// 1/length) and `T_i` leg `i`'s compensation table, when it has one
 /// ([`LegTableDescription`]).
 ///
-/// # Example
-/// ```
-/// use tricept_kinematics::description::LegEffectsDescription;
-/// let e = LegEffectsDescription { lead_ppm: [50.0, 0.0, 0.0], ..Default::default() };
-/// assert!(!e.is_zero());
-/// assert!(LegEffectsDescription::default().is_zero());
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_kinematics::description::LegEffectsDescription;
+let e = LegEffectsDescription { lead_ppm: [50.0, 0.0, 0.0], ..Default::default() };
+assert!(!e.is_zero());
+assert!(LegEffectsDescription::default().is_zero());
+```
+"#
+)]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
 pub struct LegEffectsDescription {
@@ -46,17 +51,22 @@ impl LegEffectsDescription {
     /// The extra length of each leg (mm) from its compensation table at
     /// the commands `commands_mm` (zero for a leg without one).
     ///
-    /// # Example
-    /// ```
-    /// use tricept_kinematics::description::{LegEffectsDescription, LegTableDescription};
-    /// let e = LegEffectsDescription {
-    ///     tables: vec![LegTableDescription::new(2, 600.0, 10.0, vec![0.0, 4.0, 2.0])],
-    ///     ..Default::default()
-    /// };
-    /// let x = e.table_extra_mm(&[605.0, 605.0, 1000.0]);
-    /// assert_eq!(x[0], 0.0);
-    /// assert!((x[1] - 0.002).abs() < 1e-15); // halfway between 0 and 4 um
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_kinematics::description::{LegEffectsDescription, LegTableDescription};
+let e = LegEffectsDescription {
+    tables: vec![LegTableDescription::new(2, 600.0, 10.0, vec![0.0, 4.0, 2.0])],
+    ..Default::default()
+};
+let x = e.table_extra_mm(&[605.0, 605.0, 1000.0]);
+assert_eq!(x[0], 0.0);
+assert!((x[1] - 0.002).abs() < 1e-15); // halfway between 0 and 4 um
+```
+"#
+    )]
     pub fn table_extra_mm(&self, commands_mm: &[f64; 3]) -> [f64; 3] {
         let mut out = [0.0; 3];
         for t in &self.tables {
@@ -73,19 +83,24 @@ impl LegEffectsDescription {
     /// keeps it, so that a table edited after the calibration is seen when
     /// the file is loaded.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_kinematics::description::{LegEffectsDescription, LegTableDescription};
-    /// let mut e = LegEffectsDescription {
-    ///     tables: vec![LegTableDescription::new(1, 600.0, 10.0, vec![0.0, 4.0, 2.0])],
-    ///     ..Default::default()
-    /// };
-    /// let written = e.tables_digest();
-    /// assert!(written.is_some());
-    /// e.tables[0].extra_length_um[1] = 4.5;
-    /// assert_ne!(e.tables_digest(), written);
-    /// assert_eq!(LegEffectsDescription::default().tables_digest(), None);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_kinematics::description::{LegEffectsDescription, LegTableDescription};
+let mut e = LegEffectsDescription {
+    tables: vec![LegTableDescription::new(1, 600.0, 10.0, vec![0.0, 4.0, 2.0])],
+    ..Default::default()
+};
+let written = e.tables_digest();
+assert!(written.is_some());
+e.tables[0].extra_length_um[1] = 4.5;
+assert_ne!(e.tables_digest(), written);
+assert_eq!(LegEffectsDescription::default().tables_digest(), None);
+```
+"#
+    )]
     pub fn tables_digest(&self) -> Option<String> {
         if self.tables.is_empty() {
             return None;
@@ -135,14 +150,19 @@ pub enum Interpolation {
 /// leg whose table reads `+3 um` at a command is 3 um longer there than
 /// the geometry says: `ik` commands it 3 um shorter.
 ///
-/// # Example
-/// ```
-/// use tricept_kinematics::description::LegTableDescription;
-/// let t = LegTableDescription::new(1, 700.0, 5.0, vec![1.0, -1.0]);
-/// assert!((t.extra_mm(702.5) - 0.0).abs() < 1e-15);
-/// assert_eq!(t.extra_mm(600.0), 0.001); // the first value holds before the table
-/// assert_eq!(t.end_mm(), 705.0);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_kinematics::description::LegTableDescription;
+let t = LegTableDescription::new(1, 700.0, 5.0, vec![1.0, -1.0]);
+assert!((t.extra_mm(702.5) - 0.0).abs() < 1e-15);
+assert_eq!(t.extra_mm(600.0), 0.001); // the first value holds before the table
+assert_eq!(t.end_mm(), 705.0);
+```
+"#
+)]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LegTableDescription {
@@ -214,12 +234,17 @@ impl LegTableDescription {
 /// dynamic leg effects: lost motion at each reversal of a leg axis, and
 /// thermal expansion of the legs relative to a reference temperature.
 ///
-/// # Example
-/// ```
-/// use tricept_kinematics::description::ControllerDescription;
-/// let c = ControllerDescription::default();
-/// assert_eq!(c.reference_temperature_c, 20.0);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_kinematics::description::ControllerDescription;
+let c = ControllerDescription::default();
+assert_eq!(c.reference_temperature_c, 20.0);
+```
+"#
+)]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ControllerDescription {
@@ -249,12 +274,17 @@ impl Default for ControllerDescription {
 /// positioning error over the workspace, a 95 % upper bound of it, the
 /// point it is of, and the parts it is made of.
 ///
-/// # Example
-/// ```
-/// use tricept_kinematics::description::AccuracyRecord;
-/// let a = AccuracyRecord { rms_mm: 0.004, upper_mm: 0.006, point: "platform".into(), parts: Default::default() };
-/// assert!(a.upper_mm >= a.rms_mm);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_kinematics::description::AccuracyRecord;
+let a = AccuracyRecord { rms_mm: 0.004, upper_mm: 0.006, point: "platform".into(), parts: Default::default() };
+assert!(a.upper_mm >= a.rms_mm);
+```
+"#
+)]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AccuracyRecord {

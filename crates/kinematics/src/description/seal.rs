@@ -219,13 +219,18 @@ impl MachineDescription {
     /// it last, on the description as it is written; nothing happens
     /// without a calibration.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_kinematics::MachineDescription;
-    /// let mut d = MachineDescription::paper();
-    /// d.seal(); // no calibration: nothing to seal
-    /// assert!(d.calibration.is_none());
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_kinematics::MachineDescription;
+let mut d = MachineDescription::paper();
+d.seal(); // no calibration: nothing to seal
+assert!(d.calibration.is_none());
+```
+"#
+    )]
     pub fn seal(&mut self) {
         if self.calibration.is_none() {
             return;

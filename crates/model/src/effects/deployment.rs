@@ -16,18 +16,23 @@ impl EffectName {
     /// already carries and the sensor-side ones. `false` when the effect
     /// is not part of a machine file (outliers) or has no such parameter.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_kinematics::Machine;
-    /// use tricept_model::effects::EffectName;
-    /// let mut m = Machine::paper();
-    /// let mut controller = None;
-    /// assert!(EffectName::LegLead.deploy(1, 40.0, &mut m, &mut controller));
-    /// assert!(EffectName::Backlash.deploy(0, 6.0, &mut m, &mut controller));
-    /// assert_eq!(m.leg_effects.lead_ppm, [0.0, 40.0, 0.0]);
-    /// assert_eq!(controller.unwrap().backlash_um, [6.0, 0.0, 0.0]);
-    /// assert!(!EffectName::Outliers.deploy(0, 1.0, &mut m, &mut None));
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_kinematics::Machine;
+use tricept_model::effects::EffectName;
+let mut m = Machine::paper();
+let mut controller = None;
+assert!(EffectName::LegLead.deploy(1, 40.0, &mut m, &mut controller));
+assert!(EffectName::Backlash.deploy(0, 6.0, &mut m, &mut controller));
+assert_eq!(m.leg_effects.lead_ppm, [0.0, 40.0, 0.0]);
+assert_eq!(controller.unwrap().backlash_um, [6.0, 0.0, 0.0]);
+assert!(!EffectName::Outliers.deploy(0, 1.0, &mut m, &mut None));
+```
+"#
+    )]
     pub fn deploy(
         self,
         index: usize,

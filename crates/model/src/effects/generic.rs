@@ -325,12 +325,17 @@ impl GenericFamily {
 
     /// The report name (`leg-periodic`, ...).
     ///
-    /// # Example
-    /// ```
-    /// use tricept_model::effects::GenericFamily;
-    /// assert_eq!(GenericFamily::LegPeriodic.as_str(), "leg-periodic");
-    /// assert_eq!("encoder-gain".parse(), Ok(GenericFamily::EncoderGain));
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_model::effects::GenericFamily;
+assert_eq!(GenericFamily::LegPeriodic.as_str(), "leg-periodic");
+assert_eq!("encoder-gain".parse(), Ok(GenericFamily::EncoderGain));
+```
+"#
+    )]
     pub fn as_str(self) -> &'static str {
         self.spec().name
     }
@@ -340,15 +345,20 @@ impl GenericFamily {
     /// those of the term in order (per leg: sine and cosine of a periodic
     /// term, `P1`, `P2`, `P3` of a polynomial, one step, one drift).
     ///
-    /// # Example
-    /// ```
-    /// use tricept_model::effects::{GenericFamily, Measure};
-    /// let j = GenericFamily::LegPeriodic.judgements(&[0, 2], None, Some(10.0));
-    /// assert_eq!(j.len(), 3);
-    /// assert_eq!(j[1].label, "periodic amplitude of leg 3");
-    /// assert_eq!(j[1].measure, Measure::Amplitude(2, 3));
-    /// assert_eq!(j[2].measure, Measure::Exact(10.0));
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_model::effects::{GenericFamily, Measure};
+let j = GenericFamily::LegPeriodic.judgements(&[0, 2], None, Some(10.0));
+assert_eq!(j.len(), 3);
+assert_eq!(j[1].label, "periodic amplitude of leg 3");
+assert_eq!(j[1].measure, Measure::Amplitude(2, 3));
+assert_eq!(j[2].measure, Measure::Exact(10.0));
+```
+"#
+    )]
     pub fn judgements(
         self,
         legs: &[usize],
@@ -457,15 +467,20 @@ impl GenericFamily {
     /// segment `edges_mm` (`[a, b]`, both included; zero without edges).
     /// `None` for the other families (a drift depends on time).
     ///
-    /// # Example
-    /// ```
-    /// use tricept_model::effects::GenericFamily;
-    /// let v = GenericFamily::LegPeriodic.leg_command_entries(700.0, Some(10.0), None, [600.0, 900.0]).unwrap();
-    /// assert!((v[1] - 1e-3).abs() < 1e-12); // cos(2 pi 700 / 10) = 1, per um
-    /// let step = |q| GenericFamily::LegStep.leg_command_entries(q, None, Some([720.0, 960.0]), [600.0, 1000.0]).unwrap();
-    /// assert_eq!((step(700.0)[0], step(800.0)[0]), (0.0, 1e-3));
-    /// assert!(GenericFamily::LegDrift.leg_command_entries(700.0, None, None, [600.0, 900.0]).is_none());
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_model::effects::GenericFamily;
+let v = GenericFamily::LegPeriodic.leg_command_entries(700.0, Some(10.0), None, [600.0, 900.0]).unwrap();
+assert!((v[1] - 1e-3).abs() < 1e-12); // cos(2 pi 700 / 10) = 1, per um
+let step = |q| GenericFamily::LegStep.leg_command_entries(q, None, Some([720.0, 960.0]), [600.0, 1000.0]).unwrap();
+assert_eq!((step(700.0)[0], step(800.0)[0]), (0.0, 1e-3));
+assert!(GenericFamily::LegDrift.leg_command_entries(700.0, None, None, [600.0, 900.0]).is_none());
+```
+"#
+    )]
     pub fn leg_command_entries(
         self,
         command_mm: f64,

@@ -104,7 +104,7 @@ macro_rules! registry {
             ///
             /// # Example
             /// ```
-            /// use tricept_model::effects::{Deployment, EffectName};
+            /// # use tricept_model::effects::{Deployment, EffectName};
             /// let s = EffectName::Compliance.spec();
             /// assert_eq!(s.name, "compliance");
             /// assert!(matches!(s.deployment, Deployment::LegEffects(_)));
@@ -155,12 +155,17 @@ impl EffectName {
     /// their units (the diagnosis and the fused identification prefix them
     /// with the effect's name: `leg-lead.lead1_ppm`).
     ///
-    /// # Example
-    /// ```
-    /// use tricept_model::effects::EffectName;
-    /// assert_eq!(EffectName::ScaleGain.parameter_names(), ["scale_gain_ppm"]);
-    /// assert!(EffectName::Outliers.parameter_names().is_empty());
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_model::effects::EffectName;
+assert_eq!(EffectName::ScaleGain.parameter_names(), ["scale_gain_ppm"]);
+assert!(EffectName::Outliers.parameter_names().is_empty());
+```
+"#
+    )]
     pub fn parameter_names(self) -> Vec<&'static str> {
         self.spec().parameters.iter().map(|p| p.name).collect()
     }
@@ -190,14 +195,19 @@ impl EffectName {
     /// part, effect whose parameter it reads as, how)`, each declared by the
     /// second ([`KnownAlias::structural`]).
     ///
-    /// # Example
-    /// ```
-    /// use tricept_model::effects::EffectName;
-    /// let (common, other, s) = EffectName::structural_aliases().next().unwrap();
-    /// assert_eq!((common.as_str(), other.as_str()), ("leg-lead", "scale-gain"));
-    /// assert!(common.spec().common_part.is_some());
-    /// assert!((s.says)(50.0, 2.0).contains("50.0"));
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_model::effects::EffectName;
+let (common, other, s) = EffectName::structural_aliases().next().unwrap();
+assert_eq!((common.as_str(), other.as_str()), ("leg-lead", "scale-gain"));
+assert!(common.spec().common_part.is_some());
+assert!((s.says)(50.0, 2.0).contains("50.0"));
+```
+"#
+    )]
     pub fn structural_aliases()
     -> impl Iterator<Item = (EffectName, EffectName, &'static Structural)> {
         EffectName::ALL.into_iter().flat_map(|other| {
@@ -237,12 +247,17 @@ impl std::str::FromStr for EffectName {
 
     /// Parses a report name.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_model::effects::EffectName;
-    /// assert_eq!("leg-lead".parse::<EffectName>(), Ok(EffectName::LegLead));
-    /// assert!("pitch".parse::<EffectName>().is_err());
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_model::effects::EffectName;
+assert_eq!("leg-lead".parse::<EffectName>(), Ok(EffectName::LegLead));
+assert!("pitch".parse::<EffectName>().is_err());
+```
+"#
+    )]
     fn from_str(s: &str) -> Result<EffectName, UnknownEffect> {
         EffectName::ALL
             .into_iter()
@@ -253,11 +268,16 @@ impl std::str::FromStr for EffectName {
 
 /// A name that is not in the vocabulary.
 ///
-/// # Example
-/// ```
-/// let e = "pitch".parse::<tricept_model::effects::EffectName>().unwrap_err();
-/// assert!(e.to_string().starts_with("unknown effect `pitch` (known: leg-lead, backlash,"));
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+let e = "pitch".parse::<tricept_model::effects::EffectName>().unwrap_err();
+assert!(e.to_string().starts_with("unknown effect `pitch` (known: leg-lead, backlash,"));
+```
+"#
+)]
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct UnknownEffect(pub String);
 
@@ -295,14 +315,19 @@ impl std::fmt::Display for EffectName {
 /// The name of a cause in a report: an effect of the vocabulary or a
 /// generic family. Serialised as the bare kebab-case name.
 ///
-/// # Example
-/// ```
-/// use tricept_model::effects::{CauseName, EffectName, GenericFamily};
-/// let c = CauseName::Catalogue(EffectName::Thermal);
-/// assert!(c == EffectName::Thermal);
-/// assert_eq!(serde_json::to_value(CauseName::Generic(GenericFamily::LegPeriodic)).unwrap(), "leg-periodic");
-/// assert_eq!("reading-drift".parse::<CauseName>().unwrap().to_string(), "reading-drift");
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r#"
+# Example
+```
+use tricept_model::effects::{CauseName, EffectName, GenericFamily};
+let c = CauseName::Catalogue(EffectName::Thermal);
+assert!(c == EffectName::Thermal);
+assert_eq!(serde_json::to_value(CauseName::Generic(GenericFamily::LegPeriodic)).unwrap(), "leg-periodic");
+assert_eq!("reading-drift".parse::<CauseName>().unwrap().to_string(), "reading-drift");
+```
+"#
+)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum CauseName {
@@ -353,14 +378,19 @@ impl CauseName {
     /// The known alias between `self` and `other`, declared by either
     /// (its [`KnownAlias::with`] names the other).
     ///
-    /// # Example
-    /// ```
-    /// use tricept_model::effects::{CauseName, EffectName};
-    /// let lead = CauseName::Catalogue(EffectName::LegLead);
-    /// let gain = CauseName::Catalogue(EffectName::ScaleGain);
-    /// assert!(lead.known_alias(gain).unwrap().why.contains("scale gain"));
-    /// assert!(lead.known_alias(lead).is_none());
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_model::effects::{CauseName, EffectName};
+let lead = CauseName::Catalogue(EffectName::LegLead);
+let gain = CauseName::Catalogue(EffectName::ScaleGain);
+assert!(lead.known_alias(gain).unwrap().why.contains("scale gain"));
+assert!(lead.known_alias(lead).is_none());
+```
+"#
+    )]
     pub fn known_alias(self, other: CauseName) -> Option<&'static KnownAlias> {
         self.known_aliases()
             .iter()

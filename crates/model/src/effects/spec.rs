@@ -362,16 +362,21 @@ impl Measure {
     /// The quantity and its standard deviation (delta method) for
     /// parameters `v` with covariance `cov` (missing entries count as 0).
     ///
-    /// # Example
-    /// ```
-    /// use nalgebra::DMatrix;
-    /// use tricept_model::effects::Measure;
-    /// let cov = DMatrix::identity(2, 2);
-    /// let (a, sd) = Measure::Amplitude(0, 1).evaluate(&[3.0, 4.0], &cov);
-    /// assert!((a - 5.0).abs() < 1e-12 && (sd - 1.0).abs() < 1e-12);
-    /// // P2 alone: from -1/2 at 0 to 1 at +-1.
-    /// assert!((Measure::PeakToValley(0, 1).evaluate(&[2.0, 0.0], &cov).0 - 3.0).abs() < 1e-9);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use nalgebra::DMatrix;
+use tricept_model::effects::Measure;
+let cov = DMatrix::identity(2, 2);
+let (a, sd) = Measure::Amplitude(0, 1).evaluate(&[3.0, 4.0], &cov);
+assert!((a - 5.0).abs() < 1e-12 && (sd - 1.0).abs() < 1e-12);
+// P2 alone: from -1/2 at 0 to 1 at +-1.
+assert!((Measure::PeakToValley(0, 1).evaluate(&[2.0, 0.0], &cov).0 - 3.0).abs() < 1e-9);
+```
+"#
+    )]
     pub fn evaluate(&self, v: &[f64], cov: &DMatrix<f64>) -> (f64, f64) {
         let c = |i: usize, j: usize| cov.get((i, j)).copied().unwrap_or(0.0);
         let value = |i: usize| v.get(i).copied().unwrap_or(f64::NAN);

@@ -91,7 +91,7 @@ impl SolverKind {
     ///
     /// # Example
     /// ```
-    /// use tricept_numerics::sparse::SolverKind;
+    /// # use tricept_numerics::sparse::SolverKind;
     /// assert_eq!(SolverKind::SparseCholesky.name(), "sparse-cholesky");
     /// assert_eq!("sparse-qr".parse::<SolverKind>(), Ok(SolverKind::SparseQr));
     /// ```

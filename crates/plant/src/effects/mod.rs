@@ -81,15 +81,20 @@ pub fn simulations() -> Vec<&'static Simulation> {
 
 /// One unmodelled effect with its magnitude.
 ///
-/// # Example
-/// ```
-/// use tricept_plant::Effect;
-/// use tricept_plant::effects::LegLead;
-/// let e = Effect::from(LegLead { ppm: [50.0, -30.0, 40.0] });
-/// assert_eq!(serde_json::to_string(&e).unwrap(), r#"{"effect":"leg-lead","ppm":[50.0,-30.0,40.0]}"#);
-/// let back: Effect = serde_json::from_str(r#"{"effect":"leg-lead","ppm":[50,-30,40]}"#).unwrap();
-/// assert_eq!(back, e);
-/// ```
+#[cfg_attr(
+    any(doc, doctest),
+    doc = r##"
+# Example
+```
+use tricept_plant::Effect;
+use tricept_plant::effects::LegLead;
+let e = Effect::from(LegLead { ppm: [50.0, -30.0, 40.0] });
+assert_eq!(serde_json::to_string(&e).unwrap(), r#"{"effect":"leg-lead","ppm":[50.0,-30.0,40.0]}"#);
+let back: Effect = serde_json::from_str(r#"{"effect":"leg-lead","ppm":[50,-30,40]}"#).unwrap();
+assert_eq!(back, e);
+```
+"##
+)]
 pub struct Effect(Box<dyn Simulate>);
 
 impl<T: Simulate + 'static> From<T> for Effect {
@@ -125,14 +130,19 @@ impl Effect {
 
     /// The input, if it is of type `T`.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_plant::Effect;
-    /// use tricept_plant::effects::{ScaleDrift, ScaleGain};
-    /// let e = Effect::from(ScaleGain { ppm: 50.0 });
-    /// assert_eq!(e.input::<ScaleGain>().map(|g| g.ppm), Some(50.0));
-    /// assert!(e.input::<ScaleDrift>().is_none());
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_plant::Effect;
+use tricept_plant::effects::{ScaleDrift, ScaleGain};
+let e = Effect::from(ScaleGain { ppm: 50.0 });
+assert_eq!(e.input::<ScaleGain>().map(|g| g.ppm), Some(50.0));
+assert!(e.input::<ScaleDrift>().is_none());
+```
+"#
+    )]
     pub fn input<T: 'static>(&self) -> Option<&T> {
         self.0.as_any().downcast_ref::<T>()
     }
@@ -157,15 +167,20 @@ impl Effect {
     /// key's unit), stiffnesses, periods, widths and exponents positive
     /// ([`EffectKey::positive`]); the error says which key is wrong.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_plant::Effect;
-    /// use tricept_plant::effects::LegPower;
-    /// let shape = |exponent| LegPower { um: [30.0, -20.0, 25.0], exponent, centre_mm: 845.0, half_width_mm: 250.0 };
-    /// assert!(Effect::from(shape(1.5)).validate().is_ok());
-    /// let e = Effect::from(shape(-1.5)).validate().unwrap_err();
-    /// assert!(e.contains("exponent"), "{e}");
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_plant::Effect;
+use tricept_plant::effects::LegPower;
+let shape = |exponent| LegPower { um: [30.0, -20.0, 25.0], exponent, centre_mm: 845.0, half_width_mm: 250.0 };
+assert!(Effect::from(shape(1.5)).validate().is_ok());
+let e = Effect::from(shape(-1.5)).validate().unwrap_err();
+assert!(e.contains("exponent"), "{e}");
+```
+"#
+    )]
     pub fn validate(&self) -> Result<(), String> {
         const LIMIT: f64 = 1e6;
         let map = self.to_json().map_err(|e| e.to_string())?;
@@ -197,14 +212,19 @@ impl Effect {
     /// its form (`leg-power` and the sawtooth `leg-periodic` only
     /// approximately: their shapes are outside the dictionary).
     ///
-    /// # Example
-    /// ```
-    /// use tricept_plant::Effect;
-    /// use tricept_plant::effects::{ScaleDrift, ScaleGain};
-    /// use tricept_model::effects::{EffectName, GenericFamily};
-    /// assert!(Effect::from(ScaleGain { ppm: 50.0 }).name() == EffectName::ScaleGain);
-    /// assert!(Effect::from(ScaleDrift { um: 3.0 }).name() == GenericFamily::ReadingDrift);
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_plant::Effect;
+use tricept_plant::effects::{ScaleDrift, ScaleGain};
+use tricept_model::effects::{EffectName, GenericFamily};
+assert!(Effect::from(ScaleGain { ppm: 50.0 }).name() == EffectName::ScaleGain);
+assert!(Effect::from(ScaleDrift { um: 3.0 }).name() == GenericFamily::ReadingDrift);
+```
+"#
+    )]
     pub fn name(&self) -> CauseName {
         let s = self.simulation();
         // Never the fallback: a test checks that every declared cause is a
@@ -216,26 +236,36 @@ impl Effect {
 
     /// The effect's JSON tag (`leg-lead`), as `--truth-effect` takes it.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_plant::Effect;
-    /// use tricept_plant::effects::ScaleGain;
-    /// assert_eq!(Effect::from(ScaleGain { ppm: 50.0 }).tag(), "scale-gain");
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_plant::Effect;
+use tricept_plant::effects::ScaleGain;
+assert_eq!(Effect::from(ScaleGain { ppm: 50.0 }).tag(), "scale-gain");
+```
+"#
+    )]
     pub fn tag(&self) -> &'static str {
         self.simulation().tag
     }
 
     /// The keys this effect takes, with units and meaning.
     ///
-    /// # Example
-    /// ```
-    /// use tricept_plant::Effect;
-    /// use tricept_plant::effects::Thermal;
-    /// let keys = Effect::from(Thermal { drift_k: 3.0, expansion_ppm_per_k: 11.5 }).keys();
-    /// assert_eq!(keys[1].key, "expansion_ppm_per_k");
-    /// assert_eq!(keys[1].unit, "ppm/K");
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_plant::Effect;
+use tricept_plant::effects::Thermal;
+let keys = Effect::from(Thermal { drift_k: 3.0, expansion_ppm_per_k: 11.5 }).keys();
+assert_eq!(keys[1].key, "expansion_ppm_per_k");
+assert_eq!(keys[1].unit, "ppm/K");
+```
+"#
+    )]
     pub fn keys(&self) -> &'static [EffectKey] {
         self.simulation().keys
     }
@@ -243,13 +273,18 @@ impl Effect {
     /// Whether the effect is in the diagnosis' vocabulary (named as itself)
     /// rather than outside it (described by a generic family).
     ///
-    /// # Example
-    /// ```
-    /// use tricept_plant::Effect;
-    /// use tricept_plant::effects::{ScaleDrift, ScaleGain};
-    /// assert!(Effect::from(ScaleGain { ppm: 50.0 }).in_vocabulary());
-    /// assert!(!Effect::from(ScaleDrift { um: 4.0 }).in_vocabulary());
-    /// ```
+    #[cfg_attr(
+        any(doc, doctest),
+        doc = r#"
+# Example
+```
+use tricept_plant::Effect;
+use tricept_plant::effects::{ScaleDrift, ScaleGain};
+assert!(Effect::from(ScaleGain { ppm: 50.0 }).in_vocabulary());
+assert!(!Effect::from(ScaleDrift { um: 4.0 }).in_vocabulary());
+```
+"#
+    )]
     pub fn in_vocabulary(&self) -> bool {
         matches!(self.name(), CauseName::Catalogue(_))
     }
