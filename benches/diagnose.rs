@@ -13,8 +13,9 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use tricept_diagnose::{DiagnoseOptions, diagnose};
 use tricept_engine::{IdentifyOptions, model::GeometricModel, robust::identify_robust};
 use tricept_ident::advanced::ParameterSet;
+use tricept_ident::effects::Effect;
 use tricept_kinematics::Machine;
-use tricept_plant::effects::{Effect, Waveform};
+use tricept_plant::effects::Waveform;
 use tricept_plant::{Campaign, Plant, random_errors};
 
 fn data(n: usize, seed: u64, effects: Vec<Effect>) -> tricept_ident::advanced::Dataset {

@@ -7,7 +7,8 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
 use tricept_benches::workspace_points;
-use tricept_kinematics::{Machine, fk::FkSeed, head::HeadBranch};
+use tricept_ident::kinematics::HeadBranch;
+use tricept_kinematics::{Machine, fk::FkSeed};
 use tricept_model::jacobian::error_jacobian;
 
 /// Cycles through the inputs without an integer division in the timed loop.
@@ -56,7 +57,7 @@ fn kinematics(c: &mut Criterion) {
         b.iter(|| {
             k = next(k, iks.len());
             let seed = iks[next(k, iks.len())].up;
-            let seed = tricept_kinematics::up_limb::UpJoints {
+            let seed = tricept_ident::kinematics::UpJoints {
                 phi_rad: 0.5 * (seed.phi_rad + iks[k].up.phi_rad),
                 theta_rad: 0.5 * (seed.theta_rad + iks[k].up.theta_rad),
                 q4_mm: 0.5 * (seed.q4_mm + iks[k].up.q4_mm),

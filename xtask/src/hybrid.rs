@@ -47,7 +47,8 @@ use tricept_engine::fusion::{
 use tricept_ident::advanced::ParameterSet;
 use tricept_ident::advanced::plot::{Axes, Curve, Reference, curves};
 use tricept_ident::effects::EffectName;
-use tricept_kinematics::{Machine, head::HeadBranch};
+use tricept_ident::kinematics::HeadBranch;
+use tricept_kinematics::Machine;
 use tricept_model::effects::stiffness_for_platform_deflection;
 use tricept_model::head_errors::Effector;
 use tricept_numerics::stats::quantile;

@@ -21,9 +21,9 @@ use tricept_ident::advanced::{ParameterSet, Poses, TrueErrors};
 use tricept_ident::calibrate::{CalibrateRequest, calibrate};
 use tricept_ident::check::{CheckRequest, check};
 use tricept_ident::export::{ControlModel, ExportOptions, ExportRequest, export};
+use tricept_ident::kinematics::MachineDescription;
 use tricept_ident::report::{ReportRequest, report};
 use tricept_ident::simulate::{SimulateRequest, simulate};
-use tricept_kinematics::MachineDescription;
 
 /// The sample's files, relative to the workspace (the page names them).
 pub const MACHINE: &str = "fixtures/report/table2.json";

@@ -20,7 +20,7 @@ use std::path::PathBuf;
 
 use nalgebra::{DMatrix, Vector3};
 use serde_json::{Value, json};
-use tricept_data::{external::ExternalData, external::PlannedPose};
+use tricept_data::external::{ExternalData, PlannedPose, write_external_path};
 use tricept_engine::fusion::{FusedModel, Source, TrackerOptions, information_factor};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
@@ -309,18 +309,16 @@ impl Plan {
         match &self.out {
             None => Ok(false),
             Some(OutFile::Check(text)) => write_text(path, text).map(|()| true),
-            Some(OutFile::Planned { records, comments }) => {
-                tricept_data::external::write_external_path(
-                    path,
-                    &ExternalData {
-                        records: records.clone(),
-                        source: String::new(),
-                    },
-                    comments,
-                )
-                .map(|()| true)
-                .map_err(|e| Error::not_written(path, &e))
-            }
+            Some(OutFile::Planned { records, comments }) => write_external_path(
+                path,
+                &ExternalData {
+                    records: records.clone(),
+                    source: String::new(),
+                },
+                comments,
+            )
+            .map(|()| true)
+            .map_err(|e| Error::not_written(path, &e)),
         }
     }
 }

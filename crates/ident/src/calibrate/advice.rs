@@ -2,9 +2,8 @@
 //! manufacturing tolerance, and the campaign advice of a campaign too small
 //! to calibrate: how many and which poses would be worthwhile.
 
-use tricept_engine::{
-    IdentError, Identification, accuracy::AccuracyModel, accuracy::PredictedAccuracy,
-};
+use tricept_engine::accuracy::{AccuracyModel, PredictedAccuracy, accuracy_points};
+use tricept_engine::{IdentError, Identification};
 use tricept_kinematics::Machine;
 use tricept_model::ParameterSet;
 
@@ -19,16 +18,11 @@ pub(crate) fn predicted_accuracy(
     id: &Identification,
     tolerance_mm: f64,
 ) -> Result<PredictedAccuracy, Error> {
-    let model = AccuracyModel::new(
-        m,
-        set,
-        &tricept_engine::accuracy::accuracy_points(m),
-        tolerance_mm,
-    )
-    .map_err(|e| match e {
-        IdentError::Invalid(why) => Error::invalid(crate::Setting::ToleranceMm, why),
-        e => Error::with_context("predicted accuracy", e),
-    })?;
+    let model =
+        AccuracyModel::new(m, set, &accuracy_points(m), tolerance_mm).map_err(|e| match e {
+            IdentError::Invalid(why) => Error::invalid(crate::Setting::ToleranceMm, why),
+            e => Error::with_context("predicted accuracy", e),
+        })?;
     model
         .assess(&id.covariance, id.design().fixed())
         .map_err(|e| Error::with_context("predicted accuracy", e))
@@ -42,13 +36,8 @@ pub(crate) fn campaign_advice(
     a: &PredictedAccuracy,
     poses: usize,
 ) -> Result<String, Error> {
-    let model = AccuracyModel::new(
-        m,
-        set,
-        &tricept_engine::accuracy::accuracy_points(m),
-        a.tolerance_mm,
-    )
-    .map_err(|e| Error::with_context("campaign advice", e))?;
+    let model = AccuracyModel::new(m, set, &accuracy_points(m), a.tolerance_mm)
+        .map_err(|e| Error::with_context("campaign advice", e))?;
     let (optimal, random) = tricept_study::campaign::worthwhile_campaigns(m, set, &model)
         .map_err(|e| Error::with_context("campaign advice", e))?;
     let fix = match (optimal, random) {
