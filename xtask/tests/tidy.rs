@@ -135,9 +135,20 @@ fn without_comments(text: &str) -> String {
     strip_keeping(text, true)
 }
 
+/// The code of a file without comments, every string literal kept (raw
+/// strings too).
+fn without_comments_keeping_raw(text: &str) -> String {
+    strip_with(text, true, true)
+}
+
 /// [`strip`], keeping the string literals when `strings` (character
 /// literals and raw strings are dropped either way).
 fn strip_keeping(text: &str, strings: bool) -> String {
+    strip_with(text, strings, false)
+}
+
+/// [`strip_keeping`], keeping raw strings too when `strings && raw`.
+fn strip_with(text: &str, strings: bool, raw: bool) -> String {
     let c: Vec<char> = text.chars().collect();
     let mut out = String::with_capacity(text.len());
     let mut i = 0;
@@ -185,8 +196,12 @@ fn strip_keeping(text: &str, strings: bool) -> String {
                 }
                 j += 1;
             }
+            if strings && raw {
+                out.extend(&c[i..j.min(c.len())]);
+            } else {
+                out.push(' ');
+            }
             i = j;
-            out.push(' ');
         } else if c[i] == '"' {
             let start = i;
             i += 1;

@@ -13,7 +13,7 @@
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
-use super::{relative, without_tests, workspace};
+use super::{relative, without_comments_keeping_raw, without_tests, workspace};
 
 /// Flag-like words that are no flags, with why: `(file, word)`.
 const NOT_FLAGS: &[(&str, &str)] = &[
@@ -30,69 +30,40 @@ const NOT_FLAGS: &[(&str, &str)] = &[
     ("crates/report/src/html.rs", "--s5"),
 ];
 
-/// The code of a Rust file without its comments, string literals kept
-/// verbatim (plain, raw and byte strings), each comment replaced by the
-/// line breaks it held; with `collect`, the string literals as well.
-fn lex(text: &str, mut collect: Option<&mut Vec<String>>) -> String {
-    let c: Vec<char> = text.chars().collect();
-    let mut out = String::with_capacity(text.len());
-    let ident_before = |i: usize| i > 0 && (c[i - 1].is_alphanumeric() || c[i - 1] == '_');
+/// The string literals of code without comments (plain and raw; a
+/// character literal is gone already).
+fn literals(code: &str) -> Vec<String> {
+    let c: Vec<char> = code.chars().collect();
+    let mut found = Vec::new();
     let mut i = 0;
     while i < c.len() {
-        let next = c.get(i + 1).copied();
-        if c[i] == '/' && next == Some('/') {
-            while i < c.len() && c[i] != '\n' {
-                i += 1;
-            }
-        } else if c[i] == '/' && next == Some('*') {
-            let mut depth = 0;
-            while i < c.len() {
-                if c[i] == '/' && c.get(i + 1) == Some(&'*') {
-                    depth += 1;
-                    i += 2;
-                } else if c[i] == '*' && c.get(i + 1) == Some(&'/') {
-                    depth -= 1;
-                    i += 2;
-                    if depth == 0 {
-                        break;
-                    }
-                } else {
-                    if c[i] == '\n' {
-                        out.push('\n');
-                    }
-                    i += 1;
-                }
-            }
-        } else if (c[i] == 'r' || (c[i] == 'b' && next == Some('r'))) && !ident_before(i) {
-            // A raw string (r"..", r#".."#, br".."), or an identifier.
-            let mut j = i + if c[i] == 'b' { 2 } else { 1 };
+        let ident_before = i > 0 && (c[i - 1].is_alphanumeric() || c[i - 1] == '_');
+        let raw_at = match (c[i], c.get(i + 1)) {
+            ('r', _) if !ident_before => Some(i + 1),
+            ('b', Some('r')) if !ident_before => Some(i + 2),
+            _ => None,
+        };
+        if let Some(mut j) = raw_at {
             let mut hashes = 0;
             while c.get(j) == Some(&'#') {
                 hashes += 1;
                 j += 1;
             }
-            if c.get(j) != Some(&'"') {
-                out.push(c[i]);
-                i += 1;
+            if c.get(j) == Some(&'"') {
+                let body = j + 1;
+                let mut end = body;
+                while end < c.len()
+                    && !(c[end] == '"' && (0..hashes).all(|h| c.get(end + 1 + h) == Some(&'#')))
+                {
+                    end += 1;
+                }
+                found.push(c[body..end.min(c.len())].iter().collect());
+                i = end + 1 + hashes;
                 continue;
             }
-            let start = i;
-            let body = j + 1;
-            j = body;
-            while j < c.len() {
-                if c[j] == '"' && (0..hashes).all(|h| c.get(j + 1 + h) == Some(&'#')) {
-                    break;
-                }
-                j += 1;
-            }
-            if let Some(found) = collect.as_deref_mut() {
-                found.push(c[body..j.min(c.len())].iter().collect());
-            }
-            let end = (j + 1 + hashes).min(c.len());
-            out.extend(&c[start..end]);
-            i = end;
-        } else if c[i] == '"' {
-            let start = i;
+        }
+        if c[i] == '"' {
+            let start = i + 1;
             i += 1;
             while i < c.len() && c[i] != '"' {
                 if c[i] == '\\' {
@@ -100,33 +71,11 @@ fn lex(text: &str, mut collect: Option<&mut Vec<String>>) -> String {
                 }
                 i += 1;
             }
-            if let Some(found) = collect.as_deref_mut() {
-                found.push(c[start + 1..i.min(c.len())].iter().collect());
-            }
-            i += 1;
-            out.extend(&c[start..i.min(c.len())]);
-        } else if c[i] == '\'' {
-            // A character literal ('x', '\n', '"') or a lifetime.
-            if next == Some('\\') {
-                let mut j = i + 2;
-                while j < c.len() && c[j] != '\'' {
-                    j += 1;
-                }
-                i = j + 1;
-                out.push(' ');
-            } else if c.get(i + 2) == Some(&'\'') {
-                i += 3;
-                out.push(' ');
-            } else {
-                out.push(c[i]);
-                i += 1;
-            }
-        } else {
-            out.push(c[i]);
-            i += 1;
+            found.push(c[start..i.min(c.len())].iter().collect());
         }
+        i += 1;
     }
-    out
+    found
 }
 
 /// The flags a text names.
@@ -163,10 +112,7 @@ fn flags_in(text: &str) -> Vec<String> {
 
 /// The string literals of a file's code outside comments and tests.
 fn code_literals(text: &str) -> Vec<String> {
-    let code = without_tests(&lex(text, None));
-    let mut found = Vec::new();
-    lex(&code, Some(&mut found));
-    found
+    literals(&without_tests(&without_comments_keeping_raw(text)))
 }
 
 /// The `.rs` files below `dir`.
@@ -189,7 +135,7 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 fn test_module_paths(files: &[PathBuf]) -> BTreeSet<PathBuf> {
     let mut out = BTreeSet::new();
     for f in files {
-        let code = lex(&std::fs::read_to_string(f).unwrap_or_default(), None);
+        let code = without_comments_keeping_raw(&std::fs::read_to_string(f).unwrap_or_default());
         let mut rest = code.as_str();
         while let Some(at) = rest.find("#[cfg(test)]") {
             rest = &rest[at + "#[cfg(test)]".len()..];
