@@ -29,6 +29,18 @@ use tricept_fleet::{BatchOptions, DataFileRecord, PriorFile, PriorProvenance, ca
 use tricept_model::ParameterSet;
 
 pub use tricept_engine::Rejection;
+/// A batch calibrated together ([`FleetResult::batch`]).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::fleet::{Batch, FleetRequest, fleet};
+/// let result = fleet(FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into(), "m3.csv".into()]))?;
+/// let batch: &Batch = result.batch();
+/// println!("{} parameters identifiable across {} machines", batch.identifiable.len(), batch.machines.len());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_fleet::Batch;
 /// The sparse solver of a fleet's joint fit.
 ///
 /// # Example
@@ -41,7 +53,7 @@ pub use tricept_engine::Rejection;
 #[doc(inline)]
 pub use tricept_fleet::SolverKind;
 pub use tricept_fleet::reml::{Distance, Spread};
-pub use tricept_fleet::{Batch, JointFit, MachineOutcome, OwnFit, SolveStats};
+pub use tricept_fleet::{JointFit, MachineOutcome, OwnFit, SolveStats};
 
 use crate::data_input::DataInput;
 use crate::error::Error;

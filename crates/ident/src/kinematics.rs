@@ -37,6 +37,17 @@ pub use crate::linalg::Vector3;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::FkSolution;
+/// Which head solution a tool pose's inverse kinematics returns.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::HeadBranch;
+/// assert_eq!(HeadBranch::default(), HeadBranch::PositiveSecondAxis);
+/// let near = HeadBranch::Nearest([0.1, -0.2]);
+/// assert_ne!(near, HeadBranch::default());
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::HeadBranch;
 /// A solution of [`Machine::inverse`].
 ///
 /// # Example
@@ -49,6 +60,17 @@ pub use tricept_kinematics::FkSolution;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::IkSolution;
+/// A machine file's contents: the description every `--machine` loads.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{Machine, MachineDescription};
+/// let description: MachineDescription = Machine::paper().to_description();
+/// assert_eq!(Machine::from_description(&description, "paper")?, Machine::paper());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::MachineDescription;
 pub use tricept_kinematics::SensorNoise as LoggedSensorNoise;
 /// A solution of [`Machine::tool_inverse`].
 ///
@@ -74,6 +96,19 @@ pub use tricept_kinematics::ToolIkSolution;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::UpJoints;
+/// One value of a solved point ([`PointSolution::cells`]).
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::kinematics::{Cell, Verb, solve_point};
+/// let solved = solve_point(Verb::Ik, &MachineInput::default().load()?, &[0.0, 0.0, 750.0])?;
+/// let numbers = solved.cells().iter().filter(|c| matches!(c, Cell::Num(_))).count();
+/// assert!(numbers >= 6);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::batch::Cell;
 pub use tricept_kinematics::batch::PointKinematics;
 /// The kinematics verbs [`solve_point`] and [`run`] solve.
 ///
@@ -85,7 +120,7 @@ pub use tricept_kinematics::batch::PointKinematics;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::batch::Verb;
-pub use tricept_kinematics::batch::{BLOCK_ROWS, BatchError, Cell, run};
+pub use tricept_kinematics::batch::{BLOCK_ROWS, BatchError, run};
 pub use tricept_kinematics::description::{
     AccuracyRecord, AxisOrder, CalibrationRecord, CircularPlacement, ControllerDescription,
     CorrelationsDescription, ExplicitPlacement, ExternalSourceRecord, HeadDescription,
@@ -94,8 +129,8 @@ pub use tricept_kinematics::description::{
     UpLimbDescription, WorkspaceDescription,
 };
 pub use tricept_kinematics::{
-    DescriptionError, Head, HeadBranch, KinematicsError, LegGeometry, Limits, MachineDescription,
-    ToolPose, UpLimb, UpLimbPose, Workspace,
+    DescriptionError, Head, KinematicsError, LegGeometry, Limits, ToolPose, UpLimb, UpLimbPose,
+    Workspace,
 };
 
 /// The geometric machine with its static leg effects, as [`Machine::extended`] holds it.
