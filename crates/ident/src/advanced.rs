@@ -84,7 +84,21 @@ pub use tricept_data::DataError;
 /// ```
 #[doc(inline)]
 pub use tricept_data::Dataset;
-pub use tricept_data::{MeasuredPose, Readings};
+/// One pose of measured data (a [`Dataset`]'s `poses`).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{MeasuredPose, read_data_from};
+/// use tricept_ident::kinematics::GeometricMachine;
+/// let csv = "q1,q2,q3,phi,theta,s\n700,701,702,0,0,5\n";
+/// let data = read_data_from(csv.as_bytes(), "memory", &GeometricMachine::paper())?;
+/// let pose: &MeasuredPose = &data.poses[0];
+/// assert_eq!(pose.commands_mm, [700.0, 701.0, 702.0]);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_data::MeasuredPose;
+pub use tricept_data::Readings;
 pub use tricept_diagnose::{DeployError, DiagnoseError};
 
 /// The manufacturing tolerance a calibration is judged against by default, mm.

@@ -28,6 +28,21 @@ use crate::error::{EXIT_OK, Error};
 use crate::inputs::Poses;
 use crate::machine_input::MachineInput;
 
+/// How large an effect must be before a diagnosis finds it ([`DetectabilityReport::rows`]).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::advanced::Poses;
+/// use tricept_ident::detectability::{Detectability, DetectabilityRequest, detectability};
+/// let report = detectability(DetectabilityRequest::new(MachineInput::default(), Poses::grid()))?;
+/// for (name, d, _) in report.rows() {
+///     let d: &Detectability = d;
+///     println!("{name}: power {} for {:?}", d.power, d.parameters);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
 pub use tricept_diagnose::detect::Detectability;
 
 /// The campaign to assess.

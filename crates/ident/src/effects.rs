@@ -39,6 +39,19 @@ pub use tricept_model::effects::{
     Needs, Parameter, PlausibleRange, PlotAxes, Simulate,
 };
 pub use tricept_model::plausibility::Range;
+
+/// An effect a simulated machine hides ([`EffectList::effects`], `simulate`'s truth).
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::{Effect, effects};
+/// let list = effects(Some("leg-lead"))?;
+/// let lead: &Effect = &list.effects()[0];
+/// let mut request = tricept_ident::simulate::SimulateRequest::new(tricept_ident::MachineInput::default());
+/// request.truth_effects.push(lead.clone());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
 pub use tricept_plant::Effect;
 
 /// The effects listed: all, or the one asked for.

@@ -35,6 +35,18 @@ use tricept_model::ParameterSet;
 
 pub use crate::outcome::{WriteOptions, Written};
 pub use tricept_engine::robust::Rejection;
+/// A batch calibrated together ([`FleetResult::batch`]).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::fleet::{Batch, FleetRequest, fleet};
+/// let result = fleet(FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into(), "m3.csv".into()]))?;
+/// let batch: &Batch = result.batch();
+/// println!("{} parameters identifiable across {} machines", batch.identifiable.len(), batch.machines.len());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_fleet::Batch;
 /// The sparse solver of a fleet's joint fit.
 ///
 /// # Example
@@ -47,9 +59,7 @@ pub use tricept_engine::robust::Rejection;
 #[doc(inline)]
 pub use tricept_fleet::batch::SolverKind;
 pub use tricept_fleet::reml::{Distance, Spread};
-pub use tricept_fleet::{
-    Batch, batch::MachineOutcome, batch::SolveStats, joint::JointFit, own::OwnFit,
-};
+pub use tricept_fleet::{batch::MachineOutcome, batch::SolveStats, joint::JointFit, own::OwnFit};
 
 use crate::Setting;
 use crate::data_input::DataInput;

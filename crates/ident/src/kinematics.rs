@@ -24,6 +24,30 @@ use crate::inputs::LoadedMachine;
 
 pub use crate::commanding::{GeometricMachine, Machine};
 pub use crate::linalg::Vector3;
+/// A machine file's contents: the description every `--machine` loads.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{Machine, MachineDescription};
+/// let description: MachineDescription = Machine::paper().to_description();
+/// assert_eq!(Machine::from_description(&description, "paper")?, Machine::paper());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::MachineDescription;
+/// One value of a solved point ([`PointSolution::cells`]).
+///
+/// # Example
+/// ```
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::kinematics::{Cell, Verb, solve_point};
+/// let solved = solve_point(Verb::Ik, &MachineInput::default().load()?, &[0.0, 0.0, 750.0])?;
+/// let numbers = solved.cells().iter().filter(|c| matches!(c, Cell::Num(_))).count();
+/// assert!(numbers >= 6);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::batch::Cell;
 pub use tricept_kinematics::batch::PointKinematics;
 /// The kinematics verbs [`solve_point`] and [`run`] solve.
 ///
@@ -35,7 +59,7 @@ pub use tricept_kinematics::batch::PointKinematics;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::batch::Verb;
-pub use tricept_kinematics::batch::{BLOCK_ROWS, BatchError, Cell, run};
+pub use tricept_kinematics::batch::{BLOCK_ROWS, BatchError, run};
 pub use tricept_kinematics::description::{
     AccuracyRecord, AxisOrder, CalibrationRecord, CircularPlacement, ControllerDescription,
     CorrelationsDescription, ExplicitPlacement, ExternalSourceRecord, HeadDescription,
@@ -56,6 +80,17 @@ pub use tricept_kinematics::description::{
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::fk::FkSolution;
+/// Which head solution a tool pose's inverse kinematics returns.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::HeadBranch;
+/// assert_eq!(HeadBranch::default(), HeadBranch::PositiveSecondAxis);
+/// let near = HeadBranch::Nearest([0.1, -0.2]);
+/// assert_ne!(near, HeadBranch::default());
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::head::HeadBranch;
 /// A solution of [`Machine::tool_inverse`].
 ///
 /// # Example
@@ -94,9 +129,8 @@ pub use tricept_kinematics::machine::SensorNoise as LoggedSensorNoise;
 #[doc(inline)]
 pub use tricept_kinematics::up_limb::UpJoints;
 pub use tricept_kinematics::{
-    KinematicsError, MachineDescription, Workspace, error::DescriptionError, head::Head,
-    head::HeadBranch, head::ToolPose, machine::LegGeometry, machine::Limits, up_limb::UpLimb,
-    up_limb::UpLimbPose,
+    KinematicsError, Workspace, error::DescriptionError, head::Head, head::ToolPose,
+    machine::LegGeometry, machine::Limits, up_limb::UpLimb, up_limb::UpLimbPose,
 };
 
 /// The geometric machine with its static leg effects, as [`Machine::extended`] holds it.
