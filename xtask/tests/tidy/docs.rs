@@ -131,8 +131,9 @@ fn the_docs_reader_finds_examples_and_internal_paths() {
 
 /// Names a door signature may use besides the door's own.
 const STD_NAMES: &[&str] = &[
-    "AsRef", "Box", "BufRead", "Display", "Fn", "Into", "Item", "Iterator", "Map", "Option",
-    "Path", "PathBuf", "Read", "Result", "Self", "Send", "String", "Sync", "Value", "Vec", "Write",
+    "AsRef", "Box", "BufRead", "Display", "Fn", "FnOnce", "Into", "Item", "Iterator", "Map",
+    "Option", "Path", "PathBuf", "Read", "Result", "Self", "Send", "String", "Sync", "Value",
+    "Vec", "Write",
 ];
 
 #[test]
