@@ -36,7 +36,8 @@
 //!
 //! # Example
 //! ```
-//! use tricept_ident::advanced::{LoadedMachine, SensorNoise, load_machine};
+//! use tricept_ident::LoadedMachine;
+//! use tricept_ident::advanced::{SensorNoise, load_machine};
 //! let noise = SensorNoise { length_noise_um: Some(2.0), ..SensorNoise::default() };
 //! let loaded: LoadedMachine = load_machine(None, &noise)?;
 //! assert!(loaded.warnings().is_empty());

@@ -9,7 +9,7 @@
 //! use tricept_ident::MachineInput;
 //! use tricept_ident::advanced::Poses;
 //! use tricept_ident::detectability::{DetectabilityRequest, detectability};
-//! let report = detectability(DetectabilityRequest::new(MachineInput::default(), Poses::grid()))?;
+//! let report = detectability(DetectabilityRequest::new(Poses::grid()))?;
 //! for (effect, _detectability, advice) in report.rows() {
 //!     println!("{effect}: {advice}");
 //! }
@@ -35,7 +35,7 @@ use crate::machine_input::MachineInput;
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::advanced::Poses;
 /// use tricept_ident::detectability::{Detectability, DetectabilityRequest, detectability};
-/// let report = detectability(DetectabilityRequest::new(MachineInput::default(), Poses::grid()))?;
+/// let report = detectability(DetectabilityRequest::new(Poses::grid()))?;
 /// for (name, d, _) in report.rows() {
 ///     let d: &Detectability = d;
 ///     println!("{name}: power {} for {:?}", d.power, d.parameters);
@@ -52,7 +52,7 @@ pub use tricept_diagnose::detect::Detectability;
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::advanced::Poses;
 /// use tricept_ident::detectability::DetectabilityRequest;
-/// let request = DetectabilityRequest::new(MachineInput::default(), Poses::grid());
+/// let request = DetectabilityRequest::new(Poses::grid());
 /// assert!(request.data.is_none());
 /// ```
 #[derive(Debug, Clone)]
@@ -101,7 +101,7 @@ crate::request::setters!(DetectabilityRequest {
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::advanced::Poses;
 /// use tricept_ident::detectability::{DetectabilityRequest, detectability};
-/// let report = detectability(DetectabilityRequest::new(MachineInput::default(), Poses::grid()))?;
+/// let report = detectability(DetectabilityRequest::new(Poses::grid()))?;
 /// for (effect, _detectability, advice) in report.rows() {
 ///     println!("{effect}: {advice}");
 /// }
@@ -124,7 +124,7 @@ crate::outcome::outcome!(DetectabilityReport);
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::advanced::Poses;
 /// use tricept_ident::detectability::{DetectabilityRequest, detectability};
-/// let report = detectability(DetectabilityRequest::new(MachineInput::default(), Poses::grid()))?;
+/// let report = detectability(DetectabilityRequest::new(Poses::grid()))?;
 /// for (effect, _detectability, advice) in report.rows() {
 ///     println!("{effect}: {advice}");
 /// }

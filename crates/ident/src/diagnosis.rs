@@ -15,7 +15,7 @@
 //! # Example
 //! ```no_run
 //! use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
-//! let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+//! let result = diagnose(DiagnoseRequest::new("campaign.csv").machine("calibrated.json"))?;
 //! if !result.explained() {
 //!     for cause in &result.diagnosis().causes {
 //!         println!("{}: {}", cause.effect, cause.description);
@@ -48,8 +48,9 @@ pub use crate::outcome::{WriteOptions, Written};
 /// ```no_run
 /// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
 /// use tricept_ident::kinematics::{Machine, Vector3};
-/// let deployed = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?.deploy()?;
-/// let machine = Machine::from(&deployed);
+/// let result = diagnose(DiagnoseRequest::new("campaign.csv").machine("calibrated.json"))?;
+/// let deployed = result.deploy()?;
+/// let machine = Machine::from(deployed);
 /// let legs_mm = machine.inverse(&Vector3::new(0.0, 0.0, 750.0))?.legs_mm;
 /// # Ok::<(), tricept_ident::Error>(())
 /// ```
@@ -60,7 +61,7 @@ pub use tricept_diagnose::Deployed;
 /// # Example
 /// ```no_run
 /// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
-/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// let result = diagnose(DiagnoseRequest::new("campaign.csv").machine("calibrated.json"))?;
 /// let diagnosis = result.diagnosis();
 /// println!("chi-square {} on {} dof", diagnosis.chi_square, diagnosis.dof);
 /// # Ok::<(), tricept_ident::Error>(())
@@ -72,7 +73,7 @@ pub use tricept_diagnose::Diagnosis;
 /// # Example
 /// ```
 /// use tricept_ident::diagnosis::{DeployRule, DiagnoseRequest};
-/// let request = DiagnoseRequest::new("calibrated.json", "campaign.csv");
+/// let request = DiagnoseRequest::new("campaign.csv").machine("calibrated.json");
 /// assert_eq!(request.deploy_rule, DeployRule::ExpectedError);
 /// ```
 #[doc(inline)]
@@ -82,7 +83,7 @@ pub use tricept_diagnose::options::DeployRule;
 /// # Example
 /// ```no_run
 /// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose, Cause};
-/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// let result = diagnose(DiagnoseRequest::new("campaign.csv").machine("calibrated.json"))?;
 /// let diagnosis = result.diagnosis();
 /// let causes: &[Cause] = &diagnosis.causes;
 /// for cause in causes.iter().filter(|c| c.plausible) {
@@ -97,7 +98,7 @@ pub use tricept_diagnose::report::Cause;
 /// # Example
 /// ```no_run
 /// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose, Gain};
-/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// let result = diagnose(DiagnoseRequest::new("campaign.csv").machine("calibrated.json"))?;
 /// let diagnosis = result.diagnosis();
 /// let gain: &Gain = &diagnosis.gain;
 /// println!("held-out rms {} -> {}", gain.holdout_rms_geometric, gain.holdout_rms_extended);
@@ -120,7 +121,8 @@ pub use tricept_diagnose::{
 /// # Example
 /// ```no_run
 /// use tricept_ident::diagnosis::{DiagnoseRequest, Identification, diagnose};
-/// let deployed = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?.deploy()?;
+/// let result = diagnose(DiagnoseRequest::new("campaign.csv").machine("calibrated.json"))?;
+/// let deployed = result.deploy()?;
 /// let id: &Identification = &deployed.id;
 /// for ((name, value), sigma) in id.names.iter().zip(&id.estimate).zip(&id.std_dev) {
 ///     println!("{name} = {value} ({sigma:?})");
@@ -200,7 +202,7 @@ crate::request::setters!(DiagnoseRequest {
 /// # Example
 /// ```no_run
 /// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
-/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// let result = diagnose(DiagnoseRequest::new("campaign.csv").machine("calibrated.json"))?;
 /// if !result.explained() {
 ///     for cause in &result.diagnosis().causes {
 ///         println!("{}: {}", cause.effect, cause.description);
@@ -239,7 +241,7 @@ struct Deployment {
 /// # Example
 /// ```no_run
 /// use tricept_ident::diagnosis::{DiagnoseRequest, diagnose};
-/// let result = diagnose(DiagnoseRequest::new("calibrated.json", "campaign.csv"))?;
+/// let result = diagnose(DiagnoseRequest::new("campaign.csv").machine("calibrated.json"))?;
 /// if !result.explained() {
 ///     for cause in &result.diagnosis().causes {
 ///         println!("{}: {}", cause.effect, cause.description);

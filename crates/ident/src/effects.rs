@@ -47,7 +47,7 @@ pub use tricept_model::plausibility::Range;
 /// use tricept_ident::effects::{Effect, effects};
 /// let list = effects(Some("leg-lead"))?;
 /// let lead: &Effect = &list.effects()[0];
-/// let mut request = tricept_ident::simulate::SimulateRequest::new(tricept_ident::MachineInput::default());
+/// let mut request = tricept_ident::simulate::SimulateRequest::new();
 /// request.truth_effects.push(lead.clone());
 /// # Ok::<(), tricept_ident::Error>(())
 /// ```

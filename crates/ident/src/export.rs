@@ -6,13 +6,13 @@
 //! ```no_run
 //! use tricept_ident::MachineInput;
 //! use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
-//! let request = ExportRequest {
-//!     machine: MachineInput::from("calibrated.json"),
-//!     options: ExportOptions::new(Controller::Heidenhain),
-//!     out: "export".into(),
-//! };
+//! let request = ExportRequest::new(
+//!     MachineInput::from("calibrated.json"),
+//!     ExportOptions::new(Controller::Heidenhain),
+//!     "export",
+//! );
 //! let exported = export(request)?;
-//! assert!(exported.written || exported.exit_code != tricept_ident::EXIT_OK);
+//! assert!(exported.written() || exported.exit_code() != tricept_ident::EXIT_OK);
 //! # Ok::<(), tricept_ident::Error>(())
 //! ```
 
@@ -53,13 +53,13 @@ pub use tricept_export::{
 /// ```no_run
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
-/// let request = ExportRequest {
-///     machine: MachineInput::from("calibrated.json"),
-///     options: ExportOptions::new(Controller::Heidenhain),
-///     out: "export".into(),
-/// };
+/// let request = ExportRequest::new(
+///     MachineInput::from("calibrated.json"),
+///     ExportOptions::new(Controller::Heidenhain),
+///     "export",
+/// );
 /// let exported = export(request)?;
-/// assert!(exported.written || exported.exit_code != tricept_ident::EXIT_OK);
+/// assert!(exported.written() || exported.exit_code() != tricept_ident::EXIT_OK);
 /// # Ok::<(), tricept_ident::Error>(())
 /// ```
 #[derive(Debug, Clone)]
@@ -97,13 +97,13 @@ impl ExportRequest {
 /// ```no_run
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
-/// let request = ExportRequest {
-///     machine: MachineInput::from("calibrated.json"),
-///     options: ExportOptions::new(Controller::Heidenhain),
-///     out: "export".into(),
-/// };
+/// let request = ExportRequest::new(
+///     MachineInput::from("calibrated.json"),
+///     ExportOptions::new(Controller::Heidenhain),
+///     "export",
+/// );
 /// let exported = export(request)?;
-/// assert!(exported.written || exported.exit_code != tricept_ident::EXIT_OK);
+/// assert!(exported.written() || exported.exit_code() != tricept_ident::EXIT_OK);
 /// # Ok::<(), tricept_ident::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
@@ -218,13 +218,13 @@ impl Export {
 /// ```no_run
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
-/// let request = ExportRequest {
-///     machine: MachineInput::from("calibrated.json"),
-///     options: ExportOptions::new(Controller::Heidenhain),
-///     out: "export".into(),
-/// };
+/// let request = ExportRequest::new(
+///     MachineInput::from("calibrated.json"),
+///     ExportOptions::new(Controller::Heidenhain),
+///     "export",
+/// );
 /// let exported = export(request)?;
-/// assert!(exported.written || exported.exit_code != tricept_ident::EXIT_OK);
+/// assert!(exported.written() || exported.exit_code() != tricept_ident::EXIT_OK);
 /// # Ok::<(), tricept_ident::Error>(())
 /// ```
 pub fn export(request: ExportRequest) -> Result<Export, Error> {

@@ -11,7 +11,7 @@
 //! ```
 //! use tricept_ident::MachineInput;
 //! use tricept_ident::simulate::{SimulateRequest, simulate};
-//! let sim = simulate(SimulateRequest::new(MachineInput::default()))?;
+//! let sim = simulate(SimulateRequest::new())?;
 //! assert!(!sim.data().poses.is_empty());
 //! assert_eq!(sim.exit_code(), tricept_ident::EXIT_OK);
 //! # Ok::<(), tricept_ident::Error>(())
@@ -169,7 +169,7 @@ impl TruthEffects {
 /// ```
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::simulate::{SimulateRequest, TrackerSimulation};
-/// let mut request = SimulateRequest::new(MachineInput::default());
+/// let mut request = SimulateRequest::new();
 /// request.tracker = Some(TrackerSimulation {
 ///     poses: "tracker-poses.csv".into(),
 ///     frame_mm_rad: [0.0; 6],
@@ -198,7 +198,7 @@ pub struct TrackerSimulation {
 /// ```
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::simulate::{SimulateRequest, BallbarSimulation};
-/// let mut request = SimulateRequest::new(MachineInput::default());
+/// let mut request = SimulateRequest::new();
 /// request.ballbar = Some(BallbarSimulation {
 ///     poses: "ballbar-poses.csv".into(),
 ///     pivot_mm: [0.0, 0.0, 600.0],
@@ -226,7 +226,7 @@ pub struct BallbarSimulation {
 /// ```
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::simulate::{SimulateRequest, TouchSimulation};
-/// let mut request = SimulateRequest::new(MachineInput::default());
+/// let mut request = SimulateRequest::new();
 /// request.touch = Some(TouchSimulation {
 ///     poses: "touch-poses.csv".into(),
 ///     sphere_mm: [0.0, 0.0, 700.0],
@@ -358,7 +358,7 @@ crate::request::setters!(SimulateRequest {
 /// ```
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::simulate::{SimulateRequest, simulate};
-/// let mut request = SimulateRequest::new(MachineInput::default());
+/// let mut request = SimulateRequest::new();
 /// request.poses = "random:12,7".parse()?;
 /// let sim = simulate(request)?;
 /// assert_eq!(sim.data().poses.len(), 12);
@@ -386,7 +386,7 @@ crate::outcome::outcome!(Simulation);
 /// ```
 /// use tricept_ident::MachineInput;
 /// use tricept_ident::simulate::{SimulateRequest, simulate};
-/// let sim = simulate(SimulateRequest::new(MachineInput::default()))?;
+/// let sim = simulate(SimulateRequest::new())?;
 /// assert!(!sim.data().poses.is_empty());
 /// assert_eq!(sim.exit_code(), tricept_ident::EXIT_OK);
 /// # Ok::<(), tricept_ident::Error>(())
