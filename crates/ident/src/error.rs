@@ -169,10 +169,17 @@ pub enum ErrorCause {
     /// A write refused: the result is not to be trusted (its exit code
     /// says why) and writing was not forced.
     RefusedWrite,
-    /// A fit that did not converge (exit code 4).
+    /// A fit that did not converge (exit code 4), when nothing more is
+    /// known. No workflow of this version fails this way: a fit that does
+    /// not converge is a *result* whose `exit_code()` is 4, and writing its
+    /// file unforced is a [`ErrorCause::RefusedWrite`] of kind
+    /// [`ErrorKind::NotConverged`]. Kept for errors of that kind a later
+    /// version may raise, so that a program's match already covers them.
     NotConverged,
-    /// A model that does not explain the data, or a campaign too small to
-    /// calibrate (exit code 3).
+    /// A model that does not explain the data (exit code 3), when nothing
+    /// more is known. As with [`ErrorCause::NotConverged`], an inadequate
+    /// fit is a result (exit code 3) and writing it unforced is a
+    /// [`ErrorCause::RefusedWrite`] of kind [`ErrorKind::Inadequate`].
     Inadequate,
     /// Another input that cannot be used (exit code 2).
     Invalid,

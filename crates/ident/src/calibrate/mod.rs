@@ -60,8 +60,8 @@
 //     model to `engine/src/accuracy/promise.rs` (`of_fit_stated`: the
 //     promise with its report line)
 // 18. `ident/src/machine_file.rs`: the mean temperature
-// 19. `ident/src/error.rs`: the exit line; `engine/src/report.rs`: the
-//     identification's table
+// 19. `engine/src/report.rs`: the identification's table (the exit line
+//     is the CLI's own, `ident_cmd.rs`, from the stored `reason()`)
 // 20. `cli/src/output.rs`: the machine file's warnings
 // 21. `cli/src/output.rs`: the report (R; between 20 and 21 the CLI reads
 //     the stored report)
