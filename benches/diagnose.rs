@@ -18,7 +18,7 @@ use tricept_kinematics::Machine;
 use tricept_plant::effects::Waveform;
 use tricept_plant::{Campaign, Plant, random_errors};
 
-fn data(n: usize, seed: u64, effects: Vec<Effect>) -> tricept_ident::advanced::Dataset {
+fn data(n: usize, seed: u64, effects: Vec<Effect>) -> tricept_ident::Dataset {
     let m = Machine::paper();
     let set = ParameterSet::paper15();
     let mut plant = Plant::geometric(m.clone(), set.to_errors(&random_errors(15, 0.25, seed)));

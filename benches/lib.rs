@@ -14,11 +14,7 @@ pub fn workspace_points(m: &Machine, n: usize) -> Vec<Vector3<f64>> {
 /// A batch of `machines` machines of the Table 1 machine, `poses` random
 /// poses each (the paper's noise): Table 2's errors as the batch error,
 /// each machine's own deviation N(0, 0.05 mm) per parameter, seeded.
-pub fn fleet_batch(
-    machines: usize,
-    poses: usize,
-    seed: u64,
-) -> Vec<tricept_ident::advanced::Dataset> {
+pub fn fleet_batch(machines: usize, poses: usize, seed: u64) -> Vec<tricept_ident::Dataset> {
     use rand::SeedableRng;
     use rand_distr::{Distribution, StandardNormal};
     let m = Machine::paper();

@@ -31,8 +31,8 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use rayon::prelude::*;
-use tricept_ident::MachineInput;
 use tricept_ident::LoadedMachine;
+use tricept_ident::MachineInput;
 use tricept_ident::advanced::SensorNoise;
 use tricept_ident::kinematics::{ExtendedMachine, HeadBranch, KinematicsError, Vector3};
 

@@ -10,10 +10,8 @@ use std::path::PathBuf;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::prelude::*;
-use tricept_ident::advanced::{
-    MachineFile, ParameterSet, Poses, SensorNoise, TrueErrors,
-};
-use tricept_ident::calibrate::CalibrateRequest;
+use tricept_ident::advanced::{ParameterSet, Poses, SensorNoise, TrueErrors};
+use tricept_ident::calibrate::{CalibrateRequest, MachineFile};
 use tricept_ident::check::CheckRequest;
 use tricept_ident::diagnosis::DiagnoseRequest;
 use tricept_ident::simulate::SimulateRequest;

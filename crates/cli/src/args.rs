@@ -9,8 +9,9 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
+use tricept_ident::Dataset;
 use tricept_ident::advanced::{
-    Dataset, EffectNames, EvalGrid, HeadAngles, HeadModel, LengthSigma, ParameterSet, SensorNoise,
+    EffectNames, EvalGrid, HeadAngles, HeadModel, LengthSigma, ParameterSet, SensorNoise,
     TrackerTargetSpec, Triple, TrueErrors,
 };
 use tricept_ident::calibrate::{CalibrateRequest, FusedSources};

@@ -19,14 +19,17 @@
 //! - **Output format**: the `format_version` of the JSON outputs
 //!   ([`OUTPUT_FORMAT_VERSION`]) and the one way it is put into one
 //!   ([`versioned_json`]: what `--json` prints).
-//! - **Result parts**: the [`MachineFile`] a result may write (kept apart
-//!   from it, to write later by the same rule). The result's shape
+//! - **Result parts**: the machine file a result may write
+//!   ([`crate::calibrate::MachineFile`], kept apart from it, to write later
+//!   by the same rule). The result's shape
 //!   ([`crate::Outcome`], [`crate::WritesMachine`]), how it writes
 //!   ([`crate::WriteOptions`], [`crate::Written`]) and the accuracy a
 //!   written file promises ([`crate::calibrate::Accuracy`]) are at the root
 //!   and in the workflows' modules.
 //! - **Low level**: the error mapping of the internal crates' errors
-//!   ([`Classify`], and the file-system failure under one, [`FileFailure`]), the data set in memory ([`Dataset`]) and its reader,
+//!   ([`Classify`]; the file-system failure under one is the root's
+//!   [`crate::FileFailure`]), the reader of data in memory
+//!   ([`read_data_from`], giving the root's [`crate::Dataset`]),
 //!   and the foreign crates whose types results hold (`nalgebra`,
 //!   `serde_json`).
 //! - **Beside the door**: files written as every verb writes them
@@ -48,13 +51,12 @@ pub use crate::calibrate::values::{
     EffectNames, EvalGrid, HeadModel, LengthSigma, TrackerTargetSpec,
 };
 pub use crate::data_input::read_data_from;
-pub use crate::error::{Classify, FileFailure};
+pub use crate::error::Classify;
 pub use crate::inputs::{
     FrameMmRad, HeadAngles, Poses, SensorNoise, Triple, TrueErrors, load_machine, parse_effects,
     parse_numbers,
 };
 pub use crate::json_version::{OUTPUT_FORMAT_VERSION, versioned_json};
-pub use crate::machine_file::MachineFile;
 pub use nalgebra;
 pub use serde_json;
 
@@ -72,20 +74,7 @@ pub use tricept_check::check::DEFAULT_POWER;
 // from ([`Classify`]).
 pub use tricept_check::CheckError;
 pub use tricept_data::DataError;
-/// Measured data in memory (what a [`DataInput`](crate::DataInput) loads).
-///
-/// # Example
-/// ```
-/// use tricept_ident::advanced::{Dataset, read_data_from};
-/// use tricept_ident::kinematics::GeometricMachine;
-/// let csv = "q1,q2,q3,phi,theta,s\n700,700,700,0,0,5\n701,699,700,0.001,0,5\n";
-/// let data: Dataset = read_data_from(csv.as_bytes(), "memory", &GeometricMachine::paper())?;
-/// assert_eq!(data.poses.len(), 2);
-/// # Ok::<(), tricept_ident::Error>(())
-/// ```
-#[doc(inline)]
-pub use tricept_data::Dataset;
-/// One pose of measured data (a [`Dataset`]'s `poses`).
+/// One pose of measured data (a [`crate::Dataset`]'s `poses`).
 ///
 /// # Example
 /// ```

@@ -41,6 +41,7 @@ use crate::machine_file;
 use crate::machine_input::MachineInput;
 
 pub use crate::accuracy::Accuracy;
+pub use crate::machine_file::MachineFile;
 pub use crate::outcome::{WriteOptions, Written};
 /// A diagnosis' final model deployed ([`DiagnoseResult::deploy`]).
 ///
@@ -501,7 +502,7 @@ impl DiagnoseResult {
     }
 
     /// The machine file of the final model, kept apart from the result
-    /// ([`crate::advanced::MachineFile`]): the description (forced when
+    /// ([`MachineFile`]): the description (forced when
     /// the data are not explained) and the verdict the write rule applies.
     pub fn machine_file(&self) -> Result<crate::machine_file::MachineFile, Error> {
         let (description, forced) = self.extended_description("the machine file", true)?;

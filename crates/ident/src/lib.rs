@@ -127,6 +127,7 @@ pub mod advanced;
 // `advanced`, unless every user needs it.
 
 // The error and the exit codes.
+pub use error::FileFailure;
 pub use error::{
     EXIT_INADEQUATE, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_OK, EXIT_OTHER, Error, ErrorCause,
     ErrorKind,
@@ -138,6 +139,20 @@ pub use setting::Setting;
 pub use data_input::DataInput;
 pub use inputs::LoadedMachine;
 pub use machine_input::MachineInput;
+/// Measured data in memory (what a [`DataInput`](crate::DataInput) loads).
+///
+/// # Example
+/// ```
+/// use tricept_ident::Dataset;
+/// use tricept_ident::advanced::read_data_from;
+/// use tricept_ident::kinematics::GeometricMachine;
+/// let csv = "q1,q2,q3,phi,theta,s\n700,700,700,0,0,5\n701,699,700,0.001,0,5\n";
+/// let data: Dataset = read_data_from(csv.as_bytes(), "memory", &GeometricMachine::paper())?;
+/// assert_eq!(data.poses.len(), 2);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_data::Dataset;
 
 // The one shape of every workflow's result, and how one writes its file.
 pub use outcome::{Outcome, WriteOptions, WritesMachine, Written};

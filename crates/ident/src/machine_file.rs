@@ -391,7 +391,7 @@ pub fn calibrated_description(
 ///
 /// # Example
 /// ```
-/// use tricept_ident::advanced::MachineFile;
+/// use tricept_ident::calibrate::MachineFile;
 /// let f = MachineFile::from_json("{}");
 /// assert!(f.is_err());
 /// ```

@@ -17,6 +17,9 @@
 //!   under the door, and no signature spells an internal crate's path.
 //!   The signatures of the re-exported internal items are not read here
 //!   (their field and method types were checked on `cargo doc`'s pages).
+//! - **Not only in `advanced`.** A type a signature outside `advanced`
+//!   returns is exported outside `advanced` too (`advanced` "may change";
+//!   what a stable call returns may not).
 
 use std::collections::BTreeSet;
 
@@ -188,5 +191,58 @@ fn door_signatures_name_door_types_only() {
     assert!(
         wrong.is_empty(),
         "door signatures naming what the door does not export: {wrong:#?}"
+    );
+}
+
+#[test]
+fn what_a_door_call_returns_is_not_only_in_advanced() {
+    let (files, reexported) = door();
+    let advanced = workspace().join("crates/ident/src/advanced.rs");
+    let mut elsewhere: BTreeSet<String> = reexported
+        .iter()
+        .filter(|(_, _, f)| *f != advanced)
+        .map(|(_, n, _)| n.clone())
+        .collect();
+    // Items written in a public module's own file (`calibrate/values.rs`
+    // is private: its items are reachable where they are re-exported).
+    let public_file = |file: &str| file == "lib.rs" || !file[..file.len() - 3].contains('/');
+    elsewhere.extend(door_items().iter().filter_map(|(i, _)| {
+        let (file, item) = i.split_once(": ")?;
+        let own_file = file
+            .strip_suffix("/mod.rs")
+            .map_or(file.to_string(), |m| format!("{m}.rs"));
+        (own_file != "advanced.rs" && public_file(&own_file))
+            .then(|| item.rsplit(' ').next().unwrap_or("").to_string())
+    }));
+    // Types only (the foreign crates `advanced` re-exports are modules).
+    let only_advanced: BTreeSet<&str> = reexported
+        .iter()
+        .filter(|(_, n, f)| *f == advanced && !elsewhere.contains(n))
+        .filter(|(_, n, _)| n.starts_with(|c: char| c.is_ascii_uppercase()))
+        .map(|(_, n, _)| n.as_str())
+        .collect();
+    assert!(files.contains_key(&advanced) && !only_advanced.is_empty());
+    let listing = std::fs::read_to_string(workspace().join("crates/ident/public-api.txt"));
+    let mut wrong = Vec::new();
+    for line in listing.unwrap_or_default().lines() {
+        let (owner, item) = line.split_once(" :: ").unwrap_or(("", line));
+        let own = match owner.rsplit(' ').next().filter(|o| !o.is_empty()) {
+            Some(owner) => ident(owner),
+            None => ident(item.split("fn ").nth(1).unwrap_or("")),
+        };
+        let returned = item.split_once(") -> ").map_or("", |(_, r)| r);
+        if own.is_empty() || only_advanced.contains(own) || !item.contains("fn ") {
+            continue;
+        }
+        let named = returned
+            .split(|c: char| !(c.is_alphanumeric() || c == '_'))
+            .find(|w| only_advanced.contains(w));
+        if let Some(name) = named {
+            wrong.push(format!("{name} in `{line}`"));
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "returned by a door call, exported only from `advanced`: {wrong:#?}"
     );
 }

@@ -92,6 +92,7 @@ pub(crate) use crate::error::exit_reason;
 use crate::inputs::LoadedMachine;
 pub use crate::linalg::DMatrix;
 use crate::machine_file;
+pub use crate::machine_file::MachineFile;
 use crate::machine_input::MachineInput;
 pub use crate::outcome::{WriteOptions, Written};
 use checked::{Checked, Work};
@@ -481,7 +482,7 @@ impl Calibration {
     }
 
     /// The machine file this calibration may write, kept apart from it
-    /// ([`crate::advanced::MachineFile`]): the description (forced when
+    /// ([`MachineFile`]): the description (forced when
     /// the exit code is not 0) and the verdict the write rule applies. An
     /// input error for data given in memory (the record holds the data
     /// file's hash).
