@@ -1234,8 +1234,41 @@ fn public_api(root: &Path) -> Vec<String> {
                 format!("{owner} :: {item}")
             });
         }
+        items.extend(generated_setters(text));
     }
     items.into_iter().collect()
+}
+
+/// The setters `request::setters!` generates, one line each as the listing
+/// writes a method (the macro's arms: `field: [some] [into] Type`).
+fn generated_setters(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for call in text.split("setters!(").skip(1) {
+        let Some((request, body)) = call.split_once('{') else {
+            continue;
+        };
+        let request = request.trim();
+        if request.starts_with('$') || request.contains(':') {
+            continue; // the macro's own rules
+        }
+        let body = body.split("});").next().unwrap_or("");
+        for field in body.split(",\n").map(str::trim).filter(|f| !f.is_empty()) {
+            let Some((name, ty)) = field.trim_end_matches(',').split_once(':') else {
+                continue;
+            };
+            let ty = ty.trim();
+            let ty = ty.strip_prefix("some ").unwrap_or(ty);
+            let param = match ty.strip_prefix("into ") {
+                Some(ty) => format!("impl Into<{ty}>"),
+                None => ty.to_string(),
+            };
+            out.push(format!(
+                "impl {request} :: pub fn {}(mut self, value: {param}) -> {request}",
+                name.trim()
+            ));
+        }
+    }
+    out
 }
 
 #[test]
