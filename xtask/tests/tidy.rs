@@ -1172,15 +1172,58 @@ fn the_root_reader_finds_public_names() {
 /// tricept-ident's public API, as text: every public item of its sources
 /// (`pub fn`, `struct`, `enum`, `trait`, `type`, `const`, `mod`, `use`
 /// and public fields, each with its signature up to its body and the item
-/// it belongs to), sorted. A stand-in for `cargo semver-checks`, which
+/// it belongs to), the setters `request::setters!` generates, and the
+/// items the door re-exports from internal crates (their fields and
+/// methods, listed under their crate: a field of a re-exported `Gain` is
+/// the door's API as much as its own), sorted. Not read: items of a whole
+/// crate re-exported as a module (`advanced::plot`) and trait methods
+/// given by a derive. A stand-in for `cargo semver-checks`, which
 /// needs a published baseline: the listing is kept in
 /// `crates/ident/public-api.txt`, and a change of the door's API fails
 /// until the listing is updated with it (`BLESS=1 cargo test -p xtask
 /// --test tidy public_api`), so that every change is declared in review
 /// (and in CHANGELOG.md).
 fn public_api(root: &Path) -> Vec<String> {
+    let mut items = BTreeSet::new();
+    for file in rust_files(&root.join("crates/ident/src")) {
+        let text = std::fs::read_to_string(&file).unwrap_or_default();
+        items.extend(api_items(&text));
+        items.extend(generated_setters(&text));
+    }
+    // The internal items the door re-exports are its API too: their
+    // fields and methods, listed under their crate.
+    let mut reexported: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for (path, _, _) in docs_reader::door().1 {
+        if let (Some(krate), Some(name)) = (path.first(), path.last())
+            && krate.starts_with("tricept_")
+            && path.len() > 1
+        {
+            reexported
+                .entry(krate.clone())
+                .or_default()
+                .insert(name.clone());
+        }
+    }
+    for (krate, names) in &reexported {
+        let dir = root
+            .join("crates")
+            .join(krate.trim_start_matches("tricept_"))
+            .join("src");
+        for file in rust_files(&dir) {
+            let text = std::fs::read_to_string(&file).unwrap_or_default();
+            let of_door = api_items(&text)
+                .into_iter()
+                .filter(|i| names.contains(subject(i)));
+            items.extend(of_door.map(|i| format!("{krate}: {i}")));
+        }
+    }
+    items.into_iter().collect()
+}
+
+/// The `.rs` files under `dir`.
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
     let mut files = Vec::new();
-    let mut stack = vec![root.join("crates/ident/src")];
+    let mut stack = vec![dir.to_path_buf()];
     while let Some(dir) = stack.pop() {
         for e in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
             let p = e.path();
@@ -1191,52 +1234,71 @@ fn public_api(root: &Path) -> Vec<String> {
             }
         }
     }
-    let mut items = BTreeSet::new();
-    for file in files {
-        let text = std::fs::read_to_string(&file).unwrap_or_default();
-        // Unit tests are not API.
-        let text = text.split("#[cfg(test)]\nmod tests").next().unwrap_or("");
-        let mut owner = String::new();
-        let mut lines = text.lines().peekable();
-        while let Some(line) = lines.next() {
-            let trimmed = line.trim_start();
-            let top = trimmed.len() == line.len();
-            let declares = |k: &&str| trimmed.starts_with(k) || trimmed.contains(&format!(" {k}"));
-            if top && ["struct ", "enum ", "trait ", "impl"].iter().any(declares) {
-                owner = trimmed.trim_end_matches(['{', ' ']).to_string();
-            }
-            // Items of a private type, and private items, are not API.
-            let private_owner = !top && !owner.starts_with("pub ") && !owner.starts_with("impl");
-            if !trimmed.starts_with("pub ") || private_owner {
-                continue;
-            }
-            let mut item = trimmed.to_string();
-            let signature = item.starts_with("pub fn ") || item.starts_with("pub const fn ");
-            let ends =
-                |s: &str| s.ends_with('{') || s.ends_with(';') || (!signature && s.ends_with(','));
-            while !ends(item.trim_end()) {
-                match lines.next() {
-                    Some(next) => {
-                        item.push(' ');
-                        item.push_str(next.trim());
-                    }
-                    None => break,
-                }
-            }
-            let item = item
-                .trim_end_matches(['{', ' '])
-                .split_whitespace()
-                .collect::<Vec<_>>()
-                .join(" ");
-            items.insert(if top {
-                item
-            } else {
-                format!("{owner} :: {item}")
-            });
+    files
+}
+
+/// The type or item a listing line is about: the implemented type of an
+/// `impl ... for T` or `impl T`, the declared name otherwise.
+fn subject(line: &str) -> &str {
+    let head = line.split(" :: ").next().unwrap_or(line);
+    let head = head.rsplit(" for ").next().unwrap_or(head);
+    let words = head
+        .split([' ', '<', '(', ':', '=', ';'])
+        .filter(|w| !w.is_empty());
+    let keyword = [
+        "pub", "impl", "struct", "enum", "trait", "type", "fn", "const", "static",
+    ];
+    words
+        .filter(|w| !keyword.contains(w) && !w.starts_with("impl<") && !w.starts_with('\''))
+        .find(|w| w.starts_with(|c: char| c.is_alphabetic() || c == '_'))
+        .unwrap_or("")
+}
+
+/// The public items of one source file: top-level items, and the public
+/// fields and methods of public types as `OWNER :: ITEM`.
+fn api_items(text: &str) -> Vec<String> {
+    let mut items = Vec::new();
+    // Unit tests are not API.
+    let text = text.split("#[cfg(test)]\nmod tests").next().unwrap_or("");
+    let mut owner = String::new();
+    let mut lines = text.lines().peekable();
+    while let Some(line) = lines.next() {
+        let trimmed = line.trim_start();
+        let top = trimmed.len() == line.len();
+        let declares = |k: &&str| trimmed.starts_with(k) || trimmed.contains(&format!(" {k}"));
+        if top && ["struct ", "enum ", "trait ", "impl"].iter().any(declares) {
+            owner = trimmed.trim_end_matches(['{', ' ']).to_string();
         }
-        items.extend(generated_setters(text));
+        // Items of a private type, and private items, are not API.
+        let private_owner = !top && !owner.starts_with("pub ") && !owner.starts_with("impl");
+        if !trimmed.starts_with("pub ") || private_owner {
+            continue;
+        }
+        let mut item = trimmed.to_string();
+        let signature = item.starts_with("pub fn ") || item.starts_with("pub const fn ");
+        let ends =
+            |s: &str| s.ends_with('{') || s.ends_with(';') || (!signature && s.ends_with(','));
+        while !ends(item.trim_end()) {
+            match lines.next() {
+                Some(next) => {
+                    item.push(' ');
+                    item.push_str(next.trim());
+                }
+                None => break,
+            }
+        }
+        let item = item
+            .trim_end_matches(['{', ' '])
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        items.push(if top {
+            item
+        } else {
+            format!("{owner} :: {item}")
+        });
     }
-    items.into_iter().collect()
+    items
 }
 
 /// The setters `request::setters!` generates, one line each as the listing

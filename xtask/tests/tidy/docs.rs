@@ -151,7 +151,12 @@ fn door_signatures_name_door_types_only() {
     );
     let listing = std::fs::read_to_string(workspace().join("crates/ident/public-api.txt"));
     let (mut read, mut wrong) = (0, Vec::new());
-    for line in listing.unwrap_or_default().lines() {
+    // Lines `tricept_X: ...` are the re-exported internal items' (not read).
+    for line in listing
+        .unwrap_or_default()
+        .lines()
+        .filter(|l| !l.starts_with("tricept_"))
+    {
         let (owner, item) = line.split_once(" :: ").unwrap_or(("", line));
         let owner = owner.rsplit(' ').next().unwrap_or("");
         let words: Vec<&str> = item.split(' ').collect();
@@ -224,7 +229,12 @@ fn what_a_door_call_returns_is_not_only_in_advanced() {
     assert!(files.contains_key(&advanced) && !only_advanced.is_empty());
     let listing = std::fs::read_to_string(workspace().join("crates/ident/public-api.txt"));
     let mut wrong = Vec::new();
-    for line in listing.unwrap_or_default().lines() {
+    // Lines `tricept_X: ...` are the re-exported internal items' (not read).
+    for line in listing
+        .unwrap_or_default()
+        .lines()
+        .filter(|l| !l.starts_with("tricept_"))
+    {
         let (owner, item) = line.split_once(" :: ").unwrap_or(("", line));
         let own = match owner.rsplit(' ').next().filter(|o| !o.is_empty()) {
             Some(owner) => ident(owner),
