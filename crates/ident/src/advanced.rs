@@ -146,6 +146,21 @@ pub use tricept_study::StudyError;
 /// assert!(!message.contains('\n'));
 /// ```
 pub mod files {
+    /// Refuses an output path [`write_atomic`] would not write: a name
+    /// ending in a separator, an existing directory, or anything but a
+    /// regular file at its end (a device, a pipe, a socket).
+    ///
+    /// # Example
+    /// ```
+    /// use std::path::Path;
+    /// use tricept_ident::advanced::files::check_output_file;
+    /// assert!(check_output_file(Path::new("out/")).is_err()); // a directory's name
+    /// assert!(check_output_file(&std::env::temp_dir()).is_err()); // a directory
+    /// assert!(check_output_file(Path::new("new-file.json")).is_ok());
+    /// ```
+    #[doc(inline)]
+    pub use tricept_data::atomic::check_output_file;
+    pub use tricept_data::external::write_external_path;
     /// A message made one bounded line, as every error of the door is.
     ///
     /// # Example
@@ -165,8 +180,69 @@ pub mod files {
     /// ```
     #[doc(inline)]
     pub use tricept_data::message::shown_path;
-    pub use tricept_data::{
-        atomic::check_output_file, external::write_external_path, write_atomic, write_path,
-        write_to,
-    };
+    /// Writes a file atomically: `content` writes the whole file into the
+    /// writer it is given; the file is replaced only when that and the
+    /// flush, sync and rename all succeed (every file the door writes).
+    ///
+    /// # Example
+    /// ```
+    /// use std::io::Write;
+    /// use tricept_ident::advanced::files::write_atomic;
+    /// let dir = std::env::temp_dir().join(format!("tricept-door-atomic-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let path = dir.join("note.txt");
+    /// write_atomic(&path, |w| w.write_all(b"first\n"))?;
+    /// let failed = write_atomic(&path, |w| {
+    ///     w.write_all(b"sec")?;
+    ///     Err(std::io::Error::other("disk full"))
+    /// });
+    /// assert!(failed.is_err());
+    /// assert_eq!(std::fs::read_to_string(&path)?, "first\n"); // as it was
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), std::io::Error>(())
+    /// ```
+    #[doc(inline)]
+    pub use tricept_data::write_atomic;
+    /// Writes measured data to a file ([`write_to`]), atomically
+    /// ([`write_atomic`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::advanced::files::write_path;
+    /// use tricept_ident::advanced::read_data_from;
+    /// use tricept_ident::kinematics::GeometricMachine;
+    /// let machine = GeometricMachine::paper();
+    /// let data = read_data_from("q1,q2,q3,phi,theta,s\n700,700,700,0,0,5\n".as_bytes(), "in", &machine)?;
+    /// let dir = std::env::temp_dir().join(format!("tricept-door-write-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// let path = dir.join("campaign.csv");
+    /// write_path(&path, &data, &[])?;
+    /// let back = read_data_from(std::fs::read(&path)?.as_slice(), "campaign.csv", &machine)?;
+    /// assert_eq!(back.poses, data.poses);
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    #[doc(inline)]
+    pub use tricept_data::write_path;
+    /// Writes measured data as the CSV every verb reads
+    /// (`docs/data-format.md`), comments first.
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::advanced::files::write_to;
+    /// use tricept_ident::advanced::read_data_from;
+    /// use tricept_ident::kinematics::GeometricMachine;
+    /// let csv = "q1,q2,q3,phi,theta,s\n700,700,700,0.001,-0.002,5\n";
+    /// let data = read_data_from(csv.as_bytes(), "memory", &GeometricMachine::paper())?;
+    /// let mut out = Vec::new();
+    /// write_to(&mut out, &data, &["simulated".into()])?;
+    /// let text = String::from_utf8(out)?;
+    /// assert!(text.starts_with("# simulated\nq1,q2,q3,phi,theta,s\n"));
+    /// let back = read_data_from(text.as_bytes(), "memory", &GeometricMachine::paper())?;
+    /// assert_eq!(back.poses[0].readings, data.poses[0].readings);
+    /// assert_eq!((data.poses[0].line, back.poses[0].line), (2, 3)); // after the comment
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    #[doc(inline)]
+    pub use tricept_data::write_to;
 }

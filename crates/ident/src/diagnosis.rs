@@ -40,6 +40,9 @@ use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
 
+mod terms_docs;
+
+pub use self::terms_docs::*;
 pub use crate::accuracy::Accuracy;
 pub use crate::outcome::{WriteOptions, Written};
 /// A diagnosis' final model deployed ([`DiagnoseResult::deploy`]).
@@ -112,9 +115,6 @@ pub use tricept_diagnose::{
     report::Evidence, report::FinalFit, report::ModelTerm, report::NoiseCheck, report::NoiseSource,
     report::PureError, report::RejectStage, report::Rejected, report::Remainder,
     report::ResidualPlot, report::Structure, report::TermScore, report::Tested,
-};
-pub use tricept_diagnose::{
-    terms::Frame, terms::GenericTerm, terms::OrderAxis, terms::Scope, terms::Term,
 };
 /// An identification, the estimates of a fit and their covariance ([`Deployed`]'s `id`).
 ///

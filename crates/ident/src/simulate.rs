@@ -17,21 +17,17 @@
 //! # Ok::<(), tricept_ident::Error>(())
 //! ```
 
+mod external_docs;
+
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
+pub use self::external_docs::*;
 use nalgebra::{Isometry3, Vector3};
 use serde_json::{Value, json};
+pub use tricept_data::external::InstrumentRecord;
 use tricept_data::{Dataset, external::PlannedPose, external::read_external_path};
-pub use tricept_data::{
-    external::BallbarData, external::ExternalData, external::ExternalRecord, external::TouchData,
-    external::TrackerData,
-};
-pub use tricept_data::{
-    external::BallbarReading, external::ExternalPose, external::InstrumentRecord,
-    external::TouchReading, external::TrackerPoint,
-};
 use tricept_engine::model::GeometricModel;
 use tricept_kinematics::Machine;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
