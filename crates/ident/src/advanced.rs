@@ -68,10 +68,6 @@ pub use serde_json;
 /// ```
 #[doc(inline)]
 pub use tricept_check::check::DEFAULT_POWER;
-// The internal crates' errors the door's [`Error`](crate::Error) is made
-// from ([`Classify`]).
-pub use tricept_check::CheckError;
-pub use tricept_data::DataError;
 /// Measured data in memory (what a [`DataInput`](crate::DataInput) loads).
 ///
 /// # Example
@@ -99,8 +95,21 @@ pub use tricept_data::Dataset;
 /// ```
 #[doc(inline)]
 pub use tricept_data::MeasuredPose;
+/// The three UP-limb sensor readings of one pose: encoders `phi` and
+/// `theta` (rad) and the linear scale `s` (mm).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{Readings, read_data_from};
+/// use tricept_ident::kinematics::GeometricMachine;
+/// let csv = "q1,q2,q3,phi,theta,s\n700,700,700,0.001,-0.002,5\n";
+/// let data = read_data_from(csv.as_bytes(), "memory", &GeometricMachine::paper())?;
+/// let r: Readings = data.poses[0].readings;
+/// assert_eq!((r.phi_rad, r.theta_rad, r.s_mm), (0.001, -0.002, 5.0));
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
 pub use tricept_data::Readings;
-pub use tricept_diagnose::{DeployError, DiagnoseError};
 
 /// The manufacturing tolerance a calibration is judged against by default, mm.
 ///
@@ -112,10 +121,156 @@ pub use tricept_diagnose::{DeployError, DiagnoseError};
 /// ```
 #[doc(inline)]
 pub use tricept_engine::accuracy::DEFAULT_TOLERANCE_MM;
-pub use tricept_engine::fusion::{TrackerTarget, fusable_effects};
-pub use tricept_engine::{IdentError, record::RecordError};
+// The internal crates' errors the door's [`Error`](crate::Error) is made
+// from ([`Classify`]).
+/// A check's failure ([`crate::check`]): an unreadable record or history, a
+/// campaign that cannot see a change, a pose out of reach.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{CheckError, Classify};
+/// use tricept_ident::{EXIT_INPUT, Error, ErrorKind};
+/// let e = CheckError::Blind("no leg moves".into());
+/// assert_eq!(e.kind(), ErrorKind::Input);
+/// let door = Error::from_library(e); // as the door returns it
+/// assert_eq!(door.exit_code(), EXIT_INPUT);
+/// assert!(door.message().contains("cannot see a change"), "{}", door.message());
+/// ```
+#[doc(inline)]
+pub use tricept_check::CheckError;
+/// A measured-data file's failure: unreadable, empty, a missing or bad
+/// column (naming file, line and column).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{DataError, Classify};
+/// use tricept_ident::{EXIT_INPUT, Error, ErrorKind};
+/// let e = DataError::NoRows { file: "today.csv".into() };
+/// assert_eq!(e.kind(), ErrorKind::Input);
+/// let door = Error::from_library(e); // as the door returns it
+/// assert_eq!(door.exit_code(), EXIT_INPUT);
+/// assert!(door.message().contains("today.csv: header only"), "{}", door.message());
+/// ```
+#[doc(inline)]
+pub use tricept_data::DataError;
+/// Why a diagnosis' model cannot be deployed into a machine file.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{DeployError, Classify};
+/// use tricept_ident::{EXIT_INPUT, Error, ErrorKind};
+/// let e = DeployError::NotDeployable("wobble_um".into());
+/// assert_eq!(e.kind(), ErrorKind::Input);
+/// let door = Error::from_library(e); // as the door returns it
+/// assert_eq!(door.exit_code(), EXIT_INPUT);
+/// assert!(door.message().contains("`wobble_um`"), "{}", door.message());
+/// ```
+#[doc(inline)]
+pub use tricept_diagnose::DeployError;
+/// A diagnosis' failure ([`crate::diagnosis`]): too few poses, a degenerate
+/// campaign, an identification's failure (of its own kind).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{DiagnoseError, Classify};
+/// use tricept_ident::{EXIT_INPUT, Error, ErrorKind};
+/// let e = DiagnoseError::TooFewPoses(12);
+/// assert_eq!(e.kind(), ErrorKind::Input);
+/// let door = Error::from_library(e); // as the door returns it
+/// assert_eq!(door.exit_code(), EXIT_INPUT);
+/// assert!(door.message().contains("too few poses (12)"), "{}", door.message());
+/// ```
+#[doc(inline)]
+pub use tricept_diagnose::DiagnoseError;
+/// An identification's failure: too few or too similar poses, unreachable
+/// poses, inconsistent options (the input's), a numerical failure (not).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{IdentError, Classify};
+/// use tricept_ident::{EXIT_INPUT, Error, ErrorKind};
+/// let e = IdentError::Invalid("weights: must be positive".into());
+/// assert_eq!(e.kind(), ErrorKind::Input);
+/// let door = Error::from_library(e); // as the door returns it
+/// assert_eq!(door.exit_code(), EXIT_INPUT);
+/// assert!(door.message().contains("weights: must be positive"), "{}", door.message());
+/// ```
+#[doc(inline)]
+pub use tricept_engine::IdentError;
+/// What is known of a laser tracker's target offset from the tool tip:
+/// free (a nuisance the fit estimates) or known to a standard deviation
+/// ([`TrackerTargetSpec::target`]).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{TrackerTarget, TrackerTargetSpec};
+/// let nest = "tip".parse::<TrackerTargetSpec>()?.target(5.0)?;
+/// assert_eq!(nest, TrackerTarget::Known { offset_mm: [0.0; 3], sigma_um: 5.0 });
+/// assert_eq!("free".parse::<TrackerTargetSpec>()?.target(5.0)?, TrackerTarget::Free);
+/// assert!(TrackerTargetSpec::Tip.target(-1.0).is_err()); // a sigma is positive
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_engine::fusion::TrackerTarget;
+/// The effects a fused calibration (UP sensors with external instruments)
+/// can fit: those whose spec says `fused`.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::fusable_effects;
+/// use tricept_ident::effects::EffectName;
+/// let fused: Vec<EffectName> = fusable_effects().collect();
+/// assert!(fused.contains(&EffectName::LegLead));
+/// let all = EffectName::ALL.iter().filter(|e| e.spec().fused).count();
+/// assert_eq!(fused.len(), all);
+/// ```
+#[doc(inline)]
+pub use tricept_engine::fusion::fusable_effects;
+/// A calibration record that cannot be trusted: unreadable, edited since it
+/// was sealed, or unsealed.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{RecordError, Classify};
+/// use tricept_ident::{EXIT_INPUT, Error, ErrorKind};
+/// let e = RecordError::Unsealed;
+/// assert_eq!(e.kind(), ErrorKind::Input);
+/// let door = Error::from_library(e); // as the door returns it
+/// assert_eq!(door.exit_code(), EXIT_INPUT);
+/// assert!(door.message().contains("no `seal`"), "{}", door.message());
+/// ```
+#[doc(inline)]
+pub use tricept_engine::record::RecordError;
+/// A fleet's failure ([`crate::fleet`]): what cannot be pooled (the
+/// input's), a machine's identification, the pooled solve.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{FleetError, Classify};
+/// use tricept_ident::{EXIT_INPUT, Error, ErrorKind};
+/// let e = FleetError::Input("two machines: at least 3 are needed".into());
+/// assert_eq!(e.kind(), ErrorKind::Input);
+/// let door = Error::from_library(e); // as the door returns it
+/// assert_eq!(door.exit_code(), EXIT_INPUT);
+/// assert!(door.message().contains("at least 3"), "{}", door.message());
+/// ```
+#[doc(inline)]
 pub use tricept_fleet::FleetError;
 pub use tricept_model::GeometricErrors;
+/// A parameter set's or parameter values' failure: an unknown name or set,
+/// values a model cannot represent.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{ModelError, Classify};
+/// use tricept_ident::{EXIT_INPUT, Error, ErrorKind};
+/// let e = ModelError::UnknownParameterSet("paper16".into());
+/// assert_eq!(e.kind(), ErrorKind::Input);
+/// let door = Error::from_library(e); // as the door returns it
+/// assert_eq!(door.exit_code(), EXIT_INPUT);
+/// assert!(door.message().contains("paper16"), "{}", door.message());
+/// ```
+#[doc(inline)]
 pub use tricept_model::ModelError;
 /// Which geometric errors a calibration identifies.
 ///
@@ -130,10 +285,38 @@ pub use tricept_model::ModelError;
 #[doc(inline)]
 pub use tricept_model::ParameterSet;
 pub use tricept_numerics::sparse::BlockError;
+/// A simulated plant's failure: a pose it cannot reach, an invalid
+/// configuration.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{PlantError, Classify};
+/// use tricept_ident::{EXIT_INPUT, Error, ErrorKind};
+/// let e = PlantError::Invalid("noise must be finite".into());
+/// assert_eq!(e.kind(), ErrorKind::Input);
+/// let door = Error::from_library(e); // as the door returns it
+/// assert_eq!(door.exit_code(), EXIT_INPUT);
+/// assert!(door.message().contains("invalid plant configuration"), "{}", door.message());
+/// ```
+#[doc(inline)]
 pub use tricept_plant::PlantError;
 /// The figures of the verbs that draw (SVG, written atomically).
 #[doc(inline)]
 pub use tricept_plot as plot;
+/// A study's failure (`tricept study`): its parts' errors, each of its own
+/// kind, or an invalid study.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{StudyError, Classify};
+/// use tricept_ident::{EXIT_INPUT, Error, ErrorKind};
+/// let e = StudyError::Invalid("trials: must be at least 1".into());
+/// assert_eq!(e.kind(), ErrorKind::Input);
+/// let door = Error::from_library(e); // as the door returns it
+/// assert_eq!(door.exit_code(), EXIT_INPUT);
+/// assert!(door.message().contains("trials"), "{}", door.message());
+/// ```
+#[doc(inline)]
 pub use tricept_study::StudyError;
 
 /// Files written as every verb writes them (atomic: temporary file and
@@ -160,6 +343,29 @@ pub mod files {
     /// ```
     #[doc(inline)]
     pub use tricept_data::atomic::check_output_file;
+    /// Writes an external instrument's records (tracker, ballbar, touch
+    /// probe) as the CSV `calibrate` reads, atomically ([`write_atomic`]).
+    ///
+    /// # Example
+    /// ```
+    /// use tricept_ident::advanced::files::write_external_path;
+    /// use tricept_ident::simulate::{ExternalData, ExternalPose, TrackerPoint};
+    /// let point = TrackerPoint {
+    ///     pose: ExternalPose { commands_mm: [800.0; 3], head_rad: [0.0; 2] },
+    ///     position_mm: [10.0, 20.0, 1100.0],
+    ///     ..Default::default()
+    /// };
+    /// let data = ExternalData { records: vec![point; 2], source: "tracker.csv".into() };
+    /// let dir = std::env::temp_dir().join(format!("tricept-door-external-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir)?;
+    /// write_external_path(&dir.join("tracker.csv"), &data, &["simulated".into()])?;
+    /// let text = std::fs::read_to_string(dir.join("tracker.csv"))?;
+    /// assert!(text.starts_with("# simulated\n"));
+    /// assert_eq!(text.lines().filter(|l| l.contains(",10,20,1100")).count(), 2);
+    /// std::fs::remove_dir_all(&dir)?;
+    /// # Ok::<(), std::io::Error>(())
+    /// ```
+    #[doc(inline)]
     pub use tricept_data::external::write_external_path;
     /// A message made one bounded line, as every error of the door is.
     ///

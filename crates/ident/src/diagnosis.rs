@@ -40,8 +40,10 @@ use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
 
+mod report_docs;
 mod terms_docs;
 
+pub use self::report_docs::*;
 pub use self::terms_docs::*;
 pub use crate::accuracy::Accuracy;
 pub use crate::outcome::{WriteOptions, Written};
@@ -71,6 +73,7 @@ pub use tricept_diagnose::Deployed;
 /// ```
 #[doc(inline)]
 pub use tricept_diagnose::Diagnosis;
+pub use tricept_diagnose::ExtendedModel;
 /// When a diagnosis deploys its final model.
 ///
 /// # Example
@@ -109,13 +112,6 @@ pub use tricept_diagnose::report::Cause;
 /// ```
 #[doc(inline)]
 pub use tricept_diagnose::report::Gain;
-pub use tricept_diagnose::report::Verdict as DiagnosisVerdict;
-pub use tricept_diagnose::{
-    ExtendedModel, report::Alias, report::CauseKind, report::ChannelRms, report::Estimate,
-    report::Evidence, report::FinalFit, report::ModelTerm, report::NoiseCheck, report::NoiseSource,
-    report::PureError, report::RejectStage, report::Rejected, report::Remainder,
-    report::ResidualPlot, report::Structure, report::TermScore, report::Tested,
-};
 /// An identification, the estimates of a fit and their covariance ([`Deployed`]'s `id`).
 ///
 /// # Example

@@ -16,6 +16,22 @@ use tricept_plant::effects::typical_effects;
 
 use crate::error::{EXIT_OK, Error};
 
+/// What an entry of an effect's columns changes: a leg's length or a
+/// reading channel (0 `phi`, 1 `theta`, 2 `s`).
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::{Basis, EffectName, Kind, LegContext};
+/// use tricept_ident::kinematics::GeometricMachine;
+/// let nominal = GeometricMachine::paper();
+/// let at = LegContext { nominal: &nominal, commands_mm: [800.0; 3], approach: None, temperature_c: None };
+/// let Kind::Leg(columns) = EffectName::LegLead.spec().kind else { unreachable!() };
+/// let legs: Vec<Basis> = columns(&at).map_err(|e| e.to_string())?.iter().map(|e| e.1).collect();
+/// assert_eq!(legs, [Basis::Leg(0), Basis::Leg(1), Basis::Leg(2)]); // a leg effect moves legs only
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_model::effects::Basis;
 /// The name a diagnosis reports a cause under: an effect of its vocabulary
 /// or a generic family.
 ///
@@ -92,6 +108,21 @@ pub use tricept_model::effects::CommonPart;
 /// ```
 #[doc(inline)]
 pub use tricept_model::effects::Deployment;
+/// One input key of a simulated effect (`--truth-effect`): its JSON key,
+/// unit and meaning, and whether its values must be positive.
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::{EffectKey, effects};
+/// let list = effects(Some("leg-lead"))?;
+/// let keys: &[EffectKey] = list.effects()[0].keys();
+/// let json = list.to_json();
+/// assert_eq!(json[0]["keys"][0]["key"], keys[0].key); // `tricept effects --json` lists them
+/// assert!(keys.iter().all(|k| !k.unit.is_empty() && !k.meaning.is_empty()));
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_model::effects::EffectKey;
 /// The diagnosis' vocabulary of effects.
 ///
 /// # Example
@@ -160,6 +191,19 @@ pub use tricept_model::effects::GenericSpec;
 /// ```
 #[doc(inline)]
 pub use tricept_model::effects::Judged;
+/// A quantity of an effect's fit judged against a plausible range, with
+/// the label its messages use.
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::{EffectName, Judgement, Measure};
+/// let judged: Vec<Judgement> = EffectName::LegLead.judgements();
+/// assert_eq!(judged.len(), 3); // each leg's lead
+/// assert!(judged.iter().all(|j| j.range.unit == "ppm"));
+/// assert_eq!(judged[1].measure, Measure::Parameter(1));
+/// ```
+#[doc(inline)]
+pub use tricept_model::effects::Judgement;
 /// How an effect enters the model: per leg, per reading, in the kinematics,
 /// or row by row.
 ///
@@ -173,6 +217,38 @@ pub use tricept_model::effects::Judged;
 /// ```
 #[doc(inline)]
 pub use tricept_model::effects::Kind;
+/// A cause an effect is known to be confused with: which, why, and what
+/// measurement tells them apart.
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::{EffectName, KnownAlias};
+/// let eccentricity = "encoder-eccentricity".parse::<EffectName>()?.spec();
+/// let alias: &KnownAlias = &eccentricity.aliases[0];
+/// assert_eq!(alias.with, "encoder-gain");
+/// assert!(!alias.why.is_empty() && !alias.separate_by.is_empty());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_model::effects::KnownAlias;
+/// What a leg effect's columns are evaluated at: the nominal machine, the
+/// leg commands (mm), the approach directions and the temperature.
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::{Basis, EffectName, Kind, LegContext};
+/// use tricept_ident::kinematics::GeometricMachine;
+/// let nominal = GeometricMachine::paper();
+/// let at = LegContext { nominal: &nominal, commands_mm: [800.0, 900.0, 1000.0], approach: None, temperature_c: None };
+/// let Kind::Leg(columns) = EffectName::LegLead.spec().kind else { unreachable!() };
+/// let entries = columns(&at).map_err(|e| e.to_string())?;
+/// // lead k of leg i: k ppm of its command, mm per ppm
+/// assert_eq!(entries[2].1, Basis::Leg(2));
+/// assert!((entries[2].2 - 1000.0e-6).abs() < 1e-15);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_model::effects::LegContext;
 /// A static leg effect's place in a machine file's leg effects.
 ///
 /// # Example
@@ -268,7 +344,51 @@ pub use tricept_model::effects::PlausibleRange;
 /// ```
 #[doc(inline)]
 pub use tricept_model::effects::PlotAxes;
+pub use tricept_model::effects::Simulate;
+/// What an effect's file says about its simulation: its `--truth-effect`
+/// tag, the cause a perfect diagnosis would name, its input keys.
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::{EffectName, EffectSimulation};
+/// let sim: &EffectSimulation = &EffectName::LegLead.spec().simulation;
+/// assert_eq!((sim.tag, sim.cause), ("leg-lead", "leg-lead")); // in the vocabulary: itself
+/// assert!(!sim.keys.is_empty());
+/// ```
+#[doc(inline)]
 pub use tricept_model::effects::Simulation as EffectSimulation;
+/// An alias that is structural: the common part of per-leg parameters
+/// that a scaled machine also explains (a common leg lead and a scale
+/// gain).
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::{EffectName, Structural};
+/// let structural: Vec<Structural> = EffectName::ALL
+///     .iter()
+///     .flat_map(|e| e.spec().aliases)
+///     .filter_map(|a| a.structural)
+///     .collect();
+/// assert!(!structural.is_empty());
+/// for s in &structural { // the effect named declares its common part
+///     assert!(s.common_of.parse::<EffectName>()?.spec().common_part.is_some());
+/// }
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_model::effects::Structural;
+/// The error of a name that is not an effect of the vocabulary (it lists
+/// the known ones).
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::{EffectName, UnknownEffect};
+/// let e: UnknownEffect = "leg-leed".parse::<EffectName>().unwrap_err();
+/// assert_eq!(e.0, "leg-leed");
+/// assert!(e.to_string().contains("unknown effect `leg-leed`") && e.to_string().contains("leg-lead"));
+/// ```
+#[doc(inline)]
+pub use tricept_model::effects::UnknownEffect;
 /// The x axis of a residual plot (with its label and unit).
 ///
 /// # Example
@@ -290,11 +410,7 @@ pub use tricept_model::effects::XAxis;
 /// ```
 #[doc(inline)]
 pub use tricept_model::effects::YAxis;
-pub use tricept_model::effects::{
-    Basis, LegContext, PoseState, SimulateObject, Structural, UnknownEffect,
-};
-pub use tricept_model::effects::{EffectKey, Judgement};
-pub use tricept_model::effects::{KnownAlias, Simulate};
+pub use tricept_model::effects::{PoseState, SimulateObject};
 /// A plausible range as the diagnosis' table holds it: does an estimate with
 /// its standard deviation fit it?
 ///

@@ -39,6 +39,21 @@ use crate::machine_input::MachineInput;
 /// ```
 #[doc(inline)]
 pub use tricept_export::AxisSummary;
+/// An export's failure: a machine file without a calibration, an option
+/// the control does not take, a failed write (not the input's fault).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::Classify;
+/// use tricept_ident::export::ExportError;
+/// use tricept_ident::{EXIT_INPUT, Error, ErrorKind};
+/// let e = ExportError::NoCalibration;
+/// assert_eq!(e.kind(), ErrorKind::Input);
+/// let door = Error::from_library(e);
+/// assert_eq!(door.exit_code(), EXIT_INPUT);
+/// assert!(door.message().contains("no calibration"), "{}", door.message());
+/// ```
+#[doc(inline)]
 pub use tricept_export::ExportError;
 /// The control and the limits of an export ([`ExportRequest`]'s `options`).
 ///

@@ -164,7 +164,7 @@ pub use tricept_kinematics::description::LoadsDescription;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::description::Placement;
-/// What a description's seal says ([`MachineDescription::seal_check`]):
+/// What a description's seal says ([`MachineDescription::seal_check`](crate::kinematics::MachineDescription::seal_check)):
 /// no record, unsealed, intact, or the fields edited since.
 ///
 /// # Example
