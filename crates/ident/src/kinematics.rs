@@ -147,9 +147,6 @@ pub use tricept_kinematics::batch::Verb;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::batch::run;
-pub use tricept_kinematics::description::{
-    AccuracyRecord, CalibrationRecord, ExternalSourceRecord, HeldParameter,
-};
 /// Why a machine description was refused: bad JSON, an unreadable file, a
 /// newer format, or a value out of range.
 ///

@@ -2,6 +2,31 @@
 //! file is made of), re-exported by [`crate::kinematics`]: kept here so the
 //! workflow module stays short.
 
+/// The accuracy a machine file promises (`calibration.accuracy`): the
+/// predicted rms positioning error over the workspace, a 95 % upper bound
+/// of it (mm), the point it is of, and its parts.
+///
+/// # Example
+/// ```
+/// use tricept_ident::WriteOptions;
+/// use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+/// use tricept_ident::kinematics::MachineDescription;
+/// let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/table2-grid-seed1.csv");
+/// let calibration = calibrate(CalibrateRequest::new(data))?;
+/// let dir = std::env::temp_dir().join(format!("tricept-door-accuracyrecord-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// calibration.write_machine(&dir.join("m.json"), WriteOptions::default())?;
+/// let description = MachineDescription::from_file(&dir.join("m.json"))?;
+/// let record = description.calibration.clone().ok_or("no record")?;
+/// let accuracy = record.accuracy.ok_or("no accuracy")?;
+/// assert!(accuracy.upper_mm >= accuracy.rms_mm);
+/// assert_eq!(accuracy.point, "platform"); // no head in this calibration
+/// assert_eq!(Some(accuracy.upper_mm), calibration.accuracy().map(|a| a.upper_mm));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::description::AccuracyRecord;
 /// Which axis of the UP limb's base U joint is fixed to the base (`x-first`,
 /// the paper's, or `y-first`).
 ///
@@ -15,6 +40,31 @@
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::description::AxisOrder;
+/// The calibration record of a machine file (`calibration`): how it was
+/// calibrated, from which data, its estimates with their uncertainty and
+/// correlations, its verdict, its accuracy, its seal.
+///
+/// # Example
+/// ```
+/// use tricept_ident::WriteOptions;
+/// use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+/// use tricept_ident::kinematics::MachineDescription;
+/// let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/table2-grid-seed1.csv");
+/// let calibration = calibrate(CalibrateRequest::new(data))?;
+/// let dir = std::env::temp_dir().join(format!("tricept-door-calibrationrecord-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// calibration.write_machine(&dir.join("m.json"), WriteOptions::default())?;
+/// let description = MachineDescription::from_file(&dir.join("m.json"))?;
+/// let record = description.calibration.clone().ok_or("no record")?;
+/// assert_eq!(record.poses_used, 75); // the fixture's grid
+/// assert!(record.converged && record.adequate && !record.forced);
+/// assert_eq!(record.correlations.names.len(), record.correlations.matrix.len());
+/// assert_eq!(description.seal_check(), tricept_ident::kinematics::SealCheck::Intact { partial: false });
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::description::CalibrationRecord;
 /// Joints on two circles at the same angles on base and platform (mm, degrees).
 ///
 /// # Example
@@ -72,6 +122,28 @@ pub use tricept_kinematics::description::CorrelationsDescription;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::description::ExplicitPlacement;
+/// An external instrument's file a fused calibration used (tracker,
+/// ballbar, touch probe): its kind, file and digest, records, fit and
+/// nuisance estimates; none for the UP sensors alone.
+///
+/// # Example
+/// ```
+/// use tricept_ident::WriteOptions;
+/// use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+/// use tricept_ident::kinematics::MachineDescription;
+/// let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/table2-grid-seed1.csv");
+/// let calibration = calibrate(CalibrateRequest::new(data))?;
+/// let dir = std::env::temp_dir().join(format!("tricept-door-externalsourcerecord-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// calibration.write_machine(&dir.join("m.json"), WriteOptions::default())?;
+/// let description = MachineDescription::from_file(&dir.join("m.json"))?;
+/// let record = description.calibration.clone().ok_or("no record")?;
+/// assert!(record.external_sources.is_empty()); // the UP limb's sensors alone
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::description::ExternalSourceRecord;
 /// The 2-axis head in a description, in the platform frame at zero head
 /// angles (the default: an A/C head, tool tip 350 mm below O').
 ///
@@ -84,6 +156,30 @@ pub use tricept_kinematics::description::ExplicitPlacement;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::description::HeadDescription;
+/// A parameter a calibration held at its prior, with why.
+///
+/// # Example
+/// ```
+/// use tricept_ident::WriteOptions;
+/// use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+/// use tricept_ident::kinematics::{HeldParameter, MachineDescription};
+/// let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/table2-grid-seed1.csv");
+/// let calibration = calibrate(CalibrateRequest::new(data))?;
+/// let dir = std::env::temp_dir().join(format!("tricept-door-heldparameter-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// calibration.write_machine(&dir.join("m.json"), WriteOptions::default())?;
+/// let description = MachineDescription::from_file(&dir.join("m.json"))?;
+/// let record = description.calibration.clone().ok_or("no record")?;
+/// for held in &record.held {
+///     assert!(!held.reason.is_empty(), "{} held without a reason", held.name);
+/// }
+/// let written: HeldParameter = serde_json::from_str(r#"{"name": "dq1", "reason": "not identifiable"}"#)?;
+/// assert_eq!((written.name.as_str(), written.reason.as_str()), ("dq1", "not identifiable"));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::description::HeldParameter;
 /// How a leg table is read between its points (linear, the only one now).
 ///
 /// # Example
