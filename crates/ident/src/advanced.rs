@@ -256,6 +256,22 @@ pub use tricept_engine::record::RecordError;
 /// ```
 #[doc(inline)]
 pub use tricept_fleet::FleetError;
+/// The 21 geometric errors of the paper's model: base and platform joint
+/// errors (mm, in their frames) and leg length errors (actual = command +
+/// `dq_i`, mm), stored leg by leg (`db`, `da`, `dq`).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::GeometricErrors;
+/// let mut v = [0.0; 21];
+/// v[6] = 0.45; // dq1: the 7th value of leg 1's block
+/// v[7] = 0.2; // db2.x: the first of leg 2's
+/// let e = GeometricErrors::from_array(&v);
+/// assert_eq!((e.dq_mm[0], e.db_mm[1].x), (0.45, 0.2));
+/// assert_eq!(e.to_array(), v);
+/// assert_eq!(GeometricErrors::default().to_array(), [0.0; 21]);
+/// ```
+#[doc(inline)]
 pub use tricept_model::GeometricErrors;
 /// A parameter set's or parameter values' failure: an unknown name or set,
 /// values a model cannot represent.
@@ -284,6 +300,19 @@ pub use tricept_model::ModelError;
 /// ```
 #[doc(inline)]
 pub use tricept_model::ParameterSet;
+/// Why the sparse solver of a fleet's joint fit failed: an unknown the
+/// rows do not determine, a failed factorisation, blocks of the wrong
+/// shape; a solver's failure, not the input's.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{BlockError, Classify, FleetError};
+/// use tricept_ident::{EXIT_OTHER, Error, ErrorKind};
+/// let e = FleetError::from(BlockError::NotDetermined { block: Some(2), column: 4 });
+/// assert_eq!(e.kind(), ErrorKind::Other);
+/// assert_eq!(Error::from_library(e).exit_code(), EXIT_OTHER);
+/// ```
+#[doc(inline)]
 pub use tricept_numerics::sparse::BlockError;
 /// A simulated plant's failure: a pose it cannot reach, an invalid
 /// configuration.
