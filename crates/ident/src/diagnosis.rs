@@ -40,9 +40,11 @@ use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
 
+mod model_docs;
 mod report_docs;
 mod terms_docs;
 
+pub use self::model_docs::*;
 pub use self::report_docs::*;
 pub use self::terms_docs::*;
 pub use crate::accuracy::Accuracy;
@@ -128,8 +130,7 @@ pub use tricept_diagnose::report::Gain;
 #[doc(inline)]
 pub use tricept_engine::Identification;
 pub use tricept_engine::{
-    identify::CampaignOffsets, identify::Design, identify::ResidualStats, model::GeometricModel,
-    model::GeometricPredictor, model::PosePredictor, model::ReadingModel, prior::Prior,
+    identify::CampaignOffsets, identify::Design, identify::ResidualStats, prior::Prior,
     prior::PriorFit,
 };
 

@@ -1,0 +1,78 @@
+//! The door's pages of the reading models a fit evaluates (the geometric
+//! model and what predicts one pose's readings), re-exported by
+//! [`crate::diagnosis`]: kept here so the workflow module stays short.
+
+/// The paper's geometric model of a machine over a parameter set: the
+/// readings a pose gives as functions of the set's error parameters.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::ParameterSet;
+/// use tricept_ident::diagnosis::{GeometricModel, ReadingModel};
+/// use tricept_ident::kinematics::GeometricMachine;
+/// let model = GeometricModel::new(GeometricMachine::paper(), ParameterSet::paper15());
+/// assert_eq!(model.names().len(), 15);
+/// assert_eq!(model.names()[0], "dxB1");
+/// ```
+#[doc(inline)]
+pub use tricept_engine::model::GeometricModel;
+/// The geometric model's predictor: a machine with the columns of a
+/// parameter set ([`GeometricModel`] at given values is one).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{MeasuredPose, ParameterSet};
+/// use tricept_ident::diagnosis::{GeometricModel, GeometricPredictor, PosePredictor, ReadingModel};
+/// use tricept_ident::kinematics::GeometricMachine;
+/// let set = ParameterSet::paper15();
+/// let direct = GeometricPredictor::new(GeometricMachine::paper(), &set);
+/// let model = GeometricModel::new(GeometricMachine::paper(), set.clone());
+/// let pose = MeasuredPose { commands_mm: [800.0, 820.0, 790.0], ..Default::default() };
+/// let (mut j1, mut j2) = ([0.0; 45], [0.0; 45]);
+/// let a = direct.predict(&pose, &mut None, &mut j1)?;
+/// let b = model.at(&[0.0; 15]).predict(&pose, &mut None, &mut j2)?;
+/// assert!((0..3).all(|i| (a[i] - b[i]).abs() < 1e-12));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_engine::model::GeometricPredictor;
+/// A reading model at given parameter values: one pose's readings
+/// `[phi, theta, s]` (rad, rad, mm) and their derivatives (3 rows of one
+/// column per parameter).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{MeasuredPose, ParameterSet};
+/// use tricept_ident::diagnosis::{GeometricModel, PosePredictor, ReadingModel};
+/// use tricept_ident::kinematics::GeometricMachine;
+/// let model = GeometricModel::new(GeometricMachine::paper(), ParameterSet::paper15());
+/// let predictor: Box<dyn PosePredictor + '_> = model.at(&[0.0; 15]);
+/// let pose = MeasuredPose { commands_mm: [800.0, 820.0, 790.0], ..Default::default() };
+/// let mut jacobian = [0.0; 45];
+/// let readings = predictor.predict(&pose, &mut None, &mut jacobian)?;
+/// assert!(readings.iter().chain(&jacobian).all(|v| v.is_finite()));
+/// assert!(jacobian.iter().any(|d| *d != 0.0));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_engine::model::PosePredictor;
+/// A model of the UP limb's readings over named parameters: evaluated at
+/// parameter values it predicts poses ([`PosePredictor`]).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::{MeasuredPose, ParameterSet};
+/// use tricept_ident::diagnosis::{GeometricModel, ReadingModel};
+/// use tricept_ident::kinematics::{GeometricMachine, Vector3};
+/// let machine = GeometricMachine::paper();
+/// let ik = machine.inverse(&Vector3::new(40.0, -30.0, 760.0))?;
+/// let model: &dyn ReadingModel = &GeometricModel::new(machine, ParameterSet::paper15());
+/// let pose = MeasuredPose { commands_mm: ik.legs_mm, ..Default::default() };
+/// let mut jacobian = vec![0.0; 3 * model.names().len()];
+/// let nominal = model.at(&vec![0.0; 15]).predict(&pose, &mut None, &mut jacobian)?;
+/// assert!((nominal[0] - ik.up.phi_rad).abs() < 1e-9); // no error: the nominal joints
+/// assert!((nominal[1] - ik.up.theta_rad).abs() < 1e-9);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_engine::model::ReadingModel;
