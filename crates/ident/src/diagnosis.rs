@@ -75,7 +75,6 @@ pub use tricept_diagnose::Deployed;
 /// ```
 #[doc(inline)]
 pub use tricept_diagnose::Diagnosis;
-pub use tricept_diagnose::ExtendedModel;
 /// When a diagnosis deploys its final model.
 ///
 /// # Example

@@ -2,6 +2,24 @@
 //! model and what predicts one pose's readings), re-exported by
 //! [`crate::diagnosis`]: kept here so the workflow module stays short.
 
+/// The geometric model extended by terms: effects of the vocabulary and
+/// generic terms, their parameters after the geometry's.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::ParameterSet;
+/// use tricept_ident::diagnosis::{ExtendedModel, GeometricModel, ReadingModel};
+/// use tricept_ident::effects::EffectName;
+/// use tricept_ident::kinematics::GeometricMachine;
+/// let geometric = GeometricModel::new(GeometricMachine::paper(), ParameterSet::paper15());
+/// let model = ExtendedModel::new(geometric, &[EffectName::LegLead]);
+/// assert_eq!(model.n_geometric(), 15);
+/// assert_eq!(model.offsets(), [15]); // the three leads follow the geometry
+/// assert_eq!(model.names().len(), 15 + 3);
+/// assert_eq!(model.effects(), [EffectName::LegLead]);
+/// ```
+#[doc(inline)]
+pub use tricept_diagnose::ExtendedModel;
 /// The paper's geometric model of a machine over a parameter set: the
 /// readings a pose gives as functions of the set's error parameters.
 ///
