@@ -128,10 +128,7 @@ pub use tricept_diagnose::report::Gain;
 /// ```
 #[doc(inline)]
 pub use tricept_engine::Identification;
-pub use tricept_engine::{
-    identify::CampaignOffsets, identify::Design, identify::ResidualStats, prior::Prior,
-    prior::PriorFit,
-};
+pub use tricept_engine::{identify::CampaignOffsets, identify::Design, identify::ResidualStats};
 
 /// What to diagnose and how.
 ///

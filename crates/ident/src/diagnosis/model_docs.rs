@@ -94,3 +94,36 @@ pub use tricept_engine::model::PosePredictor;
 /// ```
 #[doc(inline)]
 pub use tricept_engine::model::ReadingModel;
+/// A Gaussian prior on some of a model's parameters (a fleet's batch
+/// prior): its mean and covariance over the parameters it covers.
+///
+/// # Example
+/// ```
+/// use tricept_ident::calibrate::DMatrix;
+/// use tricept_ident::diagnosis::Prior;
+/// let covariance = DMatrix::from_row_slice(2, 2, &[0.01, 0.0, 0.0, 0.04]);
+/// let prior = Prior::new(vec![0.1, 0.0, 0.3], &[0, 2], &covariance)?;
+/// assert_eq!((prior.dimension(), prior.parameters()), (2, 3));
+/// // (0.2 - 0.1)^2 / 0.01 + (0.1 - 0.3)^2 / 0.04 = 1 + 1; parameter 1 not covered
+/// assert!((prior.chi_square(&[0.2, 5.0, 0.1]) - 2.0).abs() < 1e-12);
+/// let not_spd = DMatrix::from_row_slice(2, 2, &[0.01, 0.0, 0.0, -0.04]);
+/// assert!(Prior::new(vec![0.1, 0.0, 0.3], &[0, 2], &not_spd).is_err());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_engine::prior::Prior;
+/// A prior's share of a fit: its chi-square at the estimate and its degrees
+/// of freedom (the parameters it covers).
+///
+/// # Example
+/// ```
+/// use tricept_ident::calibrate::DMatrix;
+/// use tricept_ident::diagnosis::{Prior, PriorFit};
+/// let prior = Prior::new(vec![0.0; 2], &[0, 1], &DMatrix::identity(2, 2))?;
+/// let estimate = [3.0, 4.0];
+/// let share = PriorFit { chi_square: prior.chi_square(&estimate), dof: prior.dimension() };
+/// assert_eq!(serde_json::to_value(share)?, serde_json::json!({"chi_square": 25.0, "dof": 2}));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_engine::prior::PriorFit;
