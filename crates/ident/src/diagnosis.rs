@@ -128,7 +128,7 @@ pub use tricept_diagnose::report::Gain;
 /// ```
 #[doc(inline)]
 pub use tricept_engine::Identification;
-pub use tricept_engine::{identify::CampaignOffsets, identify::Design, identify::ResidualStats};
+pub use tricept_engine::identify::Design;
 
 /// What to diagnose and how.
 ///

@@ -20,6 +20,39 @@
 /// ```
 #[doc(inline)]
 pub use tricept_diagnose::ExtendedModel;
+/// One campaign's sensor zero offsets `[phi, theta, s]` (rad, rad, mm)
+/// with their standard deviations, when a fit pools several campaigns.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let result = fleet(FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into(), "m3.csv".into()]))?;
+/// for id in result.batch().machines.iter().filter_map(|m| m.own.id.as_ref()) {
+///     // one file, one campaign: its offsets are the fit's
+///     assert_eq!(id.campaign_offsets.len(), 1);
+///     assert_eq!(id.campaign_offsets[0].offsets, id.offsets);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_engine::identify::CampaignOffsets;
+/// The residuals of a fit: their RMS per channel (rad, rad, mm), the
+/// chi-square with its degrees of freedom and their ratio, the largest
+/// standardised residual.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let result = fleet(FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into(), "m3.csv".into()]))?;
+/// for id in result.batch().machines.iter().filter_map(|m| m.own.id.as_ref()) {
+///     let stats = &id.stats;
+///     let ratio = stats.chi_square / stats.dof as f64;
+///     assert!((stats.reduced_chi_square - ratio).abs() <= 1e-9 * ratio.max(1.0));
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_engine::identify::ResidualStats;
 /// The paper's geometric model of a machine over a parameter set: the
 /// readings a pose gives as functions of the set's error parameters.
 ///
