@@ -329,7 +329,15 @@ pub use tricept_numerics::sparse::BlockError;
 /// ```
 #[doc(inline)]
 pub use tricept_plant::PlantError;
-/// The figures of the verbs that draw (SVG, written atomically).
+/// The figures of the verbs that draw (SVG, written atomically): heat maps
+/// of the workspace plane, curves, scatter plots.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::plot::plane_z;
+/// assert_eq!(plane_z([750.0, 750.0]), "z = 750 mm"); // a map's title names its plane
+/// assert_eq!(plane_z([700.0, 812.5]), "z = 700 to 812.5 mm");
+/// ```
 #[doc(inline)]
 pub use tricept_plot as plot;
 /// A study's failure (`tricept study`): its parts' errors, each of its own
