@@ -1276,8 +1276,13 @@ fn api_items(text: &str) -> Vec<String> {
         }
         let mut item = trimmed.to_string();
         let signature = item.starts_with("pub fn ") || item.starts_with("pub const fn ");
-        let ends =
-            |s: &str| s.ends_with('{') || s.ends_with(';') || (!signature && s.ends_with(','));
+        // A grouped re-export (`pub use a::{\n b,\n c,\n};`) runs to its `;`.
+        let reexport = item.starts_with("pub use ");
+        let ends = |s: &str| {
+            s.ends_with(';')
+                || (!reexport && s.ends_with('{'))
+                || (!signature && !reexport && s.ends_with(','))
+        };
         while !ends(item.trim_end()) {
             match lines.next() {
                 Some(next) => {

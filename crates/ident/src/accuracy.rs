@@ -20,6 +20,19 @@ use tricept_model::ParameterSet;
 
 use crate::error::Error;
 
+/// The accuracy a machine file will deliver: the predicted rms positioning
+/// error over the workspace and a 95 % upper bound of it (mm), the point
+/// positioned, and the parts it is made of (added in quadrature).
+///
+/// # Example
+/// ```
+/// use tricept_ident::calibrate::Accuracy;
+/// let a = Accuracy::combine("platform", &[(0.003, 0.005), (0.004, 0.012)], serde_json::Map::new());
+/// assert!((a.rms_mm - 0.005).abs() < 1e-15); // 3 and 4 um in quadrature
+/// assert!((a.upper_mm - 0.013).abs() < 1e-15);
+/// assert!(a.line().starts_with("accuracy this file will deliver: 0.0050 mm rms at the platform"));
+/// ```
+#[doc(inline)]
 pub use tricept_engine::accuracy::Accuracy;
 pub(crate) use tricept_engine::accuracy::fused::{fused_structure, head_scale, of_fusion};
 

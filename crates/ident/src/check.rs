@@ -58,6 +58,38 @@ pub use tricept_check::CheckReport;
 /// ```
 #[doc(inline)]
 pub use tricept_check::CheckVerdict;
+/// What a candidate change is: a leg, a base or platform joint, the legs'
+/// thermal state, or a sensor's gain (in JSON, kebab-case).
+///
+/// # Example
+/// ```
+/// use tricept_ident::check::CandidateKind;
+/// assert_eq!(serde_json::to_value(CandidateKind::BaseJoint)?, "base-joint");
+/// assert_eq!(serde_json::to_value(CandidateKind::Sensor)?, "sensor");
+/// # Ok::<(), serde_json::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_check::candidates::CandidateKind;
+/// A change a check names (a set of them explains the readings together):
+/// its estimate, the platform error it causes (um), its test, its aliases.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::check::{CheckRequest, check};
+/// let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
+/// let report = result.check_report();
+/// use tricept_ident::check::CandidateKind;
+/// for change in &report.changes {
+///     assert_eq!(change.std_dev.len(), change.estimate.len());
+///     assert!(change.platform_mean_um <= change.platform_max_um);
+///     if change.kind == CandidateKind::Sensor {
+///         assert_eq!(change.platform_mean_um, 0.0); // a sensor does not move the platform
+///     }
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_check::changes::Change;
 /// The significance level a check tests a change at by default.
 ///
 /// # Example
@@ -83,10 +115,86 @@ pub use tricept_check::check::DEFAULT_ALPHA;
 /// ```
 #[doc(inline)]
 pub use tricept_check::history::Trend;
-pub use tricept_check::{candidates::CandidateKind, noise::ChannelNoise};
-pub use tricept_check::{
-    changes::Change, noise::NoiseSeen, parts::CandidateResult, parts::ChiSquare, parts::Rejected,
-};
+/// The noise of one logged reading per channel: encoders `phi` and `theta`
+/// (arcsec), scale `s` (um).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::check::{CheckRequest, check};
+/// let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
+/// let report = result.check_report();
+/// let stated = &report.noise.stated;
+/// assert!(stated.phi_arcsec > 0.0 && stated.s_um > 0.0);
+/// println!("scale: {:.2} um seen, {:.2} um stated", report.noise.seen.s_um, stated.s_um);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_check::noise::ChannelNoise;
+/// The noise a check campaign shows against the stated one: their ratio
+/// (about 1 when as stated) and each channel's.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::check::{CheckRequest, check};
+/// let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
+/// let report = result.check_report();
+/// let noise = &report.noise;
+/// if noise.factor > 2.0 {
+///     println!("readings {:.1} times noisier than the machine file says", noise.factor);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_check::noise::NoiseSeen;
+/// What a check says of one candidate: its estimated change with standard
+/// deviations, its likelihood-ratio test, the change it detects.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::check::{CandidateResult, CheckRequest, check};
+/// let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
+/// let candidates: &[CandidateResult] = &result.check_report().candidates;
+/// for c in candidates {
+///     assert!(c.fitted <= c.parameters.len() && c.estimate.len() == c.parameters.len());
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_check::parts::CandidateResult;
+/// A chi-square test: statistic, degrees of freedom, p-value (and its log,
+/// finite where the p-value underflows), critical value.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::check::{CheckRequest, check};
+/// let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
+/// let report = result.check_report();
+/// let fit = &report.consistency; // the calibrated machine against the campaign
+/// assert!((0.0..=1.0).contains(&fit.p_value));
+/// if fit.p_value > 1e-300 {
+///     assert!((fit.ln_p_value - fit.p_value.ln()).abs() < 1e-9);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_check::parts::ChiSquare;
+/// A pose a check set aside: its number and line, its deleted residual in
+/// noise standard deviations, and the reading off the most.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::check::{CheckRequest, check};
+/// let result = check(CheckRequest::new("calibrated.json", "today.csv"))?;
+/// let report = result.check_report();
+/// for pose in &report.rejected {
+///     let unit = if pose.column == "s" { "um" } else { "arcsec" };
+///     assert_eq!(pose.unit, unit);
+///     println!("line {}: {} off by {} {}", pose.line, pose.column, pose.residual, pose.unit);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_check::parts::Rejected;
 
 /// A check campaign against a calibrated machine.
 ///

@@ -55,6 +55,24 @@ use crate::machine_input::MachineInput;
 /// ```
 #[doc(inline)]
 pub use tricept_model::volumetric::ErrorMap;
+/// The largest, smallest, mean and RMS length of a map's error vectors
+/// (mm): [`ErrorMap::stats`].
+///
+/// # Example
+/// ```
+/// use tricept_ident::compensate::{ErrorMap, MapStats};
+/// use tricept_ident::kinematics::Vector3;
+/// let map = ErrorMap {
+///     targets_mm: vec![Vector3::new(0.0, 0.0, 700.0), Vector3::new(100.0, 0.0, 700.0)],
+///     errors_mm: vec![Vector3::new(0.003, 0.004, 0.0), Vector3::new(0.0, 0.0, 0.001)],
+/// };
+/// let stats: MapStats = map.stats();
+/// assert!((stats.max_mm - 0.005).abs() < 1e-15); // |(3, 4, 0) um| = 5 um
+/// assert!((stats.min_mm - 0.001).abs() < 1e-15);
+/// assert!((stats.mean_mm - 0.003).abs() < 1e-15);
+/// assert!((stats.rms_mm - 13e-6f64.sqrt()).abs() < 1e-15); // sqrt((25 + 1) / 2) um
+/// ```
+#[doc(inline)]
 pub use tricept_model::volumetric::MapStats;
 
 /// The largest interpolation error (um) the default table spacing allows.

@@ -40,6 +40,13 @@ use crate::inputs::LoadedMachine;
 use crate::machine_file;
 use crate::machine_input::MachineInput;
 
+mod model_docs;
+mod report_docs;
+mod terms_docs;
+
+pub use self::model_docs::*;
+pub use self::report_docs::*;
+pub use self::terms_docs::*;
 pub use crate::accuracy::Accuracy;
 pub use crate::machine_file::MachineFile;
 pub use crate::outcome::{WriteOptions, Written};
@@ -107,16 +114,6 @@ pub use tricept_diagnose::report::Cause;
 /// ```
 #[doc(inline)]
 pub use tricept_diagnose::report::Gain;
-pub use tricept_diagnose::report::Verdict as DiagnosisVerdict;
-pub use tricept_diagnose::{
-    ExtendedModel, report::Alias, report::CauseKind, report::ChannelRms, report::Estimate,
-    report::Evidence, report::FinalFit, report::ModelTerm, report::NoiseCheck, report::NoiseSource,
-    report::PureError, report::RejectStage, report::Rejected, report::Remainder,
-    report::ResidualPlot, report::Structure, report::TermScore, report::Tested,
-};
-pub use tricept_diagnose::{
-    terms::Frame, terms::GenericTerm, terms::OrderAxis, terms::Scope, terms::Term,
-};
 /// An identification, the estimates of a fit and their covariance ([`Deployed`]'s `id`).
 ///
 /// # Example
@@ -132,11 +129,7 @@ pub use tricept_diagnose::{
 /// ```
 #[doc(inline)]
 pub use tricept_engine::Identification;
-pub use tricept_engine::{
-    identify::CampaignOffsets, identify::Design, identify::ResidualStats, model::GeometricModel,
-    model::GeometricPredictor, model::PosePredictor, model::ReadingModel, prior::Prior,
-    prior::PriorFit,
-};
+pub use tricept_engine::identify::Design;
 
 /// What to diagnose and how.
 ///

@@ -21,6 +21,40 @@ use std::path::PathBuf;
 use crate::error::{EXIT_INADEQUATE, EXIT_OK, Error};
 use crate::machine_input::MachineInput;
 
+/// One leg axis of an export: its table's points, their spacing and range
+/// (mm), and the error of the table's format (um).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
+/// let options = ExportOptions::new(Controller::Sinumerik);
+/// let exported = export(ExportRequest::new(MachineInput::from("calibrated.json"), options, "export"))?;
+/// for (i, axis) in exported.summary().axes.iter().enumerate() {
+///     assert_eq!(usize::from(axis.leg), i + 1);
+///     let span_mm = axis.step_mm * (axis.points as f64 - 1.0);
+///     assert!((axis.max_mm - axis.min_mm - span_mm).abs() < 1e-6);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_export::AxisSummary;
+/// An export's failure: a machine file without a calibration, an option
+/// the control does not take, a failed write (not the input's fault).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::Classify;
+/// use tricept_ident::export::ExportError;
+/// use tricept_ident::{EXIT_INPUT, Error, ErrorKind};
+/// let e = ExportError::NoCalibration;
+/// assert_eq!(e.kind(), ErrorKind::Input);
+/// let door = Error::from_library(e);
+/// assert_eq!(door.exit_code(), EXIT_INPUT);
+/// assert!(door.message().contains("no calibration"), "{}", door.message());
+/// ```
+#[doc(inline)]
+pub use tricept_export::ExportError;
 /// The control and the limits of an export ([`ExportRequest`]'s `options`).
 ///
 /// # Example
@@ -32,6 +66,70 @@ use crate::machine_input::MachineInput;
 /// ```
 #[doc(inline)]
 pub use tricept_export::ExportOptions;
+/// The summary an export writes beside the control's files: the control,
+/// its limits, the files, the leg axes and what the files cannot carry.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
+/// let options = ExportOptions::new(Controller::Sinumerik);
+/// let exported = export(ExportRequest::new(MachineInput::from("calibrated.json"), options, "export"))?;
+/// use tricept_ident::export::ControlModel;
+/// let summary = exported.summary();
+/// assert_eq!(summary.control, ControlModel::Sinumerik840dSl); // the family's model
+/// assert_eq!(summary.axes.len(), 3);
+/// assert_eq!(summary.within_tolerance, summary.limits.is_empty()); // nothing to raise
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_export::ExportSummary;
+/// A part of the calibration the control's files cannot carry: what it is,
+/// its size over the workspace (um) and why.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::MachineInput;
+/// use tricept_ident::export::{Controller, ExportOptions, ExportRequest, export};
+/// let options = ExportOptions::new(Controller::Sinumerik);
+/// let exported = export(ExportRequest::new(MachineInput::from("calibrated.json"), options, "export"))?;
+/// for part in &exported.summary().not_exported {
+///     assert!(part.size_um >= 0.0 && !part.why.is_empty(), "{}", part.what);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_export::NotExported;
+/// A control model's limits (`control_limits` of the export's summary): the
+/// points per axis, and Fanuc's shared point numbers, value range and
+/// magnification.
+///
+/// # Example
+/// ```
+/// use tricept_ident::export::{ControlLimits, ControlModel};
+/// let sinumerik: ControlLimits = ControlModel::Sinumerik840dSl.limits();
+/// assert_eq!(sinumerik.points_per_axis.value, 801);
+/// assert!(sinumerik.point_numbers.is_none());
+/// let fanuc = ControlModel::Fanuc0i.limits();
+/// let shared = fanuc.point_numbers.map(|n| n.value as usize);
+/// assert_eq!(shared.map(|n| n / 3), Some(ControlModel::Fanuc0i.default_max_points()));
+/// ```
+#[doc(inline)]
+pub use tricept_export::control::ControlLimits;
+/// A CNC control model (`--control`): its family, its limits, its name.
+///
+/// # Example
+/// ```
+/// use tricept_ident::export::{ControlModel, Controller};
+/// let model: ControlModel = "fanuc-30i".parse()?;
+/// assert_eq!(model.family(), Controller::Fanuc);
+/// assert_eq!(model.to_string(), "fanuc-30i");
+/// assert_eq!(ControlModel::of_family(Controller::Sinumerik), ControlModel::Sinumerik840dSl);
+/// assert!(ControlModel::ALL.iter().all(|m| m.as_str().parse::<ControlModel>() == Ok(*m)));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_export::control::ControlModel;
 /// The CNC control an export writes for.
 ///
 /// # Example
@@ -42,10 +140,19 @@ pub use tricept_export::ExportOptions;
 /// ```
 #[doc(inline)]
 pub use tricept_export::control::Controller;
-pub use tricept_export::{
-    AxisSummary, ExportError, ExportSummary, NotExported, control::ControlLimits,
-    control::ControlModel, control::Limit,
-};
+/// One limit of a control model: its value, whether a source states it is the
+/// most the control takes (`hard`), and its source.
+///
+/// # Example
+/// ```
+/// use tricept_ident::export::{ControlModel, Limit};
+/// let tnc640: Limit = ControlModel::HeidenhainTnc640.limits().points_per_axis;
+/// let tnc407: Limit = ControlModel::HeidenhainTnc407.limits().points_per_axis;
+/// assert_eq!(tnc640.value, tnc407.value); // the TNC 407's documented value stands in
+/// assert!(!tnc640.hard && tnc640.source.contains("not in the sources found"));
+/// ```
+#[doc(inline)]
+pub use tricept_export::control::Limit;
 
 /// What to export, and where.
 ///

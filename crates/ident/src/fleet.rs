@@ -34,6 +34,23 @@ use tricept_fleet::{
 use tricept_model::ParameterSet;
 
 pub use crate::outcome::{WriteOptions, Written};
+/// A pose a calibration set aside as a gross error: its index and line,
+/// its deleted residual in noise standard deviations (`None`: the fitted
+/// model cannot reach it).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let result = fleet(FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into(), "m3.csv".into()]))?;
+/// let batch = result.batch();
+/// for machine in &batch.machines {
+///     for pose in &machine.own.rejected {
+///         println!("{} line {}: {:?} sigma", machine.own.source, pose.line, pose.residual_sigma);
+///     }
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
 pub use tricept_engine::robust::Rejection;
 /// A batch calibrated together ([`FleetResult::batch`]).
 ///
@@ -47,6 +64,39 @@ pub use tricept_engine::robust::Rejection;
 /// ```
 #[doc(inline)]
 pub use tricept_fleet::Batch;
+/// One machine's place in its batch: its own calibration, whether it is a
+/// member (or why not), its distance, its estimate.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let result = fleet(FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into(), "m3.csv".into()]))?;
+/// let batch = result.batch();
+/// let outliers = batch.machines.iter().filter(|m| m.outlier).count();
+/// assert_eq!(outliers, batch.outliers().len());
+/// assert_eq!(batch.machines.iter().filter(|m| m.in_batch).count(), batch.members());
+/// for m in batch.machines.iter().filter(|m| !m.in_batch) {
+///     println!("{} kept out: {:?}", m.own.source, m.kept_out);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_fleet::batch::MachineOutcome;
+/// A sparse solve of a fleet's joint fit: the factorisation, its size
+/// (unknowns, non-zeros, rows) and its time (s).
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let result = fleet(FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into(), "m3.csv".into()]))?;
+/// let batch = result.batch();
+/// let stats = &batch.joint.stats;
+/// assert!(stats.nonzeros <= stats.rows * stats.unknowns); // a sparse J
+/// println!("{:?}: {} unknowns in {:.3} s", stats.kind, stats.unknowns, stats.seconds);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_fleet::batch::SolveStats;
 /// The sparse solver of a fleet's joint fit.
 ///
 /// # Example
@@ -58,8 +108,77 @@ pub use tricept_fleet::Batch;
 /// ```
 #[doc(inline)]
 pub use tricept_fleet::batch::SolverKind;
-pub use tricept_fleet::reml::{Distance, Spread};
-pub use tricept_fleet::{batch::MachineOutcome, batch::SolveStats, joint::JointFit, own::OwnFit};
+/// The joint fit of a batch: each member's parameters and offsets, the
+/// batch mean with its covariance, the chi-squares, the solve.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let result = fleet(FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into(), "m3.csv".into()]))?;
+/// let batch = result.batch();
+/// let joint = &batch.joint;
+/// assert_eq!(joint.mean.len(), batch.identifiable.len());
+/// assert_eq!(joint.parameters.len(), batch.members());
+/// assert_eq!(joint.offsets.len(), batch.members());
+/// assert!(joint.parameters.iter().all(|p| p.len() == batch.names.len()));
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_fleet::joint::JointFit;
+/// One machine's calibration from its own data: its identification (or why
+/// not), the poses rejected and kept, and its exit code.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let result = fleet(FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into(), "m3.csv".into()]))?;
+/// let batch = result.batch();
+/// for own in batch.machines.iter().map(|m| &m.own) {
+///     assert!([0, 2, 3, 4].contains(&own.exit_code));
+///     if own.id.is_none() {
+///         assert!(own.reason.is_some(), "a failed fit says why");
+///     }
+///     println!("{}: exit {} {:?}", own.source, own.exit_code, own.reason);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_fleet::own::OwnFit;
+/// A machine against the rest of its batch: the chi-square of its estimate's
+/// distance from the others' mean, its degrees of freedom, and each
+/// parameter's `z`.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let result = fleet(FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into(), "m3.csv".into()]))?;
+/// let batch = result.batch();
+/// for machine in &batch.machines {
+///     if let Some(d) = &machine.distance {
+///         assert_eq!(d.dof, batch.identifiable.len());
+///         println!("{}: T = {:.1} ({} dof)", machine.own.source, d.chi_square, d.dof);
+///     }
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_fleet::reml::Distance;
+/// The spread of a fleet's parameters between machines (REML): each
+/// parameter's variance with its uncertainty, and the batch mean.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::fleet::{FleetRequest, fleet};
+/// let result = fleet(FleetRequest::new(vec!["m1.csv".into(), "m2.csv".into(), "m3.csv".into()]))?;
+/// let batch = result.batch();
+/// let spread = &batch.spread;
+/// for (tau_mm, variance) in spread.spread_mm().iter().zip(&spread.variance) {
+///     assert!((tau_mm * tau_mm - variance.max(0.0)).abs() < 1e-12);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_fleet::reml::Spread;
 
 use crate::Setting;
 use crate::data_input::DataInput;

@@ -25,10 +25,86 @@ use crate::error::Error;
 use crate::inputs::Poses;
 use crate::machine_input::MachineInput;
 
-pub use tricept_engine::{
-    report::Combination, report::CorrelatedPair, report::IdentifiabilityReport,
-    report::NamedValues, report::Observability,
-};
+/// A combination of parameters: `(name, coefficient)` terms, its singular
+/// value, and its standard deviation when the data determine it.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::Poses;
+/// use tricept_ident::identifiability::{Campaign, IdentifiabilityRequest, assess_identifiability};
+/// let request = IdentifiabilityRequest::new(Campaign::Poses(Poses::grid()));
+/// let assessed = assess_identifiability(request)?;
+/// let report = assessed.identifiability_report();
+/// for c in report.unidentifiable.iter().chain(&report.weak) {
+///     let size: Vec<f64> = c.terms.iter().map(|(_, k)| k.abs()).collect();
+///     assert!(size.windows(2).all(|w| w[0] >= w[1]), "largest first");
+/// }
+/// assert!(report.unidentifiable.iter().all(|c| c.std_dev_mm.is_none()));
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_engine::report::Combination;
+/// Two strongly correlated parameters (`|correlation| >= 0.9`).
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::Poses;
+/// use tricept_ident::identifiability::{Campaign, IdentifiabilityRequest, assess_identifiability};
+/// let request = IdentifiabilityRequest::new(Campaign::Poses(Poses::grid()));
+/// let assessed = assess_identifiability(request)?;
+/// let report = assessed.identifiability_report();
+/// for pair in &report.correlated_pairs {
+///     assert!(pair.correlation.abs() >= 0.9 && pair.a != pair.b);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_engine::report::CorrelatedPair;
+/// What a pose set and the UP limb's sensors can identify: rank, singular
+/// values, observability, the combinations the data cannot see, the
+/// predicted standard deviations.
+///
+/// # Example
+/// ```
+/// use tricept_ident::advanced::Poses;
+/// use tricept_ident::identifiability::{Campaign, IdentifiabilityRequest, assess_identifiability};
+/// let request = IdentifiabilityRequest::new(Campaign::Poses(Poses::grid()));
+/// let assessed = assess_identifiability(request)?;
+/// let report = assessed.identifiability_report();
+/// assert_eq!((report.n_params, report.names.len()), (15, 15)); // paper15
+/// assert_eq!(report.singular_values.len(), report.n_params);
+/// assert_eq!(report.unidentifiable.len(), report.fixed.len()); // one per held parameter
+/// assert!(report.rank <= report.n_params);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_engine::report::IdentifiabilityReport;
+/// Optional values by parameter name, in parameter order (a JSON object,
+/// `null` where there is none).
+///
+/// # Example
+/// ```
+/// use tricept_ident::identifiability::NamedValues;
+/// let names = ["dq1".to_string(), "dq2".to_string()];
+/// let sd = NamedValues::new(&names, &[Some(0.002), None]);
+/// assert_eq!(sd.get("dq1"), Some(0.002));
+/// assert_eq!(sd.get("dq2"), None); // held: no standard deviation
+/// assert_eq!(sd.get("dq9"), None);
+/// ```
+#[doc(inline)]
+pub use tricept_engine::report::NamedValues;
+/// The observability indices of a pose set from the singular values of its
+/// (scaled) identification matrix.
+///
+/// # Example
+/// ```
+/// use tricept_ident::identifiability::Observability;
+/// let o = Observability::from_singular_values(&[4.0, 2.0, 1.0], 30);
+/// assert!((o.o2 - 0.25).abs() < 1e-15); // inverse condition number
+/// assert_eq!(o.o3, 1.0); // the smallest singular value
+/// ```
+#[doc(inline)]
+pub use tricept_engine::report::Observability;
 
 /// The poses to assess.
 ///

@@ -22,8 +22,23 @@ use serde_json::{Map, Value};
 use crate::error::{EXIT_OK, Error};
 use crate::inputs::LoadedMachine;
 
+mod description_docs;
+
+pub use self::description_docs::*;
 pub use crate::commanding::{GeometricMachine, Machine};
 pub use crate::linalg::Vector3;
+/// Why a kinematics solve failed: a non-finite input, out of reach or
+/// stroke, no assembly, not converged, singular.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{GeometricMachine, KinematicsError, Vector3};
+/// let m = GeometricMachine::paper();
+/// let e = m.inverse(&Vector3::new(f64::NAN, 0.0, 750.0)).unwrap_err();
+/// assert!(matches!(e, KinematicsError::NotFinite { .. }), "{e}");
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::KinematicsError;
 /// A machine file's contents: the description every `--machine` loads.
 ///
 /// # Example
@@ -35,6 +50,48 @@ pub use crate::linalg::Vector3;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::MachineDescription;
+/// The workspace cylinder of O' in solver form, mm.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{GeometricMachine, Vector3, Workspace};
+/// let w: Workspace = GeometricMachine::paper().workspace;
+/// assert_eq!((w.z_min_mm, w.z_max_mm, w.mid_plane_z_mm()), (650.0, 850.0, 750.0));
+/// assert!(w.contains(&Vector3::new(400.0, 0.0, 700.0)));
+/// assert!(!w.contains(&Vector3::new(0.0, 0.0, 900.0)));
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::Workspace;
+/// Rows [`run`] solves together (in parallel) before it writes them: the
+/// memory a batch holds whatever its length.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{BLOCK_ROWS, GeometricMachine, Verb, run};
+/// let csv = "x,y,z\n".to_string() + &"0,0,750\n".repeat(BLOCK_ROWS + 1);
+/// let mut out = Vec::new();
+/// let rows = run(Verb::Ik, &GeometricMachine::paper(), csv.as_bytes(), "p.csv", &mut out, || false)
+///     .map_err(|e| e.to_string())?; // BatchError: Display, not std::error::Error
+/// assert_eq!(rows, BLOCK_ROWS + 1); // two blocks, one output
+/// assert_eq!(String::from_utf8(out)?.lines().count(), BLOCK_ROWS + 2);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::batch::BLOCK_ROWS;
+/// Why [`run`] stopped: bad input, a point it cannot solve (with its line)
+/// or a failed write.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{BatchError, GeometricMachine, Verb, run};
+/// let csv = "x,y,z\n0,0,750\n0,0,5000\n";
+/// let e = run(Verb::Ik, &GeometricMachine::paper(), csv.as_bytes(), "p.csv", Vec::new(), || false);
+/// assert!(matches!(e, Err(BatchError::Point { line: 3, .. })));
+/// let bad = run(Verb::Ik, &GeometricMachine::paper(), "x,y\n0,0\n".as_bytes(), "p.csv", Vec::new(), || false);
+/// assert!(matches!(bad, Err(BatchError::Input(_))));
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::batch::BatchError;
 /// One value of a solved point ([`PointSolution::cells`]).
 ///
 /// # Example
@@ -48,6 +105,20 @@ pub use tricept_kinematics::MachineDescription;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::batch::Cell;
+/// A machine [`run`] can solve points on: inverse and forward kinematics
+/// of the platform point.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{ExtendedMachine, GeometricMachine, PointKinematics, Vector3};
+/// fn first_leg_mm(m: &dyn PointKinematics) -> f64 {
+///     m.inverse(&Vector3::new(0.0, 0.0, 750.0)).map_or(f64::NAN, |ik| ik.legs_mm[0])
+/// }
+/// let nominal = ExtendedMachine::new(GeometricMachine::paper());
+/// assert!((first_leg_mm(&GeometricMachine::paper()) - 773.3).abs() < 0.1);
+/// assert_eq!(first_leg_mm(&GeometricMachine::paper()), first_leg_mm(&nominal));
+/// ```
+#[doc(inline)]
 pub use tricept_kinematics::batch::PointKinematics;
 /// The kinematics verbs [`solve_point`] and [`run`] solve.
 ///
@@ -59,14 +130,36 @@ pub use tricept_kinematics::batch::PointKinematics;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::batch::Verb;
-pub use tricept_kinematics::batch::{BLOCK_ROWS, BatchError, run};
-pub use tricept_kinematics::description::{
-    AccuracyRecord, AxisOrder, CalibrationRecord, CircularPlacement, ControllerDescription,
-    CorrelationsDescription, ExplicitPlacement, ExternalSourceRecord, HeadDescription,
-    HeldParameter, Interpolation, LegEffectsDescription, LegTableDescription, LimitsDescription,
-    LoadsDescription, Placement, SealCheck, SensorDescription, SensorOffsetsDescription,
-    UpLimbDescription, WorkspaceDescription,
-};
+/// Solves the rows of a CSV of `verb`'s inputs on `machine` and writes its
+/// keys' CSV to `out`, in blocks of [`BLOCK_ROWS`]; returns the rows written
+/// (the door's errors: [`solve_batch`]).
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{GeometricMachine, Verb, run};
+/// let mut out = Vec::new();
+/// let csv = "x,y,z\n0,0,750\n10,0,750\n";
+/// let rows = run(Verb::Ik, &GeometricMachine::paper(), csv.as_bytes(), "p.csv", &mut out, || false)
+///     .map_err(|e| e.to_string())?; // BatchError: Display, not std::error::Error
+/// assert_eq!(rows, 2);
+/// assert!(String::from_utf8(out)?.starts_with("x,y,z,q1,q2,q3"));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::batch::run;
+/// Why a machine description was refused: bad JSON, an unreadable file, a
+/// newer format, or a value out of range.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{DescriptionError, MachineDescription};
+/// let e = MachineDescription::from_json("{ not json").unwrap_err();
+/// assert!(matches!(e, DescriptionError::Json { .. }), "{e}");
+/// let newer = MachineDescription::paper().to_json().replace("\"format_version\": 1", "\"format_version\": 99");
+/// assert!(matches!(MachineDescription::from_json(&newer), Err(DescriptionError::NewerFormat(_))));
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::error::DescriptionError;
 /// A solution of [`Machine::forward`].
 ///
 /// # Example
@@ -80,6 +173,18 @@ pub use tricept_kinematics::description::{
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::fk::FkSolution;
+/// The 2-axis head in solver form (unit axes, points on them, tool tip),
+/// in the platform frame.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{GeometricMachine, Head, HeadDescription};
+/// let head: Head = GeometricMachine::paper().head;
+/// assert_eq!(head.to_description(), HeadDescription::default());
+/// assert_eq!(Head::from_description(&HeadDescription::default()), head);
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::head::Head;
 /// Which head solution a tool pose's inverse kinematics returns.
 ///
 /// # Example
@@ -104,6 +209,17 @@ pub use tricept_kinematics::head::HeadBranch;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::head::ToolIkSolution;
+/// A tool pose: tip (mm) and unit tool axis.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{GeometricMachine, ToolPose, Vector3};
+/// let pose: ToolPose = GeometricMachine::paper().head.tool_in_platform([0.0, 0.0]);
+/// assert!((pose.tip_mm - Vector3::new(0.0, 0.0, 350.0)).norm() < 1e-12);
+/// assert!((pose.axis.norm() - 1.0).abs() < 1e-12);
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::head::ToolPose;
 /// A solution of [`Machine::inverse`].
 ///
 /// # Example
@@ -116,6 +232,46 @@ pub use tricept_kinematics::head::ToolIkSolution;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::machine::IkSolution;
+/// The three legs at one configuration: platform joints, geometric lengths
+/// (mm) and unit directions.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{GeometricMachine, LegGeometry, Vector3};
+/// let m = GeometricMachine::paper();
+/// let ik = m.inverse(&Vector3::new(20.0, 10.0, 770.0))?;
+/// let legs: LegGeometry = m.legs_at(&ik.up);
+/// for i in 0..3 { // nominal: length = command
+///     assert!((legs.lengths_mm[i] - ik.legs_mm[i]).abs() < 1e-9);
+///     assert!((legs.directions[i].norm() - 1.0).abs() < 1e-12);
+/// }
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::machine::LegGeometry;
+/// Joint limits in solver form: strokes (mm) and the UP limb's largest tilt (rad).
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{GeometricMachine, Limits};
+/// let l: Limits = GeometricMachine::paper().limits;
+/// assert!((l.max_tilt_rad() - 40f64.to_radians()).abs() < 1e-15);
+/// assert_eq!(Limits::new([450.0, 1250.0], l.up_stroke_mm, l.max_tilt_rad()), l);
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::machine::Limits;
+/// A machine's sensor noise in solver form: one reading's encoder (rad) and
+/// scale (mm) noise, and the readings averaged per logged value.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{LoggedSensorNoise, SensorDescription};
+/// let n = LoggedSensorNoise::from_description(&SensorDescription::default());
+/// assert!((n.length_mm - 0.0005).abs() < 1e-15); // 0.5 um
+/// let [_, _, s_mm] = n.logged_sigma(); // the mean of 3 readings
+/// assert!((s_mm - 0.0005 / 3f64.sqrt()).abs() < 1e-15);
+/// ```
+#[doc(inline)]
 pub use tricept_kinematics::machine::SensorNoise as LoggedSensorNoise;
 /// The UP limb's joints of a pose (an [`IkSolution`]'s `up`).
 ///
@@ -128,10 +284,32 @@ pub use tricept_kinematics::machine::SensorNoise as LoggedSensorNoise;
 /// ```
 #[doc(inline)]
 pub use tricept_kinematics::up_limb::UpJoints;
-pub use tricept_kinematics::{
-    KinematicsError, Workspace, error::DescriptionError, head::Head, head::ToolPose,
-    machine::LegGeometry, machine::Limits, up_limb::UpLimb, up_limb::UpLimbPose,
-};
+/// The UP limb's chain: axis order and class-2 errors (skew, offset, twist).
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{AxisOrder, GeometricMachine, UpLimb};
+/// let limb: UpLimb = GeometricMachine::paper().up_limb;
+/// assert!(limb.is_ideal());
+/// assert_eq!(limb, UpLimb::ideal(AxisOrder::XFirst));
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::up_limb::UpLimb;
+/// The UP limb at one joint configuration: platform orientation and point
+/// (mm), limb axis and the angle axes.
+///
+/// # Example
+/// ```
+/// use tricept_ident::kinematics::{GeometricMachine, UpLimbPose, Vector3};
+/// let m = GeometricMachine::paper();
+/// let target = Vector3::new(-40.0, 25.0, 780.0);
+/// let pose: UpLimbPose = m.up_limb.pose(&m.inverse(&target)?.up);
+/// assert!((pose.position_mm - target).norm() < 1e-9);
+/// assert!((pose.limb_axis.norm() - 1.0).abs() < 1e-12);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[doc(inline)]
+pub use tricept_kinematics::up_limb::UpLimbPose;
 
 /// The geometric machine with its static leg effects, as [`Machine::extended`] holds it.
 ///

@@ -67,6 +67,31 @@ pub trait Outcome {
 
 /// A result that can write a calibrated machine file (or a batch's
 /// prior): the accuracy the file promises and the one write rule.
+///
+/// # Example
+/// ```
+/// use std::path::Path;
+/// use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+/// use tricept_ident::kinematics::MachineDescription;
+/// use tricept_ident::{Error, WriteOptions, WritesMachine};
+///
+/// /// Deploys any result that writes a machine file; returns its promise.
+/// fn deploy(result: &impl WritesMachine, path: &Path) -> Result<Option<f64>, Error> {
+///     result.write_machine(path, WriteOptions::default())?;
+///     Ok(result.accuracy().map(|a| a.upper_mm))
+/// }
+///
+/// let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/table2-grid-seed1.csv");
+/// let calibration = calibrate(CalibrateRequest::new(data))?;
+/// let dir = std::env::temp_dir().join(format!("tricept-door-deploy-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// let promised = deploy(&calibration, &dir.join("calibrated.json"))?;
+/// let record = MachineDescription::from_file(&dir.join("calibrated.json"))?.calibration;
+/// let recorded = record.and_then(|c| c.accuracy).map(|a| a.upper_mm);
+/// assert!(promised.is_some() && recorded == promised); // the file states the promise
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub trait WritesMachine: Outcome {
     /// The accuracy the file it writes promises (`None` when it writes
     /// none, or states none).
@@ -111,6 +136,21 @@ impl WriteOptions {
 
 /// What a result wrote: which file, where, and why it was written although
 /// not to be trusted (a forced write).
+///
+/// # Example
+/// ```
+/// use tricept_ident::WriteOptions;
+/// use tricept_ident::calibrate::{CalibrateRequest, calibrate};
+/// let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/data/table2-grid-seed1.csv");
+/// let calibration = calibrate(CalibrateRequest::new(data))?;
+/// let dir = std::env::temp_dir().join(format!("tricept-door-written-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// let written = calibration.write_machine(&dir.join("m.json"), WriteOptions::default())?;
+/// assert_eq!((written.what(), written.path()), ("machine file", dir.join("m.json").as_path()));
+/// assert_eq!(written.forced(), None); // exit code 0: nothing to force
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, PartialEq, Eq)]
 #[non_exhaustive]
 pub struct Written {

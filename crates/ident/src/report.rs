@@ -38,7 +38,47 @@ use crate::inputs::LoadedMachine;
 use crate::machine_file::sha256_file;
 use crate::machine_input::MachineInput;
 
-pub use tricept_report::verdict::{Reason, Shown};
+/// One reason of a page's verdict: the level it calls for, what it says,
+/// and the values it reads ([`Verdict::reasons`], worst first).
+///
+/// # Example
+/// ```
+/// use tricept_ident::report::{Level, Reason, Shown};
+/// let reason = Reason {
+///     level: Level::Caution,
+///     says: "the campaign's residuals are larger than its sensors' noise".into(),
+///     shows: vec![Shown { src: "machine".into(), path: "/calibration/chi2_per_dof".into() }],
+/// };
+/// let json = serde_json::to_value(&reason)?;
+/// assert_eq!(json["level"], "caution"); // as the page's JSON names it
+/// assert_eq!(json["shows"][0]["path"], "/calibration/chi2_per_dof");
+/// # Ok::<(), serde_json::Error>(())
+/// ```
+///
+/// A page's verdict is its worst reason:
+/// ```no_run
+/// use tricept_ident::report::{Level, ReportRequest, report};
+/// let page = report(ReportRequest::new("calibrated.json", "machine.html"))?;
+/// let worst = page.verdict().reasons.iter().map(|r| r.level).max();
+/// assert_eq!(worst.unwrap_or(Level::Trusted), page.verdict().level);
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_report::verdict::Reason;
+/// A value a verdict's reason reads: its source's id on the page and the
+/// JSON pointer of the value in it.
+///
+/// # Example
+/// ```
+/// use tricept_ident::report::Shown;
+/// let shown = Shown { src: "machine".into(), path: "/calibration/chi2_per_dof".into() };
+/// let machine_file = serde_json::json!({"calibration": {"chi2_per_dof": 1.08}});
+/// assert_eq!(machine_file.pointer(&shown.path), Some(&serde_json::json!(1.08)));
+/// assert_eq!(serde_json::to_value(&shown)?["src"], "machine");
+/// # Ok::<(), serde_json::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_report::verdict::Shown;
 
 /// How far a calibrated machine can be trusted.
 ///

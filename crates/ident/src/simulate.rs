@@ -17,21 +17,31 @@
 //! # Ok::<(), tricept_ident::Error>(())
 //! ```
 
+mod external_docs;
+
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
+pub use self::external_docs::*;
 use nalgebra::{Isometry3, Vector3};
 use serde_json::{Value, json};
+/// The fields every instrument's record shares ([`InstrumentRecord::reading`]):
+/// where the machine stood, the row's standard deviation, the setup, the
+/// temperature and the line in its file.
+///
+/// # Example
+/// ```
+/// use tricept_ident::simulate::{InstrumentRecord, TouchReading, TrackerPoint};
+/// let point = TrackerPoint { setup: 2, temp_c: Some(20.5), line: 7, ..Default::default() };
+/// let common = point.reading();
+/// assert_eq!((common.setup, common.temp_c, common.line), (Some(2), Some(20.5), 7));
+/// let touch = TouchReading { line: 3, ..Default::default() };
+/// assert_eq!((touch.reading().setup, touch.reading().line), (None, 3)); // no setups
+/// ```
+#[doc(inline)]
+pub use tricept_data::external::InstrumentRecord;
 use tricept_data::{Dataset, external::PlannedPose, external::read_external_path};
-pub use tricept_data::{
-    external::BallbarData, external::ExternalData, external::ExternalRecord, external::TouchData,
-    external::TrackerData,
-};
-pub use tricept_data::{
-    external::BallbarReading, external::ExternalPose, external::InstrumentRecord,
-    external::TouchReading, external::TrackerPoint,
-};
 use tricept_engine::model::GeometricModel;
 use tricept_kinematics::Machine;
 use tricept_kinematics::units::RAD_PER_ARCSEC;
