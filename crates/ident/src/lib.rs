@@ -139,7 +139,7 @@ pub use setting::Setting;
 pub use data_input::DataInput;
 pub use inputs::LoadedMachine;
 pub use machine_input::MachineInput;
-/// Measured data in memory (what a [`DataInput`](crate::DataInput) loads).
+/// Measured data in memory (what a [`DataInput`] loads).
 ///
 /// # Example
 /// ```
