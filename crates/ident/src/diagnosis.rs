@@ -129,6 +129,20 @@ pub use tricept_diagnose::report::Gain;
 /// ```
 #[doc(inline)]
 pub use tricept_engine::Identification;
+/// The identification design of a fit ([`Identification::design`]): its
+/// numerical rank, the parameters estimated and those held at their prior.
+///
+/// # Example
+/// ```no_run
+/// use tricept_ident::diagnosis::{Design, DiagnoseRequest, diagnose};
+/// let result = diagnose(DiagnoseRequest::new("campaign.csv").machine("calibrated.json"))?;
+/// let deployed = result.deploy()?;
+/// let design: &Design = deployed.id.design();
+/// let held: Vec<&String> = design.fixed().iter().map(|&i| &deployed.id.names[i]).collect();
+/// println!("rank {}, held at their prior: {held:?}", design.rank());
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
 pub use tricept_engine::identify::Design;
 
 /// What to diagnose and how.

@@ -344,7 +344,70 @@ pub use tricept_model::effects::PlausibleRange;
 /// ```
 #[doc(inline)]
 pub use tricept_model::effects::PlotAxes;
+/// What a [`Simulate`] hook may depend on at one pose of a simulated
+/// campaign (commands in mm, the temperature change in K, the approach
+/// direction of each leg).
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::{EffectName, PoseState};
+/// use tricept_ident::kinematics::{GeometricMachine, Machine, Vector3};
+/// // Backlash depends on the direction each leg approached from.
+/// let backlash = (EffectName::Backlash.spec().simulation.typical)();
+/// let ik = Machine::paper().inverse(&Vector3::new(0.0, 0.0, 750.0))?;
+/// let extra = |approach: [i8; 3]| {
+///     let state = PoseState {
+///         commands_mm: ik.legs_mm, nominal_up: ik.up, delta_temp_k: 0.0, approach, fraction: 0.0,
+///     };
+///     let mut extra_mm = [0.0; 3];
+///     backlash.extra_leg_length(&GeometricMachine::paper(), &state, &mut extra_mm);
+///     extra_mm
+/// };
+/// assert_ne!(extra([1; 3]), extra([-1; 3]));
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
+pub use tricept_model::effects::PoseState;
+/// An effect's simulation hooks (what [`EffectSimulation`]'s `typical` and
+/// `parse` return): each adds its part to a simulated campaign.
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::{EffectName, PoseState, Simulate};
+/// use tricept_ident::kinematics::{GeometricMachine, Machine, Vector3};
+/// // A leg lead adds length in proportion to the commanded length.
+/// let lead: Box<dyn Simulate> = (EffectName::LegLead.spec().simulation.typical)();
+/// let ik = Machine::paper().inverse(&Vector3::new(0.0, 0.0, 750.0))?;
+/// let at = |scale: f64| {
+///     let commands_mm = ik.legs_mm.map(|q| q * scale);
+///     let state = PoseState {
+///         commands_mm, nominal_up: ik.up, delta_temp_k: 0.0, approach: [1; 3], fraction: 0.0,
+///     };
+///     let mut extra_mm = [0.0; 3];
+///     lead.extra_leg_length(&GeometricMachine::paper(), &state, &mut extra_mm);
+///     extra_mm
+/// };
+/// let (once, twice) = (at(1.0), at(2.0));
+/// assert!(once.iter().any(|e| e.abs() > 1e-6));
+/// for leg in 0..3 {
+///     assert!((twice[leg] - 2.0 * once[leg]).abs() < 1e-12);
+/// }
+/// # Ok::<(), tricept_ident::Error>(())
+/// ```
+#[doc(inline)]
 pub use tricept_model::effects::Simulate;
+/// What every [`Simulate`] type has from its `Clone` and `Serialize`
+/// (implemented for all of them).
+///
+/// # Example
+/// ```
+/// use tricept_ident::effects::{EffectName, SimulateObject};
+/// let lead = (EffectName::LegLead.spec().simulation.typical)();
+/// let copy = lead.clone_box();
+/// assert_eq!(format!("{copy:?}"), format!("{lead:?}"));
+/// ```
+#[doc(inline)]
+pub use tricept_model::effects::SimulateObject;
 /// What an effect's file says about its simulation: its `--truth-effect`
 /// tag, the cause a perfect diagnosis would name, its input keys.
 ///
@@ -410,7 +473,6 @@ pub use tricept_model::effects::XAxis;
 /// ```
 #[doc(inline)]
 pub use tricept_model::effects::YAxis;
-pub use tricept_model::effects::{PoseState, SimulateObject};
 /// A plausible range as the diagnosis' table holds it: does an estimate with
 /// its standard deviation fit it?
 ///
