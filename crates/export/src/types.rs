@@ -176,7 +176,10 @@ pub struct ExportSummary {
     pub parameters: Vec<String>,
     /// The tolerance on the format error, um.
     pub tolerance_um: f64,
-    /// Whether every axis' format error is within the tolerance.
+    /// Whether the files are written: every axis' format error within the
+    /// tolerance *and* nothing past the control's ranges (`limits` empty).
+    /// A Fanuc table whose points exceed the control's range is `false`
+    /// even when its format errors are within the tolerance.
     pub within_tolerance: bool,
     /// The limits to raise for the axes past the tolerance (or the
     /// control's ranges the files would exceed): nothing is written.
