@@ -1185,15 +1185,15 @@ fn the_root_reader_finds_public_names() {
 /// (and in CHANGELOG.md).
 fn public_api(root: &Path) -> Vec<String> {
     let mut items = BTreeSet::new();
-    for file in rust_files(&root.join("crates/ident/src")) {
-        let text = std::fs::read_to_string(&file).unwrap_or_default();
-        items.extend(api_items(&text));
-        items.extend(generated_setters(&text));
+    let (door_files, door_reexports) = docs_reader::door();
+    for text in door_files.values() {
+        items.extend(api_items(text));
+        items.extend(generated_setters(text));
     }
     // The internal items the door re-exports are its API too: their
     // fields and methods, listed under their crate.
     let mut reexported: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
-    for (path, _, _) in docs_reader::door().1 {
+    for (path, _, _) in door_reexports {
         if let (Some(krate), Some(name)) = (path.first(), path.last())
             && krate.starts_with("tricept_")
             && path.len() > 1
@@ -1209,32 +1209,14 @@ fn public_api(root: &Path) -> Vec<String> {
             .join("crates")
             .join(krate.trim_start_matches("tricept_"))
             .join("src");
-        for file in rust_files(&dir) {
-            let text = std::fs::read_to_string(&file).unwrap_or_default();
-            let of_door = api_items(&text)
+        for text in docs_reader::sources(&dir).values() {
+            let of_door = api_items(text)
                 .into_iter()
                 .filter(|i| names.contains(subject(i)));
             items.extend(of_door.map(|i| format!("{krate}: {i}")));
         }
     }
     items.into_iter().collect()
-}
-
-/// The `.rs` files under `dir`.
-fn rust_files(dir: &Path) -> Vec<PathBuf> {
-    let mut files = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(dir) = stack.pop() {
-        for e in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.extension().is_some_and(|x| x == "rs") {
-                files.push(p);
-            }
-        }
-    }
-    files
 }
 
 /// The type or item a listing line is about: the implemented type of an
@@ -1254,12 +1236,12 @@ fn subject(line: &str) -> &str {
         .unwrap_or("")
 }
 
-/// The public items of one source file: top-level items, and the public
-/// fields and methods of public types as `OWNER :: ITEM`.
+/// The public items of one source file, its unit tests cut off as
+/// `docs_reader::sources` reads it (unit tests are not API): top-level
+/// items, and the public fields and methods of public types as
+/// `OWNER :: ITEM`.
 fn api_items(text: &str) -> Vec<String> {
     let mut items = Vec::new();
-    // Unit tests are not API.
-    let text = text.split("#[cfg(test)]\nmod tests").next().unwrap_or("");
     let mut owner = String::new();
     let mut lines = text.lines().peekable();
     while let Some(line) = lines.next() {
